@@ -1,0 +1,168 @@
+//! Points, poses and small planar geometry helpers.
+
+use serde::{Deserialize, Serialize};
+use std::f64::consts::PI;
+
+/// A point or vector in the plane (metres in the world frame unless a function says otherwise).
+#[derive(Clone, Copy, Debug, PartialEq, Default, Serialize, Deserialize)]
+pub struct Point {
+    /// x (east).
+    pub x: f64,
+    /// y (north).
+    pub y: f64,
+}
+
+impl Point {
+    /// A new point.
+    #[inline]
+    pub const fn new(x: f64, y: f64) -> Self {
+        Self { x, y }
+    }
+    /// Euclidean distance.
+    #[inline]
+    pub fn dist(self, o: Point) -> f64 {
+        (self.x - o.x).hypot(self.y - o.y)
+    }
+    /// Squared distance.
+    #[inline]
+    pub fn dist2(self, o: Point) -> f64 {
+        let dx = self.x - o.x;
+        let dy = self.y - o.y;
+        dx * dx + dy * dy
+    }
+    /// `self - o`.
+    #[inline]
+    pub fn sub(self, o: Point) -> Point {
+        Point::new(self.x - o.x, self.y - o.y)
+    }
+    /// `self + o`.
+    #[inline]
+    pub fn add(self, o: Point) -> Point {
+        Point::new(self.x + o.x, self.y + o.y)
+    }
+    /// `self * k`.
+    #[inline]
+    pub fn scale(self, k: f64) -> Point {
+        Point::new(self.x * k, self.y * k)
+    }
+    /// Vector length.
+    #[inline]
+    pub fn norm(self) -> f64 {
+        self.x.hypot(self.y)
+    }
+    /// Dot product.
+    #[inline]
+    pub fn dot(self, o: Point) -> f64 {
+        self.x * o.x + self.y * o.y
+    }
+    /// Both coordinates finite.
+    #[inline]
+    pub fn is_finite(self) -> bool {
+        self.x.is_finite() && self.y.is_finite()
+    }
+}
+
+/// A robot pose `(x, y, theta)`: theta 0 = east, counter-clockwise positive, in (-pi, pi].
+#[derive(Clone, Copy, Debug, PartialEq, Default, Serialize, Deserialize)]
+pub struct Pose {
+    /// x (east), metres.
+    pub x: f64,
+    /// y (north), metres.
+    pub y: f64,
+    /// Heading, radians.
+    pub theta: f64,
+}
+
+impl Pose {
+    /// A new pose (theta is wrapped).
+    #[inline]
+    pub fn new(x: f64, y: f64, theta: f64) -> Self {
+        Self { x, y, theta: wrap_angle(theta) }
+    }
+    /// The position part.
+    #[inline]
+    pub fn position(&self) -> Point {
+        Point::new(self.x, self.y)
+    }
+}
+
+/// Wraps an angle into (-pi, pi].
+#[inline]
+pub fn wrap_angle(a: f64) -> f64 {
+    if !a.is_finite() {
+        return a;
+    }
+    let mut w = a % (2.0 * PI);
+    if w <= -PI {
+        w += 2.0 * PI;
+    } else if w > PI {
+        w -= 2.0 * PI;
+    }
+    w
+}
+
+/// Distance from point `p` to segment `a`-`b`.
+#[inline]
+pub fn point_segment_dist2(p: Point, a: Point, b: Point) -> f64 {
+    let d = b.sub(a);
+    let l2 = d.dot(d);
+    if l2 == 0.0 {
+        return p.dist2(a);
+    }
+    let t = (p.sub(a).dot(d) / l2).clamp(0.0, 1.0);
+    p.dist2(a.add(d.scale(t)))
+}
+
+/// First parameter `t` in `[0, 1]` at which the point `a + t (b - a)` comes strictly closer than
+/// `radius` to `q`, or `None`. A motion that starts inside and leaves (or is tangent) is
+/// not reported unless it is moving inwards at `t = 0`.
+#[inline]
+pub fn first_entry(a: Point, b: Point, q: Point, radius: f64) -> Option<f64> {
+    let d = b.sub(a);
+    let f = a.sub(q);
+    let aa = d.dot(d);
+    let bb = 2.0 * f.dot(d);
+    let cc = f.dot(f) - radius * radius;
+    if cc < 0.0 {
+        // Already inside: a contact now if moving inwards (or not away).
+        return if bb < 0.0 || aa == 0.0 { Some(0.0) } else { None };
+    }
+    if aa == 0.0 {
+        return None;
+    }
+    let disc = bb * bb - 4.0 * aa * cc;
+    if disc <= 0.0 {
+        return None; // misses or only touches
+    }
+    let t = (-bb - disc.sqrt()) / (2.0 * aa);
+    if (0.0..=1.0).contains(&t) {
+        Some(t)
+    } else {
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn wrap() {
+        assert!((wrap_angle(3.0 * PI) - PI).abs() < 1e-12);
+        assert!((wrap_angle(-PI) - PI).abs() < 1e-12);
+        assert!((wrap_angle(-PI / 2.0) + PI / 2.0).abs() < 1e-12);
+        assert_eq!(wrap_angle(0.0), 0.0);
+    }
+
+    #[test]
+    fn entry() {
+        let a = Point::new(0.0, 0.0);
+        let b = Point::new(10.0, 0.0);
+        let t = first_entry(a, b, Point::new(5.0, 0.0), 1.0).unwrap();
+        assert!((t - 0.4).abs() < 1e-12);
+        assert_eq!(first_entry(a, b, Point::new(5.0, 1.0), 1.0), None); // tangent
+        assert_eq!(first_entry(a, b, Point::new(-0.5, 0.0), 1.0), None); // inside, leaving
+        assert_eq!(first_entry(a, b, Point::new(0.5, 0.0), 1.0), Some(0.0));
+        assert!((point_segment_dist2(Point::new(5.0, 2.0), a, b) - 4.0).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,406 @@
+//! Occupancy grids and the one place that converts between pixels and the world frame.
+//!
+//! Conventions (see `world-and-metrics.md`): world x east, y north, metres; the map `origin` is the
+//! world pose of the **lower-left** pixel's lower-left corner; image row 0 is the **top** row.
+//! Pixel `(col, row)` therefore has its centre at
+//! `origin + R(yaw) * ((col + 0.5) * res, (height - row - 0.5) * res)`.
+//!
+//! Pixels outside the image are occupied.
+
+use std::fmt;
+use std::str::FromStr;
+
+use serde::{Deserialize, Serialize};
+
+use crate::geometry::{Point, Pose};
+
+/// Trinary occupancy of one map pixel (ROS `map_server` trinary mode).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[repr(u8)]
+pub enum Cell {
+    /// Known free floor: traversable and to be covered.
+    Free = 0,
+    /// Known obstacle.
+    Occupied = 1,
+    /// Unknown: never traversable, never counted as floor.
+    Unknown = 2,
+}
+
+impl Cell {
+    /// `true` only for [`Cell::Free`].
+    #[inline]
+    pub fn is_free(self) -> bool {
+        self == Cell::Free
+    }
+}
+
+/// Geometry of a grid: size, resolution and placement in the world. Holds no cell data.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MapFrame {
+    /// Number of columns (pixels along image x).
+    pub width: usize,
+    /// Number of rows (pixels along image y, row 0 at the top).
+    pub height: usize,
+    /// Side of one pixel in metres.
+    pub resolution: f64,
+    /// World pose of the lower-left corner of the lower-left pixel (`x`, `y`, `yaw`).
+    pub origin: Pose,
+}
+
+impl MapFrame {
+    /// A frame with zero origin.
+    pub fn new(width: usize, height: usize, resolution: f64) -> Self {
+        Self { width, height, resolution, origin: Pose::new(0.0, 0.0, 0.0) }
+    }
+
+    /// Number of pixels.
+    #[inline]
+    pub fn len(&self) -> usize {
+        self.width * self.height
+    }
+
+    /// `true` when the grid has no pixel.
+    #[inline]
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Row-major index of `(col, row)`; the caller guarantees it is inside.
+    #[inline]
+    pub fn index(&self, col: usize, row: usize) -> usize {
+        row * self.width + col
+    }
+
+    /// `(col, row)` of a row-major index.
+    #[inline]
+    pub fn col_row(&self, index: usize) -> (usize, usize) {
+        (index % self.width, index / self.width)
+    }
+
+    /// World point -> continuous *grid* coordinates `(gx, gy)` in pixels, y up, with the
+    /// lower-left map corner at (0, 0). Pixel `(col, row)` covers
+    /// `[col, col+1] x [height-row-1, height-row]`.
+    #[inline]
+    pub fn world_to_grid(&self, p: Point) -> Point {
+        let dx = p.x - self.origin.x;
+        let dy = p.y - self.origin.y;
+        let (s, c) = self.origin.theta.sin_cos();
+        Point::new((c * dx + s * dy) / self.resolution, (-s * dx + c * dy) / self.resolution)
+    }
+
+    /// Continuous grid coordinates (pixels, y up) -> world point. Inverse of [`Self::world_to_grid`].
+    #[inline]
+    pub fn grid_to_world(&self, g: Point) -> Point {
+        let (s, c) = self.origin.theta.sin_cos();
+        let gx = g.x * self.resolution;
+        let gy = g.y * self.resolution;
+        Point::new(self.origin.x + c * gx - s * gy, self.origin.y + s * gx + c * gy)
+    }
+
+    /// Grid coordinates of the centre of pixel `(col, row)`.
+    #[inline]
+    pub fn pixel_center_grid(&self, col: usize, row: usize) -> Point {
+        Point::new(col as f64 + 0.5, (self.height - row) as f64 - 0.5)
+    }
+
+    /// World coordinates of the centre of pixel `(col, row)`.
+    #[inline]
+    pub fn pixel_center(&self, col: usize, row: usize) -> Point {
+        self.grid_to_world(self.pixel_center_grid(col, row))
+    }
+
+    /// The pixel `(col, row)` whose square contains grid point `g`, as signed integers (may lie
+    /// outside the image).
+    #[inline]
+    pub fn grid_to_pixel_signed(&self, g: Point) -> (i64, i64) {
+        let col = g.x.floor() as i64;
+        let row = self.height as i64 - 1 - g.y.floor() as i64;
+        (col, row)
+    }
+
+    /// The pixel containing world point `p`, or `None` outside the image.
+    pub fn pixel_of(&self, p: Point) -> Option<(usize, usize)> {
+        let (c, r) = self.grid_to_pixel_signed(self.world_to_grid(p));
+        self.checked(c, r)
+    }
+
+    /// Converts signed pixel coordinates to unsigned ones when inside the image.
+    #[inline]
+    pub fn checked(&self, col: i64, row: i64) -> Option<(usize, usize)> {
+        if col >= 0 && row >= 0 && (col as usize) < self.width && (row as usize) < self.height {
+            Some((col as usize, row as usize))
+        } else {
+            None
+        }
+    }
+
+    /// Width of the mapped area in metres.
+    pub fn width_m(&self) -> f64 {
+        self.width as f64 * self.resolution
+    }
+
+    /// Height of the mapped area in metres.
+    pub fn height_m(&self) -> f64 {
+        self.height as f64 * self.resolution
+    }
+}
+
+/// A 2-D occupancy grid: a [`MapFrame`] plus one [`Cell`] per pixel, row-major, row 0 on top.
+///
+/// Grids read like drawings in tests (`#` occupied, `.` free, `?` unknown; the first line is the
+/// top row):
+///
+/// ```
+/// use ccpp_core::grid::{Cell, GridMap};
+/// let g: GridMap = "####\n#..#\n#.?#\n####".parse().unwrap();
+/// assert_eq!(g.frame().width, 4);
+/// assert_eq!(g.get(1, 1), Cell::Free);
+/// assert_eq!(g.get(2, 2), Cell::Unknown);
+/// assert_eq!(g.get_signed(-1, 0), Cell::Occupied); // outside is occupied
+/// ```
+#[derive(Clone, PartialEq)]
+pub struct GridMap {
+    frame: MapFrame,
+    cells: Vec<Cell>,
+}
+
+/// Error building a grid from parts or from ASCII art.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum GridError {
+    /// The cell vector does not match `width * height`.
+    #[error("grid has {got} cells but {width}x{height} needs {expected}")]
+    SizeMismatch {
+        /// Width given.
+        width: usize,
+        /// Height given.
+        height: usize,
+        /// `width * height`.
+        expected: usize,
+        /// Cells given.
+        got: usize,
+    },
+    /// Resolution is not a finite positive number.
+    #[error("resolution must be a finite number > 0, got {0}")]
+    BadResolution(f64),
+    /// Origin has a non-finite component.
+    #[error("origin must be finite, got ({0}, {1}, {2})")]
+    BadOrigin(f64, f64, f64),
+    /// The grid has no pixel.
+    #[error("the map is empty (0 pixels)")]
+    Empty,
+    /// ASCII rows of different lengths.
+    #[error("ASCII map row {row} has {got} characters, expected {expected}")]
+    RaggedRow {
+        /// Row index (0 = first line).
+        row: usize,
+        /// Expected length.
+        expected: usize,
+        /// Actual length.
+        got: usize,
+    },
+    /// Unknown ASCII character.
+    #[error("ASCII map has unknown character {0:?} (use '#', '.', '?')")]
+    BadChar(char),
+}
+
+impl GridMap {
+    /// Builds a grid from a frame and row-major cells (row 0 on top).
+    ///
+    /// # Errors
+    /// When sizes mismatch, the grid is empty, or resolution/origin are not finite and positive.
+    pub fn new(frame: MapFrame, cells: Vec<Cell>) -> Result<Self, GridError> {
+        if !(frame.resolution.is_finite() && frame.resolution > 0.0) {
+            return Err(GridError::BadResolution(frame.resolution));
+        }
+        let o = frame.origin;
+        if !(o.x.is_finite() && o.y.is_finite() && o.theta.is_finite()) {
+            return Err(GridError::BadOrigin(o.x, o.y, o.theta));
+        }
+        if frame.width == 0 || frame.height == 0 {
+            return Err(GridError::Empty);
+        }
+        if cells.len() != frame.len() {
+            return Err(GridError::SizeMismatch {
+                width: frame.width,
+                height: frame.height,
+                expected: frame.len(),
+                got: cells.len(),
+            });
+        }
+        Ok(Self { frame, cells })
+    }
+
+    /// A grid filled with one value.
+    ///
+    /// # Errors
+    /// As [`GridMap::new`].
+    pub fn filled(frame: MapFrame, value: Cell) -> Result<Self, GridError> {
+        Self::new(frame, vec![value; frame.len()])
+    }
+
+    /// Parses ASCII art where each character stands for a `scale x scale` block of pixels of
+    /// `resolution` metres. `#` occupied, `.` free, `?` unknown; other whitespace-only lines are
+    /// ignored, leading/trailing spaces of each line are trimmed.
+    ///
+    /// # Errors
+    /// Ragged rows, unknown characters, empty art or a bad resolution.
+    pub fn from_ascii_scaled(art: &str, scale: usize, resolution: f64) -> Result<Self, GridError> {
+        let rows: Vec<&str> = art.lines().map(str::trim).filter(|l| !l.is_empty()).collect();
+        let w = rows.first().map_or(0, |r| r.chars().count());
+        let mut small = Vec::with_capacity(w * rows.len());
+        for (i, r) in rows.iter().enumerate() {
+            let n = r.chars().count();
+            if n != w {
+                return Err(GridError::RaggedRow { row: i, expected: w, got: n });
+            }
+            for ch in r.chars() {
+                small.push(match ch {
+                    '#' => Cell::Occupied,
+                    '.' => Cell::Free,
+                    '?' => Cell::Unknown,
+                    other => return Err(GridError::BadChar(other)),
+                });
+            }
+        }
+        let scale = scale.max(1);
+        let frame = MapFrame::new(w * scale, rows.len() * scale, resolution);
+        let mut cells = Vec::with_capacity(frame.len());
+        for r in 0..frame.height {
+            for c in 0..frame.width {
+                cells.push(small[(r / scale) * w + c / scale]);
+            }
+        }
+        Self::new(frame, cells)
+    }
+
+    /// The grid's geometry.
+    #[inline]
+    pub fn frame(&self) -> &MapFrame {
+        &self.frame
+    }
+
+    /// Replaces the world placement (resolution and origin) keeping the cells.
+    ///
+    /// # Errors
+    /// When the resolution or origin are invalid.
+    pub fn with_placement(mut self, resolution: f64, origin: Pose) -> Result<Self, GridError> {
+        self.frame.resolution = resolution;
+        self.frame.origin = origin;
+        Self::new(self.frame, self.cells)
+    }
+
+    /// Row-major cells, row 0 on top.
+    #[inline]
+    pub fn cells(&self) -> &[Cell] {
+        &self.cells
+    }
+
+    /// Mutable row-major cells.
+    #[inline]
+    pub fn cells_mut(&mut self) -> &mut [Cell] {
+        &mut self.cells
+    }
+
+    /// Cell at `(col, row)`; panics if outside (use [`Self::get_signed`] for unchecked input).
+    #[inline]
+    pub fn get(&self, col: usize, row: usize) -> Cell {
+        self.cells[self.frame.index(col, row)]
+    }
+
+    /// Cell at signed `(col, row)`; outside the image is [`Cell::Occupied`].
+    #[inline]
+    pub fn get_signed(&self, col: i64, row: i64) -> Cell {
+        match self.frame.checked(col, row) {
+            Some((c, r)) => self.get(c, r),
+            None => Cell::Occupied,
+        }
+    }
+
+    /// Sets the cell at `(col, row)`.
+    #[inline]
+    pub fn set(&mut self, col: usize, row: usize, value: Cell) {
+        let i = self.frame.index(col, row);
+        self.cells[i] = value;
+    }
+
+    /// Counts of (free, occupied, unknown) pixels.
+    pub fn counts(&self) -> (usize, usize, usize) {
+        let mut n = [0usize; 3];
+        for &c in &self.cells {
+            n[c as usize] += 1;
+        }
+        (n[0], n[1], n[2])
+    }
+}
+
+impl FromStr for GridMap {
+    type Err = GridError;
+    /// One pixel per character at 1 m/px; see [`GridMap::from_ascii_scaled`].
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Self::from_ascii_scaled(s, 1, 1.0)
+    }
+}
+
+impl fmt::Debug for GridMap {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(
+            f,
+            "GridMap {}x{} @ {} m/px, origin ({}, {}, {})",
+            self.frame.width,
+            self.frame.height,
+            self.frame.resolution,
+            self.frame.origin.x,
+            self.frame.origin.y,
+            self.frame.origin.theta
+        )?;
+        for r in 0..self.frame.height {
+            for c in 0..self.frame.width {
+                let ch = match self.get(c, r) {
+                    Cell::Free => '.',
+                    Cell::Occupied => '#',
+                    Cell::Unknown => '?',
+                };
+                write!(f, "{ch}")?;
+            }
+            writeln!(f)?;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ascii_roundtrip_and_frames() {
+        let g: GridMap = "#..\n.?#".parse().unwrap();
+        assert_eq!(g.counts(), (3, 2, 1));
+        let dbg = format!("{g:?}");
+        assert!(dbg.ends_with("#..\n.?#\n"));
+        // Pixel (0, 1) is the lower-left pixel: centre (0.5, 0.5) at 1 m/px.
+        assert_eq!(g.frame().pixel_center(0, 1), Point::new(0.5, 0.5));
+        assert_eq!(g.frame().pixel_center(2, 0), Point::new(2.5, 1.5));
+        assert_eq!(g.frame().pixel_of(Point::new(2.9, 1.1)), Some((2, 0)));
+        assert_eq!(g.frame().pixel_of(Point::new(3.1, 1.1)), None);
+    }
+
+    #[test]
+    fn rotated_origin_roundtrip() {
+        let mut f = MapFrame::new(10, 10, 0.05);
+        f.origin = Pose::new(1.0, -2.0, 0.7);
+        let p = Point::new(0.3, -1.7);
+        let back = f.grid_to_world(f.world_to_grid(p));
+        assert!((back.x - p.x).abs() < 1e-12 && (back.y - p.y).abs() < 1e-12);
+    }
+
+    #[test]
+    fn scaled_ascii() {
+        let g = GridMap::from_ascii_scaled("#.\n..", 3, 0.1).unwrap();
+        assert_eq!(g.frame().width, 6);
+        assert_eq!(g.get(2, 2), Cell::Occupied);
+        assert_eq!(g.get(3, 2), Cell::Free);
+        assert!(matches!("#x".parse::<GridMap>(), Err(GridError::BadChar('x'))));
+        assert!(matches!("#.\n#".parse::<GridMap>(), Err(GridError::RaggedRow { .. })));
+    }
+}
