@@ -2,6 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
+use std::ops::{Add, Sub};
 
 /// A point or vector in the plane (metres in the world frame unless a function says otherwise).
 #[derive(Clone, Copy, Debug, PartialEq, Default, Serialize, Deserialize)]
@@ -30,16 +31,6 @@ impl Point {
         let dy = self.y - o.y;
         dx * dx + dy * dy
     }
-    /// `self - o`.
-    #[inline]
-    pub fn sub(self, o: Point) -> Point {
-        Point::new(self.x - o.x, self.y - o.y)
-    }
-    /// `self + o`.
-    #[inline]
-    pub fn add(self, o: Point) -> Point {
-        Point::new(self.x + o.x, self.y + o.y)
-    }
     /// `self * k`.
     #[inline]
     pub fn scale(self, k: f64) -> Point {
@@ -62,6 +53,22 @@ impl Point {
     }
 }
 
+impl std::ops::Sub for Point {
+    type Output = Point;
+    #[inline]
+    fn sub(self, o: Point) -> Point {
+        Point::new(self.x - o.x, self.y - o.y)
+    }
+}
+
+impl std::ops::Add for Point {
+    type Output = Point;
+    #[inline]
+    fn add(self, o: Point) -> Point {
+        Point::new(self.x + o.x, self.y + o.y)
+    }
+}
+
 /// A robot pose `(x, y, theta)`: theta 0 = east, counter-clockwise positive, in (-pi, pi].
 #[derive(Clone, Copy, Debug, PartialEq, Default, Serialize, Deserialize)]
 pub struct Pose {
@@ -77,7 +84,11 @@ impl Pose {
     /// A new pose (theta is wrapped).
     #[inline]
     pub fn new(x: f64, y: f64, theta: f64) -> Self {
-        Self { x, y, theta: wrap_angle(theta) }
+        Self {
+            x,
+            y,
+            theta: wrap_angle(theta),
+        }
     }
     /// The position part.
     #[inline]
@@ -125,7 +136,11 @@ pub fn first_entry(a: Point, b: Point, q: Point, radius: f64) -> Option<f64> {
     let cc = f.dot(f) - radius * radius;
     if cc < 0.0 {
         // Already inside: a contact now if moving inwards (or not away).
-        return if bb < 0.0 || aa == 0.0 { Some(0.0) } else { None };
+        return if bb < 0.0 || aa == 0.0 {
+            Some(0.0)
+        } else {
+            None
+        };
     }
     if aa == 0.0 {
         return None;

@@ -50,7 +50,12 @@ pub struct MapFrame {
 impl MapFrame {
     /// A frame with zero origin.
     pub fn new(width: usize, height: usize, resolution: f64) -> Self {
-        Self { width, height, resolution, origin: Pose::new(0.0, 0.0, 0.0) }
+        Self {
+            width,
+            height,
+            resolution,
+            origin: Pose::new(0.0, 0.0, 0.0),
+        }
     }
 
     /// Number of pixels.
@@ -85,7 +90,10 @@ impl MapFrame {
         let dx = p.x - self.origin.x;
         let dy = p.y - self.origin.y;
         let (s, c) = self.origin.theta.sin_cos();
-        Point::new((c * dx + s * dy) / self.resolution, (-s * dx + c * dy) / self.resolution)
+        Point::new(
+            (c * dx + s * dy) / self.resolution,
+            (-s * dx + c * dy) / self.resolution,
+        )
     }
 
     /// Continuous grid coordinates (pixels, y up) -> world point. Inverse of [`Self::world_to_grid`].
@@ -94,7 +102,10 @@ impl MapFrame {
         let (s, c) = self.origin.theta.sin_cos();
         let gx = g.x * self.resolution;
         let gy = g.y * self.resolution;
-        Point::new(self.origin.x + c * gx - s * gy, self.origin.y + s * gx + c * gy)
+        Point::new(
+            self.origin.x + c * gx - s * gy,
+            self.origin.y + s * gx + c * gy,
+        )
     }
 
     /// Grid coordinates of the centre of pixel `(col, row)`.
@@ -245,13 +256,21 @@ impl GridMap {
     /// # Errors
     /// Ragged rows, unknown characters, empty art or a bad resolution.
     pub fn from_ascii_scaled(art: &str, scale: usize, resolution: f64) -> Result<Self, GridError> {
-        let rows: Vec<&str> = art.lines().map(str::trim).filter(|l| !l.is_empty()).collect();
+        let rows: Vec<&str> = art
+            .lines()
+            .map(str::trim)
+            .filter(|l| !l.is_empty())
+            .collect();
         let w = rows.first().map_or(0, |r| r.chars().count());
         let mut small = Vec::with_capacity(w * rows.len());
         for (i, r) in rows.iter().enumerate() {
             let n = r.chars().count();
             if n != w {
-                return Err(GridError::RaggedRow { row: i, expected: w, got: n });
+                return Err(GridError::RaggedRow {
+                    row: i,
+                    expected: w,
+                    got: n,
+                });
             }
             for ch in r.chars() {
                 small.push(match ch {
@@ -400,7 +419,13 @@ mod tests {
         assert_eq!(g.frame().width, 6);
         assert_eq!(g.get(2, 2), Cell::Occupied);
         assert_eq!(g.get(3, 2), Cell::Free);
-        assert!(matches!("#x".parse::<GridMap>(), Err(GridError::BadChar('x'))));
-        assert!(matches!("#.\n#".parse::<GridMap>(), Err(GridError::RaggedRow { .. })));
+        assert!(matches!(
+            "#x".parse::<GridMap>(),
+            Err(GridError::BadChar('x'))
+        ));
+        assert!(matches!(
+            "#.\n#".parse::<GridMap>(),
+            Err(GridError::RaggedRow { .. })
+        ));
     }
 }

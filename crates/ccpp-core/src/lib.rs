@@ -1,16 +1,27 @@
 //! # ccpp-core
 //!
 //! The I/O-free heart of **ccpp**, a complete coverage path planning toolkit for mobile robots on
-//! 2-D occupancy grids: grids and frames ([`grid`]), geometry ([`geometry`]), the distance
-//! transform ([`dt`]), the ground truth ([`world`]), the online step protocol ([`planner`]), the
-//! simulator ([`sim`]), the trace ([`trace`]), the metrics ([`metrics`]) and the planners
-//! ([`planners`]).
+//! 2-D occupancy grids: grids and frames ([`grid`]), geometry ([`geometry`], [`collide`]), the
+//! distance transform ([`dt`]), the ground truth ([`world`]), the online step protocol
+//! ([`planner`]), the simulator ([`sim`]), the trace ([`trace`]), tiles ([`tiles`]), the metrics
+//! ([`metrics`]) and the planners ([`planners`]).
 //!
-//! Data flows one way: map -> [`world::World`] -> [`sim::Simulator`] <-> planner -> [`trace::Trace`]
-//! -> [`metrics::Metrics`]. Planners never score themselves.
+//! Data flows one way: map -> [`world::World`] -> [`sim::Simulator`] <-> planner ->
+//! [`trace::Trace`] -> [`metrics::Metrics`]. Planners never score themselves.
 
+pub mod collide;
+pub mod dt;
 pub mod geometry;
 pub mod grid;
+pub mod inflate;
+pub mod metrics;
+pub mod planner;
+pub mod planners;
+pub mod rng;
+pub mod sim;
+pub mod tiles;
+pub mod trace;
+pub mod world;
 
 pub use geometry::{Point, Pose};
 pub use grid::{Cell, GridMap, MapFrame};

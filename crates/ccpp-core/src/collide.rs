@@ -1,0 +1,141 @@
+//! Exact disk and swept-disk collision tests against a pixel grid.
+//!
+//! **Obstacle model** (one definition for the simulator and for every planner's own checks): a
+//! non-free pixel is the disk inscribed in its square, i.e. a disk of radius half a pixel at the
+//! pixel centre. A robot disk of radius `r` centred at `p` touches it when
+//! `|p - centre| < r + res/2`. Adjacent blocked pixels therefore form a closed wall (no gap), and
+//! a 1-pixel diagonal wall leaves gaps of `(sqrt 2 - 1)` px, too narrow for any robot of radius at
+//! least half a pixel. The squares' corners stick out of their inscribed disks by at most
+//! (sqrt 2 - 1)/2 px; that is the stated tolerance of the model.
+//!
+//! Computations here are in *grid coordinates* (pixels, y up, see
+//! [`crate::grid::MapFrame::world_to_grid`]).
+
+use crate::geometry::{first_entry, Point};
+use crate::grid::{GridMap, MapFrame};
+
+/// Contact tolerance in pixels: a disk at exactly `r + res/2` from a blocked centre is not in
+/// contact (touching is allowed, overlapping is not).
+pub const CONTACT_EPS_PX: f64 = 1e-6;
+
+/// Anything that can say whether a pixel blocks the robot.
+pub trait Occupancy {
+    /// The grid's geometry.
+    fn frame(&self) -> &MapFrame;
+    /// `true` when pixel `(col, row)` (signed; outside the image) blocks the robot.
+    fn blocked(&self, col: i64, row: i64) -> bool;
+}
+
+impl Occupancy for GridMap {
+    fn frame(&self) -> &MapFrame {
+        GridMap::frame(self)
+    }
+    #[inline]
+    fn blocked(&self, col: i64, row: i64) -> bool {
+        !self.get_signed(col, row).is_free()
+    }
+}
+
+/// Contact radius in pixels for a robot of radius `r_px` pixels.
+#[inline]
+pub fn contact_radius_px(r_px: f64) -> f64 {
+    r_px + 0.5 - CONTACT_EPS_PX
+}
+
+/// Centre (grid coordinates) of signed pixel `(col, row)`.
+#[inline]
+fn center(frame: &MapFrame, col: i64, row: i64) -> Point {
+    Point::new(col as f64 + 0.5, (frame.height as i64 - row) as f64 - 0.5)
+}
+
+/// Signed pixel range (inclusive) whose centres may lie within `reach` of the box `lo..hi`
+/// (grid coordinates).
+#[inline]
+fn pixel_window(frame: &MapFrame, lo: Point, hi: Point, reach: f64) -> (i64, i64, i64, i64) {
+    let c0 = (lo.x - reach - 0.5).floor() as i64;
+    let c1 = (hi.x + reach - 0.5).ceil() as i64;
+    // gy = height - row - 0.5  =>  row = height - gy - 0.5
+    let h = frame.height as f64;
+    let r0 = (h - (hi.y + reach) - 0.5).floor() as i64;
+    let r1 = (h - (lo.y - reach) - 0.5).ceil() as i64;
+    (c0, c1, r0, r1)
+}
+
+/// Does a robot disk of radius `r_px` (pixels) centred at grid point `p` overlap a blocked pixel?
+pub fn disk_hits(occ: &impl Occupancy, p: Point, r_px: f64) -> bool {
+    let rc = contact_radius_px(r_px);
+    let rc2 = rc * rc;
+    let frame = *occ.frame();
+    let (c0, c1, r0, r1) = pixel_window(&frame, p, p, rc);
+    for row in r0..=r1 {
+        for col in c0..=c1 {
+            if occ.blocked(col, row) && center(&frame, col, row).dist2(p) < rc2 {
+                return true;
+            }
+        }
+    }
+    false
+}
+
+/// First parameter `t` in `[0, 1]` at which a disk of radius `r_px` moving from `a` to `b`
+/// (grid coordinates) comes into contact with a blocked pixel; `None` when the whole motion is
+/// free. Brute force over the swept capsule's bounding box: use for short motions, or call
+/// through a distance-transform accelerated caller ([`crate::world::World::first_contact`]).
+pub fn segment_first_contact(occ: &impl Occupancy, a: Point, b: Point, r_px: f64) -> Option<f64> {
+    let rc = contact_radius_px(r_px);
+    let frame = *occ.frame();
+    let lo = Point::new(a.x.min(b.x), a.y.min(b.y));
+    let hi = Point::new(a.x.max(b.x), a.y.max(b.y));
+    let (c0, c1, r0, r1) = pixel_window(&frame, lo, hi, rc);
+    let mut best: Option<f64> = None;
+    for row in r0..=r1 {
+        for col in c0..=c1 {
+            if !occ.blocked(col, row) {
+                continue;
+            }
+            let q = center(&frame, col, row);
+            // Quick reject by distance to the segment.
+            if crate::geometry::point_segment_dist2(q, a, b) >= rc * rc {
+                continue;
+            }
+            if let Some(t) = first_entry(a, b, q, rc) {
+                if best.is_none_or(|bt| t < bt) {
+                    best = Some(t);
+                    if t == 0.0 {
+                        return best;
+                    }
+                }
+            }
+        }
+    }
+    best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn disk_against_wall() {
+        // Wall pixel centre at gx = 0.5 (col 0); robot r = 1 px: contact when x < 2.0.
+        let g: GridMap = "#.....\n#.....\n#.....".parse().unwrap();
+        assert!(!disk_hits(&g, Point::new(2.0, 1.5), 1.0));
+        assert!(disk_hits(&g, Point::new(1.99, 1.5), 1.0));
+        // The border (outside) is occupied: top edge at gy = 3, outside centres at 3.5.
+        assert!(disk_hits(&g, Point::new(3.0, 2.2), 1.0));
+        assert!(!disk_hits(&g, Point::new(3.0, 1.5), 1.0));
+    }
+
+    #[test]
+    fn sweep_stops_at_contact() {
+        let g: GridMap = "..........#".parse().unwrap();
+        // Moving right at gy = 0.5 with r = 0 px: contact radius ~0.5 around centre 10.5.
+        let t =
+            segment_first_contact(&g, Point::new(0.5, 0.5), Point::new(10.5, 0.5), 0.0).unwrap();
+        assert!((0.5 + 10.0 * t - 10.0).abs() < 1e-5);
+        assert_eq!(
+            segment_first_contact(&g, Point::new(0.5, 0.5), Point::new(9.0, 0.5), 0.0),
+            None
+        );
+    }
+}

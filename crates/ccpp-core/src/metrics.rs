@@ -1,0 +1,477 @@
+//! Run metrics, computed from the world (truth) and the trace only — never reported by planners.
+//! Definitions: `world-and-metrics.md`; each field below repeats its own.
+
+use std::ops::Sub;
+use fixedbitset::FixedBitSet;
+use serde::{Deserialize, Serialize};
+
+use crate::geometry::{point_segment_dist2, wrap_angle, Point, Pose};
+use crate::sim::RunOutput;
+use crate::tiles::{reachable_tiles, Tile, TileGrid, TileSet};
+use crate::trace::{Event, Record, Trace};
+use crate::world::World;
+
+/// Tolerance in pixels when deciding whether a pixel centre is within `r_tool` of the path.
+pub const SWEEP_EPS_PX: f64 = 1e-6;
+
+/// The metrics of one run (serialized with exactly these keys).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Metrics {
+    /// Planner name.
+    pub planner: String,
+    /// Map name (file stem).
+    pub map: String,
+    /// Robot radius `r`, metres.
+    pub robot_radius_m: f64,
+    /// Tool radius `r_tool`, metres.
+    pub tool_radius_m: f64,
+    /// Tiles whose centre the robot visited / tiles reachable from the start tile by
+    /// collision-free 4-neighbour moves (tile planners; `null` otherwise).
+    pub coverage_rate: Option<f64>,
+    /// `|swept ∩ A| / |A|` in pixels.
+    pub effective_coverage: f64,
+    /// Total translation, metres.
+    pub path_length_m: f64,
+    /// `path_length_m / (area(A) / (2 r_tool))`.
+    pub path_ratio: f64,
+    /// `path_length_m * 2 r_tool / area(swept) - 1`.
+    pub redundancy: f64,
+    /// `(tile entries - distinct tiles entered) / distinct tiles entered`.
+    pub revisit_rate: f64,
+    /// Coverage segments started.
+    pub regions: u32,
+    /// Transfers between regions.
+    pub backtracks: u32,
+    /// Total length of the transfers, metres.
+    pub backtrack_length_m: f64,
+    /// In-place rotations (consecutive rotations merged; zero-angle ones not counted).
+    pub turns: u32,
+    /// Total absolute rotation, radians.
+    pub rotation_rad: f64,
+    /// Bumper contacts.
+    pub collisions: u32,
+    /// Planning + simulation wall time, seconds (the one non-deterministic figure).
+    pub wall_time_s: f64,
+}
+
+/// The swept pixels of a trace: pixel centres within `r_tool` of the executed centre polyline
+/// (inclusive, with [`SWEEP_EPS_PX`]). The start position alone sweeps a disk.
+pub fn swept_pixels(world: &World, trace: &Trace) -> FixedBitSet {
+    let frame = *world.frame();
+    let mut swept = FixedBitSet::with_capacity(frame.len());
+    let rt = world.robot().tool_radius / frame.resolution + SWEEP_EPS_PX;
+    let mut prev: Option<Point> = None;
+    for p in trace.poses() {
+        let g = frame.world_to_grid(p.position());
+        match prev {
+            None => stamp_capsule(&mut swept, &frame, g, g, rt),
+            Some(a) if a != g => stamp_capsule(&mut swept, &frame, a, g, rt),
+            Some(_) => {}
+        }
+        prev = Some(g);
+    }
+    swept
+}
+
+/// Marks pixel centres within `rt` (pixels) of segment `a`-`b` (grid coordinates), row by row.
+fn stamp_capsule(
+    bits: &mut FixedBitSet,
+    frame: &crate::grid::MapFrame,
+    a: Point,
+    b: Point,
+    rt: f64,
+) {
+    let rt2 = rt * rt;
+    let h = frame.height as f64;
+    let ylo = a.y.min(b.y) - rt;
+    let yhi = a.y.max(b.y) + rt;
+    // Rows whose centre gy = h - row - 0.5 lies in [ylo, yhi].
+    let r0 = (h - yhi - 0.5).ceil().max(0.0) as i64;
+    let r1 = ((h - ylo - 0.5).floor() as i64).min(frame.height as i64 - 1);
+    let d = b.sub(a);
+    for row in r0..=r1 {
+        let gy = h - row as f64 - 0.5;
+        // The segment point closest in y: its x minimises the distance along this row.
+        let t = if d.y == 0.0 {
+            0.0
+        } else {
+            ((gy - a.y) / d.y).clamp(0.0, 1.0)
+        };
+        let xs = a.x + t * d.x;
+        let c_mid = (xs - 0.5).round() as i64;
+        let inside = |c: i64| point_segment_dist2(Point::new(c as f64 + 0.5, gy), a, b) <= rt2;
+        // Walk left and right from the nearest column while inside.
+        let mut c = c_mid;
+        while c >= 0 && inside(c) {
+            if (c as usize) < frame.width {
+                bits.insert(frame.index(c as usize, row as usize));
+            }
+            c -= 1;
+        }
+        let mut c = c_mid + 1;
+        while c < frame.width as i64 && inside(c) {
+            if c >= 0 {
+                bits.insert(frame.index(c as usize, row as usize));
+            }
+            c += 1;
+        }
+        // When the nearest column itself lies off the image, scan the image part directly.
+        if c_mid < 0 || c_mid >= frame.width as i64 {
+            for c in 0..frame.width as i64 {
+                if inside(c) {
+                    bits.insert(frame.index(c as usize, row as usize));
+                }
+            }
+        }
+    }
+}
+
+/// Tile entries along a polyline (Amanatides-Woo traversal); a corner crossing is one entry.
+fn tile_entries(grid: &TileGrid, poses: &[Pose], mut visit: impl FnMut(Tile)) {
+    let Some(first) = poses.first() else { return };
+    let mut cur = grid.tile_of(first.position());
+    visit(cur);
+    for w in poses.windows(2) {
+        let a = w[0].position();
+        let b = w[1].position();
+        if a == b {
+            continue;
+        }
+        let target = grid.tile_of(b);
+        // Positions in tile units, tile (i, j) spans [i - 0.5, i + 0.5].
+        let ua = Point::new(
+            (a.x - grid.anchor.x) / grid.side,
+            (a.y - grid.anchor.y) / grid.side,
+        );
+        let ub = Point::new(
+            (b.x - grid.anchor.x) / grid.side,
+            (b.y - grid.anchor.y) / grid.side,
+        );
+        let d = ub.sub(ua);
+        let step_i = if d.x > 0.0 { 1 } else { -1 };
+        let step_j = if d.y > 0.0 { 1 } else { -1 };
+        let next_boundary = |u: f64, i: i32, s: i32| f64::from(i) + 0.5 * f64::from(s) - u;
+        let mut t_max_x = if d.x == 0.0 {
+            f64::INFINITY
+        } else {
+            next_boundary(ua.x, cur.0, step_i) / d.x
+        };
+        let mut t_max_y = if d.y == 0.0 {
+            f64::INFINITY
+        } else {
+            next_boundary(ua.y, cur.1, step_j) / d.y
+        };
+        let t_dx = if d.x == 0.0 {
+            f64::INFINITY
+        } else {
+            1.0 / d.x.abs()
+        };
+        let t_dy = if d.y == 0.0 {
+            f64::INFINITY
+        } else {
+            1.0 / d.y.abs()
+        };
+        let mut guard = 0usize;
+        while cur != target && guard < 10_000_000 {
+            guard += 1;
+            let tie = (t_max_x - t_max_y).abs() < 1e-9;
+            if tie {
+                if t_max_x > 1.0 + 1e-9 {
+                    break;
+                }
+                cur = (cur.0 + step_i, cur.1 + step_j);
+                t_max_x += t_dx;
+                t_max_y += t_dy;
+            } else if t_max_x < t_max_y {
+                if t_max_x > 1.0 + 1e-9 {
+                    break;
+                }
+                cur.0 += step_i;
+                t_max_x += t_dx;
+            } else {
+                if t_max_y > 1.0 + 1e-9 {
+                    break;
+                }
+                cur.1 += step_j;
+                t_max_y += t_dy;
+            }
+            visit(cur);
+        }
+        if cur != target {
+            cur = target;
+            visit(cur);
+        }
+    }
+}
+
+/// Computes all metrics of a run.
+pub fn compute(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
+    let frame = *world.frame();
+    let robot = world.robot();
+    let trace = &run.trace;
+    let poses: Vec<Pose> = trace.poses().collect();
+    let px_area = frame.resolution * frame.resolution;
+
+    // Path length, turns, rotation.
+    let mut path_length = 0.0;
+    let mut turns = 0u32;
+    let mut rotation = 0.0;
+    let mut in_turn = false;
+    for w in poses.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        let d = a.position().dist(b.position());
+        if d > 0.0 {
+            path_length += d;
+            in_turn = false;
+        } else {
+            let ang = wrap_angle(b.theta - a.theta).abs();
+            if ang > crate::sim::MIN_ROTATION {
+                rotation += ang;
+                if !in_turn {
+                    turns += 1;
+                    in_turn = true;
+                }
+            }
+        }
+    }
+
+    // Regions, backtracks, collisions, backtrack length (poses between start/end marks).
+    let mut regions = 0u32;
+    let mut backtracks = 0u32;
+    let mut collisions = 0u32;
+    let mut backtrack_length = 0.0;
+    let mut in_backtrack = false;
+    let mut last: Option<Point> = None;
+    for r in &trace.records {
+        match r {
+            Record::Pose { pose, .. } => {
+                let p = Point::new(pose[0], pose[1]);
+                if in_backtrack {
+                    if let Some(l) = last {
+                        backtrack_length += l.dist(p);
+                    }
+                }
+                last = Some(p);
+            }
+            Record::Event { event, .. } => match event {
+                Event::RegionStart { .. } => regions += 1,
+                Event::BacktrackStart => {
+                    backtracks += 1;
+                    in_backtrack = true;
+                }
+                Event::BacktrackEnd => in_backtrack = false,
+                Event::Collision { .. } => collisions += 1,
+                _ => {}
+            },
+        }
+    }
+
+    // Swept area and effective coverage.
+    let swept = swept_pixels(world, trace);
+    let swept_count = swept.count_ones(..);
+    let acc = world.accessible();
+    let covered = swept.intersection(acc).count();
+    let a_count = world.accessible_count();
+    let effective_coverage = if a_count == 0 {
+        0.0
+    } else {
+        covered as f64 / a_count as f64
+    };
+    let area_a = a_count as f64 * px_area;
+    let two_rt = 2.0 * robot.tool_radius;
+    let path_ratio = if area_a > 0.0 {
+        path_length / (area_a / two_rt)
+    } else {
+        0.0
+    };
+    let swept_area = swept_count as f64 * px_area;
+    let redundancy = if swept_area > 0.0 {
+        path_length * two_rt / swept_area - 1.0
+    } else {
+        0.0
+    };
+
+    // Tiles: revisit rate (planner tile side, else 2 r_tool) and coverage rate (tile planners).
+    let start = world.start().position();
+    let side = run.tile_side.unwrap_or(two_rt);
+    let grid = TileGrid::new(start, side);
+    let (i0, i1, j0, j1) = grid.bounds_for(world);
+    let mut distinct = TileSet::new(i0, i1, j0, j1);
+    let mut entries = 0usize;
+    tile_entries(&grid, &poses, |t| {
+        entries += 1;
+        distinct.insert(t);
+    });
+    let nd = distinct.len();
+    let revisit_rate = if nd == 0 {
+        0.0
+    } else {
+        (entries - nd) as f64 / nd as f64
+    };
+
+    let coverage_rate = run.tile_side.map(|side| {
+        let grid = TileGrid::new(start, side);
+        let reach = reachable_tiles(world, &grid);
+        if reach.is_empty() {
+            return 0.0;
+        }
+        let visited = visited_tile_centres(&grid, &poses, &reach);
+        visited as f64 / reach.len() as f64
+    });
+
+    Metrics {
+        planner: run.planner.to_string(),
+        map: map_name.to_string(),
+        robot_radius_m: robot.radius,
+        tool_radius_m: robot.tool_radius,
+        coverage_rate,
+        effective_coverage,
+        path_length_m: path_length,
+        path_ratio,
+        redundancy,
+        revisit_rate,
+        regions,
+        backtracks,
+        backtrack_length_m: backtrack_length,
+        turns,
+        rotation_rad: rotation,
+        collisions,
+        wall_time_s: run.wall_time_s,
+    }
+}
+
+/// Number of tiles of `reach` whose centre lies on the executed polyline (within 1e-6 tile).
+fn visited_tile_centres(grid: &TileGrid, poses: &[Pose], reach: &TileSet) -> usize {
+    let eps = 1e-6 * grid.side;
+    let (i0, i1, j0, j1) = reach.bounds();
+    let mut hit = TileSet::new(i0, i1, j0, j1);
+    if let Some(p) = poses.first() {
+        let t = grid.tile_of(p.position());
+        if grid.center(t).dist(p.position()) <= eps {
+            hit.insert(t);
+        }
+    }
+    for w in poses.windows(2) {
+        let a = w[0].position();
+        let b = w[1].position();
+        if a == b {
+            continue;
+        }
+        let ta = grid.tile_of(a);
+        let tb = grid.tile_of(b);
+        for j in ta.1.min(tb.1)..=ta.1.max(tb.1) {
+            for i in ta.0.min(tb.0)..=ta.0.max(tb.0) {
+                if point_segment_dist2(grid.center((i, j)), a, b) <= eps * eps {
+                    hit.insert((i, j));
+                }
+            }
+        }
+    }
+    hit.iter().filter(|&t| reach.contains(t)).count()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::grid::GridMap;
+    use crate::planner::{Planner, Sensor, Step};
+    use crate::sim::{simulate, SimConfig};
+    use crate::world::Robot;
+
+    struct Script(Vec<Step>);
+    impl Planner for Script {
+        fn name(&self) -> &'static str {
+            "script"
+        }
+        fn next(&mut self, _: &dyn Sensor) -> Step {
+            if self.0.is_empty() {
+                Step::Done
+            } else {
+                self.0.remove(0)
+            }
+        }
+    }
+
+    fn open_room() -> GridMap {
+        // 6 m x 4 m at 0.01 m/px with a 1-pixel wall.
+        let (w, h) = (600, 400);
+        let mut cells = vec![crate::grid::Cell::Free; w * h];
+        for r in 0..h {
+            for c in 0..w {
+                if r == 0 || c == 0 || r == h - 1 || c == w - 1 {
+                    cells[r * w + c] = crate::grid::Cell::Occupied;
+                }
+            }
+        }
+        GridMap::new(crate::grid::MapFrame::new(w, h, 0.01), cells).unwrap()
+    }
+
+    #[test]
+    fn straight_pass_length_and_swept_area() {
+        let world =
+            World::new(open_room(), Robot::new(0.2), Some(Pose::new(2.0, 2.0, 0.0))).unwrap();
+        let out = simulate(
+            &world,
+            &mut Script(vec![Step::Translate(2.0)]),
+            &SimConfig::default(),
+        );
+        let m = compute(&world, &out, "room");
+        assert!((m.path_length_m - 2.0).abs() < 1e-12);
+        let rt = 0.2;
+        let expect = 2.0 * 2.0 * rt + std::f64::consts::PI * rt * rt;
+        let swept = swept_pixels(&world, &out.trace).count_ones(..) as f64 * 1e-4;
+        // Within one pixel row along the pass (2 m x 0.01 m).
+        assert!(
+            (swept - expect).abs() < 2.0 * 0.01,
+            "swept {swept} vs {expect}"
+        );
+        assert_eq!(m.collisions, 0);
+        assert_eq!(m.turns, 0);
+        assert_eq!(m.coverage_rate, None);
+    }
+
+    #[test]
+    fn path_into_wall_collides_and_stops() {
+        let world =
+            World::new(open_room(), Robot::new(0.2), Some(Pose::new(2.0, 2.0, 0.0))).unwrap();
+        let out = simulate(
+            &world,
+            &mut Script(vec![Step::Translate(10.0)]),
+            &SimConfig::default(),
+        );
+        let m = compute(&world, &out, "room");
+        assert!(m.collisions >= 1);
+        // Wall pixel centres at x = 5.995, y = 1.995 / 2.005: contact at distance 0.205.
+        let expect = 5.995 - (0.205f64.powi(2) - 0.005f64.powi(2)).sqrt() - 2.0;
+        assert!(
+            (m.path_length_m - expect).abs() < 1e-6,
+            "{}",
+            m.path_length_m
+        );
+    }
+
+    #[test]
+    fn turns_merge_and_revisits_count() {
+        let world =
+            World::new(open_room(), Robot::new(0.2), Some(Pose::new(2.0, 2.0, 0.0))).unwrap();
+        let steps = vec![
+            Step::Translate(0.4),
+            Step::Rotate(1.0),
+            Step::Rotate(std::f64::consts::FRAC_PI_2 - 1.0),
+            Step::Rotate(0.0),
+            Step::Translate(0.4),
+            Step::Rotate(std::f64::consts::PI),
+            Step::Translate(0.4),
+        ];
+        let out = simulate(&world, &mut Script(steps), &SimConfig::default());
+        let m = compute(&world, &out, "room");
+        assert_eq!(m.turns, 2);
+        assert!((m.rotation_rad - 1.5 * std::f64::consts::PI).abs() < 1e-9);
+        // Tiles of 0.4 m: start tile, east tile, north-east tile, back to the east tile.
+        assert!(
+            (m.revisit_rate - 1.0 / 3.0).abs() < 1e-9,
+            "{}",
+            m.revisit_rate
+        );
+    }
+}

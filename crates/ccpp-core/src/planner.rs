@@ -1,0 +1,210 @@
+//! The online step protocol: what a planner may know ([`Sensor`]) and what it may do ([`Step`]).
+//!
+//! An online planner learns the world only through [`Sensor::scan`] (the occupancy of the map
+//! pixels within `sensor_range` of the robot centre) and [`Sensor::bumped`]. It may keep what it
+//! saw in a [`KnownMap`]. It may know the map *frame* (extent, resolution, origin): the area the
+//! robot is asked to work in, never its contents.
+
+use fixedbitset::FixedBitSet;
+
+use crate::collide::{self, Occupancy};
+use crate::geometry::{Point, Pose};
+use crate::grid::{Cell, GridMap, MapFrame};
+use crate::trace::Event;
+use crate::world::Robot;
+
+/// One decision of a planner.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Step {
+    /// Rotate in place by this angle (radians, counter-clockwise positive).
+    Rotate(f64),
+    /// Translate along the current heading by this distance (metres; negative = reverse).
+    Translate(f64),
+    /// Rotate to face the point, then translate to it (`beta`, `alpha`, `d` of seed 000).
+    MoveTo(Point),
+    /// Record an event in the trace.
+    Mark(Event),
+    /// Coverage is complete.
+    Done,
+}
+
+/// The pixels within sensor range of the robot, read from the true map.
+///
+/// The planner can read only the pixels whose centre lies within `range` of the robot centre
+/// (pixels outside the image read as occupied).
+pub struct Scan<'a> {
+    map: &'a GridMap,
+    center: Point,
+    range_px: f64,
+}
+
+impl<'a> Scan<'a> {
+    /// A scan of `map` around world point `center` with radius `range` metres. Only the simulator
+    /// should build these.
+    pub fn new(map: &'a GridMap, center: Point, range: f64) -> Self {
+        let g = map.frame().world_to_grid(center);
+        Self {
+            map,
+            center: g,
+            range_px: range / map.frame().resolution,
+        }
+    }
+
+    /// Calls `f(col, row, cell)` for every in-range pixel that lies inside the image, in
+    /// row-major order. (Out-of-image pixels are occupied by convention and never change.)
+    pub fn for_each(&self, mut f: impl FnMut(usize, usize, Cell)) {
+        let frame = self.map.frame();
+        let r = self.range_px;
+        let r2 = r * r;
+        let h = frame.height as f64;
+        let c0 = (self.center.x - r - 0.5).floor().max(0.0) as usize;
+        let c1 = ((self.center.x + r - 0.5).ceil().max(0.0) as usize).min(frame.width - 1);
+        let r0 = (h - (self.center.y + r) - 0.5).floor().max(0.0) as usize;
+        let r1 = ((h - (self.center.y - r) - 0.5).ceil().max(0.0) as usize).min(frame.height - 1);
+        for row in r0..=r1 {
+            let gy = h - row as f64 - 0.5;
+            let dy2 = (gy - self.center.y).powi(2);
+            if dy2 > r2 {
+                continue;
+            }
+            for col in c0..=c1 {
+                let dx = col as f64 + 0.5 - self.center.x;
+                if dx * dx + dy2 <= r2 {
+                    f(col, row, self.map.get(col, row));
+                }
+            }
+        }
+    }
+}
+
+/// What a real robot can know.
+pub trait Sensor {
+    /// The working area's frame (extent, resolution, origin) — not its contents.
+    fn frame(&self) -> &MapFrame;
+    /// The robot model.
+    fn robot(&self) -> Robot;
+    /// The robot's pose (odometry/localization).
+    fn pose(&self) -> Pose;
+    /// Sensor range in metres.
+    fn sensor_range(&self) -> f64;
+    /// The occupancy of the pixels within sensor range.
+    fn scan(&self) -> Scan<'_>;
+    /// `true` when the last motion stopped on a bumper contact.
+    fn bumped(&self) -> bool;
+}
+
+/// A coverage planner driven step by step by the simulator.
+pub trait Planner {
+    /// Short machine name (`ba-star`, `random-bounce`, ...).
+    fn name(&self) -> &'static str;
+    /// Tile side in metres for tile-based planners (enables the `coverage_rate` metric).
+    fn tile_side(&self) -> Option<f64> {
+        None
+    }
+    /// `true` for planners that read the whole map up front (offline).
+    fn is_offline(&self) -> bool {
+        false
+    }
+    /// The next decision.
+    fn next(&mut self, sensor: &dyn Sensor) -> Step;
+}
+
+/// A planner's memory of what its sensor has shown: each pixel is unseen, or seen with its
+/// occupancy. Unseen pixels block motion in every check.
+#[derive(Clone)]
+pub struct KnownMap {
+    grid: GridMap,
+    seen: FixedBitSet,
+}
+
+impl KnownMap {
+    /// Nothing seen yet.
+    ///
+    /// # Panics
+    /// Never for a frame that came from a valid map.
+    pub fn new(frame: &MapFrame) -> Self {
+        let grid = GridMap::filled(*frame, Cell::Unknown).expect("frame of a valid map");
+        Self {
+            grid,
+            seen: FixedBitSet::with_capacity(frame.len()),
+        }
+    }
+
+    /// Stores every pixel of a scan.
+    pub fn integrate(&mut self, scan: &Scan<'_>) {
+        let w = self.grid.frame().width;
+        let cells = self.grid.cells_mut();
+        let seen = &mut self.seen;
+        scan.for_each(|c, r, cell| {
+            let i = r * w + c;
+            cells[i] = cell;
+            seen.insert(i);
+        });
+    }
+
+    /// The frame.
+    pub fn frame(&self) -> &MapFrame {
+        self.grid.frame()
+    }
+
+    /// Has pixel `(col, row)` been seen?
+    pub fn is_seen(&self, col: usize, row: usize) -> bool {
+        self.seen.contains(self.grid.frame().index(col, row))
+    }
+
+    /// The known value of a seen pixel (`Unknown` when unseen).
+    pub fn get(&self, col: usize, row: usize) -> Cell {
+        self.grid.get(col, row)
+    }
+
+    /// The pixels seen so far.
+    pub fn seen(&self) -> &FixedBitSet {
+        &self.seen
+    }
+
+    /// Can the robot (radius `r` metres) stand at world point `p`, as far as it knows?
+    pub fn disk_free(&self, p: Point, r: f64) -> bool {
+        let f = self.grid.frame();
+        !collide::disk_hits(self, f.world_to_grid(p), r / f.resolution)
+    }
+
+    /// Is the straight move from `a` to `b` free, as far as it knows?
+    pub fn segment_free(&self, a: Point, b: Point, r: f64) -> bool {
+        let f = self.grid.frame();
+        collide::segment_first_contact(
+            self,
+            f.world_to_grid(a),
+            f.world_to_grid(b),
+            r / f.resolution,
+        )
+        .is_none()
+    }
+
+    /// Farthest free distance (metres, up to `max`) along heading `theta` from `p`, as far as it
+    /// knows.
+    pub fn free_distance(&self, p: Point, theta: f64, max: f64, r: f64) -> f64 {
+        let f = self.grid.frame();
+        let a = f.world_to_grid(p);
+        let b = f.world_to_grid(Point::new(p.x + max * theta.cos(), p.y + max * theta.sin()));
+        match collide::segment_first_contact(self, a, b, r / f.resolution) {
+            Some(t) => t * max,
+            None => max,
+        }
+    }
+}
+
+impl Occupancy for KnownMap {
+    fn frame(&self) -> &MapFrame {
+        self.grid.frame()
+    }
+    #[inline]
+    fn blocked(&self, col: i64, row: i64) -> bool {
+        match self.grid.frame().checked(col, row) {
+            Some((c, r)) => {
+                let i = self.grid.frame().index(c, r);
+                !(self.seen.contains(i) && self.grid.cells()[i].is_free())
+            }
+            None => true,
+        }
+    }
+}

@@ -1,0 +1,67 @@
+//! The coverage planners, one module each, behind the [`Planner`](crate::planner::Planner) trait,
+//! and the catalogue that builds them by name.
+
+pub mod random_bounce;
+
+use serde::{Deserialize, Serialize};
+
+use crate::planner::Planner;
+use crate::world::World;
+
+/// One catalogue entry.
+#[derive(Clone, Copy, Debug)]
+pub struct PlannerInfo {
+    /// Name used on the command line.
+    pub name: &'static str,
+    /// One-line description.
+    pub description: &'static str,
+    /// `true` when the planner reads the whole map up front.
+    pub offline: bool,
+}
+
+/// Every planner ccpp knows.
+pub const CATALOG: &[PlannerInfo] = &[PlannerInfo {
+    name: "random-bounce",
+    description: "Roomba-like baseline: straight until the sensed obstacle, seeded random turn, distance budget (online)",
+    offline: false,
+}];
+
+/// Options of every planner, one section each (the single source of truth for CLI, config
+/// files and bindings).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PlannerOptions {
+    /// `random-bounce`.
+    pub random_bounce: random_bounce::RandomBounceOptions,
+}
+
+/// Error building a planner.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum BuildError {
+    /// No planner of that name.
+    #[error("unknown planner {0:?}; run `ccpp planners` for the list")]
+    Unknown(String),
+}
+
+/// Builds the planner `name`. Online planners get nothing from `world` but operator settings
+/// derived from it (such as the random-bounce distance budget); offline ones read its map.
+///
+/// # Errors
+/// [`BuildError::Unknown`] for an unknown name.
+pub fn build(
+    name: &str,
+    opts: &PlannerOptions,
+    world: &World,
+) -> Result<Box<dyn Planner>, BuildError> {
+    match name {
+        "random-bounce" => {
+            let mut o = opts.random_bounce.clone();
+            if o.budget_m.is_none() {
+                let ideal = world.accessible_area_m2() / (2.0 * world.robot().tool_radius);
+                o.budget_m = Some(3.0 * ideal);
+            }
+            Ok(Box::new(random_bounce::RandomBounce::new(o)))
+        }
+        other => Err(BuildError::Unknown(other.to_string())),
+    }
+}
