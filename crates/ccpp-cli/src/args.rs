@@ -1,0 +1,136 @@
+//! Command-line arguments.
+
+use std::path::PathBuf;
+
+use clap::{Args, Parser, Subcommand};
+
+/// Complete coverage path planning for mobile robots on 2-D occupancy-grid maps.
+#[derive(Parser, Debug)]
+#[command(name = "ccpp", version, about, long_about = None)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// Subcommands.
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Simulate one planner on one map and write metrics, path, trace and a picture.
+    Run(RunArgs),
+    /// Run the flagship planner on the bundled demo map (writes ./ccpp-demo/).
+    Demo(DemoArgs),
+    /// List the planners.
+    Planners,
+    /// Describe a map: size, resolution, pixel classes, components, accessible area.
+    Info(InfoArgs),
+}
+
+/// Map loading options shared by commands.
+#[derive(Args, Debug, Clone, Default)]
+pub struct MapArgs {
+    /// Map file: a ROS map_server YAML (with its PGM/PNG) or a bare PGM/PNG image.
+    #[arg(long, value_name = "FILE")]
+    pub map: PathBuf,
+    /// Override the resolution (m/px); bare images default to 0.05.
+    #[arg(long, value_name = "M")]
+    pub resolution: Option<f64>,
+    /// Override the origin `X,Y[,YAW]` (world pose of the lower-left pixel).
+    #[arg(long, value_name = "X,Y[,YAW]", value_parser = parse_triple)]
+    pub origin: Option<[f64; 3]>,
+    /// Override `occupied_thresh`.
+    #[arg(long, value_name = "P")]
+    pub occupied_thresh: Option<f64>,
+    /// Override `free_thresh`.
+    #[arg(long, value_name = "P")]
+    pub free_thresh: Option<f64>,
+    /// Grow obstacles by this many metres (exact distance transform) before planning.
+    #[arg(long, value_name = "M")]
+    pub inflate: Option<f64>,
+}
+
+/// Robot options shared by commands.
+#[derive(Args, Debug, Clone)]
+pub struct RobotArgs {
+    /// Robot (footprint) radius in metres.
+    #[arg(long, value_name = "M", default_value_t = 0.15)]
+    pub radius: f64,
+    /// Cleaning tool radius in metres (default: the robot radius).
+    #[arg(long, value_name = "M")]
+    pub tool_radius: Option<f64>,
+    /// Start pose `X,Y[,THETA]` in metres/radians (default: the widest free spot, heading east).
+    #[arg(long, value_name = "X,Y[,THETA]", value_parser = parse_triple)]
+    pub start: Option<[f64; 3]>,
+}
+
+/// `ccpp run`.
+#[derive(Args, Debug)]
+pub struct RunArgs {
+    /// The map.
+    #[command(flatten)]
+    pub map: MapArgs,
+    /// The robot.
+    #[command(flatten)]
+    pub robot: RobotArgs,
+    /// Planner name (see `ccpp planners`).
+    #[arg(long, value_name = "NAME")]
+    pub planner: String,
+    /// Seed for planners that use randomness.
+    #[arg(long, value_name = "N")]
+    pub seed: Option<u64>,
+    /// Planner options file (YAML or JSON), sections named after the planners, e.g.
+    /// `random_bounce: { budget_m: 200 }`.
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
+    /// Sensor range in metres (default 4 r).
+    #[arg(long, value_name = "M")]
+    pub sensor_range: Option<f64>,
+    /// Output folder.
+    #[arg(long, value_name = "DIR", default_value = "ccpp-out")]
+    pub out: PathBuf,
+    /// Print the metrics JSON alone on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `ccpp demo`.
+#[derive(Args, Debug)]
+pub struct DemoArgs {
+    /// Output folder.
+    #[arg(long, value_name = "DIR", default_value = "ccpp-demo")]
+    pub out: PathBuf,
+    /// Planner to run (default: the flagship).
+    #[arg(long, value_name = "NAME")]
+    pub planner: Option<String>,
+}
+
+/// `ccpp info`.
+#[derive(Args, Debug)]
+pub struct InfoArgs {
+    /// The map.
+    #[command(flatten)]
+    pub map: MapArgs,
+    /// The robot.
+    #[command(flatten)]
+    pub robot: RobotArgs,
+    /// Print JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Parses `A,B` or `A,B,C` into three numbers (C defaults to 0).
+fn parse_triple(s: &str) -> Result<[f64; 3], String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if !(2..=3).contains(&parts.len()) {
+        return Err(format!("expected X,Y or X,Y,THETA, got {s:?}"));
+    }
+    let mut v = [0.0; 3];
+    for (k, p) in parts.iter().enumerate() {
+        let x: f64 = p.parse().map_err(|_| format!("{p:?} is not a number"))?;
+        if !x.is_finite() {
+            return Err(format!("{p:?} is not a finite number"));
+        }
+        v[k] = x;
+    }
+    Ok(v)
+}

@@ -1,0 +1,180 @@
+//! A validated run: map + robot + planner + settings, and its execution.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+use ccpp_core::metrics::{self, Metrics};
+use ccpp_core::planners::{self, PlannerOptions};
+use ccpp_core::sim::{simulate, RunOutput, SimConfig};
+use ccpp_core::world::{Robot, World};
+use ccpp_core::{GridMap, Pose};
+use ccpp_io::map::{load_map, load_map_bytes, LoadOptions};
+
+use crate::args::{DemoArgs, MapArgs, RobotArgs, RunArgs};
+
+/// The planner `ccpp demo` runs.
+pub const FLAGSHIP: &str = "random-bounce";
+
+const DEMO_YAML: &str = include_str!("../assets/aws_small_house.yaml");
+const DEMO_IMAGE: &[u8] = include_bytes!("../assets/aws_small_house.pgm");
+
+/// A map ready for planning, with the name used in reports.
+pub struct PreparedMap {
+    /// The (possibly inflated) grid.
+    pub grid: GridMap,
+    /// Short name (file stem).
+    pub name: String,
+    /// Where it came from, for messages.
+    pub source: PathBuf,
+}
+
+/// Everything a run needs, validated.
+pub struct Job {
+    /// The map.
+    pub map: PreparedMap,
+    /// The robot.
+    pub robot: Robot,
+    /// Start pose (None = default start).
+    pub start: Option<Pose>,
+    /// Planner name.
+    pub planner: String,
+    /// Planner options.
+    pub options: PlannerOptions,
+    /// Simulator settings.
+    pub sim: SimConfig,
+    /// Output folder.
+    pub out: PathBuf,
+}
+
+/// A finished run.
+pub struct JobResult {
+    /// The truth it ran on.
+    pub world: World,
+    /// Trace and timing.
+    pub run: RunOutput,
+    /// The metrics.
+    pub metrics: Metrics,
+}
+
+fn check_metres(name: &str, v: f64) -> Result<()> {
+    if !v.is_finite() || v <= 0.0 {
+        bail!("{name} must be a finite number > 0 m, got {v}");
+    }
+    Ok(())
+}
+
+/// Loads and prepares the map of `args` (validating overrides and inflation).
+pub fn prepare_map(args: &MapArgs) -> Result<PreparedMap> {
+    let opts = LoadOptions {
+        resolution: args.resolution,
+        origin: args.origin,
+        occupied_thresh: args.occupied_thresh,
+        free_thresh: args.free_thresh,
+        negate: None,
+    };
+    let loaded = load_map(&args.map, &opts)?;
+    let name = args
+        .map
+        .file_stem()
+        .map_or_else(|| "map".to_string(), |s| s.to_string_lossy().into_owned());
+    finish_map(loaded.grid, name, loaded.source, args.inflate)
+}
+
+fn finish_map(grid: GridMap, name: String, source: PathBuf, inflate: Option<f64>) -> Result<PreparedMap> {
+    let grid = match inflate {
+        None => grid,
+        Some(m) if m == 0.0 => grid,
+        Some(m) => {
+            check_metres("--inflate", m).with_context(|| format!("map {}", source.display()))?;
+            ccpp_core::inflate::inflate(&grid, m)
+        }
+    };
+    Ok(PreparedMap { grid, name, source })
+}
+
+/// Validates the robot arguments.
+pub fn robot_from(args: &RobotArgs) -> Result<(Robot, Option<Pose>)> {
+    check_metres("--radius", args.radius)?;
+    if let Some(t) = args.tool_radius {
+        check_metres("--tool-radius", t)?;
+    }
+    let robot = Robot { radius: args.radius, tool_radius: args.tool_radius.unwrap_or(args.radius) };
+    robot.validate()?;
+    let start = args.start.map(|s| Pose::new(s[0], s[1], s[2]));
+    Ok((robot, start))
+}
+
+fn read_options(path: &Path) -> Result<PlannerOptions> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("cannot read planner options {}", path.display()))?;
+    let is_json = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json"));
+    let opts: PlannerOptions = if is_json {
+        serde_json::from_str(&text)
+            .map_err(|e| anyhow::anyhow!("planner options {}: {e}", path.display()))?
+    } else {
+        serde_saphyr::from_str(&text)
+            .map_err(|e| anyhow::anyhow!("planner options {}: {e}", path.display()))?
+    };
+    Ok(opts)
+}
+
+impl Job {
+    /// A job from `ccpp run` arguments.
+    pub fn from_run_args(a: &RunArgs) -> Result<Self> {
+        if !planners::CATALOG.iter().any(|p| p.name == a.planner) {
+            bail!("unknown planner {:?}; run `ccpp planners` for the list", a.planner);
+        }
+        let (robot, start) = robot_from(&a.robot)?;
+        if let Some(r) = a.sensor_range {
+            check_metres("--sensor-range", r)?;
+        }
+        let mut options = match &a.config {
+            Some(p) => read_options(p)?,
+            None => PlannerOptions::default(),
+        };
+        if let Some(seed) = a.seed {
+            options.random_bounce.seed = seed;
+        }
+        let map = prepare_map(&a.map)?;
+        Ok(Self {
+            map,
+            robot,
+            start,
+            planner: a.planner.clone(),
+            options,
+            sim: SimConfig { sensor_range: a.sensor_range, ..SimConfig::default() },
+            out: a.out.clone(),
+        })
+    }
+
+    /// The demo job: the flagship planner on the bundled map.
+    pub fn demo(a: &DemoArgs) -> Result<Self> {
+        let name = Path::new("aws_small_house.yaml");
+        let loaded = load_map_bytes(name, Some(DEMO_YAML), DEMO_IMAGE, &LoadOptions::default())
+            .context("bundled demo map")?;
+        let map = finish_map(loaded.grid, "aws_small_house".into(), name.into(), None)?;
+        let planner = a.planner.clone().unwrap_or_else(|| FLAGSHIP.to_string());
+        if !planners::CATALOG.iter().any(|p| p.name == planner) {
+            bail!("unknown planner {planner:?}; run `ccpp planners` for the list");
+        }
+        Ok(Self {
+            map,
+            robot: Robot::new(0.15),
+            start: None,
+            planner,
+            options: PlannerOptions::default(),
+            sim: SimConfig::default(),
+            out: a.out.clone(),
+        })
+    }
+
+    /// Builds the world, runs the planner in the simulator and computes the metrics.
+    pub fn execute(&self) -> Result<JobResult> {
+        let world = World::new(self.map.grid.clone(), self.robot, self.start)
+            .with_context(|| format!("map {}", self.map.source.display()))?;
+        let mut planner = planners::build(&self.planner, &self.options, &world)?;
+        let run = simulate(&world, planner.as_mut(), &self.sim);
+        let metrics = metrics::compute(&world, &run, &self.map.name);
+        Ok(JobResult { world, run, metrics })
+    }
+}

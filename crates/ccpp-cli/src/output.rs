@@ -1,0 +1,109 @@
+//! Writing a run's files and printing its summary.
+
+use std::fmt::Write as _;
+
+use anyhow::{Context, Result};
+use ccpp_core::metrics::Metrics;
+use ccpp_core::trace::Trace;
+use ccpp_io::write_atomic;
+use ccpp_render::{coverage_png, CoverageStyle};
+
+use crate::job::{Job, JobResult};
+
+/// The trace as JSON Lines.
+pub fn trace_jsonl(trace: &Trace) -> Result<String> {
+    let mut s = String::with_capacity(trace.records.len() * 48);
+    for r in &trace.records {
+        s.push_str(&serde_json::to_string(r)?);
+        s.push('\n');
+    }
+    Ok(s)
+}
+
+/// The executed poses as CSV `x,y,theta` (metres, radians).
+pub fn path_csv(trace: &Trace) -> String {
+    let mut s = String::from("x,y,theta\n");
+    for p in trace.poses() {
+        let _ = writeln!(s, "{},{},{}", p.x, p.y, p.theta);
+    }
+    s
+}
+
+/// The metrics as pretty JSON.
+pub fn metrics_json(m: &Metrics) -> Result<String> {
+    let mut s = serde_json::to_string_pretty(m)?;
+    s.push('\n');
+    Ok(s)
+}
+
+/// Title lines for pictures.
+pub fn title_lines(m: &Metrics) -> Vec<String> {
+    let cov = m.coverage_rate.map_or_else(|| "-".to_string(), |c| format!("{:.1}%", 100.0 * c));
+    vec![
+        format!("{} on {}  r={} m  tool={} m", m.planner, m.map, m.robot_radius_m, m.tool_radius_m),
+        format!(
+            "effective coverage {:.1}%  tiles {}  path {:.1} m  ratio {:.2}  regions {}  turns {}  collisions {}",
+            100.0 * m.effective_coverage,
+            cov,
+            m.path_length_m,
+            m.path_ratio,
+            m.regions,
+            m.turns,
+            m.collisions
+        ),
+    ]
+}
+
+/// Renders everything first, then writes each file atomically, so a failure leaves no partial
+/// file; then prints the summary (or the metrics JSON alone).
+pub fn emit(job: &Job, r: &JobResult, json_only: bool) -> Result<()> {
+    let metrics = metrics_json(&r.metrics)?;
+    let trace = trace_jsonl(&r.run.trace)?;
+    let path = path_csv(&r.run.trace);
+    let style = CoverageStyle { title: title_lines(&r.metrics), ..CoverageStyle::default() };
+    let png = coverage_png(&r.world, &r.run.trace, &style)?;
+    std::fs::create_dir_all(&job.out)
+        .with_context(|| format!("cannot create output folder {}", job.out.display()))?;
+    let files: [(&str, &[u8]); 4] = [
+        ("metrics.json", metrics.as_bytes()),
+        ("path.csv", path.as_bytes()),
+        ("trace.jsonl", trace.as_bytes()),
+        ("coverage.png", &png),
+    ];
+    for (name, bytes) in files {
+        write_atomic(&job.out.join(name), bytes)?;
+    }
+    if json_only {
+        print!("{metrics}");
+    } else {
+        print!("{}", summary(&r.metrics));
+        println!("wrote {}/{{metrics.json, path.csv, trace.jsonl, coverage.png}}", job.out.display());
+    }
+    Ok(())
+}
+
+/// A short human table of the metrics.
+pub fn summary(m: &Metrics) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "{} on {} (r = {} m, tool r = {} m)", m.planner, m.map, m.robot_radius_m, m.tool_radius_m);
+    let cov = m.coverage_rate.map_or_else(|| "n/a".to_string(), |c| format!("{c:.4}"));
+    let rows: [(&str, String); 13] = [
+        ("coverage_rate", cov),
+        ("effective_coverage", format!("{:.4}", m.effective_coverage)),
+        ("path_length_m", format!("{:.2}", m.path_length_m)),
+        ("path_ratio", format!("{:.3}", m.path_ratio)),
+        ("redundancy", format!("{:.3}", m.redundancy)),
+        ("revisit_rate", format!("{:.3}", m.revisit_rate)),
+        ("regions", m.regions.to_string()),
+        ("backtracks", m.backtracks.to_string()),
+        ("backtrack_length_m", format!("{:.2}", m.backtrack_length_m)),
+        ("turns", m.turns.to_string()),
+        ("rotation_rad", format!("{:.1}", m.rotation_rad)),
+        ("collisions", m.collisions.to_string()),
+        ("wall_time_s", format!("{:.3}", m.wall_time_s)),
+    ];
+    for (k, v) in rows {
+        let _ = writeln!(s, "  {k:<20} {v:>12}");
+    }
+    s
+}
