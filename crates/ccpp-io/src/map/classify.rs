@@ -113,3 +113,105 @@ impl Thresholds {
 pub fn classify(v: u8, t: &Thresholds) -> Cell {
     t.classify_level(f64::from(v))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn map_saver_values_under_ros_defaults() {
+        let t = Thresholds::default();
+        assert_eq!(classify(254, &t), Cell::Free);
+        assert_eq!(classify(255, &t), Cell::Free);
+        assert_eq!(classify(206, &t), Cell::Free);
+        assert_eq!(classify(205, &t), Cell::Unknown);
+        assert_eq!(classify(90, &t), Cell::Unknown);
+        assert_eq!(classify(89, &t), Cell::Occupied);
+        assert_eq!(classify(0, &t), Cell::Occupied);
+    }
+
+    #[test]
+    fn other_thresholds_and_negate() {
+        let willow = Thresholds {
+            free: 0.1,
+            ..Thresholds::default()
+        };
+        assert_eq!(classify(206, &willow), Cell::Unknown);
+        assert_eq!(classify(230, &willow), Cell::Free);
+        let depot = Thresholds {
+            free: 0.25,
+            ..Thresholds::default()
+        };
+        assert_eq!(classify(205, &depot), Cell::Free);
+        let neg = Thresholds {
+            negate: true,
+            ..Thresholds::default()
+        };
+        assert_eq!(classify(0, &neg), Cell::Free);
+        assert_eq!(classify(255, &neg), Cell::Occupied);
+        assert_eq!(classify(50, &neg), Cell::Unknown); // p = 0.19608
+    }
+
+    #[test]
+    fn strict_comparisons_at_exact_ties() {
+        // p = 51 / 255 = 0.2 exactly: neither > 0.2 nor < 0.2.
+        let t = Thresholds {
+            occupied: 0.2,
+            free: 0.1,
+            negate: false,
+        };
+        assert_eq!(classify(204, &t), Cell::Unknown);
+        assert_eq!(classify(203, &t), Cell::Occupied);
+        let t = Thresholds {
+            occupied: 0.9,
+            free: 0.2,
+            negate: false,
+        };
+        assert_eq!(classify(204, &t), Cell::Unknown);
+        assert_eq!(classify(205, &t), Cell::Free);
+        assert_eq!(t.classify_probability(f64::NAN), Cell::Unknown);
+    }
+
+    #[test]
+    fn lut_matches_classify() {
+        let t = Thresholds {
+            occupied: 0.5,
+            free: 0.3,
+            negate: true,
+        };
+        let lut = t.lut();
+        for v in 0..=255u8 {
+            assert_eq!(lut[usize::from(v)], classify(v, &t));
+        }
+    }
+
+    #[test]
+    fn validate() {
+        let p = Path::new("x.yaml");
+        assert!(Thresholds::default().validate(p).is_ok());
+        assert!(Thresholds {
+            occupied: 1.0,
+            free: 0.0,
+            negate: false
+        }
+        .validate(p)
+        .is_ok());
+        for (o, f) in [
+            (0.5, 0.5),
+            (0.5, 0.6),
+            (1.1, 0.1),
+            (0.5, -0.1),
+            (f64::NAN, 0.1),
+        ] {
+            let t = Thresholds {
+                occupied: o,
+                free: f,
+                negate: false,
+            };
+            assert!(
+                matches!(t.validate(p), Err(MapError::BadValue { .. })),
+                "{o} {f}"
+            );
+        }
+    }
+}

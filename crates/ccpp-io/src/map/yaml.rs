@@ -101,10 +101,14 @@ impl MapYaml {
     /// [`MapError::BadValue`] for out-of-domain values (see [`validate_placement`] and
     /// [`Thresholds::validate`]). The mode is not checked here.
     pub fn parse(text: &str, path: &Path) -> Result<Self, MapError> {
-        let raw: RawYaml = serde_saphyr::from_str(text).map_err(|e| MapError::Yaml {
-            path: path.to_path_buf(),
-            message: one_line(&e.to_string()),
-        })?;
+        // Let `.nan` / `.inf` through so they are reported as bad values of their field.
+        let mut options = serde_saphyr::Options::default();
+        options.non_finite_float_policy = serde_saphyr::NonFiniteFloatPolicy::PassThrough;
+        let raw: RawYaml =
+            serde_saphyr::from_str_with_options(text, options).map_err(|e| MapError::Yaml {
+                path: path.to_path_buf(),
+                message: yaml_message(&e),
+            })?;
         let missing = |field| MapError::MissingField {
             path: path.to_path_buf(),
             field,
@@ -162,6 +166,16 @@ impl MapYaml {
     }
 }
 
+/// The parser's message without its source snippet, on one line.
+fn yaml_message(e: &serde_saphyr::Error) -> String {
+    let mut opts = serde_saphyr::RenderOptions::default();
+    opts.snippets = serde_saphyr::SnippetMode::Off;
+    let text = one_line(&e.render_with_options(opts));
+    text.strip_prefix("error: ")
+        .map(str::to_owned)
+        .unwrap_or(text)
+}
+
 /// Checks that `resolution` is finite and > 0 and that `origin` is finite.
 ///
 /// # Errors
@@ -182,4 +196,141 @@ pub fn validate_placement(resolution: f64, origin: [f64; 3], path: &Path) -> Res
         });
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<MapYaml, MapError> {
+        MapYaml::parse(text, Path::new("dir/test.yaml"))
+    }
+
+    const BASE: &str = "image: m.pgm\nresolution: 0.05\norigin: [-1, -2.5, 0.0]\n";
+
+    #[test]
+    fn defaults_and_integer_origin() {
+        let y = parse(BASE).unwrap();
+        assert_eq!(y.image, "m.pgm");
+        assert_eq!(y.resolution, 0.05);
+        assert_eq!(y.origin, [-1.0, -2.5, 0.0]);
+        assert!(!y.negate);
+        assert_eq!(y.occupied_thresh, 0.65);
+        assert_eq!(y.free_thresh, 0.196);
+        assert_eq!(y.mode, None);
+    }
+
+    #[test]
+    fn negate_forms() {
+        for (text, want) in [("0", false), ("1", true), ("false", false), ("true", true)] {
+            let y = parse(&format!("{BASE}negate: {text}\n")).unwrap();
+            assert_eq!(y.negate, want, "negate: {text}");
+        }
+        for text in ["2", "-1", "0.5", "\"0\""] {
+            let e = parse(&format!("{BASE}negate: {text}\n")).unwrap_err();
+            assert!(
+                matches!(
+                    e,
+                    MapError::BadValue {
+                        field: "negate",
+                        ..
+                    }
+                ),
+                "negate: {text} -> {e}"
+            );
+            assert!(e.to_string().contains("test.yaml"));
+        }
+    }
+
+    #[test]
+    fn comments_unknown_keys_and_mode() {
+        let y = parse(&format!(
+            "# licence header\n{BASE}mode: trinary # comment\nextra_key: [1, 2]\n\
+             occupied_thresh: 0.7\nfree_thresh: 0.25\n"
+        ))
+        .unwrap();
+        assert_eq!(y.mode.as_deref(), Some("trinary"));
+        assert_eq!(
+            y.thresholds(),
+            Thresholds {
+                occupied: 0.7,
+                free: 0.25,
+                negate: false
+            }
+        );
+    }
+
+    #[test]
+    fn missing_fields() {
+        for field in ["image", "resolution", "origin"] {
+            let text: String = BASE
+                .lines()
+                .filter(|l| !l.starts_with(field))
+                .map(|l| format!("{l}\n"))
+                .collect();
+            let e = parse(&text).unwrap_err();
+            assert!(
+                matches!(e, MapError::MissingField { field: f, .. } if f == field),
+                "{e}"
+            );
+            let msg = e.to_string();
+            assert!(msg.contains("test.yaml") && msg.contains(field), "{msg}");
+        }
+    }
+
+    #[test]
+    fn bad_values() {
+        let cases = [
+            (
+                "image: m.pgm\nresolution: -0.05\norigin: [0, 0, 0]\n",
+                "resolution",
+            ),
+            (
+                "image: m.pgm\nresolution: 0\norigin: [0, 0, 0]\n",
+                "resolution",
+            ),
+            (
+                "image: m.pgm\nresolution: .nan\norigin: [0, 0, 0]\n",
+                "resolution",
+            ),
+            (
+                "image: m.pgm\nresolution: .inf\norigin: [0, 0, 0]\n",
+                "resolution",
+            ),
+            (
+                "image: m.pgm\nresolution: 0.1\norigin: [0, .nan, 0]\n",
+                "origin",
+            ),
+            ("image: m.pgm\nresolution: 0.1\norigin: [0, 0]\n", "origin"),
+            ("image: ''\nresolution: 0.1\norigin: [0, 0, 0]\n", "image"),
+            (&format!("{BASE}occupied_thresh: 1.5\n"), "occupied_thresh"),
+            (&format!("{BASE}free_thresh: -0.1\n"), "free_thresh"),
+            (&format!("{BASE}free_thresh: 0.7\n"), "free_thresh"),
+            (&format!("{BASE}free_thresh: 0.65\n"), "free_thresh"),
+        ];
+        for (text, field) in cases {
+            let e = parse(text).unwrap_err();
+            assert!(
+                matches!(e, MapError::BadValue { field: f, .. } if f == field),
+                "{text:?} -> {e}"
+            );
+            let msg = e.to_string();
+            assert!(msg.contains("test.yaml") && !msg.contains('\n'), "{msg}");
+        }
+    }
+
+    #[test]
+    fn malformed_yaml_is_one_line() {
+        for text in [
+            "image: [unclosed\nresolution: 0.05\n",
+            "resolution: abc\nimage: m.pgm\norigin: [0, 0, 0]\n",
+            "- a\n- b\n",
+            "\u{0}\u{1}",
+        ] {
+            let e = parse(text).unwrap_err();
+            assert!(matches!(e, MapError::Yaml { .. }), "{text:?} -> {e}");
+            let msg = e.to_string();
+            assert!(msg.contains("test.yaml") && !msg.contains('\n'), "{msg}");
+        }
+    }
 }
