@@ -1,0 +1,142 @@
+//! Image decoding and conversion of pixels to cells.
+//!
+//! Grey level rule (documented in [`crate::map`]): grey images use their value; colour images
+//! use the exact mean `(R + G + B) / 3` as an `f64` (no rounding, as `map_server` does); alpha
+//! is ignored; 16-bit samples are mapped to the 0..=255 scale as `v / 257` (exact, not truncated
+//! to 8 bits first); float samples as `v * 255` clamped to `[0, 255]`.
+
+use std::io::{BufRead, Seek};
+use std::path::Path;
+
+use ccpp_core::grid::Cell;
+use image::{DynamicImage, ImageReader};
+
+use super::classify::Thresholds;
+use super::error::{one_line, MapError};
+
+/// Width, height and row-major cells (row 0 on top) of a decoded and classified image.
+pub(crate) struct Classified {
+    pub width: usize,
+    pub height: usize,
+    pub cells: Vec<Cell>,
+}
+
+/// Decodes an image (format guessed from its content) and classifies every pixel. The decoded
+/// image buffer is dropped before returning, so at most the image plus the cells are alive.
+pub(crate) fn decode_and_classify<R: BufRead + Seek>(
+    reader: ImageReader<R>,
+    path: &Path,
+    t: &Thresholds,
+) -> Result<Classified, MapError> {
+    let decode_err = |e: &dyn std::fmt::Display| MapError::Decode {
+        path: path.to_path_buf(),
+        message: one_line(&e.to_string()),
+    };
+    let reader = reader.with_guessed_format().map_err(|e| MapError::Io {
+        path: path.to_path_buf(),
+        source: e,
+    })?;
+    if reader.format().is_none() {
+        return Err(MapError::Decode {
+            path: path.to_path_buf(),
+            message: "not a PNG or PNM/PGM image (unrecognised content)".to_owned(),
+        });
+    }
+    let img = reader.decode().map_err(|e| decode_err(&e))?;
+    let width = img.width() as usize;
+    let height = img.height() as usize;
+    let cells = classify_image(&img, t);
+    drop(img);
+    Ok(Classified {
+        width,
+        height,
+        cells,
+    })
+}
+
+/// Classifies every pixel of a decoded image, row-major from the top row.
+fn classify_image(img: &DynamicImage, t: &Thresholds) -> Vec<Cell> {
+    let n = img.width() as usize * img.height() as usize;
+    let mut cells = Vec::with_capacity(n);
+    match img {
+        DynamicImage::ImageLuma8(b) => {
+            let lut = t.lut();
+            cells.extend(b.as_raw().iter().map(|&v| lut[usize::from(v)]));
+        }
+        DynamicImage::ImageLumaA8(b) => {
+            let lut = t.lut();
+            cells.extend(b.as_raw().chunks_exact(2).map(|p| lut[usize::from(p[0])]));
+        }
+        DynamicImage::ImageRgb8(b) => {
+            let lut = sum_lut(t);
+            cells.extend(b.as_raw().chunks_exact(3).map(|p| lut[rgb_sum(p)]));
+        }
+        DynamicImage::ImageRgba8(b) => {
+            let lut = sum_lut(t);
+            cells.extend(b.as_raw().chunks_exact(4).map(|p| lut[rgb_sum(p)]));
+        }
+        DynamicImage::ImageLuma16(b) => {
+            cells.extend(
+                b.as_raw()
+                    .iter()
+                    .map(|&v| t.classify_level(level16(f64::from(v)))),
+            );
+        }
+        DynamicImage::ImageLumaA16(b) => {
+            cells.extend(
+                b.as_raw()
+                    .chunks_exact(2)
+                    .map(|p| t.classify_level(level16(f64::from(p[0])))),
+            );
+        }
+        DynamicImage::ImageRgb16(b) => {
+            cells.extend(
+                b.as_raw()
+                    .chunks_exact(3)
+                    .map(|p| t.classify_level(rgb16_level(p))),
+            );
+        }
+        DynamicImage::ImageRgba16(b) => {
+            cells.extend(
+                b.as_raw()
+                    .chunks_exact(4)
+                    .map(|p| t.classify_level(rgb16_level(p))),
+            );
+        }
+        other => {
+            // Float images (and any future variant): go through 32-bit float RGB.
+            let rgb = other.to_rgb32f();
+            cells.extend(rgb.as_raw().chunks_exact(3).map(|p| {
+                let mean = (f64::from(p[0]) + f64::from(p[1]) + f64::from(p[2])) / 3.0;
+                t.classify_level((mean * 255.0).clamp(0.0, 255.0))
+            }));
+        }
+    }
+    debug_assert_eq!(cells.len(), n);
+    cells
+}
+
+/// `R + G + B` of an 8-bit pixel (alpha, if any, is ignored).
+#[inline]
+fn rgb_sum(p: &[u8]) -> usize {
+    usize::from(p[0]) + usize::from(p[1]) + usize::from(p[2])
+}
+
+/// Classification of every possible 8-bit `R + G + B` sum (0..=765), using the exact mean.
+fn sum_lut(t: &Thresholds) -> Vec<Cell> {
+    (0..=765u16)
+        .map(|s| t.classify_level(f64::from(s) / 3.0))
+        .collect()
+}
+
+/// A 16-bit sample on the 0..=255 scale.
+#[inline]
+fn level16(v: f64) -> f64 {
+    v / 257.0
+}
+
+/// Mean of R, G, B of a 16-bit pixel on the 0..=255 scale.
+#[inline]
+fn rgb16_level(p: &[u16]) -> f64 {
+    (f64::from(p[0]) + f64::from(p[1]) + f64::from(p[2])) / (3.0 * 257.0)
+}

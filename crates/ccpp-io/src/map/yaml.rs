@@ -1,0 +1,336 @@
+//! The ROS `map_server` YAML file ([`MapYaml`]).
+
+use std::fmt;
+use std::path::Path;
+
+use serde::de::{self, Deserializer, Visitor};
+use serde::Deserialize;
+
+use super::classify::Thresholds;
+use super::error::{one_line, MapError};
+
+/// Default `occupied_thresh` of ROS `map_server` when the YAML has none.
+pub const DEFAULT_OCCUPIED_THRESH: f64 = 0.65;
+/// Default `free_thresh` of ROS `map_server` when the YAML has none.
+pub const DEFAULT_FREE_THRESH: f64 = 0.196;
+
+/// A parsed and validated ROS `map_server` YAML.
+///
+/// ```yaml
+/// image: map.pgm            # required; relative to the YAML's folder, or absolute
+/// resolution: 0.05          # required; metres per pixel, finite and > 0
+/// origin: [-10, -10, 0.0]   # required; world pose (x, y, yaw) of the lower-left pixel
+/// negate: 0                 # optional, 0/1 or false/true (default 0)
+/// occupied_thresh: 0.65     # optional (default 0.65)
+/// free_thresh: 0.196        # optional (default 0.196)
+/// mode: trinary             # optional; only trinary is supported by the loader
+/// ```
+///
+/// Unknown keys are ignored, as `map_server` does.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MapYaml {
+    /// The image file as written in the YAML (not yet resolved against the YAML's folder).
+    pub image: String,
+    /// Metres per pixel.
+    pub resolution: f64,
+    /// World pose `(x, y, yaw)` of the lower-left corner of the lower-left pixel.
+    pub origin: [f64; 3],
+    /// `true` when the image is negated (`p = v / 255`).
+    pub negate: bool,
+    /// Occupancy probability above which a pixel is occupied.
+    pub occupied_thresh: f64,
+    /// Occupancy probability below which a pixel is free.
+    pub free_thresh: f64,
+    /// The `mode` field when present (`trinary`, `scale` or `raw` in `map_server`).
+    pub mode: Option<String>,
+}
+
+/// What the YAML holds before the required fields are checked.
+#[derive(Deserialize)]
+struct RawYaml {
+    image: Option<String>,
+    resolution: Option<f64>,
+    origin: Option<Vec<f64>>,
+    negate: Option<Negate>,
+    occupied_thresh: Option<f64>,
+    free_thresh: Option<f64>,
+    mode: Option<String>,
+}
+
+/// `negate` as written: an integer or a boolean.
+enum Negate {
+    Int(i64),
+    Bool(bool),
+    Other(String),
+}
+
+impl<'de> Deserialize<'de> for Negate {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct V;
+        impl Visitor<'_> for V {
+            type Value = Negate;
+            fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str("0, 1, false or true")
+            }
+            fn visit_bool<E: de::Error>(self, v: bool) -> Result<Negate, E> {
+                Ok(Negate::Bool(v))
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<Negate, E> {
+                Ok(Negate::Int(v))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<Negate, E> {
+                Ok(i64::try_from(v).map_or_else(|_| Negate::Other(v.to_string()), Negate::Int))
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<Negate, E> {
+                Ok(Negate::Other(v.to_string()))
+            }
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<Negate, E> {
+                Ok(Negate::Other(format!("{v:?}")))
+            }
+        }
+        deserializer.deserialize_any(V)
+    }
+}
+
+impl MapYaml {
+    /// Parses and validates the text of a map YAML. `path` is only used in error messages.
+    ///
+    /// # Errors
+    /// [`MapError::Yaml`] for malformed YAML or wrongly typed fields,
+    /// [`MapError::MissingField`] when `image`, `resolution` or `origin` is absent, and
+    /// [`MapError::BadValue`] for out-of-domain values (see [`validate_placement`] and
+    /// [`Thresholds::validate`]). The mode is not checked here.
+    pub fn parse(text: &str, path: &Path) -> Result<Self, MapError> {
+        // Let `.nan` / `.inf` through so they are reported as bad values of their field.
+        let mut options = serde_saphyr::Options::default();
+        options.non_finite_float_policy = serde_saphyr::NonFiniteFloatPolicy::PassThrough;
+        let raw: RawYaml =
+            serde_saphyr::from_str_with_options(text, options).map_err(|e| MapError::Yaml {
+                path: path.to_path_buf(),
+                message: yaml_message(&e),
+            })?;
+        let missing = |field| MapError::MissingField {
+            path: path.to_path_buf(),
+            field,
+        };
+        let bad = |field, reason| MapError::BadValue {
+            path: path.to_path_buf(),
+            field,
+            reason,
+        };
+
+        let image = raw.image.ok_or_else(|| missing("image"))?;
+        if image.trim().is_empty() {
+            return Err(bad("image", "the image file name is empty".to_owned()));
+        }
+        let resolution = raw.resolution.ok_or_else(|| missing("resolution"))?;
+        let origin_v = raw.origin.ok_or_else(|| missing("origin"))?;
+        let origin: [f64; 3] = origin_v.as_slice().try_into().map_err(|_| {
+            bad(
+                "origin",
+                format!(
+                    "expected 3 numbers [x, y, yaw], got {} ({origin_v:?})",
+                    origin_v.len()
+                ),
+            )
+        })?;
+        let negate = match raw.negate {
+            None | Some(Negate::Int(0) | Negate::Bool(false)) => false,
+            Some(Negate::Int(1) | Negate::Bool(true)) => true,
+            Some(Negate::Int(v)) => return Err(bad("negate", format!("{v} is not 0 or 1"))),
+            Some(Negate::Other(v)) => {
+                return Err(bad("negate", format!("{v} is not 0, 1, false or true")))
+            }
+        };
+        let yaml = Self {
+            image,
+            resolution,
+            origin,
+            negate,
+            occupied_thresh: raw.occupied_thresh.unwrap_or(DEFAULT_OCCUPIED_THRESH),
+            free_thresh: raw.free_thresh.unwrap_or(DEFAULT_FREE_THRESH),
+            mode: raw.mode,
+        };
+        validate_placement(yaml.resolution, yaml.origin, path)?;
+        yaml.thresholds().validate(path)?;
+        Ok(yaml)
+    }
+
+    /// The classification thresholds of this YAML.
+    pub fn thresholds(&self) -> Thresholds {
+        Thresholds {
+            occupied: self.occupied_thresh,
+            free: self.free_thresh,
+            negate: self.negate,
+        }
+    }
+}
+
+/// The parser's message without its source snippet, on one line.
+fn yaml_message(e: &serde_saphyr::Error) -> String {
+    let mut opts = serde_saphyr::RenderOptions::default();
+    opts.snippets = serde_saphyr::SnippetMode::Off;
+    let text = one_line(&e.render_with_options(opts));
+    text.strip_prefix("error: ")
+        .map(str::to_owned)
+        .unwrap_or(text)
+}
+
+/// Checks that `resolution` is finite and > 0 and that `origin` is finite.
+///
+/// # Errors
+/// [`MapError::BadValue`] naming `path` and the field.
+pub fn validate_placement(resolution: f64, origin: [f64; 3], path: &Path) -> Result<(), MapError> {
+    if !(resolution.is_finite() && resolution > 0.0) {
+        return Err(MapError::BadValue {
+            path: path.to_path_buf(),
+            field: "resolution",
+            reason: format!("{resolution} is not a finite number > 0"),
+        });
+    }
+    if !origin.iter().all(|v| v.is_finite()) {
+        return Err(MapError::BadValue {
+            path: path.to_path_buf(),
+            field: "origin",
+            reason: format!("{origin:?} has a non-finite component"),
+        });
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<MapYaml, MapError> {
+        MapYaml::parse(text, Path::new("dir/test.yaml"))
+    }
+
+    const BASE: &str = "image: m.pgm\nresolution: 0.05\norigin: [-1, -2.5, 0.0]\n";
+
+    #[test]
+    fn defaults_and_integer_origin() {
+        let y = parse(BASE).unwrap();
+        assert_eq!(y.image, "m.pgm");
+        assert_eq!(y.resolution, 0.05);
+        assert_eq!(y.origin, [-1.0, -2.5, 0.0]);
+        assert!(!y.negate);
+        assert_eq!(y.occupied_thresh, 0.65);
+        assert_eq!(y.free_thresh, 0.196);
+        assert_eq!(y.mode, None);
+    }
+
+    #[test]
+    fn negate_forms() {
+        for (text, want) in [("0", false), ("1", true), ("false", false), ("true", true)] {
+            let y = parse(&format!("{BASE}negate: {text}\n")).unwrap();
+            assert_eq!(y.negate, want, "negate: {text}");
+        }
+        for text in ["2", "-1", "0.5", "\"0\""] {
+            let e = parse(&format!("{BASE}negate: {text}\n")).unwrap_err();
+            assert!(
+                matches!(
+                    e,
+                    MapError::BadValue {
+                        field: "negate",
+                        ..
+                    }
+                ),
+                "negate: {text} -> {e}"
+            );
+            assert!(e.to_string().contains("test.yaml"));
+        }
+    }
+
+    #[test]
+    fn comments_unknown_keys_and_mode() {
+        let y = parse(&format!(
+            "# licence header\n{BASE}mode: trinary # comment\nextra_key: [1, 2]\n\
+             occupied_thresh: 0.7\nfree_thresh: 0.25\n"
+        ))
+        .unwrap();
+        assert_eq!(y.mode.as_deref(), Some("trinary"));
+        assert_eq!(
+            y.thresholds(),
+            Thresholds {
+                occupied: 0.7,
+                free: 0.25,
+                negate: false
+            }
+        );
+    }
+
+    #[test]
+    fn missing_fields() {
+        for field in ["image", "resolution", "origin"] {
+            let text: String = BASE
+                .lines()
+                .filter(|l| !l.starts_with(field))
+                .map(|l| format!("{l}\n"))
+                .collect();
+            let e = parse(&text).unwrap_err();
+            assert!(
+                matches!(e, MapError::MissingField { field: f, .. } if f == field),
+                "{e}"
+            );
+            let msg = e.to_string();
+            assert!(msg.contains("test.yaml") && msg.contains(field), "{msg}");
+        }
+    }
+
+    #[test]
+    fn bad_values() {
+        let cases = [
+            (
+                "image: m.pgm\nresolution: -0.05\norigin: [0, 0, 0]\n",
+                "resolution",
+            ),
+            (
+                "image: m.pgm\nresolution: 0\norigin: [0, 0, 0]\n",
+                "resolution",
+            ),
+            (
+                "image: m.pgm\nresolution: .nan\norigin: [0, 0, 0]\n",
+                "resolution",
+            ),
+            (
+                "image: m.pgm\nresolution: .inf\norigin: [0, 0, 0]\n",
+                "resolution",
+            ),
+            (
+                "image: m.pgm\nresolution: 0.1\norigin: [0, .nan, 0]\n",
+                "origin",
+            ),
+            ("image: m.pgm\nresolution: 0.1\norigin: [0, 0]\n", "origin"),
+            ("image: ''\nresolution: 0.1\norigin: [0, 0, 0]\n", "image"),
+            (&format!("{BASE}occupied_thresh: 1.5\n"), "occupied_thresh"),
+            (&format!("{BASE}free_thresh: -0.1\n"), "free_thresh"),
+            (&format!("{BASE}free_thresh: 0.7\n"), "free_thresh"),
+            (&format!("{BASE}free_thresh: 0.65\n"), "free_thresh"),
+        ];
+        for (text, field) in cases {
+            let e = parse(text).unwrap_err();
+            assert!(
+                matches!(e, MapError::BadValue { field: f, .. } if f == field),
+                "{text:?} -> {e}"
+            );
+            let msg = e.to_string();
+            assert!(msg.contains("test.yaml") && !msg.contains('\n'), "{msg}");
+        }
+    }
+
+    #[test]
+    fn malformed_yaml_is_one_line() {
+        for text in [
+            "image: [unclosed\nresolution: 0.05\n",
+            "resolution: abc\nimage: m.pgm\norigin: [0, 0, 0]\n",
+            "- a\n- b\n",
+            "\u{0}\u{1}",
+        ] {
+            let e = parse(text).unwrap_err();
+            assert!(matches!(e, MapError::Yaml { .. }), "{text:?} -> {e}");
+            let msg = e.to_string();
+            assert!(msg.contains("test.yaml") && !msg.contains('\n'), "{msg}");
+        }
+    }
+}
