@@ -5,7 +5,7 @@
 //! * [`map`]: loads ROS `map_server` maps (YAML + PGM/PNG) and bare images into a
 //!   [`GridMap`](ccpp_core::grid::GridMap), following `map_server`'s trinary rule exactly (see
 //!   the module docs for the grey-level, alpha and 16-bit conventions);
-//! * [`write`]: atomic file writers and a `map_saver`-style map writer.
+//! * [`write`](mod@write): atomic file writers and a `map_saver`-style map writer.
 //!
 //! Errors are [`thiserror`] enums that always name the file concerned; nothing here panics on
 //! user data.

@@ -38,6 +38,12 @@ pub enum WriteError {
         /// The destination path.
         path: PathBuf,
     },
+    /// The image file name derived from the YAML path is not UTF-8, so a YAML cannot name it.
+    #[error("cannot save a map as {}: the file name is not UTF-8", path.display())]
+    NonUtf8Name {
+        /// The destination YAML path.
+        path: PathBuf,
+    },
 }
 
 /// The temporary path `<name>.tmp` beside `path`.
@@ -112,7 +118,8 @@ pub fn encode_pgm(grid: &GridMap) -> Vec<u8> {
 /// A `map_server` YAML for an image written by [`encode_pgm`]: `image` (as given, quoted),
 /// `resolution`, `origin`, `negate: 0`, `occupied_thresh: 0.65`, `free_thresh: 0.196`,
 /// `mode: trinary`. Those thresholds read 254 back as free, 0 as occupied and 205 as unknown.
-/// Numbers are written in plain decimal with the shortest digits that round-trip, so they reload exactly.
+/// Numbers are written in plain decimal with the shortest digits that round-trip, so they
+/// reload exactly.
 pub fn map_yaml(frame: &MapFrame, image: &str) -> String {
     let mut quoted = String::with_capacity(image.len() + 2);
     quoted.push('"');
@@ -149,9 +156,12 @@ pub fn save_map(grid: &GridMap, yaml_path: &Path) -> Result<PathBuf, WriteError>
         })?;
     let mut image_name = OsString::from(stem);
     image_name.push(".pgm");
-    let image_path = yaml_path.with_file_name(&image_name);
+    let name = image_name.to_str().ok_or_else(|| WriteError::NonUtf8Name {
+        path: yaml_path.to_path_buf(),
+    })?;
+    let image_path = yaml_path.with_file_name(name);
     write_atomic(&image_path, &encode_pgm(grid))?;
-    let yaml = map_yaml(grid.frame(), &image_name.to_string_lossy());
+    let yaml = map_yaml(grid.frame(), name);
     write_atomic(yaml_path, yaml.as_bytes())?;
     Ok(image_path)
 }

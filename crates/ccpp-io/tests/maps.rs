@@ -2,6 +2,8 @@
 //! a hand-written P5 parser (PGM) or the `image` crate's raw buffer (PNG), the YAML read with a
 //! line parser, and the trinary rule evaluated with exact integer arithmetic on rationals.
 
+#![allow(clippy::unwrap_used)] // tests may panic on broken fixtures
+
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 

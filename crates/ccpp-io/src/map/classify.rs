@@ -115,6 +115,7 @@ pub fn classify(v: u8, t: &Thresholds) -> Cell {
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
 

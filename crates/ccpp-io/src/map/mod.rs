@@ -2,7 +2,8 @@
 //!
 //! # Pixel rule
 //!
-//! Each pixel becomes a [`Cell`](ccpp_core::grid::Cell) by `map_server`'s **trinary** mode (the only supported mode):
+//! Each pixel becomes a [`Cell`](ccpp_core::grid::Cell) by `map_server`'s **trinary** mode
+//! (the only supported mode; `scale` and `raw` are refused with [`MapError::UnsupportedMode`]):
 //!
 //! 1. Grey level `v` on the 0..=255 scale:
 //!    * grey images (8-bit): the value itself;

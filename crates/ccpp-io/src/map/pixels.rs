@@ -42,7 +42,15 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
             message: "not a PNG or PNM/PGM image (unrecognised content)".to_owned(),
         });
     }
-    let img = reader.decode().map_err(|e| decode_err(&e))?;
+    let img = reader.decode().map_err(|e| match e {
+        image::ImageError::IoError(io) if io.kind() == std::io::ErrorKind::UnexpectedEof => {
+            MapError::Decode {
+                path: path.to_path_buf(),
+                message: "truncated: the file ends before its image data does".to_owned(),
+            }
+        }
+        other => decode_err(&other),
+    })?;
     let width = img.width() as usize;
     let height = img.height() as usize;
     let cells = classify_image(&img, t);

@@ -199,6 +199,7 @@ pub fn validate_placement(resolution: f64, origin: [f64; 3], path: &Path) -> Res
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
 
@@ -266,7 +267,7 @@ mod tests {
             let text: String = BASE
                 .lines()
                 .filter(|l| !l.starts_with(field))
-                .map(|l| format!("{l}\n"))
+                .flat_map(|l| [l, "\n"])
                 .collect();
             let e = parse(&text).unwrap_err();
             assert!(
