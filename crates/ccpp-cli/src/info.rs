@@ -103,7 +103,11 @@ pub fn run(a: &InfoArgs) -> Result<()> {
         unknown_px: unk,
         free_m2: free as f64 * res2,
         free_components: ncomp,
-        largest_component_share: if free == 0 { 0.0 } else { largest as f64 / free as f64 },
+        largest_component_share: if free == 0 {
+            0.0
+        } else {
+            largest as f64 / free as f64
+        },
         robot_radius_m: robot.radius,
         cfree_px: world.cfree().count_ones(..),
         start: [s.x, s.y, s.theta],
@@ -116,15 +120,37 @@ pub fn run(a: &InfoArgs) -> Result<()> {
     }
     let n = f.len() as f64 / 100.0;
     println!("map            {} ({})", info.map, map.source.display());
-    println!("size           {} x {} px, {} m/px = {:.2} x {:.2} m", f.width, f.height, f.resolution, info.width_m, info.height_m);
-    println!("origin         ({}, {}, {})", f.origin.x, f.origin.y, f.origin.theta);
-    println!("free           {free} px ({:.1} %), {:.1} m2", free as f64 / n, info.free_m2);
+    println!(
+        "size           {} x {} px, {} m/px = {:.2} x {:.2} m",
+        f.width, f.height, f.resolution, info.width_m, info.height_m
+    );
+    println!(
+        "origin         ({}, {}, {})",
+        f.origin.x, f.origin.y, f.origin.theta
+    );
+    println!(
+        "free           {free} px ({:.1} %), {:.1} m2",
+        free as f64 / n,
+        info.free_m2
+    );
     println!("occupied       {occ} px ({:.1} %)", occ as f64 / n);
     println!("unknown        {unk} px ({:.1} %)", unk as f64 / n);
-    println!("components     {ncomp} (4-connected free), largest {:.1} % of free", 100.0 * info.largest_component_share);
-    println!("robot radius   {} m: C-free {} px", robot.radius, info.cfree_px);
+    println!(
+        "components     {ncomp} (4-connected free), largest {:.1} % of free",
+        100.0 * info.largest_component_share
+    );
+    println!(
+        "robot radius   {} m: C-free {} px",
+        robot.radius, info.cfree_px
+    );
     println!("start          ({:.3}, {:.3}, {:.3})", s.x, s.y, s.theta);
-    println!("reachable      {} px of C-free from the start", info.reachable_px);
-    println!("accessible     {:.2} m2 (floor the tool can touch from the start)", info.accessible_m2);
+    println!(
+        "reachable      {} px of C-free from the start",
+        info.reachable_px
+    );
+    println!(
+        "accessible     {:.2} m2 (floor the tool can touch from the start)",
+        info.accessible_m2
+    );
     Ok(())
 }

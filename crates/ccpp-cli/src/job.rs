@@ -80,7 +80,12 @@ pub fn prepare_map(args: &MapArgs) -> Result<PreparedMap> {
     finish_map(loaded.grid, name, loaded.source, args.inflate)
 }
 
-fn finish_map(grid: GridMap, name: String, source: PathBuf, inflate: Option<f64>) -> Result<PreparedMap> {
+fn finish_map(
+    grid: GridMap,
+    name: String,
+    source: PathBuf,
+    inflate: Option<f64>,
+) -> Result<PreparedMap> {
     let grid = match inflate {
         None => grid,
         Some(m) if m == 0.0 => grid,
@@ -98,7 +103,10 @@ pub fn robot_from(args: &RobotArgs) -> Result<(Robot, Option<Pose>)> {
     if let Some(t) = args.tool_radius {
         check_metres("--tool-radius", t)?;
     }
-    let robot = Robot { radius: args.radius, tool_radius: args.tool_radius.unwrap_or(args.radius) };
+    let robot = Robot {
+        radius: args.radius,
+        tool_radius: args.tool_radius.unwrap_or(args.radius),
+    };
     robot.validate()?;
     let start = args.start.map(|s| Pose::new(s[0], s[1], s[2]));
     Ok((robot, start))
@@ -107,7 +115,9 @@ pub fn robot_from(args: &RobotArgs) -> Result<(Robot, Option<Pose>)> {
 fn read_options(path: &Path) -> Result<PlannerOptions> {
     let text = std::fs::read_to_string(path)
         .with_context(|| format!("cannot read planner options {}", path.display()))?;
-    let is_json = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json"));
+    let is_json = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("json"));
     let opts: PlannerOptions = if is_json {
         serde_json::from_str(&text)
             .map_err(|e| anyhow::anyhow!("planner options {}: {e}", path.display()))?
@@ -122,7 +132,10 @@ impl Job {
     /// A job from `ccpp run` arguments.
     pub fn from_run_args(a: &RunArgs) -> Result<Self> {
         if !planners::CATALOG.iter().any(|p| p.name == a.planner) {
-            bail!("unknown planner {:?}; run `ccpp planners` for the list", a.planner);
+            bail!(
+                "unknown planner {:?}; run `ccpp planners` for the list",
+                a.planner
+            );
         }
         let (robot, start) = robot_from(&a.robot)?;
         if let Some(r) = a.sensor_range {
@@ -142,7 +155,10 @@ impl Job {
             start,
             planner: a.planner.clone(),
             options,
-            sim: SimConfig { sensor_range: a.sensor_range, ..SimConfig::default() },
+            sim: SimConfig {
+                sensor_range: a.sensor_range,
+                ..SimConfig::default()
+            },
             out: a.out.clone(),
         })
     }
@@ -175,6 +191,10 @@ impl Job {
         let mut planner = planners::build(&self.planner, &self.options, &world)?;
         let run = simulate(&world, planner.as_mut(), &self.sim);
         let metrics = metrics::compute(&world, &run, &self.map.name);
-        Ok(JobResult { world, run, metrics })
+        Ok(JobResult {
+            world,
+            run,
+            metrics,
+        })
     }
 }

@@ -38,18 +38,24 @@ pub fn metrics_json(m: &Metrics) -> Result<String> {
 
 /// Title lines for pictures.
 pub fn title_lines(m: &Metrics) -> Vec<String> {
-    let cov = m.coverage_rate.map_or_else(|| "-".to_string(), |c| format!("{:.1}%", 100.0 * c));
+    let cov = m
+        .coverage_rate
+        .map_or_else(|| "-".to_string(), |c| format!("{:.1}%", 100.0 * c));
     vec![
-        format!("{} on {}  r={} m  tool={} m", m.planner, m.map, m.robot_radius_m, m.tool_radius_m),
         format!(
-            "effective coverage {:.1}%  tiles {}  path {:.1} m  ratio {:.2}  regions {}  turns {}  collisions {}",
+            "{} on {}  r={} m  tool={} m",
+            m.planner, m.map, m.robot_radius_m, m.tool_radius_m
+        ),
+        format!(
+            "effective coverage {:.1}%  tiles {}  path {:.1} m  ratio {:.2}",
             100.0 * m.effective_coverage,
             cov,
             m.path_length_m,
             m.path_ratio,
-            m.regions,
-            m.turns,
-            m.collisions
+        ),
+        format!(
+            "regions {}  revisits {:.2}  turns {}  collisions {}",
+            m.regions, m.revisit_rate, m.turns, m.collisions
         ),
     ]
 }
@@ -60,7 +66,10 @@ pub fn emit(job: &Job, r: &JobResult, json_only: bool) -> Result<()> {
     let metrics = metrics_json(&r.metrics)?;
     let trace = trace_jsonl(&r.run.trace)?;
     let path = path_csv(&r.run.trace);
-    let style = CoverageStyle { title: title_lines(&r.metrics), ..CoverageStyle::default() };
+    let style = CoverageStyle {
+        title: title_lines(&r.metrics),
+        ..CoverageStyle::default()
+    };
     let png = coverage_png(&r.world, &r.run.trace, &style)?;
     std::fs::create_dir_all(&job.out)
         .with_context(|| format!("cannot create output folder {}", job.out.display()))?;
@@ -77,7 +86,10 @@ pub fn emit(job: &Job, r: &JobResult, json_only: bool) -> Result<()> {
         print!("{metrics}");
     } else {
         print!("{}", summary(&r.metrics));
-        println!("wrote {}/{{metrics.json, path.csv, trace.jsonl, coverage.png}}", job.out.display());
+        println!(
+            "wrote {}/{{metrics.json, path.csv, trace.jsonl, coverage.png}}",
+            job.out.display()
+        );
     }
     Ok(())
 }
@@ -85,8 +97,14 @@ pub fn emit(job: &Job, r: &JobResult, json_only: bool) -> Result<()> {
 /// A short human table of the metrics.
 pub fn summary(m: &Metrics) -> String {
     let mut s = String::new();
-    let _ = writeln!(s, "{} on {} (r = {} m, tool r = {} m)", m.planner, m.map, m.robot_radius_m, m.tool_radius_m);
-    let cov = m.coverage_rate.map_or_else(|| "n/a".to_string(), |c| format!("{c:.4}"));
+    let _ = writeln!(
+        s,
+        "{} on {} (r = {} m, tool r = {} m)",
+        m.planner, m.map, m.robot_radius_m, m.tool_radius_m
+    );
+    let cov = m
+        .coverage_rate
+        .map_or_else(|| "n/a".to_string(), |c| format!("{c:.4}"));
     let rows: [(&str, String); 13] = [
         ("coverage_rate", cov),
         ("effective_coverage", format!("{:.4}", m.effective_coverage)),

@@ -19,9 +19,7 @@ use ccpp_core::metrics::swept_pixels;
 use ccpp_core::trace::{Event, Record, Trace};
 use ccpp_core::world::World;
 use ccpp_core::Point;
-use tiny_skia::{
-    Color, FillRule, Paint, PathBuilder, Pixmap, Rect, Stroke, StrokeDash, Transform,
-};
+use tiny_skia::{Color, FillRule, Paint, PathBuilder, Pixmap, Rect, Stroke, StrokeDash, Transform};
 
 /// Rendering failures.
 #[derive(Debug, thiserror::Error)]
@@ -48,7 +46,11 @@ pub struct CoverageStyle {
 
 impl Default for CoverageStyle {
     fn default() -> Self {
-        Self { min_width: 900, max_side: 3000, title: Vec::new() }
+        Self {
+            min_width: 900,
+            max_side: 3000,
+            title: Vec::new(),
+        }
     }
 }
 
@@ -83,31 +85,79 @@ struct View {
     scale: f32,
     height: f64,
     top: f32,
+    col0: f64,
+    row0: f64,
 }
 
 impl View {
     fn to_canvas(self, world: &World, p: Point) -> (f32, f32) {
         let g = world.frame().world_to_grid(p);
-        (g.x as f32 * self.scale, (self.height - g.y) as f32 * self.scale + self.top)
+        (
+            ((g.x - self.col0) as f32) * self.scale,
+            ((self.height - g.y - self.row0) as f32) * self.scale + self.top,
+        )
     }
+}
+
+/// The part of the map worth drawing: the bounding box of known (free or occupied) pixels and
+/// of the path, with a small margin. Returns `(col0, row0, cols, rows)`.
+pub fn crop_box(world: &World, trace: &Trace) -> (usize, usize, usize, usize) {
+    let f = *world.frame();
+    let (mut c0, mut c1, mut r0, mut r1) = (usize::MAX, 0usize, usize::MAX, 0usize);
+    let mut add = |c: usize, r: usize| {
+        c0 = c0.min(c);
+        c1 = c1.max(c);
+        r0 = r0.min(r);
+        r1 = r1.max(r);
+    };
+    for (i, cell) in world.map().cells().iter().enumerate() {
+        if *cell != Cell::Unknown {
+            add(i % f.width, i / f.width);
+        }
+    }
+    for p in trace.poses() {
+        if let Some((c, r)) = f.pixel_of(p.position()) {
+            add(c, r);
+        }
+    }
+    if c0 == usize::MAX {
+        return (0, 0, f.width, f.height);
+    }
+    let m = (f.width.max(f.height) / 50).max(4);
+    let c0 = c0.saturating_sub(m);
+    let r0 = r0.saturating_sub(m);
+    let c1 = (c1 + m).min(f.width - 1);
+    let r1 = (r1 + m).min(f.height - 1);
+    (c0, r0, c1 - c0 + 1, r1 - r0 + 1)
 }
 
 /// Draws the coverage picture of a run and returns PNG bytes.
 ///
 /// # Errors
 /// When the canvas cannot be allocated or encoded.
-pub fn coverage_png(world: &World, trace: &Trace, style: &CoverageStyle) -> Result<Vec<u8>, RenderError> {
+pub fn coverage_png(
+    world: &World,
+    trace: &Trace,
+    style: &CoverageStyle,
+) -> Result<Vec<u8>, RenderError> {
     let pixmap = coverage_pixmap(world, trace, style)?;
-    pixmap.encode_png().map_err(|e| RenderError::Encode(e.to_string()))
+    pixmap
+        .encode_png()
+        .map_err(|e| RenderError::Encode(e.to_string()))
 }
 
 /// Draws the coverage picture of a run.
 ///
 /// # Errors
 /// When the canvas cannot be allocated.
-pub fn coverage_pixmap(world: &World, trace: &Trace, style: &CoverageStyle) -> Result<Pixmap, RenderError> {
+pub fn coverage_pixmap(
+    world: &World,
+    trace: &Trace,
+    style: &CoverageStyle,
+) -> Result<Pixmap, RenderError> {
     let frame = *world.frame();
-    let (w, h) = (frame.width as u32, frame.height as u32);
+    let (col0, row0, cols, rows) = crop_box(world, trace);
+    let (w, h) = (cols as u32, rows as u32);
     let scale = if w < style.min_width {
         (style.min_width as f32 / w as f32).ceil().min(16.0)
     } else {
@@ -117,7 +167,11 @@ pub fn coverage_pixmap(world: &World, trace: &Trace, style: &CoverageStyle) -> R
     let cw = ((w as f32 * scale).round() as u32).max(1);
     let ch_map = ((h as f32 * scale).round() as u32).max(1);
     let line_h = font::GLYPH_H * text_scale(cw) + 4;
-    let header = if style.title.is_empty() { 0 } else { line_h * style.title.len() as u32 + 6 };
+    let header = if style.title.is_empty() {
+        0
+    } else {
+        line_h * style.title.len() as u32 + 6
+    };
     let legend = line_h + 8;
     let ch = ch_map + header + legend;
     let mut pm = Pixmap::new(cw, ch).ok_or(RenderError::Canvas(cw, ch))?;
@@ -150,9 +204,9 @@ pub fn coverage_pixmap(world: &World, trace: &Trace, style: &CoverageStyle) -> R
         let data = pm.data_mut();
         for y in 0..ch_map {
             let row = ((y as f32 + 0.5) / scale) as usize;
-            let row = row.min(frame.height - 1);
+            let row = (row0 + row).min(frame.height - 1);
             for x in 0..cw {
-                let col = (((x as f32 + 0.5) / scale) as usize).min(frame.width - 1);
+                let col = (col0 + ((x as f32 + 0.5) / scale) as usize).min(frame.width - 1);
                 let c = colour_of(frame.index(col, row));
                 let o = (((y + header) * cw + x) * 4) as usize;
                 data[o] = c[0];
@@ -162,7 +216,13 @@ pub fn coverage_pixmap(world: &World, trace: &Trace, style: &CoverageStyle) -> R
             }
         }
     }
-    let view = View { scale, height: frame.height as f64, top: header as f32 };
+    let view = View {
+        scale,
+        height: frame.height as f64,
+        top: header as f32,
+        col0: col0 as f64,
+        row0: row0 as f64,
+    };
     draw_path(&mut pm, world, trace, view);
     draw_markers(&mut pm, world, trace, view);
 
@@ -186,7 +246,7 @@ fn draw_legend(pm: &mut Pixmap, y: u32, ts: u32) {
         ([246, 246, 242], "UNREACHABLE"),
         ([30, 30, 30], "OBSTACLE"),
         ([170, 170, 170], "UNKNOWN"),
-        ([60, 60, 60], "- - BACKTRACK"),
+        ([60, 60, 60], "BACKTRACK (DASHED)"),
     ];
     let mut x = 6u32;
     let box_side = font::GLYPH_H * ts;
@@ -194,7 +254,13 @@ fn draw_legend(pm: &mut Pixmap, y: u32, ts: u32) {
         if let Some(r) = Rect::from_xywh(x as f32, y as f32, box_side as f32, box_side as f32) {
             pm.fill_rect(r, &paint(rgb(c)), Transform::identity(), None);
             let border = PathBuilder::from_rect(r);
-            pm.stroke_path(&border, &paint(rgb([80, 80, 80])), &Stroke::default(), Transform::identity(), None);
+            pm.stroke_path(
+                &border,
+                &paint(rgb([80, 80, 80])),
+                &Stroke::default(),
+                Transform::identity(),
+                None,
+            );
         }
         x += box_side + 4;
         x = font::draw_text(pm, x, y, ts, label, [20, 20, 20]) + 12;
@@ -217,7 +283,10 @@ fn draw_path(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
                 pb.line_to(x, y);
             }
             if let Some(path) = pb.finish() {
-                let mut stroke = Stroke { width, ..Stroke::default() };
+                let mut stroke = Stroke {
+                    width,
+                    ..Stroke::default()
+                };
                 stroke.line_join = tiny_skia::LineJoin::Round;
                 let colour = if style.1 {
                     stroke.dash = StrokeDash::new(vec![width * 4.0, width * 3.0], 0.0);
@@ -268,7 +337,10 @@ fn draw_path(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
 fn draw_markers(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
     let rad = (world.robot().radius / world.frame().resolution) as f32 * view.scale;
     let m = rad.clamp(3.0, 14.0);
-    let stroke = Stroke { width: (m / 4.0).max(1.5), ..Stroke::default() };
+    let stroke = Stroke {
+        width: (m / 4.0).max(1.5),
+        ..Stroke::default()
+    };
     for (_, e) in trace.events() {
         match e {
             Event::CriticalPoint { x, y } => {
@@ -280,7 +352,13 @@ fn draw_markers(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
             Event::StartPoint { x, y } => {
                 let (cx, cy) = view.to_canvas(world, Point::new(*x, *y));
                 if let Some(c) = PathBuilder::from_circle(cx, cy, m * 0.6) {
-                    pm.stroke_path(&c, &paint(rgb([130, 40, 160])), &stroke, Transform::identity(), None);
+                    pm.stroke_path(
+                        &c,
+                        &paint(rgb([130, 40, 160])),
+                        &stroke,
+                        Transform::identity(),
+                        None,
+                    );
                 }
             }
             Event::Collision { x, y } => {
@@ -291,7 +369,13 @@ fn draw_markers(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
                 pb.move_to(cx - m, cy + m);
                 pb.line_to(cx + m, cy - m);
                 if let Some(p) = pb.finish() {
-                    pm.stroke_path(&p, &paint(rgb([230, 0, 0])), &stroke, Transform::identity(), None);
+                    pm.stroke_path(
+                        &p,
+                        &paint(rgb([230, 0, 0])),
+                        &stroke,
+                        Transform::identity(),
+                        None,
+                    );
                 }
             }
             _ => {}
@@ -301,7 +385,13 @@ fn draw_markers(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
     let s = world.start();
     let (sx, sy) = view.to_canvas(world, s.position());
     if let Some(c) = PathBuilder::from_circle(sx, sy, rad.max(4.0)) {
-        pm.fill_path(&c, &paint(rgb([0, 170, 60])), FillRule::Winding, Transform::identity(), None);
+        pm.fill_path(
+            &c,
+            &paint(rgb([0, 170, 60])),
+            FillRule::Winding,
+            Transform::identity(),
+            None,
+        );
     }
     let mut pb = PathBuilder::new();
     pb.move_to(sx, sy);
@@ -310,12 +400,24 @@ fn draw_markers(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
         sy - rad.max(4.0) * 1.6 * s.theta.sin() as f32,
     );
     if let Some(p) = pb.finish() {
-        pm.stroke_path(&p, &paint(rgb([0, 100, 30])), &stroke, Transform::identity(), None);
+        pm.stroke_path(
+            &p,
+            &paint(rgb([0, 100, 30])),
+            &stroke,
+            Transform::identity(),
+            None,
+        );
     }
     if let Some(end) = trace.poses().last() {
         let (ex, ey) = view.to_canvas(world, end.position());
         if let Some(c) = PathBuilder::from_circle(ex, ey, rad.max(4.0)) {
-            pm.stroke_path(&c, &paint(Color::BLACK), &stroke, Transform::identity(), None);
+            pm.stroke_path(
+                &c,
+                &paint(Color::BLACK),
+                &stroke,
+                Transform::identity(),
+                None,
+            );
         }
     }
 }
