@@ -29,7 +29,7 @@ pub enum Command {
 /// Map loading options shared by commands.
 #[derive(Args, Debug, Clone, Default)]
 pub struct MapArgs {
-    /// Map file: a ROS map_server YAML (with its PGM/PNG) or a bare PGM/PNG image.
+    /// Map file: a ROS `map_server` YAML (with its PGM/PNG) or a bare PGM/PNG image.
     #[arg(long, value_name = "FILE")]
     pub map: PathBuf,
     /// Override the resolution (m/px); bare images default to 0.05.

@@ -87,8 +87,7 @@ fn finish_map(
     inflate: Option<f64>,
 ) -> Result<PreparedMap> {
     let grid = match inflate {
-        None => grid,
-        Some(m) if m == 0.0 => grid,
+        None | Some(0.0) => grid,
         Some(m) => {
             check_metres("--inflate", m).with_context(|| format!("map {}", source.display()))?;
             ccpp_core::inflate::inflate(&grid, m)
