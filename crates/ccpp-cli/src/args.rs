@@ -36,7 +36,7 @@ pub struct MapArgs {
     #[arg(long, value_name = "M")]
     pub resolution: Option<f64>,
     /// Override the origin `X,Y[,YAW]` (world pose of the lower-left pixel).
-    #[arg(long, value_name = "X,Y[,YAW]", value_parser = parse_triple)]
+    #[arg(long, value_name = "X,Y[,YAW]", value_parser = parse_triple, allow_hyphen_values = true)]
     pub origin: Option<[f64; 3]>,
     /// Override `occupied_thresh`.
     #[arg(long, value_name = "P")]
@@ -59,12 +59,13 @@ pub struct RobotArgs {
     #[arg(long, value_name = "M")]
     pub tool_radius: Option<f64>,
     /// Start pose `X,Y[,THETA]` in metres/radians (default: the widest free spot, heading east).
-    #[arg(long, value_name = "X,Y[,THETA]", value_parser = parse_triple)]
+    #[arg(long, value_name = "X,Y[,THETA]", value_parser = parse_triple, allow_hyphen_values = true)]
     pub start: Option<[f64; 3]>,
 }
 
 /// `ccpp run`.
 #[derive(Args, Debug)]
+#[command(allow_negative_numbers = true)]
 pub struct RunArgs {
     /// The map.
     #[command(flatten)]
@@ -106,6 +107,7 @@ pub struct DemoArgs {
 
 /// `ccpp info`.
 #[derive(Args, Debug)]
+#[command(allow_negative_numbers = true)]
 pub struct InfoArgs {
     /// The map.
     #[command(flatten)]

@@ -1,0 +1,292 @@
+//! End-to-end tests of the `ccpp` binary.
+
+use std::path::{Path, PathBuf};
+
+use assert_cmd::Command;
+
+fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name)
+}
+
+fn shared_maps() -> Option<PathBuf> {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/maps");
+    p.is_dir().then_some(p)
+}
+
+fn ccpp() -> Command {
+    Command::cargo_bin("ccpp").unwrap()
+}
+
+fn read_json(p: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+}
+
+#[test]
+fn planners_lists_random_bounce() {
+    let out = ccpp()
+        .arg("planners")
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let s = String::from_utf8(out).unwrap();
+    assert!(s.lines().any(|l| l.starts_with("random-bounce")), "{s}");
+}
+
+#[test]
+fn demo_writes_all_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("demo");
+    ccpp().args(["demo", "--out"]).arg(&out).assert().success();
+    for f in ["metrics.json", "path.csv", "trace.jsonl", "coverage.png"] {
+        let p = out.join(f);
+        assert!(
+            p.is_file() && std::fs::metadata(&p).unwrap().len() > 0,
+            "{f}"
+        );
+    }
+    let m = read_json(&out.join("metrics.json"));
+    assert_eq!(m["collisions"], 0);
+    assert!(m["effective_coverage"].as_f64().unwrap() > 0.5);
+    let png = std::fs::read(out.join("coverage.png")).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+}
+
+const METRIC_KEYS: [&str; 17] = [
+    "planner",
+    "map",
+    "robot_radius_m",
+    "tool_radius_m",
+    "coverage_rate",
+    "effective_coverage",
+    "path_length_m",
+    "path_ratio",
+    "redundancy",
+    "revisit_rate",
+    "regions",
+    "backtracks",
+    "backtrack_length_m",
+    "turns",
+    "rotation_rad",
+    "collisions",
+    "wall_time_s",
+];
+
+#[test]
+fn run_json_prints_exactly_the_metrics_and_is_deterministic() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |sub: &str| {
+        let out = dir.path().join(sub);
+        let o = ccpp()
+            .args([
+                "run",
+                "--planner",
+                "random-bounce",
+                "--seed",
+                "7",
+                "--json",
+                "--map",
+            ])
+            .arg(data("teb_empty_box.yaml"))
+            .arg("--out")
+            .arg(&out)
+            .assert()
+            .success()
+            .get_output()
+            .stdout
+            .clone();
+        (out, o)
+    };
+    let (a, stdout) = run("a");
+    let v: serde_json::Value = serde_json::from_slice(&stdout).unwrap();
+    let keys: Vec<&str> = v.as_object().unwrap().keys().map(String::as_str).collect();
+    for k in METRIC_KEYS {
+        assert!(keys.contains(&k), "missing {k}");
+    }
+    assert_eq!(v["map"], "teb_empty_box");
+    assert_eq!(v["coverage_rate"], serde_json::Value::Null);
+    let (b, _) = run("b");
+    for f in ["path.csv", "trace.jsonl", "coverage.png"] {
+        assert_eq!(
+            std::fs::read(a.join(f)).unwrap(),
+            std::fs::read(b.join(f)).unwrap(),
+            "{f}"
+        );
+    }
+    let (mut ma, mut mb) = (
+        read_json(&a.join("metrics.json")),
+        read_json(&b.join("metrics.json")),
+    );
+    ma["wall_time_s"] = 0.into();
+    mb["wall_time_s"] = 0.into();
+    assert_eq!(ma, mb);
+    // path.csv header and rows.
+    let csv = std::fs::read_to_string(a.join("path.csv")).unwrap();
+    assert!(csv.starts_with("x,y,theta\n"));
+    assert!(csv.lines().count() > 10);
+}
+
+#[test]
+fn info_reports_counts() {
+    let o = ccpp()
+        .args(["info", "--json", "--map"])
+        .arg(data("teb_empty_box.yaml"))
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let v: serde_json::Value = serde_json::from_slice(&o).unwrap();
+    assert_eq!(v["width_px"], 120);
+    let total = v["free_px"].as_u64().unwrap()
+        + v["occupied_px"].as_u64().unwrap()
+        + v["unknown_px"].as_u64().unwrap();
+    assert_eq!(total, 120 * 120);
+    assert!(v["accessible_m2"].as_f64().unwrap() > 20.0);
+}
+
+/// Runs `ccpp run` with `args`, expects failure with a one-line error containing every needle,
+/// no panic and no file in the output folder.
+fn expect_error(args: &[&str], map: &Path, needles: &[&str]) {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let a = ccpp()
+        .args(["run", "--planner", "random-bounce", "--map"])
+        .arg(map)
+        .arg("--out")
+        .arg(&out)
+        .args(args)
+        .assert()
+        .failure();
+    let o = a.get_output();
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!err.contains("panicked"), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
+    assert!(err.starts_with("error: "), "{err}");
+    for n in needles {
+        assert!(err.contains(n), "{err:?} should contain {n:?}");
+    }
+    assert!(
+        !out.exists() || std::fs::read_dir(&out).unwrap().next().is_none(),
+        "partial output"
+    );
+    assert!(o.stdout.is_empty());
+}
+
+#[test]
+fn bad_inputs_fail_cleanly() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let good = data("teb_empty_box.yaml");
+    let gs = good.to_str().unwrap();
+    let _ = gs;
+
+    // Missing file.
+    expect_error(&[], &d.join("nope.yaml"), &["nope.yaml"]);
+
+    // YAML missing resolution.
+    std::fs::copy(data("teb_empty_box.png"), d.join("teb_empty_box.png")).unwrap();
+    let y = d.join("nores.yaml");
+    std::fs::write(&y, "image: teb_empty_box.png\norigin: [0, 0, 0]\n").unwrap();
+    expect_error(&[], &y, &["nores.yaml", "resolution"]);
+
+    // Image named in the YAML absent.
+    let y = d.join("noimg.yaml");
+    std::fs::write(
+        &y,
+        "image: missing.png\nresolution: 0.05\norigin: [0, 0, 0]\n",
+    )
+    .unwrap();
+    expect_error(&[], &y, &["noimg.yaml", "missing.png"]);
+
+    // Corrupt PNG.
+    let p = d.join("corrupt.png");
+    std::fs::write(&p, b"\x89PNG\r\n\x1a\nthis is not a png").unwrap();
+    expect_error(&[], &p, &["corrupt.png"]);
+
+    // Malformed YAML.
+    let y = d.join("bad.yaml");
+    std::fs::write(&y, "image: [unclosed\nresolution: 0.05\n").unwrap();
+    expect_error(&[], &y, &["bad.yaml"]);
+
+    // Start in an obstacle (the wall at the west edge), start outside the map.
+    expect_error(
+        &["--start", "-2.98,0"],
+        &good,
+        &["teb_empty_box.yaml", "obstacle"],
+    );
+    expect_error(
+        &["--start", "10,0"],
+        &good,
+        &["teb_empty_box.yaml", "outside"],
+    );
+
+    // Radius <= 0 or NaN, tool radius larger than the robot.
+    expect_error(&["--radius", "0"], &good, &["radius"]);
+    expect_error(&["--radius", "-0.2"], &good, &["radius"]);
+    expect_error(&["--radius", "NaN"], &good, &["radius"]);
+    expect_error(
+        &["--radius", "0.1", "--tool-radius", "0.2"],
+        &good,
+        &["tool radius"],
+    );
+
+    // Robot larger than every free space.
+    expect_error(
+        &["--radius", "4"],
+        &good,
+        &["teb_empty_box.yaml", "does not fit"],
+    );
+
+    // Negative inflation, unknown planner.
+    expect_error(&["--inflate", "-1"], &good, &["--inflate"]);
+    let dir2 = tempfile::tempdir().unwrap();
+    let a = ccpp()
+        .args(["run", "--planner", "nope", "--map"])
+        .arg(&good)
+        .arg("--out")
+        .arg(dir2.path().join("o"))
+        .assert()
+        .failure();
+    assert!(String::from_utf8_lossy(&a.get_output().stderr).contains("unknown planner"));
+}
+
+#[test]
+fn random_bounce_on_every_shared_map_is_collision_free() {
+    let Some(maps) = shared_maps() else {
+        eprintln!("shared maps not found; skipping");
+        return;
+    };
+    let mut yamls: Vec<PathBuf> = std::fs::read_dir(&maps)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "yaml"))
+        .collect();
+    yamls.sort();
+    assert_eq!(yamls.len(), 14);
+    let dir = tempfile::tempdir().unwrap();
+    for y in yamls {
+        let out = dir.path().join(y.file_stem().unwrap());
+        let o = ccpp()
+            .args(["run", "--planner", "random-bounce", "--json", "--map"])
+            .arg(&y)
+            .arg("--out")
+            .arg(&out)
+            .assert()
+            .success()
+            .get_output()
+            .stdout
+            .clone();
+        let v: serde_json::Value = serde_json::from_slice(&o).unwrap();
+        assert_eq!(v["collisions"], 0, "{}", y.display());
+        assert!(
+            v["effective_coverage"].as_f64().unwrap() > 0.3,
+            "{}",
+            y.display()
+        );
+    }
+}
