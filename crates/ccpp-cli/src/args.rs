@@ -24,6 +24,8 @@ pub enum Command {
     Planners,
     /// Describe a map: size, resolution, pixel classes, components, accessible area.
     Info(InfoArgs),
+    /// Run every planner on every map in parallel; write results.csv, results.md and plots.
+    Bench(BenchArgs),
 }
 
 /// Map loading options shared by commands.
@@ -103,6 +105,63 @@ pub struct DemoArgs {
     /// Planner to run (default: the flagship).
     #[arg(long, value_name = "NAME")]
     pub planner: Option<String>,
+}
+
+/// `ccpp bench`.
+#[derive(Args, Debug)]
+#[command(allow_negative_numbers = true)]
+pub struct BenchArgs {
+    /// Map files and/or folders (a folder contributes its `*.yaml` maps, or its images).
+    #[arg(long, value_name = "DIR|FILES", num_args = 1.., required = true)]
+    pub maps: Vec<PathBuf>,
+    /// Planners, comma-separated (default: all).
+    #[arg(long, value_name = "A,B,...", value_delimiter = ',')]
+    pub planners: Vec<String>,
+    /// Robot radius and tool radius (the start is each map's default start).
+    #[command(flatten)]
+    pub robot: BenchRobotArgs,
+    /// Grow obstacles by this many metres before planning.
+    #[arg(long, value_name = "M")]
+    pub inflate: Option<f64>,
+    /// Seed for planners that use randomness.
+    #[arg(long, value_name = "N")]
+    pub seed: Option<u64>,
+    /// Planner options file (YAML or JSON).
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
+    /// Output folder.
+    #[arg(long, value_name = "DIR", default_value = "ccpp-bench")]
+    pub out: PathBuf,
+    /// Redo runs whose results already exist in the output folder.
+    #[arg(long)]
+    pub force: bool,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_name = "N")]
+    pub jobs: Option<usize>,
+    /// No progress bar.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+/// Robot options of `ccpp bench` (no start: each map uses its default start).
+#[derive(Args, Debug, Clone)]
+pub struct BenchRobotArgs {
+    /// Robot (footprint) radius in metres.
+    #[arg(long, value_name = "M", default_value_t = 0.15)]
+    pub radius: f64,
+    /// Cleaning tool radius in metres (default: the robot radius).
+    #[arg(long, value_name = "M")]
+    pub tool_radius: Option<f64>,
+}
+
+impl From<&BenchRobotArgs> for RobotArgs {
+    fn from(b: &BenchRobotArgs) -> Self {
+        Self {
+            radius: b.radius,
+            tool_radius: b.tool_radius,
+            start: None,
+        }
+    }
 }
 
 /// `ccpp info`.

@@ -19,6 +19,7 @@ const DEMO_YAML: &str = include_str!("../assets/aws_small_house.yaml");
 const DEMO_IMAGE: &[u8] = include_bytes!("../assets/aws_small_house.pgm");
 
 /// A map ready for planning, with the name used in reports.
+#[derive(Clone)]
 pub struct PreparedMap {
     /// The (possibly inflated) grid.
     pub grid: GridMap,
@@ -111,7 +112,8 @@ pub fn robot_from(args: &RobotArgs) -> Result<(Robot, Option<Pose>)> {
     Ok((robot, start))
 }
 
-fn read_options(path: &Path) -> Result<PlannerOptions> {
+/// Reads planner options from a YAML or JSON file.
+pub fn read_options(path: &Path) -> Result<PlannerOptions> {
     let text = std::fs::read_to_string(path)
         .with_context(|| format!("cannot read planner options {}", path.display()))?;
     let is_json = path

@@ -4,9 +4,11 @@
 //! the `ccpp-core`, `ccpp-io` and `ccpp-render` crates.
 
 mod args;
+mod bench;
 mod info;
 mod job;
 mod output;
+mod plots;
 
 use std::process::ExitCode;
 
@@ -46,5 +48,6 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
             Ok(())
         }
         Command::Info(a) => info::run(&a),
+        Command::Bench(a) => bench::run(&a),
     }
 }

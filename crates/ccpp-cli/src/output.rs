@@ -1,6 +1,7 @@
 //! Writing a run's files and printing its summary.
 
 use std::fmt::Write as _;
+use std::path::Path;
 
 use anyhow::{Context, Result};
 use ccpp_core::metrics::Metrics;
@@ -60,9 +61,9 @@ pub fn title_lines(m: &Metrics) -> Vec<String> {
     ]
 }
 
-/// Renders everything first, then writes each file atomically, so a failure leaves no partial
-/// file; then prints the summary (or the metrics JSON alone).
-pub fn emit(job: &Job, r: &JobResult, json_only: bool) -> Result<()> {
+/// Renders everything first, then writes each file atomically into `out`, so a failure leaves
+/// no partial file. `metrics.json` is written last: its presence marks a complete run.
+pub fn write_run_files(out: &Path, r: &JobResult) -> Result<String> {
     let metrics = metrics_json(&r.metrics)?;
     let trace = trace_jsonl(&r.run.trace)?;
     let path = path_csv(&r.run.trace);
@@ -71,17 +72,23 @@ pub fn emit(job: &Job, r: &JobResult, json_only: bool) -> Result<()> {
         ..CoverageStyle::default()
     };
     let png = coverage_png(&r.world, &r.run.trace, &style)?;
-    std::fs::create_dir_all(&job.out)
-        .with_context(|| format!("cannot create output folder {}", job.out.display()))?;
+    std::fs::create_dir_all(out)
+        .with_context(|| format!("cannot create output folder {}", out.display()))?;
     let files: [(&str, &[u8]); 4] = [
-        ("metrics.json", metrics.as_bytes()),
         ("path.csv", path.as_bytes()),
         ("trace.jsonl", trace.as_bytes()),
         ("coverage.png", &png),
+        ("metrics.json", metrics.as_bytes()),
     ];
     for (name, bytes) in files {
-        write_atomic(&job.out.join(name), bytes)?;
+        write_atomic(&out.join(name), bytes)?;
     }
+    Ok(metrics)
+}
+
+/// Writes the run's files, then prints the summary (or the metrics JSON alone).
+pub fn emit(job: &Job, r: &JobResult, json_only: bool) -> Result<()> {
+    let metrics = write_run_files(&job.out, r)?;
     if json_only {
         print!("{metrics}");
     } else {

@@ -64,8 +64,8 @@ pub fn swept_pixels(world: &World, trace: &Trace) -> FixedBitSet {
     for p in trace.poses() {
         let g = frame.world_to_grid(p.position());
         match prev {
-            None => stamp_capsule(&mut swept, &frame, g, g, rt),
-            Some(a) if a != g => stamp_capsule(&mut swept, &frame, a, g, rt),
+            None => stamp_capsule(&mut swept, &frame, g, g, rt, &mut |_| {}),
+            Some(a) if a != g => stamp_capsule(&mut swept, &frame, a, g, rt, &mut |_| {}),
             Some(_) => {}
         }
         prev = Some(g);
@@ -80,6 +80,7 @@ fn stamp_capsule(
     a: Point,
     b: Point,
     rt: f64,
+    on_new: &mut impl FnMut(usize),
 ) {
     let rt2 = rt * rt;
     let h = frame.height as f64;
@@ -104,14 +105,14 @@ fn stamp_capsule(
         let mut c = c_mid;
         while c >= 0 && inside(c) {
             if (c as usize) < frame.width {
-                bits.insert(frame.index(c as usize, row as usize));
+                put(bits, frame.index(c as usize, row as usize), on_new);
             }
             c -= 1;
         }
         let mut c = c_mid + 1;
         while c < frame.width as i64 && inside(c) {
             if c >= 0 {
-                bits.insert(frame.index(c as usize, row as usize));
+                put(bits, frame.index(c as usize, row as usize), on_new);
             }
             c += 1;
         }
@@ -119,11 +120,72 @@ fn stamp_capsule(
         if c_mid < 0 || c_mid >= frame.width as i64 {
             for c in 0..frame.width as i64 {
                 if inside(c) {
-                    bits.insert(frame.index(c as usize, row as usize));
+                    put(bits, frame.index(c as usize, row as usize), on_new);
                 }
             }
         }
     }
+}
+
+#[inline]
+fn put(bits: &mut FixedBitSet, i: usize, on_new: &mut impl FnMut(usize)) {
+    if !bits.put(i) {
+        on_new(i);
+    }
+}
+
+/// Effective coverage as the path unrolls: points `[distance_m, coverage]` at the start and
+/// after each travelled `total / samples` metres (and at the end), for coverage-over-distance
+/// plots.
+pub fn coverage_curve(world: &World, trace: &Trace, samples: usize) -> Vec<[f64; 2]> {
+    let frame = *world.frame();
+    let acc = world.accessible();
+    let a_count = world.accessible_count().max(1) as f64;
+    let rt = world.robot().tool_radius / frame.resolution + SWEEP_EPS_PX;
+    let poses: Vec<Pose> = trace.poses().collect();
+    let Some(first) = poses.first() else {
+        return Vec::new();
+    };
+    let total: f64 = poses
+        .windows(2)
+        .map(|w| w[0].position().dist(w[1].position()))
+        .sum();
+    let step = if samples == 0 || total == 0.0 {
+        f64::INFINITY
+    } else {
+        total / samples as f64
+    };
+    let mut swept = FixedBitSet::with_capacity(frame.len());
+    let covered = std::cell::Cell::new(0usize);
+    let mut on_new = |i: usize| {
+        if acc.contains(i) {
+            covered.set(covered.get() + 1);
+        }
+    };
+    let g0 = frame.world_to_grid(first.position());
+    stamp_capsule(&mut swept, &frame, g0, g0, rt, &mut on_new);
+    let mut out = vec![[0.0, covered.get() as f64 / a_count]];
+    let mut travelled = 0.0;
+    let mut next_mark = step;
+    for w in poses.windows(2) {
+        let (a, b) = (w[0].position(), w[1].position());
+        if a == b {
+            continue;
+        }
+        let (ga, gb) = (frame.world_to_grid(a), frame.world_to_grid(b));
+        stamp_capsule(&mut swept, &frame, ga, gb, rt, &mut on_new);
+        travelled += a.dist(b);
+        if travelled + 1e-9 >= next_mark {
+            while next_mark <= travelled + 1e-9 {
+                next_mark += step;
+            }
+            out.push([travelled, covered.get() as f64 / a_count]);
+        }
+    }
+    if out.last().is_some_and(|l| l[0] < travelled) {
+        out.push([travelled, covered.get() as f64 / a_count]);
+    }
+    out
 }
 
 /// Tile entries along a polyline (Amanatides-Woo traversal); a corner crossing is one entry.
@@ -448,6 +510,27 @@ mod tests {
             "{}",
             m.path_length_m
         );
+    }
+
+    #[test]
+    fn coverage_curve_ends_at_effective_coverage() {
+        let world =
+            World::new(open_room(), Robot::new(0.2), Some(Pose::new(2.0, 2.0, 0.0))).unwrap();
+        let steps = vec![
+            Step::Translate(2.0),
+            Step::Rotate(1.0),
+            Step::Translate(1.0),
+        ];
+        let out = simulate(&world, &mut Script(steps), &SimConfig::default());
+        let m = compute(&world, &out, "room");
+        let c = coverage_curve(&world, &out.trace, 10);
+        assert!(c.len() >= 3);
+        assert!(c
+            .windows(2)
+            .all(|w| w[1][0] > w[0][0] && w[1][1] >= w[0][1]));
+        let last = c.last().unwrap();
+        assert!((last[0] - 3.0).abs() < 1e-9);
+        assert!((last[1] - m.effective_coverage).abs() < 1e-12);
     }
 
     #[test]

@@ -64,6 +64,11 @@ fn glyph(c: char) -> [u8; 7] {
     }
 }
 
+/// Width in canvas pixels of `text` at `scale`.
+pub fn text_width(text: &str, scale: u32) -> u32 {
+    text.chars().count() as u32 * GLYPH_W * scale
+}
+
 /// Draws `text` with its top-left at `(x, y)`, each font pixel `scale` canvas pixels; returns
 /// the x just after the text.
 pub fn draw_text(pm: &mut Pixmap, x: u32, y: u32, scale: u32, text: &str, rgb: [u8; 3]) -> u32 {

@@ -12,6 +12,7 @@
 //! - start: green disk; critical points: orange squares; chosen start points: purple rings;
 //!   collisions: red crosses; final pose: black ring.
 
+pub mod chart;
 mod font;
 
 use ccpp_core::grid::Cell;

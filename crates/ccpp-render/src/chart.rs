@@ -1,0 +1,642 @@
+//! Small charts described once and drawn twice: as SVG text and as a PNG (tiny-skia + the
+//! built-in bitmap font), so both files always show the same thing.
+
+use std::fmt::Write as _;
+
+use base64::Engine as _;
+use tiny_skia::{
+    Color, FillRule, Paint, PathBuilder, Pixmap, PixmapPaint, Rect, Stroke, StrokeDash, Transform,
+};
+
+use crate::font;
+use crate::RenderError;
+
+/// Series colours.
+pub const SERIES: [[u8; 3]; 8] = [
+    [0, 114, 178],
+    [213, 94, 0],
+    [0, 158, 115],
+    [204, 121, 167],
+    [230, 159, 0],
+    [86, 180, 233],
+    [120, 120, 120],
+    [150, 40, 40],
+];
+
+/// Text anchor.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Anchor {
+    /// Left-aligned at x.
+    Start,
+    /// Centred on x.
+    Middle,
+    /// Right-aligned at x.
+    End,
+}
+
+#[derive(Clone, Debug)]
+enum Shape {
+    Line {
+        pts: Vec<(f32, f32)>,
+        rgb: [u8; 3],
+        width: f32,
+        dashed: bool,
+    },
+    Rect {
+        x: f32,
+        y: f32,
+        w: f32,
+        h: f32,
+        fill: Option<[u8; 3]>,
+        stroke: Option<[u8; 3]>,
+    },
+    Text {
+        x: f32,
+        y: f32,
+        px: u32,
+        text: String,
+        rgb: [u8; 3],
+        anchor: Anchor,
+    },
+    Image {
+        x: f32,
+        y: f32,
+        w: f32,
+        h: f32,
+        png: Vec<u8>,
+    },
+}
+
+/// A chart: a canvas size and shapes in drawing order (y down, pixels).
+#[derive(Clone, Debug, Default)]
+pub struct Chart {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    shapes: Vec<Shape>,
+}
+
+impl Chart {
+    /// An empty chart.
+    pub fn new(width: u32, height: u32) -> Self {
+        Self {
+            width,
+            height,
+            shapes: Vec::new(),
+        }
+    }
+
+    /// A polyline.
+    pub fn line(&mut self, pts: Vec<(f32, f32)>, rgb: [u8; 3], width: f32, dashed: bool) {
+        self.shapes.push(Shape::Line {
+            pts,
+            rgb,
+            width,
+            dashed,
+        });
+    }
+
+    /// A rectangle.
+    pub fn rect(
+        &mut self,
+        x: f32,
+        y: f32,
+        w: f32,
+        h: f32,
+        fill: Option<[u8; 3]>,
+        stroke: Option<[u8; 3]>,
+    ) {
+        self.shapes.push(Shape::Rect {
+            x,
+            y,
+            w,
+            h,
+            fill,
+            stroke,
+        });
+    }
+
+    /// Text whose top is at `y`, `px` pixels high (a multiple of 8 renders crispest in PNG).
+    pub fn text(
+        &mut self,
+        x: f32,
+        y: f32,
+        px: u32,
+        text: impl Into<String>,
+        rgb: [u8; 3],
+        anchor: Anchor,
+    ) {
+        self.shapes.push(Shape::Text {
+            x,
+            y,
+            px,
+            text: text.into(),
+            rgb,
+            anchor,
+        });
+    }
+
+    /// An embedded PNG picture scaled into the box.
+    pub fn image(&mut self, x: f32, y: f32, w: f32, h: f32, png: Vec<u8>) {
+        self.shapes.push(Shape::Image { x, y, w, h, png });
+    }
+
+    /// The chart as a standalone SVG document.
+    pub fn to_svg(&self) -> String {
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}" font-family="DejaVu Sans Mono, monospace">"#,
+            w = self.width,
+            h = self.height
+        );
+        let _ = writeln!(s, r##"<rect width="100%" height="100%" fill="#ffffff"/>"##);
+        for sh in &self.shapes {
+            match sh {
+                Shape::Line {
+                    pts,
+                    rgb,
+                    width,
+                    dashed,
+                } => {
+                    if pts.len() < 2 {
+                        continue;
+                    }
+                    let mut d = String::new();
+                    for (k, (x, y)) in pts.iter().enumerate() {
+                        let _ = write!(d, "{}{:.2},{:.2}", if k == 0 { "M" } else { " L" }, x, y);
+                    }
+                    let dash = if *dashed {
+                        format!(
+                            r#" stroke-dasharray="{:.1},{:.1}""#,
+                            width * 4.0,
+                            width * 3.0
+                        )
+                    } else {
+                        String::new()
+                    };
+                    let _ = writeln!(
+                        s,
+                        r#"<path d="{d}" fill="none" stroke="{}" stroke-width="{width:.2}" stroke-linejoin="round"{dash}/>"#,
+                        hex(*rgb)
+                    );
+                }
+                Shape::Rect {
+                    x,
+                    y,
+                    w,
+                    h,
+                    fill,
+                    stroke,
+                } => {
+                    let fill = fill.map_or_else(|| "none".to_string(), hex);
+                    let stroke = stroke.map_or_else(String::new, |c| {
+                        format!(r#" stroke="{}" stroke-width="1""#, hex(c))
+                    });
+                    let _ = writeln!(
+                        s,
+                        r#"<rect x="{x:.2}" y="{y:.2}" width="{w:.2}" height="{h:.2}" fill="{fill}"{stroke}/>"#
+                    );
+                }
+                Shape::Text {
+                    x,
+                    y,
+                    px,
+                    text,
+                    rgb,
+                    anchor,
+                } => {
+                    let a = match anchor {
+                        Anchor::Start => "start",
+                        Anchor::Middle => "middle",
+                        Anchor::End => "end",
+                    };
+                    let _ = writeln!(
+                        s,
+                        r#"<text x="{x:.2}" y="{:.2}" font-size="{px}" fill="{}" text-anchor="{a}">{}</text>"#,
+                        y + *px as f32 * 0.85,
+                        hex(*rgb),
+                        escape(text)
+                    );
+                }
+                Shape::Image { x, y, w, h, png } => {
+                    let b64 = base64::engine::general_purpose::STANDARD.encode(png);
+                    let _ = writeln!(
+                        s,
+                        r#"<image x="{x:.2}" y="{y:.2}" width="{w:.2}" height="{h:.2}" preserveAspectRatio="xMidYMid meet" href="data:image/png;base64,{b64}"/>"#
+                    );
+                }
+            }
+        }
+        s.push_str("</svg>\n");
+        s
+    }
+
+    /// The chart as PNG bytes.
+    ///
+    /// # Errors
+    /// When the canvas cannot be allocated or encoded.
+    pub fn to_png(&self) -> Result<Vec<u8>, RenderError> {
+        let mut pm = Pixmap::new(self.width, self.height)
+            .ok_or(RenderError::Canvas(self.width, self.height))?;
+        pm.fill(Color::WHITE);
+        for sh in &self.shapes {
+            match sh {
+                Shape::Line {
+                    pts,
+                    rgb,
+                    width,
+                    dashed,
+                } => {
+                    let mut pb = PathBuilder::new();
+                    let Some(first) = pts.first() else { continue };
+                    pb.move_to(first.0, first.1);
+                    for p in &pts[1..] {
+                        pb.line_to(p.0, p.1);
+                    }
+                    if let Some(path) = pb.finish() {
+                        let mut st = Stroke {
+                            width: *width,
+                            ..Stroke::default()
+                        };
+                        st.line_join = tiny_skia::LineJoin::Round;
+                        if *dashed {
+                            st.dash = StrokeDash::new(vec![width * 4.0, width * 3.0], 0.0);
+                        }
+                        pm.stroke_path(&path, &paint(*rgb), &st, Transform::identity(), None);
+                    }
+                }
+                Shape::Rect {
+                    x,
+                    y,
+                    w,
+                    h,
+                    fill,
+                    stroke,
+                } => {
+                    if let Some(r) = Rect::from_xywh(*x, *y, w.max(0.5), h.max(0.5)) {
+                        if let Some(f) = fill {
+                            pm.fill_rect(r, &paint(*f), Transform::identity(), None);
+                        }
+                        if let Some(c) = stroke {
+                            let p = PathBuilder::from_rect(r);
+                            pm.stroke_path(
+                                &p,
+                                &paint(*c),
+                                &Stroke::default(),
+                                Transform::identity(),
+                                None,
+                            );
+                        }
+                    }
+                }
+                Shape::Text {
+                    x,
+                    y,
+                    px,
+                    text,
+                    rgb,
+                    anchor,
+                } => {
+                    let scale = (px / 8).max(1);
+                    let w = font::text_width(text, scale) as f32;
+                    let x0 = match anchor {
+                        Anchor::Start => *x,
+                        Anchor::Middle => x - w / 2.0,
+                        Anchor::End => x - w,
+                    };
+                    font::draw_text(
+                        &mut pm,
+                        x0.max(0.0) as u32,
+                        y.max(0.0) as u32,
+                        scale,
+                        text,
+                        *rgb,
+                    );
+                }
+                Shape::Image { x, y, w, h, png } => {
+                    if let Ok(img) = Pixmap::decode_png(png) {
+                        let sx = w / img.width() as f32;
+                        let sy = h / img.height() as f32;
+                        let k = sx.min(sy);
+                        let ox = x + (w - img.width() as f32 * k) / 2.0;
+                        let oy = y + (h - img.height() as f32 * k) / 2.0;
+                        let pp = PixmapPaint {
+                            quality: tiny_skia::FilterQuality::Bilinear,
+                            ..PixmapPaint::default()
+                        };
+                        pm.draw_pixmap(
+                            0,
+                            0,
+                            img.as_ref(),
+                            &pp,
+                            Transform::from_row(k, 0.0, 0.0, k, ox, oy),
+                            None,
+                        );
+                    }
+                }
+            }
+        }
+        // Silence unused warnings for fill rule in some builds.
+        let _ = FillRule::Winding;
+        pm.encode_png()
+            .map_err(|e| RenderError::Encode(e.to_string()))
+    }
+}
+
+fn paint(rgb: [u8; 3]) -> Paint<'static> {
+    let mut p = Paint::default();
+    p.set_color(Color::from_rgba8(rgb[0], rgb[1], rgb[2], 255));
+    p.anti_alias = true;
+    p
+}
+
+fn hex(c: [u8; 3]) -> String {
+    format!("#{:02x}{:02x}{:02x}", c[0], c[1], c[2])
+}
+
+fn escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// A "nice" axis step for a range.
+fn nice_step(range: f64, ticks: usize) -> f64 {
+    if !(range.is_finite() && range > 0.0) {
+        return 1.0;
+    }
+    let raw = range / ticks.max(1) as f64;
+    let mag = 10f64.powf(raw.log10().floor());
+    let n = raw / mag;
+    let k = if n < 1.5 {
+        1.0
+    } else if n < 3.5 {
+        2.0
+    } else if n < 7.5 {
+        5.0
+    } else {
+        10.0
+    };
+    k * mag
+}
+
+fn fmt_tick(v: f64, step: f64) -> String {
+    if step >= 1.0 {
+        format!("{v:.0}")
+    } else if step >= 0.1 {
+        format!("{v:.1}")
+    } else {
+        format!("{v:.2}")
+    }
+}
+
+/// A line chart: one polyline per named series of `[x, y]` points.
+pub fn line_chart(
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[(String, Vec<[f64; 2]>)],
+    y_max: Option<f64>,
+) -> Chart {
+    let (w, h) = (900u32, 520u32);
+    let mut c = Chart::new(w, h);
+    let (l, r, t, b) = (80.0f32, 200.0f32, 48.0f32, 60.0f32);
+    let pw = w as f32 - l - r;
+    let ph = h as f32 - t - b;
+    let xmax = series
+        .iter()
+        .flat_map(|s| s.1.iter().map(|p| p[0]))
+        .fold(0.0f64, f64::max)
+        .max(1e-9);
+    let ymax = y_max.unwrap_or_else(|| {
+        series
+            .iter()
+            .flat_map(|s| s.1.iter().map(|p| p[1]))
+            .fold(0.0f64, f64::max)
+            .max(1e-9)
+    });
+    c.text(
+        w as f32 / 2.0,
+        12.0,
+        16,
+        title,
+        [20, 20, 20],
+        Anchor::Middle,
+    );
+    // Grid and ticks.
+    let xs = nice_step(xmax, 6);
+    let ys = nice_step(ymax, 5);
+    let mut v = 0.0;
+    while v <= xmax + 1e-9 {
+        let x = l + (v / xmax) as f32 * pw;
+        c.line(vec![(x, t), (x, t + ph)], [225, 225, 225], 1.0, false);
+        c.text(
+            x,
+            t + ph + 6.0,
+            8,
+            fmt_tick(v, xs),
+            [60, 60, 60],
+            Anchor::Middle,
+        );
+        v += xs;
+    }
+    let mut v = 0.0;
+    while v <= ymax + 1e-9 {
+        let y = t + ph - (v / ymax) as f32 * ph;
+        c.line(vec![(l, y), (l + pw, y)], [225, 225, 225], 1.0, false);
+        c.text(
+            l - 6.0,
+            y - 4.0,
+            8,
+            fmt_tick(v, ys),
+            [60, 60, 60],
+            Anchor::End,
+        );
+        v += ys;
+    }
+    c.rect(l, t, pw, ph, None, Some([120, 120, 120]));
+    c.text(
+        l + pw / 2.0,
+        h as f32 - 26.0,
+        8,
+        x_label,
+        [40, 40, 40],
+        Anchor::Middle,
+    );
+    c.text(8.0, t - 20.0, 8, y_label, [40, 40, 40], Anchor::Start);
+    for (k, (name, pts)) in series.iter().enumerate() {
+        let col = SERIES[k % SERIES.len()];
+        let poly: Vec<(f32, f32)> = pts
+            .iter()
+            .map(|p| {
+                (
+                    l + (p[0] / xmax) as f32 * pw,
+                    t + ph - (p[1].min(ymax) / ymax) as f32 * ph,
+                )
+            })
+            .collect();
+        c.line(poly, col, 2.0, false);
+        let ly = t + 10.0 + k as f32 * 22.0;
+        c.line(
+            vec![(l + pw + 14.0, ly + 4.0), (l + pw + 40.0, ly + 4.0)],
+            col,
+            3.0,
+            false,
+        );
+        c.text(
+            l + pw + 46.0,
+            ly,
+            8,
+            name.clone(),
+            [30, 30, 30],
+            Anchor::Start,
+        );
+    }
+    c
+}
+
+/// Bar panels: for each metric a small bar chart with one bar per planner.
+pub fn bar_panels(title: &str, planners: &[String], metrics: &[(String, Vec<f64>)]) -> Chart {
+    let cols = 3usize;
+    let rows = metrics.len().div_ceil(cols).max(1);
+    let (pw, ph) = (300f32, 230f32);
+    let w = (cols as f32 * pw) as u32;
+    let h = (rows as f32 * ph + 60.0 + 24.0 * planners.len().div_ceil(4) as f32) as u32;
+    let mut c = Chart::new(w, h);
+    c.text(
+        w as f32 / 2.0,
+        12.0,
+        16,
+        title,
+        [20, 20, 20],
+        Anchor::Middle,
+    );
+    for (m, (name, vals)) in metrics.iter().enumerate() {
+        let ox = (m % cols) as f32 * pw;
+        let oy = 40.0 + (m / cols) as f32 * ph;
+        let (l, t, iw, ih) = (ox + 50.0, oy + 24.0, pw - 70.0, ph - 50.0);
+        c.text(
+            ox + pw / 2.0,
+            oy + 4.0,
+            8,
+            name.clone(),
+            [30, 30, 30],
+            Anchor::Middle,
+        );
+        let vmax = vals
+            .iter()
+            .copied()
+            .filter(|v| v.is_finite())
+            .fold(0.0f64, f64::max)
+            .max(1e-9);
+        let step = nice_step(vmax, 4);
+        let top = (vmax / step).ceil() * step;
+        let mut v = 0.0;
+        while v <= top + 1e-9 {
+            let y = t + ih - (v / top) as f32 * ih;
+            c.line(vec![(l, y), (l + iw, y)], [230, 230, 230], 1.0, false);
+            c.text(
+                l - 4.0,
+                y - 4.0,
+                8,
+                fmt_tick(v, step),
+                [80, 80, 80],
+                Anchor::End,
+            );
+            v += step;
+        }
+        let n = vals.len().max(1) as f32;
+        let bw = iw / n;
+        for (k, v) in vals.iter().enumerate() {
+            if !v.is_finite() {
+                continue;
+            }
+            let bh = (v / top) as f32 * ih;
+            c.rect(
+                l + k as f32 * bw + bw * 0.15,
+                t + ih - bh,
+                bw * 0.7,
+                bh,
+                Some(SERIES[k % SERIES.len()]),
+                None,
+            );
+        }
+        c.rect(l, t, iw, ih, None, Some([150, 150, 150]));
+    }
+    let ly = 40.0 + rows as f32 * ph;
+    for (k, p) in planners.iter().enumerate() {
+        let x = 20.0 + (k % 4) as f32 * 220.0;
+        let y = ly + (k / 4) as f32 * 24.0;
+        c.rect(x, y, 14.0, 14.0, Some(SERIES[k % SERIES.len()]), None);
+        c.text(x + 20.0, y + 3.0, 8, p.clone(), [30, 30, 30], Anchor::Start);
+    }
+    c
+}
+
+/// Pictures side by side with labels (up to `cols` per row), each in a `cell_w x cell_h` box.
+pub fn image_grid(
+    title: &str,
+    items: &[(String, Vec<u8>)],
+    cols: usize,
+    cell_w: u32,
+    cell_h: u32,
+) -> Chart {
+    let cols = cols.max(1).min(items.len().max(1));
+    let rows = items.len().div_ceil(cols).max(1);
+    let w = cols as u32 * cell_w;
+    let h = rows as u32 * (cell_h + 24) + 40;
+    let mut c = Chart::new(w, h);
+    c.text(
+        w as f32 / 2.0,
+        12.0,
+        16,
+        title,
+        [20, 20, 20],
+        Anchor::Middle,
+    );
+    for (k, (label, png)) in items.iter().enumerate() {
+        let x = (k % cols) as f32 * cell_w as f32;
+        let y = 40.0 + (k / cols) as f32 * (cell_h + 24) as f32;
+        c.text(
+            x + cell_w as f32 / 2.0,
+            y,
+            8,
+            label.clone(),
+            [30, 30, 30],
+            Anchor::Middle,
+        );
+        c.image(
+            x + 4.0,
+            y + 16.0,
+            cell_w as f32 - 8.0,
+            cell_h as f32 - 4.0,
+            png.clone(),
+        );
+    }
+    c
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn svg_and_png_agree_on_size_and_are_deterministic() {
+        let series = vec![("a".to_string(), vec![[0.0, 0.0], [10.0, 0.5], [20.0, 0.9]])];
+        let c = line_chart("T", "distance (m)", "coverage", &series, Some(1.0));
+        let svg = c.to_svg();
+        assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+        assert!(svg.contains(r#"width="900""#));
+        assert_eq!(
+            svg,
+            line_chart("T", "distance (m)", "coverage", &series, Some(1.0)).to_svg()
+        );
+        let png = c.to_png().unwrap();
+        let img = Pixmap::decode_png(&png).unwrap();
+        assert_eq!((img.width(), img.height()), (900, 520));
+        assert_eq!(nice_step(100.0, 5), 20.0);
+    }
+}
