@@ -189,8 +189,11 @@ impl Job {
     pub fn execute(&self) -> Result<JobResult> {
         let world = World::new(self.map.grid.clone(), self.robot, self.start)
             .with_context(|| format!("map {}", self.map.source.display()))?;
+        // Wall time covers planning (offline planners plan in `build`) and simulation.
+        let started = std::time::Instant::now();
         let mut planner = planners::build(&self.planner, &self.options, &world)?;
-        let run = simulate(&world, planner.as_mut(), &self.sim);
+        let mut run = simulate(&world, planner.as_mut(), &self.sim);
+        run.wall_time_s = started.elapsed().as_secs_f64();
         let metrics = metrics::compute(&world, &run, &self.map.name);
         Ok(JobResult {
             world,

@@ -256,11 +256,11 @@ fn bad_inputs_fail_cleanly() {
     assert!(String::from_utf8_lossy(&a.get_output().stderr).contains("unknown planner"));
 }
 
-#[test]
-fn random_bounce_on_every_shared_map_is_collision_free() {
+/// Runs `planner` on every shared map (default start, r = 0.15 m) and returns the metrics.
+fn run_on_shared_maps(planner: &str) -> Vec<(String, serde_json::Value)> {
     let Some(maps) = shared_maps() else {
         eprintln!("shared maps not found; skipping");
-        return;
+        return Vec::new();
     };
     let mut yamls: Vec<PathBuf> = std::fs::read_dir(&maps)
         .unwrap()
@@ -270,24 +270,46 @@ fn random_bounce_on_every_shared_map_is_collision_free() {
     yamls.sort();
     assert_eq!(yamls.len(), 14);
     let dir = tempfile::tempdir().unwrap();
+    let mut out = Vec::new();
     for y in yamls {
-        let out = dir.path().join(y.file_stem().unwrap());
+        let name = y.file_stem().unwrap().to_string_lossy().into_owned();
         let o = ccpp()
-            .args(["run", "--planner", "random-bounce", "--json", "--map"])
+            .args([
+                "run",
+                "--radius",
+                "0.15",
+                "--json",
+                "--planner",
+                planner,
+                "--map",
+            ])
             .arg(&y)
             .arg("--out")
-            .arg(&out)
+            .arg(dir.path().join(&name))
             .assert()
             .success()
             .get_output()
             .stdout
             .clone();
-        let v: serde_json::Value = serde_json::from_slice(&o).unwrap();
-        assert_eq!(v["collisions"], 0, "{}", y.display());
-        assert!(
-            v["effective_coverage"].as_f64().unwrap() > 0.3,
-            "{}",
-            y.display()
-        );
+        out.push((name, serde_json::from_slice(&o).unwrap()));
+    }
+    out
+}
+
+#[test]
+fn random_bounce_on_every_shared_map_is_collision_free() {
+    for (name, v) in run_on_shared_maps("random-bounce") {
+        assert_eq!(v["collisions"], 0, "{name}");
+        assert!(v["effective_coverage"].as_f64().unwrap() > 0.3, "{name}");
+    }
+}
+
+#[test]
+fn bcd_on_every_shared_map_covers_95_percent() {
+    for (name, v) in run_on_shared_maps("bcd") {
+        assert_eq!(v["collisions"], 0, "{name}");
+        let e = v["effective_coverage"].as_f64().unwrap();
+        assert!(e >= 0.95, "{name}: effective coverage {e}");
+        assert!(v["regions"].as_u64().unwrap() >= 1, "{name}");
     }
 }

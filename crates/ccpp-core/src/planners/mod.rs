@@ -1,6 +1,7 @@
 //! The coverage planners, one module each, behind the [`Planner`](crate::planner::Planner) trait,
 //! and the catalogue that builds them by name.
 
+pub mod bcd;
 pub mod random_bounce;
 
 use serde::{Deserialize, Serialize};
@@ -20,11 +21,18 @@ pub struct PlannerInfo {
 }
 
 /// Every planner ccpp knows.
-pub const CATALOG: &[PlannerInfo] = &[PlannerInfo {
-    name: "random-bounce",
-    description: "Roomba-like baseline: straight until the sensed obstacle, seeded random turn, distance budget (online)",
-    offline: false,
-}];
+pub const CATALOG: &[PlannerInfo] = &[
+    PlannerInfo {
+        name: "random-bounce",
+        description: "Roomba-like baseline: straight until the sensed obstacle, seeded random turn, distance budget (online)",
+        offline: false,
+    },
+    PlannerInfo {
+        name: "bcd",
+        description: "Boustrophedon cellular decomposition of the known map, lanes 2 r_tool apart (offline baseline)",
+        offline: true,
+    },
+];
 
 /// Options of every planner, one section each (the single source of truth for CLI, config
 /// files and bindings).
@@ -33,6 +41,8 @@ pub const CATALOG: &[PlannerInfo] = &[PlannerInfo {
 pub struct PlannerOptions {
     /// `random-bounce`.
     pub random_bounce: random_bounce::RandomBounceOptions,
+    /// `bcd`.
+    pub bcd: bcd::BcdOptions,
 }
 
 /// Error building a planner.
@@ -62,6 +72,7 @@ pub fn build(
             }
             Ok(Box::new(random_bounce::RandomBounce::new(o)))
         }
+        "bcd" => Ok(Box::new(bcd::Bcd::new(world, &opts.bcd))),
         other => Err(BuildError::Unknown(other.to_string())),
     }
 }
