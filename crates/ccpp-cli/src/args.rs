@@ -26,6 +26,8 @@ pub enum Command {
     Info(InfoArgs),
     /// Run every planner on every map in parallel; write results.csv, results.md and plots.
     Bench(BenchArgs),
+    /// Write the interactive replay.html (self-contained) and replay.gif of a finished run.
+    Replay(ReplayArgs),
 }
 
 /// Map loading options shared by commands.
@@ -94,6 +96,17 @@ pub struct RunArgs {
     /// Print the metrics JSON alone on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Also write replay.html and replay.gif.
+    #[arg(long)]
+    pub replay: bool,
+}
+
+/// `ccpp replay`.
+#[derive(Args, Debug)]
+pub struct ReplayArgs {
+    /// A run's output folder (with run.json, trace.jsonl, metrics.json).
+    #[arg(value_name = "DIR")]
+    pub dir: PathBuf,
 }
 
 /// `ccpp demo`.

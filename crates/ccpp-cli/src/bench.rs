@@ -201,7 +201,7 @@ fn run_one(
         out: dir.to_path_buf(),
     };
     let result = job.execute().map_err(|e| format!("{e:#}"))?;
-    write_run_files(dir, &result).map_err(|e| format!("{e:#}"))?;
+    write_run_files(dir, &job, &result).map_err(|e| format!("{e:#}"))?;
     Ok(result.metrics)
 }
 

@@ -27,6 +27,56 @@ pub struct PreparedMap {
     pub name: String,
     /// Where it came from, for messages.
     pub source: PathBuf,
+    /// How to load it again (for `ccpp replay`).
+    pub recipe: MapRecipe,
+}
+
+/// How a prepared map was made: enough to rebuild it exactly.
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
+pub struct MapRecipe {
+    /// Map file (absolute when it could be resolved); `None` for the bundled demo map.
+    pub path: Option<PathBuf>,
+    /// Resolution override.
+    pub resolution: Option<f64>,
+    /// Origin override.
+    pub origin: Option<[f64; 3]>,
+    /// `occupied_thresh` override.
+    pub occupied_thresh: Option<f64>,
+    /// `free_thresh` override.
+    pub free_thresh: Option<f64>,
+    /// Obstacle inflation in metres.
+    pub inflate: Option<f64>,
+}
+
+impl MapRecipe {
+    /// Loads and prepares the map again.
+    pub fn prepare(&self) -> Result<PreparedMap> {
+        match &self.path {
+            None => demo_map(),
+            Some(p) => prepare_map(&MapArgs {
+                map: p.clone(),
+                resolution: self.resolution,
+                origin: self.origin,
+                occupied_thresh: self.occupied_thresh,
+                free_thresh: self.free_thresh,
+                inflate: self.inflate,
+            }),
+        }
+    }
+}
+
+/// The bundled demo map.
+pub fn demo_map() -> Result<PreparedMap> {
+    let name = Path::new("aws_small_house.yaml");
+    let loaded = load_map_bytes(name, Some(DEMO_YAML), DEMO_IMAGE, &LoadOptions::default())
+        .context("bundled demo map")?;
+    finish_map(
+        loaded.grid,
+        "aws_small_house".into(),
+        name.into(),
+        None,
+        MapRecipe::default(),
+    )
 }
 
 /// Everything a run needs, validated.
@@ -78,7 +128,15 @@ pub fn prepare_map(args: &MapArgs) -> Result<PreparedMap> {
         .map
         .file_stem()
         .map_or_else(|| "map".to_string(), |s| s.to_string_lossy().into_owned());
-    finish_map(loaded.grid, name, loaded.source, args.inflate)
+    let recipe = MapRecipe {
+        path: Some(std::fs::canonicalize(&args.map).unwrap_or_else(|_| args.map.clone())),
+        resolution: args.resolution,
+        origin: args.origin,
+        occupied_thresh: args.occupied_thresh,
+        free_thresh: args.free_thresh,
+        inflate: args.inflate,
+    };
+    finish_map(loaded.grid, name, loaded.source, args.inflate, recipe)
 }
 
 fn finish_map(
@@ -86,6 +144,7 @@ fn finish_map(
     name: String,
     source: PathBuf,
     inflate: Option<f64>,
+    recipe: MapRecipe,
 ) -> Result<PreparedMap> {
     let grid = match inflate {
         None | Some(0.0) => grid,
@@ -94,7 +153,12 @@ fn finish_map(
             ccpp_core::inflate::inflate(&grid, m)
         }
     };
-    Ok(PreparedMap { grid, name, source })
+    Ok(PreparedMap {
+        grid,
+        name,
+        source,
+        recipe,
+    })
 }
 
 /// Validates the robot arguments.
@@ -166,10 +230,7 @@ impl Job {
 
     /// The demo job: the flagship planner on the bundled map.
     pub fn demo(a: &DemoArgs) -> Result<Self> {
-        let name = Path::new("aws_small_house.yaml");
-        let loaded = load_map_bytes(name, Some(DEMO_YAML), DEMO_IMAGE, &LoadOptions::default())
-            .context("bundled demo map")?;
-        let map = finish_map(loaded.grid, "aws_small_house".into(), name.into(), None)?;
+        let map = demo_map()?;
         let planner = a.planner.clone().unwrap_or_else(|| FLAGSHIP.to_string());
         if !planners::CATALOG.iter().any(|p| p.name == planner) {
             bail!("unknown planner {planner:?}; run `ccpp planners` for the list");

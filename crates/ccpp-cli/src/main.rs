@@ -33,12 +33,12 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Run(a) => {
             let job = job::Job::from_run_args(&a)?;
             let result = job.execute()?;
-            output::emit(&job, &result, a.json)
+            output::emit(&job, &result, a.json, a.replay)
         }
         Command::Demo(a) => {
             let job = job::Job::demo(&a)?;
             let result = job.execute()?;
-            output::emit(&job, &result, false)
+            output::emit(&job, &result, false, true)
         }
         Command::Planners => {
             for p in ccpp_core::planners::CATALOG {
@@ -49,5 +49,6 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
         }
         Command::Info(a) => info::run(&a),
         Command::Bench(a) => bench::run(&a),
+        Command::Replay(a) => output::replay_dir(&a.dir),
     }
 }

@@ -9,7 +9,12 @@ use ccpp_core::trace::Trace;
 use ccpp_io::write_atomic;
 use ccpp_render::{coverage_png, CoverageStyle};
 
-use crate::job::{Job, JobResult};
+use ccpp_core::planners::PlannerOptions;
+use ccpp_core::sim::SimConfig;
+use ccpp_core::world::{Robot, World};
+use ccpp_core::Pose;
+
+use crate::job::{Job, JobResult, MapRecipe};
 
 /// The trace as JSON Lines.
 pub fn trace_jsonl(trace: &Trace) -> Result<String> {
@@ -63,8 +68,21 @@ pub fn title_lines(m: &Metrics) -> Vec<String> {
 
 /// Renders everything first, then writes each file atomically into `out`, so a failure leaves
 /// no partial file. `metrics.json` is written last: its presence marks a complete run.
-pub fn write_run_files(out: &Path, r: &JobResult) -> Result<String> {
+pub fn write_run_files(out: &Path, job: &Job, r: &JobResult) -> Result<String> {
     let metrics = metrics_json(&r.metrics)?;
+    let start = r.world.start();
+    let record = RunRecord {
+        map: job.map.recipe.clone(),
+        map_name: job.map.name.clone(),
+        robot: job.robot,
+        start: [start.x, start.y, start.theta],
+        planner: job.planner.clone(),
+        options: job.options.clone(),
+        sim: job.sim,
+        tile_side: r.run.tile_side,
+    };
+    let mut run_json = serde_json::to_string_pretty(&record)?;
+    run_json.push('\n');
     let trace = trace_jsonl(&r.run.trace)?;
     let path = path_csv(&r.run.trace);
     let style = CoverageStyle {
@@ -74,7 +92,8 @@ pub fn write_run_files(out: &Path, r: &JobResult) -> Result<String> {
     let png = coverage_png(&r.world, &r.run.trace, &style)?;
     std::fs::create_dir_all(out)
         .with_context(|| format!("cannot create output folder {}", out.display()))?;
-    let files: [(&str, &[u8]); 4] = [
+    let files: [(&str, &[u8]); 5] = [
+        ("run.json", run_json.as_bytes()),
         ("path.csv", path.as_bytes()),
         ("trace.jsonl", trace.as_bytes()),
         ("coverage.png", &png),
@@ -86,9 +105,81 @@ pub fn write_run_files(out: &Path, r: &JobResult) -> Result<String> {
     Ok(metrics)
 }
 
+/// What ran, so that `ccpp replay` can rebuild the world exactly.
+#[derive(serde::Serialize, serde::Deserialize)]
+pub struct RunRecord {
+    /// How to load the map again.
+    pub map: MapRecipe,
+    /// Map name.
+    pub map_name: String,
+    /// The robot.
+    pub robot: Robot,
+    /// The start pose actually used.
+    pub start: [f64; 3],
+    /// Planner name.
+    pub planner: String,
+    /// Planner options.
+    pub options: PlannerOptions,
+    /// Simulator settings.
+    pub sim: SimConfig,
+    /// The planner's tile side, if any.
+    pub tile_side: Option<f64>,
+}
+
+/// Writes `replay.html` and `replay.gif` of a finished run into `out`.
+pub fn write_replay(
+    out: &Path,
+    world: &World,
+    trace: &Trace,
+    tile_side: Option<f64>,
+    metrics: &str,
+    title: &str,
+) -> Result<()> {
+    let html = ccpp_render::replay::replay_html(world, trace, tile_side, metrics, title)?;
+    let gif =
+        ccpp_render::replay::replay_gif(world, trace, &ccpp_render::replay::GifOptions::default())?;
+    write_atomic(&out.join("replay.html"), html.as_bytes())?;
+    write_atomic(&out.join("replay.gif"), &gif)?;
+    Ok(())
+}
+
+/// `ccpp replay DIR`: rebuilds the world of a finished run and writes its replay files.
+pub fn replay_dir(dir: &Path) -> Result<()> {
+    let rec_path = dir.join("run.json");
+    let text = std::fs::read_to_string(&rec_path).with_context(|| {
+        format!(
+            "{} is not a ccpp run folder (no readable run.json)",
+            dir.display()
+        )
+    })?;
+    let rec: RunRecord =
+        serde_json::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", rec_path.display()))?;
+    let map = rec.map.prepare()?;
+    let start = Pose::new(rec.start[0], rec.start[1], rec.start[2]);
+    let world = World::new(map.grid, rec.robot, Some(start))
+        .with_context(|| format!("map {}", map.source.display()))?;
+    let trace = crate::plots::read_trace(&dir.join("trace.jsonl"))?;
+    let metrics = std::fs::read_to_string(dir.join("metrics.json")).unwrap_or_default();
+    let title = format!("{} on {}", rec.planner, rec.map_name);
+    write_replay(dir, &world, &trace, rec.tile_side, &metrics, &title)?;
+    println!("wrote {}/replay.html and replay.gif", dir.display());
+    Ok(())
+}
+
 /// Writes the run's files, then prints the summary (or the metrics JSON alone).
-pub fn emit(job: &Job, r: &JobResult, json_only: bool) -> Result<()> {
-    let metrics = write_run_files(&job.out, r)?;
+pub fn emit(job: &Job, r: &JobResult, json_only: bool, replay: bool) -> Result<()> {
+    let metrics = write_run_files(&job.out, job, r)?;
+    if replay {
+        let title = format!("{} on {}", r.metrics.planner, r.metrics.map);
+        write_replay(
+            &job.out,
+            &r.world,
+            &r.run.trace,
+            r.run.tile_side,
+            &metrics,
+            &title,
+        )?;
+    }
     if json_only {
         print!("{metrics}");
     } else {

@@ -313,3 +313,217 @@ fn bcd_on_every_shared_map_covers_95_percent() {
         assert!(v["regions"].as_u64().unwrap() >= 1, "{name}");
     }
 }
+
+#[test]
+fn small_bench_writes_csv_md_and_plots_and_resumes() {
+    let dir = tempfile::tempdir().unwrap();
+    let maps = dir.path().join("maps");
+    std::fs::create_dir_all(&maps).unwrap();
+    for f in ["teb_empty_box.yaml", "teb_empty_box.png"] {
+        std::fs::copy(data(f), maps.join(f)).unwrap();
+    }
+    // A second, smaller map: a bare image (0.05 m/px) with a block in a room.
+    let mut img = image::GrayImage::from_pixel(60, 40, image::Luma([254]));
+    for (x, y, p) in img.enumerate_pixels_mut() {
+        if x == 0 || y == 0 || x == 59 || y == 39 || (25..35).contains(&x) && (15..25).contains(&y)
+        {
+            *p = image::Luma([0]);
+        }
+    }
+    img.save(maps.join("block_room.png")).unwrap();
+    // A broken map must become a failure row, not abort the bench.
+    std::fs::write(
+        maps.join("broken.yaml"),
+        "image: none.png\nresolution: 0.05\norigin: [0,0,0]\n",
+    )
+    .unwrap();
+    let out = dir.path().join("bench");
+    let bench = |force: bool| {
+        let mut c = ccpp();
+        c.args([
+            "bench",
+            "--quiet",
+            "--planners",
+            "random-bounce,bcd",
+            "--maps",
+        ])
+        .arg(maps.join("teb_empty_box.yaml"))
+        .arg(maps.join("block_room.png"))
+        .arg(maps.join("broken.yaml"))
+        .arg("--out")
+        .arg(&out);
+        if force {
+            c.arg("--force");
+        }
+        c.assert().success();
+    };
+    bench(false);
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    let lines: Vec<&str> = csv.lines().collect();
+    let header: Vec<&str> = lines[0].split(',').collect();
+    for k in [
+        "map",
+        "planner",
+        "status",
+        "error",
+        "effective_coverage",
+        "path_ratio",
+        "regions",
+        "revisit_rate",
+        "turns",
+        "wall_time_s",
+    ] {
+        assert!(header.contains(&k), "column {k} in {header:?}");
+    }
+    assert_eq!(lines.len(), 1 + 3 * 2, "{csv}");
+    let ok_rows = lines[1..].iter().filter(|l| l.contains(",ok,")).count();
+    let err_rows = lines[1..].iter().filter(|l| l.contains(",error,")).count();
+    assert_eq!((ok_rows, err_rows), (4, 2), "{csv}");
+    // Every row has as many fields as the header (quoted fields contain no newline).
+    for l in &lines[1..] {
+        if l.contains(",ok,") {
+            assert_eq!(l.split(',').count(), header.len(), "{l}");
+        }
+    }
+    let md = std::fs::read_to_string(out.join("results.md")).unwrap();
+    assert!(md.contains("## Summary") && md.contains("## block_room") && md.contains("| bcd |"));
+    for f in [
+        "summary.svg",
+        "summary.png",
+        "coverage_block_room.svg",
+        "coverage_block_room.png",
+        "paths_teb_empty_box.png",
+    ] {
+        assert!(out.join("plots").join(f).is_file(), "{f}");
+    }
+    let svg = std::fs::read_to_string(out.join("plots/summary.svg")).unwrap();
+    assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+    // Resuming skips finished runs: their trace files are left untouched.
+    let trace = out.join("runs/block_room/bcd/trace.jsonl");
+    let before = std::fs::metadata(&trace).unwrap().modified().unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(20));
+    bench(false);
+    assert_eq!(
+        std::fs::metadata(&trace).unwrap().modified().unwrap(),
+        before
+    );
+    bench(true);
+    assert_ne!(
+        std::fs::metadata(&trace).unwrap().modified().unwrap(),
+        before
+    );
+}
+
+fn chromium() -> Option<PathBuf> {
+    [
+        "/usr/bin/chromium",
+        "/usr/bin/chromium-browser",
+        "/usr/bin/google-chrome",
+    ]
+    .iter()
+    .map(PathBuf::from)
+    .find(|p| p.is_file())
+}
+
+#[test]
+fn replay_page_works_in_headless_chromium() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    ccpp()
+        .args(["run", "--planner", "bcd", "--replay", "--map"])
+        .arg(data("teb_empty_box.yaml"))
+        .arg("--out")
+        .arg(&out)
+        .assert()
+        .success();
+    let html = std::fs::read_to_string(out.join("replay.html")).unwrap();
+    // Self-contained: no network or external file reference.
+    for bad in ["http://", "https://", "src=\"/", "<link"] {
+        assert!(!html.contains(bad), "replay.html references {bad}");
+    }
+    let gif = std::fs::read(out.join("replay.gif")).unwrap();
+    assert_eq!(&gif[..6], b"GIF89a");
+    // `ccpp replay DIR` rebuilds the same page from the run folder.
+    std::fs::remove_file(out.join("replay.html")).unwrap();
+    ccpp().arg("replay").arg(&out).assert().success();
+    assert_eq!(
+        std::fs::read_to_string(out.join("replay.html")).unwrap(),
+        html
+    );
+
+    let Some(chrome) = chromium() else {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "CI must install chromium (see .ci/run)"
+        );
+        eprintln!("chromium not found; skipping the browser part");
+        return;
+    };
+    let url = format!("file://{}", out.join("replay.html").display());
+    let profile = tempfile::tempdir().unwrap();
+    let base = |c: &mut std::process::Command| {
+        c.args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--disable-quic",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            "--virtual-time-budget=5000",
+            "--enable-logging=stderr",
+            "--v=0",
+        ])
+        .arg(format!("--user-data-dir={}", profile.path().display()));
+    };
+    let mut c = std::process::Command::new(&chrome);
+    base(&mut c);
+    let o = c
+        .arg("--dump-dom")
+        .arg(format!("{url}#selftest"))
+        .output()
+        .unwrap();
+    let dom = String::from_utf8_lossy(&o.stdout);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        dom.contains("SELFTEST PASS"),
+        "self test failed: {}",
+        dom.lines()
+            .find(|l| l.contains("SELFTEST"))
+            .unwrap_or("no result")
+    );
+    for l in err.lines() {
+        let l = l.to_ascii_lowercase();
+        assert!(
+            !(l.contains("console") && (l.contains("error") || l.contains("uncaught"))),
+            "console error: {l}"
+        );
+    }
+    // Screenshot of the last frame, kept as a test artefact.
+    let shot = Path::new(env!("CARGO_TARGET_TMPDIR")).join("replay-last-frame.png");
+    let mut c = std::process::Command::new(&chrome);
+    base(&mut c);
+    let o = c
+        .arg("--window-size=1300,900")
+        .arg(format!("--screenshot={}", shot.display()))
+        .arg(format!("{url}#frame=last"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let img = image::open(&shot).unwrap().to_rgb8();
+    let swept = img
+        .pixels()
+        .filter(|p| {
+            (i32::from(p[0]) - 120).abs() < 20
+                && (i32::from(p[1]) - 190).abs() < 20
+                && (i32::from(p[2]) - 245).abs() < 20
+        })
+        .count();
+    assert!(
+        swept > 10_000,
+        "the last frame shows only {swept} swept-colour pixels ({})",
+        shot.display()
+    );
+    eprintln!("screenshot kept at {}", shot.display());
+}

@@ -127,6 +127,43 @@ fn stamp_capsule(
     }
 }
 
+/// Incremental sweeping: add executed segments one by one and read the swept pixels so far.
+pub struct Sweeper<'w> {
+    world: &'w World,
+    swept: FixedBitSet,
+    rt: f64,
+}
+
+impl<'w> Sweeper<'w> {
+    /// Nothing swept yet.
+    pub fn new(world: &'w World) -> Self {
+        let f = world.frame();
+        Self {
+            world,
+            swept: FixedBitSet::with_capacity(f.len()),
+            rt: world.robot().tool_radius / f.resolution + SWEEP_EPS_PX,
+        }
+    }
+
+    /// Sweeps the segment `a`-`b` (world points; `a == b` sweeps a disk).
+    pub fn add(&mut self, a: Point, b: Point) {
+        let f = *self.world.frame();
+        stamp_capsule(
+            &mut self.swept,
+            &f,
+            f.world_to_grid(a),
+            f.world_to_grid(b),
+            self.rt,
+            &mut |_| {},
+        );
+    }
+
+    /// The swept pixels so far.
+    pub fn swept(&self) -> &FixedBitSet {
+        &self.swept
+    }
+}
+
 #[inline]
 fn put(bits: &mut FixedBitSet, i: usize, on_new: &mut impl FnMut(usize)) {
     if !bits.put(i) {

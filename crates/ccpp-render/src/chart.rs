@@ -639,4 +639,31 @@ mod tests {
         assert_eq!((img.width(), img.height()), (900, 520));
         assert_eq!(nice_step(100.0, 5), 20.0);
     }
+
+    #[test]
+    fn svg_snapshots() {
+        let series = vec![
+            (
+                "ba-star".to_string(),
+                vec![[0.0, 0.0], [50.0, 0.6], [100.0, 0.98]],
+            ),
+            (
+                "random-bounce".to_string(),
+                vec![[0.0, 0.0], [80.0, 0.4], [300.0, 0.85]],
+            ),
+        ];
+        insta::assert_snapshot!(
+            "line_chart",
+            line_chart("Coverage", "distance (m)", "coverage", &series, Some(1.0)).to_svg()
+        );
+        let planners = vec!["a".to_string(), "b".to_string()];
+        let metrics = vec![
+            ("effective coverage".to_string(), vec![0.9, 0.7]),
+            ("turns".to_string(), vec![120.0, 800.0]),
+        ];
+        insta::assert_snapshot!(
+            "bar_panels",
+            bar_panels("Summary", &planners, &metrics).to_svg()
+        );
+    }
 }

@@ -14,6 +14,7 @@
 
 pub mod chart;
 mod font;
+pub mod replay;
 
 use ccpp_core::grid::Cell;
 use ccpp_core::metrics::swept_pixels;
