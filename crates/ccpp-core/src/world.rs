@@ -537,3 +537,66 @@ mod tests {
         assert!(w.accessible_count() > 0);
     }
 }
+
+#[cfg(test)]
+mod proptests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn arb_map() -> impl Strategy<Value = GridMap> {
+        (
+            8usize..30,
+            8usize..30,
+            proptest::collection::vec(0u8..100, 900),
+        )
+            .prop_map(|(w, h, v)| {
+                let cells = (0..w * h)
+                    .map(|i| {
+                        if v[i % v.len()] < 12 {
+                            Cell::Occupied
+                        } else {
+                            Cell::Free
+                        }
+                    })
+                    .collect();
+                GridMap::new(MapFrame::new(w, h, 0.1), cells).unwrap()
+            })
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(96))]
+        /// `first_contact` agrees with dense sampling of the exact disk test.
+        #[test]
+        fn first_contact_matches_sampling(
+            map in arb_map(),
+            r in 0.05f64..0.25,
+            a in (0.0f64..1.0, 0.0f64..1.0),
+            b in (0.0f64..1.0, 0.0f64..1.0),
+        ) {
+            let f = *map.frame();
+            let pa = Point::new(a.0 * f.width_m(), a.1 * f.height_m());
+            let pb = Point::new(b.0 * f.width_m(), b.1 * f.height_m());
+            let robot = Robot::new(r);
+            // Any valid start will do; skip maps where the robot fits nowhere.
+            let Ok(world) = World::new(map, robot, None) else { return Ok(()) };
+            if world.disk_collides(pa) {
+                return Ok(());
+            }
+            let n = 400;
+            let first_hit = (0..=n).map(|k| k as f64 / f64::from(n)).find(|&t| {
+                world.disk_collides(Point::new(pa.x + t * (pb.x - pa.x), pa.y + t * (pb.y - pa.y)))
+            });
+            match world.first_contact(pa, pb) {
+                None => prop_assert!(first_hit.is_none(), "sampling hits at {first_hit:?}"),
+                Some(t) => {
+                    // Just before t the disk is free; sampling finds no hit much earlier.
+                    let before = (t - 1e-6).max(0.0);
+                    prop_assert!(!world.disk_collides(Point::new(pa.x + before * (pb.x - pa.x), pa.y + before * (pb.y - pa.y))));
+                    if let Some(h) = first_hit {
+                        prop_assert!(h + 1.0 / f64::from(n) >= t - 1e-9, "sampled hit {h} before contact {t}");
+                    }
+                }
+            }
+        }
+    }
+}
