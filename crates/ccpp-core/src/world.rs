@@ -583,7 +583,7 @@ mod proptests {
                 return Ok(());
             }
             let n = 400;
-            let first_hit = (0..=n).map(|k| k as f64 / f64::from(n)).find(|&t| {
+            let first_hit = (0..=n).map(|k| f64::from(k) / f64::from(n)).find(|&t| {
                 world.disk_collides(Point::new(pa.x + t * (pb.x - pa.x), pa.y + t * (pb.y - pa.y)))
             });
             match world.first_contact(pa, pb) {
