@@ -9,8 +9,9 @@
 //! 1. each image column is cut into runs of C-free pixels; a cell continues while exactly one run
 //!    of the previous column overlaps exactly one run of the current column; at every other
 //!    event (split, merge, birth, death) the involved cells close and new ones open;
-//! 2. cells touching across an event are adjacent; the order is a depth-first walk of the
-//!    adjacency graph from the start's cell, nearest unvisited neighbour first (short transfers);
+//! 2. cells touching across an event are adjacent; the order is greedy from the start's cell:
+//!    next comes the unvisited neighbour (in the adjacency graph) nearest by path length over
+//!    C-free, or, when all neighbours are done, the nearest unvisited cell (short transfers);
 //! 3. each cell is covered by vertical lanes spaced `2 r_tool` (floor to whole pixels, first and
 //!    last lane on the cell's edges), alternating up and down, entered at the corner nearest the
 //!    robot;
@@ -166,6 +167,64 @@ impl Search<'_> {
         10 * dx.max(dy) + 4 * dx.min(dy)
     }
 
+    /// Dijkstra from `s` over the working set to the nearest pixel satisfying `goal`.
+    fn nearest(&mut self, s: (usize, usize), goal: &dyn Fn(usize) -> bool) -> Option<usize> {
+        self.gen = self.gen.wrapping_add(1);
+        if self.gen == 0 {
+            self.stamp.iter_mut().for_each(|x| *x = 0);
+            self.gen = 1;
+        }
+        let w = self.width;
+        let si = s.1 * w + s.0;
+        self.stamp[si] = self.gen;
+        self.g[si] = 0;
+        let mut heap = BinaryHeap::new();
+        heap.push(Reverse((0u32, si as u32)));
+        while let Some(Reverse((g, i))) = heap.pop() {
+            let i = i as usize;
+            if g > self.g[i] {
+                continue;
+            }
+            if goal(i) {
+                return Some(i);
+            }
+            let (c, r) = ((i % w) as i64, (i / w) as i64);
+            for (dc, dr) in [
+                (1, 0),
+                (0, -1),
+                (-1, 0),
+                (0, 1),
+                (1, -1),
+                (-1, -1),
+                (-1, 1),
+                (1, 1),
+            ] {
+                let (nc, nr) = (c + dc, r + dr);
+                if nc < 0 || nr < 0 || nc >= self.width as i64 || nr >= self.height as i64 {
+                    continue;
+                }
+                let j = nr as usize * w + nc as usize;
+                if !self.ok[j] {
+                    continue;
+                }
+                let diag = dc != 0 && dr != 0;
+                if diag
+                    && !(self.ok[r as usize * w + nc as usize]
+                        && self.ok[nr as usize * w + c as usize])
+                {
+                    continue;
+                }
+                let ng = g + if diag { 14 } else { 10 };
+                if self.stamp[j] != self.gen || ng < self.g[j] {
+                    self.stamp[j] = self.gen;
+                    self.g[j] = ng;
+                    heap.push(Reverse((ng, j as u32)));
+                }
+            }
+        }
+        None
+    }
+
     /// A* from `s` to `t` (both working pixels), 8-connected, no corner cutting.
     fn path(&mut self, s: (usize, usize), t: (usize, usize)) -> Option<Vec<(usize, usize)>> {
         self.gen = self.gen.wrapping_add(1);
@@ -296,37 +355,14 @@ impl Bcd {
         let Some(mut here) = cur else {
             return Self { steps };
         };
-        // Cell order: DFS from the start's cell, nearest unvisited neighbour first.
+        // Cell order, greedy: the nearest (by path length over the working set) unvisited cell
+        // among the current cell's neighbours in the adjacency graph, else among all cells.
         let n = dec.cells.len();
         let mut visited = vec![false; n];
-        let first = dec.cell_of[here.1 * w + here.0] as usize;
-        let mut order = Vec::with_capacity(n);
-        let mut stack = vec![first];
-        while let Some(cid) = stack.pop() {
-            if visited[cid] {
-                continue;
-            }
-            visited[cid] = true;
-            order.push(cid);
-            let centre = |k: usize| {
-                let c = &dec.cells[k];
-                c.c0 as f64 + c.runs.len() as f64 / 2.0
-            };
-            let mut nb: Vec<usize> = dec.adj[cid]
-                .iter()
-                .copied()
-                .filter(|&k| !visited[k])
-                .collect();
-            // Push farthest first so the nearest is popped next; ties by id.
-            nb.sort_by(|&a, &b| {
-                let da = (centre(a) - centre(cid)).abs();
-                let db = (centre(b) - centre(cid)).abs();
-                db.total_cmp(&da).then(b.cmp(&a))
-            });
-            stack.extend(nb);
-        }
+        let mut next = Some(dec.cell_of[here.1 * w + here.0] as usize);
         let mut region = 0u32;
-        for cid in order {
+        while let Some(cid) = next.take() {
+            visited[cid] = true;
             let cell = &dec.cells[cid];
             let c0 = cell.c0;
             let c1 = c0 + cell.runs.len() - 1;
@@ -390,6 +426,28 @@ impl Bcd {
                 down = !down;
             }
             steps.push_back(Step::Mark(Event::RegionEnd { region }));
+            let cell_at = |i: usize| dec.cell_of[i] as usize;
+            let unvisited_nb: Vec<usize> = dec.adj[cid]
+                .iter()
+                .copied()
+                .filter(|&k| !visited[k])
+                .collect();
+            let found = if unvisited_nb.is_empty() {
+                search.nearest(here, &|i| {
+                    dec.cell_of[i] != u32::MAX && !visited[cell_at(i)]
+                })
+            } else {
+                search
+                    .nearest(here, &|i| {
+                        dec.cell_of[i] != u32::MAX && unvisited_nb.contains(&cell_at(i))
+                    })
+                    .or_else(|| {
+                        search.nearest(here, &|i| {
+                            dec.cell_of[i] != u32::MAX && !visited[cell_at(i)]
+                        })
+                    })
+            };
+            next = found.map(cell_at);
         }
         Self { steps }
     }
