@@ -1,6 +1,7 @@
 //! The coverage planners, one module each, behind the [`Planner`](crate::planner::Planner) trait,
 //! and the catalogue that builds them by name.
 
+pub mod ba_star;
 pub mod random_bounce;
 
 use serde::{Deserialize, Serialize};
@@ -20,11 +21,18 @@ pub struct PlannerInfo {
 }
 
 /// Every planner ccpp knows.
-pub const CATALOG: &[PlannerInfo] = &[PlannerInfo {
-    name: "random-bounce",
-    description: "Roomba-like baseline: straight until the sensed obstacle, seeded random turn, distance budget (online)",
-    offline: false,
-}];
+pub const CATALOG: &[PlannerInfo] = &[
+    PlannerInfo {
+        name: "random-bounce",
+        description: "Roomba-like baseline: straight until the sensed obstacle, seeded random turn, distance budget (online)",
+        offline: false,
+    },
+    PlannerInfo {
+        name: "ba-star",
+        description: "BA* (Viet et al. 2013): boustrophedon regions on 2r tiles, A* + smoothed backtracking to the nearest corner tile (online)",
+        offline: false,
+    },
+];
 
 /// Options of every planner, one section each (the single source of truth for CLI, config
 /// files and bindings).
@@ -33,6 +41,8 @@ pub const CATALOG: &[PlannerInfo] = &[PlannerInfo {
 pub struct PlannerOptions {
     /// `random-bounce`.
     pub random_bounce: random_bounce::RandomBounceOptions,
+    /// `ba-star`.
+    pub ba_star: ba_star::BaStarOptions,
 }
 
 /// Error building a planner.
@@ -61,6 +71,13 @@ pub fn build(
                 o.budget_m = Some(3.0 * ideal);
             }
             Ok(Box::new(random_bounce::RandomBounce::new(o)))
+        }
+        "ba-star" => {
+            let mut o = opts.ba_star.clone();
+            if o.tile_side_m.is_none() {
+                o.tile_side_m = Some(2.0 * world.robot().radius);
+            }
+            Ok(Box::new(ba_star::BaStar::new(o)))
         }
         other => Err(BuildError::Unknown(other.to_string())),
     }
