@@ -600,6 +600,24 @@ impl TileModel {
         }
     }
 
+    /// Tiles whose disk reaches outside the image are obstacles from the frame alone (the
+    /// outside of the map is occupied): judge them once, before any scan.
+    fn judge_frame_edges(&mut self, known: &KnownMap, r: f64) {
+        let frame = *known.frame();
+        let rc = contact_radius_px(r / frame.resolution) + 1.0;
+        let (w, h) = (frame.width as f64, frame.height as f64);
+        for k in 0..self.state.len() {
+            let t = (self.i0 + (k % self.w) as i32, self.j0 + (k / self.w) as i32);
+            let p = self.grid.center(t);
+            let g = frame.world_to_grid(p);
+            if g.x - rc > 0.0 && g.y - rc > 0.0 && g.x + rc < w && g.y + rc < h {
+                continue;
+            }
+            let j = judge_motion(known, p, p, r);
+            self.state[k] = (self.state[k] & !ST_STAND) | j as u8;
+        }
+    }
+
     fn bounds(&self) -> (i32, i32, i32, i32) {
         (
             self.i0,
@@ -994,7 +1012,9 @@ impl BaStar {
         self.side = Some(side);
         let frame = *sensor.frame();
         let grid = TileGrid::new(sensor.pose().position(), side);
-        let tiles = TileModel::new(grid, &frame);
+        let mut tiles = TileModel::new(grid, &frame);
+        let known = KnownMap::new(&frame);
+        tiles.judge_frame_edges(&known, r);
         let search = TileSearch::new(tiles.bounds());
         let range = sensor.sensor_range();
         let window = ((range + r + frame.resolution) / side).ceil() as i32 + 1;
@@ -1008,7 +1028,7 @@ impl BaStar {
             }));
         }
         self.mind = Some(Box::new(Mind {
-            known: KnownMap::new(&frame),
+            known,
             tiles,
             search,
             r,
