@@ -482,3 +482,87 @@ fn smoothing_off_follows_the_raw_path() {
     let (_, ms, _) = run(&wd, BaStarOptions::default());
     assert!(ms.backtrack_length_m <= m.backtrack_length_m + 1e-9);
 }
+
+// ---------------------------------------------------------------------------------------------
+// The three-valued motion judgement agrees with the known map's own checks.
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig { cases: 48, ..Default::default() })]
+    #[test]
+    fn judge_motion_matches_known_map(
+        seed in proptest::prelude::any::<u64>(),
+        r_px in 1.0f64..6.0,
+        range_px in 4.0f64..30.0,
+    ) {
+        use ccpp_core::planner::{KnownMap, Scan};
+        use ccpp_core::planners::ba_star::{judge_motion, Judgement};
+        let mut rng = ccpp_core::rng::SplitMix64::new(seed);
+        let (w, h) = (48usize, 40usize);
+        let res = 0.05;
+        let mut cells = vec![Cell::Free; w * h];
+        for c in &mut cells {
+            let u = rng.next_f64();
+            if u < 0.04 {
+                *c = Cell::Occupied;
+            } else if u < 0.05 {
+                *c = Cell::Unknown;
+            }
+        }
+        let truth = GridMap::new(ccpp_core::grid::MapFrame::new(w, h, res), cells).unwrap();
+        let mut known = KnownMap::new(truth.frame());
+        for _ in 0..3 {
+            let c = Point::new(rng.range(0.0, w as f64 * res), rng.range(0.0, h as f64 * res));
+            known.integrate(&Scan::new(&truth, c, range_px * res));
+        }
+        // Optimistic map: unseen pixels free.
+        let mut opt = truth.clone();
+        for row in 0..h {
+            for col in 0..w {
+                if !known.is_seen(col, row) {
+                    opt.set(col, row, Cell::Free);
+                }
+            }
+        }
+        let r = r_px * res;
+        for _ in 0..40 {
+            let a = Point::new(rng.range(-0.2, w as f64 * res + 0.2), rng.range(-0.2, h as f64 * res + 0.2));
+            let b = if rng.next_f64() < 0.3 {
+                a
+            } else {
+                Point::new(a.x + rng.range(-1.0, 1.0), a.y + rng.range(-1.0, 1.0))
+            };
+            let j = judge_motion(&known, a, b, r);
+            let pess = if a == b { known.disk_free(a, r) } else { known.segment_free(a, b, r) };
+            let f = *truth.frame();
+            let opt_blocked = ccpp_core::collide::segment_first_contact(
+                &opt, f.world_to_grid(a), f.world_to_grid(b), r / res).is_some();
+            proptest::prop_assert_eq!(j == Judgement::Free, pess, "{:?} {:?}", a, b);
+            proptest::prop_assert_eq!(j == Judgement::Blocked, opt_blocked, "{:?} {:?}", a, b);
+        }
+    }
+
+    #[test]
+    fn astar_cost_equals_dijkstra(seed in proptest::prelude::any::<u64>()) {
+        let mut rng = ccpp_core::rng::SplitMix64::new(seed);
+        let mut covered = Vec::new();
+        for j in 0..=8 {
+            for i in 0..=8 {
+                if rng.next_f64() < 0.7 {
+                    covered.push((i, j));
+                }
+            }
+        }
+        let g = Grid { covered: covered.clone() };
+        let mut s = TileSearch::new(g.bounds());
+        let from = covered[0];
+        for &to in &covered {
+            let d = s.nearest(&g, from, |t| t == to).map(|x| x.1);
+            let a = s.astar(&g, from, to);
+            proptest::prop_assert_eq!(d, a.as_ref().map(|x| x.1));
+            if let Some((p, _)) = a {
+                proptest::prop_assert_eq!(p[0], from);
+                proptest::prop_assert_eq!(*p.last().unwrap(), to);
+            }
+        }
+    }
+}
