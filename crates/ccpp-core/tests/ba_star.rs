@@ -566,3 +566,20 @@ proptest::proptest! {
         }
     }
 }
+
+/// Proptest counterexample (w 40, h 50, density 0.177, seed 16331919354862280521): a lane ends
+/// at walls on both sides next to an uncovered lane that runs past both ends, so no diagonal is
+/// blocked and the paper's six pairs never put it in L.
+#[test]
+fn lane_end_extension_completes_the_paper_mu() {
+    let (art, c, r) = random_art(40, 50, 0.177_443_441_716_639_53, 16_331_919_354_862_280_521).unwrap();
+    let wd = world(&art, c, r, 0.0);
+    let paper = BaStarOptions {
+        lane_end_corners: false,
+        ..Default::default()
+    };
+    let (_, m, p) = run(&wd, paper);
+    assert!(m.coverage_rate.unwrap() < 1.0);
+    assert!(p.frontier_without_candidates());
+    check_run(&art, c, r, 0.0);
+}

@@ -11,6 +11,8 @@
 //! 2. **Backtracking list** `L = { s covered | mu(s) >= 1 }`, with
 //!    `mu(s) = b(s1,s8) + b(s1,s2) + b(s5,s6) + b(s5,s4) + b(s7,s6) + b(s7,s8)` (see
 //!    [`corner_score`]). Maintained incrementally, checked against a full recomputation in tests.
+//!    **Deviation:** by default `mu` also counts [`lane_end_score`] (a side neighbour free while
+//!    the lane ends at an obstacle); the paper's six pairs alone can miss a frontier and stall.
 //! 3. **Selection.** One Dijkstra from the critical point over covered tiles (8-connected, no
 //!    corner cutting) stops at the first tile of `L` it settles; ties: smaller `j`, then smaller `i`
 //!    ([`TileSearch::nearest`]).
@@ -99,6 +101,9 @@ pub struct BaStarOptions {
     /// Record the backtracking list `L` at every critical point (`backtrack_list` events). Large
     /// maps produce big traces; switch off when only the metrics matter.
     pub record_backtrack_list: bool,
+    /// Extend `mu` by [`lane_end_score`] (default `true`). `false` is the paper's `mu` exactly,
+    /// which can leave reachable tiles uncovered (see [`lane_end_score`]).
+    pub lane_end_corners: bool,
 }
 
 impl Default for BaStarOptions {
@@ -107,6 +112,7 @@ impl Default for BaStarOptions {
             tile_side_m: None,
             smoothing: true,
             record_backtrack_list: true,
+            lane_end_corners: true,
         }
     }
 }
@@ -203,6 +209,23 @@ pub fn judge_motion(known: &KnownMap, a: Point, b: Point, r: f64) -> Judgement {
 /// The pairs `(a, b)` of neighbour indices (0-based: `s1` = 0 ... `s8` = 7) summed by `mu`:
 /// `(s1,s8), (s1,s2), (s5,s6), (s5,s4), (s7,s6), (s7,s8)`.
 pub const MU_PAIRS: [(usize, usize); 6] = [(0, 7), (0, 1), (4, 5), (4, 3), (6, 5), (6, 7)];
+
+/// The pairs `(a, b)` of the lane-end extension ([`lane_end_score`]): `(s1,s3), (s1,s7),
+/// (s5,s3), (s5,s7)`.
+pub const LANE_END_PAIRS: [(usize, usize); 4] = [(0, 2), (0, 6), (4, 2), (4, 6)];
+
+/// The lane-end extension of `mu` (a deviation from the paper, on by default, see
+/// [`BaStarOptions::lane_end_corners`]): the number of pairs of [`LANE_END_PAIRS`] with
+/// `free[a] && obstacle[b]`: a side neighbour is free-uncovered while the lane of `s` ends at an
+/// obstacle. Without it, a covered lane that ends at walls on both sides next to an uncovered
+/// lane running past both of its ends (so no diagonal is blocked) is never in `L`, and coverage
+/// stalls (a property-test counterexample, kept as a regression test).
+pub fn lane_end_score(free: [bool; 8], obstacle: [bool; 8]) -> u32 {
+    LANE_END_PAIRS
+        .iter()
+        .filter(|&&(a, b)| free[a] && obstacle[b])
+        .count() as u32
+}
 
 /// The corner score `mu(s)`: the number of pairs of [`MU_PAIRS`] with `free[a] && blocked[b]`.
 /// `free[k]`: neighbour `s(k+1)` is free-uncovered (only read for the 4-neighbours E, W, S);
@@ -562,6 +585,8 @@ struct TileModel {
     /// moves towards s5..s8 are stored at the neighbour.
     moves: Vec<u8>,
     l_count: usize,
+    /// Add [`lane_end_score`] to `mu`.
+    lane_end_corners: bool,
 }
 
 impl TileModel {
@@ -597,6 +622,7 @@ impl TileModel {
             state: vec![0; w * h],
             moves: vec![0; w * h],
             l_count: 0,
+            lane_end_corners: true,
         }
     }
 
@@ -702,7 +728,7 @@ impl TileModel {
         !self.covered(n) && self.cached_move(s, k) == Judgement::Free
     }
 
-    /// `mu(s)` from the cached judgements.
+    /// `mu(s)` from the cached judgements (plus the lane-end extension when enabled).
     fn mu(&self, s: Tile) -> u32 {
         let mut free = [false; 8];
         let mut blocked = [false; 8];
@@ -715,7 +741,15 @@ impl TileModel {
         for (k, &(di, dj)) in N8.iter().enumerate() {
             blocked[k] = self.blocked((s.0 + di, s.1 + dj));
         }
-        corner_score(free, blocked)
+        let mut mu = corner_score(free, blocked);
+        if self.lane_end_corners {
+            let mut obstacle = [false; 8];
+            for k in [2, 6] {
+                obstacle[k] = self.stand((s.0 + N8[k].0, s.1 + N8[k].1)) == Judgement::Blocked;
+            }
+            mu += lane_end_score(free, obstacle);
+        }
+        mu
     }
 
     /// Recomputes the L membership of `t`.
@@ -771,10 +805,21 @@ struct Mind {
     tiles: TileModel,
     search: TileSearch,
     r: f64,
-    /// Half-width (tiles) of the window of tiles a scan can change.
-    window: i32,
+    /// Contact radius in pixels.
+    rc_px: f64,
+    /// `(sin, cos)` of the frame's yaw.
+    rot: (f64, f64),
     last_scan: Option<Pose>,
+    /// Per tile: centre in grid coordinates (computed once, as `judge_motion` computes it).
+    gcenter: Vec<Point>,
+    /// Per tile: pixels of the contact disk not yet seen ([`UNCOUNTED`] before the first).
+    unseen: Vec<u32>,
+    /// Pixels first seen in the current scan: `(col, row, free)`.
+    new_px: Vec<(u32, u32, bool)>,
 }
+
+/// Marks a tile that has not started counting its unseen pixels.
+const UNCOUNTED: u32 = u32::MAX;
 
 impl std::fmt::Debug for Mind {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -811,31 +856,126 @@ impl Mind {
         j
     }
 
+    /// Calls `f(k, t)` for every tile `t` (array index `k`) whose contact disk holds the centre
+    /// of pixel `(col, row)`, with exactly the predicate of [`judge_motion`].
+    #[inline]
+    fn tiles_touching_pixel(&mut self, col: u32, row: u32, mut f: impl FnMut(&mut Self, usize, Tile)) {
+        let frame = *self.known.frame();
+        let q = Point::new(
+            f64::from(col) + 0.5,
+            frame.height as f64 - f64::from(row) - 0.5,
+        );
+        // World position of the pixel centre (only to enumerate candidate tiles).
+        let (sn, cs) = self.rot;
+        let (gx, gy) = (q.x * frame.resolution, q.y * frame.resolution);
+        let wx = frame.origin.x + cs * gx - sn * gy;
+        let wy = frame.origin.y + sn * gx + cs * gy;
+        let g = &self.tiles.grid;
+        let ux = (wx - g.anchor.x) / g.side;
+        let uy = (wy - g.anchor.y) / g.side;
+        let rt = self.rc_px * frame.resolution / g.side + 1e-6;
+        let (i0, i1) = ((ux - rt).ceil() as i32, (ux + rt).floor() as i32);
+        let (j0, j1) = ((uy - rt).ceil() as i32, (uy + rt).floor() as i32);
+        let rc2 = self.rc_px * self.rc_px;
+        for j in j0..=j1 {
+            for i in i0..=i1 {
+                let t = (i, j);
+                let Some(k) = self.tiles.idx(t) else { continue };
+                let c = self.gcenter[k];
+                if point_segment_dist2(q, c, c) < rc2 {
+                    f(self, k, t);
+                }
+            }
+        }
+    }
+
+    /// Number of image pixels in the contact disk of tile `k` (centre `c` in grid coordinates),
+    /// or `None` when the disk reaches outside the image.
+    fn disk_pixels(&self, c: Point) -> Option<u32> {
+        let frame = self.known.frame();
+        let rc = self.rc_px;
+        let rc2 = rc * rc;
+        let h = frame.height as f64;
+        let row0 = (h - (c.y + rc) - 0.5).floor() as i64 - 1;
+        let row1 = (h - (c.y - rc) - 0.5).ceil() as i64 + 1;
+        let col0 = (c.x - rc - 0.5).floor() as i64 - 1;
+        let col1 = (c.x + rc - 0.5).ceil() as i64 + 1;
+        let mut n = 0;
+        for row in row0..=row1 {
+            let gy = h - row as f64 - 0.5;
+            for col in col0..=col1 {
+                let q = Point::new(col as f64 + 0.5, gy);
+                if point_segment_dist2(q, c, c) < rc2 {
+                    frame.checked(col, row)?;
+                    n += 1;
+                }
+            }
+        }
+        Some(n)
+    }
+
+    fn set_stand(&mut self, k: usize, t: Tile, j: Judgement) {
+        self.tiles.state[k] = (self.tiles.state[k] & !ST_STAND) | j as u8;
+        self.tiles.update_l_around(t);
+    }
+
     /// Integrates a scan taken at `pose` and refreshes every judgement it can change.
+    ///
+    /// Standability is kept exact incrementally: each undetermined tile counts the pixels of its
+    /// contact disk not yet seen (initialised the first time one of them is seen, when none
+    /// was); a newly seen blocked pixel makes it `Blocked`, the count reaching 0 makes it `Free`.
+    /// This equals [`judge_motion`] at the tile centre after every scan (tests check it).
     fn sense(&mut self, sensor: &dyn Sensor) {
         let pose = sensor.pose();
         if self.last_scan == Some(pose) {
             return;
         }
         self.last_scan = Some(pose);
-        self.known.integrate(&sensor.scan());
-        let c = self.tiles.grid.tile_of(pose.position());
-        let w = self.window;
-        for j in c.1 - w..=c.1 + w {
-            for i in c.0 - w..=c.0 + w {
-                let t = (i, j);
-                let Some(k) = self.tiles.idx(t) else { continue };
-                if self.tiles.state[k] & ST_STAND != Judgement::Undetermined as u8 {
-                    continue;
+        let scan = sensor.scan();
+        let mut new_px = std::mem::take(&mut self.new_px);
+        new_px.clear();
+        {
+            let known = &self.known;
+            scan.for_each(|c, r, cell| {
+                if !known.is_seen(c, r) {
+                    new_px.push((c as u32, r as u32, cell.is_free()));
                 }
-                let p = self.center(t);
-                let jd = judge_motion(&self.known, p, p, self.r);
-                if jd != Judgement::Undetermined {
-                    self.tiles.state[k] = (self.tiles.state[k] & !ST_STAND) | jd as u8;
-                    self.tiles.update_l_around(t);
-                }
-            }
+            });
         }
+        // Phase 1: start counting for tiles touched for the first time (nothing of their disk
+        // has been seen before: a pixel is new exactly once, and every tile it touches starts
+        // counting then).
+        for &(c, r, _) in &new_px {
+            self.tiles_touching_pixel(c, r, |m, k, t| {
+                if m.unseen[k] != UNCOUNTED
+                    || m.tiles.state[k] & ST_STAND != Judgement::Undetermined as u8
+                {
+                    return;
+                }
+                match m.disk_pixels(m.gcenter[k]) {
+                    Some(n) => m.unseen[k] = n,
+                    None => m.set_stand(k, t, Judgement::Blocked),
+                }
+            });
+        }
+        self.known.integrate(&scan);
+        // Phase 2: count the new pixels down.
+        for &(c, r, free) in &new_px {
+            self.tiles_touching_pixel(c, r, |m, k, t| {
+                if m.tiles.state[k] & ST_STAND != Judgement::Undetermined as u8 {
+                    return;
+                }
+                if !free {
+                    m.set_stand(k, t, Judgement::Blocked);
+                } else {
+                    m.unseen[k] -= 1;
+                    if m.unseen[k] == 0 {
+                        m.set_stand(k, t, Judgement::Free);
+                    }
+                }
+            });
+        }
+        self.new_px = new_px;
     }
 
     /// Marks `t` covered (the robot stands on it), decides its moves and updates L.
@@ -1013,11 +1153,18 @@ impl BaStar {
         let frame = *sensor.frame();
         let grid = TileGrid::new(sensor.pose().position(), side);
         let mut tiles = TileModel::new(grid, &frame);
+        tiles.lane_end_corners = self.opts.lane_end_corners;
         let known = KnownMap::new(&frame);
         tiles.judge_frame_edges(&known, r);
         let search = TileSearch::new(tiles.bounds());
+        let n_tiles = tiles.state.len();
         let range = sensor.sensor_range();
-        let window = ((range + r + frame.resolution) / side).ceil() as i32 + 1;
+        let gcenter = (0..tiles.state.len())
+            .map(|k| {
+                let t = (tiles.i0 + (k % tiles.w) as i32, tiles.j0 + (k / tiles.w) as i32);
+                frame.world_to_grid(grid.center(t))
+            })
+            .collect();
         if range < side + r + frame.resolution {
             self.pending.push_back(Step::Mark(Event::Note {
                 text: format!(
@@ -1032,8 +1179,12 @@ impl BaStar {
             tiles,
             search,
             r,
-            window,
+            rc_px: contact_radius_px(r / frame.resolution),
+            rot: frame.origin.theta.sin_cos(),
             last_scan: None,
+            gcenter,
+            unseen: vec![UNCOUNTED; n_tiles],
+            new_px: Vec::new(),
         }));
     }
 
