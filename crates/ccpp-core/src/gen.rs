@@ -154,9 +154,6 @@ pub fn office(width_px: usize, height_px: usize, resolution: f64, seed: u64) -> 
             yy = cy1;
         }
     }
-    GridMap::new(
-        MapFrame::new(width_px, height_px, resolution),
-        c.cells,
-    )
-    .expect("cells match the frame")
+    GridMap::new(MapFrame::new(width_px, height_px, resolution), c.cells)
+        .expect("cells match the frame")
 }

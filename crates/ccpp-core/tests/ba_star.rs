@@ -1,5 +1,7 @@
 //! BA* through the simulator and the metrics, plus the seed's unified scenario on tile indices.
 
+#![allow(clippy::unwrap_used)] // helpers of a test file
+
 use std::f64::consts::{FRAC_PI_2, PI};
 
 use ccpp_core::grid::{Cell, GridMap};
@@ -164,7 +166,9 @@ fn unified_scenario_critical_point_and_mu() {
     let blocked = |t: Tile| g.covered(t) || wall(t);
     // (50,50): all four neighbours blocked (north wall, the rest covered).
     let cp = (5, 5);
-    assert!([0, 2, 4, 6].iter().all(|&k| blocked((cp.0 + N8[k].0, cp.1 + N8[k].1))));
+    assert!([0, 2, 4, 6]
+        .iter()
+        .all(|&k| blocked((cp.0 + N8[k].0, cp.1 + N8[k].1))));
     // (40,50): s5 = (30,50) free, s4 = (30,60) wall, s1 = (50,50) covered.
     let s = (4, 5);
     let mut free = [false; 8];
@@ -572,7 +576,8 @@ proptest::proptest! {
 /// blocked and the paper's six pairs never put it in L.
 #[test]
 fn lane_end_extension_completes_the_paper_mu() {
-    let (art, c, r) = random_art(40, 50, 0.177_443_441_716_639_53, 16_331_919_354_862_280_521).unwrap();
+    let (art, c, r) =
+        random_art(40, 50, 0.177_443_441_716_639_53, 16_331_919_354_862_280_521).unwrap();
     let wd = world(&art, c, r, 0.0);
     let paper = BaStarOptions {
         lane_end_corners: false,
@@ -582,4 +587,25 @@ fn lane_end_extension_completes_the_paper_mu() {
     assert!(m.coverage_rate.unwrap() < 1.0);
     assert!(p.frontier_without_candidates());
     check_run(&art, c, r, 0.0);
+}
+
+/// Proptest counterexample (w 37, h 38, density 0.211, seed 2993061010301113817): the start
+/// tile sits between two walls; BM goes north first and leaves its free south neighbour, whose
+/// diagonals are free, so the paper's pairs never see it.
+#[test]
+fn start_tile_south_neighbour_is_a_candidate() {
+    let (art, c, r) =
+        random_art(37, 38, 0.211_171_978_379_263_02, 2_993_061_010_301_113_817).unwrap();
+    let wd = world(&art, c, r, 0.0);
+    let paper = BaStarOptions {
+        lane_end_corners: false,
+        ..Default::default()
+    };
+    let (_, m, p) = run(&wd, paper);
+    assert!(m.coverage_rate.unwrap() < 1.0);
+    assert!(p.frontier_without_candidates());
+    check_run(&art, c, r, 0.0);
+    // The smallest form: a start in a 1-wide N-S corridor, in the middle.
+    let art = "#.#\n#.#\n#.#\n#.#\n#.#";
+    check_run(art, 1, 2, 0.0);
 }

@@ -1,6 +1,6 @@
 //! BA*: online complete coverage by boustrophedon motions and A*-based backtracking.
 //!
-//! Hoang Huu Viet, Viet-Hung Dang, Md Nasir Uddin Laskar, TaeChoong Chung, "BA*: an online
+//! Hoang Huu Viet, Viet-Hung Dang, Md Nasir Uddin Laskar, `TaeChoong` Chung, "BA*: an online
 //! complete coverage algorithm for cleaning robots", *Applied Intelligence* 39, 217–235 (2013)
 //! (seed 000). The resolved choices of `algorithms.md` (section BA*) are followed exactly:
 //!
@@ -12,7 +12,8 @@
 //!    `mu(s) = b(s1,s8) + b(s1,s2) + b(s5,s6) + b(s5,s4) + b(s7,s6) + b(s7,s8)` (see
 //!    [`corner_score`]). Maintained incrementally, checked against a full recomputation in tests.
 //!    **Deviation:** by default `mu` also counts [`lane_end_score`] (a side neighbour free while
-//!    the lane ends at an obstacle); the paper's six pairs alone can miss a frontier and stall.
+//!    the lane ends at an obstacle; the start tile's south neighbour); the paper's six pairs alone
+//!    can miss a frontier and stall.
 //! 3. **Selection.** One Dijkstra from the critical point over covered tiles (8-connected, no
 //!    corner cutting) stops at the first tile of `L` it settles; ties: smaller `j`, then smaller `i`
 //!    ([`TileSearch::nearest`]).
@@ -180,22 +181,27 @@ pub fn judge_motion(known: &KnownMap, a: Point, b: Point, r: f64) -> Judgement {
         let c0 = (xa.min(xb) - rc - 0.5).floor() as i64 - 1;
         let c1 = (xa.max(xb) + rc - 0.5).ceil() as i64 + 1;
         for col in c0..=c1 {
-            let q = Point::new(col as f64 + 0.5, gy);
-            if point_segment_dist2(q, ga, gb) >= rc2 {
-                continue;
-            }
-            if first_entry(ga, gb, q, rc).is_none() {
-                continue;
-            }
-            match frame.checked(col, row) {
-                None => return Judgement::Blocked,
+            // Cheap state first: seen free pixels never matter, whatever their distance.
+            let unseen = match frame.checked(col, row) {
+                None => false,
                 Some((c, rr)) => {
                     if !known.is_seen(c, rr) {
-                        undetermined = true;
-                    } else if !known.get(c, rr).is_free() {
-                        return Judgement::Blocked;
+                        true
+                    } else if known.get(c, rr).is_free() {
+                        continue;
+                    } else {
+                        false
                     }
                 }
+            };
+            let q = Point::new(col as f64 + 0.5, gy);
+            if point_segment_dist2(q, ga, gb) >= rc2 || first_entry(ga, gb, q, rc).is_none() {
+                continue;
+            }
+            if unseen {
+                undetermined = true;
+            } else {
+                return Judgement::Blocked;
             }
         }
     }
@@ -210,21 +216,39 @@ pub fn judge_motion(known: &KnownMap, a: Point, b: Point, r: f64) -> Judgement {
 /// `(s1,s8), (s1,s2), (s5,s6), (s5,s4), (s7,s6), (s7,s8)`.
 pub const MU_PAIRS: [(usize, usize); 6] = [(0, 7), (0, 1), (4, 5), (4, 3), (6, 5), (6, 7)];
 
-/// The pairs `(a, b)` of the lane-end extension ([`lane_end_score`]): `(s1,s3), (s1,s7),
-/// (s5,s3), (s5,s7)`.
+/// The pairs `(a, b)` of the lane-end extension counted against an *obstacle* `b`
+/// ([`lane_end_score`]): `(s1,s3), (s1,s7), (s5,s3), (s5,s7)`.
 pub const LANE_END_PAIRS: [(usize, usize); 4] = [(0, 2), (0, 6), (4, 2), (4, 6)];
 
+/// The pairs `(a, b)` of the lane-end extension counted against a *blocked* `b`
+/// ([`lane_end_score`]): `(s7,s1), (s7,s5)`.
+pub const START_PAIRS: [(usize, usize); 2] = [(6, 0), (6, 4)];
+
 /// The lane-end extension of `mu` (a deviation from the paper, on by default, see
-/// [`BaStarOptions::lane_end_corners`]): the number of pairs of [`LANE_END_PAIRS`] with
-/// `free[a] && obstacle[b]`: a side neighbour is free-uncovered while the lane of `s` ends at an
-/// obstacle. Without it, a covered lane that ends at walls on both sides next to an uncovered
-/// lane running past both of its ends (so no diagonal is blocked) is never in `L`, and coverage
-/// stalls (a property-test counterexample, kept as a regression test).
-pub fn lane_end_score(free: [bool; 8], obstacle: [bool; 8]) -> u32 {
-    LANE_END_PAIRS
+/// [`BaStarOptions::lane_end_corners`]): the pairs of [`LANE_END_PAIRS`] with
+/// `free[a] && obstacle[b]` (a side neighbour is free-uncovered while the lane of `s` ends at an
+/// obstacle) plus the pairs of [`START_PAIRS`] with `free[a] && blocked[b]` (the south neighbour
+/// is free-uncovered while `s` is flanked by a blocked tile).
+///
+/// Why: the paper's six pairs need a blocked *diagonal*. Property tests found two frontiers
+/// without one, where coverage stalls with `L` empty (both kept as regression tests): (1) a lane
+/// that ends at obstacles next to an uncovered lane running past both of its ends; (2) the start
+/// tile, whose south neighbour BM leaves behind when it goes north first (every other covered
+/// tile with a free south neighbour was entered sideways from a tile whose south was blocked, so
+/// the paper's `(s7,s6)` / `(s7,s8)` see it). With the extension, every covered tile with a
+/// free-uncovered neighbour is in `L` or shares a lane with one that is — unless a standable
+/// north/south neighbour is not enterable by the straight move (a pixel-level sliver), which no
+/// test map has produced.
+pub fn lane_end_score(free: [bool; 8], obstacle: [bool; 8], blocked: [bool; 8]) -> u32 {
+    let a = LANE_END_PAIRS
         .iter()
         .filter(|&&(a, b)| free[a] && obstacle[b])
-        .count() as u32
+        .count();
+    let b = START_PAIRS
+        .iter()
+        .filter(|&&(a, b)| free[a] && blocked[b])
+        .count();
+    (a + b) as u32
 }
 
 /// The corner score `mu(s)`: the number of pairs of [`MU_PAIRS`] with `free[a] && blocked[b]`.
@@ -409,7 +433,8 @@ impl TileSearch {
         self.idx(to)?;
         self.begin();
         self.relax(s, 0, u32::MAX);
-        self.heap.push(Reverse((heuristic(from, to), from.1, from.0)));
+        self.heap
+            .push(Reverse((heuristic(from, to), from.1, from.0)));
         while let Some(Reverse((_, j, i))) = self.heap.pop() {
             let t = (i, j);
             let Some(k) = self.idx(t) else { continue };
@@ -666,8 +691,7 @@ impl TileModel {
 
     #[inline]
     fn covered(&self, t: Tile) -> bool {
-        self.idx(t)
-            .is_some_and(|k| self.state[k] & ST_COVERED != 0)
+        self.idx(t).is_some_and(|k| self.state[k] & ST_COVERED != 0)
     }
 
     #[inline]
@@ -747,7 +771,7 @@ impl TileModel {
             for k in [2, 6] {
                 obstacle[k] = self.stand((s.0 + N8[k].0, s.1 + N8[k].1)) == Judgement::Blocked;
             }
-            mu += lane_end_score(free, obstacle);
+            mu += lane_end_score(free, obstacle, blocked);
         }
         mu
     }
@@ -859,7 +883,12 @@ impl Mind {
     /// Calls `f(k, t)` for every tile `t` (array index `k`) whose contact disk holds the centre
     /// of pixel `(col, row)`, with exactly the predicate of [`judge_motion`].
     #[inline]
-    fn tiles_touching_pixel(&mut self, col: u32, row: u32, mut f: impl FnMut(&mut Self, usize, Tile)) {
+    fn tiles_touching_pixel(
+        &mut self,
+        col: u32,
+        row: u32,
+        mut f: impl FnMut(&mut Self, usize, Tile),
+    ) {
         let frame = *self.known.frame();
         let q = Point::new(
             f64::from(col) + 0.5,
@@ -934,14 +963,11 @@ impl Mind {
         let scan = sensor.scan();
         let mut new_px = std::mem::take(&mut self.new_px);
         new_px.clear();
-        {
-            let known = &self.known;
-            scan.for_each(|c, r, cell| {
-                if !known.is_seen(c, r) {
-                    new_px.push((c as u32, r as u32, cell.is_free()));
-                }
-            });
-        }
+        // Integrate now, remembering the pixels seen for the first time; phase 1 below only
+        // needs the disk sizes, which do not depend on what is seen.
+        self.known.integrate_with(&scan, |c, r, cell| {
+            new_px.push((c as u32, r as u32, cell.is_free()));
+        });
         // Phase 1: start counting for tiles touched for the first time (nothing of their disk
         // has been seen before: a pixel is new exactly once, and every tile it touches starts
         // counting then).
@@ -958,20 +984,19 @@ impl Mind {
                 }
             });
         }
-        self.known.integrate(&scan);
         // Phase 2: count the new pixels down.
         for &(c, r, free) in &new_px {
             self.tiles_touching_pixel(c, r, |m, k, t| {
                 if m.tiles.state[k] & ST_STAND != Judgement::Undetermined as u8 {
                     return;
                 }
-                if !free {
-                    m.set_stand(k, t, Judgement::Blocked);
-                } else {
+                if free {
                     m.unseen[k] -= 1;
                     if m.unseen[k] == 0 {
                         m.set_stand(k, t, Judgement::Free);
                     }
+                } else {
+                    m.set_stand(k, t, Judgement::Blocked);
                 }
             });
         }
@@ -1052,7 +1077,9 @@ impl BaStar {
 
     /// The covered tiles, row-major (`j`, then `i`).
     pub fn covered_tiles(&self) -> Vec<Tile> {
-        let Some(m) = &self.mind else { return Vec::new() };
+        let Some(m) = &self.mind else {
+            return Vec::new();
+        };
         let t = &m.tiles;
         (0..t.state.len())
             .filter(|&k| t.state[k] & ST_COVERED != 0)
@@ -1069,7 +1096,9 @@ impl BaStar {
 
     /// `L` recomputed from scratch from the tile judgements, row-major.
     pub fn backtrack_list_full(&self) -> Vec<Tile> {
-        let Some(m) = &self.mind else { return Vec::new() };
+        let Some(m) = &self.mind else {
+            return Vec::new();
+        };
         let t = &m.tiles;
         let mut out = Vec::new();
         for k in 0..t.state.len() {
@@ -1124,9 +1153,7 @@ impl BaStar {
                     let v = (tile.0 + N8[n].0, tile.1 + N8[n].1);
                     let f = judge_motion(&m.known, p, m.center(v), m.r);
                     if f != c {
-                        return Err(format!(
-                            "move {tile:?}->{v:?}: cached {c:?}, fresh {f:?}"
-                        ));
+                        return Err(format!("move {tile:?}->{v:?}: cached {c:?}, fresh {f:?}"));
                     }
                 }
             }
@@ -1161,7 +1188,10 @@ impl BaStar {
         let range = sensor.sensor_range();
         let gcenter = (0..tiles.state.len())
             .map(|k| {
-                let t = (tiles.i0 + (k % tiles.w) as i32, tiles.j0 + (k / tiles.w) as i32);
+                let t = (
+                    tiles.i0 + (k % tiles.w) as i32,
+                    tiles.j0 + (k / tiles.w) as i32,
+                );
                 frame.world_to_grid(grid.center(t))
             })
             .collect();
@@ -1202,7 +1232,8 @@ impl BaStar {
         }
         // Critical point.
         let cp = m.center(c);
-        self.pending.push_back(Step::Mark(Event::CriticalPoint { x: cp.x, y: cp.y }));
+        self.pending
+            .push_back(Step::Mark(Event::CriticalPoint { x: cp.x, y: cp.y }));
         self.pending.push_back(Step::Mark(Event::RegionEnd {
             region: self.region,
         }));
@@ -1254,8 +1285,9 @@ impl BaStar {
         let spc = m.center(sp);
         self.pending
             .push_back(Step::Mark(Event::StartPoint { x: spc.x, y: spc.y }));
-        self.pending
-            .push_back(Step::Mark(Event::PathRaw { points: to_pts(&raw) }));
+        self.pending.push_back(Step::Mark(Event::PathRaw {
+            points: to_pts(&raw),
+        }));
         self.pending.push_back(Step::Mark(Event::PathSmoothed {
             points: to_pts(&smoothed),
         }));
