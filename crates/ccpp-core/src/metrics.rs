@@ -1,9 +1,9 @@
 //! Run metrics, computed from the world (truth) and the trace only — never reported by planners.
 //! Definitions: `world-and-metrics.md`; each field below repeats its own.
 
+use std::ops::Sub;
 use fixedbitset::FixedBitSet;
 use serde::{Deserialize, Serialize};
-use std::ops::Sub;
 
 use crate::geometry::{point_segment_dist2, wrap_angle, Point, Pose};
 use crate::sim::RunOutput;

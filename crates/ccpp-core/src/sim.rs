@@ -2,8 +2,8 @@
 //! drive (exact in-place rotations and straight translations), checks every motion against the
 //! true map, stops on contact (the bumper) and records the [`Trace`].
 
-use serde::{Deserialize, Serialize};
 use std::ops::{Add, Sub};
+use serde::{Deserialize, Serialize};
 
 use crate::geometry::{wrap_angle, Point, Pose};
 use crate::grid::MapFrame;

@@ -2,9 +2,9 @@
 //! surface, plus exact collision checks. Only the simulator, the metrics and offline planners
 //! look at a [`World`]; online planners never do.
 
+use std::ops::{Add, Sub};
 use fixedbitset::FixedBitSet;
 use serde::{Deserialize, Serialize};
-use std::ops::{Add, Sub};
 
 use crate::collide::{self, contact_radius_px};
 use crate::dt::{squared_edt, INF};
