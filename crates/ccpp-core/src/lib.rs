@@ -2,7 +2,7 @@
 //!
 //! The I/O-free heart of **ccpp**, a complete coverage path planning toolkit for mobile robots on
 //! 2-D occupancy grids: grids and frames ([`grid`]), geometry ([`geometry`], [`collide`]), the
-//! distance transform ([`dt`]), the ground truth ([`world`]), the online step protocol
+//! distance transform ([`dt`]), synthetic maps ([`gen`]), the ground truth ([`world`]), the online step protocol
 //! ([`planner`]), the simulator ([`sim`]), the trace ([`trace`]), tiles ([`tiles`]), the metrics
 //! ([`metrics`]) and the planners ([`planners`]).
 //!
@@ -11,6 +11,7 @@
 
 pub mod collide;
 pub mod dt;
+pub mod gen;
 pub mod geometry;
 pub mod grid;
 pub mod inflate;

@@ -142,6 +142,25 @@ impl KnownMap {
         });
     }
 
+    /// Stores every pixel of a scan and calls `first_seen(col, row, cell)` for each pixel seen
+    /// for the first time (in the scan's row-major order).
+    pub fn integrate_with(
+        &mut self,
+        scan: &Scan<'_>,
+        mut first_seen: impl FnMut(usize, usize, Cell),
+    ) {
+        let w = self.grid.frame().width;
+        let cells = self.grid.cells_mut();
+        let seen = &mut self.seen;
+        scan.for_each(|c, r, cell| {
+            let i = r * w + c;
+            if !seen.put(i) {
+                cells[i] = cell;
+                first_seen(c, r, cell);
+            }
+        });
+    }
+
     /// The frame.
     pub fn frame(&self) -> &MapFrame {
         self.grid.frame()

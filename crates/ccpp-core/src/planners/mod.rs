@@ -1,6 +1,7 @@
 //! The coverage planners, one module each, behind the [`Planner`](crate::planner::Planner) trait,
 //! and the catalogue that builds them by name.
 
+pub mod ba_star;
 pub mod bcd;
 pub mod random_bounce;
 
@@ -23,6 +24,11 @@ pub struct PlannerInfo {
 /// Every planner ccpp knows.
 pub const CATALOG: &[PlannerInfo] = &[
     PlannerInfo {
+        name: "ba-star",
+        description: "BA* (Viet et al. 2013): boustrophedon regions on 2r tiles, A* + smoothed backtracking to the nearest corner tile (online)",
+        offline: false,
+    },
+    PlannerInfo {
         name: "random-bounce",
         description: "Roomba-like baseline: straight until the sensed obstacle, seeded random turn, distance budget (online)",
         offline: false,
@@ -41,6 +47,8 @@ pub const CATALOG: &[PlannerInfo] = &[
 pub struct PlannerOptions {
     /// `random-bounce`.
     pub random_bounce: random_bounce::RandomBounceOptions,
+    /// `ba-star`.
+    pub ba_star: ba_star::BaStarOptions,
     /// `bcd`.
     pub bcd: bcd::BcdOptions,
 }
@@ -71,6 +79,13 @@ pub fn build(
                 o.budget_m = Some(3.0 * ideal);
             }
             Ok(Box::new(random_bounce::RandomBounce::new(o)))
+        }
+        "ba-star" => {
+            let mut o = opts.ba_star.clone();
+            if o.tile_side_m.is_none() {
+                o.tile_side_m = Some(2.0 * world.robot().radius);
+            }
+            Ok(Box::new(ba_star::BaStar::new(o)))
         }
         "bcd" => Ok(Box::new(bcd::Bcd::new(world, &opts.bcd))),
         other => Err(BuildError::Unknown(other.to_string())),

@@ -1,0 +1,611 @@
+//! BA* through the simulator and the metrics, plus the seed's unified scenario on tile indices.
+
+#![allow(clippy::unwrap_used)] // helpers of a test file
+
+use std::f64::consts::{FRAC_PI_2, PI};
+
+use ccpp_core::grid::{Cell, GridMap};
+use ccpp_core::metrics::{compute, Metrics};
+use ccpp_core::planner::{Planner, Sensor, Step};
+use ccpp_core::planners::ba_star::{
+    corner_score, motion_to, BaStar, BaStarOptions, TileGraph, TileSearch, COST_ORTHO,
+};
+use ccpp_core::sim::{simulate, RunOutput, SimConfig};
+use ccpp_core::tiles::{Tile, N8};
+use ccpp_core::trace::{Event, Trace};
+use ccpp_core::world::{Robot, World};
+use ccpp_core::{Point, Pose};
+
+/// Robot radius: one character = 11 px at 0.01 m = 0.11 m = one tile of side 2r. (An odd number
+/// of pixels puts tile centres on pixel centres, so a 1-character corridor is in C-free.)
+const R: f64 = 0.055;
+const SCALE: usize = 11;
+const SIDE: f64 = 0.11;
+
+fn map(art: &str) -> GridMap {
+    GridMap::from_ascii_scaled(art, SCALE, 0.01).unwrap()
+}
+
+/// World with the start at the centre of character (col, row) (row 0 = top line).
+fn world(art: &str, col: usize, row: usize, theta: f64) -> World {
+    let m = map(art);
+    let rows = m.frame().height / SCALE;
+    let x = (col as f64 + 0.5) * SIDE;
+    let y = ((rows - 1 - row) as f64 + 0.5) * SIDE;
+    World::new(m, Robot::new(R), Some(Pose::new(x, y, theta))).unwrap()
+}
+
+fn run(w: &World, opts: BaStarOptions) -> (RunOutput, Metrics, BaStar) {
+    let mut p = BaStar::new(opts);
+    let out = simulate(w, &mut p, &SimConfig::default());
+    let m = compute(w, &out, "test");
+    (out, m, p)
+}
+
+fn room(w: usize, h: usize) -> String {
+    vec![".".repeat(w); h].join("\n")
+}
+
+fn moves(trace: &Trace) -> usize {
+    let poses: Vec<Pose> = trace.poses().collect();
+    poses
+        .windows(2)
+        .filter(|p| p[0].position().dist(p[1].position()) > 0.0)
+        .count()
+}
+
+#[test]
+fn empty_room_from_a_corner_facing_north() {
+    for (w, h) in [(1, 1), (2, 3), (5, 4), (8, 8), (13, 6)] {
+        let wd = world(&room(w, h), 0, h - 1, FRAC_PI_2);
+        let (out, m, p) = run(&wd, BaStarOptions::default());
+        assert_eq!(m.regions, 1, "{w}x{h}");
+        assert_eq!(m.backtracks, 0);
+        assert_eq!(moves(&out.trace), w * h - 1, "{w}x{h}");
+        assert_eq!(m.turns as usize, 2 * (w - 1), "{w}x{h}");
+        assert_eq!(m.revisit_rate, 0.0);
+        assert_eq!(m.coverage_rate, Some(1.0));
+        assert_eq!(m.collisions, 0);
+        assert!(!p.frontier_without_candidates());
+        assert!(p.backtrack_list().is_empty());
+    }
+}
+
+#[test]
+fn room_with_a_central_block_needs_regions() {
+    let art = "\
+        ..........\n\
+        ..........\n\
+        ...####...\n\
+        ...####...\n\
+        ...####...\n\
+        ..........\n\
+        ..........";
+    let wd = world(art, 0, 6, FRAC_PI_2);
+    let (_, m, p) = run(&wd, BaStarOptions::default());
+    assert!(m.regions > 1, "{m:?}");
+    assert_eq!(m.regions, m.backtracks + 1);
+    assert_eq!(m.coverage_rate, Some(1.0));
+    assert_eq!(m.collisions, 0);
+    assert!(!p.frontier_without_candidates());
+}
+
+#[test]
+fn corridor_east_west_has_no_turns() {
+    let art = "\
+        ##########\n\
+        ..........\n\
+        ##########";
+    let wd = world(art, 0, 1, 0.0);
+    let (out, m, _) = run(&wd, BaStarOptions::default());
+    assert_eq!(m.turns, 0);
+    assert_eq!(m.regions, 1);
+    assert_eq!(moves(&out.trace), 9);
+    assert_eq!(m.coverage_rate, Some(1.0));
+}
+
+#[test]
+fn boxed_in_start_ends_at_once() {
+    let art = "\
+        .....\n\
+        ..#..\n\
+        .#.#.\n\
+        ..#..\n\
+        .....";
+    let wd = world(art, 2, 2, 0.3);
+    let (out, m, _) = run(&wd, BaStarOptions::default());
+    assert_eq!(m.regions, 1);
+    assert_eq!(moves(&out.trace), 0);
+    assert_eq!(m.turns, 0);
+    assert_eq!(m.coverage_rate, Some(1.0));
+    assert!(out
+        .trace
+        .events()
+        .any(|(_, e)| matches!(e, Event::CriticalPoint { .. })));
+}
+
+// ---------------------------------------------------------------------------------------------
+// The seed's unified scenario on tile indices (tiles of side 10, tile (i, j) centred at
+// (10 i, 10 j)): critical point (50,50), candidates (40,50) and (10,10).
+
+/// A hand-made tile graph: covered tiles, every move between them free.
+struct Grid {
+    covered: Vec<Tile>,
+}
+
+impl TileGraph for Grid {
+    fn bounds(&self) -> (i32, i32, i32, i32) {
+        (0, 8, 0, 8)
+    }
+    fn covered(&self, t: Tile) -> bool {
+        self.covered.contains(&t)
+    }
+    fn move_free(&self, _: Tile, _: usize) -> bool {
+        true
+    }
+}
+
+fn scenario() -> Grid {
+    // Room 1..=6 x 1..=5 covered except (3,5) = (30,50), still unknown (free); the row j = 6 is
+    // the north wall.
+    let mut covered = Vec::new();
+    for j in 1..=5 {
+        for i in 1..=6 {
+            if (i, j) != (3, 5) {
+                covered.push((i, j));
+            }
+        }
+    }
+    Grid { covered }
+}
+
+#[test]
+fn unified_scenario_critical_point_and_mu() {
+    let g = scenario();
+    let wall = |t: Tile| t.1 >= 6 || t.0 <= 0 || t.0 >= 7 || t.1 <= 0;
+    let blocked = |t: Tile| g.covered(t) || wall(t);
+    // (50,50): all four neighbours blocked (north wall, the rest covered).
+    let cp = (5, 5);
+    assert!([0, 2, 4, 6]
+        .iter()
+        .all(|&k| blocked((cp.0 + N8[k].0, cp.1 + N8[k].1))));
+    // (40,50): s5 = (30,50) free, s4 = (30,60) wall, s1 = (50,50) covered.
+    let s = (4, 5);
+    let mut free = [false; 8];
+    let mut bl = [false; 8];
+    for (k, &(di, dj)) in N8.iter().enumerate() {
+        let n = (s.0 + di, s.1 + dj);
+        bl[k] = blocked(n);
+        free[k] = k % 2 == 0 && !blocked(n);
+    }
+    assert!(free[4] && bl[3], "the (s5, s4) pair");
+    assert!(corner_score(free, bl) >= 1);
+    // Only the (s5, s4) pair and the (s5, s6) pair fire.
+    assert_eq!(corner_score(free, bl), 2);
+    // The critical point itself has no free 4-neighbour, so mu = 0.
+    let mut f0 = [false; 8];
+    for k in [0, 4, 6] {
+        f0[k] = !blocked((cp.0 + N8[k].0, cp.1 + N8[k].1));
+    }
+    assert_eq!(corner_score(f0, [true; 8]), 0);
+}
+
+#[test]
+fn unified_scenario_selection_and_path() {
+    let g = scenario();
+    let mut search = TileSearch::new(g.bounds());
+    let candidates = [(4, 5), (1, 1)];
+    let (sp, cost) = search
+        .nearest(&g, (5, 5), |t| candidates.contains(&t))
+        .unwrap();
+    assert_eq!(sp, (4, 5));
+    let side = 10.0;
+    let j_a = cost as f64 / COST_ORTHO as f64 * side;
+    assert!((j_a - 10.0).abs() < 1e-9);
+    let (path_b, cost_b) = search.astar(&g, (5, 5), (1, 1)).unwrap();
+    let j_b = cost_b as f64 / COST_ORTHO as f64 * side;
+    assert!((j_b - 40.0 * 2f64.sqrt()).abs() < 1e-3, "{j_b}");
+    assert!(j_b > 56.0 && j_b < 57.0);
+    assert_eq!(path_b, vec![(5, 5), (4, 4), (3, 3), (2, 2), (1, 1)]);
+    let (path_a, _) = search.astar(&g, (5, 5), (4, 5)).unwrap();
+    assert_eq!(path_a, vec![(5, 5), (4, 5)]);
+    // Only (1,1) as a candidate: Dijkstra finds it at the same cost as A*.
+    let (t, c) = search.nearest(&g, (5, 5), |t| t == (1, 1)).unwrap();
+    assert_eq!((t, c), ((1, 1), cost_b));
+}
+
+#[test]
+fn unified_scenario_execution() {
+    let (beta, alpha, d) = motion_to(Pose::new(50.0, 50.0, FRAC_PI_2), Point::new(40.0, 50.0));
+    assert!((beta - PI).abs() < 1e-12);
+    assert!((alpha - FRAC_PI_2).abs() < 1e-12);
+    assert!((d - 10.0).abs() < 1e-12);
+}
+
+#[test]
+fn astar_needs_both_orthogonal_tiles_for_a_diagonal() {
+    // (0,0) and (1,1) covered, (1,0) covered, (0,1) not: the diagonal is not an edge.
+    let g = Grid {
+        covered: vec![(1, 1), (2, 1), (2, 2)],
+    };
+    let mut s = TileSearch::new(g.bounds());
+    let (p, c) = s.astar(&g, (1, 1), (2, 2)).unwrap();
+    assert_eq!(p, vec![(1, 1), (2, 1), (2, 2)]);
+    assert_eq!(c, 2 * COST_ORTHO);
+    assert!(s.astar(&g, (1, 1), (5, 5)).is_none());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Invariants on random maps, checked after every planner step.
+
+/// Wraps the planner and checks invariants after every step.
+struct Checked {
+    p: BaStar,
+    errors: Vec<String>,
+    criticals: usize,
+}
+
+impl Checked {
+    fn err(&mut self, e: String) {
+        if self.errors.len() < 5 {
+            self.errors.push(e);
+        }
+    }
+
+    /// Independent check that the swept disk of a segment stays on covered tiles: dense samples,
+    /// every tile square closer than r to a sample must be covered.
+    fn segment_on_covered(&self, a: Point, b: Point) -> Result<(), String> {
+        let g = self.p.tile_grid().unwrap();
+        let rho = R / g.side;
+        let ua = ((a.x - g.anchor.x) / g.side, (a.y - g.anchor.y) / g.side);
+        let ub = ((b.x - g.anchor.x) / g.side, (b.y - g.anchor.y) / g.side);
+        let n = (((ub.0 - ua.0).hypot(ub.1 - ua.1)) * 64.0).ceil() as usize + 1;
+        for s in 0..=n {
+            let t = s as f64 / n as f64;
+            let (x, y) = (ua.0 + t * (ub.0 - ua.0), ua.1 + t * (ub.1 - ua.1));
+            for di in -1..=1 {
+                for dj in -1..=1 {
+                    let tile = (x.round() as i32 + di, y.round() as i32 + dj);
+                    let dx = (f64::from(tile.0) - 0.5 - x)
+                        .max(0.0)
+                        .max(x - f64::from(tile.0) - 0.5);
+                    let dy = (f64::from(tile.1) - 0.5 - y)
+                        .max(0.0)
+                        .max(y - f64::from(tile.1) - 0.5);
+                    if dx.hypot(dy) < rho - 1e-6 && !self.p.is_covered(tile) {
+                        return Err(format!("segment {a:?}->{b:?} touches uncovered {tile:?}"));
+                    }
+                }
+            }
+        }
+        let known = self.p.known_map().unwrap();
+        if !known.segment_free(a, b, R) {
+            return Err(format!("segment {a:?}->{b:?} not free on the known map"));
+        }
+        Ok(())
+    }
+}
+
+impl Planner for Checked {
+    fn name(&self) -> &'static str {
+        self.p.name()
+    }
+    fn tile_side(&self) -> Option<f64> {
+        self.p.tile_side()
+    }
+    fn next(&mut self, sensor: &dyn Sensor) -> Step {
+        let step = self.p.next(sensor);
+        let inc = self.p.backtrack_list();
+        let full = self.p.backtrack_list_full();
+        if inc != full {
+            self.err(format!("L incremental {inc:?} != full {full:?}"));
+        }
+        match &step {
+            Step::MoveTo(pt) if !self.p.is_backtracking() => {
+                let g = self.p.tile_grid().unwrap();
+                let t = g.tile_of(*pt);
+                if self.p.is_covered(t) {
+                    self.err(format!("BM enters covered tile {t:?}"));
+                }
+            }
+            Step::Mark(Event::PathSmoothed { points }) => {
+                for w in points.windows(2) {
+                    let a = Point::new(w[0][0], w[0][1]);
+                    let b = Point::new(w[1][0], w[1][1]);
+                    if let Err(e) = self.segment_on_covered(a, b) {
+                        self.err(e);
+                    }
+                }
+            }
+            Step::Mark(Event::CriticalPoint { .. }) => {
+                self.criticals += 1;
+                if self.criticals <= 4 {
+                    if let Err(e) = self.p.check_judgements() {
+                        self.err(e);
+                    }
+                }
+            }
+            Step::Done => {
+                if let Err(e) = self.p.check_judgements() {
+                    self.err(e);
+                }
+                if self.p.frontier_without_candidates() {
+                    self.err("safeguard: free tile next to a covered one with L empty".into());
+                }
+            }
+            _ => {}
+        }
+        step
+    }
+}
+
+/// A random ASCII map and a free start character.
+fn random_art(w: usize, h: usize, density: f64, seed: u64) -> Option<(String, usize, usize)> {
+    let mut rng = ccpp_core::rng::SplitMix64::new(seed);
+    let mut rows = Vec::new();
+    let mut free = Vec::new();
+    for r in 0..h {
+        let mut line = String::new();
+        for c in 0..w {
+            if rng.next_f64() < density {
+                line.push('#');
+            } else {
+                line.push('.');
+                free.push((c, r));
+            }
+        }
+        rows.push(line);
+    }
+    if free.is_empty() {
+        return None;
+    }
+    let (c, r) = free[(rng.next_u64() % free.len() as u64) as usize];
+    Some((rows.join("\n"), c, r))
+}
+
+fn check_run(art: &str, col: usize, row: usize, theta: f64) {
+    let wd = world(art, col, row, theta);
+    let mut c = Checked {
+        p: BaStar::new(BaStarOptions::default()),
+        errors: Vec::new(),
+        criticals: 0,
+    };
+    let out = simulate(&wd, &mut c, &SimConfig::default());
+    assert!(c.errors.is_empty(), "{:?}\n{art}", c.errors);
+    let m = compute(&wd, &out, "random");
+    assert_eq!(m.coverage_rate, Some(1.0), "{m:?}\n{art}");
+    assert_eq!(m.collisions, 0);
+    assert_eq!(m.regions, m.backtracks + 1);
+    // Identical input, identical trace.
+    let (again, _, _) = run(&wd, BaStarOptions::default());
+    assert_eq!(out.trace, again.trace);
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig { cases: 64, ..Default::default() })]
+    #[test]
+    fn random_maps_are_covered(
+        w in 5usize..=60,
+        h in 5usize..=60,
+        density in 0.0f64..0.35,
+        seed in proptest::prelude::any::<u64>(),
+        heading in 0usize..4,
+    ) {
+        if let Some((art, c, r)) = random_art(w, h, density, seed) {
+            check_run(&art, c, r, heading as f64 * FRAC_PI_2);
+        }
+    }
+}
+
+#[test]
+fn block_room_with_checks() {
+    let art = "\
+        ..........\n\
+        ..........\n\
+        ...####...\n\
+        ...####...\n\
+        ...####...\n\
+        ..........\n\
+        ..........";
+    check_run(art, 0, 6, FRAC_PI_2);
+    check_run(art, 5, 0, 0.0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Online honesty.
+
+fn flip_unseen(wd: &World, p: &BaStar) -> World {
+    let known = p.known_map().unwrap();
+    let mut m = wd.map().clone();
+    let f = *m.frame();
+    for row in 0..f.height {
+        for col in 0..f.width {
+            if !known.is_seen(col, row) {
+                let v = if m.get(col, row).is_free() {
+                    Cell::Occupied
+                } else {
+                    Cell::Free
+                };
+                m.set(col, row, v);
+            }
+        }
+    }
+    World::new(m, wd.robot(), Some(wd.start())).unwrap()
+}
+
+#[test]
+fn trace_ignores_pixels_never_sensed() {
+    for seed in 0..6u64 {
+        let (art, c, r) = random_art(24, 18, 0.25, seed).unwrap();
+        // A sealed-off part behind a wall thicker than the sensor range.
+        let art: String = art
+            .lines()
+            .enumerate()
+            .map(|(i, l)| format!("{l}#####{}", if i % 3 == 0 { "..#.." } else { "....." }))
+            .collect::<Vec<_>>()
+            .join("\n");
+        let wd = world(&art, c, r, 0.0);
+        let (out, _, p) = run(&wd, BaStarOptions::default());
+        let flipped = flip_unseen(&wd, &p);
+        let unseen = p.known_map().unwrap().seen().count_zeroes(..);
+        assert!(unseen > 0);
+        let (out2, m2, _) = run(&flipped, BaStarOptions::default());
+        assert_eq!(out.trace, out2.trace, "seed {seed}");
+        assert_eq!(m2.collisions, 0);
+    }
+}
+
+#[test]
+fn smoothing_off_follows_the_raw_path() {
+    let art = "\
+        ..............\n\
+        ..##......##..\n\
+        ..##..##..##..\n\
+        ......##......\n\
+        ..............";
+    let wd = world(art, 0, 4, FRAC_PI_2);
+    let opts = BaStarOptions {
+        smoothing: false,
+        ..Default::default()
+    };
+    let (out, m, _) = run(&wd, opts);
+    assert_eq!(m.coverage_rate, Some(1.0));
+    let mut any = false;
+    let mut raw = None;
+    for (_, e) in out.trace.events() {
+        match e {
+            Event::PathRaw { points } => raw = Some(points.clone()),
+            Event::PathSmoothed { points } => {
+                assert_eq!(Some(points), raw.as_ref());
+                any = true;
+            }
+            _ => {}
+        }
+    }
+    assert!(any);
+    let (_, ms, _) = run(&wd, BaStarOptions::default());
+    assert!(ms.backtrack_length_m <= m.backtrack_length_m + 1e-9);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The three-valued motion judgement agrees with the known map's own checks.
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig { cases: 48, ..Default::default() })]
+    #[test]
+    fn judge_motion_matches_known_map(
+        seed in proptest::prelude::any::<u64>(),
+        r_px in 1.0f64..6.0,
+        range_px in 4.0f64..30.0,
+    ) {
+        use ccpp_core::planner::{KnownMap, Scan};
+        use ccpp_core::planners::ba_star::{judge_motion, Judgement};
+        let mut rng = ccpp_core::rng::SplitMix64::new(seed);
+        let (w, h) = (48usize, 40usize);
+        let res = 0.05;
+        let mut cells = vec![Cell::Free; w * h];
+        for c in &mut cells {
+            let u = rng.next_f64();
+            if u < 0.04 {
+                *c = Cell::Occupied;
+            } else if u < 0.05 {
+                *c = Cell::Unknown;
+            }
+        }
+        let truth = GridMap::new(ccpp_core::grid::MapFrame::new(w, h, res), cells).unwrap();
+        let mut known = KnownMap::new(truth.frame());
+        for _ in 0..3 {
+            let c = Point::new(rng.range(0.0, w as f64 * res), rng.range(0.0, h as f64 * res));
+            known.integrate(&Scan::new(&truth, c, range_px * res));
+        }
+        // Optimistic map: unseen pixels free.
+        let mut opt = truth.clone();
+        for row in 0..h {
+            for col in 0..w {
+                if !known.is_seen(col, row) {
+                    opt.set(col, row, Cell::Free);
+                }
+            }
+        }
+        let r = r_px * res;
+        for _ in 0..40 {
+            let a = Point::new(rng.range(-0.2, w as f64 * res + 0.2), rng.range(-0.2, h as f64 * res + 0.2));
+            let b = if rng.next_f64() < 0.3 {
+                a
+            } else {
+                Point::new(a.x + rng.range(-1.0, 1.0), a.y + rng.range(-1.0, 1.0))
+            };
+            let j = judge_motion(&known, a, b, r);
+            let pess = if a == b { known.disk_free(a, r) } else { known.segment_free(a, b, r) };
+            let f = *truth.frame();
+            let opt_blocked = ccpp_core::collide::segment_first_contact(
+                &opt, f.world_to_grid(a), f.world_to_grid(b), r / res).is_some();
+            proptest::prop_assert_eq!(j == Judgement::Free, pess, "{:?} {:?}", a, b);
+            proptest::prop_assert_eq!(j == Judgement::Blocked, opt_blocked, "{:?} {:?}", a, b);
+        }
+    }
+
+    #[test]
+    fn astar_cost_equals_dijkstra(seed in proptest::prelude::any::<u64>()) {
+        let mut rng = ccpp_core::rng::SplitMix64::new(seed);
+        let mut covered = Vec::new();
+        for j in 0..=8 {
+            for i in 0..=8 {
+                if rng.next_f64() < 0.7 {
+                    covered.push((i, j));
+                }
+            }
+        }
+        let g = Grid { covered: covered.clone() };
+        let mut s = TileSearch::new(g.bounds());
+        let from = covered[0];
+        for &to in &covered {
+            let d = s.nearest(&g, from, |t| t == to).map(|x| x.1);
+            let a = s.astar(&g, from, to);
+            proptest::prop_assert_eq!(d, a.as_ref().map(|x| x.1));
+            if let Some((p, _)) = a {
+                proptest::prop_assert_eq!(p[0], from);
+                proptest::prop_assert_eq!(*p.last().unwrap(), to);
+            }
+        }
+    }
+}
+
+/// Proptest counterexample (w 40, h 50, density 0.177, seed 16331919354862280521): a lane ends
+/// at walls on both sides next to an uncovered lane that runs past both ends, so no diagonal is
+/// blocked and the paper's six pairs never put it in L.
+#[test]
+fn lane_end_extension_completes_the_paper_mu() {
+    let (art, c, r) =
+        random_art(40, 50, 0.177_443_441_716_639_53, 16_331_919_354_862_280_521).unwrap();
+    let wd = world(&art, c, r, 0.0);
+    let paper = BaStarOptions {
+        lane_end_corners: false,
+        ..Default::default()
+    };
+    let (_, m, p) = run(&wd, paper);
+    assert!(m.coverage_rate.unwrap() < 1.0);
+    assert!(p.frontier_without_candidates());
+    check_run(&art, c, r, 0.0);
+}
+
+/// Proptest counterexample (w 37, h 38, density 0.211, seed 2993061010301113817): the start
+/// tile sits between two walls; BM goes north first and leaves its free south neighbour, whose
+/// diagonals are free, so the paper's pairs never see it.
+#[test]
+fn start_tile_south_neighbour_is_a_candidate() {
+    let (art, c, r) =
+        random_art(37, 38, 0.211_171_978_379_263_02, 2_993_061_010_301_113_817).unwrap();
+    let wd = world(&art, c, r, 0.0);
+    let paper = BaStarOptions {
+        lane_end_corners: false,
+        ..Default::default()
+    };
+    let (_, m, p) = run(&wd, paper);
+    assert!(m.coverage_rate.unwrap() < 1.0);
+    assert!(p.frontier_without_candidates());
+    check_run(&art, c, r, 0.0);
+    // The smallest form: a start in a 1-wide N-S corridor, in the middle.
+    let art = "#.#\n#.#\n#.#\n#.#\n#.#";
+    check_run(art, 1, 2, 0.0);
+}
