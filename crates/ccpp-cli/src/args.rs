@@ -90,6 +90,12 @@ pub struct RunArgs {
     /// Sensor range in metres (default 4 r).
     #[arg(long, value_name = "M")]
     pub sensor_range: Option<f64>,
+    /// Tile side in metres for tile planners (default 2 r).
+    #[arg(long, value_name = "M")]
+    pub tile_side: Option<f64>,
+    /// BA* backtracking path smoothing (A*SPT): `on` (default) or `off` to compare.
+    #[arg(long, value_name = "on|off", value_parser = parse_on_off)]
+    pub smoothing: Option<bool>,
     /// Output folder.
     #[arg(long, value_name = "DIR", default_value = "ccpp-out")]
     pub out: PathBuf,
@@ -207,4 +213,13 @@ fn parse_triple(s: &str) -> Result<[f64; 3], String> {
         v[k] = x;
     }
     Ok(v)
+}
+
+/// Parses `on`/`off` (also `true`/`false`, `1`/`0`).
+fn parse_on_off(s: &str) -> Result<bool, String> {
+    match s.to_ascii_lowercase().as_str() {
+        "on" | "true" | "1" | "yes" => Ok(true),
+        "off" | "false" | "0" | "no" => Ok(false),
+        _ => Err(format!("expected on or off, got {s:?}")),
+    }
 }

@@ -13,7 +13,7 @@ use ccpp_io::map::{load_map, load_map_bytes, LoadOptions};
 use crate::args::{DemoArgs, MapArgs, RobotArgs, RunArgs};
 
 /// The planner `ccpp demo` runs.
-pub const FLAGSHIP: &str = "random-bounce";
+pub const FLAGSHIP: &str = "ba-star";
 
 const DEMO_YAML: &str = include_str!("../assets/aws_small_house.yaml");
 const DEMO_IMAGE: &[u8] = include_bytes!("../assets/aws_small_house.pgm");
@@ -212,6 +212,13 @@ impl Job {
         };
         if let Some(seed) = a.seed {
             options.random_bounce.seed = seed;
+        }
+        if let Some(t) = a.tile_side {
+            check_metres("--tile-side", t)?;
+            options.ba_star.tile_side_m = Some(t);
+        }
+        if let Some(s) = a.smoothing {
+            options.ba_star.smoothing = s;
         }
         let map = prepare_map(&a.map)?;
         Ok(Self {
