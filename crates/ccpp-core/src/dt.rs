@@ -19,40 +19,64 @@ pub fn squared_edt(
     border_is_feature: bool,
 ) -> Vec<u32> {
     let n = width * height;
-    let mut out = vec![INF; n];
     if n == 0 {
-        return out;
+        return Vec::new();
     }
-    let big = (width.max(height) as f64 + 2.0).powi(2) * 4.0;
-    // Pass 1: columns, 1-D distance to the nearest feature in the same column.
-    let mut f = vec![0f64; height.max(width)];
-    let mut d = vec![0f64; height.max(width)];
-    let mut v = vec![0usize; height.max(width)];
-    let mut z = vec![0f64; height.max(width) + 1];
-    let mut col_d = vec![f64::INFINITY; n];
-    for c in 0..width {
-        for r in 0..height {
-            f[r] = if is_feature(r * width + c) { 0.0 } else { big };
-        }
-        dt1d(&f[..height], &mut d[..height], &mut v, &mut z);
-        for r in 0..height {
-            col_d[r * width + c] = d[r];
-        }
-    }
-    // Pass 2: rows.
+    // Phase 1 (Meijster et al.): distance to the nearest feature in the same column, in two
+    // row-order sweeps (cache friendly). `NONE` = no feature in the column.
+    const NONE: u32 = u32::MAX / 4;
+    let mut g = vec![NONE; n];
+    let edge = if border_is_feature { 0 } else { NONE };
     for r in 0..height {
-        f[..width].copy_from_slice(&col_d[r * width..(r + 1) * width]);
-        dt1d(&f[..width], &mut d[..width], &mut v, &mut z);
+        for c in 0..width {
+            let i = r * width + c;
+            g[i] = if is_feature(i) {
+                0
+            } else if r == 0 {
+                edge.saturating_add(1).min(NONE)
+            } else {
+                (g[i - width] + 1).min(NONE)
+            };
+        }
+    }
+    for r in (0..height).rev() {
+        for c in 0..width {
+            let i = r * width + c;
+            let below = if r + 1 == height {
+                edge.saturating_add(1).min(NONE)
+            } else {
+                (g[i + width] + 1).min(NONE)
+            };
+            if below < g[i] {
+                g[i] = below;
+            }
+        }
+    }
+    // Phase 2 (Felzenszwalb-Huttenlocher lower envelope) along each row.
+    let big = (width.max(height) as f64 + 2.0).powi(2) * 4.0;
+    let mut f = vec![0f64; width];
+    let mut d = vec![0f64; width];
+    let mut v = vec![0usize; width];
+    let mut z = vec![0f64; width + 1];
+    let mut out = vec![INF; n];
+    for r in 0..height {
+        let row = &g[r * width..(r + 1) * width];
+        for (fc, &gc) in f.iter_mut().zip(row) {
+            *fc = if gc >= NONE {
+                big
+            } else {
+                f64::from(gc) * f64::from(gc)
+            };
+        }
+        dt1d(&f, &mut d, &mut v, &mut z);
+        let o = &mut out[r * width..(r + 1) * width];
         for c in 0..width {
             let mut best = d[c];
             if border_is_feature {
-                let b = [(c + 1), (width - c), (r + 1), (height - r)]
-                    .into_iter()
-                    .min()
-                    .unwrap_or(1) as f64;
+                let b = (c + 1).min(width - c) as f64;
                 best = best.min(b * b);
             }
-            out[r * width + c] = if best >= big { INF } else { best as u32 };
+            o[c] = if best >= big { INF } else { best as u32 };
         }
     }
     out
