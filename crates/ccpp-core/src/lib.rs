@@ -11,9 +11,12 @@
 
 pub mod collide;
 pub mod dt;
+pub mod exec;
 pub mod geometry;
 pub mod grid;
+pub mod georef;
 pub mod inflate;
+pub mod landmarks;
 pub mod metrics;
 pub mod planner;
 pub mod planners;
