@@ -1,7 +1,9 @@
 //! The coverage planners, one module each, behind the [`Planner`](crate::planner::Planner) trait,
 //! and the catalogue that builds them by name.
 
+pub mod bsa_bfs;
 pub mod random_bounce;
+pub mod rect_boustrophedon;
 
 use serde::{Deserialize, Serialize};
 
@@ -20,11 +22,23 @@ pub struct PlannerInfo {
 }
 
 /// Every planner ccpp knows.
-pub const CATALOG: &[PlannerInfo] = &[PlannerInfo {
-    name: "random-bounce",
-    description: "Roomba-like baseline: straight until the sensed obstacle, seeded random turn, distance budget (online)",
-    offline: false,
-}];
+pub const CATALOG: &[PlannerInfo] = &[
+    PlannerInfo {
+        name: "random-bounce",
+        description: "Roomba-like baseline: straight until the sensed obstacle, seeded random turn, distance budget (online)",
+        offline: false,
+    },
+    PlannerInfo {
+        name: "bsa-bfs",
+        description: "Vacuum-robot BSA (seed 003): cells +x,+y,-x,-y, return-cell stack, BFS return over visited cells, PID execution (online)",
+        offline: false,
+    },
+    PlannerInfo {
+        name: "rect-boustrophedon",
+        description: "Known-map lane waypoints for a rectangular robot (seed 001): lanes b apart, waypoints every l, blocked edges joined by clearance A* (offline)",
+        offline: true,
+    },
+];
 
 /// Options of every planner, one section each (the single source of truth for CLI, config
 /// files and bindings).
@@ -33,6 +47,10 @@ pub const CATALOG: &[PlannerInfo] = &[PlannerInfo {
 pub struct PlannerOptions {
     /// `random-bounce`.
     pub random_bounce: random_bounce::RandomBounceOptions,
+    /// `bsa-bfs`.
+    pub bsa_bfs: bsa_bfs::BsaBfsOptions,
+    /// `rect-boustrophedon`.
+    pub rect_boustrophedon: rect_boustrophedon::RectOptions,
 }
 
 /// Error building a planner.
@@ -62,6 +80,11 @@ pub fn build(
             }
             Ok(Box::new(random_bounce::RandomBounce::new(o)))
         }
+        "bsa-bfs" => Ok(Box::new(bsa_bfs::BsaBfs::new(opts.bsa_bfs.clone()))),
+        "rect-boustrophedon" => Ok(Box::new(rect_boustrophedon::RectBoustrophedon::new(
+            world,
+            &opts.rect_boustrophedon,
+        ))),
         other => Err(BuildError::Unknown(other.to_string())),
     }
 }
