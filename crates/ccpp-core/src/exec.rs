@@ -19,11 +19,21 @@
 //!
 //! For a segment `from -> to` the tracker aims at the point `lookahead_m` ahead of the robot's
 //! projection on the segment (clamped to `to`), so a robot that starts or drifts off the line
-//! steers back onto it. The heading error to that aim point drives the angular PID. While the
-//! heading error exceeds `align_rad` the robot turns in place (`v = 0`); otherwise the linear
-//! PID acts on the remaining distance along the segment, scaled by `cos(heading error)`. The
-//! goal is reached when the estimate is within `tolerance_m` of `to`. A heading goal is reached
-//! when the heading error is below `heading_tolerance_rad`.
+//! steers back onto it. The heading error to that aim point drives the angular PID. A motion
+//! starts by turning in place (`v = 0`) until the heading error is below
+//! `heading_tolerance_rad`, and turns in place again whenever it exceeds `align_rad`; otherwise
+//! the linear PID acts on the remaining distance along the segment, scaled by
+//! `cos(heading error)`. The goal is reached when the estimate is within `tolerance_m` of `to`.
+//! A heading goal is reached when the heading error is below `heading_tolerance_rad`.
+//!
+//! Both commands are shaped for arrival: at least a creep value (`min_speed_mps`,
+//! `min_turn_rate`) so the approach ends in finite time, and never more than `error / dt`, so a
+//! control period never overshoots (the last period lands on the goal). Without noise the robot
+//! therefore stops **on** its waypoint and turns to the exact heading, and the defaults use tight
+//! tolerances (`1e-6` m, `1e-9` rad): the shared maps contain cells and moves whose clearance to
+//! the wall is exactly zero at `r = 0.15` m (a disk tangent to an obstacle pixel), and a robot
+//! that leaves such a line by a micrometre touches the wall. Seed 001's real robot used 3-4 cm;
+//! raise `tolerance_m` to model that (and expect contacts on tight maps).
 //!
 //! # Example: a step response
 //!
@@ -180,6 +190,10 @@ pub struct PidOptions {
     pub heading_tolerance_rad: f64,
     /// Above this heading error the robot turns in place before driving, radians.
     pub align_rad: f64,
+    /// Creep speed: the linear command is at least this (m/s) while the goal is not reached.
+    pub min_speed_mps: f64,
+    /// Creep turn rate: the angular command is at least this (rad/s) while turning in place.
+    pub min_turn_rate: f64,
     /// Aim point distance ahead of the robot's projection on the segment, metres.
     pub lookahead_m: f64,
     /// Record the true pose in the trace every this many control steps (the end of every motion
@@ -210,9 +224,11 @@ impl Default for PidOptions {
                 output_limit: 2.0,
                 integral_limit: 0.5,
             },
-            tolerance_m: 0.005,
-            heading_tolerance_rad: 0.002,
-            align_rad: 0.02,
+            tolerance_m: 1e-6,
+            heading_tolerance_rad: 1e-9,
+            align_rad: 0.05,
+            min_speed_mps: 0.02,
+            min_turn_rate: 0.05,
             lookahead_m: 0.05,
             record_every: 1,
             max_steps_per_motion: 20_000,
@@ -230,6 +246,17 @@ pub enum Execution {
     Ideal,
     /// PID tracking on a unicycle model stepped at `dt_s`.
     Pid(PidOptions),
+}
+
+/// Shapes a command `u` for an error `err`: at least `min` in the error's direction, at most
+/// `|err| / dt` (no overshoot within one period).
+fn arrive(u: f64, err: f64, min: f64, dt: f64) -> f64 {
+    let mut u = u;
+    if u.abs() < min || u.signum() != err.signum() {
+        u = min.max(u.abs()) * err.signum();
+    }
+    let cap = err.abs() / dt;
+    u.clamp(-cap, cap)
 }
 
 /// The unicycle (differential-drive) kinematics `x' = v cos(theta)`, `y' = v sin(theta)`,
@@ -281,6 +308,8 @@ pub struct Tracker {
     opts: PidOptions,
     linear: Pid,
     angular: Pid,
+    /// Turning in place until the heading error is below `heading_tolerance_rad`.
+    aligning: bool,
 }
 
 impl Tracker {
@@ -290,6 +319,7 @@ impl Tracker {
             opts: *opts,
             linear: Pid::new(opts.linear),
             angular: Pid::new(opts.angular),
+            aligning: true,
         }
     }
 
@@ -297,6 +327,7 @@ impl Tracker {
     pub fn reset(&mut self) {
         self.linear.reset();
         self.angular.reset();
+        self.aligning = true;
     }
 
     /// The next command for `goal` at estimate `est`, or `None` when the goal is reached.
@@ -308,7 +339,8 @@ impl Tracker {
                 if err.abs() < o.heading_tolerance_rad {
                     return None;
                 }
-                Some((0.0, self.angular.update(err, o.dt_s)))
+                let w = self.angular.update(err, o.dt_s);
+                Some((0.0, arrive(w, err, o.min_turn_rate, o.dt_s)))
             }
             Goal::Segment { from, to, reverse } => {
                 let p = est.position();
@@ -343,14 +375,20 @@ impl Tracker {
                     bearing += std::f64::consts::PI;
                 }
                 let err = wrap_angle(bearing - est.theta);
-                let omega = self.angular.update(err, o.dt_s);
-                if err.abs() > o.align_rad {
+                let omega = arrive(self.angular.update(err, o.dt_s), err, 0.0, o.dt_s);
+                if self.aligning && err.abs() < o.heading_tolerance_rad {
+                    self.aligning = false;
+                } else if !self.aligning && err.abs() > o.align_rad {
+                    self.aligning = true;
+                }
+                if self.aligning {
                     self.linear.reset();
-                    return Some((0.0, omega));
+                    return Some((0.0, arrive(omega, err, o.min_turn_rate, o.dt_s)));
                 }
                 // Remaining distance: along the segment, or straight to the goal once past it.
                 let remaining = if along > 0.0 { along } else { dist };
-                let v = self.linear.update(remaining, o.dt_s).max(0.0) * err.cos();
+                let v = self.linear.update(remaining, o.dt_s);
+                let v = arrive(v, remaining, o.min_speed_mps, o.dt_s).max(0.0) * err.cos();
                 Some((if reverse { -v } else { v }, omega))
             }
         }

@@ -35,7 +35,7 @@ fn main() {
     };
     maps.sort();
     println!(
-        "| map | planner | coverage_rate | effective_coverage | collisions | tracking mean / max (mm) | rect_guarantee | wall s |"
+        "| map | planner | coverage_rate | effective_coverage | collisions | tracking mean / max (µm) | rect_guarantee | wall s |"
     );
     println!("|---|---|---|---|---|---|---|---|");
     for path in &maps {
@@ -67,15 +67,15 @@ fn main() {
             let mut run = simulate(&world, p.as_mut(), &SimConfig::default());
             run.wall_time_s = started.elapsed().as_secs_f64();
             let m = metrics::compute(&world, &run, &name);
-            let f = |v: Option<f64>, k: f64| v.map_or_else(|| "-".to_string(), |x| format!("{:.2}", x * k));
+            let f = |v: Option<f64>, k: f64| v.map_or_else(|| "-".to_string(), |x| format!("{:.3}", x * k));
             println!(
                 "| {name} | {planner} | {} | {:.4} | {} | {} / {} | {} | {:.2} |",
                 m.coverage_rate.map_or_else(|| "-".to_string(), |c| format!("{c:.4}")),
                 m.effective_coverage,
                 m.collisions,
-                f(m.tracking_error_mean_m, 1000.0),
-                f(m.tracking_error_max_m, 1000.0),
-                f(m.rect_guarantee, 1.0),
+                f(m.tracking_error_mean_m, 1e6),
+                f(m.tracking_error_max_m, 1e6),
+                m.rect_guarantee.map_or_else(|| "-".to_string(), |g| format!("{g:.6}")),
                 m.wall_time_s,
             );
         }
