@@ -269,11 +269,7 @@ impl Unicycle {
         let th1 = p.theta + omega * dt;
         if (omega * dt).abs() < 1e-9 {
             let th = p.theta + 0.5 * omega * dt;
-            Pose::new(
-                p.x + v * dt * th.cos(),
-                p.y + v * dt * th.sin(),
-                th1,
-            )
+            Pose::new(p.x + v * dt * th.cos(), p.y + v * dt * th.sin(), th1)
         } else {
             let k = v / omega;
             Pose::new(
@@ -485,6 +481,9 @@ mod tests {
         for _ in 0..100 {
             p = Unicycle::step(p, 1.0, 1.0, std::f64::consts::FRAC_PI_2 / 100.0);
         }
-        assert!((p.x - 1.0).abs() < 1e-9 && (p.y - 1.0).abs() < 1e-9, "{p:?}");
+        assert!(
+            (p.x - 1.0).abs() < 1e-9 && (p.y - 1.0).abs() < 1e-9,
+            "{p:?}"
+        );
     }
 }

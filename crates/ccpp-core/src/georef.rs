@@ -162,7 +162,10 @@ pub fn fit_affine(pairs: &[(Point, Point)]) -> Result<AffineFit, GeorefError> {
         wc.y - (m[2] * pc.x + m[3] * pc.y),
     ];
     let affine = Affine { m, t };
-    let residuals: Vec<f64> = pairs.iter().map(|(p, w)| affine.apply(*p).dist(*w)).collect();
+    let residuals: Vec<f64> = pairs
+        .iter()
+        .map(|(p, w)| affine.apply(*p).dist(*w))
+        .collect();
     let rms_residual = (residuals.iter().map(|r| r * r).sum::<f64>() / n).sqrt();
     let max_residual = residuals.iter().copied().fold(0.0, f64::max);
     Ok(AffineFit {
@@ -212,11 +215,18 @@ mod tests {
             .map(|_| {
                 let p = Point::new(rng.range(0.0, 200.0), rng.range(0.0, 200.0));
                 let w = truth.apply(p);
-                (p, Point::new(w.x + 0.01 * rng.gaussian(), w.y + 0.01 * rng.gaussian()))
+                (
+                    p,
+                    Point::new(w.x + 0.01 * rng.gaussian(), w.y + 0.01 * rng.gaussian()),
+                )
             })
             .collect();
         let fit = fit_affine(&pairs).unwrap();
-        assert!(fit.rms_residual > 0.003 && fit.rms_residual < 0.03, "{}", fit.rms_residual);
+        assert!(
+            fit.rms_residual > 0.003 && fit.rms_residual < 0.03,
+            "{}",
+            fit.rms_residual
+        );
         assert!((fit.affine.m[0] - 0.05).abs() < 1e-3);
         assert_eq!(fit.residuals.len(), 40);
     }

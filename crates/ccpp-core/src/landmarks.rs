@@ -1,6 +1,6 @@
 //! Pose correction from **non-unique** landmarks (seed 001).
 //!
-//! Seed 001 localizes a Jetbot with AprilTags whose ids repeat: every tag bearing the seen id
+//! Seed 001 localizes a Jetbot with `AprilTags` whose ids repeat: every tag bearing the seen id
 //! implies one candidate global pose of the robot (tag pose in the world composed with the
 //! inverse of the tag's pose relative to the robot), and the candidate **closest to the
 //! odometry estimate** is taken as the robot's pose. The choice is right whenever the odometry

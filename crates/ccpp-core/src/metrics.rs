@@ -89,9 +89,7 @@ pub fn tracking_error(trace: &Trace) -> Option<(f64, f64)> {
             Record::Event { .. } => {}
         }
     }
-    if seg.is_none() {
-        return None;
-    }
+    seg?;
     Some((if n == 0 { 0.0 } else { sum / n as f64 }, max))
 }
 

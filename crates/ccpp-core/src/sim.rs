@@ -322,7 +322,7 @@ impl<'w> Simulator<'w> {
         self.bumped = false;
         let mut contact = false;
         let mut moved = false;
-        let mut k = 0u64;
+        let mut since_record = 0u64;
         for _ in 0..st.opts.max_steps_per_motion {
             let Some((v, w)) = st.tracker.command(self.est, goal) else {
                 break;
@@ -346,14 +346,21 @@ impl<'w> Simulator<'w> {
             } else {
                 self.world.first_contact(a, b)
             };
-            k += 1;
             if let Some(t) = hit {
                 let p = a + (b - a).scale(t);
                 // The estimate advances by the same fraction of its own motion.
                 let e0 = self.est.position();
                 let e = e0 + (new_est.position() - e0).scale(t);
-                self.pose = Pose::new(p.x, p.y, self.pose.theta + t * wrap_angle(new_true.theta - self.pose.theta));
-                self.est = Pose::new(e.x, e.y, self.est.theta + t * wrap_angle(new_est.theta - self.est.theta));
+                self.pose = Pose::new(
+                    p.x,
+                    p.y,
+                    self.pose.theta + t * wrap_angle(new_true.theta - self.pose.theta),
+                );
+                self.est = Pose::new(
+                    e.x,
+                    e.y,
+                    self.est.theta + t * wrap_angle(new_est.theta - self.est.theta),
+                );
                 if t > 0.0 {
                     self.trace.push_pose(self.t, self.pose);
                 }
@@ -365,7 +372,9 @@ impl<'w> Simulator<'w> {
             self.pose = new_true;
             self.est = new_est;
             moved = true;
-            if k % every == 0 {
+            since_record += 1;
+            if since_record >= every {
+                since_record = 0;
                 self.trace.push_pose(self.t, self.pose);
                 moved = false;
             }
@@ -379,7 +388,11 @@ impl<'w> Simulator<'w> {
             self.trace.push_pose(self.t, self.pose);
         }
         self.bumped = contact;
-        st.anchor = if contact { None } else { next_anchor.or(st.anchor) };
+        st.anchor = if contact {
+            None
+        } else {
+            next_anchor.or(st.anchor)
+        };
         self.pid = Some(st);
     }
 
@@ -443,6 +456,8 @@ impl<'w> Simulator<'w> {
     }
 }
 
+// `pose` is the estimate by design: the planner sees odometry/localization, not the truth.
+#[allow(clippy::misnamed_getters)]
 impl Sensor for Simulator<'_> {
     fn frame(&self) -> &MapFrame {
         self.world.frame()
@@ -507,5 +522,124 @@ mod tests {
                 .count(),
             1
         );
+    }
+
+    use crate::exec::{OdometryNoise, PidOptions};
+    use crate::landmarks::Landmark;
+
+    fn big_room() -> World {
+        // 8 m x 8 m at 0.05 m/px with a 1-pixel wall; start in the middle.
+        let mut art = String::new();
+        for r in 0..160 {
+            for c in 0..160 {
+                art.push(if r == 0 || c == 0 || r == 159 || c == 159 {
+                    '#'
+                } else {
+                    '.'
+                });
+            }
+            art.push('\n');
+        }
+        let map = GridMap::from_ascii_scaled(&art, 1, 0.05).unwrap();
+        World::new(map, Robot::new(0.15), Some(Pose::new(4.0, 4.0, 0.0))).unwrap()
+    }
+
+    fn square(n: usize) -> Vec<Step> {
+        let mut v = Vec::new();
+        for _ in 0..n {
+            for (x, y) in [(5.0, 4.0), (5.0, 5.0), (4.0, 5.0), (4.0, 4.0)] {
+                v.push(Step::MoveTo(Point::new(x, y)));
+            }
+        }
+        v
+    }
+
+    fn pid(noise: Option<OdometryNoise>) -> SimConfig {
+        SimConfig {
+            exec: Some(Execution::Pid(PidOptions {
+                noise,
+                ..PidOptions::default()
+            })),
+            ..SimConfig::default()
+        }
+    }
+
+    #[test]
+    fn square_is_tracked_with_bounded_error() {
+        let world = big_room();
+        let out = simulate(&world, &mut Script(square(2)), &pid(None));
+        let m = crate::metrics::compute(&world, &out, "room");
+        assert_eq!(m.collisions, 0);
+        let (mean, max) = crate::metrics::tracking_error(&out.trace).unwrap();
+        assert!(max < 1e-6, "max tracking error {max}");
+        assert!(mean <= max);
+        assert_eq!(m.tracking_error_max_m, Some(max));
+        // Two laps of 4 m, and the turns are in place.
+        assert!((m.path_length_m - 8.0).abs() < 1e-4, "{}", m.path_length_m);
+        let end = out.trace.poses().last().unwrap();
+        assert!(end.position().dist(Point::new(4.0, 4.0)) < 1e-6);
+        // A coarse tolerance still tracks the square within it (plus the lateral overshoot of
+        // the corner, bounded by the tolerance too).
+        let coarse = SimConfig {
+            exec: Some(Execution::Pid(PidOptions {
+                tolerance_m: 0.03,
+                heading_tolerance_rad: 0.01,
+                ..PidOptions::default()
+            })),
+            ..SimConfig::default()
+        };
+        let out = simulate(&world, &mut Script(square(1)), &coarse);
+        let (_, max) = crate::metrics::tracking_error(&out.trace).unwrap();
+        assert!(max < 0.03 + 1e-9, "coarse max {max}");
+    }
+
+    #[test]
+    fn noise_is_seeded_and_reproducible() {
+        let world = big_room();
+        let noise = |seed| {
+            Some(OdometryNoise {
+                seed,
+                ..OdometryNoise::default()
+            })
+        };
+        let a = simulate(&world, &mut Script(square(2)), &pid(noise(5)));
+        let b = simulate(&world, &mut Script(square(2)), &pid(noise(5)));
+        let c = simulate(&world, &mut Script(square(2)), &pid(noise(6)));
+        assert_eq!(a.trace, b.trace);
+        assert_ne!(a.trace, c.trace);
+        // The truth left the planned square while the estimate followed it.
+        let (_, max) = crate::metrics::tracking_error(&a.trace).unwrap();
+        assert!(max > 1e-3, "{max}");
+    }
+
+    /// Drift of the truth from the planned path after `laps` laps, with or without landmarks.
+    fn final_drift(landmarks: Vec<Landmark>, laps: usize) -> f64 {
+        let world = big_room();
+        let mut cfg = pid(Some(OdometryNoise {
+            seed: 11,
+            linear_rel_std: 0.05,
+            angular_rel_std: 0.05,
+            heading_drift_std: 0.3,
+        }));
+        cfg.landmarks.landmarks = landmarks;
+        cfg.landmarks.range_m = 2.0;
+        let mut sim = Simulator::new(&world, &cfg);
+        let mut worst: f64 = 0.0;
+        for step in square(laps) {
+            sim.execute(step);
+            let d = sim.true_pose().position().dist(sim.estimate().position());
+            worst = worst.max(d);
+        }
+        worst
+    }
+
+    #[test]
+    fn landmarks_bound_the_drift() {
+        // Two tags with the same id at opposite corners of the square (1.41 m apart).
+        let tags = vec![Landmark::new(4, 4.0, 4.0), Landmark::new(4, 5.0, 5.0)];
+        let without = final_drift(Vec::new(), 12);
+        let with = final_drift(tags, 12);
+        assert!(without > 0.1, "dead reckoning should drift: {without}");
+        assert!(with < 0.05, "landmarks should bound it: {with}");
     }
 }

@@ -10,7 +10,7 @@ use ccpp_core::metrics;
 use ccpp_core::planners::{self, PlannerOptions};
 use ccpp_core::sim::{simulate, SimConfig};
 use ccpp_core::world::{Robot, World};
-use ccpp_io::load_map;
+use ccpp_io::{load_map, LoadOptions};
 
 fn main() {
     let mut args = std::env::args().skip(1);
@@ -39,8 +39,10 @@ fn main() {
     );
     println!("|---|---|---|---|---|---|---|---|");
     for path in &maps {
-        let name = path.file_stem().map_or_else(String::new, |s| s.to_string_lossy().into_owned());
-        let grid = match load_map(path, &Default::default()) {
+        let name = path
+            .file_stem()
+            .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+        let grid = match load_map(path, &LoadOptions::default()) {
             Ok(m) => m.grid,
             Err(e) => {
                 println!("| {name} | - | load error: {e} |");
@@ -67,15 +69,19 @@ fn main() {
             let mut run = simulate(&world, p.as_mut(), &SimConfig::default());
             run.wall_time_s = started.elapsed().as_secs_f64();
             let m = metrics::compute(&world, &run, &name);
-            let f = |v: Option<f64>, k: f64| v.map_or_else(|| "-".to_string(), |x| format!("{:.3}", x * k));
+            let f = |v: Option<f64>, k: f64| {
+                v.map_or_else(|| "-".to_string(), |x| format!("{:.3}", x * k))
+            };
             println!(
                 "| {name} | {planner} | {} | {:.4} | {} | {} / {} | {} | {:.2} |",
-                m.coverage_rate.map_or_else(|| "-".to_string(), |c| format!("{c:.4}")),
+                m.coverage_rate
+                    .map_or_else(|| "-".to_string(), |c| format!("{c:.4}")),
                 m.effective_coverage,
                 m.collisions,
                 f(m.tracking_error_mean_m, 1e6),
                 f(m.tracking_error_max_m, 1e6),
-                m.rect_guarantee.map_or_else(|| "-".to_string(), |g| format!("{g:.6}")),
+                m.rect_guarantee
+                    .map_or_else(|| "-".to_string(), |g| format!("{g:.6}")),
                 m.wall_time_s,
             );
         }

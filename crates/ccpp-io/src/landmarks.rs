@@ -1,5 +1,5 @@
 //! `--landmarks FILE`: landmarks for the simulator's pose correction
-//! ([`ccpp_core::landmarks`], seed 001's non-unique AprilTags).
+//! ([`ccpp_core::landmarks`], seed 001's non-unique `AprilTags`).
 //!
 //! Two formats, chosen by content: a JSON array of `{"id": 1, "x": 2.0, "y": 3.0}` objects
 //! (optional `"theta"`, radians), or CSV lines `id,x,y[,theta]` (commas, semicolons or
@@ -125,10 +125,27 @@ mod tests {
     #[test]
     fn csv_and_json() {
         let l = parse_landmarks("# tags\n1 0 0\n2;1.5;-2;0.5\n").unwrap();
-        assert_eq!(l, vec![Landmark::new(1, 0.0, 0.0), Landmark { id: 2, x: 1.5, y: -2.0, theta: 0.5 }]);
+        assert_eq!(
+            l,
+            vec![
+                Landmark::new(1, 0.0, 0.0),
+                Landmark {
+                    id: 2,
+                    x: 1.5,
+                    y: -2.0,
+                    theta: 0.5
+                }
+            ]
+        );
         let e = parse_landmarks("1,0,0\n-1,0,0\n").unwrap_err();
-        assert!(matches!(e, LandmarkFileError::BadLine { line: 2, .. }), "{e}");
-        assert!(matches!(parse_landmarks("[{\"id\":1}]"), Err(LandmarkFileError::Json(_))));
+        assert!(
+            matches!(e, LandmarkFileError::BadLine { line: 2, .. }),
+            "{e}"
+        );
+        assert!(matches!(
+            parse_landmarks("[{\"id\":1}]"),
+            Err(LandmarkFileError::Json(_))
+        ));
         assert!(parse_landmarks("").unwrap().is_empty());
     }
 

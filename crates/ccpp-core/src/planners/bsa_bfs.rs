@@ -7,7 +7,7 @@
 //!   order `+x, +y, -x, -y` of cell indices, give the next cell (the first) and **return cells**
 //!   (the others, pushed on a stack);
 //! * at a dead end (a *critical* cell) pops return cells until an unvisited one and switches to
-//!   **BFS_PLAN**: a breadth-first search over visited cells from the critical cell to it, whose
+//!   **`BFS_PLAN`**: a breadth-first search over visited cells from the critical cell to it, whose
 //!   path is spliced into the plan;
 //! * **MOVE** executes the plan cell to cell with linear and angular PID controllers;
 //! * **FINISHED** when no return cell is left.
@@ -391,7 +391,10 @@ impl Planner for BsaBfs {
     }
 
     fn tile_side(&self) -> Option<f64> {
-        self.cells.as_ref().map(|c| c.side).or(self.opts.cell_side_m)
+        self.cells
+            .as_ref()
+            .map(|c| c.side)
+            .or(self.opts.cell_side_m)
     }
 
     fn preferred_execution(&self) -> Option<Execution> {
@@ -475,7 +478,11 @@ mod tests {
 
     #[test]
     fn ascii_maps_full_coverage_no_collision_under_pid() {
-        for (art, name) in [(EMPTY, "empty"), (BLOCKS, "blocks"), (TWO_ROOMS, "two rooms")] {
+        for (art, name) in [
+            (EMPTY, "empty"),
+            (BLOCKS, "blocks"),
+            (TWO_ROOMS, "two rooms"),
+        ] {
             let m = run(art, 10, None);
             assert_eq!(m.coverage_rate, Some(1.0), "{name}: {m:?}");
             assert_eq!(m.collisions, 0, "{name}");
@@ -524,7 +531,11 @@ mod tests {
         for r in 0..h {
             for c in 0..w {
                 let border = r == 0 || c == 0 || r == h - 1 || c == w - 1;
-                s.push(if border || rng.next_f64() < density { '#' } else { '.' });
+                s.push(if border || rng.next_f64() < density {
+                    '#'
+                } else {
+                    '.'
+                });
             }
             s.push('\n');
         }

@@ -1,6 +1,6 @@
 //! `rect-boustrophedon`: known-map lane waypoints for a rectangular robot (seed 001), offline.
 //!
-//! Seed 001 (a Jetbot homework on coverage with non-unique AprilTag landmarks) covers a
+//! Seed 001 (a Jetbot homework on coverage with non-unique `AprilTag` landmarks) covers a
 //! rectangle `(0,0)-(w,h)` with a robot of length `l` and width `b`: waypoints every `l` along
 //! x, lanes `b` apart, direction alternating, the last lane clamped to `y = h`; lane edges that
 //! cross an obstacle are dropped and the pieces joined by collision-free shortest paths (the seed
@@ -98,8 +98,8 @@ impl Default for RectOptions {
 /// and odd lanes -x. Degenerate input (non-positive sizes, empty area) gives no lane.
 pub fn lanes(area: [f64; 4], length: f64, width: f64) -> Vec<Vec<Point>> {
     let [x0, y0, x1, y1] = area;
-    if !(length > 0.0 && width > 0.0 && x1 >= x0 && y1 >= y0) || !area.iter().all(|v| v.is_finite())
-    {
+    let ok = length > 0.0 && width > 0.0 && x1 >= x0 && y1 >= y0;
+    if !(ok && area.iter().all(|v| v.is_finite())) {
         return Vec::new();
     }
     let steps = |lo: f64, hi: f64, d: f64| -> Vec<f64> {
@@ -247,9 +247,7 @@ impl<'a> Roadmap<'a> {
     fn valid(&self, p: Point) -> bool {
         let f = self.w.frame();
         match f.pixel_of(p) {
-            Some((c, r)) => {
-                self.w.reachable().contains(f.index(c, r)) && !self.w.disk_collides(p)
-            }
+            Some((c, r)) => self.w.reachable().contains(f.index(c, r)) && !self.w.disk_collides(p),
             None => false,
         }
     }
@@ -340,7 +338,8 @@ impl<'a> Roadmap<'a> {
                 }
                 let diag = dc != 0 && dr != 0;
                 if diag
-                    && !(reach.contains((r * w + nc) as usize) && reach.contains((nr * w + c) as usize))
+                    && !(reach.contains((r * w + nc) as usize)
+                        && reach.contains((nr * w + c) as usize))
                 {
                     continue;
                 }
