@@ -78,7 +78,7 @@ pub fn write_run_files(out: &Path, job: &Job, r: &JobResult) -> Result<String> {
         start: [start.x, start.y, start.theta],
         planner: job.planner.clone(),
         options: job.options.clone(),
-        sim: job.sim,
+        sim: job.sim.clone(),
         tile_side: r.run.tile_side,
     };
     let mut run_json = serde_json::to_string_pretty(&record)?;

@@ -4,7 +4,9 @@
 //! 2-D occupancy grids: grids and frames ([`grid`]), geometry ([`geometry`], [`collide`]), the
 //! distance transform ([`dt`]), synthetic maps ([`gen`]), the ground truth ([`world`]), the online step protocol
 //! ([`planner`]), the simulator ([`sim`]), the trace ([`trace`]), tiles ([`tiles`]), the metrics
-//! ([`metrics`]) and the planners ([`planners`]).
+//! ([`metrics`]) and the planners ([`planners`]); motion execution by PID tracking on a
+//! unicycle ([`exec`]), pose correction from non-unique landmarks ([`landmarks`]) and the
+//! least-squares affine pixel <-> world fit ([`georef`]).
 //!
 //! Data flows one way: map -> [`world::World`] -> [`sim::Simulator`] <-> planner ->
 //! [`trace::Trace`] -> [`metrics::Metrics`]. Planners never score themselves.
@@ -12,9 +14,12 @@
 pub mod collide;
 pub mod dt;
 pub mod gen;
+pub mod exec;
 pub mod geometry;
+pub mod georef;
 pub mod grid;
 pub mod inflate;
+pub mod landmarks;
 pub mod metrics;
 pub mod planner;
 pub mod planners;

@@ -52,6 +52,53 @@ pub struct Metrics {
     pub collisions: u32,
     /// Planning + simulation wall time, seconds (the one non-deterministic figure).
     pub wall_time_s: f64,
+    /// PID execution only: mean distance of the recorded true poses from the segment they were
+    /// following ([`Event::PlannedSegment`]), metres. Absent for ideal execution.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tracking_error_mean_m: Option<f64>,
+    /// PID execution only: largest such distance, metres.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tracking_error_max_m: Option<f64>,
+    /// Rectangular-robot lane sweeps only ([`Event::RectLanes`]): seed 001's coverage guarantee
+    /// `(b - delta) / b`, with `b` the lane spacing and `delta` the lateral tolerance: the PID
+    /// waypoint tolerance ([`Event::Execution`]), 0 under ideal execution; clamped to [0, 1].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rect_guarantee: Option<f64>,
+}
+
+/// Tracking error of a PID run: `(mean, max)` distance of the pose records from the planned
+/// segment in force (the last [`Event::PlannedSegment`] before them); `None` when the trace has
+/// no planned segment (ideal execution).
+pub fn tracking_error(trace: &Trace) -> Option<(f64, f64)> {
+    let mut seg: Option<(Point, Point)> = None;
+    let (mut sum, mut max, mut n) = (0.0, 0.0f64, 0usize);
+    for r in &trace.records {
+        match r {
+            Record::Event {
+                event: Event::PlannedSegment { from, to },
+                ..
+            } => seg = Some((Point::new(from[0], from[1]), Point::new(to[0], to[1]))),
+            Record::Pose { pose, .. } => {
+                if let Some((a, b)) = seg {
+                    let d = point_segment_dist2(Point::new(pose[0], pose[1]), a, b).sqrt();
+                    sum += d;
+                    max = max.max(d);
+                    n += 1;
+                }
+            }
+            Record::Event { .. } => {}
+        }
+    }
+    seg?;
+    Some((if n == 0 { 0.0 } else { sum / n as f64 }, max))
+}
+
+/// The PID waypoint tolerance recorded in the trace ([`Event::Execution`]), if any.
+pub fn execution_tolerance(trace: &Trace) -> Option<f64> {
+    trace.events().find_map(|(_, e)| match e {
+        Event::Execution { tolerance_m, .. } => Some(*tolerance_m),
+        _ => None,
+    })
 }
 
 /// The swept pixels of a trace: pixel centres within `r_tool` of the executed centre polyline
@@ -408,16 +455,26 @@ pub fn compute(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
         (entries - nd) as f64 / nd as f64
     };
 
+    // Under PID execution a tile centre counts as visited within the waypoint tolerance.
+    let exec_tol = execution_tolerance(trace);
     let coverage_rate = run.tile_side.map(|side| {
         let grid = TileGrid::new(start, side);
         let reach = reachable_tiles(world, &grid);
         if reach.is_empty() {
             return 0.0;
         }
-        let visited = visited_tile_centres(&grid, &poses, &reach);
+        let visited = visited_tile_centres(&grid, &poses, &reach, exec_tol);
         visited as f64 / reach.len() as f64
     });
 
+    let tracking = tracking_error(trace);
+    let rect_guarantee = trace.events().find_map(|(_, e)| match e {
+        Event::RectLanes { width_m, .. } if *width_m > 0.0 => {
+            let delta = exec_tol.unwrap_or(0.0);
+            Some(((width_m - delta) / width_m).clamp(0.0, 1.0))
+        }
+        _ => None,
+    });
     Metrics {
         planner: run.planner.to_string(),
         map: map_name.to_string(),
@@ -436,12 +493,21 @@ pub fn compute(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
         rotation_rad: rotation,
         collisions,
         wall_time_s: run.wall_time_s,
+        tracking_error_mean_m: tracking.map(|t| t.0),
+        tracking_error_max_m: tracking.map(|t| t.1),
+        rect_guarantee,
     }
 }
 
-/// Number of tiles of `reach` whose centre lies on the executed polyline (within 1e-6 tile).
-fn visited_tile_centres(grid: &TileGrid, poses: &[Pose], reach: &TileSet) -> usize {
-    let eps = 1e-6 * grid.side;
+/// Number of tiles of `reach` whose centre lies on the executed polyline (within 1e-6 tile, or
+/// within the PID waypoint tolerance `tol` when given).
+fn visited_tile_centres(
+    grid: &TileGrid,
+    poses: &[Pose],
+    reach: &TileSet,
+    tol: Option<f64>,
+) -> usize {
+    let eps = (1e-6 * grid.side).max(tol.map_or(0.0, |t| t + 1e-9));
     let (i0, i1, j0, j1) = reach.bounds();
     let mut hit = TileSet::new(i0, i1, j0, j1);
     if let Some(p) = poses.first() {
@@ -458,8 +524,10 @@ fn visited_tile_centres(grid: &TileGrid, poses: &[Pose], reach: &TileSet) -> usi
         }
         let ta = grid.tile_of(a);
         let tb = grid.tile_of(b);
-        for j in ta.1.min(tb.1)..=ta.1.max(tb.1) {
-            for i in ta.0.min(tb.0)..=ta.0.max(tb.0) {
+        // A tolerance may reach one tile beyond the segment's own tiles.
+        let m = i32::from(eps > 0.25 * grid.side);
+        for j in ta.1.min(tb.1) - m..=ta.1.max(tb.1) + m {
+            for i in ta.0.min(tb.0) - m..=ta.0.max(tb.0) + m {
                 if point_segment_dist2(grid.center((i, j)), a, b) <= eps * eps {
                     hit.insert((i, j));
                 }

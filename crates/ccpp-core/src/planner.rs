@@ -105,6 +105,11 @@ pub trait Planner {
     fn is_offline(&self) -> bool {
         false
     }
+    /// The execution mode this planner is meant to run under, used by the simulator when
+    /// [`SimConfig::exec`](crate::sim::SimConfig::exec) is `None`; `None` = ideal execution.
+    fn preferred_execution(&self) -> Option<crate::exec::Execution> {
+        None
+    }
     /// The next decision.
     fn next(&mut self, sensor: &dyn Sensor) -> Step;
 }

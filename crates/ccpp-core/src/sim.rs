@@ -1,13 +1,35 @@
-//! The simulator: holds the truth, executes each planner [`Step`] with an ideal differential
-//! drive (exact in-place rotations and straight translations), checks every motion against the
-//! true map, stops on contact (the bumper) and records the [`Trace`].
+//! The simulator: holds the truth, executes each planner [`Step`], checks every motion against
+//! the true map, stops on contact (the bumper) and records the [`Trace`].
+//!
+//! Two execution modes ([`Execution`], chosen by [`SimConfig::exec`] or, when that is `None`,
+//! by the planner's [`Planner::preferred_execution`]):
+//!
+//! * **ideal** (the default): exact in-place rotations and straight translations; one pose
+//!   record per motion;
+//! * **PID** ([`crate::exec`]): a unicycle stepped every `dt_s` seconds under linear and angular
+//!   PID control. Each small motion of the **true** pose is collision-checked (the chord of the
+//!   arc against the true map; contact stops the motion and counts a collision, as in ideal
+//!   mode). The controller and the planner see the pose **estimate** ([`Sensor::pose`]): equal
+//!   to the truth without noise, dead-reckoned from the commanded speeds with
+//!   [`crate::exec::OdometryNoise`] (the truth then moves with perturbed speeds), and reset from
+//!   landmark observations when [`SimConfig::landmarks`] has some ([`crate::landmarks`]).
+//!   The trace gets an [`Event::Execution`] at the start, an [`Event::PlannedSegment`] before
+//!   each translation, and true poses every `record_every` control steps plus at the end of
+//!   each motion. `MoveTo` follows the segment from the previous planned goal (when the last
+//!   motion ended without contact) to the new one, so the robot steers back onto the plan.
+//!
+//! The sensor scan is always taken around the **true** position and returned in map
+//! coordinates (a scan registered to the map), whatever the estimate.
 
 use serde::{Deserialize, Serialize};
 use std::ops::{Add, Sub};
 
+use crate::exec::{Execution, Goal, PidOptions, Tracker, Unicycle};
 use crate::geometry::{wrap_angle, Point, Pose};
 use crate::grid::MapFrame;
+use crate::landmarks::{choose_pose, nearest_in_range, observe, LandmarkConfig};
 use crate::planner::{Planner, Scan, Sensor, Step};
+use crate::rng::SplitMix64;
 use crate::trace::{Event, Trace};
 use crate::world::{Robot, World};
 
@@ -15,13 +37,19 @@ use crate::world::{Robot, World};
 pub const MIN_ROTATION: f64 = 1e-9;
 
 /// Simulator settings.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct SimConfig {
     /// Sensor range in metres; `None` = `4 r` (enough to classify all 8 neighbour tiles).
     pub sensor_range: Option<f64>,
     /// Safety cap on planner steps.
     pub max_steps: u64,
+    /// How motions are executed; `None` = the planner's
+    /// [`preferred_execution`](Planner::preferred_execution), else [`Execution::Ideal`].
+    pub exec: Option<Execution>,
+    /// Landmarks for pose correction under PID execution (ignored in ideal mode, where the
+    /// estimate is the truth).
+    pub landmarks: LandmarkConfig,
 }
 
 impl Default for SimConfig {
@@ -29,6 +57,8 @@ impl Default for SimConfig {
         Self {
             sensor_range: None,
             max_steps: 50_000_000,
+            exec: None,
+            landmarks: LandmarkConfig::default(),
         }
     }
 }
@@ -58,36 +88,110 @@ pub struct RunOutput {
     pub wall_time_s: f64,
 }
 
+/// PID execution state.
+struct PidState {
+    opts: PidOptions,
+    tracker: Tracker,
+    noise_rng: Option<SplitMix64>,
+    /// Planned position after the last motion that ended without contact.
+    anchor: Option<Point>,
+    landmarks: LandmarkConfig,
+    /// Control steps since the last landmark observation.
+    since_fix: u64,
+}
+
 /// Drives a planner over a world.
 pub struct Simulator<'w> {
     world: &'w World,
+    /// The true pose.
     pose: Pose,
+    /// The pose estimate (equal to `pose` in ideal mode).
+    est: Pose,
     bumped: bool,
     range: f64,
     t: u64,
     trace: Trace,
+    pid: Option<PidState>,
+    landmarks: LandmarkConfig,
+    exec_set: bool,
 }
 
 impl<'w> Simulator<'w> {
-    /// A simulator at the world's start pose.
+    /// A simulator at the world's start pose. With `config.exec == Some(..)` the execution mode
+    /// is fixed now; with `None` it is chosen at [`run`](Self::run) from the planner (ideal
+    /// when stepping through [`execute`](Self::execute) directly).
     pub fn new(world: &'w World, config: &SimConfig) -> Self {
         let range = config.sensor_range.unwrap_or(4.0 * world.robot().radius);
         let pose = world.start();
         let mut trace = Trace::default();
         trace.push_pose(0, pose);
-        Self {
+        let mut sim = Self {
             world,
             pose,
+            est: pose,
             bumped: false,
             range,
             t: 0,
             trace,
+            pid: None,
+            landmarks: config.landmarks.clone(),
+            exec_set: false,
+        };
+        if let Some(e) = config.exec {
+            sim.set_execution(e);
         }
+        sim
+    }
+
+    /// Sets the execution mode (before the first step; later calls are ignored).
+    fn set_execution(&mut self, exec: Execution) {
+        if self.exec_set {
+            return;
+        }
+        self.exec_set = true;
+        if let Execution::Pid(opts) = exec {
+            self.trace.push_event(
+                self.t,
+                Event::Execution {
+                    mode: "pid".to_string(),
+                    dt_s: opts.dt_s,
+                    tolerance_m: opts.tolerance_m,
+                },
+            );
+            self.pid = Some(PidState {
+                opts,
+                tracker: Tracker::new(&opts),
+                noise_rng: opts.noise.map(|n| SplitMix64::new(n.seed)),
+                anchor: Some(self.pose.position()),
+                landmarks: self.landmarks.clone(),
+                since_fix: 0,
+            });
+        }
+    }
+
+    /// The true pose.
+    pub fn true_pose(&self) -> Pose {
+        self.pose
+    }
+
+    /// The pose estimate (what the planner sees).
+    pub fn estimate(&self) -> Pose {
+        self.est
+    }
+
+    /// The trace so far.
+    pub fn trace(&self) -> &Trace {
+        &self.trace
     }
 
     /// Executes one step (anything but `Done`).
     pub fn execute(&mut self, step: Step) {
         self.t += 1;
+        self.exec_set = true;
+        if self.pid.is_some() {
+            self.execute_pid(step);
+            return;
+        }
         match step {
             Step::Rotate(a) => self.rotate(a),
             Step::Translate(d) => self.translate(d),
@@ -109,6 +213,7 @@ impl<'w> Simulator<'w> {
             return;
         }
         self.pose.theta = wrap_angle(self.pose.theta + a);
+        self.est = self.pose;
         self.bumped = false;
         self.trace.push_pose(self.t, self.pose);
     }
@@ -143,11 +248,185 @@ impl<'w> Simulator<'w> {
                     .push_event(self.t, Event::Collision { x: p.x, y: p.y });
             }
         }
+        self.est = self.pose;
+    }
+
+    fn execute_pid(&mut self, step: Step) {
+        let Some(st) = self.pid.as_ref() else { return };
+        let est = self.est;
+        let anchor = st.anchor;
+        match step {
+            Step::Rotate(a) => {
+                if a.is_finite() && a.abs() >= MIN_ROTATION {
+                    self.pid_motion(&Goal::Heading(wrap_angle(est.theta + a)), anchor);
+                }
+            }
+            Step::Translate(d) => {
+                if d.is_finite() && d != 0.0 {
+                    let from = est.position();
+                    let to = Point::new(from.x + d * est.theta.cos(), from.y + d * est.theta.sin());
+                    self.push_segment(from, to);
+                    self.pid_motion(
+                        &Goal::Segment {
+                            from,
+                            to,
+                            reverse: d < 0.0,
+                        },
+                        Some(to),
+                    );
+                }
+            }
+            Step::MoveTo(p) => {
+                if p.is_finite() {
+                    let from = anchor.unwrap_or(est.position());
+                    self.push_segment(from, p);
+                    self.pid_motion(
+                        &Goal::Segment {
+                            from,
+                            to: p,
+                            reverse: false,
+                        },
+                        Some(p),
+                    );
+                }
+            }
+            Step::Mark(e) => self.trace.push_event(self.t, e),
+            Step::Done => {}
+        }
+    }
+
+    fn push_segment(&mut self, from: Point, to: Point) {
+        self.trace.push_event(
+            self.t,
+            Event::PlannedSegment {
+                from: [from.x, from.y],
+                to: [to.x, to.y],
+            },
+        );
+    }
+
+    /// Runs the controller until `goal` is reached, contact, or the per-motion cap. On success
+    /// the PID anchor becomes `next_anchor`.
+    fn pid_motion(&mut self, goal: &Goal, next_anchor: Option<Point>) {
+        let Some(mut st) = self.pid.take() else {
+            return;
+        };
+        st.tracker.reset();
+        let dt = st.opts.dt_s;
+        let every = u64::from(st.opts.record_every.max(1));
+        let fix_every = if st.landmarks.landmarks.is_empty() {
+            u64::MAX
+        } else {
+            ((st.landmarks.period_s / dt).round() as u64).max(1)
+        };
+        self.bumped = false;
+        let mut contact = false;
+        let mut moved = false;
+        let mut since_record = 0u64;
+        for _ in 0..st.opts.max_steps_per_motion {
+            let Some((v, w)) = st.tracker.command(self.est, goal) else {
+                break;
+            };
+            // The truth moves with the (possibly perturbed) speeds; the estimate integrates the
+            // commanded (measured) ones.
+            let (vt, wt) = match (st.opts.noise, st.noise_rng.as_mut()) {
+                (Some(n), Some(rng)) => (
+                    v * (1.0 + n.linear_rel_std * rng.gaussian()),
+                    w * (1.0 + n.angular_rel_std * rng.gaussian())
+                        + n.heading_drift_std * v.abs() * rng.gaussian(),
+                ),
+                _ => (v, w),
+            };
+            let new_est = Unicycle::step(self.est, v, w, dt);
+            let new_true = Unicycle::step(self.pose, vt, wt, dt);
+            let a = self.pose.position();
+            let b = new_true.position();
+            let hit = if a == b {
+                None
+            } else {
+                self.world.first_contact(a, b)
+            };
+            if let Some(t) = hit {
+                let p = a + (b - a).scale(t);
+                // The estimate advances by the same fraction of its own motion.
+                let e0 = self.est.position();
+                let e = e0 + (new_est.position() - e0).scale(t);
+                self.pose = Pose::new(
+                    p.x,
+                    p.y,
+                    self.pose.theta + t * wrap_angle(new_true.theta - self.pose.theta),
+                );
+                self.est = Pose::new(
+                    e.x,
+                    e.y,
+                    self.est.theta + t * wrap_angle(new_est.theta - self.est.theta),
+                );
+                if t > 0.0 {
+                    self.trace.push_pose(self.t, self.pose);
+                }
+                self.trace
+                    .push_event(self.t, Event::Collision { x: p.x, y: p.y });
+                contact = true;
+                break;
+            }
+            self.pose = new_true;
+            self.est = new_est;
+            moved = true;
+            since_record += 1;
+            if since_record >= every {
+                since_record = 0;
+                self.trace.push_pose(self.t, self.pose);
+                moved = false;
+            }
+            st.since_fix += 1;
+            if st.since_fix >= fix_every {
+                st.since_fix = 0;
+                self.landmark_fix(&st.landmarks);
+            }
+        }
+        if moved {
+            self.trace.push_pose(self.t, self.pose);
+        }
+        self.bumped = contact;
+        st.anchor = if contact {
+            None
+        } else {
+            next_anchor.or(st.anchor)
+        };
+        self.pid = Some(st);
+    }
+
+    /// Observes the nearest landmark in range (from the truth) and resets the estimate to the
+    /// candidate closest to it.
+    fn landmark_fix(&mut self, cfg: &LandmarkConfig) {
+        let Some(l) = nearest_in_range(self.pose.position(), &cfg.landmarks, cfg.range_m) else {
+            return;
+        };
+        let obs = observe(self.pose, l);
+        if let Some(p) = choose_pose(self.est, &obs, &cfg.landmarks) {
+            self.est = p;
+            self.trace.push_event(
+                self.t,
+                Event::LandmarkFix {
+                    id: obs.id,
+                    x: p.x,
+                    y: p.y,
+                    theta: p.theta,
+                },
+            );
+        }
     }
 
     /// Runs `planner` to completion (or the step cap).
     pub fn run(mut self, planner: &mut dyn Planner, config: &SimConfig) -> RunOutput {
         let started = std::time::Instant::now();
+        if !self.exec_set {
+            let e = config
+                .exec
+                .or_else(|| planner.preferred_execution())
+                .unwrap_or_default();
+            self.set_execution(e);
+        }
         let mut stop = StopReason::MaxSteps;
         for _ in 0..config.max_steps {
             let step = planner.next(&self);
@@ -177,6 +456,8 @@ impl<'w> Simulator<'w> {
     }
 }
 
+// `pose` is the estimate by design: the planner sees odometry/localization, not the truth.
+#[allow(clippy::misnamed_getters)]
 impl Sensor for Simulator<'_> {
     fn frame(&self) -> &MapFrame {
         self.world.frame()
@@ -185,7 +466,7 @@ impl Sensor for Simulator<'_> {
         self.world.robot()
     }
     fn pose(&self) -> Pose {
-        self.pose
+        self.est
     }
     fn sensor_range(&self) -> f64 {
         self.range
@@ -241,5 +522,124 @@ mod tests {
                 .count(),
             1
         );
+    }
+
+    use crate::exec::{OdometryNoise, PidOptions};
+    use crate::landmarks::Landmark;
+
+    fn big_room() -> World {
+        // 8 m x 8 m at 0.05 m/px with a 1-pixel wall; start in the middle.
+        let mut art = String::new();
+        for r in 0..160 {
+            for c in 0..160 {
+                art.push(if r == 0 || c == 0 || r == 159 || c == 159 {
+                    '#'
+                } else {
+                    '.'
+                });
+            }
+            art.push('\n');
+        }
+        let map = GridMap::from_ascii_scaled(&art, 1, 0.05).unwrap();
+        World::new(map, Robot::new(0.15), Some(Pose::new(4.0, 4.0, 0.0))).unwrap()
+    }
+
+    fn square(n: usize) -> Vec<Step> {
+        let mut v = Vec::new();
+        for _ in 0..n {
+            for (x, y) in [(5.0, 4.0), (5.0, 5.0), (4.0, 5.0), (4.0, 4.0)] {
+                v.push(Step::MoveTo(Point::new(x, y)));
+            }
+        }
+        v
+    }
+
+    fn pid(noise: Option<OdometryNoise>) -> SimConfig {
+        SimConfig {
+            exec: Some(Execution::Pid(PidOptions {
+                noise,
+                ..PidOptions::default()
+            })),
+            ..SimConfig::default()
+        }
+    }
+
+    #[test]
+    fn square_is_tracked_with_bounded_error() {
+        let world = big_room();
+        let out = simulate(&world, &mut Script(square(2)), &pid(None));
+        let m = crate::metrics::compute(&world, &out, "room");
+        assert_eq!(m.collisions, 0);
+        let (mean, max) = crate::metrics::tracking_error(&out.trace).unwrap();
+        assert!(max < 1e-6, "max tracking error {max}");
+        assert!(mean <= max);
+        assert_eq!(m.tracking_error_max_m, Some(max));
+        // Two laps of 4 m, and the turns are in place.
+        assert!((m.path_length_m - 8.0).abs() < 1e-4, "{}", m.path_length_m);
+        let end = out.trace.poses().last().unwrap();
+        assert!(end.position().dist(Point::new(4.0, 4.0)) < 1e-6);
+        // A coarse tolerance still tracks the square within it (plus the lateral overshoot of
+        // the corner, bounded by the tolerance too).
+        let coarse = SimConfig {
+            exec: Some(Execution::Pid(PidOptions {
+                tolerance_m: 0.03,
+                heading_tolerance_rad: 0.01,
+                ..PidOptions::default()
+            })),
+            ..SimConfig::default()
+        };
+        let out = simulate(&world, &mut Script(square(1)), &coarse);
+        let (_, max) = crate::metrics::tracking_error(&out.trace).unwrap();
+        assert!(max < 0.03 + 1e-9, "coarse max {max}");
+    }
+
+    #[test]
+    fn noise_is_seeded_and_reproducible() {
+        let world = big_room();
+        let noise = |seed| {
+            Some(OdometryNoise {
+                seed,
+                ..OdometryNoise::default()
+            })
+        };
+        let a = simulate(&world, &mut Script(square(2)), &pid(noise(5)));
+        let b = simulate(&world, &mut Script(square(2)), &pid(noise(5)));
+        let c = simulate(&world, &mut Script(square(2)), &pid(noise(6)));
+        assert_eq!(a.trace, b.trace);
+        assert_ne!(a.trace, c.trace);
+        // The truth left the planned square while the estimate followed it.
+        let (_, max) = crate::metrics::tracking_error(&a.trace).unwrap();
+        assert!(max > 1e-3, "{max}");
+    }
+
+    /// Drift of the truth from the planned path after `laps` laps, with or without landmarks.
+    fn final_drift(landmarks: Vec<Landmark>, laps: usize) -> f64 {
+        let world = big_room();
+        let mut cfg = pid(Some(OdometryNoise {
+            seed: 11,
+            linear_rel_std: 0.05,
+            angular_rel_std: 0.05,
+            heading_drift_std: 0.3,
+        }));
+        cfg.landmarks.landmarks = landmarks;
+        cfg.landmarks.range_m = 2.0;
+        let mut sim = Simulator::new(&world, &cfg);
+        let mut worst: f64 = 0.0;
+        for step in square(laps) {
+            sim.execute(step);
+            let d = sim.true_pose().position().dist(sim.estimate().position());
+            worst = worst.max(d);
+        }
+        worst
+    }
+
+    #[test]
+    fn landmarks_bound_the_drift() {
+        // Two tags with the same id at opposite corners of the square (1.41 m apart).
+        let tags = vec![Landmark::new(4, 4.0, 4.0), Landmark::new(4, 5.0, 5.0)];
+        let without = final_drift(Vec::new(), 12);
+        let with = final_drift(tags, 12);
+        assert!(without > 0.1, "dead reckoning should drift: {without}");
+        assert!(with < 0.05, "landmarks should bound it: {with}");
     }
 }

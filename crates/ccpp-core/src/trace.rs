@@ -85,6 +85,44 @@ pub enum Event {
         /// Text.
         text: String,
     },
+    /// The simulator executes motions by PID tracking on a unicycle model (see
+    /// [`crate::exec`]); written once at the start of such a run. Absent for ideal execution.
+    Execution {
+        /// `pid`.
+        mode: String,
+        /// Control period, seconds.
+        dt_s: f64,
+        /// Waypoint tolerance, metres: a waypoint counts as reached within this distance (the
+        /// `coverage_rate` metric uses it as the tile-centre visit tolerance).
+        tolerance_m: f64,
+    },
+    /// The straight segment the robot is asked to follow next (PID execution only). The pose
+    /// records up to the next such event are measured against it (`tracking_error_*`).
+    PlannedSegment {
+        /// Start (planned position before the motion), world.
+        from: [f64; 2],
+        /// Goal, world.
+        to: [f64; 2],
+    },
+    /// Rectangular-robot lane sweep (seed 001): lane spacing and robot length, for the
+    /// `rect_guarantee` metric.
+    RectLanes {
+        /// Robot length `l` (waypoint spacing along a lane), metres.
+        length_m: f64,
+        /// Robot width `b` (lane spacing), metres.
+        width_m: f64,
+    },
+    /// The pose estimate was reset from a landmark observation (see [`crate::landmarks`]).
+    LandmarkFix {
+        /// Observed (shared) landmark id.
+        id: u32,
+        /// Corrected estimate x.
+        x: f64,
+        /// Corrected estimate y.
+        y: f64,
+        /// Corrected estimate heading.
+        theta: f64,
+    },
 }
 
 /// One trace line.

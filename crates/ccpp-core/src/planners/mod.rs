@@ -3,7 +3,9 @@
 
 pub mod ba_star;
 pub mod bcd;
+pub mod bsa_bfs;
 pub mod random_bounce;
+pub mod rect_boustrophedon;
 
 use serde::{Deserialize, Serialize};
 
@@ -34,6 +36,16 @@ pub const CATALOG: &[PlannerInfo] = &[
         offline: false,
     },
     PlannerInfo {
+        name: "bsa-bfs",
+        description: "Vacuum-robot BSA (seed 003): cells +x,+y,-x,-y, return-cell stack, BFS return over visited cells, PID execution (online)",
+        offline: false,
+    },
+    PlannerInfo {
+        name: "rect-boustrophedon",
+        description: "Known-map lane waypoints for a rectangular robot (seed 001): lanes b apart, waypoints every l, blocked edges joined by clearance A* (offline)",
+        offline: true,
+    },
+    PlannerInfo {
         name: "bcd",
         description: "Boustrophedon cellular decomposition of the known map, lanes 2 r_tool apart (offline baseline)",
         offline: true,
@@ -51,6 +63,10 @@ pub struct PlannerOptions {
     pub ba_star: ba_star::BaStarOptions,
     /// `bcd`.
     pub bcd: bcd::BcdOptions,
+    /// `bsa-bfs`.
+    pub bsa_bfs: bsa_bfs::BsaBfsOptions,
+    /// `rect-boustrophedon`.
+    pub rect_boustrophedon: rect_boustrophedon::RectOptions,
 }
 
 /// Error building a planner.
@@ -88,6 +104,11 @@ pub fn build(
             Ok(Box::new(ba_star::BaStar::new(o)))
         }
         "bcd" => Ok(Box::new(bcd::Bcd::new(world, &opts.bcd))),
+        "bsa-bfs" => Ok(Box::new(bsa_bfs::BsaBfs::new(opts.bsa_bfs.clone()))),
+        "rect-boustrophedon" => Ok(Box::new(rect_boustrophedon::RectBoustrophedon::new(
+            world,
+            &opts.rect_boustrophedon,
+        ))),
         other => Err(BuildError::Unknown(other.to_string())),
     }
 }

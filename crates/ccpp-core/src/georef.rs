@@ -1,0 +1,255 @@
+//! An affine world <-> pixel transform fitted by least squares from point pairs (seed 003).
+//!
+//! Seed 003 (a vacuum-robot BSA with BFS return) reads its map as an image and relates image
+//! pixels to world coordinates by an affine transform fitted with `numpy.linalg.lstsq` on
+//! measured point pairs, and inverts it (as a 3x3 matrix) for the other direction. Here the fit
+//! is from **pixel to world** (`world = A * pixel + b`, six parameters), solved by the normal
+//! equations on centred coordinates, with the residuals reported; [`Affine::inverse`] gives the
+//! world-to-pixel map.
+//!
+//! For maps that come with a `map_server` YAML, [`crate::grid::MapFrame`] already is the one
+//! pixel <-> world helper; this fit is for images whose placement is known only through
+//! surveyed points (`--georef FILE`, parsed by `ccpp_io::georef`).
+//!
+//! ```
+//! use ccpp_core::georef::fit_affine;
+//! use ccpp_core::Point;
+//! // 0.05 m/px, image row 0 on top of a 100-row image, origin (-1, 2).
+//! let to_world = |c: f64, r: f64| Point::new(-1.0 + 0.05 * c, 2.0 + 0.05 * (100.0 - r));
+//! let pairs: Vec<(Point, Point)> = [(0.0, 0.0), (50.0, 10.0), (20.0, 90.0), (99.0, 99.0)]
+//!     .iter()
+//!     .map(|&(c, r)| (Point::new(c, r), to_world(c, r)))
+//!     .collect();
+//! let fit = fit_affine(&pairs).unwrap();
+//! assert!(fit.rms_residual < 1e-9);
+//! let w = fit.affine.apply(Point::new(10.0, 40.0));
+//! assert!(w.dist(to_world(10.0, 40.0)) < 1e-9);
+//! let px = fit.affine.inverse().unwrap().apply(w);
+//! assert!(px.dist(Point::new(10.0, 40.0)) < 1e-9);
+//! ```
+
+use serde::{Deserialize, Serialize};
+
+use crate::geometry::Point;
+
+/// An affine map `q = [[a, b], [c, d]] p + [tx, ty]`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Affine {
+    /// Row-major 2x2 linear part `[a, b, c, d]`.
+    pub m: [f64; 4],
+    /// Translation `[tx, ty]`.
+    pub t: [f64; 2],
+}
+
+impl Affine {
+    /// The identity.
+    pub const IDENTITY: Affine = Affine {
+        m: [1.0, 0.0, 0.0, 1.0],
+        t: [0.0, 0.0],
+    };
+
+    /// Applies the map.
+    pub fn apply(&self, p: Point) -> Point {
+        let [a, b, c, d] = self.m;
+        Point::new(a * p.x + b * p.y + self.t[0], c * p.x + d * p.y + self.t[1])
+    }
+
+    /// Determinant of the linear part.
+    pub fn det(&self) -> f64 {
+        self.m[0] * self.m[3] - self.m[1] * self.m[2]
+    }
+
+    /// The inverse map.
+    ///
+    /// # Errors
+    /// [`GeorefError::Singular`] when the linear part is (numerically) singular.
+    pub fn inverse(&self) -> Result<Affine, GeorefError> {
+        let det = self.det();
+        let scale = self.m.iter().map(|v| v.abs()).fold(0.0, f64::max);
+        if !det.is_finite() || det.abs() <= 1e-12 * scale * scale {
+            return Err(GeorefError::Singular);
+        }
+        let [a, b, c, d] = self.m;
+        let m = [d / det, -b / det, -c / det, a / det];
+        let t = [
+            -(m[0] * self.t[0] + m[1] * self.t[1]),
+            -(m[2] * self.t[0] + m[3] * self.t[1]),
+        ];
+        Ok(Affine { m, t })
+    }
+}
+
+/// A least-squares fit and its residuals.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AffineFit {
+    /// Pixel -> world map.
+    pub affine: Affine,
+    /// `|affine(pixel_i) - world_i|` for each pair, in world units.
+    pub residuals: Vec<f64>,
+    /// Root mean square of the residuals.
+    pub rms_residual: f64,
+    /// Largest residual.
+    pub max_residual: f64,
+}
+
+/// Errors of [`fit_affine`].
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum GeorefError {
+    /// Fewer than three pairs.
+    #[error("an affine fit needs at least 3 point pairs, got {0}")]
+    TooFewPairs(usize),
+    /// A coordinate is NaN or infinite.
+    #[error("point pair {0} has a non-finite coordinate")]
+    NonFinite(usize),
+    /// The pixel points are (nearly) collinear: the fit is not determined.
+    #[error("the pixel points are collinear: an affine fit needs 3 points not on one line")]
+    Collinear,
+    /// The fitted linear part is singular (cannot invert).
+    #[error("the affine transform is singular and has no inverse")]
+    Singular,
+}
+
+/// Fits `world = A pixel + b` to `pairs` of `(pixel, world)` points by least squares.
+///
+/// # Errors
+/// Fewer than 3 pairs, non-finite input, or collinear pixel points.
+pub fn fit_affine(pairs: &[(Point, Point)]) -> Result<AffineFit, GeorefError> {
+    if pairs.len() < 3 {
+        return Err(GeorefError::TooFewPairs(pairs.len()));
+    }
+    if let Some(i) = pairs
+        .iter()
+        .position(|(p, w)| !(p.is_finite() && w.is_finite()))
+    {
+        return Err(GeorefError::NonFinite(i));
+    }
+    let n = pairs.len() as f64;
+    let (mut pc, mut wc) = (Point::default(), Point::default());
+    for (p, w) in pairs {
+        pc = pc + *p;
+        wc = wc + *w;
+    }
+    pc = pc.scale(1.0 / n);
+    wc = wc.scale(1.0 / n);
+    // Normal equations on centred coordinates: S = sum dp dp^T, R = sum dw dp^T, A = R S^-1.
+    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
+    let (mut rxx, mut rxy, mut ryx, mut ryy) = (0.0, 0.0, 0.0, 0.0);
+    for (p, w) in pairs {
+        let dp = *p - pc;
+        let dw = *w - wc;
+        sxx += dp.x * dp.x;
+        sxy += dp.x * dp.y;
+        syy += dp.y * dp.y;
+        rxx += dw.x * dp.x;
+        rxy += dw.x * dp.y;
+        ryx += dw.y * dp.x;
+        ryy += dw.y * dp.y;
+    }
+    let det = sxx * syy - sxy * sxy;
+    let spread = (sxx + syy).max(f64::MIN_POSITIVE);
+    if det <= 1e-12 * spread * spread {
+        return Err(GeorefError::Collinear);
+    }
+    let (i00, i01, i11) = (syy / det, -sxy / det, sxx / det);
+    let m = [
+        rxx * i00 + rxy * i01,
+        rxx * i01 + rxy * i11,
+        ryx * i00 + ryy * i01,
+        ryx * i01 + ryy * i11,
+    ];
+    let t = [
+        wc.x - (m[0] * pc.x + m[1] * pc.y),
+        wc.y - (m[2] * pc.x + m[3] * pc.y),
+    ];
+    let affine = Affine { m, t };
+    let residuals: Vec<f64> = pairs
+        .iter()
+        .map(|(p, w)| affine.apply(*p).dist(*w))
+        .collect();
+    let rms_residual = (residuals.iter().map(|r| r * r).sum::<f64>() / n).sqrt();
+    let max_residual = residuals.iter().copied().fold(0.0, f64::max);
+    Ok(AffineFit {
+        affine,
+        residuals,
+        rms_residual,
+        max_residual,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::SplitMix64;
+
+    #[test]
+    fn exact_fit_and_inverse() {
+        let truth = Affine {
+            m: [0.05 * 0.8, -0.05 * 0.6, -0.05 * 0.6, -0.05 * 0.8],
+            t: [3.0, -7.0],
+        };
+        let pairs: Vec<_> = [(0.0, 0.0), (100.0, 0.0), (0.0, 50.0), (70.0, 30.0)]
+            .iter()
+            .map(|&(x, y)| {
+                let p = Point::new(x, y);
+                (p, truth.apply(p))
+            })
+            .collect();
+        let fit = fit_affine(&pairs).unwrap();
+        for k in 0..4 {
+            assert!((fit.affine.m[k] - truth.m[k]).abs() < 1e-12);
+        }
+        assert!(fit.max_residual < 1e-9);
+        let inv = fit.affine.inverse().unwrap();
+        let p = Point::new(12.5, -3.0);
+        assert!(inv.apply(fit.affine.apply(p)).dist(p) < 1e-9);
+    }
+
+    #[test]
+    fn noisy_fit_reports_residuals() {
+        let truth = Affine {
+            m: [0.05, 0.0, 0.0, -0.05],
+            t: [1.0, 10.0],
+        };
+        let mut rng = SplitMix64::new(3);
+        let pairs: Vec<_> = (0..40)
+            .map(|_| {
+                let p = Point::new(rng.range(0.0, 200.0), rng.range(0.0, 200.0));
+                let w = truth.apply(p);
+                (
+                    p,
+                    Point::new(w.x + 0.01 * rng.gaussian(), w.y + 0.01 * rng.gaussian()),
+                )
+            })
+            .collect();
+        let fit = fit_affine(&pairs).unwrap();
+        assert!(
+            fit.rms_residual > 0.003 && fit.rms_residual < 0.03,
+            "{}",
+            fit.rms_residual
+        );
+        assert!((fit.affine.m[0] - 0.05).abs() < 1e-3);
+        assert_eq!(fit.residuals.len(), 40);
+    }
+
+    #[test]
+    fn degenerate_inputs() {
+        let p = |x, y| (Point::new(x, y), Point::new(x, y));
+        assert_eq!(
+            fit_affine(&[p(0.0, 0.0), p(1.0, 1.0)]),
+            Err(GeorefError::TooFewPairs(2))
+        );
+        assert_eq!(
+            fit_affine(&[p(0.0, 0.0), p(1.0, 1.0), p(2.0, 2.0), p(5.0, 5.0)]),
+            Err(GeorefError::Collinear)
+        );
+        assert_eq!(
+            fit_affine(&[p(0.0, 0.0), p(1.0, f64::NAN), p(2.0, 2.0)]),
+            Err(GeorefError::NonFinite(1))
+        );
+        let flat = Affine {
+            m: [1.0, 2.0, 2.0, 4.0],
+            t: [0.0, 0.0],
+        };
+        assert_eq!(flat.inverse(), Err(GeorefError::Singular));
+    }
+}

@@ -1,0 +1,146 @@
+//! `--georef FILE`: point pairs for the affine pixel -> world fit of seed 003
+//! ([`ccpp_core::georef::fit_affine`]).
+//!
+//! Format: one pair per line, `px,py,wx,wy` (pixel column, pixel row, world x, world y; commas
+//! or whitespace between the numbers). Blank lines and lines starting with `#` are skipped; a
+//! first line that does not parse as numbers is taken as a header and skipped.
+//!
+//! ```
+//! let text = "px,py,wx,wy\n0,0,0,5\n100,0,5,5\n0,100,0,0\n";
+//! let pairs = ccpp_io::georef::parse_georef(text).unwrap();
+//! let fit = ccpp_core::georef::fit_affine(&pairs).unwrap();
+//! let w = fit.affine.apply(ccpp_core::Point::new(50.0, 50.0));
+//! assert!((w.x - 2.5).abs() < 1e-9 && (w.y - 2.5).abs() < 1e-9);
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use ccpp_core::georef::{fit_affine, AffineFit, GeorefError};
+use ccpp_core::Point;
+
+/// Errors reading a georef file.
+#[derive(Debug, thiserror::Error)]
+pub enum GeorefFileError {
+    /// The file could not be read.
+    #[error("cannot read georef file {path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// A line is not four numbers.
+    #[error("georef line {line}: expected `px,py,wx,wy` (four numbers), got {text:?}")]
+    BadLine {
+        /// 1-based line number.
+        line: usize,
+        /// The line.
+        text: String,
+    },
+    /// The fit failed.
+    #[error("georef file {path}: {source}")]
+    Fit {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: GeorefError,
+    },
+}
+
+/// Splits a line into fields on commas, semicolons or whitespace.
+pub(crate) fn fields(line: &str) -> impl Iterator<Item = &str> {
+    line.split(|c: char| c == ',' || c == ';' || c.is_whitespace())
+        .filter(|s| !s.is_empty())
+}
+
+/// Parses `(pixel, world)` pairs from the text of a georef file.
+///
+/// # Errors
+/// [`GeorefFileError::BadLine`] for a line that is not four finite numbers (other than a
+/// header on the first content line).
+pub fn parse_georef(text: &str) -> Result<Vec<(Point, Point)>, GeorefFileError> {
+    let mut pairs = Vec::new();
+    let mut first = true;
+    for (n, raw) in text.lines().enumerate() {
+        let line = raw.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        let nums: Option<Vec<f64>> = fields(line)
+            .map(|f| f.parse::<f64>().ok().filter(|v| v.is_finite()))
+            .collect();
+        let header = std::mem::replace(&mut first, false);
+        match nums {
+            Some(v) if v.len() == 4 => {
+                pairs.push((Point::new(v[0], v[1]), Point::new(v[2], v[3])));
+            }
+            None if header => {}
+            _ => {
+                return Err(GeorefFileError::BadLine {
+                    line: n + 1,
+                    text: line.to_string(),
+                })
+            }
+        }
+    }
+    Ok(pairs)
+}
+
+/// Reads a georef file and fits the affine pixel -> world transform.
+///
+/// # Errors
+/// Unreadable file, bad line, or a fit that fails (fewer than 3 pairs, collinear points).
+pub fn load_georef(path: &Path) -> Result<AffineFit, GeorefFileError> {
+    let text = std::fs::read_to_string(path).map_err(|source| GeorefFileError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let pairs = parse_georef(&text)?;
+    fit_affine(&pairs).map_err(|source| GeorefFileError::Fit {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_comments_header_and_separators() {
+        let t = "# survey\nu v x y\n1 2 3 4\n5,6,7,8\n\n9;10;11;12\n";
+        let p = parse_georef(t).unwrap();
+        assert_eq!(p.len(), 3);
+        assert_eq!(p[1], (Point::new(5.0, 6.0), Point::new(7.0, 8.0)));
+    }
+
+    #[test]
+    fn bad_lines_are_named() {
+        let e = parse_georef("1,2,3,4\n1,2,3\n").unwrap_err();
+        assert!(e.to_string().contains("line 2"), "{e}");
+        let e = parse_georef("1,2,3,4\n1,2,x,4\n").unwrap_err();
+        assert!(matches!(e, GeorefFileError::BadLine { line: 2, .. }));
+    }
+
+    #[test]
+    fn file_roundtrip_and_fit_errors() {
+        let dir = tempfile::tempdir().unwrap();
+        let f = dir.path().join("g.csv");
+        std::fs::write(&f, "0,0,0,0\n1,1,1,1\n2,2,2,2\n").unwrap();
+        let e = load_georef(&f).unwrap_err();
+        assert!(matches!(
+            e,
+            GeorefFileError::Fit {
+                source: GeorefError::Collinear,
+                ..
+            }
+        ));
+        std::fs::write(&f, "0,0,0,0\n10,0,1,0\n0,10,0,-1\n").unwrap();
+        let fit = load_georef(&f).unwrap();
+        assert!(fit.max_residual < 1e-12);
+        assert!(matches!(
+            load_georef(&dir.path().join("missing.csv")),
+            Err(GeorefFileError::Io { .. })
+        ));
+    }
+}

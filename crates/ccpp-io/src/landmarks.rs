@@ -1,0 +1,163 @@
+//! `--landmarks FILE`: landmarks for the simulator's pose correction
+//! ([`ccpp_core::landmarks`], seed 001's non-unique `AprilTags`).
+//!
+//! Two formats, chosen by content: a JSON array of `{"id": 1, "x": 2.0, "y": 3.0}` objects
+//! (optional `"theta"`, radians), or CSV lines `id,x,y[,theta]` (commas, semicolons or
+//! whitespace; blank and `#` lines skipped; a non-numeric first line is a header).
+//!
+//! ```
+//! let l = ccpp_io::landmarks::parse_landmarks("id,x,y\n1,0.5,2\n1,4.5,2,1.57\n").unwrap();
+//! assert_eq!(l.len(), 2);
+//! assert_eq!(l[1].theta, 1.57);
+//! let j = ccpp_io::landmarks::parse_landmarks(r#"[{"id": 3, "x": 1, "y": 2}]"#).unwrap();
+//! assert_eq!(j[0].id, 3);
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use ccpp_core::landmarks::Landmark;
+
+use crate::georef::fields;
+
+/// Errors reading a landmark file.
+#[derive(Debug, thiserror::Error)]
+pub enum LandmarkFileError {
+    /// The file could not be read.
+    #[error("cannot read landmark file {path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// Invalid JSON.
+    #[error("landmark JSON: {0}")]
+    Json(String),
+    /// A CSV line is not `id,x,y[,theta]`.
+    #[error("landmark line {line}: expected `id,x,y[,theta]` (integer id, finite numbers), got {text:?}")]
+    BadLine {
+        /// 1-based line number.
+        line: usize,
+        /// The line.
+        text: String,
+    },
+    /// A landmark has a non-finite coordinate.
+    #[error("landmark {index} has a non-finite coordinate")]
+    NonFinite {
+        /// 0-based index.
+        index: usize,
+    },
+}
+
+fn parse_csv_line(line: &str) -> Option<Landmark> {
+    let f: Vec<&str> = fields(line).collect();
+    if !(3..=4).contains(&f.len()) {
+        return None;
+    }
+    let id = f[0].parse::<u32>().ok()?;
+    let num = |s: &str| s.parse::<f64>().ok().filter(|v| v.is_finite());
+    Some(Landmark {
+        id,
+        x: num(f[1])?,
+        y: num(f[2])?,
+        theta: match f.get(3) {
+            Some(s) => num(s)?,
+            None => 0.0,
+        },
+    })
+}
+
+/// Parses landmarks from JSON or CSV text.
+///
+/// # Errors
+/// Invalid JSON, a bad CSV line, or a non-finite coordinate.
+pub fn parse_landmarks(text: &str) -> Result<Vec<Landmark>, LandmarkFileError> {
+    let trimmed = text.trim_start();
+    let list: Vec<Landmark> = if trimmed.starts_with('[') {
+        serde_json::from_str(trimmed).map_err(|e| LandmarkFileError::Json(e.to_string()))?
+    } else {
+        let mut out = Vec::new();
+        let mut first = true;
+        for (n, raw) in text.lines().enumerate() {
+            let line = raw.trim();
+            if line.is_empty() || line.starts_with('#') {
+                continue;
+            }
+            let header = std::mem::replace(&mut first, false);
+            match parse_csv_line(line) {
+                Some(l) => out.push(l),
+                None if header && !line.starts_with(|c: char| c.is_ascii_digit()) => {}
+                None => {
+                    return Err(LandmarkFileError::BadLine {
+                        line: n + 1,
+                        text: line.to_string(),
+                    })
+                }
+            }
+        }
+        out
+    };
+    if let Some(index) = list
+        .iter()
+        .position(|l| !(l.x.is_finite() && l.y.is_finite() && l.theta.is_finite()))
+    {
+        return Err(LandmarkFileError::NonFinite { index });
+    }
+    Ok(list)
+}
+
+/// Reads and parses a landmark file.
+///
+/// # Errors
+/// As [`parse_landmarks`], plus an unreadable file.
+pub fn load_landmarks(path: &Path) -> Result<Vec<Landmark>, LandmarkFileError> {
+    let text = std::fs::read_to_string(path).map_err(|source| LandmarkFileError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    parse_landmarks(&text)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn csv_and_json() {
+        let l = parse_landmarks("# tags\n1 0 0\n2;1.5;-2;0.5\n").unwrap();
+        assert_eq!(
+            l,
+            vec![
+                Landmark::new(1, 0.0, 0.0),
+                Landmark {
+                    id: 2,
+                    x: 1.5,
+                    y: -2.0,
+                    theta: 0.5
+                }
+            ]
+        );
+        let e = parse_landmarks("1,0,0\n-1,0,0\n").unwrap_err();
+        assert!(
+            matches!(e, LandmarkFileError::BadLine { line: 2, .. }),
+            "{e}"
+        );
+        assert!(matches!(
+            parse_landmarks("[{\"id\":1}]"),
+            Err(LandmarkFileError::Json(_))
+        ));
+        assert!(parse_landmarks("").unwrap().is_empty());
+    }
+
+    #[test]
+    fn file() {
+        let dir = tempfile::tempdir().unwrap();
+        let f = dir.path().join("l.json");
+        std::fs::write(&f, r#"[{"id":1,"x":1,"y":2,"theta":0.1}]"#).unwrap();
+        assert_eq!(load_landmarks(&f).unwrap()[0].theta, 0.1);
+        assert!(matches!(
+            load_landmarks(&dir.path().join("none")),
+            Err(LandmarkFileError::Io { .. })
+        ));
+    }
+}
