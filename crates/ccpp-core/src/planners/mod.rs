@@ -1,6 +1,8 @@
 //! The coverage planners, one module each, behind the [`Planner`](crate::planner::Planner) trait,
 //! and the catalogue that builds them by name.
 
+pub mod bsa;
+pub mod bsa_extended;
 pub mod random_bounce;
 
 use serde::{Deserialize, Serialize};
@@ -20,11 +22,23 @@ pub struct PlannerInfo {
 }
 
 /// Every planner ccpp knows.
-pub const CATALOG: &[PlannerInfo] = &[PlannerInfo {
-    name: "random-bounce",
-    description: "Roomba-like baseline: straight until the sensed obstacle, seeded random turn, distance budget (online)",
-    offline: false,
-}];
+pub const CATALOG: &[PlannerInfo] = &[
+    PlannerInfo {
+        name: "random-bounce",
+        description: "Roomba-like baseline: straight until the sensed obstacle, seeded random turn, distance budget (online)",
+        offline: false,
+    },
+    PlannerInfo {
+        name: "bsa",
+        description: "Backtracking Spiral Algorithm: spirals on robot-sized cells, BFS backtracking over visited cells (online)",
+        offline: false,
+    },
+    PlannerInfo {
+        name: "bsa-extended",
+        description: "BSA plus wall following at map resolution and gap-crossing return paths, for coverage near obstacles (online)",
+        offline: false,
+    },
+];
 
 /// Options of every planner, one section each (the single source of truth for CLI, config
 /// files and bindings).
@@ -33,6 +47,10 @@ pub const CATALOG: &[PlannerInfo] = &[PlannerInfo {
 pub struct PlannerOptions {
     /// `random-bounce`.
     pub random_bounce: random_bounce::RandomBounceOptions,
+    /// `bsa`.
+    pub bsa: bsa::BsaOptions,
+    /// `bsa-extended`.
+    pub bsa_extended: bsa_extended::BsaExtendedOptions,
 }
 
 /// Error building a planner.
@@ -62,6 +80,8 @@ pub fn build(
             }
             Ok(Box::new(random_bounce::RandomBounce::new(o)))
         }
+        "bsa" => Ok(Box::new(bsa::Bsa::new(opts.bsa.clone()))),
+        "bsa-extended" => Ok(Box::new(bsa::Bsa::extended(opts.bsa_extended.clone()))),
         other => Err(BuildError::Unknown(other.to_string())),
     }
 }
