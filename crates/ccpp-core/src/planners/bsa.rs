@@ -667,13 +667,18 @@ pub(crate) fn heading_of(a: Tile, b: Tile) -> usize {
 }
 
 /// Drops the interior cells of straight runs of a 4-connected cell path.
+///
+/// ```text
+/// (0,0) (1,0) (2,0) (2,1) (2,2) (3,2)  ->  (0,0) (2,0) (2,2) (3,2)
+/// ```
 pub(crate) fn merge_collinear(cells: &[Tile]) -> Vec<Tile> {
     let mut out: Vec<Tile> = Vec::with_capacity(cells.len());
     for &t in cells {
         if out.len() >= 2 {
             let a = out[out.len() - 2];
             let b = out[out.len() - 1];
-            if heading_of(a, b) == heading_of(b, t) {
+            let dir = |p: Tile, q: Tile| ((q.0 - p.0).signum(), (q.1 - p.1).signum());
+            if dir(a, b) == dir(b, t) {
                 out.pop();
             }
         }
@@ -701,5 +706,27 @@ impl Planner for Bsa {
             }
             self.decide(sensor);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn merge_collinear_keeps_every_corner() {
+        let path = [(0, 0), (1, 0), (2, 0), (2, 1), (2, 2), (2, 3), (3, 3), (4, 3), (4, 2)];
+        assert_eq!(
+            merge_collinear(&path),
+            vec![(0, 0), (2, 0), (2, 3), (4, 3), (4, 2)]
+        );
+    }
+
+    #[test]
+    fn sides_turn_the_right_way() {
+        assert_eq!(Side::Left.rls(0), 1);
+        assert_eq!(Side::Left.ols(0), 3);
+        assert_eq!(Side::Right.rls(0), 3);
+        assert_eq!(Side::Right.ols(1), 2);
     }
 }
