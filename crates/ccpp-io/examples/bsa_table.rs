@@ -41,7 +41,13 @@ fn main() {
         let mb = compute(&world, &b, &name);
         let e = simulate(
             &world,
-            &mut Bsa::extended(BsaExtendedOptions::default()),
+            &mut Bsa::extended(BsaExtendedOptions {
+                clearance_px: std::env::var("BSA_CLEARANCE_PX")
+                    .ok()
+                    .and_then(|s| s.parse().ok())
+                    .unwrap_or(BsaExtendedOptions::default().clearance_px),
+                ..Default::default()
+            }),
             &cfg,
         );
         let me = compute(&world, &e, &name);

@@ -597,23 +597,12 @@ impl Bsa {
             region: core.region,
         }));
         core.validate_bps();
-        let plan = match self.ext.as_mut() {
-            Some(ext) => ext.select(core),
-            None => core.select_basic().map(|cells| {
-                let raw: Vec<Point> = cells.iter().map(|&t| core.center(t)).collect();
-                let moves = merge_collinear(&cells)
-                    .into_iter()
-                    .map(|t| core.center(t))
-                    .collect();
-                let target = *cells.last().expect("path ends at the BP");
-                let prev = cells[cells.len() - 2];
-                ReturnPlan {
-                    target,
-                    entry: heading_of(prev, target),
-                    raw,
-                    moves,
-                }
-            }),
+        // A path over visited cells first (basic BSA, and the paper's first choice for the
+        // extended version); only where none exists may the extension cross partially
+        // occupied cells.
+        let plan = match core.select_basic() {
+            Some(cells) => Some(basic_plan(core, &cells)),
+            None => self.ext.as_mut().and_then(|ext| ext.select(core)),
         };
         let Some(plan) = plan else {
             self.phase = Phase::Finished;
@@ -626,7 +615,7 @@ impl Bsa {
         q.push_back(Step::Mark(Event::PathRaw {
             points: plan.raw.iter().map(|p| [p.x, p.y]).collect(),
         }));
-        if self.ext.is_some() {
+        if plan.raw.len() != plan.moves.len() {
             q.push_back(Step::Mark(Event::PathSmoothed {
                 points: plan.moves.iter().map(|p| [p.x, p.y]).collect(),
             }));
@@ -643,6 +632,23 @@ impl Bsa {
         core.cell = plan.target;
         core.heading = plan.entry;
         self.phase = Phase::Arrive(plan.entry);
+    }
+}
+
+/// The transfer along a cell path over visited cells (collinear steps merged).
+fn basic_plan(core: &Core, cells: &[Tile]) -> ReturnPlan {
+    let raw: Vec<Point> = cells.iter().map(|&t| core.center(t)).collect();
+    let moves = merge_collinear(cells)
+        .into_iter()
+        .map(|t| core.center(t))
+        .collect();
+    let target = *cells.last().expect("path ends at the BP");
+    let prev = cells[cells.len() - 2];
+    ReturnPlan {
+        target,
+        entry: heading_of(prev, target),
+        raw,
+        moves,
     }
 }
 

@@ -21,9 +21,11 @@
 //!   pixel onto the iso-clearance curve (towards its nearest known obstacle pixel until the
 //!   clearance is exactly `c`). So the robot drives the contour at about one-pixel sampling, at
 //!   clearance `c`, with every segment checked free on the known map before it is commanded.
-//!   The default `c` is a quarter pixel rather than the one pixel the brief suggested: with a
-//!   robot at one pixel of clearance the tool no longer reaches the free pixel that touches a
-//!   wall, which costs a pixel-wide band along every wall (several per cent of `A`).
+//!   The default `c` is 0.05 px rather than the one pixel the brief suggested: at one pixel of
+//!   clearance the tool no longer reaches the free pixel that touches a wall, which costs a
+//!   pixel-wide band along every wall (several per cent of `A`); a small positive `c` keeps the
+//!   one-pixel chords between contour samples clear of the obstacles. Measured on the shared
+//!   maps at r = 0.15 m: 0.05 px beat 0, 0.02, 0.1, 0.25 and 0.4 px on effective coverage.
 //! * **Online**: each tracing step reads only pixels within `r + c + 2` px of the robot; a step
 //!   that would need an unsensed pixel waits until the robot has moved and sensed again.
 //! * **Stop**: when the robot returns within 1.5 px of the stored start after having been more
@@ -115,7 +117,7 @@ impl Default for BsaExtendedOptions {
     fn default() -> Self {
         Self {
             side: Side::Left,
-            clearance_px: 0.25,
+            clearance_px: 0.05,
             gap_cost: 4,
             pipe_halfwidth: 1.0,
             max_follow_steps: 5_000_000,
