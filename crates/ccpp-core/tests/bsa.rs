@@ -16,11 +16,11 @@ const R: f64 = 0.1;
 
 /// World of an ASCII map, start at the centre of character (col, row) (row 0 = top line).
 fn world(art: &str, col: usize, row: usize, theta: f64) -> World {
-    let map = GridMap::from_ascii_scaled(art, SCALE, RES).unwrap();
+    let map = GridMap::from_ascii_scaled(art, SCALE, RES).expect("valid art");
     let h = map.frame().height as f64 * RES;
     let c = SCALE as f64 * RES;
     let start = Pose::new((col as f64 + 0.5) * c, h - (row as f64 + 0.5) * c, theta);
-    World::new(map, Robot::new(R), Some(start)).unwrap()
+    World::new(map, Robot::new(R), Some(start)).expect("robot fits at the start")
 }
 
 fn run(w: &World, side: Side) -> (RunOutput, Metrics) {
@@ -124,7 +124,10 @@ fn rs4_moves_forward() {
     for side in [Side::Left, Side::Right] {
         let w = world(art, 1, 1, 0.0);
         let (out, m) = run(&w, side);
-        assert_eq!(cells(&w, &out), vec![(1, 1), (2, 1), (3, 1), (4, 1), (5, 1)]);
+        assert_eq!(
+            cells(&w, &out),
+            vec![(1, 1), (2, 1), (3, 1), (4, 1), (5, 1)]
+        );
         assert_eq!(m.turns, 0, "{side:?}");
         assert_eq!(m.coverage_rate, Some(1.0));
     }
@@ -246,7 +249,11 @@ fn extended_beats_basic_near_obstacles() {
     ] {
         let map = GridMap::from_ascii_scaled(art, 8, 0.025).unwrap();
         let h = map.frame().height as f64 * 0.025;
-        let start = Pose::new((col as f64 + 0.5) * 0.2, h - (row as f64 + 0.5) * 0.2, 0.0);
+        let start = Pose::new(
+            (f64::from(col) + 0.5) * 0.2,
+            h - (f64::from(row) + 0.5) * 0.2,
+            0.0,
+        );
         let w = World::new(map, Robot::new(0.08), Some(start)).unwrap();
         for side in [Side::Left, Side::Right] {
             let (_, mb) = run(&w, side);
@@ -331,4 +338,3 @@ mod props {
         }
     }
 }
-

@@ -33,7 +33,9 @@ fn main() {
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     let mut revisits = Vec::new();
     for y in &yamls {
-        let name = y.file_stem().unwrap().to_string_lossy().to_string();
+        let name = y
+            .file_stem()
+            .map_or_else(String::new, |s| s.to_string_lossy().to_string());
         let loaded = load_map(y, &LoadOptions::default()).expect("map loads");
         let world = World::new(loaded.grid, Robot::new(r), None).expect("world");
         let cfg = SimConfig::default();

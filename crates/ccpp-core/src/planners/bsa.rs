@@ -46,17 +46,15 @@
 //! use ccpp_core::world::{Robot, World};
 //! use ccpp_core::planners::bsa::{Bsa, BsaOptions};
 //! use ccpp_core::sim::{simulate, SimConfig};
-//! // Characters of 0.2 m (4 px of 0.05 m), robot of radius 0.1 m: one cell per character.
-//! let map = GridMap::from_ascii_scaled(
-//!     "########\n\
-//!      #......#\n\
-//!      #..##..#\n\
-//!      #......#\n\
-//!      ########",
-//!     4,
-//!     0.05,
-//! )
-//! .unwrap();
+//! // Characters of 0.2 m (5 px of 0.04 m), robot of radius 0.1 m: one cell per character.
+//! let art = concat!(
+//!     "########\n",
+//!     "#......#\n",
+//!     "#..##..#\n",
+//!     "#......#\n",
+//!     "########",
+//! );
+//! let map = GridMap::from_ascii_scaled(art, 5, 0.04).unwrap();
 //! let world = World::new(map, Robot::new(0.1), Some(Pose::new(0.3, 0.3, 0.0))).unwrap();
 //! let mut bsa = Bsa::new(BsaOptions::default());
 //! let out = simulate(&world, &mut bsa, &SimConfig::default());
@@ -107,7 +105,7 @@ impl Side {
 }
 
 /// Options of [`Bsa`] (`--planner bsa`).
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct BsaOptions {
     /// Reference lateral side of the spirals (`left` or `right`).
@@ -492,7 +490,7 @@ impl Bsa {
     /// The heading a new spiral starts with, given the heading `e` that entered the cell: the
     /// first of `e`, `OLS(e)`, `back(e)`, `RLS(e)` with the RLS blocked and the front free, else
     /// the first with a free front, else `e`.
-    fn initial_heading(side: Side, e: usize, blocked: &[bool; 4]) -> usize {
+    fn initial_heading(side: Side, e: usize, blocked: [bool; 4]) -> usize {
         let cands = [e, side.ols(e), (e + 2) % 4, side.rls(e)];
         cands
             .iter()
@@ -504,7 +502,7 @@ impl Bsa {
 
     /// Records the BPs around the current cell (all free unvisited neighbours but heading `h`),
     /// then moves one cell forward along `h`.
-    fn forward(core: &mut Core, queue: &mut VecDeque<Step>, h: usize, blocked: &[bool; 4]) {
+    fn forward(core: &mut Core, queue: &mut VecDeque<Step>, h: usize, blocked: [bool; 4]) {
         let c = core.cell;
         for d in 0..4 {
             if d != h && !blocked[d] {
@@ -558,14 +556,14 @@ impl Bsa {
             Phase::Approach => {
                 let h = core.heading;
                 if !blocked[h] {
-                    Self::forward(core, &mut self.queue, h, &blocked);
+                    Self::forward(core, &mut self.queue, h, blocked);
                     return;
                 }
-                core.heading = Self::initial_heading(self.side, h, &blocked);
+                core.heading = Self::initial_heading(self.side, h, blocked);
                 self.phase = Phase::Spiral;
             }
             Phase::Arrive(e) => {
-                core.heading = Self::initial_heading(self.side, e, &blocked);
+                core.heading = Self::initial_heading(self.side, e, blocked);
                 self.phase = Phase::Spiral;
             }
             _ => {}
@@ -577,22 +575,25 @@ impl Bsa {
         }
         let side = self.side;
         let mut h = core.heading;
-        if !blocked[side.rls(h)] {
-            // RS2: RLS free -> turn to the RLS and move forward.
-            h = side.rls(h);
-        } else {
+        if blocked[side.rls(h)] {
             // RS3: front blocked -> turn to the OLS (repeat until the front is free; RS1 rules
             // out all four blocked). RS4: move forward.
             while blocked[h] {
                 h = side.ols(h);
             }
+        } else {
+            // RS2: RLS free -> turn to the RLS and move forward.
+            h = side.rls(h);
         }
-        Self::forward(core, &mut self.queue, h, &blocked);
+        Self::forward(core, &mut self.queue, h, blocked);
     }
 
     /// RS1 fired: end the spiral, select a BP, plan the return path, start the next spiral.
     fn end_spiral(&mut self) {
-        let core = self.core.as_mut().expect("core exists once planning started");
+        let core = self
+            .core
+            .as_mut()
+            .expect("core exists once planning started");
         self.queue.push_back(Step::Mark(Event::RegionEnd {
             region: core.region,
         }));
@@ -721,7 +722,17 @@ mod tests {
 
     #[test]
     fn merge_collinear_keeps_every_corner() {
-        let path = [(0, 0), (1, 0), (2, 0), (2, 1), (2, 2), (2, 3), (3, 3), (4, 3), (4, 2)];
+        let path = [
+            (0, 0),
+            (1, 0),
+            (2, 0),
+            (2, 1),
+            (2, 2),
+            (2, 3),
+            (3, 3),
+            (4, 3),
+            (4, 2),
+        ];
         assert_eq!(
             merge_collinear(&path),
             vec![(0, 0), (2, 0), (2, 3), (4, 3), (4, 2)]

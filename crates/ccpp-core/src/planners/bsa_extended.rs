@@ -57,17 +57,17 @@
 //! use ccpp_core::planners::bsa_extended::BsaExtendedOptions;
 //! use ccpp_core::sim::{simulate, SimConfig};
 //! use ccpp_core::metrics::compute;
-//! let map = GridMap::from_ascii_scaled(
-//!     "#########\n\
-//!      #.......#\n\
-//!      #..#....#\n\
-//!      #.....#.#\n\
-//!      #.......#\n\
-//!      #########",
-//!     5,
-//!     0.04,
-//! )
-//! .unwrap();
+//! // Characters of 0.2 m, robot of radius 0.08 m: cells of 0.16 m that do not line up with the
+//! // obstacles, so basic BSA leaves bands near them.
+//! let art = concat!(
+//!     "#########\n",
+//!     "#.......#\n",
+//!     "#..#....#\n",
+//!     "#.....#.#\n",
+//!     "#.......#\n",
+//!     "#########",
+//! );
+//! let map = GridMap::from_ascii_scaled(art, 5, 0.04).unwrap();
 //! let start = Some(Pose::new(0.3, 0.3, 0.0));
 //! let world = World::new(map, Robot::new(0.08), start).unwrap();
 //! let basic = simulate(&world, &mut Bsa::new(BsaOptions::default()), &SimConfig::default());
@@ -319,10 +319,7 @@ impl Extension {
         match best {
             Some((d2, q)) if d2.sqrt() > rr => {
                 let d = d2.sqrt();
-                Point::new(
-                    q.x + (bc.x - q.x) * rr / d,
-                    q.y + (bc.y - q.y) * rr / d,
-                )
+                Point::new(q.x + (bc.x - q.x) * rr / d, q.y + (bc.y - q.y) * rr / d)
             }
             _ => bc,
         }
@@ -761,11 +758,7 @@ impl Extension {
                     if c < g_cost[k] {
                         g_cost[k] = c;
                         parent[k] = k;
-                        heap.push(std::cmp::Reverse((
-                            (c + g.dist(b)).to_bits(),
-                            p.1,
-                            p.0,
-                        )));
+                        heap.push(std::cmp::Reverse(((c + g.dist(b)).to_bits(), p.1, p.0)));
                     }
                 }
             }
@@ -790,11 +783,7 @@ impl Extension {
                     g_cost[kq] = c;
                     parent[kq] = k;
                     let gq = self.center_grid(q);
-                    heap.push(std::cmp::Reverse((
-                        (c + gq.dist(b)).to_bits(),
-                        q.1,
-                        q.0,
-                    )));
+                    heap.push(std::cmp::Reverse(((c + gq.dist(b)).to_bits(), q.1, q.0)));
                 }
             }
         }

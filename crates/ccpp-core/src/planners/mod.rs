@@ -80,7 +80,7 @@ pub fn build(
             }
             Ok(Box::new(random_bounce::RandomBounce::new(o)))
         }
-        "bsa" => Ok(Box::new(bsa::Bsa::new(opts.bsa.clone()))),
+        "bsa" => Ok(Box::new(bsa::Bsa::new(opts.bsa))),
         "bsa-extended" => Ok(Box::new(bsa::Bsa::extended(opts.bsa_extended.clone()))),
         other => Err(BuildError::Unknown(other.to_string())),
     }
