@@ -58,7 +58,12 @@ impl TileGrid {
 
     /// Inclusive tile index bounds `(i0, i1, j0, j1)` whose centres can lie on the map of `world`.
     pub fn bounds_for(&self, world: &World) -> (i32, i32, i32, i32) {
-        let f = world.frame();
+        self.bounds_for_frame(world.frame())
+    }
+
+    /// Inclusive tile index bounds `(i0, i1, j0, j1)` whose centres can lie on a map of frame
+    /// `f` (what an online planner may know: the frame, not the contents).
+    pub fn bounds_for_frame(&self, f: &crate::grid::MapFrame) -> (i32, i32, i32, i32) {
         let corners = [
             f.grid_to_world(Point::new(0.0, 0.0)),
             f.grid_to_world(Point::new(f.width as f64, 0.0)),

@@ -4,6 +4,8 @@
 pub mod ba_star;
 pub mod bcd;
 pub mod bsa_bfs;
+pub mod bsa;
+pub mod bsa_extended;
 pub mod random_bounce;
 pub mod rect_boustrophedon;
 
@@ -31,8 +33,13 @@ pub const CATALOG: &[PlannerInfo] = &[
         offline: false,
     },
     PlannerInfo {
-        name: "random-bounce",
-        description: "Roomba-like baseline: straight until the sensed obstacle, seeded random turn, distance budget (online)",
+        name: "bsa",
+        description: "Backtracking Spiral Algorithm: spirals on robot-sized cells, BFS backtracking over visited cells (online)",
+        offline: false,
+    },
+    PlannerInfo {
+        name: "bsa-extended",
+        description: "BSA plus wall following at map resolution and gap-crossing return paths, for coverage near obstacles (online)",
         offline: false,
     },
     PlannerInfo {
@@ -41,13 +48,18 @@ pub const CATALOG: &[PlannerInfo] = &[
         offline: false,
     },
     PlannerInfo {
-        name: "rect-boustrophedon",
-        description: "Known-map lane waypoints for a rectangular robot (seed 001): lanes b apart, waypoints every l, blocked edges joined by clearance A* (offline)",
-        offline: true,
+        name: "random-bounce",
+        description: "Roomba-like baseline: straight until the sensed obstacle, seeded random turn, distance budget (online)",
+        offline: false,
     },
     PlannerInfo {
         name: "bcd",
         description: "Boustrophedon cellular decomposition of the known map, lanes 2 r_tool apart (offline baseline)",
+        offline: true,
+    },
+    PlannerInfo {
+        name: "rect-boustrophedon",
+        description: "Known-map lane waypoints for a rectangular robot (seed 001): lanes b apart, waypoints every l, blocked edges joined by clearance A* (offline)",
         offline: true,
     },
 ];
@@ -67,6 +79,10 @@ pub struct PlannerOptions {
     pub bsa_bfs: bsa_bfs::BsaBfsOptions,
     /// `rect-boustrophedon`.
     pub rect_boustrophedon: rect_boustrophedon::RectOptions,
+    /// `bsa`.
+    pub bsa: bsa::BsaOptions,
+    /// `bsa-extended`.
+    pub bsa_extended: bsa_extended::BsaExtendedOptions,
 }
 
 /// Error building a planner.
@@ -109,6 +125,8 @@ pub fn build(
             world,
             &opts.rect_boustrophedon,
         ))),
+        "bsa" => Ok(Box::new(bsa::Bsa::new(opts.bsa))),
+        "bsa-extended" => Ok(Box::new(bsa::Bsa::extended(opts.bsa_extended.clone()))),
         other => Err(BuildError::Unknown(other.to_string())),
     }
 }

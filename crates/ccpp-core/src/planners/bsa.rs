@@ -1,0 +1,749 @@
+//! BSA: the Backtracking Spiral Algorithm (basic version), an online coverage planner on cells
+//! of the robot's size.
+//!
+//! Source: E. González, O. Álvarez, Y. Díaz, C. Parra, C. Bustacara, "BSA: a complete coverage
+//! algorithm", ICRA 2005 (seeds 002/004), which summarises the basic algorithm of González,
+//! Alarcón, Aristizábal and Parra (IROS 2003). The extended version that also covers partially
+//! occupied cells lives in [`super::bsa_extended`] and reuses this module's machinery.
+//!
+//! # The algorithm as implemented
+//!
+//! * **Cells**: squares of side `2 r` anchored at the start position (the same tiling as
+//!   [`crate::tiles::TileGrid`], so `coverage_rate` is measured on these cells). A neighbour cell
+//!   is *free* when the robot can stand at its centre and move straight to it from the current
+//!   cell's centre, as far as the robot knows ([`KnownMap`]: only sensed pixels, unseen pixels
+//!   block). With the default sensor range `4 r` every pixel these checks read has been sensed,
+//!   so the answer is final and is cached per cell edge.
+//! * **Spiral filling** relative to the reference lateral side RLS ([`Side`], default left; OLS
+//!   is the other one). Visited cells are virtual obstacles. At each cell the rules are applied
+//!   in order: **RS1** all four neighbours blocked: the spiral ends; **RS2** the RLS neighbour is
+//!   free: turn to the RLS and move forward; **RS3** the front is blocked: turn to the OLS (and
+//!   evaluate again); **RS4** otherwise move forward.
+//! * **Backtracking points (BP)**: before every forward move, every free unvisited neighbour
+//!   other than the one being entered is recorded (one [`Event::BacktrackPoint`] per new point).
+//! * **Spiral end**: BPs that have been visited since are dropped; the closest remaining one by a
+//!   breadth-first search over visited cells (4-connected, each step along a known free edge) is
+//!   selected. *Ties* (same BFS distance): smaller `j`, then smaller `i` (the rule BA* uses). The
+//!   robot goes there over visited cells (collinear steps merged; events
+//!   [`Event::StartPoint`], [`Event::BacktrackStart`], [`Event::PathRaw`],
+//!   [`Event::BacktrackEnd`]) and starts a new spiral ([`Event::RegionStart`]). Planning stops
+//!   when no BP remains. `regions` = spirals.
+//! * **Heading of a new spiral** (the paper: "the robot is located nearby an obstacle, which is
+//!   situated in the RLS"): with `e` the direction of the move that entered the cell, the first
+//!   heading of `e`, `OLS(e)`, `back(e)`, `RLS(e)` whose RLS neighbour is blocked and whose front
+//!   is free; failing that the first with a free front.
+//! * **First spiral** (the paper assumes the robot starts next to an obstacle): when no
+//!   neighbour of the start cell is blocked, the robot first drives straight along its start
+//!   heading (rounded to a multiple of 90°), marking and recording BPs as usual, until the cell
+//!   ahead is blocked; then it picks the spiral heading by the rule above. In an empty room this
+//!   gives one spiral that ends near the centre without revisiting a cell.
+//!
+//! Every motion is a [`Step::MoveTo`] between cell centres that the planner has checked free on
+//! its [`KnownMap`], so a correct run has no collision.
+//!
+//! ```
+//! use ccpp_core::{GridMap, Pose};
+//! use ccpp_core::world::{Robot, World};
+//! use ccpp_core::planners::bsa::{Bsa, BsaOptions};
+//! use ccpp_core::sim::{simulate, SimConfig};
+//! // Characters of 0.2 m (5 px of 0.04 m), robot of radius 0.1 m: one cell per character.
+//! let art = concat!(
+//!     "########\n",
+//!     "#......#\n",
+//!     "#..##..#\n",
+//!     "#......#\n",
+//!     "########",
+//! );
+//! let map = GridMap::from_ascii_scaled(art, 5, 0.04).unwrap();
+//! let world = World::new(map, Robot::new(0.1), Some(Pose::new(0.3, 0.3, 0.0))).unwrap();
+//! let mut bsa = Bsa::new(BsaOptions::default());
+//! let out = simulate(&world, &mut bsa, &SimConfig::default());
+//! let m = ccpp_core::metrics::compute(&world, &out, "ring");
+//! assert_eq!(m.coverage_rate, Some(1.0));
+//! assert_eq!(m.collisions, 0);
+//! ```
+
+use std::collections::VecDeque;
+
+use serde::{Deserialize, Serialize};
+
+use super::bsa_extended::{BsaExtendedOptions, Extension};
+use crate::geometry::Point;
+use crate::planner::{KnownMap, Planner, Sensor, Step};
+use crate::tiles::{Tile, TileGrid};
+use crate::trace::Event;
+
+/// The reference lateral side (RLS): where BSA keeps obstacles while filling a spiral.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Side {
+    /// Obstacles on the robot's left (the spiral turns counter-clockwise).
+    #[default]
+    Left,
+    /// Obstacles on the robot's right (the spiral turns clockwise).
+    Right,
+}
+
+impl Side {
+    /// The RLS heading of heading `h` (0 E, 1 N, 2 W, 3 S).
+    #[inline]
+    pub(crate) fn rls(self, h: usize) -> usize {
+        match self {
+            Side::Left => (h + 1) % 4,
+            Side::Right => (h + 3) % 4,
+        }
+    }
+
+    /// The OLS heading of heading `h`.
+    #[inline]
+    pub(crate) fn ols(self, h: usize) -> usize {
+        match self {
+            Side::Left => (h + 3) % 4,
+            Side::Right => (h + 1) % 4,
+        }
+    }
+}
+
+/// Options of [`Bsa`] (`--planner bsa`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct BsaOptions {
+    /// Reference lateral side of the spirals (`left` or `right`).
+    pub side: Side,
+}
+
+/// Cell headings, counter-clockwise from east: E, N, W, S (tile offsets).
+pub const HEADINGS: [Tile; 4] = [(1, 0), (0, 1), (-1, 0), (0, -1)];
+
+/// Cell flag: the robot stood at the centre (a virtual obstacle for the spiral rules).
+pub(crate) const VISITED: u8 = 1;
+/// Cell flag: recorded as a backtracking point.
+pub(crate) const BP: u8 = 2;
+/// Cell flag: the robot's centre has been inside the cell (extended: gap cells of return paths).
+pub(crate) const TOUCHED: u8 = 4;
+/// Cell flag: the robot can stand at the centre (final, from sensed pixels).
+pub(crate) const STAND_FREE: u8 = 8;
+/// Cell flag: the robot cannot stand at the centre (final).
+pub(crate) const STAND_BLOCKED: u8 = 16;
+/// Cell flag: given up as a backtracking target (no return path found).
+pub(crate) const DEAD: u8 = 32;
+
+/// Edge state: the straight move between the centres is free.
+pub(crate) const EDGE_FREE: u8 = 1;
+/// Edge state: the move is blocked.
+pub(crate) const EDGE_BLOCKED: u8 = 2;
+
+#[inline]
+pub(crate) fn add(t: Tile, d: usize) -> Tile {
+    (t.0 + HEADINGS[d].0, t.1 + HEADINGS[d].1)
+}
+
+/// Dense per-cell state over the cells that can lie on the map.
+pub(crate) struct Cells {
+    i0: i32,
+    j0: i32,
+    w: usize,
+    h: usize,
+    flags: Vec<u8>,
+    /// Two bits per heading (E, N, W, S): 0 unknown, [`EDGE_FREE`], [`EDGE_BLOCKED`].
+    edges: Vec<u8>,
+    /// Extended BSA: bit `d` set once the obstacle trigger was evaluated towards heading `d`.
+    checked: Vec<u8>,
+    /// Search scratch: generation stamp, cost and parent per cell.
+    stamp: Vec<u32>,
+    cost: Vec<u32>,
+    parent: Vec<u32>,
+    generation: u32,
+}
+
+impl Cells {
+    fn new((i0, i1, j0, j1): (i32, i32, i32, i32)) -> Self {
+        let w = (i1 - i0 + 1).max(0) as usize;
+        let h = (j1 - j0 + 1).max(0) as usize;
+        let n = w * h;
+        Self {
+            i0,
+            j0,
+            w,
+            h,
+            flags: vec![0; n],
+            edges: vec![0; n],
+            checked: vec![0; n],
+            stamp: vec![0; n],
+            cost: vec![0; n],
+            parent: vec![0; n],
+            generation: 0,
+        }
+    }
+
+    #[inline]
+    pub(crate) fn idx(&self, t: Tile) -> Option<usize> {
+        let di = t.0 - self.i0;
+        let dj = t.1 - self.j0;
+        if di < 0 || dj < 0 || di as usize >= self.w || dj as usize >= self.h {
+            None
+        } else {
+            Some(dj as usize * self.w + di as usize)
+        }
+    }
+
+    #[inline]
+    pub(crate) fn tile(&self, k: usize) -> Tile {
+        (self.i0 + (k % self.w) as i32, self.j0 + (k / self.w) as i32)
+    }
+
+    #[inline]
+    pub(crate) fn has(&self, t: Tile, f: u8) -> bool {
+        self.idx(t).is_some_and(|k| self.flags[k] & f != 0)
+    }
+
+    #[inline]
+    pub(crate) fn set(&mut self, t: Tile, f: u8) {
+        if let Some(k) = self.idx(t) {
+            self.flags[k] |= f;
+        }
+    }
+
+    #[inline]
+    pub(crate) fn clear(&mut self, t: Tile, f: u8) {
+        if let Some(k) = self.idx(t) {
+            self.flags[k] &= !f;
+        }
+    }
+
+    /// Edge state from `t` towards heading `d` (cells off the range: blocked).
+    #[inline]
+    pub(crate) fn edge(&self, t: Tile, d: usize) -> u8 {
+        match (self.idx(t), self.idx(add(t, d))) {
+            (Some(k), Some(_)) => (self.edges[k] >> (2 * d)) & 3,
+            _ => EDGE_BLOCKED,
+        }
+    }
+
+    /// Stores an edge state for both directions of the edge.
+    fn set_edge(&mut self, t: Tile, d: usize, v: u8) {
+        if let Some(k) = self.idx(t) {
+            self.edges[k] = (self.edges[k] & !(3 << (2 * d))) | (v << (2 * d));
+        }
+        let n = add(t, d);
+        let back = (d + 2) % 4;
+        if let Some(k) = self.idx(n) {
+            self.edges[k] = (self.edges[k] & !(3 << (2 * back))) | (v << (2 * back));
+        }
+    }
+
+    /// Was the trigger towards `d` evaluated at `t`? Marks it evaluated.
+    pub(crate) fn check_once(&mut self, t: Tile, d: usize) -> bool {
+        match self.idx(t) {
+            Some(k) => {
+                let first = self.checked[k] & (1 << d) == 0;
+                self.checked[k] |= 1 << d;
+                first
+            }
+            None => false,
+        }
+    }
+
+    /// Starts a new search: every cell's scratch becomes stale.
+    pub(crate) fn new_search(&mut self) {
+        self.generation = self.generation.wrapping_add(1);
+        if self.generation == 0 {
+            self.stamp.iter_mut().for_each(|s| *s = 0);
+            self.generation = 1;
+        }
+    }
+
+    /// Search cost of cell `k` in the current search (`None` when unreached).
+    #[inline]
+    pub(crate) fn cost_of(&self, k: usize) -> Option<u32> {
+        (self.stamp[k] == self.generation).then(|| self.cost[k])
+    }
+
+    #[inline]
+    pub(crate) fn reach(&mut self, k: usize, cost: u32, parent: usize) {
+        self.stamp[k] = self.generation;
+        self.cost[k] = cost;
+        self.parent[k] = parent as u32;
+    }
+
+    /// Path from the search root to `k` (cells, root first).
+    pub(crate) fn path_to(&self, mut k: usize) -> Vec<Tile> {
+        let mut out = vec![self.tile(k)];
+        while self.parent[k] as usize != k {
+            k = self.parent[k] as usize;
+            out.push(self.tile(k));
+        }
+        out.reverse();
+        out
+    }
+}
+
+/// What the planner knows and where it is (built on the first step).
+pub(crate) struct Core {
+    pub(crate) known: KnownMap,
+    pub(crate) grid: TileGrid,
+    /// Robot radius, metres.
+    pub(crate) r: f64,
+    /// Sensor range, metres.
+    pub(crate) range: f64,
+    pub(crate) cells: Cells,
+    /// Recorded backtracking points (validated at each spiral end).
+    pub(crate) bps: Vec<Tile>,
+    /// The cell whose centre the robot is at (or will be once the queued steps ran).
+    pub(crate) cell: Tile,
+    /// Current heading (0 E, 1 N, 2 W, 3 S).
+    pub(crate) heading: usize,
+    /// Current spiral number.
+    pub(crate) region: u32,
+}
+
+impl Core {
+    fn new(sensor: &dyn Sensor) -> Self {
+        let r = sensor.robot().radius;
+        let pose = sensor.pose();
+        let grid = TileGrid::new(pose.position(), 2.0 * r);
+        let cells = Cells::new(grid.bounds_for_frame(sensor.frame()));
+        let q = (pose.theta / std::f64::consts::FRAC_PI_2).round() as i64;
+        Self {
+            known: KnownMap::new(sensor.frame()),
+            grid,
+            r,
+            range: sensor.sensor_range(),
+            cells,
+            bps: Vec::new(),
+            cell: (0, 0),
+            heading: q.rem_euclid(4) as usize,
+            region: 0,
+        }
+    }
+
+    #[inline]
+    pub(crate) fn center(&self, t: Tile) -> Point {
+        self.grid.center(t)
+    }
+
+    /// Is the move from the current cell towards `d` free? Computed once (the robot is at the
+    /// cell centre, so every pixel the check reads has been sensed) and cached for both ends.
+    fn probe(&mut self, d: usize) -> bool {
+        let c = self.cell;
+        match self.cells.edge(c, d) {
+            EDGE_FREE => true,
+            EDGE_BLOCKED => false,
+            _ => {
+                let n = add(c, d);
+                let free = self.cells.idx(n).is_some()
+                    && self
+                        .known
+                        .segment_free(self.center(c), self.center(n), self.r);
+                self.cells
+                    .set_edge(c, d, if free { EDGE_FREE } else { EDGE_BLOCKED });
+                if free {
+                    self.cells.set(n, STAND_FREE);
+                }
+                free
+            }
+        }
+    }
+
+    /// Free neighbours of the current cell (E, N, W, S) and which of them are blocked for the
+    /// spiral rules (not free, or visited: a virtual obstacle).
+    pub(crate) fn around(&mut self) -> ([bool; 4], [bool; 4]) {
+        let mut free = [false; 4];
+        let mut blocked = [true; 4];
+        for d in 0..4 {
+            free[d] = self.probe(d);
+            blocked[d] = !free[d] || self.cells.has(add(self.cell, d), VISITED);
+        }
+        (free, blocked)
+    }
+
+    /// Records `t` as a backtracking point (once).
+    pub(crate) fn add_bp(&mut self, t: Tile, queue: &mut VecDeque<Step>) {
+        if self.cells.has(t, BP | VISITED | DEAD) || self.cells.idx(t).is_none() {
+            return;
+        }
+        self.cells.set(t, BP);
+        self.bps.push(t);
+        let p = self.center(t);
+        queue.push_back(Step::Mark(Event::BacktrackPoint { x: p.x, y: p.y }));
+    }
+
+    /// Marks `t` visited (a virtual obstacle).
+    pub(crate) fn visit(&mut self, t: Tile) {
+        self.cells.set(t, VISITED | TOUCHED | STAND_FREE);
+    }
+
+    /// Drops the BPs that are no longer unvisited (or were given up).
+    pub(crate) fn validate_bps(&mut self) {
+        let cells = &mut self.cells;
+        self.bps.retain(|&t| {
+            let keep = !cells.has(t, VISITED | DEAD);
+            if !keep {
+                cells.clear(t, BP);
+            }
+            keep
+        });
+    }
+
+    /// Basic BSA selection: breadth-first search over visited cells from the current cell; the
+    /// nearest BP entered along a known free edge (ties: smaller `j`, then smaller `i`). Returns
+    /// the cell path, current cell first, BP last.
+    fn select_basic(&mut self) -> Option<Vec<Tile>> {
+        let start = self.cells.idx(self.cell)?;
+        self.cells.new_search();
+        self.cells.reach(start, 0, start);
+        let mut level = vec![start];
+        let mut depth = 0u32;
+        while !level.is_empty() {
+            let mut best: Option<(Tile, usize)> = None;
+            let mut next = Vec::new();
+            for &k in &level {
+                let u = self.cells.tile(k);
+                for d in 0..4 {
+                    if self.cells.edge(u, d) != EDGE_FREE {
+                        continue;
+                    }
+                    let n = add(u, d);
+                    let Some(kn) = self.cells.idx(n) else {
+                        continue;
+                    };
+                    if self.cells.has(n, VISITED) {
+                        if self.cells.cost_of(kn).is_none() {
+                            self.cells.reach(kn, depth + 1, k);
+                            next.push(kn);
+                        }
+                    } else if self.cells.has(n, BP)
+                        && best.is_none_or(|(b, _)| (n.1, n.0) < (b.1, b.0))
+                    {
+                        best = Some((n, k));
+                    }
+                }
+            }
+            if let Some((n, k)) = best {
+                let mut path = self.cells.path_to(k);
+                path.push(n);
+                return Some(path);
+            }
+            level = next;
+            depth += 1;
+        }
+        None
+    }
+}
+
+/// Phase of the planner.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Phase {
+    /// Nothing done yet.
+    Init,
+    /// First spiral, before meeting an obstacle: straight along the start heading.
+    Approach,
+    /// Just arrived at a new spiral's first cell, entered along this heading.
+    Arrive(usize),
+    /// Spiral filling.
+    Spiral,
+    /// Extended BSA: wall following (driven by [`Extension`]).
+    Follow,
+    /// No BP left.
+    Finished,
+}
+
+/// The BSA planner (basic with [`Bsa::new`], extended with [`Bsa::extended`]).
+pub struct Bsa {
+    side: Side,
+    name: &'static str,
+    ext: Option<Extension>,
+    core: Option<Core>,
+    phase: Phase,
+    /// Phase to return to after a wall follow.
+    resume: Phase,
+    queue: VecDeque<Step>,
+}
+
+impl Bsa {
+    /// Basic BSA (`--planner bsa`).
+    pub fn new(opts: BsaOptions) -> Self {
+        Self {
+            side: opts.side,
+            name: "bsa",
+            ext: None,
+            core: None,
+            phase: Phase::Init,
+            resume: Phase::Spiral,
+            queue: VecDeque::new(),
+        }
+    }
+
+    /// Extended BSA (`--planner bsa-extended`): see [`super::bsa_extended`].
+    pub fn extended(opts: BsaExtendedOptions) -> Self {
+        Self {
+            side: opts.side,
+            name: "bsa-extended",
+            ext: Some(Extension::new(opts)),
+            core: None,
+            phase: Phase::Init,
+            resume: Phase::Spiral,
+            queue: VecDeque::new(),
+        }
+    }
+
+    /// The heading a new spiral starts with, given the heading `e` that entered the cell: the
+    /// first of `e`, `OLS(e)`, `back(e)`, `RLS(e)` with the RLS blocked and the front free, else
+    /// the first with a free front, else `e`.
+    fn initial_heading(side: Side, e: usize, blocked: [bool; 4]) -> usize {
+        let cands = [e, side.ols(e), (e + 2) % 4, side.rls(e)];
+        cands
+            .iter()
+            .copied()
+            .find(|&h| blocked[side.rls(h)] && !blocked[h])
+            .or_else(|| cands.iter().copied().find(|&h| !blocked[h]))
+            .unwrap_or(e)
+    }
+
+    /// Records the BPs around the current cell (all free unvisited neighbours but heading `h`),
+    /// then moves one cell forward along `h`.
+    fn forward(core: &mut Core, queue: &mut VecDeque<Step>, h: usize, blocked: [bool; 4]) {
+        let c = core.cell;
+        for d in 0..4 {
+            if d != h && !blocked[d] {
+                core.add_bp(add(c, d), queue);
+            }
+        }
+        let n = add(c, h);
+        core.heading = h;
+        core.visit(n);
+        core.cell = n;
+        queue.push_back(Step::MoveTo(core.center(n)));
+    }
+
+    /// Plans the next steps into the queue (the robot is at the pose the planner expects).
+    fn decide(&mut self, sensor: &dyn Sensor) {
+        let core = self.core.get_or_insert_with(|| Core::new(sensor));
+        core.known.integrate(&sensor.scan());
+        if self.phase == Phase::Follow {
+            let ext = self.ext.as_mut().expect("follow only in extended mode");
+            ext.follow_step(core, &mut self.queue, self.side);
+            if !ext.following() {
+                self.phase = self.resume;
+            }
+            return;
+        }
+        if self.phase == Phase::Init {
+            if let Some(ext) = self.ext.as_mut() {
+                ext.init(core);
+            }
+            core.region = 1;
+            self.queue
+                .push_back(Step::Mark(Event::RegionStart { region: 1 }));
+            let c = core.cell;
+            core.visit(c);
+            let (_, blocked) = core.around();
+            self.phase = if blocked.iter().any(|&b| b) {
+                Phase::Arrive(core.heading)
+            } else {
+                Phase::Approach
+            };
+        }
+        let (_, blocked) = core.around();
+        if let Some(ext) = self.ext.as_mut() {
+            if ext.try_trigger(core, &mut self.queue, self.side) {
+                self.resume = self.phase;
+                self.phase = Phase::Follow;
+                return;
+            }
+        }
+        match self.phase {
+            Phase::Approach => {
+                let h = core.heading;
+                if !blocked[h] {
+                    Self::forward(core, &mut self.queue, h, blocked);
+                    return;
+                }
+                core.heading = Self::initial_heading(self.side, h, blocked);
+                self.phase = Phase::Spiral;
+            }
+            Phase::Arrive(e) => {
+                core.heading = Self::initial_heading(self.side, e, blocked);
+                self.phase = Phase::Spiral;
+            }
+            _ => {}
+        }
+        // RS1: all around blocked -> the spiral ends.
+        if blocked.iter().all(|&b| b) {
+            self.end_spiral();
+            return;
+        }
+        let side = self.side;
+        let mut h = core.heading;
+        if blocked[side.rls(h)] {
+            // RS3: front blocked -> turn to the OLS (repeat until the front is free; RS1 rules
+            // out all four blocked). RS4: move forward.
+            while blocked[h] {
+                h = side.ols(h);
+            }
+        } else {
+            // RS2: RLS free -> turn to the RLS and move forward.
+            h = side.rls(h);
+        }
+        Self::forward(core, &mut self.queue, h, blocked);
+    }
+
+    /// RS1 fired: end the spiral, select a BP, plan the return path, start the next spiral.
+    fn end_spiral(&mut self) {
+        let core = self
+            .core
+            .as_mut()
+            .expect("core exists once planning started");
+        self.queue.push_back(Step::Mark(Event::RegionEnd {
+            region: core.region,
+        }));
+        core.validate_bps();
+        // A path over visited cells first (basic BSA, and the paper's first choice for the
+        // extended version); only where none exists may the extension cross partially
+        // occupied cells.
+        let plan = match core.select_basic() {
+            Some(cells) => Some(basic_plan(core, &cells)),
+            None => self.ext.as_mut().and_then(|ext| ext.select(core)),
+        };
+        let Some(plan) = plan else {
+            self.phase = Phase::Finished;
+            return;
+        };
+        let q = &mut self.queue;
+        let p = core.center(plan.target);
+        q.push_back(Step::Mark(Event::StartPoint { x: p.x, y: p.y }));
+        q.push_back(Step::Mark(Event::BacktrackStart));
+        q.push_back(Step::Mark(Event::PathRaw {
+            points: plan.raw.iter().map(|p| [p.x, p.y]).collect(),
+        }));
+        if plan.raw.len() != plan.moves.len() {
+            q.push_back(Step::Mark(Event::PathSmoothed {
+                points: plan.moves.iter().map(|p| [p.x, p.y]).collect(),
+            }));
+        }
+        for &m in plan.moves.iter().skip(1) {
+            q.push_back(Step::MoveTo(m));
+        }
+        q.push_back(Step::Mark(Event::BacktrackEnd));
+        core.region += 1;
+        q.push_back(Step::Mark(Event::RegionStart {
+            region: core.region,
+        }));
+        core.visit(plan.target);
+        core.cell = plan.target;
+        core.heading = plan.entry;
+        self.phase = Phase::Arrive(plan.entry);
+    }
+}
+
+/// The transfer along a cell path over visited cells (collinear steps merged).
+fn basic_plan(core: &Core, cells: &[Tile]) -> ReturnPlan {
+    let raw: Vec<Point> = cells.iter().map(|&t| core.center(t)).collect();
+    let moves = merge_collinear(cells)
+        .into_iter()
+        .map(|t| core.center(t))
+        .collect();
+    let target = *cells.last().expect("path ends at the BP");
+    let prev = cells[cells.len() - 2];
+    ReturnPlan {
+        target,
+        entry: heading_of(prev, target),
+        raw,
+        moves,
+    }
+}
+
+/// A planned transfer to the next spiral's first cell.
+pub(crate) struct ReturnPlan {
+    /// The selected BP.
+    pub(crate) target: Tile,
+    /// Heading of the last move (into the BP).
+    pub(crate) entry: usize,
+    /// Cell centres of the cell path (for the trace).
+    pub(crate) raw: Vec<Point>,
+    /// Points to drive through, the current position first.
+    pub(crate) moves: Vec<Point>,
+}
+
+/// Heading from cell `a` to 4-neighbour `b` (E if they are not 4-neighbours).
+pub(crate) fn heading_of(a: Tile, b: Tile) -> usize {
+    HEADINGS
+        .iter()
+        .position(|&o| (a.0 + o.0, a.1 + o.1) == b)
+        .unwrap_or(0)
+}
+
+/// Drops the interior cells of straight runs of a 4-connected cell path.
+///
+/// ```text
+/// (0,0) (1,0) (2,0) (2,1) (2,2) (3,2)  ->  (0,0) (2,0) (2,2) (3,2)
+/// ```
+pub(crate) fn merge_collinear(cells: &[Tile]) -> Vec<Tile> {
+    let mut out: Vec<Tile> = Vec::with_capacity(cells.len());
+    for &t in cells {
+        if out.len() >= 2 {
+            let a = out[out.len() - 2];
+            let b = out[out.len() - 1];
+            let dir = |p: Tile, q: Tile| ((q.0 - p.0).signum(), (q.1 - p.1).signum());
+            if dir(a, b) == dir(b, t) {
+                out.pop();
+            }
+        }
+        out.push(t);
+    }
+    out
+}
+
+impl Planner for Bsa {
+    fn name(&self) -> &'static str {
+        self.name
+    }
+
+    fn tile_side(&self) -> Option<f64> {
+        self.core.as_ref().map(|c| c.grid.side)
+    }
+
+    fn next(&mut self, sensor: &dyn Sensor) -> Step {
+        loop {
+            if let Some(s) = self.queue.pop_front() {
+                return s;
+            }
+            if self.phase == Phase::Finished {
+                return Step::Done;
+            }
+            self.decide(sensor);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn merge_collinear_keeps_every_corner() {
+        let path = [
+            (0, 0),
+            (1, 0),
+            (2, 0),
+            (2, 1),
+            (2, 2),
+            (2, 3),
+            (3, 3),
+            (4, 3),
+            (4, 2),
+        ];
+        assert_eq!(
+            merge_collinear(&path),
+            vec![(0, 0), (2, 0), (2, 3), (4, 3), (4, 2)]
+        );
+    }
+
+    #[test]
+    fn sides_turn_the_right_way() {
+        assert_eq!(Side::Left.rls(0), 1);
+        assert_eq!(Side::Left.ols(0), 3);
+        assert_eq!(Side::Right.rls(0), 3);
+        assert_eq!(Side::Right.ols(1), 2);
+    }
+}

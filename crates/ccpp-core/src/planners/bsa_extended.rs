@@ -1,0 +1,839 @@
+//! Extended BSA: basic BSA plus wall following, so that the partially occupied cells near
+//! obstacles are swept too (higher `effective_coverage`).
+//!
+//! Source: E. González, O. Álvarez, Y. Díaz, C. Parra, C. Bustacara, "BSA: a complete coverage
+//! algorithm", ICRA 2005, section III (seeds 002/004). The spiral and backtracking machinery is
+//! [`super::bsa`]'s; this module adds the paper's two components.
+//!
+//! # Wall following (paper III.B–C)
+//!
+//! * **Trigger**: at every spiral cell, for each neighbour that is blocked by a real obstacle
+//!   (not free, not a virtual obstacle), the robot looks along that heading for the obstacle's
+//!   boundary. If the boundary there has not been followed before (no followed contour pixel
+//!   within 2 px), a wall follow starts. The paper marks the cell where the obstacle was
+//!   detected so that a visited obstacle is not circled twice; here the *followed contour
+//!   pixels* are remembered, which answers the same question at map resolution.
+//! * **The contour**: the robot keeps a set clearance `c` ([`BsaExtendedOptions::clearance_px`],
+//!   default 0.25 px) from the obstacles it knows. Let `S` be the pixel centres where the robot
+//!   disk grown by `c` is free on the [`KnownMap`] (unseen pixels block). The procedure traces
+//!   the boundary of `S` with Moore-neighbour tracing (obstacle on the RLS: clockwise scan for a
+//!   left RLS, counter-clockwise for right), one pixel per step, and projects each boundary
+//!   pixel onto the iso-clearance curve (towards its nearest known obstacle pixel until the
+//!   clearance is exactly `c`). So the robot drives the contour at about one-pixel sampling, at
+//!   clearance `c`, with every segment checked free on the known map before it is commanded.
+//!   The default `c` is 0.05 px rather than the one pixel the brief suggested: at one pixel of
+//!   clearance the tool no longer reaches the free pixel that touches a wall, which costs a
+//!   pixel-wide band along every wall (several per cent of `A`); a small positive `c` keeps the
+//!   one-pixel chords between contour samples clear of the obstacles. Measured on the shared
+//!   maps at r = 0.15 m: 0.05 px beat 0, 0.02, 0.1, 0.25 and 0.4 px on effective coverage.
+//! * **Online**: each tracing step reads only pixels within `r + c + 2` px of the robot; a step
+//!   that would need an unsensed pixel waits until the robot has moved and sensed again.
+//! * **Stop**: when the robot returns within 1.5 px of the stored start after having been more
+//!   than 3 px away from it (or the tracer repeats a state). The robot then drives back to the
+//!   start and to the centre of the cell it left, and the spiral resumes there.
+//! * **Marking**: while following, the cells the robot's centre passes through are marked
+//!   *touched* and every free unvisited cell (the one under the robot and its four neighbours)
+//!   is recorded as a BP, as the spiral does. Deviation from the paper: cells are not marked as
+//!   virtual obstacles by the follow (only standing at a cell's centre marks it), because a cell
+//!   the robot merely skirted is not swept and its neighbours would never be examined for BPs.
+//!
+//! # Return paths (paper III.D)
+//!
+//! Dijkstra over cells from the spiral's end: a visited cell costs 1, a touched (partially
+//! occupied) cell costs [`BsaExtendedOptions::gap_cost`], so paths over visited cells are
+//! preferred and gaps are used only where needed. The nearest BP (ties: smaller `j`, then `i`)
+//! is the target. Runs of touched cells (gaps) are crossed inside a *virtual pipe*: the pixels
+//! within [`BsaExtendedOptions::pipe_halfwidth`] cell sides of the reference line through the
+//! cell centres. The paper crosses a gap reactively, following the wall one way and reversing
+//! when the robot leaves the pipe; here the robot searches its known pixel map inside the pipe
+//! (A* over `S`) before moving, which finds the way round the obstacle that stays in the pipe
+//! without driving the failed side first. When a gap cannot be crossed inside its pipe its cell
+//! edges are banned and the search repeats; a BP that cannot be reached is given up.
+//!
+//! ```
+//! use ccpp_core::{GridMap, Pose};
+//! use ccpp_core::world::{Robot, World};
+//! use ccpp_core::planners::bsa::{Bsa, BsaOptions};
+//! use ccpp_core::planners::bsa_extended::BsaExtendedOptions;
+//! use ccpp_core::sim::{simulate, SimConfig};
+//! use ccpp_core::metrics::compute;
+//! // Characters of 0.2 m, robot of radius 0.08 m: cells of 0.16 m that do not line up with the
+//! // obstacles, so basic BSA leaves bands near them.
+//! let art = concat!(
+//!     "#########\n",
+//!     "#.......#\n",
+//!     "#..#....#\n",
+//!     "#.....#.#\n",
+//!     "#.......#\n",
+//!     "#########",
+//! );
+//! let map = GridMap::from_ascii_scaled(art, 5, 0.04).unwrap();
+//! let start = Some(Pose::new(0.3, 0.3, 0.0));
+//! let world = World::new(map, Robot::new(0.08), start).unwrap();
+//! let basic = simulate(&world, &mut Bsa::new(BsaOptions::default()), &SimConfig::default());
+//! let ext = simulate(
+//!     &world,
+//!     &mut Bsa::extended(BsaExtendedOptions::default()),
+//!     &SimConfig::default(),
+//! );
+//! let (mb, me) = (compute(&world, &basic, "m"), compute(&world, &ext, "m"));
+//! assert_eq!(me.collisions, 0);
+//! assert!(me.effective_coverage > mb.effective_coverage);
+//! ```
+
+use std::collections::{BinaryHeap, HashSet, VecDeque};
+
+use fixedbitset::FixedBitSet;
+use serde::{Deserialize, Serialize};
+
+use super::bsa::{
+    add, heading_of, Core, ReturnPlan, Side, BP, DEAD, EDGE_FREE, STAND_BLOCKED, STAND_FREE,
+    TOUCHED, VISITED,
+};
+use crate::collide::Occupancy;
+use crate::geometry::{point_segment_dist2, Point};
+use crate::grid::MapFrame;
+use crate::planner::{KnownMap, Step};
+use crate::tiles::{Tile, N8};
+use crate::trace::Event;
+
+/// Options of extended BSA (`--planner bsa-extended`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct BsaExtendedOptions {
+    /// Reference lateral side of the spirals and of the wall following (`left` or `right`).
+    pub side: Side,
+    /// Clearance kept from obstacles while wall following, in map pixels (>= 0).
+    pub clearance_px: f64,
+    /// Cost of a partially occupied (touched) cell in return paths; a visited cell costs 1.
+    pub gap_cost: u32,
+    /// Half width of the virtual pipe around a gap's reference line, in cell sides.
+    pub pipe_halfwidth: f64,
+    /// Safety cap on the steps of one wall follow.
+    pub max_follow_steps: usize,
+}
+
+impl Default for BsaExtendedOptions {
+    fn default() -> Self {
+        Self {
+            side: Side::Left,
+            clearance_px: 0.05,
+            gap_cost: 4,
+            pipe_halfwidth: 1.0,
+            max_follow_steps: 5_000_000,
+        }
+    }
+}
+
+/// Disk status on the known map.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Status {
+    /// No blocked pixel in contact, every pixel in contact seen: final.
+    Free,
+    /// A known blocked pixel (or the outside) in contact: final.
+    Blocked,
+    /// Free as far as seen, but some pixel in contact is unseen.
+    Unseen,
+}
+
+/// Status of a disk of radius `r_px` (pixels) at grid point `g` on the known map, with the
+/// obstacle model of [`crate::collide`].
+fn disk_status(known: &KnownMap, g: Point, r_px: f64) -> Status {
+    let f = *known.frame();
+    let rc = crate::collide::contact_radius_px(r_px);
+    let rc2 = rc * rc;
+    let h = f.height as f64;
+    let c0 = (g.x - rc - 0.5).floor() as i64;
+    let c1 = (g.x + rc - 0.5).ceil() as i64;
+    let r0 = (h - (g.y + rc) - 0.5).floor() as i64;
+    let r1 = (h - (g.y - rc) - 0.5).ceil() as i64;
+    let mut unseen = false;
+    for row in r0..=r1 {
+        let gy = h - row as f64 - 0.5;
+        let dy2 = (gy - g.y).powi(2);
+        if dy2 >= rc2 {
+            continue;
+        }
+        for col in c0..=c1 {
+            let dx = col as f64 + 0.5 - g.x;
+            if dx * dx + dy2 >= rc2 {
+                continue;
+            }
+            match f.checked(col, row) {
+                None => return Status::Blocked,
+                Some((c, r)) => {
+                    if !known.is_seen(c, r) {
+                        unseen = true;
+                    } else if !known.get(c, r).is_free() {
+                        return Status::Blocked;
+                    }
+                }
+            }
+        }
+    }
+    if unseen {
+        Status::Unseen
+    } else {
+        Status::Free
+    }
+}
+
+/// A pixel in signed `(col, row)` (row 0 at the top).
+type Px = (i64, i64);
+
+/// The pixel reached from `p` by N8 offset `k` (N8 is y-up: rows go the other way).
+#[inline]
+fn step(p: Px, k: usize) -> Px {
+    (p.0 + i64::from(N8[k].0), p.1 - i64::from(N8[k].1))
+}
+
+/// N8 index of the offset from `a` to its 8-neighbour `b`.
+fn dir8(a: Px, b: Px) -> Option<usize> {
+    let d = ((b.0 - a.0) as i32, (a.1 - b.1) as i32);
+    N8.iter().position(|&o| o == d)
+}
+
+/// One wall follow in progress.
+struct Follow {
+    /// The cell to return to.
+    home: Tile,
+    /// Current boundary pixel and the N8 index of its background neighbour.
+    b: Px,
+    k: usize,
+    start_b: Px,
+    start_k: usize,
+    /// Start and current robot positions (grid coordinates).
+    start_pos: Point,
+    pos: Point,
+    /// Has the robot been away from the start?
+    away: bool,
+    steps: usize,
+    states: HashSet<(Px, usize)>,
+    /// Every position driven (grid coordinates), for a safe retreat.
+    trail: Vec<Point>,
+}
+
+/// Extended-BSA state.
+pub(crate) struct Extension {
+    opts: BsaExtendedOptions,
+    frame: Option<MapFrame>,
+    /// Robot radius in pixels.
+    r_px: f64,
+    /// Per pixel: 0 undecided, 1 in `S`, 2 not in `S` (final answers only).
+    s_memo: Vec<u8>,
+    /// Followed contour pixels.
+    traced: FixedBitSet,
+    follow: Option<Follow>,
+}
+
+impl Extension {
+    pub(crate) fn new(opts: BsaExtendedOptions) -> Self {
+        Self {
+            opts,
+            frame: None,
+            r_px: 0.0,
+            s_memo: Vec::new(),
+            traced: FixedBitSet::new(),
+            follow: None,
+        }
+    }
+
+    /// Sizes the per-pixel state (first step).
+    pub(crate) fn init(&mut self, core: &Core) {
+        let f = *core.known.frame();
+        self.r_px = core.r / f.resolution;
+        self.s_memo = vec![0; f.len()];
+        self.traced = FixedBitSet::with_capacity(f.len());
+        self.frame = Some(f);
+        self.opts.clearance_px = self.opts.clearance_px.max(0.0);
+    }
+
+    /// Is a wall follow in progress?
+    pub(crate) fn following(&self) -> bool {
+        self.follow.is_some()
+    }
+
+    fn frame(&self) -> MapFrame {
+        self.frame.expect("extension initialised")
+    }
+
+    /// Is pixel `p` in `S` (the robot grown by the clearance fits at its centre)? `None` when an
+    /// unseen pixel decides (not memoised).
+    fn in_s(&mut self, known: &KnownMap, p: Px) -> Option<bool> {
+        let f = self.frame();
+        let Some((c, r)) = f.checked(p.0, p.1) else {
+            return Some(false);
+        };
+        let i = f.index(c, r);
+        match self.s_memo[i] {
+            1 => return Some(true),
+            2 => return Some(false),
+            _ => {}
+        }
+        let g = f.pixel_center_grid(c, r);
+        match disk_status(known, g, self.r_px + self.opts.clearance_px) {
+            Status::Free => {
+                self.s_memo[i] = 1;
+                Some(true)
+            }
+            Status::Blocked => {
+                self.s_memo[i] = 2;
+                Some(false)
+            }
+            Status::Unseen => None,
+        }
+    }
+
+    fn center_grid(&self, p: Px) -> Point {
+        let f = self.frame();
+        Point::new(p.0 as f64 + 0.5, (f.height as i64 - p.1) as f64 - 0.5)
+    }
+
+    fn pixel_of_grid(&self, g: Point) -> Px {
+        self.frame().grid_to_pixel_signed(g)
+    }
+
+    fn world(&self, g: Point) -> Point {
+        self.frame().grid_to_world(g)
+    }
+
+    /// Projects boundary pixel `b` onto the iso-clearance curve: towards its nearest known
+    /// blocked pixel centre until the clearance is exactly `c`.
+    fn project(&self, known: &KnownMap, b: Px) -> Point {
+        let bc = self.center_grid(b);
+        let rr = self.r_px + 0.5 + self.opts.clearance_px;
+        let w = (rr + 2.0).ceil() as i64;
+        let mut best: Option<(f64, Point)> = None;
+        for row in b.1 - w..=b.1 + w {
+            for col in b.0 - w..=b.0 + w {
+                if !known.blocked(col, row) {
+                    continue;
+                }
+                let q = self.center_grid((col, row));
+                let d2 = q.dist2(bc);
+                if best.is_none_or(|(bd, _)| d2 < bd) {
+                    best = Some((d2, q));
+                }
+            }
+        }
+        match best {
+            Some((d2, q)) if d2.sqrt() > rr => {
+                let d = d2.sqrt();
+                Point::new(q.x + (bc.x - q.x) * rr / d, q.y + (bc.y - q.y) * rr / d)
+            }
+            _ => bc,
+        }
+    }
+
+    fn seg_free(&self, known: &KnownMap, r: f64, a: Point, b: Point) -> bool {
+        known.segment_free(self.world(a), self.world(b), r)
+    }
+
+    /// Looks from the current cell's centre along heading `d` for the boundary of `S`: the last
+    /// pixel in `S` and the N8 index of the first pixel out of it. `None` when the centre is not
+    /// in `S`, the ray runs out of sensed pixels, or finds nothing within reach.
+    fn find_contour(&mut self, core: &Core, d: usize) -> Option<(Px, usize)> {
+        let f = self.frame();
+        let c = core.center(core.cell);
+        let g0 = f.world_to_grid(c);
+        let o = super::bsa::HEADINGS[d];
+        let g1 = f.world_to_grid(Point::new(c.x + f64::from(o.0), c.y + f64::from(o.1)));
+        let len = g0.dist(g1);
+        let u = Point::new((g1.x - g0.x) / len, (g1.y - g0.y) / len);
+        let mut cur = self.pixel_of_grid(g0);
+        if self.in_s(&core.known, cur) != Some(true) {
+            return None;
+        }
+        let reach = 3.0 * self.r_px + 2.0;
+        let mut s = 0.0;
+        while s < reach {
+            s += 0.5;
+            let p = self.pixel_of_grid(Point::new(g0.x + u.x * s, g0.y + u.y * s));
+            if p == cur {
+                continue;
+            }
+            match self.in_s(&core.known, p) {
+                Some(true) => cur = p,
+                Some(false) => return dir8(cur, p).map(|k| (cur, k)),
+                None => return None,
+            }
+        }
+        None
+    }
+
+    fn near_traced(&self, b: Px) -> bool {
+        let f = self.frame();
+        for row in b.1 - 2..=b.1 + 2 {
+            for col in b.0 - 2..=b.0 + 2 {
+                if let Some((c, r)) = f.checked(col, row) {
+                    if self.traced.contains(f.index(c, r)) {
+                        return true;
+                    }
+                }
+            }
+        }
+        false
+    }
+
+    /// The obstacle trigger: starts a wall follow when a real obstacle next to the current cell
+    /// has not been followed yet. Returns `true` when a follow started.
+    pub(crate) fn try_trigger(
+        &mut self,
+        core: &mut Core,
+        queue: &mut VecDeque<Step>,
+        _side: Side,
+    ) -> bool {
+        let c = core.cell;
+        for d in 0..4 {
+            let n = add(c, d);
+            if core.cells.has(n, VISITED) || core.cells.edge(c, d) == EDGE_FREE {
+                continue;
+            }
+            if !core.cells.check_once(c, d) {
+                continue;
+            }
+            let Some((b0, k0)) = self.find_contour(core, d) else {
+                continue;
+            };
+            if self.near_traced(b0) {
+                continue;
+            }
+            let p0 = self.project(&core.known, b0);
+            let home = self.frame().world_to_grid(core.center(c));
+            if !self.seg_free(&core.known, core.r, home, p0) {
+                continue;
+            }
+            queue.push_back(Step::Mark(Event::WallFollowStart));
+            queue.push_back(Step::MoveTo(self.world(p0)));
+            let mut states = HashSet::new();
+            states.insert((b0, k0));
+            self.follow = Some(Follow {
+                home: c,
+                b: b0,
+                k: k0,
+                start_b: b0,
+                start_k: k0,
+                start_pos: p0,
+                pos: p0,
+                away: false,
+                steps: 0,
+                states,
+                trail: vec![home, p0],
+            });
+            self.mark(core, b0, p0, queue);
+            return true;
+        }
+        false
+    }
+
+    /// Bookkeeping at a followed position: contour pixel, touched cell, BPs around.
+    fn mark(&mut self, core: &mut Core, b: Px, p: Point, queue: &mut VecDeque<Step>) {
+        let f = self.frame();
+        if let Some((c, r)) = f.checked(b.0, b.1) {
+            self.traced.insert(f.index(c, r));
+        }
+        let pw = self.world(p);
+        let t = core.grid.tile_of(pw);
+        core.cells.set(t, TOUCHED);
+        // Only cells whose standing disk lies inside the sensed circle can be decided here.
+        let decide_within = core.range - core.r - 2.0 * f.resolution;
+        for n in [t, add(t, 0), add(t, 1), add(t, 2), add(t, 3)] {
+            if core.cells.has(n, VISITED | BP | DEAD | STAND_BLOCKED) || core.cells.idx(n).is_none()
+            {
+                continue;
+            }
+            let cn = core.center(n);
+            if !core.cells.has(n, STAND_FREE) {
+                if cn.dist(pw) > decide_within {
+                    continue;
+                }
+                match disk_status(&core.known, f.world_to_grid(cn), self.r_px) {
+                    Status::Free => core.cells.set(n, STAND_FREE),
+                    Status::Blocked => {
+                        core.cells.set(n, STAND_BLOCKED);
+                        continue;
+                    }
+                    Status::Unseen => continue,
+                }
+            }
+            core.add_bp(n, queue);
+        }
+    }
+
+    /// One Moore-tracing step from `(b, k)`; `Err(true)` when an unseen pixel decides (and
+    /// `force` is off), `Err(false)` for an isolated pixel.
+    fn moore(
+        &mut self,
+        known: &KnownMap,
+        b: Px,
+        k: usize,
+        cw: bool,
+        force: bool,
+    ) -> Result<(Px, usize), bool> {
+        for t in 1..=8 {
+            let kk = if cw { (k + 8 - t) % 8 } else { (k + t) % 8 };
+            let q = step(b, kk);
+            let ins = match self.in_s(known, q) {
+                Some(v) => v,
+                None if force => false,
+                None => return Err(true),
+            };
+            if ins {
+                let prev = if cw { (kk + 1) % 8 } else { (kk + 7) % 8 };
+                let bg = step(b, prev);
+                return dir8(q, bg).map(|nk| (q, nk)).ok_or(false);
+            }
+        }
+        Err(false)
+    }
+
+    /// Advances the wall follow by a batch of steps (those decidable from what was sensed).
+    pub(crate) fn follow_step(&mut self, core: &mut Core, queue: &mut VecDeque<Step>, side: Side) {
+        let Some(mut f) = self.follow.take() else {
+            return;
+        };
+        let cw = side == Side::Left;
+        let mut finished = false;
+        let mut retreat = false;
+        for batch in 0..16 {
+            if f.steps >= self.opts.max_follow_steps {
+                finished = true;
+                break;
+            }
+            let (nb, nk) = match self.moore(&core.known, f.b, f.k, cw, batch == 0) {
+                Ok(s) => s,
+                Err(true) => break,
+                Err(false) => {
+                    finished = true;
+                    break;
+                }
+            };
+            f.steps += 1;
+            let p = self.project(&core.known, nb);
+            let r = core.r;
+            let mut path = Vec::with_capacity(2);
+            if self.seg_free(&core.known, r, f.pos, p) {
+                path.push(p);
+            } else {
+                let bc = self.center_grid(nb);
+                if self.seg_free(&core.known, r, f.pos, bc) {
+                    path.push(bc);
+                    if self.seg_free(&core.known, r, bc, p) {
+                        path.push(p);
+                    }
+                } else {
+                    finished = true;
+                    retreat = true;
+                    break;
+                }
+            }
+            for &q in &path {
+                if q.dist(f.pos) > 1e-9 {
+                    queue.push_back(Step::MoveTo(self.world(q)));
+                    f.trail.push(q);
+                    f.pos = q;
+                }
+            }
+            f.b = nb;
+            f.k = nk;
+            self.mark(core, nb, f.pos, queue);
+            let d = f.pos.dist(f.start_pos);
+            if d > 3.0 {
+                f.away = true;
+            }
+            if (nb, nk) == (f.start_b, f.start_k)
+                || (f.away && d < 1.5)
+                || !f.states.insert((nb, nk))
+            {
+                finished = true;
+                break;
+            }
+        }
+        if !finished {
+            self.follow = Some(f);
+            return;
+        }
+        // Back to the start, then to the cell centre; retreat along the trail if a straight
+        // move is not known free.
+        let home = self.frame().world_to_grid(core.center(f.home));
+        let direct = !retreat
+            && self.seg_free(&core.known, core.r, f.pos, f.start_pos)
+            && self.seg_free(&core.known, core.r, f.start_pos, home);
+        if direct {
+            queue.push_back(Step::MoveTo(self.world(f.start_pos)));
+        } else {
+            for &q in f.trail.iter().rev().skip(1) {
+                queue.push_back(Step::MoveTo(self.world(q)));
+            }
+        }
+        queue.push_back(Step::MoveTo(core.center(f.home)));
+        queue.push_back(Step::Mark(Event::WallFollowEnd));
+        core.cell = f.home;
+    }
+
+    /// Extended selection: Dijkstra over visited (cost 1) and touched (cost `gap_cost`) cells to
+    /// the nearest BP, gaps crossed in their virtual pipe. `None` when no BP can be reached.
+    pub(crate) fn select(&mut self, core: &mut Core) -> Option<ReturnPlan> {
+        let mut banned: HashSet<(Tile, usize)> = HashSet::new();
+        let mut tries = 0;
+        loop {
+            if core.bps.is_empty() {
+                return None;
+            }
+            let path = self.dijkstra(core, &banned)?;
+            match self.build(core, &path) {
+                Ok(moves) => {
+                    let target = *path.last().expect("non-empty path");
+                    let entry = heading_of(path[path.len() - 2], target);
+                    return Some(ReturnPlan {
+                        target,
+                        entry,
+                        raw: path.iter().map(|&t| core.center(t)).collect(),
+                        moves,
+                    });
+                }
+                Err((i, e)) => {
+                    for w in path[i..=e].windows(2) {
+                        let d = heading_of(w[0], w[1]);
+                        banned.insert((w[0], d));
+                        banned.insert((w[1], (d + 2) % 4));
+                    }
+                    tries += 1;
+                    if tries > 8 {
+                        let target = *path.last().expect("non-empty path");
+                        core.cells.set(target, DEAD);
+                        core.validate_bps();
+                        banned.clear();
+                        tries = 0;
+                    }
+                }
+            }
+        }
+    }
+
+    fn dijkstra(&self, core: &mut Core, banned: &HashSet<(Tile, usize)>) -> Option<Vec<Tile>> {
+        let cells = &mut core.cells;
+        let start = cells.idx(core.cell)?;
+        cells.new_search();
+        cells.reach(start, 0, start);
+        let mut heap = BinaryHeap::new();
+        heap.push(std::cmp::Reverse((0u32, core.cell.1, core.cell.0)));
+        let gap = self.opts.gap_cost.max(1);
+        while let Some(std::cmp::Reverse((cost, j, i))) = heap.pop() {
+            let u = (i, j);
+            let ku = cells.idx(u).expect("pushed cells are in range");
+            if cells.cost_of(ku) != Some(cost) {
+                continue;
+            }
+            let u_visited = cells.has(u, VISITED);
+            if ku != start && !u_visited && cells.has(u, BP) {
+                return Some(cells.path_to(ku));
+            }
+            for d in 0..4 {
+                if banned.contains(&(u, d)) {
+                    continue;
+                }
+                let n = add(u, d);
+                let Some(kn) = cells.idx(n) else {
+                    continue;
+                };
+                let direct = u_visited && cells.edge(u, d) == EDGE_FREE;
+                let step_cost = if cells.has(n, VISITED) {
+                    if u_visited && !direct {
+                        // Both visited but the straight move is blocked: a gap between them.
+                        gap
+                    } else if direct {
+                        1
+                    } else {
+                        gap
+                    }
+                } else if cells.has(n, BP) && !cells.has(n, DEAD) {
+                    if direct {
+                        1
+                    } else {
+                        gap
+                    }
+                } else if cells.has(n, TOUCHED) {
+                    gap
+                } else {
+                    continue;
+                };
+                let nc = cost + step_cost;
+                if cells.cost_of(kn).is_none_or(|c| nc < c) {
+                    cells.reach(kn, nc, ku);
+                    heap.push(std::cmp::Reverse((nc, n.1, n.0)));
+                }
+            }
+        }
+        None
+    }
+
+    /// Turns a cell path into points: straight moves along known free edges between visited
+    /// cells, pipe crossings elsewhere. `Err((i, e))` names the path slice that failed.
+    fn build(&mut self, core: &Core, path: &[Tile]) -> Result<Vec<Point>, (usize, usize)> {
+        let m = path.len() - 1;
+        let solid = |k: usize| k == m || core.cells.has(path[k], VISITED);
+        let mut pts = vec![core.center(path[0])];
+        let mut i = 0;
+        while i < m {
+            let d = heading_of(path[i], path[i + 1]);
+            if solid(i + 1) && core.cells.edge(path[i], d) == EDGE_FREE {
+                pts.push(core.center(path[i + 1]));
+                i += 1;
+                continue;
+            }
+            let e = (i + 1..=m).find(|&k| solid(k)).unwrap_or(m);
+            match self.pipe(core, &path[i..=e]) {
+                Some(p) => pts.extend(p.into_iter().skip(1)),
+                None => return Err((i, e)),
+            }
+            i = e;
+        }
+        Ok(simplify_collinear(&pts))
+    }
+
+    /// A* over `S` restricted to the virtual pipe around the cells' reference line, from the
+    /// first cell's centre to the last's; line-of-sight simplified, every segment known free.
+    fn pipe(&mut self, core: &Core, cells: &[Tile]) -> Option<Vec<Point>> {
+        let f = self.frame();
+        let r = core.r;
+        let line: Vec<Point> = cells
+            .iter()
+            .map(|&t| f.world_to_grid(core.center(t)))
+            .collect();
+        let a = line[0];
+        let b = *line.last().expect("non-empty");
+        if self.seg_free(&core.known, r, a, b) {
+            return Some(vec![self.world(a), self.world(b)]);
+        }
+        let hw = self.opts.pipe_halfwidth.max(0.5) * core.grid.side / f.resolution;
+        let hw2 = hw * hw;
+        let (mut x0, mut x1, mut y0, mut y1) = (a.x, a.x, a.y, a.y);
+        for p in &line {
+            x0 = x0.min(p.x);
+            x1 = x1.max(p.x);
+            y0 = y0.min(p.y);
+            y1 = y1.max(p.y);
+        }
+        let c0 = (x0 - hw).floor() as i64;
+        let c1 = (x1 + hw).ceil() as i64;
+        let rows0 = self.pixel_of_grid(Point::new(x0, y1 + hw)).1;
+        let rows1 = self.pixel_of_grid(Point::new(x0, y0 - hw)).1;
+        let w = (c1 - c0 + 1) as usize;
+        let h = (rows1 - rows0 + 1) as usize;
+        let in_pipe = |g: Point| {
+            line.windows(2)
+                .any(|s| point_segment_dist2(g, s[0], s[1]) <= hw2)
+                || (line.len() == 1 && g.dist2(a) <= hw2)
+        };
+        // Node state: 0 unknown, 1 usable, 2 not usable.
+        let mut usable = vec![0u8; w * h];
+        let mut g_cost = vec![f64::INFINITY; w * h];
+        let mut parent = vec![usize::MAX; w * h];
+        let idx = |p: Px| -> Option<usize> {
+            let (dc, dr) = (p.0 - c0, p.1 - rows0);
+            (dc >= 0 && dr >= 0 && (dc as usize) < w && (dr as usize) < h)
+                .then(|| dr as usize * w + dc as usize)
+        };
+        let mut ok = |me: &mut Self, p: Px, k: usize| -> bool {
+            if usable[k] == 0 {
+                let g = me.center_grid(p);
+                usable[k] = if in_pipe(g) && me.in_s(&core.known, p) == Some(true) {
+                    1
+                } else {
+                    2
+                };
+            }
+            usable[k] == 1
+        };
+        let mut heap = BinaryHeap::new();
+        let pa = self.pixel_of_grid(a);
+        for dr in -2..=2 {
+            for dc in -2..=2 {
+                let p = (pa.0 + dc, pa.1 + dr);
+                let Some(k) = idx(p) else { continue };
+                let g = self.center_grid(p);
+                if ok(self, p, k) && self.seg_free(&core.known, r, a, g) {
+                    let c = a.dist(g);
+                    if c < g_cost[k] {
+                        g_cost[k] = c;
+                        parent[k] = k;
+                        heap.push(std::cmp::Reverse(((c + g.dist(b)).to_bits(), p.1, p.0)));
+                    }
+                }
+            }
+        }
+        let mut goal = None;
+        while let Some(std::cmp::Reverse((_, row, col))) = heap.pop() {
+            let p = (col, row);
+            let k = idx(p).expect("pushed nodes are in range");
+            let g = self.center_grid(p);
+            if g.dist(b) <= 2.9 && self.seg_free(&core.known, r, g, b) {
+                goal = Some(k);
+                break;
+            }
+            for (kk, o) in N8.iter().enumerate() {
+                let q = step(p, kk);
+                let Some(kq) = idx(q) else { continue };
+                if !ok(self, q, kq) {
+                    continue;
+                }
+                let c = g_cost[k] + f64::from(o.0.abs() + o.1.abs()).sqrt();
+                if c < g_cost[kq] {
+                    g_cost[kq] = c;
+                    parent[kq] = k;
+                    let gq = self.center_grid(q);
+                    heap.push(std::cmp::Reverse(((c + gq.dist(b)).to_bits(), q.1, q.0)));
+                }
+            }
+        }
+        let mut k = goal?;
+        let mut rev = vec![b];
+        loop {
+            let p = (c0 + (k % w) as i64, rows0 + (k / w) as i64);
+            rev.push(self.center_grid(p));
+            if parent[k] == k {
+                break;
+            }
+            k = parent[k];
+        }
+        rev.push(a);
+        rev.reverse();
+        // Greedy line-of-sight simplification.
+        let mut out = vec![a];
+        let mut i = 0;
+        while i < rev.len() - 1 {
+            let mut j = i + 1;
+            while j + 1 < rev.len() && self.seg_free(&core.known, r, rev[i], rev[j + 1]) {
+                j += 1;
+            }
+            if !self.seg_free(&core.known, r, rev[i], rev[j]) {
+                return None;
+            }
+            out.push(rev[j]);
+            i = j;
+        }
+        Some(out.into_iter().map(|g| self.world(g)).collect())
+    }
+}
+
+/// Drops points in the middle of straight runs.
+fn simplify_collinear(pts: &[Point]) -> Vec<Point> {
+    let mut out: Vec<Point> = Vec::with_capacity(pts.len());
+    for &p in pts {
+        if out.last().is_some_and(|&l: &Point| l.dist(p) < 1e-12) {
+            continue;
+        }
+        if out.len() >= 2 {
+            let a = out[out.len() - 2];
+            let b = out[out.len() - 1];
+            let cross = (b.x - a.x) * (p.y - b.y) - (b.y - a.y) * (p.x - b.x);
+            let dot = (b.x - a.x) * (p.x - b.x) + (b.y - a.y) * (p.y - b.y);
+            if cross.abs() < 1e-12 && dot > 0.0 {
+                out.pop();
+            }
+        }
+        out.push(p);
+    }
+    out
+}
