@@ -28,6 +28,8 @@ pub enum Command {
     Bench(BenchArgs),
     /// Write the interactive replay.html (self-contained) and replay.gif of a finished run.
     Replay(ReplayArgs),
+    /// Print the lane waypoints of a rectangular robot (seed 001) for a map, as CSV or JSON.
+    Waypoints(WaypointsArgs),
 }
 
 /// Map loading options shared by commands.
@@ -48,6 +50,11 @@ pub struct MapArgs {
     /// Override `free_thresh`.
     #[arg(long, value_name = "P")]
     pub free_thresh: Option<f64>,
+    /// Place the image by a least-squares affine fit of surveyed point pairs: a CSV of
+    /// `px,py,wx,wy` lines (pixel coordinates from the image's top-left corner, y down; world
+    /// metres). Overrides resolution and origin.
+    #[arg(long, value_name = "FILE")]
+    pub georef: Option<PathBuf>,
     /// Grow obstacles by this many metres (exact distance transform) before planning.
     #[arg(long, value_name = "M")]
     pub inflate: Option<f64>,
@@ -96,6 +103,29 @@ pub struct RunArgs {
     /// BA* backtracking path smoothing (A*SPT): `on` (default) or `off` to compare.
     #[arg(long, value_name = "on|off", value_parser = parse_on_off)]
     pub smoothing: Option<bool>,
+    /// BSA reference lateral side: `left` (default) or `right`.
+    #[arg(long, value_name = "left|right")]
+    pub side: Option<String>,
+    /// Rectangular robot length in metres (rect-boustrophedon: waypoint spacing).
+    #[arg(long, value_name = "M")]
+    pub length: Option<f64>,
+    /// Rectangular robot width in metres (rect-boustrophedon: lane spacing).
+    #[arg(long, value_name = "M")]
+    pub width: Option<f64>,
+    /// Area to cover `X0,Y0,X1,Y1` (rect-boustrophedon; default: the start's free component).
+    #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = parse_quad, allow_hyphen_values = true)]
+    pub area: Option<[f64; 4]>,
+    /// Motion execution: `ideal` (exact rotate/translate) or `pid` (unicycle with PID
+    /// tracking). Default: the planner's choice (bsa-bfs and rect-boustrophedon: pid).
+    #[arg(long, value_name = "ideal|pid")]
+    pub exec: Option<String>,
+    /// Odometry noise under PID execution: relative std of linear and angular speed
+    /// `LIN[,ANG]` (seeded by --seed).
+    #[arg(long, value_name = "LIN[,ANG]")]
+    pub odometry_noise: Option<String>,
+    /// Landmarks for pose correction under PID (CSV `id,x,y[,theta]` or a JSON array).
+    #[arg(long, value_name = "FILE")]
+    pub landmarks: Option<PathBuf>,
     /// Output folder.
     #[arg(long, value_name = "DIR", default_value = "ccpp-out")]
     pub out: PathBuf,
@@ -105,6 +135,33 @@ pub struct RunArgs {
     /// Also write replay.html and replay.gif.
     #[arg(long)]
     pub replay: bool,
+}
+
+/// `ccpp waypoints`.
+#[derive(Args, Debug)]
+#[command(allow_negative_numbers = true)]
+pub struct WaypointsArgs {
+    /// The map.
+    #[command(flatten)]
+    pub map: MapArgs,
+    /// The robot (its radius is the smallest clearance kept).
+    #[command(flatten)]
+    pub robot: RobotArgs,
+    /// Robot length in metres (waypoint spacing along a lane).
+    #[arg(long, value_name = "M", default_value_t = 0.3)]
+    pub length: f64,
+    /// Robot width in metres (lane spacing).
+    #[arg(long, value_name = "M", default_value_t = 0.3)]
+    pub width: f64,
+    /// Area to cover `X0,Y0,X1,Y1` (default: the start's free component).
+    #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = parse_quad, allow_hyphen_values = true)]
+    pub area: Option<[f64; 4]>,
+    /// Output format.
+    #[arg(long, value_name = "csv|json", default_value = "csv")]
+    pub format: String,
+    /// Write to this file instead of stdout.
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
 }
 
 /// `ccpp replay`.
@@ -196,6 +253,26 @@ pub struct InfoArgs {
     /// Print JSON.
     #[arg(long)]
     pub json: bool,
+}
+
+/// Parses `A,B,C,D` into four finite numbers.
+fn parse_quad(s: &str) -> Result<[f64; 4], String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.len() != 4 {
+        return Err(format!("expected X0,Y0,X1,Y1, got {s:?}"));
+    }
+    let mut v = [0.0; 4];
+    for (k, p) in parts.iter().enumerate() {
+        let x: f64 = p.parse().map_err(|_| format!("{p:?} is not a number"))?;
+        if !x.is_finite() {
+            return Err(format!("{p:?} is not a finite number"));
+        }
+        v[k] = x;
+    }
+    if v[2] <= v[0] || v[3] <= v[1] {
+        return Err(format!("area {s:?} must have X1 > X0 and Y1 > Y0"));
+    }
+    Ok(v)
 }
 
 /// Parses `A,B` or `A,B,C` into three numbers (C defaults to 0).

@@ -3,7 +3,9 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
+use ccpp_core::exec::{Execution, OdometryNoise, PidOptions};
 use ccpp_core::metrics::{self, Metrics};
+use ccpp_core::planners::bsa::Side;
 use ccpp_core::planners::{self, PlannerOptions};
 use ccpp_core::sim::{simulate, RunOutput, SimConfig};
 use ccpp_core::world::{Robot, World};
@@ -46,6 +48,8 @@ pub struct MapRecipe {
     pub free_thresh: Option<f64>,
     /// Obstacle inflation in metres.
     pub inflate: Option<f64>,
+    /// Georeference point-pair file.
+    pub georef: Option<PathBuf>,
 }
 
 impl MapRecipe {
@@ -60,9 +64,42 @@ impl MapRecipe {
                 occupied_thresh: self.occupied_thresh,
                 free_thresh: self.free_thresh,
                 inflate: self.inflate,
+                georef: self.georef.clone(),
             }),
         }
     }
+}
+
+/// Places `grid` by the affine fit of the point pairs in `path` (pixel coordinates from the
+/// image's top-left corner, y down). ccpp frames are similarities (rotation + uniform scale),
+/// so a fit with more than 1 % shear or anisotropy is refused.
+pub fn apply_georef(grid: GridMap, path: &Path) -> Result<GridMap> {
+    let fit = ccpp_io::georef::load_georef(path)
+        .map_err(|e| anyhow::anyhow!("georef {}: {e}", path.display()))?;
+    let [a, b, c, d] = fit.affine.m;
+    let res = (a * d - b * c).abs().sqrt();
+    if !(res.is_finite() && res > 0.0) {
+        bail!("georef {}: degenerate transform", path.display());
+    }
+    let yaw = c.atan2(a);
+    // Pixel y grows downwards, so the second column is res * (sin yaw, -cos yaw).
+    let (sy, cy) = yaw.sin_cos();
+    let dev = ((a - res * cy).powi(2)
+        + (c - res * sy).powi(2)
+        + (b - res * sy).powi(2)
+        + (d + res * cy).powi(2))
+    .sqrt()
+        / res;
+    if dev > 0.01 {
+        bail!(
+            "georef {}: the fitted transform has {:.1} % shear or anisotropy; ccpp needs rotation + uniform scale",
+            path.display(),
+            100.0 * dev
+        );
+    }
+    let h = grid.frame().height as f64;
+    let o = fit.affine.apply(ccpp_core::Point::new(0.0, h));
+    Ok(grid.with_placement(res, Pose::new(o.x, o.y, yaw))?)
 }
 
 /// The bundled demo map.
@@ -123,7 +160,10 @@ pub fn prepare_map(args: &MapArgs) -> Result<PreparedMap> {
         free_thresh: args.free_thresh,
         negate: None,
     };
-    let loaded = load_map(&args.map, &opts)?;
+    let mut loaded = load_map(&args.map, &opts)?;
+    if let Some(g) = &args.georef {
+        loaded.grid = apply_georef(loaded.grid, g)?;
+    }
     let name = args
         .map
         .file_stem()
@@ -135,6 +175,10 @@ pub fn prepare_map(args: &MapArgs) -> Result<PreparedMap> {
         occupied_thresh: args.occupied_thresh,
         free_thresh: args.free_thresh,
         inflate: args.inflate,
+        georef: args
+            .georef
+            .as_ref()
+            .map(|g| std::fs::canonicalize(g).unwrap_or_else(|_| g.clone())),
     };
     finish_map(loaded.grid, name, loaded.source, args.inflate, recipe)
 }
@@ -219,6 +263,63 @@ impl Job {
         }
         if let Some(s) = a.smoothing {
             options.ba_star.smoothing = s;
+        }
+        if let Some(side) = &a.side {
+            let side = match side.to_ascii_lowercase().as_str() {
+                "left" => Side::Left,
+                "right" => Side::Right,
+                other => bail!("--side must be left or right, got {other:?}"),
+            };
+            options.bsa.side = side;
+            options.bsa_extended.side = side;
+        }
+        if let Some(l) = a.length {
+            check_metres("--length", l)?;
+            options.rect_boustrophedon.length_m = l;
+        }
+        if let Some(w) = a.width {
+            check_metres("--width", w)?;
+            options.rect_boustrophedon.width_m = w;
+        }
+        if a.area.is_some() {
+            options.rect_boustrophedon.area = a.area;
+        }
+        let mut sim = SimConfig {
+            sensor_range: a.sensor_range,
+            ..SimConfig::default()
+        };
+        let mut pid = PidOptions::default();
+        if let Some(n) = &a.odometry_noise {
+            let v: Vec<f64> = n
+                .split(',')
+                .map(|x| x.trim().parse::<f64>())
+                .collect::<Result<_, _>>()
+                .map_err(|_| anyhow::anyhow!("--odometry-noise expects LIN[,ANG], got {n:?}"))?;
+            if v.is_empty() || v.len() > 2 || v.iter().any(|x| !x.is_finite() || *x < 0.0) {
+                bail!("--odometry-noise expects one or two finite numbers >= 0, got {n:?}");
+            }
+            pid.noise = Some(OdometryNoise {
+                seed: a.seed.unwrap_or(0),
+                linear_rel_std: v[0],
+                angular_rel_std: v.get(1).copied().unwrap_or(v[0]),
+                ..OdometryNoise::default()
+            });
+        }
+        sim.exec = match a.exec.as_deref().map(str::to_ascii_lowercase).as_deref() {
+            None if pid.noise.is_some() => Some(Execution::Pid(pid)),
+            None => None,
+            Some("ideal") => {
+                if pid.noise.is_some() {
+                    bail!("--odometry-noise needs --exec pid");
+                }
+                Some(Execution::Ideal)
+            }
+            Some("pid") => Some(Execution::Pid(pid)),
+            Some(other) => bail!("--exec must be ideal or pid, got {other:?}"),
+        };
+        if let Some(p) = &a.landmarks {
+            sim.landmarks.landmarks = ccpp_io::landmarks::load_landmarks(p)
+                .map_err(|e| anyhow::anyhow!("landmarks {}: {e}", p.display()))?;
         }
         let map = prepare_map(&a.map)?;
         Ok(Self {

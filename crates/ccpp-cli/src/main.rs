@@ -9,6 +9,7 @@ mod info;
 mod job;
 mod output;
 mod plots;
+mod waypoints;
 
 use std::process::ExitCode;
 
@@ -43,12 +44,13 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Planners => {
             for p in ccpp_core::planners::CATALOG {
                 let kind = if p.offline { "offline" } else { "online" };
-                println!("{:<16} {:<8} {}", p.name, kind, p.description);
+                println!("{:<19} {:<8} {}", p.name, kind, p.description);
             }
             Ok(())
         }
         Command::Info(a) => info::run(&a),
         Command::Bench(a) => bench::run(&a),
         Command::Replay(a) => output::replay_dir(&a.dir),
+        Command::Waypoints(a) => waypoints::run(&a),
     }
 }

@@ -13,8 +13,8 @@
 
 pub mod collide;
 pub mod dt;
-pub mod gen;
 pub mod exec;
+pub mod gen;
 pub mod geometry;
 pub mod georef;
 pub mod grid;

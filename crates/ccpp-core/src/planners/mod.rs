@@ -3,8 +3,8 @@
 
 pub mod ba_star;
 pub mod bcd;
-pub mod bsa_bfs;
 pub mod bsa;
+pub mod bsa_bfs;
 pub mod bsa_extended;
 pub mod random_bounce;
 pub mod rect_boustrophedon;
@@ -29,37 +29,37 @@ pub struct PlannerInfo {
 pub const CATALOG: &[PlannerInfo] = &[
     PlannerInfo {
         name: "ba-star",
-        description: "BA* (Viet et al. 2013): boustrophedon regions on 2r tiles, A* + smoothed backtracking to the nearest corner tile (online)",
+        description: "BA* (Viet et al. 2013): boustrophedon regions on 2r tiles, A* + smoothed backtracking to the nearest corner tile",
         offline: false,
     },
     PlannerInfo {
         name: "bsa",
-        description: "Backtracking Spiral Algorithm: spirals on robot-sized cells, BFS backtracking over visited cells (online)",
+        description: "Backtracking Spiral Algorithm: spirals on robot-sized cells, BFS backtracking over visited cells",
         offline: false,
     },
     PlannerInfo {
         name: "bsa-extended",
-        description: "BSA plus wall following at map resolution and gap-crossing return paths, for coverage near obstacles (online)",
+        description: "BSA plus wall following at map resolution and gap-crossing return paths, for coverage near obstacles",
         offline: false,
     },
     PlannerInfo {
         name: "bsa-bfs",
-        description: "Vacuum-robot BSA (seed 003): cells +x,+y,-x,-y, return-cell stack, BFS return over visited cells, PID execution (online)",
+        description: "Vacuum-robot BSA (seed 003): cells +x,+y,-x,-y, return-cell stack, BFS return over visited cells, PID execution",
         offline: false,
     },
     PlannerInfo {
         name: "random-bounce",
-        description: "Roomba-like baseline: straight until the sensed obstacle, seeded random turn, distance budget (online)",
+        description: "Roomba-like baseline: straight until the sensed obstacle, seeded random turn, distance budget",
         offline: false,
     },
     PlannerInfo {
         name: "bcd",
-        description: "Boustrophedon cellular decomposition of the known map, lanes 2 r_tool apart (offline baseline)",
+        description: "Boustrophedon cellular decomposition of the known map, lanes 2 r_tool apart (the known-map baseline)",
         offline: true,
     },
     PlannerInfo {
         name: "rect-boustrophedon",
-        description: "Known-map lane waypoints for a rectangular robot (seed 001): lanes b apart, waypoints every l, blocked edges joined by clearance A* (offline)",
+        description: "Known-map lane waypoints for a rectangular robot (seed 001): lanes b apart, waypoints every l, blocked edges joined by clearance A*",
         offline: true,
     },
 ];
