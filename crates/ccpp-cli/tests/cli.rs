@@ -258,6 +258,11 @@ fn bad_inputs_fail_cleanly() {
 
 /// Runs `planner` on every shared map (default start, r = 0.15 m) and returns the metrics.
 fn run_on_shared_maps(planner: &str) -> Vec<(String, serde_json::Value)> {
+    run_on_shared_maps_with(planner, &[])
+}
+
+/// As [`run_on_shared_maps`] with extra arguments.
+fn run_on_shared_maps_with(planner: &str, extra: &[&str]) -> Vec<(String, serde_json::Value)> {
     let Some(maps) = shared_maps() else {
         eprintln!("shared maps not found; skipping");
         return Vec::new();
@@ -284,6 +289,7 @@ fn run_on_shared_maps(planner: &str) -> Vec<(String, serde_json::Value)> {
                 "--map",
             ])
             .arg(&y)
+            .args(extra)
             .arg("--out")
             .arg(dir.path().join(&name))
             .assert()
@@ -302,6 +308,130 @@ fn random_bounce_on_every_shared_map_is_collision_free() {
         assert_eq!(v["collisions"], 0, "{name}");
         assert!(v["effective_coverage"].as_f64().unwrap() > 0.3, "{name}");
     }
+}
+
+#[test]
+fn ba_star_on_every_shared_map_covers_every_reachable_tile() {
+    for (name, v) in run_on_shared_maps("ba-star") {
+        assert_eq!(v["collisions"], 0, "{name}");
+        assert_eq!(v["coverage_rate"], 1.0, "{name}");
+        assert_eq!(
+            v["regions"].as_u64().unwrap(),
+            v["backtracks"].as_u64().unwrap() + 1,
+            "{name}"
+        );
+    }
+}
+
+#[test]
+fn bsa_basic_and_extended_on_every_shared_map() {
+    let basic = run_on_shared_maps("bsa");
+    let extended = run_on_shared_maps("bsa-extended");
+    let mut revisit = 0.0;
+    for ((name, b), (_, e)) in basic.iter().zip(&extended) {
+        assert_eq!(b["collisions"], 0, "bsa {name}");
+        assert_eq!(b["coverage_rate"], 1.0, "bsa {name}");
+        assert_eq!(e["collisions"], 0, "bsa-extended {name}");
+        let (eb, ee) = (
+            b["effective_coverage"].as_f64().unwrap(),
+            e["effective_coverage"].as_f64().unwrap(),
+        );
+        // Every shared map has obstacles: extended must do strictly better.
+        assert!(ee > eb, "{name}: extended {ee} <= basic {eb}");
+        assert!(ee >= 0.95, "{name}: extended effective coverage {ee}");
+        revisit += b["revisit_rate"].as_f64().unwrap();
+    }
+    if !basic.is_empty() {
+        eprintln!(
+            "bsa mean revisit_rate {:.3} (paper: 0.23)",
+            revisit / basic.len() as f64
+        );
+    }
+}
+
+#[test]
+fn bsa_bfs_and_rect_boustrophedon_on_every_shared_map() {
+    for (name, v) in run_on_shared_maps("bsa-bfs") {
+        assert_eq!(v["collisions"], 0, "bsa-bfs {name}");
+        assert_eq!(v["coverage_rate"], 1.0, "bsa-bfs {name}");
+        assert!(
+            v["tracking_error_max_m"].is_number(),
+            "bsa-bfs {name}: PID tracking error reported"
+        );
+    }
+    for (name, v) in
+        run_on_shared_maps_with("rect-boustrophedon", &["--length", "0.3", "--width", "0.3"])
+    {
+        assert_eq!(v["collisions"], 0, "rect-boustrophedon {name}");
+        assert!(v["rect_guarantee"].as_f64().unwrap() > 0.99, "{name}");
+    }
+}
+
+#[test]
+fn waypoints_follow_the_seed_001_example() {
+    // A 3 x 2 m free room; the seed's area (0,0)-(1.1,0.5) with B = 0.1 inside it.
+    let dir = tempfile::tempdir().unwrap();
+    let mut img = image::GrayImage::from_pixel(60, 40, image::Luma([254]));
+    for (x, y, p) in img.enumerate_pixels_mut() {
+        if x == 0 || y == 0 || x == 59 || y == 39 {
+            *p = image::Luma([0]);
+        }
+    }
+    let map = dir.path().join("room.png");
+    img.save(&map).unwrap();
+    let o = ccpp()
+        .args([
+            "waypoints",
+            "--radius",
+            "0.02",
+            "--length",
+            "0.1",
+            "--width",
+            "0.1",
+            "--area",
+            "0.5,0.5,1.6,1.0",
+            "--format",
+            "json",
+            "--map",
+        ])
+        .arg(&map)
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let v: serde_json::Value = serde_json::from_slice(&o).unwrap();
+    let pts = v["waypoints"].as_array().unwrap();
+    let mut ys: Vec<f64> = pts.iter().map(|p| p[1].as_f64().unwrap()).collect();
+    ys.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+    // Six lanes 0.1 apart, the last one clamped to the top edge.
+    assert_eq!(ys.len(), 6, "{ys:?}");
+    for (k, y) in ys.iter().enumerate() {
+        assert!((y - (0.5 + 0.1 * k as f64)).abs() < 1e-9, "{ys:?}");
+    }
+    assert!((ys[5] - 1.0).abs() < 1e-9);
+    let csv = ccpp()
+        .args([
+            "waypoints",
+            "--radius",
+            "0.02",
+            "--length",
+            "0.1",
+            "--width",
+            "0.1",
+            "--area",
+            "0.5,0.5,1.6,1.0",
+            "--map",
+        ])
+        .arg(&map)
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let csv = String::from_utf8(csv).unwrap();
+    assert!(csv.starts_with("x,y\n"));
+    assert_eq!(csv.lines().count(), pts.len() + 1);
 }
 
 #[test]

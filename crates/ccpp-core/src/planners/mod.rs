@@ -1,4 +1,4 @@
-//! The coverage planners, one module each, behind the [`Planner`](crate::planner::Planner) trait,
+//! The coverage planners, one module each, behind the [`Planner`] trait,
 //! and the catalogue that builds them by name.
 
 pub mod ba_star;
