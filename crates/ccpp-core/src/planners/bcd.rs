@@ -169,18 +169,47 @@ impl Search<'_> {
 
     /// Dijkstra from `s` over the working set to the nearest pixel satisfying `goal`.
     fn nearest(&mut self, s: (usize, usize), goal: &dyn Fn(usize) -> bool) -> Option<usize> {
+        self.search(s, None, goal)
+    }
+
+    /// A* from `s` to `t` (both working pixels), 8-connected, no corner cutting.
+    fn path(&mut self, s: (usize, usize), t: (usize, usize)) -> Option<Vec<(usize, usize)>> {
+        let w = self.width;
+        let ti = t.1 * w + t.0;
+        let end = self.search(s, Some(t), &|i| i == ti)?;
+        let mut out = vec![(end % w, end / w)];
+        let mut k = end;
+        while self.parent[k] != u32::MAX {
+            k = self.parent[k] as usize;
+            out.push((k % w, k / w));
+        }
+        out.reverse();
+        Some(out)
+    }
+
+    /// Best-first search from `s` until a pixel satisfies `goal`: A* with the octile heuristic
+    /// towards `target` when given, Dijkstra otherwise. Integer costs 10 / 14, no corner cutting;
+    /// ties by cost, then pixel index. Leaves the search tree in `parent`.
+    fn search(
+        &mut self,
+        s: (usize, usize),
+        target: Option<(usize, usize)>,
+        goal: &dyn Fn(usize) -> bool,
+    ) -> Option<usize> {
         self.gen = self.gen.wrapping_add(1);
         if self.gen == 0 {
             self.stamp.iter_mut().for_each(|x| *x = 0);
             self.gen = 1;
         }
         let w = self.width;
+        let h_of = |p: (usize, usize)| target.map_or(0, |t| Self::octile(p, t));
+        let mut heap = BinaryHeap::new();
         let si = s.1 * w + s.0;
         self.stamp[si] = self.gen;
         self.g[si] = 0;
-        let mut heap = BinaryHeap::new();
-        heap.push(Reverse((0u32, si as u32)));
-        while let Some(Reverse((g, i))) = heap.pop() {
+        self.parent[si] = u32::MAX;
+        heap.push(Reverse((h_of(s), 0u32, si as u32)));
+        while let Some(Reverse((_, g, i))) = heap.pop() {
             let i = i as usize;
             if g > self.g[i] {
                 continue;
@@ -218,77 +247,12 @@ impl Search<'_> {
                 if self.stamp[j] != self.gen || ng < self.g[j] {
                     self.stamp[j] = self.gen;
                     self.g[j] = ng;
-                    heap.push(Reverse((ng, j as u32)));
-                }
-            }
-        }
-        None
-    }
-
-    /// A* from `s` to `t` (both working pixels), 8-connected, no corner cutting.
-    fn path(&mut self, s: (usize, usize), t: (usize, usize)) -> Option<Vec<(usize, usize)>> {
-        self.gen = self.gen.wrapping_add(1);
-        if self.gen == 0 {
-            self.stamp.iter_mut().for_each(|x| *x = 0);
-            self.gen = 1;
-        }
-        let w = self.width;
-        let idx = |p: (usize, usize)| p.1 * w + p.0;
-        let mut heap = BinaryHeap::new();
-        let si = idx(s);
-        self.stamp[si] = self.gen;
-        self.g[si] = 0;
-        self.parent[si] = u32::MAX;
-        heap.push(Reverse((Self::octile(s, t), 0u32, si as u32)));
-        let ti = idx(t);
-        while let Some(Reverse((_, g, i))) = heap.pop() {
-            let i = i as usize;
-            if g > self.g[i] {
-                continue;
-            }
-            if i == ti {
-                let mut out = vec![(i % w, i / w)];
-                let mut k = i;
-                while self.parent[k] != u32::MAX {
-                    k = self.parent[k] as usize;
-                    out.push((k % w, k / w));
-                }
-                out.reverse();
-                return Some(out);
-            }
-            let (c, r) = ((i % w) as i64, (i / w) as i64);
-            for (dc, dr) in [
-                (1, 0),
-                (0, -1),
-                (-1, 0),
-                (0, 1),
-                (1, -1),
-                (-1, -1),
-                (-1, 1),
-                (1, 1),
-            ] {
-                let (nc, nr) = (c + dc, r + dr);
-                if nc < 0 || nr < 0 || nc >= self.width as i64 || nr >= self.height as i64 {
-                    continue;
-                }
-                let j = nr as usize * w + nc as usize;
-                if !self.ok[j] {
-                    continue;
-                }
-                let diag = dc != 0 && dr != 0;
-                if diag
-                    && !(self.ok[r as usize * w + nc as usize]
-                        && self.ok[nr as usize * w + c as usize])
-                {
-                    continue;
-                }
-                let ng = g + if diag { 14 } else { 10 };
-                if self.stamp[j] != self.gen || ng < self.g[j] {
-                    self.stamp[j] = self.gen;
-                    self.g[j] = ng;
                     self.parent[j] = i as u32;
-                    let h = Self::octile((nc as usize, nr as usize), t);
-                    heap.push(Reverse((ng + h, ng, j as u32)));
+                    heap.push(Reverse((
+                        ng + h_of((nc as usize, nr as usize)),
+                        ng,
+                        j as u32,
+                    )));
                 }
             }
         }
