@@ -43,13 +43,13 @@ fn shared_maps(c: &mut Criterion) {
         .measurement_time(Duration::from_secs(3));
     if let Some(map) = load("aws_small_warehouse_002.yaml") {
         g.bench_function("ba-star/aws_small_warehouse_002/r0.1", |b| {
-            b.iter(|| run(&map, "ba-star", 0.1))
+            b.iter(|| run(&map, "ba-star", 0.1));
         });
     }
     if let Some(map) = load("aws_small_house.yaml") {
         for planner in ["ba-star", "bsa", "bsa-extended"] {
             g.bench_function(format!("{planner}/aws_small_house/r0.15"), |b| {
-                b.iter(|| run(&map, planner, 0.15))
+                b.iter(|| run(&map, planner, 0.15));
             });
         }
     }
