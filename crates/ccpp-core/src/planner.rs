@@ -50,6 +50,48 @@ impl<'a> Scan<'a> {
         }
     }
 
+    /// Calls `f(row, lo, hi)` for every image row holding in-range pixels, top to bottom: the
+    /// in-range pixels of the row are exactly columns `lo..=hi` (the same pixels, in the same
+    /// order, as [`Self::for_each`]).
+    pub fn for_each_row_span(&self, mut f: impl FnMut(usize, usize, usize)) {
+        let frame = self.map.frame();
+        let r = self.range_px;
+        let r2 = r * r;
+        let h = frame.height as f64;
+        let c0 = (self.center.x - r - 0.5).floor().max(0.0) as usize;
+        let c1 = ((self.center.x + r - 0.5).ceil().max(0.0) as usize).min(frame.width - 1);
+        let r0 = (h - (self.center.y + r) - 0.5).floor().max(0.0) as usize;
+        let r1 = ((h - (self.center.y - r) - 0.5).ceil().max(0.0) as usize).min(frame.height - 1);
+        if c0 > c1 {
+            return;
+        }
+        let inside = |col: usize, dy2: f64| {
+            let dx = col as f64 + 0.5 - self.center.x;
+            dx * dx + dy2 <= r2
+        };
+        for row in r0..=r1 {
+            let gy = h - row as f64 - 0.5;
+            let dy2 = (gy - self.center.y).powi(2);
+            if dy2 > r2 {
+                continue;
+            }
+            // `dx * dx + dy2` is monotone on each side of the centre (rounding is monotone), so
+            // the in-range columns of a row are one interval.
+            let mut lo = c0;
+            while lo <= c1 && !inside(lo, dy2) {
+                lo += 1;
+            }
+            if lo > c1 {
+                continue;
+            }
+            let mut hi = c1;
+            while !inside(hi, dy2) {
+                hi -= 1;
+            }
+            f(row, lo, hi);
+        }
+    }
+
     /// Calls `f(col, row, cell)` for every in-range pixel that lies inside the image, in
     /// row-major order. (Out-of-image pixels are occupied by convention and never change.)
     pub fn for_each(&self, mut f: impl FnMut(usize, usize, Cell)) {
@@ -120,7 +162,12 @@ pub trait Planner {
 pub struct KnownMap {
     grid: GridMap,
     seen: FixedBitSet,
+    /// Seen and free (the pixels that never block).
+    free: FixedBitSet,
 }
+
+/// Bits per block of a [`FixedBitSet`].
+const BLOCK_BITS: usize = usize::BITS as usize;
 
 impl KnownMap {
     /// Nothing seen yet.
@@ -132,36 +179,56 @@ impl KnownMap {
         Self {
             grid,
             seen: FixedBitSet::with_capacity(frame.len()),
+            free: FixedBitSet::with_capacity(frame.len()),
         }
     }
 
     /// Stores every pixel of a scan.
     pub fn integrate(&mut self, scan: &Scan<'_>) {
-        let w = self.grid.frame().width;
-        let cells = self.grid.cells_mut();
-        let seen = &mut self.seen;
-        scan.for_each(|c, r, cell| {
-            let i = r * w + c;
-            cells[i] = cell;
-            seen.insert(i);
-        });
+        self.integrate_with(scan, |_, _, _| {});
     }
 
     /// Stores every pixel of a scan and calls `first_seen(col, row, cell)` for each pixel seen
     /// for the first time (in the scan's row-major order).
+    ///
+    /// Works a block of the seen bitset at a time: pixels already seen cost nothing (their
+    /// value never changes: the map is static).
     pub fn integrate_with(
         &mut self,
         scan: &Scan<'_>,
         mut first_seen: impl FnMut(usize, usize, Cell),
     ) {
         let w = self.grid.frame().width;
+        let truth = scan.map.cells();
         let cells = self.grid.cells_mut();
-        let seen = &mut self.seen;
-        scan.for_each(|c, r, cell| {
-            let i = r * w + c;
-            if !seen.put(i) {
-                cells[i] = cell;
-                first_seen(c, r, cell);
+        let seen = self.seen.as_mut_slice();
+        let free = self.free.as_mut_slice();
+        scan.for_each_row_span(|row, lo, hi| {
+            let (a, b) = (row * w + lo, row * w + hi + 1);
+            let mut blk = a / BLOCK_BITS;
+            while blk * BLOCK_BITS < b {
+                let base = blk * BLOCK_BITS;
+                let from = a.max(base) - base;
+                let to = b.min(base + BLOCK_BITS) - base;
+                let mask = if to - from == BLOCK_BITS {
+                    usize::MAX
+                } else {
+                    ((1usize << (to - from)) - 1) << from
+                };
+                let mut new = !seen[blk] & mask;
+                seen[blk] |= mask;
+                while new != 0 {
+                    let bit = new.trailing_zeros() as usize;
+                    new &= new - 1;
+                    let i = base + bit;
+                    let cell = truth[i];
+                    cells[i] = cell;
+                    if cell.is_free() {
+                        free[blk] |= 1 << bit;
+                    }
+                    first_seen(i - row * w, row, cell);
+                }
+                blk += 1;
             }
         });
     }
@@ -184,6 +251,27 @@ impl KnownMap {
     /// The pixels seen so far.
     pub fn seen(&self) -> &FixedBitSet {
         &self.seen
+    }
+
+    /// The pixels seen and free so far (those that never block the robot).
+    pub fn known_free(&self) -> &FixedBitSet {
+        &self.free
+    }
+
+    /// Are pixels `col0..=col1` of image row `row` all seen and free? `false` when the range
+    /// leaves the image.
+    #[inline]
+    pub fn row_known_free(&self, row: i64, col0: i64, col1: i64) -> bool {
+        let f = self.grid.frame();
+        if row < 0 || col0 < 0 || row as usize >= f.height || col1 as usize >= f.width {
+            return false;
+        }
+        if col1 < col0 {
+            return true;
+        }
+        let base = row as usize * f.width;
+        self.free
+            .contains_all_in_range(base + col0 as usize..base + col1 as usize + 1)
     }
 
     /// Can the robot (radius `r` metres) stand at world point `p`, as far as it knows?
@@ -224,10 +312,7 @@ impl Occupancy for KnownMap {
     #[inline]
     fn blocked(&self, col: i64, row: i64) -> bool {
         match self.grid.frame().checked(col, row) {
-            Some((c, r)) => {
-                let i = self.grid.frame().index(c, r);
-                !(self.seen.contains(i) && self.grid.cells()[i].is_free())
-            }
+            Some((c, r)) => !self.free.contains(self.grid.frame().index(c, r)),
             None => true,
         }
     }

@@ -180,6 +180,10 @@ pub fn judge_motion(known: &KnownMap, a: Point, b: Point, r: f64) -> Judgement {
         let xb = ga.x + th * dx;
         let c0 = (xa.min(xb) - rc - 0.5).floor() as i64 - 1;
         let c1 = (xa.max(xb) + rc - 0.5).ceil() as i64 + 1;
+        // A row of seen free pixels decides nothing (the per-pixel loop would skip them all).
+        if known.row_known_free(row, c0, c1) {
+            continue;
+        }
         for col in c0..=c1 {
             // Cheap state first: seen free pixels never matter, whatever their distance.
             let unseen = match frame.checked(col, row) {
