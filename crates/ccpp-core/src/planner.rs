@@ -8,7 +8,7 @@
 use fixedbitset::FixedBitSet;
 
 use crate::collide::{self, Occupancy};
-use crate::geometry::{Point, Pose};
+use crate::geometry::{ceil_i64, floor_i64, Point, Pose};
 use crate::grid::{Cell, GridMap, MapFrame};
 use crate::trace::Event;
 use crate::world::Robot;
@@ -65,10 +65,11 @@ impl<'a> Scan<'a> {
         if c0 > c1 {
             return;
         }
-        let inside = |col: usize, dy2: f64| {
+        let inside = |col: i64, dy2: f64| {
             let dx = col as f64 + 0.5 - self.center.x;
             dx * dx + dy2 <= r2
         };
+        let (c0, c1) = (c0 as i64, c1 as i64);
         for row in r0..=r1 {
             let gy = h - row as f64 - 0.5;
             let dy2 = (gy - self.center.y).powi(2);
@@ -76,18 +77,34 @@ impl<'a> Scan<'a> {
                 continue;
             }
             // `dx * dx + dy2` is monotone on each side of the centre (rounding is monotone), so
-            // the in-range columns of a row are one interval.
-            let mut lo = c0;
+            // the in-range columns of a row are one interval. Guess its ends from the square
+            // root, then settle them with the exact test.
+            let half = (r2 - dy2).sqrt();
+            let mut lo = ceil_i64(self.center.x - 0.5 - half).clamp(c0, c1 + 1);
+            while lo > c0 && inside(lo - 1, dy2) {
+                lo -= 1;
+            }
             while lo <= c1 && !inside(lo, dy2) {
                 lo += 1;
             }
             if lo > c1 {
-                continue;
+                // Empty, or the guess overshot the whole interval: settle it from the left.
+                lo = c0;
+                while lo <= c1 && !inside(lo, dy2) {
+                    lo += 1;
+                }
+                if lo > c1 {
+                    continue;
+                }
             }
-            let mut hi = c1;
+            let mut hi = floor_i64(self.center.x - 0.5 + half).clamp(lo, c1);
+            while hi < c1 && inside(hi + 1, dy2) {
+                hi += 1;
+            }
             while !inside(hi, dy2) {
                 hi -= 1;
             }
+            let (lo, hi) = (lo as usize, hi as usize);
             f(row, lo, hi);
         }
     }
@@ -169,6 +186,16 @@ pub struct KnownMap {
 /// Bits per block of a [`FixedBitSet`].
 const BLOCK_BITS: usize = usize::BITS as usize;
 
+/// The bits `from..to` of a block (`from < to <= BLOCK_BITS`).
+#[inline]
+fn range_mask(from: usize, to: usize) -> usize {
+    if to - from == BLOCK_BITS {
+        usize::MAX
+    } else {
+        ((1usize << (to - from)) - 1) << from
+    }
+}
+
 impl KnownMap {
     /// Nothing seen yet.
     ///
@@ -208,13 +235,7 @@ impl KnownMap {
             let mut blk = a / BLOCK_BITS;
             while blk * BLOCK_BITS < b {
                 let base = blk * BLOCK_BITS;
-                let from = a.max(base) - base;
-                let to = b.min(base + BLOCK_BITS) - base;
-                let mask = if to - from == BLOCK_BITS {
-                    usize::MAX
-                } else {
-                    ((1usize << (to - from)) - 1) << from
-                };
+                let mask = range_mask(a.max(base) - base, b.min(base + BLOCK_BITS) - base);
                 let mut new = !seen[blk] & mask;
                 seen[blk] |= mask;
                 while new != 0 {
@@ -258,20 +279,34 @@ impl KnownMap {
         &self.free
     }
 
-    /// Are pixels `col0..=col1` of image row `row` all seen and free? `false` when the range
-    /// leaves the image.
-    #[inline]
-    pub fn row_known_free(&self, row: i64, col0: i64, col1: i64) -> bool {
-        let f = self.grid.frame();
-        if row < 0 || col0 < 0 || row as usize >= f.height || col1 as usize >= f.width {
-            return false;
+    /// Calls `f(col, seen)` for each pixel of image row `row`, columns `col0..=col1` (inside
+    /// the image), that is not known free (unseen, or seen and not free), in column order,
+    /// until `f` returns `false`. Known-free pixels cost a bit each, a block at a time.
+    pub(crate) fn for_each_not_known_free(
+        &self,
+        row: usize,
+        col0: usize,
+        col1: usize,
+        mut f: impl FnMut(usize, bool) -> bool,
+    ) {
+        let base = row * self.grid.frame().width;
+        let (a, b) = (base + col0, base + col1 + 1);
+        let free = self.free.as_slice();
+        let seen = self.seen.as_slice();
+        let mut blk = a / BLOCK_BITS;
+        while blk * BLOCK_BITS < b {
+            let start = blk * BLOCK_BITS;
+            let mut todo =
+                !free[blk] & range_mask(a.max(start) - start, b.min(start + BLOCK_BITS) - start);
+            while todo != 0 {
+                let bit = todo.trailing_zeros() as usize;
+                todo &= todo - 1;
+                if !f(start + bit - base, seen[blk] >> bit & 1 == 1) {
+                    return;
+                }
+            }
+            blk += 1;
         }
-        if col1 < col0 {
-            return true;
-        }
-        let base = row as usize * f.width;
-        self.free
-            .contains_all_in_range(base + col0 as usize..base + col1 as usize + 1)
     }
 
     /// Can the robot (radius `r` metres) stand at world point `p`, as far as it knows?
@@ -314,6 +349,36 @@ impl Occupancy for KnownMap {
         match self.grid.frame().checked(col, row) {
             Some((c, r)) => !self.free.contains(self.grid.frame().index(c, r)),
             None => true,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn row_spans_match_for_each() {
+        let map = GridMap::filled(MapFrame::new(37, 23, 0.05), Cell::Free).expect("map");
+        let mut seed = 3u64;
+        let mut next = || {
+            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for k in 0..3000 {
+            let center = Point::new(next() * 2.4 - 0.3, next() * 1.6 - 0.3);
+            // Ranges on and off pixel-centre distances, down to nothing.
+            let range = if k % 3 == 0 {
+                (next() * 8.0).round() * 0.025
+            } else {
+                next() * 0.6
+            };
+            let scan = Scan::new(&map, center, range);
+            let mut a = Vec::new();
+            scan.for_each(|c, r, _| a.push((c, r)));
+            let mut b = Vec::new();
+            scan.for_each_row_span(|r, lo, hi| b.extend((lo..=hi).map(|c| (c, r))));
+            assert_eq!(a, b, "centre {center:?} range {range}");
         }
     }
 }
