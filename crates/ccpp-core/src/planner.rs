@@ -282,6 +282,7 @@ impl KnownMap {
     /// Calls `f(col, seen)` for each pixel of image row `row`, columns `col0..=col1` (inside
     /// the image), that is not known free (unseen, or seen and not free), in column order,
     /// until `f` returns `false`. Known-free pixels cost a bit each, a block at a time.
+    #[inline]
     pub(crate) fn for_each_not_known_free(
         &self,
         row: usize,
