@@ -6,6 +6,9 @@
 /// Squared distance used for "no feature anywhere".
 pub const INF: u32 = u32::MAX;
 
+/// Column distance meaning "no feature in this column" (phase 1).
+const NONE: u32 = u32::MAX / 4;
+
 /// Squared Euclidean distance from every pixel centre to the nearest feature pixel centre.
 ///
 /// `is_feature(index)` is called once per row-major index. With `border_is_feature`, the ring of
@@ -24,7 +27,6 @@ pub fn squared_edt(
     }
     // Phase 1 (Meijster et al.): distance to the nearest feature in the same column, in two
     // row-order sweeps (cache friendly). `NONE` = no feature in the column.
-    const NONE: u32 = u32::MAX / 4;
     let mut g = vec![NONE; n];
     let edge = if border_is_feature { 0 } else { NONE };
     for r in 0..height {
