@@ -157,9 +157,91 @@ pub fn first_entry(a: Point, b: Point, q: Point, radius: f64) -> Option<f64> {
     }
 }
 
+/// `x.floor() as i64`, bit for bit (NaN and infinities included), without a call into libm
+/// (the baseline x86-64 target has no rounding instruction).
+#[inline]
+pub fn floor_i64(x: f64) -> i64 {
+    let t = x as i64;
+    if (t as f64) > x {
+        t.saturating_sub(1)
+    } else {
+        t
+    }
+}
+
+/// `x.ceil() as i64`, bit for bit, without a call into libm.
+#[inline]
+pub fn ceil_i64(x: f64) -> i64 {
+    let t = x as i64;
+    if (t as f64) < x {
+        t.saturating_add(1)
+    } else {
+        t
+    }
+}
+
+/// `x.floor() as i32`, bit for bit (saturating), without a call into libm.
+#[inline]
+pub fn floor_i32(x: f64) -> i32 {
+    floor_i64(x).clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32
+}
+
+/// `x.ceil() as i32`, bit for bit (saturating), without a call into libm.
+#[inline]
+pub fn ceil_i32(x: f64) -> i32 {
+    ceil_i64(x).clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn fast_floor_and_ceil_match_std() {
+        let mut v = vec![
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            2.5,
+            -2.5,
+            1e-300,
+            -1e-300,
+            4_503_599_627_370_495.5,
+            -4_503_599_627_370_495.5,
+            9.007_199_254_740_993e15,
+            2f64.powi(31) - 0.5,
+            -(2f64.powi(31)) - 0.5,
+            2f64.powi(63),
+            -(2f64.powi(63)),
+            9.3e18,
+            -9.3e18,
+            1e300,
+            -1e300,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            f64::MAX,
+            f64::MIN,
+            f64::EPSILON,
+        ];
+        let mut seed = 7u64;
+        for _ in 0..20_000 {
+            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+            let u = (seed >> 11) as f64 / (1u64 << 53) as f64;
+            let e = (seed % 70) as i32 - 10;
+            v.push((u - 0.5) * 2f64.powi(e));
+            v.push(f64::from_bits(seed));
+        }
+        for x in v {
+            assert_eq!(floor_i64(x), x.floor() as i64, "{x:e}");
+            assert_eq!(ceil_i64(x), x.ceil() as i64, "{x:e}");
+            assert_eq!(floor_i32(x), x.floor() as i32, "{x:e}");
+            assert_eq!(ceil_i32(x), x.ceil() as i32, "{x:e}");
+        }
+    }
 
     #[test]
     fn wrap() {

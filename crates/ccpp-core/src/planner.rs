@@ -8,7 +8,7 @@
 use fixedbitset::FixedBitSet;
 
 use crate::collide::{self, Occupancy};
-use crate::geometry::{Point, Pose};
+use crate::geometry::{ceil_i64, floor_i64, Point, Pose};
 use crate::grid::{Cell, GridMap, MapFrame};
 use crate::trace::Event;
 use crate::world::Robot;
@@ -47,6 +47,65 @@ impl<'a> Scan<'a> {
             map,
             center: g,
             range_px: range / map.frame().resolution,
+        }
+    }
+
+    /// Calls `f(row, lo, hi)` for every image row holding in-range pixels, top to bottom: the
+    /// in-range pixels of the row are exactly columns `lo..=hi` (the same pixels, in the same
+    /// order, as [`Self::for_each`]).
+    pub fn for_each_row_span(&self, mut f: impl FnMut(usize, usize, usize)) {
+        let frame = self.map.frame();
+        let r = self.range_px;
+        let r2 = r * r;
+        let h = frame.height as f64;
+        let c0 = (self.center.x - r - 0.5).floor().max(0.0) as usize;
+        let c1 = ((self.center.x + r - 0.5).ceil().max(0.0) as usize).min(frame.width - 1);
+        let r0 = (h - (self.center.y + r) - 0.5).floor().max(0.0) as usize;
+        let r1 = ((h - (self.center.y - r) - 0.5).ceil().max(0.0) as usize).min(frame.height - 1);
+        if c0 > c1 {
+            return;
+        }
+        let inside = |col: i64, dy2: f64| {
+            let dx = col as f64 + 0.5 - self.center.x;
+            dx * dx + dy2 <= r2
+        };
+        let (c0, c1) = (c0 as i64, c1 as i64);
+        for row in r0..=r1 {
+            let gy = h - row as f64 - 0.5;
+            let dy2 = (gy - self.center.y).powi(2);
+            if dy2 > r2 {
+                continue;
+            }
+            // `dx * dx + dy2` is monotone on each side of the centre (rounding is monotone), so
+            // the in-range columns of a row are one interval. Guess its ends from the square
+            // root, then settle them with the exact test.
+            let half = (r2 - dy2).sqrt();
+            let mut lo = ceil_i64(self.center.x - 0.5 - half).clamp(c0, c1 + 1);
+            while lo > c0 && inside(lo - 1, dy2) {
+                lo -= 1;
+            }
+            while lo <= c1 && !inside(lo, dy2) {
+                lo += 1;
+            }
+            if lo > c1 {
+                // Empty, or the guess overshot the whole interval: settle it from the left.
+                lo = c0;
+                while lo <= c1 && !inside(lo, dy2) {
+                    lo += 1;
+                }
+                if lo > c1 {
+                    continue;
+                }
+            }
+            let mut hi = floor_i64(self.center.x - 0.5 + half).clamp(lo, c1);
+            while hi < c1 && inside(hi + 1, dy2) {
+                hi += 1;
+            }
+            while !inside(hi, dy2) {
+                hi -= 1;
+            }
+            let (lo, hi) = (lo as usize, hi as usize);
+            f(row, lo, hi);
         }
     }
 
@@ -120,6 +179,21 @@ pub trait Planner {
 pub struct KnownMap {
     grid: GridMap,
     seen: FixedBitSet,
+    /// Seen and free (the pixels that never block).
+    free: FixedBitSet,
+}
+
+/// Bits per block of a [`FixedBitSet`].
+const BLOCK_BITS: usize = usize::BITS as usize;
+
+/// The bits `from..to` of a block (`from < to <= BLOCK_BITS`).
+#[inline]
+fn range_mask(from: usize, to: usize) -> usize {
+    if to - from == BLOCK_BITS {
+        usize::MAX
+    } else {
+        ((1usize << (to - from)) - 1) << from
+    }
 }
 
 impl KnownMap {
@@ -132,36 +206,50 @@ impl KnownMap {
         Self {
             grid,
             seen: FixedBitSet::with_capacity(frame.len()),
+            free: FixedBitSet::with_capacity(frame.len()),
         }
     }
 
     /// Stores every pixel of a scan.
     pub fn integrate(&mut self, scan: &Scan<'_>) {
-        let w = self.grid.frame().width;
-        let cells = self.grid.cells_mut();
-        let seen = &mut self.seen;
-        scan.for_each(|c, r, cell| {
-            let i = r * w + c;
-            cells[i] = cell;
-            seen.insert(i);
-        });
+        self.integrate_with(scan, |_, _, _| {});
     }
 
     /// Stores every pixel of a scan and calls `first_seen(col, row, cell)` for each pixel seen
     /// for the first time (in the scan's row-major order).
+    ///
+    /// Works a block of the seen bitset at a time: pixels already seen cost nothing (their
+    /// value never changes: the map is static).
     pub fn integrate_with(
         &mut self,
         scan: &Scan<'_>,
         mut first_seen: impl FnMut(usize, usize, Cell),
     ) {
         let w = self.grid.frame().width;
+        let truth = scan.map.cells();
         let cells = self.grid.cells_mut();
-        let seen = &mut self.seen;
-        scan.for_each(|c, r, cell| {
-            let i = r * w + c;
-            if !seen.put(i) {
-                cells[i] = cell;
-                first_seen(c, r, cell);
+        let seen = self.seen.as_mut_slice();
+        let free = self.free.as_mut_slice();
+        scan.for_each_row_span(|row, lo, hi| {
+            let (a, b) = (row * w + lo, row * w + hi + 1);
+            let mut blk = a / BLOCK_BITS;
+            while blk * BLOCK_BITS < b {
+                let base = blk * BLOCK_BITS;
+                let mask = range_mask(a.max(base) - base, b.min(base + BLOCK_BITS) - base);
+                let mut new = !seen[blk] & mask;
+                seen[blk] |= mask;
+                while new != 0 {
+                    let bit = new.trailing_zeros() as usize;
+                    new &= new - 1;
+                    let i = base + bit;
+                    let cell = truth[i];
+                    cells[i] = cell;
+                    if cell.is_free() {
+                        free[blk] |= 1 << bit;
+                    }
+                    first_seen(i - row * w, row, cell);
+                }
+                blk += 1;
             }
         });
     }
@@ -184,6 +272,42 @@ impl KnownMap {
     /// The pixels seen so far.
     pub fn seen(&self) -> &FixedBitSet {
         &self.seen
+    }
+
+    /// The pixels seen and free so far (those that never block the robot).
+    pub fn known_free(&self) -> &FixedBitSet {
+        &self.free
+    }
+
+    /// Calls `f(col, seen)` for each pixel of image row `row`, columns `col0..=col1` (inside
+    /// the image), that is not known free (unseen, or seen and not free), in column order,
+    /// until `f` returns `false`. Known-free pixels cost a bit each, a block at a time.
+    #[inline]
+    pub(crate) fn for_each_not_known_free(
+        &self,
+        row: usize,
+        col0: usize,
+        col1: usize,
+        mut f: impl FnMut(usize, bool) -> bool,
+    ) {
+        let base = row * self.grid.frame().width;
+        let (a, b) = (base + col0, base + col1 + 1);
+        let free = self.free.as_slice();
+        let seen = self.seen.as_slice();
+        let mut blk = a / BLOCK_BITS;
+        while blk * BLOCK_BITS < b {
+            let start = blk * BLOCK_BITS;
+            let mut todo =
+                !free[blk] & range_mask(a.max(start) - start, b.min(start + BLOCK_BITS) - start);
+            while todo != 0 {
+                let bit = todo.trailing_zeros() as usize;
+                todo &= todo - 1;
+                if !f(start + bit - base, seen[blk] >> bit & 1 == 1) {
+                    return;
+                }
+            }
+            blk += 1;
+        }
     }
 
     /// Can the robot (radius `r` metres) stand at world point `p`, as far as it knows?
@@ -224,11 +348,38 @@ impl Occupancy for KnownMap {
     #[inline]
     fn blocked(&self, col: i64, row: i64) -> bool {
         match self.grid.frame().checked(col, row) {
-            Some((c, r)) => {
-                let i = self.grid.frame().index(c, r);
-                !(self.seen.contains(i) && self.grid.cells()[i].is_free())
-            }
+            Some((c, r)) => !self.free.contains(self.grid.frame().index(c, r)),
             None => true,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn row_spans_match_for_each() {
+        let map = GridMap::filled(MapFrame::new(37, 23, 0.05), Cell::Free).expect("map");
+        let mut seed = 3u64;
+        let mut next = || {
+            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for k in 0..3000 {
+            let center = Point::new(next() * 2.4 - 0.3, next() * 1.6 - 0.3);
+            // Ranges on and off pixel-centre distances, down to nothing.
+            let range = if k % 3 == 0 {
+                (next() * 8.0).round() * 0.025
+            } else {
+                next() * 0.6
+            };
+            let scan = Scan::new(&map, center, range);
+            let mut a = Vec::new();
+            scan.for_each(|c, r, _| a.push((c, r)));
+            let mut b = Vec::new();
+            scan.for_each_row_span(|r, lo, hi| b.extend((lo..=hi).map(|c| (c, r))));
+            assert_eq!(a, b, "centre {center:?} range {range}");
         }
     }
 }

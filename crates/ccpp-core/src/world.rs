@@ -251,47 +251,23 @@ impl World {
                 }
             }
         }
-        let mut stack: Vec<usize> = Vec::new();
         if let Some(&s) = seeds.first() {
-            seen.insert(s);
-            stack.push(s);
-        }
-        let (w, h) = (frame.width, frame.height);
-        while let Some(i) = stack.pop() {
-            let (c, r) = (i % w, i / w);
-            for dr in -1i64..=1 {
-                for dc in -1i64..=1 {
-                    if dc == 0 && dr == 0 {
-                        continue;
-                    }
-                    let (nc, nr) = (c as i64 + dc, r as i64 + dr);
-                    if nc < 0 || nr < 0 || nc >= w as i64 || nr >= h as i64 {
-                        continue;
-                    }
-                    let j = nr as usize * w + nc as usize;
-                    if self.cfree.contains(j) && !seen.contains(j) {
-                        seen.insert(j);
-                        stack.push(j);
-                    }
-                }
-            }
+            fill_component(
+                &self.cfree,
+                frame.width,
+                frame.height,
+                s,
+                &mut seen,
+                |_, _, _| {},
+            );
         }
         seen
     }
 
     fn compute_accessible(&mut self) {
         let frame = *self.map.frame();
-        let reach = &self.reachable;
-        let dt = squared_edt(frame.width, frame.height, |i| reach.contains(i), false);
         let rt = self.robot.tool_radius / frame.resolution + 1e-6;
-        let rt2 = rt * rt;
-        let cells = self.map.cells();
-        let mut acc = FixedBitSet::with_capacity(frame.len());
-        for (i, &d2) in dt.iter().enumerate() {
-            if cells[i] == Cell::Free && d2 != INF && f64::from(d2) <= rt2 {
-                acc.insert(i);
-            }
-        }
+        let acc = accessible_pixels(&self.map, &self.reachable, rt);
         self.accessible_count = acc.count_ones(..);
         self.accessible = acc;
     }
@@ -423,50 +399,145 @@ impl World {
 
 /// The default start: the C-free pixel centre with the largest clearance in the largest C-free
 /// 8-connected component; ties by row-major order; heading east.
+///
+/// Components are visited in the order of their first pixel (row-major); the first of the
+/// largest wins, and within it the largest `dt2`, then the smallest index.
 fn default_start(frame: &MapFrame, cfree: &FixedBitSet, dt2: &[u32]) -> Pose {
     let (w, h) = (frame.width, frame.height);
-    let mut label = vec![u32::MAX; frame.len()];
-    let mut best_comp = (0usize, 0u32); // (size, label)
-    let mut next = 0u32;
-    let mut stack = Vec::new();
+    let mut visited = FixedBitSet::with_capacity(frame.len());
+    // (size, best dt2, best index) of the chosen component.
+    let mut best: Option<(usize, u32, usize)> = None;
     for i in cfree.ones() {
-        if label[i] != u32::MAX {
+        if visited.contains(i) {
             continue;
         }
         let mut size = 0usize;
-        label[i] = next;
-        stack.push(i);
-        while let Some(k) = stack.pop() {
-            size += 1;
-            let (c, r) = ((k % w) as i64, (k / w) as i64);
-            for dr in -1i64..=1 {
-                for dc in -1i64..=1 {
-                    let (nc, nr) = (c + dc, r + dr);
-                    if nc < 0 || nr < 0 || nc >= w as i64 || nr >= h as i64 {
-                        continue;
+        let mut top = (0u32, usize::MAX);
+        fill_component(cfree, w, h, i, &mut visited, |row, lo, hi| {
+            size += hi - lo + 1;
+            let base = row * w;
+            for (k, &d) in dt2[base + lo..=base + hi].iter().enumerate() {
+                let idx = base + lo + k;
+                if top.1 == usize::MAX || d > top.0 || (d == top.0 && idx < top.1) {
+                    top = (d, idx);
+                }
+            }
+        });
+        if best.is_none_or(|b| size > b.0) {
+            best = Some((size, top.0, top.1));
+        }
+    }
+    let idx = best.map_or(usize::MAX, |b| b.2);
+    let (c, r) = frame.col_row(idx);
+    let p = frame.pixel_center(c, r);
+    Pose::new(p.x, p.y, 0.0)
+}
+
+/// Scanline flood fill of the 8-connected component of `set` (a `w` x `h` row-major bitset)
+/// holding `seed`: marks it in `visited` (which must not hold any of it yet) and calls
+/// `on_run(row, lo, hi)` once for each maximal horizontal run `lo..=hi` of it.
+fn fill_component(
+    set: &FixedBitSet,
+    w: usize,
+    h: usize,
+    seed: usize,
+    visited: &mut FixedBitSet,
+    mut on_run: impl FnMut(usize, usize, usize),
+) {
+    let mut stack = vec![seed];
+    while let Some(i) = stack.pop() {
+        if visited.contains(i) {
+            continue;
+        }
+        let (row, col) = (i / w, i % w);
+        let base = row * w;
+        // The whole run holding `i` is unvisited: runs are always filled whole.
+        let mut lo = col;
+        while lo > 0 && set.contains(base + lo - 1) {
+            lo -= 1;
+        }
+        let mut hi = col;
+        while hi + 1 < w && set.contains(base + hi + 1) {
+            hi += 1;
+        }
+        visited.insert_range(base + lo..base + hi + 1);
+        on_run(row, lo, hi);
+        // 8-connected: the rows above and below, one column wider on each side.
+        let (c0, c1) = (lo.saturating_sub(1), (hi + 1).min(w - 1));
+        for nrow in [row.wrapping_sub(1), row + 1] {
+            if nrow >= h {
+                continue;
+            }
+            let nb = nrow * w;
+            let mut c = c0;
+            while c <= c1 {
+                let j = nb + c;
+                if set.contains(j) && !visited.contains(j) {
+                    stack.push(j);
+                    // Skip the rest of this run.
+                    while c <= c1 && set.contains(nb + c) {
+                        c += 1;
                     }
-                    let j = nr as usize * w + nc as usize;
-                    if cfree.contains(j) && label[j] == u32::MAX {
-                        label[j] = next;
-                        stack.push(j);
-                    }
+                } else {
+                    c += 1;
                 }
             }
         }
-        if size > best_comp.0 {
-            best_comp = (size, next);
-        }
-        next += 1;
     }
-    let mut best = (0u32, usize::MAX);
-    for i in cfree.ones() {
-        if label[i] == best_comp.1 && (best.1 == usize::MAX || dt2[i] > best.0) {
-            best = (dt2[i], i);
+}
+
+/// The accessible surface: free pixels whose centre lies within `rt` pixels of a `reachable`
+/// centre (`d2 <= rt^2` on integer squared distances, exactly as a distance transform would
+/// decide). Small tools test the few offsets of the disk around each free non-reachable pixel;
+/// large ones use the distance transform.
+fn accessible_pixels(map: &GridMap, reachable: &FixedBitSet, rt: f64) -> FixedBitSet {
+    let frame = *map.frame();
+    let (w, h) = (frame.width, frame.height);
+    let cells = map.cells();
+    let rt2 = rt * rt;
+    let k = rt.floor().max(0.0) as i64 + 1;
+    let mut offsets = Vec::new();
+    if k <= 8 {
+        for dy in -k..=k {
+            for dx in -k..=k {
+                let d2 = (dx * dx + dy * dy) as u32;
+                if f64::from(d2) <= rt2 {
+                    offsets.push((dx, dy, d2));
+                }
+            }
+        }
+        // Nearest first: most hits are adjacent.
+        offsets.sort_by_key(|o| o.2);
+    }
+    let mut acc = FixedBitSet::with_capacity(frame.len());
+    if k > 8 {
+        let dt = squared_edt(w, h, |i| reachable.contains(i), false);
+        for (i, &d2) in dt.iter().enumerate() {
+            if cells[i] == Cell::Free && d2 != INF && f64::from(d2) <= rt2 {
+                acc.insert(i);
+            }
+        }
+        return acc;
+    }
+    acc.union_with(reachable);
+    for i in 0..frame.len() {
+        if cells[i] != Cell::Free || reachable.contains(i) {
+            continue;
+        }
+        let (c, r) = ((i % w) as i64, (i / w) as i64);
+        let hit = offsets.iter().any(|&(dx, dy, _)| {
+            let (nc, nr) = (c + dx, r + dy);
+            nc >= 0
+                && nr >= 0
+                && (nc as usize) < w
+                && (nr as usize) < h
+                && reachable.contains(nr as usize * w + nc as usize)
+        });
+        if hit {
+            acc.insert(i);
         }
     }
-    let (c, r) = frame.col_row(best.1);
-    let p = frame.pixel_center(c, r);
-    Pose::new(p.x, p.y, 0.0)
+    acc
 }
 
 #[cfg(test)]
@@ -561,6 +632,119 @@ mod proptests {
                     .collect();
                 GridMap::new(MapFrame::new(w, h, 0.1), cells).unwrap()
             })
+    }
+
+    /// The previous `default_start` (a label per pixel), as the reference.
+    fn default_start_reference(frame: &MapFrame, cfree: &FixedBitSet, dt2: &[u32]) -> Pose {
+        let (w, h) = (frame.width, frame.height);
+        let mut label = vec![u32::MAX; frame.len()];
+        let mut best_comp = (0usize, 0u32);
+        let mut next = 0u32;
+        let mut stack = Vec::new();
+        for i in cfree.ones() {
+            if label[i] != u32::MAX {
+                continue;
+            }
+            let mut size = 0usize;
+            label[i] = next;
+            stack.push(i);
+            while let Some(k) = stack.pop() {
+                size += 1;
+                let (c, r) = ((k % w) as i64, (k / w) as i64);
+                for dr in -1i64..=1 {
+                    for dc in -1i64..=1 {
+                        let (nc, nr) = (c + dc, r + dr);
+                        if nc < 0 || nr < 0 || nc >= w as i64 || nr >= h as i64 {
+                            continue;
+                        }
+                        let j = nr as usize * w + nc as usize;
+                        if cfree.contains(j) && label[j] == u32::MAX {
+                            label[j] = next;
+                            stack.push(j);
+                        }
+                    }
+                }
+            }
+            if size > best_comp.0 {
+                best_comp = (size, next);
+            }
+            next += 1;
+        }
+        let mut best = (0u32, usize::MAX);
+        for i in cfree.ones() {
+            if label[i] == best_comp.1 && (best.1 == usize::MAX || dt2[i] > best.0) {
+                best = (dt2[i], i);
+            }
+        }
+        let (c, r) = frame.col_row(best.1);
+        let p = frame.pixel_center(c, r);
+        Pose::new(p.x, p.y, 0.0)
+    }
+
+    /// The previous pixel-by-pixel 8-connected flood fill, as the reference.
+    fn flood_reference(cfree: &FixedBitSet, w: usize, h: usize, seed: usize) -> FixedBitSet {
+        let mut seen = FixedBitSet::with_capacity(w * h);
+        seen.insert(seed);
+        let mut stack = vec![seed];
+        while let Some(i) = stack.pop() {
+            let (c, r) = ((i % w) as i64, (i / w) as i64);
+            for dr in -1i64..=1 {
+                for dc in -1i64..=1 {
+                    let (nc, nr) = (c + dc, r + dr);
+                    if nc < 0 || nr < 0 || nc >= w as i64 || nr >= h as i64 {
+                        continue;
+                    }
+                    let j = nr as usize * w + nc as usize;
+                    if cfree.contains(j) && !seen.contains(j) {
+                        seen.insert(j);
+                        stack.push(j);
+                    }
+                }
+            }
+        }
+        seen
+    }
+
+    /// The previous accessible surface (a distance transform from the reachable set).
+    fn accessible_reference(map: &GridMap, reach: &FixedBitSet, rt: f64) -> FixedBitSet {
+        let f = *map.frame();
+        let dt = squared_edt(f.width, f.height, |i| reach.contains(i), false);
+        let mut acc = FixedBitSet::with_capacity(f.len());
+        for (i, &d2) in dt.iter().enumerate() {
+            if map.cells()[i] == Cell::Free && d2 != INF && f64::from(d2) <= rt * rt {
+                acc.insert(i);
+            }
+        }
+        acc
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(128))]
+        /// The scanline fills and the offset dilation give exactly the previous start,
+        /// reachable set and accessible surface.
+        #[test]
+        fn world_sets_match_reference(
+            map in arb_map(),
+            r in 0.05f64..0.25,
+            tool in 0.2f64..1.0,
+            big_tool in 0.0f64..1.2,
+        ) {
+            let f = *map.frame();
+            let robot = Robot { radius: r, tool_radius: r * tool };
+            let Ok(world) = World::new(map.clone(), robot, None) else { return Ok(()) };
+            let start = default_start_reference(&f, world.cfree(), &world.obstacle_dt2);
+            prop_assert_eq!(world.start(), start);
+            let (c, row) = f.grid_to_pixel_signed(f.world_to_grid(start.position()));
+            let seed = f.index(c as usize, row as usize);
+            prop_assert_eq!(world.reachable(), &flood_reference(world.cfree(), f.width, f.height, seed));
+            for rt in [r * tool / f.resolution + 1e-6, big_tool * 12.0, 7.999, 8.0, 9.5] {
+                prop_assert_eq!(
+                    accessible_pixels(&map, world.reachable(), rt),
+                    accessible_reference(&map, world.reachable(), rt),
+                    "rt {}", rt
+                );
+            }
+        }
     }
 
     proptest! {

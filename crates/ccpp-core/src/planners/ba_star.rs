@@ -85,7 +85,10 @@ use std::collections::{BinaryHeap, VecDeque};
 use serde::{Deserialize, Serialize};
 
 use crate::collide::contact_radius_px;
-use crate::geometry::{first_entry, point_segment_dist2, wrap_angle, Point, Pose};
+use crate::geometry::{
+    ceil_i32, ceil_i64, first_entry, floor_i32, floor_i64, point_segment_dist2, wrap_angle, Point,
+    Pose,
+};
 use crate::grid::MapFrame;
 use crate::planner::{KnownMap, Planner, Sensor, Step};
 use crate::tiles::{Tile, TileGrid, N8};
@@ -157,8 +160,9 @@ pub fn judge_motion(known: &KnownMap, a: Point, b: Point, r: f64) -> Judgement {
     let ylo = ga.y.min(gb.y) - rc;
     let yhi = ga.y.max(gb.y) + rc;
     // Pixel centre of row `row` is at gy = h - row - 0.5.
-    let row0 = (h - yhi - 0.5).floor() as i64 - 1;
-    let row1 = (h - ylo - 0.5).ceil() as i64 + 1;
+    let row0 = floor_i64(h - yhi - 0.5) - 1;
+    let row1 = ceil_i64(h - ylo - 0.5) + 1;
+    let (w, hh) = (frame.width as i64, frame.height as i64);
     let mut undetermined = false;
     for row in row0..=row1 {
         let gy = h - row as f64 - 0.5;
@@ -178,31 +182,41 @@ pub fn judge_motion(known: &KnownMap, a: Point, b: Point, r: f64) -> Judgement {
         }
         let xa = ga.x + tl * dx;
         let xb = ga.x + th * dx;
-        let c0 = (xa.min(xb) - rc - 0.5).floor() as i64 - 1;
-        let c1 = (xa.max(xb) + rc - 0.5).ceil() as i64 + 1;
-        for col in c0..=c1 {
-            // Cheap state first: seen free pixels never matter, whatever their distance.
-            let unseen = match frame.checked(col, row) {
-                None => false,
-                Some((c, rr)) => {
-                    if !known.is_seen(c, rr) {
-                        true
-                    } else if known.get(c, rr).is_free() {
-                        continue;
-                    } else {
-                        false
-                    }
-                }
-            };
+        let c0 = floor_i64(xa.min(xb) - rc - 0.5) - 1;
+        let c1 = ceil_i64(xa.max(xb) + rc - 0.5) + 1;
+        let touches = |col: i64| {
             let q = Point::new(col as f64 + 0.5, gy);
-            if point_segment_dist2(q, ga, gb) >= rc2 || first_entry(ga, gb, q, rc).is_none() {
-                continue;
-            }
-            if unseen {
-                undetermined = true;
-            } else {
+            point_segment_dist2(q, ga, gb) < rc2 && first_entry(ga, gb, q, rc).is_some()
+        };
+        // Outside the image every pixel is occupied (and seen).
+        if row < 0 || row >= hh {
+            if (c0..=c1).any(touches) {
                 return Judgement::Blocked;
             }
+            continue;
+        }
+        if (c0..=c1.min(-1)).any(touches) || (c0.max(w)..=c1).any(touches) {
+            return Judgement::Blocked;
+        }
+        let (lo, hi) = (c0.max(0), c1.min(w - 1));
+        if lo > hi {
+            continue;
+        }
+        // Inside: seen free pixels never matter, whatever their distance; visit the others.
+        let mut blocked = false;
+        known.for_each_not_known_free(row as usize, lo as usize, hi as usize, |col, seen| {
+            if !touches(col as i64) {
+                return true;
+            }
+            if seen {
+                blocked = true;
+                return false;
+            }
+            undetermined = true;
+            true
+        });
+        if blocked {
+            return Judgement::Blocked;
         }
     }
     if undetermined {
@@ -521,14 +535,14 @@ pub fn for_each_swept_tile(a: Tile, b: Tile, rho: f64, mut f: impl FnMut(Tile) -
     let step: i32 = if b.1 >= a.1 { 1 } else { -1 };
     let reach = rho + 0.5;
     let j_first = if step > 0 {
-        (pa.y - reach).floor() as i32
+        floor_i32(pa.y - reach)
     } else {
-        (pa.y + reach).ceil() as i32
+        ceil_i32(pa.y + reach)
     };
     let j_last = if step > 0 {
-        (pb.y + reach).ceil() as i32
+        ceil_i32(pb.y + reach)
     } else {
-        (pb.y - reach).floor() as i32
+        floor_i32(pb.y - reach)
     };
     let mut j = j_first;
     loop {
@@ -543,8 +557,8 @@ pub fn for_each_swept_tile(a: Tile, b: Tile, rho: f64, mut f: impl FnMut(Tile) -
         if tl <= th && (dy != 0.0 || (pa.y - y).abs() <= reach) {
             let xa = pa.x + tl * dx;
             let xb = pa.x + th * dx;
-            let i_lo = (xa.min(xb) - reach).floor() as i32;
-            let i_hi = (xa.max(xb) + reach).ceil() as i32;
+            let i_lo = floor_i32(xa.min(xb) - reach);
+            let i_hi = ceil_i32(xa.max(xb) + reach);
             let (mut i, i_end, istep) = if dx >= 0.0 {
                 (i_lo, i_hi, 1)
             } else {
@@ -903,8 +917,8 @@ impl Mind {
         let ux = (wx - g.anchor.x) / g.side;
         let uy = (wy - g.anchor.y) / g.side;
         let rt = self.rc_px * frame.resolution / g.side + 1e-6;
-        let (i0, i1) = ((ux - rt).ceil() as i32, (ux + rt).floor() as i32);
-        let (j0, j1) = ((uy - rt).ceil() as i32, (uy + rt).floor() as i32);
+        let (i0, i1) = (ceil_i32(ux - rt), floor_i32(ux + rt));
+        let (j0, j1) = (ceil_i32(uy - rt), floor_i32(uy + rt));
         let rc2 = self.rc_px * self.rc_px;
         for j in j0..=j1 {
             for i in i0..=i1 {
@@ -925,10 +939,10 @@ impl Mind {
         let rc = self.rc_px;
         let rc2 = rc * rc;
         let h = frame.height as f64;
-        let row0 = (h - (c.y + rc) - 0.5).floor() as i64 - 1;
-        let row1 = (h - (c.y - rc) - 0.5).ceil() as i64 + 1;
-        let col0 = (c.x - rc - 0.5).floor() as i64 - 1;
-        let col1 = (c.x + rc - 0.5).ceil() as i64 + 1;
+        let row0 = floor_i64(h - (c.y + rc) - 0.5) - 1;
+        let row1 = ceil_i64(h - (c.y - rc) - 0.5) + 1;
+        let col0 = floor_i64(c.x - rc - 0.5) - 1;
+        let col1 = ceil_i64(c.x + rc - 0.5) + 1;
         let mut n = 0;
         for row in row0..=row1 {
             let gy = h - row as f64 - 0.5;
