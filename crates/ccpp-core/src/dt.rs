@@ -18,13 +18,13 @@ pub fn squared_edt(
     is_feature: impl Fn(usize) -> bool,
     border_is_feature: bool,
 ) -> Vec<u32> {
+    // Phase 1 (Meijster et al.): distance to the nearest feature in the same column, in two
+    // row-order sweeps (cache friendly). `NONE` = no feature in the column.
+    const NONE: u32 = u32::MAX / 4;
     let n = width * height;
     if n == 0 {
         return Vec::new();
     }
-    // Phase 1 (Meijster et al.): distance to the nearest feature in the same column, in two
-    // row-order sweeps (cache friendly). `NONE` = no feature in the column.
-    const NONE: u32 = u32::MAX / 4;
     let mut g = vec![NONE; n];
     let edge = if border_is_feature { 0 } else { NONE };
     for r in 0..height {
