@@ -1,6 +1,8 @@
 //! Runs `bsa-bfs` and `rect-boustrophedon` (PID execution, their default) on every map of
 //! `shared/maps` at r = 0.15 m (rectangle 0.3 x 0.3 m) from the default start and prints one
-//! table row per run: coverage rate, effective coverage, collisions, tracking error, wall time.
+//! table row per run: coverage rate, effective coverage, collisions, tracking error, wall time
+//! (planner construction plus simulation) and the construction time alone (an offline planner
+//! plans there).
 //!
 //! `cargo run --release -p ccpp-io --example exec_table [MAPS_DIR] [PLANNER...]`
 
@@ -35,9 +37,9 @@ fn main() {
     };
     maps.sort();
     println!(
-        "| map | planner | coverage_rate | effective_coverage | collisions | tracking mean / max (µm) | rect_guarantee | wall s |"
+        "| map | planner | coverage_rate | effective_coverage | collisions | tracking mean / max (µm) | rect_guarantee | wall s | build s |"
     );
-    println!("|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|");
     for path in &maps {
         let name = path
             .file_stem()
@@ -66,6 +68,7 @@ fn main() {
                     continue;
                 }
             };
+            let build_s = started.elapsed().as_secs_f64();
             let mut run = simulate(&world, p.as_mut(), &SimConfig::default());
             run.wall_time_s = started.elapsed().as_secs_f64();
             let m = metrics::compute(&world, &run, &name);
@@ -73,7 +76,7 @@ fn main() {
                 v.map_or_else(|| "-".to_string(), |x| format!("{:.3}", x * k))
             };
             println!(
-                "| {name} | {planner} | {} | {:.4} | {} | {} / {} | {} | {:.2} |",
+                "| {name} | {planner} | {} | {:.4} | {} | {} / {} | {} | {:.2} | {:.2} |",
                 m.coverage_rate
                     .map_or_else(|| "-".to_string(), |c| format!("{c:.4}")),
                 m.effective_coverage,
@@ -83,6 +86,7 @@ fn main() {
                 m.rect_guarantee
                     .map_or_else(|| "-".to_string(), |g| format!("{g:.6}")),
                 m.wall_time_s,
+                build_s,
             );
         }
     }

@@ -284,6 +284,8 @@ pub(crate) struct Core {
     pub(crate) grid: TileGrid,
     /// Robot radius, metres.
     pub(crate) r: f64,
+    /// Cleaning tool radius, metres.
+    pub(crate) tool: f64,
     /// Sensor range, metres.
     pub(crate) range: f64,
     pub(crate) cells: Cells,
@@ -308,6 +310,7 @@ impl Core {
             known: KnownMap::new(sensor.frame()),
             grid,
             r,
+            tool: sensor.robot().tool_radius,
             range: sensor.sensor_range(),
             cells,
             bps: Vec::new(),
@@ -706,6 +709,9 @@ impl Planner for Bsa {
     fn next(&mut self, sensor: &dyn Sensor) -> Step {
         loop {
             if let Some(s) = self.queue.pop_front() {
+                if let (Step::MoveTo(p), Some(ext)) = (&s, self.ext.as_mut()) {
+                    ext.driven(sensor.pose().position(), *p);
+                }
                 return s;
             }
             if self.phase == Phase::Finished {

@@ -22,7 +22,12 @@
 //! * **detours (roadmap)**: when the straight move between consecutive waypoints is not free,
 //!   the pieces are joined by an **A\* search over the pixel grid of the clearance disk's
 //!   reachable C-free space** (8-connected, no corner cutting, every edge checked exactly),
-//!   shortened by greedy line-of-sight string pulling. This is complete on the pixel grid and
+//!   shortened by line-of-sight string pulling (galloping search for the farthest visible path
+//!   point). The search arrays are allocated once per plan (generation stamps), the step costs
+//!   are integer octile costs, the heuristic is the maximum of the octile distance and an ALT
+//!   landmark bound (exact graph distances from a few far-apart pixels, computed by Dial's
+//!   algorithm at the first detour; also answers "not connected" without searching), and moves
+//!   between pixels whose clearance (distance transform) proves them free are not re-checked. This is complete on the pixel grid and
 //!   keeps the clearance of the circumscribed disk; it replaces the seed's Voronoi roadmap.
 //!
 //! [`waypoints`] returns the plain waypoint list (lane points and detour points in order);
@@ -233,14 +238,193 @@ pub fn plan(world: &World, opts: &RectOptions) -> RectPlan {
     }
 }
 
-/// A* over the reachable C-free pixels of a clearance world.
+/// Cost of a straight pixel step in the A\* search (integer octile costs: 99 / 70 ~ sqrt 2).
+const STRAIGHT: u32 = 70;
+/// Cost of a diagonal pixel step.
+const DIAG: u32 = 99;
+/// Landmarks of the ALT heuristic.
+const LANDMARKS: usize = 12;
+/// N8 offsets `(dc, dr)` (rows down), straight ones first.
+const N8: [(i64, i64); 8] = [
+    (1, 0),
+    (0, 1),
+    (-1, 0),
+    (0, -1),
+    (1, 1),
+    (-1, 1),
+    (-1, -1),
+    (1, -1),
+];
+
+/// A\* over the reachable C-free pixels of a clearance world.
+///
+/// The search arrays are allocated once per plan and reset by generation stamps; the pixels
+/// whose clearance proves every edge between them free are precomputed from the world's
+/// distance transform, and the exact segment checks of the other edges are memoised (the map
+/// is static).
 struct Roadmap<'a> {
     w: &'a World,
+    /// Reachable pixels with clearance `>= r + 0.45 px`: an edge between two of them is free.
+    safe: fixedbitset::FixedBitSet,
+    /// Per pixel and N8 direction: exact edge check done (bit `k`) / its result (bit `k + 8`).
+    edge_memo: Vec<u16>,
+    g: Vec<u32>,
+    came: Vec<u32>,
+    /// `open[i] == gen`: `g[i]` and `came[i]` are valid in the current search.
+    open: Vec<u32>,
+    /// `closed[i] == gen`: pixel `i` is expanded in the current search.
+    closed: Vec<u32>,
+    gen: u32,
+    heap: BinaryHeap<Reverse<(u32, u32, u32)>>,
+    /// Compact index of each reachable pixel (`u32::MAX` elsewhere), for the landmark tables.
+    compact: Vec<u32>,
+    /// ALT landmarks: exact search-graph distances from each landmark, by compact index
+    /// (`u32::MAX` = not connected); computed at the first detour.
+    landmarks: Option<Vec<Vec<u32>>>,
 }
 
 impl<'a> Roadmap<'a> {
     fn new(w: &'a World) -> Self {
-        Self { w }
+        let f = *w.frame();
+        let n = f.len();
+        let need = w.robot().radius + 0.45 * f.resolution;
+        let mut safe = fixedbitset::FixedBitSet::with_capacity(n);
+        for i in w.reachable().ones() {
+            let (c, r) = f.col_row(i);
+            if w.pixel_clearance(c, r) >= need {
+                safe.insert(i);
+            }
+        }
+        Self {
+            w,
+            safe,
+            edge_memo: vec![0; n],
+            g: vec![0; n],
+            came: vec![0; n],
+            open: vec![0; n],
+            closed: vec![0; n],
+            gen: 0,
+            heap: BinaryHeap::new(),
+            compact: Vec::new(),
+            landmarks: None,
+        }
+    }
+
+    /// The search-graph successor of pixel `i` along N8 direction `k`, with its step cost: a
+    /// reachable pixel, no corner cutting, the move checked free.
+    #[inline]
+    fn succ(&mut self, i: usize, k: usize) -> Option<(usize, u32)> {
+        let f = self.w.frame();
+        let (w, hgt) = (f.width as i64, f.height as i64);
+        let (c, r) = (i as i64 % w, i as i64 / w);
+        let (dc, dr) = N8[k];
+        let (nc, nr) = (c + dc, r + dr);
+        if nc < 0 || nr < 0 || nc >= w || nr >= hgt {
+            return None;
+        }
+        let j = (nr * w + nc) as usize;
+        let reach = self.w.reachable();
+        if !reach.contains(j) {
+            return None;
+        }
+        let diag = dc != 0 && dr != 0;
+        if diag && !(reach.contains((r * w + nc) as usize) && reach.contains((nr * w + c) as usize))
+        {
+            return None;
+        }
+        if !self.edge_free(i, j, k) {
+            return None;
+        }
+        Some((j, if diag { DIAG } else { STRAIGHT }))
+    }
+
+    /// Exact distances over the search graph from pixel `src` (Dial's bucket queue: the
+    /// step costs are small integers), by compact index.
+    fn distances_from(&mut self, src: usize) -> Vec<u32> {
+        let n = self.compact.iter().filter(|&&c| c != u32::MAX).count();
+        let mut d = vec![u32::MAX; n];
+        let nb = DIAG as usize + 1;
+        let mut buckets: Vec<Vec<u32>> = vec![Vec::new(); nb];
+        d[self.compact[src] as usize] = 0;
+        buckets[0].push(src as u32);
+        let mut pending = 1usize;
+        let mut cost = 0u32;
+        while pending > 0 {
+            let slot = cost as usize % nb;
+            while let Some(i) = buckets[slot].pop() {
+                pending -= 1;
+                let i = i as usize;
+                if d[self.compact[i] as usize] != cost {
+                    continue;
+                }
+                for k in 0..8 {
+                    let Some((j, step)) = self.succ(i, k) else {
+                        continue;
+                    };
+                    let cj = self.compact[j] as usize;
+                    let nc = cost + step;
+                    if nc < d[cj] {
+                        d[cj] = nc;
+                        buckets[nc as usize % nb].push(j as u32);
+                        pending += 1;
+                    }
+                }
+            }
+            cost += 1;
+        }
+        d
+    }
+
+    /// Picks [`LANDMARKS`] landmarks by farthest-point selection from `seed` and stores their
+    /// distance tables.
+    fn init_landmarks(&mut self, seed: usize) {
+        let f = *self.w.frame();
+        let mut compact = vec![u32::MAX; f.len()];
+        let mut pixel_of = Vec::new();
+        for (k, i) in self.w.reachable().ones().enumerate() {
+            compact[i] = k as u32;
+            pixel_of.push(i);
+        }
+        self.compact = compact;
+        let mut tables: Vec<Vec<u32>> = Vec::with_capacity(LANDMARKS);
+        let first = self.distances_from(seed);
+        // min over the landmarks so far of the distance (the seed's table to start with).
+        let mut nearest = first;
+        for _ in 0..LANDMARKS {
+            let far = nearest
+                .iter()
+                .enumerate()
+                .filter(|&(_, &d)| d != u32::MAX)
+                .max_by_key(|&(k, &d)| (d, std::cmp::Reverse(k)))
+                .map(|(k, _)| pixel_of[k]);
+            let Some(far) = far else { break };
+            let t = self.distances_from(far);
+            for (m, &d) in nearest.iter_mut().zip(&t) {
+                *m = (*m).min(d);
+            }
+            tables.push(t);
+        }
+        self.landmarks = Some(tables);
+    }
+
+    /// The ALT lower bound on the distance from `i` to `t` (triangle inequality over the
+    /// landmarks; 0 where a table does not know both).
+    #[inline]
+    fn alt(&self, i: usize, t: usize) -> u32 {
+        let (ci, ct) = (self.compact[i] as usize, self.compact[t] as usize);
+        self.landmarks.as_ref().map_or(0, |ls| {
+            ls.iter()
+                .map(|l| {
+                    let (a, b) = (l[ci], l[ct]);
+                    if a == u32::MAX || b == u32::MAX {
+                        0
+                    } else {
+                        a.abs_diff(b)
+                    }
+                })
+                .max()
+                .unwrap_or(0)
+        })
     }
 
     /// Can the clearance disk stand at `p` inside the start's component?
@@ -276,16 +460,27 @@ impl<'a> Roadmap<'a> {
         best.map(|b| b.1)
     }
 
-    fn edge_free(&self, a: usize, b: usize) -> bool {
+    /// Is the move from pixel `a` to its N8 neighbour `b` (direction `k`) free?
+    fn edge_free(&mut self, a: usize, b: usize, k: usize) -> bool {
+        if self.safe.contains(a) && self.safe.contains(b) {
+            return true;
+        }
+        let m = self.edge_memo[a];
+        if m & (1 << k) != 0 {
+            return m & (1 << (k + 8)) != 0;
+        }
         let f = self.w.frame();
         let (ca, ra) = f.col_row(a);
         let (cb, rb) = f.col_row(b);
-        let need = self.w.robot().radius + 0.45 * f.resolution;
-        if self.w.pixel_clearance(ca, ra) >= need && self.w.pixel_clearance(cb, rb) >= need {
-            return true;
-        }
-        self.w
-            .segment_free(f.pixel_center(ca, ra), f.pixel_center(cb, rb))
+        let free = self
+            .w
+            .segment_free(f.pixel_center(ca, ra), f.pixel_center(cb, rb));
+        // The reverse direction of N8[k] is N8[k ^ 2] (E<->W, N<->S, NE<->SW, NW<->SE).
+        let back = k ^ 2;
+        let bit = |d: usize| (1u16 << d) | (u16::from(free) << (d + 8));
+        self.edge_memo[a] |= bit(k);
+        self.edge_memo[b] |= bit(back);
+        free
     }
 
     /// Shortest collision-free path from `a` to `b` (both included), string-pulled.
@@ -293,71 +488,79 @@ impl<'a> Roadmap<'a> {
         let f = *self.w.frame();
         let s = self.attach(a)?;
         let t = self.attach(b)?;
-        let reach = self.w.reachable();
-        let n = f.len();
-        let mut g = vec![f64::INFINITY; n];
-        let mut came = vec![u32::MAX; n];
-        let mut closed = fixedbitset::FixedBitSet::with_capacity(n);
-        let (tc, tr) = f.col_row(t);
-        let h = |i: usize| {
-            let (c, r) = f.col_row(i);
-            (c as f64 - tc as f64).hypot(r as f64 - tr as f64)
+        self.gen = self.gen.wrapping_add(1);
+        if self.gen == 0 {
+            self.open.fill(0);
+            self.closed.fill(0);
+            self.gen = 1;
+        }
+        let gen = self.gen;
+        let w = f.width as i64;
+        let (tc, tr) = ((t as i64 % w), (t as i64 / w));
+        // Octile distance in the same integer units: consistent with the step costs.
+        if self.landmarks.is_none() {
+            self.init_landmarks(s);
+        }
+        // Different components of the search graph (the first landmark's table sees all of
+        // the seed's component): no path, without searching.
+        if let Some(l0) = self.landmarks.as_ref().and_then(|ls| ls.first()) {
+            let (ds, dt) = (l0[self.compact[s] as usize], l0[self.compact[t] as usize]);
+            if (ds == u32::MAX) != (dt == u32::MAX) {
+                return None;
+            }
+        }
+        // Octile distance in the same integer units, and the landmark bound: both consistent
+        // with the step costs, so is their maximum.
+        let octile = |i: usize| -> u32 {
+            let (c, r) = (i as i64 % w, i as i64 / w);
+            let (dx, dy) = ((c - tc).unsigned_abs(), (r - tr).unsigned_abs());
+            let (lo, hi) = (dx.min(dy) as u32, dx.max(dy) as u32);
+            DIAG * lo + STRAIGHT * (hi - lo)
         };
-        let key = |x: f64| Reverse((x * 1024.0) as u64);
-        let mut heap = BinaryHeap::new();
-        g[s] = 0.0;
-        came[s] = s as u32;
-        heap.push((key(h(s)), s));
-        let (w, hgt) = (f.width as i64, f.height as i64);
-        while let Some((_, i)) = heap.pop() {
-            if closed.contains(i) {
+        let h = |me: &Self, i: usize| octile(i).max(me.alt(i, t));
+        self.heap.clear();
+        self.g[s] = 0;
+        self.came[s] = s as u32;
+        self.open[s] = gen;
+        // Key: f, then h (deeper nodes first on ties), then the index (determinism).
+        let hs = h(self, s);
+        self.heap.push(Reverse((hs, hs, s as u32)));
+        let mut found = false;
+        while let Some(Reverse((_, _, i))) = self.heap.pop() {
+            let i = i as usize;
+            if self.closed[i] == gen {
                 continue;
             }
-            closed.insert(i);
+            self.closed[i] = gen;
             if i == t {
+                found = true;
                 break;
             }
-            let (c, r) = (i as i64 % w, i as i64 / w);
-            for (dc, dr) in [
-                (1, 0),
-                (0, 1),
-                (-1, 0),
-                (0, -1),
-                (1, 1),
-                (-1, 1),
-                (-1, -1),
-                (1, -1),
-            ] {
-                let (nc, nr) = (c + dc, r + dr);
-                if nc < 0 || nr < 0 || nc >= w || nr >= hgt {
+            let gi = self.g[i];
+            for k in 0..8 {
+                let Some((j, step)) = self.succ(i, k) else {
+                    continue;
+                };
+                if self.closed[j] == gen {
                     continue;
                 }
-                let j = (nr * w + nc) as usize;
-                if !reach.contains(j) || closed.contains(j) {
-                    continue;
-                }
-                let diag = dc != 0 && dr != 0;
-                if diag
-                    && !(reach.contains((r * w + nc) as usize)
-                        && reach.contains((nr * w + c) as usize))
-                {
-                    continue;
-                }
-                let cost = g[i] + if diag { std::f64::consts::SQRT_2 } else { 1.0 };
-                if cost < g[j] && self.edge_free(i, j) {
-                    g[j] = cost;
-                    came[j] = i as u32;
-                    heap.push((key(cost + h(j)), j));
+                let cost = gi + step;
+                if self.open[j] != gen || cost < self.g[j] {
+                    self.g[j] = cost;
+                    self.came[j] = i as u32;
+                    self.open[j] = gen;
+                    let hj = h(self, j);
+                    self.heap.push(Reverse((cost + hj, hj, j as u32)));
                 }
             }
         }
-        if !closed.contains(t) {
+        if !found {
             return None;
         }
         let mut cells = vec![t];
         let mut k = t;
         while k != s {
-            k = came[k] as usize;
+            k = self.came[k] as usize;
             cells.push(k);
         }
         cells.reverse();
@@ -367,16 +570,38 @@ impl<'a> Roadmap<'a> {
             f.pixel_center(c, r)
         }));
         pts.push(b);
-        // Greedy string pulling: from each kept point, go as far along the path as is visible.
+        // String pulling: from each kept point, the farthest path point found visible by a
+        // galloping then binary search (consecutive path points are joined by checked moves,
+        // so every kept segment is checked free, in O(log n) checks per kept point).
+        let visible = |i: usize, j: usize| self.w.segment_free(pts[i], pts[j]);
         let mut out = vec![a];
         let mut i = 0;
         while i + 1 < pts.len() {
-            let mut j = i + 1;
-            while j + 1 < pts.len() && self.w.segment_free(pts[i], pts[j + 1]) {
-                j += 1;
+            let last = pts.len() - 1;
+            let (mut lo, mut hi) = (i + 1, None);
+            let mut step = 1;
+            while lo < last {
+                let cand = (lo + step).min(last);
+                if visible(i, cand) {
+                    lo = cand;
+                    step *= 2;
+                } else {
+                    hi = Some(cand);
+                    break;
+                }
             }
-            out.push(pts[j]);
-            i = j;
+            if let Some(mut hi) = hi {
+                while hi - lo > 1 {
+                    let mid = lo + (hi - lo) / 2;
+                    if visible(i, mid) {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+            }
+            out.push(pts[lo]);
+            i = lo;
         }
         Some(out)
     }
