@@ -187,6 +187,12 @@ impl Cells {
         }
     }
 
+    /// Number of cells in the range.
+    #[inline]
+    pub(crate) fn len(&self) -> usize {
+        self.w * self.h
+    }
+
     #[inline]
     pub(crate) fn tile(&self, k: usize) -> Tile {
         (self.i0 + (k % self.w) as i32, self.j0 + (k / self.w) as i32)

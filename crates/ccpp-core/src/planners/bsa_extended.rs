@@ -759,7 +759,8 @@ impl Extension {
     /// Extended selection: Dijkstra over visited (cost 1) and touched (cost `gap_cost`) cells to
     /// the nearest BP, gaps crossed in their virtual pipe. `None` when no BP can be reached.
     pub(crate) fn select(&mut self, core: &mut Core) -> Option<ReturnPlan> {
-        let mut banned: HashSet<(Tile, usize)> = HashSet::new();
+        // Banned moves: bit `d` of a cell's byte bans leaving it towards heading `d`.
+        let mut banned = vec![0u8; core.cells.len()];
         let mut tries = 0;
         loop {
             if core.bps.is_empty() {
@@ -780,15 +781,19 @@ impl Extension {
                 Err((i, e)) => {
                     for w in path[i..=e].windows(2) {
                         let d = heading_of(w[0], w[1]);
-                        banned.insert((w[0], d));
-                        banned.insert((w[1], (d + 2) % 4));
+                        if let Some(k) = core.cells.idx(w[0]) {
+                            banned[k] |= 1 << d;
+                        }
+                        if let Some(k) = core.cells.idx(w[1]) {
+                            banned[k] |= 1 << ((d + 2) % 4);
+                        }
                     }
                     tries += 1;
                     if tries > 8 {
                         let target = *path.last().expect("non-empty path");
                         core.cells.set(target, DEAD);
                         core.validate_bps();
-                        banned.clear();
+                        banned.fill(0);
                         tries = 0;
                     }
                 }
@@ -796,7 +801,7 @@ impl Extension {
         }
     }
 
-    fn dijkstra(&self, core: &mut Core, banned: &HashSet<(Tile, usize)>) -> Option<Vec<Tile>> {
+    fn dijkstra(&self, core: &mut Core, banned: &[u8]) -> Option<Vec<Tile>> {
         let cells = &mut core.cells;
         let start = cells.idx(core.cell)?;
         cells.new_search();
@@ -815,7 +820,7 @@ impl Extension {
                 return Some(cells.path_to(ku));
             }
             for d in 0..4 {
-                if banned.contains(&(u, d)) {
+                if banned[ku] & (1 << d) != 0 {
                     continue;
                 }
                 let n = add(u, d);
