@@ -145,6 +145,25 @@ impl MapFrame {
         }
     }
 
+    /// Axis-aligned world bounding box of the image, `(lower-left, upper-right)` corners
+    /// (equal to the image extent when the origin has no yaw).
+    pub fn world_bounds(&self) -> (Point, Point) {
+        let (w, h) = (self.width as f64, self.height as f64);
+        let mut lo = Point::new(f64::INFINITY, f64::INFINITY);
+        let mut hi = Point::new(f64::NEG_INFINITY, f64::NEG_INFINITY);
+        for g in [
+            Point::new(0.0, 0.0),
+            Point::new(w, 0.0),
+            Point::new(0.0, h),
+            Point::new(w, h),
+        ] {
+            let c = self.grid_to_world(g);
+            lo = Point::new(lo.x.min(c.x), lo.y.min(c.y));
+            hi = Point::new(hi.x.max(c.x), hi.y.max(c.y));
+        }
+        (lo, hi)
+    }
+
     /// Width of the mapped area in metres.
     pub fn width_m(&self) -> f64 {
         self.width as f64 * self.resolution

@@ -64,26 +64,9 @@ impl TileGrid {
     /// Inclusive tile index bounds `(i0, i1, j0, j1)` whose centres can lie on a map of frame
     /// `f` (what an online planner may know: the frame, not the contents).
     pub fn bounds_for_frame(&self, f: &crate::grid::MapFrame) -> (i32, i32, i32, i32) {
-        let corners = [
-            f.grid_to_world(Point::new(0.0, 0.0)),
-            f.grid_to_world(Point::new(f.width as f64, 0.0)),
-            f.grid_to_world(Point::new(0.0, f.height as f64)),
-            f.grid_to_world(Point::new(f.width as f64, f.height as f64)),
-        ];
-        let (mut x0, mut x1, mut y0, mut y1) = (
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-        );
-        for c in corners {
-            x0 = x0.min(c.x);
-            x1 = x1.max(c.x);
-            y0 = y0.min(c.y);
-            y1 = y1.max(c.y);
-        }
-        let a = self.tile_of(Point::new(x0, y0));
-        let b = self.tile_of(Point::new(x1, y1));
+        let (lo, hi) = f.world_bounds();
+        let a = self.tile_of(lo);
+        let b = self.tile_of(hi);
         (a.0 - 1, b.0 + 1, a.1 - 1, b.1 + 1)
     }
 }

@@ -194,22 +194,14 @@ impl World {
         }
         let frame = self.map.frame();
         if frame.pixel_of(s.position()).is_none() {
-            let corners = [
-                frame.grid_to_world(Point::new(0.0, 0.0)),
-                frame.grid_to_world(Point::new(frame.width as f64, 0.0)),
-                frame.grid_to_world(Point::new(0.0, frame.height as f64)),
-                frame.grid_to_world(Point::new(frame.width as f64, frame.height as f64)),
-            ];
-            let fold = |f: fn(f64, f64) -> f64, sel: fn(&Point) -> f64, init: f64| {
-                corners.iter().map(sel).fold(init, f)
-            };
+            let (lo, hi) = frame.world_bounds();
             return Err(WorldError::StartOutside {
                 x: s.x,
                 y: s.y,
-                x0: fold(f64::min, |p| p.x, f64::INFINITY),
-                x1: fold(f64::max, |p| p.x, f64::NEG_INFINITY),
-                y0: fold(f64::min, |p| p.y, f64::INFINITY),
-                y1: fold(f64::max, |p| p.y, f64::NEG_INFINITY),
+                x0: lo.x,
+                x1: hi.x,
+                y0: lo.y,
+                y1: hi.y,
             });
         }
         if self.disk_collides(s.position()) {

@@ -630,26 +630,9 @@ struct TileModel {
 
 impl TileModel {
     fn new(grid: TileGrid, frame: &MapFrame) -> Self {
-        let corners = [
-            frame.grid_to_world(Point::new(0.0, 0.0)),
-            frame.grid_to_world(Point::new(frame.width as f64, 0.0)),
-            frame.grid_to_world(Point::new(0.0, frame.height as f64)),
-            frame.grid_to_world(Point::new(frame.width as f64, frame.height as f64)),
-        ];
-        let (mut x0, mut x1, mut y0, mut y1) = (
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-        );
-        for c in corners {
-            x0 = x0.min(c.x);
-            x1 = x1.max(c.x);
-            y0 = y0.min(c.y);
-            y1 = y1.max(c.y);
-        }
-        let a = grid.tile_of(Point::new(x0, y0));
-        let b = grid.tile_of(Point::new(x1, y1));
+        let (lo, hi) = frame.world_bounds();
+        let a = grid.tile_of(lo);
+        let b = grid.tile_of(hi);
         let w = (b.0 - a.0 + 1).max(1) as usize;
         let h = (b.1 - a.1 + 1).max(1) as usize;
         Self {

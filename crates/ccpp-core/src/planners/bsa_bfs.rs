@@ -170,20 +170,7 @@ impl BsaBfs {
         self.r = r + self.opts.clearance_margin_m.max(0.0);
         let side = self.opts.cell_side_m.unwrap_or(2.0 * r);
         let anchor = sensor.pose().position();
-        let corners = [
-            f.grid_to_world(Point::new(0.0, 0.0)),
-            f.grid_to_world(Point::new(f.width as f64, 0.0)),
-            f.grid_to_world(Point::new(0.0, f.height as f64)),
-            f.grid_to_world(Point::new(f.width as f64, f.height as f64)),
-        ];
-        let (mut lo, mut hi) = (
-            Point::new(f64::INFINITY, f64::INFINITY),
-            Point::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
-        );
-        for c in corners {
-            lo = Point::new(lo.x.min(c.x), lo.y.min(c.y));
-            hi = Point::new(hi.x.max(c.x), hi.y.max(c.y));
-        }
+        let (lo, hi) = f.world_bounds();
         let i0 = ((lo.x - anchor.x) / side).floor() as i32 - 1;
         let i1 = ((hi.x - anchor.x) / side).ceil() as i32 + 1;
         let j0 = ((lo.y - anchor.y) / side).floor() as i32 - 1;
