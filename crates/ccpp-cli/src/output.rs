@@ -184,8 +184,13 @@ pub fn emit(job: &Job, r: &JobResult, json_only: bool, replay: bool) -> Result<(
         print!("{metrics}");
     } else {
         print!("{}", summary(&r.metrics));
+        let extra = if replay {
+            ", replay.html, replay.gif"
+        } else {
+            ""
+        };
         println!(
-            "wrote {}/{{metrics.json, path.csv, trace.jsonl, coverage.png}}",
+            "wrote {}/{{metrics.json, path.csv, trace.jsonl, coverage.png, run.json{extra}}}",
             job.out.display()
         );
     }
