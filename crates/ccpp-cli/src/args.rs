@@ -255,20 +255,23 @@ pub struct InfoArgs {
     pub json: bool,
 }
 
+/// Parses a comma-separated list of finite numbers.
+fn parse_finite_list(s: &str) -> Result<Vec<f64>, String> {
+    s.split(',')
+        .map(str::trim)
+        .map(|p| match p.parse::<f64>() {
+            Ok(x) if x.is_finite() => Ok(x),
+            Ok(_) => Err(format!("{p:?} is not a finite number")),
+            Err(_) => Err(format!("{p:?} is not a number")),
+        })
+        .collect()
+}
+
 /// Parses `A,B,C,D` into four finite numbers.
 fn parse_quad(s: &str) -> Result<[f64; 4], String> {
-    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
-    if parts.len() != 4 {
-        return Err(format!("expected X0,Y0,X1,Y1, got {s:?}"));
-    }
-    let mut v = [0.0; 4];
-    for (k, p) in parts.iter().enumerate() {
-        let x: f64 = p.parse().map_err(|_| format!("{p:?} is not a number"))?;
-        if !x.is_finite() {
-            return Err(format!("{p:?} is not a finite number"));
-        }
-        v[k] = x;
-    }
+    let v: [f64; 4] = parse_finite_list(s)?
+        .try_into()
+        .map_err(|_| format!("expected X0,Y0,X1,Y1, got {s:?}"))?;
     if v[2] <= v[0] || v[3] <= v[1] {
         return Err(format!("area {s:?} must have X1 > X0 and Y1 > Y0"));
     }
@@ -277,18 +280,12 @@ fn parse_quad(s: &str) -> Result<[f64; 4], String> {
 
 /// Parses `A,B` or `A,B,C` into three numbers (C defaults to 0).
 fn parse_triple(s: &str) -> Result<[f64; 3], String> {
-    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    let parts = parse_finite_list(s)?;
     if !(2..=3).contains(&parts.len()) {
         return Err(format!("expected X,Y or X,Y,THETA, got {s:?}"));
     }
     let mut v = [0.0; 3];
-    for (k, p) in parts.iter().enumerate() {
-        let x: f64 = p.parse().map_err(|_| format!("{p:?} is not a number"))?;
-        if !x.is_finite() {
-            return Err(format!("{p:?} is not a finite number"));
-        }
-        v[k] = x;
-    }
+    v[..parts.len()].copy_from_slice(&parts);
     Ok(v)
 }
 

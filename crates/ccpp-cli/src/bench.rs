@@ -13,7 +13,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
 use crate::args::{BenchArgs, MapArgs};
-use crate::job::{prepare_map, read_options, robot_from, Job, PreparedMap};
+use crate::job::{planner_options, prepare_map, robot_from, Job, PreparedMap};
 use crate::output::write_run_files;
 
 /// One row of the results: a run, or its failure.
@@ -96,13 +96,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         }
     }
     let (robot, _) = robot_from(&(&a.robot).into())?;
-    let mut options = match &a.config {
-        Some(p) => read_options(p)?,
-        None => PlannerOptions::default(),
-    };
-    if let Some(seed) = a.seed {
-        options.random_bounce.seed = seed;
-    }
+    let options = planner_options(a.config.as_deref(), a.seed)?;
     let maps = expand_maps(&a.maps)?;
     std::fs::create_dir_all(&a.out)
         .with_context(|| format!("cannot create output folder {}", a.out.display()))?;

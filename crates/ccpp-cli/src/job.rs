@@ -220,6 +220,18 @@ pub fn robot_from(args: &RobotArgs) -> Result<(Robot, Option<Pose>)> {
     Ok((robot, start))
 }
 
+/// Planner options from an optional YAML/JSON file, with `--seed` applied.
+pub fn planner_options(config: Option<&Path>, seed: Option<u64>) -> Result<PlannerOptions> {
+    let mut options = match config {
+        Some(p) => read_options(p)?,
+        None => PlannerOptions::default(),
+    };
+    if let Some(seed) = seed {
+        options.random_bounce.seed = seed;
+    }
+    Ok(options)
+}
+
 /// Reads planner options from a YAML or JSON file.
 pub fn read_options(path: &Path) -> Result<PlannerOptions> {
     let text = std::fs::read_to_string(path)
@@ -250,13 +262,7 @@ impl Job {
         if let Some(r) = a.sensor_range {
             check_metres("--sensor-range", r)?;
         }
-        let mut options = match &a.config {
-            Some(p) => read_options(p)?,
-            None => PlannerOptions::default(),
-        };
-        if let Some(seed) = a.seed {
-            options.random_bounce.seed = seed;
-        }
+        let mut options = planner_options(a.config.as_deref(), a.seed)?;
         if let Some(t) = a.tile_side {
             check_metres("--tile-side", t)?;
             options.ba_star.tile_side_m = Some(t);
