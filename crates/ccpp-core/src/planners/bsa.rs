@@ -187,6 +187,30 @@ impl Cells {
         }
     }
 
+    /// Index of the neighbour of cell `k` towards heading `d` (`None` off the range).
+    #[inline]
+    pub(crate) fn step(&self, k: usize, d: usize) -> Option<usize> {
+        let (di, dj) = (k % self.w, k / self.w);
+        match d {
+            0 => (di + 1 < self.w).then_some(k + 1),
+            1 => (dj + 1 < self.h).then_some(k + self.w),
+            2 => (di > 0).then(|| k - 1),
+            _ => (dj > 0).then(|| k - self.w),
+        }
+    }
+
+    /// All flags of cell `k`.
+    #[inline]
+    pub(crate) fn flags_at(&self, k: usize) -> u8 {
+        self.flags[k]
+    }
+
+    /// Edge state of cell `k` towards heading `d`, for a neighbour inside the range.
+    #[inline]
+    pub(crate) fn edge_at(&self, k: usize, d: usize) -> u8 {
+        (self.edges[k] >> (2 * d)) & 3
+    }
+
     /// Number of cells in the range.
     #[inline]
     pub(crate) fn len(&self) -> usize {

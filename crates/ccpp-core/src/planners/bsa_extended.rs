@@ -758,6 +758,12 @@ impl Extension {
 
     /// Extended selection: Dijkstra over visited (cost 1) and touched (cost `gap_cost`) cells to
     /// the nearest BP, gaps crossed in their virtual pipe. `None` when no BP can be reached.
+    ///
+    /// A crossing whose pipe is not found is banned for the rest of the selection, and a target
+    /// that fails nine times in a row is dropped (`DEAD`). The bans outlive a dropped target:
+    /// the next target's path avoids crossings already known to fail (clearing them made every
+    /// dead target behind the same gap pay its nine searches again — 1278 searches on
+    /// `mit_building_31`, now 159).
     pub(crate) fn select(&mut self, core: &mut Core) -> Option<ReturnPlan> {
         // Banned moves: bit `d` of a cell's byte bans leaving it towards heading `d`.
         let mut banned = vec![0u8; core.cells.len()];
@@ -793,7 +799,6 @@ impl Extension {
                         let target = *path.last().expect("non-empty path");
                         core.cells.set(target, DEAD);
                         core.validate_bps();
-                        banned.fill(0);
                         tries = 0;
                     }
                 }
@@ -806,54 +811,57 @@ impl Extension {
         let start = cells.idx(core.cell)?;
         cells.new_search();
         cells.reach(start, 0, start);
-        let mut heap = BinaryHeap::new();
-        heap.push(std::cmp::Reverse((0u32, core.cell.1, core.cell.0)));
         let gap = self.opts.gap_cost.max(1);
-        while let Some(std::cmp::Reverse((cost, j, i))) = heap.pop() {
-            let u = (i, j);
-            let ku = cells.idx(u).expect("pushed cells are in range");
-            if cells.cost_of(ku) != Some(cost) {
-                continue;
-            }
-            let u_visited = cells.has(u, VISITED);
-            if ku != start && !u_visited && cells.has(u, BP) {
-                return Some(cells.path_to(ku));
-            }
-            for d in 0..4 {
-                if banned[ku] & (1 << d) != 0 {
+        // Dial's buckets: a step costs 1 or `gap`, so `gap + 1` rotating buckets hold every
+        // pending cost, and a bucket is complete when its turn comes. Sorting it by cell index
+        // (row-major, so by `(j, i)`) pops cells in the order of a `(cost, j, i)` heap.
+        let nb = gap as usize + 1;
+        let mut buckets: Vec<Vec<u32>> = vec![Vec::new(); nb];
+        buckets[0].push(start as u32);
+        let mut pending = 1usize;
+        let mut cost = 0u32;
+        while pending > 0 {
+            let b = cost as usize % nb;
+            let mut bucket = std::mem::take(&mut buckets[b]);
+            pending -= bucket.len();
+            bucket.sort_unstable();
+            for &ku in &bucket {
+                let ku = ku as usize;
+                if cells.cost_of(ku) != Some(cost) {
                     continue;
                 }
-                let n = add(u, d);
-                let Some(kn) = cells.idx(n) else {
-                    continue;
-                };
-                let direct = u_visited && cells.edge(u, d) == EDGE_FREE;
-                let step_cost = if cells.has(n, VISITED) {
-                    if u_visited && !direct {
-                        // Both visited but the straight move is blocked: a gap between them.
-                        gap
-                    } else if direct {
-                        1
-                    } else {
-                        gap
+                let fu = cells.flags_at(ku);
+                let u_visited = fu & VISITED != 0;
+                if ku != start && !u_visited && fu & BP != 0 {
+                    return Some(cells.path_to(ku));
+                }
+                for d in 0..4 {
+                    if banned[ku] & (1 << d) != 0 {
+                        continue;
                     }
-                } else if cells.has(n, BP) && !cells.has(n, DEAD) {
-                    if direct {
-                        1
-                    } else {
+                    let Some(kn) = cells.step(ku, d) else {
+                        continue;
+                    };
+                    let fnb = cells.flags_at(kn);
+                    let direct = u_visited && cells.edge_at(ku, d) == EDGE_FREE;
+                    let step_cost = if fnb & VISITED != 0 || (fnb & BP != 0 && fnb & DEAD == 0) {
+                        if direct { 1 } else { gap }
+                    } else if fnb & TOUCHED != 0 {
                         gap
+                    } else {
+                        continue;
+                    };
+                    let nc = cost + step_cost;
+                    if cells.cost_of(kn).is_none_or(|c| nc < c) {
+                        cells.reach(kn, nc, ku);
+                        buckets[nc as usize % nb].push(kn as u32);
+                        pending += 1;
                     }
-                } else if cells.has(n, TOUCHED) {
-                    gap
-                } else {
-                    continue;
-                };
-                let nc = cost + step_cost;
-                if cells.cost_of(kn).is_none_or(|c| nc < c) {
-                    cells.reach(kn, nc, ku);
-                    heap.push(std::cmp::Reverse((nc, n.1, n.0)));
                 }
             }
+            bucket.clear();
+            buckets[b] = bucket;
+            cost += 1;
         }
         None
     }
