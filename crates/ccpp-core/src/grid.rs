@@ -89,6 +89,10 @@ impl MapFrame {
     pub fn world_to_grid(&self, p: Point) -> Point {
         let dx = p.x - self.origin.x;
         let dy = p.y - self.origin.y;
+        if self.origin.theta == 0.0 {
+            // The rotation is the identity (bit for bit: 1 * dx + 0 * dy == dx).
+            return Point::new(dx / self.resolution, dy / self.resolution);
+        }
         let (s, c) = self.origin.theta.sin_cos();
         Point::new(
             (c * dx + s * dy) / self.resolution,
@@ -99,9 +103,13 @@ impl MapFrame {
     /// Continuous grid coordinates (pixels, y up) -> world point. Inverse of [`Self::world_to_grid`].
     #[inline]
     pub fn grid_to_world(&self, g: Point) -> Point {
-        let (s, c) = self.origin.theta.sin_cos();
         let gx = g.x * self.resolution;
         let gy = g.y * self.resolution;
+        if self.origin.theta == 0.0 {
+            // The rotation is the identity (bit for bit, as above).
+            return Point::new(self.origin.x + gx, self.origin.y + gy);
+        }
+        let (s, c) = self.origin.theta.sin_cos();
         Point::new(
             self.origin.x + c * gx - s * gy,
             self.origin.y + s * gx + c * gy,

@@ -156,6 +156,9 @@ pub fn judge_motion(known: &KnownMap, a: Point, b: Point, r: f64) -> Judgement {
     let rc = contact_radius_px(r / frame.resolution);
     let rc2 = rc * rc;
     let h = frame.height as f64;
+    if ga == gb {
+        return judge_point(known, ga, rc);
+    }
     let (dx, dy) = (gb.x - ga.x, gb.y - ga.y);
     let ylo = ga.y.min(gb.y) - rc;
     let yhi = ga.y.max(gb.y) + rc;
@@ -208,6 +211,63 @@ pub fn judge_motion(known: &KnownMap, a: Point, b: Point, r: f64) -> Judgement {
             if !touches(col as i64) {
                 return true;
             }
+            if seen {
+                blocked = true;
+                return false;
+            }
+            undetermined = true;
+            true
+        });
+        if blocked {
+            return Judgement::Blocked;
+        }
+    }
+    if undetermined {
+        Judgement::Undetermined
+    } else {
+        Judgement::Free
+    }
+}
+
+/// [`judge_motion`] for a motionless disk at grid point `g` (contact radius `rc` pixels): the
+/// same predicate (`|q - g|^2 < rc^2` for a pixel centre `q`), evaluated as one column interval
+/// per row — the predicate is convex in the column, so each row's touching pixels are the
+/// interval between the first and last column that satisfy it — then read off the bitsets.
+fn judge_point(known: &KnownMap, g: Point, rc: f64) -> Judgement {
+    let frame = *known.frame();
+    let rc2 = rc * rc;
+    let h = frame.height as f64;
+    let (w, hh) = (frame.width as i64, frame.height as i64);
+    let row0 = floor_i64(h - (g.y + rc) - 0.5) - 1;
+    let row1 = ceil_i64(h - (g.y - rc) - 0.5) + 1;
+    let mut undetermined = false;
+    for row in row0..=row1 {
+        let gy = h - row as f64 - 0.5;
+        let dy = gy - g.y;
+        let rem = rc2 - dy * dy;
+        if rem <= 0.0 {
+            // dx^2 + dy^2 >= dy^2 >= rc^2: no pixel of this row touches.
+            continue;
+        }
+        let touches = |col: i64| Point::new(col as f64 + 0.5, gy).dist2(g) < rc2;
+        let half = rem.sqrt();
+        let mut lo = ceil_i64(g.x - half - 0.5) - 1;
+        let mut hi = floor_i64(g.x + half - 0.5) + 1;
+        while lo <= hi && !touches(lo) {
+            lo += 1;
+        }
+        while hi >= lo && !touches(hi) {
+            hi -= 1;
+        }
+        if lo > hi {
+            continue;
+        }
+        // Outside the image every pixel is occupied (and seen).
+        if row < 0 || row >= hh || lo < 0 || hi >= w {
+            return Judgement::Blocked;
+        }
+        let mut blocked = false;
+        known.for_each_not_known_free(row as usize, lo as usize, hi as usize, |_, seen| {
             if seen {
                 blocked = true;
                 return false;
@@ -828,19 +888,37 @@ struct Mind {
     r: f64,
     /// Contact radius in pixels.
     rc_px: f64,
-    /// `(sin, cos)` of the frame's yaw.
-    rot: (f64, f64),
     last_scan: Option<Pose>,
-    /// Per tile: centre in grid coordinates (computed once, as `judge_motion` computes it).
-    gcenter: Vec<Point>,
-    /// Per tile: pixels of the contact disk not yet seen ([`UNCOUNTED`] before the first).
-    unseen: Vec<u32>,
-    /// Pixels first seen in the current scan: `(col, row, free)`.
-    new_px: Vec<(u32, u32, bool)>,
+    /// Scratch for [`Mind::sense`]: per row of the last scan, the column span of the pixels
+    /// seen for the first time (`(usize::MAX, 0)` when none).
+    new_spans: Vec<(usize, usize)>,
+    /// Per-tile cache of the contact disk's pixel spans for [`Mind::judge_tile`].
+    disk: DiskCache,
 }
 
-/// Marks a tile that has not started counting its unseen pixels.
-const UNCOUNTED: u32 = u32::MAX;
+/// The contact disk of each tile as pixel spans: `rows` slots per tile of `[lo, hi]` column
+/// offsets from `col0[k]` for rows `row0[k]..` (`lo > hi`: no pixel in that row);
+/// `row0[k] == i32::MIN` until computed.
+#[derive(Clone)]
+struct DiskCache {
+    rows: usize,
+    row0: Vec<i32>,
+    col0: Vec<i32>,
+    spans: Vec<[u8; 2]>,
+}
+
+impl DiskCache {
+    fn new(n_tiles: usize, rc_px: f64) -> Self {
+        // Rows a disk's span test visits: 2 rc plus the rounding and margin rows.
+        let rows = (2.0 * rc_px).ceil() as usize + 4;
+        Self {
+            rows,
+            row0: vec![i32::MIN; n_tiles],
+            col0: vec![0; n_tiles],
+            spans: vec![[1, 0]; n_tiles * rows],
+        }
+    }
+}
 
 impl std::fmt::Debug for Mind {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -877,69 +955,6 @@ impl Mind {
         j
     }
 
-    /// Calls `f(k, t)` for every tile `t` (array index `k`) whose contact disk holds the centre
-    /// of pixel `(col, row)`, with exactly the predicate of [`judge_motion`].
-    #[inline]
-    fn tiles_touching_pixel(
-        &mut self,
-        col: u32,
-        row: u32,
-        mut f: impl FnMut(&mut Self, usize, Tile),
-    ) {
-        let frame = *self.known.frame();
-        let q = Point::new(
-            f64::from(col) + 0.5,
-            frame.height as f64 - f64::from(row) - 0.5,
-        );
-        // World position of the pixel centre (only to enumerate candidate tiles).
-        let (sn, cs) = self.rot;
-        let (gx, gy) = (q.x * frame.resolution, q.y * frame.resolution);
-        let wx = frame.origin.x + cs * gx - sn * gy;
-        let wy = frame.origin.y + sn * gx + cs * gy;
-        let g = &self.tiles.grid;
-        let ux = (wx - g.anchor.x) / g.side;
-        let uy = (wy - g.anchor.y) / g.side;
-        let rt = self.rc_px * frame.resolution / g.side + 1e-6;
-        let (i0, i1) = (ceil_i32(ux - rt), floor_i32(ux + rt));
-        let (j0, j1) = (ceil_i32(uy - rt), floor_i32(uy + rt));
-        let rc2 = self.rc_px * self.rc_px;
-        for j in j0..=j1 {
-            for i in i0..=i1 {
-                let t = (i, j);
-                let Some(k) = self.tiles.idx(t) else { continue };
-                let c = self.gcenter[k];
-                if point_segment_dist2(q, c, c) < rc2 {
-                    f(self, k, t);
-                }
-            }
-        }
-    }
-
-    /// Number of image pixels in the contact disk of tile `k` (centre `c` in grid coordinates),
-    /// or `None` when the disk reaches outside the image.
-    fn disk_pixels(&self, c: Point) -> Option<u32> {
-        let frame = self.known.frame();
-        let rc = self.rc_px;
-        let rc2 = rc * rc;
-        let h = frame.height as f64;
-        let row0 = floor_i64(h - (c.y + rc) - 0.5) - 1;
-        let row1 = ceil_i64(h - (c.y - rc) - 0.5) + 1;
-        let col0 = floor_i64(c.x - rc - 0.5) - 1;
-        let col1 = ceil_i64(c.x + rc - 0.5) + 1;
-        let mut n = 0;
-        for row in row0..=row1 {
-            let gy = h - row as f64 - 0.5;
-            for col in col0..=col1 {
-                let q = Point::new(col as f64 + 0.5, gy);
-                if point_segment_dist2(q, c, c) < rc2 {
-                    frame.checked(col, row)?;
-                    n += 1;
-                }
-            }
-        }
-        Some(n)
-    }
-
     fn set_stand(&mut self, k: usize, t: Tile, j: Judgement) {
         self.tiles.state[k] = (self.tiles.state[k] & !ST_STAND) | j as u8;
         self.tiles.update_l_around(t);
@@ -947,10 +962,11 @@ impl Mind {
 
     /// Integrates a scan taken at `pose` and refreshes every judgement it can change.
     ///
-    /// Standability is kept exact incrementally: each undetermined tile counts the pixels of its
-    /// contact disk not yet seen (initialised the first time one of them is seen, when none
-    /// was); a newly seen blocked pixel makes it `Blocked`, the count reaching 0 makes it `Free`.
-    /// This equals [`judge_motion`] at the tile centre after every scan (tests check it).
+    /// A tile's standability can change only when a pixel of its contact disk is seen for the
+    /// first time. The newly seen pixels are kept as one column span per row; an undetermined
+    /// tile is judged again — with [`judge_motion`]'s predicate at the tile centre, the
+    /// definition itself (tests check the cache against it after every step) — only when the
+    /// bounding box of its disk meets one of those spans.
     fn sense(&mut self, sensor: &dyn Sensor) {
         let pose = sensor.pose();
         if self.last_scan == Some(pose) {
@@ -958,46 +974,158 @@ impl Mind {
         }
         self.last_scan = Some(pose);
         let scan = sensor.scan();
-        let mut new_px = std::mem::take(&mut self.new_px);
-        new_px.clear();
-        // Integrate now, remembering the pixels seen for the first time; phase 1 below only
-        // needs the disk sizes, which do not depend on what is seen.
-        self.known.integrate_with(&scan, |c, r, cell| {
-            new_px.push((c as u32, r as u32, cell.is_free()));
+        // Rows come top to bottom, each row's new pixels left to right.
+        let mut spans = std::mem::take(&mut self.new_spans);
+        spans.clear();
+        let mut first_row = 0usize;
+        self.known.integrate_with(&scan, |c, r, _| {
+            if spans.is_empty() {
+                first_row = r;
+            }
+            let k = r - first_row;
+            if k >= spans.len() {
+                spans.resize(k + 1, (usize::MAX, 0));
+            }
+            let s = &mut spans[k];
+            s.0 = s.0.min(c);
+            s.1 = s.1.max(c);
         });
-        // Phase 1: start counting for tiles touched for the first time (nothing of their disk
-        // has been seen before: a pixel is new exactly once, and every tile it touches starts
-        // counting then).
-        for &(c, r, _) in &new_px {
-            self.tiles_touching_pixel(c, r, |m, k, t| {
-                if m.unseen[k] != UNCOUNTED
-                    || m.tiles.state[k] & ST_STAND != Judgement::Undetermined as u8
-                {
-                    return;
-                }
-                match m.disk_pixels(m.gcenter[k]) {
-                    Some(n) => m.unseen[k] = n,
-                    None => m.set_stand(k, t, Judgement::Blocked),
-                }
-            });
+        if spans.is_empty() {
+            self.new_spans = spans;
+            return;
         }
-        // Phase 2: count the new pixels down.
-        for &(c, r, free) in &new_px {
-            self.tiles_touching_pixel(c, r, |m, k, t| {
-                if m.tiles.state[k] & ST_STAND != Judgement::Undetermined as u8 {
-                    return;
+        let last_row = first_row + spans.len() - 1;
+        let (c0, c1) = spans
+            .iter()
+            .fold((usize::MAX, 0), |(a, b), s| (a.min(s.0), b.max(s.1)));
+        // Candidate tiles: the new pixels' box grown by the contact radius, in grid
+        // coordinates, then the hull of its corners in tile indices (tiles are axis-aligned in
+        // the world frame).
+        let frame = *self.known.frame();
+        let h = frame.height as f64;
+        let rc = self.rc_px;
+        let m = rc + 1.0;
+        let (x0, x1) = (c0 as f64 + 0.5 - m, c1 as f64 + 0.5 + m);
+        let (y0, y1) = (
+            h - last_row as f64 - 0.5 - m,
+            h - first_row as f64 - 0.5 + m,
+        );
+        let grid = self.tiles.grid;
+        let (mut i0, mut i1, mut j0, mut j1) = (i32::MAX, i32::MIN, i32::MAX, i32::MIN);
+        for (x, y) in [(x0, y0), (x1, y0), (x0, y1), (x1, y1)] {
+            let t = grid.tile_of(frame.grid_to_world(Point::new(x, y)));
+            i0 = i0.min(t.0);
+            i1 = i1.max(t.0);
+            j0 = j0.min(t.1);
+            j1 = j1.max(t.1);
+        }
+        for j in j0..=j1 {
+            for i in i0..=i1 {
+                let t = (i, j);
+                let Some(k) = self.tiles.idx(t) else { continue };
+                if self.tiles.state[k] & ST_STAND != Judgement::Undetermined as u8 {
+                    continue;
                 }
-                if free {
-                    m.unseen[k] -= 1;
-                    if m.unseen[k] == 0 {
-                        m.set_stand(k, t, Judgement::Free);
+                let g = frame.world_to_grid(self.center(t));
+                // Pixel rows and columns the disk can reach (one pixel of margin).
+                let r_lo = floor_i64(h - (g.y + rc) - 0.5) - 1;
+                let r_hi = ceil_i64(h - (g.y - rc) - 0.5) + 1;
+                let c_lo = floor_i64(g.x - rc - 0.5) - 1;
+                let c_hi = ceil_i64(g.x + rc - 0.5) + 1;
+                let rows = r_lo.max(first_row as i64)..=r_hi.min(last_row as i64);
+                let hit = rows.into_iter().any(|row| {
+                    let s = spans[(row - first_row as i64) as usize];
+                    s.0 <= s.1 && (s.0 as i64) <= c_hi && (s.1 as i64) >= c_lo
+                });
+                if !hit {
+                    continue;
+                }
+                let judged = self.judge_tile(k, g);
+                if judged != Judgement::Undetermined {
+                    self.set_stand(k, t, judged);
+                }
+            }
+        }
+        self.new_spans = spans;
+    }
+
+    /// [`judge_point`] for tile `k` (disk centre `g` in grid coordinates), with the disk's
+    /// pixel spans computed once per tile by the same predicate and cached (a tile is judged
+    /// again each time new pixels reach its disk, until it is decided).
+    fn judge_tile(&mut self, k: usize, g: Point) -> Judgement {
+        let n = self.disk.rows;
+        if self.disk.row0[k] == i32::MIN {
+            let frame = *self.known.frame();
+            let rc = self.rc_px;
+            let rc2 = rc * rc;
+            let h = frame.height as f64;
+            let (w, hh) = (frame.width as i64, frame.height as i64);
+            let row0 = floor_i64(h - (g.y + rc) - 0.5) - 1;
+            let row1 = ceil_i64(h - (g.y - rc) - 0.5) + 1;
+            let col0 = floor_i64(g.x - rc - 0.5) - 1;
+            if row1 - row0 + 1 > n as i64 || !(0..=i64::from(i32::MAX)).contains(&row0) {
+                return judge_point(&self.known, g, rc);
+            }
+            let slots = &mut self.disk.spans[k * n..(k + 1) * n];
+            slots.fill([1, 0]);
+            for (slot, row) in slots.iter_mut().zip(row0..=row1) {
+                let gy = h - row as f64 - 0.5;
+                let dy = gy - g.y;
+                let rem = rc2 - dy * dy;
+                if rem <= 0.0 {
+                    continue;
+                }
+                let touches = |col: i64| Point::new(col as f64 + 0.5, gy).dist2(g) < rc2;
+                let half = rem.sqrt();
+                let mut lo = ceil_i64(g.x - half - 0.5) - 1;
+                let mut hi = floor_i64(g.x + half - 0.5) + 1;
+                while lo <= hi && !touches(lo) {
+                    lo += 1;
+                }
+                while hi >= lo && !touches(hi) {
+                    hi -= 1;
+                }
+                if lo > hi {
+                    continue;
+                }
+                if row >= hh || lo < 0 || hi >= w || hi - col0 > 250 {
+                    // Reaches outside the image (blocked), or too wide to cache.
+                    return judge_point(&self.known, g, rc);
+                }
+                *slot = [(lo - col0) as u8, (hi - col0) as u8];
+            }
+            self.disk.row0[k] = row0 as i32;
+            self.disk.col0[k] = col0 as i32;
+        }
+        let (row0, col0) = (self.disk.row0[k] as usize, self.disk.col0[k] as usize);
+        let mut undetermined = false;
+        for (i, &[a, b]) in self.disk.spans[k * n..(k + 1) * n].iter().enumerate() {
+            if a > b {
+                continue;
+            }
+            let mut blocked = false;
+            self.known.for_each_not_known_free(
+                row0 + i,
+                col0 + usize::from(a),
+                col0 + usize::from(b),
+                |_, seen| {
+                    if seen {
+                        blocked = true;
+                        return false;
                     }
-                } else {
-                    m.set_stand(k, t, Judgement::Blocked);
-                }
-            });
+                    undetermined = true;
+                    true
+                },
+            );
+            if blocked {
+                return Judgement::Blocked;
+            }
         }
-        self.new_px = new_px;
+        if undetermined {
+            Judgement::Undetermined
+        } else {
+            Judgement::Free
+        }
     }
 
     /// Marks `t` covered (the robot stands on it), decides its moves and updates L.
@@ -1183,15 +1311,6 @@ impl BaStar {
         let search = TileSearch::new(tiles.bounds());
         let n_tiles = tiles.state.len();
         let range = sensor.sensor_range();
-        let gcenter = (0..tiles.state.len())
-            .map(|k| {
-                let t = (
-                    tiles.i0 + (k % tiles.w) as i32,
-                    tiles.j0 + (k / tiles.w) as i32,
-                );
-                frame.world_to_grid(grid.center(t))
-            })
-            .collect();
         if range < side + r + frame.resolution {
             self.pending.push_back(Step::Mark(Event::Note {
                 text: format!(
@@ -1207,11 +1326,9 @@ impl BaStar {
             search,
             r,
             rc_px: contact_radius_px(r / frame.resolution),
-            rot: frame.origin.theta.sin_cos(),
             last_scan: None,
-            gcenter,
-            unseen: vec![UNCOUNTED; n_tiles],
-            new_px: Vec::new(),
+            new_spans: Vec::new(),
+            disk: DiskCache::new(n_tiles, contact_radius_px(r / frame.resolution)),
         }));
     }
 

@@ -845,7 +845,11 @@ impl Extension {
                     let fnb = cells.flags_at(kn);
                     let direct = u_visited && cells.edge_at(ku, d) == EDGE_FREE;
                     let step_cost = if fnb & VISITED != 0 || (fnb & BP != 0 && fnb & DEAD == 0) {
-                        if direct { 1 } else { gap }
+                        if direct {
+                            1
+                        } else {
+                            gap
+                        }
                     } else if fnb & TOUCHED != 0 {
                         gap
                     } else {
