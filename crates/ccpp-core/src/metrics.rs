@@ -121,7 +121,7 @@ pub fn swept_pixels(world: &World, trace: &Trace) -> FixedBitSet {
 }
 
 /// Marks pixel centres within `rt` (pixels) of segment `a`-`b` (grid coordinates), row by row.
-fn stamp_capsule(
+pub(crate) fn stamp_capsule(
     bits: &mut FixedBitSet,
     frame: &crate::grid::MapFrame,
     a: Point,

@@ -173,6 +173,17 @@ pub trait Planner {
     fn next(&mut self, sensor: &dyn Sensor) -> Step;
 }
 
+/// What a [`KnownMap`] says about a disk ([`KnownMap::disk_state`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum DiskState {
+    /// Every pixel seen free.
+    Free,
+    /// A pixel seen blocked or outside the image.
+    Blocked,
+    /// Nothing blocked, but some pixel not seen yet.
+    Unseen,
+}
+
 /// A planner's memory of what its sensor has shown: each pixel is unseen, or seen with its
 /// occupancy. Unseen pixels block motion in every check.
 #[derive(Clone)]
@@ -307,6 +318,66 @@ impl KnownMap {
                 }
             }
             blk += 1;
+        }
+    }
+
+    /// What is known of the disk of radius `rc` pixels at grid point `g`: the pixels whose
+    /// centre `q` has `|q - g|^2 < rc^2` ([`crate::collide`]'s contact test with `rc` the
+    /// contact radius). Blocked when one of them is seen blocked or lies outside the image,
+    /// else unseen when one of them is not seen yet, else free.
+    ///
+    /// The predicate is convex in the column, so each row's pixels are the interval between
+    /// the first and the last column satisfying it; the interval is read off the bitsets.
+    pub(crate) fn disk_state(&self, g: Point, rc: f64) -> DiskState {
+        let frame = *self.grid.frame();
+        let rc2 = rc * rc;
+        let h = frame.height as f64;
+        let (w, hh) = (frame.width as i64, frame.height as i64);
+        let row0 = floor_i64(h - (g.y + rc) - 0.5) - 1;
+        let row1 = ceil_i64(h - (g.y - rc) - 0.5) + 1;
+        let mut unseen = false;
+        for row in row0..=row1 {
+            let gy = h - row as f64 - 0.5;
+            let dy = gy - g.y;
+            let rem = rc2 - dy * dy;
+            if rem <= 0.0 {
+                // dx^2 + dy^2 >= dy^2 >= rc^2: no pixel of this row touches.
+                continue;
+            }
+            let touches = |col: i64| Point::new(col as f64 + 0.5, gy).dist2(g) < rc2;
+            let half = rem.sqrt();
+            let mut lo = ceil_i64(g.x - half - 0.5) - 1;
+            let mut hi = floor_i64(g.x + half - 0.5) + 1;
+            while lo <= hi && !touches(lo) {
+                lo += 1;
+            }
+            while hi >= lo && !touches(hi) {
+                hi -= 1;
+            }
+            if lo > hi {
+                continue;
+            }
+            // Outside the image every pixel is occupied (and seen).
+            if row < 0 || row >= hh || lo < 0 || hi >= w {
+                return DiskState::Blocked;
+            }
+            let mut blocked = false;
+            self.for_each_not_known_free(row as usize, lo as usize, hi as usize, |_, seen| {
+                if seen {
+                    blocked = true;
+                    return false;
+                }
+                unseen = true;
+                true
+            });
+            if blocked {
+                return DiskState::Blocked;
+            }
+        }
+        if unseen {
+            DiskState::Unseen
+        } else {
+            DiskState::Free
         }
     }
 

@@ -90,7 +90,7 @@ use crate::geometry::{
     Pose,
 };
 use crate::grid::MapFrame;
-use crate::planner::{KnownMap, Planner, Sensor, Step};
+use crate::planner::{DiskState, KnownMap, Planner, Sensor, Step};
 use crate::tiles::{Tile, TileGrid, N8};
 use crate::trace::Event;
 
@@ -230,59 +230,12 @@ pub fn judge_motion(known: &KnownMap, a: Point, b: Point, r: f64) -> Judgement {
 }
 
 /// [`judge_motion`] for a motionless disk at grid point `g` (contact radius `rc` pixels): the
-/// same predicate (`|q - g|^2 < rc^2` for a pixel centre `q`), evaluated as one column interval
-/// per row — the predicate is convex in the column, so each row's touching pixels are the
-/// interval between the first and last column that satisfy it — then read off the bitsets.
+/// same predicate (`|q - g|^2 < rc^2` for a pixel centre `q`), by [`KnownMap::disk_state`].
 fn judge_point(known: &KnownMap, g: Point, rc: f64) -> Judgement {
-    let frame = *known.frame();
-    let rc2 = rc * rc;
-    let h = frame.height as f64;
-    let (w, hh) = (frame.width as i64, frame.height as i64);
-    let row0 = floor_i64(h - (g.y + rc) - 0.5) - 1;
-    let row1 = ceil_i64(h - (g.y - rc) - 0.5) + 1;
-    let mut undetermined = false;
-    for row in row0..=row1 {
-        let gy = h - row as f64 - 0.5;
-        let dy = gy - g.y;
-        let rem = rc2 - dy * dy;
-        if rem <= 0.0 {
-            // dx^2 + dy^2 >= dy^2 >= rc^2: no pixel of this row touches.
-            continue;
-        }
-        let touches = |col: i64| Point::new(col as f64 + 0.5, gy).dist2(g) < rc2;
-        let half = rem.sqrt();
-        let mut lo = ceil_i64(g.x - half - 0.5) - 1;
-        let mut hi = floor_i64(g.x + half - 0.5) + 1;
-        while lo <= hi && !touches(lo) {
-            lo += 1;
-        }
-        while hi >= lo && !touches(hi) {
-            hi -= 1;
-        }
-        if lo > hi {
-            continue;
-        }
-        // Outside the image every pixel is occupied (and seen).
-        if row < 0 || row >= hh || lo < 0 || hi >= w {
-            return Judgement::Blocked;
-        }
-        let mut blocked = false;
-        known.for_each_not_known_free(row as usize, lo as usize, hi as usize, |_, seen| {
-            if seen {
-                blocked = true;
-                return false;
-            }
-            undetermined = true;
-            true
-        });
-        if blocked {
-            return Judgement::Blocked;
-        }
-    }
-    if undetermined {
-        Judgement::Undetermined
-    } else {
-        Judgement::Free
+    match known.disk_state(g, rc) {
+        DiskState::Free => Judgement::Free,
+        DiskState::Blocked => Judgement::Blocked,
+        DiskState::Unseen => Judgement::Undetermined,
     }
 }
 

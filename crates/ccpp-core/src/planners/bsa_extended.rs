@@ -104,7 +104,7 @@ use super::bsa::{
 use crate::collide::Occupancy;
 use crate::geometry::{point_segment_dist2, Point};
 use crate::grid::MapFrame;
-use crate::planner::{KnownMap, Step};
+use crate::planner::{DiskState, KnownMap, Step};
 use crate::tiles::{Tile, N8};
 use crate::trace::Event;
 
@@ -153,42 +153,10 @@ enum Status {
 /// Status of a disk of radius `r_px` (pixels) at grid point `g` on the known map, with the
 /// obstacle model of [`crate::collide`].
 fn disk_status(known: &KnownMap, g: Point, r_px: f64) -> Status {
-    let f = *known.frame();
-    let rc = crate::collide::contact_radius_px(r_px);
-    let rc2 = rc * rc;
-    let h = f.height as f64;
-    let c0 = (g.x - rc - 0.5).floor() as i64;
-    let c1 = (g.x + rc - 0.5).ceil() as i64;
-    let r0 = (h - (g.y + rc) - 0.5).floor() as i64;
-    let r1 = (h - (g.y - rc) - 0.5).ceil() as i64;
-    let mut unseen = false;
-    for row in r0..=r1 {
-        let gy = h - row as f64 - 0.5;
-        let dy2 = (gy - g.y).powi(2);
-        if dy2 >= rc2 {
-            continue;
-        }
-        for col in c0..=c1 {
-            let dx = col as f64 + 0.5 - g.x;
-            if dx * dx + dy2 >= rc2 {
-                continue;
-            }
-            match f.checked(col, row) {
-                None => return Status::Blocked,
-                Some((c, r)) => {
-                    if !known.is_seen(c, r) {
-                        unseen = true;
-                    } else if !known.get(c, r).is_free() {
-                        return Status::Blocked;
-                    }
-                }
-            }
-        }
-    }
-    if unseen {
-        Status::Unseen
-    } else {
-        Status::Free
+    match known.disk_state(g, crate::collide::contact_radius_px(r_px)) {
+        DiskState::Free => Status::Free,
+        DiskState::Blocked => Status::Blocked,
+        DiskState::Unseen => Status::Unseen,
     }
 }
 
@@ -245,6 +213,9 @@ pub(crate) struct Extension {
     skin_done: FixedBitSet,
     /// Tool radius in pixels.
     tool_px: f64,
+    /// [`Self::project`]'s search window as pixel offsets `(dcol, drow)`, nearest first, ties
+    /// in row-major order (the order of a scan of the window).
+    near: Vec<(i64, i64)>,
     follow: Option<Follow>,
 }
 
@@ -260,6 +231,7 @@ impl Extension {
             covered: FixedBitSet::new(),
             skin_done: FixedBitSet::new(),
             tool_px: 0.0,
+            near: Vec::new(),
             follow: None,
         }
     }
@@ -276,6 +248,12 @@ impl Extension {
         self.tool_px = core.tool / f.resolution;
         self.frame = Some(f);
         self.opts.clearance_px = self.opts.clearance_px.max(0.0);
+        let w = (self.r_px + 0.5 + self.opts.clearance_px + 2.0).ceil() as i64;
+        let mut near: Vec<(i64, i64, i64)> = (-w..=w)
+            .flat_map(|dr| (-w..=w).map(move |dc| (dc * dc + dr * dr, dr, dc)))
+            .collect();
+        near.sort_unstable();
+        self.near = near.into_iter().map(|(_, dr, dc)| (dc, dr)).collect();
     }
 
     /// Is a wall follow in progress?
@@ -342,20 +320,7 @@ impl Extension {
     fn stamp(&mut self, a: Point, b: Point) {
         let f = self.frame();
         let rt = self.tool_px + 1e-6;
-        let c0 = (a.x.min(b.x) - rt - 0.5).floor() as i64;
-        let c1 = (a.x.max(b.x) + rt - 0.5).ceil() as i64;
-        let r0 = self.pixel_of_grid(Point::new(a.x, a.y.max(b.y) + rt)).1;
-        let r1 = self.pixel_of_grid(Point::new(a.x, a.y.min(b.y) - rt)).1;
-        for row in r0..=r1 {
-            for col in c0..=c1 {
-                let Some((c, r)) = f.checked(col, row) else {
-                    continue;
-                };
-                if point_segment_dist2(self.center_grid((col, row)), a, b) <= rt * rt {
-                    self.covered.insert(f.index(c, r));
-                }
-            }
-        }
+        crate::metrics::stamp_capsule(&mut self.covered, &f, a, b, rt, &mut |_| {});
     }
 
     /// Records a commanded motion (world points) as swept.
@@ -366,14 +331,13 @@ impl Extension {
         }
     }
 
-    /// Known free pixels within the tool's reach of grid point `g` that no motion of the
-    /// extension has swept yet.
-    fn gain(&self, known: &KnownMap, g: Point, ahead: &[Point]) -> usize {
+    /// Is there a known free pixel within the tool's reach of grid point `g` that no motion of
+    /// the extension has swept yet and the next follow positions `ahead` will not sweep?
+    fn gains(&self, known: &KnownMap, g: Point, ahead: &[Point]) -> bool {
         let f = self.frame();
         let rt = self.tool_px + 1e-6;
         let p = self.pixel_of_grid(g);
         let w = rt.ceil() as i64 + 1;
-        let mut n = 0;
         for row in p.1 - w..=p.1 + w {
             for col in p.0 - w..=p.0 + w {
                 let Some((c, r)) = f.checked(col, row) else {
@@ -387,11 +351,11 @@ impl Extension {
                         point_segment_dist2(self.center_grid((col, row)), s[0], s[1]) <= rt * rt
                     })
                 {
-                    n += 1;
+                    return true;
                 }
             }
         }
-        n
+        false
     }
 
     /// Skin excursions from the followed position `pos` (boundary pixel `b`): the pixels where
@@ -434,7 +398,7 @@ impl Extension {
                 continue;
             }
             let g = self.center_grid(q);
-            if self.gain(known, g, ahead) == 0 || !self.seg_free(known, r, at, g) {
+            if !self.gains(known, g, ahead) || !self.seg_free(known, r, at, g) {
                 continue;
             }
             self.skin_done.insert(qi);
@@ -463,20 +427,17 @@ impl Extension {
     fn project(&self, known: &KnownMap, b: Px) -> Point {
         let bc = self.center_grid(b);
         let rr = self.r_px + 0.5 + self.opts.clearance_px;
-        let w = (rr + 2.0).ceil() as i64;
-        let mut best: Option<(f64, Point)> = None;
-        for row in b.1 - w..=b.1 + w {
-            for col in b.0 - w..=b.0 + w {
-                if !known.blocked(col, row) {
-                    continue;
-                }
-                let q = self.center_grid((col, row));
-                let d2 = q.dist2(bc);
-                if best.is_none_or(|(bd, _)| d2 < bd) {
-                    best = Some((d2, q));
-                }
-            }
-        }
+        // Pixel centres are whole pixels apart: the squared distance is the integer
+        // `dcol^2 + drow^2`, so the first blocked pixel in `near` order is the nearest one, and
+        // among equally near ones the first in a row-major scan of the window.
+        let best = self
+            .near
+            .iter()
+            .find(|&&(dc, dr)| known.blocked(b.0 + dc, b.1 + dr))
+            .map(|&(dc, dr)| {
+                let q = self.center_grid((b.0 + dc, b.1 + dr));
+                (q.dist2(bc), q)
+            });
         match best {
             Some((d2, q)) if d2.sqrt() > rr => {
                 let d = d2.sqrt();
@@ -484,6 +445,20 @@ impl Extension {
             }
             _ => bc,
         }
+    }
+
+    /// [`Self::project`] through a small memo of recent projections (valid while the known map
+    /// does not change).
+    fn project_memo(&self, known: &KnownMap, b: Px, memo: &mut VecDeque<(Px, Point)>) -> Point {
+        if let Some(&(_, p)) = memo.iter().find(|(q, _)| *q == b) {
+            return p;
+        }
+        let p = self.project(known, b);
+        if memo.len() > LOOKAHEAD + 1 {
+            memo.pop_front();
+        }
+        memo.push_back((b, p));
+        p
     }
 
     fn seg_free(&self, known: &KnownMap, r: f64, a: Point, b: Point) -> bool {
@@ -656,6 +631,9 @@ impl Extension {
         let cw = side == Side::Left;
         let mut finished = false;
         let mut retreat = false;
+        // Projections of this call (nothing is sensed during it, so they stay valid): each
+        // look-ahead position becomes a followed position in the next iterations.
+        let mut memo: VecDeque<(Px, Point)> = VecDeque::with_capacity(LOOKAHEAD + 2);
         for batch in 0..16 {
             if f.steps >= self.opts.max_follow_steps {
                 finished = true;
@@ -670,7 +648,7 @@ impl Extension {
                 }
             };
             f.steps += 1;
-            let p = self.project(&core.known, nb);
+            let p = self.project_memo(&core.known, nb, &mut memo);
             let r = core.r;
             let mut path = Vec::with_capacity(2);
             if self.seg_free(&core.known, r, f.pos, p) {
@@ -706,7 +684,7 @@ impl Extension {
             for _ in 0..LOOKAHEAD {
                 match self.moore(&core.known, ab, ak, cw, false) {
                     Ok((b2, k2)) => {
-                        ahead.push(self.project(&core.known, b2));
+                        ahead.push(self.project_memo(&core.known, b2, &mut memo));
                         (ab, ak) = (b2, k2);
                     }
                     Err(_) => break,
