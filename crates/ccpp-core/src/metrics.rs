@@ -5,7 +5,7 @@ use fixedbitset::FixedBitSet;
 use serde::{Deserialize, Serialize};
 use std::ops::Sub;
 
-use crate::geometry::{point_segment_dist2, wrap_angle, Point, Pose};
+use crate::geometry::{ceil_i64, floor_i64, point_segment_dist2, wrap_angle, Point, Pose};
 use crate::sim::RunOutput;
 use crate::tiles::{reachable_tiles, Tile, TileGrid, TileSet};
 use crate::trace::{Event, Record, Trace};
@@ -120,7 +120,13 @@ pub fn swept_pixels(world: &World, trace: &Trace) -> FixedBitSet {
     swept
 }
 
-/// Marks pixel centres within `rt` (pixels) of segment `a`-`b` (grid coordinates), row by row.
+/// Marks pixel centres within `rt` (pixels) of segment `a`-`b` (grid coordinates), row by row,
+/// calling `on_new(index)` for each pixel not marked before.
+///
+/// The distance to a segment is convex along a row, so each row's pixels form one run of
+/// columns. The run's ends are estimated in closed form (union of the two end disks and the
+/// band around the segment, cut by the row), then settled with the exact predicate
+/// `point_segment_dist2(centre, a, b) <= rt^2`, and the run is marked a bitset block at a time.
 pub(crate) fn stamp_capsule(
     bits: &mut FixedBitSet,
     frame: &crate::grid::MapFrame,
@@ -131,46 +137,116 @@ pub(crate) fn stamp_capsule(
 ) {
     let rt2 = rt * rt;
     let h = frame.height as f64;
+    let w = frame.width as i64;
     let ylo = a.y.min(b.y) - rt;
     let yhi = a.y.max(b.y) + rt;
     // Rows whose centre gy = h - row - 0.5 lies in [ylo, yhi].
     let r0 = (h - yhi - 0.5).ceil().max(0.0) as i64;
     let r1 = ((h - ylo - 0.5).floor() as i64).min(frame.height as i64 - 1);
     let d = b.sub(a);
+    let l2 = d.dot(d);
+    let len = l2.sqrt();
     for row in r0..=r1 {
         let gy = h - row as f64 - 0.5;
-        // The segment point closest in y: its x minimises the distance along this row.
-        let t = if d.y == 0.0 {
-            0.0
-        } else {
-            ((gy - a.y) / d.y).clamp(0.0, 1.0)
-        };
-        let xs = a.x + t * d.x;
-        let c_mid = (xs - 0.5).round() as i64;
         let inside = |c: i64| point_segment_dist2(Point::new(c as f64 + 0.5, gy), a, b) <= rt2;
-        // Walk left and right from the nearest column while inside.
-        let mut c = c_mid;
-        while c >= 0 && inside(c) {
-            if (c as usize) < frame.width {
-                put(bits, frame.index(c as usize, row as usize), on_new);
-            }
-            c -= 1;
-        }
-        let mut c = c_mid + 1;
-        while c < frame.width as i64 && inside(c) {
-            if c >= 0 {
-                put(bits, frame.index(c as usize, row as usize), on_new);
-            }
-            c += 1;
-        }
-        // When the nearest column itself lies off the image, scan the image part directly.
-        if c_mid < 0 || c_mid >= frame.width as i64 {
-            for c in 0..frame.width as i64 {
-                if inside(c) {
-                    put(bits, frame.index(c as usize, row as usize), on_new);
-                }
+        // Closed-form x-extent of the capsule on this row (slightly generous is fine: the
+        // ends are settled with the predicate below).
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for e in [a, b] {
+            let dy = gy - e.y;
+            let rem = rt2 - dy * dy;
+            if rem >= 0.0 {
+                let hw = rem.sqrt();
+                lo = lo.min(e.x - hw);
+                hi = hi.max(e.x + hw);
             }
         }
+        let dya = gy - a.y;
+        if d.y != 0.0 {
+            // Perpendicular distance <= rt ...
+            let (p, q) = (
+                a.x + (d.x * dya - rt * len) / d.y,
+                a.x + (d.x * dya + rt * len) / d.y,
+            );
+            let (mut blo, mut bhi) = (p.min(q), p.max(q));
+            // ... and the projection on the segment within [0, 1].
+            if d.x != 0.0 {
+                let (p, q) = (a.x - dya * d.y / d.x, a.x + (l2 - dya * d.y) / d.x);
+                blo = blo.max(p.min(q));
+                bhi = bhi.min(p.max(q));
+            } else if !(0.0..=l2).contains(&(dya * d.y)) {
+                blo = f64::INFINITY;
+            }
+            if blo <= bhi {
+                lo = lo.min(blo);
+                hi = hi.max(bhi);
+            }
+        } else if dya.abs() <= rt {
+            lo = lo.min(a.x.min(b.x));
+            hi = hi.max(a.x.max(b.x));
+        }
+        if !(lo <= hi) {
+            continue;
+        }
+        let mut c_lo = ceil_i64(lo - 0.5).clamp(-1, w);
+        let mut c_hi = floor_i64(hi - 0.5).clamp(-1, w);
+        // Settle the ends with the exact predicate (a step or two at most).
+        let first = c_lo;
+        while c_lo <= c_hi && !inside(c_lo) {
+            c_lo += 1;
+        }
+        if c_lo > c_hi {
+            // The estimate holds no pixel of the run (rounding at a tangent row): the run, if
+            // any, is a pixel just outside it.
+            match [first - 1, c_hi + 1].into_iter().find(|&c| inside(c)) {
+                Some(c) => (c_lo, c_hi) = (c, c),
+                None => continue,
+            }
+        }
+        while c_lo > 0 && inside(c_lo - 1) {
+            c_lo -= 1;
+        }
+        if inside(c_hi) {
+            while c_hi < w - 1 && inside(c_hi + 1) {
+                c_hi += 1;
+            }
+        } else {
+            while c_hi > c_lo && !inside(c_hi) {
+                c_hi -= 1;
+            }
+        }
+        let (c_lo, c_hi) = (c_lo.max(0), c_hi.min(w - 1));
+        if c_lo > c_hi {
+            continue;
+        }
+        let base = row as usize * frame.width;
+        put_range(bits, base + c_lo as usize, base + c_hi as usize, on_new);
+    }
+}
+
+/// Marks bits `from..=to`, calling `on_new` for each bit not set before.
+#[inline]
+fn put_range(bits: &mut FixedBitSet, from: usize, to: usize, on_new: &mut impl FnMut(usize)) {
+    const BITS: usize = usize::BITS as usize;
+    let blocks = bits.as_mut_slice();
+    let (a, b) = (from, to + 1);
+    let mut blk = a / BITS;
+    while blk * BITS < b {
+        let start = blk * BITS;
+        let (lo, hi) = (a.max(start) - start, b.min(start + BITS) - start);
+        let mask = if hi - lo == BITS {
+            usize::MAX
+        } else {
+            ((1usize << (hi - lo)) - 1) << lo
+        };
+        let mut new = mask & !blocks[blk];
+        blocks[blk] |= mask;
+        while new != 0 {
+            let bit = new.trailing_zeros() as usize;
+            new &= new - 1;
+            on_new(start + bit);
+        }
+        blk += 1;
     }
 }
 
@@ -208,13 +284,6 @@ impl<'w> Sweeper<'w> {
     /// The swept pixels so far.
     pub fn swept(&self) -> &FixedBitSet {
         &self.swept
-    }
-}
-
-#[inline]
-fn put(bits: &mut FixedBitSet, i: usize, on_new: &mut impl FnMut(usize)) {
-    if !bits.put(i) {
-        on_new(i);
     }
 }
 
@@ -544,6 +613,43 @@ mod tests {
     use crate::planner::{Planner, Sensor, Step};
     use crate::sim::{simulate, SimConfig};
     use crate::world::Robot;
+
+    /// `stamp_capsule` marks exactly the pixel centres within `rt` of the segment, for random
+    /// segments (any direction, zero length, partly off the image) and radii down to a pixel.
+    #[test]
+    fn stamp_capsule_equals_brute_force() {
+        let frame = crate::grid::MapFrame {
+            width: 40,
+            height: 30,
+            resolution: 0.05,
+            origin: Pose::new(0.0, 0.0, 0.0),
+        };
+        let mut rng = crate::rng::SplitMix64::new(7);
+        for case in 0..4000 {
+            let a = Point::new(rng.range(-3.0, 43.0), rng.range(-3.0, 33.0));
+            let b = match case % 4 {
+                0 => a,
+                1 => Point::new(rng.range(-3.0, 43.0), a.y),
+                2 => Point::new(a.x, rng.range(-3.0, 33.0)),
+                _ => Point::new(rng.range(-3.0, 43.0), rng.range(-3.0, 33.0)),
+            };
+            let rt = rng.range(0.2, 6.0);
+            let mut got = FixedBitSet::with_capacity(frame.len());
+            let mut news = 0;
+            stamp_capsule(&mut got, &frame, a, b, rt, &mut |_| news += 1);
+            let mut want = FixedBitSet::with_capacity(frame.len());
+            for row in 0..frame.height {
+                for col in 0..frame.width {
+                    let q = frame.pixel_center_grid(col, row);
+                    if point_segment_dist2(q, a, b) <= rt * rt {
+                        want.insert(frame.index(col, row));
+                    }
+                }
+            }
+            assert_eq!(got, want, "case {case}: {a:?} {b:?} rt {rt}");
+            assert_eq!(news, want.count_ones(..));
+        }
+    }
 
     struct Script(Vec<Step>);
     impl Planner for Script {

@@ -1,6 +1,13 @@
-//! Planners end to end (`World::new` + simulate + metrics) on real maps from the shared set:
-//! BA* on `aws_small_warehouse_002` (1536x1504 px, 0.02 m/px) at r = 0.1 m (target: under 1 s),
-//! and BA* / BSA / extended BSA on the small house at r = 0.15 m for the relative-speed targets.
+//! Planners on real maps from the shared set.
+//!
+//! - `shared_maps`: end to end (`World::new` + simulate + metrics): BA* on
+//!   `aws_small_warehouse_002` (1536x1504 px, 0.02 m/px) at r = 0.1 m (target: under 1 s), and
+//!   BA* / BSA / extended BSA on the small house at r = 0.15 m.
+//! - `relative_speed`: BA*, BSA and extended BSA on every shared map at r = 0.15 m, timing what
+//!   `wall_time_s` times (planner construction + simulation, the world built once), for the
+//!   targets "bsa within 2x of BA*, bsa-extended within 5x" per map. Select one map with e.g.
+//!   `cargo bench -p ccpp-io --bench shared_maps -- relative_speed/.*/teb_maze`.
+//!
 //! Skips with a note when `../shared/maps` is absent.
 
 use std::path::Path;
@@ -12,10 +19,12 @@ use ccpp_core::world::{Robot, World};
 use ccpp_core::GridMap;
 use criterion::{criterion_group, criterion_main, Criterion};
 
+fn maps_dir() -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/maps")
+}
+
 fn load(name: &str) -> Option<GridMap> {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/maps")
-        .join(name);
+    let p = maps_dir().join(name);
     if !p.is_file() {
         eprintln!("{} not found; skipping", p.display());
         return None;
@@ -56,5 +65,38 @@ fn shared_maps(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, shared_maps);
+fn relative_speed(c: &mut Criterion) {
+    let mut g = c.benchmark_group("relative_speed");
+    g.sample_size(10)
+        .warm_up_time(Duration::from_millis(100))
+        .measurement_time(Duration::from_millis(1500));
+    let mut names: Vec<String> = std::fs::read_dir(maps_dir())
+        .map(|d| {
+            d.filter_map(|e| e.ok())
+                .map(|e| e.file_name().to_string_lossy().into_owned())
+                .filter(|n| n.ends_with(".yaml"))
+                .collect()
+        })
+        .unwrap_or_default();
+    names.sort();
+    let mut opts = PlannerOptions::default();
+    opts.ba_star.record_backtrack_list = false;
+    let cfg = SimConfig::default();
+    for name in names {
+        let Some(map) = load(&name) else { continue };
+        let world = World::new(map, Robot::new(0.15), None).expect("world");
+        let stem = name.trim_end_matches(".yaml");
+        for planner in ["ba-star", "bsa", "bsa-extended"] {
+            g.bench_function(format!("{planner}/{stem}"), |b| {
+                b.iter(|| {
+                    let mut p = build(planner, &opts, &world).expect("planner");
+                    simulate(&world, p.as_mut(), &cfg)
+                });
+            });
+        }
+    }
+    g.finish();
+}
+
+criterion_group!(benches, shared_maps, relative_speed);
 criterion_main!(benches);

@@ -553,6 +553,9 @@ impl Bsa {
     fn decide(&mut self, sensor: &dyn Sensor) {
         let core = self.core.get_or_insert_with(|| Core::new(sensor));
         core.known.integrate(&sensor.scan());
+        if let Some(ext) = self.ext.as_mut() {
+            ext.new_scan();
+        }
         if self.phase == Phase::Follow {
             let ext = self.ext.as_mut().expect("follow only in extended mode");
             ext.follow_step(core, &mut self.queue, self.side);

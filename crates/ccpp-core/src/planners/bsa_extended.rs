@@ -136,6 +136,9 @@ impl Default for BsaExtendedOptions {
     }
 }
 
+/// `s_memo` / `s0_memo` value for "undecided for lack of sensing" (until the next scan).
+const UNSEEN: u8 = 3;
+
 /// Follow steps looked ahead when deciding on skin excursions.
 const LOOKAHEAD: usize = 6;
 
@@ -201,14 +204,21 @@ pub(crate) struct Extension {
     frame: Option<MapFrame>,
     /// Robot radius in pixels.
     r_px: f64,
-    /// Per pixel: 0 undecided, 1 in `S`, 2 not in `S` (final answers only).
+    /// Per pixel: 0 undecided, 1 in `S`, 2 not in `S`, [`UNSEEN`] undecided for lack of
+    /// sensing since the last scan.
     s_memo: Vec<u8>,
+    /// Pixels marked [`UNSEEN`] since the last scan: `(pixel, in s0_memo)`.
+    unseen_marks: Vec<(usize, bool)>,
     /// Followed contour pixels.
     traced: FixedBitSet,
-    /// Per pixel: 0 undecided, 1 in `S0` (the robot disk fits at clearance 0), 2 not.
+    /// Per pixel: 0 undecided, 1 in `S0` (the robot disk fits at clearance 0), 2 not, or
+    /// unseen as in `s_memo`.
     s0_memo: Vec<u8>,
     /// Pixels the extension's own motions swept (the planner's estimate, for excursions).
     covered: FixedBitSet,
+    /// Targets (world) of queued moves already recorded in `covered` when planned, in queue
+    /// order.
+    prestamped: VecDeque<Point>,
     /// Skin pixels (in `S0`, not in `S`) already driven to.
     skin_done: FixedBitSet,
     /// Tool radius in pixels.
@@ -226,9 +236,11 @@ impl Extension {
             frame: None,
             r_px: 0.0,
             s_memo: Vec::new(),
+            unseen_marks: Vec::new(),
             traced: FixedBitSet::new(),
             s0_memo: Vec::new(),
             covered: FixedBitSet::new(),
+            prestamped: VecDeque::new(),
             skin_done: FixedBitSet::new(),
             tool_px: 0.0,
             near: Vec::new(),
@@ -265,8 +277,19 @@ impl Extension {
         self.frame.expect("extension initialised")
     }
 
+    /// The known map changed (a scan was integrated): "unseen" answers expire.
+    pub(crate) fn new_scan(&mut self) {
+        for &(i, s0) in &self.unseen_marks {
+            let memo = if s0 { &mut self.s0_memo } else { &mut self.s_memo };
+            if memo[i] == UNSEEN {
+                memo[i] = 0;
+            }
+        }
+        self.unseen_marks.clear();
+    }
+
     /// Is pixel `p` in `S` (the robot grown by the clearance fits at its centre)? `None` when an
-    /// unseen pixel decides (not memoised).
+    /// unseen pixel decides (memoised until the next scan).
     fn in_s(&mut self, known: &KnownMap, p: Px) -> Option<bool> {
         let f = self.frame();
         let Some((c, r)) = f.checked(p.0, p.1) else {
@@ -276,6 +299,7 @@ impl Extension {
         match self.s_memo[i] {
             1 => return Some(true),
             2 => return Some(false),
+            UNSEEN => return None,
             _ => {}
         }
         let g = f.pixel_center_grid(c, r);
@@ -288,12 +312,16 @@ impl Extension {
                 self.s_memo[i] = 2;
                 Some(false)
             }
-            Status::Unseen => None,
+            Status::Unseen => {
+                self.s_memo[i] = UNSEEN;
+                self.unseen_marks.push((i, false));
+                None
+            }
         }
     }
 
     /// Is pixel `p` in `S0` (the robot disk itself fits at its centre, clearance 0)? `None`
-    /// when an unseen pixel decides (not memoised).
+    /// when an unseen pixel decides (memoised until the next scan).
     fn in_s0(&mut self, known: &KnownMap, p: Px) -> Option<bool> {
         let f = self.frame();
         let (c, r) = f.checked(p.0, p.1)?;
@@ -301,6 +329,7 @@ impl Extension {
         match self.s0_memo[i] {
             1 => return Some(true),
             2 => return Some(false),
+            UNSEEN => return None,
             _ => {}
         }
         match disk_status(known, f.pixel_center_grid(c, r), self.r_px) {
@@ -312,7 +341,11 @@ impl Extension {
                 self.s0_memo[i] = 2;
                 Some(false)
             }
-            Status::Unseen => None,
+            Status::Unseen => {
+                self.s0_memo[i] = UNSEEN;
+                self.unseen_marks.push((i, true));
+                None
+            }
         }
     }
 
@@ -323,8 +356,14 @@ impl Extension {
         crate::metrics::stamp_capsule(&mut self.covered, &f, a, b, rt, &mut |_| {});
     }
 
-    /// Records a commanded motion (world points) as swept.
+    /// Records a commanded motion (world points) as swept — unless it is one of the moves
+    /// already recorded when they were planned (wall-follow and excursion moves, found by
+    /// their target among the next few of [`Self::prestamped`]).
     pub(crate) fn driven(&mut self, from: Point, to: Point) {
+        if let Some(k) = self.prestamped.iter().take(4).position(|&q| q == to) {
+            self.prestamped.drain(..=k);
+            return;
+        }
         if self.frame.is_some() {
             let f = self.frame();
             self.stamp(f.world_to_grid(from), f.world_to_grid(to));
@@ -334,25 +373,46 @@ impl Extension {
     /// Is there a known free pixel within the tool's reach of grid point `g` that no motion of
     /// the extension has swept yet and the next follow positions `ahead` will not sweep?
     fn gains(&self, known: &KnownMap, g: Point, ahead: &[Point]) -> bool {
+        const BITS: usize = usize::BITS as usize;
         let f = self.frame();
         let rt = self.tool_px + 1e-6;
+        let rt2 = rt * rt;
         let p = self.pixel_of_grid(g);
         let w = rt.ceil() as i64 + 1;
-        for row in p.1 - w..=p.1 + w {
-            for col in p.0 - w..=p.0 + w {
-                let Some((c, r)) = f.checked(col, row) else {
-                    continue;
+        // Candidates: known free and not swept, a block of the bitsets at a time.
+        let free = known.known_free().as_slice();
+        let cov = self.covered.as_slice();
+        let lo = (p.0 - w).max(0);
+        let hi = (p.0 + w).min(f.width as i64 - 1);
+        if lo > hi {
+            return false;
+        }
+        for row in (p.1 - w).max(0)..=(p.1 + w).min(f.height as i64 - 1) {
+            let base = row as usize * f.width;
+            let (a, b) = (base + lo as usize, base + hi as usize + 1);
+            let mut blk = a / BITS;
+            while blk * BITS < b {
+                let start = blk * BITS;
+                let (from, to) = (a.max(start) - start, b.min(start + BITS) - start);
+                let mask = if to - from == BITS {
+                    usize::MAX
+                } else {
+                    ((1usize << (to - from)) - 1) << from
                 };
-                if known.is_seen(c, r)
-                    && known.get(c, r).is_free()
-                    && !self.covered.contains(f.index(c, r))
-                    && self.center_grid((col, row)).dist2(g) <= rt * rt
-                    && !ahead.windows(2).any(|s| {
-                        point_segment_dist2(self.center_grid((col, row)), s[0], s[1]) <= rt * rt
-                    })
-                {
-                    return true;
+                let mut todo = free[blk] & !cov[blk] & mask;
+                while todo != 0 {
+                    let bit = todo.trailing_zeros() as usize;
+                    todo &= todo - 1;
+                    let q = self.center_grid(((start + bit - base) as i64, row));
+                    if q.dist2(g) <= rt2
+                        && !ahead
+                            .windows(2)
+                            .any(|s| point_segment_dist2(q, s[0], s[1]) <= rt2)
+                    {
+                        return true;
+                    }
                 }
+                blk += 1;
             }
         }
         false
@@ -403,6 +463,7 @@ impl Extension {
             }
             self.skin_done.insert(qi);
             self.stamp(at, g);
+            self.prestamped.push_back(self.world(g));
             moves.push(g);
             stack.push((q, g, 0));
         }
@@ -669,6 +730,7 @@ impl Extension {
             for &q in &path {
                 if q.dist(f.pos) > 1e-9 {
                     self.stamp(f.pos, q);
+                    self.prestamped.push_back(self.world(q));
                     queue.push_back(Step::MoveTo(self.world(q)));
                     f.trail.push(q);
                     f.pos = q;
