@@ -24,6 +24,22 @@ pub trait Occupancy {
     fn frame(&self) -> &MapFrame;
     /// `true` when pixel `(col, row)` (signed; outside the image) blocks the robot.
     fn blocked(&self, col: i64, row: i64) -> bool;
+    /// Calls `f(col)` for each blocked pixel of image row `row`, columns `lo..=hi` (inside the
+    /// image), left to right, until `f` returns `false`. The default asks [`Self::blocked`]
+    /// pixel by pixel; bitset-backed grids skip free runs a word at a time.
+    fn for_each_blocked_in_row(
+        &self,
+        row: usize,
+        lo: usize,
+        hi: usize,
+        f: &mut dyn FnMut(usize) -> bool,
+    ) {
+        for col in lo..=hi {
+            if self.blocked(col as i64, row as i64) && !f(col) {
+                return;
+            }
+        }
+    }
 }
 
 impl Occupancy for GridMap {
@@ -83,28 +99,55 @@ pub fn disk_hits(occ: &impl Occupancy, p: Point, r_px: f64) -> bool {
 /// through a distance-transform accelerated caller ([`crate::world::World::first_contact`]).
 pub fn segment_first_contact(occ: &impl Occupancy, a: Point, b: Point, r_px: f64) -> Option<f64> {
     let rc = contact_radius_px(r_px);
+    let rc2 = rc * rc;
     let frame = *occ.frame();
     let lo = Point::new(a.x.min(b.x), a.y.min(b.y));
     let hi = Point::new(a.x.max(b.x), a.y.max(b.y));
     let (c0, c1, r0, r1) = pixel_window(&frame, lo, hi, rc);
+    let (w, h) = (frame.width as i64, frame.height as i64);
     let mut best: Option<f64> = None;
-    for row in r0..=r1 {
-        for col in c0..=c1 {
-            if !occ.blocked(col, row) {
-                continue;
-            }
-            let q = center(&frame, col, row);
-            // Quick reject by distance to the segment.
-            if crate::geometry::point_segment_dist2(q, a, b) >= rc * rc {
-                continue;
-            }
-            if let Some(t) = first_entry(a, b, q, rc) {
-                if best.is_none_or(|bt| t < bt) {
-                    best = Some(t);
-                    if t == 0.0 {
-                        return best;
-                    }
+    // Earliest contact with the blocked pixel `(col, row)`; `false` once contact is at t = 0
+    // (nothing can come earlier).
+    let mut consider = |col: i64, row: i64| -> bool {
+        let q = center(&frame, col, row);
+        // Quick reject by distance to the segment.
+        if crate::geometry::point_segment_dist2(q, a, b) >= rc2 {
+            return true;
+        }
+        if let Some(t) = first_entry(a, b, q, rc) {
+            if best.is_none_or(|bt| t < bt) {
+                best = Some(t);
+                if t == 0.0 {
+                    return false;
                 }
+            }
+        }
+        true
+    };
+    for row in r0..=r1 {
+        if row < 0 || row >= h {
+            // Outside the image every pixel blocks.
+            for col in c0..=c1 {
+                if !consider(col, row) {
+                    return best;
+                }
+            }
+            continue;
+        }
+        for col in (c0..=c1.min(-1)).chain(c0.max(w)..=c1) {
+            if !consider(col, row) {
+                return best;
+            }
+        }
+        let (lo, hi) = (c0.max(0), c1.min(w - 1));
+        if lo <= hi {
+            let mut go = true;
+            occ.for_each_blocked_in_row(row as usize, lo as usize, hi as usize, &mut |col| {
+                go = consider(col as i64, row);
+                go
+            });
+            if !go {
+                return best;
             }
         }
     }

@@ -11,6 +11,7 @@
 //! Data flows one way: map -> [`world::World`] -> [`sim::Simulator`] <-> planner ->
 //! [`trace::Trace`] -> [`metrics::Metrics`]. Planners never score themselves.
 
+mod bits;
 pub mod collide;
 pub mod dt;
 pub mod exec;

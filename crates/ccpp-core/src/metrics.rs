@@ -185,7 +185,7 @@ pub(crate) fn stamp_capsule(
             lo = lo.min(a.x.min(b.x));
             hi = hi.max(a.x.max(b.x));
         }
-        if !(lo <= hi) {
+        if lo > hi {
             continue;
         }
         let mut c_lo = ceil_i64(lo - 0.5).clamp(-1, w);
@@ -227,18 +227,13 @@ pub(crate) fn stamp_capsule(
 /// Marks bits `from..=to`, calling `on_new` for each bit not set before.
 #[inline]
 fn put_range(bits: &mut FixedBitSet, from: usize, to: usize, on_new: &mut impl FnMut(usize)) {
-    const BITS: usize = usize::BITS as usize;
+    use crate::bits::{range_mask, BLOCK_BITS};
     let blocks = bits.as_mut_slice();
     let (a, b) = (from, to + 1);
-    let mut blk = a / BITS;
-    while blk * BITS < b {
-        let start = blk * BITS;
-        let (lo, hi) = (a.max(start) - start, b.min(start + BITS) - start);
-        let mask = if hi - lo == BITS {
-            usize::MAX
-        } else {
-            ((1usize << (hi - lo)) - 1) << lo
-        };
+    let mut blk = a / BLOCK_BITS;
+    while blk * BLOCK_BITS < b {
+        let start = blk * BLOCK_BITS;
+        let mask = range_mask(a.max(start) - start, b.min(start + BLOCK_BITS) - start);
         let mut new = mask & !blocks[blk];
         blocks[blk] |= mask;
         while new != 0 {

@@ -7,6 +7,7 @@
 
 use fixedbitset::FixedBitSet;
 
+use crate::bits::{range_mask, BLOCK_BITS};
 use crate::collide::{self, Occupancy};
 use crate::geometry::{ceil_i64, floor_i64, Point, Pose};
 use crate::grid::{Cell, GridMap, MapFrame};
@@ -173,6 +174,22 @@ pub trait Planner {
     fn next(&mut self, sensor: &dyn Sensor) -> Step;
 }
 
+/// The disk of contact radius `rc` pixels around a pixel centre, as row half-widths: entry
+/// `dy` is the largest `dx >= 0` with `dx^2 + dy^2 < rc^2`, or -1 when the row holds no pixel.
+pub(crate) fn pixel_disk_spans(rc: f64) -> Vec<i64> {
+    let rc2 = rc * rc;
+    let reach = rc.ceil().max(0.0) as i64;
+    (0..=reach)
+        .map(|dy| {
+            let mut hw = -1;
+            while (((hw + 1) * (hw + 1) + dy * dy) as f64) < rc2 {
+                hw += 1;
+            }
+            hw
+        })
+        .collect()
+}
+
 /// What a [`KnownMap`] says about a disk ([`KnownMap::disk_state`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum DiskState {
@@ -192,19 +209,6 @@ pub struct KnownMap {
     seen: FixedBitSet,
     /// Seen and free (the pixels that never block).
     free: FixedBitSet,
-}
-
-/// Bits per block of a [`FixedBitSet`].
-const BLOCK_BITS: usize = usize::BITS as usize;
-
-/// The bits `from..to` of a block (`from < to <= BLOCK_BITS`).
-#[inline]
-fn range_mask(from: usize, to: usize) -> usize {
-    if to - from == BLOCK_BITS {
-        usize::MAX
-    } else {
-        ((1usize << (to - from)) - 1) << from
-    }
 }
 
 impl KnownMap {
@@ -302,23 +306,14 @@ impl KnownMap {
         mut f: impl FnMut(usize, bool) -> bool,
     ) {
         let base = row * self.grid.frame().width;
-        let (a, b) = (base + col0, base + col1 + 1);
         let free = self.free.as_slice();
         let seen = self.seen.as_slice();
-        let mut blk = a / BLOCK_BITS;
-        while blk * BLOCK_BITS < b {
-            let start = blk * BLOCK_BITS;
-            let mut todo =
-                !free[blk] & range_mask(a.max(start) - start, b.min(start + BLOCK_BITS) - start);
-            while todo != 0 {
-                let bit = todo.trailing_zeros() as usize;
-                todo &= todo - 1;
-                if !f(start + bit - base, seen[blk] >> bit & 1 == 1) {
-                    return;
-                }
-            }
-            blk += 1;
-        }
+        crate::bits::for_each_set(
+            base + col0,
+            base + col1 + 1,
+            |k| !free[k],
+            |i| f(i - base, seen[i / BLOCK_BITS] >> (i % BLOCK_BITS) & 1 == 1),
+        );
     }
 
     /// What is known of the disk of radius `rc` pixels at grid point `g`: the pixels whose
@@ -381,6 +376,43 @@ impl KnownMap {
         }
     }
 
+    /// [`Self::disk_state`] at the centre of pixel `(col, row)`, with the disk given as
+    /// [`pixel_disk_spans`] (centres are whole pixels apart, so the disk is the same integer
+    /// pattern around every pixel and the predicate is exact in integers).
+    pub(crate) fn disk_state_px(&self, col: i64, row: i64, spans: &[i64]) -> DiskState {
+        let frame = *self.grid.frame();
+        let (w, hh) = (frame.width as i64, frame.height as i64);
+        let reach = spans.len() as i64 - 1;
+        let mut unseen = false;
+        for dy in -reach..=reach {
+            let hw = spans[dy.unsigned_abs() as usize];
+            if hw < 0 {
+                continue;
+            }
+            let (r, lo, hi) = (row + dy, col - hw, col + hw);
+            if r < 0 || r >= hh || lo < 0 || hi >= w {
+                return DiskState::Blocked;
+            }
+            let mut blocked = false;
+            self.for_each_not_known_free(r as usize, lo as usize, hi as usize, |_, seen| {
+                if seen {
+                    blocked = true;
+                    return false;
+                }
+                unseen = true;
+                true
+            });
+            if blocked {
+                return DiskState::Blocked;
+            }
+        }
+        if unseen {
+            DiskState::Unseen
+        } else {
+            DiskState::Free
+        }
+    }
+
     /// Can the robot (radius `r` metres) stand at world point `p`, as far as it knows?
     pub fn disk_free(&self, p: Point, r: f64) -> bool {
         let f = self.grid.frame();
@@ -422,6 +454,15 @@ impl Occupancy for KnownMap {
             Some((c, r)) => !self.free.contains(self.grid.frame().index(c, r)),
             None => true,
         }
+    }
+    fn for_each_blocked_in_row(
+        &self,
+        row: usize,
+        lo: usize,
+        hi: usize,
+        f: &mut dyn FnMut(usize) -> bool,
+    ) {
+        self.for_each_not_known_free(row, lo, hi, |col, _| f(col));
     }
 }
 

@@ -118,6 +118,8 @@ pub struct World {
     /// Squared distance (px^2) from each pixel centre to the nearest non-free pixel centre,
     /// counting the outside as non-free.
     obstacle_dt2: Vec<u32>,
+    /// Non-free pixels (the simulator's collision checks skip free runs a word at a time).
+    blocked: FixedBitSet,
     cfree: FixedBitSet,
     reachable: FixedBitSet,
     accessible: FixedBitSet,
@@ -171,11 +173,18 @@ impl World {
             Some(s) => s,
             None => default_start(&frame, &cfree, &obstacle_dt2),
         };
+        let mut blocked = FixedBitSet::with_capacity(frame.len());
+        for (i, c) in cells.iter().enumerate() {
+            if !c.is_free() {
+                blocked.insert(i);
+            }
+        }
         let mut world = Self {
             map,
             robot,
             start,
             obstacle_dt2,
+            blocked,
             cfree,
             reachable: FixedBitSet::with_capacity(frame.len()),
             accessible: FixedBitSet::with_capacity(frame.len()),
@@ -375,7 +384,11 @@ impl World {
             }
             let e = (s + 1.0).min(len);
             let q = ga.add(u.scale(e));
-            if let Some(t) = collide::segment_first_contact(&self.map, p, q, r_px) {
+            let truth = Truth {
+                map: &self.map,
+                blocked: &self.blocked,
+            };
+            if let Some(t) = collide::segment_first_contact(&truth, p, q, r_px) {
                 return Some(((s + t * (e - s)) / len).clamp(0.0, 1.0));
             }
             s = e;
@@ -386,6 +399,33 @@ impl World {
     /// Is the straight motion of the robot from `a` to `b` free of contact?
     pub fn segment_free(&self, a: Point, b: Point) -> bool {
         self.first_contact(a, b).is_none()
+    }
+}
+
+/// The true map as an [`collide::Occupancy`] with its non-free pixels as a bitset.
+struct Truth<'a> {
+    map: &'a GridMap,
+    blocked: &'a FixedBitSet,
+}
+
+impl collide::Occupancy for Truth<'_> {
+    fn frame(&self) -> &MapFrame {
+        self.map.frame()
+    }
+    #[inline]
+    fn blocked(&self, col: i64, row: i64) -> bool {
+        !self.map.get_signed(col, row).is_free()
+    }
+    fn for_each_blocked_in_row(
+        &self,
+        row: usize,
+        lo: usize,
+        hi: usize,
+        f: &mut dyn FnMut(usize) -> bool,
+    ) {
+        let base = row * self.map.frame().width;
+        let blocks = self.blocked.as_slice();
+        crate::bits::for_each_set(base + lo, base + hi + 1, |k| blocks[k], |i| f(i - base));
     }
 }
 

@@ -72,9 +72,13 @@ fn relative_speed(c: &mut Criterion) {
         .measurement_time(Duration::from_millis(1500));
     let mut names: Vec<String> = std::fs::read_dir(maps_dir())
         .map(|d| {
-            d.filter_map(|e| e.ok())
+            d.filter_map(Result::ok)
                 .map(|e| e.file_name().to_string_lossy().into_owned())
-                .filter(|n| n.ends_with(".yaml"))
+                .filter(|n| {
+                    Path::new(n)
+                        .extension()
+                        .is_some_and(|e| e.eq_ignore_ascii_case("yaml"))
+                })
                 .collect()
         })
         .unwrap_or_default();

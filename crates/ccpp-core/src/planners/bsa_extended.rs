@@ -104,7 +104,7 @@ use super::bsa::{
 use crate::collide::Occupancy;
 use crate::geometry::{point_segment_dist2, Point};
 use crate::grid::MapFrame;
-use crate::planner::{DiskState, KnownMap, Step};
+use crate::planner::{pixel_disk_spans, DiskState, KnownMap, Step};
 use crate::tiles::{Tile, N8};
 use crate::trace::Event;
 
@@ -207,6 +207,9 @@ pub(crate) struct Extension {
     /// Per pixel: 0 undecided, 1 in `S`, 2 not in `S`, [`UNSEEN`] undecided for lack of
     /// sensing since the last scan.
     s_memo: Vec<u8>,
+    /// The disks of `S` and `S0` tests around a pixel centre ([`pixel_disk_spans`]).
+    s_disk: Vec<i64>,
+    s0_disk: Vec<i64>,
     /// Pixels marked [`UNSEEN`] since the last scan: `(pixel, in s0_memo)`.
     unseen_marks: Vec<(usize, bool)>,
     /// Followed contour pixels.
@@ -237,6 +240,8 @@ impl Extension {
             r_px: 0.0,
             s_memo: Vec::new(),
             unseen_marks: Vec::new(),
+            s_disk: Vec::new(),
+            s0_disk: Vec::new(),
             traced: FixedBitSet::new(),
             s0_memo: Vec::new(),
             covered: FixedBitSet::new(),
@@ -260,6 +265,10 @@ impl Extension {
         self.tool_px = core.tool / f.resolution;
         self.frame = Some(f);
         self.opts.clearance_px = self.opts.clearance_px.max(0.0);
+        self.s_disk = pixel_disk_spans(crate::collide::contact_radius_px(
+            self.r_px + self.opts.clearance_px,
+        ));
+        self.s0_disk = pixel_disk_spans(crate::collide::contact_radius_px(self.r_px));
         let w = (self.r_px + 0.5 + self.opts.clearance_px + 2.0).ceil() as i64;
         let mut near: Vec<(i64, i64, i64)> = (-w..=w)
             .flat_map(|dr| (-w..=w).map(move |dc| (dc * dc + dr * dr, dr, dc)))
@@ -280,7 +289,11 @@ impl Extension {
     /// The known map changed (a scan was integrated): "unseen" answers expire.
     pub(crate) fn new_scan(&mut self) {
         for &(i, s0) in &self.unseen_marks {
-            let memo = if s0 { &mut self.s0_memo } else { &mut self.s_memo };
+            let memo = if s0 {
+                &mut self.s0_memo
+            } else {
+                &mut self.s_memo
+            };
             if memo[i] == UNSEEN {
                 memo[i] = 0;
             }
@@ -302,17 +315,16 @@ impl Extension {
             UNSEEN => return None,
             _ => {}
         }
-        let g = f.pixel_center_grid(c, r);
-        match disk_status(known, g, self.r_px + self.opts.clearance_px) {
-            Status::Free => {
+        match known.disk_state_px(c as i64, r as i64, &self.s_disk) {
+            DiskState::Free => {
                 self.s_memo[i] = 1;
                 Some(true)
             }
-            Status::Blocked => {
+            DiskState::Blocked => {
                 self.s_memo[i] = 2;
                 Some(false)
             }
-            Status::Unseen => {
+            DiskState::Unseen => {
                 self.s_memo[i] = UNSEEN;
                 self.unseen_marks.push((i, false));
                 None
@@ -332,16 +344,16 @@ impl Extension {
             UNSEEN => return None,
             _ => {}
         }
-        match disk_status(known, f.pixel_center_grid(c, r), self.r_px) {
-            Status::Free => {
+        match known.disk_state_px(c as i64, r as i64, &self.s0_disk) {
+            DiskState::Free => {
                 self.s0_memo[i] = 1;
                 Some(true)
             }
-            Status::Blocked => {
+            DiskState::Blocked => {
                 self.s0_memo[i] = 2;
                 Some(false)
             }
-            Status::Unseen => {
+            DiskState::Unseen => {
                 self.s0_memo[i] = UNSEEN;
                 self.unseen_marks.push((i, true));
                 None
@@ -373,7 +385,6 @@ impl Extension {
     /// Is there a known free pixel within the tool's reach of grid point `g` that no motion of
     /// the extension has swept yet and the next follow positions `ahead` will not sweep?
     fn gains(&self, known: &KnownMap, g: Point, ahead: &[Point]) -> bool {
-        const BITS: usize = usize::BITS as usize;
         let f = self.frame();
         let rt = self.tool_px + 1e-6;
         let rt2 = rt * rt;
@@ -390,29 +401,20 @@ impl Extension {
         for row in (p.1 - w).max(0)..=(p.1 + w).min(f.height as i64 - 1) {
             let base = row as usize * f.width;
             let (a, b) = (base + lo as usize, base + hi as usize + 1);
-            let mut blk = a / BITS;
-            while blk * BITS < b {
-                let start = blk * BITS;
-                let (from, to) = (a.max(start) - start, b.min(start + BITS) - start);
-                let mask = if to - from == BITS {
-                    usize::MAX
-                } else {
-                    ((1usize << (to - from)) - 1) << from
-                };
-                let mut todo = free[blk] & !cov[blk] & mask;
-                while todo != 0 {
-                    let bit = todo.trailing_zeros() as usize;
-                    todo &= todo - 1;
-                    let q = self.center_grid(((start + bit - base) as i64, row));
-                    if q.dist2(g) <= rt2
-                        && !ahead
+            let none = crate::bits::for_each_set(
+                a,
+                b,
+                |k| free[k] & !cov[k],
+                |i| {
+                    let q = self.center_grid(((i - base) as i64, row));
+                    q.dist2(g) > rt2
+                        || ahead
                             .windows(2)
                             .any(|s| point_segment_dist2(q, s[0], s[1]) <= rt2)
-                    {
-                        return true;
-                    }
-                }
-                blk += 1;
+                },
+            );
+            if !none {
+                return true;
             }
         }
         false

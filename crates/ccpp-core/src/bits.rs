@@ -1,0 +1,80 @@
+//! Word-at-a-time scans over the blocks of a [`fixedbitset::FixedBitSet`] (row runs of pixel
+//! bitsets: free runs cost one word operation, not one test per pixel).
+
+/// Bits per block of a `FixedBitSet`.
+pub(crate) const BLOCK_BITS: usize = usize::BITS as usize;
+
+/// The bits `from..to` of a block (`from < to <= BLOCK_BITS`).
+#[inline]
+pub(crate) fn range_mask(from: usize, to: usize) -> usize {
+    if to - from == BLOCK_BITS {
+        usize::MAX
+    } else {
+        ((1usize << (to - from)) - 1) << from
+    }
+}
+
+/// Calls `f(i)` for every index `i` in `a..b` whose bit is set in `word(block)`, in increasing
+/// order, until `f` returns `false`; returns `false` when stopped early.
+#[inline]
+pub(crate) fn for_each_set(
+    a: usize,
+    b: usize,
+    word: impl Fn(usize) -> usize,
+    mut f: impl FnMut(usize) -> bool,
+) -> bool {
+    let mut blk = a / BLOCK_BITS;
+    while blk * BLOCK_BITS < b {
+        let start = blk * BLOCK_BITS;
+        let mut todo =
+            word(blk) & range_mask(a.max(start) - start, b.min(start + BLOCK_BITS) - start);
+        while todo != 0 {
+            let bit = todo.trailing_zeros() as usize;
+            todo &= todo - 1;
+            if !f(start + bit) {
+                return false;
+            }
+        }
+        blk += 1;
+    }
+    true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn visits_exactly_the_set_bits_in_range() {
+        let words = [0b1011usize, usize::MAX, 1 << 63];
+        for a in 0..3 * BLOCK_BITS {
+            for b in a..=3 * BLOCK_BITS {
+                let mut got = Vec::new();
+                for_each_set(
+                    a,
+                    b,
+                    |k| words[k],
+                    |i| {
+                        got.push(i);
+                        true
+                    },
+                );
+                let want: Vec<usize> = (a..b)
+                    .filter(|&i| words[i / BLOCK_BITS] >> (i % BLOCK_BITS) & 1 == 1)
+                    .collect();
+                assert_eq!(got, want, "{a}..{b}");
+            }
+        }
+        let mut n = 0;
+        assert!(!for_each_set(
+            0,
+            3 * BLOCK_BITS,
+            |k| words[k],
+            |_| {
+                n += 1;
+                n < 3
+            }
+        ));
+        assert_eq!(n, 3);
+    }
+}
