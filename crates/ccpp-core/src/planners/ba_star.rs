@@ -328,19 +328,27 @@ pub fn graph_edge(g: &impl TileGraph, t: Tile, k: usize) -> bool {
 }
 
 /// Reusable dense scratch for Dijkstra and A* over a tile rectangle (no hashing; generation
-/// stamps avoid clearing between searches).
+/// stamps avoid clearing between searches). One record per tile, so a visit touches one cache
+/// line; heap entries carry the row-major tile index, whose order is the `(j, i)` tie-break.
 #[derive(Clone, Debug)]
 pub struct TileSearch {
     i0: i32,
     j0: i32,
     w: usize,
     h: usize,
-    dist: Vec<u64>,
-    parent: Vec<u32>,
-    stamp: Vec<u32>,
-    closed: Vec<u32>,
+    nodes: Vec<SearchNode>,
     generation: u32,
-    heap: BinaryHeap<Reverse<(u64, i32, i32)>>,
+    heap: BinaryHeap<Reverse<(u64, u32)>>,
+}
+
+/// Per-tile search state: valid when `stamp` is the current generation; settled when `closed`
+/// is.
+#[derive(Clone, Copy, Debug, Default)]
+struct SearchNode {
+    dist: u64,
+    parent: u32,
+    stamp: u32,
+    closed: u32,
 }
 
 impl TileSearch {
@@ -353,10 +361,13 @@ impl TileSearch {
             j0,
             w,
             h,
-            dist: vec![0; w * h],
-            parent: vec![u32::MAX; w * h],
-            stamp: vec![0; w * h],
-            closed: vec![0; w * h],
+            nodes: vec![
+                SearchNode {
+                    parent: u32::MAX,
+                    ..SearchNode::default()
+                };
+                w * h
+            ],
             generation: 0,
             heap: BinaryHeap::new(),
         }
@@ -381,8 +392,10 @@ impl TileSearch {
     fn begin(&mut self) {
         self.generation = self.generation.wrapping_add(1);
         if self.generation == 0 {
-            self.stamp.fill(0);
-            self.closed.fill(0);
+            for n in &mut self.nodes {
+                n.stamp = 0;
+                n.closed = 0;
+            }
             self.generation = 1;
         }
         self.heap.clear();
@@ -390,10 +403,12 @@ impl TileSearch {
 
     #[inline]
     fn relax(&mut self, k: usize, d: u64, parent: u32) -> bool {
-        if self.stamp[k] != self.generation || d < self.dist[k] {
-            self.stamp[k] = self.generation;
-            self.dist[k] = d;
-            self.parent[k] = parent;
+        let gen = self.generation;
+        let n = &mut self.nodes[k];
+        if n.stamp != gen || d < n.dist {
+            n.stamp = gen;
+            n.dist = d;
+            n.parent = parent;
             true
         } else {
             false
@@ -403,8 +418,8 @@ impl TileSearch {
     fn path_to(&self, k: usize) -> Vec<Tile> {
         let mut path = vec![self.tile(k)];
         let mut c = k;
-        while self.parent[c] != u32::MAX {
-            c = self.parent[c] as usize;
+        while self.nodes[c].parent != u32::MAX {
+            c = self.nodes[c].parent as usize;
             path.push(self.tile(c));
         }
         path.reverse();
@@ -422,14 +437,15 @@ impl TileSearch {
         let s = self.idx(from)?;
         self.begin();
         self.relax(s, 0, u32::MAX);
-        self.heap.push(Reverse((0, from.1, from.0)));
-        while let Some(Reverse((d, j, i))) = self.heap.pop() {
-            let t = (i, j);
-            let Some(k) = self.idx(t) else { continue };
-            if self.closed[k] == self.generation || d > self.dist[k] {
+        self.heap.push(Reverse((0, s as u32)));
+        while let Some(Reverse((d, k))) = self.heap.pop() {
+            let k = k as usize;
+            let n = self.nodes[k];
+            if n.closed == self.generation || d > n.dist {
                 continue;
             }
-            self.closed[k] = self.generation;
+            self.nodes[k].closed = self.generation;
+            let t = self.tile(k);
             if is_target(t) {
                 return Some((t, d));
             }
@@ -442,13 +458,13 @@ impl TileSearch {
         for (n, &(di, dj)) in N8.iter().enumerate() {
             let v = (t.0 + di, t.1 + dj);
             let Some(kv) = self.idx(v) else { continue };
-            if self.closed[kv] == self.generation || !graph_edge(g, t, n) {
+            if self.nodes[kv].closed == self.generation || !graph_edge(g, t, n) {
                 continue;
             }
             let nd = d + if n % 2 == 1 { COST_DIAG } else { COST_ORTHO };
             if self.relax(kv, nd, k as u32) {
                 let f = nd + goal.map_or(0, |gl| heuristic(v, gl));
-                self.heap.push(Reverse((f, v.1, v.0)));
+                self.heap.push(Reverse((f, kv as u32)));
             }
         }
     }
@@ -460,16 +476,15 @@ impl TileSearch {
         self.idx(to)?;
         self.begin();
         self.relax(s, 0, u32::MAX);
-        self.heap
-            .push(Reverse((heuristic(from, to), from.1, from.0)));
-        while let Some(Reverse((_, j, i))) = self.heap.pop() {
-            let t = (i, j);
-            let Some(k) = self.idx(t) else { continue };
-            if self.closed[k] == self.generation {
+        self.heap.push(Reverse((heuristic(from, to), s as u32)));
+        while let Some(Reverse((_, k))) = self.heap.pop() {
+            let k = k as usize;
+            if self.nodes[k].closed == self.generation {
                 continue;
             }
-            self.closed[k] = self.generation;
-            let d = self.dist[k];
+            self.nodes[k].closed = self.generation;
+            let d = self.nodes[k].dist;
+            let t = self.tile(k);
             if t == to {
                 return Some((self.path_to(k), d));
             }
