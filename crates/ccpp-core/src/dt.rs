@@ -54,35 +54,53 @@ pub fn squared_edt(
             }
         }
     }
-    // Phase 2 (Felzenszwalb-Huttenlocher lower envelope) along each row.
+    // Phase 2 (Felzenszwalb-Huttenlocher lower envelope) along each row; rows are independent,
+    // so large images split them between two threads.
     let big = (width.max(height) as f64 + 2.0).powi(2) * 4.0;
-    let mut f = vec![0f64; width];
-    let mut d = vec![0f64; width];
-    let mut v = vec![0usize; width];
-    let mut z = vec![0f64; width + 1];
     let mut out = vec![INF; n];
-    for r in 0..height {
-        let row = &g[r * width..(r + 1) * width];
-        for (fc, &gc) in f.iter_mut().zip(row) {
-            *fc = if gc >= NONE {
-                big
-            } else {
-                f64::from(gc) * f64::from(gc)
-            };
-        }
-        dt1d(&f, &mut d, &mut v, &mut z);
-        let o = &mut out[r * width..(r + 1) * width];
-        for c in 0..width {
-            let mut best = d[c];
-            if border_is_feature {
-                let b = (c + 1).min(width - c) as f64;
-                best = best.min(b * b);
+    let rows_pass = |g_rows: &[u32], out_rows: &mut [u32]| {
+        let mut f = vec![0f64; width];
+        let mut d = vec![0f64; width];
+        let mut v = vec![0usize; width];
+        let mut z = vec![0f64; width + 1];
+        for (row, o) in g_rows
+            .chunks_exact(width)
+            .zip(out_rows.chunks_exact_mut(width))
+        {
+            for (fc, &gc) in f.iter_mut().zip(row) {
+                *fc = if gc >= NONE {
+                    big
+                } else {
+                    f64::from(gc) * f64::from(gc)
+                };
             }
-            o[c] = if best >= big { INF } else { best as u32 };
+            dt1d(&f, &mut d, &mut v, &mut z);
+            for c in 0..width {
+                let mut best = d[c];
+                if border_is_feature {
+                    let b = (c + 1).min(width - c) as f64;
+                    best = best.min(b * b);
+                }
+                o[c] = if best >= big { INF } else { best as u32 };
+            }
         }
+    };
+    if n >= PARALLEL_MIN_PIXELS && height >= 2 {
+        let split = height / 2 * width;
+        let (g0, g1) = g.split_at(split);
+        let (o0, o1) = out.split_at_mut(split);
+        std::thread::scope(|s| {
+            s.spawn(|| rows_pass(g1, o1));
+            rows_pass(g0, o0);
+        });
+    } else {
+        rows_pass(&g, &mut out);
     }
     out
 }
+
+/// Images at least this large (pixels) run phase 2 on two threads.
+const PARALLEL_MIN_PIXELS: usize = 1 << 20;
 
 /// Lower envelope of parabolas: `d[q] = min_p (q - p)^2 + f[p]`.
 fn dt1d(f: &[f64], d: &mut [f64], v: &mut [usize], z: &mut [f64]) {

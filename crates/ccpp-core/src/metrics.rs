@@ -105,19 +105,44 @@ pub fn execution_tolerance(trace: &Trace) -> Option<f64> {
 /// (inclusive, with [`SWEEP_EPS_PX`]). The start position alone sweeps a disk.
 pub fn swept_pixels(world: &World, trace: &Trace) -> FixedBitSet {
     let frame = *world.frame();
-    let mut swept = FixedBitSet::with_capacity(frame.len());
     let rt = world.robot().tool_radius / frame.resolution + SWEEP_EPS_PX;
-    let mut prev: Option<Point> = None;
-    for p in trace.poses() {
-        let g = frame.world_to_grid(p.position());
-        match prev {
-            None => stamp_capsule(&mut swept, &frame, g, g, rt, &mut |_| {}),
-            Some(a) if a != g => stamp_capsule(&mut swept, &frame, a, g, rt, &mut |_| {}),
-            Some(_) => {}
+    let points: Vec<Point> = trace
+        .poses()
+        .map(|p| frame.world_to_grid(p.position()))
+        .collect();
+    // Segments between consecutive distinct points (a lone first point sweeps its disk).
+    let sweep = |pts: &[Point], first: bool| {
+        let mut swept = FixedBitSet::with_capacity(frame.len());
+        if first {
+            if let Some(&g) = pts.first() {
+                stamp_capsule(&mut swept, &frame, g, g, rt, &mut |_| {});
+            }
         }
-        prev = Some(g);
+        for w in pts.windows(2) {
+            if w[0] != w[1] {
+                stamp_capsule(&mut swept, &frame, w[0], w[1], rt, &mut |_| {});
+            }
+        }
+        swept
+    };
+    // Long traces: two halves on two threads (sharing the middle point), then the union.
+    if points.len() < 1 << 14 {
+        return sweep(&points, true);
     }
-    swept
+    let mid = points.len() / 2;
+    let (mut a, b) = std::thread::scope(|s| {
+        let second = s.spawn(|| sweep(&points[mid..], false));
+        let first = sweep(&points[..=mid], true);
+        (first, second.join())
+    });
+    match b {
+        Ok(b) => a.union_with(&b),
+        Err(_) => {
+            // A panic in the helper thread cannot come from these pure loops; sweep serially.
+            return sweep(&points, true);
+        }
+    }
+    a
 }
 
 /// Marks pixel centres within `rt` (pixels) of segment `a`-`b` (grid coordinates), row by row,

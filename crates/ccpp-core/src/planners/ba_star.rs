@@ -856,7 +856,8 @@ struct Mind {
     r: f64,
     /// Contact radius in pixels.
     rc_px: f64,
-    last_scan: Option<Pose>,
+    /// Where the last scan was integrated.
+    last_scan: Option<Point>,
     /// Scratch for [`Mind::sense`]: per row of the last scan, the column span of the pixels
     /// seen for the first time (`(usize::MAX, 0)` when none).
     new_spans: Vec<(usize, usize)>,
@@ -936,11 +937,12 @@ impl Mind {
     /// definition itself (tests check the cache against it after every step) — only when the
     /// bounding box of its disk meets one of those spans.
     fn sense(&mut self, sensor: &dyn Sensor) {
-        let pose = sensor.pose();
-        if self.last_scan == Some(pose) {
+        // The sensor sees a disk around the robot: turning in place shows nothing new.
+        let at = sensor.pose().position();
+        if self.last_scan == Some(at) {
             return;
         }
-        self.last_scan = Some(pose);
+        self.last_scan = Some(at);
         let scan = sensor.scan();
         // Rows come top to bottom, each row's new pixels left to right.
         let mut spans = std::mem::take(&mut self.new_spans);
