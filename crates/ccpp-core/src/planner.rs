@@ -174,6 +174,39 @@ pub trait Planner {
     fn next(&mut self, sensor: &dyn Sensor) -> Step;
 }
 
+/// Image rows (signed, one row of margin each side) that the disk of radius `rc` pixels at grid
+/// point `g` can reach.
+pub(crate) fn disk_rows(frame: &MapFrame, g: Point, rc: f64) -> std::ops::RangeInclusive<i64> {
+    let h = frame.height as f64;
+    floor_i64(h - (g.y + rc) - 0.5) - 1..=ceil_i64(h - (g.y - rc) - 0.5) + 1
+}
+
+/// The columns (signed) of image row `row` whose pixel centre `q` has `|q - g|^2 < rc^2`, or
+/// `None`. The predicate is convex in the column, so they are the interval between the first
+/// and the last column satisfying it: guessed from the square root, settled with the predicate.
+#[inline]
+pub(crate) fn disk_row_span(frame: &MapFrame, g: Point, rc: f64, row: i64) -> Option<(i64, i64)> {
+    let rc2 = rc * rc;
+    let gy = frame.height as f64 - row as f64 - 0.5;
+    let dy = gy - g.y;
+    let rem = rc2 - dy * dy;
+    if rem <= 0.0 {
+        // dx^2 + dy^2 >= dy^2 >= rc^2: no pixel of this row touches.
+        return None;
+    }
+    let touches = |col: i64| Point::new(col as f64 + 0.5, gy).dist2(g) < rc2;
+    let half = rem.sqrt();
+    let mut lo = ceil_i64(g.x - half - 0.5) - 1;
+    let mut hi = floor_i64(g.x + half - 0.5) + 1;
+    while lo <= hi && !touches(lo) {
+        lo += 1;
+    }
+    while hi >= lo && !touches(hi) {
+        hi -= 1;
+    }
+    (lo <= hi).then_some((lo, hi))
+}
+
 /// The disk of contact radius `rc` pixels around a pixel centre, as row half-widths: entry
 /// `dy` is the largest `dx >= 0` with `dx^2 + dy^2 < rc^2`, or -1 when the row holds no pixel.
 pub(crate) fn pixel_disk_spans(rc: f64) -> Vec<i64> {
@@ -325,47 +358,19 @@ impl KnownMap {
     /// the first and the last column satisfying it; the interval is read off the bitsets.
     pub(crate) fn disk_state(&self, g: Point, rc: f64) -> DiskState {
         let frame = *self.grid.frame();
-        let rc2 = rc * rc;
-        let h = frame.height as f64;
         let (w, hh) = (frame.width as i64, frame.height as i64);
-        let row0 = floor_i64(h - (g.y + rc) - 0.5) - 1;
-        let row1 = ceil_i64(h - (g.y - rc) - 0.5) + 1;
         let mut unseen = false;
-        for row in row0..=row1 {
-            let gy = h - row as f64 - 0.5;
-            let dy = gy - g.y;
-            let rem = rc2 - dy * dy;
-            if rem <= 0.0 {
-                // dx^2 + dy^2 >= dy^2 >= rc^2: no pixel of this row touches.
+        for row in disk_rows(&frame, g, rc) {
+            let Some((lo, hi)) = disk_row_span(&frame, g, rc, row) else {
                 continue;
-            }
-            let touches = |col: i64| Point::new(col as f64 + 0.5, gy).dist2(g) < rc2;
-            let half = rem.sqrt();
-            let mut lo = ceil_i64(g.x - half - 0.5) - 1;
-            let mut hi = floor_i64(g.x + half - 0.5) + 1;
-            while lo <= hi && !touches(lo) {
-                lo += 1;
-            }
-            while hi >= lo && !touches(hi) {
-                hi -= 1;
-            }
-            if lo > hi {
-                continue;
-            }
+            };
             // Outside the image every pixel is occupied (and seen).
-            if row < 0 || row >= hh || lo < 0 || hi >= w {
-                return DiskState::Blocked;
-            }
-            let mut blocked = false;
-            self.for_each_not_known_free(row as usize, lo as usize, hi as usize, |_, seen| {
-                if seen {
-                    blocked = true;
-                    return false;
-                }
-                unseen = true;
-                true
-            });
-            if blocked {
+            if row < 0
+                || row >= hh
+                || lo < 0
+                || hi >= w
+                || self.row_blocked(row as usize, lo as usize, hi as usize, &mut unseen)
+            {
                 return DiskState::Blocked;
             }
         }
@@ -390,19 +395,12 @@ impl KnownMap {
                 continue;
             }
             let (r, lo, hi) = (row + dy, col - hw, col + hw);
-            if r < 0 || r >= hh || lo < 0 || hi >= w {
-                return DiskState::Blocked;
-            }
-            let mut blocked = false;
-            self.for_each_not_known_free(r as usize, lo as usize, hi as usize, |_, seen| {
-                if seen {
-                    blocked = true;
-                    return false;
-                }
-                unseen = true;
-                true
-            });
-            if blocked {
+            if r < 0
+                || r >= hh
+                || lo < 0
+                || hi >= w
+                || self.row_blocked(r as usize, lo as usize, hi as usize, &mut unseen)
+            {
                 return DiskState::Blocked;
             }
         }
@@ -411,6 +409,21 @@ impl KnownMap {
         } else {
             DiskState::Free
         }
+    }
+
+    /// Does a seen blocked pixel lie in image row `row`, columns `lo..=hi`? Sets `unseen` when
+    /// an unseen pixel lies there (before the first blocked one).
+    pub(crate) fn row_blocked(&self, row: usize, lo: usize, hi: usize, unseen: &mut bool) -> bool {
+        let mut blocked = false;
+        self.for_each_not_known_free(row, lo, hi, |_, seen| {
+            if seen {
+                blocked = true;
+                return false;
+            }
+            *unseen = true;
+            true
+        });
+        blocked
     }
 
     /// Can the robot (radius `r` metres) stand at world point `p`, as far as it knows?

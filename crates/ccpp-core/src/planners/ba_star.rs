@@ -90,7 +90,7 @@ use crate::geometry::{
     Pose,
 };
 use crate::grid::MapFrame;
-use crate::planner::{DiskState, KnownMap, Planner, Sensor, Step};
+use crate::planner::{disk_row_span, disk_rows, DiskState, KnownMap, Planner, Sensor, Step};
 use crate::tiles::{Tile, TileGrid, N8};
 use crate::trace::Event;
 
@@ -1027,37 +1027,19 @@ impl Mind {
         if self.disk.row0[k] == i32::MIN {
             let frame = *self.known.frame();
             let rc = self.rc_px;
-            let rc2 = rc * rc;
-            let h = frame.height as f64;
             let (w, hh) = (frame.width as i64, frame.height as i64);
-            let row0 = floor_i64(h - (g.y + rc) - 0.5) - 1;
-            let row1 = ceil_i64(h - (g.y - rc) - 0.5) + 1;
+            let rows = disk_rows(&frame, g, rc);
+            let (row0, row1) = (*rows.start(), *rows.end());
             let col0 = floor_i64(g.x - rc - 0.5) - 1;
             if row1 - row0 + 1 > n as i64 || !(0..=i64::from(i32::MAX)).contains(&row0) {
                 return judge_point(&self.known, g, rc);
             }
             let slots = &mut self.disk.spans[k * n..(k + 1) * n];
             slots.fill([1, 0]);
-            for (slot, row) in slots.iter_mut().zip(row0..=row1) {
-                let gy = h - row as f64 - 0.5;
-                let dy = gy - g.y;
-                let rem = rc2 - dy * dy;
-                if rem <= 0.0 {
+            for (slot, row) in slots.iter_mut().zip(rows) {
+                let Some((lo, hi)) = disk_row_span(&frame, g, rc, row) else {
                     continue;
-                }
-                let touches = |col: i64| Point::new(col as f64 + 0.5, gy).dist2(g) < rc2;
-                let half = rem.sqrt();
-                let mut lo = ceil_i64(g.x - half - 0.5) - 1;
-                let mut hi = floor_i64(g.x + half - 0.5) + 1;
-                while lo <= hi && !touches(lo) {
-                    lo += 1;
-                }
-                while hi >= lo && !touches(hi) {
-                    hi -= 1;
-                }
-                if lo > hi {
-                    continue;
-                }
+                };
                 if row >= hh || lo < 0 || hi >= w || hi - col0 > 250 {
                     // Reaches outside the image (blocked), or too wide to cache.
                     return judge_point(&self.known, g, rc);
@@ -1070,24 +1052,14 @@ impl Mind {
         let (row0, col0) = (self.disk.row0[k] as usize, self.disk.col0[k] as usize);
         let mut undetermined = false;
         for (i, &[a, b]) in self.disk.spans[k * n..(k + 1) * n].iter().enumerate() {
-            if a > b {
-                continue;
-            }
-            let mut blocked = false;
-            self.known.for_each_not_known_free(
-                row0 + i,
-                col0 + usize::from(a),
-                col0 + usize::from(b),
-                |_, seen| {
-                    if seen {
-                        blocked = true;
-                        return false;
-                    }
-                    undetermined = true;
-                    true
-                },
-            );
-            if blocked {
+            if a <= b
+                && self.known.row_blocked(
+                    row0 + i,
+                    col0 + usize::from(a),
+                    col0 + usize::from(b),
+                    &mut undetermined,
+                )
+            {
                 return Judgement::Blocked;
             }
         }
