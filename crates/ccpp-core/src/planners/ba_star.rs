@@ -1030,7 +1030,8 @@ impl Mind {
             let (w, hh) = (frame.width as i64, frame.height as i64);
             let rows = disk_rows(&frame, g, rc);
             let (row0, row1) = (*rows.start(), *rows.end());
-            let col0 = floor_i64(g.x - rc - 0.5) - 1;
+            // Offsets are taken from here; any touching column is >= 0 (else blocked).
+            let col0 = (floor_i64(g.x - rc - 0.5) - 1).max(0);
             if row1 - row0 + 1 > n as i64 || !(0..=i64::from(i32::MAX)).contains(&row0) {
                 return judge_point(&self.known, g, rc);
             }
