@@ -996,21 +996,40 @@ impl Mind {
                 if self.tiles.state[k] & ST_STAND != Judgement::Undetermined as u8 {
                     continue;
                 }
-                let g = frame.world_to_grid(self.center(t));
-                // Pixel rows and columns the disk can reach (one pixel of margin).
-                let r_lo = floor_i64(h - (g.y + rc) - 0.5) - 1;
-                let r_hi = ceil_i64(h - (g.y - rc) - 0.5) + 1;
-                let c_lo = floor_i64(g.x - rc - 0.5) - 1;
-                let c_hi = ceil_i64(g.x + rc - 0.5) + 1;
-                let rows = r_lo.max(first_row as i64)..=r_hi.min(last_row as i64);
-                let hit = rows.into_iter().any(|row| {
-                    let s = spans[(row - first_row as i64) as usize];
-                    s.0 <= s.1 && (s.0 as i64) <= c_hi && (s.1 as i64) >= c_lo
-                });
+                let hit = if self.disk.row0[k] == i32::MIN {
+                    // Not cached yet: the rows and columns the disk can reach (one pixel of
+                    // margin).
+                    let g = frame.world_to_grid(self.center(t));
+                    let r_lo = floor_i64(h - (g.y + rc) - 0.5) - 1;
+                    let r_hi = ceil_i64(h - (g.y - rc) - 0.5) + 1;
+                    let c_lo = floor_i64(g.x - rc - 0.5) - 1;
+                    let c_hi = ceil_i64(g.x + rc - 0.5) + 1;
+                    let rows = r_lo.max(first_row as i64)..=r_hi.min(last_row as i64);
+                    rows.into_iter().any(|row| {
+                        let s = spans[(row - first_row as i64) as usize];
+                        s.0 <= s.1 && (s.0 as i64) <= c_hi && (s.1 as i64) >= c_lo
+                    })
+                } else {
+                    // Cached: the disk's own pixel runs against the new ones.
+                    let n = self.disk.rows;
+                    let (row0, col0) = (self.disk.row0[k] as usize, self.disk.col0[k] as usize);
+                    self.disk.spans[k * n..(k + 1) * n]
+                        .iter()
+                        .enumerate()
+                        .any(|(i, &[a, b])| {
+                            let row = row0 + i;
+                            a <= b && (first_row..=last_row).contains(&row) && {
+                                let s = spans[row - first_row];
+                                s.0 <= s.1
+                                    && s.0 <= col0 + usize::from(b)
+                                    && s.1 >= col0 + usize::from(a)
+                            }
+                        })
+                };
                 if !hit {
                     continue;
                 }
-                let judged = self.judge_tile(k, g);
+                let judged = self.judge_tile(k, t);
                 if judged != Judgement::Undetermined {
                     self.set_stand(k, t, judged);
                 }
@@ -1022,10 +1041,11 @@ impl Mind {
     /// [`judge_point`] for tile `k` (disk centre `g` in grid coordinates), with the disk's
     /// pixel spans computed once per tile by the same predicate and cached (a tile is judged
     /// again each time new pixels reach its disk, until it is decided).
-    fn judge_tile(&mut self, k: usize, g: Point) -> Judgement {
+    fn judge_tile(&mut self, k: usize, t: Tile) -> Judgement {
         let n = self.disk.rows;
         if self.disk.row0[k] == i32::MIN {
             let frame = *self.known.frame();
+            let g = frame.world_to_grid(self.center(t));
             let rc = self.rc_px;
             let (w, hh) = (frame.width as i64, frame.height as i64);
             let rows = disk_rows(&frame, g, rc);
