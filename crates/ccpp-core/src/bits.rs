@@ -40,6 +40,30 @@ pub(crate) fn for_each_set(
     true
 }
 
+/// Sets the bits `a..b` of `blocks` and calls `on_new(i)` for every index `i` among them that
+/// was not set before, in increasing order.
+#[inline]
+pub(crate) fn insert_range(
+    blocks: &mut [usize],
+    a: usize,
+    b: usize,
+    mut on_new: impl FnMut(usize),
+) {
+    let mut blk = a / BLOCK_BITS;
+    while blk * BLOCK_BITS < b {
+        let start = blk * BLOCK_BITS;
+        let mask = range_mask(a.max(start) - start, b.min(start + BLOCK_BITS) - start);
+        let mut new = mask & !blocks[blk];
+        blocks[blk] |= mask;
+        while new != 0 {
+            let bit = new.trailing_zeros() as usize;
+            new &= new - 1;
+            on_new(start + bit);
+        }
+        blk += 1;
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -76,5 +100,15 @@ mod tests {
             }
         ));
         assert_eq!(n, 3);
+    }
+
+    #[test]
+    fn insert_range_reports_only_new_bits() {
+        let mut words = [0b1010usize, 0, 0];
+        let mut new = Vec::new();
+        insert_range(&mut words, 1, BLOCK_BITS + 3, |i| new.push(i));
+        let want: Vec<usize> = (1..BLOCK_BITS + 3).filter(|&i| i != 1 && i != 3).collect();
+        assert_eq!(new, want);
+        assert_eq!(words, [usize::MAX - 1, 0b111, 0]);
     }
 }

@@ -130,19 +130,15 @@ pub fn swept_pixels(world: &World, trace: &Trace) -> FixedBitSet {
         return sweep(&points, true);
     }
     let mid = points.len() / 2;
-    let (mut a, b) = std::thread::scope(|s| {
+    std::thread::scope(|s| {
         let second = s.spawn(|| sweep(&points[mid..], false));
-        let first = sweep(&points[..=mid], true);
-        (first, second.join())
-    });
-    match b {
-        Ok(b) => a.union_with(&b),
-        Err(_) => {
-            // A panic in the helper thread cannot come from these pure loops; sweep serially.
-            return sweep(&points, true);
+        let mut swept = sweep(&points[..=mid], true);
+        match second.join() {
+            Ok(b) => swept.union_with(&b),
+            Err(panic) => std::panic::resume_unwind(panic),
         }
-    }
-    a
+        swept
+    })
 }
 
 /// Marks pixel centres within `rt` (pixels) of segment `a`-`b` (grid coordinates), row by row,
@@ -245,28 +241,12 @@ pub(crate) fn stamp_capsule(
             continue;
         }
         let base = row as usize * frame.width;
-        put_range(bits, base + c_lo as usize, base + c_hi as usize, on_new);
-    }
-}
-
-/// Marks bits `from..=to`, calling `on_new` for each bit not set before.
-#[inline]
-fn put_range(bits: &mut FixedBitSet, from: usize, to: usize, on_new: &mut impl FnMut(usize)) {
-    use crate::bits::{range_mask, BLOCK_BITS};
-    let blocks = bits.as_mut_slice();
-    let (a, b) = (from, to + 1);
-    let mut blk = a / BLOCK_BITS;
-    while blk * BLOCK_BITS < b {
-        let start = blk * BLOCK_BITS;
-        let mask = range_mask(a.max(start) - start, b.min(start + BLOCK_BITS) - start);
-        let mut new = mask & !blocks[blk];
-        blocks[blk] |= mask;
-        while new != 0 {
-            let bit = new.trailing_zeros() as usize;
-            new &= new - 1;
-            on_new(start + bit);
-        }
-        blk += 1;
+        crate::bits::insert_range(
+            bits.as_mut_slice(),
+            base + c_lo as usize,
+            base + c_hi as usize + 1,
+            &mut *on_new,
+        );
     }
 }
 

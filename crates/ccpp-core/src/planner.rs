@@ -7,7 +7,7 @@
 
 use fixedbitset::FixedBitSet;
 
-use crate::bits::{range_mask, BLOCK_BITS};
+use crate::bits::BLOCK_BITS;
 use crate::collide::{self, Occupancy};
 use crate::geometry::{ceil_i64, floor_i64, Point, Pose};
 use crate::grid::{Cell, GridMap, MapFrame};
@@ -279,26 +279,15 @@ impl KnownMap {
         let seen = self.seen.as_mut_slice();
         let free = self.free.as_mut_slice();
         scan.for_each_row_span(|row, lo, hi| {
-            let (a, b) = (row * w + lo, row * w + hi + 1);
-            let mut blk = a / BLOCK_BITS;
-            while blk * BLOCK_BITS < b {
-                let base = blk * BLOCK_BITS;
-                let mask = range_mask(a.max(base) - base, b.min(base + BLOCK_BITS) - base);
-                let mut new = !seen[blk] & mask;
-                seen[blk] |= mask;
-                while new != 0 {
-                    let bit = new.trailing_zeros() as usize;
-                    new &= new - 1;
-                    let i = base + bit;
-                    let cell = truth[i];
-                    cells[i] = cell;
-                    if cell.is_free() {
-                        free[blk] |= 1 << bit;
-                    }
-                    first_seen(i - row * w, row, cell);
+            let base = row * w;
+            crate::bits::insert_range(seen, base + lo, base + hi + 1, |i| {
+                let cell = truth[i];
+                cells[i] = cell;
+                if cell.is_free() {
+                    free[i / BLOCK_BITS] |= 1 << (i % BLOCK_BITS);
                 }
-                blk += 1;
-            }
+                first_seen(i - base, row, cell);
+            });
         });
     }
 
@@ -358,48 +347,37 @@ impl KnownMap {
     /// the first and the last column satisfying it; the interval is read off the bitsets.
     pub(crate) fn disk_state(&self, g: Point, rc: f64) -> DiskState {
         let frame = *self.grid.frame();
-        let (w, hh) = (frame.width as i64, frame.height as i64);
-        let mut unseen = false;
-        for row in disk_rows(&frame, g, rc) {
-            let Some((lo, hi)) = disk_row_span(&frame, g, rc, row) else {
-                continue;
-            };
-            // Outside the image every pixel is occupied (and seen).
-            if row < 0
-                || row >= hh
-                || lo < 0
-                || hi >= w
-                || self.row_blocked(row as usize, lo as usize, hi as usize, &mut unseen)
-            {
-                return DiskState::Blocked;
-            }
-        }
-        if unseen {
-            DiskState::Unseen
-        } else {
-            DiskState::Free
-        }
+        self.runs_state(
+            disk_rows(&frame, g, rc)
+                .filter_map(|row| disk_row_span(&frame, g, rc, row).map(|(lo, hi)| (row, lo, hi))),
+        )
     }
 
     /// [`Self::disk_state`] at the centre of pixel `(col, row)`, with the disk given as
     /// [`pixel_disk_spans`] (centres are whole pixels apart, so the disk is the same integer
     /// pattern around every pixel and the predicate is exact in integers).
     pub(crate) fn disk_state_px(&self, col: i64, row: i64, spans: &[i64]) -> DiskState {
+        let reach = spans.len() as i64 - 1;
+        self.runs_state((-reach..=reach).filter_map(|dy| {
+            let hw = spans[dy.unsigned_abs() as usize];
+            (hw >= 0).then_some((row + dy, col - hw, col + hw))
+        }))
+    }
+
+    /// What is known of the pixels in the runs `(row, lo, hi)` (signed; columns `lo..=hi`):
+    /// blocked when one is seen blocked or lies outside the image, else unseen when one is not
+    /// seen yet, else free.
+    pub(crate) fn runs_state(&self, runs: impl Iterator<Item = (i64, i64, i64)>) -> DiskState {
         let frame = *self.grid.frame();
         let (w, hh) = (frame.width as i64, frame.height as i64);
-        let reach = spans.len() as i64 - 1;
         let mut unseen = false;
-        for dy in -reach..=reach {
-            let hw = spans[dy.unsigned_abs() as usize];
-            if hw < 0 {
-                continue;
-            }
-            let (r, lo, hi) = (row + dy, col - hw, col + hw);
-            if r < 0
-                || r >= hh
+        for (row, lo, hi) in runs {
+            // Outside the image every pixel is occupied (and seen).
+            if row < 0
+                || row >= hh
                 || lo < 0
                 || hi >= w
-                || self.row_blocked(r as usize, lo as usize, hi as usize, &mut unseen)
+                || self.row_blocked(row as usize, lo as usize, hi as usize, &mut unseen)
             {
                 return DiskState::Blocked;
             }

@@ -232,10 +232,16 @@ pub fn judge_motion(known: &KnownMap, a: Point, b: Point, r: f64) -> Judgement {
 /// [`judge_motion`] for a motionless disk at grid point `g` (contact radius `rc` pixels): the
 /// same predicate (`|q - g|^2 < rc^2` for a pixel centre `q`), by [`KnownMap::disk_state`].
 fn judge_point(known: &KnownMap, g: Point, rc: f64) -> Judgement {
-    match known.disk_state(g, rc) {
-        DiskState::Free => Judgement::Free,
-        DiskState::Blocked => Judgement::Blocked,
-        DiskState::Unseen => Judgement::Undetermined,
+    known.disk_state(g, rc).into()
+}
+
+impl From<DiskState> for Judgement {
+    fn from(s: DiskState) -> Self {
+        match s {
+            DiskState::Free => Judgement::Free,
+            DiskState::Blocked => Judgement::Blocked,
+            DiskState::Unseen => Judgement::Undetermined,
+        }
     }
 }
 
@@ -934,8 +940,9 @@ impl Mind {
     /// A tile's standability can change only when a pixel of its contact disk is seen for the
     /// first time. The newly seen pixels are kept as one column span per row; an undetermined
     /// tile is judged again — with [`judge_motion`]'s predicate at the tile centre, the
-    /// definition itself (tests check the cache against it after every step) — only when the
-    /// bounding box of its disk meets one of those spans.
+    /// definition itself (tests check the cache against it after every step) — only when its
+    /// cached disk runs (before the first judgement: the bounding box of its disk) meet one of
+    /// those spans.
     fn sense(&mut self, sensor: &dyn Sensor) {
         // The sensor sees a disk around the robot: turning in place shows nothing new.
         let at = sensor.pose().position();
@@ -1000,11 +1007,11 @@ impl Mind {
                     // Not cached yet: the rows and columns the disk can reach (one pixel of
                     // margin).
                     let g = frame.world_to_grid(self.center(t));
-                    let r_lo = floor_i64(h - (g.y + rc) - 0.5) - 1;
-                    let r_hi = ceil_i64(h - (g.y - rc) - 0.5) + 1;
+                    let rows = disk_rows(&frame, g, rc);
                     let c_lo = floor_i64(g.x - rc - 0.5) - 1;
                     let c_hi = ceil_i64(g.x + rc - 0.5) + 1;
-                    let rows = r_lo.max(first_row as i64)..=r_hi.min(last_row as i64);
+                    let rows =
+                        (*rows.start()).max(first_row as i64)..=(*rows.end()).min(last_row as i64);
                     rows.into_iter().any(|row| {
                         let s = spans[(row - first_row as i64) as usize];
                         s.0 <= s.1 && (s.0 as i64) <= c_hi && (s.1 as i64) >= c_lo
@@ -1038,9 +1045,9 @@ impl Mind {
         self.new_spans = spans;
     }
 
-    /// [`judge_point`] for tile `k` (disk centre `g` in grid coordinates), with the disk's
-    /// pixel spans computed once per tile by the same predicate and cached (a tile is judged
-    /// again each time new pixels reach its disk, until it is decided).
+    /// [`judge_point`] for tile `k` (`t`), with the disk's pixel spans computed once per tile
+    /// by the same predicate and cached (a tile is judged again each time new pixels reach its
+    /// disk, until it is decided).
     fn judge_tile(&mut self, k: usize, t: Tile) -> Judgement {
         let n = self.disk.rows;
         if self.disk.row0[k] == i32::MIN {
@@ -1070,25 +1077,13 @@ impl Mind {
             self.disk.row0[k] = row0 as i32;
             self.disk.col0[k] = col0 as i32;
         }
-        let (row0, col0) = (self.disk.row0[k] as usize, self.disk.col0[k] as usize);
-        let mut undetermined = false;
-        for (i, &[a, b]) in self.disk.spans[k * n..(k + 1) * n].iter().enumerate() {
-            if a <= b
-                && self.known.row_blocked(
-                    row0 + i,
-                    col0 + usize::from(a),
-                    col0 + usize::from(b),
-                    &mut undetermined,
-                )
-            {
-                return Judgement::Blocked;
-            }
-        }
-        if undetermined {
-            Judgement::Undetermined
-        } else {
-            Judgement::Free
-        }
+        let (row0, col0) = (i64::from(self.disk.row0[k]), i64::from(self.disk.col0[k]));
+        let runs = self.disk.spans[k * n..(k + 1) * n]
+            .iter()
+            .zip(row0..)
+            .filter(|(&[a, b], _)| a <= b)
+            .map(|(&[a, b], row)| (row, col0 + i64::from(a), col0 + i64::from(b)));
+        self.known.runs_state(runs).into()
     }
 
     /// Marks `t` covered (the robot stands on it), decides its moves and updates L.
@@ -1273,6 +1268,7 @@ impl BaStar {
         tiles.judge_frame_edges(&known, r);
         let search = TileSearch::new(tiles.bounds());
         let n_tiles = tiles.state.len();
+        let rc_px = contact_radius_px(r / frame.resolution);
         let range = sensor.sensor_range();
         if range < side + r + frame.resolution {
             self.pending.push_back(Step::Mark(Event::Note {
@@ -1288,10 +1284,10 @@ impl BaStar {
             tiles,
             search,
             r,
-            rc_px: contact_radius_px(r / frame.resolution),
+            rc_px,
             last_scan: None,
             new_spans: Vec::new(),
-            disk: DiskCache::new(n_tiles, contact_radius_px(r / frame.resolution)),
+            disk: DiskCache::new(n_tiles, rc_px),
         }));
     }
 

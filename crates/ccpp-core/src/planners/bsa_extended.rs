@@ -142,27 +142,6 @@ const UNSEEN: u8 = 3;
 /// Follow steps looked ahead when deciding on skin excursions.
 const LOOKAHEAD: usize = 6;
 
-/// Disk status on the known map.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Status {
-    /// No blocked pixel in contact, every pixel in contact seen: final.
-    Free,
-    /// A known blocked pixel (or the outside) in contact: final.
-    Blocked,
-    /// Free as far as seen, but some pixel in contact is unseen.
-    Unseen,
-}
-
-/// Status of a disk of radius `r_px` (pixels) at grid point `g` on the known map, with the
-/// obstacle model of [`crate::collide`].
-fn disk_status(known: &KnownMap, g: Point, r_px: f64) -> Status {
-    match known.disk_state(g, crate::collide::contact_radius_px(r_px)) {
-        DiskState::Free => Status::Free,
-        DiskState::Blocked => Status::Blocked,
-        DiskState::Unseen => Status::Unseen,
-    }
-}
-
 /// A pixel in signed `(col, row)` (row 0 at the top).
 type Px = (i64, i64);
 
@@ -308,54 +287,42 @@ impl Extension {
         let Some((c, r)) = f.checked(p.0, p.1) else {
             return Some(false);
         };
-        let i = f.index(c, r);
-        match self.s_memo[i] {
-            1 => return Some(true),
-            2 => return Some(false),
-            UNSEEN => return None,
-            _ => {}
-        }
-        match known.disk_state_px(c as i64, r as i64, &self.s_disk) {
-            DiskState::Free => {
-                self.s_memo[i] = 1;
-                Some(true)
-            }
-            DiskState::Blocked => {
-                self.s_memo[i] = 2;
-                Some(false)
-            }
-            DiskState::Unseen => {
-                self.s_memo[i] = UNSEEN;
-                self.unseen_marks.push((i, false));
-                None
-            }
-        }
+        self.memo_test(known, (c, r), false)
     }
 
     /// Is pixel `p` in `S0` (the robot disk itself fits at its centre, clearance 0)? `None`
     /// when an unseen pixel decides (memoised until the next scan).
     fn in_s0(&mut self, known: &KnownMap, p: Px) -> Option<bool> {
-        let f = self.frame();
-        let (c, r) = f.checked(p.0, p.1)?;
-        let i = f.index(c, r);
-        match self.s0_memo[i] {
+        let (c, r) = self.frame().checked(p.0, p.1)?;
+        self.memo_test(known, (c, r), true)
+    }
+
+    /// The `S` (or, with `s0`, `S0`) test of pixel `(c, r)` through its memo.
+    fn memo_test(&mut self, known: &KnownMap, (c, r): (usize, usize), s0: bool) -> Option<bool> {
+        let i = self.frame().index(c, r);
+        let (memo, disk) = if s0 {
+            (&mut self.s0_memo, &self.s0_disk)
+        } else {
+            (&mut self.s_memo, &self.s_disk)
+        };
+        match memo[i] {
             1 => return Some(true),
             2 => return Some(false),
             UNSEEN => return None,
             _ => {}
         }
-        match known.disk_state_px(c as i64, r as i64, &self.s0_disk) {
+        match known.disk_state_px(c as i64, r as i64, disk) {
             DiskState::Free => {
-                self.s0_memo[i] = 1;
+                memo[i] = 1;
                 Some(true)
             }
             DiskState::Blocked => {
-                self.s0_memo[i] = 2;
+                memo[i] = 2;
                 Some(false)
             }
             DiskState::Unseen => {
-                self.s0_memo[i] = UNSEEN;
-                self.unseen_marks.push((i, true));
+                memo[i] = UNSEEN;
+                self.unseen_marks.push((i, s0));
                 None
             }
         }
@@ -646,13 +613,14 @@ impl Extension {
                 if cn.dist(pw) > decide_within {
                     continue;
                 }
-                match disk_status(&core.known, f.world_to_grid(cn), self.r_px) {
-                    Status::Free => core.cells.set(n, STAND_FREE),
-                    Status::Blocked => {
+                let rc = crate::collide::contact_radius_px(self.r_px);
+                match core.known.disk_state(f.world_to_grid(cn), rc) {
+                    DiskState::Free => core.cells.set(n, STAND_FREE),
+                    DiskState::Blocked => {
                         core.cells.set(n, STAND_BLOCKED);
                         continue;
                     }
-                    Status::Unseen => continue,
+                    DiskState::Unseen => continue,
                 }
             }
             core.add_bp(n, queue);
