@@ -12,8 +12,10 @@
 //!    `mu(s) = b(s1,s8) + b(s1,s2) + b(s5,s6) + b(s5,s4) + b(s7,s6) + b(s7,s8)` (see
 //!    [`corner_score`]). Maintained incrementally, checked against a full recomputation in tests.
 //!    **Deviation:** by default `mu` also counts [`lane_end_score`] (a side neighbour free while
-//!    the lane ends at an obstacle; the start tile's south neighbour); the paper's six pairs alone
-//!    can miss a frontier and stall.
+//!    the lane ends at an obstacle; the start tile's south neighbour) and the same lane ends
+//!    judged by *moves* rather than by standability ([`SIDE_END_PAIRS`]: a free side that the
+//!    lane does not carry on, which pixel clutter produces at standable but unenterable tiles);
+//!    the paper's six pairs alone can miss a frontier and stall.
 //! 3. **Selection.** One Dijkstra from the critical point over covered tiles (8-connected, no
 //!    corner cutting) stops at the first tile of `L` it settles; ties: smaller `j`, then smaller `i`
 //!    ([`TileSearch::nearest`]).
@@ -105,8 +107,9 @@ pub struct BaStarOptions {
     /// Record the backtracking list `L` at every critical point (`backtrack_list` events). Large
     /// maps produce big traces; switch off when only the metrics matter.
     pub record_backtrack_list: bool,
-    /// Extend `mu` by [`lane_end_score`] (default `true`). `false` is the paper's `mu` exactly,
-    /// which can leave reachable tiles uncovered (see [`lane_end_score`]).
+    /// Extend `mu` by [`lane_end_score`] and the move-judged lane ends of [`SIDE_END_PAIRS`]
+    /// (default `true`). `false` is the paper's `mu` exactly, which can leave reachable tiles
+    /// uncovered (see [`lane_end_score`]).
     pub lane_end_corners: bool,
 }
 
@@ -257,6 +260,11 @@ pub const LANE_END_PAIRS: [(usize, usize); 4] = [(0, 2), (0, 6), (4, 2), (4, 6)]
 /// ([`lane_end_score`]): `(s7,s1), (s7,s5)`.
 pub const START_PAIRS: [(usize, usize); 2] = [(6, 0), (6, 4)];
 
+/// The pairs `(a, b)` of the pixel-level lane-end extension (see `TileModel::open_lane_ends`):
+/// the free side `a` (E, W or S) and the lane direction `b` along which it must continue:
+/// `(s1,s3), (s1,s7), (s5,s3), (s5,s7), (s7,s1), (s7,s5)`.
+pub const SIDE_END_PAIRS: [(usize, usize); 6] = [(0, 2), (0, 6), (4, 2), (4, 6), (6, 0), (6, 4)];
+
 /// The lane-end extension of `mu` (a deviation from the paper, on by default, see
 /// [`BaStarOptions::lane_end_corners`]): the pairs of [`LANE_END_PAIRS`] with
 /// `free[a] && obstacle[b]` (a side neighbour is free-uncovered while the lane of `s` ends at an
@@ -269,9 +277,10 @@ pub const START_PAIRS: [(usize, usize); 2] = [(6, 0), (6, 4)];
 /// tile, whose south neighbour BM leaves behind when it goes north first (every other covered
 /// tile with a free south neighbour was entered sideways from a tile whose south was blocked, so
 /// the paper's `(s7,s6)` / `(s7,s8)` see it). With the extension, every covered tile with a
-/// free-uncovered neighbour is in `L` or shares a lane with one that is — unless a standable
-/// north/south neighbour is not enterable by the straight move (a pixel-level sliver), which no
-/// test map has produced.
+/// free-uncovered neighbour is in `L` or shares a lane with one that is — on tile-aligned
+/// obstacles. Pixel clutter can make a standable neighbour unenterable; the planner then also
+/// counts the [`SIDE_END_PAIRS`], judged by moves (a lane that ends at a standable tile it cannot
+/// enter was missed, see the regression map `ba_star_pixel_clutter`).
 pub fn lane_end_score(free: [bool; 8], obstacle: [bool; 8], blocked: [bool; 8]) -> u32 {
     let a = LANE_END_PAIRS
         .iter()
@@ -803,8 +812,45 @@ impl TileModel {
                 obstacle[k] = self.stand((s.0 + N8[k].0, s.1 + N8[k].1)) == Judgement::Blocked;
             }
             mu += lane_end_score(free, obstacle, blocked);
+            mu += self.open_lane_ends(s, free);
         }
         mu
+    }
+
+    /// Does the lane of the covered tile `s` carry its free side `a` on to the neighbour
+    /// `n = s + N8[b]`: `n` covered, the move `s -> n` free and `n`'s side `a` free-uncovered?
+    #[inline]
+    fn side_continues(&self, s: Tile, b: usize, a: usize) -> bool {
+        let n = (s.0 + N8[b].0, s.1 + N8[b].1);
+        self.covered(n) && self.cached_move(s, b) == Judgement::Free && self.free_uncovered(n, a)
+    }
+
+    /// The pixel-level part of the lane-end extension: the pairs `(a, b)` of [`SIDE_END_PAIRS`]
+    /// with `a` free-uncovered, `b` not free-uncovered, and the lane not carrying the free side
+    /// `a` on to `b` ([`TileModel::side_continues`]).
+    ///
+    /// Why: [`corner_score`] and [`lane_end_score`] judge the tiles `b` and the diagonals by
+    /// *standability* alone. On tile-aligned obstacles a standable neighbour can always be
+    /// entered by the straight move, so "not standable" is the same as "not enterable"; pixel
+    /// clutter breaks that. A single pixel beside the segment between two standable tile
+    /// centres blocks the move while both disks are free, so a lane could end at a standable
+    /// but unenterable tile (the regression map `ba_star_pixel_clutter`: the lane end at
+    /// `(-2, -1)` with its whole west side uncovered was never put in `L`, BA* stopped at 2/3 of
+    /// the reachable tiles), or a standable diagonal could be unenterable from the lane's next
+    /// tile. Judged by moves instead, the rule is complete: every covered tile with a
+    /// free-uncovered neighbour `a` in E, W, S leads, walking along the lane (N for a side E/W,
+    /// E for S) while the free side continues, to a tile where it stops; that tile has a pair
+    /// here unless its own next neighbour is free-uncovered, which can only be E for side S
+    /// (BM never leaves a covered tile with a free-uncovered north: it goes there first), and
+    /// then the E side starts a walk of the first kind. On tile-aligned maps every such pair is
+    /// also a pair of [`corner_score`] or [`lane_end_score`], so `L` is unchanged there.
+    fn open_lane_ends(&self, s: Tile, free: [bool; 8]) -> u32 {
+        SIDE_END_PAIRS
+            .iter()
+            .filter(|&&(a, b)| {
+                free[a] && !self.free_uncovered(s, b) && !self.side_continues(s, b, a)
+            })
+            .count() as u32
     }
 
     /// Recomputes the L membership of `t`.
@@ -1234,7 +1280,13 @@ impl BaStar {
                 let c = t.cached_move(tile, n);
                 if c != Judgement::Undetermined {
                     let v = (tile.0 + N8[n].0, tile.1 + N8[n].1);
-                    let f = judge_motion(&m.known, p, m.center(v), m.r);
+                    // As `Mind::judge_move`: a move with an unstandable end is blocked (in
+                    // both directions; `judge_motion` alone lets a disk leave a contact).
+                    let f = if cached == Judgement::Blocked || t.stand(v) == Judgement::Blocked {
+                        Judgement::Blocked
+                    } else {
+                        judge_motion(&m.known, p, m.center(v), m.r)
+                    };
                     if f != c {
                         return Err(format!("move {tile:?}->{v:?}: cached {c:?}, fresh {f:?}"));
                     }
