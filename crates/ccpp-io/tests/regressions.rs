@@ -3,7 +3,7 @@
 
 #![allow(clippy::unwrap_used)] // tests may panic on broken fixtures
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use ccpp_core::metrics::{compute, Metrics};
 use ccpp_core::planners::{build, PlannerOptions};
@@ -24,7 +24,7 @@ fn regression_map(name: &str) -> Option<PathBuf> {
     }
 }
 
-fn run(path: &PathBuf, planner: &str) -> Metrics {
+fn run(path: &Path, planner: &str) -> Metrics {
     let map = load_map(path, &LoadOptions::default()).unwrap();
     let world = World::new(map.grid, Robot::new(0.15), None).unwrap();
     let mut p = build(planner, &PlannerOptions::default(), &world).unwrap();
@@ -34,7 +34,7 @@ fn run(path: &PathBuf, planner: &str) -> Metrics {
 }
 
 /// A 154 x 46 px field with about 1 % single-pixel obstacles: BA* stopped with the western
-/// half reachable and never visited (coverage_rate 0.667, effective coverage 0.31) because a
+/// half reachable and never visited (`coverage_rate` 0.667, effective coverage 0.31) because a
 /// lane end beside a standable but unenterable tile was never a backtracking candidate. The
 /// other tile planners covered it; all four must.
 #[test]
