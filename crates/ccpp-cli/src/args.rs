@@ -126,6 +126,9 @@ pub struct RunArgs {
     /// Landmarks for pose correction under PID (CSV `id,x,y[,theta]` or a JSON array).
     #[arg(long, value_name = "FILE")]
     pub landmarks: Option<PathBuf>,
+    /// Refuse runs whose estimated memory exceeds this many MB (default 4096).
+    #[arg(long, value_name = "MB")]
+    pub max_memory: Option<u64>,
     /// Output folder.
     #[arg(long, value_name = "DIR", default_value = "ccpp-out")]
     pub out: PathBuf,
@@ -156,6 +159,9 @@ pub struct WaypointsArgs {
     /// Area to cover `X0,Y0,X1,Y1` (default: the start's free component).
     #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = parse_quad, allow_hyphen_values = true)]
     pub area: Option<[f64; 4]>,
+    /// Refuse plans whose estimated memory exceeds this many MB (default 4096).
+    #[arg(long, value_name = "MB")]
+    pub max_memory: Option<u64>,
     /// Output format.
     #[arg(long, value_name = "csv|json", default_value = "csv")]
     pub format: String,
@@ -205,6 +211,9 @@ pub struct BenchArgs {
     /// Planner options file (YAML or JSON).
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
+    /// Refuse each run whose estimated memory exceeds this many MB (default 4096).
+    #[arg(long, value_name = "MB")]
+    pub max_memory: Option<u64>,
     /// Output folder.
     #[arg(long, value_name = "DIR", default_value = "ccpp-bench")]
     pub out: PathBuf,

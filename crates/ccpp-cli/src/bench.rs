@@ -8,12 +8,13 @@ use anyhow::{bail, Context, Result};
 use ccpp_core::metrics::Metrics;
 use ccpp_core::planners::{self, PlannerOptions};
 use ccpp_core::sim::SimConfig;
+use ccpp_io::scenario::{Scenario, DEFAULT_MAX_MEMORY_MB};
 use ccpp_io::write_atomic;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
 use crate::args::{BenchArgs, MapArgs};
-use crate::job::{planner_options, prepare_map, robot_from, Job, PreparedMap};
+use crate::job::{parse_planner, planner_options, prepare_map, robot_from, Job, PreparedMap};
 use crate::output::write_run_files;
 
 /// One row of the results: a run, or its failure.
@@ -185,13 +186,17 @@ fn run_one(
         }
     }
     let map = map.as_ref().map_err(Clone::clone)?;
-    let job = Job {
+    let kind = parse_planner(planner).map_err(|e| format!("{e:#}"))?;
+    let mut job = Job {
+        scenario: Scenario {
+            map: map.recipe.clone(),
+            robot,
+            start: None,
+            planner: options.config(kind),
+            sim: SimConfig::default(),
+            max_memory_mb: a.max_memory.unwrap_or(DEFAULT_MAX_MEMORY_MB),
+        },
         map: map.clone(),
-        robot,
-        start: None,
-        planner: planner.to_string(),
-        options: options.clone(),
-        sim: SimConfig::default(),
         out: dir.to_path_buf(),
     };
     let result = job.execute().map_err(|e| format!("{e:#}"))?;

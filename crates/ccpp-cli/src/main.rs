@@ -32,12 +32,12 @@ fn main() -> ExitCode {
 fn dispatch(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Run(a) => {
-            let job = job::Job::from_run_args(&a)?;
+            let mut job = job::Job::from_run_args(&a)?;
             let result = job.execute()?;
             output::emit(&job, &result, a.json, a.replay)
         }
         Command::Demo(a) => {
-            let job = job::Job::demo(&a)?;
+            let mut job = job::Job::demo(&a)?;
             let result = job.execute()?;
             output::emit(&job, &result, false, true)
         }

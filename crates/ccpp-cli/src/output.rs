@@ -9,30 +9,19 @@ use ccpp_core::trace::Trace;
 use ccpp_io::write_atomic;
 use ccpp_render::{coverage_png, CoverageStyle};
 
-use ccpp_core::planners::PlannerOptions;
-use ccpp_core::sim::SimConfig;
-use ccpp_core::world::{Robot, World};
-use ccpp_core::Pose;
+use ccpp_core::world::World;
+use ccpp_io::scenario::Scenario;
 
-use crate::job::{Job, JobResult, MapRecipe};
+use crate::job::{Job, JobResult};
 
 /// The trace as JSON Lines.
 pub fn trace_jsonl(trace: &Trace) -> Result<String> {
-    let mut s = String::with_capacity(trace.records.len() * 48);
-    for r in &trace.records {
-        s.push_str(&serde_json::to_string(r)?);
-        s.push('\n');
-    }
-    Ok(s)
+    Ok(ccpp_io::trace::trace_jsonl(trace)?)
 }
 
 /// The executed poses as CSV `x,y,theta` (metres, radians).
 pub fn path_csv(trace: &Trace) -> String {
-    let mut s = String::from("x,y,theta\n");
-    for p in trace.poses() {
-        let _ = writeln!(s, "{},{},{}", p.x, p.y, p.theta);
-    }
-    s
+    ccpp_io::trace::path_csv(trace)
 }
 
 /// The metrics as pretty JSON.
@@ -70,19 +59,12 @@ pub fn title_lines(m: &Metrics) -> Vec<String> {
 /// no partial file. `metrics.json` is written last: its presence marks a complete run.
 pub fn write_run_files(out: &Path, job: &Job, r: &JobResult) -> Result<String> {
     let metrics = metrics_json(&r.metrics)?;
+    // run.json is the scenario itself (with the start actually used): `Scenario::run` on it
+    // reproduces this run.
+    let mut scenario = job.scenario.clone();
     let start = r.world.start();
-    let record = RunRecord {
-        map: job.map.recipe.clone(),
-        map_name: job.map.name.clone(),
-        robot: job.robot,
-        start: [start.x, start.y, start.theta],
-        planner: job.planner.clone(),
-        options: job.options.clone(),
-        sim: job.sim.clone(),
-        tile_side: r.run.tile_side,
-    };
-    let mut run_json = serde_json::to_string_pretty(&record)?;
-    run_json.push('\n');
+    scenario.start = Some([start.x, start.y, start.theta]);
+    let run_json = scenario.to_json()?;
     let trace = trace_jsonl(&r.run.trace)?;
     let path = path_csv(&r.run.trace);
     let style = CoverageStyle {
@@ -105,27 +87,6 @@ pub fn write_run_files(out: &Path, job: &Job, r: &JobResult) -> Result<String> {
     Ok(metrics)
 }
 
-/// What ran, so that `ccpp replay` can rebuild the world exactly.
-#[derive(serde::Serialize, serde::Deserialize)]
-pub struct RunRecord {
-    /// How to load the map again.
-    pub map: MapRecipe,
-    /// Map name.
-    pub map_name: String,
-    /// The robot.
-    pub robot: Robot,
-    /// The start pose actually used.
-    pub start: [f64; 3],
-    /// Planner name.
-    pub planner: String,
-    /// Planner options.
-    pub options: PlannerOptions,
-    /// Simulator settings.
-    pub sim: SimConfig,
-    /// The planner's tile side, if any.
-    pub tile_side: Option<f64>,
-}
-
 /// Writes `replay.html` and `replay.gif` of a finished run into `out`.
 pub fn write_replay(
     out: &Path,
@@ -146,22 +107,24 @@ pub fn write_replay(
 /// `ccpp replay DIR`: rebuilds the world of a finished run and writes its replay files.
 pub fn replay_dir(dir: &Path) -> Result<()> {
     let rec_path = dir.join("run.json");
-    let text = std::fs::read_to_string(&rec_path).with_context(|| {
+    let text = ccpp_io::file::read_text(&rec_path).with_context(|| {
         format!(
             "{} is not a ccpp run folder (no readable run.json)",
             dir.display()
         )
     })?;
-    let rec: RunRecord =
+    let scenario: Scenario =
         serde_json::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", rec_path.display()))?;
-    let map = rec.map.prepare()?;
-    let start = Pose::new(rec.start[0], rec.start[1], rec.start[2]);
-    let world = World::new(map.grid, rec.robot, Some(start))
-        .with_context(|| format!("map {}", map.source.display()))?;
-    let trace = crate::plots::read_trace(&dir.join("trace.jsonl"))?;
+    let map = crate::job::load_recipe(&scenario.map)?;
+    let world = scenario.world(&map)?;
+    // Poses must lie on the map (a robot cannot leave it): a damaged trace is refused here
+    // instead of hanging the renderer.
+    let margin = scenario.robot.radius + 2.0 * world.frame().resolution;
+    let trace =
+        ccpp_io::trace::read_trace(&dir.join("trace.jsonl"), Some((world.frame(), margin)))?;
     let metrics = std::fs::read_to_string(dir.join("metrics.json")).unwrap_or_default();
-    let title = format!("{} on {}", rec.planner, rec.map_name);
-    write_replay(dir, &world, &trace, rec.tile_side, &metrics, &title)?;
+    let title = format!("{} on {}", scenario.planner.name(), map.name);
+    write_replay(dir, &world, &trace, scenario.tile_side(), &metrics, &title)?;
     println!("wrote {}/replay.html and replay.gif", dir.display());
     Ok(())
 }

@@ -2,35 +2,47 @@
 
 use std::fmt::Write as _;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{anyhow, bail, Result};
 use ccpp_core::planners::rect_boustrophedon::{plan, RectOptions};
-use ccpp_core::world::World;
+use ccpp_core::planners::PlannerConfig;
+use ccpp_core::sim::SimConfig;
+use ccpp_io::scenario::{Scenario, ScenarioError, DEFAULT_MAX_MEMORY_MB};
 use ccpp_io::write_atomic;
 
 use crate::args::WaypointsArgs;
-use crate::job::{prepare_map, robot_from};
+use crate::job::{recipe_from, robot_from};
 
 /// Runs `ccpp waypoints`.
 pub fn run(a: &WaypointsArgs) -> Result<()> {
-    for (name, v) in [("--length", a.length), ("--width", a.width)] {
-        if !v.is_finite() || v <= 0.0 {
-            bail!("{name} must be a finite number > 0 m, got {v}");
-        }
-    }
     let format = a.format.to_ascii_lowercase();
     if format != "csv" && format != "json" {
         bail!("--format must be csv or json, got {:?}", a.format);
     }
     let (robot, start) = robot_from(&a.robot)?;
-    let map = prepare_map(&a.map)?;
-    let world = World::new(map.grid, robot, start)
-        .with_context(|| format!("map {}", map.source.display()))?;
     let opts = RectOptions {
         length_m: a.length,
         width_m: a.width,
         area: a.area,
         ..RectOptions::default()
     };
+    // The same validation, checks and memory estimate as `ccpp run --planner
+    // rect-boustrophedon`.
+    let scenario = Scenario {
+        map: recipe_from(&a.map),
+        robot,
+        start: start.map(|p| [p.x, p.y, p.theta]),
+        planner: PlannerConfig::RectBoustrophedon(opts.clone()),
+        sim: SimConfig::default(),
+        max_memory_mb: a.max_memory.unwrap_or(DEFAULT_MAX_MEMORY_MB),
+    };
+    let flag = |e: ScenarioError| match &e {
+        ScenarioError::Options(o) if o.field.ends_with("length_m") => anyhow!("--length: {e}"),
+        ScenarioError::Options(o) if o.field.ends_with("width_m") => anyhow!("--width: {e}"),
+        _ => e.into(),
+    };
+    scenario.validate().map_err(flag)?;
+    let map = recipe_from(&a.map).load()?;
+    let world = scenario.world(&map).map_err(flag)?;
     let p = plan(&world, &opts);
     let text = if format == "csv" {
         let mut s = String::from("x,y\n");

@@ -24,6 +24,7 @@ pub mod landmarks;
 pub mod metrics;
 pub mod planner;
 pub mod planners;
+pub mod raster;
 pub mod rng;
 pub mod sim;
 pub mod tiles;

@@ -14,6 +14,10 @@ use crate::grid::{Cell, GridMap, MapFrame};
 use crate::trace::Event;
 use crate::world::Robot;
 
+/// Rotations smaller than this (radians) are not executed by the simulator (planners skip
+/// them too).
+pub const MIN_ROTATION: f64 = 1e-9;
+
 /// One decision of a planner.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Step {

@@ -33,8 +33,7 @@ use crate::rng::SplitMix64;
 use crate::trace::{Event, Trace};
 use crate::world::{Robot, World};
 
-/// Rotations smaller than this (radians) are not executed.
-pub const MIN_ROTATION: f64 = 1e-9;
+pub use crate::planner::MIN_ROTATION;
 
 /// Simulator settings.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -50,6 +49,13 @@ pub struct SimConfig {
     /// Landmarks for pose correction under PID execution (ignored in ideal mode, where the
     /// estimate is the truth).
     pub landmarks: LandmarkConfig,
+}
+
+impl SimConfig {
+    /// The sensor range in force for `robot`: [`sensor_range`](Self::sensor_range) or `4 r`.
+    pub fn sensor_range_for(&self, robot: &Robot) -> f64 {
+        self.sensor_range.unwrap_or(4.0 * robot.radius)
+    }
 }
 
 impl Default for SimConfig {
@@ -121,7 +127,7 @@ impl<'w> Simulator<'w> {
     /// is fixed now; with `None` it is chosen at [`run`](Self::run) from the planner (ideal
     /// when stepping through [`execute`](Self::execute) directly).
     pub fn new(world: &'w World, config: &SimConfig) -> Self {
-        let range = config.sensor_range.unwrap_or(4.0 * world.robot().radius);
+        let range = config.sensor_range_for(&world.robot());
         let pose = world.start();
         let mut trace = Trace::default();
         trace.push_pose(0, pose);

@@ -91,7 +91,7 @@ pub fn parse_georef(text: &str) -> Result<Vec<(Point, Point)>, GeorefFileError> 
 /// # Errors
 /// Unreadable file, bad line, or a fit that fails (fewer than 3 pairs, collinear points).
 pub fn load_georef(path: &Path) -> Result<AffineFit, GeorefFileError> {
-    let text = std::fs::read_to_string(path).map_err(|source| GeorefFileError::Io {
+    let text = crate::file::read_text(path).map_err(|source| GeorefFileError::Io {
         path: path.to_path_buf(),
         source,
     })?;

@@ -111,7 +111,7 @@ pub fn parse_landmarks(text: &str) -> Result<Vec<Landmark>, LandmarkFileError> {
 /// # Errors
 /// As [`parse_landmarks`], plus an unreadable file.
 pub fn load_landmarks(path: &Path) -> Result<Vec<Landmark>, LandmarkFileError> {
-    let text = std::fs::read_to_string(path).map_err(|source| LandmarkFileError::Io {
+    let text = crate::file::read_text(path).map_err(|source| LandmarkFileError::Io {
         path: path.to_path_buf(),
         source,
     })?;

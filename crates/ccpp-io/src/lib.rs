@@ -7,14 +7,21 @@
 //!   the module docs for the grey-level, alpha and 16-bit conventions);
 //! * [`write`](mod@write): atomic file writers and a `map_saver`-style map writer;
 //! * [`georef`]: `--georef` point-pair files for the affine pixel <-> world fit (seed 003);
-//! * [`landmarks`]: `--landmarks` files (CSV or JSON) for the simulator's pose correction.
+//! * [`landmarks`]: `--landmarks` files (CSV or JSON) for the simulator's pose correction;
+//! * [`scenario`]: the serializable description of a run ([`Scenario`](scenario::Scenario)),
+//!   its one validation (including the memory estimate) and its execution;
+//! * [`trace`](mod@trace): `trace.jsonl` / `path.csv` writers and the checked trace reader;
+//! * [`file`]: opening user files (regular files only: a FIFO is refused, not read forever).
 //!
 //! Errors are [`thiserror`] enums that always name the file concerned; nothing here panics on
 //! user data.
 
+pub mod file;
 pub mod georef;
 pub mod landmarks;
 pub mod map;
+pub mod scenario;
+pub mod trace;
 pub mod write;
 
 pub use map::{load_map, load_map_bytes, LoadOptions, LoadedMap, MapError, MapYaml, Thresholds};

@@ -1440,7 +1440,7 @@ impl BaStar {
             if let Some(k) = first {
                 let gamma = f64::from(N8[k].1).atan2(f64::from(N8[k].0));
                 let alpha = wrap_angle(gamma - sensor.pose().theta);
-                if alpha.abs() > crate::sim::MIN_ROTATION {
+                if alpha.abs() > crate::planner::MIN_ROTATION {
                     self.pending.push_back(Step::Rotate(alpha));
                 }
             }

@@ -332,7 +332,7 @@ impl Extension {
     fn stamp(&mut self, a: Point, b: Point) {
         let f = self.frame();
         let rt = self.tool_px + 1e-6;
-        crate::metrics::stamp_capsule(&mut self.covered, &f, a, b, rt, &mut |_| {});
+        crate::raster::stamp_capsule(&mut self.covered, &f, a, b, rt, &mut |_| {});
     }
 
     /// Records a commanded motion (world points) as swept — unless it is one of the moves

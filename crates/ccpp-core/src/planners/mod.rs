@@ -1,5 +1,12 @@
-//! The coverage planners, one module each, behind the [`Planner`] trait,
-//! and the catalogue that builds them by name.
+//! The coverage planners, one module each, behind the [`Planner`] trait, and the **registry**:
+//! one row per planner (its [`PlannerKind`], command-line name, description, online/offline,
+//! options type and options section), from which [`PlannerKind`], [`PlannerConfig`] (one
+//! planner's options, tagged with its name), [`PlannerOptions`] (every planner's options, one
+//! section each, the `--config` file) and [`CATALOG`] are generated.
+//!
+//! Adding a planner: write its module, implement [`PlannerSettings`] for its options type (the
+//! validation, the resource estimate and the constructor, in [`settings`]), and add one row to
+//! the `registry!` invocation below.
 
 pub mod ba_star;
 pub mod bcd;
@@ -8,81 +15,254 @@ pub mod bsa_bfs;
 pub mod bsa_extended;
 pub mod random_bounce;
 pub mod rect_boustrophedon;
+pub mod settings;
 
 use serde::{Deserialize, Serialize};
 
 use crate::planner::Planner;
 use crate::world::World;
 
+pub use settings::{OptionsError, PlannerSettings, ResourceEstimate, Setup};
+
 /// One catalogue entry.
 #[derive(Clone, Copy, Debug)]
 pub struct PlannerInfo {
-    /// Name used on the command line.
+    /// Which planner.
+    pub kind: PlannerKind,
+    /// Name used on the command line and in files (kebab-case).
     pub name: &'static str,
+    /// Name of its section in [`PlannerOptions`] (snake_case).
+    pub section: &'static str,
     /// One-line description.
     pub description: &'static str,
     /// `true` when the planner reads the whole map up front.
     pub offline: bool,
 }
 
-/// Every planner ccpp knows.
-pub const CATALOG: &[PlannerInfo] = &[
-    PlannerInfo {
-        name: "ba-star",
-        description: "BA* (Viet et al. 2013): boustrophedon regions on 2r tiles, A* + smoothed backtracking to the nearest corner tile",
-        offline: false,
-    },
-    PlannerInfo {
-        name: "bsa",
-        description: "Backtracking Spiral Algorithm: spirals on robot-sized cells, BFS backtracking over visited cells",
-        offline: false,
-    },
-    PlannerInfo {
-        name: "bsa-extended",
-        description: "BSA plus wall following at map resolution and gap-crossing return paths, for coverage near obstacles",
-        offline: false,
-    },
-    PlannerInfo {
-        name: "bsa-bfs",
-        description: "Vacuum-robot BSA (seed 003): cells +x,+y,-x,-y, return-cell stack, BFS return over visited cells, PID execution",
-        offline: false,
-    },
-    PlannerInfo {
-        name: "random-bounce",
-        description: "Roomba-like baseline: straight until the sensed obstacle, seeded random turn, distance budget",
-        offline: false,
-    },
-    PlannerInfo {
-        name: "bcd",
-        description: "Boustrophedon cellular decomposition of the known map, lanes 2 r_tool apart (the known-map baseline)",
-        offline: true,
-    },
-    PlannerInfo {
-        name: "rect-boustrophedon",
-        description: "Known-map lane waypoints for a rectangular robot (seed 001): lanes b apart, waypoints every l, blocked edges joined by clearance A*",
-        offline: true,
-    },
-];
+/// Generates the planner registry from one row per planner.
+macro_rules! registry {
+    ($(
+        $(#[$doc:meta])*
+        $variant:ident {
+            name: $name:literal,
+            section: $section:ident,
+            options: $opts:ty,
+            offline: $offline:literal,
+            description: $desc:literal $(,)?
+        }
+    )*) => {
+        /// Every planner ccpp knows (serialized by its kebab-case command-line name).
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+        pub enum PlannerKind {
+            $(
+                $(#[$doc])*
+                #[serde(rename = $name)]
+                $variant,
+            )*
+        }
 
-/// Options of every planner, one section each (the single source of truth for CLI, config
-/// files and bindings).
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct PlannerOptions {
-    /// `random-bounce`.
-    pub random_bounce: random_bounce::RandomBounceOptions,
-    /// `ba-star`.
-    pub ba_star: ba_star::BaStarOptions,
-    /// `bcd`.
-    pub bcd: bcd::BcdOptions,
-    /// `bsa-bfs`.
-    pub bsa_bfs: bsa_bfs::BsaBfsOptions,
-    /// `rect-boustrophedon`.
-    pub rect_boustrophedon: rect_boustrophedon::RectOptions,
-    /// `bsa`.
-    pub bsa: bsa::BsaOptions,
-    /// `bsa-extended`.
-    pub bsa_extended: bsa_extended::BsaExtendedOptions,
+        impl PlannerKind {
+            /// All planners, in catalogue order.
+            pub const ALL: &'static [PlannerKind] = &[$(PlannerKind::$variant),*];
+
+            /// The catalogue entry.
+            pub fn info(self) -> &'static PlannerInfo {
+                match self {
+                    $(PlannerKind::$variant => &CATALOG[PlannerKind::$variant as usize],)*
+                }
+            }
+        }
+
+        /// Every planner ccpp knows, in [`PlannerKind`] order.
+        pub const CATALOG: &[PlannerInfo] = &[$(
+            PlannerInfo {
+                kind: PlannerKind::$variant,
+                name: $name,
+                section: stringify!($section),
+                description: $desc,
+                offline: $offline,
+            },
+        )*];
+
+        /// Options of every planner, one section each (the `--config` file format).
+        #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+        #[serde(default, deny_unknown_fields)]
+        pub struct PlannerOptions {
+            $(
+                #[doc = concat!("`", $name, "`.")]
+                pub $section: $opts,
+            )*
+        }
+
+        impl PlannerOptions {
+            /// Validates every section (errors name the section and the field).
+            ///
+            /// # Errors
+            /// The first invalid option.
+            pub fn validate(&self) -> Result<(), OptionsError> {
+                $(
+                    self.$section
+                        .validate()
+                        .map_err(|e| e.in_section(stringify!($section)))?;
+                )*
+                Ok(())
+            }
+
+            /// The options of planner `kind` (its section).
+            pub fn config(&self, kind: PlannerKind) -> PlannerConfig {
+                match kind {
+                    $(PlannerKind::$variant => PlannerConfig::$variant(self.$section.clone()),)*
+                }
+            }
+        }
+
+        /// One planner with its options: a planner's options cannot be given to another.
+        /// Serialized as `"planner": NAME, "options": {..}`.
+        #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+        #[serde(tag = "planner", content = "options")]
+        pub enum PlannerConfig {
+            $(
+                #[doc = concat!("`", $name, "`.")]
+                #[serde(rename = $name)]
+                $variant($opts),
+            )*
+        }
+
+        impl PlannerConfig {
+            /// Which planner.
+            pub fn kind(&self) -> PlannerKind {
+                match self {
+                    $(PlannerConfig::$variant(_) => PlannerKind::$variant,)*
+                }
+            }
+
+            /// The options as the common settings interface.
+            pub fn settings(&self) -> &dyn PlannerSettings {
+                match self {
+                    $(PlannerConfig::$variant(o) => o,)*
+                }
+            }
+
+            /// The options as the common settings interface, mutable.
+            pub fn settings_mut(&mut self) -> &mut dyn PlannerSettings {
+                match self {
+                    $(PlannerConfig::$variant(o) => o,)*
+                }
+            }
+        }
+    };
+}
+
+registry! {
+    /// Roomba-like baseline.
+    RandomBounce {
+        name: "random-bounce",
+        section: random_bounce,
+        options: random_bounce::RandomBounceOptions,
+        offline: false,
+        description: "Roomba-like baseline: straight until the sensed obstacle, seeded random turn, distance budget",
+    }
+    /// BA* (Viet et al. 2013).
+    BaStar {
+        name: "ba-star",
+        section: ba_star,
+        options: ba_star::BaStarOptions,
+        offline: false,
+        description: "BA* (Viet et al. 2013): boustrophedon regions on 2r tiles, A* + smoothed backtracking to the nearest corner tile",
+    }
+    /// Backtracking Spiral Algorithm.
+    Bsa {
+        name: "bsa",
+        section: bsa,
+        options: bsa::BsaOptions,
+        offline: false,
+        description: "Backtracking Spiral Algorithm: spirals on robot-sized cells, BFS backtracking over visited cells",
+    }
+    /// BSA with wall following and gap crossing.
+    BsaExtended {
+        name: "bsa-extended",
+        section: bsa_extended,
+        options: bsa_extended::BsaExtendedOptions,
+        offline: false,
+        description: "BSA plus wall following at map resolution and gap-crossing return paths, for coverage near obstacles",
+    }
+    /// The vacuum-robot BSA of seed 003.
+    BsaBfs {
+        name: "bsa-bfs",
+        section: bsa_bfs,
+        options: bsa_bfs::BsaBfsOptions,
+        offline: false,
+        description: "Vacuum-robot BSA (seed 003): cells +x,+y,-x,-y, return-cell stack, BFS return over visited cells, PID execution",
+    }
+    /// Boustrophedon cellular decomposition.
+    Bcd {
+        name: "bcd",
+        section: bcd,
+        options: bcd::BcdOptions,
+        offline: true,
+        description: "Boustrophedon cellular decomposition of the known map, lanes 2 r_tool apart (the known-map baseline)",
+    }
+    /// Lane waypoints for a rectangular robot (seed 001).
+    RectBoustrophedon {
+        name: "rect-boustrophedon",
+        section: rect_boustrophedon,
+        options: rect_boustrophedon::RectOptions,
+        offline: true,
+        description: "Known-map lane waypoints for a rectangular robot (seed 001): lanes b apart, waypoints every l, blocked edges joined by clearance A*",
+    }
+}
+
+impl PlannerKind {
+    /// Command-line name (kebab-case).
+    pub fn name(self) -> &'static str {
+        self.info().name
+    }
+}
+
+impl std::fmt::Display for PlannerKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for PlannerKind {
+    type Err = BuildError;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        CATALOG
+            .iter()
+            .find(|p| p.name == s)
+            .map(|p| p.kind)
+            .ok_or_else(|| BuildError::Unknown(s.to_string()))
+    }
+}
+
+impl PlannerConfig {
+    /// The default options of planner `kind`.
+    pub fn new(kind: PlannerKind) -> Self {
+        PlannerOptions::default().config(kind)
+    }
+
+    /// Command-line name of the planner.
+    pub fn name(&self) -> &'static str {
+        self.kind().name()
+    }
+
+    /// Validates the options (errors name the section and the field).
+    ///
+    /// # Errors
+    /// The first invalid option.
+    pub fn validate(&self) -> Result<(), OptionsError> {
+        self.settings()
+            .validate()
+            .map_err(|e| e.in_section(self.kind().info().section))
+    }
+
+    /// Builds the planner for `world`. Online planners get nothing from `world` but what an
+    /// operator knows (its frame and the robot); offline ones read its map.
+    pub fn build(&self, world: &World) -> Box<dyn Planner> {
+        self.settings().build(world)
+    }
 }
 
 /// Error building a planner.
@@ -93,8 +273,7 @@ pub enum BuildError {
     Unknown(String),
 }
 
-/// Builds the planner `name`. Online planners get nothing from `world` but operator settings
-/// derived from it (such as the random-bounce distance budget); offline ones read its map.
+/// Builds the planner `name` with its section of `opts` (see [`PlannerConfig::build`]).
 ///
 /// # Errors
 /// [`BuildError::Unknown`] for an unknown name.
@@ -103,30 +282,6 @@ pub fn build(
     opts: &PlannerOptions,
     world: &World,
 ) -> Result<Box<dyn Planner>, BuildError> {
-    match name {
-        "random-bounce" => {
-            let mut o = opts.random_bounce.clone();
-            if o.budget_m.is_none() {
-                let ideal = world.accessible_area_m2() / (2.0 * world.robot().tool_radius);
-                o.budget_m = Some(3.0 * ideal);
-            }
-            Ok(Box::new(random_bounce::RandomBounce::new(o)))
-        }
-        "ba-star" => {
-            let mut o = opts.ba_star.clone();
-            if o.tile_side_m.is_none() {
-                o.tile_side_m = Some(2.0 * world.robot().radius);
-            }
-            Ok(Box::new(ba_star::BaStar::new(o)))
-        }
-        "bcd" => Ok(Box::new(bcd::Bcd::new(world, &opts.bcd))),
-        "bsa-bfs" => Ok(Box::new(bsa_bfs::BsaBfs::new(opts.bsa_bfs.clone()))),
-        "rect-boustrophedon" => Ok(Box::new(rect_boustrophedon::RectBoustrophedon::new(
-            world,
-            &opts.rect_boustrophedon,
-        ))),
-        "bsa" => Ok(Box::new(bsa::Bsa::new(opts.bsa))),
-        "bsa-extended" => Ok(Box::new(bsa::Bsa::extended(opts.bsa_extended.clone()))),
-        other => Err(BuildError::Unknown(other.to_string())),
-    }
+    let kind: PlannerKind = name.parse()?;
+    Ok(opts.config(kind).build(world))
 }

@@ -34,8 +34,10 @@ use crate::trace::Event;
 pub struct RandomBounceOptions {
     /// Seed of the turn angles.
     pub seed: u64,
-    /// Distance budget in metres; `None` lets the runner choose (3x the ideal lane-by-lane length
-    /// of the accessible area).
+    /// Distance budget in metres; `None` = 3x the lane-by-lane length of the map frame's area
+    /// (`3 * width_m * height_m / (2 r_tool)`, see
+    /// [`default_budget`](super::settings::default_budget)): what an operator knows, not the
+    /// map's contents.
     pub budget_m: Option<f64>,
     /// Smallest turn after a bump, degrees.
     pub min_turn_deg: f64,

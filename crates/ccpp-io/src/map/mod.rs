@@ -29,7 +29,6 @@ mod error;
 mod pixels;
 mod yaml;
 
-use std::fs::File;
 use std::io::{BufReader, Cursor};
 use std::path::{Path, PathBuf};
 
@@ -104,7 +103,7 @@ pub fn load_map(path: &Path, opts: &LoadOptions) -> Result<LoadedMap, MapError> 
         }
     }
     if is_yaml_path(path) {
-        let bytes = std::fs::read(path).map_err(|e| MapError::Io {
+        let bytes = crate::file::read_bytes(path).map_err(|e| MapError::Io {
             path: path.to_path_buf(),
             source: e,
         })?;
@@ -114,7 +113,7 @@ pub fn load_map(path: &Path, opts: &LoadOptions) -> Result<LoadedMap, MapError> 
         })?;
         let yaml = MapYaml::parse(text, path)?;
         let image_path = path.parent().unwrap_or(Path::new("")).join(&yaml.image);
-        let file = match File::open(&image_path) {
+        let file = match crate::file::open_regular(&image_path) {
             Ok(f) => f,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
                 return Err(MapError::ImageNotFound {
@@ -132,7 +131,7 @@ pub fn load_map(path: &Path, opts: &LoadOptions) -> Result<LoadedMap, MapError> 
         let reader = ImageReader::new(BufReader::new(file));
         finish(Some(&yaml), path, image_path, reader, opts)
     } else {
-        let file = File::open(path).map_err(|e| MapError::Io {
+        let file = crate::file::open_regular(path).map_err(|e| MapError::Io {
             path: path.to_path_buf(),
             source: e,
         })?;

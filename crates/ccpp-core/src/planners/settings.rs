@@ -1,0 +1,616 @@
+//! Each planner's options behind one interface, [`PlannerSettings`]: validation of the values
+//! (the one place both the command line and option files go through), the checks that need the
+//! map frame and the robot (a tile larger than the map, a sensor that cannot see a neighbour
+//! tile), the resource estimate made before anything is allocated, and the constructor.
+//!
+//! Resource estimates are deliberately generous upper bounds of the dominant allocations
+//! (per-pixel arrays, per-tile / per-cell state, trace records and their text): the point is to
+//! refuse runs that would take gigabytes or hours *before* allocating, not to predict the peak.
+
+use crate::exec::{Execution, PidGains, PidOptions};
+use crate::grid::MapFrame;
+use crate::planner::Planner;
+use crate::world::{Robot, World};
+
+use super::ba_star::{BaStar, BaStarOptions};
+use super::bcd::{Bcd, BcdOptions};
+use super::bsa::{Bsa, BsaOptions};
+use super::bsa_bfs::{BsaBfs, BsaBfsOptions};
+use super::bsa_extended::BsaExtendedOptions;
+use super::random_bounce::{RandomBounce, RandomBounceOptions};
+use super::rect_boustrophedon::{RectBoustrophedon, RectOptions};
+
+/// Bytes per map pixel of a run: the grid, the distance transform, C-free / reachable /
+/// accessible / swept bitsets, the known map of online planners, the rendered picture.
+pub const PIXEL_BYTES: f64 = 64.0;
+/// Bytes per tile (or cell) of a tile planner: tile state, search record, cached disk spans, and
+/// the trace records of visiting it (in memory and as text).
+pub const TILE_BYTES: f64 = 600.0;
+/// Bytes per trace record: the record in memory and its `trace.jsonl` / `path.csv` lines.
+pub const RECORD_BYTES: f64 = 200.0;
+
+/// An invalid option value.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{field}: {message}")]
+pub struct OptionsError {
+    /// The option, as `section.field` once the section is known.
+    pub field: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl OptionsError {
+    /// An error about `field`.
+    pub fn new(field: &str, message: impl Into<String>) -> Self {
+        Self {
+            field: field.to_string(),
+            message: message.into(),
+        }
+    }
+
+    /// Prefixes the field with its options section (`ba_star.tile_side_m`).
+    #[must_use]
+    pub fn in_section(mut self, section: &str) -> Self {
+        if !self.field.is_empty() && !self.field.starts_with(section) {
+            self.field = format!("{section}.{}", self.field);
+        }
+        self
+    }
+}
+
+/// What a planner's checks and estimate may use: what an operator knows before the run.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Setup {
+    /// The map frame (extent, resolution, origin).
+    pub frame: MapFrame,
+    /// The robot.
+    pub robot: Robot,
+    /// The sensor range in force, metres.
+    pub sensor_range: f64,
+}
+
+impl Setup {
+    /// Number of tiles of side `side` whose centre can lie on the map (with a border tile).
+    pub fn tiles(&self, side: f64) -> f64 {
+        let (w, h) = (self.frame.width_m(), self.frame.height_m());
+        // A rotated frame spans at most its diagonal in each axis.
+        let d = w.hypot(h);
+        let (w, h) = if self.frame.origin.theta == 0.0 {
+            (w, h)
+        } else {
+            (d, d)
+        };
+        (w / side + 3.0) * (h / side + 3.0)
+    }
+
+    /// Number of map pixels.
+    pub fn pixels(&self) -> f64 {
+        self.frame.width as f64 * self.frame.height as f64
+    }
+
+    /// Area of the map frame, m² (what an operator knows without the map's contents).
+    pub fn frame_area_m2(&self) -> f64 {
+        self.frame.width_m() * self.frame.height_m()
+    }
+}
+
+/// A resource estimate: bytes and what they are for.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ResourceEstimate {
+    /// Estimated bytes (may be huge or infinite: kept as `f64`).
+    pub bytes: f64,
+    /// The dominant quantity, for messages (`"9.0e6 tiles of 0.001 m"`).
+    pub detail: String,
+}
+
+impl ResourceEstimate {
+    /// `count` units of `bytes_each`, described as `count what`.
+    pub fn units(count: f64, bytes_each: f64, what: &str) -> Self {
+        Self {
+            bytes: count * bytes_each,
+            detail: format!("{} {what}", fmt_count(count)),
+        }
+    }
+}
+
+/// A count as `123456` or `1.2e18`.
+pub fn fmt_count(n: f64) -> String {
+    if n < 1e7 {
+        format!("{n:.0}")
+    } else {
+        format!("{n:.1e}")
+    }
+}
+
+/// A planner's options: validation, checks against the setup, resource estimate, constructor.
+/// Implemented by every options type of the registry.
+pub trait PlannerSettings {
+    /// Checks each value on its own (finite, positive, ordered...). Errors name the field.
+    ///
+    /// # Errors
+    /// The first invalid value.
+    fn validate(&self) -> Result<(), OptionsError>;
+
+    /// Checks the options against the map frame, the robot and the sensor: runs that are legal
+    /// but cannot do anything (a tile larger than the map, a sensor that cannot see a neighbour
+    /// tile, an area outside the map) are refused with what is wrong.
+    ///
+    /// # Errors
+    /// What makes the run degenerate.
+    fn check(&self, setup: &Setup) -> Result<(), OptionsError>;
+
+    /// The planner's share of the memory a run needs (tiles, cells, waypoints, trace).
+    fn estimate(&self, setup: &Setup) -> ResourceEstimate;
+
+    /// The tile (cell) side the planner works on, if it is tile-based.
+    fn tile_side(&self, robot: &Robot) -> Option<f64>;
+
+    /// The execution the planner asks for when the simulator settings do not fix one.
+    fn preferred_execution(&self) -> Option<Execution> {
+        None
+    }
+
+    /// Builds the planner for `world` (offline planners plan here).
+    fn build(&self, world: &World) -> Box<dyn Planner>;
+}
+
+fn finite_pos(field: &str, v: f64) -> Result<(), OptionsError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(OptionsError::new(
+            field,
+            format!("must be a finite number > 0, got {v}"),
+        ))
+    }
+}
+
+fn finite_nonneg(field: &str, v: f64) -> Result<(), OptionsError> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(())
+    } else {
+        Err(OptionsError::new(
+            field,
+            format!("must be a finite number >= 0, got {v}"),
+        ))
+    }
+}
+
+fn opt_finite_pos(field: &str, v: Option<f64>) -> Result<(), OptionsError> {
+    v.map_or(Ok(()), |v| finite_pos(field, v))
+}
+
+fn gains(field: &str, g: &PidGains) -> Result<(), OptionsError> {
+    for (name, v) in [("kp", g.kp), ("ki", g.ki), ("kd", g.kd)] {
+        if !v.is_finite() {
+            return Err(OptionsError::new(
+                &format!("{field}.{name}"),
+                format!("must be finite, got {v}"),
+            ));
+        }
+    }
+    finite_pos(&format!("{field}.output_limit"), g.output_limit)?;
+    finite_nonneg(&format!("{field}.integral_limit"), g.integral_limit)
+}
+
+/// Validates execution settings (PID gains, periods, tolerances, odometry noise).
+///
+/// # Errors
+/// The first invalid value, named `field.subfield`.
+pub fn validate_execution(field: &str, e: &Execution) -> Result<(), OptionsError> {
+    let Execution::Pid(p) = e else {
+        return Ok(());
+    };
+    validate_pid(field, p)
+}
+
+fn validate_pid(field: &str, p: &PidOptions) -> Result<(), OptionsError> {
+    let f = |s: &str| format!("{field}.{s}");
+    finite_pos(&f("dt_s"), p.dt_s)?;
+    gains(&f("linear"), &p.linear)?;
+    gains(&f("angular"), &p.angular)?;
+    finite_nonneg(&f("tolerance_m"), p.tolerance_m)?;
+    finite_nonneg(&f("heading_tolerance_rad"), p.heading_tolerance_rad)?;
+    finite_nonneg(&f("align_rad"), p.align_rad)?;
+    finite_pos(&f("min_speed_mps"), p.min_speed_mps)?;
+    finite_pos(&f("min_turn_rate"), p.min_turn_rate)?;
+    finite_nonneg(&f("lookahead_m"), p.lookahead_m)?;
+    if p.record_every == 0 {
+        return Err(OptionsError::new(&f("record_every"), "must be >= 1"));
+    }
+    if p.max_steps_per_motion == 0 {
+        return Err(OptionsError::new(
+            &f("max_steps_per_motion"),
+            "must be >= 1",
+        ));
+    }
+    if let Some(n) = &p.noise {
+        finite_nonneg(&f("noise.linear_rel_std"), n.linear_rel_std)?;
+        finite_nonneg(&f("noise.angular_rel_std"), n.angular_rel_std)?;
+        finite_nonneg(&f("noise.heading_drift_std"), n.heading_drift_std)?;
+    }
+    Ok(())
+}
+
+/// Trace records of a PID-executed path of `path_m` metres: one every `record_every` control
+/// steps of at most `output_limit * dt_s` metres each (creeping is slower but bounded by the
+/// per-motion step cap).
+fn pid_records(e: Option<&Execution>, path_m: f64) -> f64 {
+    match e {
+        Some(Execution::Pid(p)) => {
+            let step = (p.linear.output_limit * p.dt_s).max(1e-12);
+            path_m / step / f64::from(p.record_every.max(1))
+        }
+        _ => 0.0,
+    }
+}
+
+/// The sensor must see a neighbour tile's whole contact disk: `side + r`.
+fn check_neighbour_sight(setup: &Setup, side: f64, what: &str) -> Result<(), OptionsError> {
+    let need = side + setup.robot.radius;
+    if setup.sensor_range < need * (1.0 - 1e-9) {
+        return Err(OptionsError::new(
+            "",
+            format!(
+                "the sensor range {} m cannot see a neighbour {what}'s disk (needs >= {what} side + r = {} m); raise the sensor range",
+                fmt_m(setup.sensor_range), fmt_m(need)
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// A tile larger than the map leaves no neighbour tile to move to.
+fn check_side_fits(setup: &Setup, side: f64, field: &str, what: &str) -> Result<(), OptionsError> {
+    let (w, h) = (setup.frame.width_m(), setup.frame.height_m());
+    if side > w.max(h) {
+        return Err(OptionsError::new(
+            field,
+            format!(
+                "{what} side {} m is larger than the map ({} x {} m): no neighbour {what} fits",
+                fmt_m(side),
+                fmt_m(w),
+                fmt_m(h)
+            ),
+        ));
+    }
+    Ok(())
+}
+
+impl PlannerSettings for RandomBounceOptions {
+    fn validate(&self) -> Result<(), OptionsError> {
+        opt_finite_pos("budget_m", self.budget_m)?;
+        for (f, v) in [
+            ("min_turn_deg", self.min_turn_deg),
+            ("max_turn_deg", self.max_turn_deg),
+        ] {
+            if !v.is_finite() {
+                return Err(OptionsError::new(f, format!("must be finite, got {v}")));
+            }
+        }
+        if self.min_turn_deg > self.max_turn_deg {
+            return Err(OptionsError::new(
+                "min_turn_deg",
+                format!(
+                    "must be <= max_turn_deg ({} > {})",
+                    self.min_turn_deg, self.max_turn_deg
+                ),
+            ));
+        }
+        if self.min_turn_deg == self.max_turn_deg && self.min_turn_deg.rem_euclid(360.0) == 0.0 {
+            return Err(OptionsError::new(
+                "max_turn_deg",
+                "the turn range holds no turn (only multiples of 360 degrees)",
+            ));
+        }
+        Ok(())
+    }
+
+    fn check(&self, s: &Setup) -> Result<(), OptionsError> {
+        let need = s.robot.radius + 1.5 * s.frame.resolution;
+        if s.sensor_range <= need {
+            return Err(OptionsError::new(
+                "",
+                format!(
+                    "the sensor range {} m sees nothing beyond the robot's footprint (random-bounce needs more than r + 1.5 px = {} m)",
+                    fmt_m(s.sensor_range), fmt_m(need)
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    fn estimate(&self, s: &Setup) -> ResourceEstimate {
+        let budget = self.budget_m.unwrap_or_else(|| default_budget(s));
+        let res = s.frame.resolution;
+        let stride = (s.sensor_range - s.robot.radius - 1.5 * res).max(0.5 * res);
+        // A stride and a turn per stride.
+        ResourceEstimate::units(budget / stride, 2.0 * RECORD_BYTES, "strides")
+    }
+
+    fn tile_side(&self, _: &Robot) -> Option<f64> {
+        None
+    }
+
+    fn build(&self, world: &World) -> Box<dyn Planner> {
+        let mut o = self.clone();
+        if o.budget_m.is_none() {
+            let s = Setup {
+                frame: *world.frame(),
+                robot: world.robot(),
+                sensor_range: 0.0,
+            };
+            o.budget_m = Some(default_budget(&s));
+        }
+        Box::new(RandomBounce::new(o))
+    }
+}
+
+/// The random-bounce default distance budget: 3x the lane-by-lane length of the map frame's
+/// area (`3 * width_m * height_m / (2 r_tool)`) — what an operator knows, never the map's
+/// contents, so the run stays online-honest.
+pub fn default_budget(s: &Setup) -> f64 {
+    3.0 * s.frame_area_m2() / (2.0 * s.robot.tool_radius)
+}
+
+impl PlannerSettings for BaStarOptions {
+    fn validate(&self) -> Result<(), OptionsError> {
+        opt_finite_pos("tile_side_m", self.tile_side_m)
+    }
+
+    fn check(&self, s: &Setup) -> Result<(), OptionsError> {
+        let t = self.tile_side_m.unwrap_or(2.0 * s.robot.radius);
+        check_side_fits(s, t, "tile_side_m", "tile")?;
+        check_neighbour_sight(s, t, "tile")
+    }
+
+    fn estimate(&self, s: &Setup) -> ResourceEstimate {
+        let t = self.tile_side_m.unwrap_or(2.0 * s.robot.radius);
+        // Cached disk spans: 2 bytes per row of the contact disk.
+        let rows = 2.0 * (s.robot.radius / s.frame.resolution + 1.0) + 4.0;
+        let mut e = ResourceEstimate::units(s.tiles(t), TILE_BYTES + 2.0 * rows, "tiles");
+        e.detail = format!("{} of {} m", e.detail, fmt_m(t));
+        e
+    }
+
+    fn tile_side(&self, robot: &Robot) -> Option<f64> {
+        Some(self.tile_side_m.unwrap_or(2.0 * robot.radius))
+    }
+
+    fn build(&self, world: &World) -> Box<dyn Planner> {
+        let mut o = self.clone();
+        if o.tile_side_m.is_none() {
+            o.tile_side_m = Some(2.0 * world.robot().radius);
+        }
+        Box::new(BaStar::new(o))
+    }
+}
+
+fn bsa_cells(s: &Setup) -> ResourceEstimate {
+    let c = 2.0 * s.robot.radius;
+    let mut e = ResourceEstimate::units(s.tiles(c), TILE_BYTES, "cells");
+    e.detail = format!("{} of {} m", e.detail, fmt_m(c));
+    e
+}
+
+impl PlannerSettings for BsaOptions {
+    fn validate(&self) -> Result<(), OptionsError> {
+        Ok(())
+    }
+
+    fn check(&self, s: &Setup) -> Result<(), OptionsError> {
+        check_neighbour_sight(s, 2.0 * s.robot.radius, "cell")
+    }
+
+    fn estimate(&self, s: &Setup) -> ResourceEstimate {
+        bsa_cells(s)
+    }
+
+    fn tile_side(&self, robot: &Robot) -> Option<f64> {
+        Some(2.0 * robot.radius)
+    }
+
+    fn build(&self, _: &World) -> Box<dyn Planner> {
+        Box::new(Bsa::new(*self))
+    }
+}
+
+impl PlannerSettings for BsaExtendedOptions {
+    fn validate(&self) -> Result<(), OptionsError> {
+        finite_nonneg("clearance_px", self.clearance_px)?;
+        finite_pos("pipe_halfwidth", self.pipe_halfwidth)?;
+        if self.gap_cost == 0 {
+            return Err(OptionsError::new("gap_cost", "must be >= 1"));
+        }
+        if self.max_follow_steps == 0 {
+            return Err(OptionsError::new("max_follow_steps", "must be >= 1"));
+        }
+        Ok(())
+    }
+
+    fn check(&self, s: &Setup) -> Result<(), OptionsError> {
+        check_neighbour_sight(s, 2.0 * s.robot.radius, "cell")
+    }
+
+    fn estimate(&self, s: &Setup) -> ResourceEstimate {
+        // Wall following works at map resolution: per-pixel state and records along walls.
+        let mut e = bsa_cells(s);
+        e.bytes += s.pixels() * 32.0;
+        e
+    }
+
+    fn tile_side(&self, robot: &Robot) -> Option<f64> {
+        Some(2.0 * robot.radius)
+    }
+
+    fn build(&self, _: &World) -> Box<dyn Planner> {
+        Box::new(Bsa::extended(self.clone()))
+    }
+}
+
+impl PlannerSettings for BsaBfsOptions {
+    fn validate(&self) -> Result<(), OptionsError> {
+        opt_finite_pos("cell_side_m", self.cell_side_m)?;
+        finite_nonneg("clearance_margin_m", self.clearance_margin_m)?;
+        validate_execution("exec", &self.exec)
+    }
+
+    fn check(&self, s: &Setup) -> Result<(), OptionsError> {
+        let c = self.cell_side_m.unwrap_or(2.0 * s.robot.radius);
+        check_side_fits(s, c, "cell_side_m", "cell")?;
+        check_neighbour_sight(s, c, "cell")
+    }
+
+    fn estimate(&self, s: &Setup) -> ResourceEstimate {
+        let c = self.cell_side_m.unwrap_or(2.0 * s.robot.radius);
+        let cells = s.tiles(c);
+        // Cell state and return stacks; the trace is counted by PID records below.
+        let mut e = ResourceEstimate::units(cells, TILE_BYTES / 3.0, "cells");
+        e.detail = format!("{} of {} m", e.detail, fmt_m(c));
+        // The lane-by-lane length of the whole frame.
+        let path = s.frame_area_m2() / c;
+        e.bytes += pid_records(Some(&self.exec), path) * RECORD_BYTES;
+        e
+    }
+
+    fn tile_side(&self, robot: &Robot) -> Option<f64> {
+        Some(self.cell_side_m.unwrap_or(2.0 * robot.radius))
+    }
+
+    fn preferred_execution(&self) -> Option<Execution> {
+        Some(self.exec)
+    }
+
+    fn build(&self, _: &World) -> Box<dyn Planner> {
+        Box::new(BsaBfs::new(self.clone()))
+    }
+}
+
+impl PlannerSettings for BcdOptions {
+    fn validate(&self) -> Result<(), OptionsError> {
+        opt_finite_pos("lane_spacing_m", self.lane_spacing_m)?;
+        finite_nonneg("margin_px", self.margin_px)
+    }
+
+    fn check(&self, _: &Setup) -> Result<(), OptionsError> {
+        Ok(())
+    }
+
+    fn estimate(&self, s: &Setup) -> ResourceEstimate {
+        let sp = self.lane_spacing_m.unwrap_or(2.0 * s.robot.tool_radius);
+        // Lane pieces and their waypoints: at most one per lane-spacing square of the frame.
+        let mut e = ResourceEstimate::units(s.tiles(sp), TILE_BYTES / 2.0, "lane squares");
+        e.detail = format!("{} of {} m", e.detail, fmt_m(sp));
+        e
+    }
+
+    fn tile_side(&self, _: &Robot) -> Option<f64> {
+        None
+    }
+
+    fn build(&self, world: &World) -> Box<dyn Planner> {
+        Box::new(Bcd::new(world, self))
+    }
+}
+
+impl PlannerSettings for RectOptions {
+    fn validate(&self) -> Result<(), OptionsError> {
+        finite_pos("length_m", self.length_m)?;
+        finite_pos("width_m", self.width_m)?;
+        opt_finite_pos("clearance_radius_m", self.clearance_radius_m)?;
+        if let Some(a) = self.area {
+            if a.iter().any(|v| !v.is_finite()) || a[2] <= a[0] || a[3] <= a[1] {
+                return Err(OptionsError::new(
+                    "area",
+                    format!("must be finite X0,Y0,X1,Y1 with X1 > X0 and Y1 > Y0, got {a:?}"),
+                ));
+            }
+        }
+        validate_execution("exec", &self.exec)
+    }
+
+    fn check(&self, s: &Setup) -> Result<(), OptionsError> {
+        let res = s.frame.resolution;
+        for (f, v) in [("length_m", self.length_m), ("width_m", self.width_m)] {
+            if v < res {
+                return Err(OptionsError::new(
+                    f,
+                    format!("{v} m is finer than the map resolution ({res} m/px)"),
+                ));
+            }
+        }
+        if let Some(a) = self.area {
+            let (lo, hi) = s.frame.world_bounds();
+            if a[2] <= lo.x || a[0] >= hi.x || a[3] <= lo.y || a[1] >= hi.y {
+                return Err(OptionsError::new(
+                    "area",
+                    format!(
+                        "{},{},{},{} lies outside the map ({},{} to {},{})",
+                        a[0], a[1], a[2], a[3], lo.x, lo.y, hi.x, hi.y
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    fn estimate(&self, s: &Setup) -> ResourceEstimate {
+        let (lo, hi) = s.frame.world_bounds();
+        let (mut w, mut h) = (hi.x - lo.x, hi.y - lo.y);
+        if let Some(a) = self.area {
+            w = w.min(a[2] - a[0]);
+            h = h.min(a[3] - a[1]);
+        }
+        let n = (w / self.width_m + 2.0) * (h / self.length_m + 2.0);
+        let mut e = ResourceEstimate::units(n, RECORD_BYTES, "waypoints");
+        let path = n * self.length_m;
+        e.bytes += pid_records(Some(&self.exec), path) * RECORD_BYTES;
+        e
+    }
+
+    fn tile_side(&self, _: &Robot) -> Option<f64> {
+        None
+    }
+
+    fn preferred_execution(&self) -> Option<Execution> {
+        Some(self.exec)
+    }
+
+    fn build(&self, world: &World) -> Box<dyn Planner> {
+        Box::new(RectBoustrophedon::new(world, self))
+    }
+}
+
+/// The memory a run needs: the per-pixel part, the metrics' tile set and the planner's share;
+/// the detail names the largest part.
+pub fn estimate_run(s: &Setup, planner: &dyn PlannerSettings) -> ResourceEstimate {
+    let own = planner.estimate(s);
+    let metrics_side = planner
+        .tile_side(&s.robot)
+        .unwrap_or(2.0 * s.robot.tool_radius);
+    let mut metric_tiles = ResourceEstimate::units(s.tiles(metrics_side), 1.0 / 8.0, "tiles");
+    metric_tiles.detail = format!(
+        "{} of {} m for the metrics",
+        metric_tiles.detail,
+        fmt_m(metrics_side)
+    );
+    let pixels = ResourceEstimate::units(s.pixels(), PIXEL_BYTES, "map pixels");
+    let bytes = own.bytes + metric_tiles.bytes + pixels.bytes;
+    let mut parts = [own, metric_tiles, pixels];
+    parts.sort_by(|a, b| b.bytes.total_cmp(&a.bytes));
+    let [largest, _, _] = parts;
+    ResourceEstimate {
+        bytes,
+        detail: largest.detail,
+    }
+}
+
+/// A length in metres, at most 6 significant digits (`0.45`, `2e-9`).
+pub fn fmt_m(v: f64) -> String {
+    if v != 0.0 && (v.abs() < 1e-3 || v.abs() >= 1e7) {
+        format!("{v:.3e}")
+    } else {
+        let s = format!("{v:.6}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    }
+}

@@ -1,0 +1,671 @@
+//! A complete, serializable description of one coverage run — map recipe, robot, start, planner
+//! with its options, simulator settings, memory limit — with **one** validation and one way to
+//! run it.
+//!
+//! The command line builds a [`Scenario`] from its flags and `--config` file and writes it as
+//! `run.json`; reading `run.json` back and calling [`Scenario::run`] reproduces the run exactly
+//! (same trace). Rust users build one with [`Scenario::builder`]; a scenario file (YAML or JSON)
+//! is [`Scenario::from_file`].
+//!
+//! Validation happens in two stages, both in this module:
+//! * [`Scenario::validate`]: every value on its own (robot, start, sensor range, execution,
+//!   landmarks, map overrides, the planner's options through
+//!   [`PlannerSettings::validate`](ccpp_core::planners::PlannerSettings::validate));
+//! * [`Scenario::check_map`], once the map is loaded: the planner's checks against the frame
+//!   (a tile larger than the map, a sensor that cannot see a neighbour tile, an area outside the
+//!   map) and the **memory estimate** against [`Scenario::max_memory_mb`], before anything
+//!   large is allocated.
+//!
+//! ```no_run
+//! use ccpp_core::planners::PlannerKind;
+//! use ccpp_io::scenario::Scenario;
+//! let run = Scenario::builder("map.yaml", PlannerKind::BaStar)
+//!     .radius(0.2)
+//!     .build()?
+//!     .run()?;
+//! println!("{}", run.metrics.effective_coverage);
+//! # Ok::<(), ccpp_io::scenario::ScenarioError>(())
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use ccpp_core::exec::Execution;
+use ccpp_core::grid::{GridError, GridMap};
+use ccpp_core::metrics::{self, Metrics};
+use ccpp_core::planners::settings::{estimate_run, validate_execution};
+use ccpp_core::planners::{OptionsError, PlannerConfig, PlannerKind, ResourceEstimate, Setup};
+use ccpp_core::sim::{simulate, RunOutput, SimConfig};
+use ccpp_core::world::{Robot, World, WorldError};
+use ccpp_core::Pose;
+use serde::{Deserialize, Serialize};
+
+use crate::map::{load_map, LoadOptions, LoadedMap, MapError};
+
+/// Default memory limit of a run, MB: room for the shared maps and the benchmark maps
+/// (`cluttered_2000` at r = 0.025 m, `office_4096` at r = 0.1 m) with a wide margin.
+pub const DEFAULT_MAX_MEMORY_MB: u64 = 4096;
+
+/// Largest map side ccpp accepts, metres (1000 km): larger frames come from a wrong
+/// resolution, and their tile and distance arithmetic would lose all precision.
+pub const MAX_MAP_SIDE_M: f64 = 1e6;
+
+fn default_max_memory_mb() -> u64 {
+    DEFAULT_MAX_MEMORY_MB
+}
+
+/// Error of a scenario: invalid values, a map that cannot be loaded, a run that would be
+/// degenerate or too big. Every message names the value or the file at fault.
+#[derive(Debug, thiserror::Error)]
+pub enum ScenarioError {
+    /// The map cannot be loaded.
+    #[error(transparent)]
+    Map(#[from] MapError),
+    /// The georeference file cannot be used.
+    #[error("georef {}: {message}", path.display())]
+    Georef {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// The map and robot do not make a world (start in a wall, robot too big...).
+    #[error("map {}: {source}", path.display())]
+    World {
+        /// The map file.
+        path: PathBuf,
+        /// The cause.
+        source: WorldError,
+    },
+    /// The map grid cannot be placed.
+    #[error("map {}: {source}", path.display())]
+    Grid {
+        /// The map file.
+        path: PathBuf,
+        /// The cause.
+        source: GridError,
+    },
+    /// A value is invalid on its own.
+    #[error("{0}")]
+    Invalid(String),
+    /// A planner option is invalid.
+    #[error("planner option {0}")]
+    Options(OptionsError),
+    /// The run would be degenerate on this map (it could not do anything useful).
+    #[error("map {}: {planner}: {message}", path.display())]
+    Degenerate {
+        /// The map file.
+        path: PathBuf,
+        /// The planner.
+        planner: &'static str,
+        /// What is wrong.
+        message: String,
+    },
+    /// The run would need more memory than allowed.
+    #[error(
+        "map {}: {planner} would need about {needed_mb} MB ({detail}), more than the memory limit of {limit_mb} MB (raise it with --max-memory MB / max_memory_mb, or use a larger robot, tile or spacing)",
+        path.display()
+    )]
+    Memory {
+        /// The map file.
+        path: PathBuf,
+        /// The planner.
+        planner: &'static str,
+        /// Estimated need, MB (rounded up; may be astronomically large).
+        needed_mb: String,
+        /// The dominant quantity.
+        detail: String,
+        /// The limit, MB.
+        limit_mb: u64,
+    },
+    /// A scenario file cannot be read or parsed.
+    #[error("scenario {}: {message}", path.display())]
+    File {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// The scenario names no map file (the map must be given by the caller).
+    #[error("the scenario names no map file")]
+    NoMapPath,
+}
+
+impl From<OptionsError> for ScenarioError {
+    fn from(e: OptionsError) -> Self {
+        Self::Options(e)
+    }
+}
+
+/// How to load and prepare the map: enough to rebuild it exactly.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct MapRecipe {
+    /// Map file (a ROS `map_server` YAML or a bare PGM/PNG); `None` when the caller supplies the
+    /// map (the CLI's bundled demo map).
+    pub path: Option<PathBuf>,
+    /// Name used in reports; `None` = the file stem.
+    pub name: Option<String>,
+    /// Resolution override, m/px.
+    pub resolution: Option<f64>,
+    /// Origin override `[x, y, yaw]`.
+    pub origin: Option<[f64; 3]>,
+    /// `occupied_thresh` override.
+    pub occupied_thresh: Option<f64>,
+    /// `free_thresh` override.
+    pub free_thresh: Option<f64>,
+    /// Grow obstacles by this many metres (exact distance transform).
+    pub inflate: Option<f64>,
+    /// Georeference point-pair file (`px,py,wx,wy` lines); overrides resolution and origin.
+    pub georef: Option<PathBuf>,
+}
+
+/// A map ready for planning.
+#[derive(Clone, Debug)]
+pub struct PreparedMap {
+    /// The (placed, inflated) grid.
+    pub grid: GridMap,
+    /// Short name for reports.
+    pub name: String,
+    /// The file it came from, for messages.
+    pub source: PathBuf,
+    /// How it was made.
+    pub recipe: MapRecipe,
+}
+
+impl MapRecipe {
+    /// A recipe for the map file `path`, no overrides.
+    pub fn file(path: impl Into<PathBuf>) -> Self {
+        Self {
+            path: Some(path.into()),
+            ..Self::default()
+        }
+    }
+
+    /// Checks the overrides on their own (the loader checks them again with the file's values).
+    ///
+    /// # Errors
+    /// A non-finite or non-positive value.
+    pub fn validate(&self) -> Result<(), ScenarioError> {
+        if let Some(r) = self.resolution {
+            if !(r.is_finite() && r > 0.0) {
+                return Err(ScenarioError::Invalid(format!(
+                    "--resolution / map.resolution must be a finite number > 0, got {r}"
+                )));
+            }
+        }
+        if let Some(m) = self.inflate {
+            if !(m.is_finite() && m >= 0.0) {
+                return Err(ScenarioError::Invalid(format!(
+                    "--inflate / map.inflate must be a finite number >= 0 m, got {m}"
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Loads the map file and prepares it (georef, inflation).
+    ///
+    /// # Errors
+    /// [`ScenarioError::NoMapPath`] without a path, else loading errors.
+    pub fn load(&self) -> Result<PreparedMap, ScenarioError> {
+        self.validate()?;
+        let path = self.path.as_ref().ok_or(ScenarioError::NoMapPath)?;
+        let opts = LoadOptions {
+            resolution: self.resolution,
+            origin: self.origin,
+            occupied_thresh: self.occupied_thresh,
+            free_thresh: self.free_thresh,
+            negate: None,
+        };
+        let loaded = load_map(path, &opts)?;
+        self.prepare(loaded)
+    }
+
+    /// Prepares a map the caller loaded (e.g. from bytes): georef, inflation, name.
+    ///
+    /// # Errors
+    /// A georef file that cannot be used, an invalid inflation.
+    pub fn prepare(&self, loaded: LoadedMap) -> Result<PreparedMap, ScenarioError> {
+        self.validate()?;
+        let mut grid = loaded.grid;
+        if let Some(g) = &self.georef {
+            grid = apply_georef(grid, g)?;
+        }
+        if let Some(m) = self.inflate {
+            if m > 0.0 {
+                grid = ccpp_core::inflate::inflate(&grid, m);
+            }
+        }
+        let name = self.name.clone().unwrap_or_else(|| {
+            loaded
+                .source
+                .file_stem()
+                .map_or_else(|| "map".to_string(), |s| s.to_string_lossy().into_owned())
+        });
+        Ok(PreparedMap {
+            grid,
+            name,
+            source: loaded.source,
+            recipe: self.clone(),
+        })
+    }
+}
+
+/// Places `grid` by the affine fit of the point pairs in `path` (pixel coordinates from the
+/// image's top-left corner, y down). ccpp frames are similarities (rotation + uniform scale),
+/// so a fit with more than 1 % shear or anisotropy is refused.
+///
+/// # Errors
+/// An unreadable or degenerate georef file, or a fit that is not a similarity.
+pub fn apply_georef(grid: GridMap, path: &Path) -> Result<GridMap, ScenarioError> {
+    let err = |message: String| ScenarioError::Georef {
+        path: path.to_path_buf(),
+        message,
+    };
+    let fit = crate::georef::load_georef(path).map_err(|e| err(e.to_string()))?;
+    let [a, b, c, d] = fit.affine.m;
+    let res = (a * d - b * c).abs().sqrt();
+    if !(res.is_finite() && res > 0.0) {
+        return Err(err("degenerate transform".into()));
+    }
+    let yaw = c.atan2(a);
+    // Pixel y grows downwards, so the second column is res * (sin yaw, -cos yaw).
+    let (sy, cy) = yaw.sin_cos();
+    let dev = ((a - res * cy).powi(2)
+        + (c - res * sy).powi(2)
+        + (b - res * sy).powi(2)
+        + (d + res * cy).powi(2))
+    .sqrt()
+        / res;
+    if dev > 0.01 {
+        return Err(err(format!(
+            "the fitted transform has {:.1} % shear or anisotropy; ccpp needs rotation + uniform scale",
+            100.0 * dev
+        )));
+    }
+    let h = grid.frame().height as f64;
+    let o = fit.affine.apply(ccpp_core::Point::new(0.0, h));
+    grid.with_placement(res, Pose::new(o.x, o.y, yaw))
+        .map_err(|source| ScenarioError::Grid {
+            path: path.to_path_buf(),
+            source,
+        })
+}
+
+/// One coverage run, fully described. `run.json` is this, serialized.
+///
+/// The planner and its options are flattened: `"planner": "ba-star", "options": {...}` (only
+/// that planner's options, see [`PlannerConfig`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Scenario {
+    /// The map.
+    pub map: MapRecipe,
+    /// The robot (radius and tool radius, metres).
+    pub robot: Robot,
+    /// Start pose `[x, y, theta]`; `None` = the widest free spot of the largest free area,
+    /// heading east.
+    #[serde(default)]
+    pub start: Option<[f64; 3]>,
+    /// The planner and its options (seeds included: `random_bounce.seed`, and the odometry
+    /// noise seed in [`SimConfig::exec`]).
+    #[serde(flatten)]
+    pub planner: PlannerConfig,
+    /// Simulator settings: sensor range, execution (ideal or PID with its options and odometry
+    /// noise), landmarks.
+    #[serde(default)]
+    pub sim: SimConfig,
+    /// Refuse runs whose estimated memory exceeds this many MB.
+    #[serde(default = "default_max_memory_mb")]
+    pub max_memory_mb: u64,
+}
+
+/// A finished run.
+pub struct Run {
+    /// The truth it ran on.
+    pub world: World,
+    /// Trace, stop reason and timing.
+    pub output: RunOutput,
+    /// The metrics.
+    pub metrics: Metrics,
+}
+
+fn invalid(msg: String) -> ScenarioError {
+    ScenarioError::Invalid(msg)
+}
+
+impl Scenario {
+    /// A scenario with default robot (r = 0.15 m), options and settings.
+    pub fn new(map: MapRecipe, planner: PlannerKind) -> Self {
+        Self {
+            map,
+            robot: Robot::new(0.15),
+            start: None,
+            planner: PlannerConfig::new(planner),
+            sim: SimConfig::default(),
+            max_memory_mb: DEFAULT_MAX_MEMORY_MB,
+        }
+    }
+
+    /// A builder for the map file `map` and `planner`.
+    pub fn builder(map: impl Into<PathBuf>, planner: PlannerKind) -> ScenarioBuilder {
+        ScenarioBuilder(Self::new(MapRecipe::file(map), planner))
+    }
+
+    /// Reads a scenario file: JSON (`.json`, such as a run's `run.json`) or YAML.
+    ///
+    /// # Errors
+    /// An unreadable or malformed file.
+    pub fn from_file(path: &Path) -> Result<Self, ScenarioError> {
+        let err = |message: String| ScenarioError::File {
+            path: path.to_path_buf(),
+            message,
+        };
+        let text = crate::file::read_text(path).map_err(|e| err(e.to_string()))?;
+        let is_json = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("json"));
+        if is_json {
+            serde_json::from_str(&text).map_err(|e| err(e.to_string()))
+        } else {
+            serde_saphyr::from_str(&text).map_err(|e| err(e.to_string()))
+        }
+    }
+
+    /// The scenario as pretty JSON (the `run.json` format).
+    ///
+    /// # Errors
+    /// Serialization failure (does not happen for valid scenarios).
+    pub fn to_json(&self) -> Result<String, serde_json::Error> {
+        let mut s = serde_json::to_string_pretty(self)?;
+        s.push('\n');
+        Ok(s)
+    }
+
+    /// The execution in force: the simulator's, else the planner's preferred one, else ideal.
+    pub fn execution(&self) -> Execution {
+        self.sim
+            .exec
+            .or_else(|| self.planner.settings().preferred_execution())
+            .unwrap_or_default()
+    }
+
+    /// The planner's tile side for this robot, if tile-based.
+    pub fn tile_side(&self) -> Option<f64> {
+        self.planner.settings().tile_side(&self.robot)
+    }
+
+    /// Validates every value on its own: the one place for it (the CLI and option files go
+    /// through here).
+    ///
+    /// # Errors
+    /// The first invalid value, named.
+    pub fn validate(&self) -> Result<(), ScenarioError> {
+        self.map.validate()?;
+        self.robot
+            .validate()
+            .map_err(|e| invalid(format!("robot: {e}")))?;
+        if let Some(s) = self.start {
+            if s.iter().any(|v| !v.is_finite()) {
+                return Err(invalid(format!("start must be finite, got {s:?}")));
+            }
+        }
+        if let Some(r) = self.sim.sensor_range {
+            if !(r.is_finite() && r > 0.0) {
+                return Err(invalid(format!(
+                    "--sensor-range / sim.sensor_range must be a finite number > 0 m, got {r}"
+                )));
+            }
+        }
+        if self.sim.max_steps == 0 {
+            return Err(invalid("sim.max_steps must be >= 1".into()));
+        }
+        if let Some(e) = &self.sim.exec {
+            validate_execution("sim.exec", e).map_err(|e| invalid(e.to_string()))?;
+        }
+        let lm = &self.sim.landmarks;
+        for (f, v) in [("range_m", lm.range_m), ("period_s", lm.period_s)] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(invalid(format!(
+                    "sim.landmarks.{f} must be a finite number > 0, got {v}"
+                )));
+            }
+        }
+        if let Some(i) = lm
+            .landmarks
+            .iter()
+            .position(|l| !(l.x.is_finite() && l.y.is_finite() && l.theta.is_finite()))
+        {
+            return Err(invalid(format!("landmark {i} has a non-finite pose")));
+        }
+        if !lm.landmarks.is_empty() && !matches!(self.execution(), Execution::Pid(_)) {
+            return Err(invalid(format!(
+                "landmarks correct the pose estimate of PID execution only, and {} runs with ideal execution (use --exec pid)",
+                self.planner.name()
+            )));
+        }
+        if self.max_memory_mb == 0 {
+            return Err(invalid(
+                "--max-memory / max_memory_mb must be >= 1 MB".into(),
+            ));
+        }
+        self.planner.validate()?;
+        Ok(())
+    }
+
+    /// What the planner's checks and estimate see for `map`.
+    pub fn setup(&self, map: &PreparedMap) -> Setup {
+        Setup {
+            frame: *map.grid.frame(),
+            robot: self.robot,
+            sensor_range: self.sim.sensor_range_for(&self.robot),
+        }
+    }
+
+    /// Checks the run against the loaded map: the map's extent, the planner's checks
+    /// (degenerate runs), then the memory estimate (before anything large is allocated).
+    /// Returns the estimate.
+    ///
+    /// # Errors
+    /// [`ScenarioError::Memory`] or [`ScenarioError::Degenerate`].
+    pub fn check_map(&self, map: &PreparedMap) -> Result<ResourceEstimate, ScenarioError> {
+        let setup = self.setup(map);
+        let planner = self.planner.name();
+        let f = setup.frame;
+        if !(f.width_m() <= MAX_MAP_SIDE_M && f.height_m() <= MAX_MAP_SIDE_M) {
+            return Err(ScenarioError::Degenerate {
+                path: map.source.clone(),
+                planner,
+                message: format!(
+                    "the map is {:e} x {:e} m ({} x {} px at {:e} m/px), larger than the {MAX_MAP_SIDE_M:e} m side ccpp handles; check the resolution",
+                    f.width_m(),
+                    f.height_m(),
+                    f.width,
+                    f.height,
+                    f.resolution
+                ),
+            });
+        }
+        self.planner.settings().check(&setup).map_err(|e| {
+            let e = e.in_section(self.planner.kind().info().section);
+            ScenarioError::Degenerate {
+                path: map.source.clone(),
+                planner,
+                message: if e.field.contains('.') {
+                    e.to_string()
+                } else {
+                    e.message
+                },
+            }
+        })?;
+        let est = estimate_run(&setup, self.planner.settings());
+        let limit = self.max_memory_mb as f64 * 1024.0 * 1024.0;
+        if !(est.bytes <= limit) {
+            let mb = est.bytes / (1024.0 * 1024.0);
+            let needed_mb = if mb < 1e9 {
+                format!("{:.0}", mb.ceil())
+            } else {
+                format!("{mb:.1e}")
+            };
+            return Err(ScenarioError::Memory {
+                path: map.source.clone(),
+                planner,
+                needed_mb,
+                detail: est.detail,
+                limit_mb: self.max_memory_mb,
+            });
+        }
+        Ok(est)
+    }
+
+    /// Validates, checks against `map` and builds the world.
+    ///
+    /// # Errors
+    /// As [`validate`](Self::validate) and [`check_map`](Self::check_map), plus a start in a
+    /// wall or a robot that fits nowhere.
+    pub fn world(&self, map: &PreparedMap) -> Result<World, ScenarioError> {
+        self.validate()?;
+        self.check_map(map)?;
+        let start = self.start.map(|s| Pose::new(s[0], s[1], s[2]));
+        World::new(map.grid.clone(), self.robot, start).map_err(|source| ScenarioError::World {
+            path: map.source.clone(),
+            source,
+        })
+    }
+
+    /// Runs the scenario on a map the caller prepared (bench runs share one map).
+    ///
+    /// # Errors
+    /// As [`world`](Self::world).
+    pub fn run_on(&self, map: &PreparedMap) -> Result<Run, ScenarioError> {
+        let world = self.world(map)?;
+        // Wall time covers planning (offline planners plan in `build`) and simulation.
+        let started = std::time::Instant::now();
+        let mut planner = self.planner.build(&world);
+        let mut output = simulate(&world, planner.as_mut(), &self.sim);
+        output.wall_time_s = started.elapsed().as_secs_f64();
+        let metrics = metrics::compute(&world, &output, &map.name);
+        Ok(Run {
+            world,
+            output,
+            metrics,
+        })
+    }
+
+    /// Loads the map and runs the scenario.
+    ///
+    /// # Errors
+    /// As [`MapRecipe::load`] and [`run_on`](Self::run_on).
+    pub fn run(&self) -> Result<Run, ScenarioError> {
+        self.validate()?;
+        let map = self.map.load()?;
+        self.run_on(&map)
+    }
+}
+
+/// Builds a [`Scenario`] step by step; [`build`](Self::build) validates it.
+#[derive(Clone, Debug)]
+pub struct ScenarioBuilder(Scenario);
+
+impl ScenarioBuilder {
+    /// Robot radius (the tool radius follows unless set).
+    #[must_use]
+    pub fn radius(mut self, r: f64) -> Self {
+        let same = self.0.robot.tool_radius == self.0.robot.radius;
+        self.0.robot.radius = r;
+        if same {
+            self.0.robot.tool_radius = r;
+        }
+        self
+    }
+
+    /// Tool radius.
+    #[must_use]
+    pub fn tool_radius(mut self, r: f64) -> Self {
+        self.0.robot.tool_radius = r;
+        self
+    }
+
+    /// Start pose.
+    #[must_use]
+    pub fn start(mut self, x: f64, y: f64, theta: f64) -> Self {
+        self.0.start = Some([x, y, theta]);
+        self
+    }
+
+    /// The planner with its options.
+    #[must_use]
+    pub fn planner(mut self, p: PlannerConfig) -> Self {
+        self.0.planner = p;
+        self
+    }
+
+    /// Simulator settings.
+    #[must_use]
+    pub fn sim(mut self, s: SimConfig) -> Self {
+        self.0.sim = s;
+        self
+    }
+
+    /// Memory limit, MB.
+    #[must_use]
+    pub fn max_memory_mb(mut self, mb: u64) -> Self {
+        self.0.max_memory_mb = mb;
+        self
+    }
+
+    /// The validated scenario.
+    ///
+    /// # Errors
+    /// As [`Scenario::validate`].
+    pub fn build(self) -> Result<Scenario, ScenarioError> {
+        self.0.validate()?;
+        Ok(self.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ccpp_core::planners::ba_star::BaStarOptions;
+
+    #[test]
+    fn json_round_trip_keeps_planner_and_options_flat() {
+        let mut s = Scenario::new(MapRecipe::file("m.yaml"), PlannerKind::BaStar);
+        s.planner = PlannerConfig::BaStar(BaStarOptions {
+            smoothing: false,
+            ..BaStarOptions::default()
+        });
+        let j = s.to_json().unwrap_or_default();
+        let v: serde_json::Value = serde_json::from_str(&j).unwrap_or_default();
+        assert_eq!(v["planner"], "ba-star");
+        assert_eq!(v["options"]["smoothing"], false);
+        let back: Scenario = serde_json::from_str(&j).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(back, s);
+        // Another planner's options are refused.
+        let bad = j.replace("\"smoothing\": false", "\"side\": \"left\"");
+        assert!(serde_json::from_str::<Scenario>(&bad).is_err());
+    }
+
+    #[test]
+    fn validate_refuses_bad_values() {
+        let mut s = Scenario::new(MapRecipe::file("m.yaml"), PlannerKind::Bcd);
+        s.planner = PlannerConfig::Bcd(ccpp_core::planners::bcd::BcdOptions {
+            lane_spacing_m: Some(f64::NAN),
+            ..Default::default()
+        });
+        let e = s
+            .validate()
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(e.contains("bcd.lane_spacing_m"), "{e}");
+        let mut s = Scenario::new(MapRecipe::file("m.yaml"), PlannerKind::BaStar);
+        s.sim.landmarks.landmarks = vec![ccpp_core::landmarks::Landmark::new(1, 0.0, 0.0)];
+        let e = s
+            .validate()
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(e.contains("PID"), "{e}");
+    }
+}
