@@ -5,10 +5,10 @@ use std::fmt::Write as _;
 use anyhow::{bail, Context, Result};
 use ccpp_core::planners::rect_boustrophedon::{plan, RectOptions};
 use ccpp_core::world::World;
-use ccpp_io::write_atomic;
 
 use crate::args::WaypointsArgs;
 use crate::job::{prepare_map, robot_from};
+use crate::staging::write_file;
 
 /// Runs `ccpp waypoints`.
 pub fn run(a: &WaypointsArgs) -> Result<()> {
@@ -52,8 +52,8 @@ pub fn run(a: &WaypointsArgs) -> Result<()> {
         s
     };
     match &a.out {
-        Some(path) => write_atomic(path, text.as_bytes())?,
-        None => print!("{text}"),
+        Some(path) => write_file(path, text.as_bytes())?,
+        None => crate::print_stdout(&text)?,
     }
     Ok(())
 }
