@@ -100,22 +100,28 @@ pub fn clap_lines(e: &clap::Error) -> (String, String) {
     // The subcommand: from clap's usage line, else the first argument naming one.
     let from_args = || {
         let sub = std::env::args().nth(1).filter(|a| {
-            ["run", "demo", "planners", "info", "bench", "replay", "waypoints"].contains(&a.as_str())
+            [
+                "run",
+                "demo",
+                "planners",
+                "info",
+                "bench",
+                "replay",
+                "waypoints",
+            ]
+            .contains(&a.as_str())
         });
         sub.map_or_else(|| "ccpp".to_string(), |s| format!("ccpp {s}"))
     };
     let command = rest
         .iter()
         .find_map(|l| l.strip_prefix("Usage: "))
-        .map_or_else(
-            from_args,
-            |u| {
-                u.split_whitespace()
-                    .take_while(|w| !w.starts_with(['-', '<', '[']))
-                    .collect::<Vec<_>>()
-                    .join(" ")
-            },
-        );
+        .map_or_else(from_args, |u| {
+            u.split_whitespace()
+                .take_while(|w| !w.starts_with(['-', '<', '[']))
+                .collect::<Vec<_>>()
+                .join(" ")
+        });
     let hint = match rest.iter().find_map(|l| l.strip_prefix("tip: ")) {
         Some(tip) => format!("hint: {tip}; see `{command} --help`"),
         None => format!("hint: see `{command} --help`"),
@@ -150,7 +156,8 @@ mod tests {
             one_line(&e),
             "planner options dup.yaml: line 2 column 1: duplicate mapping key: ba_star"
         );
-        let e = anyhow::anyhow!("planner options big.yaml: budget breached: Nodes {{ nodes: 250001 }}");
+        let e =
+            anyhow::anyhow!("planner options big.yaml: budget breached: Nodes {{ nodes: 250001 }}");
         assert_eq!(
             one_line(&e),
             "planner options big.yaml: the YAML is too large or too deeply nested (250001 nodes)"

@@ -174,7 +174,9 @@ pub fn run(a: &InfoArgs) -> Result<()> {
         Ok(w) => (Some(w), None),
         Err(e @ WorldError::RobotTooBig { .. }) => (None, Some(e.to_string())),
         // A start the user gave that does not work is a user error.
-        Err(e) => return Err(anyhow::Error::new(e).context(format!("map {}", map.source.display()))),
+        Err(e) => {
+            return Err(anyhow::Error::new(e).context(format!("map {}", map.source.display())))
+        }
     };
     let res2 = f.resolution * f.resolution;
     let s = world.as_ref().map(World::start);
@@ -220,7 +222,11 @@ pub fn run(a: &InfoArgs) -> Result<()> {
         t.push_str(&s);
         t.push('\n');
     };
-    line(format!("map            {} ({})", info.map, map.source.display()));
+    line(format!(
+        "map            {} ({})",
+        info.map,
+        map.source.display()
+    ));
     line(format!(
         "size           {} x {} px, {} m/px = {:.2} x {:.2} m",
         f.width, f.height, f.resolution, info.width_m, info.height_m

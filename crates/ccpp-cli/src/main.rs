@@ -13,6 +13,7 @@ mod plots;
 mod staging;
 mod waypoints;
 
+use std::fmt::Write as _;
 use std::io::Write as _;
 use std::process::ExitCode;
 
@@ -60,6 +61,9 @@ fn clap_exit(e: &clap::Error) -> ExitCode {
 
 /// Prints `text` on stdout. A closed stdout (`ccpp waypoints ... | head`) is not an error: the
 /// reader has what it wanted, so the text is dropped and the command still succeeds.
+///
+/// # Errors
+/// Any other write error.
 pub fn print_stdout(text: &str) -> anyhow::Result<()> {
     let mut out = std::io::stdout().lock();
     match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
@@ -88,7 +92,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
             let mut s = String::new();
             for p in ccpp_core::planners::CATALOG {
                 let kind = if p.offline { "offline" } else { "online" };
-                s.push_str(&format!("{:<19} {:<8} {}\n", p.name, kind, p.description));
+                let _ = writeln!(s, "{:<19} {:<8} {}", p.name, kind, p.description);
             }
             print_stdout(&s)
         }

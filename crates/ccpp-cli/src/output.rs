@@ -106,8 +106,7 @@ pub fn render_run_files(job: &Job, r: &JobResult, replay: bool) -> Result<RunFil
     ];
     if replay {
         let title = format!("{} on {}", r.metrics.planner, r.metrics.map);
-        let (html, gif) =
-            render_replay(&r.world, &r.run.trace, r.run.tile_side, &metrics, &title)?;
+        let (html, gif) = render_replay(&r.world, &r.run.trace, r.run.tile_side, &metrics, &title)?;
         files.push(("replay.html", html.into_bytes()));
         files.push(("replay.gif", gif));
     }

@@ -283,7 +283,9 @@ impl Drop for Staging {
 pub fn write_file(path: &Path, bytes: &[u8]) -> Result<(), ccpp_io::WriteError> {
     let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
     if std::env::var_os(FAIL_WRITE_ENV).is_some_and(|v| v == name) {
-        return ccpp_io::write::write_atomic_with(path, |_| Err(std::io::Error::from_raw_os_error(28)));
+        return ccpp_io::write::write_atomic_with(path, |_| {
+            Err(std::io::Error::from_raw_os_error(28))
+        });
     }
     let mut tmp = path.as_os_str().to_owned();
     tmp.push(".tmp");

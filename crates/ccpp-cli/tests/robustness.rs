@@ -53,9 +53,11 @@ fn planner_of(dir: &Path) -> String {
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("run.json")).unwrap()).unwrap();
     let m: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("metrics.json")).unwrap())
-            .unwrap();
-    assert_eq!(v["planner"], m["planner"], "run.json and metrics.json disagree");
+        serde_json::from_str(&std::fs::read_to_string(dir.join("metrics.json")).unwrap()).unwrap();
+    assert_eq!(
+        v["planner"], m["planner"],
+        "run.json and metrics.json disagree"
+    );
     v["planner"].as_str().unwrap().to_string()
 }
 
@@ -104,7 +106,11 @@ fn a_failed_write_leaves_the_older_complete_run() {
         let err = stderr_of(&o);
         assert_eq!(err.lines().count(), 1, "{err}");
         assert!(err.contains(name) && err.contains("os error 28"), "{err}");
-        assert_eq!(err.matches("os error 28").count(), 1, "cause repeated: {err}");
+        assert_eq!(
+            err.matches("os error 28").count(),
+            1,
+            "cause repeated: {err}"
+        );
         assert!(!err.contains(".ccpp-new"), "staging path leaked: {err}");
         assert_eq!(entries(&out), BASE_SET, "{name}");
         assert_eq!(planner_of(&out), "bcd");
@@ -138,7 +144,10 @@ fn run_refuses_an_out_folder_with_other_files() {
         .get_output()
         .clone();
     let err = stderr_of(&o);
-    assert!(err.starts_with("error: ") && err.contains("notes.txt"), "{err}");
+    assert!(
+        err.starts_with("error: ") && err.contains("notes.txt"),
+        "{err}"
+    );
     assert_eq!(entries(&out), ["notes.txt"]);
 }
 
@@ -265,7 +274,8 @@ fn bench_resume_reruns_when_anything_that_defines_a_run_changed() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("bench");
     let maps = [data("teb_empty_box.yaml")];
-    let radius = |out: &Path| -> Vec<String> { csv_rows(out).iter().map(|r| r[4].clone()).collect() };
+    let radius =
+        |out: &Path| -> Vec<String> { csv_rows(out).iter().map(|r| r[4].clone()).collect() };
     bench(&out, &maps, &["--planners", "bcd", "--radius", "0.15"])
         .assert()
         .success();
@@ -288,9 +298,13 @@ fn bench_resume_reruns_when_anything_that_defines_a_run_changed() {
         before
     );
     // A different seed or a changed map content reruns.
-    bench(&out, &maps, &["--planners", "bcd", "--radius", "0.3", "--seed", "9"])
-        .assert()
-        .success();
+    bench(
+        &out,
+        &maps,
+        &["--planners", "bcd", "--radius", "0.3", "--seed", "9"],
+    )
+    .assert()
+    .success();
     assert_ne!(
         std::fs::metadata(&trace).unwrap().modified().unwrap(),
         before
@@ -300,9 +314,13 @@ fn bench_resume_reruns_when_anything_that_defines_a_run_changed() {
     std::fs::copy(data("teb_empty_box.png"), copy.join("teb_empty_box.png")).unwrap();
     std::fs::copy(data("teb_empty_box.yaml"), copy.join("teb_empty_box.yaml")).unwrap();
     let m2 = [copy.join("teb_empty_box.yaml")];
-    bench(&out, &m2, &["--planners", "bcd", "--radius", "0.3", "--seed", "9"])
-        .assert()
-        .success();
+    bench(
+        &out,
+        &m2,
+        &["--planners", "bcd", "--radius", "0.3", "--seed", "9"],
+    )
+    .assert()
+    .success();
     let t2 = std::fs::metadata(&trace).unwrap().modified().unwrap();
     std::thread::sleep(std::time::Duration::from_millis(20));
     let yaml = std::fs::read_to_string(copy.join("teb_empty_box.yaml")).unwrap();
@@ -312,9 +330,13 @@ fn bench_resume_reruns_when_anything_that_defines_a_run_changed() {
     )
     .unwrap();
     assert!(yaml.contains("resolution: 0.05"), "{yaml}");
-    bench(&out, &m2, &["--planners", "bcd", "--radius", "0.3", "--seed", "9"])
-        .assert()
-        .success();
+    bench(
+        &out,
+        &m2,
+        &["--planners", "bcd", "--radius", "0.3", "--seed", "9"],
+    )
+    .assert()
+    .success();
     assert_ne!(std::fs::metadata(&trace).unwrap().modified().unwrap(), t2);
 }
 
@@ -336,7 +358,9 @@ fn bench_keeps_maps_with_the_same_name_apart_and_refuses_missing_paths() {
         maps.push(d.join("room.png"));
     }
     let out = dir.path().join("bench");
-    bench(&out, &maps, &["--planners", "bcd"]).assert().success();
+    bench(&out, &maps, &["--planners", "bcd"])
+        .assert()
+        .success();
     let rows = csv_rows(&out);
     assert_eq!(rows.len(), 2);
     assert_ne!(rows[0][0], rows[1][0], "{rows:?}");
@@ -351,7 +375,10 @@ fn bench_keeps_maps_with_the_same_name_apart_and_refuses_missing_paths() {
         .clone();
     let err = stderr_of(&o);
     assert_eq!(err.lines().count(), 1, "{err}");
-    assert!(err.contains("nope") && err.contains("no such file"), "{err}");
+    assert!(
+        err.contains("nope") && err.contains("no such file"),
+        "{err}"
+    );
     assert!(!out.join("runs/nope").exists());
 }
 
@@ -403,7 +430,11 @@ fn user_errors_are_one_line_and_exit_1() {
     );
     assert!(!e.contains("Usage"), "{e}");
     check(&["run", "--map", m], &["--planner"], 2);
-    check(&["run", "--planner", "bcd", "--raidus", "1", "--map", m], &["--radius"], 2);
+    check(
+        &["run", "--planner", "bcd", "--raidus", "1", "--map", m],
+        &["--radius"],
+        2,
+    );
     check(&[], &["no command"], 2);
     ccpp().arg("--help").assert().success();
     ccpp().args(["run", "--help"]).assert().success();
@@ -411,30 +442,55 @@ fn user_errors_are_one_line_and_exit_1() {
     // Causes are not repeated.
     let dir = tempfile::tempdir().unwrap();
     let e = check(
-        &["run", "--planner", "bcd", "--map", dir.path().to_str().unwrap()],
+        &[
+            "run",
+            "--planner",
+            "bcd",
+            "--map",
+            dir.path().to_str().unwrap(),
+        ],
         &["not a regular file"],
         1,
     );
     assert_eq!(e.matches("not a regular file").count(), 1, "{e}");
     // Config errors: one line, no library advice or debug dumps.
     let dup = dir.path().join("dup.yaml");
-    std::fs::write(&dup, "ba_star: {tile_side_m: 0.3}\nba_star: {tile_side_m: 0.4}\n").unwrap();
+    std::fs::write(
+        &dup,
+        "ba_star: {tile_side_m: 0.3}\nba_star: {tile_side_m: 0.4}\n",
+    )
+    .unwrap();
     let e = check(
-        &["run", "--planner", "ba-star", "--map", m, "--config", dup.to_str().unwrap()],
+        &[
+            "run",
+            "--planner",
+            "ba-star",
+            "--map",
+            m,
+            "--config",
+            dup.to_str().unwrap(),
+        ],
         &["dup.yaml", "line 2", "duplicate"],
         1,
     );
     assert!(!e.contains("DuplicateKeyPolicy"), "{e}");
+    // A map YAML past the YAML reader's size budget.
+    std::fs::copy(
+        data("teb_empty_box.png"),
+        dir.path().join("teb_empty_box.png"),
+    )
+    .unwrap();
     let big = dir.path().join("big.yaml");
-    let mut text = String::from("ba_star: {tile_side_m: 0.3}\nx: [");
+    let mut text = std::fs::read_to_string(&map).unwrap();
+    text.push_str("x: [");
     for _ in 0..260_000 {
         text.push_str("1,");
     }
     text.push_str("1]\n");
     std::fs::write(&big, text).unwrap();
     let e = check(
-        &["run", "--planner", "ba-star", "--map", m, "--config", big.to_str().unwrap()],
-        &["big.yaml"],
+        &["info", "--map", big.to_str().unwrap()],
+        &["big.yaml", "too large"],
         1,
     );
     assert!(!e.contains("budget") && !e.contains('{'), "{e}");
@@ -471,7 +527,10 @@ fn a_start_outside_the_building_is_warned_about() {
         .get_output()
         .clone();
     let err = stderr_of(&o);
-    assert!(err.starts_with("warning: ") && err.contains("border"), "{err}");
+    assert!(
+        err.starts_with("warning: ") && err.contains("border"),
+        "{err}"
+    );
     let s = String::from_utf8_lossy(&o.stdout);
     // 200 x 160 px at 0.05 m/px: 80 m2, minus the walls; the building is 4 x 3 m.
     assert!(s.contains("start area:") && s.contains("m2 free"), "{s}");
@@ -526,7 +585,10 @@ fn run_summary_leads_with_effective_coverage() {
         .clone();
     let s = String::from_utf8_lossy(&o.stdout);
     let rows: Vec<&str> = s.lines().skip(1).collect();
-    assert!(rows[0].trim_start().starts_with("effective_coverage"), "{s}");
+    assert!(
+        rows[0].trim_start().starts_with("effective_coverage"),
+        "{s}"
+    );
     assert!(rows[1].trim_start().starts_with("coverage_rate"), "{s}");
 }
 
