@@ -139,7 +139,7 @@ pub fn check_target(target: &Path) -> Result<()> {
     };
     if !meta.is_dir() {
         bail!(
-            "output folder {} exists and is not a folder",
+            "output folder {} exists and is not a plain folder",
             target.display()
         );
     }
