@@ -9,13 +9,17 @@ use ccpp_core::metrics::Metrics;
 use ccpp_core::planners::{self, PlannerOptions};
 use ccpp_core::sim::SimConfig;
 use ccpp_io::scenario::{Scenario, DEFAULT_MAX_MEMORY_MB};
-use ccpp_io::write_atomic;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
 use crate::args::{BenchArgs, MapArgs};
 use crate::job::{parse_planner, planner_options, prepare_map, robot_from, Job, PreparedMap};
 use crate::output::write_run_files;
+use crate::staging::write_file;
+
+/// Test hook: a planner named by this environment variable panics in `ccpp bench`, to check
+/// that one failing run becomes an error row and the others finish.
+pub const PANIC_ENV: &str = "CCPP_TEST_PANIC_PLANNER";
 
 /// One row of the results: a run, or its failure.
 pub struct Row {
@@ -59,8 +63,10 @@ pub fn expand_maps(items: &[PathBuf]) -> Result<Vec<PathBuf>> {
             } else {
                 out.extend(yamls);
             }
-        } else {
+        } else if item.is_file() {
             out.push(item.clone());
+        } else {
+            bail!("--maps {}: no such file or folder", item.display());
         }
     }
     if out.is_empty() {
@@ -81,6 +87,111 @@ fn map_name(p: &Path) -> String {
         .map_or_else(|| "map".into(), |s| s.to_string_lossy().into_owned())
 }
 
+/// Drops repeated maps (the same file named twice) and gives every map a distinct name, used
+/// for its run folders, rows and plots: the file stem, or, when two maps in different folders
+/// share a stem, `<folder>-<stem>` (then `-2`, `-3`, ... if that still repeats).
+pub fn name_maps(maps: Vec<PathBuf>) -> Vec<(PathBuf, String)> {
+    let mut seen = Vec::new();
+    let mut kept = Vec::new();
+    for m in maps {
+        let canon = std::fs::canonicalize(&m).unwrap_or_else(|_| m.clone());
+        if !seen.contains(&canon) {
+            seen.push(canon);
+            kept.push(m);
+        }
+    }
+    let stems: Vec<String> = kept.iter().map(|p| map_name(p)).collect();
+    let mut names: Vec<String> = kept
+        .iter()
+        .zip(&stems)
+        .map(|(p, stem)| {
+            if stems.iter().filter(|s| *s == stem).count() == 1 {
+                return stem.clone();
+            }
+            let canon = std::fs::canonicalize(p).unwrap_or_else(|_| p.clone());
+            match canon
+                .parent()
+                .and_then(Path::file_name)
+                .map(|n| n.to_string_lossy().into_owned())
+            {
+                Some(folder) => format!("{folder}-{stem}"),
+                None => stem.clone(),
+            }
+        })
+        .collect();
+    for i in 0..names.len() {
+        let earlier = names[..i].iter().filter(|n| **n == names[i]).count();
+        if earlier > 0 {
+            let mut k = earlier + 1;
+            while names.contains(&format!("{}-{k}", names[i])) {
+                k += 1;
+            }
+            names[i] = format!("{}-{k}", names[i]);
+        }
+    }
+    kept.into_iter().zip(names).collect()
+}
+
+/// 64-bit FNV-1a, a fixed hash for cache keys (stable across runs and Rust versions).
+struct Fnv(u64);
+
+impl Fnv {
+    fn new() -> Self {
+        Self(0xcbf2_9ce4_8422_2325)
+    }
+    fn bytes(&mut self, b: &[u8]) {
+        for &x in b {
+            self.0 ^= u64::from(x);
+            self.0 = self.0.wrapping_mul(0x0100_0000_01b3);
+        }
+        // Length-delimit the fields.
+        self.0 ^= b.len() as u64;
+        self.0 = self.0.wrapping_mul(0x0100_0000_01b3);
+    }
+}
+
+/// A hash of the prepared grid's content: size, placement and every cell.
+pub fn grid_hash(g: &ccpp_core::GridMap) -> u64 {
+    let f = g.frame();
+    let mut h = Fnv::new();
+    h.bytes(&(f.width as u64).to_le_bytes());
+    h.bytes(&(f.height as u64).to_le_bytes());
+    for v in [f.resolution, f.origin.x, f.origin.y, f.origin.theta] {
+        h.bytes(&v.to_bits().to_le_bytes());
+    }
+    let cells: Vec<u8> = g
+        .cells()
+        .iter()
+        .map(|c| match c {
+            ccpp_core::Cell::Free => 0,
+            ccpp_core::Cell::Occupied => 1,
+            ccpp_core::Cell::Unknown => 2,
+        })
+        .collect();
+    h.bytes(&cells);
+    h.0
+}
+
+/// What defines a bench run, as written to its `bench-key.txt`: a finished run is reused only
+/// when this matches exactly. Covers the map's content (after inflation), the planner, its
+/// options (seed included), the robot, the simulator settings and the ccpp version.
+pub fn run_key(
+    grid_hash: u64,
+    planner: &str,
+    options: &PlannerOptions,
+    robot: ccpp_core::world::Robot,
+    sim: &SimConfig,
+) -> Result<String> {
+    let mut h = Fnv::new();
+    h.bytes(&grid_hash.to_le_bytes());
+    h.bytes(planner.as_bytes());
+    h.bytes(serde_json::to_string(options)?.as_bytes());
+    h.bytes(serde_json::to_string(&robot)?.as_bytes());
+    h.bytes(serde_json::to_string(sim)?.as_bytes());
+    h.bytes(env!("CARGO_PKG_VERSION").as_bytes());
+    Ok(format!("ccpp-bench-key v1 {:016x}\n", h.0))
+}
+
 /// Runs the benchmark.
 pub fn run(a: &BenchArgs) -> Result<()> {
     let planners: Vec<String> = if a.planners.is_empty() {
@@ -98,7 +209,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     }
     let (robot, _) = robot_from(&(&a.robot).into())?;
     let options = planner_options(a.config.as_deref(), a.seed)?;
-    let maps = expand_maps(&a.maps)?;
+    let maps = name_maps(expand_maps(&a.maps)?);
     std::fs::create_dir_all(&a.out)
         .with_context(|| format!("cannot create output folder {}", a.out.display()))?;
     if let Some(j) = a.jobs {
@@ -111,20 +222,30 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     // Load every map once (in parallel); a map that fails to load fails all its runs.
     let prepared: Vec<(PathBuf, Result<PreparedMap, String>)> = maps
         .par_iter()
-        .map(|m| {
+        .map(|(m, name)| {
             let args = MapArgs {
                 map: m.clone(),
                 inflate: a.inflate,
                 ..MapArgs::default()
             };
-            (m.clone(), prepare_map(&args).map_err(|e| format!("{e:#}")))
+            let map = prepare_map(&args)
+                .map(|mut p| {
+                    p.name.clone_from(name);
+                    p
+                })
+                .map_err(|e| crate::errors::one_line(&e));
+            (m.clone(), map)
         })
+        .collect();
+    let hashes: Vec<Option<u64>> = prepared
+        .par_iter()
+        .map(|(_, m)| m.as_ref().ok().map(|m| grid_hash(&m.grid)))
         .collect();
 
     let mut tasks = Vec::new();
-    for (mi, (path, _)) in prepared.iter().enumerate() {
+    for (mi, (_, name)) in maps.iter().enumerate() {
         for p in &planners {
-            tasks.push((mi, map_name(path), p.clone()));
+            tasks.push((mi, name.clone(), p.clone()));
         }
     }
     let bar = ProgressBar::new(tasks.len() as u64);
@@ -140,7 +261,18 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         .par_iter()
         .map(|(mi, name, planner)| {
             let dir = a.out.join("runs").join(name).join(planner);
-            let outcome = run_one(a, &prepared[*mi].1, &dir, planner, robot, &options);
+            let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                run_one(
+                    a,
+                    &prepared[*mi].1,
+                    hashes[*mi],
+                    &dir,
+                    planner,
+                    robot,
+                    &options,
+                )
+            }))
+            .unwrap_or_else(|payload| Err(panic_message(payload.as_ref())));
             let _guard = done.lock();
             bar.inc(1);
             bar.set_message(format!("{name} / {planner}"));
@@ -154,53 +286,83 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         .collect();
     bar.finish_and_clear();
 
-    write_atomic(&a.out.join("results.csv"), results_csv(&rows).as_bytes())?;
-    write_atomic(&a.out.join("results.md"), results_md(&rows).as_bytes())?;
+    write_file(&a.out.join("results.csv"), results_csv(&rows).as_bytes())?;
+    write_file(&a.out.join("results.md"), results_md(&rows).as_bytes())?;
     crate::plots::write_all(&a.out, &rows, &prepared, robot)?;
     let failed = rows.iter().filter(|r| r.outcome.is_err()).count();
-    println!(
-        "{} runs ({} failed) on {} maps x {} planners; wrote {}/results.csv, results.md, plots/",
+    crate::print_stdout(&format!(
+        "{} runs ({} failed) on {} maps x {} planners; wrote {}/results.csv, results.md, plots/\n",
         rows.len(),
         failed,
         prepared.len(),
         planners.len(),
         a.out.display()
-    );
+    ))?;
+    if failed > 0 {
+        bail!(
+            "{failed} of {} runs failed; see the error column of {}",
+            rows.len(),
+            a.out.join("results.csv").display()
+        );
+    }
     Ok(())
+}
+
+/// The message of a caught panic.
+fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    let msg = payload
+        .downcast_ref::<&str>()
+        .map(|s| (*s).to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "unknown cause".to_string());
+    format!("the run panicked: {msg}")
 }
 
 fn run_one(
     a: &BenchArgs,
     map: &Result<PreparedMap, String>,
+    grid_hash: Option<u64>,
     dir: &Path,
     planner: &str,
     robot: ccpp_core::world::Robot,
     options: &PlannerOptions,
 ) -> Result<Metrics, String> {
+    if let Some(hook) = std::env::var_os(PANIC_ENV) {
+        assert!(hook != planner, "{PANIC_ENV} asked {planner} to panic");
+    }
+    let map = map.as_ref().map_err(Clone::clone)?;
+    let sim = SimConfig::default();
+    let key = grid_hash
+        .map(|h| run_key(h, planner, options, robot, &sim))
+        .transpose()
+        .map_err(|e| crate::errors::one_line(&e))?;
     let metrics_path = dir.join("metrics.json");
-    if !a.force && metrics_path.is_file() && dir.join("trace.jsonl").is_file() {
-        if let Ok(text) = std::fs::read_to_string(&metrics_path) {
-            if let Ok(m) = serde_json::from_str::<Metrics>(&text) {
-                return Ok(m);
+    if !a.force && dir.join("trace.jsonl").is_file() {
+        let same_key = std::fs::read_to_string(dir.join("bench-key.txt")).ok() == key;
+        if same_key {
+            if let Ok(text) = std::fs::read_to_string(&metrics_path) {
+                if let Ok(m) = serde_json::from_str::<Metrics>(&text) {
+                    return Ok(m);
+                }
             }
         }
     }
-    let map = map.as_ref().map_err(Clone::clone)?;
-    let kind = parse_planner(planner).map_err(|e| format!("{e:#}"))?;
+    let kind = parse_planner(planner).map_err(|e| crate::errors::one_line(&e))?;
     let mut job = Job {
         scenario: Scenario {
             map: map.recipe.clone(),
             robot,
             start: None,
             planner: options.config(kind),
-            sim: SimConfig::default(),
+            sim,
             max_memory_mb: a.max_memory.unwrap_or(DEFAULT_MAX_MEMORY_MB),
         },
         map: map.clone(),
         out: dir.to_path_buf(),
     };
-    let result = job.execute().map_err(|e| format!("{e:#}"))?;
-    write_run_files(dir, &job, &result).map_err(|e| format!("{e:#}"))?;
+    let result = job.execute().map_err(|e| crate::errors::one_line(&e))?;
+    let extra = [("bench-key.txt", key.unwrap_or_default().into_bytes())];
+    write_run_files(dir, &job, &result, false, &extra).map_err(|e| crate::errors::one_line(&e))?;
     Ok(result.metrics)
 }
 
@@ -250,15 +412,11 @@ pub fn results_csv(rows: &[Row]) -> String {
                 f.push(m.robot_radius_m.to_string());
                 f.push(m.tool_radius_m.to_string());
                 f.push(m.coverage_rate.map_or_else(String::new, |c| c.to_string()));
-                for v in [
-                    m.effective_coverage,
-                    m.path_length_m,
-                    m.path_ratio,
-                    m.redundancy,
-                    m.revisit_rate,
-                ] {
+                for v in [m.effective_coverage, m.path_length_m, m.path_ratio] {
                     f.push(v.to_string());
                 }
+                f.push(m.redundancy.map_or_else(String::new, |v| v.to_string()));
+                f.push(m.revisit_rate.to_string());
                 f.push(m.regions.to_string());
                 f.push(m.backtracks.to_string());
                 f.push(m.backtrack_length_m.to_string());

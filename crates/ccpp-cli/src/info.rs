@@ -1,14 +1,15 @@
 //! `ccpp info`: what a map holds and how much of it a robot can reach.
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use ccpp_core::grid::{Cell, GridMap};
-use ccpp_core::world::World;
+use ccpp_core::world::{World, WorldError};
+use ccpp_core::Point;
 use serde::Serialize;
 
 use crate::args::InfoArgs;
 use crate::job::{prepare_map, robot_from};
 
-/// The report.
+/// The report. Robot-dependent fields are `null` when the robot does not fit on the map.
 #[derive(Serialize)]
 struct Info {
     map: String,
@@ -27,13 +28,55 @@ struct Info {
     /// Share of the free pixels in the largest component.
     largest_component_share: f64,
     robot_radius_m: f64,
+    /// Whether the robot fits somewhere on the map (with the start given, there).
+    robot_fits: bool,
+    /// Why the robot does not fit, when it does not.
+    robot_error: Option<String>,
     /// C-free pixel centres (the robot fits) on the whole map.
-    cfree_px: usize,
-    start: [f64; 3],
+    cfree_px: Option<usize>,
+    start: Option<[f64; 3]>,
+    /// Area of the 4-connected free component holding the start (m^2).
+    start_component_m2: Option<f64>,
+    /// Whether that component reaches the image border (the start may be outside a building).
+    start_component_touches_border: Option<bool>,
     /// C-free pixels reachable from the start.
-    reachable_px: usize,
+    reachable_px: Option<usize>,
     /// Accessible surface from the start (m^2).
-    accessible_m2: f64,
+    accessible_m2: Option<f64>,
+}
+
+/// Flood-fills the 4-connected free pixels from `seed` (marking `seen`); returns the
+/// component's pixel count and whether it touches the image border.
+fn flood(g: &GridMap, seed: usize, seen: &mut [bool], stack: &mut Vec<usize>) -> (usize, bool) {
+    let f = *g.frame();
+    let cells = g.cells();
+    let (mut size, mut border) = (0usize, false);
+    seen[seed] = true;
+    stack.push(seed);
+    while let Some(k) = stack.pop() {
+        size += 1;
+        let (c, r) = f.col_row(k);
+        border |= c == 0 || r == 0 || c + 1 == f.width || r + 1 == f.height;
+        let mut visit = |j: usize| {
+            if cells[j] == Cell::Free && !seen[j] {
+                seen[j] = true;
+                stack.push(j);
+            }
+        };
+        if c > 0 {
+            visit(k - 1);
+        }
+        if c + 1 < f.width {
+            visit(k + 1);
+        }
+        if r > 0 {
+            visit(k - f.width);
+        }
+        if r + 1 < f.height {
+            visit(k + f.width);
+        }
+    }
+    (size, border)
 }
 
 /// Counts 4-connected components of free pixels and the size of the largest.
@@ -48,34 +91,75 @@ fn free_components(g: &GridMap) -> (usize, usize) {
             continue;
         }
         n += 1;
-        let mut size = 0;
-        seen[i] = true;
-        stack.push(i);
-        while let Some(k) = stack.pop() {
-            size += 1;
-            let (c, r) = f.col_row(k);
-            let mut visit = |j: usize| {
-                if cells[j] == Cell::Free && !seen[j] {
-                    seen[j] = true;
-                    stack.push(j);
-                }
-            };
-            if c > 0 {
-                visit(k - 1);
-            }
-            if c + 1 < f.width {
-                visit(k + 1);
-            }
-            if r > 0 {
-                visit(k - f.width);
-            }
-            if r + 1 < f.height {
-                visit(k + f.width);
-            }
-        }
+        let (size, _) = flood(g, i, &mut seen, &mut stack);
         largest = largest.max(size);
     }
     (n, largest)
+}
+
+/// The free component holding a start position.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StartComponent {
+    /// Its area, m^2 (0 when the start pixel is not free).
+    pub area_m2: f64,
+    /// All free area of the map, m^2.
+    pub free_m2: f64,
+    /// Whether it reaches the image border.
+    pub touches_border: bool,
+}
+
+impl StartComponent {
+    /// The 4-connected free component of `g` holding `start`.
+    pub fn of(g: &GridMap, start: Point) -> Self {
+        let f = *g.frame();
+        let res2 = f.resolution * f.resolution;
+        let free_m2 = g.counts().0 as f64 * res2;
+        let Some((c, r)) = f.pixel_of(start) else {
+            return Self {
+                area_m2: 0.0,
+                free_m2,
+                touches_border: false,
+            };
+        };
+        let seed = f.index(c, r);
+        if g.cells()[seed] != Cell::Free {
+            return Self {
+                area_m2: 0.0,
+                free_m2,
+                touches_border: false,
+            };
+        }
+        let mut seen = vec![false; f.len()];
+        let (size, touches_border) = flood(g, seed, &mut seen, &mut Vec::new());
+        Self {
+            area_m2: size as f64 * res2,
+            free_m2,
+            touches_border,
+        }
+    }
+
+    /// One line: the component's area next to all free area.
+    pub fn line(&self) -> String {
+        let share = if self.free_m2 > 0.0 {
+            100.0 * self.area_m2 / self.free_m2
+        } else {
+            0.0
+        };
+        format!(
+            "{:.1} m2 of {:.1} m2 free ({share:.0} %) in the free area holding the start",
+            self.area_m2, self.free_m2
+        )
+    }
+
+    /// The warning to print when the start's free area reaches the image border.
+    pub fn warning(&self) -> Option<String> {
+        self.touches_border.then(|| {
+            "warning: the free area holding the start reaches the map's border, so the start \
+             may be outside the building (only that area is covered); pass --start X,Y to \
+             start inside"
+                .to_string()
+        })
+    }
 }
 
 /// Runs `ccpp info`.
@@ -86,10 +170,17 @@ pub fn run(a: &InfoArgs) -> Result<()> {
     let f = *g.frame();
     let (free, occ, unk) = g.counts();
     let (ncomp, largest) = free_components(g);
-    let world = World::new(g.clone(), robot, start)
-        .with_context(|| format!("map {}", map.source.display()))?;
-    let s = world.start();
+    let (world, robot_error) = match World::new(g.clone(), robot, start) {
+        Ok(w) => (Some(w), None),
+        Err(e @ WorldError::RobotTooBig { .. }) => (None, Some(e.to_string())),
+        // A start the user gave that does not work is a user error.
+        Err(e) => {
+            return Err(anyhow::Error::new(e).context(format!("map {}", map.source.display())))
+        }
+    };
     let res2 = f.resolution * f.resolution;
+    let s = world.as_ref().map(World::start);
+    let comp = s.map(|s| StartComponent::of(g, s.position()));
     let info = Info {
         map: map.name.clone(),
         width_px: f.width,
@@ -109,48 +200,77 @@ pub fn run(a: &InfoArgs) -> Result<()> {
             largest as f64 / free as f64
         },
         robot_radius_m: robot.radius,
-        cfree_px: world.cfree().count_ones(..),
-        start: [s.x, s.y, s.theta],
-        reachable_px: world.reachable().count_ones(..),
-        accessible_m2: world.accessible_area_m2(),
+        robot_fits: world.is_some(),
+        robot_error: robot_error.clone(),
+        cfree_px: world.as_ref().map(|w| w.cfree().count_ones(..)),
+        start: s.map(|s| [s.x, s.y, s.theta]),
+        start_component_m2: comp.map(|c| c.area_m2),
+        start_component_touches_border: comp.map(|c| c.touches_border),
+        reachable_px: world.as_ref().map(|w| w.reachable().count_ones(..)),
+        accessible_m2: world.as_ref().map(World::accessible_area_m2),
     };
+    if let Some(w) = comp.and_then(|c| c.warning()) {
+        eprintln!("{w}");
+    }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&info)?);
+        crate::print_stdout(&format!("{}\n", serde_json::to_string_pretty(&info)?))?;
         return Ok(());
     }
     let n = f.len() as f64 / 100.0;
-    println!("map            {} ({})", info.map, map.source.display());
-    println!(
+    let mut t = String::new();
+    let mut line = |s: String| {
+        t.push_str(&s);
+        t.push('\n');
+    };
+    line(format!(
+        "map            {} ({})",
+        info.map,
+        map.source.display()
+    ));
+    line(format!(
         "size           {} x {} px, {} m/px = {:.2} x {:.2} m",
         f.width, f.height, f.resolution, info.width_m, info.height_m
-    );
-    println!(
+    ));
+    line(format!(
         "origin         ({}, {}, {})",
         f.origin.x, f.origin.y, f.origin.theta
-    );
-    println!(
+    ));
+    line(format!(
         "free           {free} px ({:.1} %), {:.1} m2",
         free as f64 / n,
         info.free_m2
-    );
-    println!("occupied       {occ} px ({:.1} %)", occ as f64 / n);
-    println!("unknown        {unk} px ({:.1} %)", unk as f64 / n);
-    println!(
+    ));
+    line(format!("occupied       {occ} px ({:.1} %)", occ as f64 / n));
+    line(format!("unknown        {unk} px ({:.1} %)", unk as f64 / n));
+    line(format!(
         "components     {ncomp} (4-connected free), largest {:.1} % of free",
         100.0 * info.largest_component_share
-    );
-    println!(
-        "robot radius   {} m: C-free {} px",
-        robot.radius, info.cfree_px
-    );
-    println!("start          ({:.3}, {:.3}, {:.3})", s.x, s.y, s.theta);
-    println!(
-        "reachable      {} px of C-free from the start",
-        info.reachable_px
-    );
-    println!(
-        "accessible     {:.2} m2 (floor the tool can touch from the start)",
-        info.accessible_m2
-    );
-    Ok(())
+    ));
+    match (&world, s, comp) {
+        (Some(w), Some(s), Some(comp)) => {
+            line(format!(
+                "robot radius   {} m: C-free {} px",
+                robot.radius,
+                w.cfree().count_ones(..)
+            ));
+            line(format!(
+                "start          ({:.3}, {:.3}, {:.3})",
+                s.x, s.y, s.theta
+            ));
+            line(format!("start area     {}", comp.line()));
+            line(format!(
+                "reachable      {} px of C-free from the start",
+                w.reachable().count_ones(..)
+            ));
+            line(format!(
+                "accessible     {:.2} m2 (floor the tool can touch from the start)",
+                w.accessible_area_m2()
+            ));
+        }
+        _ => line(format!(
+            "robot          {}",
+            robot_error.as_deref().unwrap_or("does not fit")
+        )),
+    }
+    crate::print_stdout(&t)
 }

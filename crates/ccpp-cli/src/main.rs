@@ -5,27 +5,72 @@
 
 mod args;
 mod bench;
+mod errors;
 mod info;
 mod job;
 mod output;
 mod plots;
+mod staging;
 mod waypoints;
 
+use std::fmt::Write as _;
+use std::io::Write as _;
 use std::process::ExitCode;
 
+use clap::error::ErrorKind;
 use clap::Parser;
 
 use crate::args::{Cli, Command};
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return clap_exit(&e),
+    };
+    staging::install_signal_handler();
     match dispatch(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            // One line: the problem and its causes.
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", errors::one_line(&e));
             ExitCode::FAILURE
         }
+    }
+}
+
+/// Help and version go to stdout with status 0; argument errors are one line and a hint on
+/// stderr with status 1, like every other user error.
+fn clap_exit(e: &clap::Error) -> ExitCode {
+    match e.kind() {
+        ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
+            let _ = e.print();
+            ExitCode::SUCCESS
+        }
+        ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+            eprintln!("error: no command given");
+            eprintln!("hint: see `ccpp --help`");
+            ExitCode::FAILURE
+        }
+        _ => {
+            let (line, hint) = errors::clap_lines(e);
+            eprintln!("error: {line}");
+            eprintln!("{hint}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// Prints `text` on stdout. A closed stdout (`ccpp waypoints ... | head`) is not an error: the
+/// reader has what it wanted, so the text is dropped and the command still succeeds.
+///
+/// # Errors
+/// Any other write error.
+pub fn print_stdout(text: &str) -> anyhow::Result<()> {
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            Err(anyhow::Error::new(e).context("cannot write to standard output"))
+        }
+        _ => Ok(()),
     }
 }
 
@@ -33,20 +78,23 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Run(a) => {
             let mut job = job::Job::from_run_args(&a)?;
+            staging::check_target(&job.out)?;
             let result = job.execute()?;
             output::emit(&job, &result, a.json, a.replay)
         }
         Command::Demo(a) => {
             let mut job = job::Job::demo(&a)?;
+            staging::check_target(&job.out)?;
             let result = job.execute()?;
             output::emit(&job, &result, false, true)
         }
         Command::Planners => {
+            let mut s = String::new();
             for p in ccpp_core::planners::CATALOG {
                 let kind = if p.offline { "offline" } else { "online" };
-                println!("{:<19} {:<8} {}", p.name, kind, p.description);
+                let _ = writeln!(s, "{:<19} {:<8} {}", p.name, kind, p.description);
             }
-            Ok(())
+            print_stdout(&s)
         }
         Command::Info(a) => info::run(&a),
         Command::Bench(a) => bench::run(&a),

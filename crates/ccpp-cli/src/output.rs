@@ -6,13 +6,14 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use ccpp_core::metrics::Metrics;
 use ccpp_core::trace::Trace;
-use ccpp_io::write_atomic;
 use ccpp_render::{coverage_png, CoverageStyle};
 
 use ccpp_core::world::World;
 use ccpp_io::scenario::Scenario;
 
+use crate::info::StartComponent;
 use crate::job::{Job, JobResult};
+use crate::staging::{write_file, Staging};
 
 /// The trace as JSON Lines.
 pub fn trace_jsonl(trace: &Trace) -> Result<String> {
@@ -55,9 +56,16 @@ pub fn title_lines(m: &Metrics) -> Vec<String> {
     ]
 }
 
-/// Renders everything first, then writes each file atomically into `out`, so a failure leaves
-/// no partial file. `metrics.json` is written last: its presence marks a complete run.
-pub fn write_run_files(out: &Path, job: &Job, r: &JobResult) -> Result<String> {
+/// A run's files, rendered in memory: `(file name, bytes)`.
+pub struct RunFiles {
+    /// The files, `metrics.json` last.
+    pub files: Vec<(&'static str, Vec<u8>)>,
+    /// The metrics JSON (also among `files`).
+    pub metrics: String,
+}
+
+/// Renders every file of a run (and the replay files when `replay`) without writing anything.
+pub fn render_run_files(job: &Job, r: &JobResult, replay: bool) -> Result<RunFiles> {
     let metrics = metrics_json(&r.metrics)?;
     // run.json is the scenario itself (with the start actually used): `Scenario::run` on it
     // reproduces this run.
@@ -72,36 +80,53 @@ pub fn write_run_files(out: &Path, job: &Job, r: &JobResult) -> Result<String> {
         ..CoverageStyle::default()
     };
     let png = coverage_png(&r.world, &r.run.trace, &style)?;
-    std::fs::create_dir_all(out)
-        .with_context(|| format!("cannot create output folder {}", out.display()))?;
-    let files: [(&str, &[u8]); 5] = [
-        ("run.json", run_json.as_bytes()),
-        ("path.csv", path.as_bytes()),
-        ("trace.jsonl", trace.as_bytes()),
-        ("coverage.png", &png),
-        ("metrics.json", metrics.as_bytes()),
+    let mut files: Vec<(&'static str, Vec<u8>)> = vec![
+        ("run.json", run_json.into_bytes()),
+        ("path.csv", path.into_bytes()),
+        ("trace.jsonl", trace.into_bytes()),
+        ("coverage.png", png),
     ];
-    for (name, bytes) in files {
-        write_atomic(&out.join(name), bytes)?;
+    if replay {
+        let title = format!("{} on {}", r.metrics.planner, r.metrics.map);
+        let (html, gif) = render_replay(&r.world, &r.run.trace, r.run.tile_side, &metrics, &title)?;
+        files.push(("replay.html", html.into_bytes()));
+        files.push(("replay.gif", gif));
     }
-    Ok(metrics)
+    files.push(("metrics.json", metrics.clone().into_bytes()));
+    Ok(RunFiles { files, metrics })
 }
 
-/// Writes `replay.html` and `replay.gif` of a finished run into `out`.
-pub fn write_replay(
+/// Writes a run's files (plus `extra` ones) as one set: everything goes into a staging folder
+/// beside `out`, which then replaces `out` whole (see [`crate::staging`]). A failure or an
+/// interrupt leaves `out` as it was. Returns the metrics JSON.
+pub fn write_run_files(
     out: &Path,
+    job: &Job,
+    r: &JobResult,
+    replay: bool,
+    extra: &[(&'static str, Vec<u8>)],
+) -> Result<String> {
+    let rendered = render_run_files(job, r, replay)?;
+    let staging = Staging::new(out)?;
+    for (name, bytes) in extra.iter().chain(&rendered.files) {
+        staging.write(name, bytes)?;
+    }
+    staging.commit()?;
+    Ok(rendered.metrics)
+}
+
+/// Renders `replay.html` and `replay.gif` of a finished run.
+pub fn render_replay(
     world: &World,
     trace: &Trace,
     tile_side: Option<f64>,
     metrics: &str,
     title: &str,
-) -> Result<()> {
+) -> Result<(String, Vec<u8>)> {
     let html = ccpp_render::replay::replay_html(world, trace, tile_side, metrics, title)?;
     let gif =
         ccpp_render::replay::replay_gif(world, trace, &ccpp_render::replay::GifOptions::default())?;
-    write_atomic(&out.join("replay.html"), html.as_bytes())?;
-    write_atomic(&out.join("replay.gif"), &gif)?;
-    Ok(())
+    Ok((html, gif))
 }
 
 /// `ccpp replay DIR`: rebuilds the world of a finished run and writes its replay files.
@@ -124,40 +149,40 @@ pub fn replay_dir(dir: &Path) -> Result<()> {
         ccpp_io::trace::read_trace(&dir.join("trace.jsonl"), Some((world.frame(), margin)))?;
     let metrics = std::fs::read_to_string(dir.join("metrics.json")).unwrap_or_default();
     let title = format!("{} on {}", scenario.planner.name(), map.name);
-    write_replay(dir, &world, &trace, scenario.tile_side(), &metrics, &title)?;
-    println!("wrote {}/replay.html and replay.gif", dir.display());
-    Ok(())
+    let (html, gif) = render_replay(&world, &trace, scenario.tile_side(), &metrics, &title)?;
+    write_file(&dir.join("replay.html"), html.as_bytes())?;
+    write_file(&dir.join("replay.gif"), &gif)?;
+    crate::print_stdout(&format!(
+        "wrote {}/replay.html and replay.gif\n",
+        dir.display()
+    ))
 }
 
-/// Writes the run's files, then prints the summary (or the metrics JSON alone).
+/// Writes the run's files (with the replay when `replay`) as one set, then prints the summary
+/// (or the metrics JSON alone). A start whose free area reaches the map's border is warned
+/// about on stderr.
 pub fn emit(job: &Job, r: &JobResult, json_only: bool, replay: bool) -> Result<()> {
-    let metrics = write_run_files(&job.out, job, r)?;
-    if replay {
-        let title = format!("{} on {}", r.metrics.planner, r.metrics.map);
-        write_replay(
-            &job.out,
-            &r.world,
-            &r.run.trace,
-            r.run.tile_side,
-            &metrics,
-            &title,
-        )?;
+    let metrics = write_run_files(&job.out, job, r, replay, &[])?;
+    let comp = StartComponent::of(r.world.map(), r.world.start().position());
+    if let Some(w) = comp.warning() {
+        eprintln!("{w}");
     }
     if json_only {
-        print!("{metrics}");
-    } else {
-        print!("{}", summary(&r.metrics));
-        let extra = if replay {
-            ", replay.html, replay.gif"
-        } else {
-            ""
-        };
-        println!(
-            "wrote {}/{{metrics.json, path.csv, trace.jsonl, coverage.png, run.json{extra}}}",
-            job.out.display()
-        );
+        return crate::print_stdout(&metrics);
     }
-    Ok(())
+    let mut s = summary(&r.metrics);
+    let _ = writeln!(s, "  start area: {}", comp.line());
+    let extra = if replay {
+        ", replay.html, replay.gif"
+    } else {
+        ""
+    };
+    let _ = writeln!(
+        s,
+        "wrote {}/{{metrics.json, path.csv, trace.jsonl, coverage.png, run.json{extra}}}",
+        job.out.display()
+    );
+    crate::print_stdout(&s)
 }
 
 /// A short human table of the metrics.
@@ -171,12 +196,17 @@ pub fn summary(m: &Metrics) -> String {
     let cov = m
         .coverage_rate
         .map_or_else(|| "n/a".to_string(), |c| format!("{c:.4}"));
+    let redundancy = m
+        .redundancy
+        .map_or_else(|| "n/a".to_string(), |v| format!("{v:.3}"));
+    // The floor actually swept leads; the tile figure (1.0 for every complete tile planner)
+    // follows.
     let rows: [(&str, String); 13] = [
-        ("coverage_rate", cov),
         ("effective_coverage", format!("{:.4}", m.effective_coverage)),
+        ("coverage_rate", cov),
         ("path_length_m", format!("{:.2}", m.path_length_m)),
         ("path_ratio", format!("{:.3}", m.path_ratio)),
-        ("redundancy", format!("{:.3}", m.redundancy)),
+        ("redundancy", redundancy),
         ("revisit_rate", format!("{:.3}", m.revisit_rate)),
         ("regions", m.regions.to_string()),
         ("backtracks", m.backtracks.to_string()),

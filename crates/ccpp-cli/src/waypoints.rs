@@ -7,10 +7,10 @@ use ccpp_core::planners::rect_boustrophedon::{plan, RectOptions};
 use ccpp_core::planners::PlannerConfig;
 use ccpp_core::sim::SimConfig;
 use ccpp_io::scenario::{Scenario, ScenarioError, DEFAULT_MAX_MEMORY_MB};
-use ccpp_io::write_atomic;
 
 use crate::args::WaypointsArgs;
 use crate::job::{recipe_from, robot_from};
+use crate::staging::write_file;
 
 /// Runs `ccpp waypoints`.
 pub fn run(a: &WaypointsArgs) -> Result<()> {
@@ -64,8 +64,8 @@ pub fn run(a: &WaypointsArgs) -> Result<()> {
         s
     };
     match &a.out {
-        Some(path) => write_atomic(path, text.as_bytes())?,
-        None => print!("{text}"),
+        Some(path) => write_file(path, text.as_bytes())?,
+        None => crate::print_stdout(&text)?,
     }
     Ok(())
 }

@@ -485,7 +485,8 @@ fn small_bench_writes_csv_md_and_plots_and_resumes() {
         if force {
             c.arg("--force");
         }
-        c.assert().success();
+        // The broken map's runs fail, so the bench exits 1 after writing every result.
+        c.assert().code(1);
     };
     bench(false);
     let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();

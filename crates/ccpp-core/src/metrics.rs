@@ -33,10 +33,19 @@ pub struct Metrics {
     pub effective_coverage: f64,
     /// Total translation, metres.
     pub path_length_m: f64,
-    /// `path_length_m / (area(A) / (2 r_tool))`.
+    /// `path_length_m / (area(A) / (2 r_tool))`: the path length over the length of an ideal
+    /// lane-by-lane sweep of all of `A`. Below 1 when the run leaves part of `A` unswept, and
+    /// also possible for a complete sweep, because the tool's reach beyond a lane's ends and
+    /// into the corners of its turns covers floor that the `2 r_tool`-wide strip model does not
+    /// count.
     pub path_ratio: f64,
-    /// `path_length_m * 2 r_tool / area(swept) - 1`.
-    pub redundancy: f64,
+    /// `path_length_m * 2 r_tool / area(swept) - 1`: the strip area the path would sweep
+    /// without any overlap, over the area it did sweep, minus one. Slightly negative for a run
+    /// that repeats little, because the half-discs at the path's ends and the wedges outside its
+    /// turns add swept area beyond the strip (one straight pass of length `L`:
+    /// `-pi r_tool / (2 L + pi r_tool)`); `None` (JSON `null`) for a zero-length path, where the
+    /// ratio means nothing.
+    pub redundancy: Option<f64>,
     /// `(tile entries - distinct tiles entered) / distinct tiles entered`.
     pub revisit_rate: f64,
     /// Coverage segments started.
@@ -392,11 +401,8 @@ pub fn compute(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
         0.0
     };
     let swept_area = swept_count as f64 * px_area;
-    let redundancy = if swept_area > 0.0 {
-        path_length * two_rt / swept_area - 1.0
-    } else {
-        0.0
-    };
+    let redundancy =
+        (path_length > 0.0 && swept_area > 0.0).then(|| path_length * two_rt / swept_area - 1.0);
 
     // Tiles: revisit rate (planner tile side, else 2 r_tool) and coverage rate (tile planners).
     let start = world.start().position();
@@ -593,6 +599,41 @@ mod tests {
         assert_eq!(m.collisions, 0);
         assert_eq!(m.turns, 0);
         assert_eq!(m.coverage_rate, None);
+        // A pass that repeats nothing has a slightly negative redundancy: the end half-discs
+        // sweep floor beyond the 2 r_tool strip.
+        let pi_r = std::f64::consts::PI * rt;
+        let want = -pi_r / (2.0 * 2.0 + pi_r);
+        let red = m.redundancy.unwrap();
+        assert!(red < 0.0 && (red - want).abs() < 0.01, "{red} vs {want}");
+        // Going back over the same pass doubles the length but not the swept area.
+        let out = simulate(
+            &world,
+            &mut Script(vec![
+                Step::Translate(2.0),
+                Step::Rotate(std::f64::consts::PI),
+                Step::Translate(2.0),
+            ]),
+            &SimConfig::default(),
+        );
+        let m2 = compute(&world, &out, "room");
+        let red2 = m2.redundancy.unwrap();
+        assert!((red2 - (2.0 * (1.0 + want) - 1.0)).abs() < 0.02, "{red2}");
+    }
+
+    #[test]
+    fn zero_length_path_has_no_redundancy() {
+        let world =
+            World::new(open_room(), Robot::new(0.2), Some(Pose::new(2.0, 2.0, 0.0))).unwrap();
+        let out = simulate(
+            &world,
+            &mut Script(vec![Step::Rotate(1.0)]),
+            &SimConfig::default(),
+        );
+        let m = compute(&world, &out, "room");
+        assert_eq!(m.path_length_m, 0.0);
+        assert_eq!(m.redundancy, None);
+        let v = serde_json::to_value(&m).unwrap();
+        assert!(v["redundancy"].is_null(), "{v}");
     }
 
     #[test]

@@ -1,0 +1,363 @@
+//! All-or-nothing output folders and cleanup on interrupt.
+//!
+//! A run's files are written into a staging folder `.<name>.ccpp-new-<pid>-<n>` beside the
+//! target folder `<name>`. Only when every file is written is the set moved into place: the old
+//! folder (if any) is renamed to `.<name>.ccpp-old-<pid>-<n>`, the staging folder is renamed to
+//! `<name>`, and the old folder is removed. A reader therefore sees the old complete set or the
+//! new complete set (for an instant, between the two renames, no folder), never a mix and never
+//! a `.tmp` file.
+//!
+//! On SIGINT/SIGTERM the handler waits for a swap in progress to finish, removes every staging
+//! folder and temporary file still registered, and exits with status 130. Folders left by a
+//! process that could not clean up (SIGKILL, power loss) carry its process id; the next run into
+//! the same target removes them, or puts an old folder back when the target is missing.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Mutex, MutexGuard, PoisonError};
+
+use anyhow::{bail, Context, Result};
+
+/// Paths to remove if the process is interrupted.
+static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+/// Held while an old folder is renamed away and the new one renamed in.
+static SWAP: Mutex<()> = Mutex::new(());
+/// Distinguishes the staging folders of one process.
+static COUNTER: AtomicU64 = AtomicU64::new(0);
+
+/// The files a run folder may hold; any other file makes [`Staging::new`] refuse the target.
+pub const RUN_FILES: [&str; 8] = [
+    "run.json",
+    "path.csv",
+    "trace.jsonl",
+    "coverage.png",
+    "metrics.json",
+    "replay.html",
+    "replay.gif",
+    "bench-key.txt",
+];
+
+/// Test hook: when this environment variable names a file, writing that file fails as on a full
+/// disk (`ENOSPC`). Used by the end-to-end tests to check that a failed run leaves no output.
+pub const FAIL_WRITE_ENV: &str = "CCPP_TEST_FAIL_WRITE";
+
+fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+fn register(p: &Path) {
+    lock(&PENDING).push(p.to_path_buf());
+}
+
+fn unregister(p: &Path) {
+    let mut v = lock(&PENDING);
+    if let Some(i) = v.iter().position(|q| q == p) {
+        v.swap_remove(i);
+    }
+}
+
+/// Removes a file or folder, retrying a few times (a worker thread may still be adding files).
+fn remove_all(p: &Path) {
+    for _ in 0..10 {
+        let r = if p.is_dir() {
+            std::fs::remove_dir_all(p)
+        } else {
+            std::fs::remove_file(p)
+        };
+        if r.is_ok() || !p.exists() {
+            return;
+        }
+    }
+}
+
+/// Installs the SIGINT/SIGTERM handler (once, at start-up).
+pub fn install_signal_handler() {
+    // Failure to install (a handler already set) only loses the cleanup.
+    let _ = ctrlc::set_handler(|| {
+        // Hold both locks until exit: no swap can be half done and no new staging folder can
+        // appear after the cleanup.
+        let _swap = lock(&SWAP);
+        let pending = lock(&PENDING);
+        for p in pending.iter() {
+            remove_all(p);
+        }
+        eprintln!("error: interrupted");
+        std::process::exit(130);
+    });
+}
+
+/// Whether the process `pid` still runs (Linux `/proc`; elsewhere assumed gone).
+fn pid_alive(pid: u32) -> bool {
+    pid == std::process::id() || Path::new("/proc").join(pid.to_string()).exists()
+}
+
+/// The process id in a name `.<name>.ccpp-<kind>-<pid>-<n>`.
+fn parse_pid(rest: &str) -> Option<u32> {
+    rest.split('-').next()?.parse().ok()
+}
+
+/// Removes staging folders of dead processes next to `target`, and puts back an old folder
+/// that a killed process had renamed away when the target is missing.
+fn clean_stale(parent: &Path, name: &str) {
+    let Ok(entries) = std::fs::read_dir(parent) else {
+        return;
+    };
+    let new_prefix = format!(".{name}.ccpp-new-");
+    let old_prefix = format!(".{name}.ccpp-old-");
+    let mut names: Vec<String> = entries
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .collect();
+    names.sort();
+    for n in names {
+        let (is_old, rest) = if let Some(r) = n.strip_prefix(&new_prefix) {
+            (false, r)
+        } else if let Some(r) = n.strip_prefix(&old_prefix) {
+            (true, r)
+        } else {
+            continue;
+        };
+        let Some(pid) = parse_pid(rest) else { continue };
+        if pid_alive(pid) {
+            continue;
+        }
+        let p = parent.join(&n);
+        let target = parent.join(name);
+        if is_old && !target.exists() && std::fs::rename(&p, &target).is_ok() {
+            continue;
+        }
+        remove_all(&p);
+    }
+}
+
+/// Checks that `target` is absent, or a folder holding only run files.
+///
+/// # Errors
+/// When it is a file, or a folder holding anything else.
+pub fn check_target(target: &Path) -> Result<()> {
+    let Ok(meta) = std::fs::symlink_metadata(target) else {
+        return Ok(());
+    };
+    if !meta.is_dir() {
+        bail!(
+            "output folder {} exists and is not a plain folder",
+            target.display()
+        );
+    }
+    let entries = std::fs::read_dir(target)
+        .with_context(|| format!("cannot read output folder {}", target.display()))?;
+    for e in entries {
+        let e = e.with_context(|| format!("cannot read output folder {}", target.display()))?;
+        let name = e.file_name();
+        let name = name.to_string_lossy();
+        let known = RUN_FILES.contains(&name.as_ref()) || name.ends_with(".tmp");
+        if !known || !e.file_type().is_ok_and(|t| t.is_file()) {
+            bail!(
+                "output folder {} holds {name}, which ccpp did not write; a run replaces the \
+                 whole folder, so choose a new or ccpp-only folder",
+                target.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// A staging folder that becomes `target` on [`Staging::commit`] and is removed otherwise.
+pub struct Staging {
+    target: PathBuf,
+    dir: PathBuf,
+    parent: PathBuf,
+    name: String,
+    done: bool,
+}
+
+impl Staging {
+    /// Creates the staging folder beside `target` (creating `target`'s parent if needed).
+    ///
+    /// # Errors
+    /// When `target` names no folder (`.`, `..`, a root), exists as a file or as a folder with
+    /// files ccpp did not write, or the staging folder cannot be created.
+    pub fn new(target: &Path) -> Result<Self> {
+        let name = match target.file_name().and_then(|n| n.to_str()) {
+            Some(n) if n != "." && n != ".." => n.to_string(),
+            _ => bail!(
+                "output folder {} must end in a folder name (not ., .. or a root)",
+                target.display()
+            ),
+        };
+        check_target(target)?;
+        let parent = match target.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        std::fs::create_dir_all(&parent)
+            .with_context(|| format!("cannot create output folder {}", parent.display()))?;
+        clean_stale(&parent, &name);
+        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+        let dir = parent.join(format!(".{name}.ccpp-new-{}-{n}", std::process::id()));
+        {
+            // Registered and created under the lock: the signal handler sees both or neither.
+            let mut pending = lock(&PENDING);
+            std::fs::create_dir(&dir)
+                .with_context(|| format!("cannot create output folder {}", target.display()))?;
+            pending.push(dir.clone());
+        }
+        Ok(Self {
+            target: target.to_path_buf(),
+            dir,
+            parent,
+            name,
+            done: false,
+        })
+    }
+
+    /// Writes `bytes` as `name` into the staging folder.
+    ///
+    /// # Errors
+    /// When the file cannot be written (named by its place in the target folder).
+    pub fn write(&self, name: &str, bytes: &[u8]) -> Result<()> {
+        write_file(&self.dir.join(name), bytes).map_err(|e| {
+            // Name the file where it would have gone, not its staging copy.
+            let shown = self.target.join(name);
+            match e {
+                ccpp_io::WriteError::Io { source, .. } => {
+                    anyhow::anyhow!("cannot write {}: {source}", shown.display())
+                }
+                other => anyhow::anyhow!("cannot write {}: {other}", shown.display()),
+            }
+        })
+    }
+
+    /// Moves the staging folder into place, replacing the old target folder.
+    ///
+    /// # Errors
+    /// When a rename fails; the old folder is then put back where possible.
+    pub fn commit(mut self) -> Result<()> {
+        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+        let old = self.parent.join(format!(
+            ".{}.ccpp-old-{}-{n}",
+            self.name,
+            std::process::id()
+        ));
+        let swap = lock(&SWAP);
+        let had_old = std::fs::symlink_metadata(&self.target).is_ok();
+        if had_old {
+            register(&old);
+            std::fs::rename(&self.target, &old).with_context(|| {
+                format!("cannot replace output folder {}", self.target.display())
+            })?;
+        }
+        if let Err(e) = std::fs::rename(&self.dir, &self.target) {
+            if had_old {
+                let _ = std::fs::rename(&old, &self.target);
+                unregister(&old);
+            }
+            return Err(e).with_context(|| {
+                format!("cannot move the new output into {}", self.target.display())
+            });
+        }
+        unregister(&self.dir);
+        self.done = true;
+        drop(swap);
+        if had_old {
+            remove_all(&old);
+            unregister(&old);
+        }
+        Ok(())
+    }
+}
+
+impl Drop for Staging {
+    fn drop(&mut self) {
+        if !self.done {
+            remove_all(&self.dir);
+            unregister(&self.dir);
+        }
+    }
+}
+
+/// Writes `bytes` to `path` atomically (see [`ccpp_io::write_atomic`]); its `.tmp` is removed
+/// if the process is interrupted meanwhile. Honours the [`FAIL_WRITE_ENV`] test hook.
+///
+/// # Errors
+/// When the file cannot be written.
+pub fn write_file(path: &Path, bytes: &[u8]) -> Result<(), ccpp_io::WriteError> {
+    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+    if std::env::var_os(FAIL_WRITE_ENV).is_some_and(|v| v == name) {
+        return ccpp_io::write::write_atomic_with(path, |_| {
+            Err(std::io::Error::from_raw_os_error(28))
+        });
+    }
+    let mut tmp = path.as_os_str().to_owned();
+    tmp.push(".tmp");
+    let tmp = PathBuf::from(tmp);
+    register(&tmp);
+    let r = ccpp_io::write_atomic(path, bytes);
+    unregister(&tmp);
+    r
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    #[test]
+    fn commit_replaces_the_whole_folder() {
+        let d = tempfile::tempdir().unwrap();
+        let target = d.path().join("out");
+        let s = Staging::new(&target).unwrap();
+        s.write("run.json", b"1").unwrap();
+        s.write("replay.gif", b"g").unwrap();
+        s.commit().unwrap();
+        let s = Staging::new(&target).unwrap();
+        s.write("run.json", b"2").unwrap();
+        s.commit().unwrap();
+        assert_eq!(std::fs::read(target.join("run.json")).unwrap(), b"2");
+        assert!(!target.join("replay.gif").exists(), "old files must go");
+        let names: Vec<_> = std::fs::read_dir(d.path()).unwrap().collect();
+        assert_eq!(names.len(), 1, "no staging folder left");
+    }
+
+    #[test]
+    fn dropped_staging_leaves_the_old_folder() {
+        let d = tempfile::tempdir().unwrap();
+        let target = d.path().join("out");
+        let s = Staging::new(&target).unwrap();
+        s.write("run.json", b"1").unwrap();
+        s.commit().unwrap();
+        let s = Staging::new(&target).unwrap();
+        s.write("run.json", b"2").unwrap();
+        drop(s);
+        assert_eq!(std::fs::read(target.join("run.json")).unwrap(), b"1");
+        assert_eq!(std::fs::read_dir(d.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn refuses_folders_with_foreign_files_and_bad_names() {
+        let d = tempfile::tempdir().unwrap();
+        let target = d.path().join("out");
+        std::fs::create_dir(&target).unwrap();
+        std::fs::write(target.join("notes.txt"), b"mine").unwrap();
+        let e = Staging::new(&target).err().unwrap().to_string();
+        assert!(e.contains("notes.txt"), "{e}");
+        assert!(Staging::new(Path::new(".")).is_err());
+        assert!(Staging::new(Path::new("/")).is_err());
+    }
+
+    #[test]
+    fn stale_folders_of_dead_processes_are_cleaned() {
+        let d = tempfile::tempdir().unwrap();
+        let target = d.path().join("out");
+        // A pid that cannot be alive (above Linux's pid_max).
+        let dead = d.path().join(".out.ccpp-new-4294967295-0");
+        std::fs::create_dir(&dead).unwrap();
+        let old = d.path().join(".out.ccpp-old-4294967295-1");
+        std::fs::create_dir(&old).unwrap();
+        std::fs::write(old.join("run.json"), b"old").unwrap();
+        let s = Staging::new(&target).unwrap();
+        assert!(!dead.exists());
+        // The target was missing, so the old folder came back.
+        assert_eq!(std::fs::read(target.join("run.json")).unwrap(), b"old");
+        drop(s);
+    }
+}

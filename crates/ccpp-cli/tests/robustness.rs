@@ -1,0 +1,624 @@
+//! End-to-end tests of the CLI's robustness: all-or-nothing output folders (full disk,
+//! interrupts), bench failures and resume keys, broken pipes, one-line errors, the start's free
+//! area, and `info` when the robot does not fit.
+#![allow(clippy::unwrap_used)]
+
+use std::path::{Path, PathBuf};
+use std::process::Stdio;
+
+use assert_cmd::Command;
+
+fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name)
+}
+
+fn ccpp() -> Command {
+    Command::cargo_bin("ccpp").unwrap()
+}
+
+fn stderr_of(o: &std::process::Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// Entry names of a folder, sorted.
+fn entries(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+const BASE_SET: [&str; 5] = [
+    "coverage.png",
+    "metrics.json",
+    "path.csv",
+    "run.json",
+    "trace.jsonl",
+];
+const REPLAY_SET: [&str; 7] = [
+    "coverage.png",
+    "metrics.json",
+    "path.csv",
+    "replay.gif",
+    "replay.html",
+    "run.json",
+    "trace.jsonl",
+];
+
+fn planner_of(dir: &Path) -> String {
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("run.json")).unwrap()).unwrap();
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("metrics.json")).unwrap()).unwrap();
+    assert_eq!(
+        v["planner"], m["planner"],
+        "run.json and metrics.json disagree"
+    );
+    v["planner"].as_str().unwrap().to_string()
+}
+
+/// An 800 x 800 px (40 x 40 m) room with pillars: big enough that a run with its replay takes
+/// a noticeable time.
+fn big_room(dir: &Path) -> PathBuf {
+    let n = 800u32;
+    let mut img = image::GrayImage::from_pixel(n, n, image::Luma([254]));
+    for (x, y, p) in img.enumerate_pixels_mut() {
+        let wall = x < 2 || y < 2 || x >= n - 2 || y >= n - 2;
+        let pillar = (x % 160) < 20 && (y % 160) < 20 && x > 40 && y > 40;
+        if wall || pillar {
+            *p = image::Luma([0]);
+        }
+    }
+    let p = dir.join("big_room.png");
+    img.save(&p).unwrap();
+    p
+}
+
+fn run_into(out: &Path, planner: &str, replay: bool) -> Command {
+    let mut c = ccpp();
+    c.args(["run", "--planner", planner, "--map"])
+        .arg(data("teb_empty_box.yaml"))
+        .arg("--out")
+        .arg(out);
+    if replay {
+        c.arg("--replay");
+    }
+    c
+}
+
+#[test]
+fn a_failed_write_leaves_the_older_complete_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    run_into(&out, "bcd", false).assert().success();
+    // Fail each file of a --replay run in turn, as a full disk would.
+    for name in REPLAY_SET {
+        let o = run_into(&out, "random-bounce", true)
+            .env("CCPP_TEST_FAIL_WRITE", name)
+            .assert()
+            .code(1)
+            .get_output()
+            .clone();
+        let err = stderr_of(&o);
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(err.contains(name) && err.contains("os error 28"), "{err}");
+        assert_eq!(
+            err.matches("os error 28").count(),
+            1,
+            "cause repeated: {err}"
+        );
+        assert!(!err.contains(".ccpp-new"), "staging path leaked: {err}");
+        assert_eq!(entries(&out), BASE_SET, "{name}");
+        assert_eq!(planner_of(&out), "bcd");
+        assert_eq!(entries(dir.path()), ["out"], "stray staging folder");
+    }
+    // Into a new folder: nothing at all.
+    let fresh = dir.path().join("fresh");
+    run_into(&fresh, "bcd", false)
+        .env("CCPP_TEST_FAIL_WRITE", "metrics.json")
+        .assert()
+        .code(1);
+    assert!(!fresh.exists());
+    // Without the fault the new set replaces the old one whole.
+    run_into(&out, "random-bounce", true).assert().success();
+    assert_eq!(entries(&out), REPLAY_SET);
+    assert_eq!(planner_of(&out), "random-bounce");
+    // And a later run without --replay drops the old replay instead of mixing it in.
+    run_into(&out, "bcd", false).assert().success();
+    assert_eq!(entries(&out), BASE_SET);
+}
+
+#[test]
+fn run_refuses_an_out_folder_with_other_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("mine");
+    std::fs::create_dir(&out).unwrap();
+    std::fs::write(out.join("notes.txt"), "keep me").unwrap();
+    let o = run_into(&out, "bcd", false)
+        .assert()
+        .code(1)
+        .get_output()
+        .clone();
+    let err = stderr_of(&o);
+    assert!(
+        err.starts_with("error: ") && err.contains("notes.txt"),
+        "{err}"
+    );
+    assert_eq!(entries(&out), ["notes.txt"]);
+}
+
+#[cfg(unix)]
+#[test]
+fn an_interrupted_run_leaves_the_old_or_the_new_complete_set() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = big_room(dir.path());
+    let work = dir.path().join("work");
+    std::fs::create_dir(&work).unwrap();
+    let out = work.join("out");
+    let bin = assert_cmd::cargo::cargo_bin("ccpp");
+    let start = |planner: &str, replay: bool| {
+        let mut c = std::process::Command::new(&bin);
+        c.args(["run", "--planner", planner, "--map"])
+            .arg(&map)
+            .arg("--out")
+            .arg(&out)
+            .stdout(Stdio::null())
+            .stderr(Stdio::null());
+        if replay {
+            c.arg("--replay");
+        }
+        c.spawn().unwrap()
+    };
+    assert!(start("bcd", false).wait().unwrap().success());
+    // How long a full run takes here, to spread the interrupts over it.
+    let t0 = std::time::Instant::now();
+    assert!(start("ba-star", true).wait().unwrap().success());
+    let full = t0.elapsed();
+    assert_eq!(entries(&out), REPLAY_SET);
+    let mut seen_old = false;
+    for (k, signal) in ["INT", "TERM", "INT", "INT", "TERM", "INT", "INT", "INT"]
+        .iter()
+        .enumerate()
+    {
+        // The old set: a bcd run without replay; the interrupted one: ba-star with replay.
+        assert!(start("bcd", false).wait().unwrap().success());
+        let mut child = start("ba-star", true);
+        std::thread::sleep(full.mul_f64(k as f64 / 7.0));
+        let _ = std::process::Command::new("kill")
+            .arg(format!("-{signal}"))
+            .arg(child.id().to_string())
+            .status();
+        let status = child.wait().unwrap();
+        // Either the signal came in time (130) or the run had already finished (0).
+        assert!(
+            status.code() == Some(130) || status.success(),
+            "{signal} at {k}: {status:?}"
+        );
+        assert_eq!(entries(&work), ["out"], "{signal} at {k}: stray files");
+        let p = planner_of(&out);
+        let want = if p == "ba-star" {
+            REPLAY_SET.as_slice()
+        } else {
+            assert_eq!(p, "bcd");
+            BASE_SET.as_slice()
+        };
+        assert_eq!(entries(&out), want, "{signal} at {k}: mixed set");
+        seen_old |= p == "bcd";
+    }
+    assert!(seen_old, "no interrupt landed before the commit");
+}
+
+/// A bench over `maps` with `extra` arguments; returns the output.
+fn bench(out: &Path, maps: &[PathBuf], extra: &[&str]) -> Command {
+    let mut c = ccpp();
+    c.args(["bench", "--quiet", "--jobs", "2", "--maps"])
+        .args(maps)
+        .arg("--out")
+        .arg(out)
+        .args(extra);
+    c
+}
+
+fn csv_rows(out: &Path) -> Vec<Vec<String>> {
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    csv.lines()
+        .skip(1)
+        .map(|l| l.split(',').map(str::to_string).collect())
+        .collect()
+}
+
+#[test]
+fn a_panicking_run_becomes_an_error_row_and_the_bench_exits_1() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bench");
+    let o = bench(
+        &out,
+        &[data("teb_empty_box.yaml")],
+        &["--planners", "bcd,random-bounce"],
+    )
+    .env("CCPP_TEST_PANIC_PLANNER", "bcd")
+    .assert()
+    .code(1)
+    .get_output()
+    .clone();
+    let err = stderr_of(&o);
+    assert!(err.contains("error: 1 of 2 runs failed"), "{err}");
+    let rows = csv_rows(&out);
+    assert_eq!(rows.len(), 2);
+    let bcd = rows.iter().find(|r| r[1] == "bcd").unwrap();
+    assert_eq!(bcd[2], "error");
+    assert!(bcd[3].contains("panicked"), "{bcd:?}");
+    let rb = rows.iter().find(|r| r[1] == "random-bounce").unwrap();
+    assert_eq!(rb[2], "ok");
+    // No half-written run folder for the panicking run.
+    assert!(!out.join("runs/teb_empty_box/bcd").exists());
+    // Every run failing is a failure too.
+    let out2 = dir.path().join("bench2");
+    bench(&out2, &[data("teb_empty_box.yaml")], &["--planners", "bcd"])
+        .env("CCPP_TEST_PANIC_PLANNER", "bcd")
+        .assert()
+        .code(1);
+    assert!(out2.join("results.csv").is_file());
+    // Without the fault the same bench succeeds.
+    bench(&out2, &[data("teb_empty_box.yaml")], &["--planners", "bcd"])
+        .assert()
+        .success();
+}
+
+#[test]
+fn bench_resume_reruns_when_anything_that_defines_a_run_changed() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bench");
+    let maps = [data("teb_empty_box.yaml")];
+    let radius =
+        |out: &Path| -> Vec<String> { csv_rows(out).iter().map(|r| r[4].clone()).collect() };
+    bench(&out, &maps, &["--planners", "bcd", "--radius", "0.15"])
+        .assert()
+        .success();
+    assert_eq!(radius(&out), ["0.15"]);
+    let trace = out.join("runs/teb_empty_box/bcd/trace.jsonl");
+    let t1 = std::fs::read(&trace).unwrap();
+    bench(&out, &maps, &["--planners", "bcd", "--radius", "0.3"])
+        .assert()
+        .success();
+    assert_eq!(radius(&out), ["0.3"], "stale row reused");
+    assert_ne!(std::fs::read(&trace).unwrap(), t1);
+    // The same settings again: reused (the run folder is not rewritten).
+    let before = std::fs::metadata(&trace).unwrap().modified().unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(20));
+    bench(&out, &maps, &["--planners", "bcd", "--radius", "0.3"])
+        .assert()
+        .success();
+    assert_eq!(
+        std::fs::metadata(&trace).unwrap().modified().unwrap(),
+        before
+    );
+    // A different seed or a changed map content reruns.
+    bench(
+        &out,
+        &maps,
+        &["--planners", "bcd", "--radius", "0.3", "--seed", "9"],
+    )
+    .assert()
+    .success();
+    assert_ne!(
+        std::fs::metadata(&trace).unwrap().modified().unwrap(),
+        before
+    );
+    let copy = dir.path().join("m");
+    std::fs::create_dir(&copy).unwrap();
+    std::fs::copy(data("teb_empty_box.png"), copy.join("teb_empty_box.png")).unwrap();
+    std::fs::copy(data("teb_empty_box.yaml"), copy.join("teb_empty_box.yaml")).unwrap();
+    let m2 = [copy.join("teb_empty_box.yaml")];
+    bench(
+        &out,
+        &m2,
+        &["--planners", "bcd", "--radius", "0.3", "--seed", "9"],
+    )
+    .assert()
+    .success();
+    let t2 = std::fs::metadata(&trace).unwrap().modified().unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(20));
+    let yaml = std::fs::read_to_string(copy.join("teb_empty_box.yaml")).unwrap();
+    std::fs::write(
+        copy.join("teb_empty_box.yaml"),
+        yaml.replace("resolution: 0.05", "resolution: 0.04"),
+    )
+    .unwrap();
+    assert!(yaml.contains("resolution: 0.05"), "{yaml}");
+    bench(
+        &out,
+        &m2,
+        &["--planners", "bcd", "--radius", "0.3", "--seed", "9"],
+    )
+    .assert()
+    .success();
+    assert_ne!(std::fs::metadata(&trace).unwrap().modified().unwrap(), t2);
+}
+
+#[test]
+fn bench_keeps_maps_with_the_same_name_apart_and_refuses_missing_paths() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut maps = Vec::new();
+    for (folder, block) in [("a", false), ("b", true)] {
+        let d = dir.path().join(folder);
+        std::fs::create_dir(&d).unwrap();
+        let mut img = image::GrayImage::from_pixel(60, 40, image::Luma([254]));
+        for (x, y, p) in img.enumerate_pixels_mut() {
+            let wall = x == 0 || y == 0 || x == 59 || y == 39;
+            if wall || block && (25..35).contains(&x) && (15..25).contains(&y) {
+                *p = image::Luma([0]);
+            }
+        }
+        img.save(d.join("room.png")).unwrap();
+        maps.push(d.join("room.png"));
+    }
+    let out = dir.path().join("bench");
+    bench(&out, &maps, &["--planners", "bcd"])
+        .assert()
+        .success();
+    let rows = csv_rows(&out);
+    assert_eq!(rows.len(), 2);
+    assert_ne!(rows[0][0], rows[1][0], "{rows:?}");
+    assert_eq!(entries(&out.join("runs")), ["a-room", "b-room"]);
+    let paths: Vec<f64> = rows.iter().map(|r| r[8].parse().unwrap()).collect();
+    assert_ne!(paths[0], paths[1], "two different maps, two different runs");
+
+    let o = bench(&out, &[dir.path().join("nope")], &[])
+        .assert()
+        .code(1)
+        .get_output()
+        .clone();
+    let err = stderr_of(&o);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("nope") && err.contains("no such file"),
+        "{err}"
+    );
+    assert!(!out.join("runs/nope").exists());
+}
+
+#[test]
+fn a_closed_stdout_is_success() {
+    let bin = assert_cmd::cargo::cargo_bin("ccpp");
+    for args in [
+        vec!["waypoints", "--length", "0.05", "--width", "0.05"],
+        vec!["info"],
+    ] {
+        let mut child = std::process::Command::new(&bin)
+            .args(&args)
+            .arg("--map")
+            .arg(data("teb_empty_box.yaml"))
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        // Close the reading end at once, like `| head -0`.
+        drop(child.stdout.take());
+        let o = child.wait_with_output().unwrap();
+        let err = stderr_of(&o);
+        assert!(!err.contains("panicked"), "{err}");
+        assert!(o.status.success(), "{args:?}: {:?} {err}", o.status);
+    }
+}
+
+#[test]
+fn user_errors_are_one_line_and_exit_1() {
+    let map = data("teb_empty_box.yaml");
+    let check = |args: &[&str], needles: &[&str], max_lines: usize| {
+        let o = ccpp().args(args).assert().code(1).get_output().clone();
+        let err = stderr_of(&o);
+        let lines: Vec<&str> = err.lines().collect();
+        assert!(!lines.is_empty() && lines.len() <= max_lines, "{err}");
+        assert!(lines[0].starts_with("error: "), "{err}");
+        assert_eq!(err.matches("error:").count(), 1, "{err}");
+        for n in needles {
+            assert!(err.contains(n), "{err:?} should contain {n:?}");
+        }
+        err
+    };
+    let m = map.to_str().unwrap();
+    // Argument errors: one line and a hint.
+    let e = check(
+        &["run", "--planner", "bcd", "--radius", "x", "--map", m],
+        &["--radius", "hint: see `ccpp run --help`"],
+        2,
+    );
+    assert!(!e.contains("Usage"), "{e}");
+    check(&["run", "--map", m], &["--planner"], 2);
+    check(
+        &["run", "--planner", "bcd", "--raidus", "1", "--map", m],
+        &["--radius"],
+        2,
+    );
+    check(&[], &["no command"], 2);
+    ccpp().arg("--help").assert().success();
+    ccpp().args(["run", "--help"]).assert().success();
+    ccpp().arg("--version").assert().success();
+    // Causes are not repeated.
+    let dir = tempfile::tempdir().unwrap();
+    let e = check(
+        &[
+            "run",
+            "--planner",
+            "bcd",
+            "--map",
+            dir.path().to_str().unwrap(),
+        ],
+        &["not a regular file"],
+        1,
+    );
+    assert_eq!(e.matches("not a regular file").count(), 1, "{e}");
+    // Config errors: one line, no library advice or debug dumps.
+    let dup = dir.path().join("dup.yaml");
+    std::fs::write(
+        &dup,
+        "ba_star: {tile_side_m: 0.3}\nba_star: {tile_side_m: 0.4}\n",
+    )
+    .unwrap();
+    let e = check(
+        &[
+            "run",
+            "--planner",
+            "ba-star",
+            "--map",
+            m,
+            "--config",
+            dup.to_str().unwrap(),
+        ],
+        &["dup.yaml", "line 2", "duplicate"],
+        1,
+    );
+    assert!(!e.contains("DuplicateKeyPolicy"), "{e}");
+    // A map YAML past the YAML reader's size budget.
+    std::fs::copy(
+        data("teb_empty_box.png"),
+        dir.path().join("teb_empty_box.png"),
+    )
+    .unwrap();
+    let big = dir.path().join("big.yaml");
+    let mut text = std::fs::read_to_string(&map).unwrap();
+    text.push_str("x: [");
+    for _ in 0..260_000 {
+        text.push_str("1,");
+    }
+    text.push_str("1]\n");
+    std::fs::write(&big, text).unwrap();
+    let e = check(
+        &["info", "--map", big.to_str().unwrap()],
+        &["big.yaml", "too large"],
+        1,
+    );
+    assert!(!e.contains("budget") && !e.contains('{'), "{e}");
+}
+
+/// A drawn floor plan: a walled building in the middle of a white (free) page.
+fn drawn_plan(dir: &Path) -> PathBuf {
+    let mut img = image::GrayImage::from_pixel(200, 160, image::Luma([254]));
+    for (x, y, p) in img.enumerate_pixels_mut() {
+        let inside_x = (60..=140).contains(&x);
+        let inside_y = (50..=110).contains(&y);
+        let wall = (inside_x && (y == 50 || y == 110)) || (inside_y && (x == 60 || x == 140));
+        if wall {
+            *p = image::Luma([0]);
+        }
+    }
+    let p = dir.join("plan.png");
+    img.save(&p).unwrap();
+    p
+}
+
+#[test]
+fn a_start_outside_the_building_is_warned_about() {
+    let dir = tempfile::tempdir().unwrap();
+    let plan = drawn_plan(dir.path());
+    let out = dir.path().join("out");
+    let o = ccpp()
+        .args(["run", "--planner", "bcd", "--map"])
+        .arg(&plan)
+        .arg("--out")
+        .arg(&out)
+        .assert()
+        .success()
+        .get_output()
+        .clone();
+    let err = stderr_of(&o);
+    assert!(
+        err.starts_with("warning: ") && err.contains("border"),
+        "{err}"
+    );
+    let s = String::from_utf8_lossy(&o.stdout);
+    // 200 x 160 px at 0.05 m/px: 80 m2, minus the walls; the building is 4 x 3 m.
+    assert!(s.contains("start area:") && s.contains("m2 free"), "{s}");
+    // Inside the building: no warning, and the start's area is the building's.
+    let o = ccpp()
+        .args(["run", "--planner", "bcd", "--start", "5,4", "--map"])
+        .arg(&plan)
+        .arg("--out")
+        .arg(&out)
+        .assert()
+        .success()
+        .get_output()
+        .clone();
+    assert!(stderr_of(&o).is_empty(), "{}", stderr_of(&o));
+    let o = ccpp()
+        .args(["info", "--json", "--map"])
+        .arg(&plan)
+        .assert()
+        .success()
+        .get_output()
+        .clone();
+    assert!(stderr_of(&o).contains("border"));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["start_component_touches_border"], true);
+    let inside = ccpp()
+        .args(["info", "--json", "--start", "5,4", "--map"])
+        .arg(&plan)
+        .assert()
+        .success()
+        .get_output()
+        .clone();
+    let w: serde_json::Value = serde_json::from_slice(&inside.stdout).unwrap();
+    assert_eq!(w["start_component_touches_border"], false);
+    let a = w["start_component_m2"].as_f64().unwrap();
+    // The inside of the walls: 79 x 59 px.
+    assert!((a - 79.0 * 59.0 * 0.0025).abs() < 1e-9, "{a}");
+    assert!(v["start_component_m2"].as_f64().unwrap() > a);
+    assert!(v["free_m2"].as_f64().unwrap() > v["start_component_m2"].as_f64().unwrap());
+}
+
+#[test]
+fn run_summary_leads_with_effective_coverage() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = ccpp()
+        .args(["run", "--planner", "ba-star", "--map"])
+        .arg(data("teb_empty_box.yaml"))
+        .arg("--out")
+        .arg(dir.path().join("o"))
+        .assert()
+        .success()
+        .get_output()
+        .clone();
+    let s = String::from_utf8_lossy(&o.stdout);
+    let rows: Vec<&str> = s.lines().skip(1).collect();
+    assert!(
+        rows[0].trim_start().starts_with("effective_coverage"),
+        "{s}"
+    );
+    assert!(rows[1].trim_start().starts_with("coverage_rate"), "{s}");
+}
+
+#[test]
+fn info_describes_a_map_the_robot_does_not_fit() {
+    let o = ccpp()
+        .args(["info", "--radius", "4", "--map"])
+        .arg(data("teb_empty_box.yaml"))
+        .assert()
+        .success()
+        .get_output()
+        .clone();
+    let s = String::from_utf8_lossy(&o.stdout);
+    assert!(s.contains("120 x 120 px") && s.contains("free "), "{s}");
+    assert!(s.lines().last().unwrap().contains("does not fit"), "{s}");
+    let o = ccpp()
+        .args(["info", "--json", "--radius", "4", "--map"])
+        .arg(data("teb_empty_box.yaml"))
+        .assert()
+        .success()
+        .get_output()
+        .clone();
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["robot_fits"], false);
+    assert_eq!(v["width_px"], 120);
+    assert!(v["accessible_m2"].is_null());
+    // A start given in an obstacle stays a user error.
+    ccpp()
+        .args(["info", "--start", "-2.98,0", "--map"])
+        .arg(data("teb_empty_box.yaml"))
+        .assert()
+        .code(1);
+}
