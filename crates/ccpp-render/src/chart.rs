@@ -615,7 +615,7 @@ pub fn line_chart(
 ) -> Chart {
     let (w, h) = (900u32, 520u32);
     let mut c = Chart::new(w, h);
-    let (l, r, t, b) = (80.0f32, 200.0f32, 48.0f32, 60.0f32);
+    let (l, r, t, b) = (80.0f32, 200.0f32, 62.0f32, 60.0f32);
     let pw = w as f32 - l - r;
     let ph = h as f32 - t - b;
     let xmax = series
@@ -838,6 +838,16 @@ pub fn image_grid(
     c
 }
 
+/// Width and height from a PNG header.
+fn png_size(png: &[u8]) -> Option<(u32, u32)> {
+    if png.len() < 24 || &png[..8] != b"\x89PNG\r\n\x1a\n" {
+        return None;
+    }
+    let w = u32::from_be_bytes(png[16..20].try_into().ok()?);
+    let h = u32::from_be_bytes(png[20..24].try_into().ok()?);
+    Some((w, h))
+}
+
 /// One picture of [`image_grid_captioned`]: a label above, caption lines below.
 #[derive(Clone, Debug, Default)]
 pub struct Panel {
@@ -845,6 +855,9 @@ pub struct Panel {
     pub label: String,
     /// Lines below the picture (figures of the run).
     pub caption: Vec<String>,
+    /// A coloured chip with white text above the caption (e.g. the effective coverage,
+    /// coloured by [`crate::coverage_verdict_colour`]).
+    pub badge: Option<(String, [u8; 3])>,
     /// The picture (PNG bytes).
     pub png: Vec<u8>,
 }
@@ -861,10 +874,22 @@ pub fn image_grid_captioned(
 ) -> Chart {
     let cols = cols.max(1).min(panels.len().max(1));
     let rows = panels.len().div_ceil(cols).max(1);
+    // No taller than the tallest picture needs at the cell's width.
+    let need = panels
+        .iter()
+        .filter_map(|p| png_size(&p.png))
+        .map(|(w, h)| ((cell_w as f32 - 12.0) * h as f32 / w.max(1) as f32).ceil() as u32)
+        .max();
+    let cell_h = need.map_or(cell_h, |n| n.clamp(40, cell_h));
     let cap_lines = panels.iter().map(|p| p.caption.len()).max().unwrap_or(0) as u32;
     let (label_px, cap_px) = (16u32, 13u32);
     let label_h = font::line_height(label_px as f32) as u32 + 4;
-    let cap_h = cap_lines * font::line_height(cap_px as f32) as u32 + 8;
+    let badge_h = if panels.iter().any(|p| p.badge.is_some()) {
+        font::line_height(cap_px as f32) as u32 + 8
+    } else {
+        0
+    };
+    let cap_h = badge_h + cap_lines * font::line_height(cap_px as f32) as u32 + 8;
     let row_h = label_h + cell_h + cap_h + 10;
     let w = cols as u32 * cell_w;
     // Measure the legend first to size the canvas.
@@ -899,10 +924,31 @@ pub fn image_grid_captioned(
             cell_h as f32,
             p.png.clone(),
         );
+        let cap_top = (label_h + cell_h + 4) as f32;
+        if let Some((text, colour)) = &p.badge {
+            let tw = font::text_width(text, cap_px as f32) + 14.0;
+            let bx = x + (cell_w as f32 - tw) / 2.0;
+            c.rect(
+                bx,
+                y + cap_top,
+                tw,
+                font::line_height(cap_px as f32) + 4.0,
+                Some(*colour),
+                None,
+            );
+            c.text(
+                bx + 7.0,
+                y + cap_top + 2.0,
+                cap_px,
+                text.clone(),
+                [255, 255, 255],
+                Anchor::Start,
+            );
+        }
         for (j, line) in p.caption.iter().enumerate() {
             c.text(
                 x + cell_w as f32 / 2.0,
-                y + (label_h + cell_h + 4) as f32 + j as f32 * font::line_height(cap_px as f32),
+                y + cap_top + badge_h as f32 + j as f32 * font::line_height(cap_px as f32),
                 cap_px,
                 line.clone(),
                 [40, 40, 40],

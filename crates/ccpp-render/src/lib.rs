@@ -689,3 +689,194 @@ fn draw_markers(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ccpp_core::grid::{GridMap, MapFrame};
+    use ccpp_core::world::Robot;
+    use ccpp_core::Pose;
+
+    /// A walled 120x80 room (0.05 m pixels) with a pillar; lanes over the first `lanes` rows,
+    /// a backtracking transfer into a second region, and one marker of each kind.
+    fn run(lanes: usize) -> (World, Trace) {
+        let (w, h) = (120usize, 80usize);
+        let mut cells = vec![Cell::Free; w * h];
+        for r in 0..h {
+            for c in 0..w {
+                if r < 2
+                    || c < 2
+                    || r >= h - 2
+                    || c >= w - 2
+                    || ((50..70).contains(&c) && (30..50).contains(&r))
+                {
+                    cells[r * w + c] = Cell::Occupied;
+                }
+            }
+        }
+        for c in 0..10 {
+            cells[c] = Cell::Unknown;
+        }
+        let map = GridMap::new(MapFrame::new(w, h, 0.05), cells).unwrap();
+        let world = World::new(map, Robot::new(0.15), Some(Pose::new(0.3, 0.3, 0.0))).unwrap();
+        let mut t = Trace::default();
+        t.push_event(0, Event::RegionStart { region: 1 });
+        let mut k = 0;
+        for lane in 0..lanes {
+            let y = 0.3 + lane as f64 * 0.3;
+            if lane == lanes / 2 {
+                t.push_event(k, Event::CriticalPoint { x: 5.6, y });
+                t.push_event(k, Event::BacktrackStart);
+                t.push_pose(k, Pose::new(0.3, y - 0.3, 0.0));
+                k += 1;
+                t.push_event(k, Event::BacktrackEnd);
+                t.push_event(k, Event::StartPoint { x: 0.3, y });
+                t.push_event(k, Event::RegionStart { region: 2 });
+                t.push_event(k, Event::Collision { x: 2.0, y });
+            }
+            let (a, b) = if lane % 2 == 0 {
+                (0.3, 5.6)
+            } else {
+                (5.6, 0.3)
+            };
+            t.push_pose(k, Pose::new(a, y, 0.0));
+            t.push_pose(k + 1, Pose::new(b, y, 0.0));
+            k += 2;
+        }
+        (world, t)
+    }
+
+    /// The picture as coarse characters: one per `step` pixels, by nearest known colour.
+    fn dump(png: &[u8], cols: u32) -> String {
+        let pm = Pixmap::decode_png(png).unwrap();
+        let step = (pm.width() / cols).max(1);
+        let known: [([u8; 3], char); 8] = [
+            ([255, 255, 255], ' '),
+            (colours::SWEPT, '.'),
+            (colours::MISSED, 'x'),
+            (colours::OBSTACLE, '#'),
+            (colours::UNKNOWN, '?'),
+            (colours::UNREACHABLE, 'o'),
+            ([20, 130, 60], 'G'),
+            ([200, 30, 30], 'R'),
+        ];
+        let mut s = format!("{}x{}\n", pm.width(), pm.height());
+        for y in (step / 2..pm.height()).step_by(step as usize) {
+            for x in (step / 2..pm.width()).step_by(step as usize) {
+                let p = pm.pixel(x, y).unwrap();
+                let c = [p.red(), p.green(), p.blue()];
+                let d = |k: [u8; 3]| {
+                    (0..3)
+                        .map(|i| (i32::from(c[i]) - i32::from(k[i])).abs())
+                        .max()
+                        .unwrap()
+                };
+                let ch = known.iter().find(|(k, _)| d(*k) <= 12).map_or(
+                    if c.iter().map(|&v| u32::from(v)).sum::<u32>() < 300 {
+                        '*'
+                    } else {
+                        '+'
+                    },
+                    |x| x.1,
+                );
+                s.push(ch);
+            }
+            s.push('\n');
+        }
+        s
+    }
+
+    fn style() -> CoverageStyle {
+        CoverageStyle {
+            title: vec![
+                "synthetic on room  r=0.15 m".into(),
+                "effective coverage and friends".into(),
+            ],
+            ..CoverageStyle::default()
+        }
+    }
+
+    #[test]
+    fn coverage_png_is_deterministic_and_matches_its_snapshot() {
+        let (world, trace) = run(12);
+        let a = coverage_png(&world, &trace, &style()).unwrap();
+        let b = coverage_png(&world, &trace, &style()).unwrap();
+        assert_eq!(a, b, "same inputs, same bytes");
+        insta::assert_snapshot!("coverage_png_dump", dump(&a, 72));
+    }
+
+    #[test]
+    fn the_legend_lists_every_marker_and_colour_drawn_with_counts() {
+        let (world, trace) = run(12);
+        let labels: Vec<String> = legend_entries(&world, &trace)
+            .into_iter()
+            .map(|e| format!("{:?} {}", e.swatch, e.label))
+            .collect();
+        insta::assert_snapshot!("legend_entries", labels.join("\n"));
+        // A run without backtracking or markers has no such entries.
+        let (world, mut trace) = run(2);
+        trace.records.retain(|r| {
+            !matches!(
+                r,
+                Record::Event {
+                    event: Event::Collision { .. } | Event::CriticalPoint { .. },
+                    ..
+                }
+            )
+        });
+        let labels: Vec<String> = legend_entries(&world, &trace)
+            .into_iter()
+            .map(|e| e.label)
+            .collect();
+        assert!(!labels
+            .iter()
+            .any(|l| l.starts_with("collision") || l.starts_with("critical")));
+        assert!(labels.iter().any(|l| l == "missed floor"));
+    }
+
+    #[test]
+    fn the_header_badge_is_green_for_a_good_run_and_red_for_a_bad_one() {
+        let header_has = |lanes: usize, colour: [u8; 3]| {
+            let (world, trace) = run(lanes);
+            let pm = coverage_pixmap(&world, &trace, &style()).unwrap();
+            (0..40).any(|y| {
+                (0..pm.width()).any(|x| {
+                    let p = pm.pixel(x, y).unwrap();
+                    [p.red(), p.green(), p.blue()] == colour
+                })
+            })
+        };
+        assert!(header_has(2, [200, 30, 30]), "2 lanes: red coverage badge");
+        assert!(!header_has(2, [200, 120, 0]), "2 lanes: no amber badge");
+        assert!(
+            header_has(12, [200, 120, 0]),
+            "12 lanes (91 %): amber badge"
+        );
+        assert_eq!(coverage_verdict_colour(0.97), [20, 130, 60]);
+        assert_eq!(coverage_verdict_colour(0.85), [200, 120, 0]);
+        assert_eq!(coverage_verdict_colour(0.5), [200, 30, 30]);
+        let (world, trace) = run(2);
+        let labels: Vec<String> = legend_entries(&world, &trace)
+            .into_iter()
+            .map(|e| e.label)
+            .collect();
+        assert!(labels.iter().any(|l| l == "collision (1)"), "{labels:?}");
+    }
+
+    #[test]
+    fn a_panel_style_picture_has_no_header_and_no_legend() {
+        let (world, trace) = run(12);
+        let full = coverage_pixmap(&world, &trace, &style()).unwrap();
+        let bare = coverage_pixmap(
+            &world,
+            &trace,
+            &CoverageStyle {
+                legend: false,
+                ..CoverageStyle::default()
+            },
+        )
+        .unwrap();
+        assert_eq!(full.width(), bare.width());
+        assert!(bare.height() + 80 < full.height());
+    }
+}
