@@ -369,7 +369,8 @@ pub fn replay_html(
 ) -> Result<String, RenderError> {
     let crop = crop_box(world, trace);
     let bg = base64::engine::general_purpose::STANDARD.encode(background_png(world, crop)?);
-    let data = replay_data(world, trace, tile_side, metrics_json, crop);
+    // `</` inside the script (a map or planner name) must not end it early.
+    let data = replay_data(world, trace, tile_side, metrics_json, crop).replace("</", "<\\/");
     let title = title
         .replace('&', "&amp;")
         .replace('<', "&lt;")
