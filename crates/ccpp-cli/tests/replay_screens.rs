@@ -150,7 +150,16 @@ fn demo_replay_side_panel_is_visible_at_desktop_sizes_and_usable_on_a_phone() {
         let page = if w >= 500 {
             format!("file://{}#frame=last", run.join("replay.html").display())
         } else {
-            url.clone()
+            // Narrower than a headless window can be: the page in a w x h iframe.
+            let phone = run.join(format!("shot-{w}x{h}.html"));
+            std::fs::write(
+                &phone,
+                format!(
+                    r#"<!DOCTYPE html><html><body style="margin:0;background:#fff"><iframe src="replay.html#frame=last" width="{w}" height="{h}" style="border:0;display:block"></iframe></body></html>"#
+                ),
+            )
+            .unwrap();
+            format!("file://{}", phone.display())
         };
         let o = chrome(&chrome_bin, profile.path())
             .arg(format!("--window-size={},{h}", w.max(500)))
