@@ -7,8 +7,10 @@ use anyhow::{Context, Result};
 use ccpp_core::metrics::{coverage_curve, Metrics};
 use ccpp_core::trace::{Record, Trace};
 use ccpp_core::world::{Robot, World};
+use ccpp_core::Pose;
 use ccpp_io::write_atomic;
-use ccpp_render::chart::{bar_panels, image_grid, line_chart, Chart};
+use ccpp_render::chart::{bar_panels, image_grid_captioned, line_chart, Chart, Panel};
+use ccpp_render::{coverage_png, coverage_verdict_colour, legend_entries_union, CoverageStyle};
 use rayon::prelude::*;
 
 use crate::bench::Row;
@@ -57,14 +59,51 @@ pub fn write_all(
             return Ok(());
         };
         let mut series = Vec::new();
-        let mut pictures = Vec::new();
-        for r in rows.iter().filter(|r| r.map == m.name && r.outcome.is_ok()) {
-            if let Ok(trace) = read_trace(&r.dir.join("trace.jsonl")) {
-                series.push((r.planner.clone(), coverage_curve(&world, &trace, 200)));
-            }
-            if let Ok(png) = std::fs::read(r.dir.join("coverage.png")) {
-                pictures.push((r.planner.clone(), png));
-            }
+        let mut panels = Vec::new();
+        let mut drawn: Vec<(World, Trace)> = Vec::new();
+        for r in rows.iter().filter(|r| r.map == m.name) {
+            let Ok(metrics) = &r.outcome else { continue };
+            let Ok(trace) = read_trace(&r.dir.join("trace.jsonl")) else {
+                continue;
+            };
+            series.push((r.planner.clone(), coverage_curve(&world, &trace, 200)));
+            // The panel: the run's picture without header or legend (one shared legend and
+            // legible captions instead), drawn from the run's own start pose.
+            let start = trace.poses().next().map(|p| Pose::new(p.x, p.y, p.theta));
+            let Ok(run_world) = World::new(m.grid.clone(), robot, start) else {
+                continue;
+            };
+            let style = CoverageStyle {
+                min_width: 500,
+                max_side: 1000,
+                title: Vec::new(),
+                legend: false,
+            };
+            let Ok(png) = coverage_png(&run_world, &trace, &style) else {
+                continue;
+            };
+            panels.push(Panel {
+                label: r.planner.clone(),
+                badge: Some((
+                    format!(
+                        "effective coverage {:.1}%",
+                        100.0 * metrics.effective_coverage
+                    ),
+                    coverage_verdict_colour(metrics.effective_coverage),
+                )),
+                caption: vec![
+                    format!(
+                        "path {:.1} m, ratio {:.2}, revisits {:.2}",
+                        metrics.path_length_m, metrics.path_ratio, metrics.revisit_rate
+                    ),
+                    format!(
+                        "regions {}, turns {}, collisions {}",
+                        metrics.regions, metrics.turns, metrics.collisions
+                    ),
+                ],
+                png,
+            });
+            drawn.push((run_world, trace));
         }
         if !series.is_empty() {
             let c = line_chart(
@@ -76,8 +115,17 @@ pub fn write_all(
             );
             write_chart(&dir, &format!("coverage_{}", m.name), &c)?;
         }
-        if !pictures.is_empty() {
-            let c = image_grid(&format!("Paths - {}", m.name), &pictures, 3, 520, 420);
+        if !panels.is_empty() {
+            let runs: Vec<(&World, &Trace)> = drawn.iter().map(|(w, t)| (w, t)).collect();
+            let legend = legend_entries_union(&runs);
+            let c = image_grid_captioned(
+                &format!("Paths - {}", m.name),
+                &panels,
+                &legend,
+                3,
+                520,
+                420,
+            );
             write_chart(&dir, &format!("paths_{}", m.name), &c)?;
         }
         Ok(())

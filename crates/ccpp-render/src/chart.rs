@@ -1,5 +1,5 @@
 //! Small charts described once and drawn twice: as SVG text and as a PNG (tiny-skia + the
-//! built-in bitmap font), so both files always show the same thing.
+//! embedded `DejaVu Sans` font), so both files always show the same thing.
 
 use std::fmt::Write as _;
 
@@ -41,6 +41,15 @@ enum Shape {
         rgb: [u8; 3],
         width: f32,
         dashed: bool,
+        cased: bool,
+    },
+    Circle {
+        cx: f32,
+        cy: f32,
+        r: f32,
+        fill: Option<[u8; 3]>,
+        stroke: Option<[u8; 3]>,
+        width: f32,
     },
     Rect {
         x: f32,
@@ -94,7 +103,118 @@ impl Chart {
             rgb,
             width,
             dashed,
+            cased: false,
         });
+    }
+
+    /// A polyline drawn over a white casing twice its width (dashed backtracking transfers:
+    /// the white gaps keep them apart from solid dark obstacles).
+    pub fn line_cased(&mut self, pts: Vec<(f32, f32)>, rgb: [u8; 3], width: f32, dashed: bool) {
+        self.shapes.push(Shape::Line {
+            pts,
+            rgb,
+            width,
+            dashed,
+            cased: true,
+        });
+    }
+
+    /// A circle, filled and/or stroked (`width` is the stroke width).
+    pub fn circle(
+        &mut self,
+        cx: f32,
+        cy: f32,
+        r: f32,
+        fill: Option<[u8; 3]>,
+        stroke: Option<[u8; 3]>,
+        width: f32,
+    ) {
+        self.shapes.push(Shape::Circle {
+            cx,
+            cy,
+            r,
+            fill,
+            stroke,
+            width,
+        });
+    }
+
+    /// Lays out a legend from `(x, y)`, wrapping at `x + width`, with text of size `px`;
+    /// returns its height.
+    pub fn legend(&mut self, x: f32, y: f32, width: f32, px: u32, entries: &[LegendEntry]) -> f32 {
+        let pxf = px as f32;
+        let s = (pxf * 1.1).round();
+        let row_h = (pxf * 1.6).round();
+        let (mut cx, mut cy) = (x, y);
+        for e in entries {
+            let item_w = s * 1.6 + 5.0 + font::text_width(&e.label, pxf);
+            if cx > x && cx + item_w > x + width {
+                cx = x;
+                cy += row_h;
+            }
+            let (sx, sy) = (cx, cy + (row_h - s) / 2.0 - pxf * 0.15);
+            let (mx, my) = (sx + s * 0.8, sy + s / 2.0);
+            match &e.swatch {
+                Swatch::Fill(c) => {
+                    self.rect(sx + s * 0.3, sy, s, s, Some(*c), Some([90, 90, 90]));
+                }
+                Swatch::Line { rgb, dashed } => {
+                    let pts = vec![(sx, my), (sx + s * 1.6, my)];
+                    if *dashed {
+                        self.line_cased(pts, *rgb, (s / 6.0).max(2.0), true);
+                    } else {
+                        self.line(pts, *rgb, (s / 6.0).max(2.0), false);
+                    }
+                }
+                Swatch::Regions(cs) => {
+                    let n = cs.len().max(1) as f32;
+                    for (k, c) in cs.iter().enumerate() {
+                        let a = sx + s * 1.6 * k as f32 / n;
+                        self.line(
+                            vec![(a, my), (a + s * 1.6 / n, my)],
+                            *c,
+                            (s / 4.0).max(2.0),
+                            false,
+                        );
+                    }
+                }
+                Swatch::Disc(c) => self.circle(mx, my, s * 0.45, Some(*c), None, 1.0),
+                Swatch::Ring(c) => {
+                    self.circle(mx, my, s * 0.4, None, Some(*c), (s / 7.0).max(1.5));
+                }
+                Swatch::Square(c) => {
+                    self.rect(
+                        mx - s * 0.35,
+                        my - s * 0.35,
+                        s * 0.7,
+                        s * 0.7,
+                        Some(*c),
+                        None,
+                    );
+                }
+                Swatch::Cross(c) => {
+                    let d = s * 0.38;
+                    let w = (s / 7.0).max(1.5);
+                    self.line(vec![(mx - d, my - d), (mx + d, my + d)], *c, w, false);
+                    self.line(vec![(mx - d, my + d), (mx + d, my - d)], *c, w, false);
+                }
+            }
+            let tx = sx + s * 1.6 + 5.0;
+            self.text(
+                tx,
+                cy + (row_h - pxf * 1.2) / 2.0,
+                px,
+                e.label.clone(),
+                [25, 25, 25],
+                Anchor::Start,
+            );
+            cx = tx + font::text_width(&e.label, pxf) + pxf;
+        }
+        if entries.is_empty() {
+            0.0
+        } else {
+            cy + row_h - y
+        }
     }
 
     /// A rectangle.
@@ -117,7 +237,7 @@ impl Chart {
         });
     }
 
-    /// Text whose top is at `y`, `px` pixels high (a multiple of 8 renders crispest in PNG).
+    /// Text whose line box starts at `y`, font size `px` (pixels per em).
     pub fn text(
         &mut self,
         x: f32,
@@ -147,7 +267,7 @@ impl Chart {
         let mut s = String::new();
         let _ = writeln!(
             s,
-            r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}" font-family="DejaVu Sans Mono, monospace">"#,
+            r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}" font-family="DejaVu Sans, Verdana, sans-serif">"#,
             w = self.width,
             h = self.height
         );
@@ -159,6 +279,7 @@ impl Chart {
                     rgb,
                     width,
                     dashed,
+                    cased,
                 } => {
                     if pts.len() < 2 {
                         continue;
@@ -176,10 +297,34 @@ impl Chart {
                     } else {
                         String::new()
                     };
+                    if *cased {
+                        let _ = writeln!(
+                            s,
+                            r##"<path d="{d}" fill="none" stroke="#ffffff" stroke-width="{:.2}" stroke-linejoin="round"/>"##,
+                            width * 2.0
+                        );
+                    }
                     let _ = writeln!(
                         s,
                         r#"<path d="{d}" fill="none" stroke="{}" stroke-width="{width:.2}" stroke-linejoin="round"{dash}/>"#,
                         hex(*rgb)
+                    );
+                }
+                Shape::Circle {
+                    cx,
+                    cy,
+                    r,
+                    fill,
+                    stroke,
+                    width,
+                } => {
+                    let fill = fill.map_or_else(|| "none".to_string(), hex);
+                    let stroke = stroke.map_or_else(String::new, |c| {
+                        format!(r#" stroke="{}" stroke-width="{width:.2}""#, hex(c))
+                    });
+                    let _ = writeln!(
+                        s,
+                        r#"<circle cx="{cx:.2}" cy="{cy:.2}" r="{r:.2}" fill="{fill}"{stroke}/>"#
                     );
                 }
                 Shape::Rect {
@@ -215,7 +360,7 @@ impl Chart {
                     let _ = writeln!(
                         s,
                         r#"<text x="{x:.2}" y="{:.2}" font-size="{px}" fill="{}" text-anchor="{a}">{}</text>"#,
-                        y + *px as f32 * 0.85,
+                        y + font::ascent(*px as f32),
                         hex(*rgb),
                         escape(text)
                     );
@@ -241,6 +386,14 @@ impl Chart {
         let mut pm = Pixmap::new(self.width, self.height)
             .ok_or(RenderError::Canvas(self.width, self.height))?;
         pm.fill(Color::WHITE);
+        self.draw_onto(&mut pm);
+        pm.encode_png()
+            .map_err(|e| RenderError::Encode(e.to_string()))
+    }
+
+    /// Draws the shapes onto an existing pixmap (the chart's size is not checked).
+    pub fn draw_onto(&self, pm: &mut Pixmap) {
+        let id = Transform::identity();
         for sh in &self.shapes {
             match sh {
                 Shape::Line {
@@ -248,6 +401,7 @@ impl Chart {
                     rgb,
                     width,
                     dashed,
+                    cased,
                 } => {
                     let mut pb = PathBuilder::new();
                     let Some(first) = pts.first() else { continue };
@@ -261,10 +415,38 @@ impl Chart {
                             ..Stroke::default()
                         };
                         st.line_join = tiny_skia::LineJoin::Round;
+                        if *cased {
+                            let casing = Stroke {
+                                width: width * 2.0,
+                                ..st.clone()
+                            };
+                            pm.stroke_path(&path, &paint([255, 255, 255]), &casing, id, None);
+                        }
                         if *dashed {
                             st.dash = StrokeDash::new(vec![width * 4.0, width * 3.0], 0.0);
                         }
-                        pm.stroke_path(&path, &paint(*rgb), &st, Transform::identity(), None);
+                        pm.stroke_path(&path, &paint(*rgb), &st, id, None);
+                    }
+                }
+                Shape::Circle {
+                    cx,
+                    cy,
+                    r,
+                    fill,
+                    stroke,
+                    width,
+                } => {
+                    if let Some(c) = PathBuilder::from_circle(*cx, *cy, *r) {
+                        if let Some(f) = fill {
+                            pm.fill_path(&c, &paint(*f), FillRule::Winding, id, None);
+                        }
+                        if let Some(s) = stroke {
+                            let st = Stroke {
+                                width: *width,
+                                ..Stroke::default()
+                            };
+                            pm.stroke_path(&c, &paint(*s), &st, id, None);
+                        }
                     }
                 }
                 Shape::Rect {
@@ -277,17 +459,11 @@ impl Chart {
                 } => {
                     if let Some(r) = Rect::from_xywh(*x, *y, w.max(0.5), h.max(0.5)) {
                         if let Some(f) = fill {
-                            pm.fill_rect(r, &paint(*f), Transform::identity(), None);
+                            pm.fill_rect(r, &paint(*f), id, None);
                         }
                         if let Some(c) = stroke {
                             let p = PathBuilder::from_rect(r);
-                            pm.stroke_path(
-                                &p,
-                                &paint(*c),
-                                &Stroke::default(),
-                                Transform::identity(),
-                                None,
-                            );
+                            pm.stroke_path(&p, &paint(*c), &Stroke::default(), id, None);
                         }
                     }
                 }
@@ -299,21 +475,14 @@ impl Chart {
                     rgb,
                     anchor,
                 } => {
-                    let scale = (px / 8).max(1);
-                    let w = font::text_width(text, scale) as f32;
+                    let size = *px as f32;
+                    let w = font::text_width(text, size);
                     let x0 = match anchor {
                         Anchor::Start => *x,
                         Anchor::Middle => x - w / 2.0,
                         Anchor::End => x - w,
                     };
-                    font::draw_text(
-                        &mut pm,
-                        x0.max(0.0) as u32,
-                        y.max(0.0) as u32,
-                        scale,
-                        text,
-                        *rgb,
-                    );
+                    font::draw_text(pm, x0.max(0.0), y.max(0.0), size, text, *rgb);
                 }
                 Shape::Image { x, y, w, h, png } => {
                     if let Ok(img) = Pixmap::decode_png(png) {
@@ -323,7 +492,11 @@ impl Chart {
                         let ox = x + (w - img.width() as f32 * k) / 2.0;
                         let oy = y + (h - img.height() as f32 * k) / 2.0;
                         let pp = PixmapPaint {
-                            quality: tiny_skia::FilterQuality::Bilinear,
+                            quality: if k < 1.0 {
+                                tiny_skia::FilterQuality::Bicubic
+                            } else {
+                                tiny_skia::FilterQuality::Bilinear
+                            },
                             ..PixmapPaint::default()
                         };
                         pm.draw_pixmap(
@@ -338,10 +511,49 @@ impl Chart {
                 }
             }
         }
-        // Silence unused warnings for fill rule in some builds.
-        let _ = FillRule::Winding;
-        pm.encode_png()
-            .map_err(|e| RenderError::Encode(e.to_string()))
+    }
+}
+
+/// What a legend entry shows next to its label.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Swatch {
+    /// A filled square (an area colour).
+    Fill([u8; 3]),
+    /// A line sample; dashed lines are drawn over a white casing.
+    Line {
+        /// Colour.
+        rgb: [u8; 3],
+        /// Dashed.
+        dashed: bool,
+    },
+    /// A line made of several colours (the path's per-region colours).
+    Regions(Vec<[u8; 3]>),
+    /// A filled disc.
+    Disc([u8; 3]),
+    /// A ring.
+    Ring([u8; 3]),
+    /// A small filled square marker.
+    Square([u8; 3]),
+    /// A cross marker.
+    Cross([u8; 3]),
+}
+
+/// One legend entry: a swatch and its label.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LegendEntry {
+    /// What is drawn.
+    pub swatch: Swatch,
+    /// What it means.
+    pub label: String,
+}
+
+impl LegendEntry {
+    /// A new entry.
+    pub fn new(swatch: Swatch, label: impl Into<String>) -> Self {
+        Self {
+            swatch,
+            label: label.into(),
+        }
     }
 }
 
@@ -403,7 +615,7 @@ pub fn line_chart(
 ) -> Chart {
     let (w, h) = (900u32, 520u32);
     let mut c = Chart::new(w, h);
-    let (l, r, t, b) = (80.0f32, 200.0f32, 48.0f32, 60.0f32);
+    let (l, r, t, b) = (80.0f32, 200.0f32, 62.0f32, 60.0f32);
     let pw = w as f32 - l - r;
     let ph = h as f32 - t - b;
     let xmax = series
@@ -420,8 +632,8 @@ pub fn line_chart(
     });
     c.text(
         w as f32 / 2.0,
-        12.0,
-        16,
+        10.0,
+        20,
         title,
         [20, 20, 20],
         Anchor::Middle,
@@ -435,8 +647,8 @@ pub fn line_chart(
         c.line(vec![(x, t), (x, t + ph)], [225, 225, 225], 1.0, false);
         c.text(
             x,
-            t + ph + 6.0,
-            8,
+            t + ph + 5.0,
+            12,
             fmt_tick(v, xs),
             [60, 60, 60],
             Anchor::Middle,
@@ -449,8 +661,8 @@ pub fn line_chart(
         c.line(vec![(l, y), (l + pw, y)], [225, 225, 225], 1.0, false);
         c.text(
             l - 6.0,
-            y - 4.0,
-            8,
+            y - 7.0,
+            12,
             fmt_tick(v, ys),
             [60, 60, 60],
             Anchor::End,
@@ -460,13 +672,13 @@ pub fn line_chart(
     c.rect(l, t, pw, ph, None, Some([120, 120, 120]));
     c.text(
         l + pw / 2.0,
-        h as f32 - 26.0,
-        8,
+        h as f32 - 28.0,
+        14,
         x_label,
         [40, 40, 40],
         Anchor::Middle,
     );
-    c.text(8.0, t - 20.0, 8, y_label, [40, 40, 40], Anchor::Start);
+    c.text(8.0, t - 24.0, 14, y_label, [40, 40, 40], Anchor::Start);
     for (k, (name, pts)) in series.iter().enumerate() {
         let col = SERIES[k % SERIES.len()];
         let poly: Vec<(f32, f32)> = pts
@@ -479,9 +691,9 @@ pub fn line_chart(
             })
             .collect();
         c.line(poly, col, 2.0, false);
-        let ly = t + 10.0 + k as f32 * 22.0;
+        let ly = t + 10.0 + k as f32 * 24.0;
         c.line(
-            vec![(l + pw + 14.0, ly + 4.0), (l + pw + 40.0, ly + 4.0)],
+            vec![(l + pw + 14.0, ly + 9.0), (l + pw + 40.0, ly + 9.0)],
             col,
             3.0,
             false,
@@ -489,7 +701,7 @@ pub fn line_chart(
         c.text(
             l + pw + 46.0,
             ly,
-            8,
+            14,
             name.clone(),
             [30, 30, 30],
             Anchor::Start,
@@ -508,8 +720,8 @@ pub fn bar_panels(title: &str, planners: &[String], metrics: &[(String, Vec<f64>
     let mut c = Chart::new(w, h);
     c.text(
         w as f32 / 2.0,
-        12.0,
-        16,
+        10.0,
+        20,
         title,
         [20, 20, 20],
         Anchor::Middle,
@@ -520,8 +732,8 @@ pub fn bar_panels(title: &str, planners: &[String], metrics: &[(String, Vec<f64>
         let (l, t, iw, ih) = (ox + 50.0, oy + 24.0, pw - 70.0, ph - 50.0);
         c.text(
             ox + pw / 2.0,
-            oy + 4.0,
-            8,
+            oy + 2.0,
+            14,
             name.clone(),
             [30, 30, 30],
             Anchor::Middle,
@@ -540,8 +752,8 @@ pub fn bar_panels(title: &str, planners: &[String], metrics: &[(String, Vec<f64>
             c.line(vec![(l, y), (l + iw, y)], [230, 230, 230], 1.0, false);
             c.text(
                 l - 4.0,
-                y - 4.0,
-                8,
+                y - 7.0,
+                11,
                 fmt_tick(v, step),
                 [80, 80, 80],
                 Anchor::End,
@@ -571,7 +783,14 @@ pub fn bar_panels(title: &str, planners: &[String], metrics: &[(String, Vec<f64>
         let x = 20.0 + (k % 4) as f32 * 220.0;
         let y = ly + (k / 4) as f32 * 24.0;
         c.rect(x, y, 14.0, 14.0, Some(SERIES[k % SERIES.len()]), None);
-        c.text(x + 20.0, y + 3.0, 8, p.clone(), [30, 30, 30], Anchor::Start);
+        c.text(
+            x + 20.0,
+            y - 1.0,
+            14,
+            p.clone(),
+            [30, 30, 30],
+            Anchor::Start,
+        );
     }
     c
 }
@@ -591,8 +810,8 @@ pub fn image_grid(
     let mut c = Chart::new(w, h);
     c.text(
         w as f32 / 2.0,
-        12.0,
-        16,
+        10.0,
+        20,
         title,
         [20, 20, 20],
         Anchor::Middle,
@@ -602,8 +821,8 @@ pub fn image_grid(
         let y = 40.0 + (k / cols) as f32 * (cell_h + 24) as f32;
         c.text(
             x + cell_w as f32 / 2.0,
-            y,
-            8,
+            y - 2.0,
+            15,
             label.clone(),
             [30, 30, 30],
             Anchor::Middle,
@@ -616,6 +835,135 @@ pub fn image_grid(
             png.clone(),
         );
     }
+    c
+}
+
+/// Width and height from a PNG header.
+fn png_size(png: &[u8]) -> Option<(u32, u32)> {
+    if png.len() < 24 || &png[..8] != b"\x89PNG\r\n\x1a\n" {
+        return None;
+    }
+    let w = u32::from_be_bytes(png[16..20].try_into().ok()?);
+    let h = u32::from_be_bytes(png[20..24].try_into().ok()?);
+    Some((w, h))
+}
+
+/// One picture of [`image_grid_captioned`]: a label above, caption lines below.
+#[derive(Clone, Debug, Default)]
+pub struct Panel {
+    /// Name above the picture.
+    pub label: String,
+    /// Lines below the picture (figures of the run).
+    pub caption: Vec<String>,
+    /// A coloured chip with white text above the caption (e.g. the effective coverage,
+    /// coloured by [`crate::coverage_verdict_colour`]).
+    pub badge: Option<(String, [u8; 3])>,
+    /// The picture (PNG bytes).
+    pub png: Vec<u8>,
+}
+
+/// Pictures side by side (up to `cols` per row), each in a `cell_w x cell_h` box with its label
+/// above and its caption lines below at a legible size, and one shared legend at the bottom.
+pub fn image_grid_captioned(
+    title: &str,
+    panels: &[Panel],
+    legend: &[LegendEntry],
+    cols: usize,
+    cell_w: u32,
+    cell_h: u32,
+) -> Chart {
+    let cols = cols.max(1).min(panels.len().max(1));
+    let rows = panels.len().div_ceil(cols).max(1);
+    // No taller than the tallest picture needs at the cell's width.
+    let need = panels
+        .iter()
+        .filter_map(|p| png_size(&p.png))
+        .map(|(w, h)| ((cell_w as f32 - 12.0) * h as f32 / w.max(1) as f32).ceil() as u32)
+        .max();
+    let cell_h = need.map_or(cell_h, |n| n.clamp(40, cell_h));
+    let cap_lines = panels.iter().map(|p| p.caption.len()).max().unwrap_or(0) as u32;
+    let (label_px, cap_px) = (16u32, 13u32);
+    let label_h = font::line_height(label_px as f32) as u32 + 4;
+    let badge_h = if panels.iter().any(|p| p.badge.is_some()) {
+        font::line_height(cap_px as f32) as u32 + 8
+    } else {
+        0
+    };
+    let cap_h = badge_h + cap_lines * font::line_height(cap_px as f32) as u32 + 8;
+    let row_h = label_h + cell_h + cap_h + 10;
+    let w = cols as u32 * cell_w;
+    // Measure the legend first to size the canvas.
+    let mut probe = Chart::new(w, 0);
+    let legend_h = probe.legend(12.0, 0.0, w as f32 - 24.0, 13, legend).ceil() as u32;
+    let top = 44u32;
+    let h = top + rows as u32 * row_h + legend_h + 16;
+    let mut c = Chart::new(w, h);
+    c.text(
+        w as f32 / 2.0,
+        10.0,
+        20,
+        title,
+        [20, 20, 20],
+        Anchor::Middle,
+    );
+    for (k, p) in panels.iter().enumerate() {
+        let x = (k % cols) as f32 * cell_w as f32;
+        let y = (top + (k / cols) as u32 * row_h) as f32;
+        c.text(
+            x + cell_w as f32 / 2.0,
+            y,
+            label_px,
+            p.label.clone(),
+            [20, 20, 20],
+            Anchor::Middle,
+        );
+        c.image(
+            x + 6.0,
+            y + label_h as f32,
+            cell_w as f32 - 12.0,
+            cell_h as f32,
+            p.png.clone(),
+        );
+        let cap_top = (label_h + cell_h + 4) as f32;
+        if let Some((text, colour)) = &p.badge {
+            let tw = font::text_width(text, cap_px as f32) + 14.0;
+            let bx = x + (cell_w as f32 - tw) / 2.0;
+            c.rect(
+                bx,
+                y + cap_top,
+                tw,
+                font::line_height(cap_px as f32) + 4.0,
+                Some(*colour),
+                None,
+            );
+            c.text(
+                bx + 7.0,
+                y + cap_top + 2.0,
+                cap_px,
+                text.clone(),
+                [255, 255, 255],
+                Anchor::Start,
+            );
+        }
+        for (j, line) in p.caption.iter().enumerate() {
+            c.text(
+                x + cell_w as f32 / 2.0,
+                y + cap_top + badge_h as f32 + j as f32 * font::line_height(cap_px as f32),
+                cap_px,
+                line.clone(),
+                [40, 40, 40],
+                Anchor::Middle,
+            );
+        }
+    }
+    let ly = (top + rows as u32 * row_h) as f32;
+    c.line(
+        vec![(8.0, ly - 4.0), (w as f32 - 8.0, ly - 4.0)],
+        [210, 210, 210],
+        1.0,
+        false,
+    );
+    c.legend(12.0, ly, w as f32 - 24.0, 13, legend);
     c
 }
 

@@ -1,103 +1,112 @@
-//! A 5x7 bitmap font (upper-case letters, digits and a little punctuation), drawn by hand for
-//! legends and titles so pictures need no font files. Lower-case input is drawn in upper case.
+//! Text for the PNG pictures: `DejaVu Sans` (Bitstream Vera licence, see `fonts/LICENSE-DejaVu.txt`)
+//! embedded in the binary and rasterised with `ab_glyph`, antialiased, mixed case. Sizes are
+//! CSS-like font sizes in pixels (pixels per em), the same number the SVG output uses.
 
+use std::sync::OnceLock;
+
+use ab_glyph::{Font, FontRef, PxScale, ScaleFont};
 use tiny_skia::Pixmap;
 
-/// Glyph height in font pixels (7 rows plus 1 spacing).
-pub const GLYPH_H: u32 = 8;
-const GLYPH_W: u32 = 6;
+static FONT_BYTES: &[u8] = include_bytes!("../fonts/DejaVuSans.ttf");
 
-/// Rows of a glyph, 5 bits each (bit 4 = leftmost column).
-fn glyph(c: char) -> [u8; 7] {
-    match c.to_ascii_uppercase() {
-        'A' => [0x0E, 0x11, 0x11, 0x1F, 0x11, 0x11, 0x11],
-        'B' => [0x1E, 0x11, 0x11, 0x1E, 0x11, 0x11, 0x1E],
-        'C' => [0x0E, 0x11, 0x10, 0x10, 0x10, 0x11, 0x0E],
-        'D' => [0x1E, 0x11, 0x11, 0x11, 0x11, 0x11, 0x1E],
-        'E' => [0x1F, 0x10, 0x10, 0x1E, 0x10, 0x10, 0x1F],
-        'F' => [0x1F, 0x10, 0x10, 0x1E, 0x10, 0x10, 0x10],
-        'G' => [0x0E, 0x11, 0x10, 0x17, 0x11, 0x11, 0x0F],
-        'H' => [0x11, 0x11, 0x11, 0x1F, 0x11, 0x11, 0x11],
-        'I' => [0x0E, 0x04, 0x04, 0x04, 0x04, 0x04, 0x0E],
-        'J' => [0x07, 0x02, 0x02, 0x02, 0x02, 0x12, 0x0C],
-        'K' => [0x11, 0x12, 0x14, 0x18, 0x14, 0x12, 0x11],
-        'L' => [0x10, 0x10, 0x10, 0x10, 0x10, 0x10, 0x1F],
-        'M' => [0x11, 0x1B, 0x15, 0x15, 0x11, 0x11, 0x11],
-        'N' => [0x11, 0x11, 0x19, 0x15, 0x13, 0x11, 0x11],
-        'O' => [0x0E, 0x11, 0x11, 0x11, 0x11, 0x11, 0x0E],
-        'P' => [0x1E, 0x11, 0x11, 0x1E, 0x10, 0x10, 0x10],
-        'Q' => [0x0E, 0x11, 0x11, 0x11, 0x15, 0x12, 0x0D],
-        'R' => [0x1E, 0x11, 0x11, 0x1E, 0x14, 0x12, 0x11],
-        'S' => [0x0F, 0x10, 0x10, 0x0E, 0x01, 0x01, 0x1E],
-        'T' => [0x1F, 0x04, 0x04, 0x04, 0x04, 0x04, 0x04],
-        'U' => [0x11, 0x11, 0x11, 0x11, 0x11, 0x11, 0x0E],
-        'V' => [0x11, 0x11, 0x11, 0x11, 0x11, 0x0A, 0x04],
-        'W' => [0x11, 0x11, 0x11, 0x15, 0x15, 0x15, 0x0A],
-        'X' => [0x11, 0x11, 0x0A, 0x04, 0x0A, 0x11, 0x11],
-        'Y' => [0x11, 0x11, 0x0A, 0x04, 0x04, 0x04, 0x04],
-        'Z' => [0x1F, 0x01, 0x02, 0x04, 0x08, 0x10, 0x1F],
-        '0' => [0x0E, 0x11, 0x13, 0x15, 0x19, 0x11, 0x0E],
-        '1' => [0x04, 0x0C, 0x04, 0x04, 0x04, 0x04, 0x0E],
-        '2' => [0x0E, 0x11, 0x01, 0x02, 0x04, 0x08, 0x1F],
-        '3' => [0x1F, 0x02, 0x04, 0x02, 0x01, 0x11, 0x0E],
-        '4' => [0x02, 0x06, 0x0A, 0x12, 0x1F, 0x02, 0x02],
-        '5' => [0x1F, 0x10, 0x1E, 0x01, 0x01, 0x11, 0x0E],
-        '6' => [0x06, 0x08, 0x10, 0x1E, 0x11, 0x11, 0x0E],
-        '7' => [0x1F, 0x01, 0x02, 0x04, 0x08, 0x08, 0x08],
-        '8' => [0x0E, 0x11, 0x11, 0x0E, 0x11, 0x11, 0x0E],
-        '9' => [0x0E, 0x11, 0x11, 0x0F, 0x01, 0x02, 0x0C],
-        '.' => [0, 0, 0, 0, 0, 0x0C, 0x0C],
-        ',' => [0, 0, 0, 0, 0x0C, 0x04, 0x08],
-        ':' => [0, 0x0C, 0x0C, 0, 0x0C, 0x0C, 0],
-        '-' => [0, 0, 0, 0x1F, 0, 0, 0],
-        '+' => [0, 0x04, 0x04, 0x1F, 0x04, 0x04, 0],
-        '=' => [0, 0, 0x1F, 0, 0x1F, 0, 0],
-        '%' => [0x18, 0x19, 0x02, 0x04, 0x08, 0x13, 0x03],
-        '/' => [0, 0x01, 0x02, 0x04, 0x08, 0x10, 0],
-        '(' => [0x02, 0x04, 0x08, 0x08, 0x08, 0x04, 0x02],
-        ')' => [0x08, 0x04, 0x02, 0x02, 0x02, 0x04, 0x08],
-        '_' => [0, 0, 0, 0, 0, 0, 0x1F],
-        '*' => [0, 0x04, 0x15, 0x0E, 0x15, 0x04, 0],
-        '#' => [0x0A, 0x0A, 0x1F, 0x0A, 0x1F, 0x0A, 0x0A],
-        '|' => [0x04, 0x04, 0x04, 0x04, 0x04, 0x04, 0x04],
-        _ => [0; 7],
+fn font() -> &'static FontRef<'static> {
+    static FONT: OnceLock<FontRef<'static>> = OnceLock::new();
+    FONT.get_or_init(|| {
+        FontRef::try_from_slice(FONT_BYTES).expect("the embedded DejaVuSans.ttf is a valid font")
+    })
+}
+
+/// The `ab_glyph` scale of a font size given in pixels per em.
+fn scale(px: f32) -> PxScale {
+    let f = font();
+    let upem = f.units_per_em().unwrap_or(2048.0);
+    PxScale::from(px * f.height_unscaled() / upem)
+}
+
+/// Distance from the top of a line to its baseline at font size `px`.
+pub fn ascent(px: f32) -> f32 {
+    font().as_scaled(scale(px)).ascent()
+}
+
+/// Recommended distance between baselines at font size `px`.
+pub fn line_height(px: f32) -> f32 {
+    (px * 1.25).ceil()
+}
+
+/// Advance width of `text` at font size `px`, in pixels.
+pub fn text_width(text: &str, px: f32) -> f32 {
+    let sf = font().as_scaled(scale(px));
+    let mut w = 0.0;
+    let mut prev = None;
+    for ch in text.chars() {
+        let id = sf.glyph_id(ch);
+        if let Some(p) = prev {
+            w += sf.kern(p, id);
+        }
+        w += sf.h_advance(id);
+        prev = Some(id);
     }
+    w
 }
 
-/// Width in canvas pixels of `text` at `scale`.
-pub fn text_width(text: &str, scale: u32) -> u32 {
-    text.chars().count() as u32 * GLYPH_W * scale
-}
-
-/// Draws `text` with its top-left at `(x, y)`, each font pixel `scale` canvas pixels; returns
-/// the x just after the text.
-pub fn draw_text(pm: &mut Pixmap, x: u32, y: u32, scale: u32, text: &str, rgb: [u8; 3]) -> u32 {
-    let (w, h) = (pm.width(), pm.height());
+/// Draws `text` with the top of its line box at `(x, y)` at font size `px`, blending
+/// antialiased coverage onto the (premultiplied) pixmap; returns the x just after the text.
+pub fn draw_text(pm: &mut Pixmap, x: f32, y: f32, px: f32, text: &str, rgb: [u8; 3]) -> f32 {
+    let f = font();
+    let sf = f.as_scaled(scale(px));
+    let baseline = (y + sf.ascent()).round();
+    let (w, h) = (i64::from(pm.width()), i64::from(pm.height()));
     let data = pm.data_mut();
     let mut cx = x;
+    let mut prev = None;
     for ch in text.chars() {
-        let g = glyph(ch);
-        for (gy, bits) in g.iter().enumerate() {
-            for gx in 0..5u32 {
-                if bits & (0x10 >> gx) == 0 {
-                    continue;
-                }
-                for sy in 0..scale {
-                    for sx in 0..scale {
-                        let px = cx + gx * scale + sx;
-                        let py = y + gy as u32 * scale + sy;
-                        if px < w && py < h {
-                            let o = ((py * w + px) * 4) as usize;
-                            data[o] = rgb[0];
-                            data[o + 1] = rgb[1];
-                            data[o + 2] = rgb[2];
-                            data[o + 3] = 255;
-                        }
-                    }
-                }
-            }
+        let id = sf.glyph_id(ch);
+        if let Some(p) = prev {
+            cx += sf.kern(p, id);
         }
-        cx += GLYPH_W * scale;
+        let glyph = id.with_scale_and_position(sf.scale(), ab_glyph::point(cx, baseline));
+        cx += sf.h_advance(id);
+        prev = Some(id);
+        let Some(outline) = f.outline_glyph(glyph) else {
+            continue;
+        };
+        let b = outline.px_bounds();
+        let (ox, oy) = (b.min.x as i64, b.min.y as i64);
+        outline.draw(|gx, gy, c| {
+            let px_x = ox + i64::from(gx);
+            let px_y = oy + i64::from(gy);
+            if px_x < 0 || px_y < 0 || px_x >= w || px_y >= h || c <= 0.0 {
+                return;
+            }
+            let a = c.min(1.0);
+            let o = ((px_y * w + px_x) * 4) as usize;
+            for k in 0..3 {
+                let d = f32::from(data[o + k]);
+                data[o + k] = (f32::from(rgb[k]) * a + d * (1.0 - a)).round() as u8;
+            }
+            let d = f32::from(data[o + 3]);
+            data[o + 3] = (255.0 * a + d * (1.0 - a)).round() as u8;
+        });
     }
     cx
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mixed_case_text_is_drawn_antialiased_and_measured() {
+        let mut pm = Pixmap::new(200, 40).unwrap();
+        pm.fill(tiny_skia::Color::WHITE);
+        let end = draw_text(&mut pm, 4.0, 4.0, 16.0, "Ba-star R=0.15", [0, 0, 0]);
+        assert!((end - 4.0 - text_width("Ba-star R=0.15", 16.0)).abs() < 1e-3);
+        // Lower case is narrower than upper case (a real proportional font).
+        assert!(text_width("abc", 16.0) < text_width("ABC", 16.0));
+        let px = pm.data();
+        let grey = px.chunks(4).filter(|p| p[0] > 20 && p[0] < 235).count();
+        let dark = px.chunks(4).filter(|p| p[0] <= 20).count();
+        assert!(dark > 40, "glyph cores are drawn ({dark})");
+        assert!(grey > 40, "edges are antialiased ({grey})");
+    }
 }

@@ -8,13 +8,19 @@
 //! - floor it could never reach (other components, too narrow): pale grey-white;
 //! - obstacles: near black; unknown: mid grey;
 //! - the executed path: one colour per region (boustrophedon region, spiral, cell), thin;
-//!   backtracking transfers dashed dark grey;
-//! - start: green disk; critical points: orange squares; chosen start points: purple rings;
-//!   collisions: red crosses; final pose: black ring.
+//!   backtracking transfers dashed near-black over a white casing;
+//! - start: green disc with a heading tick; critical points: orange squares; chosen restart
+//!   points: purple rings; collisions: red crosses; final pose: black ring.
+//!
+//! The legend under the map lists exactly the classes and markers that the picture shows (with
+//! counts), and the header carries a coloured badge with the effective coverage (green from
+//! 95 %, amber from 80 %, red below) and the collision count, so a bad run stands out.
 
 pub mod chart;
 mod font;
 pub mod replay;
+
+use chart::{Chart, LegendEntry, Swatch};
 
 use ccpp_core::grid::Cell;
 use ccpp_core::metrics::swept_pixels;
@@ -44,6 +50,8 @@ pub struct CoverageStyle {
     pub max_side: u32,
     /// Title printed in the header (planner, map, figures).
     pub title: Vec<String>,
+    /// Draw the legend under the map (off for small panels that share one legend).
+    pub legend: bool,
 }
 
 impl Default for CoverageStyle {
@@ -52,8 +60,37 @@ impl Default for CoverageStyle {
             min_width: 900,
             max_side: 3000,
             title: Vec::new(),
+            legend: true,
         }
     }
+}
+
+/// Colours of the coverage picture's areas and markers.
+pub mod colours {
+    /// Swept reachable floor.
+    pub const SWEPT: [u8; 3] = [170, 215, 250];
+    /// Reachable floor the run missed.
+    pub const MISSED: [u8; 3] = [250, 150, 130];
+    /// Swept floor outside the reachable area.
+    pub const SWEPT_OUTSIDE: [u8; 3] = [200, 225, 245];
+    /// Free floor the robot can never reach.
+    pub const UNREACHABLE: [u8; 3] = [246, 246, 242];
+    /// Obstacles.
+    pub const OBSTACLE: [u8; 3] = [30, 30, 30];
+    /// Unknown map pixels.
+    pub const UNKNOWN: [u8; 3] = [170, 170, 170];
+    /// Backtracking transfers (dashed, over a white casing).
+    pub const BACKTRACK: [u8; 3] = [20, 20, 20];
+    /// Start disc.
+    pub const START: [u8; 3] = [0, 170, 60];
+    /// Final pose ring.
+    pub const END: [u8; 3] = [0, 0, 0];
+    /// Critical points.
+    pub const CRITICAL: [u8; 3] = [240, 140, 0];
+    /// Chosen restart points.
+    pub const RESTART: [u8; 3] = [130, 40, 160];
+    /// Collisions.
+    pub const COLLISION: [u8; 3] = [230, 0, 0];
 }
 
 /// Region colours (colour-blind-friendly-ish, distinct on light blue).
@@ -148,6 +185,200 @@ pub fn coverage_png(
         .map_err(|e| RenderError::Encode(e.to_string()))
 }
 
+/// Counts of what a run's picture shows, for its legend.
+#[derive(Clone, Debug, Default, PartialEq)]
+#[allow(clippy::struct_excessive_bools)] // one flag per area class, read by `entries_of`
+struct Shown {
+    swept: bool,
+    missed: bool,
+    swept_outside: bool,
+    unreachable: bool,
+    obstacle: bool,
+    unknown: bool,
+    regions: usize,
+    backtrack: bool,
+    critical: usize,
+    restart: usize,
+    collisions: usize,
+    poses: usize,
+}
+
+fn shown(world: &World, trace: &Trace, crop: (usize, usize, usize, usize)) -> Shown {
+    let f = *world.frame();
+    let swept = swept_pixels(world, trace);
+    let acc = world.accessible();
+    let cells = world.map().cells();
+    let mut s = Shown::default();
+    let (c0, r0, w, h) = crop;
+    for r in r0..r0 + h {
+        for c in c0..c0 + w {
+            let i = f.index(c, r);
+            match cells[i] {
+                Cell::Occupied => s.obstacle = true,
+                Cell::Unknown => s.unknown = true,
+                Cell::Free => match (acc.contains(i), swept.contains(i)) {
+                    (true, true) => s.swept = true,
+                    (true, false) => s.missed = true,
+                    (false, true) => s.swept_outside = true,
+                    (false, false) => s.unreachable = true,
+                },
+            }
+        }
+    }
+    let mut in_bt = false;
+    let mut regions = std::collections::BTreeSet::new();
+    let mut region = 0u32;
+    let mut last: Option<[f64; 2]> = None;
+    for r in &trace.records {
+        match r {
+            Record::Pose { pose, .. } => {
+                let p = [pose[0], pose[1]];
+                if last.is_some_and(|l| l != p) {
+                    if in_bt {
+                        s.backtrack = true;
+                    } else {
+                        regions.insert(region);
+                    }
+                }
+                last = Some(p);
+                s.poses += 1;
+            }
+            Record::Event { event, .. } => match event {
+                Event::RegionStart { region: k } => region = *k,
+                Event::BacktrackStart => in_bt = true,
+                Event::BacktrackEnd => in_bt = false,
+                Event::CriticalPoint { .. } => s.critical += 1,
+                Event::StartPoint { .. } => s.restart += 1,
+                Event::Collision { .. } => s.collisions += 1,
+                _ => {}
+            },
+        }
+    }
+    s.regions = regions.len();
+    s
+}
+
+fn plural(n: usize, one: &str, many: &str) -> String {
+    if n == 1 {
+        format!("{n} {one}")
+    } else {
+        format!("{n} {many}")
+    }
+}
+
+/// The legend of a run's coverage picture: every area class and marker the picture shows,
+/// with counts, in a fixed order.
+pub fn legend_entries(world: &World, trace: &Trace) -> Vec<LegendEntry> {
+    entries_of(&shown(world, trace, crop_box(world, trace)))
+}
+
+/// The union of several runs' legends (for a grid of pictures sharing one legend), without
+/// counts.
+pub fn legend_entries_union(runs: &[(&World, &Trace)]) -> Vec<LegendEntry> {
+    let mut all = Shown::default();
+    for (w, t) in runs {
+        let s = shown(w, t, crop_box(w, t));
+        all.swept |= s.swept;
+        all.missed |= s.missed;
+        all.swept_outside |= s.swept_outside;
+        all.unreachable |= s.unreachable;
+        all.obstacle |= s.obstacle;
+        all.unknown |= s.unknown;
+        all.regions = all.regions.max(s.regions);
+        all.backtrack |= s.backtrack;
+        all.critical = all.critical.max(s.critical.min(1));
+        all.restart = all.restart.max(s.restart.min(1));
+        all.collisions = all.collisions.max(s.collisions.min(1));
+        all.poses = all.poses.max(s.poses);
+    }
+    let mut e = entries_of(&all);
+    // Counts differ per run: drop them from the shared legend.
+    for x in &mut e {
+        if let Some(k) = x.label.find(" (") {
+            x.label.truncate(k);
+        }
+    }
+    e
+}
+
+fn entries_of(s: &Shown) -> Vec<LegendEntry> {
+    use colours as c;
+    let mut e = Vec::new();
+    let mut add = |on: bool, sw: Swatch, label: String| {
+        if on {
+            e.push(LegendEntry::new(sw, label));
+        }
+    };
+    add(s.swept, Swatch::Fill(c::SWEPT), "swept floor".into());
+    add(s.missed, Swatch::Fill(c::MISSED), "missed floor".into());
+    add(
+        s.swept_outside,
+        Swatch::Fill(c::SWEPT_OUTSIDE),
+        "swept, beyond reachable floor".into(),
+    );
+    add(
+        s.unreachable,
+        Swatch::Fill(c::UNREACHABLE),
+        "floor out of reach".into(),
+    );
+    add(s.obstacle, Swatch::Fill(c::OBSTACLE), "obstacle".into());
+    add(s.unknown, Swatch::Fill(c::UNKNOWN), "unknown".into());
+    add(
+        s.regions > 0,
+        Swatch::Regions(PALETTE[..s.regions.clamp(1, 5)].to_vec()),
+        if s.regions > 1 {
+            format!("path, one colour per region ({} regions)", s.regions)
+        } else {
+            "path".into()
+        },
+    );
+    add(
+        s.backtrack,
+        Swatch::Line {
+            rgb: c::BACKTRACK,
+            dashed: true,
+        },
+        "backtracking transfer".into(),
+    );
+    add(s.poses > 0, Swatch::Disc(c::START), "start".into());
+    add(s.poses > 0, Swatch::Ring(c::END), "end".into());
+    add(
+        s.critical > 0,
+        Swatch::Square(c::CRITICAL),
+        format!("critical point ({})", s.critical),
+    );
+    add(
+        s.restart > 0,
+        Swatch::Ring(c::RESTART),
+        format!("chosen restart point ({})", s.restart),
+    );
+    add(
+        s.collisions > 0,
+        Swatch::Cross(c::COLLISION),
+        format!("collision ({})", s.collisions),
+    );
+    e
+}
+
+/// Effective coverage as the picture shows it: swept reachable pixels over reachable pixels.
+fn effective_coverage(world: &World, trace: &Trace) -> f64 {
+    let swept = swept_pixels(world, trace);
+    let acc = world.accessible();
+    let hit = acc.ones().filter(|&i| swept.contains(i)).count();
+    hit as f64 / world.accessible_count().max(1) as f64
+}
+
+/// Badge colour of an effective coverage: green from 95 %, amber from 80 %, red below.
+pub fn coverage_verdict_colour(coverage: f64) -> [u8; 3] {
+    if coverage >= 0.95 {
+        [20, 130, 60]
+    } else if coverage >= 0.80 {
+        [200, 120, 0]
+    } else {
+        [200, 30, 30]
+    }
+}
+
 /// Draws the coverage picture of a run.
 ///
 /// # Errors
@@ -158,7 +389,8 @@ pub fn coverage_pixmap(
     style: &CoverageStyle,
 ) -> Result<Pixmap, RenderError> {
     let frame = *world.frame();
-    let (col0, row0, cols, rows) = crop_box(world, trace);
+    let crop = crop_box(world, trace);
+    let (col0, row0, cols, rows) = crop;
     let (w, h) = (cols as u32, rows as u32);
     let scale = if w < style.min_width {
         (style.min_width as f32 / w as f32).ceil().min(16.0)
@@ -168,14 +400,76 @@ pub fn coverage_pixmap(
     let scale = scale.min(style.max_side as f32 / w.max(h) as f32).max(0.05);
     let cw = ((w as f32 * scale).round() as u32).max(1);
     let ch_map = ((h as f32 * scale).round() as u32).max(1);
-    let line_h = font::GLYPH_H * text_scale(cw) + 4;
-    let header = if style.title.is_empty() {
-        0
+    // Text sizes follow the canvas width (about 60 characters per line).
+    let px = (cw as f32 / 62.0).clamp(13.0, 30.0).round();
+    let title_px = (px * 1.25).round();
+    let mut head = Chart::new(cw, 0);
+    let mut header = 0u32;
+    if !style.title.is_empty() {
+        let mut y = 6.0f32;
+        let cov = effective_coverage(world, trace);
+        let collisions = trace
+            .events()
+            .filter(|(_, e)| matches!(e, Event::Collision { .. }))
+            .count();
+        // Badges, right-aligned on the first line.
+        let badges = [
+            (
+                format!("{:.1}% covered", 100.0 * cov),
+                coverage_verdict_colour(cov),
+            ),
+            (
+                plural(collisions, "collision", "collisions"),
+                if collisions == 0 {
+                    [20, 130, 60]
+                } else {
+                    [200, 30, 30]
+                },
+            ),
+        ];
+        let bh = font::line_height(title_px) + 4.0;
+        let mut bx = cw as f32 - 6.0;
+        for (text, colour) in badges.iter().rev() {
+            let tw = font::text_width(text, title_px) + 16.0;
+            bx -= tw;
+            head.rect(bx, y - 2.0, tw, bh, Some(*colour), None);
+            head.text(
+                bx + 8.0,
+                y + 1.0,
+                title_px as u32,
+                text.clone(),
+                [255, 255, 255],
+                chart::Anchor::Start,
+            );
+            bx -= 8.0;
+        }
+        for (k, line) in style.title.iter().enumerate() {
+            let size = if k == 0 { title_px } else { px };
+            head.text(
+                8.0,
+                y + if k == 0 { 1.0 } else { 0.0 },
+                size as u32,
+                line.clone(),
+                [20, 20, 20],
+                chart::Anchor::Start,
+            );
+            y += if k == 0 {
+                bh + 4.0
+            } else {
+                font::line_height(px)
+            };
+        }
+        header = (y + 6.0).ceil() as u32;
+    }
+    let mut foot = Chart::new(cw, 0);
+    let legend_h = if style.legend {
+        let entries = entries_of(&shown(world, trace, crop));
+        let top = ch_map + header + 8;
+        (foot.legend(8.0, top as f32, cw as f32 - 16.0, px as u32, &entries) + 8.0).ceil() as u32
     } else {
-        line_h * style.title.len() as u32 + 6
+        0
     };
-    let legend = line_h + 8;
-    let ch = ch_map + header + legend;
+    let ch = ch_map + header + legend_h;
     let mut pm = Pixmap::new(cw, ch).ok_or(RenderError::Canvas(cw, ch))?;
     pm.fill(Color::WHITE);
 
@@ -185,21 +479,14 @@ pub fn coverage_pixmap(
     let cells = world.map().cells();
     let colour_of = |i: usize| -> [u8; 3] {
         match cells[i] {
-            Cell::Occupied => [30, 30, 30],
-            Cell::Unknown => [170, 170, 170],
-            Cell::Free => {
-                if acc.contains(i) {
-                    if swept.contains(i) {
-                        [170, 215, 250]
-                    } else {
-                        [250, 150, 130]
-                    }
-                } else if swept.contains(i) {
-                    [200, 225, 245]
-                } else {
-                    [246, 246, 242]
-                }
-            }
+            Cell::Occupied => colours::OBSTACLE,
+            Cell::Unknown => colours::UNKNOWN,
+            Cell::Free => match (acc.contains(i), swept.contains(i)) {
+                (true, true) => colours::SWEPT,
+                (true, false) => colours::MISSED,
+                (false, true) => colours::SWEPT_OUTSIDE,
+                (false, false) => colours::UNREACHABLE,
+            },
         }
     };
     {
@@ -227,46 +514,9 @@ pub fn coverage_pixmap(
     };
     draw_path(&mut pm, world, trace, view);
     draw_markers(&mut pm, world, trace, view);
-
-    // Header and legend text.
-    let ts = text_scale(cw);
-    for (k, line) in style.title.iter().enumerate() {
-        font::draw_text(&mut pm, 6, 4 + k as u32 * line_h, ts, line, [20, 20, 20]);
-    }
-    draw_legend(&mut pm, ch_map + header + 4, ts);
+    head.draw_onto(&mut pm);
+    foot.draw_onto(&mut pm);
     Ok(pm)
-}
-
-fn text_scale(canvas_width: u32) -> u32 {
-    (canvas_width / 450).clamp(1, 4)
-}
-
-fn draw_legend(pm: &mut Pixmap, y: u32, ts: u32) {
-    let items: [([u8; 3], &str); 6] = [
-        ([170, 215, 250], "SWEPT"),
-        ([250, 150, 130], "MISSED"),
-        ([246, 246, 242], "UNREACHABLE"),
-        ([30, 30, 30], "OBSTACLE"),
-        ([170, 170, 170], "UNKNOWN"),
-        ([60, 60, 60], "BACKTRACK (DASHED)"),
-    ];
-    let mut x = 6u32;
-    let box_side = font::GLYPH_H * ts;
-    for (c, label) in items {
-        if let Some(r) = Rect::from_xywh(x as f32, y as f32, box_side as f32, box_side as f32) {
-            pm.fill_rect(r, &paint(rgb(c)), Transform::identity(), None);
-            let border = PathBuilder::from_rect(r);
-            pm.stroke_path(
-                &border,
-                &paint(rgb([80, 80, 80])),
-                &Stroke::default(),
-                Transform::identity(),
-                None,
-            );
-        }
-        x += box_side + 4;
-        x = font::draw_text(pm, x, y, ts, label, [20, 20, 20]) + 12;
-    }
 }
 
 fn draw_path(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
@@ -291,8 +541,19 @@ fn draw_path(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
                 };
                 stroke.line_join = tiny_skia::LineJoin::Round;
                 let colour = if style.1 {
+                    let casing = Stroke {
+                        width: width * 2.0,
+                        ..stroke.clone()
+                    };
+                    pm.stroke_path(
+                        &path,
+                        &paint(Color::WHITE),
+                        &casing,
+                        Transform::identity(),
+                        None,
+                    );
                     stroke.dash = StrokeDash::new(vec![width * 4.0, width * 3.0], 0.0);
-                    rgb([60, 60, 60])
+                    rgb(colours::BACKTRACK)
                 } else {
                     rgb(PALETTE[style.0.saturating_sub(1) % PALETTE.len()])
                 };
@@ -348,7 +609,12 @@ fn draw_markers(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
             Event::CriticalPoint { x, y } => {
                 let (cx, cy) = view.to_canvas(world, Point::new(*x, *y));
                 if let Some(r) = Rect::from_xywh(cx - m * 0.4, cy - m * 0.4, m * 0.8, m * 0.8) {
-                    pm.fill_rect(r, &paint(rgb([240, 140, 0])), Transform::identity(), None);
+                    pm.fill_rect(
+                        r,
+                        &paint(rgb(colours::CRITICAL)),
+                        Transform::identity(),
+                        None,
+                    );
                 }
             }
             Event::StartPoint { x, y } => {
@@ -356,7 +622,7 @@ fn draw_markers(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
                 if let Some(c) = PathBuilder::from_circle(cx, cy, m * 0.6) {
                     pm.stroke_path(
                         &c,
-                        &paint(rgb([130, 40, 160])),
+                        &paint(rgb(colours::RESTART)),
                         &stroke,
                         Transform::identity(),
                         None,
@@ -373,7 +639,7 @@ fn draw_markers(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
                 if let Some(p) = pb.finish() {
                     pm.stroke_path(
                         &p,
-                        &paint(rgb([230, 0, 0])),
+                        &paint(rgb(colours::COLLISION)),
                         &stroke,
                         Transform::identity(),
                         None,
@@ -389,7 +655,7 @@ fn draw_markers(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
     if let Some(c) = PathBuilder::from_circle(sx, sy, rad.max(4.0)) {
         pm.fill_path(
             &c,
-            &paint(rgb([0, 170, 60])),
+            &paint(rgb(colours::START)),
             FillRule::Winding,
             Transform::identity(),
             None,
@@ -421,5 +687,196 @@ fn draw_markers(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
                 None,
             );
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ccpp_core::grid::{GridMap, MapFrame};
+    use ccpp_core::world::Robot;
+    use ccpp_core::Pose;
+
+    /// A walled 120x80 room (0.05 m pixels) with a pillar; lanes over the first `lanes` rows,
+    /// a backtracking transfer into a second region, and one marker of each kind.
+    fn run(lanes: usize) -> (World, Trace) {
+        let (w, h) = (120usize, 80usize);
+        let mut cells = vec![Cell::Free; w * h];
+        for r in 0..h {
+            for c in 0..w {
+                if r < 2
+                    || c < 2
+                    || r >= h - 2
+                    || c >= w - 2
+                    || ((50..70).contains(&c) && (30..50).contains(&r))
+                {
+                    cells[r * w + c] = Cell::Occupied;
+                }
+            }
+        }
+        for c in 0..10 {
+            cells[c] = Cell::Unknown;
+        }
+        let map = GridMap::new(MapFrame::new(w, h, 0.05), cells).unwrap();
+        let world = World::new(map, Robot::new(0.15), Some(Pose::new(0.3, 0.3, 0.0))).unwrap();
+        let mut t = Trace::default();
+        t.push_event(0, Event::RegionStart { region: 1 });
+        let mut k = 0;
+        for lane in 0..lanes {
+            let y = 0.3 + lane as f64 * 0.3;
+            if lane == lanes / 2 {
+                t.push_event(k, Event::CriticalPoint { x: 5.6, y });
+                t.push_event(k, Event::BacktrackStart);
+                t.push_pose(k, Pose::new(0.3, y - 0.3, 0.0));
+                k += 1;
+                t.push_event(k, Event::BacktrackEnd);
+                t.push_event(k, Event::StartPoint { x: 0.3, y });
+                t.push_event(k, Event::RegionStart { region: 2 });
+                t.push_event(k, Event::Collision { x: 2.0, y });
+            }
+            let (a, b) = if lane % 2 == 0 {
+                (0.3, 5.6)
+            } else {
+                (5.6, 0.3)
+            };
+            t.push_pose(k, Pose::new(a, y, 0.0));
+            t.push_pose(k + 1, Pose::new(b, y, 0.0));
+            k += 2;
+        }
+        (world, t)
+    }
+
+    /// The picture as coarse characters: one per `step` pixels, by nearest known colour.
+    fn dump(png: &[u8], cols: u32) -> String {
+        let pm = Pixmap::decode_png(png).unwrap();
+        let step = (pm.width() / cols).max(1);
+        let known: [([u8; 3], char); 8] = [
+            ([255, 255, 255], ' '),
+            (colours::SWEPT, '.'),
+            (colours::MISSED, 'x'),
+            (colours::OBSTACLE, '#'),
+            (colours::UNKNOWN, '?'),
+            (colours::UNREACHABLE, 'o'),
+            ([20, 130, 60], 'G'),
+            ([200, 30, 30], 'R'),
+        ];
+        let mut s = format!("{}x{}\n", pm.width(), pm.height());
+        for y in (step / 2..pm.height()).step_by(step as usize) {
+            for x in (step / 2..pm.width()).step_by(step as usize) {
+                let p = pm.pixel(x, y).unwrap();
+                let c = [p.red(), p.green(), p.blue()];
+                let d = |k: [u8; 3]| {
+                    (0..3)
+                        .map(|i| (i32::from(c[i]) - i32::from(k[i])).abs())
+                        .max()
+                        .unwrap()
+                };
+                let ch = known.iter().find(|(k, _)| d(*k) <= 12).map_or(
+                    if c.iter().map(|&v| u32::from(v)).sum::<u32>() < 300 {
+                        '*'
+                    } else {
+                        '+'
+                    },
+                    |x| x.1,
+                );
+                s.push(ch);
+            }
+            s.push('\n');
+        }
+        s
+    }
+
+    fn style() -> CoverageStyle {
+        CoverageStyle {
+            title: vec![
+                "synthetic on room  r=0.15 m".into(),
+                "effective coverage and friends".into(),
+            ],
+            ..CoverageStyle::default()
+        }
+    }
+
+    #[test]
+    fn coverage_png_is_deterministic_and_matches_its_snapshot() {
+        let (world, trace) = run(12);
+        let a = coverage_png(&world, &trace, &style()).unwrap();
+        let b = coverage_png(&world, &trace, &style()).unwrap();
+        assert_eq!(a, b, "same inputs, same bytes");
+        insta::assert_snapshot!("coverage_png_dump", dump(&a, 72));
+    }
+
+    #[test]
+    fn the_legend_lists_every_marker_and_colour_drawn_with_counts() {
+        let (world, trace) = run(12);
+        let labels: Vec<String> = legend_entries(&world, &trace)
+            .into_iter()
+            .map(|e| format!("{:?} {}", e.swatch, e.label))
+            .collect();
+        insta::assert_snapshot!("legend_entries", labels.join("\n"));
+        // A run without backtracking or markers has no such entries.
+        let (world, mut trace) = run(2);
+        trace.records.retain(|r| {
+            !matches!(
+                r,
+                Record::Event {
+                    event: Event::Collision { .. } | Event::CriticalPoint { .. },
+                    ..
+                }
+            )
+        });
+        let labels: Vec<String> = legend_entries(&world, &trace)
+            .into_iter()
+            .map(|e| e.label)
+            .collect();
+        assert!(!labels
+            .iter()
+            .any(|l| l.starts_with("collision") || l.starts_with("critical")));
+        assert!(labels.iter().any(|l| l == "missed floor"));
+    }
+
+    #[test]
+    fn the_header_badge_is_green_for_a_good_run_and_red_for_a_bad_one() {
+        let header_has = |lanes: usize, colour: [u8; 3]| {
+            let (world, trace) = run(lanes);
+            let pm = coverage_pixmap(&world, &trace, &style()).unwrap();
+            (0..40).any(|y| {
+                (0..pm.width()).any(|x| {
+                    let p = pm.pixel(x, y).unwrap();
+                    [p.red(), p.green(), p.blue()] == colour
+                })
+            })
+        };
+        assert!(header_has(2, [200, 30, 30]), "2 lanes: red coverage badge");
+        assert!(!header_has(2, [200, 120, 0]), "2 lanes: no amber badge");
+        assert!(
+            header_has(12, [200, 120, 0]),
+            "12 lanes (91 %): amber badge"
+        );
+        assert_eq!(coverage_verdict_colour(0.97), [20, 130, 60]);
+        assert_eq!(coverage_verdict_colour(0.85), [200, 120, 0]);
+        assert_eq!(coverage_verdict_colour(0.5), [200, 30, 30]);
+        let (world, trace) = run(2);
+        let labels: Vec<String> = legend_entries(&world, &trace)
+            .into_iter()
+            .map(|e| e.label)
+            .collect();
+        assert!(labels.iter().any(|l| l == "collision (1)"), "{labels:?}");
+    }
+
+    #[test]
+    fn a_panel_style_picture_has_no_header_and_no_legend() {
+        let (world, trace) = run(12);
+        let full = coverage_pixmap(&world, &trace, &style()).unwrap();
+        let bare = coverage_pixmap(
+            &world,
+            &trace,
+            &CoverageStyle {
+                legend: false,
+                ..CoverageStyle::default()
+            },
+        )
+        .unwrap();
+        assert_eq!(full.width(), bare.width());
+        assert!(bare.height() + 80 < full.height());
     }
 }

@@ -4,7 +4,7 @@ use std::fmt::Write as _;
 
 use base64::Engine as _;
 use ccpp_core::grid::Cell;
-use ccpp_core::metrics::Sweeper;
+use ccpp_core::metrics::{coverage_curve, Sweeper};
 use ccpp_core::trace::{Event, Record, Trace};
 use ccpp_core::world::World;
 use ccpp_core::Point;
@@ -71,7 +71,91 @@ fn js_num(v: f64) -> String {
     }
 }
 
-/// The replay data as a JS object literal (deterministic text).
+/// Largest display error of the decimated path, in map pixels.
+const DECIMATE_TOL_PX: f64 = 0.25;
+/// Quantisation of display coordinates: 1/`Q` map pixel.
+const Q: f64 = 8.0;
+/// Samples of the live coverage curve.
+const COVERAGE_SAMPLES: usize = 2000;
+
+fn push_varint(out: &mut Vec<u8>, mut v: u64) {
+    while v >= 0x80 {
+        out.push((v as u8 & 0x7f) | 0x80);
+        v >>= 7;
+    }
+    out.push(v as u8);
+}
+
+fn zigzag(v: i64) -> u64 {
+    ((v << 1) ^ (v >> 63)) as u64
+}
+
+/// The poses kept for display: the first and last, every pose an event or a first tile visit
+/// is anchored to, and enough others that the drawn polyline stays within
+/// [`DECIMATE_TOL_PX`] of the executed one (Reumann-Witkam: a point is dropped while it stays
+/// within the tolerance of the line through the last kept point and moves forward along it).
+fn decimate(pts: &[[f64; 2]], forced: &[bool]) -> Vec<usize> {
+    let n = pts.len();
+    let mut kept = Vec::new();
+    if n == 0 {
+        return kept;
+    }
+    kept.push(0);
+    let tol2 = DECIMATE_TOL_PX * DECIMATE_TOL_PX;
+    let d2 = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2);
+    let mut anchor = 0usize;
+    let mut dir: Option<[f64; 2]> = None; // unit direction from the anchor
+    let mut last_proj = 0.0f64;
+    for j in 1..n {
+        if forced[j] || j == n - 1 {
+            kept.push(j);
+            anchor = j;
+            dir = None;
+            last_proj = 0.0;
+            continue;
+        }
+        let a = pts[anchor];
+        let p = pts[j];
+        let Some(u) = dir else {
+            let dd = d2(a, p);
+            if dd > tol2 {
+                let l = dd.sqrt();
+                dir = Some([(p[0] - a[0]) / l, (p[1] - a[1]) / l]);
+                last_proj = l;
+            }
+            continue;
+        };
+        let (vx, vy) = (p[0] - a[0], p[1] - a[1]);
+        let proj = vx * u[0] + vy * u[1];
+        let perp = (vx * u[1] - vy * u[0]).abs();
+        if perp <= DECIMATE_TOL_PX && proj + DECIMATE_TOL_PX >= last_proj {
+            last_proj = last_proj.max(proj);
+            continue;
+        }
+        // Keep the previous pose and start a new stretch there.
+        let prev = j - 1;
+        if prev != anchor {
+            kept.push(prev);
+            anchor = prev;
+        }
+        let a = pts[anchor];
+        let dd = d2(a, p);
+        if dd > tol2 {
+            let l = dd.sqrt();
+            dir = Some([(p[0] - a[0]) / l, (p[1] - a[1]) / l]);
+            last_proj = l;
+        } else {
+            dir = None;
+            last_proj = 0.0;
+        }
+    }
+    kept
+}
+
+/// The replay data as a JS object literal (deterministic text). The path travels as one
+/// base64 blob of varints: for each displayed pose the x and y deltas (zigzag, 1/8 map pixel,
+/// canvas orientation), the step-counter delta, the travelled-distance delta (mm, of the
+/// rounded running total, so no drift), then one heading byte per pose.
 fn replay_data(
     world: &World,
     trace: &Trace,
@@ -80,86 +164,175 @@ fn replay_data(
     crop: (usize, usize, usize, usize),
 ) -> String {
     let f = *world.frame();
-    let mut poses = String::from("[");
-    let mut events = String::from("[");
-    let mut n = 0usize;
+    let (c0, r0, w, h) = crop;
+    // Pass 1: poses in crop pixel coordinates (y down), step counters, distances, anchors.
+    let mut pts: Vec<[f64; 2]> = Vec::new();
+    let mut theta: Vec<f64> = Vec::new();
+    let mut steps: Vec<u64> = Vec::new();
+    let mut dist: Vec<f64> = Vec::new();
+    let mut forced: Vec<bool> = Vec::new();
+    let mut raw_events: Vec<(usize, &Event)> = Vec::new();
+    let mut tiles: Vec<usize> = Vec::new();
+    let mut seen_tiles = std::collections::BTreeSet::new();
+    let start = world.start();
+    let mut travelled = 0.0f64;
+    let mut last_world: Option<Point> = None;
     for r in &trace.records {
         match r {
-            Record::Pose { pose, .. } => {
-                if n > 0 {
-                    poses.push(',');
+            Record::Pose { t, pose } => {
+                let wp = Point::new(pose[0], pose[1]);
+                if let Some(l) = last_world {
+                    travelled += l.dist(wp);
                 }
-                let _ = write!(
-                    poses,
-                    "[{},{},{}]",
-                    js_num(pose[0]),
-                    js_num(pose[1]),
-                    js_num(pose[2])
-                );
-                n += 1;
+                last_world = Some(wp);
+                let g = f.world_to_grid(wp);
+                pts.push([g.x - c0 as f64, f.height as f64 - g.y - r0 as f64]);
+                theta.push(pose[2]);
+                steps.push(*t);
+                dist.push(travelled);
+                forced.push(false);
+                if let Some(t) = tile_side {
+                    let fi = (pose[0] - start.x) / t;
+                    let fj = (pose[1] - start.y) / t;
+                    let (i2, j2) = (fi.round(), fj.round());
+                    if (fi - i2).abs() < 1e-3
+                        && (fj - j2).abs() < 1e-3
+                        && seen_tiles.insert((i2 as i64, j2 as i64))
+                    {
+                        tiles.push(pts.len() - 1);
+                    }
+                }
             }
             Record::Event { event, .. } => {
-                let i = n.saturating_sub(1);
-                let item = match event {
-                    Event::RegionStart { region } => {
-                        Some(format!(r#"{{"i":{i},"k":"region","n":{region}}}"#))
-                    }
-                    Event::CriticalPoint { x, y } => Some(format!(
-                        r#"{{"i":{i},"k":"critical","x":{},"y":{}}}"#,
-                        js_num(*x),
-                        js_num(*y)
-                    )),
-                    Event::StartPoint { x, y } => Some(format!(
-                        r#"{{"i":{i},"k":"start","x":{},"y":{}}}"#,
-                        js_num(*x),
-                        js_num(*y)
-                    )),
-                    Event::BacktrackStart => Some(format!(r#"{{"i":{i},"k":"bt_start"}}"#)),
-                    Event::BacktrackEnd => Some(format!(r#"{{"i":{i},"k":"bt_end"}}"#)),
-                    Event::Collision { x, y } => Some(format!(
-                        r#"{{"i":{i},"k":"collision","x":{},"y":{}}}"#,
-                        js_num(*x),
-                        js_num(*y)
-                    )),
-                    Event::BacktrackList { points } => {
-                        let pts: Vec<String> = points
-                            .iter()
-                            .map(|p| format!("[{},{}]", js_num(p[0]), js_num(p[1])))
-                            .collect();
-                        Some(format!(r#"{{"i":{i},"k":"list","p":[{}]}}"#, pts.join(",")))
-                    }
-                    Event::BacktrackPoint { x, y } => Some(format!(
-                        r#"{{"i":{i},"k":"bp","x":{},"y":{}}}"#,
-                        js_num(*x),
-                        js_num(*y)
-                    )),
-                    _ => None,
-                };
-                if let Some(item) = item {
-                    if events.len() > 1 {
-                        events.push(',');
-                    }
-                    events.push_str(&item);
+                let i = pts.len().saturating_sub(1);
+                if let Some(x) = forced.get_mut(i) {
+                    *x = true;
                 }
+                raw_events.push((i, event));
             }
         }
     }
-    poses.push(']');
+    let kept = decimate(&pts, &forced);
+    let display = |orig: usize| -> usize { kept.partition_point(|&k| k < orig) };
+    // The blob.
+    let mut blob = Vec::with_capacity(kept.len() * 6);
+    for axis in 0..2 {
+        let mut prev = 0i64;
+        for &k in &kept {
+            let q = (pts[k][axis] * Q).round() as i64;
+            push_varint(&mut blob, zigzag(q - prev));
+            prev = q;
+        }
+    }
+    let mut prev_t = 0u64;
+    for &k in &kept {
+        push_varint(&mut blob, steps[k].saturating_sub(prev_t));
+        prev_t = prev_t.max(steps[k]);
+    }
+    let mut prev_mm = 0u64;
+    for &k in &kept {
+        let mm = (dist[k] * 1000.0).round() as u64;
+        push_varint(&mut blob, mm.saturating_sub(prev_mm));
+        prev_mm = prev_mm.max(mm);
+    }
+    for &k in &kept {
+        let a = theta[k].rem_euclid(std::f64::consts::TAU);
+        blob.push(((a / std::f64::consts::TAU * 256.0).round() as u32 % 256) as u8);
+    }
+    let blob = base64::engine::general_purpose::STANDARD.encode(&blob);
+    // Events, in display indices and crop pixel coordinates.
+    let to_px = |x: f64, y: f64| {
+        let g = f.world_to_grid(Point::new(x, y));
+        (
+            js_num(g.x - c0 as f64),
+            js_num(f.height as f64 - g.y - r0 as f64),
+        )
+    };
+    let mut events = String::from("[");
+    for (i, event) in raw_events {
+        let i = display(i);
+        let item = match event {
+            Event::RegionStart { region } => Some(format!(r#"[{i},"region",{region}]"#)),
+            Event::CriticalPoint { x, y } => {
+                let (a, b) = to_px(*x, *y);
+                Some(format!(r#"[{i},"critical",{a},{b}]"#))
+            }
+            Event::StartPoint { x, y } => {
+                let (a, b) = to_px(*x, *y);
+                Some(format!(r#"[{i},"restart",{a},{b}]"#))
+            }
+            Event::BacktrackStart => Some(format!(r#"[{i},"bt_start"]"#)),
+            Event::BacktrackEnd => Some(format!(r#"[{i},"bt_end"]"#)),
+            Event::Collision { x, y } => {
+                let (a, b) = to_px(*x, *y);
+                Some(format!(r#"[{i},"collision",{a},{b}]"#))
+            }
+            Event::BacktrackList { points } => {
+                let mut pts = String::new();
+                for (k, p) in points.iter().enumerate() {
+                    let (a, b) = to_px(p[0], p[1]);
+                    if k > 0 {
+                        pts.push(',');
+                    }
+                    let _ = write!(pts, "{a},{b}");
+                }
+                Some(format!(r#"[{i},"list",[{pts}]]"#))
+            }
+            _ => None,
+        };
+        if let Some(item) = item {
+            if events.len() > 1 {
+                events.push(',');
+            }
+            events.push_str(&item);
+        }
+    }
     events.push(']');
-    let (c0, r0, w, h) = crop;
-    let start = world.start();
+    // First tile visits: display index (of the first displayed pose at or after the visit)
+    // delta, then the visiting pose's x and y (zigzag deltas, 1/Q px), as varints.
+    let mut tblob = Vec::with_capacity(tiles.len() * 4);
+    let (mut pi, mut px, mut py) = (0u64, 0i64, 0i64);
+    for &i in &tiles {
+        let d = display(i) as u64;
+        let qx = (pts[i][0] * Q).round() as i64;
+        let qy = (pts[i][1] * Q).round() as i64;
+        push_varint(&mut tblob, d - pi);
+        push_varint(&mut tblob, zigzag(qx - px));
+        push_varint(&mut tblob, zigzag(qy - py));
+        (pi, px, py) = (d, qx, qy);
+    }
+    let tblob = base64::engine::general_purpose::STANDARD.encode(&tblob);
+    // Live coverage: [distance m, coverage] samples.
+    let curve = coverage_curve(world, trace, COVERAGE_SAMPLES);
+    let mut cov = String::from("[");
+    for (k, c) in curve.iter().enumerate() {
+        if k > 0 {
+            cov.push(',');
+        }
+        let _ = write!(cov, "{},{}", js_num(c[0]), js_num(c[1]));
+    }
+    cov.push(']');
+    let (sx, sy) = {
+        let g = f.world_to_grid(start.position());
+        (g.x - c0 as f64, f.height as f64 - g.y - r0 as f64)
+    };
+    // Tile side in map pixels (first visits are drawn around the visiting pose).
+    let tile = tile_side.map_or_else(|| "null".to_string(), |t| js_num(t / f.resolution));
+    let yaw = f.origin.theta;
     format!(
-        r#"{{"res":{res},"ox":{ox},"oy":{oy},"yaw":{yaw},"height":{height},"c0":{c0},"r0":{r0},"w":{w},"h":{h},"r":{r},"rt":{rt},"tile":{tile},"start":[{sx},{sy}],"poses":{poses},"events":{events},"metrics":{metrics}}}"#,
-        res = f.resolution,
-        ox = f.origin.x,
-        oy = f.origin.y,
-        yaw = f.origin.theta,
-        height = f.height,
-        r = world.robot().radius,
-        rt = world.robot().tool_radius,
-        tile = tile_side.map_or_else(|| "null".into(), |t| t.to_string()),
-        sx = js_num(start.x),
-        sy = js_num(start.y),
+        r#"{{"w":{w},"h":{h},"res":{res},"yaw":{yaw},"r":{r},"rt":{rt},"tile":{tile},"start":[{sx},{sy},{st}],"n":{n},"m":{m},"q":{q},"blob":"{blob}","events":{events},"nt":{nt},"tblob":"{tblob}","cov":{cov},"palette":{palette},"metrics":{metrics}}}"#,
+        res = js_num(f.resolution),
+        yaw = js_num(yaw),
+        r = js_num(world.robot().radius / f.resolution),
+        rt = js_num(world.robot().tool_radius / f.resolution),
+        sx = js_num(sx),
+        sy = js_num(sy),
+        st = js_num(start.theta),
+        n = pts.len(),
+        nt = tiles.len(),
+        m = kept.len(),
+        q = Q,
+        palette = palette_js(),
         metrics = if metrics_json.trim().is_empty() {
             "{}"
         } else {
@@ -168,7 +341,22 @@ fn replay_data(
     )
 }
 
+fn palette_js() -> String {
+    let items: Vec<String> = crate::PALETTE
+        .iter()
+        .map(|c| format!("\"rgb({},{},{})\"", c[0], c[1], c[2]))
+        .collect();
+    format!("[{}]", items.join(","))
+}
+
 /// Builds the self-contained `replay.html` of a run.
+///
+/// The page sizes its canvas to the window (the side panel stays visible from 1280x720 up and
+/// moves under the map on narrow screens), ships the path decimated for display (every event
+/// kept) as compact base64 varints, draws incrementally on offscreen layers, and shows the
+/// travelled distance, step, live effective coverage and current region or backtracking at the
+/// scrubber. Opened with `#selftest` it checks itself and writes the result (timings and the
+/// side panel's bounding boxes) into the title and `#selftest`.
 ///
 /// # Errors
 /// When the background image cannot be drawn.
@@ -181,15 +369,27 @@ pub fn replay_html(
 ) -> Result<String, RenderError> {
     let crop = crop_box(world, trace);
     let bg = base64::engine::general_purpose::STANDARD.encode(background_png(world, crop)?);
-    let data = replay_data(world, trace, tile_side, metrics_json, crop);
-    let title = title.replace('&', "&amp;").replace('<', "&lt;");
-    let mut html = String::with_capacity(data.len() + bg.len() + 8000);
+    // `</` inside the script (a map or planner name) must not end it early.
+    let data = replay_data(world, trace, tile_side, metrics_json, crop).replace("</", "<\\/");
+    let title = title
+        .replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;");
+    let mut html = String::with_capacity(data.len() + bg.len() + 16000);
     html.push_str(
         &TEMPLATE
             .replace("{{TITLE}}", &title)
             .replace(
                 "{{SWEPT}}",
                 &format!("rgb({},{},{})", C_SWEPT[0], C_SWEPT[1], C_SWEPT[2]),
+            )
+            .replace(
+                "{{ACC}}",
+                &format!("rgb({},{},{})", C_ACC[0], C_ACC[1], C_ACC[2]),
+            )
+            .replace(
+                "{{OUT}}",
+                &format!("rgb({},{},{})", C_FREE_OUT[0], C_FREE_OUT[1], C_FREE_OUT[2]),
             )
             .replace("{{SR}}", &C_SWEPT[0].to_string())
             .replace("{{SG}}", &C_SWEPT[1].to_string())
@@ -199,150 +399,7 @@ pub fn replay_html(
     Ok(html)
 }
 
-const TEMPLATE: &str = r##"<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8"><title>{{TITLE}}</title>
-<meta name="viewport" content="width=device-width, initial-scale=1">
-<style>
-body{margin:0;font:14px system-ui,sans-serif;background:#f4f4f4;color:#222}
-header{padding:8px 12px;background:#fff;border-bottom:1px solid #ccc}
-#controls{display:flex;gap:10px;align-items:center;padding:8px 12px;background:#fff;border-bottom:1px solid #ddd;flex-wrap:wrap}
-#scrub{flex:1;min-width:200px}
-#wrap{display:flex;gap:12px;padding:12px}
-canvas{background:#fff;border:1px solid #bbb;image-rendering:pixelated;max-width:100%}
-#side{min-width:230px;font-size:13px}
-#side table{border-collapse:collapse}#side td{padding:1px 6px}
-.key{display:inline-block;width:12px;height:12px;border:1px solid #888;vertical-align:middle;margin-right:4px}
-</style></head><body>
-<header><b>ccpp replay</b> — {{TITLE}}</header>
-<div id="controls">
-<button id="play" type="button">Play</button>
-<label>Speed <select id="speed"><option value="1">1x</option><option value="4">4x</option><option value="16" selected>16x</option><option value="64">64x</option><option value="256">256x</option></select></label>
-<input id="scrub" type="range" min="0" max="0" value="0" aria-label="frame">
-<span id="label">0 / 0</span>
-</div>
-<div id="wrap"><canvas id="view"></canvas>
-<div id="side"><div id="legend">
-<div><span class="key" style="background:{{SWEPT}}"></span>swept floor</div>
-<div><span class="key" style="background:rgb(250,205,190)"></span>floor not yet swept</div>
-<div><span class="key" style="background:#1e1e1e"></span>obstacle <span class="key" style="background:#aaa"></span>unknown</div>
-<div><span class="key" style="background:#ffa000"></span>critical point <span class="key" style="background:#8e24aa"></span>backtracking list</div>
-<div><span class="key" style="background:#444"></span>backtracking path (dashed)</div>
-</div><h4>Metrics</h4><table id="metrics"></table><pre id="selftest"></pre></div></div>
-<img id="bg" alt="" style="display:none" src="data:image/png;base64,{{BG}}">
-<script>
-"use strict";
-const D = {{DATA}};
-const errors = [];
-window.addEventListener("error", e => errors.push(String(e.message)));
-const canvas = document.getElementById("view"), ctx = canvas.getContext("2d");
-const scrub = document.getElementById("scrub"), label = document.getElementById("label");
-const playBtn = document.getElementById("play"), speedSel = document.getElementById("speed");
-const N = D.poses.length;
-scrub.max = String(Math.max(0, N - 1));
-const S = Math.max(1, Math.min(8, 1100 / Math.max(D.w, D.h / 0.8)));
-canvas.width = Math.round(D.w * S); canvas.height = Math.round(D.h * S);
-const swept = document.createElement("canvas"); swept.width = canvas.width; swept.height = canvas.height;
-const sctx = swept.getContext("2d");
-const cy = Math.cos(D.yaw), sy = Math.sin(D.yaw);
-function toCanvas(x, y) {
-  const dx = x - D.ox, dy = y - D.oy;
-  const gx = (cy * dx + sy * dy) / D.res, gy = (-sy * dx + cy * dy) / D.res;
-  return [(gx - D.c0) * S, (D.height - gy - D.r0) * S];
-}
-const P = D.poses.map(p => toCanvas(p[0], p[1]));
-// Backtracking flags per segment end index.
-const inBt = new Uint8Array(N);
-{ let bt = false, k = 0; const ev = D.events;
-  for (let i = 0; i < N; i++) { while (k < ev.length && ev[k].i < i) { if (ev[k].k === "bt_start") bt = true; if (ev[k].k === "bt_end") bt = false; k++; } inBt[i] = bt ? 1 : 0; } }
-let drawnTo = 0;
-function sweepTo(i) {
-  if (i < drawnTo) { sctx.clearRect(0, 0, swept.width, swept.height); drawnTo = 0; }
-  sctx.strokeStyle = "{{SWEPT}}"; sctx.fillStyle = "{{SWEPT}}"; sctx.lineCap = "round"; sctx.lineJoin = "round";
-  sctx.lineWidth = 2 * D.rt / D.res * S;
-  if (drawnTo === 0 && N > 0) { sctx.beginPath(); sctx.arc(P[0][0], P[0][1], D.rt / D.res * S, 0, 2 * Math.PI); sctx.fill(); }
-  sctx.beginPath();
-  for (let k = Math.max(1, drawnTo); k <= i; k++) { sctx.moveTo(P[k - 1][0], P[k - 1][1]); sctx.lineTo(P[k][0], P[k][1]); }
-  sctx.stroke();
-  drawnTo = Math.max(drawnTo, i);
-}
-const bg = document.getElementById("bg");
-let frame = 0, playing = false;
-const robotAt = [0, 0];
-function draw(i) {
-  frame = Math.max(0, Math.min(N - 1, i));
-  ctx.imageSmoothingEnabled = false;
-  ctx.drawImage(bg, 0, 0, canvas.width, canvas.height);
-  sweepTo(frame);
-  ctx.globalAlpha = 0.85; ctx.drawImage(swept, 0, 0); ctx.globalAlpha = 1;
-  // Tiles covered so far (tile planners).
-  if (D.tile) {
-    const t = D.tile, half = t / 2, seen = new Set();
-    ctx.strokeStyle = "rgba(0,60,140,0.25)"; ctx.lineWidth = 1;
-    for (let k = 0; k <= frame; k++) {
-      const p = D.poses[k], fi = (p[0] - D.start[0]) / t, fj = (p[1] - D.start[1]) / t;
-      const i2 = Math.round(fi), j2 = Math.round(fj);
-      if (Math.abs(fi - i2) < 1e-3 && Math.abs(fj - j2) < 1e-3) {
-        const key = i2 + "," + j2; if (seen.has(key)) continue; seen.add(key);
-        const a = toCanvas(D.start[0] + i2 * t - half, D.start[1] + j2 * t + half), b = toCanvas(D.start[0] + i2 * t + half, D.start[1] + j2 * t - half);
-        ctx.strokeRect(Math.min(a[0], b[0]), Math.min(a[1], b[1]), Math.abs(b[0] - a[0]), Math.abs(b[1] - a[1]));
-      }
-    }
-  }
-  // Path: solid while covering, dashed while backtracking.
-  ctx.lineWidth = Math.max(1, S * 0.6);
-  for (const dashed of [false, true]) {
-    ctx.setLineDash(dashed ? [6, 4] : []); ctx.strokeStyle = dashed ? "#444" : "rgb(0,70,160)";
-    ctx.beginPath();
-    for (let k = 1; k <= frame; k++) if ((inBt[k] === 1) === dashed) { ctx.moveTo(P[k - 1][0], P[k - 1][1]); ctx.lineTo(P[k][0], P[k][1]); }
-    ctx.stroke();
-  }
-  ctx.setLineDash([]);
-  let list = null;
-  for (const e of D.events) {
-    if (e.i > frame) break;
-    if (e.k === "critical") { const c = toCanvas(e.x, e.y); ctx.fillStyle = "#ffa000"; ctx.fillRect(c[0] - 4, c[1] - 4, 8, 8); }
-    else if (e.k === "collision") { const c = toCanvas(e.x, e.y); ctx.strokeStyle = "red"; ctx.lineWidth = 2; ctx.beginPath(); ctx.moveTo(c[0]-5,c[1]-5); ctx.lineTo(c[0]+5,c[1]+5); ctx.moveTo(c[0]-5,c[1]+5); ctx.lineTo(c[0]+5,c[1]-5); ctx.stroke(); }
-    else if (e.k === "list") list = e.p;
-  }
-  if (list) { ctx.fillStyle = "#8e24aa"; for (const p of list) { const c = toCanvas(p[0], p[1]); ctx.beginPath(); ctx.arc(c[0], c[1], 3, 0, 2 * Math.PI); ctx.fill(); } }
-  if (N > 0) {
-    const p = D.poses[frame], c = P[frame], rr = D.r / D.res * S;
-    ctx.fillStyle = "rgba(0,160,60,0.8)"; ctx.beginPath(); ctx.arc(c[0], c[1], Math.max(3, rr), 0, 2 * Math.PI); ctx.fill();
-    ctx.strokeStyle = "#fff"; ctx.lineWidth = 2; ctx.beginPath(); ctx.moveTo(c[0], c[1]);
-    ctx.lineTo(c[0] + Math.max(3, rr) * Math.cos(p[2]), c[1] - Math.max(3, rr) * Math.sin(p[2])); ctx.stroke();
-    robotAt[0] = c[0]; robotAt[1] = c[1];
-  }
-  scrub.value = String(frame);
-  label.textContent = frame + " / " + (N - 1);
-}
-function tick() {
-  if (!playing) return;
-  if (frame >= N - 1) { playing = false; playBtn.textContent = "Play"; return; }
-  draw(frame + Number(speedSel.value));
-  requestAnimationFrame(tick);
-}
-playBtn.addEventListener("click", () => { playing = !playing; playBtn.textContent = playing ? "Pause" : "Play"; if (playing) { if (frame >= N - 1) draw(0); requestAnimationFrame(tick); } });
-scrub.addEventListener("input", () => { draw(Number(scrub.value)); });
-const mt = document.getElementById("metrics");
-for (const [k, v] of Object.entries(D.metrics)) { const tr = document.createElement("tr"); tr.innerHTML = "<td>" + k + "</td><td>" + (typeof v === "number" ? (Number.isInteger(v) ? v : v.toFixed(4)) : String(v)) + "</td>"; mt.appendChild(tr); }
-function start() {
-  const h = location.hash;
-  draw(h.includes("frame=last") ? N - 1 : 0);
-  if (h.includes("selftest")) {
-    draw(0); const a = robotAt.slice();
-    scrub.value = String(N - 1); scrub.dispatchEvent(new Event("input"));
-    const b = robotAt.slice();
-    const moved = N > 1 && (Math.abs(a[0] - b[0]) + Math.abs(a[1] - b[1])) > 0.5;
-    const px = ctx.getImageData(0, 0, canvas.width, canvas.height).data;
-    let sweptPx = 0; for (let k = 0; k < px.length; k += 4) if (Math.abs(px[k] - {{SR}}) < 24 && Math.abs(px[k+1] - {{SG}}) < 24 && Math.abs(px[k+2] - {{SB}}) < 24) sweptPx++;
-    const ok = moved && sweptPx > 0 && errors.length === 0;
-    const msg = "SELFTEST " + (ok ? "PASS" : "FAIL") + " moved=" + moved + " swept_px=" + sweptPx + " errors=" + errors.length + " frames=" + N;
-    document.getElementById("selftest").textContent = msg; document.title = msg;
-  }
-}
-if (bg.complete) start(); else bg.addEventListener("load", start);
-</script></body></html>
-"##;
+const TEMPLATE: &str = include_str!("replay_template.html");
 
 /// Options of [`replay_gif`].
 #[derive(Clone, Debug)]

@@ -1,0 +1,310 @@
+//! The replay page in real headless Chromium (Debian's package): the side panel's values are
+//! inside the viewport at common desktop sizes (checked on element bounding boxes the page
+//! writes out), the page works on a phone-sized viewport, and a 2 M-pose run stays small,
+//! opens fast and seeks fast. Without Chromium the browser parts are skipped (CI installs it).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use ccpp_core::grid::{Cell, GridMap, MapFrame};
+use ccpp_core::trace::{Event, Trace};
+use ccpp_core::world::{Robot, World};
+use ccpp_core::Pose;
+use ccpp_render::replay::replay_html;
+
+const RES: f64 = 0.05;
+
+/// A walled `w x h` pixel room with a pillar in the middle.
+fn room(w: usize, h: usize) -> GridMap {
+    let frame = MapFrame::new(w, h, RES);
+    let mut cells = vec![Cell::Free; w * h];
+    for r in 0..h {
+        for c in 0..w {
+            let wall = r < 2 || c < 2 || r >= h - 2 || c >= w - 2;
+            let pillar = (w * 2 / 5..w * 3 / 5).contains(&c) && (h * 2 / 5..h * 3 / 5).contains(&r);
+            if wall || pillar {
+                cells[r * w + c] = Cell::Occupied;
+            }
+        }
+    }
+    GridMap::new(frame, cells).expect("valid room")
+}
+
+/// A lawnmower run of about `n` poses in small steps with a slight deterministic wobble (as a
+/// PID-tracked robot leaves), two regions joined by a backtracking transfer, and one of each
+/// marker event.
+fn run(w: usize, h: usize, n: usize) -> (World, Trace) {
+    let map = room(w, h);
+    let r = 0.15;
+    let (x0, y0) = (0.3, 0.3);
+    let (x1, y1) = (w as f64 * RES - 0.3, h as f64 * RES - 0.3);
+    let world = World::new(map, Robot::new(r), Some(Pose::new(x0, y0, 0.0))).expect("fits");
+    let lanes = ((y1 - y0) / (2.0 * r)).floor() as usize + 1;
+    let lane_len = x1 - x0;
+    let step = lane_len * lanes as f64 / n as f64;
+    let per_lane = (lane_len / step).ceil() as usize;
+    let mut t = Trace::default();
+    let mut k = 0u64;
+    t.push_event(0, Event::RegionStart { region: 1 });
+    for lane in 0..lanes {
+        if lane == lanes / 2 {
+            t.push_event(k, Event::CriticalPoint { x: x1, y: y0 });
+            t.push_event(k, Event::BacktrackStart);
+            t.push_event(k, Event::StartPoint { x: x0, y: y0 });
+            t.push_event(k, Event::BacktrackEnd);
+            t.push_event(k, Event::RegionStart { region: 2 });
+            t.push_event(k, Event::Collision { x: x0, y: y0 });
+        }
+        let y = y0 + lane as f64 * 2.0 * r;
+        for s in 0..=per_lane {
+            let f = s as f64 / per_lane as f64;
+            let x = if lane % 2 == 0 {
+                x0 + f * lane_len
+            } else {
+                x1 - f * lane_len
+            };
+            let wobble = 0.004 * ((s as f64) * 0.05).sin();
+            let theta = if lane % 2 == 0 {
+                0.0
+            } else {
+                std::f64::consts::PI
+            };
+            t.push_pose(k, Pose::new(x, y + wobble, theta));
+            k += 1;
+        }
+    }
+    (world, t)
+}
+
+fn chromium() -> Option<PathBuf> {
+    ["/usr/bin/chromium", "/usr/bin/chromium-browser"]
+        .iter()
+        .map(PathBuf::from)
+        .find(|p| p.is_file())
+}
+
+fn require_chromium() -> Option<PathBuf> {
+    let c = chromium();
+    if c.is_none() {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "CI must install chromium (see .ci/run)"
+        );
+        eprintln!("chromium not found; skipping the browser part");
+    }
+    c
+}
+
+/// Runs headless Chromium on `url` and returns (DOM, stderr).
+fn dump_dom(chrome: &Path, url: &str, virtual_time: bool) -> (String, String) {
+    let profile = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!(
+        "chrome-profile-{}-{}",
+        std::process::id(),
+        url.len()
+    ));
+    let mut c = Command::new(chrome);
+    c.args([
+        "--headless",
+        "--no-sandbox",
+        "--disable-gpu",
+        "--disable-quic",
+        "--no-first-run",
+        "--disable-background-networking",
+        "--disable-component-update",
+        "--disable-sync",
+        "--enable-logging=stderr",
+        "--v=0",
+        "--window-size=2000,1200",
+        "--hide-scrollbars",
+    ])
+    .arg(format!("--user-data-dir={}", profile.display()));
+    if virtual_time {
+        c.arg("--virtual-time-budget=10000");
+    }
+    let o = c
+        .arg("--dump-dom")
+        .arg(url)
+        .output()
+        .expect("chromium runs");
+    let _ = std::fs::remove_dir_all(&profile);
+    (
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+fn self_json(dom: &str) -> Option<serde_json::Value> {
+    let a = dom.find("SELFJSON ")? + 9;
+    let b = dom[a..].find(" ENDSELFJSON")? + a;
+    let text = dom[a..b].replace("&quot;", "\"").replace("&amp;", "&");
+    Some(serde_json::from_str(&text).expect("self-test JSON"))
+}
+
+/// The browser tests run one at a time (timings are measured; the machine is small).
+static BROWSER: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+/// Loads `url` until the page's self-test result is in the DOM (a busy machine can make
+/// Chromium dump the DOM before the iframe's message arrived); at most three tries.
+fn self_test(chrome: &Path, url: &str, virtual_time: bool) -> serde_json::Value {
+    let mut last = String::new();
+    for _ in 0..3 {
+        let (dom, err) = dump_dom(chrome, url, virtual_time);
+        no_console_errors(&err);
+        if let Some(v) = self_json(&dom) {
+            return v;
+        }
+        last = dom;
+    }
+    panic!(
+        "no self-test result from {url}: ...{}",
+        &last[last.len().saturating_sub(400)..]
+    );
+}
+
+fn no_console_errors(stderr: &str) {
+    for l in stderr.lines() {
+        let l = l.to_ascii_lowercase();
+        assert!(
+            !(l.contains("console") && (l.contains("error") || l.contains("uncaught"))),
+            "console error: {l}"
+        );
+    }
+}
+
+fn boxes(v: &serde_json::Value) -> Vec<(String, [f64; 4])> {
+    v["boxes"]
+        .as_object()
+        .expect("boxes")
+        .iter()
+        .map(|(k, b)| {
+            let a: Vec<f64> = b
+                .as_array()
+                .expect("box")
+                .iter()
+                .map(|x| x.as_f64().expect("number"))
+                .collect();
+            (k.clone(), [a[0], a[1], a[2], a[3]])
+        })
+        .collect()
+}
+
+#[test]
+fn side_panel_values_are_visible_at_desktop_sizes_and_the_page_fits_a_phone() {
+    let (world, trace) = run(300, 200, 20_000);
+    let metrics = r#"{"planner":"synthetic","map":"room","effective_coverage":0.93,"coverage_rate":0.99,"path_length_m":123.4,"path_ratio":1.05,"revisit_rate":0.1,"regions":2,"backtracks":1,"turns":40,"collisions":1,"wall_time_s":0.01}"#;
+    let html = replay_html(&world, &trace, None, metrics, "synthetic on room").expect("page");
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("replay-boxes");
+    std::fs::create_dir_all(&dir).expect("dir");
+    std::fs::write(dir.join("replay.html"), &html).expect("write");
+    let Some(chrome) = require_chromium() else {
+        return;
+    };
+    let _serial = BROWSER
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    for (w, h) in [(1280u32, 720u32), (1366, 768), (1920, 1080), (390, 844)] {
+        // The page runs in an iframe of exactly w x h (a real viewport of that size) and posts
+        // its self-test, with the bounding boxes it measured, to the wrapper.
+        let wrapper = dir.join(format!("frame-{w}x{h}.html"));
+        std::fs::write(
+            &wrapper,
+            format!(
+                r#"<!DOCTYPE html><html><body style="margin:0"><iframe src="replay.html#selftest" width="{w}" height="{h}" style="border:0;display:block"></iframe><pre id="out">waiting</pre><script>window.addEventListener("message", e => {{ document.getElementById("out").textContent = String(e.data); }});</script></body></html>"#
+            ),
+        )
+        .expect("wrapper");
+        let v = self_test(&chrome, &format!("file://{}", wrapper.display()), true);
+        assert_eq!(v["pass"], true, "{w}x{h}: {v}");
+        assert_eq!(v["errors"].as_array().map(Vec::len), Some(0));
+        assert_eq!(
+            (v["vw"].as_f64(), v["vh"].as_f64()),
+            (Some(f64::from(w)), Some(f64::from(h)))
+        );
+        let b = boxes(&v);
+        let get = |k: &str| b.iter().find(|x| x.0 == k).expect(k).1;
+        let canvas = get("canvas");
+        assert!(
+            canvas[2] - canvas[0] > 200.0,
+            "{w}x{h}: canvas too small {canvas:?}"
+        );
+        assert!(
+            canvas[0] >= 0.0 && canvas[2] <= f64::from(w),
+            "{w}x{h}: canvas {canvas:?}"
+        );
+        // Every live value and whole-run metric value, by its own box.
+        let values: Vec<_> = b
+            .iter()
+            .filter(|x| x.0.starts_with("now-") || x.0.starts_with("m-"))
+            .collect();
+        assert!(values.len() >= 14, "{w}x{h}: {} value boxes", values.len());
+        for (k, r) in &values {
+            assert!(r[2] > r[0] && r[3] > r[1], "{w}x{h}: {k} has no size");
+            assert!(
+                r[0] >= 0.0 && r[2] <= f64::from(w),
+                "{w}x{h}: {k} {r:?} cut off sideways"
+            );
+        }
+        if w >= 1280 {
+            assert_eq!(v["page_scrolls"], false, "{w}x{h}: the page scrolls");
+            assert_eq!(v["values_visible"], true, "{w}x{h}: {v}");
+            for (k, r) in &values {
+                assert!(
+                    r[1] >= 0.0 && r[3] <= f64::from(h),
+                    "{w}x{h}: {k} {r:?} below the fold"
+                );
+            }
+            let side = get("side");
+            assert!(side[0] >= canvas[2], "{w}x{h}: the panel overlaps the map");
+            assert!(side[2] <= f64::from(w), "{w}x{h}: the panel is cut off");
+        } else {
+            // Phone: the map on top, full width; the panel below it.
+            let side = get("side");
+            assert!(
+                side[1] >= canvas[3],
+                "{w}x{h}: the panel is not under the map"
+            );
+            assert!(canvas[2] - canvas[0] > f64::from(w) * 0.8);
+            assert_eq!(v["hscroll"], false, "{w}x{h}: the page scrolls sideways");
+        }
+        eprintln!("{w}x{h}: {}", v["boxes"]);
+    }
+}
+
+#[test]
+fn a_two_million_pose_run_gives_a_small_page_that_opens_and_seeks_fast() {
+    let (world, trace) = run(1200, 800, 2_100_000);
+    let n = trace.poses().count();
+    assert!(n >= 2_000_000, "{n} poses");
+    let t0 = std::time::Instant::now();
+    let html = replay_html(&world, &trace, None, "{}", "long run").expect("page");
+    let build_s = t0.elapsed().as_secs_f64();
+    let mb = html.len() as f64 / 1e6;
+    eprintln!("{n} poses: page {mb:.2} MB, built in {build_s:.2} s");
+    assert!(mb < 4.0, "page of {mb:.2} MB");
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("replay-long");
+    std::fs::create_dir_all(&dir).expect("dir");
+    let page = dir.join("replay.html");
+    std::fs::write(&page, &html).expect("write");
+    let Some(chrome) = require_chromium() else {
+        return;
+    };
+    // Real time (no virtual time budget): the self-test runs before the load event ends.
+    let _serial = BROWSER
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    let v = self_test(
+        &chrome,
+        &format!("file://{}#selftest", page.display()),
+        false,
+    );
+    assert_eq!(v["pass"], true, "{v}");
+    assert_eq!(v["poses"].as_u64(), Some(n as u64));
+    let first = v["first_frame_ms"].as_f64().expect("first frame");
+    let seek = v["seek_end_ms"].as_f64().expect("seek");
+    eprintln!(
+        "first frame {first} ms, seek to end {seek} ms, {} display poses",
+        v["frames"]
+    );
+    assert!(first < 3000.0, "first frame after {first} ms");
+    assert!(seek < 1000.0, "seek to the end took {seek} ms");
+}
