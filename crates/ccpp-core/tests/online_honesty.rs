@@ -59,9 +59,7 @@ fn flip_far(world: &World, trace: &Trace, reach: f64) -> (World, usize) {
         for col in 0..f.width {
             let g = Point::new(col as f64 + 0.5, f.height as f64 - row as f64 - 0.5);
             let p = f.grid_to_world(g);
-            let near = poses
-                .iter()
-                .any(|q| (q.x - p.x).hypot(q.y - p.y) <= reach);
+            let near = poses.iter().any(|q| (q.x - p.x).hypot(q.y - p.y) <= reach);
             if !near {
                 let v = if m.get(col, row).is_free() {
                     Cell::Occupied
