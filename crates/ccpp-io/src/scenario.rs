@@ -471,7 +471,8 @@ impl Scenario {
         let setup = self.setup(map);
         let planner = self.planner.name();
         let f = setup.frame;
-        if !(f.width_m() <= MAX_MAP_SIDE_M && f.height_m() <= MAX_MAP_SIDE_M) {
+        let fits = |v: f64| v.is_finite() && v <= MAX_MAP_SIDE_M;
+        if !(fits(f.width_m()) && fits(f.height_m())) {
             return Err(ScenarioError::Degenerate {
                 path: map.source.clone(),
                 planner,
@@ -499,7 +500,7 @@ impl Scenario {
         })?;
         let est = estimate_run(&setup, self.planner.settings());
         let limit = self.max_memory_mb as f64 * 1024.0 * 1024.0;
-        if !(est.bytes <= limit) {
+        if est.bytes.is_nan() || est.bytes > limit {
             let mb = est.bytes / (1024.0 * 1024.0);
             let needed_mb = if mb < 1e9 {
                 format!("{:.0}", mb.ceil())

@@ -31,7 +31,7 @@ pub struct PlannerInfo {
     pub kind: PlannerKind,
     /// Name used on the command line and in files (kebab-case).
     pub name: &'static str,
-    /// Name of its section in [`PlannerOptions`] (snake_case).
+    /// Name of its section in [`PlannerOptions`] (`snake_case`).
     pub section: &'static str,
     /// One-line description.
     pub description: &'static str,

@@ -1,0 +1,609 @@
+//! Every `ccpp run` flag changes the output of the planners it applies to and is refused, with
+//! one clear line, by those it does not apply to; bounded resources (issue 10 §3): absurd sizes,
+//! FIFOs and damaged traces end within seconds with one `error:` line and exit code 1; `run.json`
+//! is the scenario, and re-running it reproduces the trace.
+#![allow(clippy::unwrap_used)]
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use assert_cmd::Command;
+
+fn ccpp() -> Command {
+    Command::cargo_bin("ccpp").unwrap()
+}
+
+/// Writes a PGM (0.05 m/px as a bare image) of `w` x `h` px: walls around, `blocked(x, y)`
+/// inside (y down from the top row).
+fn pgm(
+    dir: &Path,
+    name: &str,
+    w: usize,
+    h: usize,
+    blocked: impl Fn(usize, usize) -> bool,
+) -> PathBuf {
+    let mut bytes = format!("P5\n{w} {h}\n255\n").into_bytes();
+    for y in 0..h {
+        for x in 0..w {
+            let wall = x == 0 || y == 0 || x == w - 1 || y == h - 1 || blocked(x, y);
+            bytes.push(if wall { 0 } else { 254 });
+        }
+    }
+    let p = dir.join(name);
+    std::fs::write(&p, bytes).unwrap();
+    p
+}
+
+/// An 8 x 6 m room with three pillars (backtracking happens).
+fn pillars(dir: &Path) -> PathBuf {
+    pgm(dir, "pillars.pgm", 160, 120, |x, y| {
+        ((40..52).contains(&x) && (20..80).contains(&y))
+            || ((90..104).contains(&x) && (50..110).contains(&y))
+            || ((120..132).contains(&x) && (10..40).contains(&y))
+    })
+}
+
+/// The 60 x 60 px (3 x 3 m) box of the issue, as a YAML map.
+fn box60(dir: &Path) -> PathBuf {
+    pgm(dir, "box.pgm", 60, 60, |_, _| false);
+    let y = dir.join("box.yaml");
+    std::fs::write(
+        &y,
+        "image: box.pgm\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n",
+    )
+    .unwrap();
+    y
+}
+
+/// Runs `ccpp run --planner P --map MAP ARGS --out DIR/SUB` and returns the output folder.
+fn run_ok(dir: &Path, sub: &str, map: &Path, planner: &str, args: &[&str]) -> PathBuf {
+    let out = dir.join(sub);
+    ccpp()
+        .args(["run", "--planner", planner, "--map"])
+        .arg(map)
+        .args(args)
+        .arg("--out")
+        .arg(&out)
+        .assert()
+        .success();
+    out
+}
+
+fn metrics(out: &Path) -> serde_json::Value {
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).unwrap()).unwrap();
+    v["wall_time_s"] = 0.into();
+    v
+}
+
+fn trace(out: &Path) -> String {
+    std::fs::read_to_string(out.join("trace.jsonl")).unwrap()
+}
+
+/// Runs `ccpp ARGS`, expects exit 1 within `secs` seconds, one `error:` line containing every
+/// needle, no panic.
+fn fails(args: &[&str], extra: &[&Path], needles: &[&str], secs: u64) {
+    let started = Instant::now();
+    let a = ccpp()
+        .args(args)
+        .args(extra)
+        .timeout(Duration::from_secs(secs + 20))
+        .assert()
+        .failure();
+    let elapsed = started.elapsed();
+    let o = a.get_output();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+    assert!(
+        elapsed < Duration::from_secs(secs),
+        "{args:?} took {elapsed:?}"
+    );
+    assert!(!err.contains("panicked"), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
+    assert!(err.starts_with("error: "), "{err}");
+    for n in needles {
+        assert!(err.contains(n), "{err:?} should contain {n:?}");
+    }
+}
+
+/// `ccpp run --planner P --map MAP ARGS` fails with the needles.
+fn run_fails(dir: &Path, map: &Path, planner: &str, args: &[&str], needles: &[&str]) {
+    let out = dir.join("refused");
+    let mut all = vec!["run", "--planner", planner, "--out", out.to_str().unwrap()];
+    all.extend_from_slice(args);
+    all.push("--map");
+    fails(&all, &[map], needles, 10);
+    assert!(!out.join("metrics.json").exists());
+}
+
+const ALL: [&str; 7] = [
+    "random-bounce",
+    "ba-star",
+    "bsa",
+    "bsa-extended",
+    "bsa-bfs",
+    "bcd",
+    "rect-boustrophedon",
+];
+
+/// Checks that `flag value` changes the output of each planner in `applies` (metrics or
+/// trace), and is refused by every other planner with "does not apply".
+fn flag_applies(dir: &Path, map: &Path, flag: &[&str], applies: &[&str], base: &[&str]) {
+    for p in ALL {
+        if applies.contains(&p) {
+            let a = run_ok(dir, &format!("{p}-base"), map, p, base);
+            let mut args = base.to_vec();
+            args.extend_from_slice(flag);
+            let b = run_ok(dir, &format!("{p}-flag"), map, p, &args);
+            assert!(
+                metrics(&a) != metrics(&b) || trace(&a) != trace(&b),
+                "{flag:?} changes nothing for {p}"
+            );
+        } else {
+            let mut args = base.to_vec();
+            args.extend_from_slice(flag);
+            run_fails(dir, map, p, &args, &[flag[0], "does not apply", p]);
+        }
+    }
+}
+
+#[test]
+fn planner_flags_apply_where_they_should() {
+    let d = tempfile::tempdir().unwrap();
+    let map = pillars(d.path());
+    let m = map.as_path();
+    let dir = d.path();
+    flag_applies(
+        dir,
+        m,
+        &["--tile-side", "0.45"],
+        &["ba-star", "bsa-bfs"],
+        &[],
+    );
+    flag_applies(dir, m, &["--smoothing", "off"], &["ba-star"], &[]);
+    flag_applies(dir, m, &["--side", "right"], &["bsa", "bsa-extended"], &[]);
+    flag_applies(dir, m, &["--length", "0.5"], &["rect-boustrophedon"], &[]);
+    flag_applies(dir, m, &["--width", "0.5"], &["rect-boustrophedon"], &[]);
+    flag_applies(
+        dir,
+        m,
+        &["--area", "0.5,0.5,4,4"],
+        &["rect-boustrophedon"],
+        &[],
+    );
+    flag_applies(dir, m, &["--seed", "5"], &["random-bounce"], &[]);
+    // The sensor range applies to the online planners only (the shortest range that still
+    // sees a neighbour tile: less is known when choosing where to go).
+    flag_applies(
+        dir,
+        m,
+        &["--sensor-range", "0.45"],
+        &["random-bounce", "ba-star", "bsa", "bsa-extended", "bsa-bfs"],
+        &[],
+    );
+}
+
+#[test]
+fn execution_flags_reach_the_simulator() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let tracking = |out: &Path| {
+        metrics(out)
+            .get("tracking_error_mean_m")
+            .and_then(serde_json::Value::as_f64)
+    };
+
+    // --exec pid on an ideal planner adds tracking; --exec ideal on a PID planner removes it.
+    let bsa = run_ok(dir, "bsa", &map, "bsa", &[]);
+    assert_eq!(tracking(&bsa), None);
+    let bsa_pid = run_ok(dir, "bsa-pid", &map, "bsa", &["--exec", "pid"]);
+    let clean = tracking(&bsa_pid).unwrap();
+    let bfs = run_ok(dir, "bfs", &map, "bsa-bfs", &[]);
+    assert!(tracking(&bfs).is_some());
+    let bfs_ideal = run_ok(dir, "bfs-ideal", &map, "bsa-bfs", &["--exec", "ideal"]);
+    assert_eq!(tracking(&bfs_ideal), None);
+    let run_json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(bfs_ideal.join("run.json")).unwrap())
+            .unwrap();
+    assert_eq!(run_json["sim"]["exec"], "ideal");
+
+    // Odometry noise: a larger tracking error; its seed changes the trace.
+    let noisy = run_ok(
+        dir,
+        "noisy",
+        &map,
+        "bsa",
+        &["--exec", "pid", "--odometry-noise", "0.2,0.2"],
+    );
+    assert!(tracking(&noisy).unwrap() > clean + 1e-3);
+    let noisy7 = run_ok(
+        dir,
+        "noisy7",
+        &map,
+        "bsa",
+        &["--odometry-noise", "0.2,0.2", "--seed", "7"],
+    );
+    assert_ne!(trace(&noisy), trace(&noisy7));
+    run_fails(
+        dir,
+        &map,
+        "bsa",
+        &["--exec", "ideal", "--odometry-noise", "0.2"],
+        &["--odometry-noise", "PID"],
+    );
+    run_fails(dir, &map, "bsa", &["--exec", "fast"], &["--exec"]);
+
+    // Landmarks correct the noisy estimate: the run changes; refused under ideal execution.
+    let lm = dir.join("landmarks.csv");
+    std::fs::write(&lm, "1,1,1\n2,4,3\n3,7,5\n4,2,5\n5,6,1\n").unwrap();
+    let lmo = dir.join("landmarks.csv");
+    let corrected = run_ok(
+        dir,
+        "corrected",
+        &map,
+        "bsa",
+        &[
+            "--exec",
+            "pid",
+            "--odometry-noise",
+            "0.2,0.2",
+            "--landmarks",
+            lmo.to_str().unwrap(),
+        ],
+    );
+    assert_ne!(trace(&noisy), trace(&corrected));
+    run_fails(
+        dir,
+        &map,
+        "ba-star",
+        &["--landmarks", lm.to_str().unwrap()],
+        &["landmarks", "PID"],
+    );
+    // --seed without noise does not apply to a deterministic planner.
+    run_fails(
+        dir,
+        &map,
+        "ba-star",
+        &["--seed", "3"],
+        &["--seed", "does not apply"],
+    );
+}
+
+#[test]
+fn map_and_robot_flags_change_the_run() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let base = run_ok(dir, "base", &map, "ba-star", &[]);
+    for (i, args) in [
+        &["--radius", "0.2"][..],
+        &["--tool-radius", "0.1"],
+        &["--start", "1,1"],
+        &["--resolution", "0.04"],
+        &["--origin", "1,2"],
+        &["--inflate", "0.1"],
+    ]
+    .iter()
+    .enumerate()
+    {
+        let out = run_ok(dir, &format!("m{i}"), &map, "ba-star", args);
+        assert!(
+            metrics(&base) != metrics(&out) || trace(&base) != trace(&out),
+            "{args:?} changes nothing"
+        );
+    }
+}
+
+#[test]
+fn config_values_go_through_the_same_validation() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = box60(dir);
+    for (i, (yaml, planner, needle)) in [
+        (
+            "ba_star: { tile_side_m: 0 }",
+            "ba-star",
+            "ba_star.tile_side_m",
+        ),
+        ("bcd: { lane_spacing_m: .nan }", "bcd", "bcd.lane_spacing_m"),
+        (
+            "random_bounce: { budget_m: -5 }",
+            "random-bounce",
+            "random_bounce.budget_m",
+        ),
+        (
+            "random_bounce: { min_turn_deg: 300, max_turn_deg: 100 }",
+            "random-bounce",
+            "min_turn_deg",
+        ),
+        (
+            "bsa_bfs: { cell_side_m: -1 }",
+            "bsa-bfs",
+            "bsa_bfs.cell_side_m",
+        ),
+        (
+            "rect_boustrophedon: { width_m: .inf }",
+            "rect-boustrophedon",
+            "width_m",
+        ),
+        ("bsa_extended: { gap_cost: 0 }", "bsa-extended", "gap_cost"),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let cfg = dir.join(format!("cfg{i}.yaml"));
+        std::fs::write(&cfg, yaml).unwrap();
+        let name = format!("cfg{i}.yaml");
+        run_fails(
+            dir,
+            &map,
+            planner,
+            &["--config", cfg.to_str().unwrap()],
+            &[&name, needle],
+        );
+    }
+    // The same values given as flags are refused by the same check, naming the flag.
+    run_fails(
+        dir,
+        &map,
+        "ba-star",
+        &["--tile-side", "0"],
+        &["--tile-side", "ba_star.tile_side_m"],
+    );
+    run_fails(
+        dir,
+        &map,
+        "rect-boustrophedon",
+        &["--width", "NaN"],
+        &["--width", "width_m"],
+    );
+    // A valid config changes the run.
+    let cfg = dir.join("ok.yaml");
+    std::fs::write(&cfg, "random_bounce: { budget_m: 20 }\n").unwrap();
+    let a = run_ok(dir, "a", &map, "random-bounce", &[]);
+    let b = run_ok(
+        dir,
+        "b",
+        &map,
+        "random-bounce",
+        &["--config", cfg.to_str().unwrap()],
+    );
+    let len = |o: &Path| metrics(o)["path_length_m"].as_f64().unwrap();
+    assert!(len(&b) <= 20.0 + 1e-9 && len(&a) > 20.0);
+}
+
+#[test]
+fn max_memory_refuses_and_allows() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = box60(dir);
+    let big = pillars(dir);
+    run_fails(
+        dir,
+        &big,
+        "ba-star",
+        &["--max-memory", "1"],
+        &["memory limit of 1 MB", "--max-memory"],
+    );
+    // The default limit (4096 MB) refuses 9e6 BA* tiles on a 3 x 3 m map.
+    run_fails(
+        dir,
+        &map,
+        "ba-star",
+        &["--tile-side", "0.001"],
+        &["memory limit of 4096 MB", "tiles of 0.001 m"],
+    );
+    run_ok(dir, "small", &big, "ba-star", &["--max-memory", "64"]);
+    fails(
+        &["waypoints", "--max-memory", "1", "--map"],
+        &[&big],
+        &["memory limit of 1 MB"],
+        10,
+    );
+}
+
+#[test]
+fn absurd_sizes_end_within_seconds() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = box60(dir);
+    run_fails(
+        dir,
+        &map,
+        "ba-star",
+        &["--radius", "1e-9"],
+        &["memory limit", "tiles"],
+    );
+    for p in [
+        "bsa-bfs",
+        "bsa",
+        "bcd",
+        "rect-boustrophedon",
+        "bsa-extended",
+    ] {
+        run_fails(dir, &map, p, &["--radius", "1e-6"], &["memory limit"]);
+    }
+    // random-bounce's sensor (4 r) sees nothing beyond its footprint at this radius.
+    run_fails(
+        dir,
+        &map,
+        "random-bounce",
+        &["--radius", "1e-6"],
+        &["sensor range"],
+    );
+    run_fails(
+        dir,
+        &map,
+        "ba-star",
+        &["--radius", "1e-4"],
+        &["memory limit"],
+    );
+    run_fails(
+        dir,
+        &map,
+        "ba-star",
+        &["--tile-side", "0.001"],
+        &["memory limit"],
+    );
+    run_fails(
+        dir,
+        &map,
+        "rect-boustrophedon",
+        &["--length", "1e-9"],
+        &["length_m", "finer than the map resolution"],
+    );
+    fails(
+        &["waypoints", "--width", "1e-6", "--map"],
+        &[&map],
+        &["width_m", "finer than the map resolution"],
+        10,
+    );
+    fails(
+        &[
+            "waypoints",
+            "--width",
+            "0.05",
+            "--length",
+            "0.05",
+            "--max-memory",
+            "2",
+            "--map",
+        ],
+        &[&map],
+        &["memory limit of 2 MB"],
+        10,
+    );
+    // A resolution that makes the map astronomically large.
+    let huge = dir.join("huge.yaml");
+    std::fs::write(
+        &huge,
+        "image: box.pgm\nresolution: 1e300\norigin: [0.0, 0.0, 0.0]\n",
+    )
+    .unwrap();
+    run_fails(dir, &huge, "ba-star", &[], &["huge.yaml", "resolution"]);
+}
+
+#[cfg(unix)]
+#[test]
+fn fifo_image_is_refused_not_read_forever() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let fifo = dir.join("fifo.pgm");
+    let ok = std::process::Command::new("mkfifo").arg(&fifo).status();
+    if !ok.is_ok_and(|s| s.success()) {
+        eprintln!("mkfifo unavailable; skipping");
+        return;
+    }
+    let y = dir.join("fifo.yaml");
+    std::fs::write(
+        &y,
+        "image: fifo.pgm\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\n",
+    )
+    .unwrap();
+    run_fails(dir, &y, "ba-star", &[], &["fifo.pgm", "not a regular file"]);
+    run_fails(
+        dir,
+        &fifo,
+        "ba-star",
+        &[],
+        &["fifo.pgm", "not a regular file"],
+    );
+}
+
+#[test]
+fn degenerate_runs_say_what_is_wrong() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = box60(dir);
+    run_fails(
+        dir,
+        &map,
+        "ba-star",
+        &["--tile-side", "100"],
+        &["larger than the map"],
+    );
+    run_fails(
+        dir,
+        &map,
+        "bsa-bfs",
+        &["--tile-side", "100"],
+        &["larger than the map"],
+    );
+    for p in ["ba-star", "bsa", "bsa-extended", "bsa-bfs", "random-bounce"] {
+        run_fails(dir, &map, p, &["--sensor-range", "1e-9"], &["sensor range"]);
+    }
+    run_fails(
+        dir,
+        &map,
+        "rect-boustrophedon",
+        &["--area", "10,10,20,20"],
+        &["area", "outside the map"],
+    );
+}
+
+#[test]
+fn replay_refuses_a_damaged_trace_quickly() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = box60(dir);
+    let out = run_ok(dir, "run", &map, "ba-star", &[]);
+    let t = trace(&out);
+    let mut lines: Vec<String> = t.lines().map(str::to_string).collect();
+    let k = lines.iter().rposition(|l| l.contains("\"pose\"")).unwrap();
+    lines[k] = r#"{"t":99,"pose":[1e300,1.0,0.0]}"#.to_string();
+    std::fs::write(out.join("trace.jsonl"), lines.join("\n")).unwrap();
+    fails(
+        &["replay"],
+        &[&out],
+        &["trace.jsonl", &format!("line {}", k + 1), "outside the map"],
+        10,
+    );
+}
+
+#[test]
+fn run_json_is_the_scenario_and_replays_exactly() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let lm = dir.join("lm.csv");
+    std::fs::write(&lm, "1,1,1\n2,4,3\n3,7,5\n").unwrap();
+    for (i, (planner, args)) in [
+        (
+            "random-bounce",
+            &["--seed", "11", "--sensor-range", "0.9"][..],
+        ),
+        ("ba-star", &["--tile-side", "0.4", "--smoothing", "off"]),
+        (
+            "bsa",
+            &[
+                "--side",
+                "right",
+                "--odometry-noise",
+                "0.1",
+                "--seed",
+                "3",
+                "--landmarks",
+                lm.to_str().unwrap(),
+            ],
+        ),
+        (
+            "rect-boustrophedon",
+            &["--length", "0.4", "--width", "0.35", "--inflate", "0.05"],
+        ),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let out = run_ok(dir, &format!("r{i}"), &map, planner, args);
+        let scenario = ccpp_io::scenario::Scenario::from_file(&out.join("run.json")).unwrap();
+        assert_eq!(scenario.planner.name(), planner);
+        let run = scenario.run().unwrap();
+        let again = ccpp_io::trace::trace_jsonl(&run.output.trace).unwrap();
+        assert_eq!(
+            again,
+            trace(&out),
+            "{planner}: re-running run.json changed the trace"
+        );
+    }
+}
