@@ -22,6 +22,8 @@ use anyhow::{bail, Context, Result};
 static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 /// Held while an old folder is renamed away and the new one renamed in.
 static SWAP: Mutex<()> = Mutex::new(());
+/// Child processes (bench runs) to stop if this process is interrupted.
+static CHILDREN: Mutex<Vec<u32>> = Mutex::new(Vec::new());
 /// Distinguishes the staging folders of one process.
 static COUNTER: AtomicU64 = AtomicU64::new(0);
 
@@ -70,6 +72,23 @@ fn remove_all(p: &Path) {
     }
 }
 
+/// Starts a child process that is stopped (SIGTERM) if this process is interrupted. Spawning
+/// and recording happen under one lock, so the signal handler never misses a child.
+///
+/// # Errors
+/// When the process cannot be started.
+pub fn spawn_child(cmd: &mut std::process::Command) -> std::io::Result<std::process::Child> {
+    let mut children = lock(&CHILDREN);
+    let child = cmd.spawn()?;
+    children.push(child.id());
+    Ok(child)
+}
+
+/// Forgets a child process that has ended.
+pub fn unregister_child(pid: u32) {
+    lock(&CHILDREN).retain(|&p| p != pid);
+}
+
 /// Installs the SIGINT/SIGTERM handler (once, at start-up).
 pub fn install_signal_handler() {
     // Failure to install (a handler already set) only loses the cleanup.
@@ -80,6 +99,16 @@ pub fn install_signal_handler() {
         let pending = lock(&PENDING);
         for p in pending.iter() {
             remove_all(p);
+        }
+        // Running children clean up their own staging folders when told to stop; holding the
+        // lock until exit keeps new ones from starting.
+        let children = lock(&CHILDREN);
+        for pid in children.iter() {
+            let _ = std::process::Command::new("kill")
+                .arg("-TERM")
+                .arg(pid.to_string())
+                .stderr(std::process::Stdio::null())
+                .status();
         }
         eprintln!("error: interrupted");
         std::process::exit(130);
