@@ -13,7 +13,7 @@
 //! the same target removes them, or puts an old folder back when the target is missing.
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Mutex, MutexGuard, PoisonError};
 
 use anyhow::{bail, Context, Result};
@@ -24,6 +24,8 @@ static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 static SWAP: Mutex<()> = Mutex::new(());
 /// Child processes (bench runs) to stop if this process is interrupted.
 static CHILDREN: Mutex<Vec<u32>> = Mutex::new(Vec::new());
+/// Set by the signal handler: no child process may start any more.
+static STOPPING: AtomicBool = AtomicBool::new(false);
 /// Distinguishes the staging folders of one process.
 static COUNTER: AtomicU64 = AtomicU64::new(0);
 
@@ -79,6 +81,12 @@ fn remove_all(p: &Path) {
 /// When the process cannot be started.
 pub fn spawn_child(cmd: &mut std::process::Command) -> std::io::Result<std::process::Child> {
     let mut children = lock(&CHILDREN);
+    if STOPPING.load(Ordering::SeqCst) {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::Interrupted,
+            "interrupted",
+        ));
+    }
     let child = cmd.spawn()?;
     children.push(child.id());
     Ok(child)
@@ -100,15 +108,22 @@ pub fn install_signal_handler() {
         for p in pending.iter() {
             remove_all(p);
         }
-        // Running children clean up their own staging folders when told to stop; holding the
-        // lock until exit keeps new ones from starting.
-        let children = lock(&CHILDREN);
-        for pid in children.iter() {
-            let _ = std::process::Command::new("kill")
-                .arg("-TERM")
-                .arg(pid.to_string())
-                .stderr(std::process::Stdio::null())
-                .status();
+        // Running children clean up their own staging folders when told to stop; no new one
+        // starts once STOPPING is set. Wait (a few seconds at most) until they have ended.
+        {
+            let children = lock(&CHILDREN);
+            STOPPING.store(true, Ordering::SeqCst);
+            for pid in children.iter() {
+                let _ = std::process::Command::new("kill")
+                    .arg("-TERM")
+                    .arg(pid.to_string())
+                    .stderr(std::process::Stdio::null())
+                    .status();
+            }
+        }
+        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(5);
+        while !lock(&CHILDREN).is_empty() && std::time::Instant::now() < deadline {
+            std::thread::sleep(std::time::Duration::from_millis(10));
         }
         eprintln!("error: interrupted");
         std::process::exit(130);
