@@ -17,8 +17,8 @@ use crate::job::{parse_planner, planner_options, prepare_map, robot_from, Job, P
 use crate::output::write_run_files;
 use crate::staging::write_file;
 
-/// Test hook: a planner named by this environment variable panics in `ccpp bench`, to check
-/// that one failing run becomes an error row and the others finish.
+/// Test hook: a planner named by this environment variable panics in a `ccpp bench` run, to
+/// check that one failing run becomes an error row and the others finish.
 pub const PANIC_ENV: &str = "CCPP_TEST_PANIC_PLANNER";
 
 /// One row of the results: a run, or its failure.
@@ -327,18 +327,16 @@ fn run_one(
     robot: ccpp_core::world::Robot,
     options: &PlannerOptions,
 ) -> Result<Metrics, String> {
-    if let Some(hook) = std::env::var_os(PANIC_ENV) {
-        assert!(hook != planner, "{PANIC_ENV} asked {planner} to panic");
-    }
     let map = map.as_ref().map_err(Clone::clone)?;
     let sim = SimConfig::default();
     let key = grid_hash
         .map(|h| run_key(h, planner, options, robot, &sim))
         .transpose()
-        .map_err(|e| crate::errors::one_line(&e))?;
+        .map_err(|e| crate::errors::one_line(&e))?
+        .unwrap_or_default();
     let metrics_path = dir.join("metrics.json");
     if !a.force && dir.join("trace.jsonl").is_file() {
-        let same_key = std::fs::read_to_string(dir.join("bench-key.txt")).ok() == key;
+        let same_key = std::fs::read_to_string(dir.join("bench-key.txt")).is_ok_and(|k| k == key);
         if same_key {
             if let Ok(text) = std::fs::read_to_string(&metrics_path) {
                 if let Ok(m) = serde_json::from_str::<Metrics>(&text) {
@@ -348,7 +346,7 @@ fn run_one(
         }
     }
     let kind = parse_planner(planner).map_err(|e| crate::errors::one_line(&e))?;
-    let mut job = Job {
+    let spec = JobSpec {
         scenario: Scenario {
             map: map.recipe.clone(),
             robot,
@@ -357,13 +355,134 @@ fn run_one(
             sim,
             max_memory_mb: a.max_memory.unwrap_or(DEFAULT_MAX_MEMORY_MB),
         },
-        map: map.clone(),
+        map_name: map.name.clone(),
         out: dir.to_path_buf(),
+        key,
     };
-    let result = job.execute().map_err(|e| crate::errors::one_line(&e))?;
-    let extra = [("bench-key.txt", key.unwrap_or_default().into_bytes())];
-    write_run_files(dir, &job, &result, false, &extra).map_err(|e| crate::errors::one_line(&e))?;
-    Ok(result.metrics)
+    run_isolated(&spec)
+}
+
+/// Hidden first argument that makes `ccpp` run one bench job (a [`JobSpec`] as JSON on stdin)
+/// and print its metrics JSON.
+pub const CHILD_ARG: &str = "__bench-job";
+
+/// Test hook: a planner named by this environment variable aborts the process running it.
+pub const ABORT_ENV: &str = "CCPP_TEST_ABORT_PLANNER";
+
+/// One bench run, as handed to the child process.
+#[derive(serde::Serialize, serde::Deserialize)]
+pub struct JobSpec {
+    /// What to run.
+    pub scenario: Scenario,
+    /// The map's name in the bench.
+    pub map_name: String,
+    /// The run folder.
+    pub out: PathBuf,
+    /// The run's key, written as `bench-key.txt`.
+    pub key: String,
+}
+
+/// Runs one job in a child process of this binary, so that a panic, an abort or a crash (stack
+/// overflow, out of memory) ends that run only, and its memory goes back when it ends.
+fn run_isolated(spec: &JobSpec) -> Result<Metrics, String> {
+    use std::io::Write as _;
+    use std::process::{Command, Stdio};
+    let input = serde_json::to_vec(spec).map_err(|e| e.to_string())?;
+    let exe = std::env::current_exe().map_err(|e| format!("cannot find the ccpp binary: {e}"))?;
+    let mut child = crate::staging::spawn_child(
+        Command::new(exe)
+            .arg(CHILD_ARG)
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped()),
+    )
+    .map_err(|e| format!("cannot start a run: {e}"))?;
+    let pid = child.id();
+    if let Some(mut stdin) = child.stdin.take() {
+        // A child that died at once shows in its status below.
+        let _ = stdin.write_all(&input);
+    }
+    let out = child.wait_with_output();
+    crate::staging::unregister_child(pid);
+    let out = out.map_err(|e| format!("lost the run: {e}"))?;
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    if out.status.success() {
+        return serde_json::from_slice::<Metrics>(&out.stdout)
+            .map_err(|e| format!("the run's metrics are unreadable: {e}"));
+    }
+    Err(child_failure(out.status, &stderr))
+}
+
+/// Words for a child run that did not succeed.
+fn child_failure(status: std::process::ExitStatus, stderr: &str) -> String {
+    let lines: Vec<&str> = stderr
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect();
+    if let Some(i) = lines.iter().position(|l| l.contains("panicked at")) {
+        let msg = lines.get(i + 1).copied().unwrap_or("unknown cause");
+        return format!("the run panicked: {msg}");
+    }
+    if let Some(e) = lines.iter().rev().find_map(|l| l.strip_prefix("error: ")) {
+        return e.to_string();
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::process::ExitStatusExt as _;
+        if let Some(sig) = status.signal() {
+            let what = match sig {
+                6 => " (abort)",
+                9 => " (killed, e.g. out of memory)",
+                11 => " (segmentation fault or stack overflow)",
+                _ => "",
+            };
+            return format!("the run crashed: signal {sig}{what}");
+        }
+    }
+    format!("the run failed ({status})")
+}
+
+/// `ccpp __bench-job`: runs the [`JobSpec`] read from stdin, writes its run folder and prints
+/// its metrics JSON. Errors are one `error:` line on stderr and exit status 1.
+pub fn child_main() -> std::process::ExitCode {
+    crate::staging::install_signal_handler();
+    match child_job() {
+        Ok(metrics) => match crate::print_stdout(&metrics) {
+            Ok(()) => std::process::ExitCode::SUCCESS,
+            Err(_) => std::process::ExitCode::FAILURE,
+        },
+        Err(e) => {
+            eprintln!("error: {}", crate::errors::one_line(&e));
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
+fn child_job() -> Result<String> {
+    use std::io::Read as _;
+    let mut text = String::new();
+    std::io::stdin()
+        .read_to_string(&mut text)
+        .context("cannot read the job")?;
+    let spec: JobSpec = serde_json::from_str(&text).context("cannot read the job")?;
+    let planner = spec.scenario.planner.name();
+    if let Some(hook) = std::env::var_os(PANIC_ENV) {
+        assert!(hook != planner, "{PANIC_ENV} asked {planner} to panic");
+    }
+    if std::env::var_os(ABORT_ENV).is_some_and(|h| h == planner) {
+        std::process::abort();
+    }
+    let mut map = crate::job::load_recipe(&spec.scenario.map)?;
+    map.name.clone_from(&spec.map_name);
+    let mut job = Job {
+        scenario: spec.scenario,
+        map,
+        out: spec.out,
+    };
+    let result = job.execute()?;
+    let extra = [("bench-key.txt", spec.key.into_bytes())];
+    write_run_files(&job.out, &job, &result, false, &extra)
 }
 
 /// Quotes a CSV field when needed.

@@ -13,7 +13,7 @@
 //! the same target removes them, or puts an old folder back when the target is missing.
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Mutex, MutexGuard, PoisonError};
 
 use anyhow::{bail, Context, Result};
@@ -22,6 +22,10 @@ use anyhow::{bail, Context, Result};
 static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 /// Held while an old folder is renamed away and the new one renamed in.
 static SWAP: Mutex<()> = Mutex::new(());
+/// Child processes (bench runs) to stop if this process is interrupted.
+static CHILDREN: Mutex<Vec<u32>> = Mutex::new(Vec::new());
+/// Set by the signal handler: no child process may start any more.
+static STOPPING: AtomicBool = AtomicBool::new(false);
 /// Distinguishes the staging folders of one process.
 static COUNTER: AtomicU64 = AtomicU64::new(0);
 
@@ -70,6 +74,29 @@ fn remove_all(p: &Path) {
     }
 }
 
+/// Starts a child process that is stopped (SIGTERM) if this process is interrupted. Spawning
+/// and recording happen under one lock, so the signal handler never misses a child.
+///
+/// # Errors
+/// When the process cannot be started.
+pub fn spawn_child(cmd: &mut std::process::Command) -> std::io::Result<std::process::Child> {
+    let mut children = lock(&CHILDREN);
+    if STOPPING.load(Ordering::SeqCst) {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::Interrupted,
+            "interrupted",
+        ));
+    }
+    let child = cmd.spawn()?;
+    children.push(child.id());
+    Ok(child)
+}
+
+/// Forgets a child process that has ended.
+pub fn unregister_child(pid: u32) {
+    lock(&CHILDREN).retain(|&p| p != pid);
+}
+
 /// Installs the SIGINT/SIGTERM handler (once, at start-up).
 pub fn install_signal_handler() {
     // Failure to install (a handler already set) only loses the cleanup.
@@ -80,6 +107,23 @@ pub fn install_signal_handler() {
         let pending = lock(&PENDING);
         for p in pending.iter() {
             remove_all(p);
+        }
+        // Running children clean up their own staging folders when told to stop; no new one
+        // starts once STOPPING is set. Wait (a few seconds at most) until they have ended.
+        {
+            let children = lock(&CHILDREN);
+            STOPPING.store(true, Ordering::SeqCst);
+            for pid in children.iter() {
+                let _ = std::process::Command::new("kill")
+                    .arg("-TERM")
+                    .arg(pid.to_string())
+                    .stderr(std::process::Stdio::null())
+                    .status();
+            }
+        }
+        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(5);
+        while !lock(&CHILDREN).is_empty() && std::time::Instant::now() < deadline {
+            std::thread::sleep(std::time::Duration::from_millis(10));
         }
         eprintln!("error: interrupted");
         std::process::exit(130);

@@ -154,6 +154,7 @@ fn run_refuses_an_out_folder_with_other_files() {
 #[cfg(unix)]
 #[test]
 fn an_interrupted_run_leaves_the_old_or_the_new_complete_set() {
+    use std::os::unix::process::ExitStatusExt as _;
     let dir = tempfile::tempdir().unwrap();
     let map = big_room(dir.path());
     let work = dir.path().join("work");
@@ -193,9 +194,10 @@ fn an_interrupted_run_leaves_the_old_or_the_new_complete_set() {
             .arg(child.id().to_string())
             .status();
         let status = child.wait().unwrap();
-        // Either the signal came in time (130) or the run had already finished (0).
+        // The signal came in time (130), the run had already finished (0), or the signal came
+        // before the process installed its handler (killed by it, nothing written yet).
         assert!(
-            status.code() == Some(130) || status.success(),
+            status.code() == Some(130) || status.success() || status.signal().is_some(),
             "{signal} at {k}: {status:?}"
         );
         assert_eq!(entries(&work), ["out"], "{signal} at {k}: stray files");
@@ -210,6 +212,65 @@ fn an_interrupted_run_leaves_the_old_or_the_new_complete_set() {
         seen_old |= p == "bcd";
     }
     assert!(seen_old, "no interrupt landed before the commit");
+}
+
+/// Every folder under `dir` (recursively), with its entries.
+fn walk(dir: &Path, out: &mut Vec<(PathBuf, Vec<String>)>) {
+    let names = entries(dir);
+    for n in &names {
+        let p = dir.join(n);
+        if p.is_dir() {
+            walk(&p, out);
+        }
+    }
+    out.push((dir.to_path_buf(), names));
+}
+
+#[cfg(unix)]
+#[test]
+fn an_interrupted_bench_leaves_only_complete_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = big_room(dir.path());
+    let out = dir.path().join("bench");
+    let bin = assert_cmd::cargo::cargo_bin("ccpp");
+    for (k, signal) in ["TERM", "INT", "TERM"].iter().enumerate() {
+        let mut child = std::process::Command::new(&bin)
+            .args(["bench", "--quiet", "--force", "--jobs", "2", "--maps"])
+            .arg(&map)
+            .arg(data("teb_empty_box.yaml"))
+            .arg("--out")
+            .arg(&out)
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(300 + 400 * k as u64));
+        let _ = std::process::Command::new("kill")
+            .arg(format!("-{signal}"))
+            .arg(child.id().to_string())
+            .status();
+        let status = child.wait().unwrap();
+        assert!(status.code() == Some(130) || status.success(), "{status:?}");
+        // Give stopped children a moment to remove their staging folders.
+        std::thread::sleep(std::time::Duration::from_millis(300));
+        let mut dirs = Vec::new();
+        walk(&out, &mut dirs);
+        for (d, names) in &dirs {
+            assert!(
+                names
+                    .iter()
+                    .all(|n| !n.starts_with('.') && !n.to_ascii_lowercase().ends_with(".tmp")),
+                "{signal}: stray entry in {}: {names:?}",
+                d.display()
+            );
+            if names.iter().any(|n| n == "metrics.json") {
+                let mut want: Vec<&str> = BASE_SET.to_vec();
+                want.push("bench-key.txt");
+                want.sort_unstable();
+                assert_eq!(names, &want, "{signal}: incomplete run {}", d.display());
+            }
+        }
+    }
 }
 
 /// A bench over `maps` with `extra` arguments; returns the output.
@@ -263,6 +324,22 @@ fn a_panicking_run_becomes_an_error_row_and_the_bench_exits_1() {
         .assert()
         .code(1);
     assert!(out2.join("results.csv").is_file());
+    // A run that aborts the process (as a stack overflow or an out-of-memory kill would)
+    // only fails its own row.
+    let out3 = dir.path().join("bench3");
+    bench(
+        &out3,
+        &[data("teb_empty_box.yaml")],
+        &["--planners", "bcd,random-bounce"],
+    )
+    .env("CCPP_TEST_ABORT_PLANNER", "random-bounce")
+    .assert()
+    .code(1);
+    let rows = csv_rows(&out3);
+    let rb = rows.iter().find(|r| r[1] == "random-bounce").unwrap();
+    assert_eq!(rb[2], "error");
+    assert!(rb[3].contains("crashed"), "{rb:?}");
+    assert_eq!(rows.iter().find(|r| r[1] == "bcd").unwrap()[2], "ok");
     // Without the fault the same bench succeeds.
     bench(&out2, &[data("teb_empty_box.yaml")], &["--planners", "bcd"])
         .assert()
@@ -297,6 +374,23 @@ fn bench_resume_reruns_when_anything_that_defines_a_run_changed() {
         std::fs::metadata(&trace).unwrap().modified().unwrap(),
         before
     );
+    // Reused or fresh, results.csv holds the run's numbers exactly.
+    let m: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(out.join("runs/teb_empty_box/bcd/metrics.json")).unwrap(),
+    )
+    .unwrap();
+    let row = &csv_rows(&out)[0];
+    for (col, key) in [
+        (7, "effective_coverage"),
+        (8, "path_length_m"),
+        (9, "path_ratio"),
+    ] {
+        assert_eq!(
+            row[col].parse::<f64>().unwrap(),
+            m[key].as_f64().unwrap(),
+            "{key}"
+        );
+    }
     // A different seed or a changed map content reruns.
     bench(
         &out,
