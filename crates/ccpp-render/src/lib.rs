@@ -314,7 +314,7 @@ fn entries_of(s: &Shown) -> Vec<LegendEntry> {
     add(
         s.swept_outside,
         Swatch::Fill(c::SWEPT_OUTSIDE),
-        "swept, beyond reachable floor".into(),
+        "swept, outside reachable floor".into(),
     );
     add(
         s.unreachable,
