@@ -607,3 +607,31 @@ fn run_json_is_the_scenario_and_replays_exactly() {
         );
     }
 }
+
+#[test]
+fn bench_max_memory_turns_runs_into_error_rows() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let bench = |sub: &str, extra: &[&str]| {
+        let out = dir.join(sub);
+        ccpp()
+            .args(["bench", "--quiet", "--planners", "ba-star,bcd", "--maps"])
+            .arg(&map)
+            .args(extra)
+            .arg("--out")
+            .arg(&out)
+            .assert()
+            .success();
+        std::fs::read_to_string(out.join("results.csv")).unwrap()
+    };
+    let limited = bench("limited", &["--max-memory", "1"]);
+    assert_eq!(
+        limited.matches("memory limit of 1 MB").count(),
+        2,
+        "{limited}"
+    );
+    let free = bench("free", &[]);
+    assert!(!free.contains("memory limit"), "{free}");
+    assert_eq!(free.matches(",ok,").count(), 2, "{free}");
+}
