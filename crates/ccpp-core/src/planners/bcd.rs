@@ -106,7 +106,7 @@ impl Default for BcdOptions {
             turn_cost_m: 0.3,
             rim: true,
             rim_min_yield: 0.0,
-            tour_rounds: 20,
+            tour_rounds: 2,
         }
     }
 }
@@ -239,7 +239,10 @@ fn decompose(nu: usize, nv: usize, cols: bool, free: &dyn Fn(usize, usize) -> bo
                 _ => false,
             };
             let id = if continues {
-                let p = prev.iter().find(|p| overl((p.0, p.1), run)).map_or(0, |p| p.2);
+                let p = prev
+                    .iter()
+                    .find(|p| overl((p.0, p.1), run))
+                    .map_or(0, |p| p.2);
                 cells[p].runs.push(run);
                 p
             } else {
@@ -363,12 +366,8 @@ impl Ctx<'_> {
         if self.free(a, b) {
             return Some(vec![b]);
         }
-        let pa = self.anchor(a);
-        let pb = self.anchor(b);
-        if std::env::var("BCD_DEBUG2").is_ok() {
-            eprintln!("route {a:?} {pa:?} -> {b:?} {pb:?} disk {} {}", self.world.disk_collides(self.frame.grid_to_world(a)), self.world.disk_collides(self.frame.grid_to_world(b)));
-        }
-        let (pa, pb) = (pa?, pb?);
+        let pa = self.anchor(a)?;
+        let pb = self.anchor(b)?;
         let diag = |i: usize, j: usize| {
             let w = self.frame.width;
             self.free(self.centre(i % w, i / w), self.centre(j % w, j / w))
@@ -459,7 +458,13 @@ impl Ctx<'_> {
 
 /// Share of the pixels of `cell`'s line `u` whose outer neighbour (towards `out` = -1 or +1
 /// along the lines) passes `other`, at least one half?
-fn side_open(ctx: &Ctx<'_>, cell: &Cell, u: usize, out: i64, other: &dyn Fn(usize) -> bool) -> bool {
+fn side_open(
+    ctx: &Ctx<'_>,
+    cell: &Cell,
+    u: usize,
+    out: i64,
+    other: &dyn Fn(usize) -> bool,
+) -> bool {
     let (a, b) = cell.runs[u - cell.u0];
     let w = ctx.frame.width;
     let n = (a..=b)
@@ -524,12 +529,7 @@ fn estimate(cell: &Cell, lanes: &[f64], turn_px: f64) -> f64 {
 
 /// A cell's two boustrophedon paths (grid points), starting at the first lane's low end and at
 /// its high end.
-fn cell_paths(
-    ctx: &Ctx<'_>,
-    search: &mut Search,
-    cell: &Cell,
-    lanes: &[f64],
-) -> [Vec<Point>; 2] {
+fn cell_paths(ctx: &Ctx<'_>, search: &mut Search, cell: &Cell, lanes: &[f64]) -> [Vec<Point>; 2] {
     let mut out = [Vec::new(), Vec::new()];
     for (k, start_hi) in [false, true].into_iter().enumerate() {
         let mut pts: Vec<Point> = Vec::new();
@@ -594,9 +594,7 @@ impl Bcd {
             Err(_) => {
                 let d = BcdOptions::default();
                 let fixed = BcdOptions {
-                    lane_spacing_m: opts
-                        .lane_spacing_m
-                        .filter(|s| s.is_finite() && *s > 0.0),
+                    lane_spacing_m: opts.lane_spacing_m.filter(|s| s.is_finite() && *s > 0.0),
                     margin_px: if opts.margin_px.is_finite() && opts.margin_px >= 0.0 {
                         opts.margin_px
                     } else {
@@ -737,9 +735,10 @@ impl Bcd {
             })
             .filter(|(_, l)| !l.is_empty())
             .collect();
-        let (ca, cb) = (d, phase);
 
-        // Cell paths and the tour.
+        // Cell paths; a first tour over the cells picks each cell's path (corner), the rim
+        // contours of what those paths miss join the cells in the final tour, where each cell
+        // keeps its path (driven either way).
         let mut paths: Vec<[Vec<Point>; 2]> = Vec::with_capacity(cells.len());
         let mut pieces = Vec::with_capacity(cells.len());
         for (cell, lanes) in &cells {
@@ -759,11 +758,29 @@ impl Bcd {
             pieces.push(piece);
             paths.push(ps);
         }
-        let dbg = std::env::var("BCD_DEBUG").is_ok();
-        let t0 = std::time::Instant::now();
-        // Rim contours of what the cells' own paths miss join the tour as pieces of their own.
+        let coarse = Coarse::new(&ctx, sp);
+        let dist = |a: Point, b: Point| coarse.dist(a, b);
         let ncells = paths.len();
         let contours: Vec<Vec<Point>> = if opts.rim {
+            let nn = coarse.nearest_tour(&pieces, start);
+            let first = tsp::solve(&pieces, start, opts.tour_rounds, &dist, Some(nn));
+            let mut keep = vec![0usize; ncells];
+            for &(c, v) in &first {
+                keep[c] = v / 2;
+            }
+            for (c, k) in keep.iter().enumerate() {
+                if *k == 1 {
+                    paths[c].swap(0, 1);
+                }
+                let p = &paths[c][0];
+                let (f, l) = (p[0], p[p.len() - 1]);
+                let len = polyline_len(p);
+                pieces[c] = tsp::Piece {
+                    entry: vec![f, l],
+                    exit: vec![l, f],
+                    inner: vec![len, len],
+                };
+            }
             let lines: Vec<&[Point]> = paths.iter().map(|p| p[0].as_slice()).collect();
             rim_contours(&ctx, &mut search, &lines, opts.rim_min_yield)
                 .into_iter()
@@ -781,17 +798,8 @@ impl Bcd {
                 inner: vec![len, len],
             });
         }
-        if dbg {
-            eprintln!("contours {} len {:.0} at {:?}", contours.len(), contours.iter().map(|c| polyline_len(c)).sum::<f64>(), t0.elapsed());
-        }
-        let tour = tsp::solve(&pieces, start, opts.tour_rounds);
-        if dbg {
-            let lanes_len: f64 = cells.iter().map(|(c, l)| estimate(c, l, 0.0) - (l[l.len()-1]-l[0])).sum();
-            let nl: usize = cells.iter().map(|(_, l)| l.len()).sum();
-            let single = cells.iter().filter(|(_, l)| l.len() == 1).count();
-            eprintln!("lanes {nl} len {lanes_len:.0} single-lane cells {single} ideal {:.0}", world.accessible_area_m2() / (2.0 * robot.tool_radius) / res);
-            eprintln!("cells {} (dec {ca} phase {cb:.2}) tour {} in {:?}", cells.len(), tour.len(), t0.elapsed());
-        }
+        let nn = coarse.nearest_tour(&pieces, start);
+        let tour = tsp::solve(&pieces, start, opts.tour_rounds, &dist, Some(nn));
 
         let mut items: Vec<Item> = vec![Item::Move(start)];
         let mut here = start;
@@ -825,9 +833,6 @@ impl Bcd {
             let entry = pts[0];
             if entry != here {
                 let Some(hop) = ctx.route(&mut search, here, entry) else {
-                    if dbg {
-                        eprintln!("no route {here:?} -> {entry:?}");
-                    }
                     continue;
                 };
                 items.push(Item::Mark(Event::BacktrackStart));
@@ -841,17 +846,8 @@ impl Bcd {
             here = pts[pts.len() - 1];
         }
 
-        if dbg {
-            let inner: f64 = tour.iter().filter(|e| e.0 < ncells).map(|&(c, v)| pieces[c].inner[v]).sum();
-            eprintln!("assembled {} items at {:?} len {:.0} inner {:.0} tourcost {:.0} sp {sp}", items.len(), t0.elapsed(), polyline_len(&moves(&items).iter().map(|m| m.0).collect::<Vec<_>>()), inner, tsp::cost(&pieces, start, &tour));
-        }
         if opts.rim {
-            for _ in 0..1 {
-                rim_pass(&ctx, &mut search, &mut items, opts.rim_min_yield);
-                if dbg {
-                    eprintln!("rim {} items at {:?} len {:.0}", items.len(), t0.elapsed(), polyline_len(&moves(&items).iter().map(|m| m.0).collect::<Vec<_>>()));
-                }
-            }
+            rim_pass(&ctx, &mut search, &mut items, opts.rim_min_yield);
         }
         let items = repair(&ctx, &mut search, items);
 
@@ -943,10 +939,6 @@ fn rim_contours(
     missed.difference_with(&swept);
     if missed.is_clear() {
         return Vec::new();
-    }
-    let dbg = std::env::var("BCD_DEBUG").is_ok();
-    if dbg {
-        eprintln!("missed {} of {}", missed.count_ones(..), acc.count_ones(..));
     }
     // Witness of each missed pixel: the nearest C-free pixel centre within reach of the tool.
     let k = rt.floor() as i64;
@@ -1054,10 +1046,12 @@ fn rim_pass(ctx: &Ctx<'_>, search: &mut Search, items: &mut Vec<Item>, min_yield
     let path = moves(items);
     let line: Vec<Point> = path.iter().map(|m| m.0).collect();
     let contours = rim_contours(ctx, search, &[&line], min_yield);
-    let dbg = std::env::var("BCD_DEBUG").is_ok();
     // Spatial index of the path's segments (buckets of 16 px).
     const B: f64 = 16.0;
-    let (bw, bh) = ((w as f64 / B).ceil() as usize + 1, (h as f64 / B).ceil() as usize + 1);
+    let (bw, bh) = (
+        (w as f64 / B).ceil() as usize + 1,
+        (h as f64 / B).ceil() as usize + 1,
+    );
     let mut buckets: Vec<Vec<u32>> = vec![Vec::new(); bw * bh];
     let bucket = |p: Point| -> (usize, usize) {
         (
@@ -1075,8 +1069,7 @@ fn rim_pass(ctx: &Ctx<'_>, search: &mut Search, items: &mut Vec<Item>, min_yield
     }
     // (insert after path segment s, at parameter t along it, the detour points)
     let mut inserts: Vec<(usize, f64, Vec<Point>)> = Vec::new();
-    let (mut sum_cost, mut sum_gain) = (0.0, 0.0);
-    for (contour, gain) in contours {
+    for (contour, _) in contours {
         let clen = polyline_len(&contour);
         let (cs, ce) = (contour[0], contour[contour.len() - 1]);
         // Cheapest insertion: segments near the contour's start, widening the search.
@@ -1114,10 +1107,9 @@ fn rim_pass(ctx: &Ctx<'_>, search: &mut Search, items: &mut Vec<Item>, min_yield
                 }
             }
         }
-        let Some((cost, s, t, rev)) = best else {
+        let Some((_, s, t, rev)) = best else {
             continue;
         };
-        let gain = gain as f64;
         let (a, b) = (path[s].0, path[s + 1].0);
         let q = a.add(b.sub(a).scale(t));
         let mut det: Vec<Point> = vec![q];
@@ -1127,14 +1119,7 @@ fn rim_pass(ctx: &Ctx<'_>, search: &mut Search, items: &mut Vec<Item>, min_yield
             det.extend(contour.iter().copied());
         }
         det.push(q);
-        if dbg {
-            sum_cost += cost;
-            sum_gain += gain;
-        }
         inserts.push((s, t, det));
-    }
-    if dbg {
-        eprintln!("mop-up detour total {sum_cost:.0} gain {sum_gain}");
     }
     // Apply: later segments first so indices stay valid; along a segment, by parameter.
     inserts.sort_by(|x, y| y.0.cmp(&x.0).then(y.1.total_cmp(&x.1)));
@@ -1153,6 +1138,299 @@ fn proj(a: Point, b: Point, p: Point) -> f64 {
         0.0
     } else {
         (p.sub(a).dot(d) / l2).clamp(0.0, 1.0)
+    }
+}
+
+/// Hop costs for the cell tour: the straight-line distance, or the length of a shortest path
+/// over a coarse grid of the C-free set when that is longer (walls between the points).
+/// Blocks of `b` pixels are open when they hold a C-free pixel and joined to a side neighbour
+/// when C-free pixels touch across their common edge.
+struct Coarse {
+    b: usize,
+    bw: usize,
+    bh: usize,
+    open: Vec<bool>,
+    /// Block joined to its east / south neighbour.
+    east: Vec<bool>,
+    south: Vec<bool>,
+    cache: std::cell::RefCell<std::collections::HashMap<(u32, u32), f64>>,
+    /// A* scratch: generation stamp and cost per block.
+    scratch: std::cell::RefCell<(u32, Vec<u32>, Vec<u32>)>,
+}
+
+impl Coarse {
+    fn new(ctx: &Ctx<'_>, sp: f64) -> Self {
+        let (w, h) = (ctx.frame.width, ctx.frame.height);
+        let b = (sp.round() as usize).max(4);
+        let (bw, bh) = (w.div_ceil(b), h.div_ceil(b));
+        let mut open = vec![false; bw * bh];
+        let mut east = vec![false; bw * bh];
+        let mut south = vec![false; bw * bh];
+        for r in 0..h {
+            for c in 0..w {
+                if !ctx.ok[r * w + c] {
+                    continue;
+                }
+                let k = (r / b) * bw + c / b;
+                open[k] = true;
+                if c + 1 < w && (c + 1) % b == 0 && ctx.ok[r * w + c + 1] {
+                    east[k] = true;
+                }
+                if r + 1 < h && (r + 1) % b == 0 && ctx.ok[(r + 1) * w + c] {
+                    south[k] = true;
+                }
+            }
+        }
+        Self {
+            b,
+            bw,
+            bh,
+            open,
+            east,
+            south,
+            cache: std::cell::RefCell::new(std::collections::HashMap::new()),
+            scratch: std::cell::RefCell::new((0, vec![0; bw * bh], vec![0; bw * bh])),
+        }
+    }
+
+    fn block(&self, p: Point) -> usize {
+        let bf = self.b as f64;
+        let c = ((p.x / bf).floor().max(0.0) as usize).min(self.bw - 1);
+        // Grid y is up; blocks count rows from the top.
+        let rows = self.bh * self.b;
+        let r_px = (rows as f64 - p.y).floor().max(0.0) as usize;
+        let r = (r_px / self.b).min(self.bh - 1);
+        r * self.bw + c
+    }
+
+    fn dist(&self, a: Point, b: Point) -> f64 {
+        let e = a.dist(b);
+        let (ka, kb) = (self.block(a), self.block(b));
+        // Near: the straight line; far (over 64 blocks): the straight line too, as searching
+        // there costs more than it tells (good tours hop short).
+        if ka == kb || e < self.b as f64 || e > 64.0 * self.b as f64 {
+            return e;
+        }
+        let key = (ka.min(kb) as u32, ka.max(kb) as u32);
+        if let Some(&g) = self.cache.borrow().get(&key) {
+            return e.max(g);
+        }
+        // Searched up to eight times the straight line; beyond, or where the coarse grid cannot
+        // join the blocks (a wall through a block), that bound stands in.
+        let g = self.astar(ka, kb, 8.0 * e).min(8.0 * e);
+        self.cache.borrow_mut().insert(key, g);
+        e.max(g)
+    }
+
+    /// Block steps from block `k` (dc, dr, cost in tenths of a block) that the coarse grid
+    /// allows.
+    fn steps(&self, k: usize, out: &mut Vec<(usize, u32)>) {
+        out.clear();
+        let bw = self.bw;
+        let (c, r) = ((k % bw) as i64, (k / bw) as i64);
+        let at = |c: i64, r: i64| r as usize * bw + c as usize;
+        let linked = |k: usize, dc: i64, dr: i64| -> bool {
+            let (c, r) = ((k % bw) as i64, (k / bw) as i64);
+            match (dc, dr) {
+                (1, 0) => self.east[k],
+                (-1, 0) => self.east[at(c - 1, r)],
+                (0, 1) => self.south[k],
+                (0, -1) => self.south[at(c, r - 1)],
+                _ => false,
+            }
+        };
+        for (dc, dr) in [
+            (1, 0),
+            (0, 1),
+            (-1, 0),
+            (0, -1),
+            (1, 1),
+            (1, -1),
+            (-1, 1),
+            (-1, -1),
+        ] {
+            let (nc, nr) = (c + dc, r + dr);
+            if nc < 0 || nr < 0 || nc >= bw as i64 || nr >= self.bh as i64 {
+                continue;
+            }
+            let j = at(nc, nr);
+            if !self.open[j] {
+                continue;
+            }
+            if dc != 0 && dr != 0 {
+                let (vh, vv) = (at(nc, r), at(c, nr));
+                let a = self.open[vh] && linked(k, dc, 0) && linked(vh, 0, dr);
+                let b = self.open[vv] && linked(k, 0, dr) && linked(vv, dc, 0);
+                if a || b {
+                    out.push((j, 14));
+                }
+            } else if linked(k, dc, dr) {
+                out.push((j, 10));
+            }
+        }
+    }
+
+    /// Nearest-neighbour tour by hop cost: from each exit, a Dijkstra over the coarse grid
+    /// finds the piece entry with the lowest `dist + inner` (straight-line order where the
+    /// coarse grid joins nothing).
+    fn nearest_tour(&self, pieces: &[tsp::Piece], start: Point) -> tsp::Tour {
+        let nblocks = self.bw * self.bh;
+        let mut at_block: Vec<Vec<(usize, usize)>> = vec![Vec::new(); nblocks];
+        for (p, piece) in pieces.iter().enumerate() {
+            for (v, &e) in piece.entry.iter().enumerate() {
+                at_block[self.block(e)].push((p, v));
+            }
+        }
+        let mut done = vec![false; pieces.len()];
+        let mut tour = Vec::with_capacity(pieces.len());
+        let mut here = start;
+        let mut stamp = vec![0u32; nblocks];
+        let mut g = vec![0u32; nblocks];
+        let mut nbrs = Vec::new();
+        let bpx = self.b as f64;
+        for round in 1..=pieces.len() as u32 {
+            let mut best: Option<(f64, usize, usize)> = None;
+            let s = self.block(here);
+            let mut heap = BinaryHeap::new();
+            stamp[s] = round;
+            g[s] = 0;
+            heap.push(Reverse((0u32, s)));
+            while let Some(Reverse((gk, k))) = heap.pop() {
+                if gk > g[k] {
+                    continue;
+                }
+                let gpx = f64::from(gk) / 10.0 * bpx;
+                if best.is_some_and(|b| gpx - 2.0 * bpx > b.0) {
+                    break;
+                }
+                for &(p, v) in &at_block[k] {
+                    if done[p] {
+                        continue;
+                    }
+                    let e = pieces[p].entry[v];
+                    let c = self.dist(here, e) + pieces[p].inner[v];
+                    if best.is_none_or(|b| c < b.0) {
+                        best = Some((c, p, v));
+                    }
+                }
+                self.steps(k, &mut nbrs);
+                for &(j, w) in &nbrs {
+                    let ng = gk + w;
+                    if stamp[j] != round || ng < g[j] {
+                        stamp[j] = round;
+                        g[j] = ng;
+                        heap.push(Reverse((ng, j)));
+                    }
+                }
+            }
+            if best.is_none() {
+                for (p, piece) in pieces.iter().enumerate() {
+                    if done[p] {
+                        continue;
+                    }
+                    for (v, &e) in piece.entry.iter().enumerate() {
+                        let c = here.dist(e) + piece.inner[v];
+                        if best.is_none_or(|b| c < b.0) {
+                            best = Some((c, p, v));
+                        }
+                    }
+                }
+            }
+            let Some((_, p, v)) = best else { break };
+            done[p] = true;
+            tour.push((p, v));
+            here = pieces[p].exit[v];
+        }
+        tour
+    }
+
+    /// Shortest block path length (pixels) between blocks `s` and `t` (8-connected; a diagonal
+    /// step needs one of its two side paths), infinite when none is shorter than `limit` px.
+    fn astar(&self, s: usize, t: usize, limit: f64) -> f64 {
+        let cap = (limit / self.b as f64 * 10.0).ceil() as u32 + 20;
+        let bw = self.bw;
+        let (tc, tr) = ((t % bw) as i64, (t / bw) as i64);
+        let hcost = |k: usize| -> u32 {
+            let dx = ((k % bw) as i64 - tc).unsigned_abs() as u32;
+            let dy = ((k / bw) as i64 - tr).unsigned_abs() as u32;
+            10 * dx.max(dy) + 4 * dx.min(dy)
+        };
+        let linked = |k: usize, dc: i64, dr: i64| -> bool {
+            let (c, r) = ((k % bw) as i64, (k / bw) as i64);
+            let at = |c: i64, r: i64| r as usize * bw + c as usize;
+            match (dc, dr) {
+                (1, 0) => self.east[k],
+                (-1, 0) => self.east[at(c - 1, r)],
+                (0, 1) => self.south[k],
+                (0, -1) => self.south[at(c, r - 1)],
+                _ => false,
+            }
+        };
+        let mut scratch = self.scratch.borrow_mut();
+        let (gen, stamp, g) = &mut *scratch;
+        *gen = gen.wrapping_add(1);
+        if *gen == 0 {
+            stamp.iter_mut().for_each(|x| *x = 0);
+            *gen = 1;
+        }
+        let gen = *gen;
+        let mut heap = BinaryHeap::new();
+        stamp[s] = gen;
+        g[s] = 0;
+        heap.push(Reverse((hcost(s), 0u32, s)));
+        while let Some(Reverse((f, gk, k))) = heap.pop() {
+            if f > cap {
+                break;
+            }
+            if gk > g[k] {
+                continue;
+            }
+            if k == t {
+                return f64::from(gk) / 10.0 * self.b as f64;
+            }
+            let (c, r) = ((k % bw) as i64, (k / bw) as i64);
+            for (dc, dr) in [
+                (1, 0),
+                (0, 1),
+                (-1, 0),
+                (0, -1),
+                (1, 1),
+                (1, -1),
+                (-1, 1),
+                (-1, -1),
+            ] {
+                let (nc, nr) = (c + dc, r + dr);
+                if nc < 0 || nr < 0 || nc >= bw as i64 || nr >= self.bh as i64 {
+                    continue;
+                }
+                let j = nr as usize * bw + nc as usize;
+                if !self.open[j] {
+                    continue;
+                }
+                let step = if dc != 0 && dr != 0 {
+                    let via_h = r as usize * bw + nc as usize;
+                    let via_v = nr as usize * bw + c as usize;
+                    let a = self.open[via_h] && linked(k, dc, 0) && linked(via_h, 0, dr);
+                    let b = self.open[via_v] && linked(k, 0, dr) && linked(via_v, dc, 0);
+                    if !(a || b) {
+                        continue;
+                    }
+                    14
+                } else {
+                    if !linked(k, dc, dr) {
+                        continue;
+                    }
+                    10
+                };
+                let ng = gk + step;
+                if stamp[j] != gen || ng < g[j] {
+                    stamp[j] = gen;
+                    g[j] = ng;
+                    heap.push(Reverse((ng + hcost(j), ng, j)));
+                }
+            }
+        }
+        f64::INFINITY
     }
 }
 

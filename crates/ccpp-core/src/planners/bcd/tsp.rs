@@ -31,12 +31,11 @@ const EPS: f64 = 1e-7;
 /// A visiting order: `(piece, variant)` pairs.
 pub(crate) type Tour = Vec<(usize, usize)>;
 
-fn d(a: Point, b: Point) -> f64 {
-    a.dist(b)
-}
+/// Hop cost between two points.
+pub(crate) type Dist<'a> = &'a dyn Fn(Point, Point) -> f64;
 
 /// Total cost of `tour` from `start`.
-pub(crate) fn cost(pieces: &[Piece], start: Point, tour: &Tour) -> f64 {
+pub(crate) fn cost(pieces: &[Piece], start: Point, tour: &Tour, d: Dist<'_>) -> f64 {
     let mut at = start;
     let mut total = 0.0;
     for &(p, v) in tour {
@@ -46,41 +45,59 @@ pub(crate) fn cost(pieces: &[Piece], start: Point, tour: &Tour) -> f64 {
     total
 }
 
-/// Plans the visiting order (see the module docs).
-pub(crate) fn solve(pieces: &[Piece], start: Point, rounds: u32) -> Tour {
-    let mut tour = nearest_neighbour(pieces, start);
+/// Plans the visiting order (see the module docs); `first`, when given, replaces the
+/// nearest-neighbour construction.
+pub(crate) fn solve(
+    pieces: &[Piece],
+    start: Point,
+    rounds: u32,
+    d: Dist<'_>,
+    first: Option<Tour>,
+) -> Tour {
+    let mut tour = first.unwrap_or_else(|| nearest_neighbour(pieces, start, d));
     if rounds == 0 {
         return tour;
     }
-    let nb = neighbour_lists(pieces);
+    let nb = neighbour_lists(pieces, d);
     for _ in 0..rounds {
-        let before = cost(pieces, start, &tour);
-        two_opt(pieces, start, &mut tour, &nb);
-        or_opt(pieces, start, &mut tour, &nb);
-        choose_variants(pieces, start, &mut tour);
-        if cost(pieces, start, &tour) >= before - EPS {
+        let before = cost(pieces, start, &tour, d);
+        two_opt(pieces, start, &mut tour, &nb, d);
+        or_opt(pieces, start, &mut tour, &nb, d);
+        choose_variants(pieces, start, &mut tour, d);
+        if cost(pieces, start, &tour, d) >= before - EPS {
             break;
         }
     }
     tour
 }
 
-fn nearest_neighbour(pieces: &[Piece], start: Point) -> Tour {
+fn nearest_neighbour(pieces: &[Piece], start: Point, d: Dist<'_>) -> Tour {
     let n = pieces.len();
     let mut done = vec![false; n];
     let mut tour = Vec::with_capacity(n);
     let mut at = start;
+    let mut cands: Vec<(f64, usize, usize)> = Vec::new();
     for _ in 0..n {
-        let mut best: Option<(f64, usize, usize)> = None;
+        // Candidates by straight-line cost (a lower bound of the hop cost), then exact costs
+        // until the bound passes the best found.
+        cands.clear();
         for (p, piece) in pieces.iter().enumerate() {
             if done[p] {
                 continue;
             }
             for v in 0..piece.entry.len() {
-                let c = d(at, piece.entry[v]) + piece.inner[v];
-                if best.is_none_or(|b| c < b.0) {
-                    best = Some((c, p, v));
-                }
+                cands.push((at.dist(piece.entry[v]) + piece.inner[v], p, v));
+            }
+        }
+        cands.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
+        let mut best: Option<(f64, usize, usize)> = None;
+        for &(lb, p, v) in &cands {
+            if best.is_some_and(|b| lb >= b.0) {
+                break;
+            }
+            let c = d(at, pieces[p].entry[v]) + pieces[p].inner[v];
+            if best.is_none_or(|b| c < b.0) {
+                best = Some((c, p, v));
             }
         }
         let Some((_, p, v)) = best else { break };
@@ -106,7 +123,7 @@ const NEIGHBOURS: usize = 12;
 
 /// The `NEIGHBOURS` pieces nearest to each piece (by the closest pair of end points), nearest
 /// first, ties by index.
-fn neighbour_lists(pieces: &[Piece]) -> Vec<Vec<usize>> {
+fn neighbour_lists(pieces: &[Piece], d: Dist<'_>) -> Vec<Vec<usize>> {
     let ends: Vec<Vec<Point>> = pieces
         .iter()
         .map(|p| {
@@ -127,19 +144,38 @@ fn neighbour_lists(pieces: &[Piece]) -> Vec<Vec<usize>> {
     };
     (0..pieces.len())
         .map(|a| {
-            let mut best: Vec<(f64, usize)> = Vec::with_capacity(NEIGHBOURS + 1);
+            // The 3 * NEIGHBOURS nearest in a straight line, re-ranked by hop cost.
+            let keep = 3 * NEIGHBOURS;
+            let mut best: Vec<(f64, usize)> = Vec::with_capacity(keep + 1);
             for b in 0..pieces.len() {
                 if a == b {
                     continue;
                 }
                 let g = gap(a, b);
-                if best.len() < NEIGHBOURS || g < best[best.len() - 1].0 {
+                if best.len() < keep || g < best[best.len() - 1].0 {
                     let at = best.partition_point(|e| e.0 <= g);
                     best.insert(at, (g, b));
-                    best.truncate(NEIGHBOURS);
+                    best.truncate(keep);
                 }
             }
-            best.into_iter().map(|e| e.1).collect()
+            // (one hop cost per candidate: between its end points nearest in a straight line)
+            let mut ranked: Vec<(f64, usize)> = best
+                .into_iter()
+                .map(|(_, b)| {
+                    let mut pair = (f64::INFINITY, ends[a][0], ends[b][0]);
+                    for p in &ends[a] {
+                        for q in &ends[b] {
+                            if p.dist2(*q) < pair.0 {
+                                pair = (p.dist2(*q), *p, *q);
+                            }
+                        }
+                    }
+                    (d(pair.1, pair.2), b)
+                })
+                .collect();
+            ranked.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+            ranked.truncate(NEIGHBOURS);
+            ranked.into_iter().map(|e| e.1).collect()
         })
         .collect()
 }
@@ -155,7 +191,7 @@ fn positions(tour: &Tour, n: usize) -> Vec<usize> {
 /// 2-opt over candidate neighbours: reversing `tour[i..=j]` makes the hops
 /// `prev(i) -> exit(j)` and `entry(i) -> entry(j + 1)`; `j` is taken where either new hop
 /// joins neighbours.
-fn two_opt(pieces: &[Piece], start: Point, tour: &mut Tour, nb: &[Vec<usize>]) {
+fn two_opt(pieces: &[Piece], start: Point, tour: &mut Tour, nb: &[Vec<usize>], d: Dist<'_>) {
     let n = tour.len();
     let entry = |t: &Tour, i: usize| pieces[t[i].0].entry[t[i].1];
     let exit = |t: &Tour, i: usize| pieces[t[i].0].exit[t[i].1];
@@ -205,7 +241,7 @@ fn two_opt(pieces: &[Piece], start: Point, tour: &mut Tour, nb: &[Vec<usize>]) {
 
 /// Or-opt over candidate neighbours: stretches of 1 to 3 pieces moved next to a neighbour of
 /// their first or last piece, either way round.
-fn or_opt(pieces: &[Piece], start: Point, tour: &mut Tour, nb: &[Vec<usize>]) {
+fn or_opt(pieces: &[Piece], start: Point, tour: &mut Tour, nb: &[Vec<usize>], d: Dist<'_>) {
     let entry = |t: &Tour, i: usize| pieces[t[i].0].entry[t[i].1];
     let exit = |t: &Tour, i: usize| pieces[t[i].0].exit[t[i].1];
     let mut pos = positions(tour, pieces.len());
@@ -277,7 +313,7 @@ fn or_opt(pieces: &[Piece], start: Point, tour: &mut Tour, nb: &[Vec<usize>]) {
 }
 
 /// Exact choice of every piece's variant for the current order (dynamic programme).
-fn choose_variants(pieces: &[Piece], start: Point, tour: &mut Tour) {
+fn choose_variants(pieces: &[Piece], start: Point, tour: &mut Tour, d: Dist<'_>) {
     let n = tour.len();
     if n == 0 {
         return;
@@ -314,7 +350,7 @@ fn choose_variants(pieces: &[Piece], start: Point, tour: &mut Tour) {
             v = u;
         }
     }
-    let old = cost(pieces, start, tour);
+    let old = cost(pieces, start, tour, d);
     if last[v] >= old - EPS {
         return;
     }
@@ -327,6 +363,10 @@ fn choose_variants(pieces: &[Piece], start: Point, tour: &mut Tour) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn euclid(a: Point, b: Point) -> f64 {
+        a.dist(b)
+    }
 
     fn point_piece(x: f64, y: f64) -> Piece {
         let p = Point::new(x, y);
@@ -341,10 +381,10 @@ mod tests {
     fn points_on_a_line_are_visited_in_order() {
         let xs = [5.0, 1.0, 9.0, 3.0, 7.0, 2.0];
         let pieces: Vec<Piece> = xs.iter().map(|&x| point_piece(x, 0.0)).collect();
-        let tour = solve(&pieces, Point::new(0.0, 0.0), 10);
+        let tour = solve(&pieces, Point::new(0.0, 0.0), 10, &euclid, None);
         let order: Vec<f64> = tour.iter().map(|&(p, _)| xs[p]).collect();
         assert_eq!(order, vec![1.0, 2.0, 3.0, 5.0, 7.0, 9.0]);
-        assert!((cost(&pieces, Point::new(0.0, 0.0), &tour) - 9.0).abs() < 1e-9);
+        assert!((cost(&pieces, Point::new(0.0, 0.0), &tour, &euclid) - 9.0).abs() < 1e-9);
     }
 
     #[test]
@@ -356,9 +396,9 @@ mod tests {
             inner: vec![10.0, 10.0],
         };
         let pieces = vec![seg(1.0), seg(0.0)];
-        let tour = solve(&pieces, Point::new(0.0, 0.0), 10);
+        let tour = solve(&pieces, Point::new(0.0, 0.0), 10, &euclid, None);
         assert_eq!(tour, vec![(1, 0), (0, 1)]);
-        assert!((cost(&pieces, Point::new(0.0, 0.0), &tour) - 21.0).abs() < 1e-9);
+        assert!((cost(&pieces, Point::new(0.0, 0.0), &tour, &euclid) - 21.0).abs() < 1e-9);
     }
 
     #[test]
@@ -374,9 +414,9 @@ mod tests {
             pieces.push(point_piece(x, y));
         }
         let start = Point::new(0.0, 0.0);
-        let nn = nearest_neighbour(&pieces, start);
-        let best = solve(&pieces, start, 20);
-        assert!(cost(&pieces, start, &best) <= cost(&pieces, start, &nn) + 1e-9);
+        let nn = nearest_neighbour(&pieces, start, &euclid);
+        let best = solve(&pieces, start, 20, &euclid, None);
+        assert!(cost(&pieces, start, &best, &euclid) <= cost(&pieces, start, &nn, &euclid) + 1e-9);
         let mut seen: Vec<usize> = best.iter().map(|e| e.0).collect();
         seen.sort_unstable();
         assert_eq!(seen, (0..40).collect::<Vec<_>>());
