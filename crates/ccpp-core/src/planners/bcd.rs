@@ -1579,6 +1579,113 @@ mod tests {
         assert_eq!((d[3].u0, d[3].runs.len()), (4, 4));
     }
 
+    fn block_room() -> World {
+        let art = "##########\n#........#\n#..##....#\n#..##....#\n#........#\n##########";
+        let map = crate::grid::GridMap::from_ascii_scaled(art, 10, 0.02).unwrap();
+        World::new(
+            map,
+            crate::world::Robot::new(0.08),
+            Some(crate::geometry::Pose::new(0.3, 0.3, 0.0)),
+        )
+        .unwrap()
+    }
+
+    fn run(world: &World, opts: &BcdOptions) -> crate::metrics::Metrics {
+        let mut p = Bcd::try_new(world, opts).unwrap();
+        let out = crate::sim::simulate(world, &mut p, &crate::sim::SimConfig::default());
+        crate::metrics::compute(world, &out, "block_room")
+    }
+
+    #[test]
+    fn lanes_sit_on_closed_edges_and_on_the_lattice_between() {
+        let cell = Cell {
+            cols: true,
+            u0: 3,
+            runs: vec![(0, 9); 20],
+        };
+        // Both sides closed: lanes on both edges, lattice lines (6 apart) in between.
+        let l = lanes_of(&cell, 6.0, 0.0, false, false);
+        assert_eq!(l, vec![3.0, 6.0, 12.0, 18.0, 22.0]);
+        assert!(l.windows(2).all(|w| w[1] - w[0] <= 6.0));
+        // Open sides: only the lattice, shared with the neighbours beyond.
+        assert_eq!(lanes_of(&cell, 6.0, 0.0, true, true), vec![6.0, 12.0, 18.0]);
+        // A lattice line within half a pixel of the edge belongs to this cell.
+        assert_eq!(
+            lanes_of(&cell, 6.0, 2.6, true, true),
+            vec![3.0, 8.6, 14.6, 20.6]
+        );
+    }
+
+    #[test]
+    fn block_room_is_covered_without_contact() {
+        let world = block_room();
+        let m = run(&world, &BcdOptions::default());
+        assert_eq!(m.collisions, 0);
+        assert!(m.effective_coverage >= 0.995, "{}", m.effective_coverage);
+    }
+
+    #[test]
+    fn rim_option_sweeps_what_lanes_miss() {
+        let world = block_room();
+        let with = run(&world, &BcdOptions::default());
+        let without = run(
+            &world,
+            &BcdOptions {
+                rim: false,
+                ..BcdOptions::default()
+            },
+        );
+        let picky = run(
+            &world,
+            &BcdOptions {
+                rim_min_yield: 1.0,
+                ..BcdOptions::default()
+            },
+        );
+        assert_eq!(without.collisions + picky.collisions, 0);
+        assert!(without.effective_coverage < with.effective_coverage);
+        assert!(without.path_length_m < with.path_length_m);
+        // A yield of a whole lane per metre is never met by a rim contour.
+        assert!(picky.effective_coverage < with.effective_coverage);
+    }
+
+    #[test]
+    fn same_plan_twice() {
+        let world = block_room();
+        let a = Bcd::new(&world, &BcdOptions::default());
+        let b = Bcd::new(&world, &BcdOptions::default());
+        assert_eq!(a.steps, b.steps);
+        assert_eq!(a.cells(), b.cells());
+    }
+
+    #[test]
+    fn invalid_options_are_refused() {
+        let world = block_room();
+        for bad in [
+            BcdOptions {
+                lane_spacing_m: Some(0.0),
+                ..BcdOptions::default()
+            },
+            BcdOptions {
+                margin_px: -1.0,
+                ..BcdOptions::default()
+            },
+            BcdOptions {
+                turn_cost_m: f64::NAN,
+                ..BcdOptions::default()
+            },
+            BcdOptions {
+                rim_min_yield: 1.5,
+                ..BcdOptions::default()
+            },
+        ] {
+            let e = Bcd::try_new(&world, &bad).err().unwrap();
+            assert!(e.to_string().starts_with("bcd option "), "{e}");
+            // The infallible constructor falls back to the defaults and still plans.
+            assert!(!Bcd::new(&world, &bad).steps.is_empty());
+        }
+    }
+
     #[test]
     fn transposed_cell_needs_one_run_per_line() {
         // An L: rows 0-1 span columns 0-3, rows 2-3 only column 0.
