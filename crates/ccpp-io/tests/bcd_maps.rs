@@ -1,10 +1,10 @@
-//! BCD, the known-map reference planner, on the team's real maps (`shared/maps`, r = r_tool =
-//! 0.15 m, each map's default start): no collision and at least 99.5 % effective coverage on
+//! BCD, the known-map reference planner, on the team's real maps (`shared/maps`,
+//! r = `r_tool` = 0.15 m, each map's default start): no collision and at least 99.5 % effective coverage on
 //! every map, and the same trace twice.
 
 #![allow(clippy::unwrap_used)] // tests may panic on broken fixtures
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use ccpp_core::metrics;
 use ccpp_core::planners::bcd::{Bcd, BcdOptions};
@@ -30,7 +30,7 @@ fn yamls() -> Vec<PathBuf> {
     v
 }
 
-fn world(yaml: &PathBuf) -> World {
+fn world(yaml: &Path) -> World {
     let map = load_map(yaml, &LoadOptions::default()).unwrap().grid;
     World::new(map, Robot::new(0.15), None).unwrap()
 }

@@ -478,7 +478,7 @@ fn side_open(
             ctx.ok_at(c, r) && other(r as usize * w + c as usize)
         })
         .count();
-    2 * n >= b - a + 1
+    2 * n > b - a
 }
 
 /// The lane positions (line coordinates) of `cell` (module docs, step 2): a lane on each
@@ -549,14 +549,13 @@ fn cell_paths(ctx: &Ctx<'_>, search: &mut Search, cell: &Cell, lanes: &[f64]) ->
                     w += 1.0;
                 }
                 chain.push(a);
-                match ctx.follow(search, &chain) {
-                    Some(v) => pts.extend(v),
-                    None => {
-                        // Unreachable along the rim (should not happen inside a cell): route.
-                        let from = *pts.last().unwrap_or(&a);
-                        if let Some(v) = ctx.route(search, from, a) {
-                            pts.extend(v);
-                        }
+                if let Some(v) = ctx.follow(search, &chain) {
+                    pts.extend(v);
+                } else {
+                    // Unreachable along the rim (should not happen inside a cell): route.
+                    let from = *pts.last().unwrap_or(&a);
+                    if let Some(v) = ctx.route(search, from, a) {
+                        pts.extend(v);
                     }
                 }
             }
@@ -589,32 +588,31 @@ impl Bcd {
     /// [`BcdOptions::validate`]) are replaced by their defaults; use [`Bcd::try_new`] to refuse
     /// them instead.
     pub fn new(world: &World, opts: &BcdOptions) -> Self {
-        match Self::try_new(world, opts) {
-            Ok(p) => p,
-            Err(_) => {
-                let d = BcdOptions::default();
-                let fixed = BcdOptions {
-                    lane_spacing_m: opts.lane_spacing_m.filter(|s| s.is_finite() && *s > 0.0),
-                    margin_px: if opts.margin_px.is_finite() && opts.margin_px >= 0.0 {
-                        opts.margin_px
-                    } else {
-                        d.margin_px
-                    },
-                    turn_cost_m: if opts.turn_cost_m.is_finite() && opts.turn_cost_m >= 0.0 {
-                        opts.turn_cost_m
-                    } else {
-                        d.turn_cost_m
-                    },
-                    rim: opts.rim,
-                    rim_min_yield: if (0.0..=1.0).contains(&opts.rim_min_yield) {
-                        opts.rim_min_yield
-                    } else {
-                        d.rim_min_yield
-                    },
-                    tour_rounds: opts.tour_rounds,
-                };
-                Self::plan(world, &fixed)
-            }
+        if let Ok(p) = Self::try_new(world, opts) {
+            p
+        } else {
+            let d = BcdOptions::default();
+            let fixed = BcdOptions {
+                lane_spacing_m: opts.lane_spacing_m.filter(|s| s.is_finite() && *s > 0.0),
+                margin_px: if opts.margin_px.is_finite() && opts.margin_px >= 0.0 {
+                    opts.margin_px
+                } else {
+                    d.margin_px
+                },
+                turn_cost_m: if opts.turn_cost_m.is_finite() && opts.turn_cost_m >= 0.0 {
+                    opts.turn_cost_m
+                } else {
+                    d.turn_cost_m
+                },
+                rim: opts.rim,
+                rim_min_yield: if (0.0..=1.0).contains(&opts.rim_min_yield) {
+                    opts.rim_min_yield
+                } else {
+                    d.rim_min_yield
+                },
+                tour_rounds: opts.tour_rounds,
+            };
+            Self::plan(world, &fixed)
         }
     }
 
@@ -1041,13 +1039,13 @@ fn rim_contours(
 /// Final mop-up of step 3: sweeps what the assembled plan still misses with contour detours
 /// inserted at the cheapest point of the path (out and back).
 fn rim_pass(ctx: &Ctx<'_>, search: &mut Search, items: &mut Vec<Item>, min_yield: f64) {
+    const B: f64 = 16.0;
     let frame = ctx.frame;
     let (w, h) = (frame.width, frame.height);
     let path = moves(items);
     let line: Vec<Point> = path.iter().map(|m| m.0).collect();
     let contours = rim_contours(ctx, search, &[&line], min_yield);
     // Spatial index of the path's segments (buckets of 16 px).
-    const B: f64 = 16.0;
     let (bw, bh) = (
         (w as f64 / B).ceil() as usize + 1,
         (h as f64 / B).ceil() as usize + 1,
@@ -1370,7 +1368,7 @@ impl Coarse {
         let (gen, stamp, g) = &mut *scratch;
         *gen = gen.wrapping_add(1);
         if *gen == 0 {
-            stamp.iter_mut().for_each(|x| *x = 0);
+            stamp.fill(0);
             *gen = 1;
         }
         let gen = *gen;
