@@ -613,25 +613,30 @@ fn bench_max_memory_turns_runs_into_error_rows() {
     let d = tempfile::tempdir().unwrap();
     let dir = d.path();
     let map = pillars(dir);
-    let bench = |sub: &str, extra: &[&str]| {
+    // `bench` exits 1 when any run failed (after writing its results), 0 when all ran.
+    let bench = |sub: &str, extra: &[&str], ok: bool| {
         let out = dir.join(sub);
-        ccpp()
+        let a = ccpp()
             .args(["bench", "--quiet", "--planners", "ba-star,bcd", "--maps"])
             .arg(&map)
             .args(extra)
             .arg("--out")
             .arg(&out)
-            .assert()
-            .success();
+            .assert();
+        if ok {
+            a.success();
+        } else {
+            a.failure().code(1);
+        }
         std::fs::read_to_string(out.join("results.csv")).unwrap()
     };
-    let limited = bench("limited", &["--max-memory", "1"]);
+    let limited = bench("limited", &["--max-memory", "1"], false);
     assert_eq!(
         limited.matches("memory limit of 1 MB").count(),
         2,
         "{limited}"
     );
-    let free = bench("free", &[]);
+    let free = bench("free", &[], true);
     assert!(!free.contains("memory limit"), "{free}");
     assert_eq!(free.matches(",ok,").count(), 2, "{free}");
 }

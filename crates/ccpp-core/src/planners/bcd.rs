@@ -1,25 +1,50 @@
-//! BCD: boustrophedon cellular decomposition, the offline (known-map) baseline.
+//! BCD: boustrophedon cellular decomposition, the offline (known-map) reference planner.
 //!
 //! H. Choset and P. Pignon, "Coverage path planning: the boustrophedon cellular decomposition",
 //! *Field and Service Robotics*, 1998; named by seed 000 as the offline reference for BA*.
 //!
-//! **Offline**: it reads the whole true map (through the [`World`]) before moving. It decomposes
-//! the robot's *configuration space* — the reachable C-free pixel centres, so every lane is
-//! drivable by construction — with a vertical sweep line moving east:
-//! 1. each image column is cut into runs of C-free pixels; a cell continues while exactly one run
-//!    of the previous column overlaps exactly one run of the current column; at every other
-//!    event (split, merge, birth, death) the involved cells close and new ones open;
-//! 2. cells touching across an event are adjacent; the order is greedy from the start's cell:
-//!    next comes the unvisited neighbour (in the adjacency graph) nearest by path length over
-//!    C-free, or, when all neighbours are done, the nearest unvisited cell (short transfers);
-//! 3. each cell is covered by vertical lanes spaced `2 r_tool` (floor to whole pixels, first and
-//!    last lane on the cell's edges), alternating up and down, entered at the corner nearest the
-//!    robot;
-//! 4. lanes and cells are joined by shortest 8-connected pixel paths (A*, octile integer costs)
-//!    over a slightly safer C-free set (clearance margin a quarter pixel, so straight steps
-//!    between pixel centres stay clear), shortened by line-of-sight checks on the true map.
+//! **Offline**: it reads the whole true map (through the [`World`]) before moving, plans the
+//! whole path, checks every straight move of it against the true map, and then replays it.
 //!
-//! Regions = cells (`RegionStart` per cell); transfers between cells are marked as backtracks.
+//! What it follows from the paper, and where it deviates:
+//! 1. **Decomposition.** The robot's *configuration space* (the reachable C-free pixel centres,
+//!    so every lane is drivable by construction) is cut by a sweep line: each line of pixels is
+//!    split into runs of C-free pixels; a cell continues while exactly one run of the previous
+//!    line overlaps exactly one run of the current line; at every other event (split, merge,
+//!    birth, death — the paper's critical points, found on the pixel grid instead of on a
+//!    polygonal map) the involved cells close and new ones open. Both a west-to-east sweep
+//!    (vertical lines) and a north-to-south sweep (horizontal lines) are decomposed; the one
+//!    whose cells are estimated cheaper (path length plus `turn_cost_m` per turn) is used.
+//! 2. **Lanes fitted to each cell** (the paper's boustrophedon motions). Per cell, lanes run
+//!    along the sweep line or, when the cell is monotone the other way too, across it — the
+//!    direction with the lower estimated cost (fewer, longer lanes: fewer turns). Lanes are
+//!    evenly spaced at most `2 r_tool` apart (`lane_spacing_m`). The first and last lanes lie on
+//!    the cell's edge where the edge is an obstacle (the lane at clearance sweeps the wall's
+//!    rim) and `r_tool` inside it where the edge is shared with neighbouring cells (whose own
+//!    lanes sweep up to the shared edge), so neighbours do not drive two lanes side by side.
+//!    Lane ends facing an obstacle are pushed from the pixel centre to the exact contact
+//!    distance (minus a 0.05 px safety gap) with the simulator's own swept-disk test, so the
+//!    tool reaches as close to the wall as the robot can.
+//! 3. **Rim.** Consecutive lanes are joined along the cell's boundary (the lane ends of every
+//!    pixel line in between, merged into straight collision-free segments that stay within
+//!    half a pixel of it), so the joins sweep the wall rim between lanes. What no lane or join
+//!    reaches — the rim at the unjoined lane ends, notches, the faces of the obstacles at split
+//!    and merge events — is found by sweeping the planned path over the map's accessible
+//!    surface; the missed pixels are grouped, each group is swept by a contour pass through the
+//!    nearest C-free positions (merged into straight collision-free segments) inserted as a
+//!    detour at the cheapest point of the path. Groups whose detour would sweep less than
+//!    `rim_min_yield` of a lane's sweep rate are skipped. This step is not in the paper (a point
+//!    robot's lanes reach the boundary; a disk's do not).
+//! 4. **Cell tour.** Instead of the paper's depth-first walk of the adjacency graph, the cells
+//!    are ordered as an open travelling-salesman path over their entry and exit points (each
+//!    cell can be started at any of its four corners): nearest-neighbour construction, then
+//!    2-opt, Or-opt and an exact choice of every cell's corner for the order, with
+//!    straight-line hop costs ([`tsp`]). Transfers are straight when collision-free, else A*
+//!    over the C-free pixel centres (8-connected, octile costs, no corner cutting), shortened
+//!    by line-of-sight checks on the true map.
+//!
+//! Deterministic: fixed scan orders and tie-breaks, no hashing. Regions = cells (`RegionStart`
+//! per cell); transfers between cells are marked as backtracks.
 //!
 //! ```
 //! use ccpp_core::{GridMap, Pose};
@@ -33,16 +58,21 @@
 //! let out = simulate(&world, &mut p, &SimConfig::default());
 //! let m = ccpp_core::metrics::compute(&world, &out, "box");
 //! assert_eq!(m.collisions, 0);
-//! assert!(m.effective_coverage > 0.95, "{}", m.effective_coverage);
-//! assert!(m.regions >= 3); // split and merge around the block
+//! assert!(m.effective_coverage > 0.995, "{}", m.effective_coverage);
+//! assert!(m.regions >= 1); // one region per cell
 //! ```
+
+mod tsp;
 
 use std::cmp::Reverse;
 use std::collections::{BinaryHeap, VecDeque};
+use std::ops::{Add, Sub};
 
+use fixedbitset::FixedBitSet;
 use serde::{Deserialize, Serialize};
 
-use crate::geometry::Point;
+use crate::geometry::{point_segment_dist2, Point};
+use crate::grid::MapFrame;
 use crate::planner::{Planner, Sensor, Step};
 use crate::trace::Event;
 use crate::world::World;
@@ -51,10 +81,21 @@ use crate::world::World;
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct BcdOptions {
-    /// Lane spacing in metres; `None` = `2 r_tool`.
+    /// Largest lane spacing in metres (lanes are spread evenly, at most this far apart);
+    /// `None` = `2 r_tool`. Must be > 0.
     pub lane_spacing_m: Option<f64>,
-    /// Extra clearance (pixels) of the set the connecting paths run through.
+    /// Extra clearance (pixels, >= 0) that transfer paths keep from obstacles when they can;
+    /// where no such path exists they fall back to the plain C-free set.
     pub margin_px: f64,
+    /// Cost of one turn, in metres of path, when choosing sweep directions (>= 0).
+    pub turn_cost_m: f64,
+    /// Sweep the rim that lanes miss (step 3 of the module docs).
+    pub rim: bool,
+    /// Skip a rim detour whose swept new area per metre is below this fraction of a lane's
+    /// (`2 r_tool` per metre); 0 sweeps every reachable missed group. In `[0, 1]`.
+    pub rim_min_yield: f64,
+    /// Improvement rounds of the cell tour (0 = nearest-neighbour order only).
+    pub tour_rounds: u32,
 }
 
 impl Default for BcdOptions {
@@ -62,160 +103,1396 @@ impl Default for BcdOptions {
         Self {
             lane_spacing_m: None,
             margin_px: 0.0,
+            turn_cost_m: 0.3,
+            rim: true,
+            rim_min_yield: 0.0,
+            tour_rounds: 2,
         }
     }
 }
 
-/// One cell: its column range and, per column, the run `[r0, r1]` of C-free rows.
-#[derive(Clone, Debug)]
-struct CellSlices {
-    c0: usize,
-    runs: Vec<(usize, usize)>,
+/// An invalid [`BcdOptions`] value.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum BcdOptionsError {
+    /// A value outside its range.
+    #[error("bcd option {name} must be {what}, got {value}")]
+    OutOfRange {
+        /// Option name.
+        name: &'static str,
+        /// The allowed range.
+        what: &'static str,
+        /// The value given.
+        value: f64,
+    },
+}
+
+impl BcdOptions {
+    /// Checks every value's range.
+    ///
+    /// # Errors
+    /// The first value outside its range.
+    pub fn check_ranges(&self) -> Result<(), BcdOptionsError> {
+        let bad = |name, what, value| Err(BcdOptionsError::OutOfRange { name, what, value });
+        if let Some(s) = self.lane_spacing_m {
+            if !(s.is_finite() && s > 0.0) {
+                return bad("lane_spacing_m", "a finite number > 0", s);
+            }
+        }
+        if !(self.margin_px.is_finite() && self.margin_px >= 0.0) {
+            return bad("margin_px", "a finite number >= 0", self.margin_px);
+        }
+        if !(self.turn_cost_m.is_finite() && self.turn_cost_m >= 0.0) {
+            return bad("turn_cost_m", "a finite number >= 0", self.turn_cost_m);
+        }
+        if !(0.0..=1.0).contains(&self.rim_min_yield) {
+            return bad("rim_min_yield", "in [0, 1]", self.rim_min_yield);
+        }
+        Ok(())
+    }
 }
 
 /// The BCD planner: a precomputed list of steps.
 pub struct Bcd {
     steps: VecDeque<Step>,
+    cells: usize,
 }
 
-/// The decomposition: cells and adjacency.
-struct Decomposition {
-    cells: Vec<CellSlices>,
-    adj: Vec<Vec<usize>>,
-    /// Cell of each (col, row) working pixel, `u32::MAX` if none.
-    cell_of: Vec<u32>,
+/// One cell of a decomposition: lines `u0..u0 + runs.len()`, and on each line the run
+/// `[v0, v1]` of pixels. `cols`: the lines are image columns (`u` = column, `v` = row),
+/// otherwise image rows (`u` = row, `v` = column).
+#[derive(Clone, Debug)]
+struct Cell {
+    cols: bool,
+    u0: usize,
+    runs: Vec<(usize, usize)>,
 }
 
-fn decompose(width: usize, height: usize, free: &dyn Fn(usize, usize) -> bool) -> Decomposition {
-    let mut cells: Vec<CellSlices> = Vec::new();
-    let mut adj: Vec<Vec<usize>> = Vec::new();
-    let mut cell_of = vec![u32::MAX; width * height];
-    // Runs of the previous column with their cell.
-    let mut prev: Vec<(usize, usize, usize)> = Vec::new();
-    for c in 0..width {
-        let mut runs: Vec<(usize, usize)> = Vec::new();
-        let mut r = 0;
-        while r < height {
-            if free(c, r) {
-                let s = r;
-                while r + 1 < height && free(c, r + 1) {
-                    r += 1;
+impl Cell {
+    fn u1(&self) -> usize {
+        self.u0 + self.runs.len() - 1
+    }
+
+    /// Pixel `(col, row)` of line `u`, position `v`.
+    fn px(&self, u: usize, v: usize) -> (usize, usize) {
+        if self.cols {
+            (u, v)
+        } else {
+            (v, u)
+        }
+    }
+
+    /// The same pixels with lines the other way, if every such line meets the cell in one run.
+    fn transposed(&self) -> Option<Cell> {
+        let lo = self.runs.iter().map(|r| r.0).min()?;
+        let hi = self.runs.iter().map(|r| r.1).max()?;
+        let mut runs = Vec::with_capacity(hi - lo + 1);
+        for v in lo..=hi {
+            let mut first: Option<usize> = None;
+            let mut last = 0;
+            for (k, &(a, b)) in self.runs.iter().enumerate() {
+                if a <= v && v <= b {
+                    let u = self.u0 + k;
+                    match first {
+                        None => first = Some(u),
+                        Some(_) if u != last + 1 => return None,
+                        Some(_) => {}
+                    }
+                    last = u;
                 }
-                runs.push((s, r));
             }
-            r += 1;
+            runs.push((first?, last));
+        }
+        Some(Cell {
+            cols: !self.cols,
+            u0: lo,
+            runs,
+        })
+    }
+}
+
+/// Decomposes the pixels where `free(u, v)` over lines `u < nu` of length `nv` (module docs,
+/// step 1). Cells are numbered in the order they open.
+fn decompose(nu: usize, nv: usize, cols: bool, free: &dyn Fn(usize, usize) -> bool) -> Vec<Cell> {
+    let mut cells: Vec<Cell> = Vec::new();
+    // Runs of the previous line with their cell.
+    let mut prev: Vec<(usize, usize, usize)> = Vec::new();
+    let mut runs: Vec<(usize, usize)> = Vec::new();
+    for u in 0..nu {
+        runs.clear();
+        let mut v = 0;
+        while v < nv {
+            if free(u, v) {
+                let s = v;
+                while v + 1 < nv && free(u, v + 1) {
+                    v += 1;
+                }
+                runs.push((s, v));
+            }
+            v += 1;
         }
         let overl = |a: (usize, usize), b: (usize, usize)| a.0 <= b.1 && b.0 <= a.1;
         let mut cur: Vec<(usize, usize, usize)> = Vec::with_capacity(runs.len());
         for &run in &runs {
-            let ov: Vec<usize> = (0..prev.len())
-                .filter(|&k| overl((prev[k].0, prev[k].1), run))
-                .collect();
-            let continues = ov.len() == 1 && {
-                let p = prev[ov[0]];
-                runs.iter().filter(|&&q| overl((p.0, p.1), q)).count() == 1
+            let mut ov = prev.iter().filter(|p| overl((p.0, p.1), run));
+            let continues = match (ov.next(), ov.next()) {
+                (Some(p), None) => runs.iter().filter(|&&q| overl((p.0, p.1), q)).count() == 1,
+                _ => false,
             };
             let id = if continues {
-                let id = prev[ov[0]].2;
-                cells[id].runs.push(run);
-                id
+                let p = prev
+                    .iter()
+                    .find(|p| overl((p.0, p.1), run))
+                    .map_or(0, |p| p.2);
+                cells[p].runs.push(run);
+                p
             } else {
-                let id = cells.len();
-                cells.push(CellSlices {
-                    c0: c,
+                cells.push(Cell {
+                    cols,
+                    u0: u,
                     runs: vec![run],
                 });
-                adj.push(Vec::new());
-                for k in ov {
-                    let o = prev[k].2;
-                    if !adj[o].contains(&id) {
-                        adj[o].push(id);
-                        adj[id].push(o);
-                    }
-                }
-                id
+                cells.len() - 1
             };
-            for rr in run.0..=run.1 {
-                cell_of[rr * width + c] = id as u32;
-            }
             cur.push((run.0, run.1, id));
         }
         prev = cur;
     }
-    Decomposition {
-        cells,
-        adj,
-        cell_of,
+    cells
+}
+
+/// Shared geometry: the world, the C-free set and helpers in grid coordinates (pixels, y up).
+struct Ctx<'a> {
+    world: &'a World,
+    frame: MapFrame,
+    /// Reachable C-free pixel centres.
+    ok: Vec<bool>,
+    /// Transfer set: `ok` with the extra margin.
+    safe: Vec<bool>,
+    /// Tool radius in pixels.
+    rt: f64,
+}
+
+/// Gap kept between a pushed lane end and the exact contact (pixels).
+const BACKOFF_PX: f64 = 0.05;
+/// How far a merged boundary segment may stray from the boundary points it replaces (pixels).
+const CONTOUR_TOL_PX: f64 = 0.5;
+
+impl Ctx<'_> {
+    fn ok_at(&self, c: i64, r: i64) -> bool {
+        self.frame
+            .checked(c, r)
+            .is_some_and(|(c, r)| self.ok[r * self.frame.width + c])
+    }
+
+    fn centre(&self, c: usize, r: usize) -> Point {
+        self.frame.pixel_center_grid(c, r)
+    }
+
+    /// Is the straight move between grid points `a` and `b` free on the true map?
+    fn free(&self, a: Point, b: Point) -> bool {
+        self.world
+            .segment_free(self.frame.grid_to_world(a), self.frame.grid_to_world(b))
+    }
+
+    /// Grid point of continuous line coordinate `t` (pixel centres at integers) and pixel
+    /// position `v` (may be fractional or outside the image) of `cell`'s orientation.
+    fn at(&self, cols: bool, t: f64, v: f64) -> Point {
+        let h = self.frame.height as f64;
+        if cols {
+            Point::new(t + 0.5, h - v - 0.5)
+        } else {
+            Point::new(v + 0.5, h - t - 0.5)
+        }
+    }
+
+    /// The end on side `hi` of the lane at line coordinate `t` of `cell` (between the lines
+    /// `floor t` and `ceil t`): from the end of the two runs' common part, pushed along the
+    /// lane to the exact contact (minus [`BACKOFF_PX`]) or, where nothing is hit, to the end
+    /// of the longer run.
+    fn lane_end(&self, cell: &Cell, t: f64, hi: bool) -> Point {
+        let (u0, u1) = (cell.u0, cell.u1());
+        let a = (t.floor().max(u0 as f64) as usize).min(u1);
+        let b = (t.ceil().max(u0 as f64) as usize).min(u1);
+        let (ra, rb) = (cell.runs[a - u0], cell.runs[b - u0]);
+        let (mut i0, mut i1) = (ra.0.max(rb.0), ra.1.min(rb.1));
+        let (n0, n1) = (ra.0.min(rb.0), ra.1.max(rb.1));
+        if i0 > i1 {
+            // The runs do not overlap (cannot happen inside a cell): use the nearer line's.
+            let r = if t - a as f64 <= 0.5 { ra } else { rb };
+            (i0, i1) = r;
+        }
+        let (v_in, v_out, v_end) = if hi {
+            (i1 as f64, n1 as f64 + 1.0, n1 as f64)
+        } else {
+            (i0 as f64, n0 as f64 - 1.0, n0 as f64)
+        };
+        let p = self.at(cell.cols, t, v_in);
+        let q = self.at(cell.cols, t, v_out);
+        let len = (v_out - v_in).abs();
+        match self
+            .world
+            .first_contact(self.frame.grid_to_world(p), self.frame.grid_to_world(q))
+        {
+            Some(s) if s * len > BACKOFF_PX => p.add(q.sub(p).scale(s - BACKOFF_PX / len)),
+            Some(_) => p,
+            None => self.at(cell.cols, t, v_end),
+        }
+    }
+
+    /// A C-free pixel centre joined to `p` by a free straight move (nearest first).
+    fn anchor(&self, p: Point) -> Option<(usize, usize)> {
+        let (c0, r0) = self.frame.grid_to_pixel_signed(p);
+        let mut best: Option<(f64, (usize, usize))> = None;
+        for dr in -2..=2 {
+            for dc in -2..=2 {
+                let (c, r) = (c0 + dc, r0 + dr);
+                if !self.ok_at(c, r) {
+                    continue;
+                }
+                let (c, r) = (c as usize, r as usize);
+                let q = self.centre(c, r);
+                let d = q.dist(p);
+                if best.is_none_or(|b| d < b.0) && self.free(p, q) {
+                    best = Some((d, (c, r)));
+                }
+            }
+        }
+        best.map(|b| b.1)
+    }
+
+    /// Moves from `a` to `b` (excluding `a`): straight when free, else an A* pixel path
+    /// shortened by line of sight; `None` when no verified path exists.
+    fn route(&self, search: &mut Search, a: Point, b: Point) -> Option<Vec<Point>> {
+        if self.free(a, b) {
+            return Some(vec![b]);
+        }
+        let pa = self.anchor(a)?;
+        let pb = self.anchor(b)?;
+        let diag = |i: usize, j: usize| {
+            let w = self.frame.width;
+            self.free(self.centre(i % w, i / w), self.centre(j % w, j / w))
+        };
+        let path = search
+            .path(&self.safe, pa, pb, &diag)
+            .or_else(|| search.path(&self.ok, pa, pb, &diag))?;
+        let mut pts = Vec::with_capacity(path.len() + 2);
+        pts.push(a);
+        pts.extend(path.iter().map(|&(c, r)| self.centre(c, r)));
+        pts.push(b);
+        pts.dedup();
+        self.shorten(&pts)
+    }
+
+    /// Line-of-sight shortening of a chain whose consecutive points are joined by free moves
+    /// (not checked: a failing link gives `None`). Returns the points after the first.
+    fn shorten(&self, pts: &[Point]) -> Option<Vec<Point>> {
+        let mut out = Vec::new();
+        let mut i = 0;
+        while i + 1 < pts.len() {
+            let mut lo = i + 1;
+            let mut step = 1;
+            let mut hi = None;
+            loop {
+                let j = (i + step).min(pts.len() - 1);
+                if self.free(pts[i], pts[j]) {
+                    lo = j;
+                    if j == pts.len() - 1 {
+                        break;
+                    }
+                    step *= 2;
+                } else {
+                    hi = Some(j);
+                    break;
+                }
+            }
+            if let Some(mut hi) = hi {
+                if hi == i + 1 {
+                    return None;
+                }
+                while hi - lo > 1 {
+                    let mid = usize::midpoint(lo, hi);
+                    if self.free(pts[i], pts[mid]) {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+            }
+            out.push(pts[lo]);
+            i = lo;
+        }
+        Some(out)
+    }
+
+    /// Follows the chain `pts` (from `pts[0]`, excluded) with straight free moves that stay
+    /// within [`CONTOUR_TOL_PX`] of every point they replace; links that are not free are
+    /// routed. Returns the points after the first (`None`: some link has no route).
+    fn follow(&self, search: &mut Search, pts: &[Point]) -> Option<Vec<Point>> {
+        let mut out = Vec::new();
+        let mut i = 0;
+        let tol2 = CONTOUR_TOL_PX * CONTOUR_TOL_PX;
+        while i + 1 < pts.len() {
+            // Farthest j whose chord keeps every point in between within the tolerance.
+            let mut jmax = i + 1;
+            for j in i + 2..pts.len() {
+                if (i + 1..j).all(|m| point_segment_dist2(pts[m], pts[i], pts[j]) <= tol2) {
+                    jmax = j;
+                } else {
+                    break;
+                }
+            }
+            let mut j = jmax;
+            while j > i + 1 && !self.free(pts[i], pts[j]) {
+                j -= 1;
+            }
+            if j == i + 1 && !self.free(pts[i], pts[j]) {
+                out.extend(self.route(search, pts[i], pts[j])?);
+            } else {
+                out.push(pts[j]);
+            }
+            i = j;
+        }
+        Some(out)
     }
 }
 
-/// Pixel path search over the working set.
-struct Search<'a> {
+/// Share of the pixels of `cell`'s line `u` whose outer neighbour (towards `out` = -1 or +1
+/// along the lines) passes `other`, at least one half?
+fn side_open(
+    ctx: &Ctx<'_>,
+    cell: &Cell,
+    u: usize,
+    out: i64,
+    other: &dyn Fn(usize) -> bool,
+) -> bool {
+    let (a, b) = cell.runs[u - cell.u0];
+    let w = ctx.frame.width;
+    let n = (a..=b)
+        .filter(|&v| {
+            let (c, r) = cell.px(u, v);
+            let (c, r) = if cell.cols {
+                (c as i64 + out, r as i64)
+            } else {
+                (c as i64, r as i64 + out)
+            };
+            ctx.ok_at(c, r) && other(r as usize * w + c as usize)
+        })
+        .count();
+    2 * n > b - a
+}
+
+/// The lane positions (line coordinates) of `cell` (module docs, step 2): a lane on each
+/// closed side and the lines `phase + k sp` in between, shared with the neighbours across open
+/// sides.
+fn lanes_of(cell: &Cell, sp: f64, phase: f64, open_lo: bool, open_hi: bool) -> Vec<f64> {
+    let (u0, u1) = (cell.u0 as f64, cell.u1() as f64);
+    let mut lanes: Vec<f64> = Vec::new();
+    if !open_lo {
+        lanes.push(u0);
+    }
+    // Lattice lines in [u0 - 1/2, u1 + 1/2): every line belongs to exactly one of the cells
+    // that meet along the lines, whatever the rounding.
+    let mut k = ((u0 - 0.5 - phase) / sp).floor();
+    loop {
+        let t = phase + k * sp;
+        if t >= u1 + 0.5 {
+            break;
+        }
+        if t >= u0 - 0.5 && lanes.last().is_none_or(|&l| t.max(u0) - l > 1e-6) {
+            lanes.push(t.clamp(u0, u1));
+        }
+        k += 1.0;
+    }
+    if !open_hi && lanes.last().is_none_or(|&l| u1 - l > 1e-6) {
+        lanes.push(u1);
+    }
+    lanes
+}
+
+/// Estimated cost of sweeping `cell` with `lanes`: lane lengths, the span between the first
+/// and last lane, and `turn_px` per turn (two per lane).
+fn estimate(cell: &Cell, lanes: &[f64], turn_px: f64) -> f64 {
+    if lanes.is_empty() {
+        return 0.0;
+    }
+    let len: f64 = lanes
+        .iter()
+        .map(|&t| {
+            let u = (t.round() as usize).clamp(cell.u0, cell.u1());
+            let (a, b) = cell.runs[u - cell.u0];
+            (b - a) as f64
+        })
+        .sum();
+    let span = lanes[lanes.len() - 1] - lanes[0];
+    len + span + turn_px * (2 * lanes.len()) as f64
+}
+
+/// A cell's two boustrophedon paths (grid points), starting at the first lane's low end and at
+/// its high end.
+fn cell_paths(ctx: &Ctx<'_>, search: &mut Search, cell: &Cell, lanes: &[f64]) -> [Vec<Point>; 2] {
+    let mut out = [Vec::new(), Vec::new()];
+    for (k, start_hi) in [false, true].into_iter().enumerate() {
+        let mut pts: Vec<Point> = Vec::new();
+        let mut hi = start_hi;
+        for (i, &u) in lanes.iter().enumerate() {
+            let a = ctx.lane_end(cell, u, hi);
+            let b = ctx.lane_end(cell, u, !hi);
+            if i == 0 {
+                pts.push(a);
+            } else {
+                // Join along the boundary on side `hi` from the previous lane.
+                let prev = lanes[i - 1];
+                let mut chain = vec![*pts.last().unwrap_or(&a)];
+                let mut w = prev.floor() + 1.0;
+                while w < u - 1e-9 {
+                    chain.push(ctx.lane_end(cell, w, hi));
+                    w += 1.0;
+                }
+                chain.push(a);
+                if let Some(v) = ctx.follow(search, &chain) {
+                    pts.extend(v);
+                } else {
+                    // Unreachable along the rim (should not happen inside a cell): route.
+                    let from = *pts.last().unwrap_or(&a);
+                    if let Some(v) = ctx.route(search, from, a) {
+                        pts.extend(v);
+                    }
+                }
+            }
+            if ctx.free(a, b) {
+                pts.push(b);
+            } else if let Some(v) = ctx.route(search, a, b) {
+                pts.extend(v);
+            }
+            hi = !hi;
+        }
+        pts.dedup();
+        out[k] = pts;
+    }
+    out
+}
+
+fn polyline_len(p: &[Point]) -> f64 {
+    p.windows(2).map(|w| w[0].dist(w[1])).sum()
+}
+
+/// One step of the plan.
+#[derive(Clone, Debug)]
+enum Item {
+    Move(Point),
+    Mark(Event),
+}
+
+impl Bcd {
+    /// Plans the whole coverage of `world` (offline). Invalid options (see
+    /// [`BcdOptions::check_ranges`]) are replaced by their defaults; use [`Bcd::try_new`] to refuse
+    /// them instead.
+    pub fn new(world: &World, opts: &BcdOptions) -> Self {
+        if let Ok(p) = Self::try_new(world, opts) {
+            p
+        } else {
+            let d = BcdOptions::default();
+            let fixed = BcdOptions {
+                lane_spacing_m: opts.lane_spacing_m.filter(|s| s.is_finite() && *s > 0.0),
+                margin_px: if opts.margin_px.is_finite() && opts.margin_px >= 0.0 {
+                    opts.margin_px
+                } else {
+                    d.margin_px
+                },
+                turn_cost_m: if opts.turn_cost_m.is_finite() && opts.turn_cost_m >= 0.0 {
+                    opts.turn_cost_m
+                } else {
+                    d.turn_cost_m
+                },
+                rim: opts.rim,
+                rim_min_yield: if (0.0..=1.0).contains(&opts.rim_min_yield) {
+                    opts.rim_min_yield
+                } else {
+                    d.rim_min_yield
+                },
+                tour_rounds: opts.tour_rounds,
+            };
+            Self::plan(world, &fixed)
+        }
+    }
+
+    /// Plans the whole coverage of `world` (offline).
+    ///
+    /// # Errors
+    /// An option out of range.
+    pub fn try_new(world: &World, opts: &BcdOptions) -> Result<Self, BcdOptionsError> {
+        opts.check_ranges()?;
+        Ok(Self::plan(world, opts))
+    }
+
+    /// Number of cells of the decomposition used.
+    pub fn cells(&self) -> usize {
+        self.cells
+    }
+
+    fn plan(world: &World, opts: &BcdOptions) -> Self {
+        let frame = *world.frame();
+        let (w, h) = (frame.width, frame.height);
+        let robot = world.robot();
+        let res = frame.resolution;
+        let reach = world.reachable();
+        let ok: Vec<bool> = (0..w * h).map(|i| reach.contains(i)).collect();
+        let need = crate::collide::contact_radius_px(robot.radius / res) + opts.margin_px;
+        let safe: Vec<bool> = (0..w * h)
+            .map(|i| ok[i] && world.pixel_clearance(i % w, i / w) / res + 0.5 >= need)
+            .collect();
+        let ctx = Ctx {
+            world,
+            frame,
+            ok,
+            safe,
+            rt: robot.tool_radius / res,
+        };
+        let spacing = opts.lane_spacing_m.unwrap_or(2.0 * robot.tool_radius);
+        let sp = (spacing / res).max(1.0);
+        let turn_px = opts.turn_cost_m / res;
+        let mut search = Search::new(w, h);
+        let start = frame.world_to_grid(world.start().position());
+
+        // 1-2. Both decompositions, each cell's cheaper lane direction, the cheaper total.
+        let ok = &ctx.ok;
+        let by_cols = decompose(w, h, true, &|c, r| ok[r * w + c]);
+        let by_rows = decompose(h, w, false, &|r, c| ok[r * w + c]);
+        // Each cell's views (along its lines; across them when monotone) with their sides'
+        // openness where C-free continues; per decomposition and lattice phase, the cheaper
+        // view of every cell and the estimated total.
+        let views = |cells: Vec<Cell>| -> Vec<Vec<(Cell, bool, bool)>> {
+            cells
+                .into_iter()
+                .map(|c| {
+                    let t = c.transposed();
+                    let mut v = Vec::with_capacity(2);
+                    for c in std::iter::once(c).chain(t) {
+                        let lo = side_open(&ctx, &c, c.u0, -1, &|_| true);
+                        let hi = side_open(&ctx, &c, c.u1(), 1, &|_| true);
+                        v.push((c, lo, hi));
+                    }
+                    v
+                })
+                .collect()
+        };
+        let decs = [views(by_cols), views(by_rows)];
+        let mut best: Option<(f64, usize, f64, Vec<usize>)> = None;
+        for (d, dec) in decs.iter().enumerate() {
+            for k in 0..6 {
+                let phase = sp * f64::from(k) / 6.0;
+                let mut total = 0.0;
+                let mut pick = Vec::with_capacity(dec.len());
+                for vs in dec {
+                    let mut b: Option<(f64, usize)> = None;
+                    for (j, (c, lo, hi)) in vs.iter().enumerate() {
+                        let lanes = lanes_of(c, sp, phase, *lo, *hi);
+                        let mut e = estimate(c, &lanes, turn_px);
+                        if !lanes.is_empty() {
+                            e += 2.0 * turn_px + sp;
+                        }
+                        if b.is_none_or(|b| e < b.0) {
+                            b = Some((e, j));
+                        }
+                    }
+                    let (e, j) = b.unwrap_or((0.0, 0));
+                    total += e;
+                    pick.push(j);
+                }
+                if best.as_ref().is_none_or(|b| total < b.0) {
+                    best = Some((total, d, phase, pick));
+                }
+            }
+        }
+        let (_, d, phase, pick) = best.unwrap_or((0.0, 0, 0.0, Vec::new()));
+        let chosen: Vec<Cell> = decs[d]
+            .iter()
+            .zip(&pick)
+            .map(|(vs, &j)| vs[j].0.clone())
+            .collect();
+        // Lanes: a side is open where the neighbouring pixels belong to cells with lanes the
+        // same way (their lattice lines continue this cell's).
+        let mut cols_at = vec![0u8; w * h];
+        for c in &chosen {
+            for (k, &(a, b)) in c.runs.iter().enumerate() {
+                for v in a..=b {
+                    let (cc, rr) = c.px(c.u0 + k, v);
+                    cols_at[rr * w + cc] = if c.cols { 1 } else { 2 };
+                }
+            }
+        }
+        let cells: Vec<(Cell, Vec<f64>)> = chosen
+            .into_iter()
+            .map(|c| {
+                let mine = if c.cols { 1 } else { 2 };
+                let same = |i: usize| cols_at[i] == mine;
+                let lo = side_open(&ctx, &c, c.u0, -1, &same);
+                let hi = side_open(&ctx, &c, c.u1(), 1, &same);
+                let lanes = lanes_of(&c, sp, phase, lo, hi);
+                (c, lanes)
+            })
+            .filter(|(_, l)| !l.is_empty())
+            .collect();
+
+        // Cell paths; a first tour over the cells picks each cell's path (corner), the rim
+        // contours of what those paths miss join the cells in the final tour, where each cell
+        // keeps its path (driven either way).
+        let mut paths: Vec<[Vec<Point>; 2]> = Vec::with_capacity(cells.len());
+        let mut pieces = Vec::with_capacity(cells.len());
+        for (cell, lanes) in &cells {
+            let ps = cell_paths(&ctx, &mut search, cell, lanes);
+            let mut piece = tsp::Piece {
+                entry: Vec::new(),
+                exit: Vec::new(),
+                inner: Vec::new(),
+            };
+            for p in &ps {
+                let (f, l) = (p[0], p[p.len() - 1]);
+                let len = polyline_len(p);
+                piece.entry.extend([f, l]);
+                piece.exit.extend([l, f]);
+                piece.inner.extend([len, len]);
+            }
+            pieces.push(piece);
+            paths.push(ps);
+        }
+        let coarse = Coarse::new(&ctx, sp);
+        let dist = |a: Point, b: Point| coarse.dist(a, b);
+        let ncells = paths.len();
+        let contours: Vec<Vec<Point>> = if opts.rim {
+            let nn = coarse.nearest_tour(&pieces, start);
+            let first = tsp::solve(&pieces, start, opts.tour_rounds, &dist, Some(nn));
+            let mut keep = vec![0usize; ncells];
+            for &(c, v) in &first {
+                keep[c] = v / 2;
+            }
+            for (c, k) in keep.iter().enumerate() {
+                if *k == 1 {
+                    paths[c].swap(0, 1);
+                }
+                let p = &paths[c][0];
+                let (f, l) = (p[0], p[p.len() - 1]);
+                let len = polyline_len(p);
+                pieces[c] = tsp::Piece {
+                    entry: vec![f, l],
+                    exit: vec![l, f],
+                    inner: vec![len, len],
+                };
+            }
+            let lines: Vec<&[Point]> = paths.iter().map(|p| p[0].as_slice()).collect();
+            rim_contours(&ctx, &mut search, &lines, opts.rim_min_yield)
+                .into_iter()
+                .map(|c| c.0)
+                .collect()
+        } else {
+            Vec::new()
+        };
+        for c in &contours {
+            let (f, l) = (c[0], c[c.len() - 1]);
+            let len = polyline_len(c);
+            pieces.push(tsp::Piece {
+                entry: vec![f, l],
+                exit: vec![l, f],
+                inner: vec![len, len],
+            });
+        }
+        let nn = coarse.nearest_tour(&pieces, start);
+        let tour = tsp::solve(&pieces, start, opts.tour_rounds, &dist, Some(nn));
+
+        let mut items: Vec<Item> = vec![Item::Move(start)];
+        let mut here = start;
+        let mut region = 0u32;
+        for &(cid, v) in &tour {
+            if cid >= ncells {
+                let c = &contours[cid - ncells];
+                let pts: Vec<Point> = if v == 0 {
+                    c.clone()
+                } else {
+                    c.iter().rev().copied().collect()
+                };
+                if pts[0] != here {
+                    let Some(hop) = ctx.route(&mut search, here, pts[0]) else {
+                        continue;
+                    };
+                    items.push(Item::Mark(Event::BacktrackStart));
+                    items.extend(hop.into_iter().map(Item::Move));
+                    items.push(Item::Mark(Event::BacktrackEnd));
+                }
+                items.extend(pts[1..].iter().copied().map(Item::Move));
+                here = pts[pts.len() - 1];
+                continue;
+            }
+            let path = &paths[cid][v / 2];
+            let pts: Vec<Point> = if v % 2 == 0 {
+                path.clone()
+            } else {
+                path.iter().rev().copied().collect()
+            };
+            let entry = pts[0];
+            if entry != here {
+                let Some(hop) = ctx.route(&mut search, here, entry) else {
+                    continue;
+                };
+                items.push(Item::Mark(Event::BacktrackStart));
+                items.extend(hop.into_iter().map(Item::Move));
+                items.push(Item::Mark(Event::BacktrackEnd));
+            }
+            region += 1;
+            items.push(Item::Mark(Event::RegionStart { region }));
+            items.extend(pts[1..].iter().copied().map(Item::Move));
+            items.push(Item::Mark(Event::RegionEnd { region }));
+            here = pts[pts.len() - 1];
+        }
+
+        if opts.rim {
+            rim_pass(&ctx, &mut search, &mut items, opts.rim_min_yield);
+        }
+        let items = repair(&ctx, &mut search, items);
+
+        let mut steps = VecDeque::with_capacity(items.len());
+        let mut at = start;
+        for it in items {
+            match it {
+                Item::Move(p) => {
+                    if p != at {
+                        steps.push_back(Step::MoveTo(frame.grid_to_world(p)));
+                        at = p;
+                    }
+                }
+                Item::Mark(e) => steps.push_back(Step::Mark(e)),
+            }
+        }
+        Self {
+            steps,
+            cells: cells.len(),
+        }
+    }
+}
+
+/// Re-checks every move of the plan on the true map and routes the ones that are not free
+/// (dropping a move that has no route, and skipping to the next reachable point).
+fn repair(ctx: &Ctx<'_>, search: &mut Search, items: Vec<Item>) -> Vec<Item> {
+    let mut out = Vec::with_capacity(items.len());
+    let mut at: Option<Point> = None;
+    for it in items {
+        match it {
+            Item::Move(p) => match at {
+                None => {
+                    out.push(Item::Move(p));
+                    at = Some(p);
+                }
+                Some(a) => {
+                    if a == p || ctx.free(a, p) {
+                        out.push(Item::Move(p));
+                        at = Some(p);
+                    } else if let Some(v) = ctx.route(search, a, p) {
+                        out.extend(v.into_iter().map(Item::Move));
+                        at = Some(p);
+                    }
+                }
+            },
+            Item::Mark(e) => out.push(Item::Mark(e)),
+        }
+    }
+    out
+}
+
+/// The moves of `items` as a polyline with, for each point, its index in `items`.
+fn moves(items: &[Item]) -> Vec<(Point, usize)> {
+    items
+        .iter()
+        .enumerate()
+        .filter_map(|(i, it)| match it {
+            Item::Move(p) => Some((*p, i)),
+            Item::Mark(_) => None,
+        })
+        .collect()
+}
+
+/// Step 3 of the module docs: the contour passes (grid polylines) that sweep the accessible
+/// pixels the polylines `lines` miss, one per 8-connected group of missed pixels, with the
+/// number of pixels each is meant to sweep; groups below `min_yield` are left out.
+fn rim_contours(
+    ctx: &Ctx<'_>,
+    search: &mut Search,
+    lines: &[&[Point]],
+    min_yield: f64,
+) -> Vec<(Vec<Point>, usize)> {
+    let frame = ctx.frame;
+    let (w, h) = (frame.width, frame.height);
+    let rt = ctx.rt + crate::metrics::SWEEP_EPS_PX;
+    let mut swept = FixedBitSet::with_capacity(frame.len());
+    for line in lines {
+        if let Some(&p) = line.first() {
+            crate::metrics::stamp_capsule(&mut swept, &frame, p, p, rt, &mut |_| {});
+        }
+        for s in line.windows(2) {
+            if s[0] != s[1] {
+                crate::metrics::stamp_capsule(&mut swept, &frame, s[0], s[1], rt, &mut |_| {});
+            }
+        }
+    }
+    let acc = ctx.world.accessible();
+    let mut missed = acc.clone();
+    missed.difference_with(&swept);
+    if missed.is_clear() {
+        return Vec::new();
+    }
+    // Witness of each missed pixel: the nearest C-free pixel centre within reach of the tool.
+    let k = rt.floor() as i64;
+    let rt2 = rt * rt;
+    let mut offsets: Vec<(i64, i64, i64)> = Vec::new();
+    for dr in -k..=k {
+        for dc in -k..=k {
+            let d2 = dc * dc + dr * dr;
+            if (d2 as f64) <= rt2 {
+                offsets.push((d2, dr, dc));
+            }
+        }
+    }
+    offsets.sort_unstable();
+    let mut witness = vec![u32::MAX; frame.len()];
+    for i in missed.ones() {
+        let (c, r) = ((i % w) as i64, (i / w) as i64);
+        for &(_, dr, dc) in &offsets {
+            if ctx.ok_at(c + dc, r + dr) {
+                witness[i] = ((r + dr) as usize * w + (c + dc) as usize) as u32;
+                break;
+            }
+        }
+    }
+    // Groups: 8-connected components of missed pixels.
+    let mut group_of = vec![u32::MAX; frame.len()];
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    for i in missed.ones() {
+        if group_of[i] != u32::MAX || witness[i] == u32::MAX {
+            continue;
+        }
+        let g = groups.len() as u32;
+        let mut members = vec![i];
+        group_of[i] = g;
+        let mut q = 0;
+        while q < members.len() {
+            let j = members[q];
+            q += 1;
+            let (c, r) = ((j % w) as i64, (j / w) as i64);
+            for dr in -1..=1 {
+                for dc in -1..=1 {
+                    let (nc, nr) = (c + dc, r + dr);
+                    if nc < 0 || nr < 0 || nc >= w as i64 || nr >= h as i64 {
+                        continue;
+                    }
+                    let n = nr as usize * w + nc as usize;
+                    if missed.contains(n) && group_of[n] == u32::MAX && witness[n] != u32::MAX {
+                        group_of[n] = g;
+                        members.push(n);
+                    }
+                }
+            }
+        }
+        groups.push(members);
+    }
+    let mut out = Vec::with_capacity(groups.len());
+    for members in &groups {
+        let mut ws: Vec<usize> = members.iter().map(|&i| witness[i] as usize).collect();
+        ws.sort_unstable();
+        ws.dedup();
+        let pts: Vec<Point> = ws.iter().map(|&i| ctx.centre(i % w, i / w)).collect();
+        // Chain: from the witness farthest from the first one, nearest neighbour onwards.
+        let far = (0..pts.len())
+            .max_by(|&a, &b| {
+                pts[a]
+                    .dist2(pts[0])
+                    .total_cmp(&pts[b].dist2(pts[0]))
+                    .then(b.cmp(&a))
+            })
+            .unwrap_or(0);
+        let mut used = vec![false; pts.len()];
+        let mut chain = vec![pts[far]];
+        used[far] = true;
+        for _ in 1..pts.len() {
+            let last = chain[chain.len() - 1];
+            let mut best: Option<(f64, usize)> = None;
+            for (j, p) in pts.iter().enumerate() {
+                if !used[j] && best.is_none_or(|b| p.dist2(last) < b.0) {
+                    best = Some((p.dist2(last), j));
+                }
+            }
+            let Some((_, j)) = best else { break };
+            used[j] = true;
+            chain.push(pts[j]);
+        }
+        let Some(tail) = ctx.follow(search, &chain) else {
+            continue;
+        };
+        let mut contour = vec![chain[0]];
+        contour.extend(tail);
+        let clen = polyline_len(&contour);
+        if (members.len() as f64) < min_yield * clen.max(1.0) * 2.0 * ctx.rt {
+            continue;
+        }
+        out.push((contour, members.len()));
+    }
+    out
+}
+
+/// Final mop-up of step 3: sweeps what the assembled plan still misses with contour detours
+/// inserted at the cheapest point of the path (out and back).
+fn rim_pass(ctx: &Ctx<'_>, search: &mut Search, items: &mut Vec<Item>, min_yield: f64) {
+    const B: f64 = 16.0;
+    let frame = ctx.frame;
+    let (w, h) = (frame.width, frame.height);
+    let path = moves(items);
+    let line: Vec<Point> = path.iter().map(|m| m.0).collect();
+    let contours = rim_contours(ctx, search, &[&line], min_yield);
+    // Spatial index of the path's segments (buckets of 16 px).
+    let (bw, bh) = (
+        (w as f64 / B).ceil() as usize + 1,
+        (h as f64 / B).ceil() as usize + 1,
+    );
+    let mut buckets: Vec<Vec<u32>> = vec![Vec::new(); bw * bh];
+    let bucket = |p: Point| -> (usize, usize) {
+        (
+            ((p.x / B).floor().max(0.0) as usize).min(bw - 1),
+            ((p.y / B).floor().max(0.0) as usize).min(bh - 1),
+        )
+    };
+    for (s, seg) in path.windows(2).enumerate() {
+        let (a, b) = (bucket(seg[0].0), bucket(seg[1].0));
+        for by in a.1.min(b.1)..=a.1.max(b.1) {
+            for bx in a.0.min(b.0)..=a.0.max(b.0) {
+                buckets[by * bw + bx].push(s as u32);
+            }
+        }
+    }
+    // (insert after path segment s, at parameter t along it, the detour points)
+    let mut inserts: Vec<(usize, f64, Vec<Point>)> = Vec::new();
+    for (contour, _) in contours {
+        let clen = polyline_len(&contour);
+        let (cs, ce) = (contour[0], contour[contour.len() - 1]);
+        // Cheapest insertion: segments near the contour's start, widening the search.
+        let mut best: Option<(f64, usize, f64, bool)> = None;
+        let (bx, by) = bucket(cs);
+        for ring in 0..bw.max(bh) {
+            let ring_i = ring as i64;
+            for y in by as i64 - ring_i..=by as i64 + ring_i {
+                for x in bx as i64 - ring_i..=bx as i64 + ring_i {
+                    if (y - by as i64).abs() != ring_i && (x - bx as i64).abs() != ring_i {
+                        continue;
+                    }
+                    if x < 0 || y < 0 || x >= bw as i64 || y >= bh as i64 {
+                        continue;
+                    }
+                    for &s in &buckets[y as usize * bw + x as usize] {
+                        let s = s as usize;
+                        let (a, b) = (path[s].0, path[s + 1].0);
+                        for rev in [false, true] {
+                            let (i0, i1) = if rev { (ce, cs) } else { (cs, ce) };
+                            let t = proj(a, b, i0);
+                            let q = a.add(b.sub(a).scale(t));
+                            let c = q.dist(i0) + clen + i1.dist(q);
+                            if best.is_none_or(|bb| c < bb.0) {
+                                best = Some((c, s, t, rev));
+                            }
+                        }
+                    }
+                }
+            }
+            // Stop once the ring is farther than the best detour's approach.
+            if let Some(bb) = best {
+                if (ring as f64 - 1.0) * B > bb.0 - clen {
+                    break;
+                }
+            }
+        }
+        let Some((_, s, t, rev)) = best else {
+            continue;
+        };
+        let (a, b) = (path[s].0, path[s + 1].0);
+        let q = a.add(b.sub(a).scale(t));
+        let mut det: Vec<Point> = vec![q];
+        if rev {
+            det.extend(contour.iter().rev().copied());
+        } else {
+            det.extend(contour.iter().copied());
+        }
+        det.push(q);
+        inserts.push((s, t, det));
+    }
+    // Apply: later segments first so indices stay valid; along a segment, by parameter.
+    inserts.sort_by(|x, y| y.0.cmp(&x.0).then(y.1.total_cmp(&x.1)));
+    for (s, _, det) in inserts {
+        let at = path[s + 1].1;
+        let new: Vec<Item> = det.into_iter().map(Item::Move).collect();
+        items.splice(at..at, new);
+    }
+}
+
+/// Parameter in `[0, 1]` of the point of segment `a`-`b` nearest to `p`.
+fn proj(a: Point, b: Point, p: Point) -> f64 {
+    let d = b.sub(a);
+    let l2 = d.dot(d);
+    if l2 == 0.0 {
+        0.0
+    } else {
+        (p.sub(a).dot(d) / l2).clamp(0.0, 1.0)
+    }
+}
+
+/// Hop costs for the cell tour: the straight-line distance, or the length of a shortest path
+/// over a coarse grid of the C-free set when that is longer (walls between the points).
+/// Blocks of `b` pixels are open when they hold a C-free pixel and joined to a side neighbour
+/// when C-free pixels touch across their common edge.
+struct Coarse {
+    b: usize,
+    bw: usize,
+    bh: usize,
+    open: Vec<bool>,
+    /// Block joined to its east / south neighbour.
+    east: Vec<bool>,
+    south: Vec<bool>,
+    cache: std::cell::RefCell<std::collections::HashMap<(u32, u32), f64>>,
+    /// A* scratch: generation stamp and cost per block.
+    scratch: std::cell::RefCell<(u32, Vec<u32>, Vec<u32>)>,
+}
+
+impl Coarse {
+    fn new(ctx: &Ctx<'_>, sp: f64) -> Self {
+        let (w, h) = (ctx.frame.width, ctx.frame.height);
+        let b = (sp.round() as usize).max(4);
+        let (bw, bh) = (w.div_ceil(b), h.div_ceil(b));
+        let mut open = vec![false; bw * bh];
+        let mut east = vec![false; bw * bh];
+        let mut south = vec![false; bw * bh];
+        for r in 0..h {
+            for c in 0..w {
+                if !ctx.ok[r * w + c] {
+                    continue;
+                }
+                let k = (r / b) * bw + c / b;
+                open[k] = true;
+                if c + 1 < w && (c + 1) % b == 0 && ctx.ok[r * w + c + 1] {
+                    east[k] = true;
+                }
+                if r + 1 < h && (r + 1) % b == 0 && ctx.ok[(r + 1) * w + c] {
+                    south[k] = true;
+                }
+            }
+        }
+        Self {
+            b,
+            bw,
+            bh,
+            open,
+            east,
+            south,
+            cache: std::cell::RefCell::new(std::collections::HashMap::new()),
+            scratch: std::cell::RefCell::new((0, vec![0; bw * bh], vec![0; bw * bh])),
+        }
+    }
+
+    fn block(&self, p: Point) -> usize {
+        let bf = self.b as f64;
+        let c = ((p.x / bf).floor().max(0.0) as usize).min(self.bw - 1);
+        // Grid y is up; blocks count rows from the top.
+        let rows = self.bh * self.b;
+        let r_px = (rows as f64 - p.y).floor().max(0.0) as usize;
+        let r = (r_px / self.b).min(self.bh - 1);
+        r * self.bw + c
+    }
+
+    fn dist(&self, a: Point, b: Point) -> f64 {
+        let e = a.dist(b);
+        let (ka, kb) = (self.block(a), self.block(b));
+        // Near: the straight line; far (over 64 blocks): the straight line too, as searching
+        // there costs more than it tells (good tours hop short).
+        if ka == kb || e < self.b as f64 || e > 64.0 * self.b as f64 {
+            return e;
+        }
+        let key = (ka.min(kb) as u32, ka.max(kb) as u32);
+        if let Some(&g) = self.cache.borrow().get(&key) {
+            return e.max(g);
+        }
+        // Searched up to eight times the straight line; beyond, or where the coarse grid cannot
+        // join the blocks (a wall through a block), that bound stands in.
+        let g = self.astar(ka, kb, 8.0 * e).min(8.0 * e);
+        self.cache.borrow_mut().insert(key, g);
+        e.max(g)
+    }
+
+    /// Block steps from block `k` (dc, dr, cost in tenths of a block) that the coarse grid
+    /// allows.
+    fn steps(&self, k: usize, out: &mut Vec<(usize, u32)>) {
+        out.clear();
+        let bw = self.bw;
+        let (c, r) = ((k % bw) as i64, (k / bw) as i64);
+        let at = |c: i64, r: i64| r as usize * bw + c as usize;
+        let linked = |k: usize, dc: i64, dr: i64| -> bool {
+            let (c, r) = ((k % bw) as i64, (k / bw) as i64);
+            match (dc, dr) {
+                (1, 0) => self.east[k],
+                (-1, 0) => self.east[at(c - 1, r)],
+                (0, 1) => self.south[k],
+                (0, -1) => self.south[at(c, r - 1)],
+                _ => false,
+            }
+        };
+        for (dc, dr) in [
+            (1, 0),
+            (0, 1),
+            (-1, 0),
+            (0, -1),
+            (1, 1),
+            (1, -1),
+            (-1, 1),
+            (-1, -1),
+        ] {
+            let (nc, nr) = (c + dc, r + dr);
+            if nc < 0 || nr < 0 || nc >= bw as i64 || nr >= self.bh as i64 {
+                continue;
+            }
+            let j = at(nc, nr);
+            if !self.open[j] {
+                continue;
+            }
+            if dc != 0 && dr != 0 {
+                let (vh, vv) = (at(nc, r), at(c, nr));
+                let a = self.open[vh] && linked(k, dc, 0) && linked(vh, 0, dr);
+                let b = self.open[vv] && linked(k, 0, dr) && linked(vv, dc, 0);
+                if a || b {
+                    out.push((j, 14));
+                }
+            } else if linked(k, dc, dr) {
+                out.push((j, 10));
+            }
+        }
+    }
+
+    /// Nearest-neighbour tour by hop cost: from each exit, a Dijkstra over the coarse grid
+    /// finds the piece entry with the lowest `dist + inner` (straight-line order where the
+    /// coarse grid joins nothing).
+    fn nearest_tour(&self, pieces: &[tsp::Piece], start: Point) -> tsp::Tour {
+        let nblocks = self.bw * self.bh;
+        let mut at_block: Vec<Vec<(usize, usize)>> = vec![Vec::new(); nblocks];
+        for (p, piece) in pieces.iter().enumerate() {
+            for (v, &e) in piece.entry.iter().enumerate() {
+                at_block[self.block(e)].push((p, v));
+            }
+        }
+        let mut done = vec![false; pieces.len()];
+        let mut tour = Vec::with_capacity(pieces.len());
+        let mut here = start;
+        let mut stamp = vec![0u32; nblocks];
+        let mut g = vec![0u32; nblocks];
+        let mut nbrs = Vec::new();
+        let bpx = self.b as f64;
+        for round in 1..=pieces.len() as u32 {
+            let mut best: Option<(f64, usize, usize)> = None;
+            let s = self.block(here);
+            let mut heap = BinaryHeap::new();
+            stamp[s] = round;
+            g[s] = 0;
+            heap.push(Reverse((0u32, s)));
+            while let Some(Reverse((gk, k))) = heap.pop() {
+                if gk > g[k] {
+                    continue;
+                }
+                let gpx = f64::from(gk) / 10.0 * bpx;
+                if best.is_some_and(|b| gpx - 2.0 * bpx > b.0) {
+                    break;
+                }
+                for &(p, v) in &at_block[k] {
+                    if done[p] {
+                        continue;
+                    }
+                    let e = pieces[p].entry[v];
+                    let c = self.dist(here, e) + pieces[p].inner[v];
+                    if best.is_none_or(|b| c < b.0) {
+                        best = Some((c, p, v));
+                    }
+                }
+                self.steps(k, &mut nbrs);
+                for &(j, w) in &nbrs {
+                    let ng = gk + w;
+                    if stamp[j] != round || ng < g[j] {
+                        stamp[j] = round;
+                        g[j] = ng;
+                        heap.push(Reverse((ng, j)));
+                    }
+                }
+            }
+            if best.is_none() {
+                for (p, piece) in pieces.iter().enumerate() {
+                    if done[p] {
+                        continue;
+                    }
+                    for (v, &e) in piece.entry.iter().enumerate() {
+                        let c = here.dist(e) + piece.inner[v];
+                        if best.is_none_or(|b| c < b.0) {
+                            best = Some((c, p, v));
+                        }
+                    }
+                }
+            }
+            let Some((_, p, v)) = best else { break };
+            done[p] = true;
+            tour.push((p, v));
+            here = pieces[p].exit[v];
+        }
+        tour
+    }
+
+    /// Shortest block path length (pixels) between blocks `s` and `t` (8-connected; a diagonal
+    /// step needs one of its two side paths), infinite when none is shorter than `limit` px.
+    fn astar(&self, s: usize, t: usize, limit: f64) -> f64 {
+        let cap = (limit / self.b as f64 * 10.0).ceil() as u32 + 20;
+        let bw = self.bw;
+        let (tc, tr) = ((t % bw) as i64, (t / bw) as i64);
+        let hcost = |k: usize| -> u32 {
+            let dx = ((k % bw) as i64 - tc).unsigned_abs() as u32;
+            let dy = ((k / bw) as i64 - tr).unsigned_abs() as u32;
+            10 * dx.max(dy) + 4 * dx.min(dy)
+        };
+        let linked = |k: usize, dc: i64, dr: i64| -> bool {
+            let (c, r) = ((k % bw) as i64, (k / bw) as i64);
+            let at = |c: i64, r: i64| r as usize * bw + c as usize;
+            match (dc, dr) {
+                (1, 0) => self.east[k],
+                (-1, 0) => self.east[at(c - 1, r)],
+                (0, 1) => self.south[k],
+                (0, -1) => self.south[at(c, r - 1)],
+                _ => false,
+            }
+        };
+        let mut scratch = self.scratch.borrow_mut();
+        let (gen, stamp, g) = &mut *scratch;
+        *gen = gen.wrapping_add(1);
+        if *gen == 0 {
+            stamp.fill(0);
+            *gen = 1;
+        }
+        let gen = *gen;
+        let mut heap = BinaryHeap::new();
+        stamp[s] = gen;
+        g[s] = 0;
+        heap.push(Reverse((hcost(s), 0u32, s)));
+        while let Some(Reverse((f, gk, k))) = heap.pop() {
+            if f > cap {
+                break;
+            }
+            if gk > g[k] {
+                continue;
+            }
+            if k == t {
+                return f64::from(gk) / 10.0 * self.b as f64;
+            }
+            let (c, r) = ((k % bw) as i64, (k / bw) as i64);
+            for (dc, dr) in [
+                (1, 0),
+                (0, 1),
+                (-1, 0),
+                (0, -1),
+                (1, 1),
+                (1, -1),
+                (-1, 1),
+                (-1, -1),
+            ] {
+                let (nc, nr) = (c + dc, r + dr);
+                if nc < 0 || nr < 0 || nc >= bw as i64 || nr >= self.bh as i64 {
+                    continue;
+                }
+                let j = nr as usize * bw + nc as usize;
+                if !self.open[j] {
+                    continue;
+                }
+                let step = if dc != 0 && dr != 0 {
+                    let via_h = r as usize * bw + nc as usize;
+                    let via_v = nr as usize * bw + c as usize;
+                    let a = self.open[via_h] && linked(k, dc, 0) && linked(via_h, 0, dr);
+                    let b = self.open[via_v] && linked(k, 0, dr) && linked(via_v, dc, 0);
+                    if !(a || b) {
+                        continue;
+                    }
+                    14
+                } else {
+                    if !linked(k, dc, dr) {
+                        continue;
+                    }
+                    10
+                };
+                let ng = gk + step;
+                if stamp[j] != gen || ng < g[j] {
+                    stamp[j] = gen;
+                    g[j] = ng;
+                    heap.push(Reverse((ng + hcost(j), ng, j)));
+                }
+            }
+        }
+        f64::INFINITY
+    }
+}
+
+/// Pixel path search (A*, 8-connected, octile integer costs, no corner cutting).
+struct Search {
     width: usize,
     height: usize,
-    ok: &'a [bool],
     stamp: Vec<u32>,
     gen: u32,
     g: Vec<u32>,
     parent: Vec<u32>,
 }
 
-impl Search<'_> {
+impl Search {
+    fn new(width: usize, height: usize) -> Self {
+        Self {
+            width,
+            height,
+            stamp: vec![0; width * height],
+            gen: 0,
+            g: vec![0; width * height],
+            parent: vec![u32::MAX; width * height],
+        }
+    }
+
     fn octile(a: (usize, usize), b: (usize, usize)) -> u32 {
         let dx = a.0.abs_diff(b.0) as u32;
         let dy = a.1.abs_diff(b.1) as u32;
         10 * dx.max(dy) + 4 * dx.min(dy)
     }
 
-    /// Dijkstra from `s` over the working set to the nearest pixel satisfying `goal`.
-    fn nearest(&mut self, s: (usize, usize), goal: &dyn Fn(usize) -> bool) -> Option<usize> {
-        self.search(s, None, goal)
-    }
-
-    /// A* from `s` to `t` (both working pixels), 8-connected, no corner cutting.
-    fn path(&mut self, s: (usize, usize), t: (usize, usize)) -> Option<Vec<(usize, usize)>> {
-        let w = self.width;
-        let ti = t.1 * w + t.0;
-        let end = self.search(s, Some(t), &|i| i == ti)?;
-        let mut out = vec![(end % w, end / w)];
-        let mut k = end;
-        while self.parent[k] != u32::MAX {
-            k = self.parent[k] as usize;
-            out.push((k % w, k / w));
-        }
-        out.reverse();
-        Some(out)
-    }
-
-    /// Best-first search from `s` until a pixel satisfies `goal`: A* with the octile heuristic
-    /// towards `target` when given, Dijkstra otherwise. Integer costs 10 / 14, no corner cutting;
-    /// ties by cost, then pixel index. Leaves the search tree in `parent`.
-    fn search(
+    /// A* from `s` to `t` over `ok` (the end pixels need not be in it). A diagonal step whose
+    /// two side pixels are not both in `ok` is taken only when `diag(from, to)` allows it. Ties
+    /// by cost, then pixel index.
+    fn path(
         &mut self,
+        ok: &[bool],
         s: (usize, usize),
-        target: Option<(usize, usize)>,
-        goal: &dyn Fn(usize) -> bool,
-    ) -> Option<usize> {
+        t: (usize, usize),
+        diag_ok: &dyn Fn(usize, usize) -> bool,
+    ) -> Option<Vec<(usize, usize)>> {
         self.gen = self.gen.wrapping_add(1);
         if self.gen == 0 {
             self.stamp.iter_mut().for_each(|x| *x = 0);
             self.gen = 1;
         }
         let w = self.width;
-        let h_of = |p: (usize, usize)| target.map_or(0, |t| Self::octile(p, t));
+        let ti = t.1 * w + t.0;
+        let passable = |j: usize| ok[j] || j == ti;
         let mut heap = BinaryHeap::new();
         let si = s.1 * w + s.0;
         self.stamp[si] = self.gen;
         self.g[si] = 0;
         self.parent[si] = u32::MAX;
-        heap.push(Reverse((h_of(s), 0u32, si as u32)));
+        heap.push(Reverse((Self::octile(s, t), 0u32, si as u32)));
+        let mut found = false;
         while let Some(Reverse((_, g, i))) = heap.pop() {
             let i = i as usize;
             if g > self.g[i] {
                 continue;
             }
-            if goal(i) {
-                return Some(i);
+            if i == ti {
+                found = true;
+                break;
             }
             let (c, r) = ((i % w) as i64, (i / w) as i64);
             for (dc, dr) in [
@@ -233,13 +1510,14 @@ impl Search<'_> {
                     continue;
                 }
                 let j = nr as usize * w + nc as usize;
-                if !self.ok[j] {
+                if !passable(j) {
                     continue;
                 }
                 let diag = dc != 0 && dr != 0;
                 if diag
-                    && !(self.ok[r as usize * w + nc as usize]
-                        && self.ok[nr as usize * w + c as usize])
+                    && !(passable(r as usize * w + nc as usize)
+                        && passable(nr as usize * w + c as usize))
+                    && !diag_ok(i, j)
                 {
                     continue;
                 }
@@ -249,233 +1527,25 @@ impl Search<'_> {
                     self.g[j] = ng;
                     self.parent[j] = i as u32;
                     heap.push(Reverse((
-                        ng + h_of((nc as usize, nr as usize)),
+                        ng + Self::octile((nc as usize, nr as usize), t),
                         ng,
                         j as u32,
                     )));
                 }
             }
         }
-        None
-    }
-}
-
-impl Bcd {
-    /// Plans the whole coverage of `world` (offline).
-    pub fn new(world: &World, opts: &BcdOptions) -> Self {
-        let frame = *world.frame();
-        let (w, h) = (frame.width, frame.height);
-        let robot = world.robot();
-        let res = frame.resolution;
-        let r_px = robot.radius / res;
-        let need = crate::collide::contact_radius_px(r_px) + opts.margin_px.max(0.0);
-        let reach = world.reachable();
-        let ok: Vec<bool> = (0..w * h)
-            .map(|i| {
-                let (c, r) = (i % w, i / w);
-                reach.contains(i) && world.pixel_clearance(c, r) / res + 0.5 >= need
-            })
-            .collect();
-        let dec = decompose(w, h, &|c, r| ok[r * w + c]);
-        let spacing = opts.lane_spacing_m.unwrap_or(2.0 * robot.tool_radius);
-        let sp = ((spacing / res) + 1e-9).floor().max(1.0) as usize;
-        let mut search = Search {
-            width: w,
-            height: h,
-            ok: &ok,
-            stamp: vec![0; w * h],
-            gen: 0,
-            g: vec![0; w * h],
-            parent: vec![u32::MAX; w * h],
-        };
-        let mut steps = VecDeque::new();
-        let px = |c: usize, r: usize| frame.pixel_center(c, r);
-        let start = world.start().position();
-        // The working pixel nearest the start (a short free move joins them).
-        let mut cur: Option<(usize, usize)> = None;
-        if let Some((c0, r0)) = frame.pixel_of(start) {
-            let mut best: Option<(f64, (usize, usize))> = None;
-            let rad = need.ceil() as i64 + 3;
-            for dr in -rad..=rad {
-                for dc in -rad..=rad {
-                    let (c, r) = (c0 as i64 + dc, r0 as i64 + dr);
-                    if c < 0 || r < 0 || c >= w as i64 || r >= h as i64 {
-                        continue;
-                    }
-                    let (c, r) = (c as usize, r as usize);
-                    if ok[r * w + c] && world.segment_free(start, px(c, r)) {
-                        let d = px(c, r).dist(start);
-                        if best.is_none_or(|b| d < b.0) {
-                            best = Some((d, (c, r)));
-                        }
-                    }
-                }
-            }
-            if let Some((_, p)) = best {
-                steps.push_back(Step::MoveTo(px(p.0, p.1)));
-                cur = Some(p);
-            }
+        if !found {
+            return None;
         }
-        let Some(mut here) = cur else {
-            return Self { steps };
-        };
-        // Cell order, greedy: the nearest (by path length over the working set) unvisited cell
-        // among the current cell's neighbours in the adjacency graph, else among all cells.
-        let n = dec.cells.len();
-        let mut visited = vec![false; n];
-        let mut next = Some(dec.cell_of[here.1 * w + here.0] as usize);
-        let mut region = 0u32;
-        while let Some(cid) = next.take() {
-            visited[cid] = true;
-            let cell = &dec.cells[cid];
-            let c0 = cell.c0;
-            let c1 = c0 + cell.runs.len() - 1;
-            let mut lanes: Vec<usize> = if c1 - c0 < sp {
-                vec![usize::midpoint(c0, c1)]
-            } else {
-                let mut v: Vec<usize> = (c0..=c1).step_by(sp).collect();
-                if *v.last().unwrap_or(&c0) != c1 {
-                    v.push(c1);
-                }
-                v
-            };
-            // Enter at the corner nearest the robot.
-            let corners = {
-                let (l, r) = (lanes[0], lanes[lanes.len() - 1]);
-                let rl = cell.runs[l - c0];
-                let rr = cell.runs[r - c0];
-                [
-                    (l, rl.0, false, true),
-                    (l, rl.1, false, false),
-                    (r, rr.0, true, true),
-                    (r, rr.1, true, false),
-                ]
-            };
-            let hp = px(here.0, here.1);
-            let best = corners
-                .iter()
-                .min_by(|a, b| px(a.0, a.1).dist(hp).total_cmp(&px(b.0, b.1).dist(hp)))
-                .copied()
-                .unwrap_or(corners[0]);
-            if best.2 {
-                lanes.reverse();
-            }
-            // `down` = start at the top row (smaller row index) and go down.
-            let mut down = best.3;
-            let entry = best.1;
-            let entry_px = (lanes[0], entry);
-            if entry_px != here {
-                steps.push_back(Step::Mark(Event::BacktrackStart));
-                let ok = push_path(&mut steps, world, &mut search, here, entry_px, &px);
-                steps.push_back(Step::Mark(Event::BacktrackEnd));
-                if !ok {
-                    continue;
-                }
-                here = entry_px;
-            }
-            region += 1;
-            steps.push_back(Step::Mark(Event::RegionStart { region }));
-            for &lane in &lanes {
-                let run = cell.runs[lane - c0];
-                let (a, b) = if down { (run.0, run.1) } else { (run.1, run.0) };
-                if (lane, a) != here
-                    && !push_path(&mut steps, world, &mut search, here, (lane, a), &px)
-                {
-                    continue;
-                }
-                here = (lane, a);
-                if push_path(&mut steps, world, &mut search, here, (lane, b), &px) {
-                    here = (lane, b);
-                }
-                down = !down;
-            }
-            steps.push_back(Step::Mark(Event::RegionEnd { region }));
-            let cell_at = |i: usize| dec.cell_of[i] as usize;
-            let unvisited_nb: Vec<usize> = dec.adj[cid]
-                .iter()
-                .copied()
-                .filter(|&k| !visited[k])
-                .collect();
-            let found = if unvisited_nb.is_empty() {
-                search.nearest(here, &|i| {
-                    dec.cell_of[i] != u32::MAX && !visited[cell_at(i)]
-                })
-            } else {
-                search
-                    .nearest(here, &|i| {
-                        dec.cell_of[i] != u32::MAX && unvisited_nb.contains(&cell_at(i))
-                    })
-                    .or_else(|| {
-                        search.nearest(here, &|i| {
-                            dec.cell_of[i] != u32::MAX && !visited[cell_at(i)]
-                        })
-                    })
-            };
-            next = found.map(cell_at);
+        let mut out = vec![t];
+        let mut k = ti;
+        while self.parent[k] != u32::MAX {
+            k = self.parent[k] as usize;
+            out.push((k % w, k / w));
         }
-        Self { steps }
+        out.reverse();
+        Some(out)
     }
-}
-
-/// Appends moves from pixel `a` to pixel `b`: straight when free, else an A* pixel path
-/// shortened by line of sight on the true map. Every emitted move is checked against the true
-/// map; returns `false` (having emitted only a verified prefix) when no verified path exists.
-fn push_path(
-    steps: &mut VecDeque<Step>,
-    world: &World,
-    search: &mut Search<'_>,
-    a: (usize, usize),
-    b: (usize, usize),
-    px: &dyn Fn(usize, usize) -> Point,
-) -> bool {
-    if world.segment_free(px(a.0, a.1), px(b.0, b.1)) {
-        steps.push_back(Step::MoveTo(px(b.0, b.1)));
-        return true;
-    }
-    let Some(path) = search.path(a, b) else {
-        return false;
-    };
-    if !world.segment_free(px(a.0, a.1), px(path[0].0, path[0].1)) {
-        return false;
-    }
-    let pts: Vec<Point> = path.iter().map(|&(c, r)| px(c, r)).collect();
-    let mut i = 0;
-    while i + 1 < pts.len() {
-        // Exponential then binary search for the farthest visible point.
-        let mut lo = i + 1;
-        let mut step = 1;
-        let mut hi = None;
-        loop {
-            let j = (i + step).min(pts.len() - 1);
-            if world.segment_free(pts[i], pts[j]) {
-                lo = j;
-                if j == pts.len() - 1 {
-                    break;
-                }
-                step *= 2;
-            } else {
-                hi = Some(j);
-                break;
-            }
-        }
-        if let Some(mut hi) = hi {
-            if hi == i + 1 {
-                // Not even the next pixel is reachable in a straight line: give up honestly.
-                return false;
-            }
-            while hi - lo > 1 {
-                let mid = usize::midpoint(lo, hi);
-                if world.segment_free(pts[i], pts[mid]) {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
-        }
-        steps.push_back(Step::MoveTo(pts[lo]));
-        i = lo;
-    }
-    true
 }
 
 impl Planner for Bcd {
@@ -498,10 +1568,139 @@ mod tests {
     fn decomposition_splits_and_merges_around_a_block() {
         let art = "........\n..##....\n..##....\n........";
         let g: crate::grid::GridMap = art.parse().unwrap();
-        let d = decompose(8, 4, &|c, r| g.get(c, r).is_free());
+        let d = decompose(8, 4, true, &|c, r| g.get(c, r).is_free());
         // Left part, above the block, below the block, right part.
-        assert_eq!(d.cells.len(), 4);
-        assert_eq!(d.adj[0].len(), 2);
-        assert_eq!(d.adj[3].len(), 2);
+        assert_eq!(d.len(), 4);
+        assert_eq!((d[0].u0, d[0].runs.len()), (0, 2));
+        assert_eq!((d[1].u0, d[1].runs.clone()), (2, vec![(0, 0), (0, 0)]));
+        assert_eq!((d[2].u0, d[2].runs.clone()), (2, vec![(3, 3), (3, 3)]));
+        assert_eq!((d[3].u0, d[3].runs.len()), (4, 4));
+    }
+
+    fn block_room() -> World {
+        let art = "##########\n#........#\n#..##....#\n#..##....#\n#........#\n##########";
+        let map = crate::grid::GridMap::from_ascii_scaled(art, 10, 0.02).unwrap();
+        World::new(
+            map,
+            crate::world::Robot::new(0.08),
+            Some(crate::geometry::Pose::new(0.3, 0.3, 0.0)),
+        )
+        .unwrap()
+    }
+
+    fn run(world: &World, opts: &BcdOptions) -> crate::metrics::Metrics {
+        let mut p = Bcd::try_new(world, opts).unwrap();
+        let out = crate::sim::simulate(world, &mut p, &crate::sim::SimConfig::default());
+        crate::metrics::compute(world, &out, "block_room")
+    }
+
+    #[test]
+    fn lanes_sit_on_closed_edges_and_on_the_lattice_between() {
+        let cell = Cell {
+            cols: true,
+            u0: 3,
+            runs: vec![(0, 9); 20],
+        };
+        // Both sides closed: lanes on both edges, lattice lines (6 apart) in between.
+        let l = lanes_of(&cell, 6.0, 0.0, false, false);
+        assert_eq!(l, vec![3.0, 6.0, 12.0, 18.0, 22.0]);
+        assert!(l.windows(2).all(|w| w[1] - w[0] <= 6.0));
+        // Open sides: only the lattice, shared with the neighbours beyond.
+        assert_eq!(lanes_of(&cell, 6.0, 0.0, true, true), vec![6.0, 12.0, 18.0]);
+        // A lattice line within half a pixel of the edge belongs to this cell.
+        assert_eq!(
+            lanes_of(&cell, 6.0, 2.6, true, true),
+            vec![3.0, 8.6, 14.6, 20.6]
+        );
+    }
+
+    #[test]
+    fn block_room_is_covered_without_contact() {
+        let world = block_room();
+        let m = run(&world, &BcdOptions::default());
+        assert_eq!(m.collisions, 0);
+        assert!(m.effective_coverage >= 0.995, "{}", m.effective_coverage);
+    }
+
+    #[test]
+    fn rim_option_sweeps_what_lanes_miss() {
+        let world = block_room();
+        let with = run(&world, &BcdOptions::default());
+        let without = run(
+            &world,
+            &BcdOptions {
+                rim: false,
+                ..BcdOptions::default()
+            },
+        );
+        let picky = run(
+            &world,
+            &BcdOptions {
+                rim_min_yield: 1.0,
+                ..BcdOptions::default()
+            },
+        );
+        assert_eq!(without.collisions + picky.collisions, 0);
+        assert!(without.effective_coverage < with.effective_coverage);
+        assert!(without.path_length_m < with.path_length_m);
+        // A yield of a whole lane per metre is never met by a rim contour.
+        assert!(picky.effective_coverage < with.effective_coverage);
+    }
+
+    #[test]
+    fn same_plan_twice() {
+        let world = block_room();
+        let a = Bcd::new(&world, &BcdOptions::default());
+        let b = Bcd::new(&world, &BcdOptions::default());
+        assert_eq!(a.steps, b.steps);
+        assert_eq!(a.cells(), b.cells());
+    }
+
+    #[test]
+    fn invalid_options_are_refused() {
+        let world = block_room();
+        for bad in [
+            BcdOptions {
+                lane_spacing_m: Some(0.0),
+                ..BcdOptions::default()
+            },
+            BcdOptions {
+                margin_px: -1.0,
+                ..BcdOptions::default()
+            },
+            BcdOptions {
+                turn_cost_m: f64::NAN,
+                ..BcdOptions::default()
+            },
+            BcdOptions {
+                rim_min_yield: 1.5,
+                ..BcdOptions::default()
+            },
+        ] {
+            let e = Bcd::try_new(&world, &bad).err().unwrap();
+            assert!(e.to_string().starts_with("bcd option "), "{e}");
+            // The infallible constructor falls back to the defaults and still plans.
+            assert!(!Bcd::new(&world, &bad).steps.is_empty());
+        }
+    }
+
+    #[test]
+    fn transposed_cell_needs_one_run_per_line() {
+        // An L: rows 0-1 span columns 0-3, rows 2-3 only column 0.
+        let l = Cell {
+            cols: true,
+            u0: 0,
+            runs: vec![(0, 3), (0, 1), (0, 1), (0, 1)],
+        };
+        let t = l.transposed().unwrap();
+        assert!(!t.cols);
+        assert_eq!(t.runs, vec![(0, 3), (0, 3), (0, 0), (0, 0)]);
+        // A U (row 1 meets the cell in columns 0 and 2 only) is not monotone across.
+        let u = Cell {
+            cols: true,
+            u0: 0,
+            runs: vec![(0, 2), (0, 0), (0, 2)],
+        };
+        assert!(u.transposed().is_none());
     }
 }

@@ -488,8 +488,11 @@ impl PlannerSettings for BsaBfsOptions {
 
 impl PlannerSettings for BcdOptions {
     fn validate(&self) -> Result<(), OptionsError> {
-        opt_finite_pos("lane_spacing_m", self.lane_spacing_m)?;
-        finite_nonneg("margin_px", self.margin_px)
+        self.check_ranges().map_err(|e| match e {
+            super::bcd::BcdOptionsError::OutOfRange { name, what, value } => {
+                OptionsError::new(name, format!("must be {what}, got {value}"))
+            }
+        })
     }
 
     fn check(&self, _: &Setup) -> Result<(), OptionsError> {

@@ -1,0 +1,424 @@
+//! Ordering of coverage pieces as an open travelling-salesman path with orientations.
+//!
+//! Each piece (a BCD cell) can be driven in a few variants: variant `v` enters at `entry(v)`,
+//! leaves at `exit(v)` and costs `inner(v)` inside the piece; variants come in pairs, `v ^ 1`
+//! being `v` driven backwards (its entry is `v`'s exit and the other way round, same inner
+//! cost). The path starts at a fixed point and visits every piece once; the cost of a hop is the
+//! straight-line distance. Construction: nearest neighbour from the start. Improvement, repeated
+//! until a round changes nothing (or `rounds` is spent): 2-opt (a reversed stretch drives each of
+//! its pieces backwards), Or-opt (stretches of 1 to 3 pieces moved elsewhere, either way round),
+//! both tried only where a new hop joins one of a piece's 12 nearest pieces, and an exact dynamic
+//! programme that picks every piece's variant for the current order.
+//! Everything is deterministic: fixed scan orders, strict improvements only, ties to the lower
+//! index.
+
+use crate::geometry::Point;
+
+/// One piece to visit.
+#[derive(Clone, Debug)]
+pub(crate) struct Piece {
+    /// Entry point of each variant.
+    pub entry: Vec<Point>,
+    /// Exit point of each variant.
+    pub exit: Vec<Point>,
+    /// Cost inside the piece of each variant.
+    pub inner: Vec<f64>,
+}
+
+/// Improvement smaller than this is ignored (keeps the loops finite under rounding).
+const EPS: f64 = 1e-7;
+
+/// A visiting order: `(piece, variant)` pairs.
+pub(crate) type Tour = Vec<(usize, usize)>;
+
+/// Hop cost between two points.
+pub(crate) type Dist<'a> = &'a dyn Fn(Point, Point) -> f64;
+
+/// Total cost of `tour` from `start`.
+pub(crate) fn cost(pieces: &[Piece], start: Point, tour: &Tour, d: Dist<'_>) -> f64 {
+    let mut at = start;
+    let mut total = 0.0;
+    for &(p, v) in tour {
+        total += d(at, pieces[p].entry[v]) + pieces[p].inner[v];
+        at = pieces[p].exit[v];
+    }
+    total
+}
+
+/// Plans the visiting order (see the module docs); `first`, when given, replaces the
+/// nearest-neighbour construction.
+pub(crate) fn solve(
+    pieces: &[Piece],
+    start: Point,
+    rounds: u32,
+    d: Dist<'_>,
+    first: Option<Tour>,
+) -> Tour {
+    let mut tour = first.unwrap_or_else(|| nearest_neighbour(pieces, start, d));
+    if rounds == 0 {
+        return tour;
+    }
+    let nb = neighbour_lists(pieces, d);
+    for _ in 0..rounds {
+        let before = cost(pieces, start, &tour, d);
+        two_opt(pieces, start, &mut tour, &nb, d);
+        or_opt(pieces, start, &mut tour, &nb, d);
+        choose_variants(pieces, start, &mut tour, d);
+        if cost(pieces, start, &tour, d) >= before - EPS {
+            break;
+        }
+    }
+    tour
+}
+
+fn nearest_neighbour(pieces: &[Piece], start: Point, d: Dist<'_>) -> Tour {
+    let n = pieces.len();
+    let mut done = vec![false; n];
+    let mut tour = Vec::with_capacity(n);
+    let mut at = start;
+    let mut cands: Vec<(f64, usize, usize)> = Vec::new();
+    for _ in 0..n {
+        // Candidates by straight-line cost (a lower bound of the hop cost), then exact costs
+        // until the bound passes the best found.
+        cands.clear();
+        for (p, piece) in pieces.iter().enumerate() {
+            if done[p] {
+                continue;
+            }
+            for v in 0..piece.entry.len() {
+                cands.push((at.dist(piece.entry[v]) + piece.inner[v], p, v));
+            }
+        }
+        cands.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
+        let mut best: Option<(f64, usize, usize)> = None;
+        for &(lb, p, v) in &cands {
+            if best.is_some_and(|b| lb >= b.0) {
+                break;
+            }
+            let c = d(at, pieces[p].entry[v]) + pieces[p].inner[v];
+            if best.is_none_or(|b| c < b.0) {
+                best = Some((c, p, v));
+            }
+        }
+        let Some((_, p, v)) = best else { break };
+        done[p] = true;
+        tour.push((p, v));
+        at = pieces[p].exit[v];
+    }
+    tour
+}
+
+/// Exit of the element before position `i` (the start for `i == 0`).
+fn prev_exit(pieces: &[Piece], start: Point, tour: &Tour, i: usize) -> Point {
+    if i == 0 {
+        start
+    } else {
+        let (p, v) = tour[i - 1];
+        pieces[p].exit[v]
+    }
+}
+
+/// Number of candidate neighbours per piece in the improvement moves.
+const NEIGHBOURS: usize = 12;
+
+/// The `NEIGHBOURS` pieces nearest to each piece (by the closest pair of end points), nearest
+/// first, ties by index.
+fn neighbour_lists(pieces: &[Piece], d: Dist<'_>) -> Vec<Vec<usize>> {
+    let ends: Vec<Vec<Point>> = pieces
+        .iter()
+        .map(|p| {
+            let mut v: Vec<Point> = p.entry.iter().chain(&p.exit).copied().collect();
+            v.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+            v.dedup();
+            v
+        })
+        .collect();
+    let gap = |a: usize, b: usize| -> f64 {
+        let mut m = f64::INFINITY;
+        for p in &ends[a] {
+            for q in &ends[b] {
+                m = m.min(p.dist2(*q));
+            }
+        }
+        m
+    };
+    (0..pieces.len())
+        .map(|a| {
+            // The 3 * NEIGHBOURS nearest in a straight line, re-ranked by hop cost.
+            let keep = 3 * NEIGHBOURS;
+            let mut best: Vec<(f64, usize)> = Vec::with_capacity(keep + 1);
+            for b in 0..pieces.len() {
+                if a == b {
+                    continue;
+                }
+                let g = gap(a, b);
+                if best.len() < keep || g < best[best.len() - 1].0 {
+                    let at = best.partition_point(|e| e.0 <= g);
+                    best.insert(at, (g, b));
+                    best.truncate(keep);
+                }
+            }
+            // (one hop cost per candidate: between its end points nearest in a straight line)
+            let mut ranked: Vec<(f64, usize)> = best
+                .into_iter()
+                .map(|(_, b)| {
+                    let mut pair = (f64::INFINITY, ends[a][0], ends[b][0]);
+                    for p in &ends[a] {
+                        for q in &ends[b] {
+                            if p.dist2(*q) < pair.0 {
+                                pair = (p.dist2(*q), *p, *q);
+                            }
+                        }
+                    }
+                    (d(pair.1, pair.2), b)
+                })
+                .collect();
+            ranked.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+            ranked.truncate(NEIGHBOURS);
+            ranked.into_iter().map(|e| e.1).collect()
+        })
+        .collect()
+}
+
+fn positions(tour: &Tour, n: usize) -> Vec<usize> {
+    let mut pos = vec![usize::MAX; n];
+    for (i, e) in tour.iter().enumerate() {
+        pos[e.0] = i;
+    }
+    pos
+}
+
+/// 2-opt over candidate neighbours: reversing `tour[i..=j]` makes the hops
+/// `prev(i) -> exit(j)` and `entry(i) -> entry(j + 1)`; `j` is taken where either new hop
+/// joins neighbours.
+fn two_opt(pieces: &[Piece], start: Point, tour: &mut Tour, nb: &[Vec<usize>], d: Dist<'_>) {
+    let n = tour.len();
+    let entry = |t: &Tour, i: usize| pieces[t[i].0].entry[t[i].1];
+    let exit = |t: &Tour, i: usize| pieces[t[i].0].exit[t[i].1];
+    let mut pos = positions(tour, pieces.len());
+    let mut improved = true;
+    let mut passes = 0;
+    let mut cand: Vec<usize> = Vec::new();
+    while improved && passes < 50 {
+        improved = false;
+        passes += 1;
+        for i in 0..n {
+            cand.clear();
+            if i > 0 {
+                cand.extend(nb[tour[i - 1].0].iter().map(|&q| pos[q]));
+            } else {
+                cand.extend(0..n.min(NEIGHBOURS));
+            }
+            cand.extend(nb[tour[i].0].iter().filter_map(|&q| pos[q].checked_sub(1)));
+            cand.push(n - 1);
+            cand.sort_unstable();
+            cand.dedup();
+            let a = prev_exit(pieces, start, tour, i);
+            let bi = entry(tour, i);
+            for &j in cand.iter().filter(|&&j| j >= i && j < n) {
+                let ej = exit(tour, j);
+                let (before, after) = if j + 1 < n {
+                    let bn = entry(tour, j + 1);
+                    (d(a, bi) + d(ej, bn), d(a, ej) + d(bi, bn))
+                } else {
+                    (d(a, bi), d(a, ej))
+                };
+                if after < before - EPS {
+                    tour[i..=j].reverse();
+                    for e in &mut tour[i..=j] {
+                        e.1 ^= 1;
+                    }
+                    for k in i..=j {
+                        pos[tour[k].0] = k;
+                    }
+                    improved = true;
+                    break;
+                }
+            }
+        }
+    }
+}
+
+/// Or-opt over candidate neighbours: stretches of 1 to 3 pieces moved next to a neighbour of
+/// their first or last piece, either way round.
+fn or_opt(pieces: &[Piece], start: Point, tour: &mut Tour, nb: &[Vec<usize>], d: Dist<'_>) {
+    let entry = |t: &Tour, i: usize| pieces[t[i].0].entry[t[i].1];
+    let exit = |t: &Tour, i: usize| pieces[t[i].0].exit[t[i].1];
+    let mut pos = positions(tour, pieces.len());
+    let mut improved = true;
+    let mut passes = 0;
+    let mut cand: Vec<usize> = Vec::new();
+    while improved && passes < 50 {
+        improved = false;
+        passes += 1;
+        let n = tour.len();
+        for k in 1..=3usize {
+            if k >= n {
+                break;
+            }
+            for i in 0..=n - k {
+                let j = i + k - 1;
+                let a = prev_exit(pieces, start, tour, i);
+                let (si, ej) = (entry(tour, i), exit(tour, j));
+                let removed = if j + 1 < n {
+                    let bn = entry(tour, j + 1);
+                    d(a, si) + d(ej, bn) - d(a, bn)
+                } else {
+                    d(a, si)
+                };
+                // Insertion between p-1 and p: next to a neighbour on either side.
+                cand.clear();
+                for &q in nb[tour[i].0].iter().chain(&nb[tour[j].0]) {
+                    cand.push(pos[q]);
+                    cand.push(pos[q] + 1);
+                }
+                cand.push(0);
+                cand.push(n);
+                cand.sort_unstable();
+                cand.dedup();
+                let mut best: Option<(f64, usize, bool)> = None;
+                for &p in &cand {
+                    if p > n || (p >= i && p <= j + 1) {
+                        continue;
+                    }
+                    let before_pt = prev_exit(pieces, start, tour, p);
+                    let next = if p < n { Some(entry(tour, p)) } else { None };
+                    for rev in [false, true] {
+                        let (s_in, s_out) = if rev { (ej, si) } else { (si, ej) };
+                        let add = match next {
+                            Some(nx) => d(before_pt, s_in) + d(s_out, nx) - d(before_pt, nx),
+                            None => d(before_pt, s_in),
+                        };
+                        if add < removed - EPS && best.is_none_or(|b| add < b.0) {
+                            best = Some((add, p, rev));
+                        }
+                    }
+                }
+                if let Some((_, p, rev)) = best {
+                    let mut seg: Vec<(usize, usize)> = tour.drain(i..=j).collect();
+                    if rev {
+                        seg.reverse();
+                        for e in &mut seg {
+                            e.1 ^= 1;
+                        }
+                    }
+                    let at = if p > j { p - k } else { p };
+                    tour.splice(at..at, seg);
+                    pos = positions(tour, pieces.len());
+                    improved = true;
+                }
+            }
+        }
+    }
+}
+
+/// Exact choice of every piece's variant for the current order (dynamic programme).
+fn choose_variants(pieces: &[Piece], start: Point, tour: &mut Tour, d: Dist<'_>) {
+    let n = tour.len();
+    if n == 0 {
+        return;
+    }
+    // best[i][v]: cost up to and including piece i driven in variant v; from[i][v]: variant of
+    // piece i-1.
+    let mut best: Vec<Vec<f64>> = Vec::with_capacity(n);
+    let mut from: Vec<Vec<usize>> = Vec::with_capacity(n);
+    for i in 0..n {
+        let pc = &pieces[tour[i].0];
+        let mut row = vec![f64::INFINITY; pc.entry.len()];
+        let mut frow = vec![0usize; pc.entry.len()];
+        for v in 0..pc.entry.len() {
+            if i == 0 {
+                row[v] = d(start, pc.entry[v]) + pc.inner[v];
+            } else {
+                let pp = &pieces[tour[i - 1].0];
+                for u in 0..pp.exit.len() {
+                    let c = best[i - 1][u] + d(pp.exit[u], pc.entry[v]) + pc.inner[v];
+                    if c < row[v] {
+                        row[v] = c;
+                        frow[v] = u;
+                    }
+                }
+            }
+        }
+        best.push(row);
+        from.push(frow);
+    }
+    let last = &best[n - 1];
+    let mut v = 0;
+    for (u, &c) in last.iter().enumerate() {
+        if c < last[v] {
+            v = u;
+        }
+    }
+    let old = cost(pieces, start, tour, d);
+    if last[v] >= old - EPS {
+        return;
+    }
+    for i in (0..n).rev() {
+        tour[i].1 = v;
+        v = from[i][v];
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn euclid(a: Point, b: Point) -> f64 {
+        a.dist(b)
+    }
+
+    fn point_piece(x: f64, y: f64) -> Piece {
+        let p = Point::new(x, y);
+        Piece {
+            entry: vec![p, p],
+            exit: vec![p, p],
+            inner: vec![0.0, 0.0],
+        }
+    }
+
+    #[test]
+    fn points_on_a_line_are_visited_in_order() {
+        let xs = [5.0, 1.0, 9.0, 3.0, 7.0, 2.0];
+        let pieces: Vec<Piece> = xs.iter().map(|&x| point_piece(x, 0.0)).collect();
+        let tour = solve(&pieces, Point::new(0.0, 0.0), 10, &euclid, None);
+        let order: Vec<f64> = tour.iter().map(|&(p, _)| xs[p]).collect();
+        assert_eq!(order, vec![1.0, 2.0, 3.0, 5.0, 7.0, 9.0]);
+        assert!((cost(&pieces, Point::new(0.0, 0.0), &tour, &euclid) - 9.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn segments_are_driven_the_short_way_round() {
+        // Two horizontal segments; variant 0 goes left to right, 1 right to left.
+        let seg = |y: f64| Piece {
+            entry: vec![Point::new(0.0, y), Point::new(10.0, y)],
+            exit: vec![Point::new(10.0, y), Point::new(0.0, y)],
+            inner: vec![10.0, 10.0],
+        };
+        let pieces = vec![seg(1.0), seg(0.0)];
+        let tour = solve(&pieces, Point::new(0.0, 0.0), 10, &euclid, None);
+        assert_eq!(tour, vec![(1, 0), (0, 1)]);
+        assert!((cost(&pieces, Point::new(0.0, 0.0), &tour, &euclid) - 21.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn improvement_never_loses_to_construction() {
+        // A scattered deterministic point set.
+        let mut pieces = Vec::new();
+        let mut s = 7u64;
+        for _ in 0..40 {
+            s = s.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+            let x = (s >> 33) as f64 / 1e6;
+            s = s.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+            let y = (s >> 33) as f64 / 1e6;
+            pieces.push(point_piece(x, y));
+        }
+        let start = Point::new(0.0, 0.0);
+        let nn = nearest_neighbour(&pieces, start, &euclid);
+        let best = solve(&pieces, start, 20, &euclid, None);
+        assert!(cost(&pieces, start, &best, &euclid) <= cost(&pieces, start, &nn, &euclid) + 1e-9);
+        let mut seen: Vec<usize> = best.iter().map(|e| e.0).collect();
+        seen.sort_unstable();
+        assert_eq!(seen, (0..40).collect::<Vec<_>>());
+    }
+}
