@@ -2,10 +2,12 @@
 //! and the catalogue that builds them by name.
 
 pub mod ba_star;
+pub mod ba_star_extended;
 pub mod bcd;
 pub mod bsa;
 pub mod bsa_bfs;
 pub mod bsa_extended;
+pub mod extension;
 pub mod random_bounce;
 pub mod rect_boustrophedon;
 
@@ -30,6 +32,11 @@ pub const CATALOG: &[PlannerInfo] = &[
     PlannerInfo {
         name: "ba-star",
         description: "BA* (Viet et al. 2013): boustrophedon regions on 2r tiles, A* + smoothed backtracking to the nearest corner tile",
+        offline: false,
+    },
+    PlannerInfo {
+        name: "ba-star-extended",
+        description: "BA* plus the seed-002 extension: online wall following of the rims its tiles leave, merged into straight known-free segments",
         offline: false,
     },
     PlannerInfo {
@@ -73,6 +80,8 @@ pub struct PlannerOptions {
     pub random_bounce: random_bounce::RandomBounceOptions,
     /// `ba-star`.
     pub ba_star: ba_star::BaStarOptions,
+    /// `ba-star-extended`.
+    pub ba_star_extended: ba_star_extended::BaStarExtendedOptions,
     /// `bcd`.
     pub bcd: bcd::BcdOptions,
     /// `bsa-bfs`.
@@ -118,6 +127,13 @@ pub fn build(
                 o.tile_side_m = Some(2.0 * world.robot().radius);
             }
             Ok(Box::new(ba_star::BaStar::new(o)))
+        }
+        "ba-star-extended" => {
+            let mut o = opts.ba_star_extended.clone();
+            if o.ba_star.tile_side_m.is_none() {
+                o.ba_star.tile_side_m = Some(2.0 * world.robot().radius);
+            }
+            Ok(Box::new(ba_star_extended::BaStarExtended::new(o)))
         }
         "bcd" => Ok(Box::new(bcd::Bcd::new(world, &opts.bcd))),
         "bsa-bfs" => Ok(Box::new(bsa_bfs::BsaBfs::new(opts.bsa_bfs.clone()))),
