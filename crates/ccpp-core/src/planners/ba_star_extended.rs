@@ -78,6 +78,8 @@ pub struct BaStarExtended {
     last_pos: Option<Point>,
     /// Inside a `wall_follow_start` / `wall_follow_end` pair.
     in_pass: bool,
+    /// Heading of the host's last lane move, while the host is in a lane.
+    lane: Option<f64>,
     /// Waypoints driven since the region's cleaning began (its start first), to retreat by.
     trail: Vec<Point>,
 }
@@ -94,6 +96,7 @@ impl BaStarExtended {
             last_pos: None,
             in_pass: false,
             trail: Vec::new(),
+            lane: None,
         }
     }
 
@@ -117,8 +120,8 @@ impl BaStarExtended {
             Vec::new()
         } else {
             let ba = &self.ba;
-            let pending = |p: Point| !last && ba.will_cover(p);
-            ext.plan_chunk(known, pos, bounded, &pending)
+            let wanted = |p: Point| last || !ba.will_cover(p);
+            ext.plan_chunk(known, pos, bounded, &wanted)
         };
         if !chunk.is_empty() {
             if !self.in_pass {
@@ -202,12 +205,43 @@ impl Planner for BaStarExtended {
                 Mode::Clean { last } => self.clean(pos, last),
                 Mode::Host => match self.ba.next(sensor) {
                     Step::Mark(Event::BacktrackStart) => {
+                        self.lane = None;
                         self.trail = vec![pos];
                         self.mode = Mode::Clean { last: false };
                     }
                     Step::Done => {
                         self.trail = vec![pos];
                         self.mode = Mode::Clean { last: true };
+                    }
+                    Step::MoveTo(target) if !self.ba.is_backtracking() => {
+                        let theta = sensor.pose().theta;
+                        let turn = crate::geometry::wrap_angle(
+                            (target.y - pos.y).atan2(target.x - pos.x) - theta,
+                        );
+                        let in_lane = self
+                            .lane
+                            .is_some_and(|h| crate::geometry::wrap_angle(h - theta).abs() < 1e-6);
+                        self.lane = Some((target.y - pos.y).atan2(target.x - pos.x));
+                        let lane_end = if self.opts.lane_ends && in_lane && turn.abs() > 0.1 {
+                            match (self.ext.as_mut(), self.ba.known_map(), self.ba.tile_grid()) {
+                                (Some(ext), Some(known), Some(g)) => {
+                                    let ba = &self.ba;
+                                    let wanted = |p: Point| !ba.will_cover(p);
+                                    ext.lane_end(known, pos, theta, target, g.side, &wanted)
+                                }
+                                _ => None,
+                            }
+                        } else {
+                            None
+                        };
+                        match lane_end {
+                            Some(pts) => {
+                                for p in pts {
+                                    self.queue.push_back(Step::MoveTo(p));
+                                }
+                            }
+                            None => return Step::MoveTo(target),
+                        }
                     }
                     s => return s,
                 },

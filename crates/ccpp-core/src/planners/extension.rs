@@ -102,6 +102,9 @@ pub struct ExtensionOptions {
     /// How far (path distance, in robot radii) the robot looks for an unswept rim when the host
     /// finishes a region; `0` cleans only once, after the host's coverage.
     pub reach_r: f64,
+    /// Drive the host's lane ends on to the wall ahead, along it, and into the next lane
+    /// (`false` turns at the last free tile centre as the host does).
+    pub lane_ends: bool,
     /// Merge the pixel steps of a wall pass into straight known-free segments (`false` drives
     /// pixel by pixel, to compare).
     pub merge_segments: bool,
@@ -111,6 +114,7 @@ impl Default for ExtensionOptions {
     fn default() -> Self {
         Self {
             reach_r: 4.0,
+            lane_ends: false,
             merge_segments: true,
         }
     }
@@ -151,12 +155,22 @@ pub(crate) struct Extension {
     /// `S0` memo per pixel: 0 undecided, 1 the robot fits, 2 it does not.
     s0: Vec<u8>,
     s0_disk: Vec<i64>,
+    /// `S1` memo (the robot fits with the clearance that makes every 8-neighbour move between
+    /// two such positions free): 0 undecided, 1 fits, 2 not.
+    s1: Vec<u8>,
+    s1_disk: Vec<i64>,
     /// Per pixel: bit `k` = the move to neighbour `NB[k]` is known free.
     edge_free: Vec<u8>,
     /// The tool disk around a pixel centre, as pixel offsets.
     tool: Vec<(i64, i64)>,
+    /// The same disk as row half-widths (entry `|drow|`).
+    tool_rows: Vec<i64>,
     /// Pixels swept (executed or claimed by a planned pass).
     swept: FixedBitSet,
+    /// Final passes: positions known not to gain enough, valid while the known map holds
+    /// `no_gain_seen` seen pixels (targets only disappear in between).
+    no_gain: FixedBitSet,
+    no_gain_seen: usize,
     // Dijkstra scratch (generation-stamped).
     dist: Vec<u64>,
     parent: Vec<u32>,
@@ -179,16 +193,33 @@ impl Extension {
                 }
             }
         }
+        let rc = crate::collide::contact_radius_px(r_px);
+        let tool_rows = (0..=reach)
+            .map(|dr| {
+                (0..=reach)
+                    .filter(|dc| ((dc * dc + dr * dr) as f64) <= rt * rt)
+                    .max()
+                    .unwrap_or(-1)
+            })
+            .collect();
         Self {
             opts,
             frame,
             r,
             rt,
             s0: vec![0; n],
-            s0_disk: pixel_disk_spans(crate::collide::contact_radius_px(r_px)),
+            s0_disk: pixel_disk_spans(rc),
+            // A blocked pixel centre at least R from both ends of a move of length l is at
+            // least sqrt(R^2 - l^2/4) from the move: R^2 >= rc^2 + 1/2 keeps diagonal moves
+            // out of contact, and every pixel such a move could touch lies in one end's disk.
+            s1: vec![0; n],
+            s1_disk: pixel_disk_spans((rc * rc + 0.5).sqrt() + 1e-9),
             edge_free: vec![0; n],
             tool: off,
+            tool_rows,
             swept: FixedBitSet::with_capacity(n),
+            no_gain: FixedBitSet::with_capacity(n),
+            no_gain_seen: usize::MAX,
             dist: vec![0; n],
             parent: vec![u32::MAX; n],
             stamp: vec![0; n],
@@ -221,7 +252,10 @@ impl Extension {
     }
 
     fn center(&self, p: Px) -> Point {
-        Point::new(p.0 as f64 + 0.5, (self.frame.height as i64 - p.1) as f64 - 0.5)
+        Point::new(
+            p.0 as f64 + 0.5,
+            (self.frame.height as i64 - p.1) as f64 - 0.5,
+        )
     }
 
     fn px_of(&self, i: usize) -> Px {
@@ -255,6 +289,27 @@ impl Extension {
         }
     }
 
+    /// Does pixel `p` lie in `S1` (see the field)? Unseen counts as no.
+    fn in_s1(&mut self, known: &KnownMap, p: Px) -> bool {
+        let Some(i) = self.idx(p) else { return false };
+        match self.s1[i] {
+            1 => return true,
+            2 => return false,
+            _ => {}
+        }
+        match known.disk_state_px(p.0, p.1, &self.s1_disk) {
+            DiskState::Free => {
+                self.s1[i] = 1;
+                true
+            }
+            DiskState::Blocked => {
+                self.s1[i] = 2;
+                false
+            }
+            DiskState::Unseen => false,
+        }
+    }
+
     /// Is the straight move between grid points `a` and `b` known free?
     fn seg_free(&self, known: &KnownMap, a: Point, b: Point) -> bool {
         judge_motion(known, self.world(a), self.world(b), self.r) == Judgement::Free
@@ -272,9 +327,11 @@ impl Extension {
         if self.in_s0(known, q) != Some(true) {
             return false;
         }
-        // Orthogonal moves between two fitting positions stay within the union of their disks
-        // only approximately: check every move on the known map (once it is free it stays so).
-        if self.seg_free(known, self.center(p), self.center(q)) {
+        // Between two `S1` positions a move is free; else check it on the known map (once free,
+        // it stays so).
+        if (self.in_s1(known, p) && self.in_s1(known, q))
+            || self.seg_free(known, self.center(p), self.center(q))
+        {
             self.edge_free[i] |= 1 << k;
             self.edge_free[j] |= 1 << ((k + 4) % 8);
             true
@@ -284,34 +341,57 @@ impl Extension {
     }
 
     /// Is pixel `q` a target?
-    fn is_target(&self, known: &KnownMap, q: Px, pending: &dyn Fn(Point) -> bool) -> bool {
+    fn is_target(&self, known: &KnownMap, q: Px, wanted: &dyn Fn(Point) -> bool) -> bool {
         let Some(i) = self.idx(q) else { return false };
         known.known_free().contains(i)
             && !self.swept.contains(i)
-            && !pending(self.world(self.center(q)))
+            && wanted(self.world(self.center(q)))
     }
 
     /// Number of targets within the tool radius of position `p` (stops at `cap`).
-    fn gain(&self, known: &KnownMap, p: Px, pending: &dyn Fn(Point) -> bool, cap: usize) -> usize {
+    fn gain(&self, known: &KnownMap, p: Px, wanted: &dyn Fn(Point) -> bool, cap: usize) -> usize {
+        let f = self.frame;
+        let (w, h) = (f.width as i64, f.height as i64);
+        let free = known.known_free().as_slice();
+        let swept = self.swept.as_slice();
+        let reach = self.tool_rows.len() as i64 - 1;
         let mut n = 0;
-        for &(dc, dr) in &self.tool {
-            if self.is_target(known, (p.0 + dc, p.1 + dr), pending) {
-                n += 1;
-                if n >= cap {
-                    break;
-                }
+        for dr in -reach..=reach {
+            let row = p.1 + dr;
+            let hw = self.tool_rows[dr.unsigned_abs() as usize];
+            if hw < 0 || row < 0 || row >= h {
+                continue;
+            }
+            let (lo, hi) = ((p.0 - hw).max(0), (p.0 + hw).min(w - 1));
+            if lo > hi {
+                continue;
+            }
+            let base = row as usize * f.width;
+            let go_on = crate::bits::for_each_set(
+                base + lo as usize,
+                base + hi as usize + 1,
+                |k| free[k] & !swept[k],
+                |i| {
+                    if wanted(self.world(self.center(((i - base) as i64, row)))) {
+                        n += 1;
+                    }
+                    n < cap
+                },
+            );
+            if !go_on {
+                break;
             }
         }
         n
     }
 
     /// Marks the targets around `p` swept; returns their indices.
-    fn claim(&mut self, known: &KnownMap, p: Px, pending: &dyn Fn(Point) -> bool) -> Vec<usize> {
+    fn claim(&mut self, known: &KnownMap, p: Px, wanted: &dyn Fn(Point) -> bool) -> Vec<usize> {
         let mut out = Vec::new();
         for k in 0..self.tool.len() {
             let (dc, dr) = self.tool[k];
             let q = (p.0 + dc, p.1 + dr);
-            if self.is_target(known, q, pending) {
+            if self.is_target(known, q, wanted) {
                 let i = self.idx(q).expect("targets are in the image");
                 self.swept.insert(i);
                 out.push(i);
@@ -350,7 +430,9 @@ impl Extension {
         self.begin();
         let gen = self.generation;
         let h = |s: &Self, p: Px| -> u64 {
-            goal.map_or(0, |g| (s.center(p).dist(g) * COST_ORTHO as f64).floor() as u64)
+            goal.map_or(0, |g| {
+                (s.center(p).dist(g) * COST_ORTHO as f64).floor() as u64
+            })
         };
         let mut heap: BinaryHeap<Reverse<(u64, usize)>> = BinaryHeap::new();
         let p0 = self.frame.grid_to_pixel_signed(from);
@@ -422,14 +504,40 @@ impl Extension {
         known: &KnownMap,
         pos: Point,
         bounded: bool,
-        pending: &dyn Fn(Point) -> bool,
+        wanted: &dyn Fn(Point) -> bool,
     ) -> Vec<Point> {
         let from = self.frame.world_to_grid(pos);
         let limit = bounded.then(|| {
             (self.opts.reach_r * self.r / self.frame.resolution * COST_ORTHO as f64) as u64
         });
+        // Thresholds, in pixels a position must sweep: a trip to a rim must gain a tool radius
+        // of pixels (half of it, at least 2, after the host's coverage: only specks stay), a step
+        // off the contour as much, a step along the contour one.
+        let tool = self.rt.ceil().max(1.0) as usize;
+        let g_start = if bounded {
+            tool
+        } else {
+            (self.rt / 2.0).ceil().max(2.0) as usize
+        };
+        let g_int = tool;
+        let g_con = 1;
+        if !bounded {
+            let seen = known.seen().count_ones(..);
+            if seen != self.no_gain_seen {
+                self.no_gain.clear();
+                self.no_gain_seen = seen;
+            }
+        }
         let Some(transit) = self.search(known, from, limit, None, &mut |s, p| {
-            s.gain(known, p, pending, 1) > 0
+            let i = s.idx(p).expect("positions are in the image");
+            if !bounded && s.no_gain.contains(i) {
+                return false;
+            }
+            let gains = s.gain(known, p, wanted, g_start) >= g_start;
+            if !gains && !bounded {
+                s.no_gain.insert(i);
+            }
+            gains
         }) else {
             return Vec::new();
         };
@@ -443,7 +551,7 @@ impl Extension {
         let mut cur = self.px_of(*transit.last().expect("non-empty path"));
         let mut dir: Option<usize> = None;
         pts.push(self.center(cur));
-        gains.push(self.claim(known, cur, pending));
+        gains.push(self.claim(known, cur, wanted));
         for _ in 0..MAX_WALK {
             let mut best: Option<(bool, usize, i64, usize)> = None;
             for k in 0..8 {
@@ -451,11 +559,14 @@ impl Extension {
                     continue;
                 }
                 let q = (cur.0 + NB[k].0, cur.1 + NB[k].1);
-                let g = self.gain(known, q, pending, usize::MAX);
-                if g == 0 {
+                let g = self.gain(known, q, wanted, usize::MAX);
+                if g < g_con {
                     continue;
                 }
                 let contour = self.on_contour(known, q);
+                if !contour && g < g_int {
+                    continue;
+                }
                 let turn = dir.map_or(0, |d| {
                     let t = (k + 8 - d) % 8;
                     t.min(8 - t) as i64
@@ -473,7 +584,7 @@ impl Extension {
             cur = (cur.0 + NB[k].0, cur.1 + NB[k].1);
             dir = Some(k);
             pts.push(self.center(cur));
-            gains.push(self.claim(known, cur, pending));
+            gains.push(self.claim(known, cur, wanted));
         }
         let kept = if self.opts.merge_segments {
             self.merge(known, &pts, &gains)
@@ -508,13 +619,65 @@ impl Extension {
         out
     }
 
+    /// Lane ends driven to the wall: the host's lane along heading `theta` ends at world point
+    /// `c` and the host moves on to `next` (the start of its next lane, beside `c`). When a
+    /// known obstacle lies within `reach` metres ahead of `c`, the robot drives on to it, along
+    /// it to the point in front of `next`, and back to `next` (the next lane, started at the
+    /// wall); the waypoints, or `None` when there is no wall ahead or nothing to gain there.
+    pub(crate) fn lane_end(
+        &mut self,
+        known: &KnownMap,
+        c: Point,
+        theta: f64,
+        next: Point,
+        reach: f64,
+        wanted: &dyn Fn(Point) -> bool,
+    ) -> Option<Vec<Point>> {
+        let res = self.frame.resolution;
+        let ahead = |p: Point| -> Option<Point> {
+            let d = known.free_distance(p, theta, reach, self.r);
+            if d >= reach - 1e-9 {
+                return None;
+            }
+            // Stop a hair short of contact, then make sure.
+            let mut d = d - 1e-3 * res;
+            for _ in 0..8 {
+                let w = Point::new(p.x + d * theta.cos(), p.y + d * theta.sin());
+                if d <= 0.0 {
+                    return None;
+                }
+                if judge_motion(known, p, w, self.r) == Judgement::Free {
+                    return Some(w);
+                }
+                d -= 0.05 * res;
+            }
+            None
+        };
+        let w = ahead(c)?;
+        if w.dist(c) < 0.5 * res {
+            return None;
+        }
+        let gw = self.frame.grid_to_pixel_signed(self.frame.world_to_grid(w));
+        if self.gain(known, gw, wanted, 2) < 2 {
+            return None;
+        }
+        let free = |a: Point, b: Point| judge_motion(known, a, b, self.r) == Judgement::Free;
+        let out = match ahead(next) {
+            Some(w2) if free(w, w2) => vec![w, w2, next],
+            _ if free(w, next) => vec![w, next],
+            _ => vec![w, c, next],
+        };
+        for w2 in out.windows(2) {
+            self.record(w2[0], w2[1]);
+        }
+        self.record(c, w);
+        Some(out)
+    }
+
     /// A transfer from world point `from` to world point `to` over positions (A*), merged into
     /// known-free straight segments; `None` when no known-free way exists.
     pub(crate) fn route(&mut self, known: &KnownMap, from: Point, to: Point) -> Option<Vec<Point>> {
-        let (gf, gt) = (
-            self.frame.world_to_grid(from),
-            self.frame.world_to_grid(to),
-        );
+        let (gf, gt) = (self.frame.world_to_grid(from), self.frame.world_to_grid(to));
         if self.seg_free(known, gf, gt) {
             return Some(vec![to]);
         }
