@@ -352,3 +352,71 @@ fn trace_ignores_pixels_never_sensed() {
         assert_eq!(m2.collisions, 0);
     }
 }
+
+/// Poses recorded inside wall passes.
+fn pass_poses(trace: &Trace) -> usize {
+    let mut inside = false;
+    let mut n = 0;
+    for r in &trace.records {
+        match r {
+            Record::Event {
+                event: Event::WallFollowStart,
+                ..
+            } => inside = true,
+            Record::Event {
+                event: Event::WallFollowEnd,
+                ..
+            } => inside = false,
+            Record::Pose { .. } if inside => n += 1,
+            _ => {}
+        }
+    }
+    n
+}
+
+#[test]
+fn a_diagonal_wall_is_followed_in_few_segments() {
+    // A 1.2 m x 0.9 m room (0.01 m/px) crossed by a thick wall at about 27 degrees.
+    let (w, h) = (120usize, 90usize);
+    let mut cells = vec![Cell::Free; w * h];
+    for row in 0..h {
+        for col in 0..w {
+            let border = col < 2 || row < 2 || col >= w - 2 || row >= h - 2;
+            // Distance to the line through (20, 70) and (100, 30) (column, row).
+            let (dx, dy) = (80.0f64, -40.0f64);
+            let (px, py) = (col as f64 - 20.0, row as f64 - 70.0);
+            let t = ((px * dx + py * dy) / (dx * dx + dy * dy)).clamp(0.0, 1.0);
+            let d = (px - t * dx).hypot(py - t * dy);
+            if border || d < 2.5 {
+                cells[row * w + col] = Cell::Occupied;
+            }
+        }
+    }
+    let map = GridMap::new(ccpp_core::MapFrame::new(w, h, 0.01), cells).unwrap();
+    let wd = World::new(map, Robot::new(0.07), Some(Pose::new(0.1, 0.1, 0.0))).unwrap();
+    let (merged_out, merged, _) = run_ext(&wd, BaStarExtendedOptions::default());
+    let opts = BaStarExtendedOptions {
+        extension: ExtensionOptions {
+            merge_segments: false,
+            ..ExtensionOptions::default()
+        },
+        ..BaStarExtendedOptions::default()
+    };
+    let (pixel_out, pixel, _) = run_ext(&wd, opts);
+    assert_eq!(merged.collisions, 0);
+    assert_eq!(pixel.collisions, 0);
+    let (a, b) = (pass_poses(&merged_out.trace), pass_poses(&pixel_out.trace));
+    assert!(b > 0 && 4 * a < b, "merged {a} pixel {b}");
+    assert!(
+        merged.turns < pixel.turns,
+        "{} {}",
+        merged.turns,
+        pixel.turns
+    );
+    assert!(merged.effective_coverage >= pixel.effective_coverage - 0.003);
+    assert!(
+        merged.effective_coverage > 0.99,
+        "{}",
+        merged.effective_coverage
+    );
+}
