@@ -22,14 +22,15 @@
 //! use ccpp_core::world::{Robot, World};
 //! use ccpp_core::planners::ba_star_extended::{BaStarExtended, BaStarExtendedOptions};
 //! use ccpp_core::sim::{simulate, SimConfig};
-//! let art = "\
-//!     #########\n\
-//!     #.......#\n\
-//!     #..##...#\n\
-//!     #.......#\n\
-//!     #########";
+//! let art = concat!(
+//!     "#########\n",
+//!     "#.......#\n",
+//!     "#..##...#\n",
+//!     "#.......#\n",
+//!     "#########",
+//! );
 //! let map = GridMap::from_ascii_scaled(art, 7, 0.02).unwrap();
-//! let world = World::new(map, Robot::new(0.1), Some(Pose::new(0.25, 0.25, 0.0))).unwrap();
+//! let world = World::new(map, Robot::new(0.1), Some(Pose::new(0.28, 0.27, 0.0))).unwrap();
 //! let mut planner = BaStarExtended::new(BaStarExtendedOptions::default());
 //! let out = simulate(&world, &mut planner, &SimConfig::default());
 //! let m = ccpp_core::metrics::compute(&world, &out, "room");
@@ -176,23 +177,20 @@ impl Planner for BaStarExtended {
 
     fn next(&mut self, sensor: &dyn Sensor) -> Step {
         let pos = sensor.pose().position();
-        match (&mut self.ext, self.last_pos) {
-            (Some(ext), Some(prev)) => {
-                if prev != pos {
-                    ext.record(prev, pos);
-                }
+        if let (Some(ext), Some(prev)) = (&mut self.ext, self.last_pos) {
+            if prev != pos {
+                ext.record(prev, pos);
             }
-            _ => {
-                let robot = sensor.robot();
-                let mut ext = Extension::new(
-                    self.opts.clone(),
-                    *sensor.frame(),
-                    robot.radius,
-                    robot.tool_radius,
-                );
-                ext.record(pos, pos);
-                self.ext = Some(ext);
-            }
+        } else {
+            let robot = sensor.robot();
+            let mut ext = Extension::new(
+                self.opts.clone(),
+                *sensor.frame(),
+                robot.radius,
+                robot.tool_radius,
+            );
+            ext.record(pos, pos);
+            self.ext = Some(ext);
         }
         self.last_pos = Some(pos);
         self.ba.observe(sensor);

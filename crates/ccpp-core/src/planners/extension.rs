@@ -146,6 +146,9 @@ const NB: [(i64, i64); 8] = [
 const COST_ORTHO: u64 = 1000;
 const COST_DIAG: u64 = 1414;
 
+/// Settled positions carry this bit in their search cost.
+const CLOSED: u64 = 1 << 63;
+
 /// Heuristic weight of transfer searches.
 const ROUTE_WEIGHT: f64 = 1.5;
 
@@ -465,8 +468,6 @@ impl Extension {
                 }
             }
         }
-        // Settled positions carry the top bit of their cost.
-        const CLOSED: u64 = 1 << 63;
         while let Some(Reverse((_, i))) = heap.pop() {
             if self.dist[i] & CLOSED != 0 {
                 continue;
