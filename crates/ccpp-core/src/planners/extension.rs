@@ -16,7 +16,7 @@
 //! stamped with the tool radius (the metric's predicate, [`crate::metrics::SWEEP_EPS_PX`]
 //! included). A **target** is a pixel the sensor has shown free, not swept yet, and not one the
 //! host will still sweep. Positions are the pixel centres where the robot disk fits on the known
-//! map (`S0`: contact radius, clearance 0, unseen pixels block — [`KnownMap::disk_state_px`]);
+//! map (`S0`: contact radius, clearance 0, unseen pixels block — `KnownMap::disk_state_px`);
 //! two 8-neighbour positions are joined when the straight move between them is known free.
 //! A position *gains* when a target lies within the tool radius of it.
 //!
