@@ -21,7 +21,7 @@ pub use ccpp_io::scenario::{MapRecipe, PreparedMap};
 use crate::args::{DemoArgs, MapArgs, RobotArgs, RunArgs};
 
 /// The planner `ccpp demo` runs.
-pub const FLAGSHIP: PlannerKind = PlannerKind::BaStar;
+pub const FLAGSHIP: PlannerKind = PlannerKind::BaStarExtended;
 
 const DEMO_YAML: &str = include_str!("../assets/aws_small_house.yaml");
 const DEMO_IMAGE: &[u8] = include_bytes!("../assets/aws_small_house.pgm");
@@ -152,7 +152,11 @@ fn not_applicable(flag: &str, kind: PlannerKind, applies_to: &str) -> anyhow::Er
 const FLAG_FIELDS: [(&str, &[&str]); 5] = [
     (
         "--tile-side",
-        &["ba_star.tile_side_m", "bsa_bfs.cell_side_m"],
+        &[
+            "ba_star.tile_side_m",
+            "ba_star_extended.ba_star.tile_side_m",
+            "bsa_bfs.cell_side_m",
+        ],
     ),
     ("--length", &["rect_boustrophedon.length_m"]),
     ("--width", &["rect_boustrophedon.width_m"]),
@@ -168,14 +172,28 @@ fn apply_planner_flags(a: &RunArgs, config: &mut PlannerConfig) -> Result<Vec<&'
         given.push("--tile-side");
         match config {
             PlannerConfig::BaStar(o) => o.tile_side_m = Some(t),
+            PlannerConfig::BaStarExtended(o) => o.ba_star.tile_side_m = Some(t),
             PlannerConfig::BsaBfs(o) => o.cell_side_m = Some(t),
-            _ => return Err(not_applicable("--tile-side", kind, "ba-star, bsa-bfs")),
+            _ => {
+                return Err(not_applicable(
+                    "--tile-side",
+                    kind,
+                    "ba-star, ba-star-extended, bsa-bfs",
+                ))
+            }
         }
     }
     if let Some(s) = a.smoothing {
         match config {
             PlannerConfig::BaStar(o) => o.smoothing = s,
-            _ => return Err(not_applicable("--smoothing", kind, "ba-star")),
+            PlannerConfig::BaStarExtended(o) => o.ba_star.smoothing = s,
+            _ => {
+                return Err(not_applicable(
+                    "--smoothing",
+                    kind,
+                    "ba-star, ba-star-extended",
+                ))
+            }
         }
     }
     if let Some(side) = &a.side {

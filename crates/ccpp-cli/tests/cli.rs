@@ -658,3 +658,49 @@ fn replay_page_works_in_headless_chromium() {
     );
     eprintln!("screenshot kept at {}", shot.display());
 }
+
+#[test]
+fn ba_star_extended_options_from_a_config_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |sub: &str, config: Option<&str>| {
+        let mut cmd = ccpp();
+        cmd.args(["run", "--planner", "ba-star-extended", "--json", "--map"])
+            .arg(data("teb_empty_box.yaml"))
+            .arg("--out")
+            .arg(dir.path().join(sub));
+        if let Some(text) = config {
+            let path = dir.path().join(format!("{sub}.yaml"));
+            std::fs::write(&path, text).unwrap();
+            cmd.arg("--config").arg(path);
+        }
+        cmd
+    };
+    let metrics = |c: &mut Command| -> serde_json::Value {
+        serde_json::from_slice(&c.assert().success().get_output().stdout).unwrap()
+    };
+    let default = metrics(&mut run("default", None));
+    let lanes = metrics(&mut run(
+        "lanes",
+        Some("ba_star_extended: { extension: { lane_ends: true } }"),
+    ));
+    assert_eq!(default["collisions"], 0);
+    assert_eq!(lanes["collisions"], 0);
+    assert!(default["effective_coverage"].as_f64().unwrap() > 0.995);
+    assert_ne!(default["path_length_m"], lanes["path_length_m"]);
+    // The BA* section of the planner's options reaches the backbone.
+    let raw = metrics(&mut run(
+        "raw",
+        Some("ba_star_extended: { ba_star: { tile_side_m: 0.4 } }"),
+    ));
+    assert_ne!(default["path_length_m"], raw["path_length_m"]);
+    // Unknown fields are refused with one line.
+    let out = run("bad", Some("ba_star_extended: { extension: { reach: 2 } }"))
+        .assert()
+        .failure()
+        .code(1)
+        .get_output()
+        .stderr
+        .clone();
+    let err = String::from_utf8(out).unwrap();
+    assert!(err.starts_with("error:") && err.contains("reach"), "{err}");
+}

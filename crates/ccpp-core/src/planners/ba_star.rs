@@ -1308,6 +1308,54 @@ impl BaStar {
         matches!(self.phase, Phase::Backtrack { .. })
     }
 
+    /// Hook for extensions: integrates the current scan into the known map (initialising the
+    /// planner on its first call) without deciding anything. [`Planner::next`] does the same
+    /// before each decision, so calling this first changes nothing.
+    pub fn observe(&mut self, sensor: &dyn Sensor) {
+        if self.mind.is_none() {
+            self.init(sensor);
+        }
+        if let Some(m) = self.mind.as_deref_mut() {
+            m.sense(sensor);
+        }
+    }
+
+    /// Hook for extensions: are steps (marks or moves) queued for the next calls?
+    pub fn has_pending(&self) -> bool {
+        !self.pending.is_empty()
+    }
+
+    /// Hook for extensions: has BA* finished (`L` empty at a critical point)?
+    pub fn is_finished(&self) -> bool {
+        matches!(self.phase, Phase::Finished)
+    }
+
+    /// Hook for extensions: the end of the current backtracking path (the centre of the chosen
+    /// start tile `s_sp`), while backtracking.
+    pub fn backtrack_goal(&self) -> Option<Point> {
+        match (&self.phase, self.mind.as_ref()) {
+            (Phase::Backtrack { path, .. }, Some(m)) => path.last().map(|&t| m.center(t)),
+            _ => None,
+        }
+    }
+
+    /// Hook for extensions: drops the rest of the current backtracking path; the caller has
+    /// driven the robot to [`Self::backtrack_goal`] and the next call arrives there.
+    pub fn skip_backtrack(&mut self) {
+        if let Phase::Backtrack { path, next } = &mut self.phase {
+            *next = path.len();
+        }
+    }
+
+    /// Hook for extensions: will BA* still sweep the tile holding world point `p`? `true` when
+    /// that tile is not covered and not judged an obstacle.
+    pub fn will_cover(&self, p: Point) -> bool {
+        self.mind.as_ref().is_some_and(|m| {
+            let t = m.tiles.grid.tile_of(p);
+            !m.tiles.covered(t) && m.tiles.stand(t) != Judgement::Blocked
+        })
+    }
+
     fn init(&mut self, sensor: &dyn Sensor) {
         let r = sensor.robot().radius;
         let side = self.opts.tile_side_m.unwrap_or(2.0 * r);

@@ -9,10 +9,12 @@
 //! the `registry!` invocation below.
 
 pub mod ba_star;
+pub mod ba_star_extended;
 pub mod bcd;
 pub mod bsa;
 pub mod bsa_bfs;
 pub mod bsa_extended;
+pub mod extension;
 pub mod random_bounce;
 pub mod rect_boustrophedon;
 pub mod settings;
@@ -169,6 +171,14 @@ registry! {
         options: ba_star::BaStarOptions,
         offline: false,
         description: "BA* (Viet et al. 2013): boustrophedon regions on 2r tiles, A* + smoothed backtracking to the nearest corner tile",
+    }
+    /// BA* plus the seed-002 extension.
+    BaStarExtended {
+        name: "ba-star-extended",
+        section: ba_star_extended,
+        options: ba_star_extended::BaStarExtendedOptions,
+        offline: false,
+        description: "BA* plus the seed-002 extension: online wall following of the rims its tiles leave, merged into straight known-free segments",
     }
     /// Backtracking Spiral Algorithm.
     Bsa {

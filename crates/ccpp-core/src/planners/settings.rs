@@ -13,6 +13,7 @@ use crate::planner::Planner;
 use crate::world::{Robot, World};
 
 use super::ba_star::{BaStar, BaStarOptions};
+use super::ba_star_extended::{BaStarExtended, BaStarExtendedOptions};
 use super::bcd::{Bcd, BcdOptions};
 use super::bsa::{Bsa, BsaOptions};
 use super::bsa_bfs::{BsaBfs, BsaBfsOptions};
@@ -383,6 +384,37 @@ impl PlannerSettings for BaStarOptions {
             o.tile_side_m = Some(2.0 * world.robot().radius);
         }
         Box::new(BaStar::new(o))
+    }
+}
+
+impl PlannerSettings for BaStarExtendedOptions {
+    fn validate(&self) -> Result<(), OptionsError> {
+        self.ba_star.validate().map_err(|e| e.in_section("ba_star"))?;
+        finite_nonneg("extension.reach_r", self.extension.reach_r)
+    }
+
+    fn check(&self, s: &Setup) -> Result<(), OptionsError> {
+        self.ba_star.check(s).map_err(|e| e.in_section("ba_star"))
+    }
+
+    fn estimate(&self, s: &Setup) -> ResourceEstimate {
+        // BA*'s tiles plus the extension's per-pixel state (swept and target bitsets, the search
+        // records of its position searches: about 16 bytes a pixel).
+        let mut e = self.ba_star.estimate(s);
+        e.bytes += 16.0 * s.pixels();
+        e
+    }
+
+    fn tile_side(&self, robot: &Robot) -> Option<f64> {
+        self.ba_star.tile_side(robot)
+    }
+
+    fn build(&self, world: &World) -> Box<dyn Planner> {
+        let mut o = self.clone();
+        if o.ba_star.tile_side_m.is_none() {
+            o.ba_star.tile_side_m = Some(2.0 * world.robot().radius);
+        }
+        Box::new(BaStarExtended::new(o))
     }
 }
 

@@ -1,0 +1,249 @@
+//! `ba-star-extended`: BA* ([`super::ba_star`], seed 000) plus the generic coverage extension
+//! of seed 002 ([`super::extension`]), so that the rims BA*'s 2r tiles leave along walls and
+//! furniture are swept too.
+//!
+//! BA* runs unchanged as the backbone. The extension steps in at two moments:
+//!
+//! * **End of a boustrophedon region** (a critical point, when BA* would start backtracking):
+//!   cleaning passes over the rims within [`ExtensionOptions::reach_r`] robot radii of the
+//!   robot — pixels BA* will still sweep (those of tiles that are neither covered nor
+//!   obstacles) are left to BA*. Then, instead of returning to the critical point, the robot
+//!   drives a known-free transfer ([`super::extension`]'s A* over positions, merged into
+//!   straight segments) straight to BA*'s chosen start point `s_sp`, and BA* resumes there.
+//!   When nothing was cleaned, BA*'s own smoothed backtracking path is driven.
+//! * **End of BA*** (`L` empty): passes over every rim left, wherever it is.
+//!
+//! The passes are marked `wall_follow_start` / `wall_follow_end` in the trace, the transfer
+//! keeps BA*'s `backtrack_start` / `backtrack_end` marks. Everything is planned from what the
+//! sensor has shown (BA*'s [`KnownMap`](crate::planner::KnownMap)), never from the world.
+//!
+//! ```
+//! use ccpp_core::{GridMap, Pose};
+//! use ccpp_core::world::{Robot, World};
+//! use ccpp_core::planners::ba_star_extended::{BaStarExtended, BaStarExtendedOptions};
+//! use ccpp_core::sim::{simulate, SimConfig};
+//! let art = concat!(
+//!     "#########\n",
+//!     "#.......#\n",
+//!     "#..##...#\n",
+//!     "#.......#\n",
+//!     "#########",
+//! );
+//! let map = GridMap::from_ascii_scaled(art, 7, 0.02).unwrap();
+//! let world = World::new(map, Robot::new(0.1), Some(Pose::new(0.28, 0.27, 0.0))).unwrap();
+//! let mut planner = BaStarExtended::new(BaStarExtendedOptions::default());
+//! let out = simulate(&world, &mut planner, &SimConfig::default());
+//! let m = ccpp_core::metrics::compute(&world, &out, "room");
+//! assert_eq!(m.collisions, 0);
+//! assert_eq!(m.coverage_rate, Some(1.0));
+//! ```
+
+use std::collections::VecDeque;
+
+use serde::{Deserialize, Serialize};
+
+use super::ba_star::{BaStar, BaStarOptions};
+use super::extension::{Extension, ExtensionOptions};
+use crate::geometry::Point;
+use crate::planner::{Planner, Sensor, Step};
+use crate::trace::Event;
+
+/// Options of [`BaStarExtended`] (`--planner ba-star-extended`, config section
+/// `ba_star_extended`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct BaStarExtendedOptions {
+    /// The BA* backbone.
+    pub ba_star: BaStarOptions,
+    /// The extension.
+    pub extension: ExtensionOptions,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Mode {
+    /// BA* decides.
+    Host,
+    /// Cleaning passes at the end of a region (`false`) or of BA* (`true`).
+    Clean { last: bool },
+    /// Everything done.
+    Done,
+}
+
+/// BA* plus the coverage extension (see the module docs).
+pub struct BaStarExtended {
+    ba: BaStar,
+    opts: ExtensionOptions,
+    ext: Option<Extension>,
+    mode: Mode,
+    queue: VecDeque<Step>,
+    last_pos: Option<Point>,
+    /// Inside a `wall_follow_start` / `wall_follow_end` pair.
+    in_pass: bool,
+    /// Heading of the host's last lane move, while the host is in a lane.
+    lane: Option<f64>,
+    /// Waypoints driven since the region's cleaning began (its start first), to retreat by.
+    trail: Vec<Point>,
+}
+
+impl BaStarExtended {
+    /// A planner with these options.
+    pub fn new(opts: BaStarExtendedOptions) -> Self {
+        Self {
+            ba: BaStar::new(opts.ba_star),
+            opts: opts.extension,
+            ext: None,
+            mode: Mode::Host,
+            queue: VecDeque::new(),
+            last_pos: None,
+            in_pass: false,
+            trail: Vec::new(),
+            lane: None,
+        }
+    }
+
+    /// The BA* backbone (its known map, tiles and backtracking list).
+    pub fn backbone(&self) -> &BaStar {
+        &self.ba
+    }
+
+    /// One cleaning chunk, or the end of the cleaning.
+    fn clean(&mut self, pos: Point, last: bool) {
+        let Some(ext) = self.ext.as_mut() else {
+            self.mode = Mode::Host;
+            return;
+        };
+        let Some(known) = self.ba.known_map() else {
+            self.mode = Mode::Host;
+            return;
+        };
+        let bounded = !last;
+        let chunk = if bounded && ext.options().reach_r <= 0.0 {
+            Vec::new()
+        } else {
+            let ba = &self.ba;
+            let wanted = |p: Point| last || !ba.will_cover(p);
+            ext.plan_chunk(known, pos, bounded, &wanted)
+        };
+        if !chunk.is_empty() {
+            if !self.in_pass {
+                self.in_pass = true;
+                self.queue.push_back(Step::Mark(Event::WallFollowStart));
+            }
+            for &p in &chunk {
+                self.queue.push_back(Step::MoveTo(p));
+                self.trail.push(p);
+            }
+            return;
+        }
+        if self.in_pass {
+            self.in_pass = false;
+            self.queue.push_back(Step::Mark(Event::WallFollowEnd));
+        }
+        if last {
+            self.mode = Mode::Done;
+            return;
+        }
+        // Transfer to BA*'s start point: direct when the robot moved, else BA*'s own path.
+        self.queue.push_back(Step::Mark(Event::BacktrackStart));
+        self.mode = Mode::Host;
+        if self.trail.len() <= 1 {
+            return;
+        }
+        let Some(goal) = self.ba.backtrack_goal() else {
+            return;
+        };
+        let route = ext.route(known, pos, goal).unwrap_or_else(|| {
+            // Retreat the way the passes came (every segment known free); BA* goes on from there.
+            self.trail.iter().rev().skip(1).copied().collect()
+        });
+        let direct = route.last() == Some(&goal);
+        for p in route {
+            self.queue.push_back(Step::MoveTo(p));
+        }
+        if direct {
+            self.ba.skip_backtrack();
+        }
+    }
+}
+
+impl Planner for BaStarExtended {
+    fn name(&self) -> &'static str {
+        "ba-star-extended"
+    }
+
+    fn tile_side(&self) -> Option<f64> {
+        self.ba.tile_side()
+    }
+
+    fn next(&mut self, sensor: &dyn Sensor) -> Step {
+        let pos = sensor.pose().position();
+        if let (Some(ext), Some(prev)) = (&mut self.ext, self.last_pos) {
+            if prev != pos {
+                ext.record(prev, pos);
+            }
+        } else {
+            let robot = sensor.robot();
+            let mut ext = Extension::new(
+                self.opts.clone(),
+                *sensor.frame(),
+                robot.radius,
+                robot.tool_radius,
+            );
+            ext.record(pos, pos);
+            self.ext = Some(ext);
+        }
+        self.last_pos = Some(pos);
+        self.ba.observe(sensor);
+        loop {
+            if let Some(s) = self.queue.pop_front() {
+                return s;
+            }
+            match self.mode {
+                Mode::Done => return Step::Done,
+                Mode::Clean { last } => self.clean(pos, last),
+                Mode::Host => match self.ba.next(sensor) {
+                    Step::Mark(Event::BacktrackStart) => {
+                        self.lane = None;
+                        self.trail = vec![pos];
+                        self.mode = Mode::Clean { last: false };
+                    }
+                    Step::Done => {
+                        self.trail = vec![pos];
+                        self.mode = Mode::Clean { last: true };
+                    }
+                    Step::MoveTo(target) if !self.ba.is_backtracking() => {
+                        let theta = sensor.pose().theta;
+                        let turn = crate::geometry::wrap_angle(
+                            (target.y - pos.y).atan2(target.x - pos.x) - theta,
+                        );
+                        let in_lane = self
+                            .lane
+                            .is_some_and(|h| crate::geometry::wrap_angle(h - theta).abs() < 1e-6);
+                        self.lane = Some((target.y - pos.y).atan2(target.x - pos.x));
+                        let lane_end = if self.opts.lane_ends && in_lane && turn.abs() > 0.1 {
+                            match (self.ext.as_mut(), self.ba.known_map(), self.ba.tile_grid()) {
+                                (Some(ext), Some(known), Some(g)) => {
+                                    let ba = &self.ba;
+                                    let wanted = |p: Point| !ba.will_cover(p);
+                                    ext.lane_end(known, pos, theta, target, g.side, &wanted)
+                                }
+                                _ => None,
+                            }
+                        } else {
+                            None
+                        };
+                        match lane_end {
+                            Some(pts) => {
+                                for p in pts {
+                                    self.queue.push_back(Step::MoveTo(p));
+                                }
+                            }
+                            None => return Step::MoveTo(target),
+                        }
+                    }
+                    s => return s,
+                },
+            }
+        }
+    }
+}
