@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use ccpp_core::metrics::{coverage_curve, Metrics};
-use ccpp_core::trace::{Record, Trace};
+use ccpp_core::trace::Trace;
 use ccpp_core::world::{Robot, World};
 use ccpp_io::write_atomic;
 use ccpp_render::chart::{bar_panels, image_grid, line_chart, Chart};
@@ -18,16 +18,7 @@ use crate::job::PreparedMap;
 pub fn read_trace(path: &Path) -> Result<Trace> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let mut records = Vec::new();
-    for (k, line) in text.lines().enumerate() {
-        if line.trim().is_empty() {
-            continue;
-        }
-        let r: Record = serde_json::from_str(line)
-            .with_context(|| format!("{} line {}: not a trace record", path.display(), k + 1))?;
-        records.push(r);
-    }
-    Ok(Trace { records })
+    ccpp_io::trace::parse_trace_jsonl(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
 }
 
 fn write_chart(dir: &Path, stem: &str, chart: &Chart) -> Result<()> {

@@ -97,14 +97,39 @@ pub fn disk_hits(occ: &impl Occupancy, p: Point, r_px: f64) -> bool {
 /// (grid coordinates) comes into contact with a blocked pixel; `None` when the whole motion is
 /// free. Brute force over the swept capsule's bounding box: use for short motions, or call
 /// through a distance-transform accelerated caller ([`crate::world::World::first_contact`]).
+///
+/// Outside the image every pixel blocks, so only pixels up to `ceil(rc) + 2` beyond the image
+/// are examined (`rc` = [`contact_radius_px`]): a motion that starts farther out is in contact
+/// at `t = 0`, and one that leaves that band from inside meets a nearer outside pixel first.
+/// Both statements are exact for `rc > sqrt(1/2)` (a disk that covers its own pixel's centre
+/// from anywhere in the pixel, i.e. `r_px > 0.21`); for smaller disks, which can slip between
+/// pixel centres, they are a conservative bound. The work is thus bounded by the image size
+/// however long the motion.
 pub fn segment_first_contact(occ: &impl Occupancy, a: Point, b: Point, r_px: f64) -> Option<f64> {
     let rc = contact_radius_px(r_px);
     let rc2 = rc * rc;
     let frame = *occ.frame();
+    let (w, h) = (frame.width as i64, frame.height as i64);
+    // The band of outside pixels examined, and the box (grid coordinates) it covers.
+    let band = rc.max(0.0).min(1e9).ceil() as i64 + 2;
+    let (box_lo, box_hi) = (
+        Point::new(-band as f64, -band as f64),
+        Point::new((w + band) as f64, (h + band) as f64),
+    );
+    let in_box =
+        |p: Point| p.x >= box_lo.x && p.x <= box_hi.x && p.y >= box_lo.y && p.y <= box_hi.y;
+    if !in_box(a) {
+        return Some(0.0);
+    }
     let lo = Point::new(a.x.min(b.x), a.y.min(b.y));
     let hi = Point::new(a.x.max(b.x), a.y.max(b.y));
     let (c0, c1, r0, r1) = pixel_window(&frame, lo, hi, rc);
-    let (w, h) = (frame.width as i64, frame.height as i64);
+    let (c0, c1, r0, r1) = (
+        c0.max(-band - 1),
+        c1.min(w + band),
+        r0.max(-band - 1),
+        r1.min(h + band),
+    );
     let mut best: Option<f64> = None;
     // Earliest contact with the blocked pixel `(col, row)`; `false` once contact is at t = 0
     // (nothing can come earlier).
@@ -151,12 +176,66 @@ pub fn segment_first_contact(occ: &impl Occupancy, a: Point, b: Point, r_px: f64
             }
         }
     }
-    best
+    // Leaving the band without contact (only possible for disks thinner than a pixel's
+    // diagonal): contact where the motion leaves the box.
+    best.or_else(|| (!in_box(b)).then(|| exit_param(a, b, box_lo, box_hi)))
+}
+
+/// Parameter `t` in `[0, 1]` at which the motion from `a` (inside the box `lo`-`hi`) to `b`
+/// (outside it) leaves the box.
+fn exit_param(a: Point, b: Point, lo: Point, hi: Point) -> f64 {
+    let (dx, dy) = (b.x - a.x, b.y - a.y);
+    let mut t = 1.0f64;
+    for (d, room) in [
+        (-dx, a.x - lo.x),
+        (dx, hi.x - a.x),
+        (-dy, a.y - lo.y),
+        (dy, hi.y - a.y),
+    ] {
+        if d > 0.0 {
+            t = t.min(room / d);
+        }
+    }
+    t.clamp(0.0, 1.0)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Runs `f` on a helper thread and fails if it takes longer than `secs` seconds.
+    fn within<T: Send + 'static>(secs: u64, f: impl FnOnce() -> T + Send + 'static) -> T {
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let _ = tx.send(f());
+        });
+        rx.recv_timeout(std::time::Duration::from_secs(secs))
+            .expect("did not finish in time")
+    }
+
+    #[test]
+    fn astronomically_long_motions_are_bounded_by_the_image() {
+        // Found by fuzzing `--config` (bsa-bfs `cell_side_m: 1.1e49`): the brute force walked
+        // every outside pixel of the motion's bounding box and never returned.
+        let g: GridMap = "..........\n".repeat(10).trim_end().parse().unwrap();
+        let a = Point::new(5.0, 5.0);
+        let short = segment_first_contact(&g, a, Point::new(25.0, 5.0), 1.0).unwrap();
+        let (long, diag, back) = within(20, move || {
+            (
+                segment_first_contact(&g, a, Point::new(5.0 + 1e12, 5.0), 1.0),
+                segment_first_contact(&g, a, Point::new(-1e49, 1e49), 1.0),
+                segment_first_contact(&g, Point::new(1e12, 5.0), a, 1.0),
+            )
+        });
+        // The same contact point (against the outside column) however far the target is.
+        let x_short = 5.0 + 20.0 * short;
+        let x_long = 5.0 + 1e12 * long.unwrap();
+        assert!((x_short - x_long).abs() < 1e-3, "{x_short} vs {x_long}");
+        assert!(x_short > 9.0 && x_short < 10.0, "{x_short}");
+        assert!(diag.is_some_and(|t| t > 0.0 && t < 1e-47), "{diag:?}");
+        // Starting far outside the image is contact at once.
+        assert_eq!(back, Some(0.0));
+    }
 
     #[test]
     fn disk_against_wall() {

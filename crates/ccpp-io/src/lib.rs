@@ -7,7 +7,8 @@
 //!   the module docs for the grey-level, alpha and 16-bit conventions);
 //! * [`write`](mod@write): atomic file writers and a `map_saver`-style map writer;
 //! * [`georef`]: `--georef` point-pair files for the affine pixel <-> world fit (seed 003);
-//! * [`landmarks`]: `--landmarks` files (CSV or JSON) for the simulator's pose correction.
+//! * [`landmarks`]: `--landmarks` files (CSV or JSON) for the simulator's pose correction;
+//! * [`trace`]: reading a run's `trace.jsonl` back.
 //!
 //! Errors are [`thiserror`] enums that always name the file concerned; nothing here panics on
 //! user data.
@@ -15,6 +16,7 @@
 pub mod georef;
 pub mod landmarks;
 pub mod map;
+pub mod trace;
 pub mod write;
 
 pub use map::{load_map, load_map_bytes, LoadOptions, LoadedMap, MapError, MapYaml, Thresholds};
