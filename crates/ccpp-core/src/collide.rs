@@ -77,12 +77,77 @@ fn pixel_window(frame: &MapFrame, lo: Point, hi: Point, reach: f64) -> (i64, i64
     (c0, c1, r0, r1)
 }
 
+/// The pixels examined around the image. Outside the image every pixel blocks, so only a band
+/// of `ceil(rc) + 2` outside pixels matters (`rc` = [`contact_radius_px`]): a disk centred
+/// farther out overlaps its own (outside) pixel, and a motion leaving the band from inside
+/// meets a nearer outside pixel first. Both statements are exact for `rc > sqrt(1/2)` (a disk
+/// that covers its own pixel's centre from anywhere in the pixel, i.e. `r_px > 0.21`); for
+/// thinner disks, which can slip between pixel centres, they are a conservative bound. The work
+/// of a test is thus bounded by the image size however far the robot is sent.
+struct Band {
+    /// Outside pixels examined on each side.
+    band: i64,
+    /// Lower-left corner of the covered box (grid coordinates).
+    lo: Point,
+    /// Upper-right corner.
+    hi: Point,
+}
+
+impl Band {
+    fn new(frame: &MapFrame, rc: f64) -> Self {
+        let band = rc.max(0.0).min(1e9).ceil() as i64 + 2;
+        Self {
+            band,
+            lo: Point::new(-band as f64, -band as f64),
+            hi: Point::new(
+                (frame.width as i64 + band) as f64,
+                (frame.height as i64 + band) as f64,
+            ),
+        }
+    }
+
+    /// Is `p` inside the covered box (`false` for NaN)?
+    fn contains(&self, p: Point) -> bool {
+        p.x >= self.lo.x && p.x <= self.hi.x && p.y >= self.lo.y && p.y <= self.hi.y
+    }
+
+    /// `window` (from [`pixel_window`]) cut to the band.
+    fn clip(&self, frame: &MapFrame, window: (i64, i64, i64, i64)) -> (i64, i64, i64, i64) {
+        let (c0, c1, r0, r1) = window;
+        let (w, h, b) = (frame.width as i64, frame.height as i64, self.band);
+        (c0.max(-b - 1), c1.min(w + b), r0.max(-b - 1), r1.min(h + b))
+    }
+
+    /// Parameter `t` in `[0, 1]` at which the motion from `a` (inside the box) to `b` (outside
+    /// it) leaves the box.
+    fn exit_param(&self, a: Point, b: Point) -> f64 {
+        let (dx, dy) = (b.x - a.x, b.y - a.y);
+        let mut t = 1.0f64;
+        for (d, room) in [
+            (-dx, a.x - self.lo.x),
+            (dx, self.hi.x - a.x),
+            (-dy, a.y - self.lo.y),
+            (dy, self.hi.y - a.y),
+        ] {
+            if d > 0.0 {
+                t = t.min(room / d);
+            }
+        }
+        t.clamp(0.0, 1.0)
+    }
+}
+
 /// Does a robot disk of radius `r_px` (pixels) centred at grid point `p` overlap a blocked pixel?
+/// A disk centred beyond the examined band of outside pixels does (see [`Band`]).
 pub fn disk_hits(occ: &impl Occupancy, p: Point, r_px: f64) -> bool {
     let rc = contact_radius_px(r_px);
     let rc2 = rc * rc;
     let frame = *occ.frame();
-    let (c0, c1, r0, r1) = pixel_window(&frame, p, p, rc);
+    let band = Band::new(&frame, rc);
+    if !band.contains(p) {
+        return true;
+    }
+    let (c0, c1, r0, r1) = band.clip(&frame, pixel_window(&frame, p, p, rc));
     for row in r0..=r1 {
         for col in c0..=c1 {
             if occ.blocked(col, row) && center(&frame, col, row).dist2(p) < rc2 {
@@ -97,39 +162,20 @@ pub fn disk_hits(occ: &impl Occupancy, p: Point, r_px: f64) -> bool {
 /// (grid coordinates) comes into contact with a blocked pixel; `None` when the whole motion is
 /// free. Brute force over the swept capsule's bounding box: use for short motions, or call
 /// through a distance-transform accelerated caller ([`crate::world::World::first_contact`]).
-///
-/// Outside the image every pixel blocks, so only pixels up to `ceil(rc) + 2` beyond the image
-/// are examined (`rc` = [`contact_radius_px`]): a motion that starts farther out is in contact
-/// at `t = 0`, and one that leaves that band from inside meets a nearer outside pixel first.
-/// Both statements are exact for `rc > sqrt(1/2)` (a disk that covers its own pixel's centre
-/// from anywhere in the pixel, i.e. `r_px > 0.21`); for smaller disks, which can slip between
-/// pixel centres, they are a conservative bound. The work is thus bounded by the image size
-/// however long the motion.
+/// Only a band of outside pixels is examined (see [`Band`]): a motion starting beyond it is in
+/// contact at `t = 0`.
 pub fn segment_first_contact(occ: &impl Occupancy, a: Point, b: Point, r_px: f64) -> Option<f64> {
     let rc = contact_radius_px(r_px);
     let rc2 = rc * rc;
     let frame = *occ.frame();
     let (w, h) = (frame.width as i64, frame.height as i64);
-    // The band of outside pixels examined, and the box (grid coordinates) it covers.
-    let band = rc.max(0.0).min(1e9).ceil() as i64 + 2;
-    let (box_lo, box_hi) = (
-        Point::new(-band as f64, -band as f64),
-        Point::new((w + band) as f64, (h + band) as f64),
-    );
-    let in_box =
-        |p: Point| p.x >= box_lo.x && p.x <= box_hi.x && p.y >= box_lo.y && p.y <= box_hi.y;
-    if !in_box(a) {
+    let band = Band::new(&frame, rc);
+    if !band.contains(a) {
         return Some(0.0);
     }
     let lo = Point::new(a.x.min(b.x), a.y.min(b.y));
     let hi = Point::new(a.x.max(b.x), a.y.max(b.y));
-    let (c0, c1, r0, r1) = pixel_window(&frame, lo, hi, rc);
-    let (c0, c1, r0, r1) = (
-        c0.max(-band - 1),
-        c1.min(w + band),
-        r0.max(-band - 1),
-        r1.min(h + band),
-    );
+    let (c0, c1, r0, r1) = band.clip(&frame, pixel_window(&frame, lo, hi, rc));
     let mut best: Option<f64> = None;
     // Earliest contact with the blocked pixel `(col, row)`; `false` once contact is at t = 0
     // (nothing can come earlier).
@@ -178,25 +224,7 @@ pub fn segment_first_contact(occ: &impl Occupancy, a: Point, b: Point, r_px: f64
     }
     // Leaving the band without contact (only possible for disks thinner than a pixel's
     // diagonal): contact where the motion leaves the box.
-    best.or_else(|| (!in_box(b)).then(|| exit_param(a, b, box_lo, box_hi)))
-}
-
-/// Parameter `t` in `[0, 1]` at which the motion from `a` (inside the box `lo`-`hi`) to `b`
-/// (outside it) leaves the box.
-fn exit_param(a: Point, b: Point, lo: Point, hi: Point) -> f64 {
-    let (dx, dy) = (b.x - a.x, b.y - a.y);
-    let mut t = 1.0f64;
-    for (d, room) in [
-        (-dx, a.x - lo.x),
-        (dx, hi.x - a.x),
-        (-dy, a.y - lo.y),
-        (dy, hi.y - a.y),
-    ] {
-        if d > 0.0 {
-            t = t.min(room / d);
-        }
-    }
-    t.clamp(0.0, 1.0)
+    best.or_else(|| (!band.contains(b)).then(|| band.exit_param(a, b)))
 }
 
 #[cfg(test)]
@@ -233,8 +261,13 @@ mod tests {
         assert!((x_short - x_long).abs() < 1e-3, "{x_short} vs {x_long}");
         assert!(x_short > 9.0 && x_short < 10.0, "{x_short}");
         assert!(diag.is_some_and(|t| t > 0.0 && t < 1e-47), "{diag:?}");
-        // Starting far outside the image is contact at once.
+        // Starting far outside the image is contact at once; so is standing there (the pixel
+        // window overflowed `i64` in `center` for such points).
         assert_eq!(back, Some(0.0));
+        let g: GridMap = "...\n...".parse().unwrap();
+        assert!(disk_hits(&g, Point::new(1e30, -1e49), 1.0));
+        assert!(disk_hits(&g, Point::new(f64::NAN, 1.0), 1.0));
+        assert!(!disk_hits(&g, Point::new(1.5, 1.0), 0.4));
     }
 
     #[test]
