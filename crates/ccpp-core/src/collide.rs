@@ -86,7 +86,7 @@ fn pixel_window(frame: &MapFrame, lo: Point, hi: Point, reach: f64) -> (i64, i64
 /// of a test is thus bounded by the image size however far the robot is sent.
 struct Band {
     /// Outside pixels examined on each side.
-    band: i64,
+    width: i64,
     /// Lower-left corner of the covered box (grid coordinates).
     lo: Point,
     /// Upper-right corner.
@@ -95,9 +95,10 @@ struct Band {
 
 impl Band {
     fn new(frame: &MapFrame, rc: f64) -> Self {
-        let band = rc.max(0.0).min(1e9).ceil() as i64 + 2;
+        // A NaN radius gives a NaN `rc`, which casts to 0.
+        let band = rc.clamp(0.0, 1e9).ceil() as i64 + 2;
         Self {
-            band,
+            width: band,
             lo: Point::new(-band as f64, -band as f64),
             hi: Point::new(
                 (frame.width as i64 + band) as f64,
@@ -114,7 +115,7 @@ impl Band {
     /// `window` (from [`pixel_window`]) cut to the band.
     fn clip(&self, frame: &MapFrame, window: (i64, i64, i64, i64)) -> (i64, i64, i64, i64) {
         let (c0, c1, r0, r1) = window;
-        let (w, h, b) = (frame.width as i64, frame.height as i64, self.band);
+        let (w, h, b) = (frame.width as i64, frame.height as i64, self.width);
         (c0.max(-b - 1), c1.min(w + b), r0.max(-b - 1), r1.min(h + b))
     }
 
