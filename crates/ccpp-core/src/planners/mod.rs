@@ -104,10 +104,11 @@ pub enum BuildError {
 }
 
 impl PlannerOptions {
-    /// Checks every numeric option: sizes finite and > 0, margins and tolerances finite and
-    /// >= 0, the rest finite. `resolution` (metres per map pixel) is the smallest tile, cell or
-    /// lane side accepted, and a tenth of it the smallest rectangular robot side: finer ones
-    /// only multiply the work (a cell side of `1e-300` m overflowed the cell indices).
+    /// Checks every numeric option: sizes finite and positive, margins and tolerances finite
+    /// and not negative, the rest finite. `resolution` (metres per map pixel) is the smallest
+    /// tile, cell or lane side accepted, and a tenth of it the smallest rectangular robot side:
+    /// finer ones only multiply the work (a cell side of `1e-300` m overflowed the cell
+    /// indices).
     ///
     /// # Errors
     /// [`BuildError::BadOption`] naming the first bad option.
