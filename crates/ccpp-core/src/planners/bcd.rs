@@ -295,7 +295,8 @@ impl Bcd {
         let mut cur: Option<(usize, usize)> = None;
         if let Some((c0, r0)) = frame.pixel_of(start) {
             let mut best: Option<(f64, (usize, usize))> = None;
-            let rad = need.ceil() as i64 + 3;
+            // No farther than the image (a huge `margin_px` overflowed `i64` here).
+            let rad = need.ceil().min(w.max(h) as f64) as i64 + 3;
             for dr in -rad..=rad {
                 for dc in -rad..=rad {
                     let (c, r) = (c0 as i64 + dc, r0 as i64 + dr);

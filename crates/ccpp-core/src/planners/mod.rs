@@ -297,6 +297,13 @@ mod tests {
         refused(&o, "bcd", "bcd.margin_px");
         let e = build("bsa-bfs", &o, &world).err().unwrap().to_string();
         assert!(e.contains("bcd.margin_px") && e.contains(">= 0"), "{e}");
+        // A margin wider than the map is accepted and leaves nothing to cover (it overflowed
+        // the start search of BCD, found by fuzzing).
+        let mut o = PlannerOptions::default();
+        o.bcd.margin_px = 8.9e74;
+        let mut p = build("bcd", &o, &world).unwrap();
+        let run = crate::sim::simulate(&world, p.as_mut(), &crate::sim::SimConfig::default());
+        assert!(run.trace.poses().count() <= 2);
         // Defaults and exactly one pixel are accepted.
         let mut o = PlannerOptions::default();
         o.bsa_bfs.cell_side_m = Some(0.05);
