@@ -77,12 +77,78 @@ fn pixel_window(frame: &MapFrame, lo: Point, hi: Point, reach: f64) -> (i64, i64
     (c0, c1, r0, r1)
 }
 
+/// The pixels examined around the image. Outside the image every pixel blocks, so only a band
+/// of `ceil(rc) + 2` outside pixels matters (`rc` = [`contact_radius_px`]): a disk centred
+/// farther out overlaps its own (outside) pixel, and a motion leaving the band from inside
+/// meets a nearer outside pixel first. Both statements are exact for `rc > sqrt(1/2)` (a disk
+/// that covers its own pixel's centre from anywhere in the pixel, i.e. `r_px > 0.21`); for
+/// thinner disks, which can slip between pixel centres, they are a conservative bound. The work
+/// of a test is thus bounded by the image size however far the robot is sent.
+struct Band {
+    /// Outside pixels examined on each side.
+    width: i64,
+    /// Lower-left corner of the covered box (grid coordinates).
+    lo: Point,
+    /// Upper-right corner.
+    hi: Point,
+}
+
+impl Band {
+    fn new(frame: &MapFrame, rc: f64) -> Self {
+        // A NaN radius gives a NaN `rc`, which casts to 0.
+        let band = rc.clamp(0.0, 1e9).ceil() as i64 + 2;
+        Self {
+            width: band,
+            lo: Point::new(-band as f64, -band as f64),
+            hi: Point::new(
+                (frame.width as i64 + band) as f64,
+                (frame.height as i64 + band) as f64,
+            ),
+        }
+    }
+
+    /// Is `p` inside the covered box (`false` for NaN)?
+    fn contains(&self, p: Point) -> bool {
+        p.x >= self.lo.x && p.x <= self.hi.x && p.y >= self.lo.y && p.y <= self.hi.y
+    }
+
+    /// `window` (from [`pixel_window`]) cut to the band.
+    fn clip(&self, frame: &MapFrame, window: (i64, i64, i64, i64)) -> (i64, i64, i64, i64) {
+        let (c0, c1, r0, r1) = window;
+        let (w, h, b) = (frame.width as i64, frame.height as i64, self.width);
+        (c0.max(-b - 1), c1.min(w + b), r0.max(-b - 1), r1.min(h + b))
+    }
+
+    /// Parameter `t` in `[0, 1]` at which the motion from `a` (inside the box) to `b` (outside
+    /// it) leaves the box.
+    fn exit_param(&self, a: Point, b: Point) -> f64 {
+        let (dx, dy) = (b.x - a.x, b.y - a.y);
+        let mut t = 1.0f64;
+        for (d, room) in [
+            (-dx, a.x - self.lo.x),
+            (dx, self.hi.x - a.x),
+            (-dy, a.y - self.lo.y),
+            (dy, self.hi.y - a.y),
+        ] {
+            if d > 0.0 {
+                t = t.min(room / d);
+            }
+        }
+        t.clamp(0.0, 1.0)
+    }
+}
+
 /// Does a robot disk of radius `r_px` (pixels) centred at grid point `p` overlap a blocked pixel?
+/// A disk centred beyond the examined band of outside pixels does (see [`Band`]).
 pub fn disk_hits(occ: &impl Occupancy, p: Point, r_px: f64) -> bool {
     let rc = contact_radius_px(r_px);
     let rc2 = rc * rc;
     let frame = *occ.frame();
-    let (c0, c1, r0, r1) = pixel_window(&frame, p, p, rc);
+    let band = Band::new(&frame, rc);
+    if !band.contains(p) {
+        return true;
+    }
+    let (c0, c1, r0, r1) = band.clip(&frame, pixel_window(&frame, p, p, rc));
     for row in r0..=r1 {
         for col in c0..=c1 {
             if occ.blocked(col, row) && center(&frame, col, row).dist2(p) < rc2 {
@@ -97,14 +163,20 @@ pub fn disk_hits(occ: &impl Occupancy, p: Point, r_px: f64) -> bool {
 /// (grid coordinates) comes into contact with a blocked pixel; `None` when the whole motion is
 /// free. Brute force over the swept capsule's bounding box: use for short motions, or call
 /// through a distance-transform accelerated caller ([`crate::world::World::first_contact`]).
+/// Only a band of outside pixels is examined (see [`Band`]): a motion starting beyond it is in
+/// contact at `t = 0`.
 pub fn segment_first_contact(occ: &impl Occupancy, a: Point, b: Point, r_px: f64) -> Option<f64> {
     let rc = contact_radius_px(r_px);
     let rc2 = rc * rc;
     let frame = *occ.frame();
+    let (w, h) = (frame.width as i64, frame.height as i64);
+    let band = Band::new(&frame, rc);
+    if !band.contains(a) {
+        return Some(0.0);
+    }
     let lo = Point::new(a.x.min(b.x), a.y.min(b.y));
     let hi = Point::new(a.x.max(b.x), a.y.max(b.y));
-    let (c0, c1, r0, r1) = pixel_window(&frame, lo, hi, rc);
-    let (w, h) = (frame.width as i64, frame.height as i64);
+    let (c0, c1, r0, r1) = band.clip(&frame, pixel_window(&frame, lo, hi, rc));
     let mut best: Option<f64> = None;
     // Earliest contact with the blocked pixel `(col, row)`; `false` once contact is at t = 0
     // (nothing can come earlier).
@@ -151,12 +223,53 @@ pub fn segment_first_contact(occ: &impl Occupancy, a: Point, b: Point, r_px: f64
             }
         }
     }
-    best
+    // Leaving the band without contact (only possible for disks thinner than a pixel's
+    // diagonal): contact where the motion leaves the box.
+    best.or_else(|| (!band.contains(b)).then(|| band.exit_param(a, b)))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Runs `f` on a helper thread and fails if it takes longer than `secs` seconds.
+    fn within<T: Send + 'static>(secs: u64, f: impl FnOnce() -> T + Send + 'static) -> T {
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let _ = tx.send(f());
+        });
+        rx.recv_timeout(std::time::Duration::from_secs(secs))
+            .expect("did not finish in time")
+    }
+
+    #[test]
+    fn astronomically_long_motions_are_bounded_by_the_image() {
+        // Found by fuzzing `--config` (bsa-bfs `cell_side_m: 1.1e49`): the brute force walked
+        // every outside pixel of the motion's bounding box and never returned.
+        let g: GridMap = "..........\n".repeat(10).trim_end().parse().unwrap();
+        let a = Point::new(5.0, 5.0);
+        let short = segment_first_contact(&g, a, Point::new(25.0, 5.0), 1.0).unwrap();
+        let (long, diag, back) = within(20, move || {
+            (
+                segment_first_contact(&g, a, Point::new(5.0 + 1e12, 5.0), 1.0),
+                segment_first_contact(&g, a, Point::new(-1e49, 1e49), 1.0),
+                segment_first_contact(&g, Point::new(1e12, 5.0), a, 1.0),
+            )
+        });
+        // The same contact point (against the outside column) however far the target is.
+        let x_short = 5.0 + 20.0 * short;
+        let x_long = 5.0 + 1e12 * long.unwrap();
+        assert!((x_short - x_long).abs() < 1e-3, "{x_short} vs {x_long}");
+        assert!(x_short > 9.0 && x_short < 10.0, "{x_short}");
+        assert!(diag.is_some_and(|t| t > 0.0 && t < 1e-47), "{diag:?}");
+        // Starting far outside the image is contact at once; so is standing there (the pixel
+        // window overflowed `i64` in `center` for such points).
+        assert_eq!(back, Some(0.0));
+        let g: GridMap = "...\n...".parse().unwrap();
+        assert!(disk_hits(&g, Point::new(1e30, -1e49), 1.0));
+        assert!(disk_hits(&g, Point::new(f64::NAN, 1.0), 1.0));
+        assert!(!disk_hits(&g, Point::new(1.5, 1.0), 0.4));
+    }
 
     #[test]
     fn disk_against_wall() {

@@ -529,6 +529,11 @@ pub fn replay_gif(world: &World, trace: &Trace, opts: &GifOptions) -> Result<Vec
 }
 
 fn draw_line(layer: &mut [bool], w: usize, h: usize, a: (f64, f64), b: (f64, f64)) {
+    // Walk only the part inside the layer (plus a pixel): a pose far outside the map, as in a
+    // hand-edited trace, must not make the walk astronomically long.
+    let Some((a, b)) = clip_segment(a, b, (-1.0, -1.0), (w as f64 + 1.0, h as f64 + 1.0)) else {
+        return;
+    };
     let steps = ((b.0 - a.0).abs().max((b.1 - a.1).abs()).ceil() as usize).max(1);
     for s in 0..=steps {
         let t = s as f64 / steps as f64;
@@ -538,6 +543,45 @@ fn draw_line(layer: &mut [bool], w: usize, h: usize, a: (f64, f64), b: (f64, f64
             layer[y as usize * w + x as usize] = true;
         }
     }
+}
+
+/// The part of segment `a`-`b` inside the box `lo`-`hi` (Liang-Barsky), `None` when there is
+/// none or a coordinate is not finite. Endpoints inside the box are returned unchanged.
+fn clip_segment(
+    a: (f64, f64),
+    b: (f64, f64),
+    lo: (f64, f64),
+    hi: (f64, f64),
+) -> Option<((f64, f64), (f64, f64))> {
+    if ![a.0, a.1, b.0, b.1].iter().all(|v| v.is_finite()) {
+        return None;
+    }
+    let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    for (p, q) in [
+        (-dx, a.0 - lo.0),
+        (dx, hi.0 - a.0),
+        (-dy, a.1 - lo.1),
+        (dy, hi.1 - a.1),
+    ] {
+        if p == 0.0 {
+            if q < 0.0 {
+                return None;
+            }
+        } else if p < 0.0 {
+            t0 = t0.max(q / p);
+        } else {
+            t1 = t1.min(q / p);
+        }
+    }
+    if t0 > t1 {
+        return None;
+    }
+    let at = |t: f64| (a.0 + t * dx, a.1 + t * dy);
+    Some((
+        if t0 > 0.0 { at(t0) } else { a },
+        if t1 < 1.0 { at(t1) } else { b },
+    ))
 }
 
 fn fill_disk(buf: &mut [u8], w: usize, h: usize, x: f64, y: f64, r: f64, v: u8) {
