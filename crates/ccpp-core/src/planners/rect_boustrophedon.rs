@@ -189,6 +189,19 @@ pub fn plan(world: &World, opts: &RectOptions) -> RectPlan {
         }
         [x0, y0, x1, y1]
     });
+    // A user area is clipped to the map: lanes beyond it cannot be driven, and an area of
+    // 1e119 m would otherwise ask for more lanes than memory holds (found by fuzzing).
+    let area = if opts.area.is_some() {
+        let (lo, hi) = f.world_bounds();
+        [
+            area[0].max(lo.x),
+            area[1].max(lo.y),
+            area[2].min(hi.x),
+            area[3].min(hi.y),
+        ]
+    } else {
+        area
+    };
     let mut rm = Roadmap::new(&rw);
     let mut waypoints = Vec::new();
     let mut dropped = 0;
@@ -682,6 +695,24 @@ mod tests {
         assert_eq!(l[5][0].y, 0.45);
         assert!((l[4][0].y - 0.4).abs() < 1e-12);
         assert!(lanes([0.0, 0.0, 1.0, 1.0], 0.0, 0.1).is_empty());
+    }
+
+    #[test]
+    fn a_huge_area_is_clipped_to_the_map() {
+        // Found by fuzzing: an area reaching 1e119 m asked for more lanes than memory holds.
+        let map = GridMap::from_ascii_scaled("######\n#....#\n#....#\n######", 8, 0.05).unwrap();
+        let world = World::new(map, Robot::new(0.15), None).unwrap();
+        let opts = RectOptions {
+            area: Some([0.2, 0.2, 3e119, 1.4]),
+            ..RectOptions::default()
+        };
+        let p = plan(&world, &opts);
+        let (lo, hi) = world.frame().world_bounds();
+        assert!(p.area[2] <= hi.x && p.area[3] <= hi.y && p.area[0] >= lo.x);
+        assert!(p
+            .waypoints
+            .iter()
+            .all(|w| w.x >= lo.x && w.x <= hi.x && w.y >= lo.y && w.y <= hi.y));
     }
 
     #[test]
