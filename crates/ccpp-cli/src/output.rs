@@ -7,7 +7,6 @@ use anyhow::{Context, Result};
 use ccpp_core::metrics::Metrics;
 use ccpp_core::trace::Trace;
 use ccpp_io::write_atomic;
-use ccpp_render::{coverage_png, CoverageStyle};
 
 use ccpp_core::world::World;
 use ccpp_io::scenario::Scenario;
@@ -26,65 +25,19 @@ pub fn path_csv(trace: &Trace) -> String {
 
 /// The metrics as pretty JSON.
 pub fn metrics_json(m: &Metrics) -> Result<String> {
-    let mut s = serde_json::to_string_pretty(m)?;
-    s.push('\n');
-    Ok(s)
+    Ok(ccpp_render::run_files::metrics_json(m)?)
 }
 
-/// Title lines for pictures.
-pub fn title_lines(m: &Metrics) -> Vec<String> {
-    let cov = m
-        .coverage_rate
-        .map_or_else(|| "-".to_string(), |c| format!("{:.1}%", 100.0 * c));
-    vec![
-        format!(
-            "{} on {}  r={} m  tool={} m",
-            m.planner, m.map, m.robot_radius_m, m.tool_radius_m
-        ),
-        format!(
-            "effective coverage {:.1}%  tiles {}  path {:.1} m  ratio {:.2}",
-            100.0 * m.effective_coverage,
-            cov,
-            m.path_length_m,
-            m.path_ratio,
-        ),
-        format!(
-            "regions {}  revisits {:.2}  turns {}  collisions {}",
-            m.regions, m.revisit_rate, m.turns, m.collisions
-        ),
-    ]
-}
-
-/// Renders everything first, then writes each file atomically into `out`, so a failure leaves
-/// no partial file. `metrics.json` is written last: its presence marks a complete run.
+/// Writes the run's files into `out` (see [`ccpp_render::run_files::write_run_files`]) and
+/// returns the metrics JSON.
 pub fn write_run_files(out: &Path, job: &Job, r: &JobResult) -> Result<String> {
-    let metrics = metrics_json(&r.metrics)?;
-    // run.json is the scenario itself (with the start actually used): `Scenario::run` on it
-    // reproduces this run.
-    let mut scenario = job.scenario.clone();
-    let start = r.world.start();
-    scenario.start = Some([start.x, start.y, start.theta]);
-    let run_json = scenario.to_json()?;
-    let trace = trace_jsonl(&r.run.trace)?;
-    let path = path_csv(&r.run.trace);
-    let style = CoverageStyle {
-        title: title_lines(&r.metrics),
-        ..CoverageStyle::default()
-    };
-    let png = coverage_png(&r.world, &r.run.trace, &style)?;
-    std::fs::create_dir_all(out)
-        .with_context(|| format!("cannot create output folder {}", out.display()))?;
-    let files: [(&str, &[u8]); 5] = [
-        ("run.json", run_json.as_bytes()),
-        ("path.csv", path.as_bytes()),
-        ("trace.jsonl", trace.as_bytes()),
-        ("coverage.png", &png),
-        ("metrics.json", metrics.as_bytes()),
-    ];
-    for (name, bytes) in files {
-        write_atomic(&out.join(name), bytes)?;
-    }
-    Ok(metrics)
+    Ok(ccpp_render::run_files::write_run_files(
+        out,
+        &job.scenario,
+        &r.world,
+        &r.run.trace,
+        &r.metrics,
+    )?)
 }
 
 /// Writes `replay.html` and `replay.gif` of a finished run into `out`.

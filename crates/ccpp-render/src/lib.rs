@@ -15,6 +15,7 @@
 pub mod chart;
 mod font;
 pub mod replay;
+pub mod run_files;
 
 use ccpp_core::grid::Cell;
 use ccpp_core::metrics::swept_pixels;
