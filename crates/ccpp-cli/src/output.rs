@@ -13,21 +13,6 @@ use ccpp_io::scenario::Scenario;
 
 use crate::job::{Job, JobResult};
 
-/// The trace as JSON Lines.
-pub fn trace_jsonl(trace: &Trace) -> Result<String> {
-    Ok(ccpp_io::trace::trace_jsonl(trace)?)
-}
-
-/// The executed poses as CSV `x,y,theta` (metres, radians).
-pub fn path_csv(trace: &Trace) -> String {
-    ccpp_io::trace::path_csv(trace)
-}
-
-/// The metrics as pretty JSON.
-pub fn metrics_json(m: &Metrics) -> Result<String> {
-    Ok(ccpp_render::run_files::metrics_json(m)?)
-}
-
 /// Writes the run's files into `out` (see [`ccpp_render::run_files::write_run_files`]) and
 /// returns the metrics JSON.
 pub fn write_run_files(out: &Path, job: &Job, r: &JobResult) -> Result<String> {

@@ -339,6 +339,7 @@ fn scenario_from(
     s.robot = Robot::new(radius);
     let mut planner_opts = serde_json::Map::new();
     let Some(options) = options else {
+        s.robot.validate().map_err(|e| err(&e))?;
         return Ok(s);
     };
     for (k, v) in options.iter() {
@@ -400,6 +401,8 @@ fn scenario_from(
             }
         }
     }
+    // The robot first, as the command line does (same message).
+    s.robot.validate().map_err(|e| err(&e))?;
     if !planner_opts.is_empty() {
         let mut cfg = serde_json::to_value(&s.planner).map_err(|e| err(&e))?;
         if let Some(Value::Object(o)) = cfg.get_mut("options") {

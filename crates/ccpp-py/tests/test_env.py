@@ -51,8 +51,11 @@ def test_boustrophedon_policy_reaches_full_coverage(room: Path) -> None:
     assert terminated and info["coverage"] == 1.0
     assert total == pytest.approx(1.0)
     assert env.swept[env.accessible].all()
-    # Everything the robot passed is known now; the metrics agree with the episode.
-    assert (obs["known"] != 2).sum() > 0.9 * (env.map.occupancy == 0).sum()
+    # The known map is the truth where seen (scans are taken at the end of each action);
+    # the metrics agree with the episode.
+    known, occ = obs["known"], env.map.occupancy
+    seen = known != 2
+    assert seen.sum() > 0.5 * occ.size and np.array_equal(known[seen], occ[seen])
     m = env.metrics()
     assert m["effective_coverage"] == 1.0 and m["collisions"] == 0
     assert info["steps"] == steps
@@ -63,6 +66,17 @@ def test_driving_into_a_wall_is_a_collision(room: Path) -> None:
     obs, _ = env.reset()
     x, y, theta = obs["pose"]
     assert theta == 0.0  # the default start heads east
+    # The scan window is the truth within range, centred on the robot's pixel.
+    scan, occ = obs["scan"], env.map.occupancy
+    k = env.scan_side // 2
+    (rows, cols) = np.nonzero(env.reachable)
+    m = env.map
+    col = int(round((x - m.origin[0]) / m.resolution - 0.5))
+    row = m.height - 1 - int(round((y - m.origin[1]) / m.resolution - 0.5))
+    window = occ[row - k : row + k + 1, col - k : col + k + 1]
+    in_range = scan != 2
+    assert in_range.sum() > 0 and np.array_equal(scan[in_range], window[in_range])
+    assert not in_range[0, 0] and in_range[k, k]
     obs, reward, terminated, truncated, info = env.step(("translate", 10.0))
     assert terminated and info["collision"] and info["collisions"] == 1 and info["bumped"]
     assert reward > 0

@@ -92,8 +92,8 @@ def test_options_change_the_run_as_the_cli_flags(shared_maps: Path, ccpp_bin: st
     assert without_time(off.metrics) == without_time(json.loads(p.stdout))
     # The same through options={...}.
     assert without_time(ccpp.run(m, "ba-star", options={"smoothing": False}).metrics) == without_time(off.metrics)
-    r2 = ccpp.run(m, "bsa", radius=0.2, tool_radius=0.25)
-    assert r2.metrics["robot_radius_m"] == 0.2 and r2.metrics["tool_radius_m"] == 0.25
+    r2 = ccpp.run(m, "bsa", radius=0.2, tool_radius=0.15)
+    assert r2.metrics["robot_radius_m"] == 0.2 and r2.metrics["tool_radius_m"] == 0.15
     # A random-bounce seed changes the path.
     a = ccpp.run(m, "random-bounce", seed=1)
     b = ccpp.run(m, "random-bounce", seed=2)
@@ -102,7 +102,7 @@ def test_options_change_the_run_as_the_cli_flags(shared_maps: Path, ccpp_bin: st
 
 def test_errors_are_the_cli_messages(ccpp_bin: str, tmp_path: Path, room: Path) -> None:
     missing = tmp_path / "nope.yaml"
-    p = cli(ccpp_bin, "run", "--map", str(missing), "--out", str(tmp_path / "o"))
+    p = cli(ccpp_bin, "run", "--map", str(missing), "--planner", "ba-star", "--out", str(tmp_path / "o"))
     assert p.returncode == 1
     line = p.stderr.strip()
     assert line.startswith("error: ") and "\n" not in line
@@ -110,12 +110,12 @@ def test_errors_are_the_cli_messages(ccpp_bin: str, tmp_path: Path, room: Path) 
         ccpp.load_map(missing)
     assert str(e.value) == line.removeprefix("error: ")
     # A robot too big for the room.
-    p = cli(ccpp_bin, "run", "--map", str(room), "--radius", "5", "--out", str(tmp_path / "o"))
+    p = cli(ccpp_bin, "run", "--map", str(room), "--planner", "ba-star", "--radius", "5", "--out", str(tmp_path / "o"))
     with pytest.raises(ccpp.CcppError) as e:
         ccpp.run(ccpp.load_map(room), radius=5.0)
     assert str(e.value) == p.stderr.strip().removeprefix("error: ")
     # Invalid values are refused by the scenario, with the CLI's wording.
-    p = cli(ccpp_bin, "run", "--map", str(room), "--radius", "-1", "--out", str(tmp_path / "o"))
+    p = cli(ccpp_bin, "run", "--map", str(room), "--planner", "ba-star", "--radius=-1", "--out", str(tmp_path / "o"))
     with pytest.raises(ccpp.CcppError) as e:
         ccpp.run(room, radius=-1.0)
     assert str(e.value) in p.stderr

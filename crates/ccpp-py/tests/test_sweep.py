@@ -38,7 +38,9 @@ def test_sweep_equals_bench(shared_maps: Path, ccpp_bin: str, tmp_path: Path, cl
         capture_output=True, text=True, check=False,
     )
     assert p.returncode == 0, p.stderr
-    expected = pd.read_csv(bench_out / "results.csv", keep_default_na=False, na_values=[""])
+    expected = pd.read_csv(
+        bench_out / "results.csv", keep_default_na=False, na_values=[""], float_precision="round_trip"
+    )
     sweep_out = tmp_path / "sweep"
     got = ccpp.sweep(maps, planners, [0.15], client=client, out=sweep_out)
     assert list(got.columns) == ccpp.CSV_COLUMNS == list(expected.columns)
