@@ -6,7 +6,6 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use ccpp_core::metrics::Metrics;
 use ccpp_core::trace::Trace;
-use ccpp_render::{coverage_png, CoverageStyle};
 
 use ccpp_core::world::World;
 use ccpp_io::scenario::Scenario;
@@ -14,47 +13,6 @@ use ccpp_io::scenario::Scenario;
 use crate::info::StartComponent;
 use crate::job::{Job, JobResult};
 use crate::staging::{write_file, Staging};
-
-/// The trace as JSON Lines.
-pub fn trace_jsonl(trace: &Trace) -> Result<String> {
-    Ok(ccpp_io::trace::trace_jsonl(trace)?)
-}
-
-/// The executed poses as CSV `x,y,theta` (metres, radians).
-pub fn path_csv(trace: &Trace) -> String {
-    ccpp_io::trace::path_csv(trace)
-}
-
-/// The metrics as pretty JSON.
-pub fn metrics_json(m: &Metrics) -> Result<String> {
-    let mut s = serde_json::to_string_pretty(m)?;
-    s.push('\n');
-    Ok(s)
-}
-
-/// Title lines for pictures.
-pub fn title_lines(m: &Metrics) -> Vec<String> {
-    let cov = m
-        .coverage_rate
-        .map_or_else(|| "-".to_string(), |c| format!("{:.1}%", 100.0 * c));
-    vec![
-        format!(
-            "{} on {}  r={} m  tool={} m",
-            m.planner, m.map, m.robot_radius_m, m.tool_radius_m
-        ),
-        format!(
-            "effective coverage {:.1}%  tiles {}  path {:.1} m  ratio {:.2}",
-            100.0 * m.effective_coverage,
-            cov,
-            m.path_length_m,
-            m.path_ratio,
-        ),
-        format!(
-            "regions {}  revisits {:.2}  turns {}  collisions {}",
-            m.regions, m.revisit_rate, m.turns, m.collisions
-        ),
-    ]
-}
 
 /// A run's files, rendered in memory: `(file name, bytes)`.
 pub struct RunFiles {
@@ -66,26 +24,16 @@ pub struct RunFiles {
 
 /// Renders every file of a run (and the replay files when `replay`) without writing anything.
 pub fn render_run_files(job: &Job, r: &JobResult, replay: bool) -> Result<RunFiles> {
-    let metrics = metrics_json(&r.metrics)?;
-    // run.json is the scenario itself (with the start actually used): `Scenario::run` on it
-    // reproduces this run.
-    let mut scenario = job.scenario.clone();
-    let start = r.world.start();
-    scenario.start = Some([start.x, start.y, start.theta]);
-    let run_json = scenario.to_json()?;
-    let trace = trace_jsonl(&r.run.trace)?;
-    let path = path_csv(&r.run.trace);
-    let style = CoverageStyle {
-        title: title_lines(&r.metrics),
-        ..CoverageStyle::default()
-    };
-    let png = coverage_png(&r.world, &r.run.trace, &style)?;
-    let mut files: Vec<(&'static str, Vec<u8>)> = vec![
-        ("run.json", run_json.into_bytes()),
-        ("path.csv", path.into_bytes()),
-        ("trace.jsonl", trace.into_bytes()),
-        ("coverage.png", png),
-    ];
+    // The library renders the standard set (the Python package's `save` writes the same
+    // bytes); the replay files go before `metrics.json`, which marks a complete run.
+    let mut files = ccpp_render::run_files::render_run_files(
+        &job.scenario,
+        &r.world,
+        &r.run.trace,
+        &r.metrics,
+    )?;
+    let (_, metrics_bytes) = files.pop().context("no metrics.json rendered")?;
+    let metrics = String::from_utf8(metrics_bytes).context("metrics.json is not UTF-8")?;
     if replay {
         let title = format!("{} on {}", r.metrics.planner, r.metrics.map);
         let (html, gif) = render_replay(&r.world, &r.run.trace, r.run.tile_side, &metrics, &title)?;

@@ -19,6 +19,7 @@
 pub mod chart;
 mod font;
 pub mod replay;
+pub mod run_files;
 
 use chart::{Chart, LegendEntry, Swatch};
 

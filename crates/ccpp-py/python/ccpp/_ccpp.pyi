@@ -1,0 +1,145 @@
+"""Type stubs of the ccpp extension module (re-exported by ``ccpp``)."""
+
+import os
+from typing import Any, Sequence
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+_Path = str | os.PathLike[str]
+
+class CcppError(Exception):
+    """A ccpp error; the message is the command line's one-line message."""
+
+class Map:
+    """An occupancy-grid map, loaded and prepared (overrides, georeference, inflation)."""
+
+    @property
+    def name(self) -> str: ...
+    @property
+    def path(self) -> str: ...
+    @property
+    def width(self) -> int: ...
+    @property
+    def height(self) -> int: ...
+    @property
+    def size(self) -> tuple[int, int]:
+        """(width, height) in pixels."""
+    @property
+    def size_m(self) -> tuple[float, float]:
+        """(width, height) in metres."""
+    @property
+    def resolution(self) -> float:
+        """Metres per pixel."""
+    @property
+    def origin(self) -> tuple[float, float, float]:
+        """(x, y, yaw) of the image's bottom-left corner."""
+    @property
+    def occupancy(self) -> npt.NDArray[np.uint8]:
+        """(height, width), image layout (row 0 = top): 0 free, 1 occupied, 2 unknown."""
+    def pixel_center(self, col: int, row: int) -> tuple[float, float]:
+        """World (x, y) of the centre of pixel (col, row)."""
+
+class RunResult:
+    """A finished run."""
+
+    @property
+    def metrics(self) -> dict[str, Any]:
+        """The keys of metrics.json."""
+    @property
+    def path(self) -> npt.NDArray[np.float64]:
+        """Executed poses, (N, 3): x, y, theta."""
+    @property
+    def swept(self) -> npt.NDArray[np.bool_]:
+        """Swept pixels, (height, width), image layout."""
+    @property
+    def accessible(self) -> npt.NDArray[np.bool_]:
+        """Pixels the tool can reach from the start, (height, width), image layout."""
+    @property
+    def events(self) -> list[dict[str, Any]]:
+        """Trace events as in trace.jsonl (with the step counter ``t``)."""
+    @property
+    def stop(self) -> str:
+        """``"done"`` or ``"max_steps"``."""
+    @property
+    def start(self) -> tuple[float, float, float]: ...
+    @property
+    def scenario_json(self) -> str:
+        """The run.json text."""
+    def save(self, folder: _Path) -> None:
+        """Writes the files of ``ccpp run --out folder``."""
+
+class Env:
+    """Step-by-step coverage environment on the simulator's physics and sensor."""
+
+    def __init__(
+        self,
+        map: Map | _Path,
+        *,
+        radius: float = 0.15,
+        tool_radius: float | None = None,
+        sensor_range: float | None = None,
+        start: Sequence[float] | None = None,
+        exec: str = "ideal",
+        max_steps: int | None = None,
+    ) -> None: ...
+    def reset(self, seed: int | None = None) -> tuple[dict[str, Any], dict[str, Any]]:
+        """Starts an episode; returns (observation, info)."""
+    def step(
+        self, action: Sequence[Any]
+    ) -> tuple[dict[str, Any], float, bool, bool, dict[str, Any]]:
+        """``("rotate", a)``, ``("translate", d)`` or ``("move_to", x, y)`` ->
+        (observation, reward m², terminated, truncated, info)."""
+    @property
+    def map(self) -> Map: ...
+    @property
+    def sensor_range(self) -> float: ...
+    @property
+    def radius(self) -> float: ...
+    @property
+    def tool_radius(self) -> float: ...
+    @property
+    def scan_side(self) -> int: ...
+    @property
+    def swept(self) -> npt.NDArray[np.bool_]: ...
+    @property
+    def accessible(self) -> npt.NDArray[np.bool_]: ...
+    @property
+    def reachable(self) -> npt.NDArray[np.bool_]:
+        """Pixel centres the robot centre can reach, (height, width), image layout."""
+    def metrics(self) -> dict[str, Any]:
+        """Metrics of the episode so far (planner ``"env"``)."""
+
+def load_map(
+    path: _Path,
+    *,
+    resolution: float | None = None,
+    origin: Sequence[float] | None = None,
+    occupied_thresh: float | None = None,
+    free_thresh: float | None = None,
+    inflate: float | None = None,
+    georef: _Path | None = None,
+    name: str | None = None,
+) -> Map:
+    """Loads a ROS map_server YAML (with its image) or a bare PGM/PNG."""
+
+def run(
+    map: Map | _Path, planner: str = "ba-star", radius: float = 0.15, **options: Any
+) -> RunResult:
+    """Runs a planner; options are scenario fields or the planner's own options."""
+
+def bench_run(
+    map_path: _Path,
+    planner: str,
+    radius: float = 0.15,
+    tool_radius: float | None = None,
+    inflate: float | None = None,
+    max_memory_mb: int | None = None,
+    out: _Path | None = None,
+) -> tuple[dict[str, Any] | None, str | None]:
+    """One ``ccpp bench`` run: (metrics, None) or (None, error message)."""
+
+def planners() -> list[dict[str, Any]]:
+    """name, offline, description and default options of every planner."""

@@ -1,0 +1,1071 @@
+//! Python bindings of ccpp: the `ccpp._ccpp` extension module, re-exported by the `ccpp`
+//! package (`python/ccpp/__init__.py`).
+//!
+//! Every run goes through [`ccpp_io::scenario::Scenario`]: the keyword options of `ccpp.run`
+//! become scenario fields, and the scenario validates them once. Errors are raised as
+//! `ccpp.CcppError` with the one-line message the command line prints (without its `error: `
+//! prefix).
+
+use std::f64::consts::PI;
+use std::path::{Path, PathBuf};
+
+use ccpp_core::exec::{Execution, PidOptions};
+use ccpp_core::grid::{Cell, MapFrame};
+use ccpp_core::metrics::{self, Metrics, Sweeper};
+use ccpp_core::planner::{KnownMap, Sensor, Step};
+use ccpp_core::planners::{PlannerConfig, PlannerKind, CATALOG};
+use ccpp_core::rng::SplitMix64;
+use ccpp_core::sim::{RunOutput, SimConfig, Simulator, StopReason};
+use ccpp_core::trace::{Event, Record, Trace};
+use ccpp_core::world::{Robot, World};
+use ccpp_core::{Point, Pose};
+use ccpp_io::scenario::{MapRecipe, PreparedMap, Scenario, ScenarioError, DEFAULT_MAX_MEMORY_MB};
+use fixedbitset::FixedBitSet;
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray2};
+use pyo3::create_exception;
+use pyo3::exceptions::PyException;
+use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+use serde_json::Value;
+
+create_exception!(
+    ccpp,
+    CcppError,
+    PyException,
+    "A ccpp error: invalid options, a map that cannot be loaded, a run that cannot be done. \
+     The message is the one-line message of the command line."
+);
+
+/// The message of `e` and its causes, as the command line prints them (`anyhow`'s `{:#}`).
+fn chain(e: &(dyn std::error::Error + 'static)) -> String {
+    let mut s = e.to_string();
+    let mut cur = e.source();
+    while let Some(c) = cur {
+        s.push_str(": ");
+        s.push_str(&c.to_string());
+        cur = c.source();
+    }
+    s
+}
+
+fn err(e: &(dyn std::error::Error + 'static)) -> PyErr {
+    CcppError::new_err(chain(e))
+}
+
+fn msg(m: impl Into<String>) -> PyErr {
+    CcppError::new_err(m.into())
+}
+
+// ---------------------------------------------------------------------------------------------
+// JSON <-> Python
+// ---------------------------------------------------------------------------------------------
+
+fn json_to_py(py: Python<'_>, v: &Value) -> PyResult<Py<PyAny>> {
+    Ok(match v {
+        Value::Null => py.None(),
+        Value::Bool(b) => PyBool::new(py, *b).to_owned().into_any().unbind(),
+        Value::Number(n) => {
+            if let Some(i) = n.as_i64() {
+                i.into_pyobject(py)?.into_any().unbind()
+            } else if let Some(u) = n.as_u64() {
+                u.into_pyobject(py)?.into_any().unbind()
+            } else {
+                n.as_f64()
+                    .unwrap_or(f64::NAN)
+                    .into_pyobject(py)?
+                    .into_any()
+                    .unbind()
+            }
+        }
+        Value::String(s) => s.into_pyobject(py)?.into_any().unbind(),
+        Value::Array(a) => {
+            let items = a
+                .iter()
+                .map(|x| json_to_py(py, x))
+                .collect::<PyResult<Vec<_>>>()?;
+            PyList::new(py, items)?.into_any().unbind()
+        }
+        Value::Object(o) => {
+            let d = PyDict::new(py);
+            for (k, x) in o {
+                d.set_item(k, json_to_py(py, x)?)?;
+            }
+            d.into_any().unbind()
+        }
+    })
+}
+
+fn py_to_json(o: &Bound<'_, PyAny>) -> PyResult<Value> {
+    if o.is_none() {
+        return Ok(Value::Null);
+    }
+    if o.is_instance_of::<PyBool>() {
+        return Ok(Value::Bool(o.extract()?));
+    }
+    if o.is_instance_of::<PyInt>() {
+        return Ok(Value::from(o.extract::<i64>()?));
+    }
+    if o.is_instance_of::<PyFloat>() {
+        let f: f64 = o.extract()?;
+        return serde_json::Number::from_f64(f)
+            .map(Value::Number)
+            .ok_or_else(|| msg(format!("option values must be finite numbers, got {f}")));
+    }
+    if o.is_instance_of::<PyString>() {
+        return Ok(Value::String(o.extract()?));
+    }
+    if let Ok(d) = o.cast::<PyDict>() {
+        let mut m = serde_json::Map::new();
+        for (k, v) in d.iter() {
+            m.insert(k.extract::<String>()?, py_to_json(&v)?);
+        }
+        return Ok(Value::Object(m));
+    }
+    if o.is_instance_of::<PyList>() || o.is_instance_of::<PyTuple>() {
+        let mut a = Vec::new();
+        for x in o.try_iter()? {
+            a.push(py_to_json(&x?)?);
+        }
+        return Ok(Value::Array(a));
+    }
+    // numpy scalars and other numbers.
+    if let Ok(f) = o.extract::<f64>() {
+        return serde_json::Number::from_f64(f)
+            .map(Value::Number)
+            .ok_or_else(|| msg(format!("option values must be finite numbers, got {f}")));
+    }
+    Err(msg(format!(
+        "cannot use {} as an option value",
+        o.get_type().name()?
+    )))
+}
+
+fn to_py<T: serde::Serialize>(py: Python<'_>, v: &T) -> PyResult<Py<PyAny>> {
+    let v = serde_json::to_value(v).map_err(|e| err(&e))?;
+    json_to_py(py, &v)
+}
+
+/// A bitset in image layout (row 0 = the image's top row) as a `bool` array `(height, width)`.
+fn mask<'py>(py: Python<'py>, frame: &MapFrame, bits: &FixedBitSet) -> Bound<'py, PyArray2<bool>> {
+    let (w, h) = (frame.width, frame.height);
+    let mut a = Array2::from_elem((h, w), false);
+    for i in bits.ones() {
+        if i < w * h {
+            a[(i / w, i % w)] = true;
+        }
+    }
+    a.into_pyarray(py)
+}
+
+// ---------------------------------------------------------------------------------------------
+// Map
+// ---------------------------------------------------------------------------------------------
+
+/// An occupancy-grid map, loaded and prepared (overrides, georeference, inflation applied).
+#[pyclass(module = "ccpp", frozen)]
+pub struct Map {
+    map: PreparedMap,
+}
+
+#[pymethods]
+impl Map {
+    /// Short name used in reports (the file stem unless given).
+    #[getter]
+    fn name(&self) -> String {
+        self.map.name.clone()
+    }
+
+    /// The map file.
+    #[getter]
+    fn path(&self) -> String {
+        self.map.source.display().to_string()
+    }
+
+    /// Image width, pixels.
+    #[getter]
+    fn width(&self) -> usize {
+        self.map.grid.frame().width
+    }
+
+    /// Image height, pixels.
+    #[getter]
+    fn height(&self) -> usize {
+        self.map.grid.frame().height
+    }
+
+    /// `(width, height)` in pixels.
+    #[getter]
+    fn size(&self) -> (usize, usize) {
+        let f = self.map.grid.frame();
+        (f.width, f.height)
+    }
+
+    /// `(width, height)` in metres.
+    #[getter]
+    fn size_m(&self) -> (f64, f64) {
+        let f = self.map.grid.frame();
+        (f.width_m(), f.height_m())
+    }
+
+    /// Metres per pixel.
+    #[getter]
+    fn resolution(&self) -> f64 {
+        self.map.grid.frame().resolution
+    }
+
+    /// `(x, y, yaw)` of the image's bottom-left corner in the world frame (ROS convention).
+    #[getter]
+    fn origin(&self) -> (f64, f64, f64) {
+        let o = self.map.grid.frame().origin;
+        (o.x, o.y, o.theta)
+    }
+
+    /// Occupancy in image layout (row 0 = top), `uint8` `(height, width)`:
+    /// 0 free, 1 occupied, 2 unknown.
+    #[getter]
+    fn occupancy<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<u8>> {
+        let f = self.map.grid.frame();
+        let cells: Vec<u8> = self.map.grid.cells().iter().map(|&c| c as u8).collect();
+        Array2::from_shape_vec((f.height, f.width), cells)
+            .unwrap_or_else(|_| Array2::zeros((f.height, f.width)))
+            .into_pyarray(py)
+    }
+
+    /// The world coordinates `(x, y)` of the centre of pixel `(col, row)`.
+    fn pixel_center(&self, col: usize, row: usize) -> (f64, f64) {
+        let p = self.map.grid.frame().pixel_center(col, row);
+        (p.x, p.y)
+    }
+
+    fn __repr__(&self) -> String {
+        let f = self.map.grid.frame();
+        format!(
+            "Map({:?}, {} x {} px, {} m/px)",
+            self.map.name, f.width, f.height, f.resolution
+        )
+    }
+}
+
+/// The recipe of a map file as the command line builds it: absolute paths, the file stem as
+/// the name.
+fn recipe_for(path: &Path) -> MapRecipe {
+    let abs = |p: &Path| std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf());
+    MapRecipe {
+        path: Some(abs(path)),
+        name: Some(
+            path.file_stem()
+                .map_or_else(|| "map".to_string(), |s| s.to_string_lossy().into_owned()),
+        ),
+        ..MapRecipe::default()
+    }
+}
+
+/// Loads a map: a ROS `map_server` YAML (with its PGM/PNG) or a bare image.
+#[pyfunction]
+#[pyo3(signature = (path, *, resolution=None, origin=None, occupied_thresh=None, free_thresh=None, inflate=None, georef=None, name=None))]
+fn load_map(
+    py: Python<'_>,
+    path: PathBuf,
+    resolution: Option<f64>,
+    origin: Option<Vec<f64>>,
+    occupied_thresh: Option<f64>,
+    free_thresh: Option<f64>,
+    inflate: Option<f64>,
+    georef: Option<PathBuf>,
+    name: Option<String>,
+) -> PyResult<Map> {
+    let mut recipe = recipe_for(&path);
+    recipe.resolution = resolution;
+    recipe.origin = match origin.as_deref() {
+        None => None,
+        Some([x, y]) => Some([*x, *y, 0.0]),
+        Some([x, y, t]) => Some([*x, *y, *t]),
+        Some(o) => {
+            return Err(msg(format!(
+                "origin expects (x, y) or (x, y, yaw), got {} values",
+                o.len()
+            )))
+        }
+    };
+    recipe.occupied_thresh = occupied_thresh;
+    recipe.free_thresh = free_thresh;
+    recipe.inflate = inflate;
+    recipe.georef = georef.map(|g| std::fs::canonicalize(&g).unwrap_or(g));
+    if name.is_some() {
+        recipe.name = name;
+    }
+    let map = py.detach(|| recipe.load()).map_err(|e| err(&e))?;
+    Ok(Map { map })
+}
+
+// ---------------------------------------------------------------------------------------------
+// Runs
+// ---------------------------------------------------------------------------------------------
+
+fn parse_kind(planner: &str) -> PyResult<PlannerKind> {
+    planner.parse::<PlannerKind>().map_err(|e| err(&e))
+}
+
+fn not_applicable(opt: &str, kind: PlannerKind, applies_to: &str) -> PyErr {
+    msg(format!(
+        "{opt} does not apply to {kind} (it applies to {applies_to})"
+    ))
+}
+
+/// Keyword options of `run` that are not planner options.
+const RUN_KEYS: [&str; 9] = [
+    "tool_radius",
+    "start",
+    "sensor_range",
+    "max_memory_mb",
+    "max_steps",
+    "exec",
+    "seed",
+    "options",
+    "name",
+];
+
+/// Builds the scenario of `ccpp.run`: keyword options -> scenario fields (validated later,
+/// once, by [`Scenario::run_on`]).
+fn scenario_from(
+    map: &PreparedMap,
+    planner: &str,
+    radius: f64,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Scenario> {
+    let kind = parse_kind(planner)?;
+    let mut s = Scenario::new(map.recipe.clone(), kind);
+    s.robot = Robot::new(radius);
+    let mut planner_opts = serde_json::Map::new();
+    let Some(options) = options else {
+        s.robot.validate().map_err(|e| err(&e))?;
+        return Ok(s);
+    };
+    for (k, v) in options.iter() {
+        let key: String = k.extract()?;
+        match key.as_str() {
+            "tool_radius" => s.robot.tool_radius = v.extract()?,
+            "start" => {
+                let p: Vec<f64> = v.extract()?;
+                s.start = match p.as_slice() {
+                    [x, y] => Some([*x, *y, 0.0]),
+                    [x, y, t] => Some([*x, *y, *t]),
+                    _ => {
+                        return Err(msg(format!(
+                            "start expects (x, y) or (x, y, theta), got {} values",
+                            p.len()
+                        )))
+                    }
+                };
+            }
+            "sensor_range" => {
+                if kind.info().offline {
+                    return Err(not_applicable(
+                        "sensor_range",
+                        kind,
+                        "the online planners; offline planners read the whole map",
+                    ));
+                }
+                s.sim.sensor_range = Some(v.extract()?);
+            }
+            "max_memory_mb" => s.max_memory_mb = v.extract()?,
+            "max_steps" => s.sim.max_steps = v.extract()?,
+            "exec" => {
+                let e: String = v.extract()?;
+                s.sim.exec = Some(match e.to_ascii_lowercase().as_str() {
+                    "ideal" => Execution::Ideal,
+                    "pid" => match s.planner.settings().preferred_execution() {
+                        Some(Execution::Pid(p)) => Execution::Pid(p),
+                        _ => Execution::Pid(PidOptions::default()),
+                    },
+                    other => return Err(msg(format!("exec must be ideal or pid, got {other:?}"))),
+                });
+            }
+            "seed" => {
+                let seed: u64 = v.extract()?;
+                match &mut s.planner {
+                    PlannerConfig::RandomBounce(o) => o.seed = seed,
+                    _ => return Err(not_applicable("seed", kind, "random-bounce")),
+                }
+            }
+            "options" => {
+                let Value::Object(o) = py_to_json(&v)? else {
+                    return Err(msg("options must be a dict of planner options"));
+                };
+                planner_opts.extend(o);
+            }
+            "name" => s.map.name = Some(v.extract()?),
+            _ => {
+                planner_opts.insert(key, py_to_json(&v)?);
+            }
+        }
+    }
+    // The robot first, as the command line does (same message).
+    s.robot.validate().map_err(|e| err(&e))?;
+    if !planner_opts.is_empty() {
+        let mut cfg = serde_json::to_value(&s.planner).map_err(|e| err(&e))?;
+        if let Some(Value::Object(o)) = cfg.get_mut("options") {
+            o.extend(planner_opts);
+        }
+        let section = kind.info().section;
+        s.planner = serde_json::from_value(cfg).map_err(|e| {
+            msg(format!(
+                "planner option {section}: {e} (or one of the run options {})",
+                RUN_KEYS.join(", ")
+            ))
+        })?;
+    }
+    Ok(s)
+}
+
+/// A finished run: metrics, path, swept and accessible masks, events; `save` writes the files
+/// of `ccpp run`.
+#[pyclass(module = "ccpp", frozen)]
+pub struct RunResult {
+    scenario: Scenario,
+    world: World,
+    output: RunOutput,
+    metrics: Metrics,
+}
+
+#[pymethods]
+impl RunResult {
+    /// The metrics (the keys of `metrics.json`).
+    #[getter]
+    fn metrics(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        to_py(py, &self.metrics)
+    }
+
+    /// The executed poses, `float64` `(N, 3)`: x, y (metres), theta (radians).
+    #[getter]
+    fn path<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let v: Vec<f64> = self
+            .output
+            .trace
+            .poses()
+            .flat_map(|p| [p.x, p.y, p.theta])
+            .collect();
+        let n = v.len() / 3;
+        Array2::from_shape_vec((n, 3), v)
+            .unwrap_or_else(|_| Array2::zeros((0, 3)))
+            .into_pyarray(py)
+    }
+
+    /// Pixels the tool swept, `bool` `(height, width)` in image layout (row 0 = top).
+    #[getter]
+    fn swept<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<bool>> {
+        let s = py.detach(|| metrics::swept_pixels(&self.world, &self.output.trace));
+        mask(py, self.world.frame(), &s)
+    }
+
+    /// Pixels the tool can reach from the start, `bool` `(height, width)` in image layout.
+    #[getter]
+    fn accessible<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<bool>> {
+        mask(py, self.world.frame(), self.world.accessible())
+    }
+
+    /// The trace's events, in order: dicts with the step counter `t`, the `event` kind and its
+    /// fields (as in `trace.jsonl`).
+    #[getter]
+    fn events(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        let ev: Vec<&Record> = self
+            .output
+            .trace
+            .records
+            .iter()
+            .filter(|r| matches!(r, Record::Event { .. }))
+            .collect();
+        to_py(py, &ev)
+    }
+
+    /// Why the run ended: `"done"` or `"max_steps"`.
+    #[getter]
+    fn stop(&self) -> &'static str {
+        match self.output.stop {
+            StopReason::Done => "done",
+            StopReason::MaxSteps => "max_steps",
+        }
+    }
+
+    /// The start pose used, `(x, y, theta)`.
+    #[getter]
+    fn start(&self) -> (f64, f64, f64) {
+        let s = self.world.start();
+        (s.x, s.y, s.theta)
+    }
+
+    /// The scenario that ran, as the `run.json` text (with the start used): `ccpp replay`
+    /// and `Scenario::run` reproduce the run from it.
+    #[getter]
+    fn scenario_json(&self) -> PyResult<String> {
+        let mut s = self.scenario.clone();
+        let st = self.world.start();
+        s.start = Some([st.x, st.y, st.theta]);
+        s.to_json().map_err(|e| err(&e))
+    }
+
+    /// Writes `run.json`, `path.csv`, `trace.jsonl`, `coverage.png` and `metrics.json` into
+    /// `folder` (created if needed), exactly as `ccpp run --out folder`.
+    fn save(&self, py: Python<'_>, folder: PathBuf) -> PyResult<()> {
+        py.detach(|| {
+            ccpp_render::run_files::write_run_files(
+                &folder,
+                &self.scenario,
+                &self.world,
+                &self.output.trace,
+                &self.metrics,
+            )
+        })
+        .map_err(|e| err(&e))?;
+        Ok(())
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "RunResult({} on {}: effective coverage {:.4}, path {:.2} m)",
+            self.metrics.planner,
+            self.metrics.map,
+            self.metrics.effective_coverage,
+            self.metrics.path_length_m
+        )
+    }
+}
+
+/// Runs `planner` on `map` with robot radius `radius`; the other keyword options are scenario
+/// fields (`tool_radius`, `start`, `sensor_range`, `exec`, `seed`, `max_steps`,
+/// `max_memory_mb`, `name`) or the planner's own options (`options={...}` or directly, e.g.
+/// `smoothing=False`). The GIL is released during the run.
+#[pyfunction]
+#[pyo3(signature = (map, planner="ba-star", radius=0.15, **options))]
+fn run(
+    py: Python<'_>,
+    map: &Bound<'_, PyAny>,
+    planner: &str,
+    radius: f64,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<RunResult> {
+    let prepared = as_map(py, map)?;
+    let scenario = scenario_from(&prepared, planner, radius, options)?;
+    let run = py
+        .detach(|| scenario.run_on(&prepared))
+        .map_err(|e| err(&e))?;
+    Ok(RunResult {
+        scenario,
+        world: run.world,
+        output: run.output,
+        metrics: run.metrics,
+    })
+}
+
+/// A `Map`, or a path loaded as one.
+fn as_map(py: Python<'_>, map: &Bound<'_, PyAny>) -> PyResult<PreparedMap> {
+    if let Ok(m) = map.cast::<Map>() {
+        return Ok(m.get().map.clone());
+    }
+    let p: PathBuf = map.extract().map_err(|_| {
+        msg("map must be a ccpp.Map (from ccpp.load_map) or the path of a map file")
+    })?;
+    let recipe = recipe_for(&p);
+    py.detach(|| recipe.load()).map_err(|e| err(&e))
+}
+
+/// One run of `ccpp bench` (default options, start and simulator settings): the metrics, or
+/// the error message the bench's `results.csv` records. With `out`, the run's files are
+/// written there.
+#[pyfunction]
+#[pyo3(signature = (map_path, planner, radius=0.15, tool_radius=None, inflate=None, max_memory_mb=None, out=None))]
+fn bench_run(
+    py: Python<'_>,
+    map_path: PathBuf,
+    planner: &str,
+    radius: f64,
+    tool_radius: Option<f64>,
+    inflate: Option<f64>,
+    max_memory_mb: Option<u64>,
+    out: Option<PathBuf>,
+) -> PyResult<(Option<Py<PyAny>>, Option<String>)> {
+    let kind = parse_kind(planner)?;
+    let robot = Robot {
+        radius,
+        tool_radius: tool_radius.unwrap_or(radius),
+    };
+    robot.validate().map_err(|e| err(&e))?;
+    let outcome: Result<Metrics, String> = py.detach(|| {
+        let mut recipe = recipe_for(&map_path);
+        recipe.inflate = inflate;
+        let map = recipe.load().map_err(|e| chain(&e))?;
+        let scenario = Scenario {
+            map: map.recipe.clone(),
+            robot,
+            start: None,
+            planner: PlannerConfig::new(kind),
+            sim: SimConfig::default(),
+            max_memory_mb: max_memory_mb.unwrap_or(DEFAULT_MAX_MEMORY_MB),
+        };
+        let run = scenario.run_on(&map).map_err(|e| chain(&e))?;
+        if let Some(dir) = &out {
+            ccpp_render::run_files::write_run_files(
+                dir,
+                &scenario,
+                &run.world,
+                &run.output.trace,
+                &run.metrics,
+            )
+            .map_err(|e| chain(&e))?;
+        }
+        Ok(run.metrics)
+    });
+    Ok(match outcome {
+        Ok(m) => (Some(to_py(py, &m)?), None),
+        Err(e) => (None, Some(e)),
+    })
+}
+
+/// The planners: a list of dicts with `name`, `offline` (reads the whole map up front),
+/// `description` and `options` (the defaults).
+#[pyfunction]
+fn planners(py: Python<'_>) -> PyResult<Py<PyAny>> {
+    let mut v = Vec::new();
+    for p in CATALOG {
+        let cfg = serde_json::to_value(PlannerConfig::new(p.kind)).map_err(|e| err(&e))?;
+        v.push(serde_json::json!({
+            "name": p.name,
+            "offline": p.offline,
+            "description": p.description,
+            "options": cfg.get("options").cloned().unwrap_or(Value::Null),
+        }));
+    }
+    json_to_py(py, &Value::Array(v))
+}
+
+// ---------------------------------------------------------------------------------------------
+// Step API
+// ---------------------------------------------------------------------------------------------
+
+/// What the simulator and the sweeper hold while an episode runs (they borrow the world).
+struct Live<'w> {
+    sim: Simulator<'w>,
+    sweeper: Sweeper<'w>,
+    known: KnownMap,
+    /// Known map in image layout: 0 free, 1 occupied, 2 unknown.
+    known_codes: Vec<u8>,
+    /// Trace records already swept.
+    records_seen: usize,
+    /// Last swept position.
+    last: Point,
+    /// Swept accessible pixels.
+    covered: usize,
+    steps: u64,
+    collisions: u32,
+}
+
+self_cell::self_cell!(
+    struct Episode {
+        owner: World,
+        #[covariant]
+        dependent: Live,
+    }
+);
+
+/// A step-by-step coverage environment on a map: the simulator's physics (collision checks,
+/// bumper, ideal or PID execution), its sensor (the pixels within `sensor_range`), and the
+/// metrics' swept-area stamping, one action at a time.
+#[pyclass(module = "ccpp")]
+pub struct Env {
+    map: PreparedMap,
+    robot: Robot,
+    sim: SimConfig,
+    start: Option<Pose>,
+    max_steps: Option<u64>,
+    episode: Option<Episode>,
+}
+
+/// `(observation, reward, terminated, truncated, info)` of [`Env::step`].
+type StepResult = (Py<PyDict>, f64, bool, bool, Py<PyDict>);
+
+/// The square scan window's half side in pixels.
+fn window_half(range: f64, res: f64) -> usize {
+    (range / res).ceil() as usize + 1
+}
+
+impl Env {
+    fn episode(&self) -> PyResult<&Episode> {
+        self.episode
+            .as_ref()
+            .ok_or_else(|| msg("call reset() before step()"))
+    }
+
+    fn observation(&self, py: Python<'_>) -> PyResult<Py<PyDict>> {
+        let ep = self.episode()?;
+        let world = ep.borrow_owner();
+        let live = ep.borrow_dependent();
+        let f = *world.frame();
+        let d = PyDict::new(py);
+        let p = live.sim.estimate();
+        d.set_item("pose", vec![p.x, p.y, p.theta].into_pyarray(py))?;
+        // Local scan: a square window of image pixels around the robot's pixel; pixels out
+        // of sensor range (or outside the image) read unknown (2).
+        let k = window_half(live.sim.sensor_range(), f.resolution);
+        let side = 2 * k + 1;
+        let mut win = Array2::from_elem((side, side), Cell::Unknown as u8);
+        let g = f.world_to_grid(live.sim.true_pose().position());
+        let (c0, r0) = f.grid_to_pixel_signed(g);
+        live.sim.scan().for_each(|col, row, cell| {
+            let i = row as i64 - r0 + k as i64;
+            let j = col as i64 - c0 + k as i64;
+            if (0..side as i64).contains(&i) && (0..side as i64).contains(&j) {
+                win[(i as usize, j as usize)] = cell as u8;
+            }
+        });
+        d.set_item("scan", win.into_pyarray(py))?;
+        let known = Array2::from_shape_vec((f.height, f.width), live.known_codes.clone())
+            .unwrap_or_else(|_| Array2::zeros((f.height, f.width)));
+        d.set_item("known", known.into_pyarray(py))?;
+        Ok(d.unbind())
+    }
+
+    fn info(&self, py: Python<'_>, collision: bool) -> PyResult<Py<PyDict>> {
+        let ep = self.episode()?;
+        let world = ep.borrow_owner();
+        let live = ep.borrow_dependent();
+        let d = PyDict::new(py);
+        let acc = world.accessible_count();
+        d.set_item(
+            "coverage",
+            if acc == 0 {
+                1.0
+            } else {
+                live.covered as f64 / acc as f64
+            },
+        )?;
+        d.set_item("collision", collision)?;
+        d.set_item("collisions", live.collisions)?;
+        d.set_item("steps", live.steps)?;
+        let t = live.sim.true_pose();
+        d.set_item("true_pose", (t.x, t.y, t.theta))?;
+        d.set_item("bumped", live.sim.bumped())?;
+        Ok(d.unbind())
+    }
+}
+
+/// Integrates the scan at the current pose into the known map.
+fn integrate_scan(live: &mut Live<'_>, frame: &MapFrame) {
+    let w = frame.width;
+    let Live {
+        sim,
+        known,
+        known_codes,
+        ..
+    } = live;
+    known.integrate_with(&sim.scan(), |col, row, cell| {
+        known_codes[row * w + col] = cell as u8;
+    });
+}
+
+/// Sweeps the poses recorded since the last call; returns whether a collision was recorded.
+fn sweep_new(live: &mut Live<'_>, world: &World) -> bool {
+    let mut collided = false;
+    let Live {
+        sim,
+        sweeper,
+        records_seen,
+        last,
+        ..
+    } = live;
+    let records = &sim.trace().records;
+    for r in &records[*records_seen..] {
+        match r {
+            Record::Pose { pose, .. } => {
+                let p = Point::new(pose[0], pose[1]);
+                if p != *last {
+                    sweeper.add(*last, p);
+                    *last = p;
+                }
+            }
+            Record::Event {
+                event: Event::Collision { .. },
+                ..
+            } => collided = true,
+            Record::Event { .. } => {}
+        }
+    }
+    *records_seen = records.len();
+    let mut s = sweeper.swept().clone();
+    s.intersect_with(world.accessible());
+    live.covered = s.count_ones(..);
+    if collided {
+        live.collisions += 1;
+    }
+    collided
+}
+
+fn parse_action(a: &Bound<'_, PyAny>) -> PyResult<Step> {
+    let bad = || {
+        msg(format!(
+            "action must be (\"rotate\", angle), (\"translate\", distance) or (\"move_to\", x, y), got {}",
+            a.repr().map_or_else(|_| "?".to_string(), |r| r.to_string())
+        ))
+    };
+    let items: Vec<Bound<'_, PyAny>> = a
+        .try_iter()
+        .map_err(|_| bad())?
+        .collect::<PyResult<_>>()
+        .map_err(|_| bad())?;
+    let Some(kind) = items.first().and_then(|k| k.extract::<String>().ok()) else {
+        return Err(bad());
+    };
+    let num = |i: usize| -> PyResult<f64> {
+        let v: f64 = items.get(i).ok_or_else(bad)?.extract().map_err(|_| bad())?;
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(msg(format!(
+                "action {kind}: values must be finite, got {v}"
+            )))
+        }
+    };
+    match (kind.as_str(), items.len()) {
+        ("rotate", 2) => Ok(Step::Rotate(num(1)?)),
+        ("translate", 2) => Ok(Step::Translate(num(1)?)),
+        ("move_to" | "move-to", 3) => Ok(Step::MoveTo(Point::new(num(1)?, num(2)?))),
+        _ => Err(bad()),
+    }
+}
+
+#[pymethods]
+impl Env {
+    /// A coverage environment on `map` (a `Map` or a map path) for a round robot of radius
+    /// `radius` (tool radius `tool_radius`, default the same) with a sensor of range
+    /// `sensor_range` metres (default 4 r). `exec` is `"ideal"` or `"pid"`; `start` a fixed
+    /// start pose (default: the widest free spot, as in runs); `max_steps` truncates episodes.
+    #[new]
+    #[pyo3(signature = (map, *, radius=0.15, tool_radius=None, sensor_range=None, start=None, exec="ideal", max_steps=None))]
+    fn new(
+        py: Python<'_>,
+        map: &Bound<'_, PyAny>,
+        radius: f64,
+        tool_radius: Option<f64>,
+        sensor_range: Option<f64>,
+        start: Option<Vec<f64>>,
+        exec: &str,
+        max_steps: Option<u64>,
+    ) -> PyResult<Self> {
+        let map = as_map(py, map)?;
+        // The scenario validates the robot, the sensor range and the execution.
+        let mut s = Scenario::new(map.recipe.clone(), PlannerKind::BaStar);
+        s.robot = Robot {
+            radius,
+            tool_radius: tool_radius.unwrap_or(radius),
+        };
+        s.sim.sensor_range = sensor_range;
+        s.sim.exec = Some(match exec.to_ascii_lowercase().as_str() {
+            "ideal" => Execution::Ideal,
+            "pid" => Execution::Pid(PidOptions::default()),
+            other => return Err(msg(format!("exec must be ideal or pid, got {other:?}"))),
+        });
+        s.start = match start.as_deref() {
+            None => None,
+            Some([x, y]) => Some([*x, *y, 0.0]),
+            Some([x, y, t]) => Some([*x, *y, *t]),
+            Some(p) => {
+                return Err(msg(format!(
+                    "start expects (x, y) or (x, y, theta), got {} values",
+                    p.len()
+                )))
+            }
+        };
+        s.validate().map_err(|e| err(&e))?;
+        Ok(Self {
+            map,
+            robot: s.robot,
+            sim: s.sim,
+            start: s.start.map(|p| Pose::new(p[0], p[1], p[2])),
+            max_steps,
+            episode: None,
+        })
+    }
+
+    /// Starts an episode and returns `(observation, info)`. Without `seed` the robot starts
+    /// at the configured start (or the widest free spot); with `seed` at a pose drawn from the
+    /// free, reachable positions (deterministic for a seed).
+    #[pyo3(signature = (seed=None))]
+    fn reset(&mut self, py: Python<'_>, seed: Option<u64>) -> PyResult<(Py<PyDict>, Py<PyDict>)> {
+        let grid = self.map.grid.clone();
+        let robot = self.robot;
+        let source = self.map.source.clone();
+        let fixed = self.start;
+        let sim_cfg = self.sim.clone();
+        let wrap = |e| ScenarioError::World {
+            path: source.clone(),
+            source: e,
+        };
+        let episode = py
+            .detach(|| -> Result<Episode, ScenarioError> {
+                let mut world = World::new(grid.clone(), robot, fixed).map_err(wrap)?;
+                if let Some(seed) = seed {
+                    let mut rng = SplitMix64::new(seed);
+                    let n = world.reachable().count_ones(..);
+                    let k = (rng.next_u64() % n.max(1) as u64) as usize;
+                    if let Some(i) = world.reachable().ones().nth(k) {
+                        let f = *world.frame();
+                        let (c, r) = f.col_row(i);
+                        let p = f.pixel_center(c, r);
+                        let theta = rng.range(-PI, PI);
+                        world = World::new(grid, robot, Some(Pose::new(p.x, p.y, theta)))
+                            .map_err(wrap)?;
+                    }
+                }
+                Ok(Episode::new(world, |w| {
+                    let f = *w.frame();
+                    let start = w.start().position();
+                    let mut sweeper = Sweeper::new(w);
+                    sweeper.add(start, start);
+                    let mut live = Live {
+                        sim: Simulator::new(w, &sim_cfg),
+                        sweeper,
+                        known: KnownMap::new(&f),
+                        known_codes: vec![Cell::Unknown as u8; f.len()],
+                        records_seen: 0,
+                        last: start,
+                        covered: 0,
+                        steps: 0,
+                        collisions: 0,
+                    };
+                    integrate_scan(&mut live, &f);
+                    sweep_new(&mut live, w);
+                    live
+                }))
+            })
+            .map_err(|e| err(&e))?;
+        self.episode = Some(episode);
+        Ok((self.observation(py)?, self.info(py, false)?))
+    }
+
+    /// Executes one action — `("rotate", angle_rad)`, `("translate", distance_m)` or
+    /// `("move_to", x, y)` — and returns `(observation, reward, terminated, truncated, info)`:
+    /// the reward is the newly swept accessible area in m²; the episode terminates on a
+    /// collision (the bumper) or when every accessible pixel is swept; it is truncated after
+    /// `max_steps` actions.
+    fn step(&mut self, py: Python<'_>, action: &Bound<'_, PyAny>) -> PyResult<StepResult> {
+        let step = parse_action(action)?;
+        let ep = self
+            .episode
+            .as_mut()
+            .ok_or_else(|| msg("call reset() before step()"))?;
+        let (gain, collided, done, steps) = ep.with_dependent_mut(|world, live| {
+            let before = live.covered;
+            live.sim.execute(step);
+            live.steps += 1;
+            let f = *world.frame();
+            integrate_scan(live, &f);
+            let collided = sweep_new(live, world);
+            let done = live.covered >= world.accessible_count();
+            (
+                (live.covered - before) as f64 * f.resolution * f.resolution,
+                collided,
+                done,
+                live.steps,
+            )
+        });
+        let truncated = self.max_steps.is_some_and(|m| steps >= m);
+        Ok((
+            self.observation(py)?,
+            gain,
+            collided || done,
+            truncated,
+            self.info(py, collided)?,
+        ))
+    }
+
+    /// The map.
+    #[getter]
+    fn map(&self) -> Map {
+        Map {
+            map: self.map.clone(),
+        }
+    }
+
+    /// The sensor range in force, metres.
+    #[getter]
+    fn sensor_range(&self) -> f64 {
+        self.sim.sensor_range_for(&self.robot)
+    }
+
+    /// The robot radius, metres.
+    #[getter]
+    fn radius(&self) -> f64 {
+        self.robot.radius
+    }
+
+    /// The tool radius, metres.
+    #[getter]
+    fn tool_radius(&self) -> f64 {
+        self.robot.tool_radius
+    }
+
+    /// Side of the square `scan` window of observations, pixels.
+    #[getter]
+    fn scan_side(&self) -> usize {
+        2 * window_half(self.sensor_range(), self.map.grid.frame().resolution) + 1
+    }
+
+    /// Swept pixels of the episode so far, `bool` `(height, width)` in image layout.
+    #[getter]
+    fn swept<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<bool>>> {
+        let ep = self.episode()?;
+        Ok(mask(
+            py,
+            ep.borrow_owner().frame(),
+            ep.borrow_dependent().sweeper.swept(),
+        ))
+    }
+
+    /// Pixel centres the robot centre can reach from the episode's start (C-free, connected),
+    /// `bool` `(height, width)` in image layout.
+    #[getter]
+    fn reachable<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<bool>>> {
+        let ep = self.episode()?;
+        let w = ep.borrow_owner();
+        Ok(mask(py, w.frame(), w.reachable()))
+    }
+
+    /// Pixels the tool can reach from the episode's start, `bool` `(height, width)`.
+    #[getter]
+    fn accessible<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<bool>>> {
+        let ep = self.episode()?;
+        let w = ep.borrow_owner();
+        Ok(mask(py, w.frame(), w.accessible()))
+    }
+
+    /// The metrics of the episode so far (as `ccpp run` computes them; planner `"env"`).
+    fn metrics(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        let ep = self.episode()?;
+        let world = ep.borrow_owner();
+        let trace: Trace = ep.borrow_dependent().sim.trace().clone();
+        let out = RunOutput {
+            trace,
+            stop: StopReason::MaxSteps,
+            tile_side: None,
+            planner: "env",
+            wall_time_s: 0.0,
+        };
+        let m = py.detach(|| metrics::compute(world, &out, &self.map.name));
+        to_py(py, &m)
+    }
+}
+
+/// The extension module.
+#[pymodule]
+fn _ccpp(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("CcppError", m.py().get_type::<CcppError>())?;
+    m.add_class::<Map>()?;
+    m.add_class::<RunResult>()?;
+    m.add_class::<Env>()?;
+    m.add_function(wrap_pyfunction!(load_map, m)?)?;
+    m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add_function(wrap_pyfunction!(bench_run, m)?)?;
+    m.add_function(wrap_pyfunction!(planners, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

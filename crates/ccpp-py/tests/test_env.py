@@ -1,0 +1,136 @@
+"""The step API: physics, sensing and sweeping of the simulator, one action at a time."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import ccpp
+
+
+def reachable_box(env: ccpp.Env) -> tuple[float, float, float, float]:
+    """World bounds of the reachable pixel centres (a rectangle in an empty room)."""
+    m = env.map
+    rows, cols = np.nonzero(env.reachable)
+    x0, y1 = m.pixel_center(int(cols.min()), int(rows.min()))
+    x1, y0 = m.pixel_center(int(cols.max()), int(rows.max()))
+    return x0, y0, x1, y1
+
+
+def test_boustrophedon_policy_reaches_full_coverage(room: Path) -> None:
+    env = ccpp.Env(ccpp.load_map(room), radius=0.15, sensor_range=0.6)
+    obs, info = env.reset()
+    assert set(obs) == {"pose", "scan", "known"}
+    assert obs["scan"].shape == (env.scan_side, env.scan_side) and obs["scan"].dtype == np.uint8
+    assert obs["known"].shape == (40, 60)
+    assert 0 < info["coverage"] < 1
+    x0, y0, x1, y1 = reachable_box(env)
+    res = env.map.resolution
+    spacing = 2 * env.tool_radius - 2 * res
+    lanes = max(1, math.ceil((y1 - y0) / spacing))
+    ys = [y0 + (y1 - y0) * k / lanes for k in range(lanes + 1)]
+    total = info["coverage"]
+    area = env.accessible.sum() * res * res
+    # The rim of the reachable rectangle, then lanes across it.
+    waypoints = [(x0, y0), (x1, y0), (x1, y1), (x0, y1), (x0, y0)]
+    for k, y in enumerate(ys):
+        waypoints += [(x0, y), (x1, y)] if k % 2 == 0 else [(x1, y), (x0, y)]
+    terminated = False
+    steps = 0
+    for x, y in waypoints:
+        obs, reward, terminated, truncated, info = env.step(("move_to", x, y))
+        steps += 1
+        assert reward >= 0 and not truncated
+        assert not info["collision"], info
+        total += reward / area
+        if terminated:
+            break
+    assert terminated and info["coverage"] == 1.0
+    assert total == pytest.approx(1.0)
+    assert env.swept[env.accessible].all()
+    # The known map is the truth where seen (scans are taken at the end of each action);
+    # the metrics agree with the episode.
+    known, occ = obs["known"], env.map.occupancy
+    seen = known != 2
+    assert seen.sum() > 0.5 * occ.size and np.array_equal(known[seen], occ[seen])
+    m = env.metrics()
+    assert m["effective_coverage"] == 1.0 and m["collisions"] == 0
+    assert info["steps"] == steps
+
+
+def test_driving_into_a_wall_is_a_collision(room: Path) -> None:
+    env = ccpp.Env(room, radius=0.15)
+    obs, _ = env.reset()
+    x, y, theta = obs["pose"]
+    assert theta == 0.0  # the default start heads east
+    # The scan window is the truth within range, centred on the robot's pixel.
+    scan, occ = obs["scan"], env.map.occupancy
+    k = env.scan_side // 2
+    (rows, cols) = np.nonzero(env.reachable)
+    m = env.map
+    col = int(round((x - m.origin[0]) / m.resolution - 0.5))
+    row = m.height - 1 - int(round((y - m.origin[1]) / m.resolution - 0.5))
+    window = occ[row - k : row + k + 1, col - k : col + k + 1]
+    in_range = scan != 2
+    assert in_range.sum() > 0 and np.array_equal(scan[in_range], window[in_range])
+    assert not in_range[0, 0] and in_range[k, k]
+    obs, reward, terminated, truncated, info = env.step(("translate", 10.0))
+    assert terminated and info["collision"] and info["collisions"] == 1 and info["bumped"]
+    assert reward > 0
+    # It stopped at the wall: the east wall's inner face is at x = 2.95 m.
+    assert obs["pose"][0] == pytest.approx(2.95 - 0.15, abs=0.05)
+    assert env.metrics()["collisions"] == 1
+    # Turning away and driving on is possible.
+    _, _, terminated, _, info = env.step(("rotate", math.pi))
+    assert not info["collision"]
+
+
+def test_reset_seed_and_actions(room: Path) -> None:
+    env = ccpp.Env(room, radius=0.15, max_steps=2)
+    a, _ = env.reset(seed=7)
+    b, _ = env.reset(seed=7)
+    c, _ = env.reset(seed=8)
+    assert np.array_equal(a["pose"], b["pose"]) and not np.array_equal(a["pose"], c["pose"])
+    env.reset()
+    _, _, _, truncated, _ = env.step(("rotate", 0.5))
+    assert not truncated
+    _, _, _, truncated, _ = env.step(("rotate", 0.5))
+    assert truncated
+    with pytest.raises(ccpp.CcppError, match="action must be"):
+        env.step(("jump", 1.0))
+    with pytest.raises(ccpp.CcppError, match="finite"):
+        env.step(("translate", float("nan")))
+    with pytest.raises(ccpp.CcppError, match="reset"):
+        ccpp.Env(room).step(("rotate", 1.0))
+    with pytest.raises(ccpp.CcppError, match="sensor"):
+        ccpp.Env(room, sensor_range=-1.0)
+    with pytest.raises(ccpp.CcppError, match="exec"):
+        ccpp.Env(room, exec="teleport")
+
+
+def test_pid_execution_is_available(room: Path) -> None:
+    env = ccpp.Env(room, radius=0.15, exec="pid")
+    env.reset()
+    _, reward, terminated, _, info = env.step(("translate", 0.5))
+    assert reward > 0 and not terminated
+    assert info["true_pose"][0] > 0.4
+
+
+def test_replaying_a_run_sweeps_what_the_run_swept(room: Path) -> None:
+    """Driving the Env along a planner's executed path gives the run's swept pixels."""
+    m = ccpp.load_map(room)
+    r = ccpp.run(m, "bsa", radius=0.15)
+    env = ccpp.Env(m, radius=0.15)
+    obs, _ = env.reset()
+    assert tuple(obs["pose"]) == r.start
+    prev = r.path[0, :2]
+    for x, y, _ in r.path[1:]:
+        if (x, y) != tuple(prev):
+            obs, _, terminated, _, info = env.step(("move_to", x, y))
+            assert not info["collision"]
+            prev = np.array([x, y])
+    assert np.array_equal(env.swept, r.swept)
+    assert info["coverage"] == pytest.approx(r.metrics["effective_coverage"], abs=1e-12)

@@ -1,0 +1,36 @@
+"""The Gymnasium wrapper."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+gymnasium = pytest.importorskip("gymnasium")
+
+from gymnasium.utils.env_checker import check_env  # noqa: E402
+
+from ccpp.gym import CoverageEnv  # noqa: E402
+
+
+def test_check_env(room: Path) -> None:
+    env = CoverageEnv(str(room), radius=0.15, max_steps=50)
+    check_env(env, skip_render_check=True)
+
+
+def test_episode(room: Path) -> None:
+    env = CoverageEnv(str(room), radius=0.15, max_steps=40, render_mode="rgb_array")
+    obs, info = env.reset(seed=3)
+    assert env.observation_space.contains(obs)
+    total = 0.0
+    done = False
+    steps = 0
+    while not done:
+        # Forward until bumping is avoided by turning left every 4 steps.
+        obs, reward, terminated, truncated, info = env.step(0 if steps % 4 else 1)
+        total += reward
+        steps += 1
+        done = terminated or truncated
+    assert total > 0 and 0 < info["coverage"] <= 1
+    img = env.render()
+    assert img is not None and img.shape == (40, 60, 3)

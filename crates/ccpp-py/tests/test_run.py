@@ -1,0 +1,141 @@
+"""ccpp.run / load_map / save against the command line."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import ccpp
+from conftest import COMPARE_MAPS
+
+PLANNERS = [p["name"] for p in ccpp.planners()]
+
+
+def cli(binary: str, *args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([binary, *args], capture_output=True, text=True, check=False)
+
+
+def without_time(m: dict) -> dict:
+    return {k: v for k, v in m.items() if k != "wall_time_s"}
+
+
+def test_planners_lists_the_catalogue() -> None:
+    names = [p["name"] for p in ccpp.planners()]
+    assert "ba-star" in names and "bcd" in names and len(names) == len(set(names))
+    ba = next(p for p in ccpp.planners() if p["name"] == "ba-star")
+    assert ba["offline"] is False and "smoothing" in ba["options"]
+
+
+@pytest.mark.parametrize("map_name", COMPARE_MAPS)
+@pytest.mark.parametrize("planner", PLANNERS)
+def test_run_equals_cli(shared_maps: Path, ccpp_bin: str, tmp_path: Path, map_name: str, planner: str) -> None:
+    path = shared_maps / f"{map_name}.yaml"
+    out = tmp_path / "cli"
+    p = cli(ccpp_bin, "run", "--map", str(path), "--planner", planner, "--out", str(out), "--json")
+    assert p.returncode == 0, p.stderr
+    expected = json.loads(p.stdout)
+    r = ccpp.run(ccpp.load_map(path), planner=planner)
+    assert without_time(r.metrics) == without_time(expected)
+    # The same files as the CLI.
+    py_out = tmp_path / "py"
+    r.save(py_out)
+    for name in ("path.csv", "trace.jsonl", "run.json"):
+        assert (py_out / name).read_bytes() == (out / name).read_bytes(), name
+    assert without_time(json.loads((py_out / "metrics.json").read_text())) == without_time(expected)
+    assert (py_out / "coverage.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    # Arrays agree with the metrics.
+    m = r.metrics
+    assert r.path.shape[1] == 3 and r.path.shape[0] >= 1
+    seg = np.diff(r.path[:, :2], axis=0)
+    assert np.hypot(seg[:, 0], seg[:, 1]).sum() == pytest.approx(m["path_length_m"], rel=1e-9, abs=1e-9)
+    acc = r.accessible
+    assert acc.dtype == bool and acc.shape == (r_height(path), r_width(path))
+    eff = (r.swept & acc).sum() / acc.sum()
+    assert eff == pytest.approx(m["effective_coverage"], abs=1e-12)
+    assert sum(1 for e in r.events if e["event"] == "collision") == m["collisions"]
+
+
+def r_width(path: Path) -> int:
+    return ccpp.load_map(path).width
+
+
+def r_height(path: Path) -> int:
+    return ccpp.load_map(path).height
+
+
+def test_map_properties(room: Path) -> None:
+    m = ccpp.load_map(room)
+    assert (m.width, m.height) == (60, 40) and m.size == (60, 40)
+    assert m.resolution == 0.05 and m.origin == (0.0, 0.0, 0.0)
+    assert m.size_m == pytest.approx((3.0, 2.0))
+    occ = m.occupancy
+    assert occ.shape == (40, 60) and occ.dtype == np.uint8
+    assert occ[0].tolist() == [1] * 60 and occ[20, 30] == 0
+    # Overrides go through the loader.
+    assert ccpp.load_map(room, resolution=0.1).size_m == pytest.approx((6.0, 4.0))
+    assert ccpp.load_map(room, inflate=0.1).occupancy.sum() > occ.sum()
+    assert ccpp.load_map(room, name="box").name == "box"
+
+
+def test_options_change_the_run_as_the_cli_flags(shared_maps: Path, ccpp_bin: str, tmp_path: Path) -> None:
+    path = shared_maps / "teb_maze.yaml"
+    m = ccpp.load_map(path)
+    base = ccpp.run(m, "ba-star")
+    off = ccpp.run(m, "ba-star", smoothing=False)
+    assert off.metrics != base.metrics
+    p = cli(ccpp_bin, "run", "--map", str(path), "--planner", "ba-star", "--smoothing", "off",
+            "--out", str(tmp_path), "--json")
+    assert without_time(off.metrics) == without_time(json.loads(p.stdout))
+    # The same through options={...}.
+    assert without_time(ccpp.run(m, "ba-star", options={"smoothing": False}).metrics) == without_time(off.metrics)
+    r2 = ccpp.run(m, "bsa", radius=0.2, tool_radius=0.15)
+    assert r2.metrics["robot_radius_m"] == 0.2 and r2.metrics["tool_radius_m"] == 0.15
+    # A random-bounce seed changes the path.
+    a = ccpp.run(m, "random-bounce", seed=1)
+    b = ccpp.run(m, "random-bounce", seed=2)
+    assert a.metrics["path_length_m"] != b.metrics["path_length_m"] or not np.array_equal(a.path, b.path)
+
+
+def test_errors_are_the_cli_messages(ccpp_bin: str, tmp_path: Path, room: Path) -> None:
+    missing = tmp_path / "nope.yaml"
+    p = cli(ccpp_bin, "run", "--map", str(missing), "--planner", "ba-star", "--out", str(tmp_path / "o"))
+    assert p.returncode == 1
+    line = p.stderr.strip()
+    assert line.startswith("error: ") and "\n" not in line
+    with pytest.raises(ccpp.CcppError) as e:
+        ccpp.load_map(missing)
+    assert str(e.value) == line.removeprefix("error: ")
+    # A robot too big for the room.
+    p = cli(ccpp_bin, "run", "--map", str(room), "--planner", "ba-star", "--radius", "5", "--out", str(tmp_path / "o"))
+    with pytest.raises(ccpp.CcppError) as e:
+        ccpp.run(ccpp.load_map(room), radius=5.0)
+    assert str(e.value) == p.stderr.strip().removeprefix("error: ")
+    # Invalid values are refused by the scenario, with the CLI's wording.
+    p = cli(ccpp_bin, "run", "--map", str(room), "--planner", "ba-star", "--radius=-1", "--out", str(tmp_path / "o"))
+    with pytest.raises(ccpp.CcppError) as e:
+        ccpp.run(room, radius=-1.0)
+    assert str(e.value) in p.stderr
+    with pytest.raises(ccpp.CcppError, match="unknown planner"):
+        ccpp.run(room, planner="nope")
+    with pytest.raises(ccpp.CcppError, match="unknown field"):
+        ccpp.run(room, planner="ba-star", nonsense=1)
+    with pytest.raises(ccpp.CcppError, match="sensor_range does not apply to bcd"):
+        ccpp.run(room, planner="bcd", sensor_range=1.0)
+    with pytest.raises(ccpp.CcppError, match="seed does not apply to ba-star"):
+        ccpp.run(room, planner="ba-star", seed=3)
+    with pytest.raises(ccpp.CcppError, match="side"):
+        ccpp.run(room, planner="ba-star", side="left")  # a bsa option given to ba-star
+
+
+def test_runs_release_the_gil(room: Path) -> None:
+    """Two runs in threads finish and agree (the GIL is released inside)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    m = ccpp.load_map(room)
+    with ThreadPoolExecutor(2) as ex:
+        rs = list(ex.map(lambda _: ccpp.run(m, "bsa").metrics, range(2)))
+    assert without_time(rs[0]) == without_time(rs[1])

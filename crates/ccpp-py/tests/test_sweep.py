@@ -1,0 +1,73 @@
+"""ccpp.sweep on a local two-worker Dask cluster against `ccpp bench`."""
+
+from __future__ import annotations
+
+import subprocess
+from pathlib import Path
+
+import pytest
+
+pd = pytest.importorskip("pandas")
+distributed = pytest.importorskip("distributed")
+
+import ccpp  # noqa: E402
+from conftest import COMPARE_MAPS  # noqa: E402
+
+# Columns that differ between any two runs (timing) or by design (output folder).
+VOLATILE = ["wall_time_s", "dir"]
+
+
+@pytest.fixture(scope="module")
+def client():
+    cluster = distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+    )
+    c = distributed.Client(cluster)
+    yield c
+    c.close()
+    cluster.close()
+
+
+def test_sweep_equals_bench(shared_maps: Path, ccpp_bin: str, tmp_path: Path, client) -> None:
+    maps = [str(shared_maps / f"{m}.yaml") for m in COMPARE_MAPS[:2]]
+    planners = [p["name"] for p in ccpp.planners()]
+    bench_out = tmp_path / "bench"
+    p = subprocess.run(
+        [ccpp_bin, "bench", "--maps", *maps, "--planners", ",".join(planners),
+         "--out", str(bench_out), "--quiet", "--jobs", "2"],
+        capture_output=True, text=True, check=False,
+    )
+    assert p.returncode == 0, p.stderr
+    expected = pd.read_csv(
+        bench_out / "results.csv", keep_default_na=False, na_values=[""], float_precision="round_trip"
+    )
+    sweep_out = tmp_path / "sweep"
+    got = ccpp.sweep(maps, planners, [0.15], client=client, out=sweep_out)
+    assert list(got.columns) == ccpp.CSV_COLUMNS == list(expected.columns)
+    assert len(got) == len(expected) == len(maps) * len(planners)
+    # The workers really ran in two processes.
+    assert len(client.scheduler_info()["workers"]) == 2
+    a = expected.drop(columns=VOLATILE).reset_index(drop=True)
+    b = got.drop(columns=VOLATILE).reset_index(drop=True)
+    b = b.astype(a.dtypes.to_dict())
+    pd.testing.assert_frame_equal(a, b, check_exact=True)
+    # The run folders hold the bench's files.
+    for row in got.itertuples():
+        assert (Path(row.dir) / "metrics.json").is_file()
+        rel = Path(row.dir).relative_to(sweep_out)
+        assert (bench_out / rel / "trace.jsonl").read_bytes() == (Path(row.dir) / "trace.jsonl").read_bytes()
+
+
+def test_sweep_radii_and_errors(room: Path, tmp_path: Path, client) -> None:
+    bad = tmp_path / "missing.yaml"
+    df = ccpp.sweep([str(room), str(bad)], ["bsa", "bcd"], [0.15, 0.2], client=client)
+    assert list(df.columns) == ccpp.CSV_COLUMNS[:2] + ["radius"] + ccpp.CSV_COLUMNS[2:]
+    assert len(df) == 2 * 2 * 2
+    ok = df[df["map"] == "room"]
+    assert (ok["status"] == "ok").all()
+    assert sorted(ok["robot_radius_m"].unique().tolist()) == [0.15, 0.2]
+    err = df[df["map"] == "missing"]
+    assert (err["status"] == "error").all() and err["error"].str.contains("missing.yaml").all()
+    assert err["effective_coverage"].isna().all()
+    with pytest.raises(ccpp.CcppError, match="unknown planner"):
+        ccpp.sweep([str(room)], ["nope"], client=client)

@@ -1,0 +1,135 @@
+//! The files of a finished run — `run.json`, `path.csv`, `trace.jsonl`, `coverage.png`,
+//! `metrics.json` — written the same way by the command line (`ccpp run`, `ccpp bench`) and the
+//! Python package (`Result.save`).
+
+use std::path::Path;
+
+use ccpp_core::metrics::Metrics;
+use ccpp_core::trace::Trace;
+use ccpp_core::world::World;
+use ccpp_io::scenario::Scenario;
+use ccpp_io::write::WriteError;
+use ccpp_io::write_atomic;
+
+use crate::{coverage_png, CoverageStyle, RenderError};
+
+/// Failure writing a run's files.
+#[derive(Debug, thiserror::Error)]
+pub enum RunFilesError {
+    /// Serializing the metrics, scenario or trace failed.
+    #[error("cannot serialize the run: {0}")]
+    Json(#[from] serde_json::Error),
+    /// The coverage picture failed.
+    #[error(transparent)]
+    Render(#[from] RenderError),
+    /// The output folder cannot be created.
+    #[error("cannot create output folder {}: {source}", path.display())]
+    Folder {
+        /// The folder.
+        path: std::path::PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// A file cannot be written.
+    #[error(transparent)]
+    Write(#[from] WriteError),
+}
+
+/// The metrics as pretty JSON (`metrics.json`).
+///
+/// # Errors
+/// Serialization failure.
+pub fn metrics_json(m: &Metrics) -> Result<String, serde_json::Error> {
+    let mut s = serde_json::to_string_pretty(m)?;
+    s.push('\n');
+    Ok(s)
+}
+
+/// Title lines of the coverage picture.
+pub fn title_lines(m: &Metrics) -> Vec<String> {
+    let cov = m
+        .coverage_rate
+        .map_or_else(|| "-".to_string(), |c| format!("{:.1}%", 100.0 * c));
+    vec![
+        format!(
+            "{} on {}  r={} m  tool={} m",
+            m.planner, m.map, m.robot_radius_m, m.tool_radius_m
+        ),
+        format!(
+            "effective coverage {:.1}%  tiles {}  path {:.1} m  ratio {:.2}",
+            100.0 * m.effective_coverage,
+            cov,
+            m.path_length_m,
+            m.path_ratio,
+        ),
+        format!(
+            "regions {}  revisits {:.2}  turns {}  collisions {}",
+            m.regions, m.revisit_rate, m.turns, m.collisions
+        ),
+    ]
+}
+
+/// Renders a run's standard files in memory, in writing order: `run.json`, `path.csv`,
+/// `trace.jsonl`, `coverage.png`, `metrics.json` (last: its presence marks a complete run).
+/// `run.json` is `scenario` with the start actually used (the world's), so that
+/// [`Scenario::run`] on it reproduces the run. The command line adds its replay files before
+/// `metrics.json` and writes the set through a staging folder; [`write_run_files`] writes it
+/// directly.
+///
+/// # Errors
+/// Serialization or rendering failures.
+pub fn render_run_files(
+    scenario: &Scenario,
+    world: &World,
+    trace: &Trace,
+    metrics: &Metrics,
+) -> Result<Vec<(&'static str, Vec<u8>)>, RunFilesError> {
+    let metrics_text = metrics_json(metrics)?;
+    let mut scenario = scenario.clone();
+    let start = world.start();
+    scenario.start = Some([start.x, start.y, start.theta]);
+    let run_json = scenario.to_json()?;
+    let trace_text = ccpp_io::trace::trace_jsonl(trace)?;
+    let path = ccpp_io::trace::path_csv(trace);
+    let style = CoverageStyle {
+        title: title_lines(metrics),
+        ..CoverageStyle::default()
+    };
+    let png = coverage_png(world, trace, &style)?;
+    Ok(vec![
+        ("run.json", run_json.into_bytes()),
+        ("path.csv", path.into_bytes()),
+        ("trace.jsonl", trace_text.into_bytes()),
+        ("coverage.png", png),
+        ("metrics.json", metrics_text.into_bytes()),
+    ])
+}
+
+/// Renders everything first ([`render_run_files`]), then writes each file atomically into
+/// `out`, so a failure leaves no partial file; `metrics.json` is written last. Returns the
+/// metrics JSON.
+///
+/// # Errors
+/// Serialization, rendering or writing failures.
+pub fn write_run_files(
+    out: &Path,
+    scenario: &Scenario,
+    world: &World,
+    trace: &Trace,
+    metrics: &Metrics,
+) -> Result<String, RunFilesError> {
+    let files = render_run_files(scenario, world, trace, metrics)?;
+    std::fs::create_dir_all(out).map_err(|source| RunFilesError::Folder {
+        path: out.to_path_buf(),
+        source,
+    })?;
+    for (name, bytes) in &files {
+        write_atomic(&out.join(name), bytes)?;
+    }
+    let metrics_text = files
+        .into_iter()
+        .find(|(n, _)| *n == "metrics.json")
+        .map(|(_, b)| String::from_utf8_lossy(&b).into_owned())
+        .unwrap_or_default();
+    Ok(metrics_text)
+}
