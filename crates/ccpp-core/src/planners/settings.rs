@@ -389,7 +389,9 @@ impl PlannerSettings for BaStarOptions {
 
 impl PlannerSettings for BaStarExtendedOptions {
     fn validate(&self) -> Result<(), OptionsError> {
-        self.ba_star.validate().map_err(|e| e.in_section("ba_star"))?;
+        self.ba_star
+            .validate()
+            .map_err(|e| e.in_section("ba_star"))?;
         finite_nonneg("extension.reach_r", self.extension.reach_r)
     }
 
