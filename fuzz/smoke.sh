@@ -3,13 +3,18 @@
 # no nightly) and runs each one for a short while from its committed corpus. Exits non-zero
 # on the first crash, panic or timeout; the failing input is left in fuzz/artifacts/.
 #
-#   bash fuzz/smoke.sh              # every target, FUZZ_SECS (default 10) seconds each
-#   FUZZ_SECS=600 bash fuzz/smoke.sh config replay
+#   bash fuzz/smoke.sh              # every target, FUZZ_RUNS (default 50000) runs each
+#   FUZZ_RUNS=1000000 FUZZ_SECS=3600 bash fuzz/smoke.sh config replay
 #
+# The mutations are seeded (FUZZ_SEED, default 1) and counted in runs, so CI explores the same
+# inputs every time: a red CI means a real regression, not a lucky draw. FUZZ_SECS (default 30)
+# caps each target's time. Long campaigns: pick another seed and more runs.
 # New inputs found go to a temporary folder, so the committed corpus is not changed.
 set -euo pipefail
 cd "$(dirname "$0")"
-SECS="${FUZZ_SECS:-10}"
+SECS="${FUZZ_SECS:-30}"
+RUNS="${FUZZ_RUNS:-50000}"
+SEED="${FUZZ_SEED:-1}"
 TARGETS=("$@")
 if [ ${#TARGETS[@]} -eq 0 ]; then
   TARGETS=(map_yaml map_image config georef landmarks replay)
@@ -27,8 +32,8 @@ work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 for t in "${TARGETS[@]}"; do
   mkdir -p "$work/$t"
-  echo "== fuzz $t for ${SECS}s"
-  if ! "target/$HOST/release/$t" -max_total_time="$SECS" -timeout=10 -rss_limit_mb=2048 \
+  echo "== fuzz $t: ${RUNS} runs, seed ${SEED}, at most ${SECS}s"
+  if ! "target/$HOST/release/$t" -seed="$SEED" -runs="$RUNS" -max_total_time="$SECS" -timeout=10 -rss_limit_mb=2048 \
     -max_len=8192 -print_final_stats=1 -artifact_prefix="artifacts/$t-" \
     "$work/$t" "corpus/$t" >"$work/$t.log" 2>&1; then
     tail -n 40 "$work/$t.log"

@@ -107,6 +107,10 @@ pub enum GeorefError {
     /// The fitted linear part is singular (cannot invert).
     #[error("the affine transform is singular and has no inverse")]
     Singular,
+    /// The coordinates are so large that the fit overflows (found by fuzzing: a pixel
+    /// coordinate of 1e177 squared is infinite and the fit came out NaN).
+    #[error("the point coordinates are too large for a fit (the sums overflow)")]
+    Overflow,
 }
 
 /// Fits `world = A pixel + b` to `pairs` of `(pixel, world)` points by least squares.
@@ -146,6 +150,9 @@ pub fn fit_affine(pairs: &[(Point, Point)]) -> Result<AffineFit, GeorefError> {
         ryy += dw.y * dp.y;
     }
     let det = sxx * syy - sxy * sxy;
+    if ![det, sxx, syy, rxx, rxy, ryx, ryy].iter().all(|v| v.is_finite()) {
+        return Err(GeorefError::Overflow);
+    }
     let spread = (sxx + syy).max(f64::MIN_POSITIVE);
     if det <= 1e-12 * spread * spread {
         return Err(GeorefError::Collinear);
@@ -161,6 +168,9 @@ pub fn fit_affine(pairs: &[(Point, Point)]) -> Result<AffineFit, GeorefError> {
         wc.x - (m[0] * pc.x + m[1] * pc.y),
         wc.y - (m[2] * pc.x + m[3] * pc.y),
     ];
+    if !m.iter().chain(&t).all(|v| v.is_finite()) {
+        return Err(GeorefError::Overflow);
+    }
     let affine = Affine { m, t };
     let residuals: Vec<f64> = pairs
         .iter()
@@ -180,6 +190,16 @@ pub fn fit_affine(pairs: &[(Point, Point)]) -> Result<AffineFit, GeorefError> {
 mod tests {
     use super::*;
     use crate::rng::SplitMix64;
+
+    #[test]
+    fn huge_coordinates_are_refused_not_fitted_to_nan() {
+        let pairs = [
+            (Point::new(0.0, 1.1e177), Point::new(1.0, 0.0)),
+            (Point::new(0.0, 0.0), Point::new(1.0, 0.0)),
+            (Point::new(10.0, 0.0), Point::new(-1.7, 0.0)),
+        ];
+        assert_eq!(fit_affine(&pairs).err(), Some(GeorefError::Overflow));
+    }
 
     #[test]
     fn exact_fit_and_inverse() {
