@@ -150,7 +150,10 @@ pub fn fit_affine(pairs: &[(Point, Point)]) -> Result<AffineFit, GeorefError> {
         ryy += dw.y * dp.y;
     }
     let det = sxx * syy - sxy * sxy;
-    if ![det, sxx, syy, rxx, rxy, ryx, ryy].iter().all(|v| v.is_finite()) {
+    if ![det, sxx, syy, rxx, rxy, ryx, ryy]
+        .iter()
+        .all(|v| v.is_finite())
+    {
         return Err(GeorefError::Overflow);
     }
     let spread = (sxx + syy).max(f64::MIN_POSITIVE);

@@ -12,8 +12,7 @@ use crate::tiles::{reachable_tiles, Tile, TileGrid, TileSet};
 use crate::trace::{Event, Record, Trace};
 use crate::world::World;
 
-/// Tolerance in pixels when deciding whether a pixel centre is within `r_tool` of the path.
-pub const SWEEP_EPS_PX: f64 = 1e-6;
+pub use crate::raster::SWEEP_EPS_PX;
 
 /// The metrics of one run (serialized with exactly these keys).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

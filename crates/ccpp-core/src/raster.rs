@@ -7,6 +7,10 @@ use fixedbitset::FixedBitSet;
 
 use crate::geometry::{ceil_i64, floor_i64, point_segment_dist2, Point};
 
+/// Tolerance in pixels when deciding whether a pixel centre is within `r_tool` of the path
+/// (the metrics and the planners that track their swept pixels use the same).
+pub const SWEEP_EPS_PX: f64 = 1e-6;
+
 /// Marks pixel centres within `rt` (pixels) of segment `a`-`b` (grid coordinates), row by row,
 /// calling `on_new(index)` for each pixel not marked before.
 ///

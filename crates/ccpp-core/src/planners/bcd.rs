@@ -920,15 +920,15 @@ fn rim_contours(
 ) -> Vec<(Vec<Point>, usize)> {
     let frame = ctx.frame;
     let (w, h) = (frame.width, frame.height);
-    let rt = ctx.rt + crate::metrics::SWEEP_EPS_PX;
+    let rt = ctx.rt + crate::raster::SWEEP_EPS_PX;
     let mut swept = FixedBitSet::with_capacity(frame.len());
     for line in lines {
         if let Some(&p) = line.first() {
-            crate::metrics::stamp_capsule(&mut swept, &frame, p, p, rt, &mut |_| {});
+            crate::raster::stamp_capsule(&mut swept, &frame, p, p, rt, &mut |_| {});
         }
         for s in line.windows(2) {
             if s[0] != s[1] {
-                crate::metrics::stamp_capsule(&mut swept, &frame, s[0], s[1], rt, &mut |_| {});
+                crate::raster::stamp_capsule(&mut swept, &frame, s[0], s[1], rt, &mut |_| {});
             }
         }
     }

@@ -13,7 +13,7 @@
 //! # What is swept, what is left (the targets)
 //!
 //! The component keeps its own estimate of the swept pixels: every executed straight motion is
-//! stamped with the tool radius (the metric's predicate, [`crate::metrics::SWEEP_EPS_PX`]
+//! stamped with the tool radius (the metric's predicate, [`crate::raster::SWEEP_EPS_PX`]
 //! included). A **target** is a pixel the sensor has shown free, not swept yet, and not one the
 //! host will still sweep. Positions are the pixel centres where the robot disk fits on the known
 //! map (`S0`: contact radius, clearance 0, unseen pixels block — `KnownMap::disk_state_px`);
@@ -196,7 +196,7 @@ impl Extension {
     pub(crate) fn new(opts: ExtensionOptions, frame: MapFrame, r: f64, tool: f64) -> Self {
         let n = frame.len();
         let r_px = r / frame.resolution;
-        let rt = tool / frame.resolution + crate::metrics::SWEEP_EPS_PX;
+        let rt = tool / frame.resolution + crate::raster::SWEEP_EPS_PX;
         let reach = rt.ceil() as i64;
         let mut off = Vec::new();
         for dr in -reach..=reach {
@@ -248,7 +248,7 @@ impl Extension {
     /// Records an executed straight motion (world points) as swept.
     pub(crate) fn record(&mut self, a: Point, b: Point) {
         let f = self.frame;
-        crate::metrics::stamp_capsule(
+        crate::raster::stamp_capsule(
             &mut self.swept,
             &f,
             f.world_to_grid(a),
