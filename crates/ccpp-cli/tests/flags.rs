@@ -116,9 +116,10 @@ fn run_fails(dir: &Path, map: &Path, planner: &str, args: &[&str], needles: &[&s
     assert!(!out.join("metrics.json").exists());
 }
 
-const ALL: [&str; 7] = [
+const ALL: [&str; 8] = [
     "random-bounce",
     "ba-star",
+    "ba-star-extended",
     "bsa",
     "bsa-extended",
     "bsa-bfs",
@@ -157,10 +158,16 @@ fn planner_flags_apply_where_they_should() {
         dir,
         m,
         &["--tile-side", "0.45"],
-        &["ba-star", "bsa-bfs"],
+        &["ba-star", "ba-star-extended", "bsa-bfs"],
         &[],
     );
-    flag_applies(dir, m, &["--smoothing", "off"], &["ba-star"], &[]);
+    flag_applies(
+        dir,
+        m,
+        &["--smoothing", "off"],
+        &["ba-star", "ba-star-extended"],
+        &[],
+    );
     flag_applies(dir, m, &["--side", "right"], &["bsa", "bsa-extended"], &[]);
     flag_applies(dir, m, &["--length", "0.5"], &["rect-boustrophedon"], &[]);
     flag_applies(dir, m, &["--width", "0.5"], &["rect-boustrophedon"], &[]);
@@ -178,7 +185,14 @@ fn planner_flags_apply_where_they_should() {
         dir,
         m,
         &["--sensor-range", "0.45"],
-        &["random-bounce", "ba-star", "bsa", "bsa-extended", "bsa-bfs"],
+        &[
+            "random-bounce",
+            "ba-star",
+            "ba-star-extended",
+            "bsa",
+            "bsa-extended",
+            "bsa-bfs",
+        ],
         &[],
     );
 }
