@@ -203,9 +203,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         a.planners.clone()
     };
     for p in &planners {
-        if !planners::CATALOG.iter().any(|c| c.name == p) {
-            bail!("unknown planner {p:?}; run `ccpp planners` for the list");
-        }
+        parse_planner(p)?;
     }
     let (robot, _) = robot_from(&(&a.robot).into())?;
     let options = planner_options(a.config.as_deref(), a.seed)?;
