@@ -3,7 +3,7 @@
 //! The I/O-free heart of **ccpp**, a complete coverage path planning toolkit for mobile robots on
 //! 2-D occupancy grids: grids and frames ([`grid`]), geometry ([`geometry`], [`collide`]), the
 //! distance transform ([`dt`]), synthetic maps ([`gen`]), the ground truth ([`world`]), the online step protocol
-//! ([`planner`]), the simulator ([`sim`]), the trace ([`trace`]), tiles ([`tiles`]), the metrics
+//! ([`planner`]), the deterministic graph searches ([`search`]), the simulator ([`sim`]), the trace ([`trace`]), tiles ([`tiles`]), the metrics
 //! ([`metrics`]) and the planners ([`planners`]); motion execution by PID tracking on a
 //! unicycle ([`exec`]), pose correction from non-unique landmarks ([`landmarks`]) and the
 //! least-squares affine pixel <-> world fit ([`georef`]).
@@ -26,6 +26,7 @@ pub mod planner;
 pub mod planners;
 pub mod raster;
 pub mod rng;
+pub mod search;
 pub mod sim;
 pub mod tiles;
 pub mod trace;

@@ -70,6 +70,7 @@ use serde::{Deserialize, Serialize};
 use super::bsa_extended::{BsaExtendedOptions, Extension};
 use crate::geometry::Point;
 use crate::planner::{KnownMap, Planner, Sensor, Step};
+use crate::search::SearchSpace;
 use crate::tiles::{Tile, TileGrid};
 use crate::trace::Event;
 
@@ -149,11 +150,8 @@ pub(crate) struct Cells {
     edges: Vec<u8>,
     /// Extended BSA: bit `d` set once the obstacle trigger was evaluated towards heading `d`.
     checked: Vec<u8>,
-    /// Search scratch: generation stamp, cost and parent per cell.
-    stamp: Vec<u32>,
-    cost: Vec<u32>,
-    parent: Vec<u32>,
-    generation: u32,
+    /// Search scratch: cost and parent per cell, reused across searches.
+    search: SearchSpace<u32>,
 }
 
 impl Cells {
@@ -169,10 +167,7 @@ impl Cells {
             flags: vec![0; n],
             edges: vec![0; n],
             checked: vec![0; n],
-            stamp: vec![0; n],
-            cost: vec![0; n],
-            parent: vec![0; n],
-            generation: 0,
+            search: SearchSpace::new(n),
         }
     }
 
@@ -276,35 +271,25 @@ impl Cells {
 
     /// Starts a new search: every cell's scratch becomes stale.
     pub(crate) fn new_search(&mut self) {
-        self.generation = self.generation.wrapping_add(1);
-        if self.generation == 0 {
-            self.stamp.iter_mut().for_each(|s| *s = 0);
-            self.generation = 1;
-        }
+        self.search.begin();
     }
 
     /// Search cost of cell `k` in the current search (`None` when unreached).
     #[inline]
     pub(crate) fn cost_of(&self, k: usize) -> Option<u32> {
-        (self.stamp[k] == self.generation).then(|| self.cost[k])
+        self.search.dist(k as u32)
     }
 
     #[inline]
     pub(crate) fn reach(&mut self, k: usize, cost: u32, parent: usize) {
-        self.stamp[k] = self.generation;
-        self.cost[k] = cost;
-        self.parent[k] = parent as u32;
+        self.search
+            .assign(k as u32, cost, (parent != k).then_some(parent as u32));
     }
 
     /// Path from the search root to `k` (cells, root first).
-    pub(crate) fn path_to(&self, mut k: usize) -> Vec<Tile> {
-        let mut out = vec![self.tile(k)];
-        while self.parent[k] as usize != k {
-            k = self.parent[k] as usize;
-            out.push(self.tile(k));
-        }
-        out.reverse();
-        out
+    pub(crate) fn path_to(&self, k: usize) -> Vec<Tile> {
+        let path = self.search.path_to(k as u32);
+        path.iter().map(|&k| self.tile(k as usize)).collect()
     }
 }
 
@@ -422,45 +407,36 @@ impl Core {
     /// nearest BP entered along a known free edge (ties: smaller `j`, then smaller `i`). Returns
     /// the cell path, current cell first, BP last.
     fn select_basic(&mut self) -> Option<Vec<Tile>> {
-        let start = self.cells.idx(self.cell)?;
-        self.cells.new_search();
-        self.cells.reach(start, 0, start);
-        let mut level = vec![start];
-        let mut depth = 0u32;
-        while !level.is_empty() {
-            let mut best: Option<(Tile, usize)> = None;
-            let mut next = Vec::new();
-            for &k in &level {
-                let u = self.cells.tile(k);
-                for d in 0..4 {
-                    if self.cells.edge(u, d) != EDGE_FREE {
-                        continue;
-                    }
-                    let n = add(u, d);
-                    let Some(kn) = self.cells.idx(n) else {
-                        continue;
-                    };
-                    if self.cells.has(n, VISITED) {
-                        if self.cells.cost_of(kn).is_none() {
-                            self.cells.reach(kn, depth + 1, k);
-                            next.push(kn);
-                        }
-                    } else if self.cells.has(n, BP)
-                        && best.is_none_or(|(b, _)| (n.1, n.0) < (b.1, b.0))
-                    {
-                        best = Some((n, k));
-                    }
+        let start = self.cells.idx(self.cell)? as u32;
+        let cells = &mut self.cells;
+        cells.search.begin();
+        cells.search.push_fifo_source(start);
+        // The best BP so far, the visited cell it is entered from and that cell's depth.
+        let mut best: Option<(Tile, u32, u32)> = None;
+        while let Some((k, depth)) = cells.search.pop_fifo() {
+            if best.is_some_and(|b| depth > b.2) {
+                break;
+            }
+            let u = cells.tile(k as usize);
+            for d in 0..4 {
+                if cells.edge(u, d) != EDGE_FREE {
+                    continue;
+                }
+                let n = add(u, d);
+                let Some(kn) = cells.idx(n) else {
+                    continue;
+                };
+                if cells.has(n, VISITED) {
+                    cells.search.discover(k, kn as u32);
+                } else if cells.has(n, BP) && best.is_none_or(|(b, _, _)| (n.1, n.0) < (b.1, b.0)) {
+                    best = Some((n, k, depth));
                 }
             }
-            if let Some((n, k)) = best {
-                let mut path = self.cells.path_to(k);
-                path.push(n);
-                return Some(path);
-            }
-            level = next;
-            depth += 1;
         }
-        None
+        let (n, k, _) = best?;
+        let mut path = cells.path_to(k as usize);
+        path.push(n);
+        Some(path)
     }
 }
 

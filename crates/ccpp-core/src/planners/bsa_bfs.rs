@@ -52,6 +52,7 @@ use serde::{Deserialize, Serialize};
 use crate::exec::{Execution, PidOptions};
 use crate::geometry::Point;
 use crate::planner::{KnownMap, Planner, Sensor, Step};
+use crate::search::SearchSpace;
 use crate::trace::Event;
 
 /// Options of [`BsaBfs`].
@@ -132,6 +133,8 @@ pub struct BsaBfs {
     /// Cached move freeness towards +x and +y: 0 unknown, 1 free, 2 blocked.
     edge: Vec<[u8; 2]>,
     return_cells: Vec<(i32, i32)>,
+    /// Reusable BFS buffers over the cells.
+    search: SearchSpace<u32>,
     cur: (i32, i32),
     queue: VecDeque<Step>,
     state: State,
@@ -151,6 +154,7 @@ impl BsaBfs {
             stand: Vec::new(),
             edge: Vec::new(),
             return_cells: Vec::new(),
+            search: SearchSpace::default(),
             cur: (0, 0),
             queue: VecDeque::new(),
             state: State::Plan,
@@ -188,6 +192,7 @@ impl BsaBfs {
         self.pushed = vec![false; n];
         self.stand = vec![0; n];
         self.edge = vec![[0; 2]; n];
+        self.search = SearchSpace::new(n);
         self.known = Some(KnownMap::new(&f));
         self.cur = (0, 0);
         if let Some(k) = cells.idx((0, 0)) {
@@ -256,37 +261,34 @@ impl BsaBfs {
             .map_or(Point::default(), |g| g.center(c))
     }
 
-    /// BFS over visited cells (plus the target) from `self.cur` to `target`; returns the cell
-    /// path including both ends.
+    /// BFS over visited cells (plus the target) from `self.cur` to `target`, neighbours in
+    /// [`ORDER`] (first discovery is the parent); returns the cell path including both ends.
     fn bfs(&mut self, target: (i32, i32)) -> Option<Vec<(i32, i32)>> {
-        let n = self.cells.as_ref()?.len();
-        let mut parent: Vec<u32> = vec![u32::MAX; n];
-        let idx = |s: &Self, c| s.cells.as_ref().and_then(|g| g.idx(c));
-        let start = idx(self, self.cur)?;
-        parent[start] = start as u32;
-        let mut q = VecDeque::from([self.cur]);
-        while let Some(c) = q.pop_front() {
+        let g = self.cells.as_ref()?;
+        let (i0, j0, w) = (g.i0, g.j0, g.w);
+        let start = g.idx(self.cur)? as u32;
+        self.search.begin();
+        self.search.push_fifo_source(start);
+        while let Some((k, _)) = self.search.pop_fifo() {
+            let c = (i0 + k as i32 % w, j0 + k as i32 / w);
             if c == target {
-                let mut path = vec![c];
-                let mut k = idx(self, c)?;
-                let g = self.cells.as_ref()?;
-                while k != start {
-                    k = parent[k] as usize;
-                    let (i, j) = ((k as i32 % g.w) + g.i0, (k as i32 / g.w) + g.j0);
-                    path.push((i, j));
-                }
-                path.reverse();
-                return Some(path);
+                let path = self.search.path_to(k);
+                return Some(
+                    path.iter()
+                        .map(|&k| (i0 + k as i32 % w, j0 + k as i32 / w))
+                        .collect(),
+                );
             }
             for (di, dj) in ORDER {
                 let nb = (c.0 + di, c.1 + dj);
-                let Some(k) = idx(self, nb) else { continue };
-                if parent[k] != u32::MAX || !(self.visited[k] || nb == target) {
+                let Some(kn) = self.cells.as_ref().and_then(|g| g.idx(nb)) else {
+                    continue;
+                };
+                if self.search.is_reached(kn as u32) || !(self.visited[kn] || nb == target) {
                     continue;
                 }
                 if self.move_free(c, nb) {
-                    parent[k] = idx(self, c)? as u32;
-                    q.push_back(nb);
+                    self.search.discover(k, kn as u32);
                 }
             }
         }

@@ -56,14 +56,14 @@
 //! assert!(m.rect_guarantee.unwrap() > 0.9);
 //! ```
 
-use std::cmp::Reverse;
-use std::collections::{BinaryHeap, VecDeque};
+use std::collections::VecDeque;
 
 use serde::{Deserialize, Serialize};
 
 use crate::exec::{Execution, PidOptions};
 use crate::geometry::Point;
 use crate::planner::{Planner, Sensor, Step};
+use crate::search::{DeeperFirst, SearchSpace};
 use crate::trace::Event;
 use crate::world::{Robot, World};
 
@@ -271,7 +271,7 @@ const N8: [(i64, i64); 8] = [
 
 /// A\* over the reachable C-free pixels of a clearance world.
 ///
-/// The search arrays are allocated once per plan and reset by generation stamps; the pixels
+/// The search buffers ([`SearchSpace`]) are allocated once per plan and reused; the pixels
 /// whose clearance proves every edge between them free are precomputed from the world's
 /// distance transform, and the exact segment checks of the other edges are memoised (the map
 /// is static).
@@ -281,14 +281,9 @@ struct Roadmap<'a> {
     safe: fixedbitset::FixedBitSet,
     /// Per pixel and N8 direction: exact edge check done (bit `k`) / its result (bit `k + 8`).
     edge_memo: Vec<u16>,
-    g: Vec<u32>,
-    came: Vec<u32>,
-    /// `open[i] == gen`: `g[i]` and `came[i]` are valid in the current search.
-    open: Vec<u32>,
-    /// `closed[i] == gen`: pixel `i` is expanded in the current search.
-    closed: Vec<u32>,
-    gen: u32,
-    heap: BinaryHeap<Reverse<(u32, u32, u32)>>,
+    /// A\* buffers over the pixels; ties of equal `f` go to the smaller `h` (deeper nodes
+    /// first), then the smaller pixel index.
+    space: SearchSpace<u32, DeeperFirst>,
     /// Compact index of each reachable pixel (`u32::MAX` elsewhere), for the landmark tables.
     compact: Vec<u32>,
     /// ALT landmarks: exact search-graph distances from each landmark, by compact index
@@ -312,12 +307,7 @@ impl<'a> Roadmap<'a> {
             w,
             safe,
             edge_memo: vec![0; n],
-            g: vec![0; n],
-            came: vec![0; n],
-            open: vec![0; n],
-            closed: vec![0; n],
-            gen: 0,
-            heap: BinaryHeap::new(),
+            space: SearchSpace::new(n),
             compact: Vec::new(),
             landmarks: None,
         }
@@ -501,13 +491,6 @@ impl<'a> Roadmap<'a> {
         let f = *self.w.frame();
         let s = self.attach(a)?;
         let t = self.attach(b)?;
-        self.gen = self.gen.wrapping_add(1);
-        if self.gen == 0 {
-            self.open.fill(0);
-            self.closed.fill(0);
-            self.gen = 1;
-        }
-        let gen = self.gen;
         let w = f.width as i64;
         let (tc, tr) = ((t as i64 % w), (t as i64 / w));
         // Octile distance in the same integer units: consistent with the step costs.
@@ -531,55 +514,35 @@ impl<'a> Roadmap<'a> {
             DIAG * lo + STRAIGHT * (hi - lo)
         };
         let h = |me: &Self, i: usize| octile(i).max(me.alt(i, t));
-        self.heap.clear();
-        self.g[s] = 0;
-        self.came[s] = s as u32;
-        self.open[s] = gen;
+        self.space.begin();
         // Key: f, then h (deeper nodes first on ties), then the index (determinism).
         let hs = h(self, s);
-        self.heap.push(Reverse((hs, hs, s as u32)));
+        self.space.push_source(s as u32, 0, hs);
         let mut found = false;
-        while let Some(Reverse((_, _, i))) = self.heap.pop() {
-            let i = i as usize;
-            if self.closed[i] == gen {
-                continue;
-            }
-            self.closed[i] = gen;
+        while let Some(x) = self.space.pop() {
+            let i = x.node as usize;
             if i == t {
                 found = true;
                 break;
             }
-            let gi = self.g[i];
             for k in 0..8 {
                 let Some((j, step)) = self.succ(i, k) else {
                     continue;
                 };
-                if self.closed[j] == gen {
-                    continue;
-                }
-                let cost = gi + step;
-                if self.open[j] != gen || cost < self.g[j] {
-                    self.g[j] = cost;
-                    self.came[j] = i as u32;
-                    self.open[j] = gen;
+                let cost = x.g + step;
+                if !self.space.is_settled(j as u32) && self.space.improves(j as u32, cost) {
                     let hj = h(self, j);
-                    self.heap.push(Reverse((cost + hj, hj, j as u32)));
+                    self.space.update(x.node, j as u32, cost, hj);
                 }
             }
         }
         if !found {
             return None;
         }
-        let mut cells = vec![t];
-        let mut k = t;
-        while k != s {
-            k = self.came[k] as usize;
-            cells.push(k);
-        }
-        cells.reverse();
+        let cells = self.space.path_to(t as u32);
         let mut pts = vec![a];
         pts.extend(cells.iter().map(|&i| {
-            let (c, r) = f.col_row(i);
+            let (c, r) = f.col_row(i as usize);
             f.pixel_center(c, r)
         }));
         pts.push(b);
