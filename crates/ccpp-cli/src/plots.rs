@@ -1,5 +1,6 @@
-//! Bench plots: coverage over travelled distance per map, summary bars, paths side by side.
-//! Every plot is written as SVG and PNG from one chart description.
+//! Bench plots: coverage over travelled distance per map, summary bars, paths side by side,
+//! effective coverage against path ratio per map and in summary. Every plot is written as SVG
+//! and PNG from one chart description, each file atomically.
 
 use std::path::{Path, PathBuf};
 
@@ -9,7 +10,9 @@ use ccpp_core::trace::Trace;
 use ccpp_core::world::{Robot, World};
 use ccpp_core::Pose;
 use ccpp_io::write_atomic;
-use ccpp_render::chart::{bar_panels, image_grid_captioned, line_chart, Chart, Panel};
+use ccpp_render::chart::{
+    bar_panels, image_grid_captioned, line_chart, tradeoff_chart, Chart, Panel,
+};
 use ccpp_render::{coverage_png, coverage_verdict_colour, legend_entries_union, CoverageStyle};
 use rayon::prelude::*;
 
@@ -94,6 +97,16 @@ pub fn write_all(
             });
             drawn.push((run_world, trace));
         }
+        let points = tradeoff_points(rows, &planners, &m.name);
+        if points.iter().any(Option::is_some) {
+            let c = tradeoff_chart(
+                &format!("Coverage against path ratio - {}", m.name),
+                &planners,
+                &points,
+                &[],
+            );
+            write_chart(&dir, &format!("tradeoff_{}", m.name), &c)?;
+        }
         if !series.is_empty() {
             let c = line_chart(
                 &format!("Effective coverage over travelled distance - {}", m.name),
@@ -176,5 +189,45 @@ pub fn write_all(
     ];
     let c = bar_panels("Summary (mean over maps)", &planners, &metrics);
     write_chart(&dir, "summary", &c)?;
+    // Trade-off summary: each planner at its means, its per-map points faint behind.
+    let means: Vec<Option<[f64; 2]>> = planners
+        .iter()
+        .map(|p| {
+            let pt = [mean(p, |m| m.path_ratio), mean(p, |m| m.effective_coverage)];
+            pt.iter().all(|v| v.is_finite()).then_some(pt)
+        })
+        .collect();
+    let per_map: Vec<Vec<[f64; 2]>> = planners
+        .iter()
+        .map(|p| {
+            rows.iter()
+                .filter(|r| &r.planner == p)
+                .filter_map(|r| r.outcome.as_ref().ok())
+                .map(|m| [m.path_ratio, m.effective_coverage])
+                .collect()
+        })
+        .collect();
+    if means.iter().any(Option::is_some) {
+        let c = tradeoff_chart(
+            "Coverage against path ratio (mean over maps)",
+            &planners,
+            &means,
+            &per_map,
+        );
+        write_chart(&dir, "tradeoff_summary", &c)?;
+    }
     Ok(())
+}
+
+/// Each planner's `[path_ratio, effective_coverage]` on `map` (`None`: no successful run).
+fn tradeoff_points(rows: &[Row], planners: &[String], map: &str) -> Vec<Option<[f64; 2]>> {
+    planners
+        .iter()
+        .map(|p| {
+            rows.iter()
+                .find(|r| r.map == map && &r.planner == p)
+                .and_then(|r| r.outcome.as_ref().ok())
+                .map(|m| [m.path_ratio, m.effective_coverage])
+        })
+        .collect()
 }

@@ -524,11 +524,27 @@ fn small_bench_writes_csv_md_and_plots_and_resumes() {
         "coverage_block_room.svg",
         "coverage_block_room.png",
         "paths_teb_empty_box.png",
+        "tradeoff_summary.svg",
+        "tradeoff_summary.png",
+        "tradeoff_block_room.svg",
+        "tradeoff_teb_empty_box.png",
     ] {
         assert!(out.join("plots").join(f).is_file(), "{f}");
     }
     let svg = std::fs::read_to_string(out.join("plots/summary.svg")).unwrap();
     assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+    // The trade-off summary: both planners as labelled points, the better corner marked; no
+    // trade-off chart for the broken map, and no temporary file left behind.
+    let svg = std::fs::read_to_string(out.join("plots/tradeoff_summary.svg")).unwrap();
+    for p in ["random-bounce", "bcd"] {
+        assert!(svg.contains(&format!(">{p}</text>")), "{p}");
+    }
+    assert!(svg.contains(">better</text>") && svg.contains(">mean over maps</text>"));
+    assert!(!out.join("plots/tradeoff_broken.svg").exists());
+    for e in std::fs::read_dir(out.join("plots")).unwrap() {
+        let name = e.unwrap().file_name().into_string().unwrap();
+        assert!(name.ends_with(".svg") || name.ends_with(".png"), "{name}");
+    }
     // Resuming skips finished runs: their trace files are left untouched.
     let trace = out.join("runs/block_room/bcd/trace.jsonl");
     let before = std::fs::metadata(&trace).unwrap().modified().unwrap();

@@ -795,6 +795,397 @@ pub fn bar_panels(title: &str, planners: &[String], metrics: &[(String, Vec<f64>
     c
 }
 
+/// Axis of a trade-off chart: linear, or logarithmic when the values span a wide range.
+#[derive(Clone, Copy, Debug)]
+struct Axis {
+    lo: f64,
+    hi: f64,
+    log: bool,
+}
+
+impl Axis {
+    /// The position in `0..=1` of value `v` along the axis.
+    fn frac(&self, v: f64) -> f64 {
+        if self.log {
+            (v.ln() - self.lo.ln()) / (self.hi.ln() - self.lo.ln())
+        } else {
+            (v - self.lo) / (self.hi - self.lo)
+        }
+    }
+}
+
+/// A tick label with at most two decimals and no trailing zeros.
+fn fmt_short(v: f64) -> String {
+    let s = format!("{v:.2}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    s.to_string()
+}
+
+/// Ticks of a logarithmic axis over `lo..=hi` spanning `len` pixels: the round mantissas first
+/// (1, 2, 5), then finer ones while they stay `gap` pixels apart.
+fn log_ticks(axis: &Axis, len: f32, gap: f32) -> Vec<f64> {
+    let levels: [&[f64]; 3] = [&[1.0, 2.0, 5.0], &[1.5, 3.0], &[1.2, 4.0, 6.0, 8.0]];
+    let mut kept: Vec<f64> = Vec::new();
+    let (e0, e1) = (
+        axis.lo.log10().floor() as i32,
+        axis.hi.log10().ceil() as i32,
+    );
+    for level in levels {
+        for e in e0..=e1 {
+            for &m in level {
+                let v = m * 10f64.powi(e);
+                if v < axis.lo || v > axis.hi {
+                    continue;
+                }
+                let x = axis.frac(v) as f32 * len;
+                if kept
+                    .iter()
+                    .all(|&k| (axis.frac(k) as f32 * len - x).abs() >= gap)
+                {
+                    kept.push(v);
+                }
+            }
+        }
+    }
+    kept.sort_by(f64::total_cmp);
+    kept
+}
+
+/// An axis-aligned box `(x, y, w, h)`.
+type Bbox = (f32, f32, f32, f32);
+
+fn overlap(a: Bbox, b: Bbox) -> f32 {
+    let w = (a.0 + a.2).min(b.0 + b.2) - a.0.max(b.0);
+    let h = (a.1 + a.3).min(b.1 + b.3) - a.1.max(b.1);
+    if w > 0.0 && h > 0.0 {
+        w * h
+    } else {
+        0.0
+    }
+}
+
+/// Places a label of size `(w, h)` next to each anchor `(x, y)` (a disc of radius `r`): the
+/// first of 8 directions at growing distances whose box stays inside `area` and overlaps no
+/// disc, no box in `blocked` and no label placed before; failing that the box of least
+/// overlap. Returns each label's box and whether it was moved off its disc (needs a leader).
+pub fn place_labels(
+    anchors: &[(f32, f32)],
+    sizes: &[(f32, f32)],
+    r: f32,
+    area: Bbox,
+    blocked: &[Bbox],
+) -> Vec<(Bbox, bool)> {
+    let discs: Vec<Bbox> = anchors
+        .iter()
+        .map(|&(x, y)| (x - r - 2.0, y - r - 2.0, 2.0 * r + 4.0, 2.0 * r + 4.0))
+        .collect();
+    let mut placed: Vec<Bbox> = Vec::new();
+    let mut out = Vec::new();
+    for (&(x, y), &(w, h)) in anchors.iter().zip(sizes) {
+        let mut best: Option<(f32, Bbox, bool)> = None;
+        'rings: for (ring, d) in [r + 4.0, r + 18.0, r + 36.0, r + 60.0]
+            .into_iter()
+            .enumerate()
+        {
+            // Right, left, above, below, then the diagonals.
+            let cands = [
+                (x + d, y - h / 2.0),
+                (x - d - w, y - h / 2.0),
+                (x - w / 2.0, y - d - h),
+                (x - w / 2.0, y + d),
+                (x + d * 0.7, y - d * 0.7 - h),
+                (x + d * 0.7, y + d * 0.7),
+                (x - d * 0.7 - w, y - d * 0.7 - h),
+                (x - d * 0.7 - w, y + d * 0.7),
+            ];
+            for (bx, by) in cands {
+                let b = (bx, by, w, h);
+                if bx < area.0
+                    || by < area.1
+                    || bx + w > area.0 + area.2
+                    || by + h > area.1 + area.3
+                {
+                    continue;
+                }
+                let cost: f32 = discs
+                    .iter()
+                    .chain(blocked)
+                    .chain(&placed)
+                    .map(|&o| overlap(b, o))
+                    .sum();
+                if best.is_none_or(|(c, _, _)| cost < c) {
+                    best = Some((cost, b, ring > 0));
+                }
+                if cost == 0.0 {
+                    break 'rings;
+                }
+            }
+        }
+        let (_, b, far) = best.unwrap_or((0.0, (x + r + 4.0, y - h / 2.0, w, h), false));
+        placed.push(b);
+        out.push((b, far));
+    }
+    out
+}
+
+/// Mixes `c` with white (`t = 0`: `c`, `t = 1`: white).
+fn faded(c: [u8; 3], t: f32) -> [u8; 3] {
+    c.map(|v| (f32::from(v) + (255.0 - f32::from(v)) * t).round() as u8)
+}
+
+/// A trade-off chart: effective coverage (y, higher is better) against path ratio (x, lower
+/// is better, on a logarithmic axis when the ratios span more than a factor 2.5), one labelled
+/// disc per planner at `points[k]` (`[path_ratio, coverage]`; `None` or non-finite: not drawn)
+/// in the colour of series `k`, with the better corner (top left) marked. `faint[k]`, when
+/// given, are further points of planner `k` drawn small and pale behind (one per map in a
+/// summary); the axes fit the main points, and faint points outside them are counted in a
+/// note instead of drawn. A disc that would cover most of an earlier one is drawn as a ring
+/// around it, so every point stays visible.
+pub fn tradeoff_chart(
+    title: &str,
+    planners: &[String],
+    points: &[Option<[f64; 2]>],
+    faint: &[Vec<[f64; 2]>],
+) -> Chart {
+    let (w, h) = (900u32, 600u32);
+    let mut c = Chart::new(w, h);
+    let (l, r, t, b) = (80.0f32, 210.0f32, 62.0f32, 66.0f32);
+    let (pw, ph) = (w as f32 - l - r, h as f32 - t - b);
+    let ok = |p: &[f64; 2]| p[0].is_finite() && p[0] > 0.0 && p[1].is_finite();
+    let mut all: Vec<[f64; 2]> = points.iter().flatten().copied().filter(ok).collect();
+    if all.is_empty() {
+        all = faint.iter().flatten().copied().filter(ok).collect();
+    }
+    let (mut x0, mut x1, mut y0, mut y1) = all.iter().fold(
+        (
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ),
+        |a, p| (a.0.min(p[0]), a.1.max(p[0]), a.2.min(p[1]), a.3.max(p[1])),
+    );
+    if all.is_empty() {
+        (x0, x1, y0, y1) = (1.0, 2.0, 0.0, 1.0);
+    }
+    let log = x1 / x0 > 2.5;
+    let xa = if log {
+        Axis {
+            lo: x0 / 1.08,
+            hi: x1 * 1.08,
+            log,
+        }
+    } else {
+        let pad = ((x1 - x0) * 0.08).max(0.05);
+        Axis {
+            lo: (x0 - pad).max(0.0),
+            hi: x1 + pad,
+            log,
+        }
+    };
+    let ystep = nice_step((y1 - y0).max(0.02), 5);
+    let ylo = ((y0 - ystep * 0.3) / ystep).floor() * ystep;
+    let ytop = (y1 / ystep).ceil() * ystep;
+    let ya = Axis {
+        lo: ylo.max(0.0).min(y0),
+        hi: ytop + ystep * 0.3,
+        log: false,
+    };
+    let px = |p: &[f64; 2]| {
+        (
+            l + xa.frac(p[0]) as f32 * pw,
+            t + ph - ya.frac(p[1]) as f32 * ph,
+        )
+    };
+    c.text(
+        w as f32 / 2.0,
+        10.0,
+        20,
+        title,
+        [20, 20, 20],
+        Anchor::Middle,
+    );
+    // The better corner: pale green, with its caption (kept free of labels).
+    let green = [0, 130, 60];
+    let (cw, ch) = (pw * 0.22, ph * 0.2);
+    c.rect(l, t, cw, ch, Some([226, 244, 230]), None);
+    let cap = "better";
+    let cap_w = font::text_width(cap, 13.0);
+    let cap_box = (l + 26.0, t + 8.0, cap_w, font::line_height(13.0));
+    c.text(cap_box.0, cap_box.1, 13, cap, green, Anchor::Start);
+    c.line(
+        vec![(l + 20.0, t + 22.0), (l + 6.0, t + 8.0)],
+        green,
+        2.0,
+        false,
+    );
+    c.line(
+        vec![(l + 6.0, t + 8.0), (l + 14.0, t + 8.0)],
+        green,
+        2.0,
+        false,
+    );
+    c.line(
+        vec![(l + 6.0, t + 8.0), (l + 6.0, t + 16.0)],
+        green,
+        2.0,
+        false,
+    );
+    // Grid and ticks.
+    let xticks: Vec<f64> = if log {
+        log_ticks(&xa, pw, 44.0)
+    } else {
+        let s = nice_step(xa.hi - xa.lo, 6);
+        let mut v = (xa.lo / s).ceil() * s;
+        let mut out = Vec::new();
+        while v <= xa.hi + 1e-9 {
+            out.push(v);
+            v += s;
+        }
+        out
+    };
+    for v in xticks {
+        let x = l + xa.frac(v) as f32 * pw;
+        c.line(vec![(x, t), (x, t + ph)], [225, 225, 225], 1.0, false);
+        c.text(
+            x,
+            t + ph + 5.0,
+            12,
+            fmt_short(v),
+            [60, 60, 60],
+            Anchor::Middle,
+        );
+    }
+    let mut v = (ya.lo / ystep).ceil() * ystep;
+    while v <= ya.hi + 1e-9 {
+        let y = t + ph - ya.frac(v) as f32 * ph;
+        c.line(vec![(l, y), (l + pw, y)], [225, 225, 225], 1.0, false);
+        c.text(
+            l - 6.0,
+            y - 7.0,
+            12,
+            fmt_tick(v, ystep),
+            [60, 60, 60],
+            Anchor::End,
+        );
+        v += ystep;
+    }
+    c.rect(l, t, pw, ph, None, Some([120, 120, 120]));
+    let x_label = if log {
+        "path ratio (log scale; lower is better)"
+    } else {
+        "path ratio (lower is better)"
+    };
+    c.text(
+        l + pw / 2.0,
+        h as f32 - 30.0,
+        14,
+        x_label,
+        [40, 40, 40],
+        Anchor::Middle,
+    );
+    c.text(
+        8.0,
+        t - 26.0,
+        14,
+        "effective coverage (higher is better)",
+        [40, 40, 40],
+        Anchor::Start,
+    );
+    // Faint points first, then the planners' discs, then their labels.
+    let mut outside = 0usize;
+    for (k, pts) in faint.iter().enumerate() {
+        let col = faded(SERIES[k % SERIES.len()], 0.55);
+        for p in pts.iter().filter(|p| ok(p)) {
+            let (x, y) = px(p);
+            if x < l || x > l + pw || y < t || y > t + ph {
+                outside += 1;
+                continue;
+            }
+            c.circle(x, y, 3.5, Some(col), None, 1.0);
+        }
+    }
+    if outside > 0 {
+        c.text(
+            8.0,
+            h as f32 - 22.0,
+            12,
+            format!("{outside} per-map points outside the axes"),
+            [110, 110, 110],
+            Anchor::Start,
+        );
+    }
+    let rad = 7.0f32;
+    let mut anchors = Vec::new();
+    let mut sizes = Vec::new();
+    let mut who = Vec::new();
+    for (k, p) in points.iter().enumerate() {
+        let Some(p) = p.filter(|p| ok(p)) else {
+            continue;
+        };
+        let (x, y) = px(&p);
+        let col = SERIES[k % SERIES.len()];
+        let close = anchors
+            .iter()
+            .filter(|&&(ax, ay): &&(f32, f32)| (ax - x).hypot(ay - y) < 1.4 * rad)
+            .count();
+        if close == 0 {
+            c.circle(x, y, rad, Some(col), Some([255, 255, 255]), 1.5);
+        } else {
+            c.circle(x, y, rad + 3.5 * close as f32, None, Some(col), 2.5);
+        }
+        let name = planners.get(k).cloned().unwrap_or_default();
+        anchors.push((x, y));
+        sizes.push((font::text_width(&name, 13.0), font::line_height(13.0)));
+        who.push((k, name));
+    }
+    let area = (l + 2.0, t + 2.0, pw - 4.0, ph - 4.0);
+    let boxes = place_labels(&anchors, &sizes, rad, area, &[cap_box]);
+    for (((bx, by, bw, bh), far), (&(x, y), (k, name))) in
+        boxes.into_iter().zip(anchors.iter().zip(who))
+    {
+        if far {
+            let end = (x.clamp(bx, bx + bw), y.clamp(by, by + bh));
+            c.line(vec![(x, y), end], [150, 150, 150], 1.0, false);
+        }
+        // The series colour darkened a quarter, for contrast on white.
+        let ink = SERIES[k % SERIES.len()].map(|v| (u16::from(v) * 3 / 4) as u8);
+        c.text(bx, by, 13, name, ink, Anchor::Start);
+    }
+    // Legend: planners, then the marks.
+    let lx = l + pw + 16.0;
+    let mut ly = t + 4.0;
+    for (k, name) in planners.iter().enumerate() {
+        let col = SERIES[k % SERIES.len()];
+        c.circle(lx + 8.0, ly + 9.0, 6.0, Some(col), None, 1.0);
+        c.text(lx + 22.0, ly, 14, name.clone(), [30, 30, 30], Anchor::Start);
+        ly += 24.0;
+    }
+    if faint.iter().any(|f| !f.is_empty()) {
+        ly += 10.0;
+        c.circle(lx + 8.0, ly + 9.0, 6.0, Some([90, 90, 90]), None, 1.0);
+        c.text(
+            lx + 22.0,
+            ly,
+            13,
+            "mean over maps",
+            [60, 60, 60],
+            Anchor::Start,
+        );
+        ly += 22.0;
+        c.circle(
+            lx + 8.0,
+            ly + 9.0,
+            3.5,
+            Some(faded([90, 90, 90], 0.55)),
+            None,
+            1.0,
+        );
+        c.text(lx + 22.0, ly, 13, "one map", [60, 60, 60], Anchor::Start);
+    }
+    c
+}
+
 /// Pictures side by side with labels (up to `cols` per row), each in a `cell_w x cell_h` box.
 pub fn image_grid(
     title: &str,
@@ -1013,5 +1404,129 @@ mod tests {
             "bar_panels",
             bar_panels("Summary", &planners, &metrics).to_svg()
         );
+        insta::assert_snapshot!(
+            "tradeoff_chart",
+            tradeoff_chart(
+                "Trade-off",
+                &planners,
+                &[Some([1.2, 0.9]), Some([1.5, 0.99])],
+                &[vec![[1.1, 0.85], [9.0, 0.2]], vec![]],
+            )
+            .to_svg()
+        );
+    }
+
+    /// The `(x, y)` of every `<text>` holding `label`, and of every circle, from the SVG.
+    fn attr(line: &str, name: &str) -> f32 {
+        let k = line.find(&format!(" {name}=\"")).unwrap() + name.len() + 3;
+        line[k..].split('"').next().unwrap().parse().unwrap()
+    }
+
+    #[test]
+    fn tradeoff_chart_draws_every_planner_once_with_readable_labels() {
+        let planners: Vec<String> = ["ba-star", "bsa", "bcd", "random-bounce", "none"]
+            .iter()
+            .map(|s| (*s).to_string())
+            .collect();
+        // Three nearly coincident points, one far right (log axis), one missing.
+        let points = [
+            Some([1.0, 0.86]),
+            Some([1.001, 0.8601]),
+            Some([1.0, 0.8602]),
+            Some([7.4, 0.5]),
+            None,
+        ];
+        let c = tradeoff_chart("T", &planners, &points, &[]);
+        let svg = c.to_svg();
+        assert!(svg.contains(">better</text>"));
+        assert!(svg.contains("log scale"));
+        // One disc or ring per drawn planner, in its colour; the missing one has none.
+        for (k, p) in points.iter().enumerate() {
+            let col = hex(SERIES[k]);
+            let n = svg
+                .lines()
+                .filter(|l| l.starts_with("<circle") && l.contains(&col))
+                .count();
+            // The legend swatch is one more circle.
+            assert_eq!(n, 1 + usize::from(p.is_some()), "{}", planners[k]);
+        }
+        // Coincident points: the later ones are rings (no fill), not hidden under a disc.
+        let rings = svg
+            .lines()
+            .filter(|l| l.starts_with("<circle") && l.contains(r#"fill="none""#))
+            .count();
+        assert_eq!(rings, 2);
+        // Labels inside the plot and not overlapping one another.
+        let boxes: Vec<(f32, f32, f32)> = planners[..4]
+            .iter()
+            .map(|p| {
+                let line = svg
+                    .lines()
+                    .filter(|l| {
+                        l.ends_with(&format!(">{p}</text>")) && l.contains(r#"font-size="13""#)
+                    })
+                    .last()
+                    .unwrap_or_else(|| panic!("label {p}"));
+                let w = font::text_width(p, 13.0);
+                (attr(line, "x"), attr(line, "y"), w)
+            })
+            .collect();
+        for (i, a) in boxes.iter().enumerate() {
+            assert!(a.0 >= 80.0 && a.0 + a.2 <= 690.0, "{a:?}");
+            for b in &boxes[i + 1..] {
+                let ov = overlap((a.0, a.1, a.2, 16.0), (b.0, b.1, b.2, 16.0));
+                assert_eq!(ov, 0.0, "{a:?} {b:?}");
+            }
+        }
+        // Deterministic, and the PNG has the SVG's size.
+        assert_eq!(svg, tradeoff_chart("T", &planners, &points, &[]).to_svg());
+        let img = Pixmap::decode_png(&c.to_png().unwrap()).unwrap();
+        assert_eq!((img.width(), img.height()), (900, 600));
+    }
+
+    #[test]
+    fn tradeoff_summary_counts_faint_points_off_the_axes() {
+        let planners = vec!["a".to_string(), "b".to_string()];
+        let faint = vec![vec![[1.1, 0.9], [30.0, 0.1]], vec![[1.3, 0.95]]];
+        let svg = tradeoff_chart(
+            "S",
+            &planners,
+            &[Some([1.1, 0.9]), Some([1.3, 0.95])],
+            &faint,
+        )
+        .to_svg();
+        assert!(
+            svg.contains(">1 per-map points outside the axes</text>"),
+            "{svg}"
+        );
+        assert!(svg.contains(">mean over maps</text>") && svg.contains(">one map</text>"));
+        // Narrow range: a linear axis.
+        assert!(!svg.contains("log scale"));
+    }
+
+    #[test]
+    fn labels_avoid_discs_blocked_boxes_and_each_other() {
+        let anchors = [
+            (100.0, 100.0),
+            (104.0, 100.0),
+            (100.0, 104.0),
+            (300.0, 300.0),
+        ];
+        let sizes = [(60.0, 16.0); 4];
+        let blocked = [(110.0, 80.0, 100.0, 40.0)];
+        let area = (0.0, 0.0, 400.0, 400.0);
+        let out = place_labels(&anchors, &sizes, 7.0, area, &blocked);
+        for (i, (a, _)) in out.iter().enumerate() {
+            assert!(a.0 >= 0.0 && a.1 >= 0.0 && a.0 + a.2 <= 400.0 && a.1 + a.3 <= 400.0);
+            assert_eq!(overlap(*a, blocked[0]), 0.0, "{a:?}");
+            for &(x, y) in &anchors {
+                assert_eq!(overlap(*a, (x - 9.0, y - 9.0, 18.0, 18.0)), 0.0, "{a:?}");
+            }
+            for (b, _) in &out[i + 1..] {
+                assert_eq!(overlap(*a, *b), 0.0, "{a:?} {b:?}");
+            }
+        }
+        // The lone point keeps its label right beside it.
+        assert_eq!(out[3], ((311.0, 292.0, 60.0, 16.0), false));
     }
 }
