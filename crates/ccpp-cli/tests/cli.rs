@@ -539,7 +539,7 @@ fn small_bench_writes_csv_md_and_plots_and_resumes() {
     for p in ["random-bounce", "bcd"] {
         assert!(svg.contains(&format!(">{p}</text>")), "{p}");
     }
-    assert!(svg.contains(">better</text>") && svg.contains(">mean over maps</text>"));
+    assert!(svg.contains(">better corner:</text>") && svg.contains(">mean over maps</text>"));
     assert!(!out.join("plots/tradeoff_broken.svg").exists());
     for e in std::fs::read_dir(out.join("plots")).unwrap() {
         let name = e.unwrap().file_name().into_string().unwrap();

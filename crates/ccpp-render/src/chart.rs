@@ -864,24 +864,23 @@ fn overlap(a: Bbox, b: Bbox) -> f32 {
     }
 }
 
-/// Places a label of size `(w, h)` next to each anchor `(x, y)` (a disc of radius `r`): the
-/// first of 8 directions at growing distances whose box stays inside `area` and overlaps no
-/// disc, no box in `blocked` and no label placed before; failing that the box of least
+/// Places a label of size `(w, h)` next to each anchor `(x, y, r)` (a disc of radius `r`):
+/// the first of 8 directions at growing distances whose box stays inside `area` and overlaps
+/// no disc, no box in `blocked` and no label placed before; failing that the box of least
 /// overlap. Returns each label's box and whether it was moved off its disc (needs a leader).
 pub fn place_labels(
-    anchors: &[(f32, f32)],
+    anchors: &[(f32, f32, f32)],
     sizes: &[(f32, f32)],
-    r: f32,
     area: Bbox,
     blocked: &[Bbox],
 ) -> Vec<(Bbox, bool)> {
     let discs: Vec<Bbox> = anchors
         .iter()
-        .map(|&(x, y)| (x - r - 2.0, y - r - 2.0, 2.0 * r + 4.0, 2.0 * r + 4.0))
+        .map(|&(x, y, r)| (x - r - 2.0, y - r - 2.0, 2.0 * r + 4.0, 2.0 * r + 4.0))
         .collect();
     let mut placed: Vec<Bbox> = Vec::new();
     let mut out = Vec::new();
-    for (&(x, y), &(w, h)) in anchors.iter().zip(sizes) {
+    for (&(x, y, r), &(w, h)) in anchors.iter().zip(sizes) {
         let mut best: Option<(f32, Bbox, bool)> = None;
         'rings: for (ring, d) in [r + 4.0, r + 18.0, r + 36.0, r + 60.0]
             .into_iter()
@@ -1005,14 +1004,13 @@ pub fn tradeoff_chart(
         [20, 20, 20],
         Anchor::Middle,
     );
-    // The better corner: pale green, with its caption (kept free of labels).
+    // The better corner: pale green with an arrow into the corner (kept free of labels; the
+    // legend names it).
     let green = [0, 130, 60];
+    let shade = [226, 244, 230];
     let (cw, ch) = (pw * 0.22, ph * 0.2);
-    c.rect(l, t, cw, ch, Some([226, 244, 230]), None);
-    let cap = "better";
-    let cap_w = font::text_width(cap, 13.0);
-    let cap_box = (l + 26.0, t + 8.0, cap_w, font::line_height(13.0));
-    c.text(cap_box.0, cap_box.1, 13, cap, green, Anchor::Start);
+    c.rect(l, t, cw, ch, Some(shade), None);
+    let arrow_box = (l, t, 24.0, 24.0);
     c.line(
         vec![(l + 20.0, t + 22.0), (l + 6.0, t + 8.0)],
         green,
@@ -1127,21 +1125,22 @@ pub fn tradeoff_chart(
         let col = SERIES[k % SERIES.len()];
         let close = anchors
             .iter()
-            .filter(|&&(ax, ay): &&(f32, f32)| (ax - x).hypot(ay - y) < 1.4 * rad)
+            .filter(|&&(ax, ay, _): &&(f32, f32, f32)| (ax - x).hypot(ay - y) < 1.4 * rad)
             .count();
+        let r_here = rad + 3.5 * close as f32;
         if close == 0 {
             c.circle(x, y, rad, Some(col), Some([255, 255, 255]), 1.5);
         } else {
-            c.circle(x, y, rad + 3.5 * close as f32, None, Some(col), 2.5);
+            c.circle(x, y, r_here, None, Some(col), 2.5);
         }
         let name = planners.get(k).cloned().unwrap_or_default();
-        anchors.push((x, y));
+        anchors.push((x, y, r_here));
         sizes.push((font::text_width(&name, 13.0), font::line_height(13.0)));
         who.push((k, name));
     }
     let area = (l + 2.0, t + 2.0, pw - 4.0, ph - 4.0);
-    let boxes = place_labels(&anchors, &sizes, rad, area, &[cap_box]);
-    for (((bx, by, bw, bh), far), (&(x, y), (k, name))) in
+    let boxes = place_labels(&anchors, &sizes, area, &[arrow_box]);
+    for (((bx, by, bw, bh), far), (&(x, y, _), (k, name))) in
         boxes.into_iter().zip(anchors.iter().zip(who))
     {
         if far {
@@ -1161,8 +1160,27 @@ pub fn tradeoff_chart(
         c.text(lx + 22.0, ly, 14, name.clone(), [30, 30, 30], Anchor::Start);
         ly += 24.0;
     }
+    ly += 10.0;
+    c.rect(lx, ly + 2.0, 16.0, 14.0, Some(shade), Some([150, 190, 160]));
+    c.text(lx + 22.0, ly, 13, "better corner:", green, Anchor::Start);
+    c.text(
+        lx + 22.0,
+        ly + 17.0,
+        13,
+        "more coverage,",
+        [60, 60, 60],
+        Anchor::Start,
+    );
+    c.text(
+        lx + 22.0,
+        ly + 34.0,
+        13,
+        "shorter path",
+        [60, 60, 60],
+        Anchor::Start,
+    );
+    ly += 56.0;
     if faint.iter().any(|f| !f.is_empty()) {
-        ly += 10.0;
         c.circle(lx + 8.0, ly + 9.0, 6.0, Some([90, 90, 90]), None, 1.0);
         c.text(
             lx + 22.0,
@@ -1438,7 +1456,7 @@ mod tests {
         ];
         let c = tradeoff_chart("T", &planners, &points, &[]);
         let svg = c.to_svg();
-        assert!(svg.contains(">better</text>"));
+        assert!(svg.contains(">better corner:</text>"));
         assert!(svg.contains("log scale"));
         // One disc or ring per drawn planner, in its colour; the missing one has none.
         for (k, p) in points.iter().enumerate() {
@@ -1507,20 +1525,20 @@ mod tests {
     #[test]
     fn labels_avoid_discs_blocked_boxes_and_each_other() {
         let anchors = [
-            (100.0, 100.0),
-            (104.0, 100.0),
-            (100.0, 104.0),
-            (300.0, 300.0),
+            (100.0, 100.0, 7.0),
+            (104.0, 100.0, 10.5),
+            (100.0, 104.0, 14.0),
+            (300.0, 300.0, 7.0),
         ];
         let sizes = [(60.0, 16.0); 4];
         let blocked = [(110.0, 80.0, 100.0, 40.0)];
         let area = (0.0, 0.0, 400.0, 400.0);
-        let out = place_labels(&anchors, &sizes, 7.0, area, &blocked);
+        let out = place_labels(&anchors, &sizes, area, &blocked);
         for (i, (a, _)) in out.iter().enumerate() {
             assert!(a.0 >= 0.0 && a.1 >= 0.0 && a.0 + a.2 <= 400.0 && a.1 + a.3 <= 400.0);
             assert_eq!(overlap(*a, blocked[0]), 0.0, "{a:?}");
-            for &(x, y) in &anchors {
-                assert_eq!(overlap(*a, (x - 9.0, y - 9.0, 18.0, 18.0)), 0.0, "{a:?}");
+            for &(x, y, r) in &anchors {
+                assert_eq!(overlap(*a, (x - r, y - r, 2.0 * r, 2.0 * r)), 0.0, "{a:?}");
             }
             for (b, _) in &out[i + 1..] {
                 assert_eq!(overlap(*a, *b), 0.0, "{a:?} {b:?}");
