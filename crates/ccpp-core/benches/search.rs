@@ -14,10 +14,10 @@ use std::collections::VecDeque;
 
 use ccpp_core::gen::office;
 use ccpp_core::planners::ba_star::{
-    graph_edge, heuristic, TileGraph, TileSearch, COST_DIAG, COST_ORTHO, N8,
+    graph_edge, heuristic, TileGraph, TileSearch, COST_DIAG, COST_ORTHO,
 };
 use ccpp_core::search::SearchSpace;
-use ccpp_core::tiles::Tile;
+use ccpp_core::tiles::{Tile, N8};
 use criterion::{criterion_group, criterion_main, Criterion};
 
 /// Free pixels of a grid as a tile graph (tile `(i, j)` = pixel column `i`, row `j`).

@@ -1480,10 +1480,9 @@ mod tests {
             .map(|p| {
                 let line = svg
                     .lines()
-                    .filter(|l| {
+                    .rfind(|l| {
                         l.ends_with(&format!(">{p}</text>")) && l.contains(r#"font-size="13""#)
                     })
-                    .last()
                     .unwrap_or_else(|| panic!("label {p}"));
                 let w = font::text_width(p, 13.0);
                 (attr(line, "x"), attr(line, "y"), w)
