@@ -58,7 +58,7 @@ fn grid() -> Pixels {
     }
 }
 
-/// The free pixel nearest (in index order) to `t`, scanning forward.
+/// The first free pixel at or after `t` in index order.
 fn free_near(g: &Pixels, t: Tile) -> Tile {
     let k0 = g.idx(t).expect("in range");
     let k = (k0..g.free.len() as u32)
@@ -140,16 +140,30 @@ fn module_flood(s: &mut SearchSpace<u64>, g: &Pixels, from: Tile) -> usize {
 fn bench(c: &mut Criterion) {
     let g = grid();
     let from = free_near(&g, (g.w / 2, g.h / 2));
-    let far = free_near(&g, (g.w - 60, g.h - 60));
-    let corner = free_near(&g, (40, 40));
-    // Targets: a band of tiles far away (the nearest one wins, ties by (j, i)).
-    let target = |t: Tile| t.1 >= g.h - 80 && t.0 < 200;
+    // The ends of the start's component in index order: A* from its first to its last pixel.
+    let comp = {
+        let mut s: SearchSpace<u64> = SearchSpace::new(g.free.len());
+        module_flood(&mut s, &g, from);
+        let order = s.fifo_order();
+        (
+            *order.iter().min().expect("non-empty"),
+            *order.iter().max().expect("non-empty"),
+            order.len(),
+        )
+    };
+    let (corner, far) = (g.tile(comp.0), g.tile(comp.1));
+    // Targets: the rows near the component's last row (the nearest wins, ties by (j, i)).
+    let target = |t: Tile| t.1 >= far.1 - 30;
     let mut old = TileSearch::new(g.bounds());
     let mut new: SearchSpace<u64> = SearchSpace::new(g.free.len());
 
     // Same answers before timing.
     let a = old.nearest(&g, from, target).expect("reachable band");
     let b = module_search(&mut new, &g, from, None, &target).expect("reachable band");
+    println!(
+        "office 2000 x 2000: component of {} px, A* {corner:?} -> {far:?}",
+        comp.2
+    );
     assert_eq!((g.idx(a.0).expect("in range"), a.1), b, "dijkstra differs");
     let a = old.astar(&g, corner, far).expect("connected");
     let b = module_search(&mut new, &g, corner, Some(far), &|_| false).expect("connected");
