@@ -122,7 +122,7 @@ fn legacy_flood(g: &Pixels, from: Tile) -> usize {
     count
 }
 
-fn module_flood(s: &mut SearchSpace<u64>, g: &Pixels, from: Tile) -> usize {
+fn module_flood(s: &mut SearchSpace<u32>, g: &Pixels, from: Tile) -> usize {
     let src = g.idx(from).expect("in range");
     s.flood_fill([src], |v, out| {
         let t = g.tile(v);
@@ -142,7 +142,7 @@ fn bench(c: &mut Criterion) {
     let from = free_near(&g, (g.w / 2, g.h / 2));
     // The ends of the start's component in index order: A* from its first to its last pixel.
     let comp = {
-        let mut s: SearchSpace<u64> = SearchSpace::new(g.free.len());
+        let mut s: SearchSpace<u32> = SearchSpace::new(g.free.len());
         module_flood(&mut s, &g, from);
         let order = s.fifo_order();
         (
@@ -156,6 +156,8 @@ fn bench(c: &mut Criterion) {
     let target = |t: Tile| t.1 >= far.1 - 30;
     let mut old = TileSearch::new(g.bounds());
     let mut new: SearchSpace<u64> = SearchSpace::new(g.free.len());
+    // BFS depths fit in u32 (12-byte records, as BSA-BFS uses).
+    let mut new_bfs: SearchSpace<u32> = SearchSpace::new(g.free.len());
 
     // Same answers before timing.
     let a = old.nearest(&g, from, target).expect("reachable band");
@@ -169,7 +171,7 @@ fn bench(c: &mut Criterion) {
     let b = module_search(&mut new, &g, corner, Some(far), &|_| false).expect("connected");
     let path: Vec<Tile> = new.path_to(b.0).iter().map(|&k| g.tile(k)).collect();
     assert_eq!((a.0, a.1), (path, b.1), "astar differs");
-    assert_eq!(legacy_flood(&g, from), module_flood(&mut new, &g, from));
+    assert_eq!(legacy_flood(&g, from), module_flood(&mut new_bfs, &g, from));
 
     let mut grp = c.benchmark_group("search_office_2000");
     grp.sample_size(10);
@@ -189,7 +191,7 @@ fn bench(c: &mut Criterion) {
         bch.iter(|| legacy_flood(&g, from));
     });
     grp.bench_function("bfs/search_space_flood_fill", |bch| {
-        bch.iter(|| module_flood(&mut new, &g, from));
+        bch.iter(|| module_flood(&mut new_bfs, &g, from));
     });
     grp.finish();
 }
