@@ -6,7 +6,8 @@
 //!   [`TileSearch::nearest`] (BA*'s own scratch) against [`SearchSpace`] driven the same way.
 //! * `astar/*`: corner to corner: [`TileSearch::astar`] against [`SearchSpace`].
 //! * `bfs/*`: a 4-connected flood of the whole component: the former BSA-BFS pattern (a fresh
-//!   parent array and a `VecDeque` per search) against [`SearchSpace::flood_fill`].
+//!   parent array and a `VecDeque` per search) against [`SearchSpace::flood_fill`] and the
+//!   same flood through the driver calls ([`SearchSpace::pop_fifo`], [`SearchSpace::discover`]).
 //!
 //! Before timing, each pair is checked to give the same cost and the same path.
 
@@ -137,6 +138,23 @@ fn module_flood(s: &mut SearchSpace<u32>, g: &Pixels, from: Tile) -> usize {
     .len()
 }
 
+/// The same flood through the driver calls (no neighbour buffer).
+fn module_flood_driver(s: &mut SearchSpace<u32>, g: &Pixels, from: Tile) -> usize {
+    s.begin();
+    s.push_fifo_source(g.idx(from).expect("in range"));
+    while let Some((v, _)) = s.pop_fifo() {
+        let t = g.tile(v);
+        for (di, dj) in [(1, 0), (0, 1), (-1, 0), (0, -1)] {
+            if let Some(k) = g.idx((t.0 + di, t.1 + dj)) {
+                if g.free[k as usize] {
+                    s.discover(v, k);
+                }
+            }
+        }
+    }
+    s.fifo_order().len()
+}
+
 fn bench(c: &mut Criterion) {
     let g = grid();
     let from = free_near(&g, (g.w / 2, g.h / 2));
@@ -172,6 +190,10 @@ fn bench(c: &mut Criterion) {
     let path: Vec<Tile> = new.path_to(b.0).iter().map(|&k| g.tile(k)).collect();
     assert_eq!((a.0, a.1), (path, b.1), "astar differs");
     assert_eq!(legacy_flood(&g, from), module_flood(&mut new_bfs, &g, from));
+    assert_eq!(
+        legacy_flood(&g, from),
+        module_flood_driver(&mut new_bfs, &g, from)
+    );
 
     let mut grp = c.benchmark_group("search_office_2000");
     grp.sample_size(10);
@@ -192,6 +214,9 @@ fn bench(c: &mut Criterion) {
     });
     grp.bench_function("bfs/search_space_flood_fill", |bch| {
         bch.iter(|| module_flood(&mut new_bfs, &g, from));
+    });
+    grp.bench_function("bfs/search_space_driver", |bch| {
+        bch.iter(|| module_flood_driver(&mut new_bfs, &g, from));
     });
     grp.finish();
 }
