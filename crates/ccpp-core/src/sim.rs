@@ -235,7 +235,7 @@ impl<'w> Simulator<'w> {
         };
         let a = self.pose.position();
         let b = Point::new(a.x + d.abs() * dir.cos(), a.y + d.abs() * dir.sin());
-        match self.world.first_contact(a, b) {
+        match self.world.true_first_contact(a, b) {
             None => {
                 self.pose.x = b.x;
                 self.pose.y = b.y;
@@ -350,7 +350,7 @@ impl<'w> Simulator<'w> {
             let hit = if a == b {
                 None
             } else {
-                self.world.first_contact(a, b)
+                self.world.true_first_contact(a, b)
             };
             if let Some(t) = hit {
                 let p = a + (b - a).scale(t);

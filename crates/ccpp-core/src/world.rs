@@ -10,6 +10,7 @@ use crate::collide::{self, contact_radius_px};
 use crate::dt::{squared_edt, INF};
 use crate::geometry::{Point, Pose};
 use crate::grid::{Cell, GridMap, MapFrame};
+use crate::zones::{MaskOccupancy, ZoneMasks};
 
 /// The robot model: a disk of radius `radius` carrying a cleaning tool of radius `tool_radius`.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -107,19 +108,64 @@ pub enum WorldError {
         /// Robot radius.
         radius: f64,
     },
+    /// The robot's disk at the start overlaps a keep-out zone.
+    #[error(
+        "start ({x:.3}, {y:.3}) is in a keep-out zone: a robot of radius {radius} m there \
+         overlaps keep-out pixels"
+    )]
+    StartInKeepout {
+        /// Start x.
+        x: f64,
+        /// Start y.
+        y: f64,
+        /// Robot radius.
+        radius: f64,
+    },
+    /// The robot's disk at the start reaches outside the work area.
+    #[error(
+        "start ({x:.3}, {y:.3}) is outside the area: a robot of radius {radius} m there is not \
+         wholly inside it; start inside the area (omit --start to have one chosen there)"
+    )]
+    StartOutsideArea {
+        /// Start x.
+        x: f64,
+        /// Start y.
+        y: f64,
+        /// Robot radius.
+        radius: f64,
+    },
+    /// The zones leave no spot where the robot fits.
+    #[error(
+        "the area minus the keep-out zones holds no floor where a robot of radius {radius} m \
+         fits ({free_px} free pixels inside the area)"
+    )]
+    NoRoomInZones {
+        /// Robot radius.
+        radius: f64,
+        /// Free pixels of the true map that are inside the area and outside every keep-out.
+        free_px: usize,
+    },
 }
 
 /// The ground truth for one robot on one map.
 #[derive(Clone)]
 pub struct World {
+    /// The true map (collisions).
     map: GridMap,
+    /// The true map with every forbidden zone pixel occupied (what planners plan on); `None`
+    /// without zones.
+    plan: Option<GridMap>,
+    zones: Option<ZoneMasks>,
     robot: Robot,
     start: Pose,
-    /// Squared distance (px^2) from each pixel centre to the nearest non-free pixel centre,
-    /// counting the outside as non-free.
+    /// Squared distance (px^2) from each pixel centre to the nearest non-free pixel centre of
+    /// the planning map (virtual walls included), counting the outside as non-free.
     obstacle_dt2: Vec<u32>,
-    /// Non-free pixels (the simulator's collision checks skip free runs a word at a time).
+    /// Non-free pixels of the true map (the simulator's collision checks skip free runs a
+    /// word at a time).
     blocked: FixedBitSet,
+    /// Non-free pixels of the planning map (with zones only).
+    plan_blocked: Option<FixedBitSet>,
     cfree: FixedBitSet,
     reachable: FixedBitSet,
     accessible: FixedBitSet,
@@ -145,9 +191,45 @@ impl World {
     /// # Errors
     /// Invalid radii, a robot that fits nowhere, a start outside the map or in an obstacle.
     pub fn new(map: GridMap, robot: Robot, start: Option<Pose>) -> Result<Self, WorldError> {
+        Self::with_zones(map, robot, start, None)
+    }
+
+    /// [`World::new`] with work zones ([`crate::zones`]): every pixel outside the area and every
+    /// keep-out pixel becomes a virtual wall. C-free, the reachable component, the accessible
+    /// surface, the default start and [`World::map`] (what planners plan on and the sensor
+    /// reads) include the virtual walls; collisions ([`World::first_contact`]) are checked
+    /// against the true map only ([`World::true_map`]). Empty zones are the same as `None`.
+    ///
+    /// # Errors
+    /// As [`World::new`], plus a start in a keep-out zone or not wholly inside the area, and
+    /// zones that leave no spot where the robot fits.
+    ///
+    /// # Panics
+    /// When a zone mask is not the map's size.
+    pub fn with_zones(
+        map: GridMap,
+        robot: Robot,
+        start: Option<Pose>,
+        zones: Option<ZoneMasks>,
+    ) -> Result<Self, WorldError> {
         robot.validate()?;
         let frame = *map.frame();
-        let cells = map.cells();
+        let zones = zones.filter(|z| !z.is_empty());
+        let plan = zones.as_ref().map(|z| {
+            assert!(
+                z.keepout.len() == frame.len()
+                    && z.area.as_ref().is_none_or(|a| a.len() == frame.len()),
+                "zone masks must match the map"
+            );
+            let mut p = map.clone();
+            for (i, c) in p.cells_mut().iter_mut().enumerate() {
+                if c.is_free() && z.forbidden(i) {
+                    *c = Cell::Occupied;
+                }
+            }
+            p
+        });
+        let cells = plan.as_ref().unwrap_or(&map).cells();
         let obstacle_dt2 = squared_edt(frame.width, frame.height, |i| !cells[i].is_free(), true);
         let r_px = robot.radius / frame.resolution;
         // C-free at a pixel centre: distance to every blocked centre >= contact radius.
@@ -163,6 +245,23 @@ impl World {
                 max_d2 = max_d2.max(d2);
             }
         }
+        if cfree.is_clear() && zones.is_some() {
+            let free_px = cells.iter().filter(|c| c.is_free()).count();
+            let fits_without = squared_edt(
+                frame.width,
+                frame.height,
+                |i| !map.cells()[i].is_free(),
+                true,
+            )
+            .iter()
+            .any(|&d2| f64::from(d2) >= rc2);
+            if fits_without {
+                return Err(WorldError::NoRoomInZones {
+                    radius: robot.radius,
+                    free_px,
+                });
+            }
+        }
         if cfree.is_clear() {
             return Err(WorldError::RobotTooBig {
                 radius: robot.radius,
@@ -174,13 +273,25 @@ impl World {
             None => default_start(&frame, &cfree, &obstacle_dt2),
         };
         let mut blocked = FixedBitSet::with_capacity(frame.len());
-        for (i, c) in cells.iter().enumerate() {
+        for (i, c) in map.cells().iter().enumerate() {
             if !c.is_free() {
                 blocked.insert(i);
             }
         }
+        let plan_blocked = plan.as_ref().map(|p| {
+            let mut b = FixedBitSet::with_capacity(frame.len());
+            for (i, c) in p.cells().iter().enumerate() {
+                if !c.is_free() {
+                    b.insert(i);
+                }
+            }
+            b
+        });
         let mut world = Self {
             map,
+            plan,
+            plan_blocked,
+            zones,
             robot,
             start,
             obstacle_dt2,
@@ -213,12 +324,33 @@ impl World {
                 y1: hi.y,
             });
         }
-        if self.disk_collides(s.position()) {
+        if self.true_disk_collides(s.position()) {
             return Err(WorldError::StartInObstacle {
                 x: s.x,
                 y: s.y,
                 radius: self.robot.radius,
             });
+        }
+        if let Some(z) = &self.zones {
+            let g = frame.world_to_grid(s.position());
+            let r_px = self.r_px();
+            let keepout = MaskOccupancy::new(frame, &z.keepout, false);
+            if collide::disk_hits(&keepout, g, r_px) {
+                return Err(WorldError::StartInKeepout {
+                    x: s.x,
+                    y: s.y,
+                    radius: self.robot.radius,
+                });
+            }
+            if let Some(area) = &z.area {
+                if collide::disk_hits(&MaskOccupancy::new(frame, area, true), g, r_px) {
+                    return Err(WorldError::StartOutsideArea {
+                        x: s.x,
+                        y: s.y,
+                        radius: self.robot.radius,
+                    });
+                }
+            }
         }
         Ok(())
     }
@@ -268,14 +400,26 @@ impl World {
     fn compute_accessible(&mut self) {
         let frame = *self.map.frame();
         let rt = self.robot.tool_radius / frame.resolution + 1e-6;
-        let acc = accessible_pixels(&self.map, &self.reachable, rt);
+        let acc = accessible_pixels(self.map(), &self.reachable, rt);
         self.accessible_count = acc.count_ones(..);
         self.accessible = acc;
     }
 
-    /// The true map.
+    /// The map planners plan on and the sensor reads: the true map, with every pixel outside
+    /// the work area and every keep-out pixel occupied when the world has zones
+    /// ([`World::with_zones`]); the true map otherwise.
     pub fn map(&self) -> &GridMap {
+        self.plan.as_ref().unwrap_or(&self.map)
+    }
+
+    /// The true map (what collisions are checked against; pictures draw it).
+    pub fn true_map(&self) -> &GridMap {
         &self.map
+    }
+
+    /// The work zones as pixel masks, if any.
+    pub fn zones(&self) -> Option<&ZoneMasks> {
+        self.zones.as_ref()
     }
 
     /// The map's geometry.
@@ -293,7 +437,7 @@ impl World {
         self.start
     }
 
-    /// C-free pixel centres (whole map).
+    /// C-free pixel centres (whole map; virtual walls count as obstacles).
     pub fn cfree(&self) -> &FixedBitSet {
         &self.cfree
     }
@@ -304,7 +448,8 @@ impl World {
     }
 
     /// The accessible surface `A`: free pixels whose centre lies within `r_tool` of a reachable
-    /// C-free centre.
+    /// C-free centre. With zones: free pixels of [`World::map`] (inside the area, outside every
+    /// keep-out) within `r_tool` of a reachable centre of C-free under the virtual walls.
     pub fn accessible(&self) -> &FixedBitSet {
         &self.accessible
     }
@@ -321,7 +466,7 @@ impl World {
     }
 
     /// Clearance in metres at the centre of pixel `(col, row)`: distance to the nearest blocked
-    /// pixel's inscribed disk.
+    /// pixel's inscribed disk (virtual walls included).
     pub fn pixel_clearance(&self, col: usize, row: usize) -> f64 {
         let d2 = self.obstacle_dt2[self.frame().index(col, row)];
         (f64::from(d2).sqrt() - 0.5) * self.frame().resolution
@@ -345,21 +490,50 @@ impl World {
         }
     }
 
-    /// Does the robot's disk centred at world point `p` overlap a non-free pixel (exact)?
+    /// Does the robot's disk centred at world point `p` overlap a non-free pixel of the
+    /// planning map [`World::map`] (exact; virtual walls included)? What offline planners
+    /// check; the simulator uses [`World::true_disk_collides`].
     pub fn disk_collides(&self, p: Point) -> bool {
+        self.disk_hits_on(p, self.map())
+    }
+
+    /// Does the robot's disk centred at world point `p` overlap a non-free pixel of the true
+    /// map (exact; virtual walls ignored)?
+    pub fn true_disk_collides(&self, p: Point) -> bool {
+        self.disk_hits_on(p, &self.map)
+    }
+
+    fn disk_hits_on(&self, p: Point, map: &GridMap) -> bool {
         let g = self.frame().world_to_grid(p);
         let r_px = self.r_px();
         if self.dist_lower_bound_px(g) > contact_radius_px(r_px) + 1e-9 {
             return false;
         }
-        collide::disk_hits(&self.map, g, r_px)
+        collide::disk_hits(map, g, r_px)
     }
 
-    /// Exact first contact of the robot's disk moving straight from `a` to `b` (world frame):
-    /// the parameter `t` in `[0, 1]` of the first overlap with a non-free pixel, or `None`.
-    /// Sphere-traces the distance transform through open space and checks pixels exactly near
-    /// obstacles, so long moves across open halls stay cheap.
+    /// Exact first contact of the robot's disk moving straight from `a` to `b` (world frame)
+    /// with the planning map [`World::map`] (virtual walls included): the parameter `t` in
+    /// `[0, 1]` of the first overlap with a non-free pixel, or `None`. What offline planners
+    /// check; the simulator uses [`World::true_first_contact`]. Sphere-traces the distance
+    /// transform through open space and checks pixels exactly near obstacles, so long moves
+    /// across open halls stay cheap.
     pub fn first_contact(&self, a: Point, b: Point) -> Option<f64> {
+        match (&self.plan, &self.plan_blocked) {
+            (Some(map), Some(blocked)) => self.contact_on(a, b, map, blocked),
+            _ => self.contact_on(a, b, &self.map, &self.blocked),
+        }
+    }
+
+    /// [`World::first_contact`] against the true map (virtual walls do not stop the robot):
+    /// the simulator's bumper.
+    pub fn true_first_contact(&self, a: Point, b: Point) -> Option<f64> {
+        self.contact_on(a, b, &self.map, &self.blocked)
+    }
+
+    /// First contact with `map` (whose non-free pixels are `blocked`). The distance transform
+    /// is the planning map's: a lower bound of the distance to `map`'s obstacles either way.
+    fn contact_on(&self, a: Point, b: Point, map: &GridMap, blocked: &FixedBitSet) -> Option<f64> {
         let frame = self.frame();
         let ga = frame.world_to_grid(a);
         let gb = frame.world_to_grid(b);
@@ -367,7 +541,7 @@ impl World {
         let r_px = self.r_px();
         let rc = contact_radius_px(r_px);
         if len == 0.0 {
-            return if collide::disk_hits(&self.map, ga, r_px) {
+            return if collide::disk_hits(map, ga, r_px) {
                 Some(0.0)
             } else {
                 None
@@ -384,10 +558,7 @@ impl World {
             }
             let e = (s + 1.0).min(len);
             let q = ga.add(u.scale(e));
-            let truth = Truth {
-                map: &self.map,
-                blocked: &self.blocked,
-            };
+            let truth = Truth { map, blocked };
             if let Some(t) = collide::segment_first_contact(&truth, p, q, r_px) {
                 return Some(((s + t * (e - s)) / len).clamp(0.0, 1.0));
             }
@@ -396,7 +567,8 @@ impl World {
         None
     }
 
-    /// Is the straight motion of the robot from `a` to `b` free of contact?
+    /// Is the straight motion of the robot from `a` to `b` free of contact with the planning
+    /// map (virtual walls included)?
     pub fn segment_free(&self, a: Point, b: Point) -> bool {
         self.first_contact(a, b).is_none()
     }

@@ -602,6 +602,8 @@ fn bench_run(
             planner: PlannerConfig::new(kind),
             sim: SimConfig::default(),
             max_memory_mb: max_memory_mb.unwrap_or(DEFAULT_MAX_MEMORY_MB),
+            area: None,
+            keepout: Vec::new(),
         };
         let run = scenario.run_on(&map).map_err(|e| chain(&e))?;
         if let Some(dir) = &out {
