@@ -355,7 +355,16 @@ impl Job {
     /// scenario's start becomes the start actually used, so that `run.json` replays exactly.
     pub fn execute(&mut self) -> Result<JobResult> {
         let run = self.scenario.run_on(&self.map)?;
-        let s = run.world.start();
+        let s = run.world.initial_pose();
+        if !run.world.approach().is_empty() {
+            let e = run.world.start();
+            eprintln!(
+                "note: the start is outside the area: the robot first drives {:.2} m on the known map to reach it at ({:.3}, {:.3})",
+                run.world.approach_length_m(),
+                e.x,
+                e.y
+            );
+        }
         self.scenario.start = Some([s.x, s.y, s.theta]);
         Ok(JobResult {
             world: run.world,

@@ -121,12 +121,26 @@ pub enum WorldError {
         /// Robot radius.
         radius: f64,
     },
-    /// The robot's disk at the start reaches outside the work area.
+    /// The robot's disk at the start reaches outside the work area (internal: such a start
+    /// gets an approach, [`World::approach`], and this is never returned).
     #[error(
         "start ({x:.3}, {y:.3}) is outside the area: a robot of radius {radius} m there is not \
-         wholly inside it; start inside the area (omit --start to have one chosen there)"
+         wholly inside it"
     )]
     StartOutsideArea {
+        /// Start x.
+        x: f64,
+        /// Start y.
+        y: f64,
+        /// Robot radius.
+        radius: f64,
+    },
+    /// No path leads from a start outside the area into it.
+    #[error(
+        "the area cannot be reached from the start ({x:.3}, {y:.3}): no path for a robot of \
+         radius {radius} m leads into it without touching an obstacle or a keep-out zone"
+    )]
+    AreaUnreachable {
         /// Start x.
         x: f64,
         /// Start y.
@@ -157,7 +171,13 @@ pub struct World {
     plan: Option<GridMap>,
     zones: Option<ZoneMasks>,
     robot: Robot,
+    /// Where coverage starts (the end of the approach when the start is outside the area).
     start: Pose,
+    /// Where the robot is placed: `start`, or a pose outside the area.
+    initial: Pose,
+    /// The approach from `initial` to `start` (waypoints after `initial`; empty when the
+    /// robot starts inside the area).
+    approach: Vec<Point>,
     /// Squared distance (px^2) from each pixel centre to the nearest non-free pixel centre of
     /// the planning map (virtual walls included), counting the outside as non-free.
     obstacle_dt2: Vec<u32>,
@@ -294,6 +314,8 @@ impl World {
             zones,
             robot,
             start,
+            initial: start,
+            approach: Vec::new(),
             obstacle_dt2,
             blocked,
             cfree,
@@ -301,7 +323,10 @@ impl World {
             accessible: FixedBitSet::with_capacity(frame.len()),
             accessible_count: 0,
         };
-        world.check_start()?;
+        match world.check_start() {
+            Err(WorldError::StartOutsideArea { .. }) => world.plan_approach()?,
+            r => r?,
+        }
         world.reachable = world.flood_reachable();
         world.compute_accessible();
         Ok(world)
@@ -353,6 +378,166 @@ impl World {
             }
         }
         Ok(())
+    }
+
+    /// The approach of a start outside the area: the shortest 8-connected chain of pixel
+    /// centres where the robot stands clear of obstacles and keep-outs (the area's border does
+    /// not count) from the start to the nearest centre that is C-free under every virtual wall,
+    /// shortened to straight segments that are free of obstacles and keep-outs (exact swept-disk
+    /// test). Sets `start` to its end (heading along its last segment).
+    fn plan_approach(&mut self) -> Result<(), WorldError> {
+        let s = self.start;
+        let unreachable = || WorldError::AreaUnreachable {
+            x: s.x,
+            y: s.y,
+            radius: self.robot.radius,
+        };
+        let Some(z) = self.zones.as_ref() else {
+            return Err(unreachable());
+        };
+        let frame = *self.map.frame();
+        let (w, h) = (frame.width, frame.height);
+        let cells = self.map.cells();
+        let dt = squared_edt(w, h, |i| !cells[i].is_free() || z.keepout.contains(i), true);
+        let r_px = self.r_px();
+        let rc = contact_radius_px(r_px);
+        let occ = Approach {
+            map: &self.map,
+            keepout: &z.keepout,
+        };
+        let free_seg =
+            |a: Point, b: Point| collide::segment_first_contact(&occ, a, b, r_px).is_none();
+        let ok = |i: usize| f64::from(dt[i]) >= rc * rc;
+        // Dijkstra with integer octile costs (70 straight, 99 diagonal).
+        let mut dist = vec![u32::MAX; frame.len()];
+        let mut parent = vec![u32::MAX; frame.len()];
+        let mut heap = std::collections::BinaryHeap::new();
+        let g0 = frame.world_to_grid(s.position());
+        let (sc, sr) = frame.grid_to_pixel_signed(g0);
+        for dr in -1..=1i64 {
+            for dc in -1..=1i64 {
+                if let Some((c, r)) = frame.checked(sc + dc, sr + dr) {
+                    let i = frame.index(c, r);
+                    if ok(i) && free_seg(g0, frame.pixel_center_grid(c, r)) {
+                        let d = if dc == 0 && dr == 0 {
+                            0
+                        } else if dc == 0 || dr == 0 {
+                            70
+                        } else {
+                            99
+                        };
+                        if d < dist[i] {
+                            dist[i] = d;
+                            heap.push(std::cmp::Reverse((d, i)));
+                        }
+                    }
+                }
+            }
+        }
+        let mut goal = None;
+        while let Some(std::cmp::Reverse((d, i))) = heap.pop() {
+            if d > dist[i] {
+                continue;
+            }
+            if self.cfree.contains(i) {
+                goal = Some(i);
+                break;
+            }
+            let (c, r) = ((i % w) as i64, (i / w) as i64);
+            for (dc, dr, cost) in [
+                (1, 0, 70),
+                (-1, 0, 70),
+                (0, 1, 70),
+                (0, -1, 70),
+                (1, 1, 99),
+                (-1, 1, 99),
+                (1, -1, 99),
+                (-1, -1, 99),
+            ] {
+                if let Some((nc, nr)) = frame.checked(c + dc, r + dr) {
+                    let j = frame.index(nc, nr);
+                    let nd = d + cost;
+                    if ok(j) && nd < dist[j] {
+                        dist[j] = nd;
+                        parent[j] = i as u32;
+                        heap.push(std::cmp::Reverse((nd, j)));
+                    }
+                }
+            }
+        }
+        let goal = goal.ok_or_else(unreachable)?;
+        let mut chain = vec![goal];
+        let mut k = goal;
+        while parent[k] != u32::MAX {
+            k = parent[k] as usize;
+            chain.push(k);
+        }
+        chain.reverse();
+        let pts: Vec<Point> = std::iter::once(g0)
+            .chain(chain.iter().map(|&i| {
+                let (c, r) = frame.col_row(i);
+                frame.pixel_center_grid(c, r)
+            }))
+            .collect();
+        // Greedy shortening: from each kept point, as far along the chain as a free segment
+        // reaches.
+        let mut kept = Vec::new();
+        let mut anchor = pts[0];
+        for j in 1..pts.len() {
+            if !free_seg(anchor, pts[j]) {
+                let prev = pts[j - 1];
+                if prev == anchor || !free_seg(prev, pts[j]) {
+                    return Err(unreachable());
+                }
+                kept.push(prev);
+                anchor = prev;
+            }
+        }
+        if let Some(&last) = pts.last() {
+            if last != g0 {
+                kept.push(last);
+            }
+        }
+        let approach: Vec<Point> = kept.iter().map(|&g| frame.grid_to_world(g)).collect();
+        let end = approach.last().copied().unwrap_or(s.position());
+        let before = if approach.len() >= 2 {
+            approach[approach.len() - 2]
+        } else {
+            s.position()
+        };
+        let theta = if end == before {
+            s.theta
+        } else {
+            (end.y - before.y).atan2(end.x - before.x)
+        };
+        self.initial = s;
+        self.start = Pose::new(end.x, end.y, theta);
+        self.approach = approach;
+        Ok(())
+    }
+
+    /// Where the robot is placed: the start, or, when the start given is outside the work
+    /// area, that pose (the robot then drives [`World::approach`] to [`World::start`] first).
+    pub fn initial_pose(&self) -> Pose {
+        self.initial
+    }
+
+    /// The approach from [`World::initial_pose`] to [`World::start`] when the start given lies
+    /// outside the work area: waypoints (world frame) after the initial position, driven
+    /// before the planner starts; empty otherwise. It avoids obstacles and keep-outs.
+    pub fn approach(&self) -> &[Point] {
+        &self.approach
+    }
+
+    /// Length of [`World::approach`], metres.
+    pub fn approach_length_m(&self) -> f64 {
+        let mut last = self.initial.position();
+        let mut len = 0.0;
+        for p in &self.approach {
+            len += last.dist(*p);
+            last = *p;
+        }
+        len
     }
 
     /// 8-connected flood fill of C-free pixel centres from the start's pixel (or, if that centre
@@ -432,7 +617,8 @@ impl World {
         self.robot
     }
 
-    /// The start pose.
+    /// The pose coverage starts from: the start, or the end of the approach when the start
+    /// given lies outside the work area ([`World::initial_pose`]).
     pub fn start(&self) -> Pose {
         self.start
     }
@@ -571,6 +757,26 @@ impl World {
     /// map (virtual walls included)?
     pub fn segment_free(&self, a: Point, b: Point) -> bool {
         self.first_contact(a, b).is_none()
+    }
+}
+
+/// The true map plus keep-out pixels (the approach's obstacles).
+struct Approach<'a> {
+    map: &'a GridMap,
+    keepout: &'a FixedBitSet,
+}
+
+impl collide::Occupancy for Approach<'_> {
+    fn frame(&self) -> &MapFrame {
+        self.map.frame()
+    }
+    fn blocked(&self, col: i64, row: i64) -> bool {
+        !self.map.get_signed(col, row).is_free()
+            || self
+                .map
+                .frame()
+                .checked(col, row)
+                .is_some_and(|(c, r)| self.keepout.contains(self.map.frame().index(c, r)))
     }
 }
 

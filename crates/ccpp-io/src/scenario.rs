@@ -556,7 +556,7 @@ impl Scenario {
             (!labels.is_empty()).then(|| ("keepout", labels.join(", ")))
         };
         match e {
-            WorldError::StartOutsideArea { .. } => area,
+            WorldError::StartOutsideArea { .. } | WorldError::AreaUnreachable { .. } => area,
             WorldError::StartInKeepout { .. } => keep(),
             WorldError::NoRoomInZones { .. } => area.or_else(keep),
             _ => None,

@@ -742,7 +742,7 @@ fn draw_markers(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
         }
     }
     // Start and end.
-    let s = world.start();
+    let s = world.initial_pose();
     let (sx, sy) = view.to_canvas(world, s.position());
     if let Some(c) = PathBuilder::from_circle(sx, sy, rad.max(4.0)) {
         pm.fill_path(
