@@ -113,13 +113,13 @@ pub struct RunArgs {
     /// Rectangular robot width in metres (rect-boustrophedon: lane spacing).
     #[arg(long, value_name = "M")]
     pub width: Option<f64>,
-    /// Work area, every planner: a polygon file (GeoJSON, or YAML list of x,y points; map
+    /// Work area, every planner: a polygon file (`GeoJSON`, or YAML list of x,y points; map
     /// coordinates) or a rectangle `X0,Y0,X1,Y1`. The robot stays inside it (virtual walls)
     /// and coverage is measured on the floor inside it. Default: the whole map.
     #[arg(long, value_name = "FILE|X0,Y0,X1,Y1", value_parser = parse_zone, allow_hyphen_values = true)]
     pub area: Option<ZoneSpec>,
-    /// Keep-out zone, every planner (repeatable): a Nav2 keepout filter mask (map_server YAML +
-    /// image in the map's frame, occupied = forbidden), a polygon file (GeoJSON or YAML) or a
+    /// Keep-out zone, every planner (repeatable): a Nav2 keepout filter mask (`map_server` YAML +
+    /// image in the map's frame, occupied = forbidden), a polygon file (`GeoJSON` or YAML) or a
     /// rectangle `X0,Y0,X1,Y1`. Never entered; entries are counted as `keepout_violations`.
     #[arg(long, value_name = "FILE|X0,Y0,X1,Y1", value_parser = parse_zone, allow_hyphen_values = true)]
     pub keepout: Vec<ZoneSpec>,

@@ -1,5 +1,7 @@
 //! `ccpp info`: what a map holds and how much of it a robot can reach.
 
+use std::fmt::Write as _;
+
 use anyhow::Result;
 use ccpp_core::grid::{Cell, GridMap};
 use ccpp_core::world::{World, WorldError};
@@ -51,6 +53,7 @@ struct Info {
 
 /// Sizes of the zones (`ccpp info --area/--keepout`).
 #[derive(Serialize)]
+#[allow(clippy::struct_field_names)] // the JSON keys carry their unit
 struct ZonesInfo {
     /// Map area inside the work area (every pixel class), m^2; `None` without an area.
     area_m2: Option<f64>,
@@ -321,9 +324,10 @@ pub fn run(a: &InfoArgs) -> Result<()> {
                 .as_ref()
                 .map(ccpp_io::zones::ZoneSpec::label)
                 .unwrap_or_default();
-            t.push_str(&format!(
-                "area           {label}: {a:.2} m2, {af:.2} m2 of it free floor\n"
-            ));
+            let _ = writeln!(
+                t,
+                "area           {label}: {a:.2} m2, {af:.2} m2 of it free floor"
+            );
         }
         if !zs.keepout.is_empty() {
             let labels: Vec<String> = zs
@@ -331,12 +335,13 @@ pub fn run(a: &InfoArgs) -> Result<()> {
                 .iter()
                 .map(ccpp_io::zones::ZoneSpec::label)
                 .collect();
-            t.push_str(&format!(
-                "keep-out       {}: {:.2} m2, {:.2} m2 of it free floor\n",
+            let _ = writeln!(
+                t,
+                "keep-out       {}: {:.2} m2, {:.2} m2 of it free floor",
                 labels.join(", "),
                 z.keepout_m2,
                 z.keepout_free_m2
-            ));
+            );
         }
     }
     crate::print_stdout(&t)

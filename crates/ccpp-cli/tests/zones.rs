@@ -1,4 +1,4 @@
-//! Work zones end to end (issue 14 part 2): keep-outs (a Nav2 mask over a room plus a GeoJSON
+//! Work zones end to end (issue 14 part 2): keep-outs (a Nav2 mask over a room plus a `GeoJSON`
 //! polygon over furniture) hold for every planner on a real shared map, with coverage measured
 //! on the allowed floor; an area polygon around one room keeps the path in that room; bad zone
 //! input gives one `error:` line naming the file.
@@ -27,7 +27,7 @@ const ALL: [&str; 8] = [
     "rect-boustrophedon",
 ];
 
-/// aws_small_house's frame: 500 x 500 px at 0.05 m/px, origin (-12.5, -12.5).
+/// `aws_small_house`'s frame: 500 x 500 px at 0.05 m/px, origin (-12.5, -12.5).
 const W: usize = 500;
 const RES: f64 = 0.05;
 const ORIGIN: f64 = -12.5;
@@ -56,7 +56,7 @@ fn mask(dir: &Path, name: &str, origin: f64, inside: impl Fn(f64, f64) -> bool) 
 }
 
 /// The east room (x in [5, 9.5], y in [-0.2, 3.4]) as a mask, the round table of the north
-/// room as a GeoJSON Feature.
+/// room as a `GeoJSON` Feature.
 fn keepouts(dir: &Path) -> (PathBuf, PathBuf) {
     let m = mask(dir, "room_mask", ORIGIN, |x, y| {
         (5.0..=9.5).contains(&x) && (-0.2..=3.4).contains(&y)

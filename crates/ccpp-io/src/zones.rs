@@ -1,6 +1,6 @@
 //! Zone files for `--area` and `--keepout` ([`ccpp_core::zones`] holds the semantics):
 //!
-//! * **GeoJSON** (`.geojson` / `.json`): a `Polygon`, `MultiPolygon`, `Feature`,
+//! * **`GeoJSON`** (`.geojson` / `.json`): a `Polygon`, `MultiPolygon`, `Feature`,
 //!   `FeatureCollection` or `GeometryCollection` of them, in **map coordinates** (metres, the
 //!   map's frame; `[x, y]` order, a third coordinate ignored). Only outer rings: a polygon with
 //!   holes is refused (give the hole's surroundings as separate polygons).
@@ -31,7 +31,7 @@ pub enum ZoneSpec {
     Rect([f64; 4]),
     /// Polygons given inline, map coordinates.
     Polygons(Vec<Polygon>),
-    /// A polygon file (GeoJSON or YAML) or, for keep-outs, a Nav2 keepout filter mask.
+    /// A polygon file (`GeoJSON` or YAML) or, for keep-outs, a Nav2 keepout filter mask.
     File(PathBuf),
 }
 
@@ -116,14 +116,15 @@ pub fn check_rect(r: [f64; 4]) -> Result<(), ZoneFileError> {
     Ok(())
 }
 
-/// Reads a zone file: GeoJSON, YAML polygons or a Nav2 mask (checked against `frame`).
+/// Reads a zone file: `GeoJSON`, YAML polygons or a Nav2 mask (checked against `frame`).
 fn read_file(path: &Path, frame: &MapFrame) -> Result<ZoneData, ZoneFileError> {
     let text = crate::file::read_text(path).map_err(|e| bad(e.to_string()))?;
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
-    if ext == "geojson" || ext == "json" || text.trim_start().starts_with('{') && ext != "yaml" {
+    let yaml_ext = ext == "yaml" || ext == "yml";
+    if ext == "geojson" || ext == "json" || (!yaml_ext && text.trim_start().starts_with('{')) {
         let v: Value = serde_json::from_str(&text).map_err(|e| bad(format!("GeoJSON: {e}")))?;
         return Ok(ZoneData::Polygons(geojson_polygons(&v)?));
     }
@@ -216,7 +217,7 @@ fn yaml_polygons(v: &Value) -> Result<Vec<Polygon>, ZoneFileError> {
     a.iter().map(ring).collect()
 }
 
-/// Polygons of a GeoJSON object.
+/// Polygons of a `GeoJSON` object.
 fn geojson_polygons(v: &Value) -> Result<Vec<Polygon>, ZoneFileError> {
     let mut out = Vec::new();
     geojson_collect(v, &mut out, 0)?;

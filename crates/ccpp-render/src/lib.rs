@@ -229,8 +229,10 @@ fn shown(world: &World, trace: &Trace, crop: (usize, usize, usize, usize)) -> Sh
     let swept = swept_pixels(world, trace);
     let acc = world.accessible();
     let cells = world.true_map().cells();
-    let mut s = Shown::default();
-    s.area_border = world.zones().is_some_and(|z| !z.area_polygons.is_empty());
+    let mut s = Shown {
+        area_border: world.zones().is_some_and(|z| !z.area_polygons.is_empty()),
+        ..Shown::default()
+    };
     let (c0, r0, w, h) = crop;
     for r in r0..r0 + h {
         for c in c0..c0 + w {
