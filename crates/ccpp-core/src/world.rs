@@ -221,8 +221,9 @@ impl World {
     /// against the true map only ([`World::true_map`]). Empty zones are the same as `None`.
     ///
     /// # Errors
-    /// As [`World::new`], plus a start in a keep-out zone or not wholly inside the area, and
-    /// zones that leave no spot where the robot fits.
+    /// As [`World::new`], plus a start in a keep-out zone, an area the start cannot reach
+    /// (a start outside the area gets an approach, [`World::approach`]), and zones that leave
+    /// no spot where the robot fits.
     ///
     /// # Panics
     /// When a zone mask is not the map's size.
