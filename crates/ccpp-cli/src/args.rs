@@ -2,6 +2,7 @@
 
 use std::path::PathBuf;
 
+use ccpp_io::zones::ZoneSpec;
 use clap::{Args, Parser, Subcommand};
 
 /// Complete coverage path planning for mobile robots on 2-D occupancy-grid maps.
@@ -112,9 +113,16 @@ pub struct RunArgs {
     /// Rectangular robot width in metres (rect-boustrophedon: lane spacing).
     #[arg(long, value_name = "M")]
     pub width: Option<f64>,
-    /// Area to cover `X0,Y0,X1,Y1` (rect-boustrophedon; default: the start's free component).
-    #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = parse_quad, allow_hyphen_values = true)]
-    pub area: Option<[f64; 4]>,
+    /// Work area, every planner: a polygon file (`GeoJSON`, or YAML list of x,y points; map
+    /// coordinates) or a rectangle `X0,Y0,X1,Y1`. The robot stays inside it (virtual walls)
+    /// and coverage is measured on the floor inside it. Default: the whole map.
+    #[arg(long, value_name = "FILE|X0,Y0,X1,Y1", value_parser = parse_zone, allow_hyphen_values = true)]
+    pub area: Option<ZoneSpec>,
+    /// Keep-out zone, every planner (repeatable): a Nav2 keepout filter mask (`map_server` YAML +
+    /// image in the map's frame, occupied = forbidden), a polygon file (`GeoJSON` or YAML) or a
+    /// rectangle `X0,Y0,X1,Y1`. Never entered; entries are counted as `keepout_violations`.
+    #[arg(long, value_name = "FILE|X0,Y0,X1,Y1", value_parser = parse_zone, allow_hyphen_values = true)]
+    pub keepout: Vec<ZoneSpec>,
     /// Motion execution: `ideal` (exact rotate/translate) or `pid` (unicycle with PID
     /// tracking). Default: the planner's choice (bsa-bfs and rect-boustrophedon: pid).
     #[arg(long, value_name = "ideal|pid")]
@@ -156,9 +164,14 @@ pub struct WaypointsArgs {
     /// Robot width in metres (lane spacing).
     #[arg(long, value_name = "M", default_value_t = 0.3)]
     pub width: f64,
-    /// Area to cover `X0,Y0,X1,Y1` (default: the start's free component).
+    /// Area to cover `X0,Y0,X1,Y1`: the seed's lane rectangle for the robot's centre
+    /// (default: the start's free component).
     #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = parse_quad, allow_hyphen_values = true)]
     pub area: Option<[f64; 4]>,
+    /// Keep-out zone (repeatable): a Nav2 keepout mask, a polygon file or `X0,Y0,X1,Y1`; no
+    /// waypoint or connection enters it.
+    #[arg(long, value_name = "FILE|X0,Y0,X1,Y1", value_parser = parse_zone, allow_hyphen_values = true)]
+    pub keepout: Vec<ZoneSpec>,
     /// Refuse plans whose estimated memory exceeds this many MB (default 4096).
     #[arg(long, value_name = "MB")]
     pub max_memory: Option<u64>,
@@ -259,6 +272,12 @@ pub struct InfoArgs {
     /// The robot.
     #[command(flatten)]
     pub robot: RobotArgs,
+    /// Work area (as for `run`): shows its size and the accessible floor inside it.
+    #[arg(long, value_name = "FILE|X0,Y0,X1,Y1", value_parser = parse_zone, allow_hyphen_values = true)]
+    pub area: Option<ZoneSpec>,
+    /// Keep-out zone (as for `run`, repeatable).
+    #[arg(long, value_name = "FILE|X0,Y0,X1,Y1", value_parser = parse_zone, allow_hyphen_values = true)]
+    pub keepout: Vec<ZoneSpec>,
     /// Print JSON.
     #[arg(long)]
     pub json: bool,
@@ -285,6 +304,19 @@ fn parse_quad(s: &str) -> Result<[f64; 4], String> {
         return Err(format!("area {s:?} must have X1 > X0 and Y1 > Y0"));
     }
     Ok(v)
+}
+
+/// Parses a zone: `X0,Y0,X1,Y1` (four numbers) is a rectangle, anything else a file name.
+fn parse_zone(s: &str) -> Result<ZoneSpec, String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    if parts.len() == 4 && parts.iter().all(|p| p.trim().parse::<f64>().is_ok()) {
+        let r = parse_quad(s)?;
+        return Ok(ZoneSpec::Rect(r));
+    }
+    if s.is_empty() {
+        return Err("expected a file or X0,Y0,X1,Y1, got an empty value".into());
+    }
+    Ok(ZoneSpec::File(PathBuf::from(s)))
 }
 
 /// Parses `A,B` or `A,B,C` into three numbers (C defaults to 0).

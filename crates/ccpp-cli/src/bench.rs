@@ -352,6 +352,8 @@ fn run_one(
             planner: options.config(kind),
             sim,
             max_memory_mb: a.max_memory.unwrap_or(DEFAULT_MAX_MEMORY_MB),
+            area: None,
+            keepout: Vec::new(),
         },
         map_name: map.name.clone(),
         out: dir.to_path_buf(),

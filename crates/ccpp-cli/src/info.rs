@@ -1,5 +1,7 @@
 //! `ccpp info`: what a map holds and how much of it a robot can reach.
 
+use std::fmt::Write as _;
+
 use anyhow::Result;
 use ccpp_core::grid::{Cell, GridMap};
 use ccpp_core::world::{World, WorldError};
@@ -41,8 +43,26 @@ struct Info {
     start_component_touches_border: Option<bool>,
     /// C-free pixels reachable from the start.
     reachable_px: Option<usize>,
-    /// Accessible surface from the start (m^2).
+    /// Accessible surface from the start (m^2); with zones, inside the area and outside the
+    /// keep-outs.
     accessible_m2: Option<f64>,
+    /// The zones given with `--area` / `--keepout`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    zones: Option<ZonesInfo>,
+}
+
+/// Sizes of the zones (`ccpp info --area/--keepout`).
+#[derive(Serialize)]
+#[allow(clippy::struct_field_names)] // the JSON keys carry their unit
+struct ZonesInfo {
+    /// Map area inside the work area (every pixel class), m^2; `None` without an area.
+    area_m2: Option<f64>,
+    /// Free floor inside the work area, m^2.
+    area_free_m2: Option<f64>,
+    /// Map area of the keep-out zones, m^2.
+    keepout_m2: f64,
+    /// Free floor in the keep-out zones, m^2.
+    keepout_free_m2: f64,
 }
 
 /// Flood-fills the 4-connected free pixels from `seed` (marking `seen`); returns the
@@ -170,7 +190,27 @@ pub fn run(a: &InfoArgs) -> Result<()> {
     let f = *g.frame();
     let (free, occ, unk) = g.counts();
     let (ncomp, largest) = free_components(g);
-    let (world, robot_error) = match World::new(g.clone(), robot, start) {
+    let mut zs =
+        ccpp_io::scenario::Scenario::new(map.recipe.clone(), ccpp_core::planners::PlannerKind::Bcd);
+    zs.area.clone_from(&a.area);
+    zs.keepout.clone_from(&a.keepout);
+    zs.robot = robot;
+    zs.validate()?;
+    let zones = zs.zone_masks(&map)?;
+    let res2 = f.resolution * f.resolution;
+    let zones_info = zones.as_ref().map(|z| {
+        let free_of = |i: usize| g.cells()[i] == Cell::Free;
+        ZonesInfo {
+            area_m2: z.area.as_ref().map(|m| m.count_ones(..) as f64 * res2),
+            area_free_m2: z
+                .area
+                .as_ref()
+                .map(|m| m.ones().filter(|&i| free_of(i)).count() as f64 * res2),
+            keepout_m2: z.keepout.count_ones(..) as f64 * res2,
+            keepout_free_m2: z.keepout.ones().filter(|&i| free_of(i)).count() as f64 * res2,
+        }
+    });
+    let (world, robot_error) = match World::with_zones(g.clone(), robot, start, zones) {
         Ok(w) => (Some(w), None),
         Err(e @ WorldError::RobotTooBig { .. }) => (None, Some(e.to_string())),
         // A start the user gave that does not work is a user error.
@@ -178,7 +218,6 @@ pub fn run(a: &InfoArgs) -> Result<()> {
             return Err(anyhow::Error::new(e).context(format!("map {}", map.source.display())))
         }
     };
-    let res2 = f.resolution * f.resolution;
     let s = world.as_ref().map(World::start);
     let comp = s.map(|s| StartComponent::of(g, s.position()));
     let info = Info {
@@ -208,6 +247,7 @@ pub fn run(a: &InfoArgs) -> Result<()> {
         start_component_touches_border: comp.map(|c| c.touches_border),
         reachable_px: world.as_ref().map(|w| w.reachable().count_ones(..)),
         accessible_m2: world.as_ref().map(World::accessible_area_m2),
+        zones: zones_info,
     };
     if let Some(w) = comp.and_then(|c| c.warning()) {
         eprintln!("{w}");
@@ -263,14 +303,46 @@ pub fn run(a: &InfoArgs) -> Result<()> {
                 w.reachable().count_ones(..)
             ));
             line(format!(
-                "accessible     {:.2} m2 (floor the tool can touch from the start)",
-                w.accessible_area_m2()
+                "accessible     {:.2} m2 (floor the tool can touch from the start{})",
+                w.accessible_area_m2(),
+                if info.zones.is_some() {
+                    ", inside the area, outside the keep-outs"
+                } else {
+                    ""
+                }
             ));
         }
         _ => line(format!(
             "robot          {}",
             robot_error.as_deref().unwrap_or("does not fit")
         )),
+    }
+    if let Some(z) = &info.zones {
+        if let (Some(a), Some(af)) = (z.area_m2, z.area_free_m2) {
+            let label = zs
+                .area
+                .as_ref()
+                .map(ccpp_io::zones::ZoneSpec::label)
+                .unwrap_or_default();
+            let _ = writeln!(
+                t,
+                "area           {label}: {a:.2} m2, {af:.2} m2 of it free floor"
+            );
+        }
+        if !zs.keepout.is_empty() {
+            let labels: Vec<String> = zs
+                .keepout
+                .iter()
+                .map(ccpp_io::zones::ZoneSpec::label)
+                .collect();
+            let _ = writeln!(
+                t,
+                "keep-out       {}: {:.2} m2, {:.2} m2 of it free floor",
+                labels.join(", "),
+                z.keepout_m2,
+                z.keepout_free_m2
+            );
+        }
     }
     crate::print_stdout(&t)
 }

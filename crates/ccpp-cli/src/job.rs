@@ -149,7 +149,7 @@ fn not_applicable(flag: &str, kind: PlannerKind, applies_to: &str) -> anyhow::Er
 }
 
 /// Which option each planner flag sets, for naming the flag in validation errors.
-const FLAG_FIELDS: [(&str, &[&str]); 5] = [
+const FLAG_FIELDS: [(&str, &[&str]); 4] = [
     (
         "--tile-side",
         &[
@@ -160,7 +160,6 @@ const FLAG_FIELDS: [(&str, &[&str]); 5] = [
     ),
     ("--length", &["rect_boustrophedon.length_m"]),
     ("--width", &["rect_boustrophedon.width_m"]),
-    ("--area", &["rect_boustrophedon.area"]),
     ("--sensor-range", &["sim.sensor_range"]),
 ];
 
@@ -215,13 +214,6 @@ fn apply_planner_flags(a: &RunArgs, config: &mut PlannerConfig) -> Result<Vec<&'
             PlannerConfig::RectBoustrophedon(o) if flag == "--length" => o.length_m = v,
             PlannerConfig::RectBoustrophedon(o) => o.width_m = v,
             _ => return Err(not_applicable(flag, kind, "rect-boustrophedon")),
-        }
-    }
-    if let Some(area) = a.area {
-        given.push("--area");
-        match config {
-            PlannerConfig::RectBoustrophedon(o) => o.area = Some(area),
-            _ => return Err(not_applicable("--area", kind, "rect-boustrophedon")),
         }
     }
     Ok(given)
@@ -330,6 +322,8 @@ impl Job {
             planner,
             sim,
             max_memory_mb: a.max_memory.unwrap_or(DEFAULT_MAX_MEMORY_MB),
+            area: a.area.clone(),
+            keepout: a.keepout.clone(),
         };
         scenario.validate().map_err(|e| name_flag(e, &given))?;
         let map = load_recipe(&scenario.map)?;
@@ -361,7 +355,16 @@ impl Job {
     /// scenario's start becomes the start actually used, so that `run.json` replays exactly.
     pub fn execute(&mut self) -> Result<JobResult> {
         let run = self.scenario.run_on(&self.map)?;
-        let s = run.world.start();
+        let s = run.world.initial_pose();
+        if !run.world.approach().is_empty() {
+            let e = run.world.start();
+            eprintln!(
+                "note: the start is outside the area: the robot first drives {:.2} m on the known map to reach it at ({:.3}, {:.3})",
+                run.world.approach_length_m(),
+                e.x,
+                e.y
+            );
+        }
         self.scenario.start = Some([s.x, s.y, s.theta]);
         Ok(JobResult {
             world: run.world,

@@ -34,6 +34,8 @@ pub fn run(a: &WaypointsArgs) -> Result<()> {
         planner: PlannerConfig::RectBoustrophedon(opts.clone()),
         sim: SimConfig::default(),
         max_memory_mb: a.max_memory.unwrap_or(DEFAULT_MAX_MEMORY_MB),
+        area: None,
+        keepout: a.keepout.clone(),
     };
     let flag = |e: ScenarioError| match &e {
         ScenarioError::Options(o) if o.field.ends_with("length_m") => anyhow!("--length: {e}"),

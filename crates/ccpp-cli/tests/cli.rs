@@ -56,7 +56,7 @@ fn demo_writes_all_files() {
     assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
 }
 
-const METRIC_KEYS: [&str; 17] = [
+const METRIC_KEYS: [&str; 18] = [
     "planner",
     "map",
     "robot_radius_m",
@@ -73,6 +73,7 @@ const METRIC_KEYS: [&str; 17] = [
     "turns",
     "rotation_rad",
     "collisions",
+    "keepout_violations",
     "wall_time_s",
 ];
 

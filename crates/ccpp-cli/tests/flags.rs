@@ -171,13 +171,9 @@ fn planner_flags_apply_where_they_should() {
     flag_applies(dir, m, &["--side", "right"], &["bsa", "bsa-extended"], &[]);
     flag_applies(dir, m, &["--length", "0.5"], &["rect-boustrophedon"], &[]);
     flag_applies(dir, m, &["--width", "0.5"], &["rect-boustrophedon"], &[]);
-    flag_applies(
-        dir,
-        m,
-        &["--area", "0.5,0.5,4,4"],
-        &["rect-boustrophedon"],
-        &[],
-    );
+    // Zones apply to every planner (virtual walls).
+    flag_applies(dir, m, &["--area", "0.5,0.5,4,4"], &ALL, &[]);
+    flag_applies(dir, m, &["--keepout", "5.5,1,6.5,5"], &ALL, &[]);
     flag_applies(dir, m, &["--seed", "5"], &["random-bounce"], &[]);
     // The sensor range applies to the online planners only (the shortest range that still
     // sees a neighbour tile: less is known when choosing where to go).

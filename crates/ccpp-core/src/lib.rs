@@ -2,7 +2,7 @@
 //!
 //! The I/O-free heart of **ccpp**, a complete coverage path planning toolkit for mobile robots on
 //! 2-D occupancy grids: grids and frames ([`grid`]), geometry ([`geometry`], [`collide`]), the
-//! distance transform ([`dt`]), synthetic maps ([`gen`]), the ground truth ([`world`]), the online step protocol
+//! distance transform ([`dt`]), synthetic maps ([`gen`]), the ground truth ([`world`]), work areas and keep-out zones ([`zones`]), the online step protocol
 //! ([`planner`]), the deterministic graph searches ([`search`]), the simulator ([`sim`]), the trace ([`trace`]), tiles ([`tiles`]), the metrics
 //! ([`metrics`]) and the planners ([`planners`]); motion execution by PID tracking on a
 //! unicycle ([`exec`]), pose correction from non-unique landmarks ([`landmarks`]) and the
@@ -31,6 +31,7 @@ pub mod sim;
 pub mod tiles;
 pub mod trace;
 pub mod world;
+pub mod zones;
 
 pub use geometry::{Point, Pose};
 pub use grid::{Cell, GridMap, MapFrame};

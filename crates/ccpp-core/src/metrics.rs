@@ -1,5 +1,10 @@
 //! Run metrics, computed from the world (truth) and the trace only — never reported by planners.
 //! Definitions: `world-and-metrics.md`; each field below repeats its own.
+//!
+//! With work zones ([`crate::zones`]) the accessible surface `A` is that of the allowed floor:
+//! free pixels inside the area and outside every keep-out, within `r_tool` of a centre the
+//! robot can reach without crossing a virtual wall ([`World::accessible`]). Every figure built
+//! on `A` (`effective_coverage`, `path_ratio`) is measured against it, not the whole map.
 
 use fixedbitset::FixedBitSet;
 use serde::{Deserialize, Serialize};
@@ -28,7 +33,8 @@ pub struct Metrics {
     /// Tiles whose centre the robot visited / tiles reachable from the start tile by
     /// collision-free 4-neighbour moves (tile planners; `null` otherwise).
     pub coverage_rate: Option<f64>,
-    /// `|swept ∩ A| / |A|` in pixels.
+    /// `|swept ∩ A| / |A|` in pixels (`A` restricted to the allowed floor when there are
+    /// zones).
     pub effective_coverage: f64,
     /// Total translation, metres.
     pub path_length_m: f64,
@@ -59,6 +65,12 @@ pub struct Metrics {
     pub rotation_rad: f64,
     /// Bumper contacts.
     pub collisions: u32,
+    /// Entries into a keep-out zone: times the robot's disk, clear of every keep-out pixel,
+    /// starts to overlap one (pixels as the disks inscribed in their squares, as for
+    /// obstacles; see [`crate::zones::keepout_entries`]); 0 without keep-outs and for a
+    /// correct planner.
+    #[serde(default)]
+    pub keepout_violations: u32,
     /// Planning + simulation wall time, seconds (the one non-deterministic figure).
     pub wall_time_s: f64,
     /// PID execution only: mean distance of the recorded true poses from the segment they were
@@ -433,6 +445,13 @@ pub fn compute(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
         visited as f64 / reach.len() as f64
     });
 
+    let keepout_violations = world.zones().map_or(0, |z| {
+        let pts: Vec<Point> = poses
+            .iter()
+            .map(|p| frame.world_to_grid(p.position()))
+            .collect();
+        crate::zones::keepout_entries(&frame, &z.keepout, &pts, robot.radius / frame.resolution)
+    });
     let tracking = tracking_error(trace);
     let rect_guarantee = trace.events().find_map(|(_, e)| match e {
         Event::RectLanes { width_m, .. } if *width_m > 0.0 => {
@@ -458,6 +477,7 @@ pub fn compute(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
         turns,
         rotation_rad: rotation,
         collisions,
+        keepout_violations,
         wall_time_s: run.wall_time_s,
         tracking_error_mean_m: tracking.map(|t| t.0),
         tracking_error_max_m: tracking.map(|t| t.1),

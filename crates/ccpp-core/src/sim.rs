@@ -128,7 +128,7 @@ impl<'w> Simulator<'w> {
     /// when stepping through [`execute`](Self::execute) directly).
     pub fn new(world: &'w World, config: &SimConfig) -> Self {
         let range = config.sensor_range_for(&world.robot());
-        let pose = world.start();
+        let pose = world.initial_pose();
         let mut trace = Trace::default();
         trace.push_pose(0, pose);
         let mut sim = Self {
@@ -143,10 +143,40 @@ impl<'w> Simulator<'w> {
             landmarks: config.landmarks.clone(),
             exec_set: false,
         };
+        sim.drive_approach();
         if let Some(e) = config.exec {
             sim.set_execution(e);
         }
         sim
+    }
+
+    /// Drives [`World::approach`] (a start outside the work area) exactly, before the planner
+    /// gets control: a [`Event::Note`] with its length, then one rotation and translation per
+    /// waypoint, checked against the true map like any motion.
+    fn drive_approach(&mut self) {
+        let world = self.world;
+        if world.approach().is_empty() {
+            return;
+        }
+        self.trace.push_event(
+            0,
+            Event::Note {
+                text: format!(
+                    "approach: the start is outside the area; driving {:.3} m to ({:.3}, {:.3})",
+                    world.approach_length_m(),
+                    world.start().x,
+                    world.start().y
+                ),
+            },
+        );
+        for &p in world.approach() {
+            let d = p.sub(self.pose.position());
+            let dist = d.norm();
+            if dist > 1e-12 {
+                self.rotate(wrap_angle(d.y.atan2(d.x) - self.pose.theta));
+                self.translate(dist);
+            }
+        }
     }
 
     /// Sets the execution mode (before the first step; later calls are ignored).
@@ -235,7 +265,7 @@ impl<'w> Simulator<'w> {
         };
         let a = self.pose.position();
         let b = Point::new(a.x + d.abs() * dir.cos(), a.y + d.abs() * dir.sin());
-        match self.world.first_contact(a, b) {
+        match self.world.true_first_contact(a, b) {
             None => {
                 self.pose.x = b.x;
                 self.pose.y = b.y;
@@ -350,7 +380,7 @@ impl<'w> Simulator<'w> {
             let hit = if a == b {
                 None
             } else {
-                self.world.first_contact(a, b)
+                self.world.true_first_contact(a, b)
             };
             if let Some(t) = hit {
                 let p = a + (b - a).scale(t);

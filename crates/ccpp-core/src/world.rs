@@ -10,6 +10,7 @@ use crate::collide::{self, contact_radius_px};
 use crate::dt::{squared_edt, INF};
 use crate::geometry::{Point, Pose};
 use crate::grid::{Cell, GridMap, MapFrame};
+use crate::zones::{MaskOccupancy, ZoneMasks};
 
 /// The robot model: a disk of radius `radius` carrying a cleaning tool of radius `tool_radius`.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -107,19 +108,84 @@ pub enum WorldError {
         /// Robot radius.
         radius: f64,
     },
+    /// The robot's disk at the start overlaps a keep-out zone.
+    #[error(
+        "start ({x:.3}, {y:.3}) is in a keep-out zone: a robot of radius {radius} m there \
+         overlaps keep-out pixels"
+    )]
+    StartInKeepout {
+        /// Start x.
+        x: f64,
+        /// Start y.
+        y: f64,
+        /// Robot radius.
+        radius: f64,
+    },
+    /// The robot's disk at the start reaches outside the work area (internal: such a start
+    /// gets an approach, [`World::approach`], and this is never returned).
+    #[error(
+        "start ({x:.3}, {y:.3}) is outside the area: a robot of radius {radius} m there is not \
+         wholly inside it"
+    )]
+    StartOutsideArea {
+        /// Start x.
+        x: f64,
+        /// Start y.
+        y: f64,
+        /// Robot radius.
+        radius: f64,
+    },
+    /// No path leads from a start outside the area into it.
+    #[error(
+        "the area cannot be reached from the start ({x:.3}, {y:.3}): no path for a robot of \
+         radius {radius} m leads into it without touching an obstacle or a keep-out zone"
+    )]
+    AreaUnreachable {
+        /// Start x.
+        x: f64,
+        /// Start y.
+        y: f64,
+        /// Robot radius.
+        radius: f64,
+    },
+    /// The zones leave no spot where the robot fits.
+    #[error(
+        "the area minus the keep-out zones holds no floor where a robot of radius {radius} m \
+         fits ({free_px} free pixels inside the area)"
+    )]
+    NoRoomInZones {
+        /// Robot radius.
+        radius: f64,
+        /// Free pixels of the true map that are inside the area and outside every keep-out.
+        free_px: usize,
+    },
 }
 
 /// The ground truth for one robot on one map.
 #[derive(Clone)]
 pub struct World {
+    /// The true map (collisions).
     map: GridMap,
+    /// The true map with every forbidden zone pixel occupied (what planners plan on); `None`
+    /// without zones.
+    plan: Option<GridMap>,
+    zones: Option<ZoneMasks>,
     robot: Robot,
+    /// Where coverage starts (the end of the approach when the start is outside the area).
     start: Pose,
-    /// Squared distance (px^2) from each pixel centre to the nearest non-free pixel centre,
-    /// counting the outside as non-free.
+    /// Where the robot is placed: `start`, or a pose outside the area.
+    initial: Pose,
+    /// The approach from `initial` to `start` (waypoints after `initial`; empty when the
+    /// robot starts inside the area).
+    approach: Vec<Point>,
+    /// Squared distance (px^2) from each pixel centre to the nearest non-free pixel centre of
+    /// the planning map (virtual walls included), counting the outside as non-free.
     obstacle_dt2: Vec<u32>,
-    /// Non-free pixels (the simulator's collision checks skip free runs a word at a time).
+    /// Non-free pixels of the true map (the simulator's collision checks skip free runs a
+    /// word at a time).
     blocked: FixedBitSet,
+    /// Non-free pixels of the planning map (with zones only).
+    plan_blocked: Option<FixedBitSet>,
     cfree: FixedBitSet,
     reachable: FixedBitSet,
     accessible: FixedBitSet,
@@ -145,9 +211,46 @@ impl World {
     /// # Errors
     /// Invalid radii, a robot that fits nowhere, a start outside the map or in an obstacle.
     pub fn new(map: GridMap, robot: Robot, start: Option<Pose>) -> Result<Self, WorldError> {
+        Self::with_zones(map, robot, start, None)
+    }
+
+    /// [`World::new`] with work zones ([`crate::zones`]): every pixel outside the area and every
+    /// keep-out pixel becomes a virtual wall. C-free, the reachable component, the accessible
+    /// surface, the default start and [`World::map`] (what planners plan on and the sensor
+    /// reads) include the virtual walls; collisions ([`World::first_contact`]) are checked
+    /// against the true map only ([`World::true_map`]). Empty zones are the same as `None`.
+    ///
+    /// # Errors
+    /// As [`World::new`], plus a start in a keep-out zone, an area the start cannot reach
+    /// (a start outside the area gets an approach, [`World::approach`]), and zones that leave
+    /// no spot where the robot fits.
+    ///
+    /// # Panics
+    /// When a zone mask is not the map's size.
+    pub fn with_zones(
+        map: GridMap,
+        robot: Robot,
+        start: Option<Pose>,
+        zones: Option<ZoneMasks>,
+    ) -> Result<Self, WorldError> {
         robot.validate()?;
         let frame = *map.frame();
-        let cells = map.cells();
+        let zones = zones.filter(|z| !z.is_empty());
+        let plan = zones.as_ref().map(|z| {
+            assert!(
+                z.keepout.len() == frame.len()
+                    && z.area.as_ref().is_none_or(|a| a.len() == frame.len()),
+                "zone masks must match the map"
+            );
+            let mut p = map.clone();
+            for (i, c) in p.cells_mut().iter_mut().enumerate() {
+                if c.is_free() && z.forbidden(i) {
+                    *c = Cell::Occupied;
+                }
+            }
+            p
+        });
+        let cells = plan.as_ref().unwrap_or(&map).cells();
         let obstacle_dt2 = squared_edt(frame.width, frame.height, |i| !cells[i].is_free(), true);
         let r_px = robot.radius / frame.resolution;
         // C-free at a pixel centre: distance to every blocked centre >= contact radius.
@@ -163,6 +266,23 @@ impl World {
                 max_d2 = max_d2.max(d2);
             }
         }
+        if cfree.is_clear() && zones.is_some() {
+            let free_px = cells.iter().filter(|c| c.is_free()).count();
+            let fits_without = squared_edt(
+                frame.width,
+                frame.height,
+                |i| !map.cells()[i].is_free(),
+                true,
+            )
+            .iter()
+            .any(|&d2| f64::from(d2) >= rc2);
+            if fits_without {
+                return Err(WorldError::NoRoomInZones {
+                    radius: robot.radius,
+                    free_px,
+                });
+            }
+        }
         if cfree.is_clear() {
             return Err(WorldError::RobotTooBig {
                 radius: robot.radius,
@@ -174,15 +294,29 @@ impl World {
             None => default_start(&frame, &cfree, &obstacle_dt2),
         };
         let mut blocked = FixedBitSet::with_capacity(frame.len());
-        for (i, c) in cells.iter().enumerate() {
+        for (i, c) in map.cells().iter().enumerate() {
             if !c.is_free() {
                 blocked.insert(i);
             }
         }
+        let plan_blocked = plan.as_ref().map(|p| {
+            let mut b = FixedBitSet::with_capacity(frame.len());
+            for (i, c) in p.cells().iter().enumerate() {
+                if !c.is_free() {
+                    b.insert(i);
+                }
+            }
+            b
+        });
         let mut world = Self {
             map,
+            plan,
+            plan_blocked,
+            zones,
             robot,
             start,
+            initial: start,
+            approach: Vec::new(),
             obstacle_dt2,
             blocked,
             cfree,
@@ -190,7 +324,10 @@ impl World {
             accessible: FixedBitSet::with_capacity(frame.len()),
             accessible_count: 0,
         };
-        world.check_start()?;
+        match world.check_start() {
+            Err(WorldError::StartOutsideArea { .. }) => world.plan_approach()?,
+            r => r?,
+        }
         world.reachable = world.flood_reachable();
         world.compute_accessible();
         Ok(world)
@@ -213,14 +350,195 @@ impl World {
                 y1: hi.y,
             });
         }
-        if self.disk_collides(s.position()) {
+        if self.true_disk_collides(s.position()) {
             return Err(WorldError::StartInObstacle {
                 x: s.x,
                 y: s.y,
                 radius: self.robot.radius,
             });
         }
+        if let Some(z) = &self.zones {
+            let g = frame.world_to_grid(s.position());
+            let r_px = self.r_px();
+            let keepout = MaskOccupancy::new(frame, &z.keepout, false);
+            if collide::disk_hits(&keepout, g, r_px) {
+                return Err(WorldError::StartInKeepout {
+                    x: s.x,
+                    y: s.y,
+                    radius: self.robot.radius,
+                });
+            }
+            if let Some(area) = &z.area {
+                if collide::disk_hits(&MaskOccupancy::new(frame, area, true), g, r_px) {
+                    return Err(WorldError::StartOutsideArea {
+                        x: s.x,
+                        y: s.y,
+                        radius: self.robot.radius,
+                    });
+                }
+            }
+        }
         Ok(())
+    }
+
+    /// The approach of a start outside the area: the shortest 8-connected chain of pixel
+    /// centres where the robot stands clear of obstacles and keep-outs (the area's border does
+    /// not count) from the start to the nearest centre that is C-free under every virtual wall,
+    /// shortened to straight segments that are free of obstacles and keep-outs (exact swept-disk
+    /// test). Sets `start` to its end (heading along its last segment).
+    fn plan_approach(&mut self) -> Result<(), WorldError> {
+        let s = self.start;
+        let unreachable = || WorldError::AreaUnreachable {
+            x: s.x,
+            y: s.y,
+            radius: self.robot.radius,
+        };
+        let Some(z) = self.zones.as_ref() else {
+            return Err(unreachable());
+        };
+        let frame = *self.map.frame();
+        let (w, h) = (frame.width, frame.height);
+        let cells = self.map.cells();
+        let dt = squared_edt(w, h, |i| !cells[i].is_free() || z.keepout.contains(i), true);
+        let r_px = self.r_px();
+        let rc = contact_radius_px(r_px);
+        let occ = Approach {
+            map: &self.map,
+            keepout: &z.keepout,
+        };
+        let free_seg =
+            |a: Point, b: Point| collide::segment_first_contact(&occ, a, b, r_px).is_none();
+        let ok = |i: usize| f64::from(dt[i]) >= rc * rc;
+        // Dijkstra with integer octile costs (70 straight, 99 diagonal).
+        let mut dist = vec![u32::MAX; frame.len()];
+        let mut parent = vec![u32::MAX; frame.len()];
+        let mut heap = std::collections::BinaryHeap::new();
+        let g0 = frame.world_to_grid(s.position());
+        let (sc, sr) = frame.grid_to_pixel_signed(g0);
+        for dr in -1..=1i64 {
+            for dc in -1..=1i64 {
+                if let Some((c, r)) = frame.checked(sc + dc, sr + dr) {
+                    let i = frame.index(c, r);
+                    if ok(i) && free_seg(g0, frame.pixel_center_grid(c, r)) {
+                        let d = if dc == 0 && dr == 0 {
+                            0
+                        } else if dc == 0 || dr == 0 {
+                            70
+                        } else {
+                            99
+                        };
+                        if d < dist[i] {
+                            dist[i] = d;
+                            heap.push(std::cmp::Reverse((d, i)));
+                        }
+                    }
+                }
+            }
+        }
+        let mut goal = None;
+        while let Some(std::cmp::Reverse((d, i))) = heap.pop() {
+            if d > dist[i] {
+                continue;
+            }
+            if self.cfree.contains(i) {
+                goal = Some(i);
+                break;
+            }
+            let (c, r) = ((i % w) as i64, (i / w) as i64);
+            for (dc, dr, cost) in [
+                (1, 0, 70),
+                (-1, 0, 70),
+                (0, 1, 70),
+                (0, -1, 70),
+                (1, 1, 99),
+                (-1, 1, 99),
+                (1, -1, 99),
+                (-1, -1, 99),
+            ] {
+                if let Some((nc, nr)) = frame.checked(c + dc, r + dr) {
+                    let j = frame.index(nc, nr);
+                    let nd = d + cost;
+                    if ok(j) && nd < dist[j] {
+                        dist[j] = nd;
+                        parent[j] = i as u32;
+                        heap.push(std::cmp::Reverse((nd, j)));
+                    }
+                }
+            }
+        }
+        let goal = goal.ok_or_else(unreachable)?;
+        let mut chain = vec![goal];
+        let mut k = goal;
+        while parent[k] != u32::MAX {
+            k = parent[k] as usize;
+            chain.push(k);
+        }
+        chain.reverse();
+        let pts: Vec<Point> = std::iter::once(g0)
+            .chain(chain.iter().map(|&i| {
+                let (c, r) = frame.col_row(i);
+                frame.pixel_center_grid(c, r)
+            }))
+            .collect();
+        // Greedy shortening: from each kept point, as far along the chain as a free segment
+        // reaches.
+        let mut kept = Vec::new();
+        let mut anchor = pts[0];
+        for j in 1..pts.len() {
+            if !free_seg(anchor, pts[j]) {
+                let prev = pts[j - 1];
+                if prev == anchor || !free_seg(prev, pts[j]) {
+                    return Err(unreachable());
+                }
+                kept.push(prev);
+                anchor = prev;
+            }
+        }
+        if let Some(&last) = pts.last() {
+            if last != g0 {
+                kept.push(last);
+            }
+        }
+        let approach: Vec<Point> = kept.iter().map(|&g| frame.grid_to_world(g)).collect();
+        let end = approach.last().copied().unwrap_or(s.position());
+        let before = if approach.len() >= 2 {
+            approach[approach.len() - 2]
+        } else {
+            s.position()
+        };
+        let theta = if end == before {
+            s.theta
+        } else {
+            (end.y - before.y).atan2(end.x - before.x)
+        };
+        self.initial = s;
+        self.start = Pose::new(end.x, end.y, theta);
+        self.approach = approach;
+        Ok(())
+    }
+
+    /// Where the robot is placed: the start, or, when the start given is outside the work
+    /// area, that pose (the robot then drives [`World::approach`] to [`World::start`] first).
+    pub fn initial_pose(&self) -> Pose {
+        self.initial
+    }
+
+    /// The approach from [`World::initial_pose`] to [`World::start`] when the start given lies
+    /// outside the work area: waypoints (world frame) after the initial position, driven
+    /// before the planner starts; empty otherwise. It avoids obstacles and keep-outs.
+    pub fn approach(&self) -> &[Point] {
+        &self.approach
+    }
+
+    /// Length of [`World::approach`], metres.
+    pub fn approach_length_m(&self) -> f64 {
+        let mut last = self.initial.position();
+        let mut len = 0.0;
+        for p in &self.approach {
+            len += last.dist(*p);
+            last = *p;
+        }
+        len
     }
 
     /// 8-connected flood fill of C-free pixel centres from the start's pixel (or, if that centre
@@ -268,14 +586,26 @@ impl World {
     fn compute_accessible(&mut self) {
         let frame = *self.map.frame();
         let rt = self.robot.tool_radius / frame.resolution + 1e-6;
-        let acc = accessible_pixels(&self.map, &self.reachable, rt);
+        let acc = accessible_pixels(self.map(), &self.reachable, rt);
         self.accessible_count = acc.count_ones(..);
         self.accessible = acc;
     }
 
-    /// The true map.
+    /// The map planners plan on and the sensor reads: the true map, with every pixel outside
+    /// the work area and every keep-out pixel occupied when the world has zones
+    /// ([`World::with_zones`]); the true map otherwise.
     pub fn map(&self) -> &GridMap {
+        self.plan.as_ref().unwrap_or(&self.map)
+    }
+
+    /// The true map (what collisions are checked against; pictures draw it).
+    pub fn true_map(&self) -> &GridMap {
         &self.map
+    }
+
+    /// The work zones as pixel masks, if any.
+    pub fn zones(&self) -> Option<&ZoneMasks> {
+        self.zones.as_ref()
     }
 
     /// The map's geometry.
@@ -288,12 +618,13 @@ impl World {
         self.robot
     }
 
-    /// The start pose.
+    /// The pose coverage starts from: the start, or the end of the approach when the start
+    /// given lies outside the work area ([`World::initial_pose`]).
     pub fn start(&self) -> Pose {
         self.start
     }
 
-    /// C-free pixel centres (whole map).
+    /// C-free pixel centres (whole map; virtual walls count as obstacles).
     pub fn cfree(&self) -> &FixedBitSet {
         &self.cfree
     }
@@ -304,7 +635,8 @@ impl World {
     }
 
     /// The accessible surface `A`: free pixels whose centre lies within `r_tool` of a reachable
-    /// C-free centre.
+    /// C-free centre. With zones: free pixels of [`World::map`] (inside the area, outside every
+    /// keep-out) within `r_tool` of a reachable centre of C-free under the virtual walls.
     pub fn accessible(&self) -> &FixedBitSet {
         &self.accessible
     }
@@ -321,7 +653,7 @@ impl World {
     }
 
     /// Clearance in metres at the centre of pixel `(col, row)`: distance to the nearest blocked
-    /// pixel's inscribed disk.
+    /// pixel's inscribed disk (virtual walls included).
     pub fn pixel_clearance(&self, col: usize, row: usize) -> f64 {
         let d2 = self.obstacle_dt2[self.frame().index(col, row)];
         (f64::from(d2).sqrt() - 0.5) * self.frame().resolution
@@ -345,21 +677,50 @@ impl World {
         }
     }
 
-    /// Does the robot's disk centred at world point `p` overlap a non-free pixel (exact)?
+    /// Does the robot's disk centred at world point `p` overlap a non-free pixel of the
+    /// planning map [`World::map`] (exact; virtual walls included)? What offline planners
+    /// check; the simulator uses [`World::true_disk_collides`].
     pub fn disk_collides(&self, p: Point) -> bool {
+        self.disk_hits_on(p, self.map())
+    }
+
+    /// Does the robot's disk centred at world point `p` overlap a non-free pixel of the true
+    /// map (exact; virtual walls ignored)?
+    pub fn true_disk_collides(&self, p: Point) -> bool {
+        self.disk_hits_on(p, &self.map)
+    }
+
+    fn disk_hits_on(&self, p: Point, map: &GridMap) -> bool {
         let g = self.frame().world_to_grid(p);
         let r_px = self.r_px();
         if self.dist_lower_bound_px(g) > contact_radius_px(r_px) + 1e-9 {
             return false;
         }
-        collide::disk_hits(&self.map, g, r_px)
+        collide::disk_hits(map, g, r_px)
     }
 
-    /// Exact first contact of the robot's disk moving straight from `a` to `b` (world frame):
-    /// the parameter `t` in `[0, 1]` of the first overlap with a non-free pixel, or `None`.
-    /// Sphere-traces the distance transform through open space and checks pixels exactly near
-    /// obstacles, so long moves across open halls stay cheap.
+    /// Exact first contact of the robot's disk moving straight from `a` to `b` (world frame)
+    /// with the planning map [`World::map`] (virtual walls included): the parameter `t` in
+    /// `[0, 1]` of the first overlap with a non-free pixel, or `None`. What offline planners
+    /// check; the simulator uses [`World::true_first_contact`]. Sphere-traces the distance
+    /// transform through open space and checks pixels exactly near obstacles, so long moves
+    /// across open halls stay cheap.
     pub fn first_contact(&self, a: Point, b: Point) -> Option<f64> {
+        match (&self.plan, &self.plan_blocked) {
+            (Some(map), Some(blocked)) => self.contact_on(a, b, map, blocked),
+            _ => self.contact_on(a, b, &self.map, &self.blocked),
+        }
+    }
+
+    /// [`World::first_contact`] against the true map (virtual walls do not stop the robot):
+    /// the simulator's bumper.
+    pub fn true_first_contact(&self, a: Point, b: Point) -> Option<f64> {
+        self.contact_on(a, b, &self.map, &self.blocked)
+    }
+
+    /// First contact with `map` (whose non-free pixels are `blocked`). The distance transform
+    /// is the planning map's: a lower bound of the distance to `map`'s obstacles either way.
+    fn contact_on(&self, a: Point, b: Point, map: &GridMap, blocked: &FixedBitSet) -> Option<f64> {
         let frame = self.frame();
         let ga = frame.world_to_grid(a);
         let gb = frame.world_to_grid(b);
@@ -367,7 +728,7 @@ impl World {
         let r_px = self.r_px();
         let rc = contact_radius_px(r_px);
         if len == 0.0 {
-            return if collide::disk_hits(&self.map, ga, r_px) {
+            return if collide::disk_hits(map, ga, r_px) {
                 Some(0.0)
             } else {
                 None
@@ -384,10 +745,7 @@ impl World {
             }
             let e = (s + 1.0).min(len);
             let q = ga.add(u.scale(e));
-            let truth = Truth {
-                map: &self.map,
-                blocked: &self.blocked,
-            };
+            let truth = Truth { map, blocked };
             if let Some(t) = collide::segment_first_contact(&truth, p, q, r_px) {
                 return Some(((s + t * (e - s)) / len).clamp(0.0, 1.0));
             }
@@ -396,9 +754,30 @@ impl World {
         None
     }
 
-    /// Is the straight motion of the robot from `a` to `b` free of contact?
+    /// Is the straight motion of the robot from `a` to `b` free of contact with the planning
+    /// map (virtual walls included)?
     pub fn segment_free(&self, a: Point, b: Point) -> bool {
         self.first_contact(a, b).is_none()
+    }
+}
+
+/// The true map plus keep-out pixels (the approach's obstacles).
+struct Approach<'a> {
+    map: &'a GridMap,
+    keepout: &'a FixedBitSet,
+}
+
+impl collide::Occupancy for Approach<'_> {
+    fn frame(&self) -> &MapFrame {
+        self.map.frame()
+    }
+    fn blocked(&self, col: i64, row: i64) -> bool {
+        !self.map.get_signed(col, row).is_free()
+            || self
+                .map
+                .frame()
+                .checked(col, row)
+                .is_some_and(|(c, r)| self.keepout.contains(self.map.frame().index(c, r)))
     }
 }
 

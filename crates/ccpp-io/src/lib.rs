@@ -11,6 +11,7 @@
 //! * [`scenario`]: the serializable description of a run ([`Scenario`](scenario::Scenario)),
 //!   its one validation (including the memory estimate) and its execution;
 //! * [`trace`](mod@trace): `trace.jsonl` / `path.csv` writers and the checked trace reader;
+//! * [`zones`]: `--area` / `--keepout` files (`GeoJSON`, YAML polygon lists, Nav2 keepout masks);
 //! * [`file`]: opening user files (regular files only: a FIFO is refused, not read forever).
 //!
 //! Errors are [`thiserror`] enums that always name the file concerned; nothing here panics on
@@ -23,6 +24,7 @@ pub mod map;
 pub mod scenario;
 pub mod trace;
 pub mod write;
+pub mod zones;
 
 pub use map::{load_map, load_map_bytes, LoadOptions, LoadedMap, MapError, MapYaml, Thresholds};
 pub use write::{save_map, write_atomic, WriteError};

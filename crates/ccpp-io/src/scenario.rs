@@ -40,6 +40,8 @@ use ccpp_core::Pose;
 use serde::{Deserialize, Serialize};
 
 use crate::map::{load_map, LoadOptions, LoadedMap, MapError};
+use crate::zones::{ZoneData, ZoneSpec};
+use ccpp_core::zones::ZoneMasks;
 
 /// Default memory limit of a run, MB: room for the shared maps and the benchmark maps
 /// (`cluttered_2000` at r = 0.025 m, `office_4096` at r = 0.1 m) with a wide margin.
@@ -122,6 +124,16 @@ pub enum ScenarioError {
     File {
         /// The file.
         path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// A zone (`--area`, `--keepout`) cannot be used.
+    #[error("{kind} {label}: {message}")]
+    Zone {
+        /// `area` or `keepout`.
+        kind: &'static str,
+        /// The file (or `rectangle ...` / `inline polygons`).
+        label: String,
         /// What is wrong.
         message: String,
     },
@@ -317,6 +329,14 @@ pub struct Scenario {
     /// Refuse runs whose estimated memory exceeds this many MB.
     #[serde(default = "default_max_memory_mb")]
     pub max_memory_mb: u64,
+    /// Work area: the robot stays inside it (virtual walls for every planner) and metrics
+    /// measure coverage of the floor inside it; `None` = the whole map.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub area: Option<ZoneSpec>,
+    /// Keep-out zones: never entered (virtual walls; entries are counted as
+    /// `keepout_violations`), not counted as floor to cover.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub keepout: Vec<ZoneSpec>,
 }
 
 /// A finished run.
@@ -343,6 +363,8 @@ impl Scenario {
             planner: PlannerConfig::new(planner),
             sim: SimConfig::default(),
             max_memory_mb: DEFAULT_MAX_MEMORY_MB,
+            area: None,
+            keepout: Vec::new(),
         }
     }
 
@@ -449,7 +471,96 @@ impl Scenario {
             ));
         }
         self.planner.validate()?;
+        self.validate_zones()?;
         Ok(())
+    }
+
+    /// The zone values that can be checked without the map (rectangles, inline polygons).
+    fn validate_zones(&self) -> Result<(), ScenarioError> {
+        let specs = self
+            .area
+            .iter()
+            .map(|a| ("area", a))
+            .chain(self.keepout.iter().map(|k| ("keepout", k)));
+        for (kind, spec) in specs {
+            let res = match spec {
+                ZoneSpec::Rect(r) => crate::zones::check_rect(*r).map_err(|e| e.to_string()),
+                ZoneSpec::Polygons(p) => {
+                    ccpp_core::zones::validate_polygons(p).map_err(|e| e.to_string())
+                }
+                ZoneSpec::File(_) => Ok(()),
+            };
+            res.map_err(|message| ScenarioError::Zone {
+                kind,
+                label: spec.label(),
+                message,
+            })?;
+        }
+        Ok(())
+    }
+
+    /// Loads and rasterises the zones onto `map`'s grid (`None` without zones).
+    ///
+    /// # Errors
+    /// [`ScenarioError::Zone`] naming the file: unreadable or malformed, an invalid polygon, a
+    /// keepout mask in another frame.
+    pub fn zone_masks(&self, map: &PreparedMap) -> Result<Option<ZoneMasks>, ScenarioError> {
+        if self.area.is_none() && self.keepout.is_empty() {
+            return Ok(None);
+        }
+        let frame = *map.grid.frame();
+        let load = |kind: &'static str, spec: &ZoneSpec, mask_ok: bool| {
+            spec.load(&frame, mask_ok).map_err(|e| ScenarioError::Zone {
+                kind,
+                label: spec.label(),
+                message: e.to_string(),
+            })
+        };
+        let area = match &self.area {
+            Some(spec) => match load("area", spec, false)? {
+                ZoneData::Polygons(p) => Some(p),
+                ZoneData::Mask(_) => None,
+            },
+            None => None,
+        };
+        let mut polys = Vec::new();
+        let mut masks = Vec::new();
+        for spec in &self.keepout {
+            match load("keepout", spec, true)? {
+                ZoneData::Polygons(p) => polys.extend(p),
+                ZoneData::Mask(m) => masks.push(m),
+            }
+        }
+        let z = ZoneMasks::new(&frame, area.as_deref(), &polys, &masks);
+        if let (Some(spec), Some(a)) = (&self.area, &z.area) {
+            if a.is_clear() {
+                return Err(ScenarioError::Zone {
+                    kind: "area",
+                    label: spec.label(),
+                    message: format!(
+                        "holds no pixel centre of the map {} (it lies outside the map or is thinner than a pixel)",
+                        map.source.display()
+                    ),
+                });
+            }
+        }
+        Ok(Some(z))
+    }
+
+    /// The zone a world error is about, for messages: the area for a start outside it, the
+    /// first keep-out for a start inside one, else the area (or the first keep-out).
+    fn zone_of(&self, e: &WorldError) -> Option<(&'static str, String)> {
+        let area = self.area.as_ref().map(|a| ("area", a.label()));
+        let keep = || {
+            let labels: Vec<String> = self.keepout.iter().map(ZoneSpec::label).collect();
+            (!labels.is_empty()).then(|| ("keepout", labels.join(", ")))
+        };
+        match e {
+            WorldError::StartOutsideArea { .. } | WorldError::AreaUnreachable { .. } => area,
+            WorldError::StartInKeepout { .. } => keep(),
+            WorldError::NoRoomInZones { .. } => area.or_else(keep),
+            _ => None,
+        }
     }
 
     /// What the planner's checks and estimate see for `map`.
@@ -526,10 +637,20 @@ impl Scenario {
     pub fn world(&self, map: &PreparedMap) -> Result<World, ScenarioError> {
         self.validate()?;
         self.check_map(map)?;
+        let zones = self.zone_masks(map)?;
         let start = self.start.map(|s| Pose::new(s[0], s[1], s[2]));
-        World::new(map.grid.clone(), self.robot, start).map_err(|source| ScenarioError::World {
-            path: map.source.clone(),
-            source,
+        World::with_zones(map.grid.clone(), self.robot, start, zones).map_err(|source| {
+            match self.zone_of(&source) {
+                Some((kind, label)) => ScenarioError::Zone {
+                    kind,
+                    label,
+                    message: format!("{source} (map {})", map.source.display()),
+                },
+                None => ScenarioError::World {
+                    path: map.source.clone(),
+                    source,
+                },
+            }
         })
     }
 
@@ -604,6 +725,20 @@ impl ScenarioBuilder {
     #[must_use]
     pub fn sim(mut self, s: SimConfig) -> Self {
         self.0.sim = s;
+        self
+    }
+
+    /// Work area (see [`Scenario::area`]).
+    #[must_use]
+    pub fn area(mut self, a: ZoneSpec) -> Self {
+        self.0.area = Some(a);
+        self
+    }
+
+    /// Adds a keep-out zone (see [`Scenario::keepout`]).
+    #[must_use]
+    pub fn keepout(mut self, k: ZoneSpec) -> Self {
+        self.0.keepout.push(k);
         self
     }
 

@@ -314,7 +314,7 @@ fn not_applicable(opt: &str, kind: PlannerKind, applies_to: &str) -> PyErr {
 }
 
 /// Keyword options of `run` that are not planner options.
-const RUN_KEYS: [&str; 9] = [
+const RUN_KEYS: [&str; 11] = [
     "tool_radius",
     "start",
     "sensor_range",
@@ -324,6 +324,8 @@ const RUN_KEYS: [&str; 9] = [
     "seed",
     "options",
     "name",
+    "area",
+    "keepout",
 ];
 
 /// Builds the scenario of `ccpp.run`: keyword options -> scenario fields (validated later,
@@ -396,6 +398,22 @@ fn scenario_from(
                 planner_opts.extend(o);
             }
             "name" => s.map.name = Some(v.extract()?),
+            // Zones: a file name, [x0, y0, x1, y1] or a list of polygons (`Scenario::area`);
+            // keepout: one zone or a list of zones (`Scenario::keepout`).
+            "area" => {
+                s.area = Some(
+                    serde_json::from_value(py_to_json(&v)?)
+                        .map_err(|e| msg(format!("area: {e}")))?,
+                );
+            }
+            "keepout" => {
+                let j = py_to_json(&v)?;
+                s.keepout = match serde_json::from_value::<ccpp_io::zones::ZoneSpec>(j.clone()) {
+                    Ok(one) => vec![one],
+                    Err(_) => serde_json::from_value(j)
+                        .map_err(|e| msg(format!("keepout: {e}")))?,
+                };
+            }
             _ => {
                 planner_opts.insert(key, py_to_json(&v)?);
             }
@@ -602,6 +620,8 @@ fn bench_run(
             planner: PlannerConfig::new(kind),
             sim: SimConfig::default(),
             max_memory_mb: max_memory_mb.unwrap_or(DEFAULT_MAX_MEMORY_MB),
+            area: None,
+            keepout: Vec::new(),
         };
         let run = scenario.run_on(&map).map_err(|e| chain(&e))?;
         if let Some(dir) = &out {

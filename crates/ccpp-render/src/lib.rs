@@ -92,6 +92,23 @@ pub mod colours {
     pub const RESTART: [u8; 3] = [130, 40, 160];
     /// Collisions.
     pub const COLLISION: [u8; 3] = [230, 0, 0];
+    /// Keep-out floor (tint; hatched with [`KEEPOUT_HATCH`]).
+    pub const KEEPOUT: [u8; 3] = [250, 215, 215];
+    /// Hatching over keep-out floor.
+    pub const KEEPOUT_HATCH: [u8; 3] = [200, 40, 40];
+    /// Free floor outside the work area.
+    pub const OUTSIDE_AREA: [u8; 3] = [226, 222, 208];
+    /// Work-area border.
+    pub const AREA_BORDER: [u8; 3] = [110, 40, 150];
+}
+
+/// Zone class of map pixel `i` for the pictures: 1 = keep-out, 2 = outside the area, 0 = none.
+fn zone_class(world: &World, i: usize) -> u8 {
+    match world.zones() {
+        Some(z) if z.keepout.contains(i) => 1,
+        Some(z) if z.area.as_ref().is_some_and(|a| !a.contains(i)) => 2,
+        _ => 0,
+    }
 }
 
 /// Region colours (colour-blind-friendly-ish, distinct on light blue).
@@ -202,14 +219,20 @@ struct Shown {
     restart: usize,
     collisions: usize,
     poses: usize,
+    keepout: bool,
+    outside_area: bool,
+    area_border: bool,
 }
 
 fn shown(world: &World, trace: &Trace, crop: (usize, usize, usize, usize)) -> Shown {
     let f = *world.frame();
     let swept = swept_pixels(world, trace);
     let acc = world.accessible();
-    let cells = world.map().cells();
-    let mut s = Shown::default();
+    let cells = world.true_map().cells();
+    let mut s = Shown {
+        area_border: world.zones().is_some_and(|z| !z.area_polygons.is_empty()),
+        ..Shown::default()
+    };
     let (c0, r0, w, h) = crop;
     for r in r0..r0 + h {
         for c in c0..c0 + w {
@@ -217,6 +240,8 @@ fn shown(world: &World, trace: &Trace, crop: (usize, usize, usize, usize)) -> Sh
             match cells[i] {
                 Cell::Occupied => s.obstacle = true,
                 Cell::Unknown => s.unknown = true,
+                Cell::Free if zone_class(world, i) == 1 => s.keepout = true,
+                Cell::Free if zone_class(world, i) == 2 => s.outside_area = true,
                 Cell::Free => match (acc.contains(i), swept.contains(i)) {
                     (true, true) => s.swept = true,
                     (true, false) => s.missed = true,
@@ -291,6 +316,9 @@ pub fn legend_entries_union(runs: &[(&World, &Trace)]) -> Vec<LegendEntry> {
         all.restart = all.restart.max(s.restart.min(1));
         all.collisions = all.collisions.max(s.collisions.min(1));
         all.poses = all.poses.max(s.poses);
+        all.keepout |= s.keepout;
+        all.outside_area |= s.outside_area;
+        all.area_border |= s.area_border;
     }
     let mut e = entries_of(&all);
     // Counts differ per run: drop them from the shared legend.
@@ -324,6 +352,24 @@ fn entries_of(s: &Shown) -> Vec<LegendEntry> {
     );
     add(s.obstacle, Swatch::Fill(c::OBSTACLE), "obstacle".into());
     add(s.unknown, Swatch::Fill(c::UNKNOWN), "unknown".into());
+    add(
+        s.keepout,
+        Swatch::Fill(c::KEEPOUT_HATCH),
+        "keep-out zone (hatched)".into(),
+    );
+    add(
+        s.outside_area,
+        Swatch::Fill(c::OUTSIDE_AREA),
+        "floor outside the area".into(),
+    );
+    add(
+        s.area_border,
+        Swatch::Line {
+            rgb: c::AREA_BORDER,
+            dashed: false,
+        },
+        "area border".into(),
+    );
     add(
         s.regions > 0,
         Swatch::Regions(PALETTE[..s.regions.clamp(1, 5)].to_vec()),
@@ -477,11 +523,20 @@ pub fn coverage_pixmap(
     // Background: classify each map pixel, then nearest-neighbour scale.
     let swept = swept_pixels(world, trace);
     let acc = world.accessible();
-    let cells = world.map().cells();
-    let colour_of = |i: usize| -> [u8; 3] {
+    let cells = world.true_map().cells();
+    let colour_of = |i: usize, x: u32, y: u32| -> [u8; 3] {
         match cells[i] {
             Cell::Occupied => colours::OBSTACLE,
             Cell::Unknown => colours::UNKNOWN,
+            Cell::Free if zone_class(world, i) == 1 => {
+                // Diagonal hatching in canvas pixels, 3 of every 9 on.
+                if (x + y) % 9 < 3 {
+                    colours::KEEPOUT_HATCH
+                } else {
+                    colours::KEEPOUT
+                }
+            }
+            Cell::Free if zone_class(world, i) == 2 => colours::OUTSIDE_AREA,
             Cell::Free => match (acc.contains(i), swept.contains(i)) {
                 (true, true) => colours::SWEPT,
                 (true, false) => colours::MISSED,
@@ -497,7 +552,7 @@ pub fn coverage_pixmap(
             let row = (row0 + row).min(frame.height - 1);
             for x in 0..cw {
                 let col = (col0 + ((x as f32 + 0.5) / scale) as usize).min(frame.width - 1);
-                let c = colour_of(frame.index(col, row));
+                let c = colour_of(frame.index(col, row), x, y);
                 let o = (((y + header) * cw + x) * 4) as usize;
                 data[o] = c[0];
                 data[o + 1] = c[1];
@@ -513,11 +568,49 @@ pub fn coverage_pixmap(
         col0: col0 as f64,
         row0: row0 as f64,
     };
+    draw_zone_borders(&mut pm, world, view);
     draw_path(&mut pm, world, trace, view);
     draw_markers(&mut pm, world, trace, view);
     head.draw_onto(&mut pm);
     foot.draw_onto(&mut pm);
     Ok(pm)
+}
+
+/// Outlines of the area polygons (solid) and keep-out polygons (hatch colour).
+fn draw_zone_borders(pm: &mut Pixmap, world: &World, view: View) {
+    let Some(z) = world.zones() else { return };
+    let width = (view.scale * 0.8).clamp(1.5, 4.0);
+    for (polys, colour) in [
+        (&z.area_polygons, colours::AREA_BORDER),
+        (&z.keepout_polygons, colours::KEEPOUT_HATCH),
+    ] {
+        for poly in polys {
+            let ring = poly.ring();
+            let mut pb = PathBuilder::new();
+            for (k, p) in ring.iter().enumerate() {
+                let (x, y) = view.to_canvas(world, *p);
+                if k == 0 {
+                    pb.move_to(x, y);
+                } else {
+                    pb.line_to(x, y);
+                }
+            }
+            pb.close();
+            if let Some(path) = pb.finish() {
+                let stroke = Stroke {
+                    width,
+                    ..Stroke::default()
+                };
+                pm.stroke_path(
+                    &path,
+                    &paint(rgb(colour)),
+                    &stroke,
+                    Transform::identity(),
+                    None,
+                );
+            }
+        }
+    }
 }
 
 fn draw_path(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
@@ -651,7 +744,7 @@ fn draw_markers(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
         }
     }
     // Start and end.
-    let s = world.start();
+    let s = world.initial_pose();
     let (sx, sy) = view.to_canvas(world, s.position());
     if let Some(c) = PathBuilder::from_circle(sx, sy, rad.max(4.0)) {
         pm.fill_path(

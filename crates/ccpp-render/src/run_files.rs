@@ -86,7 +86,7 @@ pub fn render_run_files(
 ) -> Result<Vec<(&'static str, Vec<u8>)>, RunFilesError> {
     let metrics_text = metrics_json(metrics)?;
     let mut scenario = scenario.clone();
-    let start = world.start();
+    let start = world.initial_pose();
     scenario.start = Some([start.x, start.y, start.theta]);
     let run_json = scenario.to_json()?;
     let trace_text = ccpp_io::trace::trace_jsonl(trace)?;

@@ -1,0 +1,538 @@
+//! Work zones: an **area** the robot must stay inside and **keep-out** regions it must never
+//! enter, as polygons in map (world) coordinates and as pixel masks on the map grid.
+//!
+//! Semantics (one definition for every planner, the simulator and the metrics):
+//!
+//! * Zones are **virtual walls** the robot knows from the start. A [`crate::world::World`] built
+//!   with zones plans on the true map with every pixel outside the area and every keep-out
+//!   pixel marked occupied ([`crate::world::World::map`]); collisions are still checked against
+//!   the true map ([`crate::world::World::true_map`]): a virtual wall does not stop a robot, it
+//!   is only a rule, and entering a keep-out is counted by the metrics
+//!   (`keepout_violations`), not prevented by the simulator.
+//! * **Rasterisation** (the pixel-centre rule): a pixel belongs to a polygon when its centre
+//!   lies inside the polygon by the even-odd rule, evaluated on each image row at the row's
+//!   centre line; a centre exactly on a left edge is inside, exactly on a right edge outside
+//!   (half-open spans), so two polygons sharing an edge never both claim a pixel column of it
+//!   and the result depends on nothing but the coordinates. Several polygons are united.
+//! * A **keep-out mask** (a Nav2 keepout filter mask, loaded by `ccpp-io`) is given directly as
+//!   pixels; it is united with the keep-out polygons.
+
+use fixedbitset::FixedBitSet;
+use serde::{Deserialize, Serialize};
+
+use crate::geometry::Point;
+use crate::grid::MapFrame;
+
+/// A simple polygon in map coordinates (metres): its vertices in order, either orientation;
+/// closing the ring (repeating the first vertex at the end) is optional.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(transparent)]
+pub struct Polygon {
+    /// Vertices `[x, y]`.
+    pub points: Vec<[f64; 2]>,
+}
+
+/// Errors of zone polygons and masks.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum ZoneError {
+    /// No polygon at all.
+    #[error("holds no polygon")]
+    NoPolygon,
+    /// A polygon with fewer than three distinct vertices.
+    #[error("polygon {index} has {distinct} distinct points; a polygon needs at least 3")]
+    TooFewPoints {
+        /// Polygon index (0-based).
+        index: usize,
+        /// Distinct vertices found.
+        distinct: usize,
+    },
+    /// A coordinate that is NaN or infinite.
+    #[error("polygon {index} has a non-finite coordinate at point {point}")]
+    NonFinite {
+        /// Polygon index (0-based).
+        index: usize,
+        /// Vertex index (0-based).
+        point: usize,
+    },
+    /// Two edges that cross or touch away from their shared vertex.
+    #[error(
+        "polygon {index} intersects itself: edge {a} ({ax:.3},{ay:.3})-({bx:.3},{by:.3}) meets \
+         edge {b}"
+    )]
+    SelfIntersecting {
+        /// Polygon index (0-based).
+        index: usize,
+        /// First edge (0-based; edge `k` runs from vertex `k` to `k + 1`).
+        a: usize,
+        /// Second edge.
+        b: usize,
+        /// Start of edge `a`.
+        ax: f64,
+        /// Start of edge `a`.
+        ay: f64,
+        /// End of edge `a`.
+        bx: f64,
+        /// End of edge `a`.
+        by: f64,
+    },
+    /// All vertices on one line.
+    #[error("polygon {index} has zero area (all its points lie on one line)")]
+    ZeroArea {
+        /// Polygon index (0-based).
+        index: usize,
+    },
+    /// More vertices than the self-intersection check accepts.
+    #[error("polygon {index} has {points} points; at most {max} are accepted")]
+    TooManyPoints {
+        /// Polygon index (0-based).
+        index: usize,
+        /// Vertices given.
+        points: usize,
+        /// The limit.
+        max: usize,
+    },
+}
+
+/// Most vertices one polygon may have (the self-intersection check is quadratic).
+pub const MAX_POLYGON_POINTS: usize = 4096;
+
+impl Polygon {
+    /// The axis-aligned rectangle `[x0, y0, x1, y1]`.
+    pub fn rect(r: [f64; 4]) -> Self {
+        let [x0, y0, x1, y1] = r;
+        Self {
+            points: vec![[x0, y0], [x1, y0], [x1, y1], [x0, y1]],
+        }
+    }
+
+    /// The vertices without consecutive duplicates and without the closing repeat.
+    pub fn ring(&self) -> Vec<Point> {
+        let mut out: Vec<Point> = Vec::with_capacity(self.points.len());
+        for p in &self.points {
+            let q = Point::new(p[0], p[1]);
+            if out.last() != Some(&q) {
+                out.push(q);
+            }
+        }
+        while out.len() > 1 && out.first() == out.last() {
+            out.pop();
+        }
+        out
+    }
+
+    /// Signed area (positive counter-clockwise), square metres.
+    pub fn signed_area(&self) -> f64 {
+        let r = self.ring();
+        let n = r.len();
+        (0..n)
+            .map(|i| {
+                let (a, b) = (r[i], r[(i + 1) % n]);
+                a.x * b.y - b.x * a.y
+            })
+            .sum::<f64>()
+            / 2.0
+    }
+
+    /// Checks the polygon (`index` names it in errors): finite coordinates, at least three
+    /// distinct vertices, non-zero area, no two edges meeting except consecutive ones at their
+    /// shared vertex.
+    ///
+    /// # Errors
+    /// The first problem found.
+    pub fn validate(&self, index: usize) -> Result<(), ZoneError> {
+        if let Some(k) = self
+            .points
+            .iter()
+            .position(|p| !(p[0].is_finite() && p[1].is_finite()))
+        {
+            return Err(ZoneError::NonFinite { index, point: k });
+        }
+        if self.points.len() > MAX_POLYGON_POINTS {
+            return Err(ZoneError::TooManyPoints {
+                index,
+                points: self.points.len(),
+                max: MAX_POLYGON_POINTS,
+            });
+        }
+        let r = self.ring();
+        let mut distinct: Vec<(u64, u64)> =
+            r.iter().map(|p| (p.x.to_bits(), p.y.to_bits())).collect();
+        distinct.sort_unstable();
+        distinct.dedup();
+        if distinct.len() < 3 {
+            return Err(ZoneError::TooFewPoints {
+                index,
+                distinct: distinct.len(),
+            });
+        }
+        let n = r.len();
+        for i in 0..n {
+            let (a, b) = (r[i], r[(i + 1) % n]);
+            for j in i + 1..n {
+                let adjacent = j == i + 1 || (i == 0 && j == n - 1);
+                let (c, d) = (r[j], r[(j + 1) % n]);
+                let meet = if adjacent {
+                    // Consecutive edges share one vertex; they may not fold back onto each
+                    // other (overlap beyond the shared vertex).
+                    let shared = if j == i + 1 { b } else { a };
+                    let (p, q) = if j == i + 1 { (a, d) } else { (b, c) };
+                    folds_back(shared, p, q)
+                } else {
+                    segments_meet(a, b, c, d)
+                };
+                if meet {
+                    return Err(ZoneError::SelfIntersecting {
+                        index,
+                        a: i,
+                        b: j,
+                        ax: a.x,
+                        ay: a.y,
+                        bx: b.x,
+                        by: b.y,
+                    });
+                }
+            }
+        }
+        if self.signed_area().abs() <= f64::EPSILON * bbox_scale(&r) {
+            return Err(ZoneError::ZeroArea { index });
+        }
+        Ok(())
+    }
+}
+
+fn bbox_scale(r: &[Point]) -> f64 {
+    let (mut lo, mut hi) = (
+        Point::new(f64::MAX, f64::MAX),
+        Point::new(f64::MIN, f64::MIN),
+    );
+    for p in r {
+        lo = Point::new(lo.x.min(p.x), lo.y.min(p.y));
+        hi = Point::new(hi.x.max(p.x), hi.y.max(p.y));
+    }
+    (hi.x - lo.x) * (hi.y - lo.y)
+}
+
+fn cross(o: Point, a: Point, b: Point) -> f64 {
+    (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x)
+}
+
+fn on_segment(p: Point, a: Point, b: Point) -> bool {
+    p.x >= a.x.min(b.x) && p.x <= a.x.max(b.x) && p.y >= a.y.min(b.y) && p.y <= a.y.max(b.y)
+}
+
+/// Do the closed segments `a-b` and `c-d` share a point?
+fn segments_meet(a: Point, b: Point, c: Point, d: Point) -> bool {
+    let d1 = cross(c, d, a);
+    let d2 = cross(c, d, b);
+    let d3 = cross(a, b, c);
+    let d4 = cross(a, b, d);
+    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0))
+        && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0))
+    {
+        return true;
+    }
+    (d1 == 0.0 && on_segment(a, c, d))
+        || (d2 == 0.0 && on_segment(b, c, d))
+        || (d3 == 0.0 && on_segment(c, a, b))
+        || (d4 == 0.0 && on_segment(d, a, b))
+}
+
+/// Two edges `shared-p` and `shared-q` meeting at `shared`: do they overlap (collinear and
+/// pointing the same way)?
+fn folds_back(shared: Point, p: Point, q: Point) -> bool {
+    let u = Point::new(p.x - shared.x, p.y - shared.y);
+    let v = Point::new(q.x - shared.x, q.y - shared.y);
+    u.x * v.y - u.y * v.x == 0.0 && u.x * v.x + u.y * v.y > 0.0
+}
+
+/// Validates a list of polygons (at least one).
+///
+/// # Errors
+/// [`ZoneError::NoPolygon`] for an empty list, else the first invalid polygon.
+pub fn validate_polygons(polys: &[Polygon]) -> Result<(), ZoneError> {
+    if polys.is_empty() {
+        return Err(ZoneError::NoPolygon);
+    }
+    for (i, p) in polys.iter().enumerate() {
+        p.validate(i)?;
+    }
+    Ok(())
+}
+
+/// Marks in `mask` (a `frame`-sized bitset) every pixel whose centre lies inside one of
+/// `polys` (the pixel-centre rule of the module docs). Polygons should be validated first;
+/// non-finite vertices are skipped.
+pub fn rasterize_into(mask: &mut FixedBitSet, frame: &MapFrame, polys: &[Polygon]) {
+    let (w, h) = (frame.width, frame.height);
+    let mut xs: Vec<f64> = Vec::new();
+    for poly in polys {
+        let ring: Vec<Point> = poly
+            .ring()
+            .into_iter()
+            .filter(|p| p.x.is_finite() && p.y.is_finite())
+            .map(|p| frame.world_to_grid(p))
+            .collect();
+        let n = ring.len();
+        if n < 3 {
+            continue;
+        }
+        let (ymin, ymax) = ring.iter().fold((f64::MAX, f64::MIN), |(lo, hi), p| {
+            (lo.min(p.y), hi.max(p.y))
+        });
+        // Rows whose centre line gy = h - row - 0.5 lies in [ymin, ymax].
+        let row_lo = (h as f64 - ymax - 0.5).ceil().max(0.0);
+        let row_hi = (h as f64 - ymin - 0.5).floor().min(h as f64 - 1.0);
+        if row_lo > row_hi {
+            continue;
+        }
+        for row in row_lo as usize..=row_hi as usize {
+            let gy = h as f64 - row as f64 - 0.5;
+            xs.clear();
+            for i in 0..n {
+                let (a, b) = (ring[i], ring[(i + 1) % n]);
+                if (a.y <= gy) != (b.y <= gy) {
+                    xs.push(a.x + (gy - a.y) * (b.x - a.x) / (b.y - a.y));
+                }
+            }
+            xs.sort_by(f64::total_cmp);
+            for pair in xs.chunks_exact(2) {
+                // Columns whose centre col + 0.5 lies in [x0, x1).
+                let c0 = (pair[0] - 0.5).ceil().max(0.0);
+                let c1 = ((pair[1] - 0.5).ceil() - 1.0).min(w as f64 - 1.0);
+                if c0 > c1 {
+                    continue;
+                }
+                let base = row * w;
+                mask.insert_range(base + c0 as usize..base + c1 as usize + 1);
+            }
+        }
+    }
+}
+
+/// The pixels whose centre lies inside one of `polys` (see [`rasterize_into`]).
+pub fn rasterize(frame: &MapFrame, polys: &[Polygon]) -> FixedBitSet {
+    let mut m = FixedBitSet::with_capacity(frame.len());
+    rasterize_into(&mut m, frame, polys);
+    m
+}
+
+/// The zones of one run as pixel masks on the map grid.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ZoneMasks {
+    /// Pixels inside the work area; `None` = the whole map.
+    pub area: Option<FixedBitSet>,
+    /// Keep-out pixels (polygons and masks united).
+    pub keepout: FixedBitSet,
+    /// The area's polygons (for drawing its border), map coordinates.
+    pub area_polygons: Vec<Polygon>,
+    /// The keep-out polygons (for drawing), map coordinates; mask pixels are only in
+    /// [`Self::keepout`].
+    pub keepout_polygons: Vec<Polygon>,
+}
+
+impl ZoneMasks {
+    /// Rasterises `area` polygons (`None` = no area restriction) and `keepout` polygons onto
+    /// `frame`, plus the keep-out pixel `masks` (each `frame`-sized).
+    pub fn new(
+        frame: &MapFrame,
+        area: Option<&[Polygon]>,
+        keepout: &[Polygon],
+        masks: &[FixedBitSet],
+    ) -> Self {
+        let mut k = rasterize(frame, keepout);
+        for m in masks {
+            k.union_with(m);
+        }
+        Self {
+            area: area.map(|a| rasterize(frame, a)),
+            keepout: k,
+            area_polygons: area.map(<[Polygon]>::to_vec).unwrap_or_default(),
+            keepout_polygons: keepout.to_vec(),
+        }
+    }
+
+    /// Is pixel `i` forbidden (outside the area or in a keep-out)?
+    pub fn forbidden(&self, i: usize) -> bool {
+        self.keepout.contains(i) || self.area.as_ref().is_some_and(|a| !a.contains(i))
+    }
+
+    /// No area restriction and no keep-out pixel.
+    pub fn is_empty(&self) -> bool {
+        self.area.is_none() && self.keepout.is_clear()
+    }
+}
+
+/// A pixel mask as an obstacle set for the exact disk tests of [`crate::collide`]: a pixel
+/// blocks when its bit is set (or clear, with `invert`); pixels outside the image never block.
+pub struct MaskOccupancy<'a> {
+    frame: &'a MapFrame,
+    bits: &'a FixedBitSet,
+    invert: bool,
+}
+
+impl<'a> MaskOccupancy<'a> {
+    /// The mask `bits` (`frame`-sized) as obstacles; `invert` makes the clear bits block.
+    pub fn new(frame: &'a MapFrame, bits: &'a FixedBitSet, invert: bool) -> Self {
+        Self {
+            frame,
+            bits,
+            invert,
+        }
+    }
+}
+
+impl crate::collide::Occupancy for MaskOccupancy<'_> {
+    fn frame(&self) -> &MapFrame {
+        self.frame
+    }
+    #[inline]
+    fn blocked(&self, col: i64, row: i64) -> bool {
+        self.frame
+            .checked(col, row)
+            .is_some_and(|(c, r)| self.bits.contains(self.frame.index(c, r)) != self.invert)
+    }
+    fn for_each_blocked_in_row(
+        &self,
+        row: usize,
+        lo: usize,
+        hi: usize,
+        f: &mut dyn FnMut(usize) -> bool,
+    ) {
+        let base = row * self.frame.width;
+        let blocks = self.bits.as_slice();
+        let inv = if self.invert { usize::MAX } else { 0 };
+        crate::bits::for_each_set(
+            base + lo,
+            base + hi + 1,
+            |k| blocks[k] ^ inv,
+            |i| f(i - base),
+        );
+    }
+}
+
+/// Keep-out entries along a centre polyline (grid coordinates): a robot of radius `r_px`
+/// pixels enters a keep-out when its disk, not overlapping any keep-out pixel (the obstacle
+/// model of [`crate::collide`]: a pixel is the disk inscribed in its square), starts to overlap
+/// one. Counted once per entry: a segment that starts clear and touches a keep-out anywhere
+/// adds one; the disk is then clear again once a segment ends clear of every keep-out pixel
+/// (an exit and a new entry inside one segment that starts inside count as none). A start
+/// inside a keep-out counts as one entry.
+pub fn keepout_entries(
+    frame: &MapFrame,
+    keepout: &FixedBitSet,
+    points: &[Point],
+    r_px: f64,
+) -> u32 {
+    if keepout.is_clear() || points.is_empty() {
+        return 0;
+    }
+    let occ = MaskOccupancy::new(frame, keepout, false);
+    let mut inside = crate::collide::disk_hits(&occ, points[0], r_px);
+    let mut n = u32::from(inside);
+    for w in points.windows(2) {
+        if w[0] == w[1] {
+            continue;
+        }
+        if !inside && crate::collide::segment_first_contact(&occ, w[0], w[1], r_px).is_some() {
+            n += 1;
+        }
+        inside = crate::collide::disk_hits(&occ, w[1], r_px);
+    }
+    n
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn poly(p: &[[f64; 2]]) -> Polygon {
+        Polygon { points: p.to_vec() }
+    }
+
+    #[test]
+    fn validation_catches_bad_polygons() {
+        assert_eq!(validate_polygons(&[]), Err(ZoneError::NoPolygon));
+        let e = poly(&[[0.0, 0.0], [1.0, 0.0], [0.0, 0.0]]).validate(0);
+        assert!(matches!(
+            e,
+            Err(ZoneError::TooFewPoints { distinct: 2, .. })
+        ));
+        let e = poly(&[[0.0, 0.0], [1.0, f64::NAN], [0.0, 1.0]]).validate(3);
+        assert_eq!(e, Err(ZoneError::NonFinite { index: 3, point: 1 }));
+        // A bow tie.
+        let e = poly(&[[0.0, 0.0], [1.0, 1.0], [1.0, 0.0], [0.0, 1.0]]).validate(0);
+        assert!(
+            matches!(e, Err(ZoneError::SelfIntersecting { .. })),
+            "{e:?}"
+        );
+        // A spike folding back on itself.
+        let e = poly(&[[0.0, 0.0], [2.0, 0.0], [1.0, 0.0], [1.0, 1.0]]).validate(0);
+        assert!(
+            matches!(e, Err(ZoneError::SelfIntersecting { .. })),
+            "{e:?}"
+        );
+        let e = poly(&[[0.0, 0.0], [1.0, 1.0], [2.0, 2.0]]).validate(0);
+        assert!(e.is_err(), "{e:?}");
+        // Closed ring and either orientation are fine.
+        poly(&[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 0.0]])
+            .validate(0)
+            .unwrap();
+        poly(&[[0.0, 0.0], [0.0, 1.0], [1.0, 1.0], [1.0, 0.0]])
+            .validate(0)
+            .unwrap();
+    }
+
+    #[test]
+    fn rasterisation_follows_the_pixel_centre_rule() {
+        // 10 x 10 pixels of 0.1 m, origin (0, 0).
+        let f = MapFrame::new(10, 10, 0.1);
+        // x in [0.2, 0.5) holds centres 0.25, 0.35, 0.45; y in [0.1, 0.3] holds 0.15, 0.25.
+        let m = rasterize(&f, &[Polygon::rect([0.2, 0.1, 0.5, 0.3])]);
+        assert_eq!(m.count_ones(..), 6);
+        for c in 2..5 {
+            for gy in [1usize, 2] {
+                assert!(m.contains(f.index(c, 9 - gy)), "col {c} gy {gy}");
+            }
+        }
+        // Two rectangles sharing an edge claim each centre once: the union is the big one.
+        let a = rasterize(&f, &[Polygon::rect([0.0, 0.0, 0.5, 1.0])]);
+        let b = rasterize(&f, &[Polygon::rect([0.5, 0.0, 1.0, 1.0])]);
+        assert!(a.is_disjoint(&b));
+        assert_eq!(a.count_ones(..) + b.count_ones(..), 100);
+        // A triangle: the orientation does not matter.
+        let t1 = rasterize(&f, &[poly(&[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])]);
+        let t2 = rasterize(&f, &[poly(&[[0.0, 0.0], [0.0, 1.0], [1.0, 0.0]])]);
+        assert_eq!(t1, t2);
+        // 45 centres lie strictly below the diagonal x + y = 1; the ten on it are decided by
+        // the half-open span rule after rounding.
+        let n = t1.count_ones(..);
+        assert!((45..=55).contains(&n), "{n}");
+        // Outside the map: nothing, no panic.
+        assert!(rasterize(&f, &[Polygon::rect([5.0, 5.0, 9.0, 9.0])]).is_clear());
+        assert_eq!(
+            rasterize(&f, &[Polygon::rect([-5.0, -5.0, 9.0, 9.0])]).count_ones(..),
+            100
+        );
+    }
+
+    #[test]
+    fn keepout_entries_are_counted_once_per_entry() {
+        let f = MapFrame::new(20, 10, 0.1);
+        // A keep-out block at x in [0.9, 1.1), all rows.
+        let k = rasterize(&f, &[Polygon::rect([0.9, 0.0, 1.1, 1.0])]);
+        let g = |x: f64, y: f64| f.world_to_grid(Point::new(x, y));
+        let r = 1.0; // px
+                     // Across and back: two entries; staying left of it: none.
+        let across = [g(0.2, 0.5), g(1.8, 0.5), g(0.2, 0.5)];
+        assert_eq!(keepout_entries(&f, &k, &across, r), 2);
+        let left = [g(0.2, 0.5), g(0.7, 0.5), g(0.2, 0.3)];
+        assert_eq!(keepout_entries(&f, &k, &left, r), 0);
+        // Into it in small steps: one entry.
+        let steps: Vec<Point> = (0..20).map(|i| g(0.5 + 0.05 * f64::from(i), 0.5)).collect();
+        assert_eq!(keepout_entries(&f, &k, &steps, r), 1);
+        assert_eq!(
+            keepout_entries(&f, &FixedBitSet::with_capacity(200), &across, r),
+            0
+        );
+    }
+}

@@ -1,0 +1,336 @@
+//! Zone files for `--area` and `--keepout` ([`ccpp_core::zones`] holds the semantics):
+//!
+//! * **`GeoJSON`** (`.geojson` / `.json`): a `Polygon`, `MultiPolygon`, `Feature`,
+//!   `FeatureCollection` or `GeometryCollection` of them, in **map coordinates** (metres, the
+//!   map's frame; `[x, y]` order, a third coordinate ignored). Only outer rings: a polygon with
+//!   holes is refused (give the hole's surroundings as separate polygons).
+//! * **YAML polygon lists** (`.yaml` / `.yml` without an `image` key): one polygon as a list of
+//!   points, or a list of polygons; a point is `[x, y]` or `{x: .., y: ..}`; a top-level
+//!   `polygons:` key holding such a list is accepted too.
+//! * **Nav2 keepout filter masks** (keep-out only): a `map_server` YAML (with an `image` key) and
+//!   its image in the map's frame, read by the map loader with the mask's own thresholds:
+//!   occupied pixels are keep-out. The mask must have exactly the map's size, resolution and
+//!   origin; anything else is refused (a mask in another frame would forbid the wrong floor).
+
+use std::path::{Path, PathBuf};
+
+use ccpp_core::grid::MapFrame;
+use ccpp_core::zones::Polygon;
+use fixedbitset::FixedBitSet;
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+
+use crate::map::{load_map, LoadOptions};
+
+/// Where a zone comes from (serialized untagged: `[x0, y0, x1, y1]`, a file name, or a list of
+/// polygons, each a list of `[x, y]`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum ZoneSpec {
+    /// The axis-aligned rectangle `[x0, y0, x1, y1]`, map coordinates.
+    Rect([f64; 4]),
+    /// Polygons given inline, map coordinates.
+    Polygons(Vec<Polygon>),
+    /// A polygon file (`GeoJSON` or YAML) or, for keep-outs, a Nav2 keepout filter mask.
+    File(PathBuf),
+}
+
+/// What a zone file holds.
+#[derive(Clone, Debug)]
+pub enum ZoneData {
+    /// Polygons in map coordinates.
+    Polygons(Vec<Polygon>),
+    /// A keep-out pixel mask on the map grid (occupied pixels of a Nav2 mask).
+    Mask(FixedBitSet),
+}
+
+/// Error reading a zone file (the message never names the file: the caller adds it).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct ZoneFileError(pub String);
+
+fn bad(m: impl Into<String>) -> ZoneFileError {
+    ZoneFileError(m.into())
+}
+
+impl ZoneSpec {
+    /// The file this spec names, if any.
+    pub fn path(&self) -> Option<&Path> {
+        match self {
+            Self::File(p) => Some(p),
+            _ => None,
+        }
+    }
+
+    /// Short description for messages and `info`: the file name, `rectangle` or `inline`.
+    pub fn label(&self) -> String {
+        match self {
+            Self::Rect(r) => format!("rectangle {},{},{},{}", r[0], r[1], r[2], r[3]),
+            Self::Polygons(p) => format!("{} inline polygon(s)", p.len()),
+            Self::File(p) => p.display().to_string(),
+        }
+    }
+
+    /// Loads the zone for a map of frame `frame`; `mask_ok` allows Nav2 masks (keep-outs).
+    /// Polygons are validated.
+    ///
+    /// # Errors
+    /// An unreadable or malformed file, an invalid polygon, a mask in another frame, or a mask
+    /// where it is not allowed.
+    pub fn load(&self, frame: &MapFrame, mask_ok: bool) -> Result<ZoneData, ZoneFileError> {
+        let polys =
+            match self {
+                Self::Rect(r) => {
+                    check_rect(*r)?;
+                    vec![Polygon::rect(*r)]
+                }
+                Self::Polygons(p) => p.clone(),
+                Self::File(path) => match read_file(path, frame)? {
+                    ZoneData::Mask(m) if mask_ok => return Ok(ZoneData::Mask(m)),
+                    ZoneData::Mask(_) => return Err(bad(
+                        "is a keepout mask; an area must be polygons (GeoJSON or a YAML list of \
+                         x,y points) or a rectangle X0,Y0,X1,Y1",
+                    )),
+                    ZoneData::Polygons(p) => p,
+                },
+            };
+        ccpp_core::zones::validate_polygons(&polys).map_err(|e| bad(e.to_string()))?;
+        Ok(ZoneData::Polygons(polys))
+    }
+}
+
+/// Checks a rectangle `[x0, y0, x1, y1]`: finite with `x1 > x0` and `y1 > y0`.
+///
+/// # Errors
+/// The rectangle is empty or not finite.
+pub fn check_rect(r: [f64; 4]) -> Result<(), ZoneFileError> {
+    if r.iter().any(|v| !v.is_finite()) {
+        return Err(bad(format!("rectangle {r:?} must be finite")));
+    }
+    if !(r[2] > r[0] && r[3] > r[1]) {
+        return Err(bad(format!(
+            "rectangle {},{},{},{} is empty: it needs X1 > X0 and Y1 > Y0",
+            r[0], r[1], r[2], r[3]
+        )));
+    }
+    Ok(())
+}
+
+/// Reads a zone file: `GeoJSON`, YAML polygons or a Nav2 mask (checked against `frame`).
+fn read_file(path: &Path, frame: &MapFrame) -> Result<ZoneData, ZoneFileError> {
+    let text = crate::file::read_text(path).map_err(|e| bad(e.to_string()))?;
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    let yaml_ext = ext == "yaml" || ext == "yml";
+    if ext == "geojson" || ext == "json" || (!yaml_ext && text.trim_start().starts_with('{')) {
+        let v: Value = serde_json::from_str(&text).map_err(|e| bad(format!("GeoJSON: {e}")))?;
+        return Ok(ZoneData::Polygons(geojson_polygons(&v)?));
+    }
+    let v: serde_json::Value =
+        serde_saphyr::from_str(&text).map_err(|e| bad(format!("YAML: {e}")))?;
+    if v.get("image").is_some() {
+        return read_mask(path, frame).map(ZoneData::Mask);
+    }
+    Ok(ZoneData::Polygons(yaml_polygons(&v)?))
+}
+
+fn read_mask(path: &Path, frame: &MapFrame) -> Result<FixedBitSet, ZoneFileError> {
+    let m = load_map(path, &LoadOptions::default()).map_err(|e| bad(e.to_string()))?;
+    let f = *m.grid.frame();
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs()).max(1.0);
+    if f.width != frame.width || f.height != frame.height {
+        return Err(bad(format!(
+            "keepout mask is {} x {} px but the map is {} x {} px; a mask must be in the map's frame",
+            f.width, f.height, frame.width, frame.height
+        )));
+    }
+    if !close(f.resolution, frame.resolution) {
+        return Err(bad(format!(
+            "keepout mask resolution {} m/px differs from the map's {} m/px; a mask must be in the map's frame",
+            f.resolution, frame.resolution
+        )));
+    }
+    let (o, p) = (f.origin, frame.origin);
+    if !(close(o.x, p.x) && close(o.y, p.y) && close(o.theta, p.theta)) {
+        return Err(bad(format!(
+            "keepout mask origin [{}, {}, {}] differs from the map's [{}, {}, {}]; a mask must be in the map's frame",
+            o.x, o.y, o.theta, p.x, p.y, p.theta
+        )));
+    }
+    let mut bits = FixedBitSet::with_capacity(f.len());
+    for (i, c) in m.grid.cells().iter().enumerate() {
+        if *c == ccpp_core::Cell::Occupied {
+            bits.insert(i);
+        }
+    }
+    Ok(bits)
+}
+
+fn point(v: &Value) -> Result<[f64; 2], ZoneFileError> {
+    let num = |x: &Value| {
+        x.as_f64()
+            .ok_or_else(|| bad(format!("coordinate {x} is not a number")))
+    };
+    match v {
+        Value::Array(a) if a.len() >= 2 => Ok([num(&a[0])?, num(&a[1])?]),
+        Value::Object(o) => match (o.get("x"), o.get("y")) {
+            (Some(x), Some(y)) => Ok([num(x)?, num(y)?]),
+            _ => Err(bad(format!("point {v} needs x and y"))),
+        },
+        _ => Err(bad(format!("point {v} is not [x, y]"))),
+    }
+}
+
+fn ring(v: &Value) -> Result<Polygon, ZoneFileError> {
+    let Value::Array(a) = v else {
+        return Err(bad(format!("a polygon must be a list of points, got {v}")));
+    };
+    Ok(Polygon {
+        points: a.iter().map(point).collect::<Result<_, _>>()?,
+    })
+}
+
+fn is_point(v: &Value) -> bool {
+    match v {
+        Value::Array(a) => a.first().is_some_and(Value::is_number),
+        Value::Object(o) => o.contains_key("x"),
+        _ => false,
+    }
+}
+
+/// Polygons of a YAML polygon list (one polygon, a list of them, or `polygons: [...]`).
+fn yaml_polygons(v: &Value) -> Result<Vec<Polygon>, ZoneFileError> {
+    let v = v.get("polygons").unwrap_or(v);
+    let Value::Array(a) = v else {
+        return Err(bad(
+            "expected a list of x,y points, a list of such lists, or a map_server YAML (keepout mask)",
+        ));
+    };
+    if a.is_empty() {
+        return Ok(Vec::new());
+    }
+    if is_point(&a[0]) {
+        return Ok(vec![ring(v)?]);
+    }
+    a.iter().map(ring).collect()
+}
+
+/// Polygons of a `GeoJSON` object.
+fn geojson_polygons(v: &Value) -> Result<Vec<Polygon>, ZoneFileError> {
+    let mut out = Vec::new();
+    geojson_collect(v, &mut out, 0)?;
+    Ok(out)
+}
+
+fn geojson_polygon(rings: &Value, out: &mut Vec<Polygon>) -> Result<(), ZoneFileError> {
+    let Value::Array(r) = rings else {
+        return Err(bad("GeoJSON Polygon coordinates must be a list of rings"));
+    };
+    if r.len() > 1 {
+        return Err(bad(
+            "GeoJSON polygon with holes: not supported; give the zone as polygons without holes",
+        ));
+    }
+    if let Some(outer) = r.first() {
+        out.push(ring(outer)?);
+    }
+    Ok(())
+}
+
+fn geojson_collect(v: &Value, out: &mut Vec<Polygon>, depth: usize) -> Result<(), ZoneFileError> {
+    if depth > 8 {
+        return Err(bad("GeoJSON nested too deeply"));
+    }
+    let ty = v.get("type").and_then(Value::as_str).unwrap_or("");
+    let coords = || {
+        v.get("coordinates")
+            .ok_or_else(|| bad(format!("GeoJSON {ty} without coordinates")))
+    };
+    match ty {
+        "Polygon" => geojson_polygon(coords()?, out),
+        "MultiPolygon" => match coords()? {
+            Value::Array(ps) => ps.iter().try_for_each(|p| geojson_polygon(p, out)),
+            _ => Err(bad("GeoJSON MultiPolygon coordinates must be a list")),
+        },
+        "Feature" => match v.get("geometry") {
+            Some(g) if !g.is_null() => geojson_collect(g, out, depth + 1),
+            _ => Ok(()),
+        },
+        "FeatureCollection" => match v.get("features") {
+            Some(Value::Array(fs)) => fs
+                .iter()
+                .try_for_each(|f| geojson_collect(f, out, depth + 1)),
+            _ => Err(bad("GeoJSON FeatureCollection without a features list")),
+        },
+        "GeometryCollection" => match v.get("geometries") {
+            Some(Value::Array(gs)) => gs
+                .iter()
+                .try_for_each(|g| geojson_collect(g, out, depth + 1)),
+            _ => Err(bad("GeoJSON GeometryCollection without a geometries list")),
+        },
+        "" => Err(bad("not GeoJSON: no \"type\"")),
+        other => Err(bad(format!(
+            "GeoJSON {other} is not a zone: use Polygon, MultiPolygon, Feature or FeatureCollection"
+        ))),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn geojson_and_yaml_shapes_parse() {
+        let g: Value = serde_json::from_str(
+            r#"{"type":"FeatureCollection","features":[
+                {"type":"Feature","properties":{},"geometry":{"type":"Polygon","coordinates":[[[0,0],[1,0],[1,1],[0,0]]]}},
+                {"type":"Feature","geometry":{"type":"MultiPolygon","coordinates":[[[[2,2],[3,2],[3,3]]],[[[5,5,0],[6,5,0],[6,6,0]]]]}}]}"#,
+        )
+        .unwrap();
+        let p = geojson_polygons(&g).unwrap();
+        assert_eq!(p.len(), 3);
+        assert_eq!(p[2].points[1], [6.0, 5.0]);
+        let holes: Value = serde_json::from_str(
+            r#"{"type":"Polygon","coordinates":[[[0,0],[4,0],[4,4]],[[1,1],[2,1],[2,2]]]}"#,
+        )
+        .unwrap();
+        assert!(geojson_polygons(&holes).is_err());
+        let line: Value =
+            serde_json::from_str(r#"{"type":"LineString","coordinates":[[0,0],[1,1]]}"#).unwrap();
+        assert!(geojson_polygons(&line)
+            .unwrap_err()
+            .to_string()
+            .contains("LineString"));
+        let one: Value = serde_saphyr::from_str("- [0, 0]\n- [1, 0]\n- [1, 1]\n").unwrap();
+        assert_eq!(yaml_polygons(&one).unwrap().len(), 1);
+        let two: Value = serde_saphyr::from_str(
+            "polygons:\n  - [[0, 0], [1, 0], [1, 1]]\n  - [{x: 2, y: 2}, {x: 3, y: 2}, {x: 3, y: 3}]\n",
+        )
+        .unwrap();
+        let p = yaml_polygons(&two).unwrap();
+        assert_eq!(p.len(), 2);
+        assert_eq!(p[1].points[2], [3.0, 3.0]);
+    }
+
+    #[test]
+    fn specs_serialize_untagged() {
+        let specs = vec![
+            ZoneSpec::Rect([0.0, 0.0, 1.0, 1.0]),
+            ZoneSpec::File("a.geojson".into()),
+            ZoneSpec::Polygons(vec![Polygon {
+                points: vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]],
+            }]),
+        ];
+        let j = serde_json::to_string(&specs).unwrap();
+        assert_eq!(
+            j,
+            r#"[[0.0,0.0,1.0,1.0],"a.geojson",[[[0.0,0.0],[1.0,0.0],[1.0,1.0]]]]"#
+        );
+        let back: Vec<ZoneSpec> = serde_json::from_str(&j).unwrap();
+        assert_eq!(back, specs);
+        let f = MapFrame::new(10, 10, 0.1);
+        assert!(ZoneSpec::Rect([1.0, 0.0, 0.0, 1.0]).load(&f, true).is_err());
+    }
+}
