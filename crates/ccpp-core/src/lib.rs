@@ -26,6 +26,7 @@ pub mod planner;
 pub mod planners;
 pub mod raster;
 pub mod rng;
+pub mod route;
 pub mod sim;
 pub mod tiles;
 pub mod trace;
