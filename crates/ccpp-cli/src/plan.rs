@@ -12,6 +12,7 @@ use ccpp_io::plan::{offline_planners, plan_route, PlanError};
 use ccpp_io::scenario::{Scenario, ScenarioError, DEFAULT_MAX_MEMORY_MB};
 
 use crate::args::PlanArgs;
+use crate::info::StartComponent;
 use crate::job::{load_recipe, parse_planner, planner_options, recipe_from, robot_from};
 use crate::staging::{check_target, Staging};
 
@@ -86,6 +87,11 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         staging.write(name, bytes)?;
     }
     staging.commit()?;
+    // As for `run`: a start whose free area reaches the map's border is probably outside.
+    let comp = StartComponent::of(plan.world.map(), plan.world.start().position());
+    if let Some(w) = comp.warning() {
+        eprintln!("{w}");
+    }
     let mut s = String::new();
     let _ = writeln!(
         s,
