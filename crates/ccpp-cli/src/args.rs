@@ -2,6 +2,7 @@
 
 use std::path::PathBuf;
 
+use ccpp_io::export::ExportFormat;
 use ccpp_io::zones::ZoneSpec;
 use clap::{Args, Parser, Subcommand};
 
@@ -29,8 +30,13 @@ pub enum Command {
     Bench(BenchArgs),
     /// Write the interactive replay.html (self-contained) and replay.gif of a finished run.
     Replay(ReplayArgs),
-    /// Print the lane waypoints of a rectangular robot (seed 001) for a map, as CSV or JSON.
+    /// Print the lane waypoints of a rectangular robot (seed 001) for a map, as CSV or JSON:
+    /// its stops every robot length along each lane, without headings (`ccpp plan --planner
+    /// rect-boustrophedon` gives the same lanes as a drivable route with headings).
     Waypoints(WaypointsArgs),
+    /// Plan a path for a robot on a known map (bcd, rect-boustrophedon) and write only the path
+    /// exports (default: `nav_path.yaml` and `waypoints.csv`); no simulation metrics.
+    Plan(PlanArgs),
 }
 
 /// Map loading options shared by commands.
@@ -146,6 +152,46 @@ pub struct RunArgs {
     /// Also write replay.html and replay.gif.
     #[arg(long)]
     pub replay: bool,
+    /// Also write the executed path as FORMAT (repeatable): `csv` (waypoints.csv), `json`
+    /// (waypoints.json), `nav-path` (`nav_path.yaml`, a ROS `nav_msgs/Path`) or `geojson`
+    /// (path.geojson).
+    #[arg(long, value_name = "FORMAT", value_parser = parse_export)]
+    pub export: Vec<ExportFormat>,
+}
+
+/// `ccpp plan`.
+#[derive(Args, Debug)]
+#[command(allow_negative_numbers = true)]
+pub struct PlanArgs {
+    /// The map.
+    #[command(flatten)]
+    pub map: MapArgs,
+    /// The robot.
+    #[command(flatten)]
+    pub robot: RobotArgs,
+    /// A known-map planner: `bcd` or `rect-boustrophedon` (online planners are refused).
+    #[arg(long, value_name = "NAME")]
+    pub planner: String,
+    /// Planner options file (YAML or JSON), sections named after the planners.
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
+    /// Rectangular robot length in metres (rect-boustrophedon: waypoint spacing).
+    #[arg(long, value_name = "M")]
+    pub length: Option<f64>,
+    /// Rectangular robot width in metres (rect-boustrophedon: lane spacing).
+    #[arg(long, value_name = "M")]
+    pub width: Option<f64>,
+    /// Refuse plans whose estimated memory exceeds this many MB (default 4096).
+    #[arg(long, value_name = "MB")]
+    pub max_memory: Option<u64>,
+    /// Write the path as FORMAT (repeatable; default `nav-path` and `csv`): `csv`
+    /// (waypoints.csv), `json` (waypoints.json), `nav-path` (`nav_path.yaml`) or `geojson`
+    /// (path.geojson).
+    #[arg(long, value_name = "FORMAT", value_parser = parse_export)]
+    pub export: Vec<ExportFormat>,
+    /// Output folder.
+    #[arg(long, value_name = "DIR", default_value = "ccpp-plan")]
+    pub out: PathBuf,
 }
 
 /// `ccpp waypoints`.
@@ -328,6 +374,11 @@ fn parse_triple(s: &str) -> Result<[f64; 3], String> {
     let mut v = [0.0; 3];
     v[..parts.len()].copy_from_slice(&parts);
     Ok(v)
+}
+
+/// Parses an export format name.
+fn parse_export(s: &str) -> Result<ExportFormat, String> {
+    s.parse::<ExportFormat>().map_err(|e| e.to_string())
 }
 
 /// Parses `on`/`off` (also `true`/`false`, `1`/`0`).

@@ -9,6 +9,7 @@ mod errors;
 mod info;
 mod job;
 mod output;
+mod plan;
 mod plots;
 mod staging;
 mod waypoints;
@@ -86,13 +87,13 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
             let mut job = job::Job::from_run_args(&a)?;
             staging::check_target(&job.out)?;
             let result = job.execute()?;
-            output::emit(&job, &result, a.json, a.replay)
+            output::emit(&job, &result, a.json, a.replay, &a.export)
         }
         Command::Demo(a) => {
             let mut job = job::Job::demo(&a)?;
             staging::check_target(&job.out)?;
             let result = job.execute()?;
-            output::emit(&job, &result, false, true)
+            output::emit(&job, &result, false, true, &[])
         }
         Command::Planners => {
             let mut s = String::new();
@@ -106,5 +107,6 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Bench(a) => bench::run(&a),
         Command::Replay(a) => output::replay_dir(&a.dir),
         Command::Waypoints(a) => waypoints::run(&a),
+        Command::Plan(a) => plan::run(&a),
     }
 }

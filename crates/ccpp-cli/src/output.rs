@@ -8,6 +8,7 @@ use ccpp_core::metrics::Metrics;
 use ccpp_core::trace::Trace;
 
 use ccpp_core::world::World;
+use ccpp_io::export::ExportFormat;
 use ccpp_io::scenario::Scenario;
 
 use crate::info::StartComponent;
@@ -106,11 +107,25 @@ pub fn replay_dir(dir: &Path) -> Result<()> {
     ))
 }
 
-/// Writes the run's files (with the replay when `replay`) as one set, then prints the summary
-/// (or the metrics JSON alone). A start whose free area reaches the map's border is warned
-/// about on stderr.
-pub fn emit(job: &Job, r: &JobResult, json_only: bool, replay: bool) -> Result<()> {
-    let metrics = write_run_files(&job.out, job, r, replay, &[])?;
+/// Writes the run's files (with the replay when `replay`, and the path in each of `exports`)
+/// as one set, then prints the summary (or the metrics JSON alone). A start whose free area
+/// reaches the map's border is warned about on stderr.
+pub fn emit(
+    job: &Job,
+    r: &JobResult,
+    json_only: bool,
+    replay: bool,
+    exports: &[ExportFormat],
+) -> Result<()> {
+    // The zones of the run go into the `GeoJSON` as polygons once runs have zones.
+    let export_files = ccpp_render::run_files::render_export_files(
+        &job.scenario,
+        &r.run.trace,
+        &r.metrics,
+        exports,
+        &[],
+    )?;
+    let metrics = write_run_files(&job.out, job, r, replay, &export_files)?;
     let comp = StartComponent::of(r.world.map(), r.world.start().position());
     if let Some(w) = comp.warning() {
         eprintln!("{w}");
@@ -120,11 +135,14 @@ pub fn emit(job: &Job, r: &JobResult, json_only: bool, replay: bool) -> Result<(
     }
     let mut s = summary(&r.metrics);
     let _ = writeln!(s, "  start area: {}", comp.line());
-    let extra = if replay {
-        ", replay.html, replay.gif"
-    } else {
-        ""
-    };
+    let mut extra = String::new();
+    if replay {
+        extra.push_str(", replay.html, replay.gif");
+    }
+    for (name, _) in &export_files {
+        extra.push_str(", ");
+        extra.push_str(name);
+    }
     let _ = writeln!(
         s,
         "wrote {}/{{metrics.json, path.csv, trace.jsonl, coverage.png, run.json{extra}}}",

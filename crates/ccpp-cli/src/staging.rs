@@ -30,7 +30,7 @@ static STOPPING: AtomicBool = AtomicBool::new(false);
 static COUNTER: AtomicU64 = AtomicU64::new(0);
 
 /// The files a run folder may hold; any other file makes [`Staging::new`] refuse the target.
-pub const RUN_FILES: [&str; 8] = [
+pub const RUN_FILES: [&str; 12] = [
     "run.json",
     "path.csv",
     "trace.jsonl",
@@ -39,6 +39,11 @@ pub const RUN_FILES: [&str; 8] = [
     "replay.html",
     "replay.gif",
     "bench-key.txt",
+    // `--export` files (`ccpp_io::export::ExportFormat::file_name`), also `ccpp plan`'s.
+    "waypoints.csv",
+    "waypoints.json",
+    "nav_path.yaml",
+    "path.geojson",
 ];
 
 /// Test hook: when this environment variable names a file, writing that file fails as on a full
@@ -344,6 +349,14 @@ pub fn write_file(path: &Path, bytes: &[u8]) -> Result<(), ccpp_io::WriteError> 
 mod tests {
     #![allow(clippy::unwrap_used)]
     use super::*;
+
+    #[test]
+    fn export_files_are_run_files() {
+        // A folder holding exports can be replaced by the next run or plan.
+        for f in ccpp_io::export::ExportFormat::ALL {
+            assert!(RUN_FILES.contains(&f.file_name()), "{f}");
+        }
+    }
 
     #[test]
     fn commit_replaces_the_whole_folder() {

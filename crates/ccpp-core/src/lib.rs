@@ -27,6 +27,7 @@ pub mod planners;
 pub mod raster;
 pub mod rng;
 pub mod search;
+pub mod route;
 pub mod sim;
 pub mod tiles;
 pub mod trace;

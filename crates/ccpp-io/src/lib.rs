@@ -12,15 +12,20 @@
 //!   its one validation (including the memory estimate) and its execution;
 //! * [`trace`](mod@trace): `trace.jsonl` / `path.csv` writers and the checked trace reader;
 //! * [`zones`]: `--area` / `--keepout` files (`GeoJSON`, YAML polygon lists, Nav2 keepout masks);
+//! * [`export`]: path exports a robot stack reads (waypoints CSV/JSON, ROS `nav_msgs/Path`
+//!   YAML, `GeoJSON`) and the waypoint readers;
+//! * [`plan`]: a known-map planner's route without simulation overhead or metrics;
 //! * [`file`]: opening user files (regular files only: a FIFO is refused, not read forever).
 //!
 //! Errors are [`thiserror`] enums that always name the file concerned; nothing here panics on
 //! user data.
 
+pub mod export;
 pub mod file;
 pub mod georef;
 pub mod landmarks;
 pub mod map;
+pub mod plan;
 pub mod scenario;
 pub mod trace;
 pub mod write;

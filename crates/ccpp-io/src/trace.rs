@@ -1,11 +1,12 @@
 //! Trace files: `trace.jsonl` (every pose and event, one JSON object a line) and `path.csv`
-//! (`x,y,theta` per executed pose), written and read back with checks, so that a damaged or
-//! hand-edited trace is refused with the line at fault instead of hanging a renderer.
+//! (the executed path at its segment ends), written and read back with checks, so that a
+//! damaged or hand-edited trace is refused with the line at fault instead of hanging a
+//! renderer.
 
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use ccpp_core::grid::MapFrame;
+use ccpp_core::route::{Route, DEFAULT_TOLERANCE_M};
 use ccpp_core::trace::{Record, Trace};
 
 /// Error reading a trace.
@@ -65,13 +66,15 @@ pub fn trace_jsonl(trace: &Trace) -> Result<String, serde_json::Error> {
     Ok(s)
 }
 
-/// The executed poses as CSV `x,y,theta` (metres, radians).
+/// The executed path as CSV, decimated to its segment ends: header `x,y,theta`, then one
+/// line per waypoint of [`Route::from_trace`] with [`DEFAULT_TOLERANCE_M`] (`x`, `y`: map
+/// frame, metres; `theta`: the heading the robot leaves the point with, radians). Collinear
+/// poses (such as the control-step samples of PID execution) and rotations in place are
+/// merged, so the size grows with the number of segments, not of control steps. Metrics are
+/// computed from the full trace, never from this file. Same columns as `waypoints.csv`
+/// ([`crate::export::waypoints_csv`]), readable with [`crate::export::parse_waypoints_csv`].
 pub fn path_csv(trace: &Trace) -> String {
-    let mut s = String::from("x,y,theta\n");
-    for p in trace.poses() {
-        let _ = writeln!(s, "{},{},{}", p.x, p.y, p.theta);
-    }
-    s
+    crate::export::waypoints_csv(&Route::from_trace(trace, DEFAULT_TOLERANCE_M))
 }
 
 /// Parses `trace.jsonl` text (`path` names it in errors). When `frame` is given, every pose

@@ -5,8 +5,10 @@
 use std::path::Path;
 
 use ccpp_core::metrics::Metrics;
+use ccpp_core::route::{Route, DEFAULT_TOLERANCE_M};
 use ccpp_core::trace::Trace;
 use ccpp_core::world::World;
+use ccpp_io::export::{render_exports, ExportFormat, ExportMeta, PolygonFeature};
 use ccpp_io::scenario::Scenario;
 use ccpp_io::write::WriteError;
 use ccpp_io::write_atomic;
@@ -103,6 +105,35 @@ pub fn render_run_files(
         ("coverage.png", png),
         ("metrics.json", metrics_text.into_bytes()),
     ])
+}
+
+/// Renders the path exports of a finished run in memory ([`ccpp_io::export`]): the route of the
+/// executed trace (merged with [`DEFAULT_TOLERANCE_M`]) in each of `formats`, `(file name,
+/// bytes)` in [`ExportFormat::ALL`] order; the `GeoJSON` carries the metrics and `polygons`
+/// (zones, in map coordinates). Nothing is written; the command line stages these files with
+/// the others.
+///
+/// # Errors
+/// Serialization failure.
+pub fn render_export_files(
+    scenario: &Scenario,
+    trace: &Trace,
+    metrics: &Metrics,
+    formats: &[ExportFormat],
+    polygons: &[PolygonFeature],
+) -> Result<Vec<(&'static str, Vec<u8>)>, RunFilesError> {
+    if formats.is_empty() {
+        return Ok(Vec::new());
+    }
+    let route = Route::from_trace(trace, DEFAULT_TOLERANCE_M);
+    let meta = ExportMeta {
+        planner: &metrics.planner,
+        map: &metrics.map,
+        robot: scenario.robot,
+        tolerance_m: DEFAULT_TOLERANCE_M,
+        metrics: Some(metrics),
+    };
+    Ok(render_exports(&route, &meta, formats, polygons)?)
 }
 
 /// Renders everything first ([`render_run_files`]), then writes each file atomically into

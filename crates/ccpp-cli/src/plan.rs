@@ -1,0 +1,115 @@
+//! `ccpp plan`: a known-map planner's path for a robot, written only as path exports (no
+//! simulation metrics, picture or trace). See [`ccpp_io::plan`].
+
+use std::fmt::Write as _;
+
+use anyhow::{anyhow, Result};
+use ccpp_core::planners::PlannerConfig;
+use ccpp_core::route::DEFAULT_TOLERANCE_M;
+use ccpp_core::sim::{SimConfig, StopReason};
+use ccpp_io::export::{render_exports, ExportFormat, ExportMeta};
+use ccpp_io::plan::{offline_planners, plan_route, PlanError};
+use ccpp_io::scenario::{Scenario, ScenarioError, DEFAULT_MAX_MEMORY_MB};
+
+use crate::args::PlanArgs;
+use crate::info::StartComponent;
+use crate::job::{load_recipe, parse_planner, planner_options, recipe_from, robot_from};
+use crate::staging::{check_target, Staging};
+
+/// The exports written when `--export` is not given.
+pub const DEFAULT_EXPORTS: [ExportFormat; 2] = [ExportFormat::Csv, ExportFormat::NavPath];
+
+/// Runs `ccpp plan`.
+pub fn run(a: &PlanArgs) -> Result<()> {
+    let kind = parse_planner(&a.planner)?;
+    if !kind.info().offline {
+        // Refused before the map is read.
+        return Err(PlanError::Online(kind.name(), offline_planners()).into());
+    }
+    let (robot, start) = robot_from(&a.robot)?;
+    let mut planner = planner_options(a.config.as_deref(), None)?.config(kind);
+    let mut given = Vec::new();
+    for (flag, v) in [("--length", a.length), ("--width", a.width)] {
+        let Some(v) = v else { continue };
+        given.push(flag);
+        match &mut planner {
+            PlannerConfig::RectBoustrophedon(o) if flag == "--length" => o.length_m = v,
+            PlannerConfig::RectBoustrophedon(o) => o.width_m = v,
+            _ => {
+                return Err(anyhow!(
+                    "{flag} does not apply to {kind} (it applies to rect-boustrophedon)"
+                ))
+            }
+        }
+    }
+    let scenario = Scenario {
+        map: recipe_from(&a.map),
+        robot,
+        start: start.map(|p| [p.x, p.y, p.theta]),
+        planner,
+        sim: SimConfig::default(),
+        max_memory_mb: a.max_memory.unwrap_or(DEFAULT_MAX_MEMORY_MB),
+    };
+    let flag = |e: ScenarioError| match &e {
+        ScenarioError::Options(o)
+            if given.contains(&"--length") && o.field.ends_with("length_m") =>
+        {
+            anyhow!("--length: {e}")
+        }
+        ScenarioError::Options(o) if given.contains(&"--width") && o.field.ends_with("width_m") => {
+            anyhow!("--width: {e}")
+        }
+        _ => e.into(),
+    };
+    scenario.validate().map_err(flag)?;
+    check_target(&a.out)?;
+    let map = load_recipe(&scenario.map)?;
+    let plan = plan_route(&scenario, &map, DEFAULT_TOLERANCE_M).map_err(|e| match e {
+        PlanError::Scenario(s) => flag(s),
+        other @ PlanError::Online(..) => other.into(),
+    })?;
+    let formats: &[ExportFormat] = if a.export.is_empty() {
+        &DEFAULT_EXPORTS
+    } else {
+        &a.export
+    };
+    let meta = ExportMeta {
+        planner: kind.name(),
+        map: &map.name,
+        robot,
+        tolerance_m: DEFAULT_TOLERANCE_M,
+        metrics: None,
+    };
+    // The zones of the plan go into the `GeoJSON` as polygons once plans have zones.
+    let files = render_exports(&plan.route, &meta, formats, &[])?;
+    let staging = Staging::new(&a.out)?;
+    for (name, bytes) in &files {
+        staging.write(name, bytes)?;
+    }
+    staging.commit()?;
+    // As for `run`: a start whose free area reaches the map's border is probably outside.
+    let comp = StartComponent::of(plan.world.map(), plan.world.start().position());
+    if let Some(w) = comp.warning() {
+        eprintln!("{w}");
+    }
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "{} on {} (r = {} m): {} waypoints, {:.2} m, planned in {:.3} s",
+        kind,
+        map.name,
+        robot.radius,
+        plan.route.waypoints.len(),
+        plan.route.length_m(),
+        plan.wall_time_s
+    );
+    if plan.stop == StopReason::MaxSteps {
+        let _ = writeln!(
+            s,
+            "  warning: the planner hit the step cap; the path is incomplete"
+        );
+    }
+    let names: Vec<&str> = files.iter().map(|(n, _)| *n).collect();
+    let _ = writeln!(s, "wrote {}/{{{}}}", a.out.display(), names.join(", "));
+    crate::print_stdout(&s)
+}

@@ -1,0 +1,424 @@
+//! Path exports (issue 14 §3): `ccpp run --export FORMAT` and `ccpp plan` write waypoints with
+//! headings as CSV and JSON (read back by ccpp's own readers), a ROS `nav_msgs/Path` YAML that
+//! parses with the right fields and quaternions matching the headings, and a `GeoJSON`
+//! `FeatureCollection` in map coordinates; `path.csv` is the executed path decimated to its
+//! segment ends. Each flag changes what it should and is refused where it does not apply.
+#![allow(clippy::unwrap_used)]
+
+use std::path::{Path, PathBuf};
+
+use assert_cmd::Command;
+use ccpp_core::route::Route;
+use ccpp_io::export::{parse_waypoints_csv, read_waypoints};
+use serde::Deserialize;
+
+fn ccpp() -> Command {
+    Command::cargo_bin("ccpp").unwrap()
+}
+
+/// Writes a PGM (0.05 m/px bare image) of `w` x `h` px: walls around, `blocked(x, y)` inside.
+fn pgm(
+    dir: &Path,
+    name: &str,
+    w: usize,
+    h: usize,
+    blocked: impl Fn(usize, usize) -> bool,
+) -> PathBuf {
+    let mut bytes = format!("P5\n{w} {h}\n255\n").into_bytes();
+    for y in 0..h {
+        for x in 0..w {
+            let wall = x == 0 || y == 0 || x == w - 1 || y == h - 1 || blocked(x, y);
+            bytes.push(if wall { 0 } else { 254 });
+        }
+    }
+    let p = dir.join(name);
+    std::fs::write(&p, bytes).unwrap();
+    p
+}
+
+/// A 5 x 4 m room with one pillar.
+fn room(dir: &Path) -> PathBuf {
+    pgm(dir, "room.pgm", 100, 80, |x, y| {
+        (40..55).contains(&x) && (20..50).contains(&y)
+    })
+}
+
+fn run(dir: &Path, sub: &str, map: &Path, planner: &str, args: &[&str]) -> PathBuf {
+    let out = dir.join(sub);
+    ccpp()
+        .args(["run", "--planner", planner, "--map"])
+        .arg(map)
+        .args(args)
+        .arg("--out")
+        .arg(&out)
+        .assert()
+        .success();
+    out
+}
+
+fn plan(dir: &Path, sub: &str, map: &Path, planner: &str, args: &[&str]) -> PathBuf {
+    let out = dir.join(sub);
+    ccpp()
+        .args(["plan", "--planner", planner, "--map"])
+        .arg(map)
+        .args(args)
+        .arg("--out")
+        .arg(&out)
+        .assert()
+        .success();
+    out
+}
+
+fn files(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+fn read(p: &Path) -> String {
+    std::fs::read_to_string(p).unwrap()
+}
+
+/// Exit 1 and one `error:` line holding every needle.
+fn refused(args: &[&str], map: Option<&Path>, needles: &[&str]) {
+    let mut c = ccpp();
+    c.args(args);
+    if let Some(m) = map {
+        c.arg("--map").arg(m);
+    }
+    let a = c.assert().failure();
+    let o = a.get_output();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+    assert!(err.starts_with("error: "), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    let first = err.lines().next().unwrap_or_default();
+    for n in needles {
+        assert!(first.contains(n), "{first:?} should contain {n:?}");
+    }
+}
+
+// nav_msgs/Path as `ros2 topic echo` prints it; unknown fields are errors, so the test checks
+// the exact shape.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Stamp {
+    sec: i64,
+    nanosec: u32,
+}
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Header {
+    stamp: Stamp,
+    frame_id: String,
+}
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Xyz {
+    x: f64,
+    y: f64,
+    z: f64,
+}
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Quat {
+    x: f64,
+    y: f64,
+    z: f64,
+    w: f64,
+}
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PoseMsg {
+    position: Xyz,
+    orientation: Quat,
+}
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PoseStamped {
+    header: Header,
+    pose: PoseMsg,
+}
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct NavPath {
+    header: Header,
+    poses: Vec<PoseStamped>,
+}
+
+/// The `nav_msgs/Path` parses as YAML, says frame `map`, and holds the route's positions with
+/// unit quaternions about z whose yaw is the waypoint's heading.
+fn check_nav_path(text: &str, route: &Route) {
+    let p: NavPath = serde_saphyr::from_str(text).unwrap();
+    assert_eq!(p.header.frame_id, "map");
+    assert_eq!((p.header.stamp.sec, p.header.stamp.nanosec), (0, 0));
+    assert_eq!(p.poses.len(), route.waypoints.len());
+    assert!(p.poses.len() >= 2);
+    for (m, w) in p.poses.iter().zip(&route.waypoints) {
+        assert_eq!(m.header.frame_id, "map");
+        assert_eq!(
+            (m.pose.position.x, m.pose.position.y, m.pose.position.z),
+            (w.x, w.y, 0.0)
+        );
+        let q = &m.pose.orientation;
+        assert_eq!((q.x, q.y), (0.0, 0.0));
+        assert!((q.z * q.z + q.w * q.w - 1.0).abs() < 1e-12);
+        let yaw = 2.0 * q.z.atan2(q.w);
+        let d = (yaw - w.theta).sin().abs() + (1.0 - (yaw - w.theta).cos());
+        assert!(d < 1e-12, "yaw {yaw} vs heading {}", w.theta);
+    }
+}
+
+/// The `GeoJSON` is a `FeatureCollection` whose first feature is the route as a `LineString` in
+/// `[x, y]` order with the planner, robot and metrics as properties.
+fn check_geojson(text: &str, route: &Route, metrics: Option<&serde_json::Value>) {
+    let v: serde_json::Value = serde_json::from_str(text).unwrap();
+    assert_eq!(v["type"], "FeatureCollection");
+    let f = &v["features"][0];
+    assert_eq!(f["type"], "Feature");
+    assert_eq!(f["geometry"]["type"], "LineString");
+    let coords = f["geometry"]["coordinates"].as_array().unwrap();
+    assert_eq!(coords.len(), route.waypoints.len());
+    for (c, w) in coords.iter().zip(&route.waypoints) {
+        assert_eq!(c.as_array().unwrap().len(), 2);
+        assert_eq!((c[0].as_f64().unwrap(), c[1].as_f64().unwrap()), (w.x, w.y));
+    }
+    assert_eq!(f["properties"]["frame_id"], "map");
+    assert_eq!(f["properties"]["robot"]["radius_m"], 0.15);
+    match metrics {
+        Some(m) => {
+            assert_eq!(f["properties"]["planner"], m["planner"]);
+            let mut got = f["properties"]["metrics"].clone();
+            let mut want = m.clone();
+            got["wall_time_s"] = 0.into();
+            want["wall_time_s"] = 0.into();
+            assert_eq!(got, want);
+        }
+        None => assert!(f["properties"]["metrics"].is_null()),
+    }
+}
+
+#[test]
+fn run_export_writes_each_format_beside_the_other_files() {
+    let d = tempfile::tempdir().unwrap();
+    let map = room(d.path());
+    let base = run(d.path(), "base", &map, "bsa", &[]);
+    assert_eq!(
+        files(&base),
+        [
+            "coverage.png",
+            "metrics.json",
+            "path.csv",
+            "run.json",
+            "trace.jsonl"
+        ]
+    );
+    let all = [
+        "--export", "geojson", "--export", "nav-path", "--export", "json", "--export", "csv",
+    ];
+    let ex = run(d.path(), "ex", &map, "bsa", &all);
+    assert_eq!(
+        files(&ex),
+        [
+            "coverage.png",
+            "metrics.json",
+            "nav_path.yaml",
+            "path.csv",
+            "path.geojson",
+            "run.json",
+            "trace.jsonl",
+            "waypoints.csv",
+            "waypoints.json"
+        ]
+    );
+    // The exports change nothing else.
+    for f in ["path.csv", "trace.jsonl", "coverage.png", "run.json"] {
+        assert_eq!(
+            std::fs::read(base.join(f)).unwrap(),
+            std::fs::read(ex.join(f)).unwrap(),
+            "{f}"
+        );
+    }
+    // CSV and JSON read back through ccpp's reader to the same route, which is path.csv's.
+    let csv = read_waypoints(&ex.join("waypoints.csv")).unwrap();
+    let json = read_waypoints(&ex.join("waypoints.json")).unwrap();
+    assert_eq!(csv, json);
+    assert_eq!(read(&ex.join("waypoints.csv")), read(&ex.join("path.csv")));
+    assert!(csv.waypoints.len() > 10);
+    // The route starts at the start pose and ends at the last pose of the trace.
+    let trace = ccpp_io::trace::read_trace(&ex.join("trace.jsonl"), None).unwrap();
+    let poses: Vec<_> = trace.poses().collect();
+    assert_eq!(
+        csv.waypoints.first().map(|p| (p.x, p.y)),
+        poses.first().map(|p| (p.x, p.y))
+    );
+    assert_eq!(csv.waypoints.last(), poses.last());
+    check_nav_path(&read(&ex.join("nav_path.yaml")), &csv);
+    let metrics: serde_json::Value = serde_json::from_str(&read(&ex.join("metrics.json"))).unwrap();
+    check_geojson(&read(&ex.join("path.geojson")), &csv, Some(&metrics));
+    // One format alone writes one file; the same run twice gives the same bytes.
+    let one = run(d.path(), "one", &map, "bsa", &["--export", "nav-path"]);
+    assert!(files(&one).contains(&"nav_path.yaml".to_string()));
+    assert!(!files(&one).contains(&"waypoints.csv".to_string()));
+    assert_eq!(
+        read(&one.join("nav_path.yaml")),
+        read(&ex.join("nav_path.yaml"))
+    );
+}
+
+#[test]
+fn path_csv_grows_with_segments_not_control_steps() {
+    // bsa-bfs runs under PID execution: one trace pose per control step.
+    let d = tempfile::tempdir().unwrap();
+    let map = room(d.path());
+    let out = run(d.path(), "pid", &map, "bsa-bfs", &[]);
+    let trace = read(&out.join("trace.jsonl"));
+    let pose_lines = trace.lines().filter(|l| l.contains("\"pose\"")).count();
+    let segments = trace
+        .lines()
+        .filter(|l| l.contains("planned_segment"))
+        .count();
+    let route = parse_waypoints_csv(&read(&out.join("path.csv")), Path::new("path.csv")).unwrap();
+    let rows = route.waypoints.len();
+    assert!(segments > 10, "{segments}");
+    // At most the start and one end per planned straight motion.
+    assert!(rows <= segments + 1, "{rows} rows for {segments} segments");
+    assert!(pose_lines > 20 * rows, "{pose_lines} poses, {rows} rows");
+    // The metrics come from the full trace: the path length is that of every pose.
+    let m: serde_json::Value = serde_json::from_str(&read(&out.join("metrics.json"))).unwrap();
+    let t = ccpp_io::trace::read_trace(&out.join("trace.jsonl"), None).unwrap();
+    let poses: Vec<_> = t.poses().collect();
+    let full: f64 = poses
+        .windows(2)
+        .map(|w| w[0].position().dist(w[1].position()))
+        .sum();
+    assert!((m["path_length_m"].as_f64().unwrap() - full).abs() < 1e-9);
+    // PID tracking here is straight: the route keeps the length within the tolerance.
+    assert!((route.length_m() - full).abs() < 1e-3 * rows as f64);
+}
+
+#[test]
+fn export_is_refused_where_it_does_not_apply() {
+    let d = tempfile::tempdir().unwrap();
+    let map = room(d.path());
+    let out = d.path().join("x");
+    let o = out.to_str().unwrap();
+    refused(
+        &["run", "--planner", "bsa", "--out", o, "--export", "kml"],
+        Some(&map),
+        &["--export", "kml", "csv, json, nav-path or geojson"],
+    );
+    refused(
+        &["plan", "--planner", "bcd", "--out", o, "--export", "png"],
+        Some(&map),
+        &["--export", "png"],
+    );
+    // bench and demo write no paths to export.
+    refused(
+        &["demo", "--out", o, "--export", "csv"],
+        None,
+        &["--export"],
+    );
+    refused(
+        &["bench", "--maps", o, "--export", "csv"],
+        None,
+        &["--export"],
+    );
+    assert!(!out.exists());
+}
+
+#[test]
+fn plan_writes_only_the_path_of_a_known_map_planner() {
+    let d = tempfile::tempdir().unwrap();
+    let map = room(d.path());
+    let p = plan(d.path(), "bcd", &map, "bcd", &[]);
+    assert_eq!(files(&p), ["nav_path.yaml", "waypoints.csv"]);
+    let route = read_waypoints(&p.join("waypoints.csv")).unwrap();
+    check_nav_path(&read(&p.join("nav_path.yaml")), &route);
+    // The planned route is the path a simulated run of the same planner executes (bcd runs
+    // ideally by default).
+    let r = run(d.path(), "bcd-run", &map, "bcd", &[]);
+    assert_eq!(read(&r.join("path.csv")), read(&p.join("waypoints.csv")));
+    // --export replaces the default set.
+    let g = plan(
+        d.path(),
+        "geo",
+        &map,
+        "bcd",
+        &["--export", "geojson", "--export", "json"],
+    );
+    assert_eq!(files(&g), ["path.geojson", "waypoints.json"]);
+    check_geojson(&read(&g.join("path.geojson")), &route, None);
+    assert_eq!(read_waypoints(&g.join("waypoints.json")).unwrap(), route);
+    // rect-boustrophedon: planned ideally even though its runs default to PID; --length and
+    // --width change the plan.
+    let rect = plan(d.path(), "rect", &map, "rect-boustrophedon", &[]);
+    let rect_run = run(
+        d.path(),
+        "rect-run",
+        &map,
+        "rect-boustrophedon",
+        &["--exec", "ideal"],
+    );
+    assert_eq!(
+        read(&rect_run.join("path.csv")),
+        read(&rect.join("waypoints.csv"))
+    );
+    for (flag, v) in [("--length", "0.5"), ("--width", "0.5")] {
+        let other = plan(
+            d.path(),
+            &format!("rect{flag}"),
+            &map,
+            "rect-boustrophedon",
+            &[flag, v],
+        );
+        assert_ne!(
+            read(&other.join("waypoints.csv")),
+            read(&rect.join("waypoints.csv")),
+            "{flag}"
+        );
+    }
+}
+
+#[test]
+fn plan_refuses_online_planners_and_foreign_flags() {
+    let d = tempfile::tempdir().unwrap();
+    let map = room(d.path());
+    let out = d.path().join("p");
+    let o = out.to_str().unwrap();
+    for p in ["ba-star", "bsa-bfs", "random-bounce"] {
+        refused(
+            &["plan", "--planner", p, "--out", o],
+            Some(&map),
+            &[p, "online planner", "bcd, rect-boustrophedon"],
+        );
+    }
+    refused(
+        &["plan", "--planner", "bcd", "--length", "0.5", "--out", o],
+        Some(&map),
+        &["--length", "does not apply to bcd"],
+    );
+    refused(
+        &[
+            "plan",
+            "--planner",
+            "rect-boustrophedon",
+            "--width",
+            "-1",
+            "--out",
+            o,
+        ],
+        Some(&map),
+        &["--width"],
+    );
+    // Simulation flags are not plan flags.
+    refused(
+        &["plan", "--planner", "bcd", "--exec", "pid", "--out", o],
+        Some(&map),
+        &["--exec"],
+    );
+    assert!(!out.exists());
+}

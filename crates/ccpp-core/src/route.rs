@@ -1,0 +1,279 @@
+//! A route a robot can drive: the waypoints of an executed path, one per segment end, each with
+//! the heading the robot leaves it with.
+//!
+//! [`Route::from_poses`] reduces a sequence of executed poses (a [`Trace`]'s
+//! [`poses`](Trace::poses)) to its segment ends in one pass:
+//!
+//! * **Collinear moves are merged.** A run of poses becomes one segment when every dropped pose
+//!   lies within `tolerance_m` of the straight line from the segment's first waypoint to its
+//!   last, and the run never falls back along that line by more than `tolerance_m`. The test is
+//!   the "sleeve" of directions from the segment start: each pose farther than the tolerance
+//!   from the start narrows the set of directions whose ray passes within the tolerance of it
+//!   (by `asin(tolerance / distance)` on either side), and a pose whose own direction lies
+//!   outside the set ends the segment at the pose before it. Under PID execution the
+//!   control-step samples of a straight motion therefore collapse to its two ends, and a curved
+//!   motion becomes the chords that stay within the tolerance.
+//! * **Rotations in place are merged.** Poses at the same position (within
+//!   [`SAME_POSITION_M`]) are one waypoint whose heading is the last of them: the heading the
+//!   robot leaves that point with.
+//!
+//! The first waypoint is the first pose (with the rotations in place that follow it merged),
+//! the last one the last pose. Every waypoint is a recorded pose (positions and headings are
+//! copied, never averaged), so the result is a deterministic function of the poses and the
+//! tolerance. A tolerance of 0 keeps every pose that is not exactly collinear (up to rounding).
+//!
+//! Metrics are computed from the full trace, never from a route.
+
+use serde::{Deserialize, Serialize};
+
+use crate::geometry::{wrap_angle, Point, Pose};
+use crate::trace::Trace;
+
+/// The default merging tolerance, metres: 1 mm, far below a map pixel (5 cm on the shared
+/// maps) and above the wobble of PID tracking along a straight segment, so a straight motion
+/// is one segment whatever its control-step samples.
+pub const DEFAULT_TOLERANCE_M: f64 = 0.001;
+
+/// Two poses closer than this are at the same position (a rotation in place), metres.
+pub const SAME_POSITION_M: f64 = 1e-9;
+
+/// Waypoints with headings at the ends of the straight segments of a path (see the module
+/// documentation for how they are chosen).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Route {
+    /// The waypoints in driving order: position (metres, map frame) and the heading the robot
+    /// leaves it with (radians, 0 = +x, counter-clockwise; the last one: the final heading).
+    pub waypoints: Vec<Pose>,
+}
+
+/// The segment being grown by [`Route::from_poses`].
+struct Sleeve {
+    /// Direction of the first pose beyond the tolerance (angles are kept relative to it).
+    reference: Option<f64>,
+    /// Allowed direction offsets from `reference`: `[lo, hi]`.
+    lo: f64,
+    hi: f64,
+    /// Largest distance from the segment start seen so far.
+    far: f64,
+}
+
+impl Sleeve {
+    const fn new() -> Self {
+        Self {
+            reference: None,
+            lo: f64::NEG_INFINITY,
+            hi: f64::INFINITY,
+            far: 0.0,
+        }
+    }
+
+    /// Whether `p` continues the straight segment from `start` within `tol`; if so the
+    /// sleeve is narrowed by it.
+    fn accept(&mut self, start: Point, p: Point, tol: f64) -> bool {
+        let d = start.dist(p);
+        if d + tol < self.far {
+            return false;
+        }
+        if d <= tol {
+            // Any line through the start passes within the tolerance of it.
+            self.far = self.far.max(d);
+            return true;
+        }
+        let dir = (p.y - start.y).atan2(p.x - start.x);
+        let reference = *self.reference.get_or_insert(dir);
+        let off = wrap_angle(dir - reference);
+        if off < self.lo || off > self.hi {
+            return false;
+        }
+        let half = (tol / d).asin();
+        self.lo = self.lo.max(off - half);
+        self.hi = self.hi.min(off + half);
+        self.far = self.far.max(d);
+        true
+    }
+}
+
+impl Route {
+    /// The route of `poses` with the merging tolerance `tolerance_m` (metres; negative or
+    /// non-finite values count as 0). Non-finite poses are skipped.
+    pub fn from_poses<I: IntoIterator<Item = Pose>>(poses: I, tolerance_m: f64) -> Self {
+        let tol = if tolerance_m.is_finite() {
+            tolerance_m.max(0.0)
+        } else {
+            0.0
+        };
+        let mut waypoints: Vec<Pose> = Vec::new();
+        // The last pose of the segment being grown (not yet a waypoint unless it is the start).
+        let mut last: Option<Pose> = None;
+        let mut sleeve = Sleeve::new();
+        for p in poses {
+            if !(p.x.is_finite() && p.y.is_finite() && p.theta.is_finite()) {
+                continue;
+            }
+            let (Some(start), Some(prev)) = (waypoints.last().copied(), last) else {
+                waypoints.push(p);
+                last = Some(p);
+                continue;
+            };
+            let at_start = prev.position().dist(start.position()) <= SAME_POSITION_M;
+            if p.position().dist(prev.position()) <= SAME_POSITION_M {
+                // A rotation in place (or a repeated pose): merged into one waypoint.
+                if at_start {
+                    if let Some(w) = waypoints.last_mut() {
+                        w.theta = p.theta;
+                    }
+                } else {
+                    waypoints.push(Pose::new(prev.x, prev.y, p.theta));
+                    sleeve = Sleeve::new();
+                }
+                last = Some(p);
+                continue;
+            }
+            if !sleeve.accept(start.position(), p.position(), tol) {
+                // The segment ends at the previous pose, which starts the next one.
+                waypoints.push(prev);
+                sleeve = Sleeve::new();
+                let accepted = sleeve.accept(prev.position(), p.position(), tol);
+                debug_assert!(accepted, "a fresh sleeve takes any pose");
+            }
+            last = Some(p);
+        }
+        if let (Some(end), Some(w)) = (last, waypoints.last()) {
+            if end != *w {
+                waypoints.push(end);
+            }
+        }
+        Self { waypoints }
+    }
+
+    /// The route of a trace's executed poses ([`Route::from_poses`]).
+    pub fn from_trace(trace: &Trace, tolerance_m: f64) -> Self {
+        Self::from_poses(trace.poses(), tolerance_m)
+    }
+
+    /// Length of the polyline through the waypoints, metres.
+    pub fn length_m(&self) -> f64 {
+        self.waypoints
+            .windows(2)
+            .map(|w| w[0].position().dist(w[1].position()))
+            .sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn xy(r: &Route) -> Vec<(f64, f64)> {
+        r.waypoints.iter().map(|p| (p.x, p.y)).collect()
+    }
+
+    #[test]
+    fn collinear_steps_merge_and_corners_stay() {
+        let mut poses = vec![Pose::new(0.0, 0.0, 0.0)];
+        for k in 1..=10 {
+            poses.push(Pose::new(0.1 * f64::from(k), 0.0, 0.0));
+        }
+        // Rotation in place at (1, 0), then north.
+        poses.push(Pose::new(1.0, 0.0, 1.0));
+        poses.push(Pose::new(1.0, 0.0, std::f64::consts::FRAC_PI_2));
+        for k in 1..=5 {
+            poses.push(Pose::new(
+                1.0,
+                0.2 * f64::from(k),
+                std::f64::consts::FRAC_PI_2,
+            ));
+        }
+        let r = Route::from_poses(poses, DEFAULT_TOLERANCE_M);
+        assert_eq!(xy(&r), vec![(0.0, 0.0), (1.0, 0.0), (1.0, 1.0)]);
+        // The corner carries the heading it is left with.
+        assert_eq!(r.waypoints[1].theta, std::f64::consts::FRAC_PI_2);
+        assert!((r.length_m() - 2.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn start_rotation_merges_into_the_first_waypoint() {
+        let poses = [
+            Pose::new(0.0, 0.0, 0.0),
+            Pose::new(0.0, 0.0, 0.5),
+            Pose::new(0.0, 0.0, 1.0),
+            Pose::new(0.0, 1.0, 1.0),
+        ];
+        let r = Route::from_poses(poses, 0.0);
+        assert_eq!(
+            r.waypoints,
+            vec![Pose::new(0.0, 0.0, 1.0), Pose::new(0.0, 1.0, 1.0)]
+        );
+    }
+
+    #[test]
+    fn wobble_within_tolerance_merges_and_beyond_does_not() {
+        // A straight line sampled with a +-0.4 mm wobble.
+        let poses: Vec<Pose> = (0..=100)
+            .map(|k| {
+                let w = if k % 2 == 0 { 0.0004 } else { -0.0004 };
+                let w = if k == 0 || k == 100 { 0.0 } else { w };
+                Pose::new(0.01 * f64::from(k), w, 0.0)
+            })
+            .collect();
+        assert_eq!(Route::from_poses(poses.clone(), 0.001).waypoints.len(), 2);
+        assert!(Route::from_poses(poses, 0.0001).waypoints.len() > 50);
+    }
+
+    #[test]
+    fn going_back_along_the_line_ends_the_segment() {
+        let poses = [
+            Pose::new(0.0, 0.0, 0.0),
+            Pose::new(1.0, 0.0, 0.0),
+            Pose::new(2.0, 0.0, 0.0),
+            Pose::new(1.5, 0.0, 0.0),
+        ];
+        let r = Route::from_poses(poses, 0.01);
+        assert_eq!(xy(&r), vec![(0.0, 0.0), (2.0, 0.0), (1.5, 0.0)]);
+    }
+
+    #[test]
+    fn arc_becomes_chords_within_tolerance() {
+        // A quarter circle of radius 1 m sampled every 0.5 degrees.
+        let poses: Vec<Pose> = (0..=180)
+            .map(|k| {
+                let a = f64::from(k).to_radians() * 0.5;
+                Pose::new(a.cos(), a.sin(), a + std::f64::consts::FRAC_PI_2)
+            })
+            .collect();
+        let tol = 0.01;
+        let r = Route::from_poses(poses.clone(), tol);
+        assert!(
+            r.waypoints.len() > 2 && r.waypoints.len() < 40,
+            "{}",
+            r.waypoints.len()
+        );
+        // Every sample lies within the tolerance of the route.
+        for p in &poses {
+            let d = r
+                .waypoints
+                .windows(2)
+                .map(|w| {
+                    crate::geometry::point_segment_dist2(
+                        p.position(),
+                        w[0].position(),
+                        w[1].position(),
+                    )
+                    .sqrt()
+                })
+                .fold(f64::INFINITY, f64::min);
+            assert!(d <= tol + 1e-12, "{d}");
+        }
+        // Deterministic.
+        assert_eq!(Route::from_poses(poses, tol), r);
+    }
+
+    #[test]
+    fn empty_and_single() {
+        assert!(Route::from_poses([], 0.1).waypoints.is_empty());
+        let one = Route::from_poses([Pose::new(1.0, 2.0, 3.0)], 0.1);
+        assert_eq!(one.waypoints, vec![Pose::new(1.0, 2.0, 3.0)]);
+        let nan = Route::from_poses([Pose::new(f64::NAN, 2.0, 3.0)], 0.1);
+        assert!(nan.waypoints.is_empty());
+    }
+}

@@ -1,0 +1,27 @@
+//! The README's "plan a path for my robot" example: a known-map planner's route on a map,
+//! written as a ROS 2 `nav_msgs/Path` (YAML) without simulating or measuring anything.
+//!
+//! `cargo run --release -p ccpp-io --example plan_nav_path -- ../shared/maps/nav2_depot.yaml nav_path.yaml`
+
+use ccpp_core::planners::PlannerKind;
+use ccpp_core::route::DEFAULT_TOLERANCE_M;
+use ccpp_io::{export, plan, scenario::Scenario};
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let mut args = std::env::args().skip(1);
+    let map = args
+        .next()
+        .unwrap_or_else(|| "../shared/maps/nav2_depot.yaml".into());
+    let out = args.next().unwrap_or_else(|| "nav_path.yaml".into());
+    let scenario = Scenario::builder(&map, PlannerKind::Bcd)
+        .radius(0.2)
+        .build()?;
+    let plan = plan::plan_route(&scenario, &scenario.map.load()?, DEFAULT_TOLERANCE_M)?;
+    std::fs::write(&out, export::nav_path_yaml(&plan.route))?;
+    println!(
+        "{} waypoints, {:.1} m -> {out}",
+        plan.route.waypoints.len(),
+        plan.route.length_m()
+    );
+    Ok(())
+}

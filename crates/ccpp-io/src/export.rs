@@ -1,0 +1,545 @@
+//! Path exports a robot stack reads: a [`Route`] (waypoints with headings at segment ends) as
+//! CSV, JSON, a ROS 2 `nav_msgs/Path` in YAML and a `GeoJSON` `FeatureCollection`, plus readers
+//! for the CSV and JSON forms.
+//!
+//! | format ([`ExportFormat`]) | file | content |
+//! |---|---|---|
+//! | `csv` | `waypoints.csv` | header `x,y,theta`, one waypoint a line (metres, radians) |
+//! | `json` | `waypoints.json` | `{"frame_id":"map", "planner", "map", "tolerance_m", "length_m", "waypoints":[{"x","y","theta"}, ..]}` |
+//! | `nav-path` | `nav_path.yaml` | a `nav_msgs/Path` as `ros2 topic echo` prints it (without the trailing `---`) |
+//! | `geojson` | `path.geojson` | a `FeatureCollection`: the route as a `LineString`, then any zone polygons |
+//!
+//! All coordinates are in the map frame (metres; `x` east, `y` north): the `GeoJSON` is not
+//! WGS 84, so GIS tools should read it in a local/unknown coordinate system. `theta` is the
+//! heading the robot leaves the waypoint with (radians, 0 = +x, counter-clockwise); the
+//! `nav_msgs/Path` carries it as the quaternion `(0, 0, sin(theta/2), cos(theta/2))`. Every
+//! number is written so that it reads back to the same `f64` (shortest round-trip form); YAML
+//! floats always have a decimal point and no exponent, so YAML 1.1 parsers read them as floats
+//! too. Output is a pure function of the inputs (byte-identical for the same route).
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
+
+use ccpp_core::metrics::Metrics;
+use ccpp_core::route::Route;
+use ccpp_core::world::Robot;
+use ccpp_core::Pose;
+use serde::{Deserialize, Serialize};
+
+/// The frame every export is expressed in (`header.frame_id` of the `nav_msgs/Path`).
+pub const FRAME_ID: &str = "map";
+
+/// An export format.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum ExportFormat {
+    /// `waypoints.csv`.
+    Csv,
+    /// `waypoints.json`.
+    Json,
+    /// `nav_path.yaml`: a ROS 2 `nav_msgs/Path`.
+    NavPath,
+    /// `path.geojson`.
+    GeoJson,
+}
+
+impl ExportFormat {
+    /// Every format, in writing order.
+    pub const ALL: [ExportFormat; 4] = [
+        ExportFormat::Csv,
+        ExportFormat::Json,
+        ExportFormat::NavPath,
+        ExportFormat::GeoJson,
+    ];
+
+    /// The name used on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            ExportFormat::Csv => "csv",
+            ExportFormat::Json => "json",
+            ExportFormat::NavPath => "nav-path",
+            ExportFormat::GeoJson => "geojson",
+        }
+    }
+
+    /// The file the format is written to.
+    pub fn file_name(self) -> &'static str {
+        match self {
+            ExportFormat::Csv => "waypoints.csv",
+            ExportFormat::Json => "waypoints.json",
+            ExportFormat::NavPath => "nav_path.yaml",
+            ExportFormat::GeoJson => "path.geojson",
+        }
+    }
+}
+
+impl std::fmt::Display for ExportFormat {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// An unknown export format name.
+#[derive(Debug, thiserror::Error)]
+#[error("unknown export format {0:?} (expected csv, json, nav-path or geojson)")]
+pub struct UnknownFormat(pub String);
+
+impl FromStr for ExportFormat {
+    type Err = UnknownFormat;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let l = s.trim().to_ascii_lowercase();
+        Self::ALL
+            .into_iter()
+            .find(|f| f.name() == l)
+            .ok_or_else(|| UnknownFormat(s.to_string()))
+    }
+}
+
+/// What a route's exports say about where it came from.
+#[derive(Clone, Debug)]
+pub struct ExportMeta<'a> {
+    /// Planner name.
+    pub planner: &'a str,
+    /// Map name.
+    pub map: &'a str,
+    /// The robot.
+    pub robot: Robot,
+    /// The merging tolerance the route was built with, metres.
+    pub tolerance_m: f64,
+    /// The run's metrics (`GeoJSON` properties), when the path was simulated and measured.
+    pub metrics: Option<&'a Metrics>,
+}
+
+/// An extra polygon for the `GeoJSON` export (a keep-out zone, a work area...): rings of map
+/// coordinates, the first the outer boundary and any others holes. Rings are written closed
+/// (the first point repeated at the end when it is not already).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PolygonFeature {
+    /// What it is (`keepout`, `area`, ...): the `kind` property.
+    pub kind: String,
+    /// Optional `name` property.
+    pub name: Option<String>,
+    /// Rings of `(x, y)` map coordinates: outer boundary first, then holes.
+    pub rings: Vec<Vec<[f64; 2]>>,
+}
+
+/// Error reading a waypoint file.
+#[derive(Debug, thiserror::Error)]
+pub enum WaypointFileError {
+    /// The file cannot be read.
+    #[error("cannot read waypoints {}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// The content is not a waypoint list.
+    #[error("waypoints {} line {line}: {message}", path.display())]
+    Parse {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line (1 for JSON errors without a line).
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// The route as CSV: header `x,y,theta`, one waypoint a line.
+pub fn waypoints_csv(route: &Route) -> String {
+    let mut s = String::with_capacity(16 + route.waypoints.len() * 48);
+    s.push_str("x,y,theta\n");
+    for p in &route.waypoints {
+        let _ = writeln!(s, "{},{},{}", p.x, p.y, p.theta);
+    }
+    s
+}
+
+/// Parses [`waypoints_csv`] text (`path` names it in errors): a header `x,y,theta` and three
+/// finite numbers a line; blank lines are skipped.
+///
+/// # Errors
+/// A missing or different header, or a line that is not three finite numbers.
+pub fn parse_waypoints_csv(text: &str, path: &Path) -> Result<Route, WaypointFileError> {
+    let err = |line: usize, message: String| WaypointFileError::Parse {
+        path: path.to_path_buf(),
+        line,
+        message,
+    };
+    let mut lines = text.lines().enumerate();
+    match lines.next() {
+        Some((_, h)) if h.trim() == "x,y,theta" => {}
+        Some((_, h)) => return Err(err(1, format!("expected the header x,y,theta, got {h:?}"))),
+        None => return Err(err(1, "empty file (expected the header x,y,theta)".into())),
+    }
+    let mut waypoints = Vec::new();
+    for (k, line) in lines {
+        if line.trim().is_empty() {
+            continue;
+        }
+        let v: Vec<f64> = line
+            .split(',')
+            .map(|x| x.trim().parse::<f64>())
+            .collect::<Result<_, _>>()
+            .map_err(|e| err(k + 1, format!("{line:?}: {e}")))?;
+        match v.as_slice() {
+            &[x, y, theta] if x.is_finite() && y.is_finite() && theta.is_finite() => {
+                waypoints.push(Pose::new(x, y, theta));
+            }
+            _ => {
+                return Err(err(
+                    k + 1,
+                    format!("expected three finite numbers x,y,theta, got {line:?}"),
+                ))
+            }
+        }
+    }
+    Ok(Route { waypoints })
+}
+
+/// One waypoint in `waypoints.json`.
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct JsonWaypoint {
+    x: f64,
+    y: f64,
+    theta: f64,
+}
+
+/// `waypoints.json`.
+#[derive(Serialize, Deserialize)]
+struct WaypointsJson {
+    frame_id: String,
+    planner: String,
+    map: String,
+    tolerance_m: f64,
+    length_m: f64,
+    waypoints: Vec<JsonWaypoint>,
+}
+
+/// The route as pretty JSON: `frame_id`, `planner`, `map`, `tolerance_m`, `length_m` and
+/// `waypoints` (objects `{"x","y","theta"}`).
+///
+/// # Errors
+/// Serialization failure (a non-finite number).
+pub fn waypoints_json(route: &Route, meta: &ExportMeta<'_>) -> Result<String, serde_json::Error> {
+    let doc = WaypointsJson {
+        frame_id: FRAME_ID.to_string(),
+        planner: meta.planner.to_string(),
+        map: meta.map.to_string(),
+        tolerance_m: meta.tolerance_m,
+        length_m: route.length_m(),
+        waypoints: route
+            .waypoints
+            .iter()
+            .map(|p| JsonWaypoint {
+                x: p.x,
+                y: p.y,
+                theta: p.theta,
+            })
+            .collect(),
+    };
+    let mut s = serde_json::to_string_pretty(&doc)?;
+    s.push('\n');
+    Ok(s)
+}
+
+/// Parses [`waypoints_json`] text (`path` names it in errors).
+///
+/// # Errors
+/// Not such a document, or a non-finite number.
+pub fn parse_waypoints_json(text: &str, path: &Path) -> Result<Route, WaypointFileError> {
+    let doc: WaypointsJson = serde_json::from_str(text).map_err(|e| WaypointFileError::Parse {
+        path: path.to_path_buf(),
+        line: e.line().max(1),
+        message: e.to_string(),
+    })?;
+    let waypoints = doc
+        .waypoints
+        .into_iter()
+        .map(|w| Pose::new(w.x, w.y, w.theta))
+        .collect();
+    Ok(Route { waypoints })
+}
+
+/// Reads `waypoints.csv` or `waypoints.json` (by extension: `.json` is JSON, anything else CSV).
+///
+/// # Errors
+/// An unreadable file or the parse errors of [`parse_waypoints_csv`] / [`parse_waypoints_json`].
+pub fn read_waypoints(path: &Path) -> Result<Route, WaypointFileError> {
+    let text = crate::file::read_text(path).map_err(|source| WaypointFileError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+    {
+        parse_waypoints_json(&text, path)
+    } else {
+        parse_waypoints_csv(&text, path)
+    }
+}
+
+/// A YAML float: the shortest round-trip decimal, never with an exponent, always with a
+/// decimal point (`1.0`, not `1`), so YAML 1.1 and 1.2 parsers both read a float.
+fn yaml_float(v: f64) -> String {
+    if !v.is_finite() {
+        return if v.is_nan() {
+            ".nan".to_string()
+        } else if v > 0.0 {
+            ".inf".to_string()
+        } else {
+            "-.inf".to_string()
+        };
+    }
+    let s = format!("{v}");
+    if s.contains('.') {
+        s
+    } else {
+        format!("{s}.0")
+    }
+}
+
+/// The quaternion `[x, y, z, w]` of a rotation by `theta` about the z axis.
+pub fn heading_quaternion(theta: f64) -> [f64; 4] {
+    let h = 0.5 * theta;
+    [0.0, 0.0, h.sin(), h.cos()]
+}
+
+/// The route as a ROS 2 `nav_msgs/Path` in the YAML shape `ros2 topic echo` prints:
+/// `header` (stamp 0, `frame_id: map`) and `poses`, a list of `geometry_msgs/PoseStamped`
+/// (same header; `pose.position` x, y, z = 0; `pose.orientation` the heading quaternion
+/// [`heading_quaternion`]). The trailing `---` document separator is left out so that the file
+/// is one YAML document.
+pub fn nav_path_yaml(route: &Route) -> String {
+    let mut s = String::with_capacity(128 + route.waypoints.len() * 280);
+    let header = |s: &mut String, indent: &str| {
+        let _ = write!(
+            s,
+            "{indent}header:\n{indent}  stamp:\n{indent}    sec: 0\n{indent}    nanosec: 0\n{indent}  frame_id: {FRAME_ID}\n"
+        );
+    };
+    header(&mut s, "");
+    if route.waypoints.is_empty() {
+        s.push_str("poses: []\n");
+        return s;
+    }
+    s.push_str("poses:\n");
+    for p in &route.waypoints {
+        let q = heading_quaternion(p.theta);
+        s.push_str("- ");
+        // The first key shares the list item's line.
+        let mut item = String::new();
+        header(&mut item, "");
+        let _ = write!(
+            item,
+            "pose:\n  position:\n    x: {}\n    y: {}\n    z: 0.0\n  orientation:\n    x: {}\n    y: {}\n    z: {}\n    w: {}\n",
+            yaml_float(p.x),
+            yaml_float(p.y),
+            yaml_float(q[0]),
+            yaml_float(q[1]),
+            yaml_float(q[2]),
+            yaml_float(q[3]),
+        );
+        for (k, line) in item.lines().enumerate() {
+            if k > 0 {
+                s.push_str("  ");
+            }
+            s.push_str(line);
+            s.push('\n');
+        }
+    }
+    s
+}
+
+/// A ring closed: the first point repeated at the end when it is not already.
+fn closed_ring(ring: &[[f64; 2]]) -> Vec<[f64; 2]> {
+    let mut r = ring.to_vec();
+    if let (Some(&first), Some(&last)) = (r.first(), r.last()) {
+        if first != last {
+            r.push(first);
+        }
+    }
+    r
+}
+
+/// The route (and `polygons`) as a `GeoJSON` `FeatureCollection` in map coordinates
+/// (`[x, y]` order, metres). The first feature is the route: a `LineString` of the waypoints
+/// (a single waypoint is repeated so the line has the two positions `GeoJSON` requires; an empty
+/// route has a `null` geometry) with properties `kind: "path"`, `frame_id`, `planner`, `map`,
+/// `robot` (`radius_m`, `tool_radius_m`), `route` (`waypoints`, `length_m`, `tolerance_m`) and
+/// `metrics` (the run's metrics, or `null` for a plan that was not measured). Then one
+/// `Polygon` feature per entry of `polygons` with properties `kind` and `name`, rings closed.
+///
+/// # Errors
+/// Serialization failure (a non-finite number).
+pub fn geojson(
+    route: &Route,
+    meta: &ExportMeta<'_>,
+    polygons: &[PolygonFeature],
+) -> Result<String, serde_json::Error> {
+    use serde_json::{json, Value};
+    let mut coords: Vec<[f64; 2]> = route.waypoints.iter().map(|p| [p.x, p.y]).collect();
+    if coords.len() == 1 {
+        coords.push(coords[0]);
+    }
+    let geometry = if coords.is_empty() {
+        Value::Null
+    } else {
+        json!({ "type": "LineString", "coordinates": coords })
+    };
+    let metrics = match meta.metrics {
+        Some(m) => serde_json::to_value(m)?,
+        None => Value::Null,
+    };
+    let mut features = vec![json!({
+        "type": "Feature",
+        "geometry": geometry,
+        "properties": {
+            "kind": "path",
+            "frame_id": FRAME_ID,
+            "planner": meta.planner,
+            "map": meta.map,
+            "robot": {
+                "radius_m": meta.robot.radius,
+                "tool_radius_m": meta.robot.tool_radius,
+            },
+            "route": {
+                "waypoints": route.waypoints.len(),
+                "length_m": route.length_m(),
+                "tolerance_m": meta.tolerance_m,
+            },
+            "metrics": metrics,
+        },
+    })];
+    for p in polygons {
+        let rings: Vec<Vec<[f64; 2]>> = p.rings.iter().map(|r| closed_ring(r)).collect();
+        features.push(json!({
+            "type": "Feature",
+            "geometry": { "type": "Polygon", "coordinates": rings },
+            "properties": { "kind": p.kind, "name": p.name },
+        }));
+    }
+    let doc = json!({ "type": "FeatureCollection", "features": features });
+    let mut s = serde_json::to_string_pretty(&doc)?;
+    s.push('\n');
+    Ok(s)
+}
+
+/// Renders `route` in each of `formats` (duplicates written once, in [`ExportFormat::ALL`]
+/// order): `(file name, bytes)`. `polygons` go into the `GeoJSON`.
+///
+/// # Errors
+/// Serialization failure (a non-finite number).
+pub fn render_exports(
+    route: &Route,
+    meta: &ExportMeta<'_>,
+    formats: &[ExportFormat],
+    polygons: &[PolygonFeature],
+) -> Result<Vec<(&'static str, Vec<u8>)>, serde_json::Error> {
+    let mut out = Vec::new();
+    for f in ExportFormat::ALL {
+        if !formats.contains(&f) {
+            continue;
+        }
+        let text = match f {
+            ExportFormat::Csv => waypoints_csv(route),
+            ExportFormat::Json => waypoints_json(route, meta)?,
+            ExportFormat::NavPath => nav_path_yaml(route),
+            ExportFormat::GeoJson => geojson(route, meta, polygons)?,
+        };
+        out.push((f.file_name(), text.into_bytes()));
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn route() -> Route {
+        Route {
+            waypoints: vec![
+                Pose::new(1.0, 2.0, 0.0),
+                Pose::new(3.5, 2.0, std::f64::consts::FRAC_PI_2),
+                Pose::new(3.5, 4.25, -3.0),
+            ],
+        }
+    }
+
+    fn meta() -> ExportMeta<'static> {
+        ExportMeta {
+            planner: "bcd",
+            map: "m",
+            robot: Robot {
+                radius: 0.15,
+                tool_radius: 0.15,
+            },
+            tolerance_m: 0.001,
+            metrics: None,
+        }
+    }
+
+    #[test]
+    fn csv_and_json_round_trip() {
+        let r = route();
+        let back = parse_waypoints_csv(&waypoints_csv(&r), Path::new("w.csv"));
+        assert_eq!(back.ok(), Some(r.clone()));
+        let text = waypoints_json(&r, &meta()).unwrap_or_default();
+        let back = parse_waypoints_json(&text, Path::new("w.json"));
+        assert_eq!(back.ok(), Some(r));
+    }
+
+    #[test]
+    fn bad_waypoint_files_name_the_line() {
+        let e = parse_waypoints_csv("x,y,theta\n1,2,3\n1,2\n", Path::new("w.csv"))
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(e.contains("w.csv line 3"), "{e}");
+        let e = parse_waypoints_csv("a,b\n", Path::new("w.csv"))
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(e.contains("header"), "{e}");
+        let e = parse_waypoints_csv("x,y,theta\n1,NaN,0\n", Path::new("w.csv"));
+        assert!(e.is_err());
+        assert!(parse_waypoints_json("{}", Path::new("w.json")).is_err());
+    }
+
+    #[test]
+    fn yaml_floats_have_a_point_and_no_exponent() {
+        assert_eq!(yaml_float(1.0), "1.0");
+        assert_eq!(yaml_float(-0.5), "-0.5");
+        assert_eq!(yaml_float(1e-17), "0.00000000000000001");
+        assert_eq!(yaml_float(1e20), "100000000000000000000.0");
+    }
+
+    #[test]
+    fn formats_parse_by_name() {
+        for f in ExportFormat::ALL {
+            assert_eq!(f.name().parse::<ExportFormat>().ok(), Some(f));
+        }
+        assert!("kml".parse::<ExportFormat>().is_err());
+    }
+
+    #[test]
+    fn geojson_closes_rings_and_keeps_xy_order() {
+        let poly = PolygonFeature {
+            kind: "keepout".into(),
+            name: Some("rug".into()),
+            rings: vec![vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]],
+        };
+        let text = geojson(&route(), &meta(), &[poly]).unwrap_or_default();
+        let v: serde_json::Value = serde_json::from_str(&text).unwrap_or_default();
+        assert_eq!(v["type"], "FeatureCollection");
+        assert_eq!(v["features"][0]["geometry"]["coordinates"][1][0], 3.5);
+        assert_eq!(v["features"][0]["geometry"]["coordinates"][2][1], 4.25);
+        let ring = &v["features"][1]["geometry"]["coordinates"][0];
+        assert_eq!(ring.as_array().map(Vec::len), Some(4));
+        assert_eq!(ring[0], ring[3]);
+        assert_eq!(v["features"][1]["properties"]["kind"], "keepout");
+    }
+}

@@ -1,0 +1,88 @@
+//! Path exports through the library (issue 14 §3, issue 13 "outputs sized to information"):
+//! `path.csv` of a PID run on a real building grows with its segments, not its control steps,
+//! while the metrics still come from the full trace; `plan_route` gives a known-map planner's
+//! route and refuses online planners.
+
+#![allow(clippy::unwrap_used)] // tests may panic on broken fixtures
+
+use std::path::PathBuf;
+
+use ccpp_core::planners::PlannerKind;
+use ccpp_core::route::{Route, DEFAULT_TOLERANCE_M};
+use ccpp_io::export::{nav_path_yaml, parse_waypoints_csv};
+use ccpp_io::plan::{plan_route, PlanError};
+use ccpp_io::scenario::Scenario;
+use ccpp_io::trace::path_csv;
+
+/// `<repo>/../shared/maps`, valid from any worktree that sits beside `shared/`.
+const MAPS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/maps");
+
+fn shared(name: &str) -> Option<PathBuf> {
+    let p = PathBuf::from(MAPS).join(name);
+    if p.is_file() {
+        Some(p)
+    } else {
+        println!("note: {} is absent; skipping", p.display());
+        None
+    }
+}
+
+#[test]
+fn bsa_bfs_path_csv_on_tuw_freihaus_eg_is_small() {
+    // bsa-bfs runs under PID execution: about 4 million control-step poses on this map, which
+    // path.csv used to list one a line (194 MB).
+    let Some(map) = shared("tuw_freihaus_eg.yaml") else {
+        return;
+    };
+    let run = Scenario::builder(&map, PlannerKind::BsaBfs)
+        .radius(0.15)
+        .build()
+        .unwrap()
+        .run()
+        .unwrap();
+    let trace = &run.output.trace;
+    let poses = trace.poses().count();
+    let csv = path_csv(trace);
+    let rows = csv.lines().count() - 1;
+    assert!(poses > 1_000_000, "{poses} poses");
+    assert!(csv.len() < 3_000_000, "path.csv is {} bytes", csv.len());
+    assert!(rows * 100 < poses, "{rows} rows for {poses} poses");
+    // The metrics are those of the full trace (the decimated path is not what is measured).
+    let all: Vec<_> = trace.poses().collect();
+    let full: f64 = all
+        .windows(2)
+        .map(|w| w[0].position().dist(w[1].position()))
+        .sum();
+    assert!((run.metrics.path_length_m - full).abs() < 1e-6);
+    // The CSV reads back to the route.
+    let back = parse_waypoints_csv(&csv, std::path::Path::new("path.csv")).unwrap();
+    assert_eq!(back, Route::from_trace(trace, DEFAULT_TOLERANCE_M));
+}
+
+#[test]
+fn plan_route_of_known_map_planners_and_online_refusal() {
+    let Some(map) = shared("teb_maze.yaml") else {
+        return;
+    };
+    let scenario = Scenario::builder(&map, PlannerKind::Bcd).build().unwrap();
+    let prepared = scenario.map.load().unwrap();
+    let plan = plan_route(&scenario, &prepared, DEFAULT_TOLERANCE_M).unwrap();
+    // The route is that of the simulated run (bcd executes ideally).
+    let run = scenario.run_on(&prepared).unwrap();
+    assert_eq!(
+        plan.route,
+        Route::from_trace(&run.output.trace, DEFAULT_TOLERANCE_M)
+    );
+    assert!(plan.route.waypoints.len() > 10);
+    assert!(nav_path_yaml(&plan.route).starts_with("header:\n"));
+    // Deterministic.
+    let again = plan_route(&scenario, &prepared, DEFAULT_TOLERANCE_M).unwrap();
+    assert_eq!(again.route, plan.route);
+    let online = Scenario::builder(&map, PlannerKind::BaStar)
+        .build()
+        .unwrap();
+    let e = plan_route(&online, &prepared, DEFAULT_TOLERANCE_M)
+        .err()
+        .unwrap();
+    assert!(matches!(e, PlanError::Online("ba-star", _)), "{e}");
+}
