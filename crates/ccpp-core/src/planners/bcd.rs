@@ -62,6 +62,7 @@
 //! assert!(m.regions >= 1); // one region per cell
 //! ```
 
+mod hops;
 mod tsp;
 
 use std::cmp::Reverse;
@@ -94,6 +95,10 @@ pub struct BcdOptions {
     /// Skip a rim detour whose swept new area per metre is below this fraction of a lane's
     /// (`2 r_tool` per metre); 0 sweeps every reachable missed group. In `[0, 1]`.
     pub rim_min_yield: f64,
+    /// Rim passes stop at this share of the accessible floor: the lowest-yield missed groups
+    /// are left out while the pixels they hold (with whatever no pass can reach) stay within
+    /// `1 - rim_coverage` of it, as estimated on the plan. 1 sweeps every group. In `[0, 1]`.
+    pub rim_coverage: f64,
     /// Improvement rounds of the cell tour (0 = nearest-neighbour order only).
     pub tour_rounds: u32,
 }
@@ -106,6 +111,7 @@ impl Default for BcdOptions {
             turn_cost_m: 0.3,
             rim: true,
             rim_min_yield: 0.0,
+            rim_coverage: 0.997,
             tour_rounds: 2,
         }
     }
@@ -146,6 +152,9 @@ impl BcdOptions {
         }
         if !(0.0..=1.0).contains(&self.rim_min_yield) {
             return bad("rim_min_yield", "in [0, 1]", self.rim_min_yield);
+        }
+        if !(0.0..=1.0).contains(&self.rim_coverage) {
+            return bad("rim_coverage", "in [0, 1]", self.rim_coverage);
         }
         Ok(())
     }
@@ -610,6 +619,11 @@ impl Bcd {
                 } else {
                     d.rim_min_yield
                 },
+                rim_coverage: if (0.0..=1.0).contains(&opts.rim_coverage) {
+                    opts.rim_coverage
+                } else {
+                    d.rim_coverage
+                },
                 tour_rounds: opts.tour_rounds,
             };
             Self::plan(world, &fixed)
@@ -756,11 +770,13 @@ impl Bcd {
             pieces.push(piece);
             paths.push(ps);
         }
-        let coarse = Coarse::new(&ctx, sp);
-        let dist = |a: Point, b: Point| coarse.dist(a, b);
+        let coarse = hops::Coarse::new(&ctx, sp);
+        let far = hops::Coarse::new(&ctx, sp * f64::from(hops::FAR_FACTOR));
         let ncells = paths.len();
         let contours: Vec<Vec<Point>> = if opts.rim {
-            let nn = coarse.nearest_tour(&pieces, start);
+            let table = hops::HopTable::new(&coarse, &far, &pieces, start);
+            let dist = |a: Point, b: Point| table.dist(a, b);
+            let nn = table.nearest_tour(&pieces, start);
             let first = tsp::solve(&pieces, start, opts.tour_rounds, &dist, Some(nn));
             let mut keep = vec![0usize; ncells];
             for &(c, v) in &first {
@@ -780,10 +796,16 @@ impl Bcd {
                 };
             }
             let lines: Vec<&[Point]> = paths.iter().map(|p| p[0].as_slice()).collect();
-            rim_contours(&ctx, &mut search, &lines, opts.rim_min_yield)
-                .into_iter()
-                .map(|c| c.0)
-                .collect()
+            rim_contours(
+                &ctx,
+                &mut search,
+                &lines,
+                opts.rim_min_yield,
+                opts.rim_coverage,
+            )
+            .into_iter()
+            .map(|c| c.0)
+            .collect()
         } else {
             Vec::new()
         };
@@ -796,7 +818,9 @@ impl Bcd {
                 inner: vec![len, len],
             });
         }
-        let nn = coarse.nearest_tour(&pieces, start);
+        let table = hops::HopTable::new(&coarse, &far, &pieces, start);
+        let dist = |a: Point, b: Point| table.dist(a, b);
+        let nn = table.nearest_tour(&pieces, start);
         let tour = tsp::solve(&pieces, start, opts.tour_rounds, &dist, Some(nn));
 
         let mut items: Vec<Item> = vec![Item::Move(start)];
@@ -845,7 +869,13 @@ impl Bcd {
         }
 
         if opts.rim {
-            rim_pass(&ctx, &mut search, &mut items, opts.rim_min_yield);
+            rim_pass(
+                &ctx,
+                &mut search,
+                &mut items,
+                opts.rim_min_yield,
+                opts.rim_coverage,
+            );
         }
         let items = repair(&ctx, &mut search, items);
 
@@ -911,12 +941,14 @@ fn moves(items: &[Item]) -> Vec<(Point, usize)> {
 
 /// Step 3 of the module docs: the contour passes (grid polylines) that sweep the accessible
 /// pixels the polylines `lines` miss, one per 8-connected group of missed pixels, with the
-/// number of pixels each is meant to sweep; groups below `min_yield` are left out.
+/// number of pixels each is meant to sweep; groups below `min_yield` are left out, and so are
+/// the lowest-yield groups that fit in the budget `1 - target` of the accessible pixels.
 fn rim_contours(
     ctx: &Ctx<'_>,
     search: &mut Search,
     lines: &[&[Point]],
     min_yield: f64,
+    target: f64,
 ) -> Vec<(Vec<Point>, usize)> {
     let frame = ctx.frame;
     let (w, h) = (frame.width, frame.height);
@@ -1033,18 +1065,50 @@ fn rim_contours(
         }
         out.push((contour, members.len()));
     }
+    // The budget: missed pixels allowed by `target`, less those no group holds.
+    let grouped: usize = out.iter().map(|c| c.1).sum();
+    let allowed = ((1.0 - target) * acc.count_ones(..) as f64).floor() as usize;
+    let mut budget = allowed.saturating_sub(missed.count_ones(..) - grouped);
+    if budget > 0 {
+        // Lowest yield (pixels per pixel of contour) first; ties by group order.
+        let mut order: Vec<usize> = (0..out.len()).collect();
+        let yield_of = |c: &(Vec<Point>, usize)| c.1 as f64 / polyline_len(&c.0).max(1.0);
+        order.sort_by(|&a, &b| {
+            yield_of(&out[a])
+                .total_cmp(&yield_of(&out[b]))
+                .then(a.cmp(&b))
+        });
+        let mut drop = vec![false; out.len()];
+        for i in order {
+            if out[i].1 <= budget {
+                budget -= out[i].1;
+                drop[i] = true;
+            }
+        }
+        let mut k = 0;
+        out.retain(|_| {
+            k += 1;
+            !drop[k - 1]
+        });
+    }
     out
 }
 
 /// Final mop-up of step 3: sweeps what the assembled plan still misses with contour detours
 /// inserted at the cheapest point of the path (out and back).
-fn rim_pass(ctx: &Ctx<'_>, search: &mut Search, items: &mut Vec<Item>, min_yield: f64) {
+fn rim_pass(
+    ctx: &Ctx<'_>,
+    search: &mut Search,
+    items: &mut Vec<Item>,
+    min_yield: f64,
+    target: f64,
+) {
     const B: f64 = 16.0;
     let frame = ctx.frame;
     let (w, h) = (frame.width, frame.height);
     let path = moves(items);
     let line: Vec<Point> = path.iter().map(|m| m.0).collect();
-    let contours = rim_contours(ctx, search, &[&line], min_yield);
+    let contours = rim_contours(ctx, search, &[&line], min_yield, target);
     // Spatial index of the path's segments (buckets of 16 px).
     let (bw, bh) = (
         (w as f64 / B).ceil() as usize + 1,
@@ -1136,299 +1200,6 @@ fn proj(a: Point, b: Point, p: Point) -> f64 {
         0.0
     } else {
         (p.sub(a).dot(d) / l2).clamp(0.0, 1.0)
-    }
-}
-
-/// Hop costs for the cell tour: the straight-line distance, or the length of a shortest path
-/// over a coarse grid of the C-free set when that is longer (walls between the points).
-/// Blocks of `b` pixels are open when they hold a C-free pixel and joined to a side neighbour
-/// when C-free pixels touch across their common edge.
-struct Coarse {
-    b: usize,
-    bw: usize,
-    bh: usize,
-    open: Vec<bool>,
-    /// Block joined to its east / south neighbour.
-    east: Vec<bool>,
-    south: Vec<bool>,
-    cache: std::cell::RefCell<std::collections::HashMap<(u32, u32), f64>>,
-    /// A* scratch: generation stamp and cost per block.
-    scratch: std::cell::RefCell<(u32, Vec<u32>, Vec<u32>)>,
-}
-
-impl Coarse {
-    fn new(ctx: &Ctx<'_>, sp: f64) -> Self {
-        let (w, h) = (ctx.frame.width, ctx.frame.height);
-        let b = (sp.round() as usize).max(4);
-        let (bw, bh) = (w.div_ceil(b), h.div_ceil(b));
-        let mut open = vec![false; bw * bh];
-        let mut east = vec![false; bw * bh];
-        let mut south = vec![false; bw * bh];
-        for r in 0..h {
-            for c in 0..w {
-                if !ctx.ok[r * w + c] {
-                    continue;
-                }
-                let k = (r / b) * bw + c / b;
-                open[k] = true;
-                if c + 1 < w && (c + 1) % b == 0 && ctx.ok[r * w + c + 1] {
-                    east[k] = true;
-                }
-                if r + 1 < h && (r + 1) % b == 0 && ctx.ok[(r + 1) * w + c] {
-                    south[k] = true;
-                }
-            }
-        }
-        Self {
-            b,
-            bw,
-            bh,
-            open,
-            east,
-            south,
-            cache: std::cell::RefCell::new(std::collections::HashMap::new()),
-            scratch: std::cell::RefCell::new((0, vec![0; bw * bh], vec![0; bw * bh])),
-        }
-    }
-
-    fn block(&self, p: Point) -> usize {
-        let bf = self.b as f64;
-        let c = ((p.x / bf).floor().max(0.0) as usize).min(self.bw - 1);
-        // Grid y is up; blocks count rows from the top.
-        let rows = self.bh * self.b;
-        let r_px = (rows as f64 - p.y).floor().max(0.0) as usize;
-        let r = (r_px / self.b).min(self.bh - 1);
-        r * self.bw + c
-    }
-
-    fn dist(&self, a: Point, b: Point) -> f64 {
-        let e = a.dist(b);
-        let (ka, kb) = (self.block(a), self.block(b));
-        // Near: the straight line; far (over 64 blocks): the straight line too, as searching
-        // there costs more than it tells (good tours hop short).
-        if ka == kb || e < self.b as f64 || e > 64.0 * self.b as f64 {
-            return e;
-        }
-        let key = (ka.min(kb) as u32, ka.max(kb) as u32);
-        if let Some(&g) = self.cache.borrow().get(&key) {
-            return e.max(g);
-        }
-        // Searched up to eight times the straight line; beyond, or where the coarse grid cannot
-        // join the blocks (a wall through a block), that bound stands in.
-        let g = self.astar(ka, kb, 8.0 * e).min(8.0 * e);
-        self.cache.borrow_mut().insert(key, g);
-        e.max(g)
-    }
-
-    /// Block steps from block `k` (dc, dr, cost in tenths of a block) that the coarse grid
-    /// allows.
-    fn steps(&self, k: usize, out: &mut Vec<(usize, u32)>) {
-        out.clear();
-        let bw = self.bw;
-        let (c, r) = ((k % bw) as i64, (k / bw) as i64);
-        let at = |c: i64, r: i64| r as usize * bw + c as usize;
-        let linked = |k: usize, dc: i64, dr: i64| -> bool {
-            let (c, r) = ((k % bw) as i64, (k / bw) as i64);
-            match (dc, dr) {
-                (1, 0) => self.east[k],
-                (-1, 0) => self.east[at(c - 1, r)],
-                (0, 1) => self.south[k],
-                (0, -1) => self.south[at(c, r - 1)],
-                _ => false,
-            }
-        };
-        for (dc, dr) in [
-            (1, 0),
-            (0, 1),
-            (-1, 0),
-            (0, -1),
-            (1, 1),
-            (1, -1),
-            (-1, 1),
-            (-1, -1),
-        ] {
-            let (nc, nr) = (c + dc, r + dr);
-            if nc < 0 || nr < 0 || nc >= bw as i64 || nr >= self.bh as i64 {
-                continue;
-            }
-            let j = at(nc, nr);
-            if !self.open[j] {
-                continue;
-            }
-            if dc != 0 && dr != 0 {
-                let (vh, vv) = (at(nc, r), at(c, nr));
-                let a = self.open[vh] && linked(k, dc, 0) && linked(vh, 0, dr);
-                let b = self.open[vv] && linked(k, 0, dr) && linked(vv, dc, 0);
-                if a || b {
-                    out.push((j, 14));
-                }
-            } else if linked(k, dc, dr) {
-                out.push((j, 10));
-            }
-        }
-    }
-
-    /// Nearest-neighbour tour by hop cost: from each exit, a Dijkstra over the coarse grid
-    /// finds the piece entry with the lowest `dist + inner` (straight-line order where the
-    /// coarse grid joins nothing).
-    fn nearest_tour(&self, pieces: &[tsp::Piece], start: Point) -> tsp::Tour {
-        let nblocks = self.bw * self.bh;
-        let mut at_block: Vec<Vec<(usize, usize)>> = vec![Vec::new(); nblocks];
-        for (p, piece) in pieces.iter().enumerate() {
-            for (v, &e) in piece.entry.iter().enumerate() {
-                at_block[self.block(e)].push((p, v));
-            }
-        }
-        let mut done = vec![false; pieces.len()];
-        let mut tour = Vec::with_capacity(pieces.len());
-        let mut here = start;
-        let mut stamp = vec![0u32; nblocks];
-        let mut g = vec![0u32; nblocks];
-        let mut nbrs = Vec::new();
-        let bpx = self.b as f64;
-        for round in 1..=pieces.len() as u32 {
-            let mut best: Option<(f64, usize, usize)> = None;
-            let s = self.block(here);
-            let mut heap = BinaryHeap::new();
-            stamp[s] = round;
-            g[s] = 0;
-            heap.push(Reverse((0u32, s)));
-            while let Some(Reverse((gk, k))) = heap.pop() {
-                if gk > g[k] {
-                    continue;
-                }
-                let gpx = f64::from(gk) / 10.0 * bpx;
-                if best.is_some_and(|b| gpx - 2.0 * bpx > b.0) {
-                    break;
-                }
-                for &(p, v) in &at_block[k] {
-                    if done[p] {
-                        continue;
-                    }
-                    let e = pieces[p].entry[v];
-                    let c = self.dist(here, e) + pieces[p].inner[v];
-                    if best.is_none_or(|b| c < b.0) {
-                        best = Some((c, p, v));
-                    }
-                }
-                self.steps(k, &mut nbrs);
-                for &(j, w) in &nbrs {
-                    let ng = gk + w;
-                    if stamp[j] != round || ng < g[j] {
-                        stamp[j] = round;
-                        g[j] = ng;
-                        heap.push(Reverse((ng, j)));
-                    }
-                }
-            }
-            if best.is_none() {
-                for (p, piece) in pieces.iter().enumerate() {
-                    if done[p] {
-                        continue;
-                    }
-                    for (v, &e) in piece.entry.iter().enumerate() {
-                        let c = here.dist(e) + piece.inner[v];
-                        if best.is_none_or(|b| c < b.0) {
-                            best = Some((c, p, v));
-                        }
-                    }
-                }
-            }
-            let Some((_, p, v)) = best else { break };
-            done[p] = true;
-            tour.push((p, v));
-            here = pieces[p].exit[v];
-        }
-        tour
-    }
-
-    /// Shortest block path length (pixels) between blocks `s` and `t` (8-connected; a diagonal
-    /// step needs one of its two side paths), infinite when none is shorter than `limit` px.
-    fn astar(&self, s: usize, t: usize, limit: f64) -> f64 {
-        let cap = (limit / self.b as f64 * 10.0).ceil() as u32 + 20;
-        let bw = self.bw;
-        let (tc, tr) = ((t % bw) as i64, (t / bw) as i64);
-        let hcost = |k: usize| -> u32 {
-            let dx = ((k % bw) as i64 - tc).unsigned_abs() as u32;
-            let dy = ((k / bw) as i64 - tr).unsigned_abs() as u32;
-            10 * dx.max(dy) + 4 * dx.min(dy)
-        };
-        let linked = |k: usize, dc: i64, dr: i64| -> bool {
-            let (c, r) = ((k % bw) as i64, (k / bw) as i64);
-            let at = |c: i64, r: i64| r as usize * bw + c as usize;
-            match (dc, dr) {
-                (1, 0) => self.east[k],
-                (-1, 0) => self.east[at(c - 1, r)],
-                (0, 1) => self.south[k],
-                (0, -1) => self.south[at(c, r - 1)],
-                _ => false,
-            }
-        };
-        let mut scratch = self.scratch.borrow_mut();
-        let (gen, stamp, g) = &mut *scratch;
-        *gen = gen.wrapping_add(1);
-        if *gen == 0 {
-            stamp.fill(0);
-            *gen = 1;
-        }
-        let gen = *gen;
-        let mut heap = BinaryHeap::new();
-        stamp[s] = gen;
-        g[s] = 0;
-        heap.push(Reverse((hcost(s), 0u32, s)));
-        while let Some(Reverse((f, gk, k))) = heap.pop() {
-            if f > cap {
-                break;
-            }
-            if gk > g[k] {
-                continue;
-            }
-            if k == t {
-                return f64::from(gk) / 10.0 * self.b as f64;
-            }
-            let (c, r) = ((k % bw) as i64, (k / bw) as i64);
-            for (dc, dr) in [
-                (1, 0),
-                (0, 1),
-                (-1, 0),
-                (0, -1),
-                (1, 1),
-                (1, -1),
-                (-1, 1),
-                (-1, -1),
-            ] {
-                let (nc, nr) = (c + dc, r + dr);
-                if nc < 0 || nr < 0 || nc >= bw as i64 || nr >= self.bh as i64 {
-                    continue;
-                }
-                let j = nr as usize * bw + nc as usize;
-                if !self.open[j] {
-                    continue;
-                }
-                let step = if dc != 0 && dr != 0 {
-                    let via_h = r as usize * bw + nc as usize;
-                    let via_v = nr as usize * bw + c as usize;
-                    let a = self.open[via_h] && linked(k, dc, 0) && linked(via_h, 0, dr);
-                    let b = self.open[via_v] && linked(k, 0, dr) && linked(via_v, dc, 0);
-                    if !(a || b) {
-                        continue;
-                    }
-                    14
-                } else {
-                    if !linked(k, dc, dr) {
-                        continue;
-                    }
-                    10
-                };
-                let ng = gk + step;
-                if stamp[j] != gen || ng < g[j] {
-                    stamp[j] = gen;
-                    g[j] = ng;
-                    heap.push(Reverse((ng + hcost(j), ng, j)));
-                }
-            }
-        }
-        f64::INFINITY
     }
 }
 
