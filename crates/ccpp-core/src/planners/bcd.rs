@@ -1,7 +1,9 @@
 //! BCD: boustrophedon cellular decomposition, the offline (known-map) reference planner.
 //!
 //! H. Choset and P. Pignon, "Coverage path planning: the boustrophedon cellular decomposition",
-//! *Field and Service Robotics*, 1998; named by seed 000 as the offline reference for BA*.
+//! *Field and Service Robotics* (1997 conference, Springer 1998), and H. Choset, "Coverage of
+//! known spaces: the boustrophedon cellular decomposition", *Autonomous Robots* 9, 2000; named
+//! by seed 000 as the offline reference for BA*.
 //!
 //! **Offline**: it reads the whole true map (through the [`World`]) before moving, plans the
 //! whole path, checks every straight move of it against the true map, and then replays it.
@@ -33,13 +35,17 @@
 //!    surface; the missed pixels are grouped, each group is swept by a contour pass through the
 //!    nearest C-free positions (merged into straight collision-free segments) inserted as a
 //!    detour at the cheapest point of the path. Groups whose detour would sweep less than
-//!    `rim_min_yield` of a lane's sweep rate are skipped. This step is not in the paper (a point
-//!    robot's lanes reach the boundary; a disk's do not).
+//!    `rim_min_yield` of a lane's sweep rate are skipped, and so are the lowest-yield groups
+//!    (pixels swept per pixel of pass) while what is left stays within `1 - rim_coverage` of the
+//!    accessible floor (default 0.997: the sawtooth of lane ends along a wall costs a whole
+//!    wall-long pass for well under a percent of the floor). This step is not in the paper (a
+//!    point robot's lanes reach the boundary; a disk's do not).
 //! 4. **Cell tour.** Instead of the paper's depth-first walk of the adjacency graph, the cells
 //!    are ordered as an open travelling-salesman path over their entry and exit points (each
 //!    cell can be started at any of its four corners): nearest-neighbour construction, then
-//!    2-opt, Or-opt and an exact choice of every cell's corner for the order, with
-//!    straight-line hop costs ([`tsp`]). Transfers are straight when collision-free, else A*
+//!    2-opt, Or-opt and an exact choice of every cell's corner for the order ([`tsp`]). Hop
+//!    costs come from a coarse grid of the C-free set, one bounded Dijkstra per end-point block
+//!    computed once per tour ([`hops`]), not a search per pair. Transfers are straight when collision-free, else A*
 //!    over the C-free pixel centres (8-connected, octile costs, no corner cutting), shortened
 //!    by line-of-sight checks on the true map.
 //!
@@ -281,10 +287,12 @@ struct Ctx<'a> {
     rt: f64,
 }
 
+/// Improvement rounds of the first tour (which only picks each cell's path for the rim step).
+const FIRST_ROUNDS: u32 = 1;
 /// Gap kept between a pushed lane end and the exact contact (pixels).
 const BACKOFF_PX: f64 = 0.05;
 /// How far a merged boundary segment may stray from the boundary points it replaces (pixels).
-const CONTOUR_TOL_PX: f64 = 0.5;
+const CONTOUR_TOL_PX: f64 = 1.0;
 
 impl Ctx<'_> {
     fn ok_at(&self, c: i64, r: i64) -> bool {
@@ -777,7 +785,13 @@ impl Bcd {
             let table = hops::HopTable::new(&coarse, &far, &pieces, start);
             let dist = |a: Point, b: Point| table.dist(a, b);
             let nn = table.nearest_tour(&pieces, start);
-            let first = tsp::solve(&pieces, start, opts.tour_rounds, &dist, Some(nn));
+            let first = tsp::solve(
+                &pieces,
+                start,
+                opts.tour_rounds.min(FIRST_ROUNDS),
+                &dist,
+                Some(nn),
+            );
             let mut keep = vec![0usize; ncells];
             for &(c, v) in &first {
                 keep[c] = v / 2;
@@ -1419,6 +1433,39 @@ mod tests {
     }
 
     #[test]
+    fn rim_coverage_trades_rim_passes_for_floor() {
+        let world = block_room();
+        let full = run(
+            &world,
+            &BcdOptions {
+                rim_coverage: 1.0,
+                ..BcdOptions::default()
+            },
+        );
+        let part = run(
+            &world,
+            &BcdOptions {
+                rim_coverage: 0.98,
+                ..BcdOptions::default()
+            },
+        );
+        assert_eq!(full.collisions + part.collisions, 0);
+        assert!(
+            full.effective_coverage >= 0.999,
+            "{}",
+            full.effective_coverage
+        );
+        // Leaving up to 2 % of the floor saves rim passes, and no more than that is left.
+        assert!(part.path_length_m < full.path_length_m);
+        assert!(part.effective_coverage < full.effective_coverage);
+        assert!(
+            part.effective_coverage >= 0.98,
+            "{}",
+            part.effective_coverage
+        );
+    }
+
+    #[test]
     fn same_plan_twice() {
         let world = block_room();
         let a = Bcd::new(&world, &BcdOptions::default());
@@ -1445,6 +1492,10 @@ mod tests {
             },
             BcdOptions {
                 rim_min_yield: 1.5,
+                ..BcdOptions::default()
+            },
+            BcdOptions {
+                rim_coverage: -0.1,
                 ..BcdOptions::default()
             },
         ] {

@@ -78,9 +78,10 @@ impl Coarse {
     /// The block of grid point `p` (grid y up; blocks count rows from the top).
     fn block(&self, p: Point) -> usize {
         let bf = self.b as f64;
-        let c = ((p.x / bf).floor().max(0.0) as usize).min(self.bw - 1);
+        // (`as usize` truncates: the floor of a non-negative value)
+        let c = ((p.x / bf).max(0.0) as usize).min(self.bw - 1);
         let rows = self.bh * self.b;
-        let r_px = (rows as f64 - p.y).floor().max(0.0) as usize;
+        let r_px = (rows as f64 - p.y).max(0.0) as usize;
         let r = (r_px / self.b).min(self.bh - 1);
         r * self.bw + c
     }
@@ -171,7 +172,9 @@ impl<'a> HopTable<'a> {
         for piece in pieces {
             piece.entry.iter().chain(&piece.exit).for_each(|&p| add(p));
         }
-        blocks.sort_unstable();
+        // Z-order, so that the rows and columns of nearby blocks (the hops asked for most)
+        // lie close together in the table.
+        blocks.sort_unstable_by_key(|&k| morton(k % coarse.bw, k / coarse.bw));
         for (i, &k) in blocks.iter().enumerate() {
             row_of[k] = i as u32;
         }
@@ -427,4 +430,17 @@ impl<'a> Far<'a> {
         let bpx = self.coarse.b as f64;
         (f64::from(g) / 10.0 - 2.0 * std::f64::consts::SQRT_2) * bpx
     }
+}
+
+/// Z-order key of block `(c, r)`: the bits of the two coordinates interleaved.
+fn morton(c: usize, r: usize) -> u64 {
+    let spread = |v: usize| {
+        let mut x = v as u64 & 0xffff_ffff;
+        x = (x | (x << 16)) & 0x0000_ffff_0000_ffff;
+        x = (x | (x << 8)) & 0x00ff_00ff_00ff_00ff;
+        x = (x | (x << 4)) & 0x0f0f_0f0f_0f0f_0f0f;
+        x = (x | (x << 2)) & 0x3333_3333_3333_3333;
+        (x | (x << 1)) & 0x5555_5555_5555_5555
+    };
+    spread(c) | (spread(r) << 1)
 }
