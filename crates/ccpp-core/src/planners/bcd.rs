@@ -19,7 +19,11 @@
 //!    whose cells are estimated cheaper (path length plus `turn_cost_m` per turn) is used.
 //! 2. **Lanes fitted to each cell** (the paper's boustrophedon motions). Per cell, lanes run
 //!    along the sweep line or, when the cell is monotone the other way too, across it — the
-//!    direction with the lower estimated cost (fewer, longer lanes: fewer turns). Lanes are
+//!    direction with the lower estimated cost (fewer, longer lanes: fewer turns). A cell
+//!    elongated along its lines that is not monotone across only because of its ends (the
+//!    rounded C-free corners beside an obstacle) is first cut into its two ends (at most
+//!    `2 sp` lines each) and a middle that can take lanes across, so a corridor cell gets a few
+//!    long lanes instead of many short ones (not in the paper, whose cells keep one direction). Lanes are
 //!    evenly spaced at most `2 r_tool` apart (`lane_spacing_m`). The first and last lanes lie on
 //!    the cell's edge where the edge is an obstacle (the lane at clearance sweeps the wall's
 //!    rim) and `r_tool` inside it where the edge is shared with neighbouring cells (whose own
@@ -223,6 +227,49 @@ impl Cell {
             runs,
         })
     }
+}
+
+/// Cells elongated along their lines (more lines than twice their longest run) that are not
+/// monotone the other way only because of their ends (rounded C-free corners) are cut into the
+/// two ends (at most `max` lines each) and a middle that can take lanes across (module docs,
+/// step 2).
+fn split_ends(cells: Vec<Cell>, max: usize) -> Vec<Cell> {
+    let mut out = Vec::with_capacity(cells.len());
+    for c in cells {
+        let n = c.runs.len();
+        let longest = c.runs.iter().map(|r| r.1 - r.0 + 1).max().unwrap_or(0);
+        if n <= 2 * longest || n <= 2 * max + 1 || c.transposed().is_some() {
+            out.push(c);
+            continue;
+        }
+        let sub = |a: usize, b: usize| Cell {
+            cols: c.cols,
+            u0: c.u0 + a,
+            runs: c.runs[a..b].to_vec(),
+        };
+        let mut cut = None;
+        'search: for t in 1..=max {
+            for (a, b) in [(t, t), (t, 0), (0, t)] {
+                if sub(a, n - b).transposed().is_some() {
+                    cut = Some((a, b));
+                    break 'search;
+                }
+            }
+        }
+        match cut {
+            Some((a, b)) => {
+                if a > 0 {
+                    out.push(sub(0, a));
+                }
+                out.push(sub(a, n - b));
+                if b > 0 {
+                    out.push(sub(n - b, n));
+                }
+            }
+            None => out.push(c),
+        }
+    }
+    out
 }
 
 /// Decomposes the pixels where `free(u, v)` over lines `u < nu` of length `nv` (module docs,
@@ -698,7 +745,11 @@ impl Bcd {
                 })
                 .collect()
         };
-        let decs = [views(by_cols), views(by_rows)];
+        let trim_max = (2.0 * sp).ceil() as usize;
+        let decs = [
+            views(split_ends(by_cols, trim_max)),
+            views(split_ends(by_rows, trim_max)),
+        ];
         let mut best: Option<(f64, usize, f64, Vec<usize>)> = None;
         for (d, dec) in decs.iter().enumerate() {
             for k in 0..6 {
@@ -1504,6 +1555,34 @@ mod tests {
             // The infallible constructor falls back to the defaults and still plans.
             assert!(!Bcd::new(&world, &bad).steps.is_empty());
         }
+    }
+
+    #[test]
+    fn elongated_cells_lose_their_rounded_ends() {
+        // A strip of 20 columns whose first and last two columns reach further down (the
+        // rounded C-free corners beside an obstacle): rows 4 and 5 meet it at both ends only,
+        // so it is not monotone across as a whole, but its middle is.
+        let mut runs = vec![(0, 3); 20];
+        runs[0] = (0, 5);
+        runs[1] = (0, 4);
+        runs[18] = (0, 4);
+        runs[19] = (0, 5);
+        let strip = Cell {
+            cols: true,
+            u0: 5,
+            runs,
+        };
+        assert!(strip.transposed().is_none());
+        let parts = split_ends(vec![strip.clone()], 4);
+        assert_eq!(parts.len(), 3);
+        assert_eq!(parts[1].u0, 7);
+        assert_eq!(parts[1].runs.len(), 16);
+        assert!(parts[1].transposed().is_some());
+        // Every line is kept, once.
+        let lines: usize = parts.iter().map(|c| c.runs.len()).sum();
+        assert_eq!(lines, 20);
+        // Ends longer than the limit: the cell stays whole.
+        assert_eq!(split_ends(vec![strip], 1).len(), 1);
     }
 
     #[test]
