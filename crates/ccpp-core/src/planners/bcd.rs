@@ -24,8 +24,8 @@
 //!    rounded C-free corners beside an obstacle) is first cut into its two ends (at most
 //!    `2 sp` lines each) and a middle that can take lanes across, so a corridor cell gets a few
 //!    long lanes instead of many short ones (not in the paper, whose cells keep one
-//!    direction). Lanes are evenly spaced at most `2 r_tool` apart (`lane_spacing_m`). The first and last lanes lie on
-//!    the cell's edge where the edge is an obstacle (the lane at clearance sweeps the wall's
+//!    direction). Lanes are evenly spaced at most `2 r_tool` apart (`lane_spacing_m`). The
+//!    first and last lanes lie on the cell's edge where the edge is an obstacle (the lane at clearance sweeps the wall's
 //!    rim) and `r_tool` inside it where the edge is shared with neighbouring cells (whose own
 //!    lanes sweep up to the shared edge), so neighbours do not drive two lanes side by side.
 //!    Lane ends facing an obstacle are pushed from the pixel centre to the exact contact
