@@ -317,6 +317,7 @@ fn config_values_go_through_the_same_validation() {
             "ba_star.tile_side_m",
         ),
         ("bcd: { lane_spacing_m: .nan }", "bcd", "bcd.lane_spacing_m"),
+        ("bcd: { rim_coverage: 1.5 }", "bcd", "bcd.rim_coverage"),
         (
             "random_bounce: { budget_m: -5 }",
             "random-bounce",

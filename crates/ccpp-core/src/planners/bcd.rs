@@ -1,7 +1,9 @@
 //! BCD: boustrophedon cellular decomposition, the offline (known-map) reference planner.
 //!
 //! H. Choset and P. Pignon, "Coverage path planning: the boustrophedon cellular decomposition",
-//! *Field and Service Robotics*, 1998; named by seed 000 as the offline reference for BA*.
+//! *Field and Service Robotics* (1997 conference, Springer 1998), and H. Choset, "Coverage of
+//! known spaces: the boustrophedon cellular decomposition", *Autonomous Robots* 9, 2000; named
+//! by seed 000 as the offline reference for BA*.
 //!
 //! **Offline**: it reads the whole true map (through the [`World`]) before moving, plans the
 //! whole path, checks every straight move of it against the true map, and then replays it.
@@ -17,9 +19,13 @@
 //!    whose cells are estimated cheaper (path length plus `turn_cost_m` per turn) is used.
 //! 2. **Lanes fitted to each cell** (the paper's boustrophedon motions). Per cell, lanes run
 //!    along the sweep line or, when the cell is monotone the other way too, across it — the
-//!    direction with the lower estimated cost (fewer, longer lanes: fewer turns). Lanes are
-//!    evenly spaced at most `2 r_tool` apart (`lane_spacing_m`). The first and last lanes lie on
-//!    the cell's edge where the edge is an obstacle (the lane at clearance sweeps the wall's
+//!    direction with the lower estimated cost (fewer, longer lanes: fewer turns). A cell
+//!    elongated along its lines that is not monotone across only because of its ends (the
+//!    rounded C-free corners beside an obstacle) is first cut into its two ends (at most
+//!    `2 sp` lines each) and a middle that can take lanes across, so a corridor cell gets a few
+//!    long lanes instead of many short ones (not in the paper, whose cells keep one
+//!    direction). Lanes are evenly spaced at most `2 r_tool` apart (`lane_spacing_m`). The
+//!    first and last lanes lie on the cell's edge where the edge is an obstacle (the lane at clearance sweeps the wall's
 //!    rim) and `r_tool` inside it where the edge is shared with neighbouring cells (whose own
 //!    lanes sweep up to the shared edge), so neighbours do not drive two lanes side by side.
 //!    Lane ends facing an obstacle are pushed from the pixel centre to the exact contact
@@ -33,13 +39,17 @@
 //!    surface; the missed pixels are grouped, each group is swept by a contour pass through the
 //!    nearest C-free positions (merged into straight collision-free segments) inserted as a
 //!    detour at the cheapest point of the path. Groups whose detour would sweep less than
-//!    `rim_min_yield` of a lane's sweep rate are skipped. This step is not in the paper (a point
-//!    robot's lanes reach the boundary; a disk's do not).
+//!    `rim_min_yield` of a lane's sweep rate are skipped, and so are the lowest-yield groups
+//!    (pixels swept per pixel of pass) while what is left stays within `1 - rim_coverage` of the
+//!    accessible floor (default 0.997: the sawtooth of lane ends along a wall costs a whole
+//!    wall-long pass for well under a percent of the floor). This step is not in the paper (a
+//!    point robot's lanes reach the boundary; a disk's do not).
 //! 4. **Cell tour.** Instead of the paper's depth-first walk of the adjacency graph, the cells
 //!    are ordered as an open travelling-salesman path over their entry and exit points (each
 //!    cell can be started at any of its four corners): nearest-neighbour construction, then
-//!    2-opt, Or-opt and an exact choice of every cell's corner for the order, with
-//!    straight-line hop costs ([`tsp`]). Transfers are straight when collision-free, else A*
+//!    2-opt, Or-opt and an exact choice of every cell's corner for the order ([`tsp`]). Hop
+//!    costs come from a coarse grid of the C-free set, one bounded Dijkstra per end-point block
+//!    computed once per tour ([`hops`]), not a search per pair. Transfers are straight when collision-free, else A*
 //!    over the C-free pixel centres (8-connected, octile costs, no corner cutting), shortened
 //!    by line-of-sight checks on the true map.
 //!
@@ -62,6 +72,7 @@
 //! assert!(m.regions >= 1); // one region per cell
 //! ```
 
+mod hops;
 mod tsp;
 
 use std::cmp::Reverse;
@@ -94,6 +105,10 @@ pub struct BcdOptions {
     /// Skip a rim detour whose swept new area per metre is below this fraction of a lane's
     /// (`2 r_tool` per metre); 0 sweeps every reachable missed group. In `[0, 1]`.
     pub rim_min_yield: f64,
+    /// Rim passes stop at this share of the accessible floor: the lowest-yield missed groups
+    /// are left out while the pixels they hold (with whatever no pass can reach) stay within
+    /// `1 - rim_coverage` of it, as estimated on the plan. 1 sweeps every group. In `[0, 1]`.
+    pub rim_coverage: f64,
     /// Improvement rounds of the cell tour (0 = nearest-neighbour order only).
     pub tour_rounds: u32,
 }
@@ -106,6 +121,7 @@ impl Default for BcdOptions {
             turn_cost_m: 0.3,
             rim: true,
             rim_min_yield: 0.0,
+            rim_coverage: 0.997,
             tour_rounds: 2,
         }
     }
@@ -146,6 +162,9 @@ impl BcdOptions {
         }
         if !(0.0..=1.0).contains(&self.rim_min_yield) {
             return bad("rim_min_yield", "in [0, 1]", self.rim_min_yield);
+        }
+        if !(0.0..=1.0).contains(&self.rim_coverage) {
+            return bad("rim_coverage", "in [0, 1]", self.rim_coverage);
         }
         Ok(())
     }
@@ -210,6 +229,49 @@ impl Cell {
     }
 }
 
+/// Cells elongated along their lines (more lines than twice their longest run) that are not
+/// monotone the other way only because of their ends (rounded C-free corners) are cut into the
+/// two ends (at most `max` lines each) and a middle that can take lanes across (module docs,
+/// step 2).
+fn split_ends(cells: Vec<Cell>, max: usize) -> Vec<Cell> {
+    let mut out = Vec::with_capacity(cells.len());
+    for c in cells {
+        let n = c.runs.len();
+        let longest = c.runs.iter().map(|r| r.1 - r.0 + 1).max().unwrap_or(0);
+        if n <= 2 * longest || n <= 2 * max + 1 || c.transposed().is_some() {
+            out.push(c);
+            continue;
+        }
+        let sub = |a: usize, b: usize| Cell {
+            cols: c.cols,
+            u0: c.u0 + a,
+            runs: c.runs[a..b].to_vec(),
+        };
+        let mut cut = None;
+        'search: for t in 1..=max {
+            for (a, b) in [(t, t), (t, 0), (0, t)] {
+                if sub(a, n - b).transposed().is_some() {
+                    cut = Some((a, b));
+                    break 'search;
+                }
+            }
+        }
+        match cut {
+            Some((a, b)) => {
+                if a > 0 {
+                    out.push(sub(0, a));
+                }
+                out.push(sub(a, n - b));
+                if b > 0 {
+                    out.push(sub(n - b, n));
+                }
+            }
+            None => out.push(c),
+        }
+    }
+    out
+}
+
 /// Decomposes the pixels where `free(u, v)` over lines `u < nu` of length `nv` (module docs,
 /// step 1). Cells are numbered in the order they open.
 fn decompose(nu: usize, nv: usize, cols: bool, free: &dyn Fn(usize, usize) -> bool) -> Vec<Cell> {
@@ -272,10 +334,12 @@ struct Ctx<'a> {
     rt: f64,
 }
 
+/// Improvement rounds of the first tour (which only picks each cell's path for the rim step).
+const FIRST_ROUNDS: u32 = 1;
 /// Gap kept between a pushed lane end and the exact contact (pixels).
 const BACKOFF_PX: f64 = 0.05;
 /// How far a merged boundary segment may stray from the boundary points it replaces (pixels).
-const CONTOUR_TOL_PX: f64 = 0.5;
+const CONTOUR_TOL_PX: f64 = 1.0;
 
 impl Ctx<'_> {
     fn ok_at(&self, c: i64, r: i64) -> bool {
@@ -610,6 +674,11 @@ impl Bcd {
                 } else {
                     d.rim_min_yield
                 },
+                rim_coverage: if (0.0..=1.0).contains(&opts.rim_coverage) {
+                    opts.rim_coverage
+                } else {
+                    d.rim_coverage
+                },
                 tour_rounds: opts.tour_rounds,
             };
             Self::plan(world, &fixed)
@@ -676,7 +745,11 @@ impl Bcd {
                 })
                 .collect()
         };
-        let decs = [views(by_cols), views(by_rows)];
+        let trim_max = (2.0 * sp).ceil() as usize;
+        let decs = [
+            views(split_ends(by_cols, trim_max)),
+            views(split_ends(by_rows, trim_max)),
+        ];
         let mut best: Option<(f64, usize, f64, Vec<usize>)> = None;
         for (d, dec) in decs.iter().enumerate() {
             for k in 0..6 {
@@ -756,12 +829,20 @@ impl Bcd {
             pieces.push(piece);
             paths.push(ps);
         }
-        let coarse = Coarse::new(&ctx, sp);
-        let dist = |a: Point, b: Point| coarse.dist(a, b);
+        let coarse = hops::Coarse::new(&ctx, sp);
+        let far = hops::Coarse::new(&ctx, sp * f64::from(hops::FAR_FACTOR));
         let ncells = paths.len();
         let contours: Vec<Vec<Point>> = if opts.rim {
-            let nn = coarse.nearest_tour(&pieces, start);
-            let first = tsp::solve(&pieces, start, opts.tour_rounds, &dist, Some(nn));
+            let table = hops::HopTable::new(&coarse, &far, &pieces, start);
+            let dist = |a: Point, b: Point| table.dist(a, b);
+            let nn = table.nearest_tour(&pieces, start);
+            let first = tsp::solve(
+                &pieces,
+                start,
+                opts.tour_rounds.min(FIRST_ROUNDS),
+                &dist,
+                Some(nn),
+            );
             let mut keep = vec![0usize; ncells];
             for &(c, v) in &first {
                 keep[c] = v / 2;
@@ -780,10 +861,16 @@ impl Bcd {
                 };
             }
             let lines: Vec<&[Point]> = paths.iter().map(|p| p[0].as_slice()).collect();
-            rim_contours(&ctx, &mut search, &lines, opts.rim_min_yield)
-                .into_iter()
-                .map(|c| c.0)
-                .collect()
+            rim_contours(
+                &ctx,
+                &mut search,
+                &lines,
+                opts.rim_min_yield,
+                opts.rim_coverage,
+            )
+            .into_iter()
+            .map(|c| c.0)
+            .collect()
         } else {
             Vec::new()
         };
@@ -796,7 +883,9 @@ impl Bcd {
                 inner: vec![len, len],
             });
         }
-        let nn = coarse.nearest_tour(&pieces, start);
+        let table = hops::HopTable::new(&coarse, &far, &pieces, start);
+        let dist = |a: Point, b: Point| table.dist(a, b);
+        let nn = table.nearest_tour(&pieces, start);
         let tour = tsp::solve(&pieces, start, opts.tour_rounds, &dist, Some(nn));
 
         let mut items: Vec<Item> = vec![Item::Move(start)];
@@ -845,7 +934,13 @@ impl Bcd {
         }
 
         if opts.rim {
-            rim_pass(&ctx, &mut search, &mut items, opts.rim_min_yield);
+            rim_pass(
+                &ctx,
+                &mut search,
+                &mut items,
+                opts.rim_min_yield,
+                opts.rim_coverage,
+            );
         }
         let items = repair(&ctx, &mut search, items);
 
@@ -911,12 +1006,14 @@ fn moves(items: &[Item]) -> Vec<(Point, usize)> {
 
 /// Step 3 of the module docs: the contour passes (grid polylines) that sweep the accessible
 /// pixels the polylines `lines` miss, one per 8-connected group of missed pixels, with the
-/// number of pixels each is meant to sweep; groups below `min_yield` are left out.
+/// number of pixels each is meant to sweep; groups below `min_yield` are left out, and so are
+/// the lowest-yield groups that fit in the budget `1 - target` of the accessible pixels.
 fn rim_contours(
     ctx: &Ctx<'_>,
     search: &mut Search,
     lines: &[&[Point]],
     min_yield: f64,
+    target: f64,
 ) -> Vec<(Vec<Point>, usize)> {
     let frame = ctx.frame;
     let (w, h) = (frame.width, frame.height);
@@ -1033,18 +1130,50 @@ fn rim_contours(
         }
         out.push((contour, members.len()));
     }
+    // The budget: missed pixels allowed by `target`, less those no group holds.
+    let grouped: usize = out.iter().map(|c| c.1).sum();
+    let allowed = ((1.0 - target) * acc.count_ones(..) as f64).floor() as usize;
+    let mut budget = allowed.saturating_sub(missed.count_ones(..) - grouped);
+    if budget > 0 {
+        // Lowest yield (pixels per pixel of contour) first; ties by group order.
+        let mut order: Vec<usize> = (0..out.len()).collect();
+        let yield_of = |c: &(Vec<Point>, usize)| c.1 as f64 / polyline_len(&c.0).max(1.0);
+        order.sort_by(|&a, &b| {
+            yield_of(&out[a])
+                .total_cmp(&yield_of(&out[b]))
+                .then(a.cmp(&b))
+        });
+        let mut drop = vec![false; out.len()];
+        for i in order {
+            if out[i].1 <= budget {
+                budget -= out[i].1;
+                drop[i] = true;
+            }
+        }
+        let mut k = 0;
+        out.retain(|_| {
+            k += 1;
+            !drop[k - 1]
+        });
+    }
     out
 }
 
 /// Final mop-up of step 3: sweeps what the assembled plan still misses with contour detours
 /// inserted at the cheapest point of the path (out and back).
-fn rim_pass(ctx: &Ctx<'_>, search: &mut Search, items: &mut Vec<Item>, min_yield: f64) {
+fn rim_pass(
+    ctx: &Ctx<'_>,
+    search: &mut Search,
+    items: &mut Vec<Item>,
+    min_yield: f64,
+    target: f64,
+) {
     const B: f64 = 16.0;
     let frame = ctx.frame;
     let (w, h) = (frame.width, frame.height);
     let path = moves(items);
     let line: Vec<Point> = path.iter().map(|m| m.0).collect();
-    let contours = rim_contours(ctx, search, &[&line], min_yield);
+    let contours = rim_contours(ctx, search, &[&line], min_yield, target);
     // Spatial index of the path's segments (buckets of 16 px).
     let (bw, bh) = (
         (w as f64 / B).ceil() as usize + 1,
@@ -1136,299 +1265,6 @@ fn proj(a: Point, b: Point, p: Point) -> f64 {
         0.0
     } else {
         (p.sub(a).dot(d) / l2).clamp(0.0, 1.0)
-    }
-}
-
-/// Hop costs for the cell tour: the straight-line distance, or the length of a shortest path
-/// over a coarse grid of the C-free set when that is longer (walls between the points).
-/// Blocks of `b` pixels are open when they hold a C-free pixel and joined to a side neighbour
-/// when C-free pixels touch across their common edge.
-struct Coarse {
-    b: usize,
-    bw: usize,
-    bh: usize,
-    open: Vec<bool>,
-    /// Block joined to its east / south neighbour.
-    east: Vec<bool>,
-    south: Vec<bool>,
-    cache: std::cell::RefCell<std::collections::HashMap<(u32, u32), f64>>,
-    /// A* scratch: generation stamp and cost per block.
-    scratch: std::cell::RefCell<(u32, Vec<u32>, Vec<u32>)>,
-}
-
-impl Coarse {
-    fn new(ctx: &Ctx<'_>, sp: f64) -> Self {
-        let (w, h) = (ctx.frame.width, ctx.frame.height);
-        let b = (sp.round() as usize).max(4);
-        let (bw, bh) = (w.div_ceil(b), h.div_ceil(b));
-        let mut open = vec![false; bw * bh];
-        let mut east = vec![false; bw * bh];
-        let mut south = vec![false; bw * bh];
-        for r in 0..h {
-            for c in 0..w {
-                if !ctx.ok[r * w + c] {
-                    continue;
-                }
-                let k = (r / b) * bw + c / b;
-                open[k] = true;
-                if c + 1 < w && (c + 1) % b == 0 && ctx.ok[r * w + c + 1] {
-                    east[k] = true;
-                }
-                if r + 1 < h && (r + 1) % b == 0 && ctx.ok[(r + 1) * w + c] {
-                    south[k] = true;
-                }
-            }
-        }
-        Self {
-            b,
-            bw,
-            bh,
-            open,
-            east,
-            south,
-            cache: std::cell::RefCell::new(std::collections::HashMap::new()),
-            scratch: std::cell::RefCell::new((0, vec![0; bw * bh], vec![0; bw * bh])),
-        }
-    }
-
-    fn block(&self, p: Point) -> usize {
-        let bf = self.b as f64;
-        let c = ((p.x / bf).floor().max(0.0) as usize).min(self.bw - 1);
-        // Grid y is up; blocks count rows from the top.
-        let rows = self.bh * self.b;
-        let r_px = (rows as f64 - p.y).floor().max(0.0) as usize;
-        let r = (r_px / self.b).min(self.bh - 1);
-        r * self.bw + c
-    }
-
-    fn dist(&self, a: Point, b: Point) -> f64 {
-        let e = a.dist(b);
-        let (ka, kb) = (self.block(a), self.block(b));
-        // Near: the straight line; far (over 64 blocks): the straight line too, as searching
-        // there costs more than it tells (good tours hop short).
-        if ka == kb || e < self.b as f64 || e > 64.0 * self.b as f64 {
-            return e;
-        }
-        let key = (ka.min(kb) as u32, ka.max(kb) as u32);
-        if let Some(&g) = self.cache.borrow().get(&key) {
-            return e.max(g);
-        }
-        // Searched up to eight times the straight line; beyond, or where the coarse grid cannot
-        // join the blocks (a wall through a block), that bound stands in.
-        let g = self.astar(ka, kb, 8.0 * e).min(8.0 * e);
-        self.cache.borrow_mut().insert(key, g);
-        e.max(g)
-    }
-
-    /// Block steps from block `k` (dc, dr, cost in tenths of a block) that the coarse grid
-    /// allows.
-    fn steps(&self, k: usize, out: &mut Vec<(usize, u32)>) {
-        out.clear();
-        let bw = self.bw;
-        let (c, r) = ((k % bw) as i64, (k / bw) as i64);
-        let at = |c: i64, r: i64| r as usize * bw + c as usize;
-        let linked = |k: usize, dc: i64, dr: i64| -> bool {
-            let (c, r) = ((k % bw) as i64, (k / bw) as i64);
-            match (dc, dr) {
-                (1, 0) => self.east[k],
-                (-1, 0) => self.east[at(c - 1, r)],
-                (0, 1) => self.south[k],
-                (0, -1) => self.south[at(c, r - 1)],
-                _ => false,
-            }
-        };
-        for (dc, dr) in [
-            (1, 0),
-            (0, 1),
-            (-1, 0),
-            (0, -1),
-            (1, 1),
-            (1, -1),
-            (-1, 1),
-            (-1, -1),
-        ] {
-            let (nc, nr) = (c + dc, r + dr);
-            if nc < 0 || nr < 0 || nc >= bw as i64 || nr >= self.bh as i64 {
-                continue;
-            }
-            let j = at(nc, nr);
-            if !self.open[j] {
-                continue;
-            }
-            if dc != 0 && dr != 0 {
-                let (vh, vv) = (at(nc, r), at(c, nr));
-                let a = self.open[vh] && linked(k, dc, 0) && linked(vh, 0, dr);
-                let b = self.open[vv] && linked(k, 0, dr) && linked(vv, dc, 0);
-                if a || b {
-                    out.push((j, 14));
-                }
-            } else if linked(k, dc, dr) {
-                out.push((j, 10));
-            }
-        }
-    }
-
-    /// Nearest-neighbour tour by hop cost: from each exit, a Dijkstra over the coarse grid
-    /// finds the piece entry with the lowest `dist + inner` (straight-line order where the
-    /// coarse grid joins nothing).
-    fn nearest_tour(&self, pieces: &[tsp::Piece], start: Point) -> tsp::Tour {
-        let nblocks = self.bw * self.bh;
-        let mut at_block: Vec<Vec<(usize, usize)>> = vec![Vec::new(); nblocks];
-        for (p, piece) in pieces.iter().enumerate() {
-            for (v, &e) in piece.entry.iter().enumerate() {
-                at_block[self.block(e)].push((p, v));
-            }
-        }
-        let mut done = vec![false; pieces.len()];
-        let mut tour = Vec::with_capacity(pieces.len());
-        let mut here = start;
-        let mut stamp = vec![0u32; nblocks];
-        let mut g = vec![0u32; nblocks];
-        let mut nbrs = Vec::new();
-        let bpx = self.b as f64;
-        for round in 1..=pieces.len() as u32 {
-            let mut best: Option<(f64, usize, usize)> = None;
-            let s = self.block(here);
-            let mut heap = BinaryHeap::new();
-            stamp[s] = round;
-            g[s] = 0;
-            heap.push(Reverse((0u32, s)));
-            while let Some(Reverse((gk, k))) = heap.pop() {
-                if gk > g[k] {
-                    continue;
-                }
-                let gpx = f64::from(gk) / 10.0 * bpx;
-                if best.is_some_and(|b| gpx - 2.0 * bpx > b.0) {
-                    break;
-                }
-                for &(p, v) in &at_block[k] {
-                    if done[p] {
-                        continue;
-                    }
-                    let e = pieces[p].entry[v];
-                    let c = self.dist(here, e) + pieces[p].inner[v];
-                    if best.is_none_or(|b| c < b.0) {
-                        best = Some((c, p, v));
-                    }
-                }
-                self.steps(k, &mut nbrs);
-                for &(j, w) in &nbrs {
-                    let ng = gk + w;
-                    if stamp[j] != round || ng < g[j] {
-                        stamp[j] = round;
-                        g[j] = ng;
-                        heap.push(Reverse((ng, j)));
-                    }
-                }
-            }
-            if best.is_none() {
-                for (p, piece) in pieces.iter().enumerate() {
-                    if done[p] {
-                        continue;
-                    }
-                    for (v, &e) in piece.entry.iter().enumerate() {
-                        let c = here.dist(e) + piece.inner[v];
-                        if best.is_none_or(|b| c < b.0) {
-                            best = Some((c, p, v));
-                        }
-                    }
-                }
-            }
-            let Some((_, p, v)) = best else { break };
-            done[p] = true;
-            tour.push((p, v));
-            here = pieces[p].exit[v];
-        }
-        tour
-    }
-
-    /// Shortest block path length (pixels) between blocks `s` and `t` (8-connected; a diagonal
-    /// step needs one of its two side paths), infinite when none is shorter than `limit` px.
-    fn astar(&self, s: usize, t: usize, limit: f64) -> f64 {
-        let cap = (limit / self.b as f64 * 10.0).ceil() as u32 + 20;
-        let bw = self.bw;
-        let (tc, tr) = ((t % bw) as i64, (t / bw) as i64);
-        let hcost = |k: usize| -> u32 {
-            let dx = ((k % bw) as i64 - tc).unsigned_abs() as u32;
-            let dy = ((k / bw) as i64 - tr).unsigned_abs() as u32;
-            10 * dx.max(dy) + 4 * dx.min(dy)
-        };
-        let linked = |k: usize, dc: i64, dr: i64| -> bool {
-            let (c, r) = ((k % bw) as i64, (k / bw) as i64);
-            let at = |c: i64, r: i64| r as usize * bw + c as usize;
-            match (dc, dr) {
-                (1, 0) => self.east[k],
-                (-1, 0) => self.east[at(c - 1, r)],
-                (0, 1) => self.south[k],
-                (0, -1) => self.south[at(c, r - 1)],
-                _ => false,
-            }
-        };
-        let mut scratch = self.scratch.borrow_mut();
-        let (gen, stamp, g) = &mut *scratch;
-        *gen = gen.wrapping_add(1);
-        if *gen == 0 {
-            stamp.fill(0);
-            *gen = 1;
-        }
-        let gen = *gen;
-        let mut heap = BinaryHeap::new();
-        stamp[s] = gen;
-        g[s] = 0;
-        heap.push(Reverse((hcost(s), 0u32, s)));
-        while let Some(Reverse((f, gk, k))) = heap.pop() {
-            if f > cap {
-                break;
-            }
-            if gk > g[k] {
-                continue;
-            }
-            if k == t {
-                return f64::from(gk) / 10.0 * self.b as f64;
-            }
-            let (c, r) = ((k % bw) as i64, (k / bw) as i64);
-            for (dc, dr) in [
-                (1, 0),
-                (0, 1),
-                (-1, 0),
-                (0, -1),
-                (1, 1),
-                (1, -1),
-                (-1, 1),
-                (-1, -1),
-            ] {
-                let (nc, nr) = (c + dc, r + dr);
-                if nc < 0 || nr < 0 || nc >= bw as i64 || nr >= self.bh as i64 {
-                    continue;
-                }
-                let j = nr as usize * bw + nc as usize;
-                if !self.open[j] {
-                    continue;
-                }
-                let step = if dc != 0 && dr != 0 {
-                    let via_h = r as usize * bw + nc as usize;
-                    let via_v = nr as usize * bw + c as usize;
-                    let a = self.open[via_h] && linked(k, dc, 0) && linked(via_h, 0, dr);
-                    let b = self.open[via_v] && linked(k, 0, dr) && linked(via_v, dc, 0);
-                    if !(a || b) {
-                        continue;
-                    }
-                    14
-                } else {
-                    if !linked(k, dc, dr) {
-                        continue;
-                    }
-                    10
-                };
-                let ng = gk + step;
-                if stamp[j] != gen || ng < g[j] {
-                    stamp[j] = gen;
-                    g[j] = ng;
-                    heap.push(Reverse((ng + hcost(j), ng, j)));
-                }
-            }
-        }
-        f64::INFINITY
     }
 }
 
@@ -1648,6 +1484,39 @@ mod tests {
     }
 
     #[test]
+    fn rim_coverage_trades_rim_passes_for_floor() {
+        let world = block_room();
+        let full = run(
+            &world,
+            &BcdOptions {
+                rim_coverage: 1.0,
+                ..BcdOptions::default()
+            },
+        );
+        let part = run(
+            &world,
+            &BcdOptions {
+                rim_coverage: 0.98,
+                ..BcdOptions::default()
+            },
+        );
+        assert_eq!(full.collisions + part.collisions, 0);
+        assert!(
+            full.effective_coverage >= 0.999,
+            "{}",
+            full.effective_coverage
+        );
+        // Leaving up to 2 % of the floor saves rim passes, and no more than that is left.
+        assert!(part.path_length_m < full.path_length_m);
+        assert!(part.effective_coverage < full.effective_coverage);
+        assert!(
+            part.effective_coverage >= 0.98,
+            "{}",
+            part.effective_coverage
+        );
+    }
+
+    #[test]
     fn same_plan_twice() {
         let world = block_room();
         let a = Bcd::new(&world, &BcdOptions::default());
@@ -1676,12 +1545,44 @@ mod tests {
                 rim_min_yield: 1.5,
                 ..BcdOptions::default()
             },
+            BcdOptions {
+                rim_coverage: -0.1,
+                ..BcdOptions::default()
+            },
         ] {
             let e = Bcd::try_new(&world, &bad).err().unwrap();
             assert!(e.to_string().starts_with("bcd option "), "{e}");
             // The infallible constructor falls back to the defaults and still plans.
             assert!(!Bcd::new(&world, &bad).steps.is_empty());
         }
+    }
+
+    #[test]
+    fn elongated_cells_lose_their_rounded_ends() {
+        // A strip of 20 columns whose first and last two columns reach further down (the
+        // rounded C-free corners beside an obstacle): rows 4 and 5 meet it at both ends only,
+        // so it is not monotone across as a whole, but its middle is.
+        let mut runs = vec![(0, 3); 20];
+        runs[0] = (0, 5);
+        runs[1] = (0, 4);
+        runs[18] = (0, 4);
+        runs[19] = (0, 5);
+        let strip = Cell {
+            cols: true,
+            u0: 5,
+            runs,
+        };
+        assert!(strip.transposed().is_none());
+        let parts = split_ends(vec![strip.clone()], 4);
+        assert_eq!(parts.len(), 3);
+        assert_eq!(parts[1].u0, 7);
+        assert_eq!(parts[1].runs.len(), 16);
+        assert!(parts[1].transposed().is_some());
+        // Every line is kept, once.
+        let lines: usize = parts.iter().map(|c| c.runs.len()).sum();
+        assert_eq!(lines, 20);
+        // Ends longer than the limit: the cell stays whole.
+        assert_eq!(split_ends(vec![strip], 1).len(), 1);
     }
 
     #[test]
