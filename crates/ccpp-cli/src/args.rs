@@ -181,6 +181,14 @@ pub struct PlanArgs {
     /// Rectangular robot width in metres (rect-boustrophedon: lane spacing).
     #[arg(long, value_name = "M")]
     pub width: Option<f64>,
+    /// Work area (as for `run`): a polygon file (`GeoJSON`, or YAML list of x,y points; map
+    /// coordinates) or a rectangle `X0,Y0,X1,Y1`; the path stays inside it.
+    #[arg(long, value_name = "FILE|X0,Y0,X1,Y1", value_parser = parse_zone, allow_hyphen_values = true)]
+    pub area: Option<ZoneSpec>,
+    /// Keep-out zone (as for `run`, repeatable): a Nav2 keepout filter mask, a polygon file or
+    /// a rectangle `X0,Y0,X1,Y1`; the path never enters it.
+    #[arg(long, value_name = "FILE|X0,Y0,X1,Y1", value_parser = parse_zone, allow_hyphen_values = true)]
+    pub keepout: Vec<ZoneSpec>,
     /// Refuse plans whose estimated memory exceeds this many MB (default 4096).
     #[arg(long, value_name = "MB")]
     pub max_memory: Option<u64>,

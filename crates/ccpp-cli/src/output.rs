@@ -117,13 +117,12 @@ pub fn emit(
     replay: bool,
     exports: &[ExportFormat],
 ) -> Result<()> {
-    // The zones of the run go into the `GeoJSON` as polygons once runs have zones.
     let export_files = ccpp_render::run_files::render_export_files(
         &job.scenario,
         &r.run.trace,
         &r.metrics,
         exports,
-        &[],
+        &ccpp_io::export::zone_features(r.world.zones()),
     )?;
     let metrics = write_run_files(&job.out, job, r, replay, &export_files)?;
     let comp = StartComponent::of(r.world.map(), r.world.start().position());

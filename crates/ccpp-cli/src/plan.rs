@@ -7,7 +7,7 @@ use anyhow::{anyhow, Result};
 use ccpp_core::planners::PlannerConfig;
 use ccpp_core::route::DEFAULT_TOLERANCE_M;
 use ccpp_core::sim::{SimConfig, StopReason};
-use ccpp_io::export::{render_exports, ExportFormat, ExportMeta};
+use ccpp_io::export::{render_exports, zone_features, ExportFormat, ExportMeta};
 use ccpp_io::plan::{offline_planners, plan_route, PlanError};
 use ccpp_io::scenario::{Scenario, ScenarioError, DEFAULT_MAX_MEMORY_MB};
 
@@ -49,6 +49,8 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         planner,
         sim: SimConfig::default(),
         max_memory_mb: a.max_memory.unwrap_or(DEFAULT_MAX_MEMORY_MB),
+        area: a.area.clone(),
+        keepout: a.keepout.clone(),
     };
     let flag = |e: ScenarioError| match &e {
         ScenarioError::Options(o)
@@ -80,8 +82,12 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         tolerance_m: DEFAULT_TOLERANCE_M,
         metrics: None,
     };
-    // The zones of the plan go into the `GeoJSON` as polygons once plans have zones.
-    let files = render_exports(&plan.route, &meta, formats, &[])?;
+    let files = render_exports(
+        &plan.route,
+        &meta,
+        formats,
+        &zone_features(plan.world.zones()),
+    )?;
     let staging = Staging::new(&a.out)?;
     for (name, bytes) in &files {
         staging.write(name, bytes)?;

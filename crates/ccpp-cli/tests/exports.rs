@@ -422,3 +422,73 @@ fn plan_refuses_online_planners_and_foreign_flags() {
     );
     assert!(!out.exists());
 }
+
+/// Points every 2 cm along the route's segments.
+fn route_samples(route: &Route) -> Vec<[f64; 2]> {
+    let mut out = Vec::new();
+    for w in route.waypoints.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        let n = ((b.x - a.x).hypot(b.y - a.y) / 0.02).ceil().max(1.0) as usize;
+        for k in 0..=n {
+            let f = k as f64 / n as f64;
+            out.push([a.x + f * (b.x - a.x), a.y + f * (b.y - a.y)]);
+        }
+    }
+    out
+}
+
+#[test]
+fn plan_takes_zones_and_exports_them() {
+    let d = tempfile::tempdir().unwrap();
+    let map = room(d.path());
+    let free = plan(d.path(), "free", &map, "bcd", &["--export", "csv"]);
+    let free_route = read_waypoints(&free.join("waypoints.csv")).unwrap();
+    let inside =
+        |p: &[f64; 2], r: [f64; 4]| p[0] > r[0] && p[0] < r[2] && p[1] > r[1] && p[1] < r[3];
+    let keep = [0.5, 0.5, 1.5, 1.5];
+    assert!(
+        route_samples(&free_route).iter().any(|p| inside(p, keep)),
+        "without the keep-out the path crosses the rectangle"
+    );
+    // --keepout: the path never enters it, the GeoJSON carries it as a closed ring.
+    let k = plan(
+        d.path(),
+        "keep",
+        &map,
+        "bcd",
+        &[
+            "--keepout",
+            "0.5,0.5,1.5,1.5",
+            "--export",
+            "csv",
+            "--export",
+            "geojson",
+        ],
+    );
+    let route = read_waypoints(&k.join("waypoints.csv")).unwrap();
+    assert!(route_samples(&route).iter().all(|p| !inside(p, keep)));
+    let g: serde_json::Value = serde_json::from_str(&read(&k.join("path.geojson"))).unwrap();
+    let zones: Vec<&serde_json::Value> = g["features"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|f| f["properties"]["kind"] == "keepout")
+        .collect();
+    assert_eq!(zones.len(), 1);
+    let ring = zones[0]["geometry"]["coordinates"][0].as_array().unwrap();
+    assert_eq!(ring.len(), 5);
+    assert_eq!(ring[0], ring[4]);
+    // --area: the path stays inside it.
+    let area = [0.1, 0.1, 1.9, 3.9];
+    let a = plan(
+        d.path(),
+        "area",
+        &map,
+        "bcd",
+        &["--area", "0.1,0.1,1.9,3.9", "--export", "csv"],
+    );
+    let route = read_waypoints(&a.join("waypoints.csv")).unwrap();
+    assert!(route.waypoints.len() > 4);
+    assert!(route_samples(&route).iter().all(|p| inside(p, area)));
+    assert!(route_samples(&free_route).iter().any(|p| !inside(p, area)));
+}

@@ -123,6 +123,26 @@ pub struct PolygonFeature {
     pub rings: Vec<Vec<[f64; 2]>>,
 }
 
+/// The zones' polygons as `GeoJSON` polygon features: the work area's polygons (`kind`
+/// `area`) and the keep-out polygons (`kind` `keepout`), each closed. Keep-outs given as a
+/// Nav2 mask are pixels, not polygons, and are not listed.
+#[must_use]
+pub fn zone_features(zones: Option<&ccpp_core::zones::ZoneMasks>) -> Vec<PolygonFeature> {
+    let Some(z) = zones else {
+        return Vec::new();
+    };
+    let feature = |kind: &str, p: &ccpp_core::zones::Polygon| PolygonFeature {
+        kind: kind.to_string(),
+        name: None,
+        rings: vec![p.points.clone()],
+    };
+    z.area_polygons
+        .iter()
+        .map(|p| feature("area", p))
+        .chain(z.keepout_polygons.iter().map(|p| feature("keepout", p)))
+        .collect()
+}
+
 /// Error reading a waypoint file.
 #[derive(Debug, thiserror::Error)]
 pub enum WaypointFileError {
