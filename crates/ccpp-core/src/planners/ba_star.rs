@@ -86,6 +86,7 @@ use std::collections::{BinaryHeap, VecDeque};
 
 use serde::{Deserialize, Serialize};
 
+use crate::bits::IndexSet;
 use crate::collide::contact_radius_px;
 use crate::geometry::{
     ceil_i32, ceil_i64, first_entry, floor_i32, floor_i64, point_segment_dist2, wrap_angle, Point,
@@ -651,7 +652,6 @@ pub fn smooth_path(path: &[Tile], mut visible: impl FnMut(Tile, Tile) -> bool) -
 // Tile state bits.
 const ST_STAND: u8 = 0b0011; // Judgement of standing at the centre
 const ST_COVERED: u8 = 0b0100;
-const ST_IN_L: u8 = 0b1000;
 
 /// The discovered tiling `M̂` with cached judgements, dense over the frame's tile extent.
 #[derive(Clone, Debug)]
@@ -661,12 +661,13 @@ struct TileModel {
     j0: i32,
     w: usize,
     h: usize,
-    /// Per tile: standability (2 bits), covered, in L.
+    /// Per tile: standability (2 bits), covered.
     state: Vec<u8>,
     /// Per tile: judgements (2 bits each) of the moves towards s1..s4 (E, NE, N, NW); the
     /// moves towards s5..s8 are stored at the neighbour.
     moves: Vec<u8>,
-    l_count: usize,
+    /// The backtracking list `L` (row-major tile indices), listed in `O(|L|)`.
+    l: IndexSet,
     /// Add [`lane_end_score`] to `mu`.
     lane_end_corners: bool,
 }
@@ -686,7 +687,7 @@ impl TileModel {
             h,
             state: vec![0; w * h],
             moves: vec![0; w * h],
-            l_count: 0,
+            l: IndexSet::new(w * h),
             lane_end_corners: true,
         }
     }
@@ -744,7 +745,7 @@ impl TileModel {
 
     #[inline]
     fn in_l(&self, t: Tile) -> bool {
-        self.idx(t).is_some_and(|k| self.state[k] & ST_IN_L != 0)
+        self.idx(t).is_some_and(|k| self.l.contains(k))
     }
 
     /// `(owner tile, slot 0..4)` of the move `t -> t + N8[k]`.
@@ -856,16 +857,10 @@ impl TileModel {
     /// Recomputes the L membership of `t`.
     fn update_l(&mut self, t: Tile) {
         let Some(k) = self.idx(t) else { return };
-        let want = self.state[k] & ST_COVERED != 0 && self.mu(t) >= 1;
-        let has = self.state[k] & ST_IN_L != 0;
-        if want != has {
-            if want {
-                self.state[k] |= ST_IN_L;
-                self.l_count += 1;
-            } else {
-                self.state[k] &= !ST_IN_L;
-                self.l_count -= 1;
-            }
+        if self.state[k] & ST_COVERED != 0 && self.mu(t) >= 1 {
+            self.l.insert(k);
+        } else {
+            self.l.remove(k);
         }
     }
 
@@ -877,12 +872,9 @@ impl TileModel {
     }
 
     fn l_tiles(&self) -> Vec<Tile> {
-        let mut v = Vec::with_capacity(self.l_count);
-        for (k, &s) in self.state.iter().enumerate() {
-            if s & ST_IN_L != 0 {
-                v.push((self.i0 + (k % self.w) as i32, self.j0 + (k / self.w) as i32));
-            }
-        }
+        let mut v = Vec::with_capacity(self.l.len());
+        self.l
+            .for_each(|k| v.push((self.i0 + (k % self.w) as i32, self.j0 + (k / self.w) as i32)));
         v
     }
 }
@@ -946,7 +938,7 @@ impl std::fmt::Debug for Mind {
         f.debug_struct("Mind")
             .field("seen_px", &self.known.seen().count_ones(..))
             .field("tiles", &(self.tiles.w, self.tiles.h))
-            .field("l", &self.tiles.l_count)
+            .field("l", &self.tiles.l.len())
             .finish_non_exhaustive()
     }
 }
@@ -1249,7 +1241,7 @@ impl BaStar {
     pub fn frontier_without_candidates(&self) -> bool {
         let Some(m) = &self.mind else { return false };
         let t = &m.tiles;
-        if t.l_count > 0 {
+        if t.l.len() > 0 {
             return false;
         }
         self.covered_tiles()
@@ -1423,7 +1415,7 @@ impl BaStar {
             self.pending
                 .push_back(Step::Mark(Event::BacktrackList { points: pts }));
         }
-        if m.tiles.l_count == 0 {
+        if m.tiles.l.len() == 0 {
             self.phase = Phase::Finished;
             return self.pending.pop_front().unwrap_or(Step::Done);
         }
