@@ -170,6 +170,19 @@ pub fn judge_motion(known: &KnownMap, a: Point, b: Point, r: f64) -> Judgement {
     let row0 = floor_i64(h - yhi - 0.5) - 1;
     let row1 = ceil_i64(h - ylo - 0.5) + 1;
     let (w, hh) = (frame.width as i64, frame.height as i64);
+    // Fast path: a small box around the capsule (it holds every column the rows below can
+    // visit) inside the image and entirely known free is free.
+    let cmin = floor_i64(ga.x.min(gb.x) - rc - 0.5) - 1;
+    let cmax = ceil_i64(ga.x.max(gb.x) + rc - 0.5) + 1;
+    if row0 >= 0
+        && row1 < hh
+        && cmin >= 0
+        && cmax < w
+        && (row1 - row0 + 1) * (cmax - cmin + 1) <= 1024
+        && known.rect_known_free(row0 as usize, row1 as usize, cmin as usize, cmax as usize)
+    {
+        return Judgement::Free;
+    }
     let mut undetermined = false;
     for row in row0..=row1 {
         let gy = h - row as f64 - 0.5;
@@ -327,6 +340,21 @@ pub trait TileGraph {
     fn covered(&self, t: Tile) -> bool;
     /// Is the straight move from `t` to its neighbour `t + N8[k]` known to be free?
     fn move_free(&self, t: Tile, k: usize) -> bool;
+    /// The edges of `t` as a mask: bit `k` set when [`graph_edge`]`(self, t, k)` holds.
+    /// Implementors may override it with a faster equivalent (the searches call it once per
+    /// settled tile).
+    fn edge_mask(&self, t: Tile) -> u8
+    where
+        Self: Sized,
+    {
+        (0..8).fold(0, |m, k| {
+            if graph_edge(self, t, k) {
+                m | 1 << k
+            } else {
+                m
+            }
+        })
+    }
 }
 
 /// Is the step `t -> t + N8[k]` an edge of the backtracking graph: both tiles covered, a
@@ -471,10 +499,14 @@ impl TileSearch {
     }
 
     fn expand(&mut self, g: &impl TileGraph, t: Tile, k: usize, d: u64, goal: Option<Tile>) {
-        for (n, &(di, dj)) in N8.iter().enumerate() {
+        let mut mask = g.edge_mask(t);
+        while mask != 0 {
+            let n = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            let (di, dj) = N8[n];
             let v = (t.0 + di, t.1 + dj);
             let Some(kv) = self.idx(v) else { continue };
-            if self.nodes[kv].closed == self.generation || !graph_edge(g, t, n) {
+            if self.nodes[kv].closed == self.generation {
                 continue;
             }
             let nd = d + if n % 2 == 1 { COST_DIAG } else { COST_ORTHO };
@@ -889,6 +921,65 @@ impl TileGraph for TileModel {
     fn move_free(&self, t: Tile, k: usize) -> bool {
         self.cached_move(t, k) == Judgement::Free
     }
+    /// [`graph_edge`] for all eight neighbours at once, read off the dense arrays (interior
+    /// tiles; tiles on the border of the range take the generic path).
+    fn edge_mask(&self, t: Tile) -> u8 {
+        let di = t.0 - self.i0;
+        let dj = t.1 - self.j0;
+        if di < 1 || dj < 1 || di as usize + 1 >= self.w || dj as usize + 1 >= self.h {
+            return (0..8).fold(0, |m, k| {
+                if graph_edge(self, t, k) {
+                    m | 1 << k
+                } else {
+                    m
+                }
+            });
+        }
+        let w = self.w;
+        let k = dj as usize * w + di as usize;
+        // Row-major index of each neighbour s1..s8 (j grows with the index).
+        let nb = [
+            k + 1,
+            k + w + 1,
+            k + w,
+            k + w - 1,
+            k - 1,
+            k - w - 1,
+            k - w,
+            k - w + 1,
+        ];
+        let cov = |i: usize| self.state[i] & ST_COVERED != 0;
+        let mut covered = 0u8;
+        for (n, &i) in nb.iter().enumerate() {
+            if cov(i) {
+                covered |= 1 << n;
+            }
+        }
+        // Move judgements: s1..s4 at `k` (slots 0..3); s5..s8 at the neighbour, slot n - 4.
+        let free =
+            |i: usize, slot: usize| (self.moves[i] >> (2 * slot)) & 3 == Judgement::Free as u8;
+        let mut mask = 0u8;
+        for n in 0..8 {
+            if covered & (1 << n) == 0 {
+                continue;
+            }
+            // A diagonal needs both orthogonal tiles beside it covered (no corner cutting).
+            if n % 2 == 1 && covered & (1 << (n - 1)) == 0
+                || n % 2 == 1 && covered & (1 << ((n + 1) % 8)) == 0
+            {
+                continue;
+            }
+            let ok = if n < 4 {
+                free(k, n)
+            } else {
+                free(nb[n], n - 4)
+            };
+            if ok {
+                mask |= 1 << n;
+            }
+        }
+        mask
+    }
 }
 
 /// Everything the planner knows once it has seen its first scan.
@@ -1283,6 +1374,16 @@ impl BaStar {
                         return Err(format!("move {tile:?}->{v:?}: cached {c:?}, fresh {f:?}"));
                     }
                 }
+            }
+            let generic = (0..8).fold(0u8, |acc, n| {
+                if graph_edge(t, tile, n) {
+                    acc | 1 << n
+                } else {
+                    acc
+                }
+            });
+            if t.edge_mask(tile) != generic {
+                return Err(format!("tile {tile:?}: edge mask differs from graph_edge"));
             }
             if t.state[k] & ST_COVERED != 0 {
                 for n in [0, 2, 4, 6] {
