@@ -170,16 +170,22 @@ pub fn judge_motion(known: &KnownMap, a: Point, b: Point, r: f64) -> Judgement {
     let row0 = floor_i64(h - yhi - 0.5) - 1;
     let row1 = ceil_i64(h - ylo - 0.5) + 1;
     let (w, hh) = (frame.width as i64, frame.height as i64);
-    // Fast path: a small box around the capsule (it holds every column the rows below can
-    // visit) inside the image and entirely known free is free.
-    let cmin = floor_i64(ga.x.min(gb.x) - rc - 0.5) - 1;
-    let cmax = ceil_i64(ga.x.max(gb.x) + rc - 0.5) + 1;
-    if row0 >= 0
-        && row1 < hh
+    // Fast path: every pixel that can touch has its centre within `rc` of the segment, so in
+    // the capsule's bounding box grown by `rc` (boundary pixels kept, with a margin for
+    // rounding). That box inside the image and entirely known free: free.
+    let eps = 1e-6;
+    let cmin = ceil_i64(ga.x.min(gb.x) - rc - 0.5 - eps);
+    let cmax = floor_i64(ga.x.max(gb.x) + rc - 0.5 + eps);
+    let rmin = ceil_i64(h - yhi - 0.5 - eps);
+    let rmax = floor_i64(h - ylo - 0.5 + eps);
+    if 0 <= rmin
+        && rmin <= rmax
+        && rmax < hh
+        && cmin <= cmax
         && cmin >= 0
         && cmax < w
-        && (row1 - row0 + 1) * (cmax - cmin + 1) <= 1024
-        && known.rect_known_free(row0 as usize, row1 as usize, cmin as usize, cmax as usize)
+        && (rmax - rmin + 1) * (cmax - cmin + 1) <= 1024
+        && known.rect_known_free(rmin as usize, rmax as usize, cmin as usize, cmax as usize)
     {
         return Judgement::Free;
     }
