@@ -391,14 +391,13 @@ pub struct TileSearch {
     heap: BinaryHeap<Reverse<(u64, u32)>>,
 }
 
-/// Per-tile search state: valid when `stamp` is the current generation; settled when `closed`
-/// is.
+/// Per-tile search state (16 bytes): labelled in this search when `stamp` is the current
+/// generation (even), settled when it is the generation + 1; stamp 0 is "never labelled".
 #[derive(Clone, Copy, Debug, Default)]
 struct SearchNode {
     dist: u64,
     parent: u32,
     stamp: u32,
-    closed: u32,
 }
 
 impl TileSearch {
@@ -411,13 +410,7 @@ impl TileSearch {
             j0,
             w,
             h,
-            nodes: vec![
-                SearchNode {
-                    parent: u32::MAX,
-                    ..SearchNode::default()
-                };
-                w * h
-            ],
+            nodes: vec![SearchNode::default(); w * h],
             generation: 0,
             heap: BinaryHeap::new(),
         }
@@ -440,17 +433,23 @@ impl TileSearch {
     }
 
     fn begin(&mut self) {
-        self.generation = self.generation.wrapping_add(1);
+        self.generation = self.generation.wrapping_add(2);
         if self.generation == 0 {
             for n in &mut self.nodes {
                 n.stamp = 0;
-                n.closed = 0;
             }
-            self.generation = 1;
+            self.generation = 2;
         }
         self.heap.clear();
     }
 
+    /// Is node `k` settled in the current search?
+    #[inline]
+    fn closed(&self, k: usize) -> bool {
+        self.nodes[k].stamp == self.generation + 1
+    }
+
+    /// Relaxes the label of node `k` (never called on a settled node).
     #[inline]
     fn relax(&mut self, k: usize, d: u64, parent: u32) -> bool {
         let gen = self.generation;
@@ -490,11 +489,10 @@ impl TileSearch {
         self.heap.push(Reverse((0, s as u32)));
         while let Some(Reverse((d, k))) = self.heap.pop() {
             let k = k as usize;
-            let n = self.nodes[k];
-            if n.closed == self.generation || d > n.dist {
+            if self.closed(k) || d > self.nodes[k].dist {
                 continue;
             }
-            self.nodes[k].closed = self.generation;
+            self.nodes[k].stamp = self.generation + 1;
             let t = self.tile(k);
             if is_target(t) {
                 return Some((t, d));
@@ -512,7 +510,7 @@ impl TileSearch {
             let (di, dj) = N8[n];
             let v = (t.0 + di, t.1 + dj);
             let Some(kv) = self.idx(v) else { continue };
-            if self.nodes[kv].closed == self.generation {
+            if self.closed(kv) {
                 continue;
             }
             let nd = d + if n % 2 == 1 { COST_DIAG } else { COST_ORTHO };
@@ -533,10 +531,10 @@ impl TileSearch {
         self.heap.push(Reverse((heuristic(from, to), s as u32)));
         while let Some(Reverse((_, k))) = self.heap.pop() {
             let k = k as usize;
-            if self.nodes[k].closed == self.generation {
+            if self.closed(k) {
                 continue;
             }
-            self.nodes[k].closed = self.generation;
+            self.nodes[k].stamp = self.generation + 1;
             let d = self.nodes[k].dist;
             let t = self.tile(k);
             if t == to {
@@ -690,6 +688,8 @@ pub fn smooth_path(path: &[Tile], mut visible: impl FnMut(Tile, Tile) -> bool) -
 // Tile state bits.
 const ST_STAND: u8 = 0b0011; // Judgement of standing at the centre
 const ST_COVERED: u8 = 0b0100;
+/// The tile's contact disk is in the [`DiskCache`].
+const ST_DISK: u8 = 0b1000;
 
 /// The discovered tiling `M̂` with cached judgements, dense over the frame's tile extent.
 #[derive(Clone, Debug)]
@@ -1007,13 +1007,12 @@ struct Mind {
 }
 
 /// The contact disk of each tile as pixel spans: `rows` slots per tile of `[lo, hi]` column
-/// offsets from `col0[k]` for rows `row0[k]..` (`lo > hi`: no pixel in that row);
-/// `row0[k] == i32::MIN` until computed.
+/// offsets from the tile's [`Mind::disk_origin`] column for the rows from its origin row
+/// (`lo > hi`: no pixel in that row). Valid only for tiles with [`ST_DISK`] set; the slots of
+/// the others are never read (zero-initialised: untouched pages cost no memory).
 #[derive(Clone)]
 struct DiskCache {
     rows: usize,
-    row0: Vec<i32>,
-    col0: Vec<i32>,
     spans: Vec<[u8; 2]>,
 }
 
@@ -1023,9 +1022,7 @@ impl DiskCache {
         let rows = (2.0 * rc_px).ceil() as usize + 4;
         Self {
             rows,
-            row0: vec![i32::MIN; n_tiles],
-            col0: vec![0; n_tiles],
-            spans: vec![[1, 0]; n_tiles * rows],
+            spans: vec![[0, 0]; n_tiles * rows],
         }
     }
 }
@@ -1138,7 +1135,7 @@ impl Mind {
                 if self.tiles.state[k] & ST_STAND != Judgement::Undetermined as u8 {
                     continue;
                 }
-                let hit = if self.disk.row0[k] == i32::MIN {
+                let hit = if self.tiles.state[k] & ST_DISK == 0 {
                     // Not cached yet: the rows and columns the disk can reach (one pixel of
                     // margin).
                     let g = frame.world_to_grid(self.center(t));
@@ -1154,7 +1151,8 @@ impl Mind {
                 } else {
                     // Cached: the disk's own pixel runs against the new ones.
                     let n = self.disk.rows;
-                    let (row0, col0) = (self.disk.row0[k] as usize, self.disk.col0[k] as usize);
+                    let (row0, col0) = self.disk_origin(t);
+                    let (row0, col0) = (row0 as usize, col0 as usize);
                     self.disk.spans[k * n..(k + 1) * n]
                         .iter()
                         .enumerate()
@@ -1180,20 +1178,33 @@ impl Mind {
         self.new_spans = spans;
     }
 
+    /// The first image row and the column offsets are taken from in the [`DiskCache`] slots of
+    /// tile `t` (signed): the first row of [`disk_rows`] at its centre, and one column of
+    /// margin left of its disk (clamped at 0: any touching column is >= 0, else blocked).
+    #[inline]
+    fn disk_origin(&self, t: Tile) -> (i64, i64) {
+        let frame = self.known.frame();
+        let g = frame.world_to_grid(self.center(t));
+        let rc = self.rc_px;
+        (
+            *disk_rows(frame, g, rc).start(),
+            (floor_i64(g.x - rc - 0.5) - 1).max(0),
+        )
+    }
+
     /// [`judge_point`] for tile `k` (`t`), with the disk's pixel spans computed once per tile
     /// by the same predicate and cached (a tile is judged again each time new pixels reach its
     /// disk, until it is decided).
     fn judge_tile(&mut self, k: usize, t: Tile) -> Judgement {
         let n = self.disk.rows;
-        if self.disk.row0[k] == i32::MIN {
+        if self.tiles.state[k] & ST_DISK == 0 {
             let frame = *self.known.frame();
             let g = frame.world_to_grid(self.center(t));
             let rc = self.rc_px;
             let (w, hh) = (frame.width as i64, frame.height as i64);
             let rows = disk_rows(&frame, g, rc);
-            let (row0, row1) = (*rows.start(), *rows.end());
-            // Offsets are taken from here; any touching column is >= 0 (else blocked).
-            let col0 = (floor_i64(g.x - rc - 0.5) - 1).max(0);
+            let row1 = *rows.end();
+            let (row0, col0) = self.disk_origin(t);
             if row1 - row0 + 1 > n as i64 || !(0..=i64::from(i32::MAX)).contains(&row0) {
                 return judge_point(&self.known, g, rc);
             }
@@ -1209,10 +1220,9 @@ impl Mind {
                 }
                 *slot = [(lo - col0) as u8, (hi - col0) as u8];
             }
-            self.disk.row0[k] = row0 as i32;
-            self.disk.col0[k] = col0 as i32;
+            self.tiles.state[k] |= ST_DISK;
         }
-        let (row0, col0) = (i64::from(self.disk.row0[k]), i64::from(self.disk.col0[k]));
+        let (row0, col0) = self.disk_origin(t);
         let runs = self.disk.spans[k * n..(k + 1) * n]
             .iter()
             .zip(row0..)
