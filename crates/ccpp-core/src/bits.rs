@@ -201,8 +201,8 @@ mod tests {
         let mut x = 12345u64;
         for _ in 0..20_000 {
             x = x
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
             let k = (x >> 33) as usize % n;
             if x & 1 == 0 {
                 assert_eq!(s.insert(k), want.insert(k));

@@ -970,8 +970,7 @@ impl TileGraph for TileModel {
                 continue;
             }
             // A diagonal needs both orthogonal tiles beside it covered (no corner cutting).
-            if n % 2 == 1 && covered & (1 << (n - 1)) == 0
-                || n % 2 == 1 && covered & (1 << ((n + 1) % 8)) == 0
+            if n % 2 == 1 && (covered & (1 << (n - 1)) == 0 || covered & (1 << ((n + 1) % 8)) == 0)
             {
                 continue;
             }
