@@ -1006,12 +1006,14 @@ struct Mind {
 }
 
 /// The contact disk of each tile as pixel spans: `rows` slots per tile of `[lo, hi]` column
-/// offsets from the tile's [`Mind::disk_origin`] column for the rows from its origin row
-/// (`lo > hi`: no pixel in that row). Valid only for tiles with [`ST_DISK`] set; the slots of
-/// the others are never read (zero-initialised: untouched pages cost no memory).
+/// offsets from `col0[k]` for rows `row0[k]..` (`lo > hi`: no pixel in that row). Valid only
+/// for tiles with [`ST_DISK`] set; the slots of the others are never read (zero-initialised:
+/// pages of tiles never judged cost no memory).
 #[derive(Clone)]
 struct DiskCache {
     rows: usize,
+    row0: Vec<i32>,
+    col0: Vec<i32>,
     spans: Vec<[u8; 2]>,
 }
 
@@ -1021,6 +1023,8 @@ impl DiskCache {
         let rows = (2.0 * rc_px).ceil() as usize + 4;
         Self {
             rows,
+            row0: vec![0; n_tiles],
+            col0: vec![0; n_tiles],
             spans: vec![[0, 0]; n_tiles * rows],
         }
     }
@@ -1150,8 +1154,7 @@ impl Mind {
                 } else {
                     // Cached: the disk's own pixel runs against the new ones.
                     let n = self.disk.rows;
-                    let (row0, col0) = self.disk_origin(t);
-                    let (row0, col0) = (row0 as usize, col0 as usize);
+                    let (row0, col0) = (self.disk.row0[k] as usize, self.disk.col0[k] as usize);
                     self.disk.spans[k * n..(k + 1) * n]
                         .iter()
                         .enumerate()
@@ -1219,9 +1222,11 @@ impl Mind {
                 }
                 *slot = [(lo - col0) as u8, (hi - col0) as u8];
             }
+            self.disk.row0[k] = row0 as i32;
+            self.disk.col0[k] = col0 as i32;
             self.tiles.state[k] |= ST_DISK;
         }
-        let (row0, col0) = self.disk_origin(t);
+        let (row0, col0) = (i64::from(self.disk.row0[k]), i64::from(self.disk.col0[k]));
         let runs = self.disk.spans[k * n..(k + 1) * n]
             .iter()
             .zip(row0..)
