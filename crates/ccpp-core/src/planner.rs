@@ -342,6 +342,23 @@ impl KnownMap {
         );
     }
 
+    /// Is every pixel of image rows `row0..=row1`, columns `col0..=col1` (inside the image)
+    /// known free? A block of the bitset at a time.
+    pub(crate) fn rect_known_free(
+        &self,
+        row0: usize,
+        row1: usize,
+        col0: usize,
+        col1: usize,
+    ) -> bool {
+        let w = self.grid.frame().width;
+        let free = self.free.as_slice();
+        (row0..=row1).all(|row| {
+            let base = row * w;
+            crate::bits::for_each_set(base + col0, base + col1 + 1, |k| !free[k], |_| false)
+        })
+    }
+
     /// What is known of the disk of radius `rc` pixels at grid point `g`: the pixels whose
     /// centre `q` has `|q - g|^2 < rc^2` ([`crate::collide`]'s contact test with `rc` the
     /// contact radius). Blocked when one of them is seen blocked or lies outside the image,

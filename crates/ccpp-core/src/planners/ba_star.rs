@@ -86,6 +86,7 @@ use std::collections::{BinaryHeap, VecDeque};
 
 use serde::{Deserialize, Serialize};
 
+use crate::bits::IndexSet;
 use crate::collide::contact_radius_px;
 use crate::geometry::{
     ceil_i32, ceil_i64, first_entry, floor_i32, floor_i64, point_segment_dist2, wrap_angle, Point,
@@ -169,6 +170,25 @@ pub fn judge_motion(known: &KnownMap, a: Point, b: Point, r: f64) -> Judgement {
     let row0 = floor_i64(h - yhi - 0.5) - 1;
     let row1 = ceil_i64(h - ylo - 0.5) + 1;
     let (w, hh) = (frame.width as i64, frame.height as i64);
+    // Fast path: every pixel that can touch has its centre within `rc` of the segment, so in
+    // the capsule's bounding box grown by `rc` (boundary pixels kept, with a margin for
+    // rounding). That box inside the image and entirely known free: free.
+    let eps = 1e-6;
+    let cmin = ceil_i64(ga.x.min(gb.x) - rc - 0.5 - eps);
+    let cmax = floor_i64(ga.x.max(gb.x) + rc - 0.5 + eps);
+    let rmin = ceil_i64(h - yhi - 0.5 - eps);
+    let rmax = floor_i64(h - ylo - 0.5 + eps);
+    if 0 <= rmin
+        && rmin <= rmax
+        && rmax < hh
+        && cmin <= cmax
+        && cmin >= 0
+        && cmax < w
+        && (rmax - rmin + 1) * (cmax - cmin + 1) <= 1024
+        && known.rect_known_free(rmin as usize, rmax as usize, cmin as usize, cmax as usize)
+    {
+        return Judgement::Free;
+    }
     let mut undetermined = false;
     for row in row0..=row1 {
         let gy = h - row as f64 - 0.5;
@@ -326,6 +346,21 @@ pub trait TileGraph {
     fn covered(&self, t: Tile) -> bool;
     /// Is the straight move from `t` to its neighbour `t + N8[k]` known to be free?
     fn move_free(&self, t: Tile, k: usize) -> bool;
+    /// The edges of `t` as a mask: bit `k` set when [`graph_edge`]`(self, t, k)` holds.
+    /// Implementors may override it with a faster equivalent (the searches call it once per
+    /// settled tile).
+    fn edge_mask(&self, t: Tile) -> u8
+    where
+        Self: Sized,
+    {
+        (0..8).fold(0, |m, k| {
+            if graph_edge(self, t, k) {
+                m | 1 << k
+            } else {
+                m
+            }
+        })
+    }
 }
 
 /// Is the step `t -> t + N8[k]` an edge of the backtracking graph: both tiles covered, a
@@ -356,14 +391,13 @@ pub struct TileSearch {
     heap: BinaryHeap<Reverse<(u64, u32)>>,
 }
 
-/// Per-tile search state: valid when `stamp` is the current generation; settled when `closed`
-/// is.
+/// Per-tile search state (16 bytes): labelled in this search when `stamp` is the current
+/// generation (even), settled when it is the generation + 1; stamp 0 is "never labelled".
 #[derive(Clone, Copy, Debug, Default)]
 struct SearchNode {
     dist: u64,
     parent: u32,
     stamp: u32,
-    closed: u32,
 }
 
 impl TileSearch {
@@ -376,13 +410,7 @@ impl TileSearch {
             j0,
             w,
             h,
-            nodes: vec![
-                SearchNode {
-                    parent: u32::MAX,
-                    ..SearchNode::default()
-                };
-                w * h
-            ],
+            nodes: vec![SearchNode::default(); w * h],
             generation: 0,
             heap: BinaryHeap::new(),
         }
@@ -405,17 +433,23 @@ impl TileSearch {
     }
 
     fn begin(&mut self) {
-        self.generation = self.generation.wrapping_add(1);
+        self.generation = self.generation.wrapping_add(2);
         if self.generation == 0 {
             for n in &mut self.nodes {
                 n.stamp = 0;
-                n.closed = 0;
             }
-            self.generation = 1;
+            self.generation = 2;
         }
         self.heap.clear();
     }
 
+    /// Is node `k` settled in the current search?
+    #[inline]
+    fn closed(&self, k: usize) -> bool {
+        self.nodes[k].stamp == self.generation + 1
+    }
+
+    /// Relaxes the label of node `k` (never called on a settled node).
     #[inline]
     fn relax(&mut self, k: usize, d: u64, parent: u32) -> bool {
         let gen = self.generation;
@@ -455,11 +489,10 @@ impl TileSearch {
         self.heap.push(Reverse((0, s as u32)));
         while let Some(Reverse((d, k))) = self.heap.pop() {
             let k = k as usize;
-            let n = self.nodes[k];
-            if n.closed == self.generation || d > n.dist {
+            if self.closed(k) || d > self.nodes[k].dist {
                 continue;
             }
-            self.nodes[k].closed = self.generation;
+            self.nodes[k].stamp = self.generation + 1;
             let t = self.tile(k);
             if is_target(t) {
                 return Some((t, d));
@@ -470,10 +503,14 @@ impl TileSearch {
     }
 
     fn expand(&mut self, g: &impl TileGraph, t: Tile, k: usize, d: u64, goal: Option<Tile>) {
-        for (n, &(di, dj)) in N8.iter().enumerate() {
+        let mut mask = g.edge_mask(t);
+        while mask != 0 {
+            let n = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            let (di, dj) = N8[n];
             let v = (t.0 + di, t.1 + dj);
             let Some(kv) = self.idx(v) else { continue };
-            if self.nodes[kv].closed == self.generation || !graph_edge(g, t, n) {
+            if self.closed(kv) {
                 continue;
             }
             let nd = d + if n % 2 == 1 { COST_DIAG } else { COST_ORTHO };
@@ -494,10 +531,10 @@ impl TileSearch {
         self.heap.push(Reverse((heuristic(from, to), s as u32)));
         while let Some(Reverse((_, k))) = self.heap.pop() {
             let k = k as usize;
-            if self.nodes[k].closed == self.generation {
+            if self.closed(k) {
                 continue;
             }
-            self.nodes[k].closed = self.generation;
+            self.nodes[k].stamp = self.generation + 1;
             let d = self.nodes[k].dist;
             let t = self.tile(k);
             if t == to {
@@ -651,7 +688,8 @@ pub fn smooth_path(path: &[Tile], mut visible: impl FnMut(Tile, Tile) -> bool) -
 // Tile state bits.
 const ST_STAND: u8 = 0b0011; // Judgement of standing at the centre
 const ST_COVERED: u8 = 0b0100;
-const ST_IN_L: u8 = 0b1000;
+/// The tile's contact disk is in the [`DiskCache`].
+const ST_DISK: u8 = 0b1000;
 
 /// The discovered tiling `M̂` with cached judgements, dense over the frame's tile extent.
 #[derive(Clone, Debug)]
@@ -661,12 +699,13 @@ struct TileModel {
     j0: i32,
     w: usize,
     h: usize,
-    /// Per tile: standability (2 bits), covered, in L.
+    /// Per tile: standability (2 bits), covered.
     state: Vec<u8>,
     /// Per tile: judgements (2 bits each) of the moves towards s1..s4 (E, NE, N, NW); the
     /// moves towards s5..s8 are stored at the neighbour.
     moves: Vec<u8>,
-    l_count: usize,
+    /// The backtracking list `L` (row-major tile indices), listed in `O(|L|)`.
+    l: IndexSet,
     /// Add [`lane_end_score`] to `mu`.
     lane_end_corners: bool,
 }
@@ -686,7 +725,7 @@ impl TileModel {
             h,
             state: vec![0; w * h],
             moves: vec![0; w * h],
-            l_count: 0,
+            l: IndexSet::new(w * h),
             lane_end_corners: true,
         }
     }
@@ -744,7 +783,7 @@ impl TileModel {
 
     #[inline]
     fn in_l(&self, t: Tile) -> bool {
-        self.idx(t).is_some_and(|k| self.state[k] & ST_IN_L != 0)
+        self.idx(t).is_some_and(|k| self.l.contains(k))
     }
 
     /// `(owner tile, slot 0..4)` of the move `t -> t + N8[k]`.
@@ -856,16 +895,10 @@ impl TileModel {
     /// Recomputes the L membership of `t`.
     fn update_l(&mut self, t: Tile) {
         let Some(k) = self.idx(t) else { return };
-        let want = self.state[k] & ST_COVERED != 0 && self.mu(t) >= 1;
-        let has = self.state[k] & ST_IN_L != 0;
-        if want != has {
-            if want {
-                self.state[k] |= ST_IN_L;
-                self.l_count += 1;
-            } else {
-                self.state[k] &= !ST_IN_L;
-                self.l_count -= 1;
-            }
+        if self.state[k] & ST_COVERED != 0 && self.mu(t) >= 1 {
+            self.l.insert(k);
+        } else {
+            self.l.remove(k);
         }
     }
 
@@ -877,12 +910,9 @@ impl TileModel {
     }
 
     fn l_tiles(&self) -> Vec<Tile> {
-        let mut v = Vec::with_capacity(self.l_count);
-        for (k, &s) in self.state.iter().enumerate() {
-            if s & ST_IN_L != 0 {
-                v.push((self.i0 + (k % self.w) as i32, self.j0 + (k / self.w) as i32));
-            }
-        }
+        let mut v = Vec::with_capacity(self.l.len());
+        self.l
+            .for_each(|k| v.push((self.i0 + (k % self.w) as i32, self.j0 + (k / self.w) as i32)));
         v
     }
 }
@@ -896,6 +926,64 @@ impl TileGraph for TileModel {
     }
     fn move_free(&self, t: Tile, k: usize) -> bool {
         self.cached_move(t, k) == Judgement::Free
+    }
+    /// [`graph_edge`] for all eight neighbours at once, read off the dense arrays (interior
+    /// tiles; tiles on the border of the range take the generic path).
+    fn edge_mask(&self, t: Tile) -> u8 {
+        let di = t.0 - self.i0;
+        let dj = t.1 - self.j0;
+        if di < 1 || dj < 1 || di as usize + 1 >= self.w || dj as usize + 1 >= self.h {
+            return (0..8).fold(0, |m, k| {
+                if graph_edge(self, t, k) {
+                    m | 1 << k
+                } else {
+                    m
+                }
+            });
+        }
+        let w = self.w;
+        let k = dj as usize * w + di as usize;
+        // Row-major index of each neighbour s1..s8 (j grows with the index).
+        let nb = [
+            k + 1,
+            k + w + 1,
+            k + w,
+            k + w - 1,
+            k - 1,
+            k - w - 1,
+            k - w,
+            k - w + 1,
+        ];
+        let cov = |i: usize| self.state[i] & ST_COVERED != 0;
+        let mut covered = 0u8;
+        for (n, &i) in nb.iter().enumerate() {
+            if cov(i) {
+                covered |= 1 << n;
+            }
+        }
+        // Move judgements: s1..s4 at `k` (slots 0..3); s5..s8 at the neighbour, slot n - 4.
+        let free =
+            |i: usize, slot: usize| (self.moves[i] >> (2 * slot)) & 3 == Judgement::Free as u8;
+        let mut mask = 0u8;
+        for n in 0..8 {
+            if covered & (1 << n) == 0 {
+                continue;
+            }
+            // A diagonal needs both orthogonal tiles beside it covered (no corner cutting).
+            if n % 2 == 1 && (covered & (1 << (n - 1)) == 0 || covered & (1 << ((n + 1) % 8)) == 0)
+            {
+                continue;
+            }
+            let ok = if n < 4 {
+                free(k, n)
+            } else {
+                free(nb[n], n - 4)
+            };
+            if ok {
+                mask |= 1 << n;
+            }
+        }
+        mask
     }
 }
 
@@ -918,8 +1006,9 @@ struct Mind {
 }
 
 /// The contact disk of each tile as pixel spans: `rows` slots per tile of `[lo, hi]` column
-/// offsets from `col0[k]` for rows `row0[k]..` (`lo > hi`: no pixel in that row);
-/// `row0[k] == i32::MIN` until computed.
+/// offsets from `col0[k]` for rows `row0[k]..` (`lo > hi`: no pixel in that row). Valid only
+/// for tiles with [`ST_DISK`] set; the slots of the others are never read (zero-initialised:
+/// pages of tiles never judged cost no memory).
 #[derive(Clone)]
 struct DiskCache {
     rows: usize,
@@ -934,9 +1023,9 @@ impl DiskCache {
         let rows = (2.0 * rc_px).ceil() as usize + 4;
         Self {
             rows,
-            row0: vec![i32::MIN; n_tiles],
+            row0: vec![0; n_tiles],
             col0: vec![0; n_tiles],
-            spans: vec![[1, 0]; n_tiles * rows],
+            spans: vec![[0, 0]; n_tiles * rows],
         }
     }
 }
@@ -946,7 +1035,7 @@ impl std::fmt::Debug for Mind {
         f.debug_struct("Mind")
             .field("seen_px", &self.known.seen().count_ones(..))
             .field("tiles", &(self.tiles.w, self.tiles.h))
-            .field("l", &self.tiles.l_count)
+            .field("l", &self.tiles.l.len())
             .finish_non_exhaustive()
     }
 }
@@ -1049,7 +1138,7 @@ impl Mind {
                 if self.tiles.state[k] & ST_STAND != Judgement::Undetermined as u8 {
                     continue;
                 }
-                let hit = if self.disk.row0[k] == i32::MIN {
+                let hit = if self.tiles.state[k] & ST_DISK == 0 {
                     // Not cached yet: the rows and columns the disk can reach (one pixel of
                     // margin).
                     let g = frame.world_to_grid(self.center(t));
@@ -1091,20 +1180,33 @@ impl Mind {
         self.new_spans = spans;
     }
 
+    /// The first image row and the column offsets are taken from in the [`DiskCache`] slots of
+    /// tile `t` (signed): the first row of [`disk_rows`] at its centre, and one column of
+    /// margin left of its disk (clamped at 0: any touching column is >= 0, else blocked).
+    #[inline]
+    fn disk_origin(&self, t: Tile) -> (i64, i64) {
+        let frame = self.known.frame();
+        let g = frame.world_to_grid(self.center(t));
+        let rc = self.rc_px;
+        (
+            *disk_rows(frame, g, rc).start(),
+            (floor_i64(g.x - rc - 0.5) - 1).max(0),
+        )
+    }
+
     /// [`judge_point`] for tile `k` (`t`), with the disk's pixel spans computed once per tile
     /// by the same predicate and cached (a tile is judged again each time new pixels reach its
     /// disk, until it is decided).
     fn judge_tile(&mut self, k: usize, t: Tile) -> Judgement {
         let n = self.disk.rows;
-        if self.disk.row0[k] == i32::MIN {
+        if self.tiles.state[k] & ST_DISK == 0 {
             let frame = *self.known.frame();
             let g = frame.world_to_grid(self.center(t));
             let rc = self.rc_px;
             let (w, hh) = (frame.width as i64, frame.height as i64);
             let rows = disk_rows(&frame, g, rc);
-            let (row0, row1) = (*rows.start(), *rows.end());
-            // Offsets are taken from here; any touching column is >= 0 (else blocked).
-            let col0 = (floor_i64(g.x - rc - 0.5) - 1).max(0);
+            let row1 = *rows.end();
+            let (row0, col0) = self.disk_origin(t);
             if row1 - row0 + 1 > n as i64 || !(0..=i64::from(i32::MAX)).contains(&row0) {
                 return judge_point(&self.known, g, rc);
             }
@@ -1122,6 +1224,7 @@ impl Mind {
             }
             self.disk.row0[k] = row0 as i32;
             self.disk.col0[k] = col0 as i32;
+            self.tiles.state[k] |= ST_DISK;
         }
         let (row0, col0) = (i64::from(self.disk.row0[k]), i64::from(self.disk.col0[k]));
         let runs = self.disk.spans[k * n..(k + 1) * n]
@@ -1249,7 +1352,7 @@ impl BaStar {
     pub fn frontier_without_candidates(&self) -> bool {
         let Some(m) = &self.mind else { return false };
         let t = &m.tiles;
-        if t.l_count > 0 {
+        if t.l.len() > 0 {
             return false;
         }
         self.covered_tiles()
@@ -1291,6 +1394,16 @@ impl BaStar {
                         return Err(format!("move {tile:?}->{v:?}: cached {c:?}, fresh {f:?}"));
                     }
                 }
+            }
+            let generic = (0..8).fold(0u8, |acc, n| {
+                if graph_edge(t, tile, n) {
+                    acc | 1 << n
+                } else {
+                    acc
+                }
+            });
+            if t.edge_mask(tile) != generic {
+                return Err(format!("tile {tile:?}: edge mask differs from graph_edge"));
             }
             if t.state[k] & ST_COVERED != 0 {
                 for n in [0, 2, 4, 6] {
@@ -1423,7 +1536,7 @@ impl BaStar {
             self.pending
                 .push_back(Step::Mark(Event::BacktrackList { points: pts }));
         }
-        if m.tiles.l_count == 0 {
+        if m.tiles.l.len() == 0 {
             self.phase = Phase::Finished;
             return self.pending.pop_front().unwrap_or(Step::Done);
         }
