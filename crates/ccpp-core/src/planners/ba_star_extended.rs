@@ -14,7 +14,10 @@
 //! * **End of BA*** (`L` empty): passes over every rim left, wherever it is.
 //!
 //! The passes are marked `wall_follow_start` / `wall_follow_end` in the trace, the transfer
-//! keeps BA*'s `backtrack_start` / `backtrack_end` marks. Everything is planned from what the
+//! keeps BA*'s `backtrack_start` / `backtrack_end` marks, and every trip of a robot diameter or
+//! more from one rim to the next (the first part of a chunk, [`super::extension`]'s
+//! `plan_pass`) is marked `backtrack_start` / `backtrack_end` too: it sweeps nothing on purpose,
+//! so it draws dashed and counts in `backtrack_length`. Everything is planned from what the
 //! sensor has shown (BA*'s [`KnownMap`](crate::planner::KnownMap)), never from the world.
 //!
 //! ```
@@ -43,7 +46,7 @@ use std::collections::VecDeque;
 use serde::{Deserialize, Serialize};
 
 use super::ba_star::{BaStar, BaStarOptions};
-use super::extension::{Extension, ExtensionOptions};
+use super::extension::{Chunk, Extension, ExtensionOptions};
 use crate::geometry::Point;
 use crate::planner::{Planner, Sensor, Step};
 use crate::trace::Event;
@@ -118,18 +121,45 @@ impl BaStarExtended {
         };
         let bounded = !last;
         let chunk = if bounded && ext.options().reach_r <= 0.0 {
-            Vec::new()
+            Chunk::default()
         } else {
             let ba = &self.ba;
             let wanted = |p: Point| last || !ba.will_cover(p);
-            ext.plan_chunk(known, pos, bounded, &wanted)
+            ext.plan_pass(known, pos, bounded, &wanted)
         };
-        if !chunk.is_empty() {
+        if !chunk.sweep.is_empty() {
+            // A transfer of a robot diameter or more is a backtracking transfer (drawn dashed,
+            // counted in `backtrack_length`); a shorter one belongs to the pass.
+            let mut at = pos;
+            let len: f64 = chunk
+                .transfer
+                .iter()
+                .map(|&p| {
+                    let d = at.dist(p);
+                    at = p;
+                    d
+                })
+                .sum();
+            let transfer = len >= 2.0 * ext.radius();
+            if transfer {
+                if self.in_pass {
+                    self.in_pass = false;
+                    self.queue.push_back(Step::Mark(Event::WallFollowEnd));
+                }
+                self.queue.push_back(Step::Mark(Event::BacktrackStart));
+            }
+            for &p in &chunk.transfer {
+                self.queue.push_back(Step::MoveTo(p));
+                self.trail.push(p);
+            }
+            if transfer {
+                self.queue.push_back(Step::Mark(Event::BacktrackEnd));
+            }
             if !self.in_pass {
                 self.in_pass = true;
                 self.queue.push_back(Step::Mark(Event::WallFollowStart));
             }
-            for &p in &chunk {
+            for &p in &chunk.sweep {
                 self.queue.push_back(Step::MoveTo(p));
                 self.trail.push(p);
             }

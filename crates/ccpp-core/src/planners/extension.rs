@@ -158,6 +158,16 @@ const MAX_MERGE: usize = 256;
 /// Longest walk of one chunk, in pixel steps.
 const MAX_WALK: usize = 20_000;
 
+/// One chunk of a cleaning pass ([`Extension::plan_pass`]), world waypoints.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub(crate) struct Chunk {
+    /// The way to the rim: waypoints before the first position that sweeps (empty when the
+    /// robot already stands on the rim).
+    pub(crate) transfer: Vec<Point>,
+    /// The sweep along the rim, after the transfer (never empty in a non-empty chunk).
+    pub(crate) sweep: Vec<Point>,
+}
+
 /// The extension's state (see the module docs).
 pub(crate) struct Extension {
     opts: ExtensionOptions,
@@ -243,6 +253,11 @@ impl Extension {
     /// The options.
     pub(crate) fn options(&self) -> &ExtensionOptions {
         &self.opts
+    }
+
+    /// The robot radius (metres).
+    pub(crate) fn radius(&self) -> f64 {
+        self.r
     }
 
     /// Records an executed straight motion (world points) as swept.
@@ -512,6 +527,7 @@ impl Extension {
     /// Plans the next chunk of a cleaning pass from world point `pos`: the waypoints (world) to
     /// drive, empty when no rim within `reach` (robot radii; `None` = unbounded) gains.
     /// `pending(p)`: will the host still sweep world point `p`?
+    #[allow(dead_code)] // the hosts that need no transfer marks (bsa-extended)
     pub(crate) fn plan_chunk(
         &mut self,
         known: &KnownMap,
@@ -519,6 +535,21 @@ impl Extension {
         bounded: bool,
         wanted: &dyn Fn(Point) -> bool,
     ) -> Vec<Point> {
+        let c = self.plan_pass(known, pos, bounded, wanted);
+        let mut out = c.transfer;
+        out.extend(c.sweep);
+        out
+    }
+
+    /// [`Self::plan_chunk`] split in two: the transfer to the rim (waypoints that reach the
+    /// first sweeping position) and the sweep along it. Both empty when nothing gains.
+    pub(crate) fn plan_pass(
+        &mut self,
+        known: &KnownMap,
+        pos: Point,
+        bounded: bool,
+        wanted: &dyn Fn(Point) -> bool,
+    ) -> Chunk {
         let from = self.frame.world_to_grid(pos);
         let limit = bounded.then(|| {
             (self.opts.reach_r * self.r / self.frame.resolution * COST_ORTHO as f64) as u64
@@ -552,7 +583,7 @@ impl Extension {
             }
             gains
         }) else {
-            return Vec::new();
+            return Chunk::default();
         };
         let mut pts: Vec<Point> = vec![from];
         let mut gains: Vec<Vec<usize>> = vec![Vec::new()];
@@ -599,12 +630,20 @@ impl Extension {
             pts.push(self.center(cur));
             gains.push(self.claim(known, cur, wanted));
         }
-        let kept = if self.opts.merge_segments {
+        let kept: Vec<usize> = if self.opts.merge_segments {
             self.merge(known, &pts, &gains)
         } else {
             (1..pts.len()).collect()
         };
-        kept.into_iter().map(|k| self.world(pts[k])).collect()
+        // Points before the walk's first position (index `nt`) make the transfer; the sweep
+        // holds at least the last point.
+        let nt = transit.len();
+        let split = kept.partition_point(|&k| k < nt);
+        let (t, w) = kept.split_at(split);
+        Chunk {
+            transfer: t.iter().map(|&k| self.world(pts[k])).collect(),
+            sweep: w.iter().map(|&k| self.world(pts[k])).collect(),
+        }
     }
 
     /// Greedy cut of the polyline `pts` into straight segments, each known free and keeping
