@@ -90,13 +90,27 @@ use crate::planner::{Planner, Sensor, Step};
 use crate::trace::Event;
 
 /// Options of [`BsaExtended`] (`--planner bsa-extended`, config section `bsa_extended`).
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct BsaExtendedOptions {
     /// Reference lateral side of the spirals (`left` or `right`).
     pub side: Side,
-    /// The extension.
+    /// The extension. Its `reach_r` defaults to 0 here (one clean-up after BSA): a spiral ends
+    /// in the middle of what it filled, far from the rims, and cleaning around spiral ends
+    /// made the mean path ratio on the shared maps 1.436 instead of 1.373.
     pub extension: ExtensionOptions,
+}
+
+impl Default for BsaExtendedOptions {
+    fn default() -> Self {
+        Self {
+            side: Side::default(),
+            extension: ExtensionOptions {
+                reach_r: 0.0,
+                ..ExtensionOptions::default()
+            },
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -238,6 +252,9 @@ impl Planner for BsaExtended {
                 robot.tool_radius,
             );
             ext.record(pos, pos);
+            // BSA's cells leave one-pixel strips along axis-parallel walls (every position there
+            // gains one pixel): the clean-up fetches them too.
+            ext.set_final_min_gain(1);
             self.ext = Some(ext);
         }
         self.last_pos = Some(pos);

@@ -194,6 +194,9 @@ pub(crate) struct Extension {
     /// `no_gain_seen` seen pixels (targets only disappear in between).
     no_gain: FixedBitSet,
     no_gain_seen: usize,
+    /// Host override of the pixels a trip must gain after the host's coverage (`None`: half a
+    /// tool radius, at least 2; see [`Self::set_final_min_gain`]).
+    final_min_gain: Option<usize>,
     // Dijkstra scratch (generation-stamped).
     dist: Vec<u64>,
     parent: Vec<u32>,
@@ -243,6 +246,7 @@ impl Extension {
             swept: FixedBitSet::with_capacity(n),
             no_gain: FixedBitSet::with_capacity(n),
             no_gain_seen: usize::MAX,
+            final_min_gain: None,
             dist: vec![0; n],
             parent: vec![u32::MAX; n],
             stamp: vec![0; n],
@@ -253,6 +257,13 @@ impl Extension {
     /// The options.
     pub(crate) fn options(&self) -> &ExtensionOptions {
         &self.opts
+    }
+
+    /// Host hook: the pixels a trip must gain after the host's coverage (default: half a tool
+    /// radius, at least 2). `bsa-extended` sets 1: its cells leave one-pixel strips along
+    /// axis-parallel walls where every position gains a single pixel.
+    pub(crate) fn set_final_min_gain(&mut self, g: usize) {
+        self.final_min_gain = Some(g);
     }
 
     /// The robot radius (metres).
@@ -560,6 +571,8 @@ impl Extension {
         let tool = self.rt.ceil().max(1.0) as usize;
         let g_start = if bounded {
             tool
+        } else if let Some(g) = self.final_min_gain {
+            g.max(1)
         } else {
             (self.rt / 2.0).ceil().max(2.0) as usize
         };
