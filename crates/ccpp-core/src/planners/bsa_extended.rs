@@ -84,7 +84,7 @@ use std::collections::VecDeque;
 use serde::{Deserialize, Serialize};
 
 use super::bsa::{Bsa, BsaOptions, Side};
-use super::extension::{Extension, ExtensionOptions};
+use super::extension::{Chunk, Extension, ExtensionOptions};
 use crate::geometry::Point;
 use crate::planner::{Planner, Sensor, Step};
 use crate::trace::Event;
@@ -165,18 +165,35 @@ impl BsaExtended {
         };
         let bounded = !last;
         let chunk = if bounded && ext.options().reach_r <= 0.0 {
-            Vec::new()
+            Chunk::default()
         } else {
             let bsa = &self.bsa;
             let wanted = |p: Point| last || !bsa.will_cover(p);
-            ext.plan_chunk(known, pos, bounded, &wanted)
+            ext.plan_pass(known, pos, bounded, &wanted)
         };
-        if !chunk.is_empty() {
+        if !chunk.sweep.is_empty() {
+            // As in ba-star-extended: a trip of a robot diameter or more between rims is a
+            // backtracking transfer (drawn dashed, counted in `backtrack_length`).
+            let transfer = polyline_len(pos, &chunk.transfer) >= 2.0 * ext.radius();
+            if transfer {
+                if self.in_pass {
+                    self.in_pass = false;
+                    self.queue.push_back(Step::Mark(Event::WallFollowEnd));
+                }
+                self.queue.push_back(Step::Mark(Event::BacktrackStart));
+            }
+            for &p in &chunk.transfer {
+                self.queue.push_back(Step::MoveTo(p));
+                self.trail.push(p);
+            }
+            if transfer {
+                self.queue.push_back(Step::Mark(Event::BacktrackEnd));
+            }
             if !self.in_pass {
                 self.in_pass = true;
                 self.queue.push_back(Step::Mark(Event::WallFollowStart));
             }
-            for &p in &chunk {
+            for &p in &chunk.sweep {
                 self.queue.push_back(Step::MoveTo(p));
                 self.trail.push(p);
             }
