@@ -269,9 +269,6 @@ impl Planner for BsaExtended {
                 robot.tool_radius,
             );
             ext.record(pos, pos);
-            // BSA's cells leave one-pixel strips along axis-parallel walls (every position there
-            // gains one pixel): the clean-up fetches them too.
-            ext.set_final_min_gain(1);
             self.ext = Some(ext);
         }
         self.last_pos = Some(pos);
