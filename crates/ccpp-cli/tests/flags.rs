@@ -348,6 +348,11 @@ fn config_values_go_through_the_same_validation() {
         ),
         // Options the rebuilt bsa-extended dropped are unknown keys now, refused by name.
         ("bsa_extended: { gap_cost: 4 }", "bsa-extended", "gap_cost"),
+        (
+            "bsa_extended: { extension: { lane_ends: true } }",
+            "bsa-extended",
+            "bsa_extended.extension.lane_ends",
+        ),
     ]
     .into_iter()
     .enumerate()

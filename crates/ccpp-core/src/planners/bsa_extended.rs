@@ -16,7 +16,9 @@
 //!   swept (the tool disk along it).
 //! * **At the end of a spiral** (BSA's [`Event::RegionEnd`], its return path to the next
 //!   backtracking point already chosen): cleaning passes over the rims within
-//!   [`ExtensionOptions::reach_r`] robot radii of the robot. A target is a known free pixel
+//!   [`ExtensionOptions::reach_r`] robot radii of the robot (default 0 for BSA: none; a
+//!   spiral ends in the middle of what it filled, and the trips to the rims from there and on
+//!   to the next spiral cost more than one tour after BSA). A target is a known free pixel
 //!   that is not swept and that BSA will not sweep anyway ([`Bsa::will_cover`]: its cell is
 //!   neither visited nor known unstandable). Then the robot drives to the next spiral's first
 //!   cell by the extension's known-free straight segments ([`Bsa::replace_transfer`]) when
@@ -26,21 +28,22 @@
 //!   wherever it is, also behind gaps BSA's cells could not cross (the extension's positions
 //!   fit through any gap the robot disk fits through: the virtual pipe of seed 002, III.D).
 //!
-//! The passes are marked `wall_follow_start` / `wall_follow_end` in the trace. Everything is
+//! The passes are marked `wall_follow_start` / `wall_follow_end` in the trace, trips of a
+//! robot diameter or more between rims `backtrack_start` / `backtrack_end`. Everything is
 //! planned from what the sensor has shown (BSA's [`KnownMap`](crate::planner::KnownMap)).
 //!
 //! # Example
 //!
-//! BSA's cells (`+` centres) do not line up with the walls; one spiral (`o`) leaves rims
-//! (`~`) along the walls and around the pillar. At the spiral's end the extension drives the
-//! contour of the rims in a few straight segments (`>`, `v`, `<`, `^`), then BSA goes on:
+//! BSA's cells (`+` centres) do not line up with the walls; its spiral over them leaves rims
+//! (`~`) along the walls and around the pillar. After BSA the extension drives the contour of
+//! the rims in a few straight segments (`>`, `v`, `<`, `^`):
 //!
 //! ```text
 //!   ############        ############
 //!   #~~~~~~~~~~#        #>>>>>>>>>v#
 //!   #~+ + + + ~#        #^+ + + + v#
 //!   #~+ ~##~+ ~#   ->   #^+ >##v+ v#
-//!   #~+ ~##~+ ~#        #^+ ^##v+ v#
+//!   #~+ ~##~+ ~#        #^+ ^##<+ v#
 //!   #~+ + + + ~#        #^+ + + + v#
 //!   #~~~~~~~~~~#        #^<<<<<<<<<#
 //!   ############        ############
@@ -95,7 +98,7 @@ use crate::trace::Event;
 pub struct BsaExtendedOptions {
     /// Reference lateral side of the spirals (`left` or `right`).
     pub side: Side,
-    /// The extension. Its `reach_r` defaults to 0 here (one clean-up after BSA): a spiral ends
+    /// The extension (`lane_ends` is refused: BSA has no lanes). Its `reach_r` defaults to 0 here (one clean-up after BSA): a spiral ends
     /// in the middle of what it filled, far from the rims, and cleaning around spiral ends
     /// made the mean path ratio on the shared maps 1.436 instead of 1.373.
     pub extension: ExtensionOptions,

@@ -451,6 +451,13 @@ impl PlannerSettings for BsaOptions {
 
 impl PlannerSettings for BsaExtendedOptions {
     fn validate(&self) -> Result<(), OptionsError> {
+        if self.extension.lane_ends {
+            // BSA fills spirals, not lanes: nothing to drive on to the wall.
+            return Err(OptionsError::new(
+                "extension.lane_ends",
+                "does not apply to bsa-extended (BSA has no lanes)",
+            ));
+        }
         finite_nonneg("extension.reach_r", self.extension.reach_r)
     }
 
