@@ -423,7 +423,7 @@ enum Phase {
     Finished,
 }
 
-/// The basic BSA planner (the host of [`super::bsa_extended::BsaExtended`]).
+/// The basic BSA planner (also the host of `bsa-extended`, see [`super::bsa_extended`]).
 pub struct Bsa {
     side: Side,
     core: Option<Core>,
