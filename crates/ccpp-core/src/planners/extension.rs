@@ -25,7 +25,7 @@
 //! 1. **Find a rim**: Dijkstra over positions from the robot to the nearest position that
 //!    sweeps at least a tool radius of target pixels (at the end of a host region the search is
 //!    bounded by [`ExtensionOptions::reach_r`] robot radii; after the host's coverage it is not,
-//!    and half a tool radius of pixels, at least 2, is enough — or a single pixel when the
+//!    and a tool radius of pixels, at least 2, is enough — or a single pixel when the
 //!    position lies on a *strip* of rim: at least 4 targets within the tool radius plus 3
 //!    pixels. Where a wall runs at a sub-pixel offset every position beside it sweeps one pixel
 //!    of a one-pixel strip; on `tuw_single_corridors` those strips were 1 % of the floor.
@@ -206,8 +206,8 @@ pub(crate) struct Extension {
     /// `no_gain_seen` seen pixels (targets only disappear in between).
     no_gain: FixedBitSet,
     no_gain_seen: usize,
-    /// Host override of the pixels a trip must gain after the host's coverage (`None`: half a
-    /// tool radius, at least 2; see [`Self::set_final_min_gain`]).
+    /// Host override of the pixels a trip must gain after the host's coverage (`None`: a tool
+    /// radius, at least 2; see [`Self::set_final_min_gain`]).
     final_min_gain: Option<usize>,
     // Dijkstra scratch (generation-stamped).
     dist: Vec<u64>,
@@ -277,8 +277,8 @@ impl Extension {
         &self.opts
     }
 
-    /// Host hook: the pixels a trip must gain after the host's coverage (default: half a tool
-    /// radius, at least 2). `bsa-extended` sets 1: its cells leave one-pixel strips along
+    /// Host hook: the pixels a trip must gain after the host's coverage (default: a tool
+    /// radius, at least 2, or one on a strip of rim). `bsa-extended` sets 1: its cells leave one-pixel strips along
     /// axis-parallel walls where every position gains a single pixel.
     #[allow(dead_code)] // used by bsa-extended
     pub(crate) fn set_final_min_gain(&mut self, g: usize) {
@@ -597,15 +597,15 @@ impl Extension {
             (self.opts.reach_r * self.r / self.frame.resolution * COST_ORTHO as f64) as u64
         });
         // Thresholds, in pixels a position must sweep: a trip to a rim must gain a tool radius
-        // of pixels (half of it, at least 2, after the host's coverage: only specks stay), a step
-        // off the contour as much, a step along the contour one.
+        // of pixels (at least 2; after the host's coverage one on a strip of rim: only specks
+        // stay), a step off the contour as much, a step along the contour one.
         let tool = self.rt.ceil().max(1.0) as usize;
         let g_start = if bounded {
             tool
         } else if let Some(g) = self.final_min_gain {
             g.max(1)
         } else {
-            (self.rt / 2.0).ceil().max(2.0) as usize
+            tool.max(2)
         };
         let g_int = tool;
         let g_con = 1;
