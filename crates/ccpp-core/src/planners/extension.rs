@@ -193,6 +193,9 @@ pub(crate) struct Extension {
     s1_disk: Vec<i64>,
     /// Per pixel: bit `k` = the move to neighbour `NB[k]` is known free.
     edge_free: Vec<u8>,
+    /// Per pixel: bit `k` = the move to neighbour `NB[k]` is known blocked (a seen obstacle
+    /// stays one, so this never changes back).
+    edge_blocked: Vec<u8>,
     /// The tool disk around a pixel centre, as pixel offsets.
     tool: Vec<(i64, i64)>,
     /// The same disk as row half-widths (entry `|drow|`).
@@ -258,6 +261,7 @@ impl Extension {
             s1: vec![0; n],
             s1_disk: pixel_disk_spans((rc * rc + 0.5).sqrt() + 1e-9),
             edge_free: vec![0; n],
+            edge_blocked: vec![0; n],
             tool: off,
             tool_rows,
             strip_rows,
@@ -382,19 +386,33 @@ impl Extension {
         if self.edge_free[i] & (1 << k) != 0 {
             return true;
         }
-        if self.in_s0(known, q) != Some(true) {
+        if self.edge_blocked[i] & (1 << k) != 0 || self.in_s0(known, q) != Some(true) {
             return false;
         }
-        // Between two `S1` positions a move is free; else check it on the known map (once free,
-        // it stays so).
-        if (self.in_s1(known, p) && self.in_s1(known, q))
-            || self.seg_free(known, self.center(p), self.center(q))
-        {
-            self.edge_free[i] |= 1 << k;
-            self.edge_free[j] |= 1 << ((k + 4) % 8);
-            true
+        // Between two `S1` positions a move is free; else check it on the known map (once free
+        // or blocked, it stays so).
+        let judged = if self.in_s1(known, p) && self.in_s1(known, q) {
+            Judgement::Free
         } else {
-            false
+            judge_motion(
+                known,
+                self.world(self.center(p)),
+                self.world(self.center(q)),
+                self.r,
+            )
+        };
+        match judged {
+            Judgement::Free => {
+                self.edge_free[i] |= 1 << k;
+                self.edge_free[j] |= 1 << ((k + 4) % 8);
+                true
+            }
+            Judgement::Blocked => {
+                self.edge_blocked[i] |= 1 << k;
+                self.edge_blocked[j] |= 1 << ((k + 4) % 8);
+                false
+            }
+            Judgement::Undetermined => false,
         }
     }
 
