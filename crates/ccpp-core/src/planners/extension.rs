@@ -25,7 +25,7 @@
 //! 1. **Find a rim**: Dijkstra over positions from the robot to the nearest position that
 //!    sweeps at least a tool radius of target pixels (at the end of a host region the search is
 //!    bounded by [`ExtensionOptions::reach_r`] robot radii; after the host's coverage it is not,
-//!    and half a tool radius of pixels, at least 2, is enough — or a single pixel when the
+//!    and a tool radius of pixels, at least 2, is enough — or a single pixel when the
 //!    position lies on a *strip* of rim: at least 4 targets within the tool radius plus 3
 //!    pixels. Where a wall runs at a sub-pixel offset every position beside it sweeps one pixel
 //!    of a one-pixel strip; on `tuw_single_corridors` those strips were 1 % of the floor.
@@ -193,6 +193,9 @@ pub(crate) struct Extension {
     s1_disk: Vec<i64>,
     /// Per pixel: bit `k` = the move to neighbour `NB[k]` is known free.
     edge_free: Vec<u8>,
+    /// Per pixel: bit `k` = the move to neighbour `NB[k]` is known blocked (a seen obstacle
+    /// stays one, so this never changes back).
+    edge_blocked: Vec<u8>,
     /// The tool disk around a pixel centre, as pixel offsets.
     tool: Vec<(i64, i64)>,
     /// The same disk as row half-widths (entry `|drow|`).
@@ -206,8 +209,8 @@ pub(crate) struct Extension {
     /// `no_gain_seen` seen pixels (targets only disappear in between).
     no_gain: FixedBitSet,
     no_gain_seen: usize,
-    /// Host override of the pixels a trip must gain after the host's coverage (`None`: half a
-    /// tool radius, at least 2; see [`Self::set_final_min_gain`]).
+    /// Host override of the pixels a trip must gain after the host's coverage (`None`: a tool
+    /// radius, at least 2; see [`Self::set_final_min_gain`]).
     final_min_gain: Option<usize>,
     // Dijkstra scratch (generation-stamped).
     dist: Vec<u64>,
@@ -258,6 +261,7 @@ impl Extension {
             s1: vec![0; n],
             s1_disk: pixel_disk_spans((rc * rc + 0.5).sqrt() + 1e-9),
             edge_free: vec![0; n],
+            edge_blocked: vec![0; n],
             tool: off,
             tool_rows,
             strip_rows,
@@ -277,8 +281,8 @@ impl Extension {
         &self.opts
     }
 
-    /// Host hook: the pixels a trip must gain after the host's coverage (default: half a tool
-    /// radius, at least 2). `bsa-extended` sets 1: its cells leave one-pixel strips along
+    /// Host hook: the pixels a trip must gain after the host's coverage (default: a tool
+    /// radius, at least 2, or one on a strip of rim). `bsa-extended` sets 1: its cells leave one-pixel strips along
     /// axis-parallel walls where every position gains a single pixel.
     #[allow(dead_code)] // used by bsa-extended
     pub(crate) fn set_final_min_gain(&mut self, g: usize) {
@@ -382,19 +386,33 @@ impl Extension {
         if self.edge_free[i] & (1 << k) != 0 {
             return true;
         }
-        if self.in_s0(known, q) != Some(true) {
+        if self.edge_blocked[i] & (1 << k) != 0 || self.in_s0(known, q) != Some(true) {
             return false;
         }
-        // Between two `S1` positions a move is free; else check it on the known map (once free,
-        // it stays so).
-        if (self.in_s1(known, p) && self.in_s1(known, q))
-            || self.seg_free(known, self.center(p), self.center(q))
-        {
-            self.edge_free[i] |= 1 << k;
-            self.edge_free[j] |= 1 << ((k + 4) % 8);
-            true
+        // Between two `S1` positions a move is free; else check it on the known map (once free
+        // or blocked, it stays so).
+        let judged = if self.in_s1(known, p) && self.in_s1(known, q) {
+            Judgement::Free
         } else {
-            false
+            judge_motion(
+                known,
+                self.world(self.center(p)),
+                self.world(self.center(q)),
+                self.r,
+            )
+        };
+        match judged {
+            Judgement::Free => {
+                self.edge_free[i] |= 1 << k;
+                self.edge_free[j] |= 1 << ((k + 4) % 8);
+                true
+            }
+            Judgement::Blocked => {
+                self.edge_blocked[i] |= 1 << k;
+                self.edge_blocked[j] |= 1 << ((k + 4) % 8);
+                false
+            }
+            Judgement::Undetermined => false,
         }
     }
 
@@ -597,15 +615,15 @@ impl Extension {
             (self.opts.reach_r * self.r / self.frame.resolution * COST_ORTHO as f64) as u64
         });
         // Thresholds, in pixels a position must sweep: a trip to a rim must gain a tool radius
-        // of pixels (half of it, at least 2, after the host's coverage: only specks stay), a step
-        // off the contour as much, a step along the contour one.
+        // of pixels (at least 2; after the host's coverage one on a strip of rim: only specks
+        // stay), a step off the contour as much, a step along the contour one.
         let tool = self.rt.ceil().max(1.0) as usize;
         let g_start = if bounded {
             tool
         } else if let Some(g) = self.final_min_gain {
             g.max(1)
         } else {
-            (self.rt / 2.0).ceil().max(2.0) as usize
+            tool.max(2)
         };
         let g_int = tool;
         let g_con = 1;
