@@ -142,7 +142,7 @@ impl BaStarExtended {
             let wanted = |p: Point| last || !ba.will_cover(p);
             ext.plan_pass(known, pos, bounded, &wanted)
         };
-        if !chunk.sweep.is_empty() {
+        if !(chunk.transfer.is_empty() && chunk.sweep.is_empty()) {
             // A transfer of a robot diameter or more is a backtracking transfer (drawn dashed,
             // counted in `backtrack_length`); a shorter one belongs to the pass.
             let mut at = pos;
@@ -170,7 +170,7 @@ impl BaStarExtended {
             if transfer {
                 self.queue.push_back(Step::Mark(Event::BacktrackEnd));
             }
-            if !self.in_pass {
+            if !self.in_pass && !chunk.sweep.is_empty() {
                 self.in_pass = true;
                 self.queue.push_back(Step::Mark(Event::WallFollowStart));
             }
