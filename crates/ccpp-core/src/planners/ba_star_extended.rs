@@ -60,7 +60,7 @@ pub struct BaStarExtendedOptions {
     pub ba_star: BaStarOptions,
     /// The extension. Its `reach_r` defaults to 0 here (one clean-up after BA*): cleaning
     /// around each region's end left the robot far from BA*'s next start, and the transfers
-    /// made the mean path ratio on the 14 shared maps 1.461 instead of 1.420 (an `extension`
+    /// made the mean path ratio on the 14 shared maps 1.461 instead of 1.421 (an `extension`
     /// section that omits `reach_r` gets the component's default, 4).
     pub extension: ExtensionOptions,
 }
@@ -142,7 +142,7 @@ impl BaStarExtended {
             let wanted = |p: Point| last || !ba.will_cover(p);
             ext.plan_pass(known, pos, bounded, &wanted)
         };
-        if !chunk.sweep.is_empty() {
+        if !(chunk.transfer.is_empty() && chunk.sweep.is_empty()) {
             // A transfer of a robot diameter or more is a backtracking transfer (drawn dashed,
             // counted in `backtrack_length`); a shorter one belongs to the pass.
             let mut at = pos;
@@ -170,7 +170,7 @@ impl BaStarExtended {
             if transfer {
                 self.queue.push_back(Step::Mark(Event::BacktrackEnd));
             }
-            if !self.in_pass {
+            if !self.in_pass && !chunk.sweep.is_empty() {
                 self.in_pass = true;
                 self.queue.push_back(Step::Mark(Event::WallFollowStart));
             }

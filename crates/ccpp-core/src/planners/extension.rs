@@ -170,10 +170,9 @@ const MAX_WALK: usize = 20_000;
 /// One chunk of a cleaning pass ([`Extension::plan_pass`]), world waypoints.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub(crate) struct Chunk {
-    /// The way to the rim: waypoints before the first position that sweeps (empty when the
-    /// robot already stands on the rim).
+    /// The way to the rim: waypoints up to the first position that sweeps.
     pub(crate) transfer: Vec<Point>,
-    /// The sweep along the rim, after the transfer (never empty in a non-empty chunk).
+    /// The sweep along the rim, after the transfer (empty when the pass ends where it starts).
     pub(crate) sweep: Vec<Point>,
 }
 
@@ -698,15 +697,21 @@ impl Extension {
             pts.push(self.center(cur));
             gains.push(self.claim(known, cur, wanted));
         }
+        // The transfer (up to the walk's first position, index `nt`) and the walk are merged
+        // apart: no segment cuts across from the way there to the rim.
+        let nt = transit.len();
         let kept: Vec<usize> = if self.opts.merge_segments {
-            self.merge(known, &pts, &gains)
+            let mut kept = self.merge(known, &pts[..=nt], &gains[..=nt]);
+            kept.extend(
+                self.merge(known, &pts[nt..], &gains[nt..])
+                    .into_iter()
+                    .map(|k| k + nt),
+            );
+            kept
         } else {
             (1..pts.len()).collect()
         };
-        // Points before the walk's first position (index `nt`) make the transfer; the sweep
-        // holds at least the last point.
-        let nt = transit.len();
-        let split = kept.partition_point(|&k| k < nt);
+        let split = kept.partition_point(|&k| k <= nt);
         let (t, w) = kept.split_at(split);
         Chunk {
             transfer: t.iter().map(|&k| self.world(pts[k])).collect(),
