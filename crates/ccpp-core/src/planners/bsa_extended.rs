@@ -174,7 +174,7 @@ impl BsaExtended {
             let wanted = |p: Point| last || !bsa.will_cover(p);
             ext.plan_pass(known, pos, bounded, &wanted)
         };
-        if !chunk.sweep.is_empty() {
+        if !(chunk.transfer.is_empty() && chunk.sweep.is_empty()) {
             // As in ba-star-extended: a trip of a robot diameter or more between rims is a
             // backtracking transfer (drawn dashed, counted in `backtrack_length`).
             let transfer = polyline_len(pos, &chunk.transfer) >= 2.0 * ext.radius();
@@ -192,7 +192,7 @@ impl BsaExtended {
             if transfer {
                 self.queue.push_back(Step::Mark(Event::BacktrackEnd));
             }
-            if !self.in_pass {
+            if !self.in_pass && !chunk.sweep.is_empty() {
                 self.in_pass = true;
                 self.queue.push_back(Step::Mark(Event::WallFollowStart));
             }
