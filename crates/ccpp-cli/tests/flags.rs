@@ -338,7 +338,18 @@ fn config_values_go_through_the_same_validation() {
             "rect-boustrophedon",
             "width_m",
         ),
-        ("bsa_extended: { gap_cost: 0 }", "bsa-extended", "gap_cost"),
+        (
+            "bsa_extended: { extension: { reach_r: -1 } }",
+            "bsa-extended",
+            "bsa_extended.extension.reach_r",
+        ),
+        // Options the rebuilt bsa-extended dropped are unknown keys now, refused by name.
+        ("bsa_extended: { gap_cost: 4 }", "bsa-extended", "gap_cost"),
+        (
+            "bsa_extended: { extension: { lane_ends: true } }",
+            "bsa-extended",
+            "bsa_extended.extension.lane_ends",
+        ),
     ]
     .into_iter()
     .enumerate()

@@ -3,7 +3,7 @@
 use std::fmt::Write as _;
 
 use ccpp_core::planners::bsa::{Bsa, BsaOptions};
-use ccpp_core::planners::bsa_extended::BsaExtendedOptions;
+use ccpp_core::planners::bsa_extended::{BsaExtended, BsaExtendedOptions};
 use ccpp_core::sim::{simulate, SimConfig};
 use ccpp_core::world::{Robot, World};
 use ccpp_core::GridMap;
@@ -42,7 +42,7 @@ fn bench(c: &mut Criterion) {
         b.iter(|| {
             simulate(
                 &world,
-                &mut Bsa::extended(BsaExtendedOptions::default()),
+                &mut BsaExtended::new(BsaExtendedOptions::default()),
                 &cfg,
             )
         });

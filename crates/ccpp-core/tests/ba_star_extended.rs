@@ -172,24 +172,81 @@ fn room_rims_are_swept() {
         starts,
         count(&out.trace, |e| matches!(e, Event::WallFollowEnd))
     );
-    assert_eq!(m.regions, m.backtracks + 1);
+    // BA*'s region changes, plus the marked transfers between rims.
+    assert!(m.backtracks + 1 >= m.regions);
+    assert_eq!(
+        count(&out.trace, |e| matches!(e, Event::BacktrackStart)),
+        count(&out.trace, |e| matches!(e, Event::BacktrackEnd))
+    );
+}
+
+/// Length of the moves inside backtrack sections after trace record `from`.
+fn backtrack_length_after(trace: &Trace, from: usize) -> f64 {
+    let (mut inside, mut last, mut len) = (false, None::<[f64; 2]>, 0.0);
+    for r in &trace.records[from..] {
+        match r {
+            Record::Event {
+                event: Event::BacktrackStart,
+                ..
+            } => inside = true,
+            Record::Event {
+                event: Event::BacktrackEnd,
+                ..
+            } => inside = false,
+            Record::Pose { pose, .. } => {
+                if let (true, Some(l)) = (inside, last) {
+                    len += (pose[0] - l[0]).hypot(pose[1] - l[1]);
+                }
+                last = Some([pose[0], pose[1]]);
+            }
+            Record::Event { .. } => {}
+        }
+    }
+    len
+}
+
+#[test]
+fn final_transfers_are_backtracking_transfers() {
+    // Cleaning only after BA*: the robot must travel between the rims of the rooms, and those
+    // trips are marked as backtracking transfers (drawn dashed, counted in the backtrack length).
+    let wd = world(HALLS, 2, 9, 0.0).unwrap();
+    let opts = BaStarExtendedOptions {
+        extension: ExtensionOptions {
+            reach_r: 0.0,
+            ..ExtensionOptions::default()
+        },
+        ..BaStarExtendedOptions::default()
+    };
+    let (out, m, _) = run_ext(&wd, opts);
+    assert_eq!(m.collisions, 0);
+    assert!(m.effective_coverage > 0.99);
+    let (_, last_region_end) = first_pass_last_region_end(&out.trace);
+    let after = backtrack_length_after(&out.trace, last_region_end);
+    assert!(after >= 2.0 * R, "{after}");
+    assert!(m.backtrack_length_m >= after);
+    assert!(m.backtracks + 1 > m.regions);
 }
 
 #[test]
 fn merging_saves_turns_and_keeps_coverage() {
     let wd = world(ROOM, 2, 4, 0.0).unwrap();
-    let (_, merged, _) = run_ext(&wd, BaStarExtendedOptions::default());
-    let opts = BaStarExtendedOptions {
+    let merge = |merge_segments| BaStarExtendedOptions {
         extension: ExtensionOptions {
-            merge_segments: false,
+            merge_segments,
             ..ExtensionOptions::default()
         },
         ..BaStarExtendedOptions::default()
     };
-    let (_, pixel, _) = run_ext(&wd, opts);
+    let (mo, merged, _) = run_ext(&wd, merge(true));
+    let (po, pixel, _) = run_ext(&wd, merge(false));
     assert_eq!(pixel.collisions, 0);
+    assert_eq!(merged.collisions, 0);
+    // Far fewer waypoints in the passes; the whole run may turn a little more or less (the
+    // merged walk leaves other one-pixel strips for later passes), never much more.
+    let (a, b) = (pass_poses(&mo.trace), pass_poses(&po.trace));
+    assert!(2 * a < b, "merged {a} pixel {b}");
     assert!(
-        merged.turns < pixel.turns,
+        merged.turns * 10 < pixel.turns * 11,
         "{} {}",
         merged.turns,
         pixel.turns
@@ -209,6 +266,19 @@ const BLOCKS: &str = "\
     #..................#\n\
     #..................#\n\
     ####################";
+
+const HALLS: &str = "\
+    ##############################\n\
+    #............................#\n\
+    #..####......####......####..#\n\
+    #..####......####......####..#\n\
+    #............................#\n\
+    #............................#\n\
+    #..####......####......####..#\n\
+    #..####......####......####..#\n\
+    #............................#\n\
+    #............................#\n\
+    ##############################";
 
 /// Index of the first wall pass and of the last region end in a trace.
 fn first_pass_last_region_end(trace: &Trace) -> (usize, usize) {
@@ -243,8 +313,18 @@ fn zero_reach_cleans_only_after_ba_star() {
     // Every pass starts after BA*'s last region ended.
     let (first_pass, last_region_end) = first_pass_last_region_end(&out.trace);
     assert!(first_pass > last_region_end && first_pass != usize::MAX);
-    // With the default reach, passes also run between regions.
-    let (out, m, _) = run_ext(&wd, BaStarExtendedOptions::default());
+    // The default cleans only after BA* too.
+    let (out_d, _, _) = run_ext(&wd, BaStarExtendedOptions::default());
+    assert_eq!(out_d.trace, out.trace);
+    // With a reach, passes also run between regions.
+    let opts = BaStarExtendedOptions {
+        extension: ExtensionOptions {
+            reach_r: 4.0,
+            ..ExtensionOptions::default()
+        },
+        ..BaStarExtendedOptions::default()
+    };
+    let (out, m, _) = run_ext(&wd, opts);
     assert_eq!(m.collisions, 0);
     let (first_pass, last_region_end) = first_pass_last_region_end(&out.trace);
     assert!(first_pass < last_region_end);

@@ -2,7 +2,7 @@
 
 use ccpp_core::metrics::{compute, Metrics};
 use ccpp_core::planners::bsa::{Bsa, BsaOptions, Side};
-use ccpp_core::planners::bsa_extended::BsaExtendedOptions;
+use ccpp_core::planners::bsa_extended::{BsaExtended, BsaExtendedOptions};
 use ccpp_core::sim::{simulate, RunOutput, SimConfig};
 use ccpp_core::trace::Event;
 use ccpp_core::world::{Robot, World};
@@ -31,7 +31,7 @@ fn run(w: &World, side: Side) -> (RunOutput, Metrics) {
 }
 
 fn run_ext(w: &World, side: Side) -> (RunOutput, Metrics) {
-    let mut p = Bsa::extended(BsaExtendedOptions {
+    let mut p = BsaExtended::new(BsaExtendedOptions {
         side,
         ..Default::default()
     });

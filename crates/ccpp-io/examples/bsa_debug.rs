@@ -8,8 +8,7 @@
 use std::path::PathBuf;
 
 use ccpp_core::metrics::{compute, swept_pixels};
-use ccpp_core::planners::bsa::Bsa;
-use ccpp_core::planners::bsa_extended::BsaExtendedOptions;
+use ccpp_core::planners::bsa_extended::{BsaExtended, BsaExtendedOptions};
 use ccpp_core::sim::{simulate, SimConfig};
 use ccpp_core::world::{Robot, World};
 use ccpp_io::{load_map, LoadOptions};
@@ -28,13 +27,7 @@ fn main() {
     let world = World::new(loaded.grid, Robot::new(r), None).expect("world");
     let run = simulate(
         &world,
-        &mut Bsa::extended(BsaExtendedOptions {
-            clearance_px: std::env::var("BSA_CLEARANCE_PX")
-                .ok()
-                .and_then(|s| s.parse().ok())
-                .unwrap_or(BsaExtendedOptions::default().clearance_px),
-            ..Default::default()
-        }),
+        &mut BsaExtended::new(BsaExtendedOptions::default()),
         &SimConfig::default(),
     );
     let m = compute(&world, &run, "debug");

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use ccpp_core::metrics::compute;
 use ccpp_core::planners::bsa::{Bsa, BsaOptions};
-use ccpp_core::planners::bsa_extended::BsaExtendedOptions;
+use ccpp_core::planners::bsa_extended::{BsaExtended, BsaExtendedOptions};
 use ccpp_core::sim::{simulate, SimConfig};
 use ccpp_core::world::{Robot, World};
 use ccpp_io::{load_map, LoadOptions};
@@ -43,13 +43,7 @@ fn main() {
         let mb = compute(&world, &b, &name);
         let e = simulate(
             &world,
-            &mut Bsa::extended(BsaExtendedOptions {
-                clearance_px: std::env::var("BSA_CLEARANCE_PX")
-                    .ok()
-                    .and_then(|s| s.parse().ok())
-                    .unwrap_or(BsaExtendedOptions::default().clearance_px),
-                ..Default::default()
-            }),
+            &mut BsaExtended::new(BsaExtendedOptions::default()),
             &cfg,
         );
         let me = compute(&world, &e, &name);

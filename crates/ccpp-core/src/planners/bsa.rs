@@ -4,7 +4,9 @@
 //! Source: E. González, O. Álvarez, Y. Díaz, C. Parra, C. Bustacara, "BSA: a complete coverage
 //! algorithm", ICRA 2005 (seeds 002/004), which summarises the basic algorithm of González,
 //! Alarcón, Aristizábal and Parra (IROS 2003). The extended version that also covers partially
-//! occupied cells lives in [`super::bsa_extended`] and reuses this module's machinery.
+//! occupied cells, [`super::bsa_extended`], drives this planner as a host of the generic
+//! coverage extension ([`super::extension`]) through a few hooks ([`Bsa::observe`],
+//! [`Bsa::will_cover`], [`Bsa::transfer`], [`Bsa::replace_transfer`]).
 //!
 //! # The algorithm as implemented
 //!
@@ -67,9 +69,8 @@ use std::collections::VecDeque;
 
 use serde::{Deserialize, Serialize};
 
-use super::bsa_extended::{BsaExtendedOptions, Extension};
 use crate::geometry::Point;
-use crate::planner::{KnownMap, Planner, Sensor, Step};
+use crate::planner::{DiskState, KnownMap, Planner, Sensor, Step};
 use crate::search::SearchSpace;
 use crate::tiles::{Tile, TileGrid};
 use crate::trace::Event;
@@ -120,14 +121,8 @@ pub const HEADINGS: [Tile; 4] = [(1, 0), (0, 1), (-1, 0), (0, -1)];
 pub(crate) const VISITED: u8 = 1;
 /// Cell flag: recorded as a backtracking point.
 pub(crate) const BP: u8 = 2;
-/// Cell flag: the robot's centre has been inside the cell (extended: gap cells of return paths).
-pub(crate) const TOUCHED: u8 = 4;
 /// Cell flag: the robot can stand at the centre (final, from sensed pixels).
 pub(crate) const STAND_FREE: u8 = 8;
-/// Cell flag: the robot cannot stand at the centre (final).
-pub(crate) const STAND_BLOCKED: u8 = 16;
-/// Cell flag: given up as a backtracking target (no return path found).
-pub(crate) const DEAD: u8 = 32;
 
 /// Edge state: the straight move between the centres is free.
 pub(crate) const EDGE_FREE: u8 = 1;
@@ -148,8 +143,6 @@ pub(crate) struct Cells {
     flags: Vec<u8>,
     /// Two bits per heading (E, N, W, S): 0 unknown, [`EDGE_FREE`], [`EDGE_BLOCKED`].
     edges: Vec<u8>,
-    /// Extended BSA: bit `d` set once the obstacle trigger was evaluated towards heading `d`.
-    checked: Vec<u8>,
     /// Search scratch: cost and parent per cell, reused across searches.
     search: SearchSpace<u32>,
 }
@@ -166,7 +159,6 @@ impl Cells {
             h,
             flags: vec![0; n],
             edges: vec![0; n],
-            checked: vec![0; n],
             search: SearchSpace::new(n),
         }
     }
@@ -180,36 +172,6 @@ impl Cells {
         } else {
             Some(dj as usize * self.w + di as usize)
         }
-    }
-
-    /// Index of the neighbour of cell `k` towards heading `d` (`None` off the range).
-    #[inline]
-    pub(crate) fn step(&self, k: usize, d: usize) -> Option<usize> {
-        let (di, dj) = (k % self.w, k / self.w);
-        match d {
-            0 => (di + 1 < self.w).then_some(k + 1),
-            1 => (dj + 1 < self.h).then_some(k + self.w),
-            2 => (di > 0).then(|| k - 1),
-            _ => (dj > 0).then(|| k - self.w),
-        }
-    }
-
-    /// All flags of cell `k`.
-    #[inline]
-    pub(crate) fn flags_at(&self, k: usize) -> u8 {
-        self.flags[k]
-    }
-
-    /// Edge state of cell `k` towards heading `d`, for a neighbour inside the range.
-    #[inline]
-    pub(crate) fn edge_at(&self, k: usize, d: usize) -> u8 {
-        (self.edges[k] >> (2 * d)) & 3
-    }
-
-    /// Number of cells in the range.
-    #[inline]
-    pub(crate) fn len(&self) -> usize {
-        self.w * self.h
     }
 
     #[inline]
@@ -257,18 +219,6 @@ impl Cells {
         }
     }
 
-    /// Was the trigger towards `d` evaluated at `t`? Marks it evaluated.
-    pub(crate) fn check_once(&mut self, t: Tile, d: usize) -> bool {
-        match self.idx(t) {
-            Some(k) => {
-                let first = self.checked[k] & (1 << d) == 0;
-                self.checked[k] |= 1 << d;
-                first
-            }
-            None => false,
-        }
-    }
-
     /// Starts a new search: every cell's scratch becomes stale.
     pub(crate) fn new_search(&mut self) {
         self.search.begin();
@@ -299,10 +249,6 @@ pub(crate) struct Core {
     pub(crate) grid: TileGrid,
     /// Robot radius, metres.
     pub(crate) r: f64,
-    /// Cleaning tool radius, metres.
-    pub(crate) tool: f64,
-    /// Sensor range, metres.
-    pub(crate) range: f64,
     pub(crate) cells: Cells,
     /// Recorded backtracking points (validated at each spiral end).
     pub(crate) bps: Vec<Tile>,
@@ -325,8 +271,6 @@ impl Core {
             known: KnownMap::new(sensor.frame()),
             grid,
             r,
-            tool: sensor.robot().tool_radius,
-            range: sensor.sensor_range(),
             cells,
             bps: Vec::new(),
             cell: (0, 0),
@@ -377,7 +321,7 @@ impl Core {
 
     /// Records `t` as a backtracking point (once).
     pub(crate) fn add_bp(&mut self, t: Tile, queue: &mut VecDeque<Step>) {
-        if self.cells.has(t, BP | VISITED | DEAD) || self.cells.idx(t).is_none() {
+        if self.cells.has(t, BP | VISITED) || self.cells.idx(t).is_none() {
             return;
         }
         self.cells.set(t, BP);
@@ -388,14 +332,14 @@ impl Core {
 
     /// Marks `t` visited (a virtual obstacle).
     pub(crate) fn visit(&mut self, t: Tile) {
-        self.cells.set(t, VISITED | TOUCHED | STAND_FREE);
+        self.cells.set(t, VISITED | STAND_FREE);
     }
 
-    /// Drops the BPs that are no longer unvisited (or were given up).
+    /// Drops the BPs that are no longer unvisited.
     pub(crate) fn validate_bps(&mut self) {
         let cells = &mut self.cells;
         self.bps.retain(|&t| {
-            let keep = !cells.has(t, VISITED | DEAD);
+            let keep = !cells.has(t, VISITED);
             if !keep {
                 cells.clear(t, BP);
             }
@@ -451,21 +395,15 @@ enum Phase {
     Arrive(usize),
     /// Spiral filling.
     Spiral,
-    /// Extended BSA: wall following (driven by [`Extension`]).
-    Follow,
     /// No BP left.
     Finished,
 }
 
-/// The BSA planner (basic with [`Bsa::new`], extended with [`Bsa::extended`]).
+/// The basic BSA planner (also the host of `bsa-extended`, see [`super::bsa_extended`]).
 pub struct Bsa {
     side: Side,
-    name: &'static str,
-    ext: Option<Extension>,
     core: Option<Core>,
     phase: Phase,
-    /// Phase to return to after a wall follow.
-    resume: Phase,
     queue: VecDeque<Step>,
 }
 
@@ -474,25 +412,102 @@ impl Bsa {
     pub fn new(opts: BsaOptions) -> Self {
         Self {
             side: opts.side,
-            name: "bsa",
-            ext: None,
             core: None,
             phase: Phase::Init,
-            resume: Phase::Spiral,
             queue: VecDeque::new(),
         }
     }
 
-    /// Extended BSA (`--planner bsa-extended`): see [`super::bsa_extended`].
-    pub fn extended(opts: BsaExtendedOptions) -> Self {
-        Self {
-            side: opts.side,
-            name: "bsa-extended",
-            ext: Some(Extension::new(opts)),
-            core: None,
-            phase: Phase::Init,
-            resume: Phase::Spiral,
-            queue: VecDeque::new(),
+    /// What the sensor has shown so far (after the first step).
+    pub fn known_map(&self) -> Option<&KnownMap> {
+        self.core.as_ref().map(|c| &c.known)
+    }
+
+    /// The cells (after the first step).
+    pub fn cell_grid(&self) -> Option<TileGrid> {
+        self.core.as_ref().map(|c| c.grid)
+    }
+
+    /// Hook for extensions: integrates the current scan into the known map (initialising the
+    /// planner on its first call) without deciding anything. [`Planner::next`] does the same
+    /// before each decision, so calling this first changes nothing.
+    pub fn observe(&mut self, sensor: &dyn Sensor) {
+        let core = self.core.get_or_insert_with(|| Core::new(sensor));
+        core.known.integrate(&sensor.scan());
+    }
+
+    /// Hook for extensions: will BSA still stand in the cell holding world point `p` (so that
+    /// the cell is swept)? `true` when the cell is not visited and its centre is not known to
+    /// be blocked for the robot (a cell BSA cannot enter although it can stand there is found
+    /// out only at the end).
+    pub fn will_cover(&self, p: Point) -> bool {
+        self.core.as_ref().is_some_and(|c| {
+            let t = c.grid.tile_of(p);
+            if c.cells.idx(t).is_none() || c.cells.has(t, VISITED) {
+                return false;
+            }
+            if c.cells.has(t, STAND_FREE) {
+                return true;
+            }
+            let f = c.known.frame();
+            let rc = crate::collide::contact_radius_px(c.r / f.resolution);
+            c.known.disk_state(f.world_to_grid(c.center(t)), rc) != DiskState::Blocked
+        })
+    }
+
+    /// Hook for extensions: the moves of the queued transfer to the next spiral (its last point
+    /// the centre of the selected backtracking point), between a spiral's [`Event::RegionEnd`]
+    /// and the transfer's [`Event::BacktrackEnd`]; `None` when no transfer is queued.
+    pub fn transfer(&self) -> Option<Vec<Point>> {
+        let start = self
+            .queue
+            .iter()
+            .position(|s| matches!(s, Step::Mark(Event::BacktrackStart)))?;
+        let end = self
+            .queue
+            .iter()
+            .position(|s| matches!(s, Step::Mark(Event::BacktrackEnd)))?;
+        let moves: Vec<Point> = self
+            .queue
+            .range(start..end)
+            .filter_map(|s| match s {
+                Step::MoveTo(p) => Some(*p),
+                _ => None,
+            })
+            .collect();
+        (!moves.is_empty()).then_some(moves)
+    }
+
+    /// Hook for extensions: replaces the moves of the queued transfer by `moves` (a known-free
+    /// way from `from`, the robot's position when the transfer starts, to
+    /// the last point of [`Self::transfer`]). The trace's smoothed path
+    /// becomes `from` followed by `moves`.
+    pub fn replace_transfer(&mut self, from: Point, moves: &[Point]) {
+        let Some(start) = self
+            .queue
+            .iter()
+            .position(|s| matches!(s, Step::Mark(Event::BacktrackStart)))
+        else {
+            return;
+        };
+        let Some(end) = self
+            .queue
+            .iter()
+            .position(|s| matches!(s, Step::Mark(Event::BacktrackEnd)))
+        else {
+            return;
+        };
+        let old: Vec<Step> = self.queue.drain(start + 1..end).collect();
+        let mut new: Vec<Step> = old
+            .into_iter()
+            .filter(|s| matches!(s, Step::Mark(Event::PathRaw { .. })))
+            .collect();
+        let mut points = vec![[from.x, from.y]];
+        points.extend(moves.iter().map(|p| [p.x, p.y]));
+        new.push(Step::Mark(Event::PathSmoothed { points }));
+        new.extend(moves.iter().map(|&p| Step::MoveTo(p)));
+        for (k, s) in new.into_iter().enumerate() {
+            self.queue.insert(start + 1 + k, s);
         }
     }
 
@@ -529,21 +544,7 @@ impl Bsa {
     fn decide(&mut self, sensor: &dyn Sensor) {
         let core = self.core.get_or_insert_with(|| Core::new(sensor));
         core.known.integrate(&sensor.scan());
-        if let Some(ext) = self.ext.as_mut() {
-            ext.new_scan();
-        }
-        if self.phase == Phase::Follow {
-            let ext = self.ext.as_mut().expect("follow only in extended mode");
-            ext.follow_step(core, &mut self.queue, self.side);
-            if !ext.following() {
-                self.phase = self.resume;
-            }
-            return;
-        }
         if self.phase == Phase::Init {
-            if let Some(ext) = self.ext.as_mut() {
-                ext.init(core);
-            }
             core.region = 1;
             self.queue
                 .push_back(Step::Mark(Event::RegionStart { region: 1 }));
@@ -557,13 +558,6 @@ impl Bsa {
             };
         }
         let (_, blocked) = core.around();
-        if let Some(ext) = self.ext.as_mut() {
-            if ext.try_trigger(core, &mut self.queue, self.side) {
-                self.resume = self.phase;
-                self.phase = Phase::Follow;
-                return;
-            }
-        }
         match self.phase {
             Phase::Approach => {
                 let h = core.heading;
@@ -610,14 +604,7 @@ impl Bsa {
             region: core.region,
         }));
         core.validate_bps();
-        // A path over visited cells first (basic BSA, and the paper's first choice for the
-        // extended version); only where none exists may the extension cross partially
-        // occupied cells.
-        let plan = match core.select_basic() {
-            Some(cells) => Some(basic_plan(core, &cells)),
-            None => self.ext.as_mut().and_then(|ext| ext.select(core)),
-        };
-        let Some(plan) = plan else {
+        let Some(plan) = core.select_basic().map(|cells| basic_plan(core, &cells)) else {
             self.phase = Phase::Finished;
             return;
         };
@@ -708,7 +695,7 @@ pub(crate) fn merge_collinear(cells: &[Tile]) -> Vec<Tile> {
 
 impl Planner for Bsa {
     fn name(&self) -> &'static str {
-        self.name
+        "bsa"
     }
 
     fn tile_side(&self) -> Option<f64> {
@@ -718,9 +705,6 @@ impl Planner for Bsa {
     fn next(&mut self, sensor: &dyn Sensor) -> Step {
         loop {
             if let Some(s) = self.queue.pop_front() {
-                if let (Step::MoveTo(p), Some(ext)) = (&s, self.ext.as_mut()) {
-                    ext.driven(sensor.pose().position(), *p);
-                }
                 return s;
             }
             if self.phase == Phase::Finished {

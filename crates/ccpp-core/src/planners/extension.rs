@@ -25,7 +25,11 @@
 //! 1. **Find a rim**: Dijkstra over positions from the robot to the nearest position that
 //!    sweeps at least a tool radius of target pixels (at the end of a host region the search is
 //!    bounded by [`ExtensionOptions::reach_r`] robot radii; after the host's coverage it is not,
-//!    and half a tool radius of pixels, at least 2, is enough — only specks stay behind).
+//!    and a tool radius of pixels, at least 2, is enough — or a single pixel when the
+//!    position lies on a *strip* of rim: at least 4 targets within the tool radius plus 3
+//!    pixels. Where a wall runs at a sub-pixel offset every position beside it sweeps one pixel
+//!    of a one-pixel strip; on `tuw_single_corridors` those strips were 1 % of the floor.
+//!    Only specks stay behind).
 //! 2. **Follow it**: a greedy walk over positions that prefers the *contour* (positions next to
 //!    one where the robot does not fit — the iso-clearance curve at the clearance the robot can
 //!    hold, 0), then the largest gain, then the smallest turn. A step along the contour must
@@ -149,6 +153,11 @@ const COST_DIAG: u64 = 1414;
 /// Settled positions carry this bit in their search cost.
 const CLOSED: u64 = 1 << 63;
 
+/// A strip of rim: at least [`STRIP_N`] targets within the tool radius plus [`STRIP_PX`]
+/// pixels (see `plan_pass`).
+const STRIP_PX: f64 = 3.0;
+const STRIP_N: usize = 4;
+
 /// Heuristic weight of transfer searches.
 const ROUTE_WEIGHT: f64 = 1.5;
 
@@ -157,6 +166,15 @@ const MAX_MERGE: usize = 256;
 
 /// Longest walk of one chunk, in pixel steps.
 const MAX_WALK: usize = 20_000;
+
+/// One chunk of a cleaning pass ([`Extension::plan_pass`]), world waypoints.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub(crate) struct Chunk {
+    /// The way to the rim: waypoints up to the first position that sweeps.
+    pub(crate) transfer: Vec<Point>,
+    /// The sweep along the rim, after the transfer (empty when the pass ends where it starts).
+    pub(crate) sweep: Vec<Point>,
+}
 
 /// The extension's state (see the module docs).
 pub(crate) struct Extension {
@@ -174,16 +192,25 @@ pub(crate) struct Extension {
     s1_disk: Vec<i64>,
     /// Per pixel: bit `k` = the move to neighbour `NB[k]` is known free.
     edge_free: Vec<u8>,
+    /// Per pixel: bit `k` = the move to neighbour `NB[k]` is known blocked (a seen obstacle
+    /// stays one, so this never changes back).
+    edge_blocked: Vec<u8>,
     /// The tool disk around a pixel centre, as pixel offsets.
     tool: Vec<(i64, i64)>,
     /// The same disk as row half-widths (entry `|drow|`).
     tool_rows: Vec<i64>,
+    /// Row half-widths of the wider disk that tells a strip of rim from a speck
+    /// ([`STRIP_PX`] more than the tool radius).
+    strip_rows: Vec<i64>,
     /// Pixels swept (executed or claimed by a planned pass).
     swept: FixedBitSet,
     /// Final passes: positions known not to gain enough, valid while the known map holds
     /// `no_gain_seen` seen pixels (targets only disappear in between).
     no_gain: FixedBitSet,
     no_gain_seen: usize,
+    /// Host override of the pixels a trip must gain after the host's coverage (`None`: a tool
+    /// radius, at least 2; see [`Self::set_final_min_gain`]).
+    final_min_gain: Option<usize>,
     // Dijkstra scratch (generation-stamped).
     dist: Vec<u64>,
     parent: Vec<u32>,
@@ -207,14 +234,19 @@ impl Extension {
             }
         }
         let rc = crate::collide::contact_radius_px(r_px);
-        let tool_rows = (0..=reach)
-            .map(|dr| {
-                (0..=reach)
-                    .filter(|dc| ((dc * dc + dr * dr) as f64) <= rt * rt)
-                    .max()
-                    .unwrap_or(-1)
-            })
-            .collect();
+        let rows = |rad: f64| -> Vec<i64> {
+            let reach = rad.ceil() as i64;
+            (0..=reach)
+                .map(|dr| {
+                    (0..=reach)
+                        .filter(|dc| ((dc * dc + dr * dr) as f64) <= rad * rad)
+                        .max()
+                        .unwrap_or(-1)
+                })
+                .collect()
+        };
+        let tool_rows = rows(rt);
+        let strip_rows = rows(rt + STRIP_PX);
         Self {
             opts,
             frame,
@@ -228,11 +260,14 @@ impl Extension {
             s1: vec![0; n],
             s1_disk: pixel_disk_spans((rc * rc + 0.5).sqrt() + 1e-9),
             edge_free: vec![0; n],
+            edge_blocked: vec![0; n],
             tool: off,
             tool_rows,
+            strip_rows,
             swept: FixedBitSet::with_capacity(n),
             no_gain: FixedBitSet::with_capacity(n),
             no_gain_seen: usize::MAX,
+            final_min_gain: None,
             dist: vec![0; n],
             parent: vec![u32::MAX; n],
             stamp: vec![0; n],
@@ -243,6 +278,19 @@ impl Extension {
     /// The options.
     pub(crate) fn options(&self) -> &ExtensionOptions {
         &self.opts
+    }
+
+    /// Host hook: the pixels a trip must gain after the host's coverage (default: a tool
+    /// radius, at least 2, or one on a strip of rim). `bsa-extended` sets 1: its cells leave one-pixel strips along
+    /// axis-parallel walls where every position gains a single pixel.
+    #[allow(dead_code)] // used by bsa-extended
+    pub(crate) fn set_final_min_gain(&mut self, g: usize) {
+        self.final_min_gain = Some(g);
+    }
+
+    /// The robot radius (metres).
+    pub(crate) fn radius(&self) -> f64 {
+        self.r
     }
 
     /// Records an executed straight motion (world points) as swept.
@@ -337,19 +385,33 @@ impl Extension {
         if self.edge_free[i] & (1 << k) != 0 {
             return true;
         }
-        if self.in_s0(known, q) != Some(true) {
+        if self.edge_blocked[i] & (1 << k) != 0 || self.in_s0(known, q) != Some(true) {
             return false;
         }
-        // Between two `S1` positions a move is free; else check it on the known map (once free,
-        // it stays so).
-        if (self.in_s1(known, p) && self.in_s1(known, q))
-            || self.seg_free(known, self.center(p), self.center(q))
-        {
-            self.edge_free[i] |= 1 << k;
-            self.edge_free[j] |= 1 << ((k + 4) % 8);
-            true
+        // Between two `S1` positions a move is free; else check it on the known map (once free
+        // or blocked, it stays so).
+        let judged = if self.in_s1(known, p) && self.in_s1(known, q) {
+            Judgement::Free
         } else {
-            false
+            judge_motion(
+                known,
+                self.world(self.center(p)),
+                self.world(self.center(q)),
+                self.r,
+            )
+        };
+        match judged {
+            Judgement::Free => {
+                self.edge_free[i] |= 1 << k;
+                self.edge_free[j] |= 1 << ((k + 4) % 8);
+                true
+            }
+            Judgement::Blocked => {
+                self.edge_blocked[i] |= 1 << k;
+                self.edge_blocked[j] |= 1 << ((k + 4) % 8);
+                false
+            }
+            Judgement::Undetermined => false,
         }
     }
 
@@ -363,15 +425,27 @@ impl Extension {
 
     /// Number of targets within the tool radius of position `p` (stops at `cap`).
     fn gain(&self, known: &KnownMap, p: Px, wanted: &dyn Fn(Point) -> bool, cap: usize) -> usize {
+        self.count_targets(known, p, wanted, cap, &self.tool_rows)
+    }
+
+    /// Number of targets in the disk `rows` (row half-widths) around `p` (stops at `cap`).
+    fn count_targets(
+        &self,
+        known: &KnownMap,
+        p: Px,
+        wanted: &dyn Fn(Point) -> bool,
+        cap: usize,
+        rows: &[i64],
+    ) -> usize {
         let f = self.frame;
         let (w, h) = (f.width as i64, f.height as i64);
         let free = known.known_free().as_slice();
         let swept = self.swept.as_slice();
-        let reach = self.tool_rows.len() as i64 - 1;
+        let reach = rows.len() as i64 - 1;
         let mut n = 0;
         for dr in -reach..=reach {
             let row = p.1 + dr;
-            let hw = self.tool_rows[dr.unsigned_abs() as usize];
+            let hw = rows[dr.unsigned_abs() as usize];
             if hw < 0 || row < 0 || row >= h {
                 continue;
             }
@@ -512,6 +586,7 @@ impl Extension {
     /// Plans the next chunk of a cleaning pass from world point `pos`: the waypoints (world) to
     /// drive, empty when no rim within `reach` (robot radii; `None` = unbounded) gains.
     /// `pending(p)`: will the host still sweep world point `p`?
+    #[allow(dead_code)] // the hosts that need no transfer marks (bsa-extended)
     pub(crate) fn plan_chunk(
         &mut self,
         known: &KnownMap,
@@ -519,18 +594,35 @@ impl Extension {
         bounded: bool,
         wanted: &dyn Fn(Point) -> bool,
     ) -> Vec<Point> {
+        let c = self.plan_pass(known, pos, bounded, wanted);
+        let mut out = c.transfer;
+        out.extend(c.sweep);
+        out
+    }
+
+    /// [`Self::plan_chunk`] split in two: the transfer to the rim (waypoints that reach the
+    /// first sweeping position) and the sweep along it. Both empty when nothing gains.
+    pub(crate) fn plan_pass(
+        &mut self,
+        known: &KnownMap,
+        pos: Point,
+        bounded: bool,
+        wanted: &dyn Fn(Point) -> bool,
+    ) -> Chunk {
         let from = self.frame.world_to_grid(pos);
         let limit = bounded.then(|| {
             (self.opts.reach_r * self.r / self.frame.resolution * COST_ORTHO as f64) as u64
         });
         // Thresholds, in pixels a position must sweep: a trip to a rim must gain a tool radius
-        // of pixels (half of it, at least 2, after the host's coverage: only specks stay), a step
-        // off the contour as much, a step along the contour one.
+        // of pixels (at least 2; after the host's coverage one on a strip of rim: only specks
+        // stay), a step off the contour as much, a step along the contour one.
         let tool = self.rt.ceil().max(1.0) as usize;
         let g_start = if bounded {
             tool
+        } else if let Some(g) = self.final_min_gain {
+            g.max(1)
         } else {
-            (self.rt / 2.0).ceil().max(2.0) as usize
+            tool.max(2)
         };
         let g_int = tool;
         let g_con = 1;
@@ -546,13 +638,19 @@ impl Extension {
             if !bounded && s.no_gain.contains(i) {
                 return false;
             }
-            let gains = s.gain(known, p, wanted, g_start) >= g_start;
+            let g = s.gain(known, p, wanted, g_start);
+            // After the host: a position that sweeps a single pixel starts a pass too when it
+            // lies on a strip of rim (enough targets in the wider disk), not on a lone speck.
+            let gains = g >= g_start
+                || (!bounded
+                    && g >= 1
+                    && s.count_targets(known, p, wanted, STRIP_N, &s.strip_rows) >= STRIP_N);
             if !gains && !bounded {
                 s.no_gain.insert(i);
             }
             gains
         }) else {
-            return Vec::new();
+            return Chunk::default();
         };
         let mut pts: Vec<Point> = vec![from];
         let mut gains: Vec<Vec<usize>> = vec![Vec::new()];
@@ -599,12 +697,26 @@ impl Extension {
             pts.push(self.center(cur));
             gains.push(self.claim(known, cur, wanted));
         }
-        let kept = if self.opts.merge_segments {
-            self.merge(known, &pts, &gains)
+        // The transfer (up to the walk's first position, index `nt`) and the walk are merged
+        // apart: no segment cuts across from the way there to the rim.
+        let nt = transit.len();
+        let kept: Vec<usize> = if self.opts.merge_segments {
+            let mut kept = self.merge(known, &pts[..=nt], &gains[..=nt]);
+            kept.extend(
+                self.merge(known, &pts[nt..], &gains[nt..])
+                    .into_iter()
+                    .map(|k| k + nt),
+            );
+            kept
         } else {
             (1..pts.len()).collect()
         };
-        kept.into_iter().map(|k| self.world(pts[k])).collect()
+        let split = kept.partition_point(|&k| k <= nt);
+        let (t, w) = kept.split_at(split);
+        Chunk {
+            transfer: t.iter().map(|&k| self.world(pts[k])).collect(),
+            sweep: w.iter().map(|&k| self.world(pts[k])).collect(),
+        }
     }
 
     /// Greedy cut of the polyline `pts` into straight segments, each known free and keeping

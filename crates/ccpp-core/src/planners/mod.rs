@@ -188,13 +188,13 @@ registry! {
         offline: false,
         description: "Backtracking Spiral Algorithm: spirals on robot-sized cells, BFS backtracking over visited cells",
     }
-    /// BSA with wall following and gap crossing.
+    /// BSA hosting the coverage extension (wall following of the rims, gap crossing).
     BsaExtended {
         name: "bsa-extended",
         section: bsa_extended,
         options: bsa_extended::BsaExtendedOptions,
         offline: false,
-        description: "BSA plus wall following at map resolution and gap-crossing return paths, for coverage near obstacles",
+        description: "BSA plus the coverage extension (as ba-star-extended): wall passes over the rims its cells leave, straight known-free transfers",
     }
     /// The vacuum-robot BSA of seed 003.
     BsaBfs {

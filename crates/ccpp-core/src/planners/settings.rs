@@ -17,7 +17,7 @@ use super::ba_star_extended::{BaStarExtended, BaStarExtendedOptions};
 use super::bcd::{Bcd, BcdOptions};
 use super::bsa::{Bsa, BsaOptions};
 use super::bsa_bfs::{BsaBfs, BsaBfsOptions};
-use super::bsa_extended::BsaExtendedOptions;
+use super::bsa_extended::{BsaExtended, BsaExtendedOptions};
 use super::random_bounce::{RandomBounce, RandomBounceOptions};
 use super::rect_boustrophedon::{RectBoustrophedon, RectOptions};
 
@@ -451,15 +451,14 @@ impl PlannerSettings for BsaOptions {
 
 impl PlannerSettings for BsaExtendedOptions {
     fn validate(&self) -> Result<(), OptionsError> {
-        finite_nonneg("clearance_px", self.clearance_px)?;
-        finite_pos("pipe_halfwidth", self.pipe_halfwidth)?;
-        if self.gap_cost == 0 {
-            return Err(OptionsError::new("gap_cost", "must be >= 1"));
+        if self.extension.lane_ends {
+            // BSA fills spirals, not lanes: nothing to drive on to the wall.
+            return Err(OptionsError::new(
+                "extension.lane_ends",
+                "does not apply to bsa-extended (BSA has no lanes)",
+            ));
         }
-        if self.max_follow_steps == 0 {
-            return Err(OptionsError::new("max_follow_steps", "must be >= 1"));
-        }
-        Ok(())
+        finite_nonneg("extension.reach_r", self.extension.reach_r)
     }
 
     fn check(&self, s: &Setup) -> Result<(), OptionsError> {
@@ -467,9 +466,9 @@ impl PlannerSettings for BsaExtendedOptions {
     }
 
     fn estimate(&self, s: &Setup) -> ResourceEstimate {
-        // Wall following works at map resolution: per-pixel state and records along walls.
+        // BSA's cells plus the extension's per-pixel state (as for ba-star-extended).
         let mut e = bsa_cells(s);
-        e.bytes += s.pixels() * 32.0;
+        e.bytes += 16.0 * s.pixels();
         e
     }
 
@@ -478,7 +477,7 @@ impl PlannerSettings for BsaExtendedOptions {
     }
 
     fn build(&self, _: &World) -> Box<dyn Planner> {
-        Box::new(Bsa::extended(self.clone()))
+        Box::new(BsaExtended::new(self.clone()))
     }
 }
 
