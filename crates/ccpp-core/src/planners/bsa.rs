@@ -219,23 +219,6 @@ impl Cells {
         }
     }
 
-    /// Starts a new search: every cell's scratch becomes stale.
-    pub(crate) fn new_search(&mut self) {
-        self.search.begin();
-    }
-
-    /// Search cost of cell `k` in the current search (`None` when unreached).
-    #[inline]
-    pub(crate) fn cost_of(&self, k: usize) -> Option<u32> {
-        self.search.dist(k as u32)
-    }
-
-    #[inline]
-    pub(crate) fn reach(&mut self, k: usize, cost: u32, parent: usize) {
-        self.search
-            .assign(k as u32, cost, (parent != k).then_some(parent as u32));
-    }
-
     /// Path from the search root to `k` (cells, root first).
     pub(crate) fn path_to(&self, k: usize) -> Vec<Tile> {
         let path = self.search.path_to(k as u32);
