@@ -9,7 +9,7 @@ use crate::geometry::{point_segment_dist2, wrap_angle, Point, Pose};
 pub(crate) use crate::raster::stamp_capsule;
 use crate::sim::RunOutput;
 use crate::tiles::{reachable_tiles, Tile, TileGrid, TileSet};
-use crate::trace::{Event, Record, Trace};
+use crate::trace::{Entry, Event, Piece, Trace};
 use crate::world::World;
 
 pub use crate::raster::SWEEP_EPS_PX;
@@ -81,21 +81,21 @@ pub struct Metrics {
 pub fn tracking_error(trace: &Trace) -> Option<(f64, f64)> {
     let mut seg: Option<(Point, Point)> = None;
     let (mut sum, mut max, mut n) = (0.0, 0.0f64, 0usize);
-    for r in &trace.records {
+    for r in trace.entries() {
         match r {
-            Record::Event {
+            Entry::Event {
                 event: Event::PlannedSegment { from, to },
                 ..
             } => seg = Some((Point::new(from[0], from[1]), Point::new(to[0], to[1]))),
-            Record::Pose { pose, .. } => {
+            Entry::Pose { pose, .. } => {
                 if let Some((a, b)) = seg {
-                    let d = point_segment_dist2(Point::new(pose[0], pose[1]), a, b).sqrt();
+                    let d = point_segment_dist2(pose.position(), a, b).sqrt();
                     sum += d;
                     max = max.max(d);
                     n += 1;
                 }
             }
-            Record::Event { .. } => {}
+            Entry::Event { .. } => {}
         }
     }
     seg?;
@@ -115,10 +115,23 @@ pub fn execution_tolerance(trace: &Trace) -> Option<f64> {
 pub fn swept_pixels(world: &World, trace: &Trace) -> FixedBitSet {
     let frame = *world.frame();
     let rt = world.robot().tool_radius / frame.resolution + SWEEP_EPS_PX;
-    let points: Vec<Point> = trace
-        .poses()
-        .map(|p| frame.world_to_grid(p.position()))
-        .collect();
+    // The executed polyline with each straight run of the trace reduced to its two ends: a
+    // run's poses lie in order on the segment between its ends, so the capsules of its steps
+    // make up the capsule of that segment.
+    let lattice = trace.lattice();
+    let mut points: Vec<Point> = Vec::with_capacity(trace.piece_count() + 1);
+    for piece in trace.pieces() {
+        match piece {
+            Piece::Pose { pose, .. } => points.push(frame.world_to_grid(pose.position())),
+            Piece::Run(run) => {
+                let [x0, y0] = run.from;
+                let [x1, y1] = run.to(lattice);
+                points.push(frame.world_to_grid(Point::new(x0, y0)));
+                points.push(frame.world_to_grid(Point::new(x1, y1)));
+            }
+            Piece::Event { .. } => {}
+        }
+    }
     // Segments between consecutive distinct points (a lone first point sweeps its disk).
     let sweep = |pts: &[Point], first: bool| {
         let mut swept = FixedBitSet::with_capacity(frame.len());
@@ -242,13 +255,16 @@ pub fn coverage_curve(world: &World, trace: &Trace, samples: usize) -> Vec<[f64;
 }
 
 /// Tile entries along a polyline (Amanatides-Woo traversal); a corner crossing is one entry.
-fn tile_entries(grid: &TileGrid, poses: &[Pose], mut visit: impl FnMut(Tile)) {
-    let Some(first) = poses.first() else { return };
+fn tile_entries(grid: &TileGrid, trace: &Trace, mut visit: impl FnMut(Tile)) {
+    let mut poses = trace.poses();
+    let Some(first) = poses.next() else { return };
     let mut cur = grid.tile_of(first.position());
     visit(cur);
-    for w in poses.windows(2) {
-        let a = w[0].position();
-        let b = w[1].position();
+    let mut prev = first.position();
+    for p in poses {
+        let a = prev;
+        let b = p.position();
+        prev = b;
         if a == b {
             continue;
         }
@@ -324,7 +340,6 @@ pub fn compute(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
     let frame = *world.frame();
     let robot = world.robot();
     let trace = &run.trace;
-    let poses: Vec<Pose> = trace.poses().collect();
     let px_area = frame.resolution * frame.resolution;
 
     // Path length, turns, rotation.
@@ -332,8 +347,10 @@ pub fn compute(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
     let mut turns = 0u32;
     let mut rotation = 0.0;
     let mut in_turn = false;
-    for w in poses.windows(2) {
-        let (a, b) = (w[0], w[1]);
+    let mut poses = trace.poses();
+    let mut prev = poses.next();
+    for b in poses {
+        let Some(a) = prev.replace(b) else { break };
         let d = a.position().dist(b.position());
         if d > 0.0 {
             path_length += d;
@@ -357,10 +374,10 @@ pub fn compute(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
     let mut backtrack_length = 0.0;
     let mut in_backtrack = false;
     let mut last: Option<Point> = None;
-    for r in &trace.records {
+    for r in trace.entries() {
         match r {
-            Record::Pose { pose, .. } => {
-                let p = Point::new(pose[0], pose[1]);
+            Entry::Pose { pose, .. } => {
+                let p = pose.position();
                 if in_backtrack {
                     if let Some(l) = last {
                         backtrack_length += l.dist(p);
@@ -368,7 +385,7 @@ pub fn compute(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
                 }
                 last = Some(p);
             }
-            Record::Event { event, .. } => match event {
+            Entry::Event { event, .. } => match event {
                 Event::RegionStart { .. } => regions += 1,
                 Event::BacktrackStart => {
                     backtracks += 1;
@@ -410,7 +427,7 @@ pub fn compute(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
     let (i0, i1, j0, j1) = grid.bounds_for(world);
     let mut distinct = TileSet::new(i0, i1, j0, j1);
     let mut entries = 0usize;
-    tile_entries(&grid, &poses, |t| {
+    tile_entries(&grid, trace, |t| {
         entries += 1;
         distinct.insert(t);
     });
@@ -429,7 +446,7 @@ pub fn compute(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
         if reach.is_empty() {
             return 0.0;
         }
-        let visited = visited_tile_centres(&grid, &poses, &reach, exec_tol);
+        let visited = visited_tile_centres(&grid, trace, &reach, exec_tol);
         visited as f64 / reach.len() as f64
     });
 
@@ -469,22 +486,26 @@ pub fn compute(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
 /// within the PID waypoint tolerance `tol` when given).
 fn visited_tile_centres(
     grid: &TileGrid,
-    poses: &[Pose],
+    trace: &Trace,
     reach: &TileSet,
     tol: Option<f64>,
 ) -> usize {
     let eps = (1e-6 * grid.side).max(tol.map_or(0.0, |t| t + 1e-9));
     let (i0, i1, j0, j1) = reach.bounds();
     let mut hit = TileSet::new(i0, i1, j0, j1);
-    if let Some(p) = poses.first() {
-        let t = grid.tile_of(p.position());
-        if grid.center(t).dist(p.position()) <= eps {
-            hit.insert(t);
-        }
+    let mut poses = trace.poses();
+    let Some(first) = poses.next() else {
+        return 0;
+    };
+    let t = grid.tile_of(first.position());
+    if grid.center(t).dist(first.position()) <= eps {
+        hit.insert(t);
     }
-    for w in poses.windows(2) {
-        let a = w[0].position();
-        let b = w[1].position();
+    let mut prev = first.position();
+    for p in poses {
+        let a = prev;
+        let b = p.position();
+        prev = b;
         if a == b {
             continue;
         }

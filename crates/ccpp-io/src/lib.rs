@@ -11,6 +11,7 @@
 //! * [`scenario`]: the serializable description of a run ([`Scenario`](scenario::Scenario)),
 //!   its one validation (including the memory estimate) and its execution;
 //! * [`trace`](mod@trace): `trace.jsonl` / `path.csv` writers and the checked trace reader;
+//! * [`phase`]: optional phase timing (`CCPP_PHASES`);
 //! * [`file`]: opening user files (regular files only: a FIFO is refused, not read forever).
 //!
 //! Errors are [`thiserror`] enums that always name the file concerned; nothing here panics on
@@ -20,6 +21,7 @@ pub mod file;
 pub mod georef;
 pub mod landmarks;
 pub mod map;
+pub mod phase;
 pub mod scenario;
 pub mod trace;
 pub mod write;

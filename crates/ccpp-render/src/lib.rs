@@ -25,7 +25,7 @@ use chart::{Chart, LegendEntry, Swatch};
 
 use ccpp_core::grid::Cell;
 use ccpp_core::metrics::swept_pixels;
-use ccpp_core::trace::{Event, Record, Trace};
+use ccpp_core::trace::{Entry, Event, Trace};
 use ccpp_core::world::World;
 use ccpp_core::Point;
 use tiny_skia::{Color, FillRule, Paint, PathBuilder, Pixmap, Rect, Stroke, StrokeDash, Transform};
@@ -205,8 +205,17 @@ struct Shown {
 }
 
 fn shown(world: &World, trace: &Trace, crop: (usize, usize, usize, usize)) -> Shown {
+    shown_with(world, trace, crop, &swept_pixels(world, trace))
+}
+
+/// [`shown`] with the swept pixels already computed.
+fn shown_with(
+    world: &World,
+    trace: &Trace,
+    crop: (usize, usize, usize, usize),
+    swept: &fixedbitset::FixedBitSet,
+) -> Shown {
     let f = *world.frame();
-    let swept = swept_pixels(world, trace);
     let acc = world.accessible();
     let cells = world.map().cells();
     let mut s = Shown::default();
@@ -230,9 +239,10 @@ fn shown(world: &World, trace: &Trace, crop: (usize, usize, usize, usize)) -> Sh
     let mut regions = std::collections::BTreeSet::new();
     let mut region = 0u32;
     let mut last: Option<[f64; 2]> = None;
-    for r in &trace.records {
+    for r in trace.entries() {
         match r {
-            Record::Pose { pose, .. } => {
+            Entry::Pose { pose, .. } => {
+                let pose = [pose.x, pose.y, pose.theta];
                 let p = [pose[0], pose[1]];
                 if last.is_some_and(|l| l != p) {
                     if in_bt {
@@ -244,7 +254,7 @@ fn shown(world: &World, trace: &Trace, crop: (usize, usize, usize, usize)) -> Sh
                 last = Some(p);
                 s.poses += 1;
             }
-            Record::Event { event, .. } => match event {
+            Entry::Event { event, .. } => match event {
                 Event::RegionStart { region: k } => region = *k,
                 Event::BacktrackStart => in_bt = true,
                 Event::BacktrackEnd => in_bt = false,
@@ -362,10 +372,9 @@ fn entries_of(s: &Shown) -> Vec<LegendEntry> {
 }
 
 /// Effective coverage as the picture shows it: swept reachable pixels over reachable pixels.
-fn effective_coverage(world: &World, trace: &Trace) -> f64 {
-    let swept = swept_pixels(world, trace);
+fn effective_coverage(world: &World, swept: &fixedbitset::FixedBitSet) -> f64 {
     let acc = world.accessible();
-    let hit = acc.ones().filter(|&i| swept.contains(i)).count();
+    let hit = acc.intersection(swept).count();
     hit as f64 / world.accessible_count().max(1) as f64
 }
 
@@ -391,6 +400,7 @@ pub fn coverage_pixmap(
 ) -> Result<Pixmap, RenderError> {
     let frame = *world.frame();
     let crop = crop_box(world, trace);
+    let swept = swept_pixels(world, trace);
     let (col0, row0, cols, rows) = crop;
     let (w, h) = (cols as u32, rows as u32);
     let scale = if w < style.min_width {
@@ -408,7 +418,7 @@ pub fn coverage_pixmap(
     let mut header = 0u32;
     if !style.title.is_empty() {
         let mut y = 6.0f32;
-        let cov = effective_coverage(world, trace);
+        let cov = effective_coverage(world, &swept);
         let collisions = trace
             .events()
             .filter(|(_, e)| matches!(e, Event::Collision { .. }))
@@ -464,7 +474,7 @@ pub fn coverage_pixmap(
     }
     let mut foot = Chart::new(cw, 0);
     let legend_h = if style.legend {
-        let entries = entries_of(&shown(world, trace, crop));
+        let entries = entries_of(&shown_with(world, trace, crop, &swept));
         let top = ch_map + header + 8;
         (foot.legend(8.0, top as f32, cw as f32 - 16.0, px as u32, &entries) + 8.0).ceil() as u32
     } else {
@@ -475,7 +485,6 @@ pub fn coverage_pixmap(
     pm.fill(Color::WHITE);
 
     // Background: classify each map pixel, then nearest-neighbour scale.
-    let swept = swept_pixels(world, trace);
     let acc = world.accessible();
     let cells = world.map().cells();
     let colour_of = |i: usize| -> [u8; 3] {
@@ -563,9 +572,10 @@ fn draw_path(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
         }
         run.clear();
     };
-    for r in &trace.records {
+    for r in trace.entries() {
         match r {
-            Record::Pose { pose, .. } => {
+            Entry::Pose { pose, .. } => {
+                let pose = [pose.x, pose.y, pose.theta];
                 let p = view.to_canvas(world, Point::new(pose[0], pose[1]));
                 if last == Some(p) {
                     continue;
@@ -587,7 +597,7 @@ fn draw_path(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
                 run.push(p);
                 last = Some(p);
             }
-            Record::Event { event, .. } => match event {
+            Entry::Event { event, .. } => match event {
                 Event::RegionStart { region: k } => region = *k as usize,
                 Event::BacktrackStart => in_backtrack = true,
                 Event::BacktrackEnd => in_backtrack = false,
@@ -816,15 +826,8 @@ mod tests {
         insta::assert_snapshot!("legend_entries", labels.join("\n"));
         // A run without backtracking or markers has no such entries.
         let (world, mut trace) = run(2);
-        trace.records.retain(|r| {
-            !matches!(
-                r,
-                Record::Event {
-                    event: Event::Collision { .. } | Event::CriticalPoint { .. },
-                    ..
-                }
-            )
-        });
+        trace
+            .retain_events(|e| !matches!(e, Event::Collision { .. } | Event::CriticalPoint { .. }));
         let labels: Vec<String> = legend_entries(&world, &trace)
             .into_iter()
             .map(|e| e.label)

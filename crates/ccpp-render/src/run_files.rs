@@ -7,6 +7,7 @@ use std::path::Path;
 use ccpp_core::metrics::Metrics;
 use ccpp_core::trace::Trace;
 use ccpp_core::world::World;
+use ccpp_io::phase;
 use ccpp_io::scenario::Scenario;
 use ccpp_io::write::WriteError;
 use ccpp_io::write_atomic;
@@ -89,13 +90,13 @@ pub fn render_run_files(
     let start = world.start();
     scenario.start = Some([start.x, start.y, start.theta]);
     let run_json = scenario.to_json()?;
-    let trace_text = ccpp_io::trace::trace_jsonl(trace)?;
-    let path = ccpp_io::trace::path_csv(trace);
+    let trace_text = phase::time("trace.jsonl", || ccpp_io::trace::trace_jsonl(trace))?;
+    let path = phase::time("path.csv", || ccpp_io::trace::path_csv(trace));
     let style = CoverageStyle {
         title: title_lines(metrics),
         ..CoverageStyle::default()
     };
-    let png = coverage_png(world, trace, &style)?;
+    let png = phase::time("coverage.png", || coverage_png(world, trace, &style))?;
     Ok(vec![
         ("run.json", run_json.into_bytes()),
         ("path.csv", path.into_bytes()),
