@@ -8,7 +8,7 @@ use ccpp_core::trace::Record;
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    if args.len() < 2 || args.len() % 2 != 0 {
+    if args.len() < 2 || args.len() & 1 == 1 {
         eprintln!("usage: trace_same A B [A2 B2 ...]");
         std::process::exit(2);
     }
