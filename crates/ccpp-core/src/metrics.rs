@@ -341,6 +341,62 @@ pub fn compute(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
     let robot = world.robot();
     let trace = &run.trace;
     let px_area = frame.resolution * frame.resolution;
+    let start = world.start().position();
+    let two_rt = 2.0 * robot.tool_radius;
+    // The swept pixels and the tile coverage are independent of the rest: on other threads.
+    std::thread::scope(|scope| {
+        let swept = scope.spawn(|| swept_pixels(world, trace));
+        let coverage_rate = scope.spawn(|| {
+            // Under PID execution a tile centre counts as visited within the waypoint tolerance.
+            let exec_tol = execution_tolerance(trace);
+            run.tile_side.map(|side| {
+                let grid = TileGrid::new(start, side);
+                let reach = reachable_tiles(world, &grid);
+                if reach.is_empty() {
+                    return 0.0;
+                }
+                let visited = visited_tile_centres(&grid, trace, &reach, exec_tol);
+                visited as f64 / reach.len() as f64
+            })
+        });
+        let mut m = compute_rest(world, run, map_name);
+        let swept: FixedBitSet = join(swept);
+        m.coverage_rate = join(coverage_rate);
+        let swept_count = swept.count_ones(..);
+        let covered = swept.intersection(world.accessible()).count();
+        let a_count = world.accessible_count();
+        m.effective_coverage = if a_count == 0 {
+            0.0
+        } else {
+            covered as f64 / a_count as f64
+        };
+        let area_a = a_count as f64 * px_area;
+        m.path_ratio = if area_a > 0.0 {
+            m.path_length_m / (area_a / two_rt)
+        } else {
+            0.0
+        };
+        let swept_area = swept_count as f64 * px_area;
+        let path_length = m.path_length_m;
+        m.redundancy = (path_length > 0.0 && swept_area > 0.0)
+            .then(|| path_length * two_rt / swept_area - 1.0);
+        m
+    })
+}
+
+/// The result of a scoped thread (its panic passed on).
+fn join<T>(h: std::thread::ScopedJoinHandle<'_, T>) -> T {
+    match h.join() {
+        Ok(v) => v,
+        Err(panic) => std::panic::resume_unwind(panic),
+    }
+}
+
+/// The metrics that follow the poses and events one by one (all but the swept area and the
+/// tile coverage, left at 0 / `None`).
+fn compute_rest(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
+    let robot = world.robot();
+    let trace = &run.trace;
 
     // Path length, turns, rotation.
     let mut path_length = 0.0;
@@ -398,29 +454,9 @@ pub fn compute(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
         }
     }
 
-    // Swept area and effective coverage.
-    let swept = swept_pixels(world, trace);
-    let swept_count = swept.count_ones(..);
-    let acc = world.accessible();
-    let covered = swept.intersection(acc).count();
-    let a_count = world.accessible_count();
-    let effective_coverage = if a_count == 0 {
-        0.0
-    } else {
-        covered as f64 / a_count as f64
-    };
-    let area_a = a_count as f64 * px_area;
+    // Tiles: revisit rate (planner tile side, else 2 r_tool); the coverage rate is computed
+    // beside this.
     let two_rt = 2.0 * robot.tool_radius;
-    let path_ratio = if area_a > 0.0 {
-        path_length / (area_a / two_rt)
-    } else {
-        0.0
-    };
-    let swept_area = swept_count as f64 * px_area;
-    let redundancy =
-        (path_length > 0.0 && swept_area > 0.0).then(|| path_length * two_rt / swept_area - 1.0);
-
-    // Tiles: revisit rate (planner tile side, else 2 r_tool) and coverage rate (tile planners).
     let start = world.start().position();
     let side = run.tile_side.unwrap_or(two_rt);
     let grid = TileGrid::new(start, side);
@@ -438,18 +474,7 @@ pub fn compute(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
         (entries - nd) as f64 / nd as f64
     };
 
-    // Under PID execution a tile centre counts as visited within the waypoint tolerance.
     let exec_tol = execution_tolerance(trace);
-    let coverage_rate = run.tile_side.map(|side| {
-        let grid = TileGrid::new(start, side);
-        let reach = reachable_tiles(world, &grid);
-        if reach.is_empty() {
-            return 0.0;
-        }
-        let visited = visited_tile_centres(&grid, trace, &reach, exec_tol);
-        visited as f64 / reach.len() as f64
-    });
-
     let tracking = tracking_error(trace);
     let rect_guarantee = trace.events().find_map(|(_, e)| match e {
         Event::RectLanes { width_m, .. } if *width_m > 0.0 => {
@@ -463,11 +488,11 @@ pub fn compute(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
         map: map_name.to_string(),
         robot_radius_m: robot.radius,
         tool_radius_m: robot.tool_radius,
-        coverage_rate,
-        effective_coverage,
+        coverage_rate: None,
+        effective_coverage: 0.0,
         path_length_m: path_length,
-        path_ratio,
-        redundancy,
+        path_ratio: 0.0,
+        redundancy: None,
         revisit_rate,
         regions,
         backtracks,

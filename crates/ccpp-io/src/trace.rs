@@ -17,6 +17,11 @@
 //! - `{"t":3,"poses":n,"from":[x,y],"step":[dx,dy],"theta":th}`: a straight run of `n` poses
 //!   whose positions follow by adding `[dx,dy]` (`f64` addition) to the previous one.
 //!
+//! - `{"t":9,"event":"backtrack_list","delta":[{"prev":0,"n":12},[x,y],{"prev":14,"n":3}]}`:
+//!   a backtracking list written against the previous one (here: its points 0 to 11, then
+//!   the point `[x,y]`, then its points 14 to 16), used when shorter than the list itself
+//!   (consecutive lists share most of their points).
+//!
 //! Expanding the runs gives back every executed pose bit for bit (runs are formed only where
 //! that holds, see [`ccpp_core::trace`]). A tile planner's trace is mostly runs, so the file
 //! holds about one line per straight move instead of one per tile. Numbers are written in the
@@ -132,6 +137,100 @@ fn push_event_line(s: &mut String, t: u64, event: &Event) -> Result<(), serde_js
     Ok(())
 }
 
+/// One item of a backtracking list written as a delta: a point, or `n` points of the previous
+/// list from index `prev` on.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+enum DeltaItem {
+    Point([f64; 2]),
+    Copy { prev: usize, n: usize },
+}
+
+/// `points` as copies of stretches of `prev` and literal points (greedy, deterministic).
+fn list_delta(prev: &[[f64; 2]], points: &[[f64; 2]]) -> Vec<DeltaItem> {
+    let key = |p: &[f64; 2]| (p[0].to_bits(), p[1].to_bits());
+    let mut index: std::collections::BTreeMap<(u64, u64), Vec<usize>> =
+        std::collections::BTreeMap::new();
+    for (k, p) in prev.iter().enumerate() {
+        index.entry(key(p)).or_default().push(k);
+    }
+    let mut out: Vec<DeltaItem> = Vec::new();
+    // The index in `prev` that the current copy continues with.
+    let mut next = usize::MAX;
+    for p in points {
+        if next < prev.len() && key(&prev[next]) == key(p) {
+            if let Some(DeltaItem::Copy { n, .. }) = out.last_mut() {
+                *n += 1;
+                next += 1;
+                continue;
+            }
+        }
+        let at = next.min(prev.len());
+        let found = index.get(&key(p)).and_then(|ks| {
+            ks.iter()
+                .copied()
+                .find(|&k| k >= at)
+                .or(ks.first().copied())
+        });
+        if let Some(k) = found {
+            out.push(DeltaItem::Copy { prev: k, n: 1 });
+            next = k + 1;
+        } else {
+            out.push(DeltaItem::Point(*p));
+            next = usize::MAX;
+        }
+    }
+    out
+}
+
+/// Resolves a delta against the previous list.
+fn apply_delta(
+    prev: Option<&Vec<[f64; 2]>>,
+    delta: &[DeltaItem],
+    budget: usize,
+) -> Result<Vec<[f64; 2]>, String> {
+    let mut out = Vec::new();
+    for item in delta {
+        let n = match *item {
+            DeltaItem::Point(_) => 1,
+            DeltaItem::Copy { n, .. } => n,
+        };
+        if out.len().saturating_add(n) > budget {
+            return Err(format!(
+                "backtrack_list points exceed {MAX_POSES_PER_BYTE} per byte of trace"
+            ));
+        }
+        match *item {
+            DeltaItem::Point(p) => out.push(p),
+            DeltaItem::Copy { prev: k, n } => {
+                let prev = prev.ok_or("a backtrack_list delta needs a backtrack_list before it")?;
+                let part = k
+                    .checked_add(n)
+                    .and_then(|end| prev.get(k..end))
+                    .ok_or_else(|| {
+                        format!(
+                            "a backtrack_list delta copies points {k}..{} of a list of {}",
+                            k.saturating_add(n),
+                            prev.len()
+                        )
+                    })?;
+                out.extend_from_slice(part);
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// A backtracking list written as a delta (`event` is `backtrack_list`, checked before).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct DeltaLine {
+    t: u64,
+    #[serde(rename = "event")]
+    _event: String,
+    delta: Vec<DeltaItem>,
+}
+
 /// The trace as JSON Lines, straight runs of poses merged into one line each (the format in
 /// the module documentation).
 ///
@@ -142,9 +241,34 @@ pub fn trace_jsonl(trace: &Trace) -> Result<String, serde_json::Error> {
     let lattice = trace.lattice();
     let mut s = String::with_capacity(trace.piece_count() * 64 + 64);
     let mut declared = false;
+    let mut prev_list: Option<&Vec<[f64; 2]>> = None;
     for piece in trace.pieces() {
         match piece {
             Piece::Pose { t, pose } => push_pose_line(&mut s, t, pose),
+            Piece::Event {
+                t,
+                event: Event::BacktrackList { points },
+            } => {
+                if let Some(prev) = prev_list {
+                    let delta = list_delta(prev, points);
+                    // Written as a delta when that takes fewer items than the list.
+                    if delta.len() < points.len() {
+                        let _ = write!(s, "{{\"t\":{t},\"event\":\"backtrack_list\",\"delta\":");
+                        s.push_str(&serde_json::to_string(&delta)?);
+                        s.push_str("}\n");
+                        prev_list = Some(points);
+                        continue;
+                    }
+                }
+                prev_list = Some(points);
+                push_event_line(
+                    &mut s,
+                    t,
+                    &Event::BacktrackList {
+                        points: points.clone(),
+                    },
+                )?;
+            }
             Piece::Event { t, event } => push_event_line(&mut s, t, event)?,
             Piece::Run(run) if run.n < 3 => {
                 for (t, p) in run.poses(lattice) {
@@ -344,6 +468,9 @@ pub fn parse_trace(
     let max_poses = text.len().saturating_mul(MAX_POSES_PER_BYTE);
     let mut trace = Trace::default();
     let mut lattice: Option<Lattice> = None;
+    let mut last_list: Option<Vec<[f64; 2]>> = None;
+    // Points of all backtracking lists together, bounded like the poses.
+    let mut list_budget = max_poses;
     let check = |line: usize, t: u64, p: Pose, trace: &mut Trace| {
         if trace.pose_count() >= max_poses {
             return Err(parse_error(
@@ -374,10 +501,28 @@ pub fn parse_trace(
         if line.trim().is_empty() {
             continue;
         }
+        if line.contains("\"event\":\"backtrack_list\"") && line.contains("\"delta\"") {
+            let d: DeltaLine =
+                serde_json::from_str(line).map_err(|e| parse_error(k + 1, e.to_string()))?;
+            let points = apply_delta(last_list.as_ref(), &d.delta, list_budget)
+                .map_err(|m| parse_error(k + 1, m))?;
+            list_budget -= points.len();
+            last_list = Some(points.clone());
+            trace.push_event(d.t, Event::BacktrackList { points });
+            continue;
+        }
         if line.contains("\"event\"") {
             let r: Record =
                 serde_json::from_str(line).map_err(|e| parse_error(k + 1, e.to_string()))?;
             match r {
+                Record::Event {
+                    t,
+                    event: Event::BacktrackList { points },
+                } => {
+                    list_budget = list_budget.saturating_sub(points.len());
+                    last_list = Some(points.clone());
+                    trace.push_event(t, Event::BacktrackList { points });
+                }
                 Record::Event { t, event } => trace.push_event(t, event),
                 Record::Pose { t, pose } => {
                     check(k + 1, t, Pose::new(pose[0], pose[1], pose[2]), &mut trace)?;
@@ -533,6 +678,59 @@ mod tests {
             let msg = e.err().map(|e| e.to_string()).unwrap_or_default();
             assert!(msg.contains(want) && msg.contains("line"), "{text}: {msg}");
         }
+    }
+
+    #[test]
+    fn backtrack_lists_are_written_as_deltas_and_read_back_exactly() {
+        let mut tr = Trace::default();
+        tr.push_pose(0, Pose::new(0.1, 0.1, 0.0));
+        let base: Vec<[f64; 2]> = (0..20).map(|k| [0.1 + 0.3 * f64::from(k), 0.7]).collect();
+        tr.push_event(
+            1,
+            Event::BacktrackList {
+                points: base.clone(),
+            },
+        );
+        // Two removed, one added in the middle, order changed at the end.
+        let mut next: Vec<[f64; 2]> = base[..5].to_vec();
+        next.push([0.25, 0.35]);
+        next.extend_from_slice(&base[7..18]);
+        next.push(base[19]);
+        next.push(base[18]);
+        tr.push_event(
+            2,
+            Event::BacktrackList {
+                points: next.clone(),
+            },
+        );
+        tr.push_event(3, Event::BacktrackList { points: Vec::new() });
+        let text = trace_jsonl(&tr).unwrap_or_default();
+        assert!(text.contains("\"delta\":[{\"prev\":0,\"n\":5},[0.25,0.35],{\"prev\":7,\"n\":11},{\"prev\":19,\"n\":1},{\"prev\":18,\"n\":1}]"), "{text}");
+        let back = parse_trace(&text, Path::new("t"), None).ok();
+        assert_eq!(back.as_ref(), Some(&tr));
+        // A copy past the previous list, or before any list, is refused with its line.
+        for bad in [
+            "{\"t\":2,\"event\":\"backtrack_list\",\"delta\":[{\"prev\":15,\"n\":9}]}",
+            "{\"t\":2,\"event\":\"backtrack_list\",\"delta\":[{\"prev\":0,\"n\":99999999}]}",
+        ] {
+            let text = format!(
+                "{{\"t\":1,\"event\":\"backtrack_list\",\"points\":{}}}\n{bad}",
+                serde_json::to_string(&base).unwrap_or_default()
+            );
+            let e = parse_trace(&text, Path::new("t"), None)
+                .err()
+                .map(|e| e.to_string());
+            assert!(e.as_deref().is_some_and(|m| m.contains("line 2")), "{e:?}");
+        }
+        let lone = "{\"t\":2,\"event\":\"backtrack_list\",\"delta\":[{\"prev\":0,\"n\":1}]}";
+        let e = parse_trace(lone, Path::new("t"), None)
+            .err()
+            .map(|e| e.to_string());
+        assert!(
+            e.as_deref()
+                .is_some_and(|m| m.contains("needs a backtrack_list before")),
+            "{e:?}"
+        );
     }
 
     #[test]

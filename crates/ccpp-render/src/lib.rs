@@ -25,7 +25,7 @@ use chart::{Chart, LegendEntry, Swatch};
 
 use ccpp_core::grid::Cell;
 use ccpp_core::metrics::swept_pixels;
-use ccpp_core::trace::{Entry, Event, Trace};
+use ccpp_core::trace::{Entry, Event, Piece, Trace};
 use ccpp_core::world::World;
 use ccpp_core::Point;
 use tiny_skia::{Color, FillRule, Paint, PathBuilder, Pixmap, Rect, Stroke, StrokeDash, Transform};
@@ -150,14 +150,37 @@ pub fn crop_box(world: &World, trace: &Trace) -> (usize, usize, usize, usize) {
         r0 = r0.min(r);
         r1 = r1.max(r);
     };
-    for (i, cell) in world.map().cells().iter().enumerate() {
-        if *cell != Cell::Unknown {
-            add(i % f.width, i / f.width);
+    for (r, row) in world.map().cells().chunks(f.width.max(1)).enumerate() {
+        let known = |c: &Cell| *c != Cell::Unknown;
+        if let (Some(a), Some(b)) = (row.iter().position(known), row.iter().rposition(known)) {
+            add(a, r);
+            add(b, r);
         }
     }
-    for p in trace.poses() {
-        if let Some((c, r)) = f.pixel_of(p.position()) {
-            add(c, r);
+    // A straight run's poses lie between its ends: when both ends are on the map, the ends
+    // bound its pixels (the map is convex in grid coordinates).
+    let lattice = trace.lattice();
+    for piece in trace.pieces() {
+        match piece {
+            Piece::Pose { pose, .. } => {
+                if let Some((c, r)) = f.pixel_of(pose.position()) {
+                    add(c, r);
+                }
+            }
+            Piece::Run(run) => {
+                let ends = [run.from, run.to(lattice)].map(|[x, y]| f.pixel_of(Point::new(x, y)));
+                if let [Some(a), Some(b)] = ends {
+                    add(a.0, a.1);
+                    add(b.0, b.1);
+                } else {
+                    for (_, p) in run.poses(lattice) {
+                        if let Some((c, r)) = f.pixel_of(p.position()) {
+                            add(c, r);
+                        }
+                    }
+                }
+            }
+            Piece::Event { .. } => {}
         }
     }
     if c0 == usize::MAX {
@@ -529,6 +552,31 @@ pub fn coverage_pixmap(
     Ok(pm)
 }
 
+/// The entries of a trace with each straight run reduced to its first and last pose (what a
+/// drawn polyline needs).
+fn path_entries(trace: &Trace) -> impl Iterator<Item = Entry<'_>> + '_ {
+    let lattice = trace.lattice();
+    trace.pieces().flat_map(move |piece| {
+        let pair = match piece {
+            Piece::Pose { t, pose } => [Some(Entry::Pose { t, pose }), None],
+            Piece::Event { t, event } => [Some(Entry::Event { t, event }), None],
+            Piece::Run(run) => {
+                let [x, y] = run.to(lattice);
+                let first = Entry::Pose {
+                    t: run.t,
+                    pose: ccpp_core::Pose::new(run.from[0], run.from[1], run.theta),
+                };
+                let last = Entry::Pose {
+                    t: run.t + u64::from(run.n) - 1,
+                    pose: ccpp_core::Pose::new(x, y, run.theta),
+                };
+                [Some(first), Some(last)]
+            }
+        };
+        pair.into_iter().flatten()
+    })
+}
+
 fn draw_path(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
     let width = (view.scale * 0.6).clamp(1.0, 3.0);
     let mut region = 0usize;
@@ -572,11 +620,10 @@ fn draw_path(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
         }
         run.clear();
     };
-    for r in trace.entries() {
+    for r in path_entries(trace) {
         match r {
             Entry::Pose { pose, .. } => {
-                let pose = [pose.x, pose.y, pose.theta];
-                let p = view.to_canvas(world, Point::new(pose[0], pose[1]));
+                let p = view.to_canvas(world, pose.position());
                 if last == Some(p) {
                     continue;
                 }
