@@ -56,11 +56,13 @@ pub fn write_run_files(
     extra: &[(&'static str, Vec<u8>)],
 ) -> Result<String> {
     let rendered = render_run_files(job, r, replay)?;
-    let staging = Staging::new(out)?;
-    for (name, bytes) in extra.iter().chain(&rendered.files) {
-        staging.write(name, bytes)?;
-    }
-    staging.commit()?;
+    ccpp_io::phase::time("write files", || -> Result<()> {
+        let staging = Staging::new(out)?;
+        for (name, bytes) in extra.iter().chain(&rendered.files) {
+            staging.write(name, bytes)?;
+        }
+        staging.commit()
+    })?;
     Ok(rendered.metrics)
 }
 

@@ -44,7 +44,7 @@ fn main() {
         m.collisions,
         m.path_length_m,
         m.backtrack_length_m,
-        run.trace.records.len()
+        run.trace.len()
     );
     if let Some(path) = out {
         let f = *world.frame();

@@ -14,7 +14,7 @@ use crate::geometry::{point_segment_dist2, wrap_angle, Point, Pose};
 pub(crate) use crate::raster::stamp_capsule;
 use crate::sim::RunOutput;
 use crate::tiles::{reachable_tiles, Tile, TileGrid, TileSet};
-use crate::trace::{Event, Record, Trace};
+use crate::trace::{Entry, Event, Piece, Trace};
 use crate::world::World;
 
 pub use crate::raster::SWEEP_EPS_PX;
@@ -93,21 +93,21 @@ pub struct Metrics {
 pub fn tracking_error(trace: &Trace) -> Option<(f64, f64)> {
     let mut seg: Option<(Point, Point)> = None;
     let (mut sum, mut max, mut n) = (0.0, 0.0f64, 0usize);
-    for r in &trace.records {
+    for r in trace.entries() {
         match r {
-            Record::Event {
+            Entry::Event {
                 event: Event::PlannedSegment { from, to },
                 ..
             } => seg = Some((Point::new(from[0], from[1]), Point::new(to[0], to[1]))),
-            Record::Pose { pose, .. } => {
+            Entry::Pose { pose, .. } => {
                 if let Some((a, b)) = seg {
-                    let d = point_segment_dist2(Point::new(pose[0], pose[1]), a, b).sqrt();
+                    let d = point_segment_dist2(pose.position(), a, b).sqrt();
                     sum += d;
                     max = max.max(d);
                     n += 1;
                 }
             }
-            Record::Event { .. } => {}
+            Entry::Event { .. } => {}
         }
     }
     seg?;
@@ -127,10 +127,23 @@ pub fn execution_tolerance(trace: &Trace) -> Option<f64> {
 pub fn swept_pixels(world: &World, trace: &Trace) -> FixedBitSet {
     let frame = *world.frame();
     let rt = world.robot().tool_radius / frame.resolution + SWEEP_EPS_PX;
-    let points: Vec<Point> = trace
-        .poses()
-        .map(|p| frame.world_to_grid(p.position()))
-        .collect();
+    // The executed polyline with each straight run of the trace reduced to its two ends: a
+    // run's poses lie in order on the segment between its ends, so the capsules of its steps
+    // make up the capsule of that segment.
+    let lattice = trace.lattice();
+    let mut points: Vec<Point> = Vec::with_capacity(trace.piece_count() + 1);
+    for piece in trace.pieces() {
+        match piece {
+            Piece::Pose { pose, .. } => points.push(frame.world_to_grid(pose.position())),
+            Piece::Run(run) => {
+                let [x0, y0] = run.from;
+                let [x1, y1] = run.to(lattice);
+                points.push(frame.world_to_grid(Point::new(x0, y0)));
+                points.push(frame.world_to_grid(Point::new(x1, y1)));
+            }
+            Piece::Event { .. } => {}
+        }
+    }
     // Segments between consecutive distinct points (a lone first point sweeps its disk).
     let sweep = |pts: &[Point], first: bool| {
         let mut swept = FixedBitSet::with_capacity(frame.len());
@@ -254,13 +267,16 @@ pub fn coverage_curve(world: &World, trace: &Trace, samples: usize) -> Vec<[f64;
 }
 
 /// Tile entries along a polyline (Amanatides-Woo traversal); a corner crossing is one entry.
-fn tile_entries(grid: &TileGrid, poses: &[Pose], mut visit: impl FnMut(Tile)) {
-    let Some(first) = poses.first() else { return };
+fn tile_entries(grid: &TileGrid, trace: &Trace, mut visit: impl FnMut(Tile)) {
+    let mut poses = trace.poses();
+    let Some(first) = poses.next() else { return };
     let mut cur = grid.tile_of(first.position());
     visit(cur);
-    for w in poses.windows(2) {
-        let a = w[0].position();
-        let b = w[1].position();
+    let mut prev = first.position();
+    for p in poses {
+        let a = prev;
+        let b = p.position();
+        prev = b;
         if a == b {
             continue;
         }
@@ -336,16 +352,73 @@ pub fn compute(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
     let frame = *world.frame();
     let robot = world.robot();
     let trace = &run.trace;
-    let poses: Vec<Pose> = trace.poses().collect();
     let px_area = frame.resolution * frame.resolution;
+    let start = world.start().position();
+    let two_rt = 2.0 * robot.tool_radius;
+    // The swept pixels and the tile coverage are independent of the rest: on other threads.
+    std::thread::scope(|scope| {
+        let swept = scope.spawn(|| swept_pixels(world, trace));
+        let coverage_rate = scope.spawn(|| {
+            // Under PID execution a tile centre counts as visited within the waypoint tolerance.
+            let exec_tol = execution_tolerance(trace);
+            run.tile_side.map(|side| {
+                let grid = TileGrid::new(start, side);
+                let reach = reachable_tiles(world, &grid);
+                if reach.is_empty() {
+                    return 0.0;
+                }
+                let visited = visited_tile_centres(&grid, trace, &reach, exec_tol);
+                visited as f64 / reach.len() as f64
+            })
+        });
+        let mut m = compute_rest(world, run, map_name);
+        let swept: FixedBitSet = join(swept);
+        m.coverage_rate = join(coverage_rate);
+        let swept_count = swept.count_ones(..);
+        let covered = swept.intersection(world.accessible()).count();
+        let a_count = world.accessible_count();
+        m.effective_coverage = if a_count == 0 {
+            0.0
+        } else {
+            covered as f64 / a_count as f64
+        };
+        let area_a = a_count as f64 * px_area;
+        m.path_ratio = if area_a > 0.0 {
+            m.path_length_m / (area_a / two_rt)
+        } else {
+            0.0
+        };
+        let swept_area = swept_count as f64 * px_area;
+        let path_length = m.path_length_m;
+        m.redundancy = (path_length > 0.0 && swept_area > 0.0)
+            .then(|| path_length * two_rt / swept_area - 1.0);
+        m
+    })
+}
+
+/// The result of a scoped thread (its panic passed on).
+fn join<T>(h: std::thread::ScopedJoinHandle<'_, T>) -> T {
+    match h.join() {
+        Ok(v) => v,
+        Err(panic) => std::panic::resume_unwind(panic),
+    }
+}
+
+/// The metrics that follow the poses and events one by one (all but the swept area and the
+/// tile coverage, left at 0 / `None`).
+fn compute_rest(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
+    let robot = world.robot();
+    let trace = &run.trace;
 
     // Path length, turns, rotation.
     let mut path_length = 0.0;
     let mut turns = 0u32;
     let mut rotation = 0.0;
     let mut in_turn = false;
-    for w in poses.windows(2) {
-        let (a, b) = (w[0], w[1]);
+    let mut poses = trace.poses();
+    let mut prev = poses.next();
+    for b in poses {
+        let Some(a) = prev.replace(b) else { break };
         let d = a.position().dist(b.position());
         if d > 0.0 {
             path_length += d;
@@ -369,10 +442,10 @@ pub fn compute(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
     let mut backtrack_length = 0.0;
     let mut in_backtrack = false;
     let mut last: Option<Point> = None;
-    for r in &trace.records {
+    for r in trace.entries() {
         match r {
-            Record::Pose { pose, .. } => {
-                let p = Point::new(pose[0], pose[1]);
+            Entry::Pose { pose, .. } => {
+                let p = pose.position();
                 if in_backtrack {
                     if let Some(l) = last {
                         backtrack_length += l.dist(p);
@@ -380,7 +453,7 @@ pub fn compute(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
                 }
                 last = Some(p);
             }
-            Record::Event { event, .. } => match event {
+            Entry::Event { event, .. } => match event {
                 Event::RegionStart { .. } => regions += 1,
                 Event::BacktrackStart => {
                     backtracks += 1;
@@ -393,36 +466,16 @@ pub fn compute(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
         }
     }
 
-    // Swept area and effective coverage.
-    let swept = swept_pixels(world, trace);
-    let swept_count = swept.count_ones(..);
-    let acc = world.accessible();
-    let covered = swept.intersection(acc).count();
-    let a_count = world.accessible_count();
-    let effective_coverage = if a_count == 0 {
-        0.0
-    } else {
-        covered as f64 / a_count as f64
-    };
-    let area_a = a_count as f64 * px_area;
+    // Tiles: revisit rate (planner tile side, else 2 r_tool); the coverage rate is computed
+    // beside this.
     let two_rt = 2.0 * robot.tool_radius;
-    let path_ratio = if area_a > 0.0 {
-        path_length / (area_a / two_rt)
-    } else {
-        0.0
-    };
-    let swept_area = swept_count as f64 * px_area;
-    let redundancy =
-        (path_length > 0.0 && swept_area > 0.0).then(|| path_length * two_rt / swept_area - 1.0);
-
-    // Tiles: revisit rate (planner tile side, else 2 r_tool) and coverage rate (tile planners).
     let start = world.start().position();
     let side = run.tile_side.unwrap_or(two_rt);
     let grid = TileGrid::new(start, side);
     let (i0, i1, j0, j1) = grid.bounds_for(world);
     let mut distinct = TileSet::new(i0, i1, j0, j1);
     let mut entries = 0usize;
-    tile_entries(&grid, &poses, |t| {
+    tile_entries(&grid, trace, |t| {
         entries += 1;
         distinct.insert(t);
     });
@@ -433,21 +486,11 @@ pub fn compute(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
         (entries - nd) as f64 / nd as f64
     };
 
-    // Under PID execution a tile centre counts as visited within the waypoint tolerance.
     let exec_tol = execution_tolerance(trace);
-    let coverage_rate = run.tile_side.map(|side| {
-        let grid = TileGrid::new(start, side);
-        let reach = reachable_tiles(world, &grid);
-        if reach.is_empty() {
-            return 0.0;
-        }
-        let visited = visited_tile_centres(&grid, &poses, &reach, exec_tol);
-        visited as f64 / reach.len() as f64
-    });
-
     let keepout_violations = world.zones().map_or(0, |z| {
-        let pts: Vec<Point> = poses
-            .iter()
+        let frame = *world.frame();
+        let pts: Vec<Point> = trace
+            .poses()
             .map(|p| frame.world_to_grid(p.position()))
             .collect();
         crate::zones::keepout_entries(&frame, &z.keepout, &pts, robot.radius / frame.resolution)
@@ -465,11 +508,11 @@ pub fn compute(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
         map: map_name.to_string(),
         robot_radius_m: robot.radius,
         tool_radius_m: robot.tool_radius,
-        coverage_rate,
-        effective_coverage,
+        coverage_rate: None,
+        effective_coverage: 0.0,
         path_length_m: path_length,
-        path_ratio,
-        redundancy,
+        path_ratio: 0.0,
+        redundancy: None,
         revisit_rate,
         regions,
         backtracks,
@@ -489,22 +532,26 @@ pub fn compute(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
 /// within the PID waypoint tolerance `tol` when given).
 fn visited_tile_centres(
     grid: &TileGrid,
-    poses: &[Pose],
+    trace: &Trace,
     reach: &TileSet,
     tol: Option<f64>,
 ) -> usize {
     let eps = (1e-6 * grid.side).max(tol.map_or(0.0, |t| t + 1e-9));
     let (i0, i1, j0, j1) = reach.bounds();
     let mut hit = TileSet::new(i0, i1, j0, j1);
-    if let Some(p) = poses.first() {
-        let t = grid.tile_of(p.position());
-        if grid.center(t).dist(p.position()) <= eps {
-            hit.insert(t);
-        }
+    let mut poses = trace.poses();
+    let Some(first) = poses.next() else {
+        return 0;
+    };
+    let t = grid.tile_of(first.position());
+    if grid.center(t).dist(first.position()) <= eps {
+        hit.insert(t);
     }
-    for w in poses.windows(2) {
-        let a = w[0].position();
-        let b = w[1].position();
+    let mut prev = first.position();
+    for p in poses {
+        let a = prev;
+        let b = p.position();
+        prev = b;
         if a == b {
             continue;
         }

@@ -1,8 +1,34 @@
 //! The trace: every executed pose and every event of a run, in order. Metrics, pictures and the
 //! replay are pure functions of (world, trace).
 //!
-//! Serialized as JSON Lines: `{"t":3,"pose":[x,y,theta]}` for poses and
-//! `{"t":3,"event":"region_start","region":1}` for events.
+//! # In memory
+//!
+//! A run of a tile planner is mostly straight moves of one tile per step, so the trace does not
+//! keep one record per pose: [`Trace::push_pose`] merges a pose into the straight run before it
+//! when it has the same heading, the next step number and the position that continues the run
+//! exactly (bit for bit), so that expanding the runs gives back every pushed pose unchanged.
+//! Two kinds of run exist:
+//!
+//! - a **lattice run**: positions `anchor + index * side` (each coordinate computed as
+//!   `anchor.x + f64::from(i) * side`, the formula of [`crate::tiles::TileGrid::center`]) whose
+//!   integer index advances by a fixed `(di, dj)`; the [`Lattice`] is fixed by the first pose
+//!   (the anchor) and the first displacement (the side, rounded to 12 significant digits);
+//! - a **step run**: each position is the previous one plus a fixed vector (`x + dx` in
+//!   floating point), as a simulator that translates by a fixed distance produces.
+//!
+//! Every other pose is kept as it is. [`Trace::entries`], [`Trace::poses`], [`Trace::events`]
+//! and [`Trace::records`] expand the runs; [`Trace::pieces`] shows them as stored (what the
+//! `trace.jsonl` writer uses). A pose costs 40 bytes when it stands alone and nothing when it
+//! extends a run (a run is 40 or 56 bytes); an event costs its [`Event`] plus 24 bytes.
+//!
+//! # On disk
+//!
+//! Serialized by `ccpp_io::trace` as JSON Lines: `{"t":3,"pose":[x,y,theta]}` for a pose,
+//! `{"t":3,"event":"region_start","region":1}` for an event, and, for a straight run of `n`
+//! poses at steps `t, t+1, ...`, `{"t":3,"poses":n,"from":[x,y],"to":[x,y],"theta":th}` (a
+//! lattice run, after a `{"lattice":[x,y,side]}` line) or
+//! `{"t":3,"poses":n,"from":[x,y],"step":[dx,dy],"theta":th}` (a step run). Files written
+//! before runs existed (one line per pose) read the same.
 
 use serde::{Deserialize, Serialize};
 
@@ -125,7 +151,7 @@ pub enum Event {
     },
 }
 
-/// One trace line.
+/// One trace line of the one-record-per-pose form (and the unit of [`Trace::records`]).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(untagged)]
 pub enum Record {
@@ -146,44 +172,590 @@ pub enum Record {
     },
 }
 
+/// One entry of a trace, borrowed: a pose or an event, with its step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Entry<'a> {
+    /// A pose.
+    Pose {
+        /// Step counter.
+        t: u64,
+        /// The pose.
+        pose: Pose,
+    },
+    /// An event.
+    Event {
+        /// Step counter.
+        t: u64,
+        /// The event.
+        event: &'a Event,
+    },
+}
+
+/// The grid of a trace's lattice runs: point `(i, j)` is at
+/// `(anchor[0] + f64::from(i) * side, anchor[1] + f64::from(j) * side)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lattice {
+    /// World position of point `(0, 0)`.
+    pub anchor: [f64; 2],
+    /// Spacing, metres (finite, > 0).
+    pub side: f64,
+}
+
+impl Lattice {
+    /// The world coordinate of index `i` along an axis whose index 0 lies at `a`.
+    #[inline]
+    fn coord(a: f64, i: i32, side: f64) -> f64 {
+        a + f64::from(i) * side
+    }
+
+    /// The world position of lattice point `(i, j)`.
+    #[inline]
+    pub fn point(&self, i: i32, j: i32) -> [f64; 2] {
+        [
+            Self::coord(self.anchor[0], i, self.side),
+            Self::coord(self.anchor[1], j, self.side),
+        ]
+    }
+
+    /// The lattice index of an axis coordinate `x` (anchor `a`) when `x` is exactly (bit for bit)
+    /// a lattice coordinate, else `None`.
+    #[inline]
+    fn index_1d(a: f64, x: f64, side: f64) -> Option<i32> {
+        let f = ((x - a) / side).round();
+        if f.is_nan() || f.abs() > f64::from(i32::MAX - 1) {
+            return None;
+        }
+        let i = f as i32;
+        (Self::coord(a, i, side).to_bits() == x.to_bits()).then_some(i)
+    }
+
+    /// The lattice index of world position `p` when `p` is exactly a lattice point.
+    #[inline]
+    pub fn index(&self, p: [f64; 2]) -> Option<(i32, i32)> {
+        Some((
+            Self::index_1d(self.anchor[0], p[0], self.side)?,
+            Self::index_1d(self.anchor[1], p[1], self.side)?,
+        ))
+    }
+
+    /// A lattice anchored at `anchor` whose side is `d` rounded to 12 significant digits, when
+    /// that is a usable spacing.
+    fn guess(anchor: [f64; 2], d: f64) -> Option<Self> {
+        let side: f64 = format!("{d:.11e}").parse().ok()?;
+        let scale = anchor[0].abs().max(anchor[1].abs()).max(1.0);
+        (side.is_finite() && side > scale * 1e-9).then_some(Self { anchor, side })
+    }
+}
+
+/// How the positions of a [`Run`] follow one another.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Advance {
+    /// Lattice points: the first at index `(i, j)`, each next one `(di, dj)` further.
+    Lattice {
+        /// First index, east.
+        i: i32,
+        /// First index, north.
+        j: i32,
+        /// Index step, east.
+        di: i32,
+        /// Index step, north.
+        dj: i32,
+    },
+    /// Each position is the previous one plus `d` (floating-point addition, per coordinate).
+    Step {
+        /// The step vector, metres.
+        d: [f64; 2],
+    },
+}
+
+/// A straight run of `n >= 2` poses with one heading, at steps `t, t + 1, ..., t + n - 1`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Run {
+    /// Step of the first pose.
+    pub t: u64,
+    /// Number of poses.
+    pub n: u32,
+    /// Heading of every pose.
+    pub theta: f64,
+    /// Position of the first pose.
+    pub from: [f64; 2],
+    /// How the next positions follow.
+    pub advance: Advance,
+}
+
+impl Run {
+    /// The poses of the run, in order (`lattice` is the trace's, needed by lattice runs).
+    pub fn poses(self, lattice: Option<Lattice>) -> impl Iterator<Item = (u64, Pose)> {
+        let mut pos = self.from;
+        (0..self.n).map(move |k| {
+            if k > 0 {
+                pos = match (self.advance, lattice) {
+                    (Advance::Lattice { i, j, di, dj }, Some(l)) => {
+                        let k = k as i32;
+                        l.point(i + k * di, j + k * dj)
+                    }
+                    (Advance::Step { d }, _) => [pos[0] + d[0], pos[1] + d[1]],
+                    (Advance::Lattice { .. }, None) => pos,
+                };
+            }
+            (self.t + u64::from(k), Pose::new(pos[0], pos[1], self.theta))
+        })
+    }
+
+    /// The position of the last pose.
+    pub fn to(self, lattice: Option<Lattice>) -> [f64; 2] {
+        match (self.advance, lattice) {
+            (Advance::Lattice { i, j, di, dj }, Some(l)) => {
+                let k = self.n as i32 - 1;
+                l.point(i + k * di, j + k * dj)
+            }
+            _ => self
+                .poses(lattice)
+                .last()
+                .map_or(self.from, |(_, p)| [p.x, p.y]),
+        }
+    }
+}
+
+/// One stored piece of a trace: a lone pose, a straight run of poses, or an event.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Piece<'a> {
+    /// A pose that extends no run.
+    Pose {
+        /// Step counter.
+        t: u64,
+        /// The pose.
+        pose: Pose,
+    },
+    /// A straight run of poses.
+    Run(Run),
+    /// An event.
+    Event {
+        /// Step counter.
+        t: u64,
+        /// The event.
+        event: &'a Event,
+    },
+}
+
+/// Stored items (40 bytes, 56 for a step run).
+#[derive(Clone, Debug, PartialEq)]
+enum Item {
+    Pose {
+        t: u64,
+        pose: [f64; 3],
+    },
+    Lattice {
+        t: u64,
+        theta: f64,
+        i: i32,
+        j: i32,
+        di: i32,
+        dj: i32,
+        n: u32,
+    },
+    Step {
+        t: u64,
+        theta: f64,
+        from: [f64; 2],
+        d: [f64; 2],
+        n: u32,
+    },
+    Event {
+        t: u64,
+        /// Index into `Trace::events`.
+        k: u32,
+    },
+}
+
+/// A position in a trace ([`Trace::end`], [`Trace::entries_from`]): entries before it were
+/// seen.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Cursor {
+    item: usize,
+    within: u32,
+}
+
 /// A whole run's record.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Trace {
-    /// The lines, in order.
-    pub records: Vec<Record>,
+    items: Vec<Item>,
+    events: Vec<Event>,
+    /// The lattice of lattice runs (fixed by the first pose and the first displacement).
+    lattice: Option<Lattice>,
+    /// First pose's position, until the lattice is fixed.
+    anchor: Option<[f64; 2]>,
+    /// Whether the lattice guess was made (right or wrong, it is made once).
+    guessed: bool,
+    /// The last pose pushed (step, x, y, theta).
+    last: Option<(u64, [f64; 3])>,
+    poses: usize,
 }
 
 impl Trace {
     /// Appends a pose.
     pub fn push_pose(&mut self, t: u64, p: Pose) {
-        self.records.push(Record::Pose {
-            t,
-            pose: [p.x, p.y, p.theta],
-        });
+        self.poses += 1;
+        let xy = [p.x, p.y];
+        if let Some((_, l)) = self.last {
+            if !self.guessed && (l[0] != p.x || l[1] != p.y) {
+                self.guessed = true;
+                if let Some(a) = self.anchor {
+                    let d = (p.x - l[0]).abs().max((p.y - l[1]).abs());
+                    self.lattice = Lattice::guess(a, d);
+                }
+            }
+        } else if self.anchor.is_none() {
+            self.anchor = Some(xy);
+        }
+        if !self.try_extend(t, p) {
+            self.items.push(Item::Pose {
+                t,
+                pose: [p.x, p.y, p.theta],
+            });
+        }
+        self.last = Some((t, [p.x, p.y, p.theta]));
+    }
+
+    /// Merges pose `p` at step `t` into the last item when it continues it exactly.
+    fn try_extend(&mut self, t: u64, p: Pose) -> bool {
+        let Some((lt, l)) = self.last else {
+            return false;
+        };
+        if t != lt.wrapping_add(1) || lt == u64::MAX || p.theta.to_bits() != l[2].to_bits() {
+            return false;
+        }
+        let lattice = self.lattice;
+        let same = |a: f64, b: f64| a.to_bits() == b.to_bits();
+        let Some(last_item) = self.items.last_mut() else {
+            return false;
+        };
+        match last_item {
+            Item::Lattice {
+                i, j, di, dj, n, ..
+            } => {
+                let Some(lat) = lattice else { return false };
+                let k = *n as i32;
+                let (Some(ni), Some(nj)) = (
+                    di.checked_mul(k).and_then(|v| v.checked_add(*i)),
+                    dj.checked_mul(k).and_then(|v| v.checked_add(*j)),
+                ) else {
+                    return false;
+                };
+                if lat.index([p.x, p.y]) == Some((ni, nj)) && *n < u32::MAX {
+                    *n += 1;
+                    return true;
+                }
+                false
+            }
+            Item::Step { d, n, .. } => {
+                if same(l[0] + d[0], p.x) && same(l[1] + d[1], p.y) && *n < u32::MAX {
+                    *n += 1;
+                    return true;
+                }
+                false
+            }
+            Item::Pose { t: pt, pose } => {
+                debug_assert_eq!(*pt, lt);
+                let (pt, pose) = (*pt, *pose);
+                if let Some(lat) = lattice {
+                    if let (Some((i0, j0)), Some((i1, j1))) =
+                        (lat.index([pose[0], pose[1]]), lat.index([p.x, p.y]))
+                    {
+                        if let (Some(di), Some(dj)) = (i1.checked_sub(i0), j1.checked_sub(j0)) {
+                            *last_item = Item::Lattice {
+                                t: pt,
+                                theta: p.theta,
+                                i: i0,
+                                j: j0,
+                                di,
+                                dj,
+                                n: 2,
+                            };
+                            return true;
+                        }
+                    }
+                }
+                let d = [p.x - pose[0], p.y - pose[1]];
+                if same(pose[0] + d[0], p.x) && same(pose[1] + d[1], p.y) {
+                    *last_item = Item::Step {
+                        t: pt,
+                        theta: p.theta,
+                        from: [pose[0], pose[1]],
+                        d,
+                        n: 2,
+                    };
+                    return true;
+                }
+                false
+            }
+            Item::Event { .. } => false,
+        }
     }
 
     /// Appends an event.
     pub fn push_event(&mut self, t: u64, event: Event) {
-        self.records.push(Record::Event { t, event });
+        let k = u32::try_from(self.events.len()).unwrap_or(u32::MAX);
+        self.events.push(event);
+        // An event ends any run: the next pose starts a new item.
+        self.items.push(Item::Event { t, k });
+    }
+
+    /// Appends a record.
+    pub fn push(&mut self, r: Record) {
+        match r {
+            Record::Pose { t, pose } => self.push_pose(t, Pose::new(pose[0], pose[1], pose[2])),
+            Record::Event { t, event } => self.push_event(t, event),
+        }
+    }
+
+    /// Appends a straight run (as [`Self::push_pose`] of each of its poses).
+    pub fn push_run(&mut self, run: Run, lattice: Option<Lattice>) {
+        for (t, p) in run.poses(lattice) {
+            self.push_pose(t, p);
+        }
+    }
+
+    /// The lattice of the lattice runs, if any was fixed.
+    pub fn lattice(&self) -> Option<Lattice> {
+        self.lattice
+    }
+
+    /// Number of poses.
+    pub fn pose_count(&self) -> usize {
+        self.poses
+    }
+
+    /// Number of events.
+    pub fn event_count(&self) -> usize {
+        self.events.len()
+    }
+
+    /// Number of entries (poses and events).
+    pub fn len(&self) -> usize {
+        self.poses + self.events.len()
+    }
+
+    /// Whether the trace holds nothing.
+    pub fn is_empty(&self) -> bool {
+        self.items.is_empty()
+    }
+
+    /// Number of stored pieces (lone poses, runs and events): what the trace costs.
+    pub fn piece_count(&self) -> usize {
+        self.items.len()
+    }
+
+    /// Bytes held by the trace's own vectors (not counting what events own on the heap).
+    pub fn heap_bytes(&self) -> usize {
+        self.items.capacity() * std::mem::size_of::<Item>()
+            + self.events.capacity() * std::mem::size_of::<Event>()
+    }
+
+    fn piece(&self, item: &Item) -> Piece<'_> {
+        match *item {
+            Item::Pose { t, pose } => Piece::Pose {
+                t,
+                pose: Pose::new(pose[0], pose[1], pose[2]),
+            },
+            Item::Lattice {
+                t,
+                theta,
+                i,
+                j,
+                di,
+                dj,
+                n,
+            } => Piece::Run(Run {
+                t,
+                n,
+                theta,
+                from: self.lattice.map_or([0.0; 2], |l| l.point(i, j)),
+                advance: Advance::Lattice { i, j, di, dj },
+            }),
+            Item::Step {
+                t,
+                theta,
+                from,
+                d,
+                n,
+            } => Piece::Run(Run {
+                t,
+                n,
+                theta,
+                from,
+                advance: Advance::Step { d },
+            }),
+            Item::Event { t, k } => Piece::Event {
+                t,
+                event: &self.events[k as usize],
+            },
+        }
+    }
+
+    /// The stored pieces, in order.
+    pub fn pieces(&self) -> impl Iterator<Item = Piece<'_>> + '_ {
+        self.items.iter().map(|it| self.piece(it))
+    }
+
+    /// Every pose and event, in order.
+    pub fn entries(&self) -> impl Iterator<Item = Entry<'_>> + '_ {
+        self.entries_from(Cursor::default())
+    }
+
+    /// The position after the last entry (a later pose may extend the last item, so the
+    /// cursor points into it).
+    pub fn end(&self) -> Cursor {
+        match self.items.last() {
+            None => Cursor::default(),
+            Some(Item::Lattice { n, .. } | Item::Step { n, .. }) => Cursor {
+                item: self.items.len() - 1,
+                within: *n,
+            },
+            Some(_) => Cursor {
+                item: self.items.len() - 1,
+                within: 1,
+            },
+        }
+    }
+
+    /// The entries from cursor `c` on (those pushed after [`Self::end`] returned `c`).
+    pub fn entries_from(&self, c: Cursor) -> impl Iterator<Item = Entry<'_>> + '_ {
+        let lattice = self.lattice;
+        self.items
+            .get(c.item..)
+            .unwrap_or(&[])
+            .iter()
+            .enumerate()
+            .flat_map(move |(k, it)| {
+                let skip = if k == 0 { c.within as usize } else { 0 };
+                let (one, run) = match self.piece(it) {
+                    Piece::Pose { t, pose } => (Some(Entry::Pose { t, pose }), None),
+                    Piece::Event { t, event } => (Some(Entry::Event { t, event }), None),
+                    Piece::Run(r) => (None, Some(r)),
+                };
+                one.into_iter().skip(skip).chain(
+                    run.into_iter()
+                        .flat_map(move |r| r.poses(lattice))
+                        .skip(skip)
+                        .map(|(t, pose)| Entry::Pose { t, pose }),
+                )
+            })
+    }
+
+    /// The records (one per pose or event, events cloned), in order.
+    pub fn records(&self) -> impl Iterator<Item = Record> + '_ {
+        self.entries().map(|e| match e {
+            Entry::Pose { t, pose } => Record::Pose {
+                t,
+                pose: [pose.x, pose.y, pose.theta],
+            },
+            Entry::Event { t, event } => Record::Event {
+                t,
+                event: event.clone(),
+            },
+        })
     }
 
     /// The executed poses, in order.
     pub fn poses(&self) -> impl Iterator<Item = Pose> + '_ {
-        self.records.iter().filter_map(|r| match r {
-            Record::Pose { pose, .. } => Some(Pose {
-                x: pose[0],
-                y: pose[1],
-                theta: pose[2],
-            }),
-            Record::Event { .. } => None,
+        self.entries().filter_map(|e| match e {
+            Entry::Pose { pose, .. } => Some(pose),
+            Entry::Event { .. } => None,
+        })
+    }
+
+    /// The executed poses with their step, in order.
+    pub fn timed_poses(&self) -> impl Iterator<Item = (u64, Pose)> + '_ {
+        self.entries().filter_map(|e| match e {
+            Entry::Pose { t, pose } => Some((t, pose)),
+            Entry::Event { .. } => None,
         })
     }
 
     /// The events, in order, with their step.
     pub fn events(&self) -> impl Iterator<Item = (u64, &Event)> + '_ {
-        self.records.iter().filter_map(|r| match r {
-            Record::Event { t, event } => Some((*t, event)),
-            Record::Pose { .. } => None,
+        self.items.iter().filter_map(|it| match *it {
+            Item::Event { t, k } => Some((t, &self.events[k as usize])),
+            _ => None,
         })
+    }
+
+    /// Keeps only the events for which `keep` is true (poses are all kept).
+    pub fn retain_events(&mut self, mut keep: impl FnMut(&Event) -> bool) {
+        let records: Vec<Record> = self.records().collect();
+        *self = records
+            .into_iter()
+            .filter(|r| match r {
+                Record::Event { event, .. } => keep(event),
+                Record::Pose { .. } => true,
+            })
+            .collect();
+    }
+}
+
+impl FromIterator<Record> for Trace {
+    fn from_iter<I: IntoIterator<Item = Record>>(iter: I) -> Self {
+        let mut t = Trace::default();
+        t.extend(iter);
+        t
+    }
+}
+
+impl Extend<Record> for Trace {
+    fn extend<I: IntoIterator<Item = Record>>(&mut self, iter: I) {
+        for r in iter {
+            self.push(r);
+        }
+    }
+}
+
+/// A record, borrowed (serialized exactly as [`Record`]).
+#[derive(Serialize)]
+#[serde(untagged)]
+enum RecordRef<'a> {
+    Pose {
+        t: u64,
+        pose: [f64; 3],
+    },
+    Event {
+        t: u64,
+        #[serde(flatten)]
+        event: &'a Event,
+    },
+}
+
+/// Serialized as `{"records": [record, ...]}`, one [`Record`] per pose or event (runs expanded).
+impl Serialize for Trace {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct as _;
+        struct Records<'a>(&'a Trace);
+        impl Serialize for Records<'_> {
+            fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+                serializer.collect_seq(self.0.entries().map(|e| match e {
+                    Entry::Pose { t, pose } => RecordRef::Pose {
+                        t,
+                        pose: [pose.x, pose.y, pose.theta],
+                    },
+                    Entry::Event { t, event } => RecordRef::Event { t, event },
+                }))
+            }
+        }
+        let mut s = serializer.serialize_struct("Trace", 1)?;
+        s.serialize_field("records", &Records(self))?;
+        s.end()
+    }
+}
+
+impl<'de> Deserialize<'de> for Trace {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        #[derive(Deserialize)]
+        struct Records {
+            records: Vec<Record>,
+        }
+        Ok(Records::deserialize(deserializer)?
+            .records
+            .into_iter()
+            .collect())
     }
 }

@@ -13,7 +13,7 @@ use ccpp_core::planners::ba_star_extended::{BaStarExtended, BaStarExtendedOption
 use ccpp_core::planners::extension::ExtensionOptions;
 use ccpp_core::planners::{build, PlannerOptions};
 use ccpp_core::sim::{simulate, RunOutput, SimConfig, StopReason};
-use ccpp_core::trace::{Event, Record, Trace};
+use ccpp_core::trace::{Entry, Event, Trace};
 use ccpp_core::world::{Robot, World};
 use ccpp_core::Pose;
 
@@ -48,11 +48,7 @@ fn run_ba(w: &World) -> Metrics {
 }
 
 fn count(trace: &Trace, f: impl Fn(&Event) -> bool) -> usize {
-    trace
-        .records
-        .iter()
-        .filter(|r| matches!(r, Record::Event { event, .. } if f(event)))
-        .count()
+    trace.events().filter(|(_, e)| f(e)).count()
 }
 
 /// Checks that every commanded move is known free when it is commanded.
@@ -183,23 +179,23 @@ fn room_rims_are_swept() {
 /// Length of the moves inside backtrack sections after trace record `from`.
 fn backtrack_length_after(trace: &Trace, from: usize) -> f64 {
     let (mut inside, mut last, mut len) = (false, None::<[f64; 2]>, 0.0);
-    for r in &trace.records[from..] {
+    for r in trace.entries().skip(from) {
         match r {
-            Record::Event {
+            Entry::Event {
                 event: Event::BacktrackStart,
                 ..
             } => inside = true,
-            Record::Event {
+            Entry::Event {
                 event: Event::BacktrackEnd,
                 ..
             } => inside = false,
-            Record::Pose { pose, .. } => {
+            Entry::Pose { pose, .. } => {
                 if let (true, Some(l)) = (inside, last) {
-                    len += (pose[0] - l[0]).hypot(pose[1] - l[1]);
+                    len += (pose.x - l[0]).hypot(pose.y - l[1]);
                 }
-                last = Some([pose[0], pose[1]]);
+                last = Some([pose.x, pose.y]);
             }
-            Record::Event { .. } => {}
+            Entry::Event { .. } => {}
         }
     }
     len
@@ -284,8 +280,8 @@ const HALLS: &str = "\
 fn first_pass_last_region_end(trace: &Trace) -> (usize, usize) {
     let mut last_region_end = 0;
     let mut first_pass = usize::MAX;
-    for (k, r) in trace.records.iter().enumerate() {
-        if let Record::Event { event, .. } = r {
+    for (k, r) in trace.entries().enumerate() {
+        if let Entry::Event { event, .. } = r {
             match event {
                 Event::RegionEnd { .. } => last_region_end = k,
                 Event::WallFollowStart => first_pass = first_pass.min(k),
@@ -350,14 +346,14 @@ fn lane_ends_drive_to_the_wall() {
     let top = |t: &Trace| t.poses().map(|p| p.y).fold(f64::MIN, f64::max);
     let bm_top = |t: &Trace| {
         let mut y = f64::MIN;
-        for r in &t.records {
+        for r in t.entries() {
             match r {
-                Record::Event {
+                Entry::Event {
                     event: Event::WallFollowStart,
                     ..
                 } => break,
-                Record::Pose { pose, .. } => y = y.max(pose[1]),
-                Record::Event { .. } => {}
+                Entry::Pose { pose, .. } => y = y.max(pose.y),
+                Entry::Event { .. } => {}
             }
         }
         y
@@ -437,17 +433,17 @@ fn trace_ignores_pixels_never_sensed() {
 fn pass_poses(trace: &Trace) -> usize {
     let mut inside = false;
     let mut n = 0;
-    for r in &trace.records {
+    for r in trace.entries() {
         match r {
-            Record::Event {
+            Entry::Event {
                 event: Event::WallFollowStart,
                 ..
             } => inside = true,
-            Record::Event {
+            Entry::Event {
                 event: Event::WallFollowEnd,
                 ..
             } => inside = false,
-            Record::Pose { .. } if inside => n += 1,
+            Entry::Pose { .. } if inside => n += 1,
             _ => {}
         }
     }

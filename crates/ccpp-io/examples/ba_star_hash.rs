@@ -31,7 +31,7 @@ fn run(name: &str, map: GridMap, r: f64) {
     println!(
         "{name}: trace {:016x} ({} records) metrics {:016x}",
         fnv(&trace),
-        out.trace.records.len(),
+        out.trace.len(),
         fnv(&metrics)
     );
 }

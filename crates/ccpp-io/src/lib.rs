@@ -15,6 +15,7 @@
 //! * [`export`]: path exports a robot stack reads (waypoints CSV/JSON, ROS `nav_msgs/Path`
 //!   YAML, `GeoJSON`) and the waypoint readers;
 //! * [`plan`]: a known-map planner's route without simulation overhead or metrics;
+//! * [`phase`]: optional phase timing (`CCPP_PHASES`);
 //! * [`file`]: opening user files (regular files only: a FIFO is refused, not read forever).
 //!
 //! Errors are [`thiserror`] enums that always name the file concerned; nothing here panics on
@@ -25,6 +26,7 @@ pub mod file;
 pub mod georef;
 pub mod landmarks;
 pub mod map;
+pub mod phase;
 pub mod plan;
 pub mod scenario;
 pub mod trace;

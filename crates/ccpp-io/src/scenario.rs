@@ -229,8 +229,8 @@ impl MapRecipe {
             free_thresh: self.free_thresh,
             negate: None,
         };
-        let loaded = load_map(path, &opts)?;
-        self.prepare(loaded)
+        let loaded = crate::phase::time("load map", || load_map(path, &opts))?;
+        crate::phase::time("prepare map", || self.prepare(loaded))
     }
 
     /// Prepares a map the caller loaded (e.g. from bytes): georef, inflation, name.
@@ -659,13 +659,16 @@ impl Scenario {
     /// # Errors
     /// As [`world`](Self::world).
     pub fn run_on(&self, map: &PreparedMap) -> Result<Run, ScenarioError> {
-        let world = self.world(map)?;
+        let world = crate::phase::time("world", || self.world(map))?;
         // Wall time covers planning (offline planners plan in `build`) and simulation.
         let started = std::time::Instant::now();
-        let mut planner = self.planner.build(&world);
-        let mut output = simulate(&world, planner.as_mut(), &self.sim);
+        let mut output = crate::phase::time("plan + simulate", || {
+            let mut planner = self.planner.build(&world);
+            simulate(&world, planner.as_mut(), &self.sim)
+        });
         output.wall_time_s = started.elapsed().as_secs_f64();
-        let metrics = metrics::compute(&world, &output, &map.name);
+        let metrics =
+            crate::phase::time("metrics", || metrics::compute(&world, &output, &map.name));
         Ok(Run {
             world,
             output,

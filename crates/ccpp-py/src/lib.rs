@@ -16,7 +16,7 @@ use ccpp_core::planner::{KnownMap, Sensor, Step};
 use ccpp_core::planners::{PlannerConfig, PlannerKind, CATALOG};
 use ccpp_core::rng::SplitMix64;
 use ccpp_core::sim::{RunOutput, SimConfig, Simulator, StopReason};
-use ccpp_core::trace::{Event, Record, Trace};
+use ccpp_core::trace::{Cursor, Entry, Event, Record, Trace};
 use ccpp_core::world::{Robot, World};
 use ccpp_core::{Point, Pose};
 use ccpp_io::scenario::{MapRecipe, PreparedMap, Scenario, ScenarioError, DEFAULT_MAX_MEMORY_MB};
@@ -487,11 +487,10 @@ impl RunResult {
     /// fields (as in `trace.jsonl`).
     #[getter]
     fn events(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
-        let ev: Vec<&Record> = self
+        let ev: Vec<Record> = self
             .output
             .trace
-            .records
-            .iter()
+            .records()
             .filter(|r| matches!(r, Record::Event { .. }))
             .collect();
         to_py(py, &ev)
@@ -670,8 +669,8 @@ struct Live<'w> {
     known: KnownMap,
     /// Known map in image layout: 0 free, 1 occupied, 2 unknown.
     known_codes: Vec<u8>,
-    /// Trace records already swept.
-    records_seen: usize,
+    /// Where the trace records not yet swept begin.
+    records_seen: Cursor,
     /// Last swept position.
     last: Point,
     /// Swept accessible pixels.
@@ -793,24 +792,24 @@ fn sweep_new(live: &mut Live<'_>, world: &World) -> bool {
         last,
         ..
     } = live;
-    let records = &sim.trace().records;
-    for r in &records[*records_seen..] {
+    let trace = sim.trace();
+    for r in trace.entries_from(*records_seen) {
         match r {
-            Record::Pose { pose, .. } => {
-                let p = Point::new(pose[0], pose[1]);
+            Entry::Pose { pose, .. } => {
+                let p = pose.position();
                 if p != *last {
                     sweeper.add(*last, p);
                     *last = p;
                 }
             }
-            Record::Event {
+            Entry::Event {
                 event: Event::Collision { .. },
                 ..
             } => collided = true,
-            Record::Event { .. } => {}
+            Entry::Event { .. } => {}
         }
     }
-    *records_seen = records.len();
+    *records_seen = trace.end();
     let mut s = sweeper.swept().clone();
     s.intersect_with(world.accessible());
     live.covered = s.count_ones(..);
@@ -946,7 +945,7 @@ impl Env {
                         sweeper,
                         known: KnownMap::new(&f),
                         known_codes: vec![Cell::Unknown as u8; f.len()],
-                        records_seen: 0,
+                        records_seen: Cursor::default(),
                         last: start,
                         covered: 0,
                         steps: 0,

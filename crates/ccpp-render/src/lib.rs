@@ -25,7 +25,7 @@ use chart::{Chart, LegendEntry, Swatch};
 
 use ccpp_core::grid::Cell;
 use ccpp_core::metrics::swept_pixels;
-use ccpp_core::trace::{Event, Record, Trace};
+use ccpp_core::trace::{Entry, Event, Piece, Trace};
 use ccpp_core::world::World;
 use ccpp_core::Point;
 use tiny_skia::{Color, FillRule, Paint, PathBuilder, Pixmap, Rect, Stroke, StrokeDash, Transform};
@@ -167,14 +167,37 @@ pub fn crop_box(world: &World, trace: &Trace) -> (usize, usize, usize, usize) {
         r0 = r0.min(r);
         r1 = r1.max(r);
     };
-    for (i, cell) in world.map().cells().iter().enumerate() {
-        if *cell != Cell::Unknown {
-            add(i % f.width, i / f.width);
+    for (r, row) in world.map().cells().chunks(f.width.max(1)).enumerate() {
+        let known = |c: &Cell| *c != Cell::Unknown;
+        if let (Some(a), Some(b)) = (row.iter().position(known), row.iter().rposition(known)) {
+            add(a, r);
+            add(b, r);
         }
     }
-    for p in trace.poses() {
-        if let Some((c, r)) = f.pixel_of(p.position()) {
-            add(c, r);
+    // A straight run's poses lie between its ends: when both ends are on the map, the ends
+    // bound its pixels (the map is convex in grid coordinates).
+    let lattice = trace.lattice();
+    for piece in trace.pieces() {
+        match piece {
+            Piece::Pose { pose, .. } => {
+                if let Some((c, r)) = f.pixel_of(pose.position()) {
+                    add(c, r);
+                }
+            }
+            Piece::Run(run) => {
+                let ends = [run.from, run.to(lattice)].map(|[x, y]| f.pixel_of(Point::new(x, y)));
+                if let [Some(a), Some(b)] = ends {
+                    add(a.0, a.1);
+                    add(b.0, b.1);
+                } else {
+                    for (_, p) in run.poses(lattice) {
+                        if let Some((c, r)) = f.pixel_of(p.position()) {
+                            add(c, r);
+                        }
+                    }
+                }
+            }
+            Piece::Event { .. } => {}
         }
     }
     if c0 == usize::MAX {
@@ -225,8 +248,17 @@ struct Shown {
 }
 
 fn shown(world: &World, trace: &Trace, crop: (usize, usize, usize, usize)) -> Shown {
+    shown_with(world, trace, crop, &swept_pixels(world, trace))
+}
+
+/// [`shown`] with the swept pixels already computed.
+fn shown_with(
+    world: &World,
+    trace: &Trace,
+    crop: (usize, usize, usize, usize),
+    swept: &fixedbitset::FixedBitSet,
+) -> Shown {
     let f = *world.frame();
-    let swept = swept_pixels(world, trace);
     let acc = world.accessible();
     let cells = world.true_map().cells();
     let mut s = Shown {
@@ -255,9 +287,10 @@ fn shown(world: &World, trace: &Trace, crop: (usize, usize, usize, usize)) -> Sh
     let mut regions = std::collections::BTreeSet::new();
     let mut region = 0u32;
     let mut last: Option<[f64; 2]> = None;
-    for r in &trace.records {
+    for r in trace.entries() {
         match r {
-            Record::Pose { pose, .. } => {
+            Entry::Pose { pose, .. } => {
+                let pose = [pose.x, pose.y, pose.theta];
                 let p = [pose[0], pose[1]];
                 if last.is_some_and(|l| l != p) {
                     if in_bt {
@@ -269,7 +302,7 @@ fn shown(world: &World, trace: &Trace, crop: (usize, usize, usize, usize)) -> Sh
                 last = Some(p);
                 s.poses += 1;
             }
-            Record::Event { event, .. } => match event {
+            Entry::Event { event, .. } => match event {
                 Event::RegionStart { region: k } => region = *k,
                 Event::BacktrackStart => in_bt = true,
                 Event::BacktrackEnd => in_bt = false,
@@ -408,10 +441,9 @@ fn entries_of(s: &Shown) -> Vec<LegendEntry> {
 }
 
 /// Effective coverage as the picture shows it: swept reachable pixels over reachable pixels.
-fn effective_coverage(world: &World, trace: &Trace) -> f64 {
-    let swept = swept_pixels(world, trace);
+fn effective_coverage(world: &World, swept: &fixedbitset::FixedBitSet) -> f64 {
     let acc = world.accessible();
-    let hit = acc.ones().filter(|&i| swept.contains(i)).count();
+    let hit = acc.intersection(swept).count();
     hit as f64 / world.accessible_count().max(1) as f64
 }
 
@@ -437,6 +469,7 @@ pub fn coverage_pixmap(
 ) -> Result<Pixmap, RenderError> {
     let frame = *world.frame();
     let crop = crop_box(world, trace);
+    let swept = swept_pixels(world, trace);
     let (col0, row0, cols, rows) = crop;
     let (w, h) = (cols as u32, rows as u32);
     let scale = if w < style.min_width {
@@ -454,7 +487,7 @@ pub fn coverage_pixmap(
     let mut header = 0u32;
     if !style.title.is_empty() {
         let mut y = 6.0f32;
-        let cov = effective_coverage(world, trace);
+        let cov = effective_coverage(world, &swept);
         let collisions = trace
             .events()
             .filter(|(_, e)| matches!(e, Event::Collision { .. }))
@@ -510,7 +543,7 @@ pub fn coverage_pixmap(
     }
     let mut foot = Chart::new(cw, 0);
     let legend_h = if style.legend {
-        let entries = entries_of(&shown(world, trace, crop));
+        let entries = entries_of(&shown_with(world, trace, crop, &swept));
         let top = ch_map + header + 8;
         (foot.legend(8.0, top as f32, cw as f32 - 16.0, px as u32, &entries) + 8.0).ceil() as u32
     } else {
@@ -521,7 +554,6 @@ pub fn coverage_pixmap(
     pm.fill(Color::WHITE);
 
     // Background: classify each map pixel, then nearest-neighbour scale.
-    let swept = swept_pixels(world, trace);
     let acc = world.accessible();
     let cells = world.true_map().cells();
     let colour_of = |i: usize, x: u32, y: u32| -> [u8; 3] {
@@ -613,6 +645,31 @@ fn draw_zone_borders(pm: &mut Pixmap, world: &World, view: View) {
     }
 }
 
+/// The entries of a trace with each straight run reduced to its first and last pose (what a
+/// drawn polyline needs).
+fn path_entries(trace: &Trace) -> impl Iterator<Item = Entry<'_>> + '_ {
+    let lattice = trace.lattice();
+    trace.pieces().flat_map(move |piece| {
+        let pair = match piece {
+            Piece::Pose { t, pose } => [Some(Entry::Pose { t, pose }), None],
+            Piece::Event { t, event } => [Some(Entry::Event { t, event }), None],
+            Piece::Run(run) => {
+                let [x, y] = run.to(lattice);
+                let first = Entry::Pose {
+                    t: run.t,
+                    pose: ccpp_core::Pose::new(run.from[0], run.from[1], run.theta),
+                };
+                let last = Entry::Pose {
+                    t: run.t + u64::from(run.n) - 1,
+                    pose: ccpp_core::Pose::new(x, y, run.theta),
+                };
+                [Some(first), Some(last)]
+            }
+        };
+        pair.into_iter().flatten()
+    })
+}
+
 fn draw_path(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
     let width = (view.scale * 0.6).clamp(1.0, 3.0);
     let mut region = 0usize;
@@ -656,10 +713,10 @@ fn draw_path(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
         }
         run.clear();
     };
-    for r in &trace.records {
+    for r in path_entries(trace) {
         match r {
-            Record::Pose { pose, .. } => {
-                let p = view.to_canvas(world, Point::new(pose[0], pose[1]));
+            Entry::Pose { pose, .. } => {
+                let p = view.to_canvas(world, pose.position());
                 if last == Some(p) {
                     continue;
                 }
@@ -680,7 +737,7 @@ fn draw_path(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
                 run.push(p);
                 last = Some(p);
             }
-            Record::Event { event, .. } => match event {
+            Entry::Event { event, .. } => match event {
                 Event::RegionStart { region: k } => region = *k as usize,
                 Event::BacktrackStart => in_backtrack = true,
                 Event::BacktrackEnd => in_backtrack = false,
@@ -909,15 +966,8 @@ mod tests {
         insta::assert_snapshot!("legend_entries", labels.join("\n"));
         // A run without backtracking or markers has no such entries.
         let (world, mut trace) = run(2);
-        trace.records.retain(|r| {
-            !matches!(
-                r,
-                Record::Event {
-                    event: Event::Collision { .. } | Event::CriticalPoint { .. },
-                    ..
-                }
-            )
-        });
+        trace
+            .retain_events(|e| !matches!(e, Event::Collision { .. } | Event::CriticalPoint { .. }));
         let labels: Vec<String> = legend_entries(&world, &trace)
             .into_iter()
             .map(|e| e.label)

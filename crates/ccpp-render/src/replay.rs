@@ -5,7 +5,7 @@ use std::fmt::Write as _;
 use base64::Engine as _;
 use ccpp_core::grid::Cell;
 use ccpp_core::metrics::{coverage_curve, Sweeper};
-use ccpp_core::trace::{Event, Record, Trace};
+use ccpp_core::trace::{Entry, Event, Trace};
 use ccpp_core::world::World;
 use ccpp_core::Point;
 use tiny_skia::{Color, Pixmap};
@@ -177,9 +177,10 @@ fn replay_data(
     let start = world.start();
     let mut travelled = 0.0f64;
     let mut last_world: Option<Point> = None;
-    for r in &trace.records {
+    for r in trace.entries() {
         match r {
-            Record::Pose { t, pose } => {
+            Entry::Pose { t, pose } => {
+                let pose = [pose.x, pose.y, pose.theta];
                 let wp = Point::new(pose[0], pose[1]);
                 if let Some(l) = last_world {
                     travelled += l.dist(wp);
@@ -188,7 +189,7 @@ fn replay_data(
                 let g = f.world_to_grid(wp);
                 pts.push([g.x - c0 as f64, f.height as f64 - g.y - r0 as f64]);
                 theta.push(pose[2]);
-                steps.push(*t);
+                steps.push(t);
                 dist.push(travelled);
                 forced.push(false);
                 if let Some(t) = tile_side {
@@ -203,7 +204,7 @@ fn replay_data(
                     }
                 }
             }
-            Record::Event { event, .. } => {
+            Entry::Event { event, .. } => {
                 let i = pts.len().saturating_sub(1);
                 if let Some(x) = forced.get_mut(i) {
                     *x = true;

@@ -9,6 +9,7 @@ use ccpp_core::route::{Route, DEFAULT_TOLERANCE_M};
 use ccpp_core::trace::Trace;
 use ccpp_core::world::World;
 use ccpp_io::export::{render_exports, ExportFormat, ExportMeta, PolygonFeature};
+use ccpp_io::phase;
 use ccpp_io::scenario::Scenario;
 use ccpp_io::write::WriteError;
 use ccpp_io::write_atomic;
@@ -91,13 +92,13 @@ pub fn render_run_files(
     let start = world.initial_pose();
     scenario.start = Some([start.x, start.y, start.theta]);
     let run_json = scenario.to_json()?;
-    let trace_text = ccpp_io::trace::trace_jsonl(trace)?;
-    let path = ccpp_io::trace::path_csv(trace);
+    let trace_text = phase::time("trace.jsonl", || ccpp_io::trace::trace_jsonl(trace))?;
+    let path = phase::time("path.csv", || ccpp_io::trace::path_csv(trace));
     let style = CoverageStyle {
         title: title_lines(metrics),
         ..CoverageStyle::default()
     };
-    let png = coverage_png(world, trace, &style)?;
+    let png = phase::time("coverage.png", || coverage_png(world, trace, &style))?;
     Ok(vec![
         ("run.json", run_json.into_bytes()),
         ("path.csv", path.into_bytes()),
