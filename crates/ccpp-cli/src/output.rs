@@ -168,7 +168,7 @@ pub fn summary(m: &Metrics) -> String {
         .map_or_else(|| "n/a".to_string(), |v| format!("{v:.3}"));
     // The floor actually swept leads; the tile figure (1.0 for every complete tile planner)
     // follows.
-    let rows: [(&str, String); 13] = [
+    let rows: [(&str, String); 14] = [
         ("effective_coverage", format!("{:.4}", m.effective_coverage)),
         ("coverage_rate", cov),
         ("path_length_m", format!("{:.2}", m.path_length_m)),
@@ -181,6 +181,7 @@ pub fn summary(m: &Metrics) -> String {
         ("turns", m.turns.to_string()),
         ("rotation_rad", format!("{:.1}", m.rotation_rad)),
         ("collisions", m.collisions.to_string()),
+        ("keepout_violations", m.keepout_violations.to_string()),
         ("wall_time_s", format!("{:.3}", m.wall_time_s)),
     ];
     for (k, v) in rows {
