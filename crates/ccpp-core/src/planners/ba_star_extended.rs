@@ -139,8 +139,13 @@ impl BaStarExtended {
             Chunk::default()
         } else {
             let ba = &self.ba;
-            let wanted = |p: Point| last || !ba.will_cover(p);
-            ext.plan_pass(known, pos, bounded, &wanted)
+            let wanted = |p: Point| !ba.will_cover(p);
+            ext.plan_pass(
+                known,
+                pos,
+                bounded,
+                (!last).then_some(&wanted as &dyn Fn(Point) -> bool),
+            )
         };
         if !(chunk.transfer.is_empty() && chunk.sweep.is_empty()) {
             // A transfer of a robot diameter or more is a backtracking transfer (drawn dashed,

@@ -171,8 +171,13 @@ impl BsaExtended {
             Chunk::default()
         } else {
             let bsa = &self.bsa;
-            let wanted = |p: Point| last || !bsa.will_cover(p);
-            ext.plan_pass(known, pos, bounded, &wanted)
+            let wanted = |p: Point| !bsa.will_cover(p);
+            ext.plan_pass(
+                known,
+                pos,
+                bounded,
+                (!last).then_some(&wanted as &dyn Fn(Point) -> bool),
+            )
         };
         if !(chunk.transfer.is_empty() && chunk.sweep.is_empty()) {
             // As in ba-star-extended: a trip of a robot diameter or more between rims is a

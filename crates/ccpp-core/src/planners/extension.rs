@@ -134,6 +134,22 @@ impl Default for ExtensionOptions {
 /// A pixel, signed `(col, row)` (row 0 at the top).
 type Px = (i64, i64);
 
+/// Which known-free unswept pixels are targets: those at whose world point the filter holds
+/// (`None`: every one).
+pub(crate) type Wanted<'a> = Option<&'a dyn Fn(Point) -> bool>;
+
+/// Target counts of the pixels around a bounded search's start, per window row as prefix sums
+/// (`pre[row * (w + 1) + c]` = targets in columns `c0..c0 + c`). Built once per search, it
+/// answers each settled position's gain with one subtraction per disk row.
+#[derive(Default)]
+struct Window {
+    c0: i64,
+    r0: i64,
+    w: i64,
+    h: i64,
+    pre: Vec<u32>,
+}
+
 /// The 8 neighbour offsets `(dcol, drow)`: E, NE, N, NW, W, SW, S, SE (rows grow downwards).
 const NB: [(i64, i64); 8] = [
     (1, 0),
@@ -204,18 +220,21 @@ pub(crate) struct Extension {
     strip_rows: Vec<i64>,
     /// Pixels swept (executed or claimed by a planned pass).
     swept: FixedBitSet,
-    /// Final passes: positions known not to gain enough, valid while the known map holds
-    /// `no_gain_seen` seen pixels (targets only disappear in between).
+    /// Final passes: positions known not to gain enough. Targets only disappear (swept grows)
+    /// except where pixels became known free since `no_gain_free` (the known-free blocks when
+    /// the memo was last brought up to date): the memo is dropped around those only.
     no_gain: FixedBitSet,
-    no_gain_seen: usize,
-    /// Host override of the pixels a trip must gain after the host's coverage (`None`: a tool
-    /// radius, at least 2; see [`Self::set_final_min_gain`]).
-    final_min_gain: Option<usize>,
+    no_gain_free: Vec<usize>,
     // Dijkstra scratch (generation-stamped).
     dist: Vec<u64>,
     parent: Vec<u32>,
     stamp: Vec<u32>,
     generation: u32,
+    /// Reused search queue.
+    heap: BinaryHeap<Reverse<(u64, usize)>>,
+    /// Target counts around a bounded search's start, valid during that search only.
+    win: Window,
+    win_on: bool,
 }
 
 impl Extension {
@@ -266,26 +285,20 @@ impl Extension {
             strip_rows,
             swept: FixedBitSet::with_capacity(n),
             no_gain: FixedBitSet::with_capacity(n),
-            no_gain_seen: usize::MAX,
-            final_min_gain: None,
+            no_gain_free: Vec::new(),
             dist: vec![0; n],
             parent: vec![u32::MAX; n],
             stamp: vec![0; n],
             generation: 0,
+            heap: BinaryHeap::new(),
+            win: Window::default(),
+            win_on: false,
         }
     }
 
     /// The options.
     pub(crate) fn options(&self) -> &ExtensionOptions {
         &self.opts
-    }
-
-    /// Host hook: the pixels a trip must gain after the host's coverage (default: a tool
-    /// radius, at least 2, or one on a strip of rim). `bsa-extended` sets 1: its cells leave one-pixel strips along
-    /// axis-parallel walls where every position gains a single pixel.
-    #[allow(dead_code)] // used by bsa-extended
-    pub(crate) fn set_final_min_gain(&mut self, g: usize) {
-        self.final_min_gain = Some(g);
     }
 
     /// The robot radius (metres).
@@ -416,16 +429,93 @@ impl Extension {
     }
 
     /// Is pixel `q` a target?
-    fn is_target(&self, known: &KnownMap, q: Px, wanted: &dyn Fn(Point) -> bool) -> bool {
+    fn is_target(&self, known: &KnownMap, q: Px, wanted: Wanted) -> bool {
         let Some(i) = self.idx(q) else { return false };
         known.known_free().contains(i)
             && !self.swept.contains(i)
-            && wanted(self.world(self.center(q)))
+            && wanted.is_none_or(|w| w(self.world(self.center(q))))
     }
 
     /// Number of targets within the tool radius of position `p` (stops at `cap`).
-    fn gain(&self, known: &KnownMap, p: Px, wanted: &dyn Fn(Point) -> bool, cap: usize) -> usize {
+    fn gain(&self, known: &KnownMap, p: Px, wanted: Wanted, cap: usize) -> usize {
+        if self.win_on {
+            if let Some(n) = self.window_count(p, cap) {
+                return n;
+            }
+        }
         self.count_targets(known, p, wanted, cap, &self.tool_rows)
+    }
+
+    /// Fills [`Self::win`] with the targets within `rad` pixels (square) of `c`.
+    fn build_window(&mut self, known: &KnownMap, c: Px, rad: i64, wanted: Wanted) {
+        let f = self.frame;
+        let (w_img, h_img) = (f.width as i64, f.height as i64);
+        let (c0, c1) = ((c.0 - rad).max(0), (c.0 + rad).min(w_img - 1));
+        let (r0, r1) = ((c.1 - rad).max(0), (c.1 + rad).min(h_img - 1));
+        if c0 > c1 || r0 > r1 {
+            self.win_on = false;
+            return;
+        }
+        let (w, h) = (c1 - c0 + 1, r1 - r0 + 1);
+        let mut pre = std::mem::take(&mut self.win.pre);
+        pre.clear();
+        pre.resize((h * (w + 1)) as usize, 0);
+        let free = known.known_free().as_slice();
+        let swept = self.swept.as_slice();
+        for r in 0..h {
+            let row = r0 + r;
+            let base = row as usize * f.width;
+            let line = &mut pre[(r * (w + 1)) as usize..((r + 1) * (w + 1)) as usize];
+            crate::bits::for_each_set(
+                base + c0 as usize,
+                base + c1 as usize + 1,
+                |k| free[k] & !swept[k],
+                |i| {
+                    let col = (i - base) as i64;
+                    if wanted.is_none_or(|wf| wf(self.world(self.center((col, row))))) {
+                        line[(col - c0 + 1) as usize] = 1;
+                    }
+                    true
+                },
+            );
+            for k in 1..line.len() {
+                line[k] += line[k - 1];
+            }
+        }
+        self.win = Window { c0, r0, w, h, pre };
+        self.win_on = true;
+    }
+
+    /// [`Self::count_targets`] over the tool disk from the window; `None` when the disk leaves it.
+    fn window_count(&self, p: Px, cap: usize) -> Option<usize> {
+        let f = self.frame;
+        let (w_img, h_img) = (f.width as i64, f.height as i64);
+        let win = &self.win;
+        let cap = cap.max(1);
+        let rows = &self.tool_rows;
+        let reach = rows.len() as i64 - 1;
+        let mut n = 0;
+        for dr in -reach..=reach {
+            let row = p.1 + dr;
+            let hw = rows[dr.unsigned_abs() as usize];
+            if hw < 0 || row < 0 || row >= h_img {
+                continue;
+            }
+            let (lo, hi) = ((p.0 - hw).max(0), (p.0 + hw).min(w_img - 1));
+            if lo > hi {
+                continue;
+            }
+            if row < win.r0 || row >= win.r0 + win.h || lo < win.c0 || hi >= win.c0 + win.w {
+                return None;
+            }
+            let base = ((row - win.r0) * (win.w + 1)) as usize;
+            n += (win.pre[base + (hi - win.c0 + 1) as usize]
+                - win.pre[base + (lo - win.c0) as usize]) as usize;
+            if n >= cap {
+                return Some(cap);
+            }
+        }
+        Some(n)
     }
 
     /// Number of targets in the disk `rows` (row half-widths) around `p` (stops at `cap`).
@@ -433,7 +523,7 @@ impl Extension {
         &self,
         known: &KnownMap,
         p: Px,
-        wanted: &dyn Fn(Point) -> bool,
+        wanted: Wanted,
         cap: usize,
         rows: &[i64],
     ) -> usize {
@@ -454,6 +544,14 @@ impl Extension {
                 continue;
             }
             let base = row as usize * f.width;
+            let Some(wanted) = wanted else {
+                // Every target counts: whole words at a time.
+                n += count_range(free, swept, base + lo as usize, base + hi as usize + 1);
+                if n >= cap.max(1) {
+                    return cap.max(1);
+                }
+                continue;
+            };
             let go_on = crate::bits::for_each_set(
                 base + lo as usize,
                 base + hi as usize + 1,
@@ -472,8 +570,40 @@ impl Extension {
         n
     }
 
+    /// Drops the [`Self::no_gain`] memo around every pixel that became known free since the
+    /// last call (a new target there may make positions within the strip disk gain).
+    fn refresh_no_gain(&mut self, known: &KnownMap) {
+        let free = known.known_free().as_slice();
+        if self.no_gain_free.len() != free.len() {
+            self.no_gain.clear();
+            self.no_gain_free = free.to_vec();
+            return;
+        }
+        let f = self.frame;
+        let (w, h) = (f.width as i64, f.height as i64);
+        let reach = self.strip_rows.len() as i64 - 1;
+        let bits = crate::bits::BLOCK_BITS;
+        for b in 0..free.len() {
+            let new = free[b] & !self.no_gain_free[b];
+            self.no_gain_free[b] = free[b];
+            let mut todo = new;
+            while todo != 0 {
+                let i = b * bits + todo.trailing_zeros() as usize;
+                todo &= todo - 1;
+                let (c, r) = f.col_row(i);
+                let (c, r) = (c as i64, r as i64);
+                let (c0, c1) = ((c - reach).max(0), (c + reach).min(w - 1));
+                for row in (r - reach).max(0)..=(r + reach).min(h - 1) {
+                    let base = row as usize * f.width;
+                    self.no_gain
+                        .remove_range(base + c0 as usize..base + c1 as usize + 1);
+                }
+            }
+        }
+    }
+
     /// Marks the targets around `p` swept; returns their indices.
-    fn claim(&mut self, known: &KnownMap, p: Px, wanted: &dyn Fn(Point) -> bool) -> Vec<usize> {
+    fn claim(&mut self, known: &KnownMap, p: Px, wanted: Wanted) -> Vec<usize> {
         let mut out = Vec::new();
         for k in 0..self.tool.len() {
             let (dc, dr) = self.tool[k];
@@ -515,7 +645,6 @@ impl Extension {
         done: &mut dyn FnMut(&mut Self, Px) -> bool,
     ) -> Option<Vec<usize>> {
         self.begin();
-        let gen = self.generation;
         // Transfers need a short known-free way, not the shortest: an inflated heuristic
         // (weighted A*) settles far fewer positions; the way is straightened afterwards.
         let h = |s: &Self, p: Px| -> u64 {
@@ -523,7 +652,24 @@ impl Extension {
                 (s.center(p).dist(g) * ROUTE_WEIGHT * COST_ORTHO as f64).floor() as u64
             })
         };
-        let mut heap: BinaryHeap<Reverse<(u64, usize)>> = BinaryHeap::new();
+        let mut heap = std::mem::take(&mut self.heap);
+        heap.clear();
+        let found = self.search_with(known, from, limit, &h, &mut heap, done);
+        self.heap = heap;
+        found
+    }
+
+    /// [`Self::search`]'s body, on the queue `heap`.
+    fn search_with(
+        &mut self,
+        known: &KnownMap,
+        from: Point,
+        limit: Option<u64>,
+        h: &dyn Fn(&Self, Px) -> u64,
+        heap: &mut BinaryHeap<Reverse<(u64, usize)>>,
+        done: &mut dyn FnMut(&mut Self, Px) -> bool,
+    ) -> Option<Vec<usize>> {
+        let gen = self.generation;
         let p0 = self.frame.grid_to_pixel_signed(from);
         for dr in -1..=1 {
             for dc in -1..=1 {
@@ -583,31 +729,15 @@ impl Extension {
         None
     }
 
-    /// Plans the next chunk of a cleaning pass from world point `pos`: the waypoints (world) to
-    /// drive, empty when no rim within `reach` (robot radii; `None` = unbounded) gains.
-    /// `pending(p)`: will the host still sweep world point `p`?
-    #[allow(dead_code)] // the hosts that need no transfer marks (bsa-extended)
-    pub(crate) fn plan_chunk(
-        &mut self,
-        known: &KnownMap,
-        pos: Point,
-        bounded: bool,
-        wanted: &dyn Fn(Point) -> bool,
-    ) -> Vec<Point> {
-        let c = self.plan_pass(known, pos, bounded, wanted);
-        let mut out = c.transfer;
-        out.extend(c.sweep);
-        out
-    }
-
-    /// [`Self::plan_chunk`] split in two: the transfer to the rim (waypoints that reach the
-    /// first sweeping position) and the sweep along it. Both empty when nothing gains.
+    /// Plans the next chunk of a cleaning pass from world point `pos`: the transfer to the rim
+    /// (waypoints that reach the first sweeping position) and the sweep along it; both empty
+    /// when no rim within `reach_r` robot radii (`bounded`; else anywhere) gains.
     pub(crate) fn plan_pass(
         &mut self,
         known: &KnownMap,
         pos: Point,
         bounded: bool,
-        wanted: &dyn Fn(Point) -> bool,
+        wanted: Wanted,
     ) -> Chunk {
         let from = self.frame.world_to_grid(pos);
         let limit = bounded.then(|| {
@@ -617,23 +747,19 @@ impl Extension {
         // of pixels (at least 2; after the host's coverage one on a strip of rim: only specks
         // stay), a step off the contour as much, a step along the contour one.
         let tool = self.rt.ceil().max(1.0) as usize;
-        let g_start = if bounded {
-            tool
-        } else if let Some(g) = self.final_min_gain {
-            g.max(1)
-        } else {
-            tool.max(2)
-        };
+        let g_start = if bounded { tool } else { tool.max(2) };
         let g_int = tool;
         let g_con = 1;
         if !bounded {
-            let seen = known.seen().count_ones(..);
-            if seen != self.no_gain_seen {
-                self.no_gain.clear();
-                self.no_gain_seen = seen;
-            }
+            self.refresh_no_gain(known);
         }
-        let Some(transit) = self.search(known, from, limit, None, &mut |s, p| {
+        if let Some(l) = limit {
+            // Every position the bounded search settles lies within `l` of `from`.
+            let rad = (l / COST_ORTHO) as i64 + self.tool_rows.len() as i64 + 2;
+            let p0 = self.frame.grid_to_pixel_signed(from);
+            self.build_window(known, p0, rad, wanted);
+        }
+        let transit = self.search(known, from, limit, None, &mut |s, p| {
             let i = s.idx(p).expect("positions are in the image");
             if !bounded && s.no_gain.contains(i) {
                 return false;
@@ -649,7 +775,9 @@ impl Extension {
                 s.no_gain.insert(i);
             }
             gains
-        }) else {
+        });
+        self.win_on = false;
+        let Some(transit) = transit else {
             return Chunk::default();
         };
         let mut pts: Vec<Point> = vec![from];
@@ -783,7 +911,7 @@ impl Extension {
             return None;
         }
         let gw = self.frame.grid_to_pixel_signed(self.frame.world_to_grid(w));
-        if self.gain(known, gw, wanted, 2) < 2 {
+        if self.gain(known, gw, Some(wanted), 2) < 2 {
             return None;
         }
         let free = |a: Point, b: Point| judge_motion(known, a, b, self.r) == Judgement::Free;
@@ -842,4 +970,18 @@ impl Extension {
         }
         Some(out)
     }
+}
+
+/// Number of bits `a..b` set in `free` and clear in `swept`.
+fn count_range(free: &[usize], swept: &[usize], a: usize, b: usize) -> usize {
+    use crate::bits::{range_mask, BLOCK_BITS};
+    let mut n = 0;
+    let mut blk = a / BLOCK_BITS;
+    while blk * BLOCK_BITS < b {
+        let start = blk * BLOCK_BITS;
+        let mask = range_mask(a.max(start) - start, b.min(start + BLOCK_BITS) - start);
+        n += (free[blk] & !swept[blk] & mask).count_ones() as usize;
+        blk += 1;
+    }
+    n
 }
