@@ -148,14 +148,16 @@ enum DeltaItem {
     Copy { prev: usize, n: usize },
 }
 
-/// `points` as copies of stretches of `prev` and literal points (greedy, deterministic).
+/// `points` as copies of stretches of `prev` and literal points (greedy, deterministic): a
+/// point that does not continue the current copy starts a copy at its first occurrence in
+/// `prev` at or after where the copy stood, else at its first occurrence.
 fn list_delta(prev: &[[f64; 2]], points: &[[f64; 2]]) -> Vec<DeltaItem> {
     let key = |p: &[f64; 2]| (p[0].to_bits(), p[1].to_bits());
-    let mut index: std::collections::BTreeMap<(u64, u64), Vec<usize>> =
-        std::collections::BTreeMap::new();
-    for (k, p) in prev.iter().enumerate() {
-        index.entry(key(p)).or_default().push(k);
-    }
+    // `prev`'s points sorted by (point, index): the occurrences of a point are one stretch, in
+    // index order (one sort instead of a map of lists; the entries are distinct).
+    let mut index: Vec<((u64, u64), usize)> =
+        prev.iter().enumerate().map(|(k, p)| (key(p), k)).collect();
+    index.sort_unstable();
     let mut out: Vec<DeltaItem> = Vec::new();
     // The index in `prev` that the current copy continues with.
     let mut next = usize::MAX;
@@ -168,12 +170,17 @@ fn list_delta(prev: &[[f64; 2]], points: &[[f64; 2]]) -> Vec<DeltaItem> {
             }
         }
         let at = next.min(prev.len());
-        let found = index.get(&key(p)).and_then(|ks| {
-            ks.iter()
-                .copied()
-                .find(|&k| k >= at)
-                .or(ks.first().copied())
-        });
+        let kp = key(p);
+        let first = index.partition_point(|&(q, _)| q < kp);
+        let found = if index.get(first).is_some_and(|&(q, _)| q == kp) {
+            let from = index.partition_point(|&e| e < (kp, at));
+            match index.get(from) {
+                Some(&(q, k)) if q == kp => Some(k),
+                _ => Some(index[first].1),
+            }
+        } else {
+            None
+        };
         if let Some(k) = found {
             out.push(DeltaItem::Copy { prev: k, n: 1 });
             next = k + 1;
@@ -681,6 +688,73 @@ mod tests {
             let e = parse_trace(&text, Path::new("t.jsonl"), Some((&f, 0.0)));
             let msg = e.err().map(|e| e.to_string()).unwrap_or_default();
             assert!(msg.contains(want) && msg.contains("line"), "{text}: {msg}");
+        }
+    }
+
+    /// The delta encoder's rule spelled out plainly: a map from point to its indices in order.
+    fn reference_delta(prev: &[[f64; 2]], points: &[[f64; 2]]) -> Vec<DeltaItem> {
+        let key = |p: &[f64; 2]| (p[0].to_bits(), p[1].to_bits());
+        let mut index: std::collections::BTreeMap<(u64, u64), Vec<usize>> =
+            std::collections::BTreeMap::new();
+        for (k, p) in prev.iter().enumerate() {
+            index.entry(key(p)).or_default().push(k);
+        }
+        let mut out: Vec<DeltaItem> = Vec::new();
+        let mut next = usize::MAX;
+        for p in points {
+            if next < prev.len() && key(&prev[next]) == key(p) {
+                if let Some(DeltaItem::Copy { n, .. }) = out.last_mut() {
+                    *n += 1;
+                    next += 1;
+                    continue;
+                }
+            }
+            let at = next.min(prev.len());
+            let found = index.get(&key(p)).and_then(|ks| {
+                ks.iter()
+                    .copied()
+                    .find(|&k| k >= at)
+                    .or(ks.first().copied())
+            });
+            if let Some(k) = found {
+                out.push(DeltaItem::Copy { prev: k, n: 1 });
+                next = k + 1;
+            } else {
+                out.push(DeltaItem::Point(*p));
+                next = usize::MAX;
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn the_sorted_delta_index_picks_the_same_copies_as_a_map_of_occurrences() {
+        // Lists over few distinct points (many repeats) and edits between them.
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut rnd = |m: u64| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state % m
+        };
+        let mut prev: Vec<[f64; 2]> = Vec::new();
+        for _ in 0..300 {
+            let len = rnd(40) as usize;
+            let mut points: Vec<[f64; 2]> = Vec::with_capacity(len);
+            for _ in 0..len {
+                if !prev.is_empty() && rnd(3) > 0 {
+                    points.push(prev[rnd(prev.len() as u64) as usize]);
+                } else {
+                    points.push([rnd(6) as f64 * 0.5, rnd(4) as f64 - 1.0]);
+                }
+            }
+            if rnd(4) == 0 {
+                points.extend_from_slice(&prev);
+            }
+            let got = list_delta(&prev, &points);
+            assert_eq!(got, reference_delta(&prev, &points));
+            assert_eq!(apply_delta(Some(&prev), &got, usize::MAX).unwrap(), points);
+            prev = points;
         }
     }
 

@@ -92,13 +92,26 @@ pub fn render_run_files(
     let start = world.initial_pose();
     scenario.start = Some([start.x, start.y, start.theta]);
     let run_json = scenario.to_json()?;
-    let trace_text = phase::time("trace.jsonl", || ccpp_io::trace::trace_jsonl(trace))?;
-    let path = phase::time("path.csv", || ccpp_io::trace::path_csv(trace));
     let style = CoverageStyle {
         title: title_lines(metrics),
         ..CoverageStyle::default()
     };
-    let png = phase::time("coverage.png", || coverage_png(world, trace, &style))?;
+    // The picture and the text files are independent pure functions of (world, trace): draw
+    // the picture on a second thread while this one writes the text (same bytes either way).
+    let (png, text) = std::thread::scope(|s| {
+        let png = s.spawn(|| phase::time("coverage.png", || coverage_png(world, trace, &style)));
+        let text = phase::time("trace.jsonl", || ccpp_io::trace::trace_jsonl(trace)).map(|t| {
+            let path = phase::time("path.csv", || ccpp_io::trace::path_csv(trace));
+            (t, path)
+        });
+        let png = match png.join() {
+            Ok(png) => png,
+            Err(panic) => std::panic::resume_unwind(panic),
+        };
+        (png, text)
+    });
+    let (trace_text, path) = text?;
+    let png = png?;
     Ok(vec![
         ("run.json", run_json.into_bytes()),
         ("path.csv", path.into_bytes()),
