@@ -942,7 +942,7 @@ impl Bcd {
                 opts.rim_coverage,
             );
         }
-        let items = repair(&ctx, &mut search, items);
+        let items = smooth(&ctx, repair(&ctx, &mut search, items));
 
         let mut steps = VecDeque::with_capacity(items.len());
         let mut at = start;
@@ -989,6 +989,59 @@ fn repair(ctx: &Ctx<'_>, search: &mut Search, items: Vec<Item>) -> Vec<Item> {
             Item::Mark(e) => out.push(Item::Mark(e)),
         }
     }
+    out
+}
+
+/// Largest distance (pixels) a smoothed move may stray from a point of the plan it replaces.
+const SMOOTH_TOL_PX: f64 = 0.5;
+/// Points a smoothed move may replace at most (bounds the work per point).
+const SMOOTH_REACH: usize = 48;
+
+/// Straightens the plan: within each run of consecutive moves (the marks stay where they
+/// are), a point is dropped when the straight move that replaces it and its neighbours is
+/// free on the true map and stays within [`SMOOTH_TOL_PX`] of every dropped point, so a
+/// jagged boundary pass becomes a few straight moves (fewer turns) sweeping almost the same
+/// floor.
+fn smooth(ctx: &Ctx<'_>, items: Vec<Item>) -> Vec<Item> {
+    let tol2 = SMOOTH_TOL_PX * SMOOTH_TOL_PX;
+    let mut out = Vec::with_capacity(items.len());
+    let mut run: Vec<Point> = Vec::new();
+    let flush = |run: &mut Vec<Point>, out: &mut Vec<Item>| {
+        let n = run.len();
+        if n > 0 {
+            out.push(Item::Move(run[0]));
+        }
+        let mut i = 0;
+        while i + 1 < n {
+            let mut j = i + 1;
+            for k in i + 2..n.min(i + 2 + SMOOTH_REACH) {
+                if (i + 1..k).all(|m| point_segment_dist2(run[m], run[i], run[k]) <= tol2)
+                    && ctx.free(run[i], run[k])
+                {
+                    j = k;
+                } else {
+                    break;
+                }
+            }
+            out.push(Item::Move(run[j]));
+            i = j;
+        }
+        run.clear();
+    };
+    for it in items {
+        match it {
+            Item::Move(p) => {
+                if run.last() != Some(&p) {
+                    run.push(p);
+                }
+            }
+            Item::Mark(e) => {
+                flush(&mut run, &mut out);
+                out.push(Item::Mark(e));
+            }
+        }
+    }
+    flush(&mut run, &mut out);
     out
 }
 
