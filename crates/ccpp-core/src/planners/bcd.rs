@@ -1477,6 +1477,46 @@ mod tests {
         .unwrap()
     }
 
+    #[test]
+    fn smoothing_straightens_wiggles_but_keeps_corners_and_marks() {
+        let world = block_room();
+        let frame = *world.frame();
+        let n = frame.width * frame.height;
+        let ctx = Ctx {
+            world: &world,
+            frame,
+            ok: vec![true; n],
+            safe: vec![true; n],
+            rt: 4.0,
+        };
+        // A wiggle of 0.3 px along a free row, then a corner, then a mark.
+        let mut items: Vec<Item> = (0..36)
+            .map(|i| {
+                Item::Move(Point::new(
+                    14.0 + 2.0 * f64::from(i),
+                    15.0 + 0.3 * f64::from(i % 2),
+                ))
+            })
+            .collect();
+        items.push(Item::Move(Point::new(84.0, 25.0)));
+        items.push(Item::Mark(Event::BacktrackStart));
+        items.push(Item::Move(Point::new(84.0, 35.0)));
+        let out = smooth(&ctx, items);
+        let pts: Vec<Point> = moves(&out).into_iter().map(|m| m.0).collect();
+        assert_eq!(pts.len(), 4, "{pts:?}");
+        assert_eq!(pts[0], Point::new(14.0, 15.0));
+        assert_eq!(pts[1], Point::new(84.0, 15.3));
+        assert_eq!(pts[2], Point::new(84.0, 25.0));
+        assert!(matches!(out[3], Item::Mark(Event::BacktrackStart)));
+        // A chord within the tolerance that would hit the block (robot radius 4 px) is not taken.
+        let around = vec![
+            Item::Move(Point::new(20.0, 43.8)),
+            Item::Move(Point::new(40.0, 44.25)),
+            Item::Move(Point::new(60.0, 43.8)),
+        ];
+        assert_eq!(moves(&smooth(&ctx, around)).len(), 3);
+    }
+
     fn run(world: &World, opts: &BcdOptions) -> crate::metrics::Metrics {
         let mut p = Bcd::try_new(world, opts).unwrap();
         let out = crate::sim::simulate(world, &mut p, &crate::sim::SimConfig::default());
