@@ -942,7 +942,7 @@ impl Bcd {
                 opts.rim_coverage,
             );
         }
-        let items = repair(&ctx, &mut search, items);
+        let items = smooth(&ctx, repair(&ctx, &mut search, items));
 
         let mut steps = VecDeque::with_capacity(items.len());
         let mut at = start;
@@ -989,6 +989,59 @@ fn repair(ctx: &Ctx<'_>, search: &mut Search, items: Vec<Item>) -> Vec<Item> {
             Item::Mark(e) => out.push(Item::Mark(e)),
         }
     }
+    out
+}
+
+/// Largest distance (pixels) a smoothed move may stray from a point of the plan it replaces.
+const SMOOTH_TOL_PX: f64 = 0.5;
+/// Points a smoothed move may replace at most (bounds the work per point).
+const SMOOTH_REACH: usize = 48;
+
+/// Straightens the plan: within each run of consecutive moves (the marks stay where they
+/// are), a point is dropped when the straight move that replaces it and its neighbours is
+/// free on the true map and stays within [`SMOOTH_TOL_PX`] of every dropped point, so a
+/// jagged boundary pass becomes a few straight moves (fewer turns) sweeping almost the same
+/// floor.
+fn smooth(ctx: &Ctx<'_>, items: Vec<Item>) -> Vec<Item> {
+    let tol2 = SMOOTH_TOL_PX * SMOOTH_TOL_PX;
+    let mut out = Vec::with_capacity(items.len());
+    let mut run: Vec<Point> = Vec::new();
+    let flush = |run: &mut Vec<Point>, out: &mut Vec<Item>| {
+        let n = run.len();
+        if n > 0 {
+            out.push(Item::Move(run[0]));
+        }
+        let mut i = 0;
+        while i + 1 < n {
+            let mut j = i + 1;
+            for k in i + 2..n.min(i + 2 + SMOOTH_REACH) {
+                if (i + 1..k).all(|m| point_segment_dist2(run[m], run[i], run[k]) <= tol2)
+                    && ctx.free(run[i], run[k])
+                {
+                    j = k;
+                } else {
+                    break;
+                }
+            }
+            out.push(Item::Move(run[j]));
+            i = j;
+        }
+        run.clear();
+    };
+    for it in items {
+        match it {
+            Item::Move(p) => {
+                if run.last() != Some(&p) {
+                    run.push(p);
+                }
+            }
+            Item::Mark(e) => {
+                flush(&mut run, &mut out);
+                out.push(Item::Mark(e));
+            }
+        }
+    }
+    flush(&mut run, &mut out);
     out
 }
 
@@ -1422,6 +1475,46 @@ mod tests {
             Some(crate::geometry::Pose::new(0.3, 0.3, 0.0)),
         )
         .unwrap()
+    }
+
+    #[test]
+    fn smoothing_straightens_wiggles_but_keeps_corners_and_marks() {
+        let world = block_room();
+        let frame = *world.frame();
+        let n = frame.width * frame.height;
+        let ctx = Ctx {
+            world: &world,
+            frame,
+            ok: vec![true; n],
+            safe: vec![true; n],
+            rt: 4.0,
+        };
+        // A wiggle of 0.3 px along a free row, then a corner, then a mark.
+        let mut items: Vec<Item> = (0..36)
+            .map(|i| {
+                Item::Move(Point::new(
+                    14.0 + 2.0 * f64::from(i),
+                    15.0 + 0.3 * f64::from(i % 2),
+                ))
+            })
+            .collect();
+        items.push(Item::Move(Point::new(84.0, 25.0)));
+        items.push(Item::Mark(Event::BacktrackStart));
+        items.push(Item::Move(Point::new(84.0, 35.0)));
+        let out = smooth(&ctx, items);
+        let pts: Vec<Point> = moves(&out).into_iter().map(|m| m.0).collect();
+        assert_eq!(pts.len(), 4, "{pts:?}");
+        assert_eq!(pts[0], Point::new(14.0, 15.0));
+        assert_eq!(pts[1], Point::new(84.0, 15.3));
+        assert_eq!(pts[2], Point::new(84.0, 25.0));
+        assert!(matches!(out[3], Item::Mark(Event::BacktrackStart)));
+        // A chord within the tolerance that would hit the block (robot radius 4 px) is not taken.
+        let around = vec![
+            Item::Move(Point::new(20.0, 43.8)),
+            Item::Move(Point::new(40.0, 44.25)),
+            Item::Move(Point::new(60.0, 43.8)),
+        ];
+        assert_eq!(moves(&smooth(&ctx, around)).len(), 3);
     }
 
     fn run(world: &World, opts: &BcdOptions) -> crate::metrics::Metrics {
