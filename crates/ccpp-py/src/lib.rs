@@ -410,8 +410,9 @@ fn scenario_from(
                 let j = py_to_json(&v)?;
                 s.keepout = match serde_json::from_value::<ccpp_io::zones::ZoneSpec>(j.clone()) {
                     Ok(one) => vec![one],
-                    Err(_) => serde_json::from_value(j)
-                        .map_err(|e| msg(format!("keepout: {e}")))?,
+                    Err(_) => {
+                        serde_json::from_value(j).map_err(|e| msg(format!("keepout: {e}")))?
+                    }
                 };
             }
             _ => {
