@@ -81,6 +81,12 @@ pub enum ZoneError {
         /// Polygon index (0-based).
         index: usize,
     },
+    /// Coordinates so large that the polygon's area is not a finite number.
+    #[error("polygon {index} has coordinates too large to compute with (its area overflows)")]
+    Overflow {
+        /// Polygon index (0-based).
+        index: usize,
+    },
     /// More vertices than the self-intersection check accepts.
     #[error("polygon {index} has {points} points; at most {max} are accepted")]
     TooManyPoints {
@@ -153,6 +159,10 @@ impl Polygon {
                 points: self.points.len(),
                 max: MAX_POLYGON_POINTS,
             });
+        }
+        if !self.signed_area().is_finite() {
+            // Products of coordinates overflow: every geometric test below would be noise.
+            return Err(ZoneError::Overflow { index });
         }
         let r = self.ring();
         let mut distinct: Vec<(u64, u64)> =
@@ -452,6 +462,10 @@ mod tests {
     #[test]
     fn validation_catches_bad_polygons() {
         assert_eq!(validate_polygons(&[]), Err(ZoneError::NoPolygon));
+        assert_eq!(
+            validate_polygons(&[Polygon::rect([0.0, 0.0, 1e300, 1e300])]),
+            Err(ZoneError::Overflow { index: 0 })
+        );
         let e = poly(&[[0.0, 0.0], [1.0, 0.0], [0.0, 0.0]]).validate(0);
         assert!(matches!(
             e,
