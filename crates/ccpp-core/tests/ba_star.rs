@@ -382,7 +382,7 @@ fn check_run(art: &str, col: usize, row: usize, theta: f64) {
 }
 
 proptest::proptest! {
-    #![proptest_config(proptest::prelude::ProptestConfig { cases: 64, ..Default::default() })]
+    #![proptest_config(proptest::prelude::ProptestConfig { cases: 64, rng_seed: proptest::test_runner::RngSeed::Fixed(0x5eed_0105), ..Default::default() })]
     #[test]
     fn random_maps_are_covered(
         w in 5usize..=60,
@@ -491,7 +491,7 @@ fn smoothing_off_follows_the_raw_path() {
 // The three-valued motion judgement agrees with the known map's own checks.
 
 proptest::proptest! {
-    #![proptest_config(proptest::prelude::ProptestConfig { cases: 48, ..Default::default() })]
+    #![proptest_config(proptest::prelude::ProptestConfig { cases: 48, rng_seed: proptest::test_runner::RngSeed::Fixed(0x5eed_0106), ..Default::default() })]
     #[test]
     fn judge_motion_matches_known_map(
         seed in proptest::prelude::any::<u64>(),

@@ -130,7 +130,7 @@ fn check_run(art: &str, col: usize, row: usize, theta: f64) {
 }
 
 proptest::proptest! {
-    #![proptest_config(proptest::prelude::ProptestConfig { cases: 24, ..Default::default() })]
+    #![proptest_config(proptest::prelude::ProptestConfig { cases: 24, rng_seed: proptest::test_runner::RngSeed::Fixed(0x5eed_0107), ..Default::default() })]
     #[test]
     fn random_maps_are_covered(
         w in 4usize..=24,

@@ -303,8 +303,46 @@ mod props {
         Some(world(&art, c, r, 0.0))
     }
 
+    /// Fixed seeds: the same cases on every run (CI and local alike); the counterexamples
+    /// proptest found earlier are named tests below.
+    fn config(cases: u32, seed: u64) -> ProptestConfig {
+        ProptestConfig {
+            cases,
+            rng_seed: proptest::test_runner::RngSeed::Fixed(seed),
+            ..ProptestConfig::default()
+        }
+    }
+
+    /// Extended BSA sweeps at least what basic BSA sweeps on `random_world(w, h, p, seed)`.
+    fn assert_extended_no_worse(w: usize, h: usize, p: f64, seed: u64) {
+        let world = random_world(w, h, p, seed).expect("a free character");
+        let (_, mb) = run(&world, Side::Left);
+        let (_, me) = run_ext(&world, Side::Left);
+        assert_eq!(me.collisions, 0);
+        assert!(
+            me.effective_coverage >= mb.effective_coverage - 1e-12,
+            "{} < {}",
+            me.effective_coverage,
+            mb.effective_coverage
+        );
+    }
+
+    /// Found by proptest (CI, stop 17): the extension's straight transfer between spirals was
+    /// shorter than BSA's cell path but skipped pixels at spiral corners that the cell path
+    /// swept, and the final clean-up leaves such specks.
+    #[test]
+    fn extended_no_worse_counterexample_15x8() {
+        assert_extended_no_worse(15, 8, 0.271_616_595_059_142_5, 4_444_818_232_748_928_553);
+    }
+
+    /// Found by proptest (CI, stop 17), same cause as the 15 x 8 case.
+    #[test]
+    fn extended_no_worse_counterexample_5x10() {
+        assert_extended_no_worse(5, 10, 0.172_224_253_015_350_52, 1_275_306_396_875_129_893);
+    }
+
     proptest! {
-        #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+        #![proptest_config(config(48, 0x00b5_a001))]
 
         #[test]
         fn bsa_covers_every_reachable_cell(
@@ -321,7 +359,7 @@ mod props {
     }
 
     proptest! {
-        #![proptest_config(ProptestConfig { cases: 8, ..ProptestConfig::default() })]
+        #![proptest_config(config(32, 0x00b5_a002))]
 
         #[test]
         fn bsa_extended_is_safe_and_no_worse(

@@ -229,6 +229,12 @@ impl BsaExtended {
                 if route.last() == Some(&goal)
                     && (moved || polyline_len(pos, &route) < polyline_len(pos, &own) - 1e-9) =>
             {
+                // What BSA's cell path would have swept on the way and this one does not is
+                // fetched by the final clean-up (a transfer over a spiral's turns sweeps the
+                // specks they left).
+                if !moved {
+                    ext.owe_skipped(known, pos, &own, &route);
+                }
                 self.bsa.replace_transfer(pos, &route);
             }
             _ => {

@@ -220,6 +220,12 @@ pub(crate) struct Extension {
     strip_rows: Vec<i64>,
     /// Pixels swept (executed or claimed by a planned pass).
     swept: FixedBitSet,
+    /// Scratch of [`Self::polyline_gains`] (all clear between calls).
+    scratch: FixedBitSet,
+    /// Pixels a host's transfer would have swept and the shorter way driven instead did not
+    /// ([`Self::owe_skipped`]); `any_owed` once one is.
+    owed: FixedBitSet,
+    any_owed: bool,
     /// Final passes: positions known not to gain enough. Targets only disappear (swept grows)
     /// except where pixels became known free since `no_gain_free` (the known-free blocks when
     /// the memo was last brought up to date): the memo is dropped around those only.
@@ -284,6 +290,9 @@ impl Extension {
             tool_rows,
             strip_rows,
             swept: FixedBitSet::with_capacity(n),
+            scratch: FixedBitSet::with_capacity(n),
+            owed: FixedBitSet::with_capacity(n),
+            any_owed: false,
             no_gain: FixedBitSet::with_capacity(n),
             no_gain_free: Vec::new(),
             dist: vec![0; n],
@@ -317,6 +326,78 @@ impl Extension {
             self.rt,
             &mut |_| {},
         );
+    }
+
+    /// The targets (known free, not swept) that driving the grid polyline `pts` would sweep,
+    /// per point: entry `m` holds those first swept by the segment ending at `pts[m]` (entry 0
+    /// is empty).
+    fn polyline_gains(&mut self, known: &KnownMap, pts: &[Point]) -> Vec<Vec<usize>> {
+        let f = self.frame;
+        let free = known.known_free();
+        let mut stamped = Vec::new();
+        let mut gains = vec![Vec::new()];
+        for s in pts.windows(2) {
+            let start = stamped.len();
+            crate::raster::stamp_capsule(&mut self.scratch, &f, s[0], s[1], self.rt, &mut |i| {
+                stamped.push(i);
+            });
+            gains.push(
+                stamped[start..]
+                    .iter()
+                    .copied()
+                    .filter(|&i| free.contains(i) && !self.swept.contains(i))
+                    .collect(),
+            );
+        }
+        for &i in &stamped {
+            self.scratch.set(i, false);
+        }
+        gains
+    }
+
+    /// Driving `alt` instead of the host's transfer `host` (both from world point `from`):
+    /// the targets the host's way would sweep and `alt` does not become *owed* — the final
+    /// clean-up fetches them even where they are specks below its thresholds, so that a
+    /// shorter transfer never sweeps less than the host would. Returns how many were added.
+    pub(crate) fn owe_skipped(
+        &mut self,
+        known: &KnownMap,
+        from: Point,
+        host: &[Point],
+        alt: &[Point],
+    ) -> usize {
+        let f = self.frame;
+        let grid = |pts: &[Point]| -> Vec<Point> {
+            std::iter::once(from)
+                .chain(pts.iter().copied())
+                .map(|p| f.world_to_grid(p))
+                .collect()
+        };
+        let gains = self.polyline_gains(known, &grid(host));
+        let alt = grid(alt);
+        let rt2 = self.rt * self.rt;
+        let mut n = 0;
+        for &i in gains.iter().flatten() {
+            let c = self.center(self.px_of(i));
+            if !alt
+                .windows(2)
+                .any(|s| point_segment_dist2(c, s[0], s[1]) <= rt2)
+            {
+                self.owed.insert(i);
+                n += 1;
+            }
+        }
+        self.any_owed |= n > 0;
+        n
+    }
+
+    /// Does position `p` sweep an owed pixel that is still unswept?
+    fn sweeps_owed(&self, p: Px) -> bool {
+        self.any_owed
+            && self.tool.iter().any(|&(dc, dr)| {
+                self.idx((p.0 + dc, p.1 + dr))
+                    .is_some_and(|i| self.owed.contains(i) && !self.swept.contains(i))
+            })
     }
 
     fn idx(&self, p: Px) -> Option<usize> {
@@ -770,7 +851,8 @@ impl Extension {
             let gains = g >= g_start
                 || (!bounded
                     && g >= 1
-                    && s.count_targets(known, p, wanted, STRIP_N, &s.strip_rows) >= STRIP_N);
+                    && (s.count_targets(known, p, wanted, STRIP_N, &s.strip_rows) >= STRIP_N
+                        || s.sweeps_owed(p)));
             if !gains && !bounded {
                 s.no_gain.insert(i);
             }
