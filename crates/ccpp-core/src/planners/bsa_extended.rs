@@ -23,7 +23,9 @@
 //!   neither visited nor known unstandable). Then the robot drives to the next spiral's first
 //!   cell by the extension's known-free straight segments ([`Bsa::replace_transfer`]) when
 //!   that way is shorter than BSA's cell path (or when the robot has moved away from the cell
-//!   path's start); BSA's own transfer otherwise.
+//!   path's start); BSA's own transfer otherwise. What BSA's cell path would have swept on
+//!   the way and the shorter way does not (specks at the spiral's turns) is owed to the final
+//!   clean-up, so the extended planner never sweeps less than BSA.
 //! * **At the end of BSA** (no backtracking point left): passes over every rim left,
 //!   wherever it is, also behind gaps BSA's cells could not cross (the extension's positions
 //!   fit through any gap the robot disk fits through: the virtual pipe of seed 002, III.D).
