@@ -56,6 +56,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::geometry::{wrap_angle, Point, Pose};
+use crate::planners::settings::present;
 
 /// Gains and limits of one PID controller.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -180,9 +181,12 @@ pub struct PidOptions {
     /// Control period, seconds.
     pub dt_s: f64,
     /// Linear controller: error = remaining distance along the segment (m), output = speed
-    /// (m/s).
+    /// (m/s). A section that omits a field gets this controller's default for it.
+    #[serde(deserialize_with = "linear_gains")]
     pub linear: PidGains,
-    /// Angular controller: error = heading error (rad), output = turn rate (rad/s).
+    /// Angular controller: error = heading error (rad), output = turn rate (rad/s). A section
+    /// that omits a field gets this controller's default for it (not [`PidGains::default`]).
+    #[serde(deserialize_with = "angular_gains")]
     pub angular: PidGains,
     /// A translation goal is reached when the estimate is within this distance of it, metres.
     pub tolerance_m: f64,
@@ -235,6 +239,44 @@ impl Default for PidOptions {
             noise: None,
         }
     }
+}
+
+/// A `linear` / `angular` section as written in an options file: the fields it gives, the
+/// others taken from that controller's default in [`PidOptions::default`].
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct GainsSection {
+    #[serde(default, deserialize_with = "present")]
+    kp: Option<f64>,
+    #[serde(default, deserialize_with = "present")]
+    ki: Option<f64>,
+    #[serde(default, deserialize_with = "present")]
+    kd: Option<f64>,
+    #[serde(default, deserialize_with = "present")]
+    output_limit: Option<f64>,
+    #[serde(default, deserialize_with = "present")]
+    integral_limit: Option<f64>,
+}
+
+impl GainsSection {
+    /// The given fields over `base` (every field listed: a new one must be added here).
+    fn over(self, base: PidGains) -> PidGains {
+        PidGains {
+            kp: self.kp.unwrap_or(base.kp),
+            ki: self.ki.unwrap_or(base.ki),
+            kd: self.kd.unwrap_or(base.kd),
+            output_limit: self.output_limit.unwrap_or(base.output_limit),
+            integral_limit: self.integral_limit.unwrap_or(base.integral_limit),
+        }
+    }
+}
+
+fn linear_gains<'de, D: serde::Deserializer<'de>>(d: D) -> Result<PidGains, D::Error> {
+    Ok(GainsSection::deserialize(d)?.over(PidOptions::default().linear))
+}
+
+fn angular_gains<'de, D: serde::Deserializer<'de>>(d: D) -> Result<PidGains, D::Error> {
+    Ok(GainsSection::deserialize(d)?.over(PidOptions::default().angular))
 }
 
 /// How the simulator executes `Rotate` / `Translate` / `MoveTo` steps.

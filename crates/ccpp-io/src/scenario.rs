@@ -785,6 +785,43 @@ mod tests {
         assert!(serde_json::from_str::<Scenario>(&bad).is_err());
     }
 
+    /// Every member path of `v` (keys, and indices into arrays of objects are not needed).
+    fn paths(v: &serde_json::Value, prefix: &mut Vec<String>, out: &mut Vec<Vec<String>>) {
+        if let serde_json::Value::Object(m) = v {
+            for (k, child) in m {
+                prefix.push(k.clone());
+                out.push(prefix.clone());
+                paths(child, prefix, out);
+                prefix.pop();
+            }
+        }
+    }
+
+    #[test]
+    fn an_omitted_field_at_any_depth_reads_back_as_the_default() {
+        for kind in PlannerKind::ALL {
+            let mut s = Scenario::new(MapRecipe::file("m.yaml"), *kind);
+            s.sim.exec = Some(Execution::Pid(ccpp_core::exec::PidOptions::default()));
+            let full = serde_json::to_value(&s).unwrap_or_default();
+            let mut all = Vec::new();
+            paths(&full, &mut Vec::new(), &mut all);
+            for path in all {
+                let (last, parent) = path.split_last().unwrap_or_else(|| unreachable!());
+                let mut v = full.clone();
+                let mut cur = &mut v;
+                for k in parent {
+                    cur = &mut cur[k.as_str()];
+                }
+                if let Some(m) = cur.as_object_mut() {
+                    m.remove(last);
+                }
+                if let Ok(back) = serde_json::from_value::<Scenario>(v) {
+                    assert_eq!(back, s, "{kind}: omitting {}", path.join("."));
+                }
+            }
+        }
+    }
+
     #[test]
     fn validate_refuses_bad_values() {
         let mut s = Scenario::new(MapRecipe::file("m.yaml"), PlannerKind::Bcd);

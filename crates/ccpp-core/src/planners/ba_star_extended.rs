@@ -60,8 +60,9 @@ pub struct BaStarExtendedOptions {
     pub ba_star: BaStarOptions,
     /// The extension. Its `reach_r` defaults to 0 here (one clean-up after BA*): cleaning
     /// around each region's end left the robot far from BA*'s next start, and the transfers
-    /// made the mean path ratio on the 14 shared maps 1.461 instead of 1.421 (an `extension`
-    /// section that omits `reach_r` gets the component's default, 4).
+    /// made the mean path ratio on the 14 shared maps 1.461 instead of 1.421. An `extension`
+    /// section that omits a field gets this planner's default for it, not the component's.
+    #[serde(deserialize_with = "super::settings::ba_star_extended_extension")]
     pub extension: ExtensionOptions,
 }
 

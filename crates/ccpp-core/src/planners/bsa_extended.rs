@@ -102,7 +102,9 @@ pub struct BsaExtendedOptions {
     pub side: Side,
     /// The extension (`lane_ends` is refused: BSA has no lanes). Its `reach_r` defaults to 0 here (one clean-up after BSA): a spiral ends
     /// in the middle of what it filled, far from the rims, and cleaning around spiral ends
-    /// made the mean path ratio on the shared maps 1.436 instead of 1.373.
+    /// made the mean path ratio on the shared maps 1.436 instead of 1.373. An `extension`
+    /// section that omits a field gets this planner's default for it, not the component's.
+    #[serde(deserialize_with = "super::settings::bsa_extended_extension")]
     pub extension: ExtensionOptions,
 }
 

