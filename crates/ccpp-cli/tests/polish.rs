@@ -104,3 +104,81 @@ fn a_partial_extension_section_keeps_the_planners_other_defaults() {
         );
     }
 }
+
+/// `ccpp ARGS` fails with exit 1 and one short `error:` line holding every needle.
+fn fails_short(args: &[&str], extra: &[&Path], needles: &[&str]) {
+    let a = ccpp().args(args).args(extra).assert().failure();
+    let o = a.get_output();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
+    assert!(err.starts_with("error: "), "{err}");
+    // The map path takes up to about 100 characters; the message itself stays short.
+    assert!(err.len() < 320, "{} characters: {err}", err.len());
+    for n in needles {
+        assert!(err.contains(n), "{err:?} should contain {n:?}");
+    }
+}
+
+#[test]
+fn huge_numbers_in_zone_and_start_errors_stay_one_short_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = pillars(dir.path());
+    let run = |extra: &[&str], needles: &[&str]| {
+        let mut args = vec![
+            "run",
+            "--planner",
+            "ba-star",
+            "--map",
+            map.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let out = dir.path().join("out");
+        fails_short(&args, &[Path::new("--out"), &out], needles);
+    };
+    run(
+        &["--area", "0,0,1e300,1e300"],
+        &["area rectangle 0,0,1e300,1e300"],
+    );
+    run(
+        &["--area", "-1e300,-1e300,1e300,1e300"],
+        &["area rectangle -1e300,-1e300,1e300,1e300"],
+    );
+    run(
+        &["--keepout", "0.5,0.5,1e300,1e300"],
+        &["keepout rectangle 0.5,0.5,1e300,1e300"],
+    );
+    run(
+        &["--start", "1e300,1e300"],
+        &["start (1.000e300, 1.000e300)"],
+    );
+    run(&["--radius", "1e300"], &["2.000e300 m"]);
+    // A polygon file whose edges cross far away: the edge is shown in scientific notation.
+    let poly = dir.path().join("bow.yaml");
+    std::fs::write(&poly, "[[0, 0], [1e150, 1e150], [1e150, 0], [0, 1e150]]\n").unwrap();
+    run(
+        &["--keepout", poly.to_str().unwrap()],
+        &["intersects itself", "1.000e150"],
+    );
+    // rect-boustrophedon's own area option.
+    let cfg = dir.path().join("rect.yaml");
+    std::fs::write(
+        &cfg,
+        "rect_boustrophedon: { area: [1e300, 1e300, 2e300, 2e300] }\n",
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    fails_short(
+        &[
+            "run",
+            "--planner",
+            "rect-boustrophedon",
+            "--map",
+            map.to_str().unwrap(),
+            "--config",
+            cfg.to_str().unwrap(),
+        ],
+        &[Path::new("--out"), &out],
+        &["1e300,1e300,2e300,2e300 lies outside the map"],
+    );
+}

@@ -13,6 +13,7 @@
 
 mod bits;
 pub mod collide;
+pub mod display;
 pub mod dt;
 pub mod exec;
 pub mod gen;

@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 use std::ops::{Add, Sub};
 
 use crate::collide::{self, contact_radius_px};
+use crate::display::Compact;
 use crate::dt::{squared_edt, INF};
 use crate::geometry::{Point, Pose};
 use crate::grid::{Cell, GridMap, MapFrame};
@@ -55,10 +56,16 @@ impl Robot {
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum WorldError {
     /// Robot radius not a finite number > 0.
-    #[error("robot radius must be a finite number > 0 m, got {0}")]
+    #[error(
+        "robot radius must be a finite number > 0 m, got {}",
+        Compact(*.0)
+    )]
     BadRadius(f64),
     /// Tool radius invalid.
-    #[error("tool radius must be a finite number in (0, radius = {radius}] m, got {tool}")]
+    #[error(
+        "tool radius must be a finite number in (0, radius = {}] m, got {}",
+        Compact(*.radius), Compact(*.tool)
+    )]
     BadToolRadius {
         /// Tool radius given.
         tool: f64,
@@ -67,8 +74,9 @@ pub enum WorldError {
     },
     /// No centre position anywhere on the map keeps the robot clear of obstacles.
     #[error(
-        "robot of radius {radius} m does not fit anywhere on the map: the widest free spot has \
-         clearance {max_clearance:.3} m"
+        "robot of radius {} m does not fit anywhere on the map: the widest free spot has \
+         clearance {:.3} m",
+        Compact(*.radius), Compact(*.max_clearance)
     )]
     RobotTooBig {
         /// Robot radius.
@@ -77,10 +85,16 @@ pub enum WorldError {
         max_clearance: f64,
     },
     /// Start pose not finite.
-    #[error("start pose must be finite, got ({0}, {1}, {2})")]
+    #[error(
+        "start pose must be finite, got ({}, {}, {})",
+        Compact(*.0), Compact(*.1), Compact(*.2)
+    )]
     BadStart(f64, f64, f64),
     /// Start outside the image.
-    #[error("start ({x:.3}, {y:.3}) is outside the map (x in [{x0:.3}, {x1:.3}], y in [{y0:.3}, {y1:.3}])")]
+    #[error(
+        "start ({:.3}, {:.3}) is outside the map (x in [{:.3}, {:.3}], y in [{:.3}, {:.3}])",
+        Compact(*.x), Compact(*.y), Compact(*.x0), Compact(*.x1), Compact(*.y0), Compact(*.y1)
+    )]
     StartOutside {
         /// Start x.
         x: f64,
@@ -97,8 +111,9 @@ pub enum WorldError {
     },
     /// The robot's disk at the start overlaps an obstacle or unknown space.
     #[error(
-        "start ({x:.3}, {y:.3}) is in an obstacle: a robot of radius {radius} m there overlaps \
-         occupied or unknown pixels"
+        "start ({:.3}, {:.3}) is in an obstacle: a robot of radius {} m there overlaps \
+         occupied or unknown pixels",
+        Compact(*.x), Compact(*.y), Compact(*.radius)
     )]
     StartInObstacle {
         /// Start x.
@@ -110,8 +125,9 @@ pub enum WorldError {
     },
     /// The robot's disk at the start overlaps a keep-out zone.
     #[error(
-        "start ({x:.3}, {y:.3}) is in a keep-out zone: a robot of radius {radius} m there \
-         overlaps keep-out pixels"
+        "start ({:.3}, {:.3}) is in a keep-out zone: a robot of radius {} m there \
+         overlaps keep-out pixels",
+        Compact(*.x), Compact(*.y), Compact(*.radius)
     )]
     StartInKeepout {
         /// Start x.
@@ -124,8 +140,9 @@ pub enum WorldError {
     /// The robot's disk at the start reaches outside the work area (internal: such a start
     /// gets an approach, [`World::approach`], and this is never returned).
     #[error(
-        "start ({x:.3}, {y:.3}) is outside the area: a robot of radius {radius} m there is not \
-         wholly inside it"
+        "start ({:.3}, {:.3}) is outside the area: a robot of radius {} m there is not \
+         wholly inside it",
+        Compact(*.x), Compact(*.y), Compact(*.radius)
     )]
     StartOutsideArea {
         /// Start x.
@@ -137,8 +154,9 @@ pub enum WorldError {
     },
     /// No path leads from a start outside the area into it.
     #[error(
-        "the area cannot be reached from the start ({x:.3}, {y:.3}): no path for a robot of \
-         radius {radius} m leads into it without touching an obstacle or a keep-out zone"
+        "the area cannot be reached from the start ({:.3}, {:.3}): no path for a robot of \
+         radius {} m leads into it without touching an obstacle or a keep-out zone",
+        Compact(*.x), Compact(*.y), Compact(*.radius)
     )]
     AreaUnreachable {
         /// Start x.
@@ -150,8 +168,9 @@ pub enum WorldError {
     },
     /// The zones leave no spot where the robot fits.
     #[error(
-        "the area minus the keep-out zones holds no floor where a robot of radius {radius} m \
-         fits ({free_px} free pixels inside the area)"
+        "the area minus the keep-out zones holds no floor where a robot of radius {} m \
+         fits ({free_px} free pixels inside the area)",
+        Compact(*.radius)
     )]
     NoRoomInZones {
         /// Robot radius.

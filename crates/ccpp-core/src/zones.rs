@@ -17,6 +17,7 @@
 //! * A **keep-out mask** (a Nav2 keepout filter mask, loaded by `ccpp-io`) is given directly as
 //!   pixels; it is united with the keep-out polygons.
 
+use crate::display::Compact;
 use fixedbitset::FixedBitSet;
 use serde::{Deserialize, Serialize};
 
@@ -56,8 +57,11 @@ pub enum ZoneError {
     },
     /// Two edges that cross or touch away from their shared vertex.
     #[error(
-        "polygon {index} intersects itself: edge {a} ({ax:.3},{ay:.3})-({bx:.3},{by:.3}) meets \
-         edge {b}"
+        "polygon {index} intersects itself: edge {a} ({:.3},{:.3})-({:.3},{:.3}) meets edge {b}",
+        Compact(*.ax),
+        Compact(*.ay),
+        Compact(*.bx),
+        Compact(*.by)
     )]
     SelfIntersecting {
         /// Polygon index (0-based).

@@ -29,6 +29,7 @@
 
 use std::path::{Path, PathBuf};
 
+use ccpp_core::display::Compact;
 use ccpp_core::exec::Execution;
 use ccpp_core::grid::{GridError, GridMap};
 use ccpp_core::metrics::{self, Metrics};
@@ -201,14 +202,16 @@ impl MapRecipe {
         if let Some(r) = self.resolution {
             if !(r.is_finite() && r > 0.0) {
                 return Err(ScenarioError::Invalid(format!(
-                    "--resolution / map.resolution must be a finite number > 0, got {r}"
+                    "--resolution / map.resolution must be a finite number > 0, got {}",
+                    Compact(r)
                 )));
             }
         }
         if let Some(m) = self.inflate {
             if !(m.is_finite() && m >= 0.0) {
                 return Err(ScenarioError::Invalid(format!(
-                    "--inflate / map.inflate must be a finite number >= 0 m, got {m}"
+                    "--inflate / map.inflate must be a finite number >= 0 m, got {}",
+                    Compact(m)
                 )));
             }
         }
@@ -434,7 +437,8 @@ impl Scenario {
         if let Some(r) = self.sim.sensor_range {
             if !(r.is_finite() && r > 0.0) {
                 return Err(invalid(format!(
-                    "--sensor-range / sim.sensor_range must be a finite number > 0 m, got {r}"
+                    "--sensor-range / sim.sensor_range must be a finite number > 0 m, got {}",
+                    Compact(r)
                 )));
             }
         }
@@ -448,7 +452,8 @@ impl Scenario {
         for (f, v) in [("range_m", lm.range_m), ("period_s", lm.period_s)] {
             if !(v.is_finite() && v > 0.0) {
                 return Err(invalid(format!(
-                    "sim.landmarks.{f} must be a finite number > 0, got {v}"
+                    "sim.landmarks.{f} must be a finite number > 0, got {}",
+                    Compact(v)
                 )));
             }
         }

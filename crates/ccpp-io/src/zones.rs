@@ -12,6 +12,7 @@
 //!   occupied pixels are keep-out. The mask must have exactly the map's size, resolution and
 //!   origin; anything else is refused (a mask in another frame would forbid the wrong floor).
 
+use ccpp_core::display::{join, Compact};
 use std::path::{Path, PathBuf};
 
 use ccpp_core::grid::MapFrame;
@@ -65,7 +66,7 @@ impl ZoneSpec {
     /// Short description for messages and `info`: the file name, `rectangle` or `inline`.
     pub fn label(&self) -> String {
         match self {
-            Self::Rect(r) => format!("rectangle {},{},{},{}", r[0], r[1], r[2], r[3]),
+            Self::Rect(r) => format!("rectangle {}", join(r)),
             Self::Polygons(p) => format!("{} inline polygon(s)", p.len()),
             Self::File(p) => p.display().to_string(),
         }
@@ -105,12 +106,12 @@ impl ZoneSpec {
 /// The rectangle is empty or not finite.
 pub fn check_rect(r: [f64; 4]) -> Result<(), ZoneFileError> {
     if r.iter().any(|v| !v.is_finite()) {
-        return Err(bad(format!("rectangle {r:?} must be finite")));
+        return Err(bad(format!("rectangle {} must be finite", join(&r))));
     }
     if !(r[2] > r[0] && r[3] > r[1]) {
         return Err(bad(format!(
-            "rectangle {},{},{},{} is empty: it needs X1 > X0 and Y1 > Y0",
-            r[0], r[1], r[2], r[3]
+            "rectangle {} is empty: it needs X1 > X0 and Y1 > Y0",
+            join(&r)
         )));
     }
     Ok(())
@@ -149,14 +150,16 @@ fn read_mask(path: &Path, frame: &MapFrame) -> Result<FixedBitSet, ZoneFileError
     if !close(f.resolution, frame.resolution) {
         return Err(bad(format!(
             "keepout mask resolution {} m/px differs from the map's {} m/px; a mask must be in the map's frame",
-            f.resolution, frame.resolution
+            Compact(f.resolution),
+            Compact(frame.resolution)
         )));
     }
     let (o, p) = (f.origin, frame.origin);
     if !(close(o.x, p.x) && close(o.y, p.y) && close(o.theta, p.theta)) {
         return Err(bad(format!(
-            "keepout mask origin [{}, {}, {}] differs from the map's [{}, {}, {}]; a mask must be in the map's frame",
-            o.x, o.y, o.theta, p.x, p.y, p.theta
+            "keepout mask origin [{}] differs from the map's [{}]; a mask must be in the map's frame",
+            join(&[o.x, o.y, o.theta]),
+            join(&[p.x, p.y, p.theta])
         )));
     }
     let mut bits = FixedBitSet::with_capacity(f.len());

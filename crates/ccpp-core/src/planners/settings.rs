@@ -221,7 +221,10 @@ fn finite_pos(field: &str, v: f64) -> Result<(), OptionsError> {
     } else {
         Err(OptionsError::new(
             field,
-            format!("must be a finite number > 0, got {v}"),
+            format!(
+                "must be a finite number > 0, got {}",
+                crate::display::Compact(v)
+            ),
         ))
     }
 }
@@ -232,7 +235,10 @@ fn finite_nonneg(field: &str, v: f64) -> Result<(), OptionsError> {
     } else {
         Err(OptionsError::new(
             field,
-            format!("must be a finite number >= 0, got {v}"),
+            format!(
+                "must be a finite number >= 0, got {}",
+                crate::display::Compact(v)
+            ),
         ))
     }
 }
@@ -618,7 +624,10 @@ impl PlannerSettings for RectOptions {
             if a.iter().any(|v| !v.is_finite()) || a[2] <= a[0] || a[3] <= a[1] {
                 return Err(OptionsError::new(
                     "area",
-                    format!("must be finite X0,Y0,X1,Y1 with X1 > X0 and Y1 > Y0, got {a:?}"),
+                    format!(
+                        "must be finite X0,Y0,X1,Y1 with X1 > X0 and Y1 > Y0, got {}",
+                        crate::display::join(&a)
+                    ),
                 ));
             }
         }
@@ -631,7 +640,11 @@ impl PlannerSettings for RectOptions {
             if v < res {
                 return Err(OptionsError::new(
                     f,
-                    format!("{v} m is finer than the map resolution ({res} m/px)"),
+                    format!(
+                        "{} m is finer than the map resolution ({} m/px)",
+                        crate::display::Compact(v),
+                        crate::display::Compact(res)
+                    ),
                 ));
             }
         }
@@ -641,8 +654,10 @@ impl PlannerSettings for RectOptions {
                 return Err(OptionsError::new(
                     "area",
                     format!(
-                        "{},{},{},{} lies outside the map ({},{} to {},{})",
-                        a[0], a[1], a[2], a[3], lo.x, lo.y, hi.x, hi.y
+                        "{} lies outside the map ({} to {})",
+                        crate::display::join(&a),
+                        crate::display::join(&[lo.x, lo.y]),
+                        crate::display::join(&[hi.x, hi.y])
                     ),
                 ));
             }
