@@ -182,3 +182,61 @@ fn huge_numbers_in_zone_and_start_errors_stay_one_short_line() {
         &["1e300,1e300,2e300,2e300 lies outside the map"],
     );
 }
+
+/// The MB a refused run says it would need.
+fn needed_mb(err: &str) -> u64 {
+    let tail = err.split("would need about ").nth(1).unwrap();
+    tail.split(' ').next().unwrap().parse().unwrap()
+}
+
+#[test]
+fn zones_count_in_the_memory_estimate() {
+    let dir = tempfile::tempdir().unwrap();
+    // 20 x 20 m of pixels, of which a 3 x 3 m room is free: big masks, a short run.
+    let map = pgm(dir.path(), "big.pgm", 400, 400, |x, y| x > 60 || y > 60);
+    let mask_png = dir.path().join("mask.pgm");
+    std::fs::copy(&map, &mask_png).unwrap();
+    let mask = dir.path().join("mask.yaml");
+    std::fs::write(
+        &mask,
+        "image: mask.pgm\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\nnegate: 1\noccupied_thresh: 0.65\nfree_thresh: 0.196\n",
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let attempt = |limit: &str, extra: &[&str]| {
+        let mut c = ccpp();
+        c.args(["run", "--planner", "ba-star", "--radius", "0.3", "--map"])
+            .arg(&map)
+            .args(["--max-memory", limit])
+            .args(extra)
+            .arg("--out")
+            .arg(&out);
+        let o = c.output().unwrap();
+        (
+            o.status.code(),
+            String::from_utf8_lossy(&o.stderr).into_owned(),
+        )
+    };
+    let need = |extra: &[&str]| {
+        let (code, err) = attempt("1", extra);
+        assert_eq!(code, Some(1), "{err}");
+        needed_mb(&err)
+    };
+    let plain = need(&[]);
+    let rect = need(&["--keepout", "1,1,1.5,1.5"]);
+    let file = need(&["--keepout", mask.to_str().unwrap()]);
+    let approach = need(&["--area", "0.5,0.5,2.5,2.5", "--start", "0.3,2.8"]);
+    assert!(
+        plain < rect && rect < file && file < approach,
+        "{plain} {rect} {file} {approach}"
+    );
+    let (_, err) = attempt("1", &["--keepout", mask.to_str().unwrap()]);
+    assert!(err.contains("for the zones"), "{err}");
+    // At the plain run's need, the plain run is allowed and the zoned ones are refused.
+    let limit = plain.to_string();
+    let (code, err) = attempt(&limit, &[]);
+    assert_eq!(code, Some(0), "{err}");
+    let (code, err) = attempt(&limit, &["--keepout", mask.to_str().unwrap()]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("memory limit"), "{err}");
+}

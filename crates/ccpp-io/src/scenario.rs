@@ -33,7 +33,7 @@ use ccpp_core::display::Compact;
 use ccpp_core::exec::Execution;
 use ccpp_core::grid::{GridError, GridMap};
 use ccpp_core::metrics::{self, Metrics};
-use ccpp_core::planners::settings::{estimate_run, validate_execution};
+use ccpp_core::planners::settings::{estimate_run, estimate_zones, validate_execution, ZoneLoad};
 use ccpp_core::planners::{OptionsError, PlannerConfig, PlannerKind, ResourceEstimate, Setup};
 use ccpp_core::sim::{simulate, RunOutput, SimConfig};
 use ccpp_core::world::{Robot, World, WorldError};
@@ -568,6 +568,19 @@ impl Scenario {
         }
     }
 
+    /// What the zones will hold, for the memory estimate (before any zone file is read).
+    pub fn zone_load(&self) -> ZoneLoad {
+        ZoneLoad {
+            any: self.area.is_some() || !self.keepout.is_empty(),
+            approach: self.area.is_some() && self.start.is_some(),
+            mask_files: self
+                .keepout
+                .iter()
+                .filter(|k| matches!(k, ZoneSpec::File(_)))
+                .count(),
+        }
+    }
+
     /// What the planner's checks and estimate see for `map`.
     pub fn setup(&self, map: &PreparedMap) -> Setup {
         Setup {
@@ -614,7 +627,12 @@ impl Scenario {
                 },
             }
         })?;
-        let est = estimate_run(&setup, self.planner.settings());
+        let mut est = estimate_run(&setup, self.planner.settings());
+        let zones = estimate_zones(&setup, self.zone_load());
+        if zones.bytes > 0.0 {
+            est.bytes += zones.bytes;
+            est.detail = format!("{}; {}", est.detail, zones.detail);
+        }
         let limit = self.max_memory_mb as f64 * 1024.0 * 1024.0;
         if est.bytes.is_nan() || est.bytes > limit {
             let mb = est.bytes / (1024.0 * 1024.0);

@@ -716,6 +716,45 @@ pub fn estimate_run(s: &Setup, planner: &dyn PlannerSettings) -> ResourceEstimat
     }
 }
 
+/// Bytes per map pixel that zones add to any run with an area or keep-outs: the area and
+/// keep-out bitsets, the planning map with its virtual walls (a second grid) and its blocked
+/// bitset, and the distance transform of the true map when the zones leave no room.
+pub const ZONE_PIXEL_BYTES: f64 = 8.0;
+/// Bytes per map pixel of the approach to an area from a start outside it: the distance
+/// transform with keep-outs, Dijkstra distances, parents and heap entries.
+pub const APPROACH_PIXEL_BYTES: f64 = 64.0;
+/// Bytes per map pixel of each keep-out file that may be a Nav2 mask (decoded image, its grid
+/// and its bitset; a mask has the map's size).
+pub const MASK_PIXEL_BYTES: f64 = 12.0;
+
+/// What a run's zones will hold, as known before any zone file is read.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ZoneLoad {
+    /// An area or at least one keep-out is given.
+    pub any: bool,
+    /// An area and an explicit start: the start may be outside the area and need an approach.
+    pub approach: bool,
+    /// Keep-out files (each may be a map-sized Nav2 mask).
+    pub mask_files: usize,
+}
+
+/// The memory zones add to a run (0 bytes without zones).
+pub fn estimate_zones(s: &Setup, z: ZoneLoad) -> ResourceEstimate {
+    if !z.any {
+        return ResourceEstimate {
+            bytes: 0.0,
+            detail: String::new(),
+        };
+    }
+    let mut per_px = ZONE_PIXEL_BYTES + MASK_PIXEL_BYTES * z.mask_files as f64;
+    if z.approach {
+        per_px += APPROACH_PIXEL_BYTES;
+    }
+    let mut e = ResourceEstimate::units(s.pixels(), per_px, "map pixels");
+    e.detail = format!("{} for the zones", e.detail);
+    e
+}
+
 /// A length in metres, at most 6 significant digits (`0.45`, `2e-9`).
 pub fn fmt_m(v: f64) -> String {
     if v != 0.0 && (v.abs() < 1e-3 || v.abs() >= 1e7) {
