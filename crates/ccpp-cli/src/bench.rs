@@ -8,7 +8,7 @@ use anyhow::{bail, Context, Result};
 use ccpp_core::metrics::Metrics;
 use ccpp_core::planners::{self, PlannerOptions};
 use ccpp_core::sim::SimConfig;
-use ccpp_io::scenario::{Scenario, DEFAULT_MAX_MEMORY_MB};
+use ccpp_io::scenario::Scenario;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
@@ -345,16 +345,12 @@ fn run_one(
     }
     let kind = parse_planner(planner).map_err(|e| crate::errors::one_line(&e))?;
     let spec = JobSpec {
-        scenario: Scenario {
-            map: map.recipe.clone(),
-            robot,
-            start: None,
-            planner: options.config(kind),
-            sim,
-            max_memory_mb: a.max_memory.unwrap_or(DEFAULT_MAX_MEMORY_MB),
-            area: None,
-            keepout: Vec::new(),
-        },
+        scenario: Scenario::configure(map.recipe.clone(), options.config(kind))
+            .robot(robot)
+            .sim(sim)
+            .memory_limit(a.max_memory)
+            .build()
+            .map_err(|e| crate::errors::one_line(&e.into()))?,
         map_name: map.name.clone(),
         out: dir.to_path_buf(),
         key,

@@ -14,7 +14,7 @@ use ccpp_core::sim::{RunOutput, SimConfig};
 use ccpp_core::world::{Robot, World};
 use ccpp_core::Pose;
 use ccpp_io::map::{load_map_bytes, LoadOptions};
-use ccpp_io::scenario::{Scenario, ScenarioError, DEFAULT_MAX_MEMORY_MB};
+use ccpp_io::scenario::{Scenario, ScenarioError};
 
 pub use ccpp_io::scenario::{MapRecipe, PreparedMap};
 
@@ -315,17 +315,14 @@ impl Job {
         if a.sensor_range.is_some() {
             given.push("--sensor-range");
         }
-        let scenario = Scenario {
-            map: recipe_from(&a.map),
-            robot,
-            start: start.map(|p| [p.x, p.y, p.theta]),
-            planner,
-            sim,
-            max_memory_mb: a.max_memory.unwrap_or(DEFAULT_MAX_MEMORY_MB),
-            area: a.area.clone(),
-            keepout: a.keepout.clone(),
-        };
-        scenario.validate().map_err(|e| name_flag(e, &given))?;
+        let scenario = Scenario::configure(recipe_from(&a.map), planner)
+            .robot(robot)
+            .start_pose(start.map(|p| [p.x, p.y, p.theta]))
+            .sim(sim)
+            .memory_limit(a.max_memory)
+            .zones(a.area.clone(), a.keepout.clone())
+            .build()
+            .map_err(|e| name_flag(e, &given))?;
         let map = load_recipe(&scenario.map)?;
         scenario.check_map(&map).map_err(|e| name_flag(e, &given))?;
         Ok(Self {
@@ -341,8 +338,7 @@ impl Job {
             Some(p) => parse_planner(p)?,
             None => FLAGSHIP,
         };
-        let scenario = Scenario::new(demo_recipe(), kind);
-        scenario.validate()?;
+        let scenario = Scenario::configure(demo_recipe(), PlannerConfig::new(kind)).build()?;
         let map = load_recipe(&scenario.map)?;
         Ok(Self {
             scenario,

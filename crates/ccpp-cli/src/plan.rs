@@ -6,10 +6,10 @@ use std::fmt::Write as _;
 use anyhow::{anyhow, Result};
 use ccpp_core::planners::PlannerConfig;
 use ccpp_core::route::DEFAULT_TOLERANCE_M;
-use ccpp_core::sim::{SimConfig, StopReason};
+use ccpp_core::sim::StopReason;
 use ccpp_io::export::{render_exports, zone_features, ExportFormat, ExportMeta};
 use ccpp_io::plan::{offline_planners, plan_route, PlanError};
-use ccpp_io::scenario::{Scenario, ScenarioError, DEFAULT_MAX_MEMORY_MB};
+use ccpp_io::scenario::{Scenario, ScenarioError};
 
 use crate::args::PlanArgs;
 use crate::info::StartComponent;
@@ -42,16 +42,6 @@ pub fn run(a: &PlanArgs) -> Result<()> {
             }
         }
     }
-    let scenario = Scenario {
-        map: recipe_from(&a.map),
-        robot,
-        start: start.map(|p| [p.x, p.y, p.theta]),
-        planner,
-        sim: SimConfig::default(),
-        max_memory_mb: a.max_memory.unwrap_or(DEFAULT_MAX_MEMORY_MB),
-        area: a.area.clone(),
-        keepout: a.keepout.clone(),
-    };
     let flag = |e: ScenarioError| match &e {
         ScenarioError::Options(o)
             if given.contains(&"--length") && o.field.ends_with("length_m") =>
@@ -63,7 +53,13 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         }
         _ => e.into(),
     };
-    scenario.validate().map_err(flag)?;
+    let scenario = Scenario::configure(recipe_from(&a.map), planner)
+        .robot(robot)
+        .start_pose(start.map(|p| [p.x, p.y, p.theta]))
+        .memory_limit(a.max_memory)
+        .zones(a.area.clone(), a.keepout.clone())
+        .build()
+        .map_err(flag)?;
     check_target(&a.out)?;
     let map = load_recipe(&scenario.map)?;
     let plan = plan_route(&scenario, &map, DEFAULT_TOLERANCE_M).map_err(|e| match e {

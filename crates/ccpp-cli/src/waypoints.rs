@@ -5,8 +5,7 @@ use std::fmt::Write as _;
 use anyhow::{anyhow, bail, Result};
 use ccpp_core::planners::rect_boustrophedon::{plan, RectOptions};
 use ccpp_core::planners::PlannerConfig;
-use ccpp_core::sim::SimConfig;
-use ccpp_io::scenario::{Scenario, ScenarioError, DEFAULT_MAX_MEMORY_MB};
+use ccpp_io::scenario::{Scenario, ScenarioError};
 
 use crate::args::WaypointsArgs;
 use crate::job::{recipe_from, robot_from};
@@ -27,22 +26,21 @@ pub fn run(a: &WaypointsArgs) -> Result<()> {
     };
     // The same validation, checks and memory estimate as `ccpp run --planner
     // rect-boustrophedon`.
-    let scenario = Scenario {
-        map: recipe_from(&a.map),
-        robot,
-        start: start.map(|p| [p.x, p.y, p.theta]),
-        planner: PlannerConfig::RectBoustrophedon(opts.clone()),
-        sim: SimConfig::default(),
-        max_memory_mb: a.max_memory.unwrap_or(DEFAULT_MAX_MEMORY_MB),
-        area: None,
-        keepout: a.keepout.clone(),
-    };
     let flag = |e: ScenarioError| match &e {
         ScenarioError::Options(o) if o.field.ends_with("length_m") => anyhow!("--length: {e}"),
         ScenarioError::Options(o) if o.field.ends_with("width_m") => anyhow!("--width: {e}"),
         _ => e.into(),
     };
-    scenario.validate().map_err(flag)?;
+    let scenario = Scenario::configure(
+        recipe_from(&a.map),
+        PlannerConfig::RectBoustrophedon(opts.clone()),
+    )
+    .robot(robot)
+    .start_pose(start.map(|p| [p.x, p.y, p.theta]))
+    .memory_limit(a.max_memory)
+    .zones(None, a.keepout.clone())
+    .build()
+    .map_err(flag)?;
     let map = recipe_from(&a.map).load()?;
     let world = scenario.world(&map).map_err(flag)?;
     let p = plan(&world, &opts);

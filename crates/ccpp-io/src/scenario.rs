@@ -311,7 +311,27 @@ pub fn apply_georef(grid: GridMap, path: &Path) -> Result<GridMap, ScenarioError
 ///
 /// The planner and its options are flattened: `"planner": "ba-star", "options": {...}` (only
 /// that planner's options, see [`PlannerConfig`]).
+///
+/// Other crates assemble one with [`Scenario::builder`] or [`Scenario::configure`] (whose
+/// [`build`](ScenarioBuilder::build) validates it) or read one with serde; a struct literal is
+/// not possible outside this crate (`non_exhaustive`), so no caller skips the validation:
+///
+/// ```compile_fail
+/// # use ccpp_core::planners::{PlannerConfig, PlannerKind};
+/// # use ccpp_io::scenario::{MapRecipe, Scenario};
+/// let s = Scenario {
+///     map: MapRecipe::file("m.yaml"),
+///     robot: ccpp_core::world::Robot::new(-1.0),
+///     start: None,
+///     planner: PlannerConfig::new(PlannerKind::BaStar),
+///     sim: ccpp_core::sim::SimConfig::default(),
+///     max_memory_mb: 1,
+///     area: None,
+///     keepout: Vec::new(),
+/// };
+/// ```
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct Scenario {
     /// The map.
     pub map: MapRecipe,
@@ -374,6 +394,14 @@ impl Scenario {
     /// A builder for the map file `map` and `planner`.
     pub fn builder(map: impl Into<PathBuf>, planner: PlannerKind) -> ScenarioBuilder {
         ScenarioBuilder(Self::new(MapRecipe::file(map), planner))
+    }
+
+    /// A builder for a map recipe and a planner with its options (the command line's `run`,
+    /// `plan`, `waypoints` and `bench`, and Python's runs go through here).
+    pub fn configure(map: MapRecipe, planner: PlannerConfig) -> ScenarioBuilder {
+        let mut s = Self::new(map, planner.kind());
+        s.planner = planner;
+        ScenarioBuilder(s)
     }
 
     /// Reads a scenario file: JSON (`.json`, such as a run's `run.json`) or YAML.
@@ -740,6 +768,28 @@ impl ScenarioBuilder {
         self
     }
 
+    /// The robot (radius and tool radius).
+    #[must_use]
+    pub fn robot(mut self, robot: Robot) -> Self {
+        self.0.robot = robot;
+        self
+    }
+
+    /// Start pose `[x, y, theta]`, or `None` for the default start.
+    #[must_use]
+    pub fn start_pose(mut self, start: Option<[f64; 3]>) -> Self {
+        self.0.start = start;
+        self
+    }
+
+    /// Work area (`None`: the whole map) and keep-out zones, replacing any set before.
+    #[must_use]
+    pub fn zones(mut self, area: Option<ZoneSpec>, keepout: Vec<ZoneSpec>) -> Self {
+        self.0.area = area;
+        self.0.keepout = keepout;
+        self
+    }
+
     /// The planner with its options.
     #[must_use]
     pub fn planner(mut self, p: PlannerConfig) -> Self {
@@ -773,6 +823,12 @@ impl ScenarioBuilder {
     pub fn max_memory_mb(mut self, mb: u64) -> Self {
         self.0.max_memory_mb = mb;
         self
+    }
+
+    /// Memory limit, MB, or `None` for [`DEFAULT_MAX_MEMORY_MB`].
+    #[must_use]
+    pub fn memory_limit(self, mb: Option<u64>) -> Self {
+        self.max_memory_mb(mb.unwrap_or(DEFAULT_MAX_MEMORY_MB))
     }
 
     /// The validated scenario.
@@ -829,6 +885,15 @@ mod tests {
             let mut all = Vec::new();
             paths(&full, &mut Vec::new(), &mut all);
             for path in all {
+                // The map file and the PID execution are set, not defaults: omitting them
+                // changes the scenario; everything inside them must not.
+                let p = path.join(".");
+                if ["map.path", "sim.exec"]
+                    .iter()
+                    .any(|set| *set == p || set.starts_with(&format!("{p}.")))
+                {
+                    continue;
+                }
                 let (last, parent) = path.split_last().unwrap_or_else(|| unreachable!());
                 let mut v = full.clone();
                 let mut cur = &mut v;
@@ -842,6 +907,42 @@ mod tests {
                     assert_eq!(back, s, "{kind}: omitting {}", path.join("."));
                 }
             }
+        }
+    }
+
+    #[test]
+    fn configure_keeps_every_part_and_validates_once_built() {
+        let planner = PlannerConfig::BaStar(BaStarOptions {
+            smoothing: false,
+            ..BaStarOptions::default()
+        });
+        let s = Scenario::configure(MapRecipe::file("m.yaml"), planner.clone())
+            .robot(Robot::new(0.2))
+            .start_pose(Some([1.0, 2.0, 0.5]))
+            .memory_limit(Some(7))
+            .zones(
+                Some(ZoneSpec::Rect([0.0, 0.0, 1.0, 1.0])),
+                vec![ZoneSpec::Rect([0.2, 0.2, 0.4, 0.4])],
+            )
+            .build()
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(s.planner, planner);
+        assert_eq!(s.robot, Robot::new(0.2));
+        assert_eq!(s.start, Some([1.0, 2.0, 0.5]));
+        assert_eq!(s.max_memory_mb, 7);
+        assert!(s.area.is_some() && s.keepout.len() == 1);
+        let d = Scenario::configure(MapRecipe::file("m.yaml"), planner.clone())
+            .memory_limit(None)
+            .build()
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(d.max_memory_mb, DEFAULT_MAX_MEMORY_MB);
+        for bad in [
+            Scenario::configure(MapRecipe::file("m.yaml"), planner.clone()).robot(Robot::new(-1.0)),
+            Scenario::configure(MapRecipe::file("m.yaml"), planner.clone())
+                .zones(Some(ZoneSpec::Rect([1.0, 1.0, 0.0, 0.0])), Vec::new()),
+            Scenario::configure(MapRecipe::file("m.yaml"), planner.clone()).memory_limit(Some(0)),
+        ] {
+            assert!(bad.build().is_err());
         }
     }
 

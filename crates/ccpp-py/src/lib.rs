@@ -19,7 +19,7 @@ use ccpp_core::sim::{RunOutput, SimConfig, Simulator, StopReason};
 use ccpp_core::trace::{Cursor, Entry, Event, Record, Trace};
 use ccpp_core::world::{Robot, World};
 use ccpp_core::{Point, Pose};
-use ccpp_io::scenario::{MapRecipe, PreparedMap, Scenario, ScenarioError, DEFAULT_MAX_MEMORY_MB};
+use ccpp_io::scenario::{MapRecipe, PreparedMap, Scenario, ScenarioError};
 use fixedbitset::FixedBitSet;
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2};
@@ -613,16 +613,11 @@ fn bench_run(
         let mut recipe = recipe_for(&map_path);
         recipe.inflate = inflate;
         let map = recipe.load().map_err(|e| chain(&e))?;
-        let scenario = Scenario {
-            map: map.recipe.clone(),
-            robot,
-            start: None,
-            planner: PlannerConfig::new(kind),
-            sim: SimConfig::default(),
-            max_memory_mb: max_memory_mb.unwrap_or(DEFAULT_MAX_MEMORY_MB),
-            area: None,
-            keepout: Vec::new(),
-        };
+        let scenario = Scenario::configure(map.recipe.clone(), PlannerConfig::new(kind))
+            .robot(robot)
+            .memory_limit(max_memory_mb)
+            .build()
+            .map_err(|e| chain(&e))?;
         let run = scenario.run_on(&map).map_err(|e| chain(&e))?;
         if let Some(dir) = &out {
             ccpp_render::run_files::write_run_files(
