@@ -240,3 +240,42 @@ fn zones_count_in_the_memory_estimate() {
     assert_eq!(code, Some(1), "{err}");
     assert!(err.contains("memory limit"), "{err}");
 }
+
+#[test]
+fn the_replay_of_a_zoned_run_carries_the_zones() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = pillars(dir.path());
+    let out = dir.path().join("out");
+    ccpp()
+        .args(["run", "--planner", "bcd", "--map"])
+        .arg(&map)
+        .args([
+            "--area",
+            "0.2,0.2,4,5.8",
+            "--keepout",
+            "0.5,3,1.5,4",
+            "--replay",
+        ])
+        .arg("--out")
+        .arg(&out)
+        .assert()
+        .success();
+    let html = std::fs::read_to_string(out.join("replay.html")).unwrap();
+    assert!(
+        html.contains(r#""zones":{"area":[["#),
+        "no zones in replay.html"
+    );
+    assert!(html.contains(r#""has_keepout":true,"has_outside":true"#));
+    // And a run without zones has none.
+    let plain = dir.path().join("plain");
+    ccpp()
+        .args(["run", "--planner", "bcd", "--map"])
+        .arg(&map)
+        .arg("--replay")
+        .arg("--out")
+        .arg(&plain)
+        .assert()
+        .success();
+    let html = std::fs::read_to_string(plain.join("replay.html")).unwrap();
+    assert!(html.contains(r#""zones":null"#));
+}

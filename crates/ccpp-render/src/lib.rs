@@ -103,7 +103,7 @@ pub mod colours {
 }
 
 /// Zone class of map pixel `i` for the pictures: 1 = keep-out, 2 = outside the area, 0 = none.
-fn zone_class(world: &World, i: usize) -> u8 {
+pub(crate) fn zone_class(world: &World, i: usize) -> u8 {
     match world.zones() {
         Some(z) if z.keepout.contains(i) => 1,
         Some(z) if z.area.as_ref().is_some_and(|a| !a.contains(i)) => 2,

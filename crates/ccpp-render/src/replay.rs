@@ -10,7 +10,8 @@ use ccpp_core::world::World;
 use ccpp_core::Point;
 use tiny_skia::{Color, Pixmap};
 
-use crate::{crop_box, RenderError};
+use crate::colours::{AREA_BORDER, KEEPOUT, KEEPOUT_HATCH, OUTSIDE_AREA};
+use crate::{crop_box, zone_class, RenderError};
 
 /// Map class colours shared by the replay page and the GIF.
 const C_OCC: [u8; 3] = [30, 30, 30];
@@ -22,17 +23,49 @@ pub const C_SWEPT: [u8; 3] = [120, 190, 245];
 const C_PATH: [u8; 3] = [0, 70, 160];
 const C_ROBOT: [u8; 3] = [0, 160, 60];
 
-fn class_colour(world: &World, i: usize) -> [u8; 3] {
-    match world.map().cells()[i] {
-        Cell::Occupied => C_OCC,
-        Cell::Unknown => C_UNK,
-        Cell::Free => {
-            if world.accessible().contains(i) {
-                C_ACC
-            } else {
-                C_FREE_OUT
-            }
-        }
+/// Period of the keep-out hatching, in map pixels (the replay's background has one pixel per
+/// map pixel; the coverage picture hatches in canvas pixels).
+const HATCH_PERIOD: usize = 6;
+
+/// Map class of pixel `i`, as in the coverage picture: obstacles and unknown pixels of the true
+/// map, keep-out floor, floor outside the work area, then floor the tool can reach or not.
+fn class_of(world: &World, i: usize) -> Class {
+    match world.true_map().cells()[i] {
+        Cell::Occupied => Class::Occupied,
+        Cell::Unknown => Class::Unknown,
+        Cell::Free => match zone_class(world, i) {
+            1 => Class::Keepout,
+            2 => Class::OutsideArea,
+            _ if world.accessible().contains(i) => Class::Accessible,
+            _ => Class::OutOfReach,
+        },
+    }
+}
+
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Class {
+    Occupied,
+    Unknown,
+    OutOfReach,
+    Accessible,
+    Keepout,
+    OutsideArea,
+}
+
+/// The keep-out hatching: a diagonal stripe at map pixel `(x, y)`.
+fn hatched(x: usize, y: usize) -> bool {
+    (x + y) % HATCH_PERIOD < 2
+}
+
+fn class_colour(world: &World, i: usize, x: usize, y: usize) -> [u8; 3] {
+    match class_of(world, i) {
+        Class::Occupied => C_OCC,
+        Class::Unknown => C_UNK,
+        Class::OutOfReach => C_FREE_OUT,
+        Class::Accessible => C_ACC,
+        Class::Keepout if hatched(x, y) => KEEPOUT_HATCH,
+        Class::Keepout => KEEPOUT,
+        Class::OutsideArea => OUTSIDE_AREA,
     }
 }
 
@@ -48,7 +81,7 @@ fn background_png(
     let data = pm.data_mut();
     for y in 0..h {
         for x in 0..w {
-            let c = class_colour(world, f.index(c0 + x, r0 + y));
+            let c = class_colour(world, f.index(c0 + x, r0 + y), c0 + x, r0 + y);
             let o = (y * w + x) * 4;
             data[o..o + 4].copy_from_slice(&[c[0], c[1], c[2], 255]);
         }
@@ -320,8 +353,9 @@ fn replay_data(
     // Tile side in map pixels (first visits are drawn around the visiting pose).
     let tile = tile_side.map_or_else(|| "null".to_string(), |t| js_num(t / f.resolution));
     let yaw = f.origin.theta;
+    let zones = zones_js(world, crop);
     format!(
-        r#"{{"w":{w},"h":{h},"res":{res},"yaw":{yaw},"r":{r},"rt":{rt},"tile":{tile},"start":[{sx},{sy},{st}],"n":{n},"m":{m},"q":{q},"blob":"{blob}","events":{events},"nt":{nt},"tblob":"{tblob}","cov":{cov},"palette":{palette},"metrics":{metrics}}}"#,
+        r#"{{"w":{w},"h":{h},"res":{res},"yaw":{yaw},"r":{r},"rt":{rt},"tile":{tile},"start":[{sx},{sy},{st}],"n":{n},"m":{m},"q":{q},"blob":"{blob}","events":{events},"nt":{nt},"tblob":"{tblob}","cov":{cov},"palette":{palette},"zones":{zones},"metrics":{metrics}}}"#,
         res = js_num(f.resolution),
         yaw = js_num(yaw),
         r = js_num(world.robot().radius / f.resolution),
@@ -339,6 +373,58 @@ fn replay_data(
         } else {
             metrics_json.trim()
         },
+    )
+}
+
+/// The zones for the page (`null` without zones): the area and keep-out polygons in crop
+/// pixel coordinates (flat `x, y` lists), whether the crop shows keep-out floor and floor
+/// outside the area, and the colours (the coverage picture's).
+fn zones_js(world: &World, crop: (usize, usize, usize, usize)) -> String {
+    let Some(z) = world.zones() else {
+        return "null".into();
+    };
+    let f = *world.frame();
+    let (c0, r0, w, h) = crop;
+    let polys = |ps: &[ccpp_core::zones::Polygon]| {
+        let items: Vec<String> = ps
+            .iter()
+            .map(|p| {
+                let pts: Vec<String> = p
+                    .ring()
+                    .iter()
+                    .map(|q| {
+                        let g = f.world_to_grid(*q);
+                        format!(
+                            "{},{}",
+                            js_num(g.x - c0 as f64),
+                            js_num(f.height as f64 - g.y - r0 as f64)
+                        )
+                    })
+                    .collect();
+                format!("[{}]", pts.join(","))
+            })
+            .collect();
+        format!("[{}]", items.join(","))
+    };
+    let (mut keepout, mut outside) = (false, false);
+    for y in r0..r0 + h {
+        for x in c0..c0 + w {
+            match class_of(world, f.index(x, y)) {
+                Class::Keepout => keepout = true,
+                Class::OutsideArea => outside = true,
+                _ => {}
+            }
+        }
+    }
+    let rgb = |c: [u8; 3]| format!("[{},{},{}]", c[0], c[1], c[2]);
+    format!(
+        r#"{{"area":{},"keep":{},"has_keepout":{keepout},"has_outside":{outside},"ko":{},"koh":{},"oa":{},"ab":{}}}"#,
+        polys(&z.area_polygons),
+        polys(&z.keepout_polygons),
+        rgb(KEEPOUT),
+        rgb(KEEPOUT_HATCH),
+        rgb(OUTSIDE_AREA),
+        rgb(AREA_BORDER)
     )
 }
 
@@ -435,7 +521,8 @@ pub fn replay_gif(world: &World, trace: &Trace, opts: &GifOptions) -> Result<Vec
         ((cw as f64 * k).round() as usize).max(1),
         ((ch as f64 * k).round() as usize).max(1),
     );
-    // Palette: 0 occ, 1 unk, 2 free-out, 3 accessible, 4 swept, 5 path, 6 robot, 7 white.
+    // Palette: 0 occ, 1 unk, 2 free-out, 3 accessible, 4 swept, 5 path, 6 robot, 7 white,
+    // 8 keep-out, 9 keep-out hatching, 10 outside the area (then padding to 16).
     let palette: Vec<u8> = [
         C_OCC,
         C_UNK,
@@ -444,6 +531,14 @@ pub fn replay_gif(world: &World, trace: &Trace, opts: &GifOptions) -> Result<Vec
         C_SWEPT,
         C_PATH,
         C_ROBOT,
+        [255, 255, 255],
+        KEEPOUT,
+        KEEPOUT_HATCH,
+        OUTSIDE_AREA,
+        [255, 255, 255],
+        [255, 255, 255],
+        [255, 255, 255],
+        [255, 255, 255],
         [255, 255, 255],
     ]
     .iter()
@@ -457,16 +552,14 @@ pub fn replay_gif(world: &World, trace: &Trace, opts: &GifOptions) -> Result<Vec
     let base: Vec<u8> = (0..gw * gh)
         .map(|p| {
             let i = src(p % gw, p / gw);
-            match world.map().cells()[i] {
-                Cell::Occupied => 0,
-                Cell::Unknown => 1,
-                Cell::Free => {
-                    if world.accessible().contains(i) {
-                        3
-                    } else {
-                        2
-                    }
-                }
+            match class_of(world, i) {
+                Class::Occupied => 0,
+                Class::Unknown => 1,
+                Class::OutOfReach => 2,
+                Class::Accessible => 3,
+                Class::Keepout if hatched(p % gw, p / gw) => 9,
+                Class::Keepout => 8,
+                Class::OutsideArea => 10,
             }
         })
         .collect();
@@ -508,7 +601,8 @@ pub fn replay_gif(world: &World, trace: &Trace, opts: &GifOptions) -> Result<Vec
             let swept = sweeper.swept();
             let mut buf = base.clone();
             for (p, v) in buf.iter_mut().enumerate() {
-                if *v >= 2 && swept.contains(src(p % gw, p / gw)) {
+                // Zones keep their colours, as in the coverage picture.
+                if (2..=3).contains(v) && swept.contains(src(p % gw, p / gw)) {
                     *v = 4;
                 }
                 if path_layer[p] {

@@ -308,3 +308,94 @@ fn a_two_million_pose_run_gives_a_small_page_that_opens_and_seeks_fast() {
     assert!(first < 3000.0, "first frame after {first} ms");
     assert!(seek < 1000.0, "seek to the end took {seek} ms");
 }
+
+/// A room with a work area (its left three fifths) and a keep-out square inside it, and a
+/// short lawnmower run inside the area around the keep-out.
+fn zoned_run() -> (World, Trace) {
+    use ccpp_core::zones::{Polygon, ZoneMasks};
+    let (w, h) = (200usize, 120usize);
+    let map = room(w, h);
+    let (wm, hm) = (w as f64 * RES, h as f64 * RES);
+    let area = [Polygon::rect([0.1, 0.1, wm * 0.38, hm - 0.1])];
+    let keepout = [Polygon::rect([1.5, 2.5, 2.5, 3.5])];
+    let zones = ZoneMasks::new(map.frame(), Some(&area), &keepout, &[]);
+    let r = 0.15;
+    let world = World::with_zones(
+        map,
+        Robot::new(r),
+        Some(Pose::new(0.4, 0.4, 0.0)),
+        Some(zones),
+    )
+    .expect("fits");
+    let mut t = Trace::default();
+    t.push_event(0, Event::RegionStart { region: 1 });
+    let mut k = 0;
+    for lane in 0..6 {
+        let y = 0.4 + lane as f64 * 0.3;
+        for s in 0..=20 {
+            let f = f64::from(s) / 20.0;
+            let x = if lane % 2 == 0 {
+                0.4 + f * 6.0
+            } else {
+                6.4 - f * 6.0
+            };
+            t.push_pose(k, Pose::new(x, y, 0.0));
+            k += 1;
+        }
+    }
+    (world, t)
+}
+
+#[test]
+fn the_replay_shows_the_zones_like_the_coverage_picture() {
+    let (world, trace) = zoned_run();
+    let html = replay_html(&world, &trace, None, "{}", "zones").expect("page");
+    // The page data holds both polygons (without a browser this is what is checked).
+    assert!(
+        html.contains(r#""zones":{"area":[["#),
+        "no zones in the page data"
+    );
+    assert!(html.contains(r#""has_keepout":true,"has_outside":true"#));
+    let (plain_world, plain_trace) = run(200, 120, 400);
+    let plain = replay_html(&plain_world, &plain_trace, None, "{}", "plain").expect("page");
+    assert!(plain.contains(r#""zones":null"#));
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("replay-zones");
+    std::fs::create_dir_all(&dir).expect("dir");
+    std::fs::write(dir.join("zones.html"), &html).expect("write");
+    std::fs::write(dir.join("plain.html"), &plain).expect("write");
+    let Some(chrome) = require_chromium() else {
+        return;
+    };
+    let _serial = BROWSER
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    let url = |f: &str| format!("file://{}#selftest", dir.join(f).display());
+    let v = self_test(&chrome, &url("zones.html"), true);
+    assert_eq!(v["pass"], true, "{v}");
+    let z = &v["zone_px"];
+    for key in ["keepout", "hatch", "outside", "area_border"] {
+        assert!(z[key].as_u64().unwrap_or(0) > 50, "{key}: {z}");
+    }
+    let legend: Vec<&str> = v["legend"]
+        .as_array()
+        .expect("legend")
+        .iter()
+        .filter_map(serde_json::Value::as_str)
+        .collect();
+    for entry in [
+        "keep-out zone (hatched)",
+        "floor outside the area",
+        "area border",
+        "keep-out border",
+    ] {
+        assert!(legend.contains(&entry), "{entry}: {legend:?}");
+    }
+    let v = self_test(&chrome, &url("plain.html"), true);
+    assert_eq!(v["pass"], true, "{v}");
+    assert!(v["zone_px"].is_null(), "{v}");
+    let legend = v["legend"].to_string();
+    assert!(
+        !legend.contains("keep-out") && !legend.contains("area"),
+        "{legend}"
+    );
+}
