@@ -27,11 +27,12 @@ pub struct RunFiles {
 pub fn render_run_files(job: &Job, r: &JobResult, replay: bool) -> Result<RunFiles> {
     // The library renders the standard set (the Python package's `save` writes the same
     // bytes); the replay files go before `metrics.json`, which marks a complete run.
-    let mut files = ccpp_render::run_files::render_run_files(
+    let mut files = ccpp_render::run_files::render_run_files_swept(
         &job.scenario,
         &r.world,
         &r.run.trace,
         &r.metrics,
+        Some(&r.swept),
     )?;
     let (_, metrics_bytes) = files.pop().context("no metrics.json rendered")?;
     let metrics = String::from_utf8(metrics_bytes).context("metrics.json is not UTF-8")?;

@@ -52,7 +52,9 @@ pub fn write_all(
         };
         let mut series = Vec::new();
         let mut panels = Vec::new();
-        let mut drawn: Vec<(World, Trace)> = Vec::new();
+        // Each drawn run's world: `None` when it is the map's (a run from the default start,
+        // as bench runs are), so a map holds one world, not one per planner.
+        let mut drawn: Vec<(Option<World>, Trace)> = Vec::new();
         for r in rows.iter().filter(|r| r.map == m.name) {
             let Ok(metrics) = &r.outcome else { continue };
             let Ok(trace) = read_trace(&r.dir.join("trace.jsonl")) else {
@@ -62,16 +64,22 @@ pub fn write_all(
             // The panel: the run's picture without header or legend (one shared legend and
             // legible captions instead), drawn from the run's own start pose.
             let start = trace.poses().next().map(|p| Pose::new(p.x, p.y, p.theta));
-            let Ok(run_world) = World::new(m.grid.clone(), robot, start) else {
-                continue;
+            let own = if start == Some(world.start()) {
+                None
+            } else {
+                let Ok(w) = World::new(m.grid.clone(), robot, start) else {
+                    continue;
+                };
+                Some(w)
             };
+            let run_world = own.as_ref().unwrap_or(&world);
             let style = CoverageStyle {
                 min_width: 500,
                 max_side: 1000,
                 title: Vec::new(),
                 legend: false,
             };
-            let Ok(png) = coverage_png(&run_world, &trace, &style) else {
+            let Ok(png) = coverage_png(run_world, &trace, &style) else {
                 continue;
             };
             panels.push(Panel {
@@ -95,7 +103,7 @@ pub fn write_all(
                 ],
                 png,
             });
-            drawn.push((run_world, trace));
+            drawn.push((own, trace));
         }
         let points = tradeoff_points(rows, &planners, &m.name);
         if points.iter().any(Option::is_some) {
@@ -118,7 +126,10 @@ pub fn write_all(
             write_chart(&dir, &format!("coverage_{}", m.name), &c)?;
         }
         if !panels.is_empty() {
-            let runs: Vec<(&World, &Trace)> = drawn.iter().map(|(w, t)| (w, t)).collect();
+            let runs: Vec<(&World, &Trace)> = drawn
+                .iter()
+                .map(|(w, t)| (w.as_ref().unwrap_or(&world), t))
+                .collect();
             let legend = legend_entries_union(&runs);
             let c = image_grid_captioned(
                 &format!("Paths - {}", m.name),

@@ -224,6 +224,22 @@ pub fn coverage_png(
     encode_png(&pixmap)
 }
 
+/// [`coverage_png`] with the swept pixels already computed (`swept` must be
+/// [`swept_pixels`]`(world, trace)`, as the metrics computed them): the same bytes without
+/// sweeping the trace again.
+///
+/// # Errors
+/// As [`coverage_png`].
+pub fn coverage_png_swept(
+    world: &World,
+    trace: &Trace,
+    style: &CoverageStyle,
+    swept: &fixedbitset::FixedBitSet,
+) -> Result<Vec<u8>, RenderError> {
+    let pixmap = coverage_pixmap_swept(world, trace, style, swept)?;
+    encode_png(&pixmap)
+}
+
 /// Encodes a picture as PNG bytes, fast: an opaque canvas (every picture of this crate) is
 /// written as 8-bit RGB, streamed row by row from the pixmap (no copy of the canvas), with
 /// `png`'s fast DEFLATE mode and its fixed filter; a canvas with any translucent pixel goes
@@ -502,9 +518,21 @@ pub fn coverage_pixmap(
     trace: &Trace,
     style: &CoverageStyle,
 ) -> Result<Pixmap, RenderError> {
+    coverage_pixmap_swept(world, trace, style, &swept_pixels(world, trace))
+}
+
+/// [`coverage_pixmap`] with the swept pixels already computed (see [`coverage_png_swept`]).
+///
+/// # Errors
+/// When the canvas cannot be allocated.
+pub fn coverage_pixmap_swept(
+    world: &World,
+    trace: &Trace,
+    style: &CoverageStyle,
+    swept: &fixedbitset::FixedBitSet,
+) -> Result<Pixmap, RenderError> {
     let frame = *world.frame();
     let crop = crop_box(world, trace);
-    let swept = swept_pixels(world, trace);
     let (col0, row0, cols, rows) = crop;
     let (w, h) = (cols as u32, rows as u32);
     let scale = if w < style.min_width {
@@ -522,7 +550,7 @@ pub fn coverage_pixmap(
     let mut header = 0u32;
     if !style.title.is_empty() {
         let mut y = 6.0f32;
-        let cov = effective_coverage(world, &swept);
+        let cov = effective_coverage(world, swept);
         let collisions = trace
             .events()
             .filter(|(_, e)| matches!(e, Event::Collision { .. }))
@@ -578,7 +606,7 @@ pub fn coverage_pixmap(
     }
     let mut foot = Chart::new(cw, 0);
     let legend_h = if style.legend {
-        let entries = entries_of(&shown_with(world, trace, crop, &swept));
+        let entries = entries_of(&shown_with(world, trace, crop, swept));
         let top = ch_map + header + 8;
         (foot.legend(8.0, top as f32, cw as f32 - 16.0, px as u32, &entries) + 8.0).ceil() as u32
     } else {

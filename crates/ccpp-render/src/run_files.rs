@@ -14,7 +14,7 @@ use ccpp_io::scenario::Scenario;
 use ccpp_io::write::WriteError;
 use ccpp_io::write_atomic;
 
-use crate::{coverage_png, CoverageStyle, RenderError};
+use crate::{coverage_png, coverage_png_swept, CoverageStyle, RenderError};
 
 /// Failure writing a run's files.
 #[derive(Debug, thiserror::Error)]
@@ -87,6 +87,22 @@ pub fn render_run_files(
     trace: &Trace,
     metrics: &Metrics,
 ) -> Result<Vec<(&'static str, Vec<u8>)>, RunFilesError> {
+    render_run_files_swept(scenario, world, trace, metrics, None)
+}
+
+/// [`render_run_files`] reusing the swept pixels when given (they must be
+/// [`ccpp_core::metrics::swept_pixels`]`(world, trace)`, as [`ccpp_io::scenario::Run::swept`]
+/// holds them): the same bytes, without sweeping the trace a second time for the picture.
+///
+/// # Errors
+/// Serialization or rendering failures.
+pub fn render_run_files_swept(
+    scenario: &Scenario,
+    world: &World,
+    trace: &Trace,
+    metrics: &Metrics,
+    swept: Option<&fixedbitset::FixedBitSet>,
+) -> Result<Vec<(&'static str, Vec<u8>)>, RunFilesError> {
     let metrics_text = metrics_json(metrics)?;
     let mut scenario = scenario.clone();
     let start = world.initial_pose();
@@ -99,7 +115,12 @@ pub fn render_run_files(
     // The picture and the text files are independent pure functions of (world, trace): draw
     // the picture on a second thread while this one writes the text (same bytes either way).
     let (png, text) = std::thread::scope(|s| {
-        let png = s.spawn(|| phase::time("coverage.png", || coverage_png(world, trace, &style)));
+        let png = s.spawn(|| {
+            phase::time("coverage.png", || match swept {
+                Some(swept) => coverage_png_swept(world, trace, &style, swept),
+                None => coverage_png(world, trace, &style),
+            })
+        });
         let text = phase::time("trace.jsonl", || ccpp_io::trace::trace_jsonl(trace)).map(|t| {
             let path = phase::time("path.csv", || ccpp_io::trace::path_csv(trace));
             (t, path)
