@@ -26,17 +26,18 @@ pub fn squared_edt(
         return Vec::new();
     }
     if height + 2 < usize::from(u16::MAX) {
-        let (g, _) = column_pass::<u16>(width, height, &is_feature, border_is_feature);
+        let g = column_pass::<u16>(width, height, &is_feature, border_is_feature);
         envelope_pass::<u16, u32>(&g, width, border_is_feature)
     } else {
-        let (g, _) = column_pass::<u32>(width, height, &is_feature, border_is_feature);
+        let g = column_pass::<u32>(width, height, &is_feature, border_is_feature);
         envelope_pass::<u32, u32>(&g, width, border_is_feature)
     }
 }
 
 /// A squared distance transform stored in the narrowest integer that holds every value
-/// exactly: 2 bytes per pixel when no pixel lies 256 pixels or more from its nearest feature
-/// (known before the values are computed, from the column distances), else 4.
+/// exactly: 2 bytes per pixel when no pixel can lie 256 pixels or more from its nearest
+/// feature (known before the values are computed, from the distances along each column and
+/// each row), else 4.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum CompactDt {
     /// Every value below `u16::MAX`; `u16::MAX` stands for [`INF`].
@@ -113,14 +114,15 @@ pub fn squared_edt_compact(
         return CompactDt::U16(Vec::new());
     }
     if height + 2 < usize::from(u16::MAX) {
-        let (g, bound) = column_pass::<u16>(width, height, &is_feature, border_is_feature);
+        let g = column_pass::<u16>(width, height, &is_feature, border_is_feature);
+        let bound = distance_bound(&g, width, border_is_feature);
         if bound.is_some_and(|b| b * b < u64::from(u16::MAX)) {
             CompactDt::U16(envelope_pass::<u16, u16>(&g, width, border_is_feature))
         } else {
             CompactDt::U32(envelope_pass::<u16, u32>(&g, width, border_is_feature))
         }
     } else {
-        let (g, _) = column_pass::<u32>(width, height, &is_feature, border_is_feature);
+        let g = column_pass::<u32>(width, height, &is_feature, border_is_feature);
         CompactDt::U32(envelope_pass::<u32, u32>(&g, width, border_is_feature))
     }
 }
@@ -163,15 +165,13 @@ impl Store for u32 {
 
 /// Phase 1 (Meijster et al.): distance to the nearest feature in the same column, in two
 /// row-order sweeps (cache friendly); `T::NONE` = no feature in the column. `T` must hold
-/// `height + 1`. Also returns an upper bound on the distance of every pixel to its nearest
-/// feature (`None`: some pixel may have none): the largest over pixels of the column distance
-/// and, with `border_is_feature`, the distance to the left or right border.
+/// `height + 1`.
 fn column_pass<T: Store>(
     width: usize,
     height: usize,
     is_feature: &impl Fn(usize) -> bool,
     border_is_feature: bool,
-) -> (Vec<T>, Option<u64>) {
+) -> Vec<T> {
     let n = width * height;
     let none = T::NONE.to_u32();
     let mut g = vec![T::NONE; n];
@@ -189,8 +189,6 @@ fn column_pass<T: Store>(
             });
         }
     }
-    let mut bound = 0u64;
-    let mut unbounded = false;
     for r in (0..height).rev() {
         for c in 0..width {
             let i = r * width + c;
@@ -202,24 +200,44 @@ fn column_pass<T: Store>(
             if T::from_u32(below) < g[i] {
                 g[i] = T::from_u32(below);
             }
-            let gc = g[i].to_u32();
-            let side = if border_is_feature {
-                Some((c + 1).min(width - c) as u64)
-            } else {
-                None
-            };
-            let here = match (gc < none, side) {
-                (true, Some(s)) => Some(u64::from(gc).min(s)),
-                (true, None) => Some(u64::from(gc)),
-                (false, s) => s,
-            };
-            match here {
-                Some(d) => bound = bound.max(d),
-                None => unbounded = true,
-            }
         }
     }
-    (g, (!unbounded).then_some(bound))
+    g
+}
+
+/// An upper bound on every pixel's distance to its nearest feature, from the column distances
+/// `g` of [`column_pass`]: the largest over pixels of the smaller of the column distance and
+/// the distance to the nearest feature (or, with `border_is_feature`, border) in the same row.
+/// `None` when some pixel may have no feature at all.
+fn distance_bound<T: Store>(g: &[T], width: usize, border_is_feature: bool) -> Option<u64> {
+    let none = T::NONE.to_u32();
+    let far = u32::MAX;
+    let start = if border_is_feature { 0 } else { far };
+    let mut left = vec![0u32; width];
+    let mut bound = 0u32;
+    for row in g.chunks_exact(width) {
+        let mut run = start;
+        for (l, &gc) in left.iter_mut().zip(row) {
+            run = if gc.to_u32() == 0 {
+                0
+            } else {
+                run.saturating_add(1)
+            };
+            *l = run;
+        }
+        let mut run = start;
+        for (l, &gc) in left.iter().zip(row).rev() {
+            let gc = gc.to_u32();
+            run = if gc == 0 { 0 } else { run.saturating_add(1) };
+            let column = if gc >= none { far } else { gc };
+            let d = column.min(run).min(*l);
+            if d == far {
+                return None;
+            }
+            bound = bound.max(d);
+        }
+    }
+    Some(u64::from(bound))
 }
 
 /// Phase 2 (Felzenszwalb-Huttenlocher lower envelope) along each row of the column distances

@@ -382,12 +382,33 @@ pub fn legend_entries(world: &World, trace: &Trace) -> Vec<LegendEntry> {
     entries_of(&shown(world, trace, crop_box(world, trace)))
 }
 
+/// What one run's coverage picture shows, kept for a legend shared by several pictures
+/// ([`legend_entries_union_of`]) without keeping the run's trace.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LegendShown(Shown);
+
+impl LegendShown {
+    /// What the picture of (`world`, `trace`) shows; `swept` must be
+    /// [`swept_pixels`]`(world, trace)`.
+    pub fn of(world: &World, trace: &Trace, swept: &fixedbitset::FixedBitSet) -> Self {
+        Self(shown_with(world, trace, crop_box(world, trace), swept))
+    }
+}
+
 /// The union of several runs' legends (for a grid of pictures sharing one legend), without
 /// counts.
 pub fn legend_entries_union(runs: &[(&World, &Trace)]) -> Vec<LegendEntry> {
+    let shown: Vec<LegendShown> = runs
+        .iter()
+        .map(|(w, t)| LegendShown(shown(w, t, crop_box(w, t))))
+        .collect();
+    legend_entries_union_of(&shown)
+}
+
+/// [`legend_entries_union`] of what each run's picture shows.
+pub fn legend_entries_union_of(runs: &[LegendShown]) -> Vec<LegendEntry> {
     let mut all = Shown::default();
-    for (w, t) in runs {
-        let s = shown(w, t, crop_box(w, t));
+    for LegendShown(s) in runs {
         all.swept |= s.swept;
         all.missed |= s.missed;
         all.swept_outside |= s.swept_outside;
