@@ -497,6 +497,18 @@ pub fn parse_trace(
     path: &Path,
     frame: Option<(&MapFrame, f64)>,
 ) -> Result<Trace, TraceFileError> {
+    let lines = text.lines().map(|l| Ok::<_, std::io::Error>(std::borrow::Cow::Borrowed(l)));
+    parse_trace_lines(lines, text.len(), path, frame)
+}
+
+/// [`parse_trace`] of the lines of a text of `byte_len` bytes, read one at a time (a read
+/// failure is [`TraceFileError::Io`]).
+fn parse_trace_lines<'a>(
+    lines: impl Iterator<Item = std::io::Result<std::borrow::Cow<'a, str>>>,
+    byte_len: usize,
+    path: &Path,
+    frame: Option<(&MapFrame, f64)>,
+) -> Result<Trace, TraceFileError> {
     let bounds = frame.map(|(f, m)| {
         let (lo, hi) = f.world_bounds();
         (lo.x - m, lo.y - m, hi.x + m, hi.y + m)
@@ -506,7 +518,7 @@ pub fn parse_trace(
         line,
         message,
     };
-    let max_poses = text.len().saturating_mul(MAX_POSES_PER_BYTE);
+    let max_poses = byte_len.saturating_mul(MAX_POSES_PER_BYTE);
     let mut trace = Trace::default();
     let mut lattice: Option<Lattice> = None;
     let mut last_list: Option<Vec<[f64; 2]>> = None;
@@ -538,7 +550,12 @@ pub fn parse_trace(
         trace.push_pose(t, p);
         Ok(())
     };
-    for (k, line) in text.lines().enumerate() {
+    for (k, line) in lines.enumerate() {
+        let line = line.map_err(|source| TraceFileError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let line: &str = &line;
         if line.trim().is_empty() {
             continue;
         }
@@ -589,11 +606,18 @@ pub fn parse_trace(
 /// # Errors
 /// See [`parse_trace`], plus an unreadable file.
 pub fn read_trace(path: &Path, frame: Option<(&MapFrame, f64)>) -> Result<Trace, TraceFileError> {
-    let text = crate::file::read_text(path).map_err(|source| TraceFileError::Io {
+    use std::io::BufRead as _;
+    let io_err = |source| TraceFileError::Io {
         path: path.to_path_buf(),
         source,
-    })?;
-    parse_trace(&text, path, frame)
+    };
+    // Read line by line: the file is never held whole in memory.
+    let file = crate::file::open_regular(path).map_err(io_err)?;
+    let len = file.metadata().map_err(io_err)?.len();
+    let lines = std::io::BufReader::new(file)
+        .lines()
+        .map(|l| l.map(std::borrow::Cow::Owned));
+    parse_trace_lines(lines, usize::try_from(len).unwrap_or(usize::MAX), path, frame)
 }
 
 #[cfg(test)]
