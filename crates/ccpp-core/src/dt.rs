@@ -84,6 +84,27 @@ impl CompactDt {
         }
     }
 
+    /// The largest value over the pixels of `range` (not empty) and the first pixel holding
+    /// it.
+    pub fn first_max(&self, range: std::ops::Range<usize>) -> (u32, usize) {
+        let start = range.start;
+        match self {
+            // `u16::MAX` stands for INF, the largest value either way.
+            Self::U16(v) => {
+                let part = &v[range];
+                let m = part.iter().copied().max().unwrap_or(0);
+                let k = part.iter().position(|&d| d == m).unwrap_or(0);
+                (if m == u16::MAX { INF } else { u32::from(m) }, start + k)
+            }
+            Self::U32(v) => {
+                let part = &v[range];
+                let m = part.iter().copied().max().unwrap_or(0);
+                let k = part.iter().position(|&d| d == m).unwrap_or(0);
+                (m, start + k)
+            }
+        }
+    }
+
     /// Calls `f(i, d2)` for every pixel in index order.
     #[inline]
     pub fn for_each(&self, mut f: impl FnMut(usize, u32)) {
@@ -418,7 +439,15 @@ mod tests {
                 .collect();
             for border in [false, true] {
                 let dt = squared_edt_compact(w, h, |i| feat[i], border);
-                assert_eq!(compact_values(&dt), brute(w, h, &feat, border));
+                let values = compact_values(&dt);
+                assert_eq!(values, brute(w, h, &feat, border));
+                for a in 0..values.len() {
+                    for b in a + 1..=values.len() {
+                        let m = *values[a..b].iter().max().unwrap();
+                        let k = a + values[a..b].iter().position(|&d| d == m).unwrap();
+                        assert_eq!(dt.first_max(a..b), (m, k));
+                    }
+                }
                 // Without the border a featureless column may leave pixels at INF: those
                 // need the wide form unless some feature bounds every pixel.
                 if border {

@@ -258,16 +258,7 @@ impl World {
         // C-free at a pixel centre: distance to every blocked centre >= contact radius.
         let rc = contact_radius_px(r_px);
         let rc2 = rc * rc;
-        let mut cfree = FixedBitSet::with_capacity(frame.len());
-        let mut max_d2 = 0u32;
-        obstacle_dt2.for_each(|i, d2| {
-            if f64::from(d2) >= rc2 {
-                cfree.insert(i);
-            }
-            if d2 != INF {
-                max_d2 = max_d2.max(d2);
-            }
-        });
+        let cfree = bitset_where(frame.len(), |i| f64::from(obstacle_dt2.get(i)) >= rc2);
         if cfree.is_clear() && zones.is_some() {
             let free_px = cells.iter().filter(|c| c.is_free()).count();
             let fits_without = squared_edt(
@@ -286,6 +277,12 @@ impl World {
             }
         }
         if cfree.is_clear() {
+            let mut max_d2 = 0u32;
+            obstacle_dt2.for_each(|_, d2| {
+                if d2 != INF {
+                    max_d2 = max_d2.max(d2);
+                }
+            });
             return Err(WorldError::RobotTooBig {
                 radius: robot.radius,
                 max_clearance: ((f64::from(max_d2)).sqrt() - 0.5).max(0.0) * frame.resolution,
@@ -295,20 +292,13 @@ impl World {
             Some(s) => s,
             None => default_start(&frame, &cfree, &obstacle_dt2),
         };
-        let mut blocked = FixedBitSet::with_capacity(frame.len());
-        for (i, c) in map.cells().iter().enumerate() {
-            if !c.is_free() {
-                blocked.insert(i);
-            }
-        }
+        let blocked = {
+            let cells = map.cells();
+            bitset_where(frame.len(), |i| !cells[i].is_free())
+        };
         let plan_blocked = plan.as_ref().map(|p| {
-            let mut b = FixedBitSet::with_capacity(frame.len());
-            for (i, c) in p.cells().iter().enumerate() {
-                if !c.is_free() {
-                    b.insert(i);
-                }
-            }
-            b
+            let cells = p.cells();
+            bitset_where(frame.len(), |i| !cells[i].is_free())
         });
         let mut world = Self {
             map,
@@ -810,6 +800,21 @@ impl collide::Occupancy for Truth<'_> {
     }
 }
 
+/// The set of `i < n` where `pred(i)` holds, built a word at a time.
+fn bitset_where(n: usize, pred: impl Fn(usize) -> bool) -> FixedBitSet {
+    let mut set = FixedBitSet::with_capacity(n);
+    let bits = usize::BITS as usize;
+    for (k, block) in set.as_mut_slice().iter_mut().enumerate() {
+        let base = k * bits;
+        let mut word = 0usize;
+        for i in base..(base + bits).min(n) {
+            word |= usize::from(pred(i)) << (i - base);
+        }
+        *block = word;
+    }
+    set
+}
+
 /// The default start: the C-free pixel centre with the largest clearance in the largest C-free
 /// 8-connected component; ties by row-major order; heading east.
 ///
@@ -829,11 +834,11 @@ fn default_start(frame: &MapFrame, cfree: &FixedBitSet, dt2: &CompactDt) -> Pose
         fill_component(cfree, w, h, i, &mut visited, |row, lo, hi| {
             size += hi - lo + 1;
             let base = row * w;
-            for idx in base + lo..=base + hi {
-                let d = dt2.get(idx);
-                if top.1 == usize::MAX || d > top.0 || (d == top.0 && idx < top.1) {
-                    top = (d, idx);
-                }
+            // The run's largest value at its first index, merged by the same rule as pixel
+            // by pixel (largest, then smallest index).
+            let (d, idx) = dt2.first_max(base + lo..base + hi + 1);
+            if top.1 == usize::MAX || d > top.0 || (d == top.0 && idx < top.1) {
+                top = (d, idx);
             }
         });
         if best.is_none_or(|b| size > b.0) {

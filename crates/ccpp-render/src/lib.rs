@@ -662,12 +662,15 @@ pub fn coverage_pixmap_swept(
         }
     };
     {
+        // The map column of each canvas column, computed once (same formula per pixel).
+        let cols: Vec<usize> = (0..cw)
+            .map(|x| (col0 + ((x as f32 + 0.5) / scale) as usize).min(frame.width - 1))
+            .collect();
         let data = pm.data_mut();
         for y in 0..ch_map {
             let row = ((y as f32 + 0.5) / scale) as usize;
             let row = (row0 + row).min(frame.height - 1);
-            for x in 0..cw {
-                let col = (col0 + ((x as f32 + 0.5) / scale) as usize).min(frame.width - 1);
+            for (x, &col) in (0..cw).zip(&cols) {
                 let c = colour_of(frame.index(col, row), x, y);
                 let o = (((y + header) * cw + x) * 4) as usize;
                 data[o] = c[0];
