@@ -473,7 +473,7 @@ fn child_job() -> Result<String> {
     map.name.clone_from(&spec.map_name);
     let mut job = Job {
         scenario: spec.scenario,
-        map,
+        map: Some(map),
         out: spec.out,
     };
     let result = job.execute()?;

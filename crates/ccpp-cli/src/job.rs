@@ -55,8 +55,8 @@ pub fn load_recipe(recipe: &MapRecipe) -> Result<PreparedMap> {
 pub struct Job {
     /// What to run (`run.json` is this, serialized).
     pub scenario: Scenario,
-    /// The map, loaded and prepared.
-    pub map: PreparedMap,
+    /// The map, loaded and prepared; [`Job::execute`] moves it into the world (`None` after).
+    pub map: Option<PreparedMap>,
     /// Output folder.
     pub out: PathBuf,
 }
@@ -69,6 +69,8 @@ pub struct JobResult {
     pub run: RunOutput,
     /// The metrics.
     pub metrics: Metrics,
+    /// The pixels the tool swept (computed with the metrics, reused by the picture).
+    pub swept: fixedbitset::FixedBitSet,
 }
 
 /// The recipe of `args`: paths made absolute so that `run.json` works from any folder.
@@ -327,7 +329,7 @@ impl Job {
         scenario.check_map(&map).map_err(|e| name_flag(e, &given))?;
         Ok(Self {
             scenario,
-            map,
+            map: Some(map),
             out: a.out.clone(),
         })
     }
@@ -342,15 +344,17 @@ impl Job {
         let map = load_recipe(&scenario.map)?;
         Ok(Self {
             scenario,
-            map,
+            map: Some(map),
             out: a.out.clone(),
         })
     }
 
     /// Builds the world, runs the planner in the simulator and computes the metrics. The
     /// scenario's start becomes the start actually used, so that `run.json` replays exactly.
+    /// The prepared map becomes the world's (no copy): a job runs once.
     pub fn execute(&mut self) -> Result<JobResult> {
-        let run = self.scenario.run_on(&self.map)?;
+        let map = self.map.take().context("the job has already run")?;
+        let run = self.scenario.run_owned(map)?;
         let s = run.world.initial_pose();
         if !run.world.approach().is_empty() {
             let e = run.world.start();
@@ -366,6 +370,7 @@ impl Job {
             world: run.world,
             run: run.output,
             metrics: run.metrics,
+            swept: run.swept,
         })
     }
 }

@@ -15,39 +15,12 @@ use crate::info::StartComponent;
 use crate::job::{Job, JobResult};
 use crate::staging::{write_file, Staging};
 
-/// A run's files, rendered in memory: `(file name, bytes)`.
-pub struct RunFiles {
-    /// The files, `metrics.json` last.
-    pub files: Vec<(&'static str, Vec<u8>)>,
-    /// The metrics JSON (also among `files`).
-    pub metrics: String,
-}
-
-/// Renders every file of a run (and the replay files when `replay`) without writing anything.
-pub fn render_run_files(job: &Job, r: &JobResult, replay: bool) -> Result<RunFiles> {
-    // The library renders the standard set (the Python package's `save` writes the same
-    // bytes); the replay files go before `metrics.json`, which marks a complete run.
-    let mut files = ccpp_render::run_files::render_run_files(
-        &job.scenario,
-        &r.world,
-        &r.run.trace,
-        &r.metrics,
-    )?;
-    let (_, metrics_bytes) = files.pop().context("no metrics.json rendered")?;
-    let metrics = String::from_utf8(metrics_bytes).context("metrics.json is not UTF-8")?;
-    if replay {
-        let title = format!("{} on {}", r.metrics.planner, r.metrics.map);
-        let (html, gif) = render_replay(&r.world, &r.run.trace, r.run.tile_side, &metrics, &title)?;
-        files.push(("replay.html", html.into_bytes()));
-        files.push(("replay.gif", gif));
-    }
-    files.push(("metrics.json", metrics.clone().into_bytes()));
-    Ok(RunFiles { files, metrics })
-}
-
 /// Writes a run's files (plus `extra` ones) as one set: everything goes into a staging folder
 /// beside `out`, which then replaces `out` whole (see [`crate::staging`]). A failure or an
-/// interrupt leaves `out` as it was. Returns the metrics JSON.
+/// interrupt leaves `out` as it was. The files are those of the library's
+/// [`ccpp_render::run_files::render_run_files`] (the Python package's `save` writes the same
+/// bytes), `trace.jsonl` streamed into its staging file as it is formed; the replay files go
+/// before `metrics.json`, written last (it marks a complete run). Returns the metrics JSON.
 pub fn write_run_files(
     out: &Path,
     job: &Job,
@@ -55,15 +28,30 @@ pub fn write_run_files(
     replay: bool,
     extra: &[(&'static str, Vec<u8>)],
 ) -> Result<String> {
-    let rendered = render_run_files(job, r, replay)?;
+    let metrics = ccpp_render::run_files::metrics_json(&r.metrics)?;
+    let staging = Staging::new(out)?;
+    for (name, bytes) in extra {
+        staging.write(name, bytes)?;
+    }
+    ccpp_render::run_files::stream_run_files::<anyhow::Error>(
+        &job.scenario,
+        &r.world,
+        &r.run.trace,
+        &r.metrics,
+        Some(&r.swept),
+        &mut |name, fill| staging.write_with(name, fill),
+    )?;
+    if replay {
+        let title = format!("{} on {}", r.metrics.planner, r.metrics.map);
+        let (html, gif) = render_replay(&r.world, &r.run.trace, r.run.tile_side, &metrics, &title)?;
+        staging.write("replay.html", html.as_bytes())?;
+        staging.write("replay.gif", &gif)?;
+    }
     ccpp_io::phase::time("write files", || -> Result<()> {
-        let staging = Staging::new(out)?;
-        for (name, bytes) in extra.iter().chain(&rendered.files) {
-            staging.write(name, bytes)?;
-        }
+        staging.write("metrics.json", metrics.as_bytes())?;
         staging.commit()
     })?;
-    Ok(rendered.metrics)
+    Ok(metrics)
 }
 
 /// Renders `replay.html` and `replay.gif` of a finished run.

@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use ccpp_core::metrics::{coverage_curve, Metrics};
+use ccpp_core::metrics::{coverage_curve, swept_pixels, Metrics};
 use ccpp_core::trace::Trace;
 use ccpp_core::world::{Robot, World};
 use ccpp_core::Pose;
@@ -13,7 +13,10 @@ use ccpp_io::write_atomic;
 use ccpp_render::chart::{
     bar_panels, image_grid_captioned, line_chart, tradeoff_chart, Chart, Panel,
 };
-use ccpp_render::{coverage_png, coverage_verdict_colour, legend_entries_union, CoverageStyle};
+use ccpp_render::{
+    coverage_png_swept, coverage_verdict_colour, legend_entries_union_of, CoverageStyle,
+    LegendShown,
+};
 use rayon::prelude::*;
 
 use crate::bench::Row;
@@ -52,7 +55,9 @@ pub fn write_all(
         };
         let mut series = Vec::new();
         let mut panels = Vec::new();
-        let mut drawn: Vec<(World, Trace)> = Vec::new();
+        // What each drawn run's picture shows, for the shared legend (its trace and world are
+        // dropped once drawn: a map holds one trace at a time).
+        let mut shown: Vec<LegendShown> = Vec::new();
         for r in rows.iter().filter(|r| r.map == m.name) {
             let Ok(metrics) = &r.outcome else { continue };
             let Ok(trace) = read_trace(&r.dir.join("trace.jsonl")) else {
@@ -61,17 +66,25 @@ pub fn write_all(
             series.push((r.planner.clone(), coverage_curve(&world, &trace, 200)));
             // The panel: the run's picture without header or legend (one shared legend and
             // legible captions instead), drawn from the run's own start pose.
+            // A run from the default start (as bench runs are) is drawn on the map's world.
             let start = trace.poses().next().map(|p| Pose::new(p.x, p.y, p.theta));
-            let Ok(run_world) = World::new(m.grid.clone(), robot, start) else {
-                continue;
+            let own = if start == Some(world.start()) {
+                None
+            } else {
+                let Ok(w) = World::new(m.grid.clone(), robot, start) else {
+                    continue;
+                };
+                Some(w)
             };
+            let run_world = own.as_ref().unwrap_or(&world);
+            let swept = swept_pixels(run_world, &trace);
             let style = CoverageStyle {
                 min_width: 500,
                 max_side: 1000,
                 title: Vec::new(),
                 legend: false,
             };
-            let Ok(png) = coverage_png(&run_world, &trace, &style) else {
+            let Ok(png) = coverage_png_swept(run_world, &trace, &style, &swept) else {
                 continue;
             };
             panels.push(Panel {
@@ -95,7 +108,7 @@ pub fn write_all(
                 ],
                 png,
             });
-            drawn.push((run_world, trace));
+            shown.push(LegendShown::of(run_world, &trace, &swept));
         }
         let points = tradeoff_points(rows, &planners, &m.name);
         if points.iter().any(Option::is_some) {
@@ -118,8 +131,7 @@ pub fn write_all(
             write_chart(&dir, &format!("coverage_{}", m.name), &c)?;
         }
         if !panels.is_empty() {
-            let runs: Vec<(&World, &Trace)> = drawn.iter().map(|(w, t)| (w, t)).collect();
-            let legend = legend_entries_union(&runs);
+            let legend = legend_entries_union_of(&shown);
             let c = image_grid_captioned(
                 &format!("Paths - {}", m.name),
                 &panels,

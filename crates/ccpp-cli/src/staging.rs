@@ -264,7 +264,20 @@ impl Staging {
     /// # Errors
     /// When the file cannot be written (named by its place in the target folder).
     pub fn write(&self, name: &str, bytes: &[u8]) -> Result<()> {
-        write_file(&self.dir.join(name), bytes).map_err(|e| {
+        self.write_with(name, &mut |w| w.write_all(bytes))
+    }
+
+    /// Writes the file `name` of the set with what `fill` writes (streamed: the file need not
+    /// be held in memory).
+    ///
+    /// # Errors
+    /// When the file cannot be written (named as in the target folder).
+    pub fn write_with(
+        &self,
+        name: &str,
+        fill: &mut dyn FnMut(&mut dyn std::io::Write) -> std::io::Result<()>,
+    ) -> Result<()> {
+        write_file_with(&self.dir.join(name), fill).map_err(|e| {
             // Name the file where it would have gone, not its staging copy.
             let shown = self.target.join(name);
             match e {
@@ -330,6 +343,14 @@ impl Drop for Staging {
 /// # Errors
 /// When the file cannot be written.
 pub fn write_file(path: &Path, bytes: &[u8]) -> Result<(), ccpp_io::WriteError> {
+    write_file_with(path, &mut |w| w.write_all(bytes))
+}
+
+/// [`write_file`] of what `fill` writes.
+fn write_file_with(
+    path: &Path,
+    fill: &mut dyn FnMut(&mut dyn std::io::Write) -> std::io::Result<()>,
+) -> Result<(), ccpp_io::WriteError> {
     let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
     if std::env::var_os(FAIL_WRITE_ENV).is_some_and(|v| v == name) {
         return ccpp_io::write::write_atomic_with(path, |_| {
@@ -340,7 +361,7 @@ pub fn write_file(path: &Path, bytes: &[u8]) -> Result<(), ccpp_io::WriteError> 
     tmp.push(".tmp");
     let tmp = PathBuf::from(tmp);
     register(&tmp);
-    let r = ccpp_io::write_atomic(path, bytes);
+    let r = ccpp_io::write::write_atomic_with(path, fill);
     unregister(&tmp);
     r
 }

@@ -349,6 +349,12 @@ fn tile_entries(grid: &TileGrid, trace: &Trace, mut visit: impl FnMut(Tile)) {
 
 /// Computes all metrics of a run.
 pub fn compute(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
+    compute_swept(world, run, map_name).0
+}
+
+/// [`compute`], also returning the swept pixels it computed ([`swept_pixels`]), for the
+/// coverage picture to reuse instead of sweeping the trace again.
+pub fn compute_swept(world: &World, run: &RunOutput, map_name: &str) -> (Metrics, FixedBitSet) {
     let frame = *world.frame();
     let robot = world.robot();
     let trace = &run.trace;
@@ -392,7 +398,7 @@ pub fn compute(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
         let path_length = m.path_length_m;
         m.redundancy = (path_length > 0.0 && swept_area > 0.0)
             .then(|| path_length * two_rt / swept_area - 1.0);
-        m
+        (m, swept)
     })
 }
 

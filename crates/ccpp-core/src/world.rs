@@ -8,7 +8,7 @@ use std::ops::{Add, Sub};
 
 use crate::collide::{self, contact_radius_px};
 use crate::display::Compact;
-use crate::dt::{squared_edt, INF};
+use crate::dt::{squared_edt, squared_edt_compact, CompactDt, INF};
 use crate::geometry::{Point, Pose};
 use crate::grid::{Cell, GridMap, MapFrame};
 use crate::zones::{MaskOccupancy, ZoneMasks};
@@ -198,8 +198,9 @@ pub struct World {
     /// robot starts inside the area).
     approach: Vec<Point>,
     /// Squared distance (px^2) from each pixel centre to the nearest non-free pixel centre of
-    /// the planning map (virtual walls included), counting the outside as non-free.
-    obstacle_dt2: Vec<u32>,
+    /// the planning map (virtual walls included), counting the outside as non-free; 2 bytes a
+    /// pixel unless some pixel lies 256 pixels or more from every obstacle.
+    obstacle_dt2: CompactDt,
     /// Non-free pixels of the true map (the simulator's collision checks skip free runs a
     /// word at a time).
     blocked: FixedBitSet,
@@ -270,21 +271,13 @@ impl World {
             p
         });
         let cells = plan.as_ref().unwrap_or(&map).cells();
-        let obstacle_dt2 = squared_edt(frame.width, frame.height, |i| !cells[i].is_free(), true);
+        let obstacle_dt2 =
+            squared_edt_compact(frame.width, frame.height, |i| !cells[i].is_free(), true);
         let r_px = robot.radius / frame.resolution;
         // C-free at a pixel centre: distance to every blocked centre >= contact radius.
         let rc = contact_radius_px(r_px);
         let rc2 = rc * rc;
-        let mut cfree = FixedBitSet::with_capacity(frame.len());
-        let mut max_d2 = 0u32;
-        for (i, &d2) in obstacle_dt2.iter().enumerate() {
-            if f64::from(d2) >= rc2 {
-                cfree.insert(i);
-            }
-            if d2 != INF {
-                max_d2 = max_d2.max(d2);
-            }
-        }
+        let cfree = bitset_where(frame.len(), |i| f64::from(obstacle_dt2.get(i)) >= rc2);
         if cfree.is_clear() && zones.is_some() {
             let free_px = cells.iter().filter(|c| c.is_free()).count();
             let fits_without = squared_edt(
@@ -303,6 +296,12 @@ impl World {
             }
         }
         if cfree.is_clear() {
+            let mut max_d2 = 0u32;
+            obstacle_dt2.for_each(|_, d2| {
+                if d2 != INF {
+                    max_d2 = max_d2.max(d2);
+                }
+            });
             return Err(WorldError::RobotTooBig {
                 radius: robot.radius,
                 max_clearance: ((f64::from(max_d2)).sqrt() - 0.5).max(0.0) * frame.resolution,
@@ -312,20 +311,13 @@ impl World {
             Some(s) => s,
             None => default_start(&frame, &cfree, &obstacle_dt2),
         };
-        let mut blocked = FixedBitSet::with_capacity(frame.len());
-        for (i, c) in map.cells().iter().enumerate() {
-            if !c.is_free() {
-                blocked.insert(i);
-            }
-        }
+        let blocked = {
+            let cells = map.cells();
+            bitset_where(frame.len(), |i| !cells[i].is_free())
+        };
         let plan_blocked = plan.as_ref().map(|p| {
-            let mut b = FixedBitSet::with_capacity(frame.len());
-            for (i, c) in p.cells().iter().enumerate() {
-                if !c.is_free() {
-                    b.insert(i);
-                }
-            }
-            b
+            let cells = p.cells();
+            bitset_where(frame.len(), |i| !cells[i].is_free())
         });
         let mut world = Self {
             map,
@@ -674,7 +666,7 @@ impl World {
     /// Clearance in metres at the centre of pixel `(col, row)`: distance to the nearest blocked
     /// pixel's inscribed disk (virtual walls included).
     pub fn pixel_clearance(&self, col: usize, row: usize) -> f64 {
-        let d2 = self.obstacle_dt2[self.frame().index(col, row)];
+        let d2 = self.obstacle_dt2.get(self.frame().index(col, row));
         (f64::from(d2).sqrt() - 0.5) * self.frame().resolution
     }
 
@@ -689,7 +681,7 @@ impl World {
         let (c, r) = frame.grid_to_pixel_signed(g);
         match frame.checked(c, r) {
             Some((c, r)) => {
-                let d2 = self.obstacle_dt2[frame.index(c, r)];
+                let d2 = self.obstacle_dt2.get(frame.index(c, r));
                 (f64::from(d2).sqrt() - std::f64::consts::FRAC_1_SQRT_2).max(0.0)
             }
             None => 0.0,
@@ -827,12 +819,27 @@ impl collide::Occupancy for Truth<'_> {
     }
 }
 
+/// The set of `i < n` where `pred(i)` holds, built a word at a time.
+fn bitset_where(n: usize, pred: impl Fn(usize) -> bool) -> FixedBitSet {
+    let mut set = FixedBitSet::with_capacity(n);
+    let bits = usize::BITS as usize;
+    for (k, block) in set.as_mut_slice().iter_mut().enumerate() {
+        let base = k * bits;
+        let mut word = 0usize;
+        for i in base..(base + bits).min(n) {
+            word |= usize::from(pred(i)) << (i - base);
+        }
+        *block = word;
+    }
+    set
+}
+
 /// The default start: the C-free pixel centre with the largest clearance in the largest C-free
 /// 8-connected component; ties by row-major order; heading east.
 ///
 /// Components are visited in the order of their first pixel (row-major); the first of the
 /// largest wins, and within it the largest `dt2`, then the smallest index.
-fn default_start(frame: &MapFrame, cfree: &FixedBitSet, dt2: &[u32]) -> Pose {
+fn default_start(frame: &MapFrame, cfree: &FixedBitSet, dt2: &CompactDt) -> Pose {
     let (w, h) = (frame.width, frame.height);
     let mut visited = FixedBitSet::with_capacity(frame.len());
     // (size, best dt2, best index) of the chosen component.
@@ -846,11 +853,11 @@ fn default_start(frame: &MapFrame, cfree: &FixedBitSet, dt2: &[u32]) -> Pose {
         fill_component(cfree, w, h, i, &mut visited, |row, lo, hi| {
             size += hi - lo + 1;
             let base = row * w;
-            for (k, &d) in dt2[base + lo..=base + hi].iter().enumerate() {
-                let idx = base + lo + k;
-                if top.1 == usize::MAX || d > top.0 || (d == top.0 && idx < top.1) {
-                    top = (d, idx);
-                }
+            // The run's largest value at its first index, merged by the same rule as pixel
+            // by pixel (largest, then smallest index).
+            let (d, idx) = dt2.first_max(base + lo..base + hi + 1);
+            if top.1 == usize::MAX || d > top.0 || (d == top.0 && idx < top.1) {
+                top = (d, idx);
             }
         });
         if best.is_none_or(|b| size > b.0) {
@@ -1162,7 +1169,11 @@ mod proptests {
             let f = *map.frame();
             let robot = Robot { radius: r, tool_radius: r * tool };
             let Ok(world) = World::new(map.clone(), robot, None) else { return Ok(()) };
-            let start = default_start_reference(&f, world.cfree(), &world.obstacle_dt2);
+            let plain = squared_edt(f.width, f.height, |i| !map.cells()[i].is_free(), true);
+            for (i, &d2) in plain.iter().enumerate() {
+                prop_assert_eq!(world.obstacle_dt2.get(i), d2);
+            }
+            let start = default_start_reference(&f, world.cfree(), &plain);
             prop_assert_eq!(world.start(), start);
             let (c, row) = f.grid_to_pixel_signed(f.world_to_grid(start.position()));
             let seed = f.index(c as usize, row as usize);

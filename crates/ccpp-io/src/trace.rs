@@ -247,16 +247,52 @@ struct DeltaLine {
 /// An event that cannot be serialized (non-finite numbers are written as `null`, so this does
 /// not happen for simulator traces).
 pub fn trace_jsonl(trace: &Trace) -> Result<String, serde_json::Error> {
-    let lattice = trace.lattice();
     let mut s = String::with_capacity(trace.piece_count() * 64 + 64);
+    trace_jsonl_into(trace, &mut s, &mut |_| Ok(()))?;
+    Ok(s)
+}
+
+/// [`trace_jsonl`]'s text written to `out` as it is formed (the whole file is never held in
+/// memory: a few tens of kilobytes at a time). Same bytes.
+///
+/// # Errors
+/// As [`trace_jsonl`], and write failures of `out` (as [`serde_json::Error::io`]).
+pub fn write_trace_jsonl(trace: &Trace, out: &mut dyn std::io::Write) -> Result<(), serde_json::Error> {
+    const CHUNK: usize = 1 << 16;
+    let mut s = String::with_capacity(CHUNK + 4096);
+    let mut flush = |s: &mut String| -> Result<(), serde_json::Error> {
+        out.write_all(s.as_bytes()).map_err(serde_json::Error::io)?;
+        s.clear();
+        Ok(())
+    };
+    trace_jsonl_into(trace, &mut s, &mut |s| {
+        if s.len() >= CHUNK {
+            flush(s)?;
+        }
+        Ok(())
+    })?;
+    flush(&mut s)
+}
+
+/// Appends the lines of [`trace_jsonl`] to `s`, calling `after_line(s)` after each piece (to
+/// drain `s` into a file).
+fn trace_jsonl_into(
+    trace: &Trace,
+    s: &mut String,
+    after_line: &mut dyn FnMut(&mut String) -> Result<(), serde_json::Error>,
+) -> Result<(), serde_json::Error> {
+    let lattice = trace.lattice();
     let mut declared = false;
     let mut prev_list: Option<&Vec<[f64; 2]>> = None;
     for piece in trace.pieces() {
+        if !s.is_empty() {
+            after_line(s)?;
+        }
         match piece {
-            Piece::Pose { t, pose } => push_pose_line(&mut s, t, pose),
+            Piece::Pose { t, pose } => push_pose_line(s, t, pose),
             Piece::Event {
                 t,
-                event: Event::BacktrackList { points },
+                event: event @ Event::BacktrackList { points },
             } => {
                 if let Some(prev) = prev_list {
                     let delta = list_delta(prev, points);
@@ -270,18 +306,12 @@ pub fn trace_jsonl(trace: &Trace) -> Result<String, serde_json::Error> {
                     }
                 }
                 prev_list = Some(points);
-                push_event_line(
-                    &mut s,
-                    t,
-                    &Event::BacktrackList {
-                        points: points.clone(),
-                    },
-                )?;
+                push_event_line(s, t, event)?;
             }
-            Piece::Event { t, event } => push_event_line(&mut s, t, event)?,
+            Piece::Event { t, event } => push_event_line(s, t, event)?,
             Piece::Run(run) if run.n < 3 => {
                 for (t, p) in run.poses(lattice) {
-                    push_pose_line(&mut s, t, p);
+                    push_pose_line(s, t, p);
                 }
             }
             Piece::Run(run) => {
@@ -289,32 +319,32 @@ pub fn trace_jsonl(trace: &Trace) -> Result<String, serde_json::Error> {
                 {
                     declared = true;
                     s.push_str("{\"lattice\":[");
-                    push_f64(&mut s, l.anchor[0]);
+                    push_f64(s, l.anchor[0]);
                     s.push(',');
-                    push_f64(&mut s, l.anchor[1]);
+                    push_f64(s, l.anchor[1]);
                     s.push(',');
-                    push_f64(&mut s, l.side);
+                    push_f64(s, l.side);
                     s.push_str("]}\n");
                 }
                 let _ = write!(s, "{{\"t\":{},\"poses\":{},\"from\":", run.t, run.n);
-                push_pair(&mut s, run.from);
+                push_pair(s, run.from);
                 match run.advance {
                     Advance::Lattice { .. } => {
                         s.push_str(",\"to\":");
-                        push_pair(&mut s, run.to(lattice));
+                        push_pair(s, run.to(lattice));
                     }
                     Advance::Step { d } => {
                         s.push_str(",\"step\":");
-                        push_pair(&mut s, d);
+                        push_pair(s, d);
                     }
                 }
                 s.push_str(",\"theta\":");
-                push_f64(&mut s, run.theta);
+                push_f64(s, run.theta);
                 s.push_str("}\n");
             }
         }
     }
-    Ok(s)
+    Ok(())
 }
 
 /// The trace as JSON Lines of the earlier form: one line per pose (no runs).
@@ -467,6 +497,18 @@ pub fn parse_trace(
     path: &Path,
     frame: Option<(&MapFrame, f64)>,
 ) -> Result<Trace, TraceFileError> {
+    let lines = text.lines().map(|l| Ok::<_, std::io::Error>(std::borrow::Cow::Borrowed(l)));
+    parse_trace_lines(lines, text.len(), path, frame)
+}
+
+/// [`parse_trace`] of the lines of a text of `byte_len` bytes, read one at a time (a read
+/// failure is [`TraceFileError::Io`]).
+fn parse_trace_lines<'a>(
+    lines: impl Iterator<Item = std::io::Result<std::borrow::Cow<'a, str>>>,
+    byte_len: usize,
+    path: &Path,
+    frame: Option<(&MapFrame, f64)>,
+) -> Result<Trace, TraceFileError> {
     let bounds = frame.map(|(f, m)| {
         let (lo, hi) = f.world_bounds();
         (lo.x - m, lo.y - m, hi.x + m, hi.y + m)
@@ -476,7 +518,7 @@ pub fn parse_trace(
         line,
         message,
     };
-    let max_poses = text.len().saturating_mul(MAX_POSES_PER_BYTE);
+    let max_poses = byte_len.saturating_mul(MAX_POSES_PER_BYTE);
     let mut trace = Trace::default();
     let mut lattice: Option<Lattice> = None;
     let mut last_list: Option<Vec<[f64; 2]>> = None;
@@ -508,7 +550,12 @@ pub fn parse_trace(
         trace.push_pose(t, p);
         Ok(())
     };
-    for (k, line) in text.lines().enumerate() {
+    for (k, line) in lines.enumerate() {
+        let line = line.map_err(|source| TraceFileError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let line: &str = &line;
         if line.trim().is_empty() {
             continue;
         }
@@ -559,11 +606,18 @@ pub fn parse_trace(
 /// # Errors
 /// See [`parse_trace`], plus an unreadable file.
 pub fn read_trace(path: &Path, frame: Option<(&MapFrame, f64)>) -> Result<Trace, TraceFileError> {
-    let text = crate::file::read_text(path).map_err(|source| TraceFileError::Io {
+    use std::io::BufRead as _;
+    let io_err = |source| TraceFileError::Io {
         path: path.to_path_buf(),
         source,
-    })?;
-    parse_trace(&text, path, frame)
+    };
+    // Read line by line: the file is never held whole in memory.
+    let file = crate::file::open_regular(path).map_err(io_err)?;
+    let len = file.metadata().map_err(io_err)?.len();
+    let lines = std::io::BufReader::new(file)
+        .lines()
+        .map(|l| l.map(std::borrow::Cow::Owned));
+    parse_trace_lines(lines, usize::try_from(len).unwrap_or(usize::MAX), path, frame)
 }
 
 #[cfg(test)]

@@ -4,7 +4,8 @@
 //! metrics.json); only the writing to disk is left out. BA* on `apartment_400x300` and
 //! `cluttered_2000` at r = 0.025 m (one pixel per tile) and on `office_1024` / `office_4096` at
 //! r = 0.1 m. Select one with e.g. `cargo bench -p ccpp-render --bench whole_run --
-//! whole_run/ba-star/apartment`. Skips with a note when `../shared/bench` is absent.
+//! whole_run/ba-star/apartment`; the `world` group times the world alone. Skips with a note
+//! when `../shared/bench` is absent.
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -20,12 +21,14 @@ fn bench_dir() -> PathBuf {
 /// One whole run; returns the bytes rendered (so nothing is optimised away).
 fn whole_run(scenario: &Scenario) -> usize {
     let map = scenario.map.load().expect("map");
-    let run = scenario.run_on(&map).expect("run");
-    let files = ccpp_render::run_files::render_run_files(
+    let run = scenario.run_owned(map).expect("run");
+    // As `ccpp run`: the picture reuses the swept pixels of the metrics.
+    let files = ccpp_render::run_files::render_run_files_swept(
         scenario,
         &run.world,
         &run.output.trace,
         &run.metrics,
+        Some(&run.swept),
     )
     .expect("files");
     files.iter().map(|(_, b)| b.len()).sum()
@@ -53,6 +56,27 @@ fn benches(c: &mut Criterion) {
             .expect("scenario");
         g.bench_function(format!("ba-star/{name}/r{r}"), |b| {
             b.iter(|| whole_run(&scenario));
+        });
+    }
+    g.finish();
+    // The world alone (distance transform, C-free, reachable component, accessible surface):
+    // the largest part of a run outside planning, metrics and files.
+    let mut g = c.benchmark_group("world");
+    g.sample_size(10)
+        .warm_up_time(Duration::from_millis(100))
+        .measurement_time(Duration::from_secs(3));
+    for (name, r) in [("cluttered_2000", 0.025), ("office_4096", 0.1)] {
+        let path = bench_dir().join(format!("{name}.yaml"));
+        if !path.is_file() {
+            continue;
+        }
+        let scenario = Scenario::builder(&path, PlannerKind::BaStar)
+            .radius(r)
+            .build()
+            .expect("scenario");
+        let map = scenario.map.load().expect("map");
+        g.bench_function(format!("{name}/r{r}"), |b| {
+            b.iter(|| scenario.world(&map).expect("world").accessible_count());
         });
     }
     g.finish();

@@ -378,7 +378,8 @@ impl Chart {
         s
     }
 
-    /// The chart as PNG bytes.
+    /// The chart as PNG bytes (through [`crate::encode_png`]: an opaque chart is written as
+    /// 8-bit RGB with fast compression).
     ///
     /// # Errors
     /// When the canvas cannot be allocated or encoded.
@@ -387,8 +388,7 @@ impl Chart {
             .ok_or(RenderError::Canvas(self.width, self.height))?;
         pm.fill(Color::WHITE);
         self.draw_onto(&mut pm);
-        pm.encode_png()
-            .map_err(|e| RenderError::Encode(e.to_string()))
+        crate::encode_png(&pm)
     }
 
     /// Draws the shapes onto an existing pixmap (the chart's size is not checked).

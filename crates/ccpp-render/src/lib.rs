@@ -224,6 +224,22 @@ pub fn coverage_png(
     encode_png(&pixmap)
 }
 
+/// [`coverage_png`] with the swept pixels already computed (`swept` must be
+/// [`swept_pixels`]`(world, trace)`, as the metrics computed them): the same bytes without
+/// sweeping the trace again.
+///
+/// # Errors
+/// As [`coverage_png`].
+pub fn coverage_png_swept(
+    world: &World,
+    trace: &Trace,
+    style: &CoverageStyle,
+    swept: &fixedbitset::FixedBitSet,
+) -> Result<Vec<u8>, RenderError> {
+    let pixmap = coverage_pixmap_swept(world, trace, style, swept)?;
+    encode_png(&pixmap)
+}
+
 /// Encodes a picture as PNG bytes, fast: an opaque canvas (every picture of this crate) is
 /// written as 8-bit RGB, streamed row by row from the pixmap (no copy of the canvas), with
 /// `png`'s fast DEFLATE mode and its fixed filter; a canvas with any translucent pixel goes
@@ -366,12 +382,33 @@ pub fn legend_entries(world: &World, trace: &Trace) -> Vec<LegendEntry> {
     entries_of(&shown(world, trace, crop_box(world, trace)))
 }
 
+/// What one run's coverage picture shows, kept for a legend shared by several pictures
+/// ([`legend_entries_union_of`]) without keeping the run's trace.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LegendShown(Shown);
+
+impl LegendShown {
+    /// What the picture of (`world`, `trace`) shows; `swept` must be
+    /// [`swept_pixels`]`(world, trace)`.
+    pub fn of(world: &World, trace: &Trace, swept: &fixedbitset::FixedBitSet) -> Self {
+        Self(shown_with(world, trace, crop_box(world, trace), swept))
+    }
+}
+
 /// The union of several runs' legends (for a grid of pictures sharing one legend), without
 /// counts.
 pub fn legend_entries_union(runs: &[(&World, &Trace)]) -> Vec<LegendEntry> {
+    let shown: Vec<LegendShown> = runs
+        .iter()
+        .map(|(w, t)| LegendShown(shown(w, t, crop_box(w, t))))
+        .collect();
+    legend_entries_union_of(&shown)
+}
+
+/// [`legend_entries_union`] of what each run's picture shows.
+pub fn legend_entries_union_of(runs: &[LegendShown]) -> Vec<LegendEntry> {
     let mut all = Shown::default();
-    for (w, t) in runs {
-        let s = shown(w, t, crop_box(w, t));
+    for LegendShown(s) in runs {
         all.swept |= s.swept;
         all.missed |= s.missed;
         all.swept_outside |= s.swept_outside;
@@ -502,9 +539,21 @@ pub fn coverage_pixmap(
     trace: &Trace,
     style: &CoverageStyle,
 ) -> Result<Pixmap, RenderError> {
+    coverage_pixmap_swept(world, trace, style, &swept_pixels(world, trace))
+}
+
+/// [`coverage_pixmap`] with the swept pixels already computed (see [`coverage_png_swept`]).
+///
+/// # Errors
+/// When the canvas cannot be allocated.
+pub fn coverage_pixmap_swept(
+    world: &World,
+    trace: &Trace,
+    style: &CoverageStyle,
+    swept: &fixedbitset::FixedBitSet,
+) -> Result<Pixmap, RenderError> {
     let frame = *world.frame();
     let crop = crop_box(world, trace);
-    let swept = swept_pixels(world, trace);
     let (col0, row0, cols, rows) = crop;
     let (w, h) = (cols as u32, rows as u32);
     let scale = if w < style.min_width {
@@ -522,7 +571,7 @@ pub fn coverage_pixmap(
     let mut header = 0u32;
     if !style.title.is_empty() {
         let mut y = 6.0f32;
-        let cov = effective_coverage(world, &swept);
+        let cov = effective_coverage(world, swept);
         let collisions = trace
             .events()
             .filter(|(_, e)| matches!(e, Event::Collision { .. }))
@@ -578,7 +627,7 @@ pub fn coverage_pixmap(
     }
     let mut foot = Chart::new(cw, 0);
     let legend_h = if style.legend {
-        let entries = entries_of(&shown_with(world, trace, crop, &swept));
+        let entries = entries_of(&shown_with(world, trace, crop, swept));
         let top = ch_map + header + 8;
         (foot.legend(8.0, top as f32, cw as f32 - 16.0, px as u32, &entries) + 8.0).ceil() as u32
     } else {
@@ -613,12 +662,15 @@ pub fn coverage_pixmap(
         }
     };
     {
+        // The map column of each canvas column, computed once (same formula per pixel).
+        let cols: Vec<usize> = (0..cw)
+            .map(|x| (col0 + ((x as f32 + 0.5) / scale) as usize).min(frame.width - 1))
+            .collect();
         let data = pm.data_mut();
         for y in 0..ch_map {
             let row = ((y as f32 + 0.5) / scale) as usize;
             let row = (row0 + row).min(frame.height - 1);
-            for x in 0..cw {
-                let col = (col0 + ((x as f32 + 0.5) / scale) as usize).min(frame.width - 1);
+            for (x, &col) in (0..cw).zip(&cols) {
                 let c = colour_of(frame.index(col, row), x, y);
                 let o = (((y + header) * cw + x) * 4) as usize;
                 data[o] = c[0];

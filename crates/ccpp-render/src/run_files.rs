@@ -2,6 +2,7 @@
 //! `metrics.json` — written the same way by the command line (`ccpp run`, `ccpp bench`) and the
 //! Python package (`Result.save`).
 
+use std::io::Write;
 use std::path::Path;
 
 use ccpp_core::metrics::Metrics;
@@ -14,7 +15,7 @@ use ccpp_io::scenario::Scenario;
 use ccpp_io::write::WriteError;
 use ccpp_io::write_atomic;
 
-use crate::{coverage_png, CoverageStyle, RenderError};
+use crate::{coverage_png, coverage_png_swept, CoverageStyle, RenderError};
 
 /// Failure writing a run's files.
 #[derive(Debug, thiserror::Error)]
@@ -72,6 +73,22 @@ pub fn title_lines(m: &Metrics) -> Vec<String> {
     ]
 }
 
+/// `run.json`: `scenario` with the start actually used (the world's).
+fn run_json(scenario: &Scenario, world: &World) -> Result<String, serde_json::Error> {
+    let mut scenario = scenario.clone();
+    let start = world.initial_pose();
+    scenario.start = Some([start.x, start.y, start.theta]);
+    scenario.to_json()
+}
+
+/// The style of a run's `coverage.png`.
+fn coverage_style(metrics: &Metrics) -> CoverageStyle {
+    CoverageStyle {
+        title: title_lines(metrics),
+        ..CoverageStyle::default()
+    }
+}
+
 /// Renders a run's standard files in memory, in writing order: `run.json`, `path.csv`,
 /// `trace.jsonl`, `coverage.png`, `metrics.json` (last: its presence marks a complete run).
 /// `run.json` is `scenario` with the start actually used (the world's), so that
@@ -87,19 +104,34 @@ pub fn render_run_files(
     trace: &Trace,
     metrics: &Metrics,
 ) -> Result<Vec<(&'static str, Vec<u8>)>, RunFilesError> {
+    render_run_files_swept(scenario, world, trace, metrics, None)
+}
+
+/// [`render_run_files`] reusing the swept pixels when given (they must be
+/// [`ccpp_core::metrics::swept_pixels`]`(world, trace)`, as [`ccpp_io::scenario::Run::swept`]
+/// holds them): the same bytes, without sweeping the trace a second time for the picture.
+///
+/// # Errors
+/// Serialization or rendering failures.
+pub fn render_run_files_swept(
+    scenario: &Scenario,
+    world: &World,
+    trace: &Trace,
+    metrics: &Metrics,
+    swept: Option<&fixedbitset::FixedBitSet>,
+) -> Result<Vec<(&'static str, Vec<u8>)>, RunFilesError> {
     let metrics_text = metrics_json(metrics)?;
-    let mut scenario = scenario.clone();
-    let start = world.initial_pose();
-    scenario.start = Some([start.x, start.y, start.theta]);
-    let run_json = scenario.to_json()?;
-    let style = CoverageStyle {
-        title: title_lines(metrics),
-        ..CoverageStyle::default()
-    };
+    let run_json = run_json(scenario, world)?;
+    let style = coverage_style(metrics);
     // The picture and the text files are independent pure functions of (world, trace): draw
     // the picture on a second thread while this one writes the text (same bytes either way).
     let (png, text) = std::thread::scope(|s| {
-        let png = s.spawn(|| phase::time("coverage.png", || coverage_png(world, trace, &style)));
+        let png = s.spawn(|| {
+            phase::time("coverage.png", || match swept {
+                Some(swept) => coverage_png_swept(world, trace, &style, swept),
+                None => coverage_png(world, trace, &style),
+            })
+        });
         let text = phase::time("trace.jsonl", || ccpp_io::trace::trace_jsonl(trace)).map(|t| {
             let path = phase::time("path.csv", || ccpp_io::trace::path_csv(trace));
             (t, path)
@@ -119,6 +151,60 @@ pub fn render_run_files(
         ("coverage.png", png),
         ("metrics.json", metrics_text.into_bytes()),
     ])
+}
+
+/// What [`stream_run_files`] writes each file with: `put(name, fill)` creates the file `name`
+/// and calls `fill` with a writer into it (the command line puts the files in its staging
+/// folder).
+pub type PutFile<'a, E> =
+    dyn FnMut(&'static str, &mut dyn FnMut(&mut dyn Write) -> std::io::Result<()>) -> Result<(), E>
+        + 'a;
+
+/// The files of [`render_run_files`] but `metrics.json` — `run.json`, `path.csv`,
+/// `trace.jsonl`, `coverage.png`, in that order — handed to `put` one by one, with
+/// `trace.jsonl` streamed as it is formed instead of built whole in memory (the largest file;
+/// `coverage.png` is drawn on a second thread meanwhile). Same bytes as
+/// [`render_run_files`]. `swept`, when given, must be
+/// [`ccpp_core::metrics::swept_pixels`]`(world, trace)`.
+///
+/// # Errors
+/// Serialization or rendering failures (converted into `E`), or what `put` returns.
+pub fn stream_run_files<E: From<RunFilesError>>(
+    scenario: &Scenario,
+    world: &World,
+    trace: &Trace,
+    metrics: &Metrics,
+    swept: Option<&fixedbitset::FixedBitSet>,
+    put: &mut PutFile<'_, E>,
+) -> Result<(), E> {
+    let run_json = run_json(scenario, world).map_err(RunFilesError::from)?;
+    let style = coverage_style(metrics);
+    std::thread::scope(|s| {
+        let png = s.spawn(|| {
+            phase::time("coverage.png", || match swept {
+                Some(swept) => coverage_png_swept(world, trace, &style, swept),
+                None => coverage_png(world, trace, &style),
+            })
+        });
+        let text = (|| -> Result<(), E> {
+            put("run.json", &mut |w| w.write_all(run_json.as_bytes()))?;
+            let path = phase::time("path.csv", || ccpp_io::trace::path_csv(trace));
+            put("path.csv", &mut |w| w.write_all(path.as_bytes()))?;
+            drop(path);
+            phase::time("trace.jsonl", || {
+                put("trace.jsonl", &mut |w| {
+                    ccpp_io::trace::write_trace_jsonl(trace, w).map_err(std::io::Error::other)
+                })
+            })
+        })();
+        let png = match png.join() {
+            Ok(png) => png,
+            Err(panic) => std::panic::resume_unwind(panic),
+        };
+        text?;
+        let png = png.map_err(RunFilesError::from)?;
+        put("coverage.png", &mut |w| w.write_all(&png))
+    })
 }
 
 /// Renders the path exports of a finished run in memory ([`ccpp_io::export`]): the route of the
