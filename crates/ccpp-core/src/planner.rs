@@ -63,10 +63,10 @@ impl<'a> Scan<'a> {
         let r = self.range_px;
         let r2 = r * r;
         let h = frame.height as f64;
-        let c0 = (self.center.x - r - 0.5).floor().max(0.0) as usize;
-        let c1 = ((self.center.x + r - 0.5).ceil().max(0.0) as usize).min(frame.width - 1);
-        let r0 = (h - (self.center.y + r) - 0.5).floor().max(0.0) as usize;
-        let r1 = ((h - (self.center.y - r) - 0.5).ceil().max(0.0) as usize).min(frame.height - 1);
+        let c0 = floor_i64(self.center.x - r - 0.5).max(0) as usize;
+        let c1 = (ceil_i64(self.center.x + r - 0.5).max(0) as usize).min(frame.width - 1);
+        let r0 = floor_i64(h - (self.center.y + r) - 0.5).max(0) as usize;
+        let r1 = (ceil_i64(h - (self.center.y - r) - 0.5).max(0) as usize).min(frame.height - 1);
         if c0 > c1 {
             return;
         }
@@ -121,10 +121,10 @@ impl<'a> Scan<'a> {
         let r = self.range_px;
         let r2 = r * r;
         let h = frame.height as f64;
-        let c0 = (self.center.x - r - 0.5).floor().max(0.0) as usize;
-        let c1 = ((self.center.x + r - 0.5).ceil().max(0.0) as usize).min(frame.width - 1);
-        let r0 = (h - (self.center.y + r) - 0.5).floor().max(0.0) as usize;
-        let r1 = ((h - (self.center.y - r) - 0.5).ceil().max(0.0) as usize).min(frame.height - 1);
+        let c0 = floor_i64(self.center.x - r - 0.5).max(0) as usize;
+        let c1 = (ceil_i64(self.center.x + r - 0.5).max(0) as usize).min(frame.width - 1);
+        let r0 = floor_i64(h - (self.center.y + r) - 0.5).max(0) as usize;
+        let r1 = (ceil_i64(h - (self.center.y - r) - 0.5).max(0) as usize).min(frame.height - 1);
         for row in r0..=r1 {
             let gy = h - row as f64 - 0.5;
             let dy2 = (gy - self.center.y).powi(2);

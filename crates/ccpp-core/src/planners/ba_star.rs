@@ -791,6 +791,11 @@ pub fn smooth_path(path: &[Tile], mut visible: impl FnMut(Tile, Tile) -> bool) -
     out
 }
 
+/// Margin (pixels) added to the contact radius when [`Mind::sense`] bounds the tiles a new
+/// pixel can affect: covers the rounding of the world/grid/tile conversions (the exact test
+/// follows; a larger margin only costs time).
+const CANDIDATE_MARGIN_PX: f64 = 0.01;
+
 // Tile state bits.
 const ST_STAND: u8 = 0b0011; // Judgement of standing at the centre
 const ST_COVERED: u8 = 0b0100;
@@ -1107,6 +1112,11 @@ struct Mind {
     /// Scratch for [`Mind::sense`]: per row of the last scan, the column span of the pixels
     /// seen for the first time (`(usize::MAX, 0)` when none).
     new_spans: Vec<(usize, usize)>,
+    /// Scratch for [`Mind::sense`]: per tile row of the candidate box, the hull of the
+    /// candidate tile columns (`(i32::MAX, i32::MIN)` when none).
+    candidate_rows: Vec<(i32, i32)>,
+    /// Rows of new pixels per candidate band in [`Mind::sense`]: about one tile side.
+    band_rows: usize,
     /// Per-tile cache of the contact disk's pixel spans for [`Mind::judge_tile`].
     disk: DiskCache,
 }
@@ -1213,31 +1223,53 @@ impl Mind {
             return;
         }
         let last_row = first_row + spans.len() - 1;
-        let (c0, c1) = spans
-            .iter()
-            .fold((usize::MAX, 0), |(a, b), s| (a.min(s.0), b.max(s.1)));
-        // Candidate tiles: the new pixels' box grown by the contact radius, in grid
-        // coordinates, then the hull of its corners in tile indices (tiles are axis-aligned in
-        // the world frame).
+        // Candidate tiles: a tile's standability can change only when a new pixel lies in its
+        // contact disk, i.e. when its centre lies within `rc` of a new pixel's centre. The new
+        // pixels are taken in bands of rows about one tile high; each band's box, grown by
+        // `rc` plus a margin for rounding, gives (as the hull of its corners in tile indices:
+        // tiles are axis-aligned in the world frame) a range of tiles per tile row, kept as the
+        // hull per tile row. Tiles are then visited row by row, each at most once.
         let frame = *self.known.frame();
         let h = frame.height as f64;
         let rc = self.rc_px;
-        let m = rc + 1.0;
-        let (x0, x1) = (c0 as f64 + 0.5 - m, c1 as f64 + 0.5 + m);
-        let (y0, y1) = (
-            h - last_row as f64 - 0.5 - m,
-            h - first_row as f64 - 0.5 + m,
-        );
+        let m = rc + CANDIDATE_MARGIN_PX;
         let grid = self.tiles.grid;
-        let (mut i0, mut i1, mut j0, mut j1) = (i32::MAX, i32::MIN, i32::MAX, i32::MIN);
-        for (x, y) in [(x0, y0), (x1, y0), (x0, y1), (x1, y1)] {
-            let t = grid.tile_of(frame.grid_to_world(Point::new(x, y)));
-            i0 = i0.min(t.0);
-            i1 = i1.max(t.0);
-            j0 = j0.min(t.1);
-            j1 = j1.max(t.1);
+        let tile_box = |c0: usize, c1: usize, r0: usize, r1: usize| {
+            let (x0, x1) = (c0 as f64 + 0.5 - m, c1 as f64 + 0.5 + m);
+            let (y0, y1) = (h - r1 as f64 - 0.5 - m, h - r0 as f64 - 0.5 + m);
+            let (mut i0, mut i1, mut j0, mut j1) = (i32::MAX, i32::MIN, i32::MAX, i32::MIN);
+            for (x, y) in [(x0, y0), (x1, y0), (x0, y1), (x1, y1)] {
+                let t = grid.tile_of(frame.grid_to_world(Point::new(x, y)));
+                i0 = i0.min(t.0);
+                i1 = i1.max(t.0);
+                j0 = j0.min(t.1);
+                j1 = j1.max(t.1);
+            }
+            (i0, i1, j0, j1)
+        };
+        let (c0, c1) = spans
+            .iter()
+            .fold((usize::MAX, 0), |(a, b), s| (a.min(s.0), b.max(s.1)));
+        let (_, _, j0, j1) = tile_box(c0, c1, first_row, last_row);
+        let mut ranges = std::mem::take(&mut self.candidate_rows);
+        ranges.clear();
+        ranges.resize((j1 - j0 + 1) as usize, (i32::MAX, i32::MIN));
+        for (b, band) in spans.chunks(self.band_rows).enumerate() {
+            let (bc0, bc1) = band
+                .iter()
+                .fold((usize::MAX, 0), |(a, b), s| (a.min(s.0), b.max(s.1)));
+            if bc0 > bc1 {
+                continue;
+            }
+            let r0 = first_row + b * self.band_rows;
+            let (bi0, bi1, bj0, bj1) = tile_box(bc0, bc1, r0, r0 + band.len() - 1);
+            for j in bj0.max(j0)..=bj1.min(j1) {
+                let r = &mut ranges[(j - j0) as usize];
+                r.0 = r.0.min(bi0);
+                r.1 = r.1.max(bi1);
+            }
         }
-        for j in j0..=j1 {
+        for (j, &(i0, i1)) in (j0..).zip(ranges.iter()) {
             for i in i0..=i1 {
                 let t = (i, j);
                 let Some(k) = self.tiles.idx(t) else { continue };
@@ -1284,6 +1316,7 @@ impl Mind {
             }
         }
         self.new_spans = spans;
+        self.candidate_rows = ranges;
     }
 
     /// The first image row and the column offsets are taken from in the [`DiskCache`] slots of
@@ -1606,6 +1639,8 @@ impl BaStar {
             rc_px,
             last_scan: None,
             new_spans: Vec::new(),
+            candidate_rows: Vec::new(),
+            band_rows: ((side / frame.resolution).floor() as usize).clamp(1, 64),
             disk: DiskCache::new(n_tiles, rc_px),
         }));
     }
