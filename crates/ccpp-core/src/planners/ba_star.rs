@@ -609,27 +609,95 @@ impl TileSearch {
     }
 
     fn expand(&mut self, g: &impl TileGraph, t: Tile, k: usize, d: u64, goal: Option<Tile>) {
+        self.expand_within(g, t, k, d, goal, u64::MAX);
+    }
+
+    /// Relaxes the edges of the settled tile `t` (index `k`, cost `d`), pushing each improved
+    /// neighbour with key `cost + heuristic`; a neighbour whose key would exceed `bound` is left
+    /// unlabelled (see [`Self::astar_within`]).
+    #[inline]
+    fn expand_within(
+        &mut self,
+        g: &impl TileGraph,
+        t: Tile,
+        k: usize,
+        d: u64,
+        goal: Option<Tile>,
+        bound: u64,
+    ) {
         let mut mask = g.edge_mask(t);
+        if mask == 0 {
+            return;
+        }
+        // Interior tiles of the search rectangle reach their neighbours by a fixed index
+        // offset; the others go through `idx` (a neighbour outside the rectangle is skipped).
+        let (di0, dj0) = (t.0 - self.i0, t.1 - self.j0);
+        let interior =
+            di0 >= 1 && dj0 >= 1 && (di0 as usize) + 1 < self.w && (dj0 as usize) + 1 < self.h;
+        let w = self.w as isize;
+        let gen = self.generation;
         while mask != 0 {
             let n = mask.trailing_zeros() as usize;
             mask &= mask - 1;
             let (di, dj) = N8[n];
             let v = (t.0 + di, t.1 + dj);
-            let Some(kv) = self.idx(v) else { continue };
-            if self.closed(kv) {
+            let kv = if interior {
+                (k as isize + di as isize + dj as isize * w) as usize
+            } else {
+                let Some(kv) = self.idx(v) else { continue };
+                kv
+            };
+            let nd = d + if n % 2 == 1 { COST_DIAG } else { COST_ORTHO };
+            let node = &mut self.nodes[kv];
+            // Settled (stamp gen + 1), or labelled at least as well: nothing to do.
+            if node.stamp == gen + 1 || (node.stamp == gen && nd >= node.dist) {
                 continue;
             }
-            let nd = d + if n % 2 == 1 { COST_DIAG } else { COST_ORTHO };
-            if self.relax(kv, nd, k as u32) {
-                let f = nd + goal.map_or(0, |gl| heuristic(v, gl));
-                self.heap.push(f, kv as u32);
+            let f = nd + goal.map_or(0, |gl| heuristic(v, gl));
+            if f > bound {
+                continue;
             }
+            node.stamp = gen;
+            node.dist = nd;
+            node.parent = k as u32;
+            self.heap.push(f, kv as u32);
         }
     }
 
     /// A* from `from` to `to` over the graph of [`graph_edge`] (costs [`COST_ORTHO`] /
     /// [`COST_DIAG`], Euclidean heuristic); the tile path (both ends included) and its cost.
     pub fn astar(&mut self, g: &impl TileGraph, from: Tile, to: Tile) -> Option<(Vec<Tile>, u64)> {
+        self.astar_within(g, from, to, u64::MAX)
+    }
+
+    /// [`Self::astar`] when the cost of the best path is known to be `cost` (say from
+    /// [`Self::nearest`] on the same graph): the same answer, without labelling the tiles whose
+    /// key `cost + heuristic` exceeds `cost`.
+    ///
+    /// Why it is the same: the queue pops pairs in `(key, index)` order, so leaving out pairs
+    /// keyed above `cost` changes neither the order of the others nor any label at or below it
+    /// (a later, better label of a left-out tile is pushed as it would have been). The goal's
+    /// key is its cost; while the full search pops only keys `<= cost` it runs exactly as this
+    /// one. Should it pop a larger key before the goal (only possible with an inconsistent
+    /// heuristic), this one runs dry first and the full search is run instead.
+    pub fn astar_bounded(
+        &mut self,
+        g: &impl TileGraph,
+        from: Tile,
+        to: Tile,
+        cost: u64,
+    ) -> Option<(Vec<Tile>, u64)> {
+        self.astar_within(g, from, to, cost)
+            .or_else(|| self.astar_within(g, from, to, u64::MAX))
+    }
+
+    fn astar_within(
+        &mut self,
+        g: &impl TileGraph,
+        from: Tile,
+        to: Tile,
+        bound: u64,
+    ) -> Option<(Vec<Tile>, u64)> {
         let s = self.idx(from)?;
         self.idx(to)?;
         self.begin();
@@ -646,7 +714,7 @@ impl TileSearch {
             if t == to {
                 return Some((self.path_to(k), d));
             }
-            self.expand(g, t, k, d, Some(to));
+            self.expand_within(g, t, k, d, Some(to), bound);
         }
         None
     }
@@ -1683,7 +1751,7 @@ impl BaStar {
         }
         let tiles = &m.tiles;
         let found = m.search.nearest(tiles, c, |t| tiles.in_l(t));
-        let Some((sp, _)) = found else {
+        let Some((sp, sp_cost)) = found else {
             // Cannot happen: covered tiles form one connected graph.
             self.pending.push_back(Step::Mark(Event::Note {
                 text: "ba-star: no backtracking candidate reachable".to_string(),
@@ -1693,7 +1761,7 @@ impl BaStar {
         };
         let raw = m
             .search
-            .astar(&m.tiles, c, sp)
+            .astar_bounded(&m.tiles, c, sp, sp_cost)
             .map_or_else(|| vec![c, sp], |(p, _)| p);
         let smoothed = if self.opts.smoothing {
             let mm = &*m;
