@@ -295,6 +295,38 @@ impl KnownMap {
         });
     }
 
+    /// Stores every pixel of a scan and calls `new_in_row(row, lo, hi)` once for each image
+    /// row holding pixels seen for the first time, top to bottom: `lo` and `hi` are the first
+    /// and last such column of the row (the pixels between them may include ones seen before).
+    /// The same pixels are stored as by [`Self::integrate_with`], without a call per pixel.
+    pub(crate) fn integrate_rows(
+        &mut self,
+        scan: &Scan<'_>,
+        mut new_in_row: impl FnMut(usize, usize, usize),
+    ) {
+        let w = self.grid.frame().width;
+        let truth = scan.map.cells();
+        let cells = self.grid.cells_mut();
+        let seen = self.seen.as_mut_slice();
+        let free = self.free.as_mut_slice();
+        scan.for_each_row_span(|row, lo, hi| {
+            let base = row * w;
+            let (mut first, mut last) = (usize::MAX, 0);
+            crate::bits::insert_range(seen, base + lo, base + hi + 1, |i| {
+                let cell = truth[i];
+                cells[i] = cell;
+                if cell.is_free() {
+                    free[i / BLOCK_BITS] |= 1 << (i % BLOCK_BITS);
+                }
+                first = first.min(i);
+                last = i;
+            });
+            if first <= last {
+                new_in_row(row, first - base, last - base);
+            }
+        });
+    }
+
     /// The frame.
     pub fn frame(&self) -> &MapFrame {
         self.grid.frame()

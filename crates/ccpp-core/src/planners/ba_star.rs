@@ -1251,7 +1251,11 @@ impl Mind {
 
     fn set_stand(&mut self, k: usize, t: Tile, j: Judgement) {
         self.tiles.state[k] = (self.tiles.state[k] & !ST_STAND) | j as u8;
-        self.tiles.update_l_around(t);
+        // `mu` reads a standability only as "is it Blocked?" (`blocked`, the lane-end
+        // obstacles), so a tile judged Free changes no tile's L membership.
+        if j == Judgement::Blocked {
+            self.tiles.update_l_around(t);
+        }
     }
 
     /// Integrates a scan taken at `pose` and refreshes every judgement it can change.
@@ -1274,17 +1278,13 @@ impl Mind {
         let mut spans = std::mem::take(&mut self.new_spans);
         spans.clear();
         let mut first_row = 0usize;
-        self.known.integrate_with(&scan, |c, r, _| {
+        self.known.integrate_rows(&scan, |r, lo, hi| {
             if spans.is_empty() {
                 first_row = r;
             }
             let k = r - first_row;
-            if k >= spans.len() {
-                spans.resize(k + 1, (usize::MAX, 0));
-            }
-            let s = &mut spans[k];
-            s.0 = s.0.min(c);
-            s.1 = s.1.max(c);
+            spans.resize(k, (usize::MAX, 0));
+            spans.push((lo, hi));
         });
         if spans.is_empty() {
             self.new_spans = spans;
