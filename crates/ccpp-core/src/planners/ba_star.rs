@@ -1302,11 +1302,19 @@ impl Mind {
         let rc = self.rc_px;
         let m = rc + CANDIDATE_MARGIN_PX;
         let grid = self.tiles.grid;
+        let unrotated = frame.origin.theta == 0.0;
         let tile_box = |c0: usize, c1: usize, r0: usize, r1: usize| {
             let (x0, x1) = (c0 as f64 + 0.5 - m, c1 as f64 + 0.5 + m);
             let (y0, y1) = (h - r1 as f64 - 0.5 - m, h - r0 as f64 - 0.5 + m);
             let (mut i0, mut i1, mut j0, mut j1) = (i32::MAX, i32::MIN, i32::MAX, i32::MIN);
-            for (x, y) in [(x0, y0), (x1, y0), (x0, y1), (x1, y1)] {
+            // Without rotation a corner's tile column depends on its x alone and its row on
+            // its y alone: two opposite corners give the same hull as four.
+            let corners: &[(f64, f64)] = if unrotated {
+                &[(x0, y0), (x1, y1)]
+            } else {
+                &[(x0, y0), (x1, y0), (x0, y1), (x1, y1)]
+            };
+            for &(x, y) in corners {
                 let t = grid.tile_of(frame.grid_to_world(Point::new(x, y)));
                 i0 = i0.min(t.0);
                 i1 = i1.max(t.0);
