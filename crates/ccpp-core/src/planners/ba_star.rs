@@ -1177,6 +1177,9 @@ struct Mind {
     rc_px: f64,
     /// Where the last scan was integrated.
     last_scan: Option<Point>,
+    /// The disk of the last scan integrated ([`crate::planner::Scan::disk_px`]): the rows a
+    /// new scan shares with it hold nothing new.
+    last_disk: Option<(Point, f64)>,
     /// Scratch for [`Mind::sense`]: per row of the last scan, the column span of the pixels
     /// seen for the first time (`(usize::MAX, 0)` when none).
     new_spans: Vec<(usize, usize)>,
@@ -1278,7 +1281,8 @@ impl Mind {
         let mut spans = std::mem::take(&mut self.new_spans);
         spans.clear();
         let mut first_row = 0usize;
-        self.known.integrate_rows(&scan, |r, lo, hi| {
+        let prev = self.last_disk.replace(scan.disk_px());
+        self.known.integrate_rows(&scan, prev, |r, lo, hi| {
             if spans.is_empty() {
                 first_row = r;
             }
@@ -1714,6 +1718,7 @@ impl BaStar {
             r,
             rc_px,
             last_scan: None,
+            last_disk: None,
             new_spans: Vec::new(),
             candidate_rows: Vec::new(),
             band_rows: ((side / frame.resolution).floor() as usize).clamp(1, 64),
