@@ -4,7 +4,9 @@
 //!
 //! * `dijkstra/*`: the nearest of a set of far targets (BA*'s backtracking selection shape):
 //!   [`TileSearch::nearest`] (BA*'s own scratch) against [`SearchSpace`] driven the same way.
-//! * `astar/*`: corner to corner: [`TileSearch::astar`] against [`SearchSpace`].
+//! * `astar/*`: corner to corner: [`TileSearch::astar`] against [`SearchSpace`], and
+//!   [`TileSearch::astar_bounded`] given the path's cost (as BA* calls it after its nearest
+//!   search), which labels no tile keyed above that cost.
 //! * `bfs/*`: a 4-connected flood of the whole component: the former BSA-BFS pattern (a fresh
 //!   parent array and a `VecDeque` per search) against [`SearchSpace::flood_fill`] and the
 //!   same flood through the driver calls ([`SearchSpace::pop_fifo`], [`SearchSpace::discover`]).
@@ -186,6 +188,9 @@ fn bench(c: &mut Criterion) {
     );
     assert_eq!((g.idx(a.0).expect("in range"), a.1), b, "dijkstra differs");
     let a = old.astar(&g, corner, far).expect("connected");
+    let bounded = old.astar_bounded(&g, corner, far, a.1).expect("connected");
+    assert_eq!(a, bounded, "bounded astar differs");
+    let cost = a.1;
     let b = module_search(&mut new, &g, corner, Some(far), &|_| false).expect("connected");
     let path: Vec<Tile> = new.path_to(b.0).iter().map(|&k| g.tile(k)).collect();
     assert_eq!((a.0, a.1), (path, b.1), "astar differs");
@@ -205,6 +210,9 @@ fn bench(c: &mut Criterion) {
     });
     grp.bench_function("astar/ba_star_tile_search", |bch| {
         bch.iter(|| old.astar(&g, corner, far));
+    });
+    grp.bench_function("astar/ba_star_tile_search_bounded", |bch| {
+        bch.iter(|| old.astar_bounded(&g, corner, far, cost));
     });
     grp.bench_function("astar/search_space", |bch| {
         bch.iter(|| module_search(&mut new, &g, corner, Some(far), &|_| false));

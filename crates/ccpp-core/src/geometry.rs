@@ -192,6 +192,27 @@ pub fn ceil_i32(x: f64) -> i32 {
     ceil_i64(x).clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32
 }
 
+/// `x.round() as i64` (half away from zero), bit for bit (saturating; NaN gives 0), without a
+/// call into libm. `x - trunc(x)` is exact in floating point, so the half test is exact.
+#[inline]
+pub fn round_i64(x: f64) -> i64 {
+    let t = x as i64;
+    let f = x - t as f64;
+    if f >= 0.5 {
+        t.saturating_add(1)
+    } else if f <= -0.5 {
+        t.saturating_sub(1)
+    } else {
+        t
+    }
+}
+
+/// `x.round() as i32`, bit for bit (saturating), without a call into libm.
+#[inline]
+pub fn round_i32(x: f64) -> i32 {
+    round_i64(x).clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -226,6 +247,12 @@ mod tests {
             f64::MAX,
             f64::MIN,
             f64::EPSILON,
+            0.499_999_999_999_999_94,
+            -0.499_999_999_999_999_94,
+            1.5,
+            -1.5,
+            4_503_599_627_370_496.5,
+            -4_503_599_627_370_496.5,
         ];
         let mut seed = 7u64;
         for _ in 0..20_000 {
@@ -240,6 +267,8 @@ mod tests {
             assert_eq!(ceil_i64(x), x.ceil() as i64, "{x:e}");
             assert_eq!(floor_i32(x), x.floor() as i32, "{x:e}");
             assert_eq!(ceil_i32(x), x.ceil() as i32, "{x:e}");
+            assert_eq!(round_i64(x), x.round() as i64, "{x:e}");
+            assert_eq!(round_i32(x), x.round() as i32, "{x:e}");
         }
     }
 

@@ -58,15 +58,38 @@ impl<'a> Scan<'a> {
     /// Calls `f(row, lo, hi)` for every image row holding in-range pixels, top to bottom: the
     /// in-range pixels of the row are exactly columns `lo..=hi` (the same pixels, in the same
     /// order, as [`Self::for_each`]).
-    pub fn for_each_row_span(&self, mut f: impl FnMut(usize, usize, usize)) {
+    pub fn for_each_row_span(&self, f: impl FnMut(usize, usize, usize)) {
+        self.row_spans_beyond(None, f);
+    }
+
+    /// Where the scan was taken (continuous grid coordinates) and its range in pixels.
+    pub(crate) fn disk_px(&self) -> (Point, f64) {
+        (self.center, self.range_px)
+    }
+
+    /// [`Self::for_each_row_span`], leaving out rows all of whose in-range pixels are in range
+    /// of an earlier scan `prev` (`(centre, range)` from [`Self::disk_px`]) of the same map:
+    /// the leading edge of a moving sensor. A row is left out only with a margin of
+    /// [`LEADING_EDGE_MARGIN_PX`] on each side, far above the rounding of either in-range test,
+    /// so every pixel it holds passed the earlier scan's test.
+    pub(crate) fn row_spans_beyond(
+        &self,
+        prev: Option<(Point, f64)>,
+        mut f: impl FnMut(usize, usize, usize),
+    ) {
+        // Only for the same range, and ranges small enough for the margin to dominate the
+        // rounding of the squared distances (`r^2` up to 1e8 px^2).
+        let prev = prev
+            .filter(|&(_, r)| r.to_bits() == self.range_px.to_bits() && r <= 1e4)
+            .map(|(c, _)| c);
         let frame = self.map.frame();
         let r = self.range_px;
         let r2 = r * r;
         let h = frame.height as f64;
-        let c0 = (self.center.x - r - 0.5).floor().max(0.0) as usize;
-        let c1 = ((self.center.x + r - 0.5).ceil().max(0.0) as usize).min(frame.width - 1);
-        let r0 = (h - (self.center.y + r) - 0.5).floor().max(0.0) as usize;
-        let r1 = ((h - (self.center.y - r) - 0.5).ceil().max(0.0) as usize).min(frame.height - 1);
+        let c0 = floor_i64(self.center.x - r - 0.5).max(0) as usize;
+        let c1 = (ceil_i64(self.center.x + r - 0.5).max(0) as usize).min(frame.width - 1);
+        let r0 = floor_i64(h - (self.center.y + r) - 0.5).max(0) as usize;
+        let r1 = (ceil_i64(h - (self.center.y - r) - 0.5).max(0) as usize).min(frame.height - 1);
         if c0 > c1 {
             return;
         }
@@ -85,6 +108,17 @@ impl<'a> Scan<'a> {
             // the in-range columns of a row are one interval. Guess its ends from the square
             // root, then settle them with the exact test.
             let half = (r2 - dy2).sqrt();
+            if let Some(a) = prev {
+                // The row's in-range pixel centres lie within `half` (plus rounding) of the
+                // centre's x; they were all in range of `a` when that interval, grown by the
+                // margin, lies within `a`'s chord of this row shrunk by the margin:
+                // `|dx| + half + 2 m <= sqrt(r^2 - dy_a^2)`.
+                let dya = gy - a.y;
+                let s = (self.center.x - a.x).abs() + half + 2.0 * LEADING_EDGE_MARGIN_PX;
+                if s * s + dya * dya < r2 {
+                    continue;
+                }
+            }
             let mut lo = ceil_i64(self.center.x - 0.5 - half).clamp(c0, c1 + 1);
             while lo > c0 && inside(lo - 1, dy2) {
                 lo -= 1;
@@ -121,10 +155,10 @@ impl<'a> Scan<'a> {
         let r = self.range_px;
         let r2 = r * r;
         let h = frame.height as f64;
-        let c0 = (self.center.x - r - 0.5).floor().max(0.0) as usize;
-        let c1 = ((self.center.x + r - 0.5).ceil().max(0.0) as usize).min(frame.width - 1);
-        let r0 = (h - (self.center.y + r) - 0.5).floor().max(0.0) as usize;
-        let r1 = ((h - (self.center.y - r) - 0.5).ceil().max(0.0) as usize).min(frame.height - 1);
+        let c0 = floor_i64(self.center.x - r - 0.5).max(0) as usize;
+        let c1 = (ceil_i64(self.center.x + r - 0.5).max(0) as usize).min(frame.width - 1);
+        let r0 = floor_i64(h - (self.center.y + r) - 0.5).max(0) as usize;
+        let r1 = (ceil_i64(h - (self.center.y - r) - 0.5).max(0) as usize).min(frame.height - 1);
         for row in r0..=r1 {
             let gy = h - row as f64 - 0.5;
             let dy2 = (gy - self.center.y).powi(2);
@@ -140,6 +174,10 @@ impl<'a> Scan<'a> {
         }
     }
 }
+
+/// Margin (pixels) by which a row of a scan must lie inside an earlier scan's disk to be left
+/// out of [`Scan::row_spans_beyond`]: far above the rounding of the in-range tests.
+const LEADING_EDGE_MARGIN_PX: f64 = 1e-3;
 
 /// What a real robot can know.
 pub trait Sensor {
@@ -292,6 +330,42 @@ impl KnownMap {
                 }
                 first_seen(i - base, row, cell);
             });
+        });
+    }
+
+    /// Stores every pixel of a scan and calls `new_in_row(row, lo, hi)` once for each image
+    /// row holding pixels seen for the first time, top to bottom: `lo` and `hi` are the first
+    /// and last such column of the row (the pixels between them may include ones seen before).
+    /// The same pixels are stored as by [`Self::integrate_with`], without a call per pixel.
+    ///
+    /// `prev`: the [`Scan::disk_px`] of the scan integrated last into this map (of the same
+    /// true map), if any; the rows already in its range are skipped (the leading edge).
+    pub(crate) fn integrate_rows(
+        &mut self,
+        scan: &Scan<'_>,
+        prev: Option<(Point, f64)>,
+        mut new_in_row: impl FnMut(usize, usize, usize),
+    ) {
+        let w = self.grid.frame().width;
+        let truth = scan.map.cells();
+        let cells = self.grid.cells_mut();
+        let seen = self.seen.as_mut_slice();
+        let free = self.free.as_mut_slice();
+        scan.row_spans_beyond(prev, |row, lo, hi| {
+            let base = row * w;
+            let (mut first, mut last) = (usize::MAX, 0);
+            crate::bits::insert_range(seen, base + lo, base + hi + 1, |i| {
+                let cell = truth[i];
+                cells[i] = cell;
+                if cell.is_free() {
+                    free[i / BLOCK_BITS] |= 1 << (i % BLOCK_BITS);
+                }
+                first = first.min(i);
+                last = i;
+            });
+            if first <= last {
+                new_in_row(row, first - base, last - base);
+            }
         });
     }
 
@@ -505,5 +579,67 @@ mod tests {
             scan.for_each_row_span(|r, lo, hi| b.extend((lo..=hi).map(|c| (c, r))));
             assert_eq!(a, b, "centre {center:?} range {range}");
         }
+    }
+
+    /// The leading edge: the rows `row_spans_beyond` leaves out hold only pixels in range of
+    /// the earlier scan, and the rows it keeps are the full rows.
+    #[test]
+    fn leading_edge_rows_are_in_range_of_the_earlier_scan() {
+        let map = GridMap::filled(MapFrame::new(61, 47, 0.05), Cell::Free).expect("map");
+        let mut seed = 11u64;
+        let mut next = || {
+            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut skipped = 0;
+        for k in 0..4000 {
+            let a = Point::new(next() * 3.0, next() * 2.3);
+            // Moves along an axis (by whole and fractional pixels) and in any direction.
+            let step = if k % 2 == 0 {
+                (next() * 8.0).round() * 0.05
+            } else {
+                next() * 0.5
+            };
+            let dir = if k % 4 < 2 {
+                f64::from((k / 4 % 4) as u8) * std::f64::consts::FRAC_PI_2
+            } else {
+                next() * std::f64::consts::TAU
+            };
+            let b = Point::new(a.x + step * dir.cos(), a.y + step * dir.sin());
+            let range = if k % 3 == 0 {
+                (next() * 10.0).round() * 0.05
+            } else {
+                next() * 0.6
+            };
+            let (sa, sb) = (Scan::new(&map, a, range), Scan::new(&map, b, range));
+            let mut seen_a = std::collections::BTreeSet::new();
+            sa.for_each(|c, r, _| {
+                seen_a.insert((c, r));
+            });
+            let mut full = Vec::new();
+            sb.for_each_row_span(|r, lo, hi| full.push((r, lo, hi)));
+            let mut kept = Vec::new();
+            sb.row_spans_beyond(Some(sa.disk_px()), |r, lo, hi| kept.push((r, lo, hi)));
+            for &(r, lo, hi) in &full {
+                if kept.contains(&(r, lo, hi)) {
+                    continue;
+                }
+                skipped += 1;
+                for c in lo..=hi {
+                    assert!(
+                        seen_a.contains(&(c, r)),
+                        "{a:?} -> {b:?}, range {range}: {c},{r}"
+                    );
+                }
+            }
+            assert!(kept.iter().all(|s| full.contains(s)));
+            // A different range: nothing left out.
+            let mut other = Vec::new();
+            sb.row_spans_beyond(Some((sa.disk_px().0, sa.disk_px().1 + 1.0)), |r, lo, hi| {
+                other.push((r, lo, hi));
+            });
+            assert_eq!(other, full);
+        }
+        assert!(skipped > 1000, "{skipped}");
     }
 }

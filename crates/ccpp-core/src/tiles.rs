@@ -5,7 +5,7 @@ use std::collections::VecDeque;
 
 use fixedbitset::FixedBitSet;
 
-use crate::geometry::Point;
+use crate::geometry::{round_i32, Point};
 use crate::world::World;
 
 /// A tile index: `i` east, `j` north.
@@ -51,8 +51,8 @@ impl TileGrid {
     #[inline]
     pub fn tile_of(&self, p: Point) -> Tile {
         (
-            ((p.x - self.anchor.x) / self.side).round() as i32,
-            ((p.y - self.anchor.y) / self.side).round() as i32,
+            round_i32((p.x - self.anchor.x) / self.side),
+            round_i32((p.y - self.anchor.y) / self.side),
         )
     }
 

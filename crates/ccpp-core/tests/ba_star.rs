@@ -222,6 +222,75 @@ fn unified_scenario_execution() {
     assert!((d - 10.0).abs() < 1e-12);
 }
 
+/// Covered tiles of a pseudo-random 24 x 24 patch (about 70 % covered), on a range larger
+/// than the patch (so searches meet the border of the range and tiles outside it).
+struct Patch {
+    covered: Vec<bool>,
+}
+
+impl Patch {
+    fn new(seed: u64) -> Self {
+        let mut x = seed;
+        let covered = (0..24 * 24)
+            .map(|_| {
+                x = x
+                    .wrapping_mul(6_364_136_223_846_793_005)
+                    .wrapping_add(1_442_695_040_888_963_407);
+                (x >> 33) % 10 < 7
+            })
+            .collect();
+        Self { covered }
+    }
+}
+
+impl TileGraph for Patch {
+    fn bounds(&self) -> (i32, i32, i32, i32) {
+        (-2, 22, -2, 22)
+    }
+    fn covered(&self, t: Tile) -> bool {
+        (0..24).contains(&t.0) && (0..24).contains(&t.1) && self.covered[(t.1 * 24 + t.0) as usize]
+    }
+    fn move_free(&self, t: Tile, k: usize) -> bool {
+        // Some moves blocked, deterministically.
+        (t.0 * 7 + t.1 * 13 + k as i32) % 11 != 0
+    }
+}
+
+#[test]
+fn bounded_astar_gives_the_full_search_answer() {
+    let mut checked = 0;
+    for seed in 0..40 {
+        let g = Patch::new(seed);
+        let mut s = TileSearch::new(g.bounds());
+        let tiles: Vec<Tile> = (0..24 * 24)
+            .map(|k| (k % 24, k / 24))
+            .filter(|&t| g.covered(t))
+            .collect();
+        let from = tiles[(seed as usize * 7) % tiles.len()];
+        for &to in tiles.iter().step_by(5) {
+            let full = s.astar(&g, from, to);
+            // The known cost (as from `nearest`), and wrong bounds: too low (the bounded search
+            // runs dry and the full one answers) and too high.
+            let cost = full.as_ref().map_or(0, |(_, c)| *c);
+            for bound in [cost, cost.saturating_sub(1), cost / 2, cost + COST_ORTHO] {
+                assert_eq!(
+                    s.astar_bounded(&g, from, to, bound),
+                    full,
+                    "seed {seed}: {from:?} -> {to:?}, bound {bound}"
+                );
+            }
+            if full.is_some() {
+                checked += 1;
+            }
+        }
+        // As BA* calls it: the cost from `nearest`.
+        if let Some((t, c)) = s.nearest(&g, from, |t| t.0 + t.1 >= 40) {
+            assert_eq!(s.astar_bounded(&g, from, t, c), s.astar(&g, from, t));
+        }
+    }
+    assert!(checked > 500, "{checked}");
+}
+
 #[test]
 fn astar_needs_both_orthogonal_tiles_for_a_diagonal() {
     // (0,0) and (1,1) covered, (1,0) covered, (0,1) not: the diagonal is not an edge.

@@ -609,27 +609,95 @@ impl TileSearch {
     }
 
     fn expand(&mut self, g: &impl TileGraph, t: Tile, k: usize, d: u64, goal: Option<Tile>) {
+        self.expand_within(g, t, k, d, goal, u64::MAX);
+    }
+
+    /// Relaxes the edges of the settled tile `t` (index `k`, cost `d`), pushing each improved
+    /// neighbour with key `cost + heuristic`; a neighbour whose key would exceed `bound` is left
+    /// unlabelled (see [`Self::astar_within`]).
+    #[inline]
+    fn expand_within(
+        &mut self,
+        g: &impl TileGraph,
+        t: Tile,
+        k: usize,
+        d: u64,
+        goal: Option<Tile>,
+        bound: u64,
+    ) {
         let mut mask = g.edge_mask(t);
+        if mask == 0 {
+            return;
+        }
+        // Interior tiles of the search rectangle reach their neighbours by a fixed index
+        // offset; the others go through `idx` (a neighbour outside the rectangle is skipped).
+        let (di0, dj0) = (t.0 - self.i0, t.1 - self.j0);
+        let interior =
+            di0 >= 1 && dj0 >= 1 && (di0 as usize) + 1 < self.w && (dj0 as usize) + 1 < self.h;
+        let w = self.w as isize;
+        let gen = self.generation;
         while mask != 0 {
             let n = mask.trailing_zeros() as usize;
             mask &= mask - 1;
             let (di, dj) = N8[n];
             let v = (t.0 + di, t.1 + dj);
-            let Some(kv) = self.idx(v) else { continue };
-            if self.closed(kv) {
+            let kv = if interior {
+                (k as isize + di as isize + dj as isize * w) as usize
+            } else {
+                let Some(kv) = self.idx(v) else { continue };
+                kv
+            };
+            let nd = d + if n % 2 == 1 { COST_DIAG } else { COST_ORTHO };
+            let node = &mut self.nodes[kv];
+            // Settled (stamp gen + 1), or labelled at least as well: nothing to do.
+            if node.stamp == gen + 1 || (node.stamp == gen && nd >= node.dist) {
                 continue;
             }
-            let nd = d + if n % 2 == 1 { COST_DIAG } else { COST_ORTHO };
-            if self.relax(kv, nd, k as u32) {
-                let f = nd + goal.map_or(0, |gl| heuristic(v, gl));
-                self.heap.push(f, kv as u32);
+            let f = nd + goal.map_or(0, |gl| heuristic(v, gl));
+            if f > bound {
+                continue;
             }
+            node.stamp = gen;
+            node.dist = nd;
+            node.parent = k as u32;
+            self.heap.push(f, kv as u32);
         }
     }
 
     /// A* from `from` to `to` over the graph of [`graph_edge`] (costs [`COST_ORTHO`] /
     /// [`COST_DIAG`], Euclidean heuristic); the tile path (both ends included) and its cost.
     pub fn astar(&mut self, g: &impl TileGraph, from: Tile, to: Tile) -> Option<(Vec<Tile>, u64)> {
+        self.astar_within(g, from, to, u64::MAX)
+    }
+
+    /// [`Self::astar`] when the cost of the best path is known to be `cost` (say from
+    /// [`Self::nearest`] on the same graph): the same answer, without labelling the tiles whose
+    /// key `cost + heuristic` exceeds `cost`.
+    ///
+    /// Why it is the same: the queue pops pairs in `(key, index)` order, so leaving out pairs
+    /// keyed above `cost` changes neither the order of the others nor any label at or below it
+    /// (a later, better label of a left-out tile is pushed as it would have been). The goal's
+    /// key is its cost; while the full search pops only keys `<= cost` it runs exactly as this
+    /// one. Should it pop a larger key before the goal (only possible with an inconsistent
+    /// heuristic), this one runs dry first and the full search is run instead.
+    pub fn astar_bounded(
+        &mut self,
+        g: &impl TileGraph,
+        from: Tile,
+        to: Tile,
+        cost: u64,
+    ) -> Option<(Vec<Tile>, u64)> {
+        self.astar_within(g, from, to, cost)
+            .or_else(|| self.astar_within(g, from, to, u64::MAX))
+    }
+
+    fn astar_within(
+        &mut self,
+        g: &impl TileGraph,
+        from: Tile,
+        to: Tile,
+        bound: u64,
+    ) -> Option<(Vec<Tile>, u64)> {
         let s = self.idx(from)?;
         self.idx(to)?;
         self.begin();
@@ -646,7 +714,7 @@ impl TileSearch {
             if t == to {
                 return Some((self.path_to(k), d));
             }
-            self.expand(g, t, k, d, Some(to));
+            self.expand_within(g, t, k, d, Some(to), bound);
         }
         None
     }
@@ -790,6 +858,11 @@ pub fn smooth_path(path: &[Tile], mut visible: impl FnMut(Tile, Tile) -> bool) -
     }
     out
 }
+
+/// Margin (pixels) added to the contact radius when [`Mind::sense`] bounds the tiles a new
+/// pixel can affect: covers the rounding of the world/grid/tile conversions (the exact test
+/// follows; a larger margin only costs time).
+const CANDIDATE_MARGIN_PX: f64 = 0.01;
 
 // Tile state bits.
 const ST_STAND: u8 = 0b0011; // Judgement of standing at the centre
@@ -1104,9 +1177,17 @@ struct Mind {
     rc_px: f64,
     /// Where the last scan was integrated.
     last_scan: Option<Point>,
+    /// The disk of the last scan integrated ([`crate::planner::Scan::disk_px`]): the rows a
+    /// new scan shares with it hold nothing new.
+    last_disk: Option<(Point, f64)>,
     /// Scratch for [`Mind::sense`]: per row of the last scan, the column span of the pixels
     /// seen for the first time (`(usize::MAX, 0)` when none).
     new_spans: Vec<(usize, usize)>,
+    /// Scratch for [`Mind::sense`]: per tile row of the candidate box, the hull of the
+    /// candidate tile columns (`(i32::MAX, i32::MIN)` when none).
+    candidate_rows: Vec<(i32, i32)>,
+    /// Rows of new pixels per candidate band in [`Mind::sense`]: about one tile side.
+    band_rows: usize,
     /// Per-tile cache of the contact disk's pixel spans for [`Mind::judge_tile`].
     disk: DiskCache,
 }
@@ -1173,7 +1254,11 @@ impl Mind {
 
     fn set_stand(&mut self, k: usize, t: Tile, j: Judgement) {
         self.tiles.state[k] = (self.tiles.state[k] & !ST_STAND) | j as u8;
-        self.tiles.update_l_around(t);
+        // `mu` reads a standability only as "is it Blocked?" (`blocked`, the lane-end
+        // obstacles), so a tile judged Free changes no tile's L membership.
+        if j == Judgement::Blocked {
+            self.tiles.update_l_around(t);
+        }
     }
 
     /// Integrates a scan taken at `pose` and refreshes every judgement it can change.
@@ -1196,48 +1281,75 @@ impl Mind {
         let mut spans = std::mem::take(&mut self.new_spans);
         spans.clear();
         let mut first_row = 0usize;
-        self.known.integrate_with(&scan, |c, r, _| {
+        let prev = self.last_disk.replace(scan.disk_px());
+        self.known.integrate_rows(&scan, prev, |r, lo, hi| {
             if spans.is_empty() {
                 first_row = r;
             }
             let k = r - first_row;
-            if k >= spans.len() {
-                spans.resize(k + 1, (usize::MAX, 0));
-            }
-            let s = &mut spans[k];
-            s.0 = s.0.min(c);
-            s.1 = s.1.max(c);
+            spans.resize(k, (usize::MAX, 0));
+            spans.push((lo, hi));
         });
         if spans.is_empty() {
             self.new_spans = spans;
             return;
         }
         let last_row = first_row + spans.len() - 1;
-        let (c0, c1) = spans
-            .iter()
-            .fold((usize::MAX, 0), |(a, b), s| (a.min(s.0), b.max(s.1)));
-        // Candidate tiles: the new pixels' box grown by the contact radius, in grid
-        // coordinates, then the hull of its corners in tile indices (tiles are axis-aligned in
-        // the world frame).
+        // Candidate tiles: a tile's standability can change only when a new pixel lies in its
+        // contact disk, i.e. when its centre lies within `rc` of a new pixel's centre. The new
+        // pixels are taken in bands of rows about one tile high; each band's box, grown by
+        // `rc` plus a margin for rounding, gives (as the hull of its corners in tile indices:
+        // tiles are axis-aligned in the world frame) a range of tiles per tile row, kept as the
+        // hull per tile row. Tiles are then visited row by row, each at most once.
         let frame = *self.known.frame();
         let h = frame.height as f64;
         let rc = self.rc_px;
-        let m = rc + 1.0;
-        let (x0, x1) = (c0 as f64 + 0.5 - m, c1 as f64 + 0.5 + m);
-        let (y0, y1) = (
-            h - last_row as f64 - 0.5 - m,
-            h - first_row as f64 - 0.5 + m,
-        );
+        let m = rc + CANDIDATE_MARGIN_PX;
         let grid = self.tiles.grid;
-        let (mut i0, mut i1, mut j0, mut j1) = (i32::MAX, i32::MIN, i32::MAX, i32::MIN);
-        for (x, y) in [(x0, y0), (x1, y0), (x0, y1), (x1, y1)] {
-            let t = grid.tile_of(frame.grid_to_world(Point::new(x, y)));
-            i0 = i0.min(t.0);
-            i1 = i1.max(t.0);
-            j0 = j0.min(t.1);
-            j1 = j1.max(t.1);
+        let unrotated = frame.origin.theta == 0.0;
+        let tile_box = |c0: usize, c1: usize, r0: usize, r1: usize| {
+            let (x0, x1) = (c0 as f64 + 0.5 - m, c1 as f64 + 0.5 + m);
+            let (y0, y1) = (h - r1 as f64 - 0.5 - m, h - r0 as f64 - 0.5 + m);
+            let (mut i0, mut i1, mut j0, mut j1) = (i32::MAX, i32::MIN, i32::MAX, i32::MIN);
+            // Without rotation a corner's tile column depends on its x alone and its row on
+            // its y alone: two opposite corners give the same hull as four.
+            let corners: &[(f64, f64)] = if unrotated {
+                &[(x0, y0), (x1, y1)]
+            } else {
+                &[(x0, y0), (x1, y0), (x0, y1), (x1, y1)]
+            };
+            for &(x, y) in corners {
+                let t = grid.tile_of(frame.grid_to_world(Point::new(x, y)));
+                i0 = i0.min(t.0);
+                i1 = i1.max(t.0);
+                j0 = j0.min(t.1);
+                j1 = j1.max(t.1);
+            }
+            (i0, i1, j0, j1)
+        };
+        let (c0, c1) = spans
+            .iter()
+            .fold((usize::MAX, 0), |(a, b), s| (a.min(s.0), b.max(s.1)));
+        let (_, _, j0, j1) = tile_box(c0, c1, first_row, last_row);
+        let mut ranges = std::mem::take(&mut self.candidate_rows);
+        ranges.clear();
+        ranges.resize((j1 - j0 + 1) as usize, (i32::MAX, i32::MIN));
+        for (b, band) in spans.chunks(self.band_rows).enumerate() {
+            let (bc0, bc1) = band
+                .iter()
+                .fold((usize::MAX, 0), |(a, b), s| (a.min(s.0), b.max(s.1)));
+            if bc0 > bc1 {
+                continue;
+            }
+            let r0 = first_row + b * self.band_rows;
+            let (bi0, bi1, bj0, bj1) = tile_box(bc0, bc1, r0, r0 + band.len() - 1);
+            for j in bj0.max(j0)..=bj1.min(j1) {
+                let r = &mut ranges[(j - j0) as usize];
+                r.0 = r.0.min(bi0);
+                r.1 = r.1.max(bi1);
+            }
         }
-        for j in j0..=j1 {
+        for (j, &(i0, i1)) in (j0..).zip(ranges.iter()) {
             for i in i0..=i1 {
                 let t = (i, j);
                 let Some(k) = self.tiles.idx(t) else { continue };
@@ -1284,6 +1396,7 @@ impl Mind {
             }
         }
         self.new_spans = spans;
+        self.candidate_rows = ranges;
     }
 
     /// The first image row and the column offsets are taken from in the [`DiskCache`] slots of
@@ -1605,7 +1718,10 @@ impl BaStar {
             r,
             rc_px,
             last_scan: None,
+            last_disk: None,
             new_spans: Vec::new(),
+            candidate_rows: Vec::new(),
+            band_rows: ((side / frame.resolution).floor() as usize).clamp(1, 64),
             disk: DiskCache::new(n_tiles, rc_px),
         }));
     }
@@ -1648,7 +1764,7 @@ impl BaStar {
         }
         let tiles = &m.tiles;
         let found = m.search.nearest(tiles, c, |t| tiles.in_l(t));
-        let Some((sp, _)) = found else {
+        let Some((sp, sp_cost)) = found else {
             // Cannot happen: covered tiles form one connected graph.
             self.pending.push_back(Step::Mark(Event::Note {
                 text: "ba-star: no backtracking candidate reachable".to_string(),
@@ -1658,7 +1774,7 @@ impl BaStar {
         };
         let raw = m
             .search
-            .astar(&m.tiles, c, sp)
+            .astar_bounded(&m.tiles, c, sp, sp_cost)
             .map_or_else(|| vec![c, sp], |(p, _)| p);
         let smoothed = if self.opts.smoothing {
             let mm = &*m;
