@@ -526,7 +526,13 @@ fn low_yield_trips_are_left_within_the_budget() {
         all_len += am.path_length_m;
         if lo.trace != ao.trace {
             differed += 1;
-            assert!(lm.effective_coverage <= am.effective_coverage + 1e-9);
+            // What is left stays small (the changed order may also sweep a little more).
+            assert!(
+                lm.effective_coverage > am.effective_coverage - 0.005,
+                "{} {}",
+                lm.effective_coverage,
+                am.effective_coverage
+            );
         }
     }
     assert!(differed >= 1);
