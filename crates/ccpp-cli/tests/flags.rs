@@ -343,6 +343,16 @@ fn config_values_go_through_the_same_validation() {
             "bsa-extended",
             "bsa_extended.extension.reach_r",
         ),
+        (
+            "ba_star_extended: { extension: { min_yield: -0.1 } }",
+            "ba-star-extended",
+            "ba_star_extended.extension.min_yield",
+        ),
+        (
+            "bsa_extended: { extension: { leave_fraction: 1.5 } }",
+            "bsa-extended",
+            "bsa_extended.extension.leave_fraction",
+        ),
         // Options the rebuilt bsa-extended dropped are unknown keys now, refused by name.
         ("bsa_extended: { gap_cost: 4 }", "bsa-extended", "gap_cost"),
         (

@@ -496,3 +496,46 @@ fn a_diagonal_wall_is_followed_in_few_segments() {
         merged.effective_coverage
     );
 }
+
+/// `min_yield` / `leave_fraction`: trips that do not pay for themselves are left, within the
+/// budget; `min_yield: 0` or `leave_fraction: 0` drive every one.
+#[test]
+fn low_yield_trips_are_left_within_the_budget() {
+    let opts = |min_yield, leave_fraction| BaStarExtendedOptions {
+        extension: ExtensionOptions {
+            reach_r: 0.0,
+            min_yield,
+            leave_fraction,
+            ..ExtensionOptions::default()
+        },
+        ..BaStarExtendedOptions::default()
+    };
+    let d = ExtensionOptions::default();
+    assert!(d.min_yield > 0.0 && d.leave_fraction > 0.0);
+    let (mut differed, mut left_len, mut all_len) = (0, 0.0, 0.0);
+    for (art, c, r) in [(HALLS, 2, 9), (BLOCKS, 1, 1), (ROOM, 2, 4)] {
+        let wd = world(art, c, r, 0.0).unwrap();
+        let (lo, lm, _) = run_ext(&wd, opts(d.min_yield, d.leave_fraction));
+        let (ao, am, _) = run_ext(&wd, opts(0.0, d.leave_fraction));
+        let (zo, _, _) = run_ext(&wd, opts(d.min_yield, 0.0));
+        // No budget: every trip is driven, as with no threshold.
+        assert_eq!(zo.trace, ao.trace);
+        assert_eq!(lm.collisions, 0);
+        assert!(lm.effective_coverage > 0.99, "{}", lm.effective_coverage);
+        left_len += lm.path_length_m;
+        all_len += am.path_length_m;
+        if lo.trace != ao.trace {
+            differed += 1;
+            // What is left stays small (the changed order may also sweep a little more).
+            assert!(
+                lm.effective_coverage > am.effective_coverage - 0.005,
+                "{} {}",
+                lm.effective_coverage,
+                am.effective_coverage
+            );
+        }
+    }
+    assert!(differed >= 1);
+    // Shorter in all (one map alone may come out longer: the greedy order changes).
+    assert!(left_len < all_len, "{left_len} {all_len}");
+}

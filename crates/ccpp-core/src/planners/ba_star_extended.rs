@@ -11,7 +11,9 @@
 //!   drives a known-free transfer ([`super::extension`]'s A* over positions, merged into
 //!   straight segments) straight to BA*'s chosen start point `s_sp`, and BA* resumes there.
 //!   When nothing was cleaned, BA*'s own smoothed backtracking path is driven.
-//! * **End of BA*** (`L` empty): passes over every rim left, wherever it is.
+//! * **End of BA*** (`L` empty): passes over every rim left, wherever it is, nearest first;
+//!   a trip that does not pay for itself ([`ExtensionOptions::min_yield`]) is left, within
+//!   [`ExtensionOptions::leave_fraction`] of the known floor.
 //!
 //! The passes are marked `wall_follow_start` / `wall_follow_end` in the trace, the transfer
 //! keeps BA*'s `backtrack_start` / `backtrack_end` marks, and every trip of a robot diameter or

@@ -458,7 +458,7 @@ impl PlannerSettings for BaStarExtendedOptions {
         self.ba_star
             .validate()
             .map_err(|e| e.in_section("ba_star"))?;
-        finite_nonneg("extension.reach_r", self.extension.reach_r)
+        self.extension.validate()
     }
 
     fn check(&self, s: &Setup) -> Result<(), OptionsError> {
@@ -524,7 +524,7 @@ impl PlannerSettings for BsaExtendedOptions {
                 "does not apply to bsa-extended (BSA has no lanes)",
             ));
         }
-        finite_nonneg("extension.reach_r", self.extension.reach_r)
+        self.extension.validate()
     }
 
     fn check(&self, s: &Setup) -> Result<(), OptionsError> {
