@@ -137,6 +137,10 @@ struct ExtensionSection {
     lane_ends: Option<bool>,
     #[serde(default, deserialize_with = "present")]
     merge_segments: Option<bool>,
+    #[serde(default, deserialize_with = "present")]
+    min_yield: Option<f64>,
+    #[serde(default, deserialize_with = "present")]
+    leave_fraction: Option<f64>,
 }
 
 /// A field that is present must hold a value (`null` is refused, as for the full type).
@@ -157,6 +161,8 @@ impl ExtensionSection {
             reach_r: self.reach_r.unwrap_or(base.reach_r),
             lane_ends: self.lane_ends.unwrap_or(base.lane_ends),
             merge_segments: self.merge_segments.unwrap_or(base.merge_segments),
+            min_yield: self.min_yield.unwrap_or(base.min_yield),
+            leave_fraction: self.leave_fraction.unwrap_or(base.leave_fraction),
         }
     }
 }
