@@ -689,6 +689,22 @@ impl Scenario {
         self.validate()?;
         self.check_map(map)?;
         let zones = self.zone_masks(map)?;
+        self.world_with_zones(map, zones)
+    }
+
+    /// The world of this scenario's robot and start on `map` with `zones` (from
+    /// [`zone_masks`](Self::zone_masks), loaded once by a caller that builds many worlds), without
+    /// the planner's checks: for callers that drive the robot themselves (Python's `Env`).
+    /// Errors about a zone name it, as [`world`](Self::world)'s do.
+    ///
+    /// # Errors
+    /// A start in a wall, outside the map or in a keep-out, an area the start cannot reach, a
+    /// robot that fits nowhere.
+    pub fn world_with_zones(
+        &self,
+        map: &PreparedMap,
+        zones: Option<ZoneMasks>,
+    ) -> Result<World, ScenarioError> {
         let start = self.start.map(|s| Pose::new(s[0], s[1], s[2]));
         World::with_zones(map.grid.clone(), self.robot, start, zones).map_err(|source| {
             match self.zone_of(&source) {
