@@ -20,7 +20,7 @@ use ccpp_core::sim::{RunOutput, SimConfig, Simulator, StopReason};
 use ccpp_core::trace::{Cursor, Entry, Event, Record, Trace};
 use ccpp_core::world::{Robot, World};
 use ccpp_core::zones::ZoneMasks;
-use ccpp_core::{Point, Pose};
+use ccpp_core::Point;
 use ccpp_io::export::{render_exports, zone_features, ExportFormat, ExportMeta};
 use ccpp_io::scenario::{MapRecipe, PreparedMap, Scenario, ScenarioError};
 use ccpp_io::zones::ZoneSpec;
