@@ -701,6 +701,22 @@ impl Scenario {
         self.zone_masks(map)
     }
 
+    /// The world of this scenario's robot and start on `map` with `zones` (from
+    /// [`zone_masks`](Self::zone_masks), loaded once by a caller that builds many worlds), without
+    /// the planner's checks: for callers that drive the robot themselves (Python's `Env`).
+    /// Errors about a zone name it, as [`world`](Self::world)'s do.
+    ///
+    /// # Errors
+    /// A start in a wall, outside the map or in a keep-out, an area the start cannot reach, a
+    /// robot that fits nowhere.
+    pub fn world_with_zones(
+        &self,
+        map: &PreparedMap,
+        zones: Option<ZoneMasks>,
+    ) -> Result<World, ScenarioError> {
+        self.world_on(map.grid.clone(), &map.source, zones)
+    }
+
     /// Builds the world on `grid` (the prepared map's, loaded from `source`).
     fn world_on(
         &self,

@@ -15,11 +15,15 @@ use ccpp_core::metrics::{self, Metrics, Sweeper};
 use ccpp_core::planner::{KnownMap, Sensor, Step};
 use ccpp_core::planners::{PlannerConfig, PlannerKind, CATALOG};
 use ccpp_core::rng::SplitMix64;
+use ccpp_core::route::{Route, DEFAULT_TOLERANCE_M};
 use ccpp_core::sim::{RunOutput, SimConfig, Simulator, StopReason};
 use ccpp_core::trace::{Cursor, Entry, Event, Record, Trace};
 use ccpp_core::world::{Robot, World};
-use ccpp_core::{Point, Pose};
+use ccpp_core::zones::ZoneMasks;
+use ccpp_core::Point;
+use ccpp_io::export::{render_exports, zone_features, ExportFormat, ExportMeta};
 use ccpp_io::scenario::{MapRecipe, PreparedMap, Scenario, ScenarioError};
+use ccpp_io::zones::ZoneSpec;
 use fixedbitset::FixedBitSet;
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2};
@@ -328,6 +332,20 @@ const RUN_KEYS: [&str; 11] = [
     "keepout",
 ];
 
+/// A work area: a file name, `[x0, y0, x1, y1]` or a list of polygons (`Scenario::area`).
+fn parse_area(v: &Bound<'_, PyAny>) -> PyResult<ZoneSpec> {
+    serde_json::from_value(py_to_json(v)?).map_err(|e| msg(format!("area: {e}")))
+}
+
+/// Keep-out zones: one zone (as for an area) or a list of zones (`Scenario::keepout`).
+fn parse_keepout(v: &Bound<'_, PyAny>) -> PyResult<Vec<ZoneSpec>> {
+    let j = py_to_json(v)?;
+    match serde_json::from_value::<ZoneSpec>(j.clone()) {
+        Ok(one) => Ok(vec![one]),
+        Err(_) => serde_json::from_value(j).map_err(|e| msg(format!("keepout: {e}"))),
+    }
+}
+
 /// Builds the scenario of `ccpp.run`: keyword options -> scenario fields (validated later,
 /// once, by [`Scenario::run_on`]).
 fn scenario_from(
@@ -400,21 +418,8 @@ fn scenario_from(
             "name" => s.map.name = Some(v.extract()?),
             // Zones: a file name, [x0, y0, x1, y1] or a list of polygons (`Scenario::area`);
             // keepout: one zone or a list of zones (`Scenario::keepout`).
-            "area" => {
-                s.area = Some(
-                    serde_json::from_value(py_to_json(&v)?)
-                        .map_err(|e| msg(format!("area: {e}")))?,
-                );
-            }
-            "keepout" => {
-                let j = py_to_json(&v)?;
-                s.keepout = match serde_json::from_value::<ccpp_io::zones::ZoneSpec>(j.clone()) {
-                    Ok(one) => vec![one],
-                    Err(_) => {
-                        serde_json::from_value(j).map_err(|e| msg(format!("keepout: {e}")))?
-                    }
-                };
-            }
+            "area" => s.area = Some(parse_area(&v)?),
+            "keepout" => s.keepout = parse_keepout(&v)?,
             _ => {
                 planner_opts.insert(key, py_to_json(&v)?);
             }
@@ -446,6 +451,176 @@ pub struct RunResult {
     world: World,
     output: RunOutput,
     metrics: Metrics,
+}
+
+impl RunResult {
+    /// The export files of the run (the command line's `render_export_files`).
+    fn export_files(&self, formats: &[ExportFormat]) -> PyResult<Vec<(&'static str, Vec<u8>)>> {
+        ccpp_render::run_files::render_export_files(
+            &self.scenario,
+            &self.output.trace,
+            &self.metrics,
+            formats,
+            &zone_features(self.world.zones()),
+        )
+        .map_err(|e| err(&e))
+    }
+}
+
+/// Export format names -> formats.
+fn parse_formats(names: &[String]) -> PyResult<Vec<ExportFormat>> {
+    names
+        .iter()
+        .map(|n| n.parse::<ExportFormat>().map_err(|e| err(&e)))
+        .collect()
+}
+
+fn check_tolerance(t: f64) -> PyResult<()> {
+    if t.is_finite() && t >= 0.0 {
+        Ok(())
+    } else {
+        Err(msg(format!(
+            "tolerance_m must be a finite number >= 0, got {}",
+            ccpp_core::display::Compact(t)
+        )))
+    }
+}
+
+/// A route's waypoints as an `(N, 3)` array.
+fn route_array<'py>(py: Python<'py>, route: &Route) -> Bound<'py, PyArray2<f64>> {
+    let v: Vec<f64> = route
+        .waypoints
+        .iter()
+        .flat_map(|p| [p.x, p.y, p.theta])
+        .collect();
+    let n = v.len() / 3;
+    Array2::from_shape_vec((n, 3), v)
+        .unwrap_or_else(|_| Array2::zeros((0, 3)))
+        .into_pyarray(py)
+}
+
+/// The one rendered export file's text.
+fn export_text(files: Vec<(&'static str, Vec<u8>)>) -> PyResult<String> {
+    let (_, bytes) = files
+        .into_iter()
+        .next()
+        .ok_or_else(|| msg("no export format given"))?;
+    String::from_utf8(bytes).map_err(|e| err(&e))
+}
+
+/// Writes `files` into `folder` (created if needed), each atomically.
+fn write_files(folder: &Path, files: &[(&'static str, Vec<u8>)]) -> PyResult<()> {
+    if files.is_empty() {
+        return Ok(());
+    }
+    std::fs::create_dir_all(folder)
+        .map_err(|e| msg(format!("cannot create {}: {e}", folder.display())))?;
+    for (name, bytes) in files {
+        ccpp_io::write::write_atomic(&folder.join(name), bytes).map_err(|e| err(&e))?;
+    }
+    Ok(())
+}
+
+/// A path planned on a known map by `ccpp.plan` (as `ccpp plan`): its waypoints and exports.
+#[pyclass(module = "ccpp", frozen)]
+pub struct PlanResult {
+    planner: &'static str,
+    map: String,
+    robot: Robot,
+    route: Route,
+    zones: Option<ZoneMasks>,
+    finished: bool,
+}
+
+impl PlanResult {
+    fn files(&self, formats: &[ExportFormat]) -> PyResult<Vec<(&'static str, Vec<u8>)>> {
+        let meta = ExportMeta {
+            planner: self.planner,
+            map: &self.map,
+            robot: self.robot,
+            tolerance_m: DEFAULT_TOLERANCE_M,
+            metrics: None,
+        };
+        render_exports(
+            &self.route,
+            &meta,
+            formats,
+            &zone_features(self.zones.as_ref()),
+        )
+        .map_err(|e| err(&e))
+    }
+}
+
+#[pymethods]
+impl PlanResult {
+    /// The waypoints, `float64` `(N, 3)`: x, y, theta at the ends of the straight segments.
+    #[getter]
+    fn waypoints<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        route_array(py, &self.route)
+    }
+
+    /// Path length, metres.
+    #[getter]
+    fn length_m(&self) -> f64 {
+        self.route.length_m()
+    }
+
+    /// Whether the planner finished (not cut by the step cap).
+    #[getter]
+    fn finished(&self) -> bool {
+        self.finished
+    }
+
+    /// The path in export format `format` (`"csv"`, `"json"`, `"nav-path"`, `"geojson"`), as
+    /// the text of the file `ccpp plan --export FORMAT` writes.
+    fn export(&self, format: &str) -> PyResult<String> {
+        export_text(self.files(&parse_formats(&[format.to_string()])?)?)
+    }
+
+    /// Writes the exports into `folder` (created if needed), as `ccpp plan --out folder`:
+    /// `export` formats, default `["csv", "nav-path"]`.
+    #[pyo3(signature = (folder, export=None))]
+    fn save(&self, folder: PathBuf, export: Option<Vec<String>>) -> PyResult<()> {
+        let names = export.unwrap_or_else(|| vec!["csv".into(), "nav-path".into()]);
+        write_files(&folder, &self.files(&parse_formats(&names)?)?)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "PlanResult({} on {}: {} waypoints, {:.2} m)",
+            self.planner,
+            self.map,
+            self.route.waypoints.len(),
+            self.route.length_m()
+        )
+    }
+}
+
+/// Plans a path with a known-map planner (`bcd`, `rect-boustrophedon`) on `map`, as
+/// `ccpp plan`: the same keyword options as `run` (zones included), no simulation metrics.
+/// The GIL is released while planning.
+#[pyfunction]
+#[pyo3(signature = (map, planner="bcd", radius=0.15, **options))]
+fn plan(
+    py: Python<'_>,
+    map: &Bound<'_, PyAny>,
+    planner: &str,
+    radius: f64,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<PlanResult> {
+    let prepared = as_map(py, map)?;
+    let scenario = scenario_from(&prepared, planner, radius, options)?;
+    let p = py
+        .detach(|| ccpp_io::plan::plan_route(&scenario, &prepared, DEFAULT_TOLERANCE_M))
+        .map_err(|e| err(&e))?;
+    Ok(PlanResult {
+        planner: scenario.planner.name(),
+        map: prepared.name.clone(),
+        robot: scenario.robot,
+        route: p.route,
+        zones: p.world.zones().cloned(),
+        finished: p.stop == StopReason::Done,
+    })
 }
 
 #[pymethods]
@@ -524,8 +699,13 @@ impl RunResult {
     }
 
     /// Writes `run.json`, `path.csv`, `trace.jsonl`, `coverage.png` and `metrics.json` into
-    /// `folder` (created if needed), exactly as `ccpp run --out folder`.
-    fn save(&self, py: Python<'_>, folder: PathBuf) -> PyResult<()> {
+    /// `folder` (created if needed), exactly as `ccpp run --out folder`; `export` (a list of
+    /// `"csv"`, `"json"`, `"nav-path"`, `"geojson"`) adds the path exports, as
+    /// `ccpp run --export FORMAT`.
+    #[pyo3(signature = (folder, export=None))]
+    fn save(&self, py: Python<'_>, folder: PathBuf, export: Option<Vec<String>>) -> PyResult<()> {
+        let formats = parse_formats(export.as_deref().unwrap_or_default())?;
+        let files = self.export_files(&formats)?;
         py.detach(|| {
             ccpp_render::run_files::write_run_files(
                 &folder,
@@ -536,7 +716,31 @@ impl RunResult {
             )
         })
         .map_err(|e| err(&e))?;
-        Ok(())
+        write_files(&folder, &files)
+    }
+
+    /// The executed path's waypoints, `float64` `(N, 3)`: x, y, theta at the ends of its
+    /// straight segments (poses merged within `tolerance_m`, as in `path.csv` and the
+    /// exports).
+    #[pyo3(signature = (tolerance_m=DEFAULT_TOLERANCE_M))]
+    fn waypoints<'py>(
+        &self,
+        py: Python<'py>,
+        tolerance_m: f64,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        check_tolerance(tolerance_m)?;
+        Ok(route_array(
+            py,
+            &Route::from_trace(&self.output.trace, tolerance_m),
+        ))
+    }
+
+    /// The path in export format `format` (`"csv"`, `"json"`, `"nav-path"`, `"geojson"`), as
+    /// the text of the file `ccpp run --export FORMAT` writes.
+    fn export(&self, format: &str) -> PyResult<String> {
+        let f = parse_formats(&[format.to_string()])?;
+        let files = self.export_files(&f)?;
+        export_text(files)
     }
 
     fn __repr__(&self) -> String {
@@ -689,9 +893,12 @@ self_cell::self_cell!(
 #[pyclass(module = "ccpp")]
 pub struct Env {
     map: PreparedMap,
+    /// The validated scenario (robot, start, simulator settings, zones); its planner is unused.
+    scenario: Scenario,
+    /// The zones, loaded once.
+    zones: Option<ZoneMasks>,
     robot: Robot,
     sim: SimConfig,
-    start: Option<Pose>,
     max_steps: Option<u64>,
     episode: Option<Episode>,
 }
@@ -854,8 +1061,12 @@ impl Env {
     /// `radius` (tool radius `tool_radius`, default the same) with a sensor of range
     /// `sensor_range` metres (default 4 r). `exec` is `"ideal"` or `"pid"`; `start` a fixed
     /// start pose (default: the widest free spot, as in runs); `max_steps` truncates episodes.
+    /// `area` and `keepout` are zones as in `run` (and `ccpp run --area/--keepout`): virtual
+    /// walls the sensor shows, keep-out entries counted as `keepout_violations`, coverage
+    /// measured on the allowed floor; a start outside the area drives there first.
     #[new]
-    #[pyo3(signature = (map, *, radius=0.15, tool_radius=None, sensor_range=None, start=None, exec="ideal", max_steps=None))]
+    #[pyo3(signature = (map, *, radius=0.15, tool_radius=None, sensor_range=None, start=None, exec="ideal", max_steps=None, area=None, keepout=None))]
+    #[allow(clippy::too_many_arguments)] // keyword arguments of a Python constructor
     fn new(
         py: Python<'_>,
         map: &Bound<'_, PyAny>,
@@ -865,21 +1076,16 @@ impl Env {
         start: Option<Vec<f64>>,
         exec: &str,
         max_steps: Option<u64>,
+        area: Option<&Bound<'_, PyAny>>,
+        keepout: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let map = as_map(py, map)?;
-        // The scenario validates the robot, the sensor range and the execution.
-        let mut s = Scenario::new(map.recipe.clone(), PlannerKind::BaStar);
-        s.robot = Robot {
-            radius,
-            tool_radius: tool_radius.unwrap_or(radius),
-        };
-        s.sim.sensor_range = sensor_range;
-        s.sim.exec = Some(match exec.to_ascii_lowercase().as_str() {
+        let exec = match exec.to_ascii_lowercase().as_str() {
             "ideal" => Execution::Ideal,
             "pid" => Execution::Pid(PidOptions::default()),
             other => return Err(msg(format!("exec must be ideal or pid, got {other:?}"))),
-        });
-        s.start = match start.as_deref() {
+        };
+        let start = match start.as_deref() {
             None => None,
             Some([x, y]) => Some([*x, *y, 0.0]),
             Some([x, y, t]) => Some([*x, *y, *t]),
@@ -890,12 +1096,33 @@ impl Env {
                 )))
             }
         };
-        s.validate().map_err(|e| err(&e))?;
+        let area = area.map(parse_area).transpose()?;
+        let keepout = keepout.map(parse_keepout).transpose()?.unwrap_or_default();
+        // The scenario validates the robot, the sensor range, the execution and the zones.
+        let s = Scenario::configure(map.recipe.clone(), PlannerConfig::new(PlannerKind::BaStar))
+            .robot(Robot {
+                radius,
+                tool_radius: tool_radius.unwrap_or(radius),
+            })
+            .start_pose(start)
+            .sim(SimConfig {
+                sensor_range,
+                exec: Some(exec),
+                ..SimConfig::default()
+            })
+            .zones(area, keepout)
+            .build()
+            .map_err(|e| err(&e))?;
+        let zones = py.detach(|| s.zone_masks(&map)).map_err(|e| err(&e))?;
+        // The zones and the start are checked now, not at the first reset.
+        py.detach(|| s.world_with_zones(&map, zones.clone()))
+            .map_err(|e| err(&e))?;
         Ok(Self {
+            scenario: s.clone(),
+            zones,
             map,
             robot: s.robot,
             sim: s.sim,
-            start: s.start.map(|p| Pose::new(p[0], p[1], p[2])),
             max_steps,
             episode: None,
         })
@@ -903,21 +1130,17 @@ impl Env {
 
     /// Starts an episode and returns `(observation, info)`. Without `seed` the robot starts
     /// at the configured start (or the widest free spot); with `seed` at a pose drawn from the
-    /// free, reachable positions (deterministic for a seed).
+    /// free, reachable positions (deterministic for a seed; with zones, inside the area and
+    /// outside the keep-outs).
     #[pyo3(signature = (seed=None))]
     fn reset(&mut self, py: Python<'_>, seed: Option<u64>) -> PyResult<(Py<PyDict>, Py<PyDict>)> {
-        let grid = self.map.grid.clone();
-        let robot = self.robot;
-        let source = self.map.source.clone();
-        let fixed = self.start;
+        let scenario = &self.scenario;
+        let map = &self.map;
+        let zones = &self.zones;
         let sim_cfg = self.sim.clone();
-        let wrap = |e| ScenarioError::World {
-            path: source.clone(),
-            source: e,
-        };
         let episode = py
             .detach(|| -> Result<Episode, ScenarioError> {
-                let mut world = World::new(grid.clone(), robot, fixed).map_err(wrap)?;
+                let mut world = scenario.world_with_zones(map, zones.clone())?;
                 if let Some(seed) = seed {
                     let mut rng = SplitMix64::new(seed);
                     let n = world.reachable().count_ones(..);
@@ -927,13 +1150,15 @@ impl Env {
                         let (c, r) = f.col_row(i);
                         let p = f.pixel_center(c, r);
                         let theta = rng.range(-PI, PI);
-                        world = World::new(grid, robot, Some(Pose::new(p.x, p.y, theta)))
-                            .map_err(wrap)?;
+                        let mut at = scenario.clone();
+                        at.start = Some([p.x, p.y, theta]);
+                        world = at.world_with_zones(map, zones.clone())?;
                     }
                 }
                 Ok(Episode::new(world, |w| {
                     let f = *w.frame();
-                    let start = w.start().position();
+                    // Where the robot is placed (before an approach to the area).
+                    let start = w.initial_pose().position();
                     let mut sweeper = Sweeper::new(w);
                     sweeper.add(start, start);
                     let mut live = Live {
@@ -1076,6 +1301,8 @@ fn _ccpp(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("CcppError", m.py().get_type::<CcppError>())?;
     m.add_class::<Map>()?;
     m.add_class::<RunResult>()?;
+    m.add_class::<PlanResult>()?;
+    m.add_function(wrap_pyfunction!(plan, m)?)?;
     m.add_class::<Env>()?;
     m.add_function(wrap_pyfunction!(load_map, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;

@@ -331,7 +331,7 @@ fn zoned_run() -> (World, Trace) {
     t.push_event(0, Event::RegionStart { region: 1 });
     let mut k = 0;
     for lane in 0..6 {
-        let y = 0.4 + lane as f64 * 0.3;
+        let y = 0.4 + f64::from(lane) * 0.3;
         for s in 0..=20 {
             let f = f64::from(s) / 20.0;
             let x = if lane % 2 == 0 {

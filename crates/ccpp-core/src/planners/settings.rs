@@ -156,7 +156,7 @@ pub(crate) fn present<'de, D: serde::Deserializer<'de>, T: serde::Deserialize<'d
 impl ExtensionSection {
     /// The given fields over `base`. Every field is listed (no `..base`), so a field added to
     /// [`ExtensionOptions`] fails to compile here until it is read from files too.
-    fn over(self, base: ExtensionOptions) -> ExtensionOptions {
+    fn over(self, base: &ExtensionOptions) -> ExtensionOptions {
         ExtensionOptions {
             reach_r: self.reach_r.unwrap_or(base.reach_r),
             lane_ends: self.lane_ends.unwrap_or(base.lane_ends),
@@ -175,7 +175,7 @@ pub(crate) fn ba_star_extended_extension<'de, D: serde::Deserializer<'de>>(
     d: D,
 ) -> Result<ExtensionOptions, D::Error> {
     let section = <ExtensionSection as serde::Deserialize>::deserialize(d)?;
-    Ok(section.over(BaStarExtendedOptions::default().extension))
+    Ok(section.over(&BaStarExtendedOptions::default().extension))
 }
 
 /// Reads `bsa_extended.extension` over `bsa-extended`'s own extension defaults.
@@ -186,7 +186,7 @@ pub(crate) fn bsa_extended_extension<'de, D: serde::Deserializer<'de>>(
     d: D,
 ) -> Result<ExtensionOptions, D::Error> {
     let section = <ExtensionSection as serde::Deserialize>::deserialize(d)?;
-    Ok(section.over(BsaExtendedOptions::default().extension))
+    Ok(section.over(&BsaExtendedOptions::default().extension))
 }
 
 /// A planner's options: validation, checks against the setup, resource estimate, constructor.

@@ -68,8 +68,27 @@ class RunResult:
     @property
     def scenario_json(self) -> str:
         """The run.json text."""
-    def save(self, folder: _Path) -> None:
-        """Writes the files of ``ccpp run --out folder``."""
+    def save(self, folder: _Path, export: Sequence[str] | None = None) -> None:
+        """Writes the files of ``ccpp run --out folder`` (``export``: ``--export`` formats)."""
+    def waypoints(self, tolerance_m: float = 0.001) -> npt.NDArray[np.float64]:
+        """Waypoints of the executed path, (N, 3): x, y, theta at segment ends."""
+    def export(self, format: str) -> str:
+        """The text of ``ccpp run --export FORMAT``'s file (csv, json, nav-path, geojson)."""
+
+class PlanResult:
+    """A path planned on a known map (``ccpp plan``)."""
+
+    @property
+    def waypoints(self) -> npt.NDArray[np.float64]:
+        """(N, 3): x, y, theta at segment ends."""
+    @property
+    def length_m(self) -> float: ...
+    @property
+    def finished(self) -> bool: ...
+    def export(self, format: str) -> str:
+        """The text of ``ccpp plan --export FORMAT``'s file (csv, json, nav-path, geojson)."""
+    def save(self, folder: _Path, export: Sequence[str] | None = None) -> None:
+        """Writes the exports (default csv and nav-path), as ``ccpp plan --out folder``."""
 
 class Env:
     """Step-by-step coverage environment on the simulator's physics and sensor."""
@@ -84,6 +103,8 @@ class Env:
         start: Sequence[float] | None = None,
         exec: str = "ideal",
         max_steps: int | None = None,
+        area: Any = None,
+        keepout: Any = None,
     ) -> None: ...
     def reset(self, seed: int | None = None) -> tuple[dict[str, Any], dict[str, Any]]:
         """Starts an episode; returns (observation, info)."""
@@ -129,6 +150,11 @@ def run(
     map: Map | _Path, planner: str = "ba-star", radius: float = 0.15, **options: Any
 ) -> RunResult:
     """Runs a planner; options are scenario fields or the planner's own options."""
+
+def plan(
+    map: Map | _Path, planner: str = "bcd", radius: float = 0.15, **options: Any
+) -> PlanResult:
+    """Plans a path with a known-map planner (``ccpp plan``); options as for ``run``."""
 
 def bench_run(
     map_path: _Path,

@@ -1,0 +1,151 @@
+"""Zones (area / keep-out) and path exports from Python, against the command line."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import ccpp
+
+AREA = [0.3, 0.3, 2.5, 1.7]
+KEEPOUT = [1.0, 0.8, 1.4, 1.2]
+FORMATS = ["csv", "json", "nav-path", "geojson"]
+FILES = {"csv": "waypoints.csv", "json": "waypoints.json", "nav-path": "nav_path.yaml", "geojson": "path.geojson"}
+
+
+def cli(binary: str, *args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([binary, *args], capture_output=True, text=True, check=False)
+
+
+def rect(r: list[float]) -> str:
+    return ",".join(str(v) for v in r)
+
+
+def csv_rows(text: str) -> np.ndarray:
+    rows = list(csv.DictReader(io.StringIO(text)))
+    return np.array([[float(r["x"]), float(r["y"]), float(r["theta"])] for r in rows])
+
+
+def no_wall_time(geojson: str) -> dict:
+    g = json.loads(geojson)
+    for f in g["features"]:
+        m = f["properties"].get("metrics")
+        if isinstance(m, dict):
+            m.pop("wall_time_s", None)
+    return g
+
+
+def test_run_with_zones_and_exports_equals_the_cli(room: Path, ccpp_bin: str, tmp_path: Path) -> None:
+    out = tmp_path / "cli"
+    args = ["run", "--map", str(room), "--planner", "bcd", "--area", rect(AREA), "--keepout", rect(KEEPOUT)]
+    for f in FORMATS:
+        args += ["--export", f]
+    p = cli(ccpp_bin, *args, "--out", str(out), "--json")
+    assert p.returncode == 0, p.stderr
+    expected = json.loads(p.stdout)
+    r = ccpp.run(room, "bcd", area=AREA, keepout=KEEPOUT)
+    m = dict(r.metrics)
+    m.pop("wall_time_s")
+    expected.pop("wall_time_s")
+    assert m == expected
+    assert m["keepout_violations"] == 0
+    # The zones change the run: less floor to cover than without them.
+    plain = ccpp.run(room, "bcd")
+    assert r.accessible.sum() < plain.accessible.sum()
+    # The same export files as `--export`.
+    py_out = tmp_path / "py"
+    r.save(py_out, export=FORMATS)
+    for f in ("csv", "json", "nav-path"):
+        name = FILES[f]
+        assert (py_out / name).read_text() == (out / name).read_text(), name
+        assert r.export(f) == (out / name).read_text(), name
+    assert no_wall_time((py_out / "path.geojson").read_text()) == no_wall_time((out / "path.geojson").read_text())
+    kinds = [f["properties"].get("kind") for f in json.loads(r.export("geojson"))["features"]]
+    assert "area" in kinds and "keepout" in kinds
+    # Waypoints: the CSV's rows; a coarser tolerance merges more.
+    w = r.waypoints()
+    assert w.shape[1] == 3 and np.array_equal(w, csv_rows(r.export("csv")))
+    assert len(r.waypoints(tolerance_m=0.05)) <= len(w)
+    # Without `export`, save writes no export file (as `ccpp run` without --export).
+    bare = tmp_path / "bare"
+    r.save(bare)
+    assert not (bare / "waypoints.csv").exists() and (bare / "path.csv").is_file()
+
+
+def test_export_refuses_unknown_formats_and_tolerances(room: Path) -> None:
+    r = ccpp.run(room, "bcd")
+    with pytest.raises(ccpp.CcppError, match="unknown export format"):
+        r.export("kml")
+    with pytest.raises(ccpp.CcppError, match="unknown export format"):
+        r.save("unused", export=["csv", "shp"])
+    with pytest.raises(ccpp.CcppError, match="tolerance_m"):
+        r.waypoints(tolerance_m=-1.0)
+
+
+def test_plan_equals_cli_plan(room: Path, ccpp_bin: str, tmp_path: Path) -> None:
+    out = tmp_path / "cli"
+    args = ["plan", "--map", str(room), "--planner", "bcd", "--keepout", rect(KEEPOUT)]
+    p = cli(ccpp_bin, *args, "--out", str(out))
+    assert p.returncode == 0, p.stderr
+    plan = ccpp.plan(room, "bcd", keepout=KEEPOUT)
+    assert plan.finished and plan.length_m > 0
+    py_out = tmp_path / "py"
+    plan.save(py_out)
+    # Default files as `ccpp plan`: waypoints.csv and nav_path.yaml, byte for byte.
+    assert sorted(x.name for x in py_out.iterdir()) == ["nav_path.yaml", "waypoints.csv"]
+    for name in ("waypoints.csv", "nav_path.yaml"):
+        assert (py_out / name).read_text() == (out / name).read_text(), name
+    assert np.array_equal(plan.waypoints, csv_rows(plan.export("csv")))
+    # The keep-out changes the plan.
+    assert plan.export("csv") != ccpp.plan(room, "bcd").export("csv")
+    with pytest.raises(ccpp.CcppError, match="online planner"):
+        ccpp.plan(room, "ba-star")
+    with pytest.raises(ccpp.CcppError, match="sensor_range does not apply to bcd"):
+        ccpp.plan(room, "bcd", sensor_range=1.0)
+    with pytest.raises(ccpp.CcppError, match="unknown field `smoothing`"):
+        ccpp.plan(room, "bcd", smoothing=False)
+
+
+def test_env_knows_its_zones(room: Path) -> None:
+    plain = ccpp.Env(room, radius=0.15, sensor_range=0.6)
+    env = ccpp.Env(room, radius=0.15, sensor_range=0.6, area=AREA, keepout=KEEPOUT, start=(0.6, 1.0, 0.0))
+    plain.reset()
+    obs, info = env.reset()
+    assert env.accessible.sum() < plain.accessible.sum()
+    # The keep-out's pixels in sensor range read as occupied (virtual walls).
+    m = env.map
+    col, row = 22, 19  # pixel centre (1.125, 1.025): inside the keep-out, 0.525 m ahead
+    assert m.pixel_center(col, row) == pytest.approx((1.125, 1.025))
+    assert m.occupancy[row, col] == 0 and obs["known"][row, col] == 1
+    assert env.metrics()["keepout_violations"] == 0
+    # A virtual wall does not stop the robot: driving into the keep-out is a violation, not a
+    # collision.
+    obs, reward, terminated, truncated, info = env.step(("translate", 0.6))
+    assert not info["collision"]
+    metrics = env.metrics()
+    assert metrics["keepout_violations"] == 1 and metrics["collisions"] == 0
+    # Seeded starts are inside the area and outside the keep-out.
+    for seed in range(5):
+        obs, _ = env.reset(seed=seed)
+        x, y, _ = obs["pose"]
+        assert AREA[0] < x < AREA[2] and AREA[1] < y < AREA[3]
+        assert not (KEEPOUT[0] - 0.15 < x < KEEPOUT[2] + 0.15 and KEEPOUT[1] - 0.15 < y < KEEPOUT[3] + 0.15)
+
+
+def test_env_drives_into_the_area_and_refuses_bad_zones(room: Path) -> None:
+    env = ccpp.Env(room, radius=0.15, area=[1.5, 0.3, 2.8, 1.7], start=(0.4, 1.0, 0.0))
+    obs, info = env.reset()
+    assert obs["pose"][0] >= 1.5 + 0.15 - 1e-9
+    assert env.metrics()["path_length_m"] > 0.9
+    with pytest.raises(ccpp.CcppError, match="keepout rectangle 1,1,0.5,0.5"):
+        ccpp.Env(room, keepout=[1.0, 1.0, 0.5, 0.5])
+    with pytest.raises(ccpp.CcppError, match="keep-out zone"):
+        ccpp.Env(room, keepout=KEEPOUT, start=(1.2, 1.0, 0.0))
+    with pytest.raises(ccpp.CcppError, match="keepout"):
+        ccpp.Env(room, keepout=str(room.parent / "missing.geojson"))
