@@ -30,7 +30,6 @@
 use std::path::{Path, PathBuf};
 
 use ccpp_core::exec::Execution;
-use fixedbitset::FixedBitSet;
 use ccpp_core::grid::{GridError, GridMap};
 use ccpp_core::metrics::{self, Metrics};
 use ccpp_core::planners::settings::{estimate_run, validate_execution};
@@ -38,6 +37,7 @@ use ccpp_core::planners::{OptionsError, PlannerConfig, PlannerKind, ResourceEsti
 use ccpp_core::sim::{simulate, RunOutput, SimConfig};
 use ccpp_core::world::{Robot, World, WorldError};
 use ccpp_core::Pose;
+use fixedbitset::FixedBitSet;
 use serde::{Deserialize, Serialize};
 
 use crate::map::{load_map, LoadOptions, LoadedMap, MapError};
