@@ -410,9 +410,9 @@ mod tests {
                 .wrapping_add(1_442_695_040_888_963_407);
             seed >> 33
         };
-        for trial in 0..60 {
+        for trial in 0..60usize {
             let (w, h) = (1 + (trial % 23), 1 + (trial * 7 % 19));
-            let density = 2 + trial % 5;
+            let density = 2 + (trial % 5) as u64;
             let mut art = String::new();
             for _ in 0..h {
                 for _ in 0..w {
@@ -426,9 +426,13 @@ mod tests {
                 if g.cells()[i] != Cell::Free {
                     continue;
                 }
-                seen.iter_mut().for_each(|s| *s = false);
+                seen.fill(false);
                 let want = flood(&g, i, &mut seen, &mut Vec::new());
-                assert_eq!(flood_runs(&g, i), want, "trial {trial} seed pixel {i}\n{art}");
+                assert_eq!(
+                    flood_runs(&g, i),
+                    want,
+                    "trial {trial} seed pixel {i}\n{art}"
+                );
             }
         }
     }

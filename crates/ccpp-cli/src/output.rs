@@ -114,8 +114,18 @@ pub fn emit(
         exports,
         &ccpp_io::export::zone_features(r.world.zones()),
     )?;
-    let metrics = write_run_files(&job.out, job, r, replay, &export_files)?;
-    let comp = StartComponent::of(r.world.map(), r.world.start().position());
+    // The start's free area (a flood fill over the map) is found while the files are written:
+    // the picture's thread outlasts the text files', leaving a core idle.
+    let (metrics, comp) = std::thread::scope(|s| {
+        let comp = s.spawn(|| StartComponent::of(r.world.map(), r.world.start().position()));
+        let metrics = write_run_files(&job.out, job, r, replay, &export_files);
+        let comp = match comp.join() {
+            Ok(c) => c,
+            Err(panic) => std::panic::resume_unwind(panic),
+        };
+        (metrics, comp)
+    });
+    let metrics = metrics?;
     if let Some(w) = comp.warning() {
         eprintln!("{w}");
     }

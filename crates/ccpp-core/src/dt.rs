@@ -264,11 +264,7 @@ fn distance_bound<T: Store>(g: &[T], width: usize, border_is_feature: bool) -> O
 /// Phase 2 (Felzenszwalb-Huttenlocher lower envelope) along each row of the column distances
 /// `g`; rows are independent, so large images split them between two threads. `O` must hold
 /// every finite result (checked by the caller); no feature gives `O::INF`.
-fn envelope_pass<G: Store, O: Store>(
-    g: &[G],
-    width: usize,
-    border_is_feature: bool,
-) -> Vec<O> {
+fn envelope_pass<G: Store, O: Store>(g: &[G], width: usize, border_is_feature: bool) -> Vec<O> {
     let n = g.len();
     let height = n / width;
     let none = G::NONE.to_u32();
@@ -473,6 +469,9 @@ mod tests {
         let (w, h) = (2, 70_000);
         let dt = squared_edt_compact(w, h, |i| i == 2 * 35_000, false);
         assert_eq!(dt.get(0), 35_000 * 35_000);
-        assert_eq!(compact_values(&dt), squared_edt(w, h, |i| i == 2 * 35_000, false));
+        assert_eq!(
+            compact_values(&dt),
+            squared_edt(w, h, |i| i == 2 * 35_000, false)
+        );
     }
 }

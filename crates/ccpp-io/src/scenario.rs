@@ -31,7 +31,6 @@ use std::path::{Path, PathBuf};
 
 use ccpp_core::display::Compact;
 use ccpp_core::exec::Execution;
-use fixedbitset::FixedBitSet;
 use ccpp_core::grid::{GridError, GridMap};
 use ccpp_core::metrics::{self, Metrics};
 use ccpp_core::planners::settings::{estimate_run, estimate_zones, validate_execution, ZoneLoad};
@@ -39,6 +38,7 @@ use ccpp_core::planners::{OptionsError, PlannerConfig, PlannerKind, ResourceEsti
 use ccpp_core::sim::{simulate, RunOutput, SimConfig};
 use ccpp_core::world::{Robot, World, WorldError};
 use ccpp_core::Pose;
+use fixedbitset::FixedBitSet;
 use serde::{Deserialize, Serialize};
 
 use crate::map::{load_map, LoadOptions, LoadedMap, MapError};

@@ -257,7 +257,10 @@ pub fn trace_jsonl(trace: &Trace) -> Result<String, serde_json::Error> {
 ///
 /// # Errors
 /// As [`trace_jsonl`], and write failures of `out` (as [`serde_json::Error::io`]).
-pub fn write_trace_jsonl(trace: &Trace, out: &mut dyn std::io::Write) -> Result<(), serde_json::Error> {
+pub fn write_trace_jsonl(
+    trace: &Trace,
+    out: &mut dyn std::io::Write,
+) -> Result<(), serde_json::Error> {
     const CHUNK: usize = 1 << 16;
     let mut s = String::with_capacity(CHUNK + 4096);
     let mut flush = |s: &mut String| -> Result<(), serde_json::Error> {
@@ -497,7 +500,9 @@ pub fn parse_trace(
     path: &Path,
     frame: Option<(&MapFrame, f64)>,
 ) -> Result<Trace, TraceFileError> {
-    let lines = text.lines().map(|l| Ok::<_, std::io::Error>(std::borrow::Cow::Borrowed(l)));
+    let lines = text
+        .lines()
+        .map(|l| Ok::<_, std::io::Error>(std::borrow::Cow::Borrowed(l)));
     parse_trace_lines(lines, text.len(), path, frame)
 }
 
@@ -617,7 +622,12 @@ pub fn read_trace(path: &Path, frame: Option<(&MapFrame, f64)>) -> Result<Trace,
     let lines = std::io::BufReader::new(file)
         .lines()
         .map(|l| l.map(std::borrow::Cow::Owned));
-    parse_trace_lines(lines, usize::try_from(len).unwrap_or(usize::MAX), path, frame)
+    parse_trace_lines(
+        lines,
+        usize::try_from(len).unwrap_or(usize::MAX),
+        path,
+        frame,
+    )
 }
 
 #[cfg(test)]

@@ -156,9 +156,8 @@ pub fn render_run_files_swept(
 /// What [`stream_run_files`] writes each file with: `put(name, fill)` creates the file `name`
 /// and calls `fill` with a writer into it (the command line puts the files in its staging
 /// folder).
-pub type PutFile<'a, E> =
-    dyn FnMut(&'static str, &mut dyn FnMut(&mut dyn Write) -> std::io::Result<()>) -> Result<(), E>
-        + 'a;
+pub type PutFile<'a, E> = dyn FnMut(&'static str, &mut dyn FnMut(&mut dyn Write) -> std::io::Result<()>) -> Result<(), E>
+    + 'a;
 
 /// The files of [`render_run_files`] but `metrics.json` — `run.json`, `path.csv`,
 /// `trace.jsonl`, `coverage.png`, in that order — handed to `put` one by one, with
