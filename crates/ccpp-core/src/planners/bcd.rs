@@ -28,6 +28,19 @@
 //!    first and last lanes lie on the cell's edge where the edge is an obstacle (the lane at clearance sweeps the wall's
 //!    rim) and `r_tool` inside it where the edge is shared with neighbouring cells (whose own
 //!    lanes sweep up to the shared edge), so neighbours do not drive two lanes side by side.
+//!    Lanes between shared edges lie on one lattice of lines `sp` apart (so they continue
+//!    across neighbours); a cell closed on both sides spreads as few lanes as keep the gaps
+//!    within `sp` evenly between its edges instead (a lattice line just inside an edge would
+//!    cost a whole extra lane: `|.|.....|.....|.|` becomes `|....|....|....|`). A cell whose
+//!    pixels the lanes of other cells already sweep gets no lanes of its own (the slivers
+//!    that critical points leave beside a cell, a few lines wide, smallest first):
+//!
+//!    ```text
+//!    ####################      | = the wide cell's lanes; its last lane (column 19)
+//!    |.....|.....|......|ss##  sweeps r_tool = 3 lines beyond it, so the sliver `ss`
+//!    |.....|.....|......|ss##  (columns 20-21, cut off by a critical point of the
+//!    |.....|.....|......|......  obstacle `##`) needs no lane and no transfer
+//!    ```
 //!    Lane ends facing an obstacle are pushed from the pixel centre to the exact contact
 //!    distance (minus a 0.05 px safety gap) with the simulator's own swept-disk test, so the
 //!    tool reaches as close to the wall as the robot can.
@@ -547,9 +560,19 @@ fn side_open(
 
 /// The lane positions (line coordinates) of `cell` (module docs, step 2): a lane on each
 /// closed side and the lines `phase + k sp` in between, shared with the neighbours across open
-/// sides.
+/// sides. A cell closed on both sides shares no lane with a neighbour: its lanes are spread
+/// evenly between its two edge lines, as few as keep every gap at most `sp`.
 fn lanes_of(cell: &Cell, sp: f64, phase: f64, open_lo: bool, open_hi: bool) -> Vec<f64> {
     let (u0, u1) = (cell.u0 as f64, cell.u1() as f64);
+    if !open_lo && !open_hi {
+        let gaps = ((u1 - u0) / sp - 1e-9).ceil();
+        if gaps < 1.0 {
+            return vec![u0];
+        }
+        return (0..=gaps as usize)
+            .map(|k| u0 + (u1 - u0) * k as f64 / gaps)
+            .collect();
+    }
     let mut lanes: Vec<f64> = Vec::new();
     if !open_lo {
         lanes.push(u0);
@@ -571,6 +594,106 @@ fn lanes_of(cell: &Cell, sp: f64, phase: f64, open_lo: bool, open_hi: bool) -> V
         lanes.push(u1);
     }
     lanes
+}
+
+/// The pixel positions `v` that the lane at line coordinate `t` of `cell` surely spans: the
+/// common part of the runs of the lines on either side of it.
+fn lane_span(cell: &Cell, t: f64) -> Option<(usize, usize)> {
+    let (u0, u1) = (cell.u0, cell.u1());
+    let a = (t.floor().max(u0 as f64) as usize).min(u1);
+    let b = (t.ceil().max(u0 as f64) as usize).min(u1);
+    let (ra, rb) = (cell.runs[a - u0], cell.runs[b - u0]);
+    let (v0, v1) = (ra.0.max(rb.0), ra.1.min(rb.1));
+    (v0 <= v1).then_some((v0, v1))
+}
+
+/// Calls `f` with every pixel index (image `w` x `h`) that the lanes of `cell` surely sweep:
+/// the pixel centres within `rt` of a lane, across it, along its sure span.
+fn for_lane_pixels(
+    cell: &Cell,
+    lanes: &[f64],
+    w: usize,
+    h: usize,
+    rt: f64,
+    f: &mut dyn FnMut(usize),
+) {
+    let nu = if cell.cols { w } else { h };
+    for &t in lanes {
+        let Some((v0, v1)) = lane_span(cell, t) else {
+            continue;
+        };
+        let ua = (t - rt).ceil().max(0.0) as usize;
+        let ub = ((t + rt).floor().max(0.0) as usize).min(nu - 1);
+        for u in ua..=ub {
+            for v in v0..=v1 {
+                let (c, r) = cell.px(u, v);
+                f(r * w + c);
+            }
+        }
+    }
+}
+
+/// Drops the cells whose every pixel the lanes of other cells already sweep (module docs,
+/// step 2), the cells with the least lane length first.
+fn drop_covered(
+    cells: Vec<(Cell, Vec<f64>)>,
+    w: usize,
+    h: usize,
+    rt: f64,
+) -> Vec<(Cell, Vec<f64>)> {
+    // How many cells' lanes sweep each pixel.
+    let mut count = vec![0u16; w * h];
+    let mut last = vec![u32::MAX; w * h];
+    for (k, (c, l)) in cells.iter().enumerate() {
+        for_lane_pixels(c, l, w, h, rt, &mut |i| {
+            if last[i] != k as u32 {
+                last[i] = k as u32;
+                count[i] = count[i].saturating_add(1);
+            }
+        });
+    }
+    let lane_len = |c: &Cell, l: &[f64]| -> usize {
+        l.iter()
+            .filter_map(|&t| lane_span(c, t))
+            .map(|(a, b)| b - a + 1)
+            .sum()
+    };
+    let mut order: Vec<usize> = (0..cells.len()).collect();
+    order.sort_by_key(|&k| (lane_len(&cells[k].0, &cells[k].1), k));
+    let mut keep = vec![true; cells.len()];
+    let mut mine = vec![false; w * h];
+    let mut touched: Vec<usize> = Vec::new();
+    for k in order {
+        let (c, l) = &cells[k];
+        touched.clear();
+        for_lane_pixels(c, l, w, h, rt, &mut |i| {
+            if !mine[i] {
+                mine[i] = true;
+                touched.push(i);
+            }
+        });
+        let covered = c.runs.iter().enumerate().all(|(j, &(a, b))| {
+            (a..=b).all(|v| {
+                let (cc, rr) = c.px(c.u0 + j, v);
+                let i = rr * w + cc;
+                count[i] > u16::from(mine[i])
+            })
+        });
+        if covered {
+            keep[k] = false;
+            for &i in &touched {
+                count[i] -= 1;
+            }
+        }
+        for &i in &touched {
+            mine[i] = false;
+        }
+    }
+    cells
+        .into_iter()
+        .zip(keep)
+        .filter_map(|(c, k)| k.then_some(c))
+        .collect()
 }
 
 /// Estimated cost of sweeping `cell` with `lanes`: lane lengths, the span between the first
@@ -806,6 +929,7 @@ impl Bcd {
             })
             .filter(|(_, l)| !l.is_empty())
             .collect();
+        let cells = drop_covered(cells, w, h, ctx.rt);
 
         // Cell paths; a first tour over the cells picks each cell's path (corner), the rim
         // contours of what those paths miss join the cells in the final tour, where each cell
@@ -1183,6 +1307,7 @@ fn rim_contours(
         }
         out.push((contour, members.len()));
     }
+
     // The budget: missed pixels allowed by `target`, less those no group holds.
     let grouped: usize = out.iter().map(|c| c.1).sum();
     let allowed = ((1.0 - target) * acc.count_ones(..) as f64).floor() as usize;
@@ -1530,10 +1655,18 @@ mod tests {
             u0: 3,
             runs: vec![(0, 9); 20],
         };
-        // Both sides closed: lanes on both edges, lattice lines (6 apart) in between.
+        // Both sides closed: lanes on both edges, as few as keep the gaps within 6 lines,
+        // evenly spread (the lattice would take 5: 3, 6, 12, 18, 22).
         let l = lanes_of(&cell, 6.0, 0.0, false, false);
-        assert_eq!(l, vec![3.0, 6.0, 12.0, 18.0, 22.0]);
+        assert_eq!(l, vec![3.0, 7.75, 12.5, 17.25, 22.0]);
         assert!(l.windows(2).all(|w| w[1] - w[0] <= 6.0));
+        let l = lanes_of(&cell, 6.0, 2.0, false, false);
+        assert_eq!(l, vec![3.0, 7.75, 12.5, 17.25, 22.0]);
+        // One closed side: its edge lane, then the lattice.
+        assert_eq!(
+            lanes_of(&cell, 6.0, 0.0, false, true),
+            vec![3.0, 6.0, 12.0, 18.0]
+        );
         // Open sides: only the lattice, shared with the neighbours beyond.
         assert_eq!(lanes_of(&cell, 6.0, 0.0, true, true), vec![6.0, 12.0, 18.0]);
         // A lattice line within half a pixel of the edge belongs to this cell.
@@ -1676,6 +1809,50 @@ mod tests {
         assert_eq!(lines, 20);
         // Ends longer than the limit: the cell stays whole.
         assert_eq!(split_ends(vec![strip], 1).len(), 1);
+    }
+
+    #[test]
+    fn cells_that_neighbours_lanes_sweep_are_dropped() {
+        // A wide cell (columns 0..=19, rows 0..=9) with lanes up to column 19, and a sliver of
+        // columns 20..=21 beside it: its pixels are within rt = 3 of the lane at column 19.
+        let wide = Cell {
+            cols: true,
+            u0: 0,
+            runs: vec![(0, 9); 20],
+        };
+        let sliver = Cell {
+            cols: true,
+            u0: 20,
+            runs: vec![(0, 9); 2],
+        };
+        let far = Cell {
+            cols: true,
+            u0: 25,
+            runs: vec![(0, 9); 2],
+        };
+        let cells = vec![
+            (wide.clone(), vec![0.0, 6.0, 12.0, 19.0]),
+            (sliver, vec![21.0]),
+            (far, vec![25.0]),
+        ];
+        let kept = drop_covered(cells, 30, 10, 3.0);
+        assert_eq!(kept.len(), 2);
+        assert_eq!(kept[0].0.u0, 0);
+        assert_eq!(kept[1].0.u0, 25);
+        // When the wide cell's lanes end at column 12 (sweeping up to 15), neither cell's
+        // lanes sweep all of the other's pixels: both stay.
+        let cells = vec![
+            (wide, vec![0.0, 6.0, 12.0]),
+            (
+                Cell {
+                    cols: true,
+                    u0: 20,
+                    runs: vec![(0, 9); 2],
+                },
+                vec![21.0],
+            ),
+        ];
+        assert_eq!(drop_covered(cells, 30, 10, 3.0).len(), 2);
     }
 
     #[test]
