@@ -56,7 +56,18 @@
 //!    (pixels swept per pixel of pass) while what is left stays within `1 - rim_coverage` of the
 //!    accessible floor (default 0.997: the sawtooth of lane ends along a wall costs a whole
 //!    wall-long pass for well under a percent of the floor). This step is not in the paper (a
-//!    point robot's lanes reach the boundary; a disk's do not).
+//!    point robot's lanes reach the boundary; a disk's do not). The passes are placed two ways
+//!    and the plan that is cheaper (length plus `turn_cost_m` per turn) is kept: as pieces of
+//!    the cell tour (step 4; chained passes along one wall), or inserted into the finished
+//!    tour as out-and-back detours at its nearest point, followed by a second mop-up of what
+//!    the detours and the smoothing left (a pass that runs past a lane end often costs less
+//!    as a detour from that lane than as a stop of the tour):
+//!
+//!    ```text
+//!    in the tour:  ...lane ═══════╗        inserted:   ...lane ════╦═══╗
+//!                                 ║ hop                        out ║   ║ lane
+//!                  pass ◄─────────╨─── hop from another cell   pass◄╝   ║
+//!    ```
 //! 4. **Cell tour.** Instead of the paper's depth-first walk of the adjacency graph, the cells
 //!    are ordered as an open travelling-salesman path over their entry and exit points (each
 //!    cell can be started at any of its four corners): nearest-neighbour construction, then
@@ -956,117 +967,146 @@ impl Bcd {
         let coarse = hops::Coarse::new(&ctx, sp);
         let far = hops::Coarse::new(&ctx, sp * f64::from(hops::FAR_FACTOR));
         let ncells = paths.len();
-        let contours: Vec<Vec<Point>> = if opts.rim {
-            let table = hops::HopTable::new(&coarse, &far, &pieces, start);
-            let dist = |a: Point, b: Point| table.dist(a, b);
-            let nn = table.nearest_tour(&pieces, start);
-            let first = tsp::solve(
-                &pieces,
-                start,
-                opts.tour_rounds.min(FIRST_ROUNDS),
-                &dist,
-                Some(nn),
-            );
-            let mut keep = vec![0usize; ncells];
-            for &(c, v) in &first {
-                keep[c] = v / 2;
+        // Two ways to sweep the rim (module docs, step 3): its passes as pieces of the tour,
+        // or inserted into the finished tour where they cost least; the cheaper plan is kept.
+        let cell_pieces = pieces;
+        let cell_paths_all = paths;
+        let mut best: Option<(f64, Vec<Item>)> = None;
+        for in_tour in [true, false] {
+            if !opts.rim && !in_tour {
+                break;
             }
-            for (c, k) in keep.iter().enumerate() {
-                if *k == 1 {
-                    paths[c].swap(0, 1);
+            let mut pieces = cell_pieces.clone();
+            let mut paths = cell_paths_all.clone();
+            let contours: Vec<Vec<Point>> = if in_tour {
+                let table = hops::HopTable::new(&coarse, &far, &pieces, start);
+                let dist = |a: Point, b: Point| table.dist(a, b);
+                let nn = table.nearest_tour(&pieces, start);
+                let first = tsp::solve(
+                    &pieces,
+                    start,
+                    opts.tour_rounds.min(FIRST_ROUNDS),
+                    &dist,
+                    Some(nn),
+                );
+                let mut keep = vec![0usize; ncells];
+                for &(c, v) in &first {
+                    keep[c] = v / 2;
                 }
-                let p = &paths[c][0];
-                let (f, l) = (p[0], p[p.len() - 1]);
-                let len = polyline_len(p);
-                pieces[c] = tsp::Piece {
+                for (c, k) in keep.iter().enumerate() {
+                    if *k == 1 {
+                        paths[c].swap(0, 1);
+                    }
+                    let p = &paths[c][0];
+                    let (f, l) = (p[0], p[p.len() - 1]);
+                    let len = polyline_len(p);
+                    pieces[c] = tsp::Piece {
+                        entry: vec![f, l],
+                        exit: vec![l, f],
+                        inner: vec![len, len],
+                    };
+                }
+                let lines: Vec<&[Point]> = paths.iter().map(|p| p[0].as_slice()).collect();
+                rim_contours(
+                    &ctx,
+                    &mut search,
+                    &lines,
+                    opts.rim_min_yield,
+                    opts.rim_coverage,
+                )
+                .into_iter()
+                .map(|c| c.0)
+                .collect()
+            } else {
+                Vec::new()
+            };
+            for c in &contours {
+                let (f, l) = (c[0], c[c.len() - 1]);
+                let len = polyline_len(c);
+                pieces.push(tsp::Piece {
                     entry: vec![f, l],
                     exit: vec![l, f],
                     inner: vec![len, len],
-                };
+                });
             }
-            let lines: Vec<&[Point]> = paths.iter().map(|p| p[0].as_slice()).collect();
-            rim_contours(
-                &ctx,
-                &mut search,
-                &lines,
-                opts.rim_min_yield,
-                opts.rim_coverage,
-            )
-            .into_iter()
-            .map(|c| c.0)
-            .collect()
-        } else {
-            Vec::new()
-        };
-        for c in &contours {
-            let (f, l) = (c[0], c[c.len() - 1]);
-            let len = polyline_len(c);
-            pieces.push(tsp::Piece {
-                entry: vec![f, l],
-                exit: vec![l, f],
-                inner: vec![len, len],
-            });
-        }
-        let table = hops::HopTable::new(&coarse, &far, &pieces, start);
-        let dist = |a: Point, b: Point| table.dist(a, b);
-        let nn = table.nearest_tour(&pieces, start);
-        let tour = tsp::solve(&pieces, start, opts.tour_rounds, &dist, Some(nn));
+            let table = hops::HopTable::new(&coarse, &far, &pieces, start);
+            let dist = |a: Point, b: Point| table.dist(a, b);
+            let nn = table.nearest_tour(&pieces, start);
+            let tour = tsp::solve(&pieces, start, opts.tour_rounds, &dist, Some(nn));
 
-        let mut items: Vec<Item> = vec![Item::Move(start)];
-        let mut here = start;
-        let mut region = 0u32;
-        for &(cid, v) in &tour {
-            if cid >= ncells {
-                let c = &contours[cid - ncells];
-                let pts: Vec<Point> = if v == 0 {
-                    c.clone()
+            let mut items: Vec<Item> = vec![Item::Move(start)];
+            let mut here = start;
+            let mut region = 0u32;
+            for &(cid, v) in &tour {
+                if cid >= ncells {
+                    let c = &contours[cid - ncells];
+                    let pts: Vec<Point> = if v == 0 {
+                        c.clone()
+                    } else {
+                        c.iter().rev().copied().collect()
+                    };
+                    if pts[0] != here {
+                        let Some(hop) = ctx.route(&mut search, here, pts[0]) else {
+                            continue;
+                        };
+                        items.push(Item::Mark(Event::BacktrackStart));
+                        items.extend(hop.into_iter().map(Item::Move));
+                        items.push(Item::Mark(Event::BacktrackEnd));
+                    }
+                    items.extend(pts[1..].iter().copied().map(Item::Move));
+                    here = pts[pts.len() - 1];
+                    continue;
+                }
+                let path = &paths[cid][v / 2];
+                let pts: Vec<Point> = if v % 2 == 0 {
+                    path.clone()
                 } else {
-                    c.iter().rev().copied().collect()
+                    path.iter().rev().copied().collect()
                 };
-                if pts[0] != here {
-                    let Some(hop) = ctx.route(&mut search, here, pts[0]) else {
+                let entry = pts[0];
+                if entry != here {
+                    let Some(hop) = ctx.route(&mut search, here, entry) else {
                         continue;
                     };
                     items.push(Item::Mark(Event::BacktrackStart));
                     items.extend(hop.into_iter().map(Item::Move));
                     items.push(Item::Mark(Event::BacktrackEnd));
                 }
+                region += 1;
+                items.push(Item::Mark(Event::RegionStart { region }));
                 items.extend(pts[1..].iter().copied().map(Item::Move));
+                items.push(Item::Mark(Event::RegionEnd { region }));
                 here = pts[pts.len() - 1];
-                continue;
             }
-            let path = &paths[cid][v / 2];
-            let pts: Vec<Point> = if v % 2 == 0 {
-                path.clone()
-            } else {
-                path.iter().rev().copied().collect()
-            };
-            let entry = pts[0];
-            if entry != here {
-                let Some(hop) = ctx.route(&mut search, here, entry) else {
-                    continue;
-                };
-                items.push(Item::Mark(Event::BacktrackStart));
-                items.extend(hop.into_iter().map(Item::Move));
-                items.push(Item::Mark(Event::BacktrackEnd));
-            }
-            region += 1;
-            items.push(Item::Mark(Event::RegionStart { region }));
-            items.extend(pts[1..].iter().copied().map(Item::Move));
-            items.push(Item::Mark(Event::RegionEnd { region }));
-            here = pts[pts.len() - 1];
-        }
 
-        if opts.rim {
-            rim_pass(
-                &ctx,
-                &mut search,
-                &mut items,
-                opts.rim_min_yield,
-                opts.rim_coverage,
-            );
+            if opts.rim {
+                rim_pass(
+                    &ctx,
+                    &mut search,
+                    &mut items,
+                    opts.rim_min_yield,
+                    opts.rim_coverage,
+                );
+            }
+            let mut items = smooth(&ctx, repair(&ctx, &mut search, items));
+            if opts.rim && !in_tour {
+                // A second mop-up of what the inserted passes and the smoothing left.
+                rim_pass(
+                    &ctx,
+                    &mut search,
+                    &mut items,
+                    opts.rim_min_yield,
+                    opts.rim_coverage,
+                );
+                items = smooth(&ctx, repair(&ctx, &mut search, items));
+            }
+            let pts: Vec<Point> = moves(&items).into_iter().map(|m| m.0).collect();
+            let cost = polyline_len(&pts) + turn_px * turns(&pts) as f64;
+            if best.as_ref().is_none_or(|b| cost < b.0) {
+                best = Some((cost, items));
+            }
         }
-        let items = smooth(&ctx, repair(&ctx, &mut search, items));
+        let items = best.map(|b| b.1).unwrap_or_default();
 
         let mut steps = VecDeque::with_capacity(items.len());
         let mut at = start;
@@ -1167,6 +1207,26 @@ fn smooth(ctx: &Ctx<'_>, items: Vec<Item>) -> Vec<Item> {
     }
     flush(&mut run, &mut out);
     out
+}
+
+/// Number of heading changes along the polyline `pts` (as the simulator counts turns).
+fn turns(pts: &[Point]) -> usize {
+    let mut n = 0;
+    let mut heading: Option<f64> = None;
+    for w in pts.windows(2) {
+        let d = w[1].sub(w[0]);
+        if d.x == 0.0 && d.y == 0.0 {
+            continue;
+        }
+        let h = d.y.atan2(d.x);
+        if heading.is_some_and(|g| {
+            crate::geometry::wrap_angle(h - g).abs() > crate::planner::MIN_ROTATION
+        }) {
+            n += 1;
+        }
+        heading = Some(h);
+    }
+    n
 }
 
 /// The moves of `items` as a polyline with, for each point, its index in `items`.
