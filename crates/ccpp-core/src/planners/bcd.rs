@@ -64,9 +64,10 @@
 //!    as a detour from that lane than as a stop of the tour):
 //!
 //!    ```text
-//!    in the tour:  ...lane ═══════╗        inserted:   ...lane ════╦═══╗
-//!                                 ║ hop                        out ║   ║ lane
-//!                  pass ◄─────────╨─── hop from another cell   pass◄╝   ║
+//!    |    |    |      rim pass ppp along the wall where the lanes | end:
+//!    |    |    |      in the tour:  ... cell A, hop, ppp, hop, cell B ...
+//!    |____|    |ppp   inserted:     ... down the lane, out along ppp and back, ...
+//!    ###############
 //!    ```
 //! 4. **Cell tour.** Instead of the paper's depth-first walk of the adjacency graph, the cells
 //!    are ordered as an open travelling-salesman path over their entry and exit points (each
