@@ -28,6 +28,19 @@
 //!    first and last lanes lie on the cell's edge where the edge is an obstacle (the lane at clearance sweeps the wall's
 //!    rim) and `r_tool` inside it where the edge is shared with neighbouring cells (whose own
 //!    lanes sweep up to the shared edge), so neighbours do not drive two lanes side by side.
+//!    Lanes between shared edges lie on one lattice of lines `sp` apart (so they continue
+//!    across neighbours); a cell closed on both sides spreads as few lanes as keep the gaps
+//!    within `sp` evenly between its edges instead (a lattice line just inside an edge would
+//!    cost a whole extra lane: `|.|.....|.....|.|` becomes `|....|....|....|`). A cell whose
+//!    pixels the lanes of other cells already sweep gets no lanes of its own (the slivers
+//!    that critical points leave beside a cell, a few lines wide, smallest first):
+//!
+//!    ```text
+//!    ####################      | = the wide cell's lanes; its last lane (column 19)
+//!    |.....|.....|......|ss##  sweeps r_tool = 3 lines beyond it, so the sliver `ss`
+//!    |.....|.....|......|ss##  (columns 20-21, cut off by a critical point of the
+//!    |.....|.....|......|......  obstacle `##`) needs no lane and no transfer
+//!    ```
 //!    Lane ends facing an obstacle are pushed from the pixel centre to the exact contact
 //!    distance (minus a 0.05 px safety gap) with the simulator's own swept-disk test, so the
 //!    tool reaches as close to the wall as the robot can.
@@ -43,7 +56,19 @@
 //!    (pixels swept per pixel of pass) while what is left stays within `1 - rim_coverage` of the
 //!    accessible floor (default 0.997: the sawtooth of lane ends along a wall costs a whole
 //!    wall-long pass for well under a percent of the floor). This step is not in the paper (a
-//!    point robot's lanes reach the boundary; a disk's do not).
+//!    point robot's lanes reach the boundary; a disk's do not). The passes are placed two ways
+//!    and the plan that is cheaper (length plus `turn_cost_m` per turn) is kept: as pieces of
+//!    the cell tour (step 4; chained passes along one wall), or inserted into the finished
+//!    tour as out-and-back detours at its nearest point, followed by a second mop-up of what
+//!    the detours and the smoothing left (a pass that runs past a lane end often costs less
+//!    as a detour from that lane than as a stop of the tour):
+//!
+//!    ```text
+//!    |    |    |      rim pass ppp along the wall where the lanes | end:
+//!    |    |    |      in the tour:  ... cell A, hop, ppp, hop, cell B ...
+//!    |____|    |ppp   inserted:     ... down the lane, out along ppp and back, ...
+//!    ###############
+//!    ```
 //! 4. **Cell tour.** Instead of the paper's depth-first walk of the adjacency graph, the cells
 //!    are ordered as an open travelling-salesman path over their entry and exit points (each
 //!    cell can be started at any of its four corners): nearest-neighbour construction, then
@@ -547,9 +572,19 @@ fn side_open(
 
 /// The lane positions (line coordinates) of `cell` (module docs, step 2): a lane on each
 /// closed side and the lines `phase + k sp` in between, shared with the neighbours across open
-/// sides.
+/// sides. A cell closed on both sides shares no lane with a neighbour: its lanes are spread
+/// evenly between its two edge lines, as few as keep every gap at most `sp`.
 fn lanes_of(cell: &Cell, sp: f64, phase: f64, open_lo: bool, open_hi: bool) -> Vec<f64> {
     let (u0, u1) = (cell.u0 as f64, cell.u1() as f64);
+    if !open_lo && !open_hi {
+        let gaps = ((u1 - u0) / sp - 1e-9).ceil();
+        if gaps < 1.0 {
+            return vec![u0];
+        }
+        return (0..=gaps as usize)
+            .map(|k| u0 + (u1 - u0) * k as f64 / gaps)
+            .collect();
+    }
     let mut lanes: Vec<f64> = Vec::new();
     if !open_lo {
         lanes.push(u0);
@@ -571,6 +606,106 @@ fn lanes_of(cell: &Cell, sp: f64, phase: f64, open_lo: bool, open_hi: bool) -> V
         lanes.push(u1);
     }
     lanes
+}
+
+/// The pixel positions `v` that the lane at line coordinate `t` of `cell` surely spans: the
+/// common part of the runs of the lines on either side of it.
+fn lane_span(cell: &Cell, t: f64) -> Option<(usize, usize)> {
+    let (u0, u1) = (cell.u0, cell.u1());
+    let a = (t.floor().max(u0 as f64) as usize).min(u1);
+    let b = (t.ceil().max(u0 as f64) as usize).min(u1);
+    let (ra, rb) = (cell.runs[a - u0], cell.runs[b - u0]);
+    let (v0, v1) = (ra.0.max(rb.0), ra.1.min(rb.1));
+    (v0 <= v1).then_some((v0, v1))
+}
+
+/// Calls `f` with every pixel index (image `w` x `h`) that the lanes of `cell` surely sweep:
+/// the pixel centres within `rt` of a lane, across it, along its sure span.
+fn for_lane_pixels(
+    cell: &Cell,
+    lanes: &[f64],
+    w: usize,
+    h: usize,
+    rt: f64,
+    f: &mut dyn FnMut(usize),
+) {
+    let nu = if cell.cols { w } else { h };
+    for &t in lanes {
+        let Some((v0, v1)) = lane_span(cell, t) else {
+            continue;
+        };
+        let ua = (t - rt).ceil().max(0.0) as usize;
+        let ub = ((t + rt).floor().max(0.0) as usize).min(nu - 1);
+        for u in ua..=ub {
+            for v in v0..=v1 {
+                let (c, r) = cell.px(u, v);
+                f(r * w + c);
+            }
+        }
+    }
+}
+
+/// Drops the cells whose every pixel the lanes of other cells already sweep (module docs,
+/// step 2), the cells with the least lane length first.
+fn drop_covered(
+    cells: Vec<(Cell, Vec<f64>)>,
+    w: usize,
+    h: usize,
+    rt: f64,
+) -> Vec<(Cell, Vec<f64>)> {
+    // How many cells' lanes sweep each pixel.
+    let mut count = vec![0u16; w * h];
+    let mut last = vec![u32::MAX; w * h];
+    for (k, (c, l)) in cells.iter().enumerate() {
+        for_lane_pixels(c, l, w, h, rt, &mut |i| {
+            if last[i] != k as u32 {
+                last[i] = k as u32;
+                count[i] = count[i].saturating_add(1);
+            }
+        });
+    }
+    let lane_len = |c: &Cell, l: &[f64]| -> usize {
+        l.iter()
+            .filter_map(|&t| lane_span(c, t))
+            .map(|(a, b)| b - a + 1)
+            .sum()
+    };
+    let mut order: Vec<usize> = (0..cells.len()).collect();
+    order.sort_by_key(|&k| (lane_len(&cells[k].0, &cells[k].1), k));
+    let mut keep = vec![true; cells.len()];
+    let mut mine = vec![false; w * h];
+    let mut touched: Vec<usize> = Vec::new();
+    for k in order {
+        let (c, l) = &cells[k];
+        touched.clear();
+        for_lane_pixels(c, l, w, h, rt, &mut |i| {
+            if !mine[i] {
+                mine[i] = true;
+                touched.push(i);
+            }
+        });
+        let covered = c.runs.iter().enumerate().all(|(j, &(a, b))| {
+            (a..=b).all(|v| {
+                let (cc, rr) = c.px(c.u0 + j, v);
+                let i = rr * w + cc;
+                count[i] > u16::from(mine[i])
+            })
+        });
+        if covered {
+            keep[k] = false;
+            for &i in &touched {
+                count[i] -= 1;
+            }
+        }
+        for &i in &touched {
+            mine[i] = false;
+        }
+    }
+    cells
+        .into_iter()
+        .zip(keep)
+        .filter_map(|(c, k)| k.then_some(c))
+        .collect()
 }
 
 /// Estimated cost of sweeping `cell` with `lanes`: lane lengths, the span between the first
@@ -806,6 +941,7 @@ impl Bcd {
             })
             .filter(|(_, l)| !l.is_empty())
             .collect();
+        let cells = drop_covered(cells, w, h, ctx.rt);
 
         // Cell paths; a first tour over the cells picks each cell's path (corner), the rim
         // contours of what those paths miss join the cells in the final tour, where each cell
@@ -832,117 +968,146 @@ impl Bcd {
         let coarse = hops::Coarse::new(&ctx, sp);
         let far = hops::Coarse::new(&ctx, sp * f64::from(hops::FAR_FACTOR));
         let ncells = paths.len();
-        let contours: Vec<Vec<Point>> = if opts.rim {
-            let table = hops::HopTable::new(&coarse, &far, &pieces, start);
-            let dist = |a: Point, b: Point| table.dist(a, b);
-            let nn = table.nearest_tour(&pieces, start);
-            let first = tsp::solve(
-                &pieces,
-                start,
-                opts.tour_rounds.min(FIRST_ROUNDS),
-                &dist,
-                Some(nn),
-            );
-            let mut keep = vec![0usize; ncells];
-            for &(c, v) in &first {
-                keep[c] = v / 2;
+        // Two ways to sweep the rim (module docs, step 3): its passes as pieces of the tour,
+        // or inserted into the finished tour where they cost least; the cheaper plan is kept.
+        let cell_pieces = pieces;
+        let cell_paths_all = paths;
+        let mut best: Option<(f64, Vec<Item>)> = None;
+        for in_tour in [true, false] {
+            if !opts.rim && !in_tour {
+                break;
             }
-            for (c, k) in keep.iter().enumerate() {
-                if *k == 1 {
-                    paths[c].swap(0, 1);
+            let mut pieces = cell_pieces.clone();
+            let mut paths = cell_paths_all.clone();
+            let contours: Vec<Vec<Point>> = if opts.rim && in_tour {
+                let table = hops::HopTable::new(&coarse, &far, &pieces, start);
+                let dist = |a: Point, b: Point| table.dist(a, b);
+                let nn = table.nearest_tour(&pieces, start);
+                let first = tsp::solve(
+                    &pieces,
+                    start,
+                    opts.tour_rounds.min(FIRST_ROUNDS),
+                    &dist,
+                    Some(nn),
+                );
+                let mut keep = vec![0usize; ncells];
+                for &(c, v) in &first {
+                    keep[c] = v / 2;
                 }
-                let p = &paths[c][0];
-                let (f, l) = (p[0], p[p.len() - 1]);
-                let len = polyline_len(p);
-                pieces[c] = tsp::Piece {
+                for (c, k) in keep.iter().enumerate() {
+                    if *k == 1 {
+                        paths[c].swap(0, 1);
+                    }
+                    let p = &paths[c][0];
+                    let (f, l) = (p[0], p[p.len() - 1]);
+                    let len = polyline_len(p);
+                    pieces[c] = tsp::Piece {
+                        entry: vec![f, l],
+                        exit: vec![l, f],
+                        inner: vec![len, len],
+                    };
+                }
+                let lines: Vec<&[Point]> = paths.iter().map(|p| p[0].as_slice()).collect();
+                rim_contours(
+                    &ctx,
+                    &mut search,
+                    &lines,
+                    opts.rim_min_yield,
+                    opts.rim_coverage,
+                )
+                .into_iter()
+                .map(|c| c.0)
+                .collect()
+            } else {
+                Vec::new()
+            };
+            for c in &contours {
+                let (f, l) = (c[0], c[c.len() - 1]);
+                let len = polyline_len(c);
+                pieces.push(tsp::Piece {
                     entry: vec![f, l],
                     exit: vec![l, f],
                     inner: vec![len, len],
-                };
+                });
             }
-            let lines: Vec<&[Point]> = paths.iter().map(|p| p[0].as_slice()).collect();
-            rim_contours(
-                &ctx,
-                &mut search,
-                &lines,
-                opts.rim_min_yield,
-                opts.rim_coverage,
-            )
-            .into_iter()
-            .map(|c| c.0)
-            .collect()
-        } else {
-            Vec::new()
-        };
-        for c in &contours {
-            let (f, l) = (c[0], c[c.len() - 1]);
-            let len = polyline_len(c);
-            pieces.push(tsp::Piece {
-                entry: vec![f, l],
-                exit: vec![l, f],
-                inner: vec![len, len],
-            });
-        }
-        let table = hops::HopTable::new(&coarse, &far, &pieces, start);
-        let dist = |a: Point, b: Point| table.dist(a, b);
-        let nn = table.nearest_tour(&pieces, start);
-        let tour = tsp::solve(&pieces, start, opts.tour_rounds, &dist, Some(nn));
+            let table = hops::HopTable::new(&coarse, &far, &pieces, start);
+            let dist = |a: Point, b: Point| table.dist(a, b);
+            let nn = table.nearest_tour(&pieces, start);
+            let tour = tsp::solve(&pieces, start, opts.tour_rounds, &dist, Some(nn));
 
-        let mut items: Vec<Item> = vec![Item::Move(start)];
-        let mut here = start;
-        let mut region = 0u32;
-        for &(cid, v) in &tour {
-            if cid >= ncells {
-                let c = &contours[cid - ncells];
-                let pts: Vec<Point> = if v == 0 {
-                    c.clone()
+            let mut items: Vec<Item> = vec![Item::Move(start)];
+            let mut here = start;
+            let mut region = 0u32;
+            for &(cid, v) in &tour {
+                if cid >= ncells {
+                    let c = &contours[cid - ncells];
+                    let pts: Vec<Point> = if v == 0 {
+                        c.clone()
+                    } else {
+                        c.iter().rev().copied().collect()
+                    };
+                    if pts[0] != here {
+                        let Some(hop) = ctx.route(&mut search, here, pts[0]) else {
+                            continue;
+                        };
+                        items.push(Item::Mark(Event::BacktrackStart));
+                        items.extend(hop.into_iter().map(Item::Move));
+                        items.push(Item::Mark(Event::BacktrackEnd));
+                    }
+                    items.extend(pts[1..].iter().copied().map(Item::Move));
+                    here = pts[pts.len() - 1];
+                    continue;
+                }
+                let path = &paths[cid][v / 2];
+                let pts: Vec<Point> = if v % 2 == 0 {
+                    path.clone()
                 } else {
-                    c.iter().rev().copied().collect()
+                    path.iter().rev().copied().collect()
                 };
-                if pts[0] != here {
-                    let Some(hop) = ctx.route(&mut search, here, pts[0]) else {
+                let entry = pts[0];
+                if entry != here {
+                    let Some(hop) = ctx.route(&mut search, here, entry) else {
                         continue;
                     };
                     items.push(Item::Mark(Event::BacktrackStart));
                     items.extend(hop.into_iter().map(Item::Move));
                     items.push(Item::Mark(Event::BacktrackEnd));
                 }
+                region += 1;
+                items.push(Item::Mark(Event::RegionStart { region }));
                 items.extend(pts[1..].iter().copied().map(Item::Move));
+                items.push(Item::Mark(Event::RegionEnd { region }));
                 here = pts[pts.len() - 1];
-                continue;
             }
-            let path = &paths[cid][v / 2];
-            let pts: Vec<Point> = if v % 2 == 0 {
-                path.clone()
-            } else {
-                path.iter().rev().copied().collect()
-            };
-            let entry = pts[0];
-            if entry != here {
-                let Some(hop) = ctx.route(&mut search, here, entry) else {
-                    continue;
-                };
-                items.push(Item::Mark(Event::BacktrackStart));
-                items.extend(hop.into_iter().map(Item::Move));
-                items.push(Item::Mark(Event::BacktrackEnd));
-            }
-            region += 1;
-            items.push(Item::Mark(Event::RegionStart { region }));
-            items.extend(pts[1..].iter().copied().map(Item::Move));
-            items.push(Item::Mark(Event::RegionEnd { region }));
-            here = pts[pts.len() - 1];
-        }
 
-        if opts.rim {
-            rim_pass(
-                &ctx,
-                &mut search,
-                &mut items,
-                opts.rim_min_yield,
-                opts.rim_coverage,
-            );
+            if opts.rim {
+                rim_pass(
+                    &ctx,
+                    &mut search,
+                    &mut items,
+                    opts.rim_min_yield,
+                    opts.rim_coverage,
+                );
+            }
+            let mut items = smooth(&ctx, repair(&ctx, &mut search, items));
+            if opts.rim && !in_tour {
+                // A second mop-up of what the inserted passes and the smoothing left.
+                rim_pass(
+                    &ctx,
+                    &mut search,
+                    &mut items,
+                    opts.rim_min_yield,
+                    opts.rim_coverage,
+                );
+                items = smooth(&ctx, repair(&ctx, &mut search, items));
+            }
+            let pts: Vec<Point> = moves(&items).into_iter().map(|m| m.0).collect();
+            let cost = polyline_len(&pts) + turn_px * turns(&pts) as f64;
+            if best.as_ref().is_none_or(|b| cost < b.0) {
+                best = Some((cost, items));
+            }
         }
-        let items = smooth(&ctx, repair(&ctx, &mut search, items));
+        let items = best.map(|b| b.1).unwrap_or_default();
 
         let mut steps = VecDeque::with_capacity(items.len());
         let mut at = start;
@@ -1043,6 +1208,26 @@ fn smooth(ctx: &Ctx<'_>, items: Vec<Item>) -> Vec<Item> {
     }
     flush(&mut run, &mut out);
     out
+}
+
+/// Number of heading changes along the polyline `pts` (as the simulator counts turns).
+fn turns(pts: &[Point]) -> usize {
+    let mut n = 0;
+    let mut heading: Option<f64> = None;
+    for w in pts.windows(2) {
+        let d = w[1].sub(w[0]);
+        if d.x == 0.0 && d.y == 0.0 {
+            continue;
+        }
+        let h = d.y.atan2(d.x);
+        if heading.is_some_and(|g| {
+            crate::geometry::wrap_angle(h - g).abs() > crate::planner::MIN_ROTATION
+        }) {
+            n += 1;
+        }
+        heading = Some(h);
+    }
+    n
 }
 
 /// The moves of `items` as a polyline with, for each point, its index in `items`.
@@ -1183,6 +1368,7 @@ fn rim_contours(
         }
         out.push((contour, members.len()));
     }
+
     // The budget: missed pixels allowed by `target`, less those no group holds.
     let grouped: usize = out.iter().map(|c| c.1).sum();
     let allowed = ((1.0 - target) * acc.count_ones(..) as f64).floor() as usize;
@@ -1530,10 +1716,18 @@ mod tests {
             u0: 3,
             runs: vec![(0, 9); 20],
         };
-        // Both sides closed: lanes on both edges, lattice lines (6 apart) in between.
+        // Both sides closed: lanes on both edges, as few as keep the gaps within 6 lines,
+        // evenly spread (the lattice would take 5: 3, 6, 12, 18, 22).
         let l = lanes_of(&cell, 6.0, 0.0, false, false);
-        assert_eq!(l, vec![3.0, 6.0, 12.0, 18.0, 22.0]);
+        assert_eq!(l, vec![3.0, 7.75, 12.5, 17.25, 22.0]);
         assert!(l.windows(2).all(|w| w[1] - w[0] <= 6.0));
+        let l = lanes_of(&cell, 6.0, 2.0, false, false);
+        assert_eq!(l, vec![3.0, 7.75, 12.5, 17.25, 22.0]);
+        // One closed side: its edge lane, then the lattice.
+        assert_eq!(
+            lanes_of(&cell, 6.0, 0.0, false, true),
+            vec![3.0, 6.0, 12.0, 18.0]
+        );
         // Open sides: only the lattice, shared with the neighbours beyond.
         assert_eq!(lanes_of(&cell, 6.0, 0.0, true, true), vec![6.0, 12.0, 18.0]);
         // A lattice line within half a pixel of the edge belongs to this cell.
@@ -1553,23 +1747,29 @@ mod tests {
 
     #[test]
     fn rim_option_sweeps_what_lanes_miss() {
+        // Every missed group swept (the default leaves the least useful 0.3 % of the floor,
+        // which in this small room can be all the lanes miss).
+        let all = BcdOptions {
+            rim_coverage: 1.0,
+            ..BcdOptions::default()
+        };
         let world = block_room();
-        let with = run(&world, &BcdOptions::default());
+        let with = run(&world, &all);
         let without = run(
             &world,
             &BcdOptions {
                 rim: false,
-                ..BcdOptions::default()
+                ..all.clone()
             },
         );
         let picky = run(
             &world,
             &BcdOptions {
                 rim_min_yield: 1.0,
-                ..BcdOptions::default()
+                ..all
             },
         );
-        assert_eq!(without.collisions + picky.collisions, 0);
+        assert_eq!(with.collisions + without.collisions + picky.collisions, 0);
         assert!(without.effective_coverage < with.effective_coverage);
         assert!(without.path_length_m < with.path_length_m);
         // A yield of a whole lane per metre is never met by a rim contour.
@@ -1676,6 +1876,50 @@ mod tests {
         assert_eq!(lines, 20);
         // Ends longer than the limit: the cell stays whole.
         assert_eq!(split_ends(vec![strip], 1).len(), 1);
+    }
+
+    #[test]
+    fn cells_that_neighbours_lanes_sweep_are_dropped() {
+        // A wide cell (columns 0..=19, rows 0..=9) with lanes up to column 19, and a sliver of
+        // columns 20..=21 beside it: its pixels are within rt = 3 of the lane at column 19.
+        let wide = Cell {
+            cols: true,
+            u0: 0,
+            runs: vec![(0, 9); 20],
+        };
+        let sliver = Cell {
+            cols: true,
+            u0: 20,
+            runs: vec![(0, 9); 2],
+        };
+        let far = Cell {
+            cols: true,
+            u0: 25,
+            runs: vec![(0, 9); 2],
+        };
+        let cells = vec![
+            (wide.clone(), vec![0.0, 6.0, 12.0, 19.0]),
+            (sliver, vec![21.0]),
+            (far, vec![25.0]),
+        ];
+        let kept = drop_covered(cells, 30, 10, 3.0);
+        assert_eq!(kept.len(), 2);
+        assert_eq!(kept[0].0.u0, 0);
+        assert_eq!(kept[1].0.u0, 25);
+        // When the wide cell's lanes end at column 12 (sweeping up to 15), neither cell's
+        // lanes sweep all of the other's pixels: both stay.
+        let cells = vec![
+            (wide, vec![0.0, 6.0, 12.0]),
+            (
+                Cell {
+                    cols: true,
+                    u0: 20,
+                    runs: vec![(0, 9); 2],
+                },
+                vec![21.0],
+            ),
+        ];
+        assert_eq!(drop_covered(cells, 30, 10, 3.0).len(), 2);
     }
 
     #[test]
