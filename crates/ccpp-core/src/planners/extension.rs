@@ -116,9 +116,6 @@
 //! assert!(me.effective_coverage > 0.99);
 //! ```
 
-use std::cmp::Reverse;
-use std::collections::BinaryHeap;
-
 use fixedbitset::FixedBitSet;
 use serde::{Deserialize, Serialize};
 
@@ -200,6 +197,87 @@ pub(crate) type Wanted<'a> = Option<&'a dyn Fn(Point) -> bool>;
 /// Target counts of the pixels around a bounded search's start, per window row as prefix sums
 /// (`pre[row * (w + 1) + c]` = targets in columns `c0..c0 + c`). Built once per search, it
 /// answers each settled position's gain with one subtraction per disk row.
+/// log2 of the key range one [`BucketQueue`] bucket holds (a sixteenth of an orthogonal step).
+const BUCKET_SHIFT: u32 = 6;
+/// The last [`BucketQueue`] bucket holds every larger key too (bounds its memory; the order
+/// stays exact, only slower, for searches of more than about a million pixel steps).
+const BUCKET_MAX: usize = 1 << 24;
+
+/// The position search's priority queue: pops the smallest `(key, index)` first, exactly the
+/// order of a binary min-heap on that pair (so plans are unchanged), but cheaper. Keys are
+/// search costs (plus a heuristic), integers in steps of about [`COST_ORTHO`]: entries go to
+/// the bucket `key >> BUCKET_SHIFT` by a plain push, and a bucket is sorted once, when the
+/// queue first pops from it (later pushes into a sorted bucket are inserted in order). The
+/// weighted-A* heuristic is not consistent, so a key may fall below the bucket being popped:
+/// the cursor then moves back to it.
+#[derive(Default)]
+struct BucketQueue {
+    /// Entries per bucket; a sorted bucket is in descending order (smallest last).
+    buckets: Vec<Vec<(u64, u32)>>,
+    /// Whether each bucket is sorted.
+    sorted: Vec<bool>,
+    /// No non-empty bucket lies below this one.
+    cur: usize,
+    /// One past the highest bucket used since the last clear.
+    top: usize,
+    /// Entries queued.
+    len: usize,
+}
+
+impl BucketQueue {
+    /// Empties the queue (keeps the buckets' storage).
+    fn clear(&mut self) {
+        let top = self.top.min(self.buckets.len());
+        for b in self.cur.min(top)..top {
+            self.buckets[b].clear();
+            self.sorted[b] = false;
+        }
+        self.cur = usize::MAX;
+        self.top = 0;
+        self.len = 0;
+    }
+
+    /// Queues position `i` at `key`.
+    fn push(&mut self, key: u64, i: usize) {
+        let b = usize::try_from(key >> BUCKET_SHIFT).map_or(BUCKET_MAX, |b| b.min(BUCKET_MAX));
+        if b >= self.buckets.len() {
+            self.buckets.resize_with(b + 1, Vec::new);
+            self.sorted.resize(b + 1, false);
+        }
+        let e = (key, i as u32);
+        let v = &mut self.buckets[b];
+        if self.sorted[b] {
+            let at = v.partition_point(|x| *x > e);
+            v.insert(at, e);
+        } else {
+            v.push(e);
+        }
+        if self.len == 0 || b < self.cur {
+            self.cur = b;
+        }
+        self.top = self.top.max(b + 1);
+        self.len += 1;
+    }
+
+    /// Removes and returns the position with the smallest `(key, index)`.
+    fn pop(&mut self) -> Option<usize> {
+        if self.len == 0 {
+            return None;
+        }
+        while self.buckets[self.cur].is_empty() {
+            self.sorted[self.cur] = false;
+            self.cur += 1;
+        }
+        let b = self.cur;
+        if !self.sorted[b] {
+            self.buckets[b].sort_unstable_by(|x, y| y.cmp(x));
+            self.sorted[b] = true;
+        }
+        self.len -= 1;
+        self.buckets[b].pop().map(|(_, i)| i as usize)
+    }
+}
+
 #[derive(Default)]
 struct Window {
     c0: i64,
@@ -329,7 +407,7 @@ pub(crate) struct Extension {
     stamp: Vec<u32>,
     generation: u32,
     /// Reused search queue.
-    heap: BinaryHeap<Reverse<(u64, usize)>>,
+    heap: BucketQueue,
     /// Target counts around a bounded search's start, valid during that search only.
     win: Window,
     win_on: bool,
@@ -394,7 +472,7 @@ impl Extension {
             parent: vec![u32::MAX; n],
             stamp: vec![0; n],
             generation: 0,
-            heap: BinaryHeap::new(),
+            heap: BucketQueue::default(),
             win: Window::default(),
             win_on: false,
             resume_at: None,
@@ -849,7 +927,7 @@ impl Extension {
         from: Point,
         limit: Option<u64>,
         h: &dyn Fn(&Self, Px) -> u64,
-        heap: &mut BinaryHeap<Reverse<(u64, usize)>>,
+        heap: &mut BucketQueue,
         done: &mut dyn FnMut(&mut Self, Px) -> bool,
     ) -> Option<Vec<usize>> {
         let p0 = self.frame.grid_to_pixel_signed(from);
@@ -860,7 +938,7 @@ impl Extension {
         } else {
             self.seed(known, from, p0, h, heap);
         }
-        while let Some(Reverse((_, i))) = heap.pop() {
+        while let Some(i) = heap.pop() {
             if self.dist[i] & CLOSED != 0 {
                 continue;
             }
@@ -893,7 +971,7 @@ impl Extension {
         from: Point,
         p0: Px,
         h: &dyn Fn(&Self, Px) -> u64,
-        heap: &mut BinaryHeap<Reverse<(u64, usize)>>,
+        heap: &mut BucketQueue,
     ) {
         let gen = self.generation;
         for dr in -1..=1 {
@@ -909,7 +987,7 @@ impl Extension {
                     self.stamp[i] = gen;
                     self.dist[i] = d;
                     self.parent[i] = u32::MAX;
-                    heap.push(Reverse((d + h(self, p), i)));
+                    heap.push(d + h(self, p), i);
                 }
             }
         }
@@ -921,7 +999,7 @@ impl Extension {
         known: &KnownMap,
         i: usize,
         h: &dyn Fn(&Self, Px) -> u64,
-        heap: &mut BinaryHeap<Reverse<(u64, usize)>>,
+        heap: &mut BucketQueue,
     ) {
         let gen = self.generation;
         let d = self.dist[i] & !CLOSED;
@@ -940,7 +1018,7 @@ impl Extension {
                 self.stamp[j] = gen;
                 self.dist[j] = nd;
                 self.parent[j] = i as u32;
-                heap.push(Reverse((nd + h(self, q), j)));
+                heap.push(nd + h(self, q), j);
             }
         }
     }
