@@ -200,8 +200,8 @@ pub(crate) type Wanted<'a> = Option<&'a dyn Fn(Point) -> bool>;
 /// log2 of the key range one [`BucketQueue`] bucket holds (a sixteenth of an orthogonal step).
 const BUCKET_SHIFT: u32 = 6;
 /// The last [`BucketQueue`] bucket holds every larger key too (bounds its memory; the order
-/// stays exact, only slower, for searches of more than about a million pixel steps).
-const BUCKET_MAX: usize = 1 << 24;
+/// stays exact, only slower, for keys beyond about 65 000 pixel steps).
+const BUCKET_MAX: usize = 1 << 20;
 
 /// The position search's priority queue: pops the smallest `(key, index)` first, exactly the
 /// order of a binary min-heap on that pair (so plans are unchanged), but cheaper. Keys are
@@ -1378,4 +1378,49 @@ fn count_range(free: &[usize], swept: &[usize], a: usize, b: usize) -> usize {
         blk += 1;
     }
     n
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{BucketQueue, BUCKET_MAX, BUCKET_SHIFT};
+    use proptest::prelude::*;
+    use std::cmp::Reverse;
+    use std::collections::BinaryHeap;
+
+    /// A key: mostly a few pixel steps of search cost, sometimes past the last bucket.
+    fn key() -> impl Strategy<Value = u64> {
+        prop_oneof![
+            8 => 0u64..20_000,
+            1 => Just((BUCKET_MAX as u64) << BUCKET_SHIFT).prop_flat_map(|b| b..b + 5_000),
+        ]
+    }
+
+    proptest! {
+        /// The bucket queue pops exactly what a binary min-heap on `(key, index)` pops, for any
+        /// mix of pushes (keys below already popped ones included), pops and clears.
+        #[test]
+        fn bucket_queue_pops_in_heap_order(
+            ops in proptest::collection::vec((0u8..10, key(), 0usize..64), 0..400)
+        ) {
+            let mut q = BucketQueue::default();
+            let mut h: BinaryHeap<Reverse<(u64, usize)>> = BinaryHeap::new();
+            for (op, k, i) in ops {
+                match op {
+                    0..=5 => {
+                        q.push(k, i);
+                        h.push(Reverse((k, i)));
+                    }
+                    6..=8 => prop_assert_eq!(q.pop(), h.pop().map(|Reverse((_, i))| i)),
+                    _ => {
+                        q.clear();
+                        h.clear();
+                    }
+                }
+            }
+            while let Some(Reverse((_, i))) = h.pop() {
+                prop_assert_eq!(q.pop(), Some(i));
+            }
+            prop_assert_eq!(q.pop(), None);
+        }
+    }
 }
