@@ -89,7 +89,7 @@ use std::collections::VecDeque;
 use serde::{Deserialize, Serialize};
 
 use super::bsa::{Bsa, BsaOptions, Side};
-use super::extension::{Chunk, Extension, ExtensionOptions};
+use super::extension::{polyline_len, Chunk, Extension, ExtensionOptions};
 use crate::geometry::Point;
 use crate::planner::{Planner, Sensor, Step};
 use crate::trace::Event;
@@ -250,17 +250,6 @@ impl BsaExtended {
             }
         }
     }
-}
-
-/// Length of the polyline from `from` through `pts`.
-fn polyline_len(from: Point, pts: &[Point]) -> f64 {
-    let mut prev = from;
-    let mut len = 0.0;
-    for &p in pts {
-        len += prev.dist(p);
-        prev = p;
-    }
-    len
 }
 
 impl Planner for BsaExtended {
