@@ -126,12 +126,7 @@ pub fn render_run_files_swept(
     // The picture and the text files are independent pure functions of (world, trace): draw
     // the picture on a second thread while this one writes the text (same bytes either way).
     let (png, text) = std::thread::scope(|s| {
-        let png = s.spawn(|| {
-            phase::time("coverage.png", || match swept {
-                Some(swept) => coverage_png_swept(world, trace, &style, swept),
-                None => coverage_png(world, trace, &style),
-            })
-        });
+        let png = s.spawn(|| coverage_picture(world, trace, &style, swept));
         let text = phase::time("trace.jsonl", || ccpp_io::trace::trace_jsonl(trace)).map(|t| {
             let path = phase::time("path.csv", || ccpp_io::trace::path_csv(trace));
             (t, path)
@@ -151,6 +146,19 @@ pub fn render_run_files_swept(
         ("coverage.png", png),
         ("metrics.json", metrics_text.into_bytes()),
     ])
+}
+
+/// `coverage.png` (timed as its phase), from `swept` when the caller has the swept pixels.
+fn coverage_picture(
+    world: &World,
+    trace: &Trace,
+    style: &CoverageStyle,
+    swept: Option<&fixedbitset::FixedBitSet>,
+) -> Result<Vec<u8>, RenderError> {
+    phase::time("coverage.png", || match swept {
+        Some(swept) => coverage_png_swept(world, trace, style, swept),
+        None => coverage_png(world, trace, style),
+    })
 }
 
 /// What [`stream_run_files`] writes each file with: `put(name, fill)` creates the file `name`
@@ -179,12 +187,7 @@ pub fn stream_run_files<E: From<RunFilesError>>(
     let run_json = run_json(scenario, world).map_err(RunFilesError::from)?;
     let style = coverage_style(metrics);
     std::thread::scope(|s| {
-        let png = s.spawn(|| {
-            phase::time("coverage.png", || match swept {
-                Some(swept) => coverage_png_swept(world, trace, &style, swept),
-                None => coverage_png(world, trace, &style),
-            })
-        });
+        let png = s.spawn(|| coverage_picture(world, trace, &style, swept));
         let text = (|| -> Result<(), E> {
             put("run.json", &mut |w| w.write_all(run_json.as_bytes()))?;
             let path = phase::time("path.csv", || ccpp_io::trace::path_csv(trace));
