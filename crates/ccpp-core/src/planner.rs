@@ -86,10 +86,7 @@ impl<'a> Scan<'a> {
         let r = self.range_px;
         let r2 = r * r;
         let h = frame.height as f64;
-        let c0 = floor_i64(self.center.x - r - 0.5).max(0) as usize;
-        let c1 = (ceil_i64(self.center.x + r - 0.5).max(0) as usize).min(frame.width - 1);
-        let r0 = floor_i64(h - (self.center.y + r) - 0.5).max(0) as usize;
-        let r1 = (ceil_i64(h - (self.center.y - r) - 0.5).max(0) as usize).min(frame.height - 1);
+        let (c0, c1, r0, r1) = self.pixel_box();
         if c0 > c1 {
             return;
         }
@@ -148,6 +145,19 @@ impl<'a> Scan<'a> {
         }
     }
 
+    /// The columns `c0..=c1` and rows `r0..=r1` of the image that can hold in-range pixels
+    /// (`c0 > c1` when none can).
+    fn pixel_box(&self) -> (usize, usize, usize, usize) {
+        let frame = self.map.frame();
+        let r = self.range_px;
+        let h = frame.height as f64;
+        let c0 = floor_i64(self.center.x - r - 0.5).max(0) as usize;
+        let c1 = (ceil_i64(self.center.x + r - 0.5).max(0) as usize).min(frame.width - 1);
+        let r0 = floor_i64(h - (self.center.y + r) - 0.5).max(0) as usize;
+        let r1 = (ceil_i64(h - (self.center.y - r) - 0.5).max(0) as usize).min(frame.height - 1);
+        (c0, c1, r0, r1)
+    }
+
     /// Calls `f(col, row, cell)` for every in-range pixel that lies inside the image, in
     /// row-major order. (Out-of-image pixels are occupied by convention and never change.)
     pub fn for_each(&self, mut f: impl FnMut(usize, usize, Cell)) {
@@ -155,10 +165,7 @@ impl<'a> Scan<'a> {
         let r = self.range_px;
         let r2 = r * r;
         let h = frame.height as f64;
-        let c0 = floor_i64(self.center.x - r - 0.5).max(0) as usize;
-        let c1 = (ceil_i64(self.center.x + r - 0.5).max(0) as usize).min(frame.width - 1);
-        let r0 = floor_i64(h - (self.center.y + r) - 0.5).max(0) as usize;
-        let r1 = (ceil_i64(h - (self.center.y - r) - 0.5).max(0) as usize).min(frame.height - 1);
+        let (c0, c1, r0, r1) = self.pixel_box();
         for row in r0..=r1 {
             let gy = h - row as f64 - 0.5;
             let dy2 = (gy - self.center.y).powi(2);
