@@ -15,23 +15,12 @@ use rayon::prelude::*;
 use crate::args::{BenchArgs, MapArgs};
 use crate::job::{parse_planner, planner_options, prepare_map, robot_from, Job, PreparedMap};
 use crate::output::write_run_files;
+use crate::row::Row;
 use crate::staging::write_file;
 
 /// Test hook: a planner named by this environment variable panics in a `ccpp bench` run, to
 /// check that one failing run becomes an error row and the others finish.
 pub const PANIC_ENV: &str = "CCPP_TEST_PANIC_PLANNER";
-
-/// One row of the results: a run, or its failure.
-pub struct Row {
-    /// Map name.
-    pub map: String,
-    /// Planner name.
-    pub planner: String,
-    /// The metrics, or the error.
-    pub outcome: Result<Metrics, String>,
-    /// Where the run's files are.
-    pub dir: PathBuf,
-}
 
 /// Expands `--maps` arguments: a folder gives its `*.yaml` maps (or, when it has none, its
 /// PNG/PGM images), sorted; a file is taken as it is.

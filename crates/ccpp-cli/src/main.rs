@@ -11,6 +11,7 @@ mod job;
 mod output;
 mod plan;
 mod plots;
+mod row;
 mod staging;
 mod waypoints;
 

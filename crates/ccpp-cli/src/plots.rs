@@ -19,8 +19,8 @@ use ccpp_render::{
 };
 use rayon::prelude::*;
 
-use crate::bench::Row;
 use crate::job::PreparedMap;
+use crate::row::Row;
 
 /// Reads a `trace.jsonl` back (the checked codec of `ccpp_io::trace`).
 pub fn read_trace(path: &Path) -> Result<Trace> {

@@ -56,7 +56,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::geometry::{wrap_angle, Point, Pose};
-use crate::planners::settings::present;
+use crate::options::present;
 
 /// Gains and limits of one PID controller.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]

@@ -23,6 +23,7 @@ pub mod grid;
 pub mod inflate;
 pub mod landmarks;
 pub mod metrics;
+mod options;
 pub mod planner;
 pub mod planners;
 pub mod raster;

@@ -164,21 +164,21 @@ impl ExtensionOptions {
     ///
     /// # Errors
     /// The first field out of range.
-    pub fn validate(&self) -> Result<(), super::settings::OptionsError> {
+    pub fn validate(&self) -> Result<(), crate::options::OptionsError> {
         for (field, v) in [
             ("extension.reach_r", self.reach_r),
             ("extension.min_yield", self.min_yield),
             ("extension.leave_fraction", self.leave_fraction),
         ] {
             if !(v.is_finite() && v >= 0.0) {
-                return Err(super::settings::OptionsError::new(
+                return Err(crate::options::OptionsError::new(
                     field,
                     format!("must be a finite number >= 0, got {v}"),
                 ));
             }
         }
         if self.leave_fraction > 1.0 {
-            return Err(super::settings::OptionsError::new(
+            return Err(crate::options::OptionsError::new(
                 "extension.leave_fraction",
                 format!("must be at most 1, got {}", self.leave_fraction),
             ));

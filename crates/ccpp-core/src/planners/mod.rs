@@ -24,7 +24,8 @@ use serde::{Deserialize, Serialize};
 use crate::planner::Planner;
 use crate::world::World;
 
-pub use settings::{OptionsError, PlannerSettings, ResourceEstimate, Setup};
+pub use crate::options::OptionsError;
+pub use settings::{PlannerSettings, ResourceEstimate, Setup};
 
 /// One catalogue entry.
 #[derive(Clone, Copy, Debug)]

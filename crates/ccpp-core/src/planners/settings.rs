@@ -9,6 +9,7 @@
 
 use crate::exec::{Execution, PidGains, PidOptions};
 use crate::grid::MapFrame;
+use crate::options::{present, OptionsError};
 use crate::planner::Planner;
 use crate::world::{Robot, World};
 
@@ -30,35 +31,6 @@ pub const PIXEL_BYTES: f64 = 64.0;
 pub const TILE_BYTES: f64 = 600.0;
 /// Bytes per trace record: the record in memory and its `trace.jsonl` / `path.csv` lines.
 pub const RECORD_BYTES: f64 = 200.0;
-
-/// An invalid option value.
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-#[error("{field}: {message}")]
-pub struct OptionsError {
-    /// The option, as `section.field` once the section is known.
-    pub field: String,
-    /// What is wrong.
-    pub message: String,
-}
-
-impl OptionsError {
-    /// An error about `field`.
-    pub fn new(field: &str, message: impl Into<String>) -> Self {
-        Self {
-            field: field.to_string(),
-            message: message.into(),
-        }
-    }
-
-    /// Prefixes the field with its options section (`ba_star.tile_side_m`).
-    #[must_use]
-    pub fn in_section(mut self, section: &str) -> Self {
-        if !self.field.is_empty() && !self.field.starts_with(section) {
-            self.field = format!("{section}.{}", self.field);
-        }
-        self
-    }
-}
 
 /// What a planner's checks and estimate may use: what an operator knows before the run.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -141,16 +113,6 @@ struct ExtensionSection {
     min_yield: Option<f64>,
     #[serde(default, deserialize_with = "present")]
     leave_fraction: Option<f64>,
-}
-
-/// A field that is present must hold a value (`null` is refused, as for the full type).
-///
-/// # Errors
-/// The value's own.
-pub(crate) fn present<'de, D: serde::Deserializer<'de>, T: serde::Deserialize<'de>>(
-    d: D,
-) -> Result<Option<T>, D::Error> {
-    T::deserialize(d).map(Some)
 }
 
 impl ExtensionSection {

@@ -5,7 +5,11 @@ use std::path::Path;
 use ccpp_core::grid::Cell;
 
 use super::error::MapError;
-use super::yaml::{DEFAULT_FREE_THRESH, DEFAULT_OCCUPIED_THRESH};
+
+/// Default `occupied_thresh` of ROS `map_server` when the YAML has none.
+pub const DEFAULT_OCCUPIED_THRESH: f64 = 0.65;
+/// Default `free_thresh` of ROS `map_server` when the YAML has none.
+pub const DEFAULT_FREE_THRESH: f64 = 0.196;
 
 /// Trinary classification thresholds of `map_server`.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -36,9 +36,9 @@ use ccpp_core::geometry::Pose;
 use ccpp_core::grid::{GridMap, MapFrame};
 use image::ImageReader;
 
-pub use classify::{classify, Thresholds};
+pub use classify::{classify, Thresholds, DEFAULT_FREE_THRESH, DEFAULT_OCCUPIED_THRESH};
 pub use error::MapError;
-pub use yaml::{validate_placement, MapYaml, DEFAULT_FREE_THRESH, DEFAULT_OCCUPIED_THRESH};
+pub use yaml::{validate_placement, MapYaml};
 
 /// Resolution (m/px) of a bare image when no override is given.
 pub const DEFAULT_BARE_RESOLUTION: f64 = 0.05;

@@ -6,13 +6,8 @@ use std::path::Path;
 use serde::de::{self, Deserializer, Visitor};
 use serde::Deserialize;
 
-use super::classify::Thresholds;
+use super::classify::{Thresholds, DEFAULT_FREE_THRESH, DEFAULT_OCCUPIED_THRESH};
 use super::error::{one_line, MapError};
-
-/// Default `occupied_thresh` of ROS `map_server` when the YAML has none.
-pub const DEFAULT_OCCUPIED_THRESH: f64 = 0.65;
-/// Default `free_thresh` of ROS `map_server` when the YAML has none.
-pub const DEFAULT_FREE_THRESH: f64 = 0.196;
 
 /// A parsed and validated ROS `map_server` YAML.
 ///
