@@ -5,24 +5,8 @@ use std::path::{Path, PathBuf};
 
 use assert_cmd::Command;
 
-fn data(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data")
-        .join(name)
-}
-
-fn shared_maps() -> Option<PathBuf> {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/maps");
-    p.is_dir().then_some(p)
-}
-
-fn ccpp() -> Command {
-    Command::cargo_bin("ccpp").unwrap()
-}
-
-fn read_json(p: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
-}
+mod common;
+use common::{ccpp, data, read_json, shared_maps};
 
 #[test]
 fn planners_lists_random_bounce() {

@@ -7,34 +7,12 @@
 
 use std::path::{Path, PathBuf};
 
-use assert_cmd::Command;
 use ccpp_core::route::Route;
 use ccpp_io::export::{parse_waypoints_csv, read_waypoints};
 use serde::Deserialize;
 
-fn ccpp() -> Command {
-    Command::cargo_bin("ccpp").unwrap()
-}
-
-/// Writes a PGM (0.05 m/px bare image) of `w` x `h` px: walls around, `blocked(x, y)` inside.
-fn pgm(
-    dir: &Path,
-    name: &str,
-    w: usize,
-    h: usize,
-    blocked: impl Fn(usize, usize) -> bool,
-) -> PathBuf {
-    let mut bytes = format!("P5\n{w} {h}\n255\n").into_bytes();
-    for y in 0..h {
-        for x in 0..w {
-            let wall = x == 0 || y == 0 || x == w - 1 || y == h - 1 || blocked(x, y);
-            bytes.push(if wall { 0 } else { 254 });
-        }
-    }
-    let p = dir.join(name);
-    std::fs::write(&p, bytes).unwrap();
-    p
-}
+mod common;
+use common::{ccpp, pgm};
 
 /// A 5 x 4 m room with one pillar.
 fn room(dir: &Path) -> PathBuf {

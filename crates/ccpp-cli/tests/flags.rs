@@ -7,41 +7,8 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use assert_cmd::Command;
-
-fn ccpp() -> Command {
-    Command::cargo_bin("ccpp").unwrap()
-}
-
-/// Writes a PGM (0.05 m/px as a bare image) of `w` x `h` px: walls around, `blocked(x, y)`
-/// inside (y down from the top row).
-fn pgm(
-    dir: &Path,
-    name: &str,
-    w: usize,
-    h: usize,
-    blocked: impl Fn(usize, usize) -> bool,
-) -> PathBuf {
-    let mut bytes = format!("P5\n{w} {h}\n255\n").into_bytes();
-    for y in 0..h {
-        for x in 0..w {
-            let wall = x == 0 || y == 0 || x == w - 1 || y == h - 1 || blocked(x, y);
-            bytes.push(if wall { 0 } else { 254 });
-        }
-    }
-    let p = dir.join(name);
-    std::fs::write(&p, bytes).unwrap();
-    p
-}
-
-/// An 8 x 6 m room with three pillars (backtracking happens).
-fn pillars(dir: &Path) -> PathBuf {
-    pgm(dir, "pillars.pgm", 160, 120, |x, y| {
-        ((40..52).contains(&x) && (20..80).contains(&y))
-            || ((90..104).contains(&x) && (50..110).contains(&y))
-            || ((120..132).contains(&x) && (10..40).contains(&y))
-    })
-}
+mod common;
+use common::{ccpp, pgm, pillars, ALL};
 
 /// The 60 x 60 px (3 x 3 m) box of the issue, as a YAML map.
 fn box60(dir: &Path) -> PathBuf {
@@ -115,17 +82,6 @@ fn run_fails(dir: &Path, map: &Path, planner: &str, args: &[&str], needles: &[&s
     fails(&all, &[map], needles, 10);
     assert!(!out.join("metrics.json").exists());
 }
-
-const ALL: [&str; 8] = [
-    "random-bounce",
-    "ba-star",
-    "ba-star-extended",
-    "bsa",
-    "bsa-extended",
-    "bsa-bfs",
-    "bcd",
-    "rect-boustrophedon",
-];
 
 /// Checks that `flag value` changes the output of each planner in `applies` (metrics or
 /// trace), and is refused by every other planner with "does not apply".

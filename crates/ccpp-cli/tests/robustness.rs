@@ -8,15 +8,8 @@ use std::process::Stdio;
 
 use assert_cmd::Command;
 
-fn data(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data")
-        .join(name)
-}
-
-fn ccpp() -> Command {
-    Command::cargo_bin("ccpp").unwrap()
-}
+mod common;
+use common::{ccpp, data};
 
 fn stderr_of(o: &std::process::Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()

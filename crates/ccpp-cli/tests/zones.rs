@@ -6,26 +6,12 @@
 
 use std::path::{Path, PathBuf};
 
-use assert_cmd::Command;
-
-fn ccpp() -> Command {
-    Command::cargo_bin("ccpp").unwrap()
-}
+mod common;
+use common::{ccpp, ALL};
 
 fn house() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/maps/aws_small_house.yaml")
 }
-
-const ALL: [&str; 8] = [
-    "random-bounce",
-    "ba-star",
-    "ba-star-extended",
-    "bsa",
-    "bsa-extended",
-    "bsa-bfs",
-    "bcd",
-    "rect-boustrophedon",
-];
 
 /// `aws_small_house`'s frame: 500 x 500 px at 0.05 m/px, origin (-12.5, -12.5).
 const W: usize = 500;

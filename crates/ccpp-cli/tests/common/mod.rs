@@ -1,0 +1,73 @@
+//! Helpers shared by the CLI's end-to-end test files (each test file is its own crate and uses
+//! only some of them, hence the `dead_code` allowance).
+#![allow(dead_code, clippy::unwrap_used)]
+
+use std::path::{Path, PathBuf};
+
+use assert_cmd::Command;
+
+/// Every planner, in the registry's order.
+pub const ALL: [&str; 8] = [
+    "random-bounce",
+    "ba-star",
+    "ba-star-extended",
+    "bsa",
+    "bsa-extended",
+    "bsa-bfs",
+    "bcd",
+    "rect-boustrophedon",
+];
+
+/// The `ccpp` binary built for these tests.
+pub fn ccpp() -> Command {
+    Command::cargo_bin("ccpp").unwrap()
+}
+
+/// A file of `tests/data`.
+pub fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name)
+}
+
+/// The shared maps folder (`../shared/maps` beside the checkout), when it is there.
+pub fn shared_maps() -> Option<PathBuf> {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/maps");
+    p.is_dir().then_some(p)
+}
+
+/// A JSON file, parsed.
+pub fn read_json(p: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+}
+
+/// Writes a PGM (0.05 m/px as a bare image) of `w` x `h` px: walls around, `blocked(x, y)`
+/// inside (y down from the top row).
+pub fn pgm(
+    dir: &Path,
+    name: &str,
+    w: usize,
+    h: usize,
+    blocked: impl Fn(usize, usize) -> bool,
+) -> PathBuf {
+    let mut bytes = format!("P5\n{w} {h}\n255\n").into_bytes();
+    for y in 0..h {
+        for x in 0..w {
+            let wall = x == 0 || y == 0 || x == w - 1 || y == h - 1 || blocked(x, y);
+            bytes.push(if wall { 0 } else { 254 });
+        }
+    }
+    let p = dir.join(name);
+    std::fs::write(&p, bytes).unwrap();
+    p
+}
+
+/// An 8 x 6 m room with three pillars: backtracking happens, and BA*-based planners cover it in
+/// several regions.
+pub fn pillars(dir: &Path) -> PathBuf {
+    pgm(dir, "pillars.pgm", 160, 120, |x, y| {
+        ((40..52).contains(&x) && (20..80).contains(&y))
+            || ((90..104).contains(&x) && (50..110).contains(&y))
+            || ((120..132).contains(&x) && (10..40).contains(&y))
+    })
+}
