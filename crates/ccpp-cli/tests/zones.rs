@@ -260,6 +260,21 @@ fn bad_zones_are_refused_with_one_line_naming_the_file() {
         &["--keepout", maze.to_str().unwrap()],
         &["keepout", "teb_maze.yaml", "200 x 200", "map's frame"],
     );
+    // A mask whose header claims 60000 x 60000 px (3.6 G pixels) and holds no pixel data: the
+    // size is refused from the header, before anything is decoded or allocated.
+    std::fs::write(dir.join("huge.pgm"), b"P5\n60000 60000\n255\n").unwrap();
+    let huge = w(
+        "huge.yaml",
+        "image: huge.pgm\nresolution: 0.05\norigin: [-12.5, -12.5, 0]\n",
+    );
+    run(
+        &["--keepout", &huge],
+        &[
+            "huge.yaml",
+            "keepout mask is 60000 x 60000 px",
+            "map's frame",
+        ],
+    );
     let shifted = mask(dir, "shifted", -12.0, |_, _| false);
     run(
         &["--keepout", shifted.to_str().unwrap()],

@@ -21,7 +21,7 @@ use fixedbitset::FixedBitSet;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
-use crate::map::{load_map, LoadOptions};
+use crate::map::{load_map, LoadOptions, MapYaml};
 
 /// Where a zone comes from (serialized untagged: `[x0, y0, x1, y1]`, a file name, or a list of
 /// polygons, each a list of `[x, y]`).
@@ -138,14 +138,25 @@ fn read_file(path: &Path, frame: &MapFrame) -> Result<ZoneData, ZoneFileError> {
 }
 
 fn read_mask(path: &Path, frame: &MapFrame) -> Result<FixedBitSet, ZoneFileError> {
+    let size_err = |w: usize, h: usize| {
+        bad(format!(
+            "keepout mask is {w} x {h} px but the map is {} x {} px; a mask must be in the map's frame",
+            frame.width, frame.height
+        ))
+    };
+    // The size is in the image header: a mask of another size is refused before its pixels
+    // are decoded (a huge or foreign mask costs nothing). Any problem reading the header is
+    // left to the loader below, which reports it properly.
+    if let Some((w, h)) = mask_image_size(path) {
+        if (w, h) != (frame.width, frame.height) {
+            return Err(size_err(w, h));
+        }
+    }
     let m = load_map(path, &LoadOptions::default()).map_err(|e| bad(e.to_string()))?;
     let f = *m.grid.frame();
     let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs()).max(1.0);
     if f.width != frame.width || f.height != frame.height {
-        return Err(bad(format!(
-            "keepout mask is {} x {} px but the map is {} x {} px; a mask must be in the map's frame",
-            f.width, f.height, frame.width, frame.height
-        )));
+        return Err(size_err(f.width, f.height));
     }
     if !close(f.resolution, frame.resolution) {
         return Err(bad(format!(
@@ -169,6 +180,21 @@ fn read_mask(path: &Path, frame: &MapFrame) -> Result<FixedBitSet, ZoneFileError
         }
     }
     Ok(bits)
+}
+
+/// Width and height of a mask's image from its header alone (`None` when the YAML or the
+/// header cannot be read; the full load then says why).
+fn mask_image_size(yaml: &Path) -> Option<(usize, usize)> {
+    let text = crate::file::read_text(yaml).ok()?;
+    let y = MapYaml::parse(&text, yaml).ok()?;
+    let image = yaml.parent().unwrap_or(Path::new("")).join(&y.image);
+    let file = crate::file::open_regular(&image).ok()?;
+    let (w, h) = image::ImageReader::new(std::io::BufReader::new(file))
+        .with_guessed_format()
+        .ok()?
+        .into_dimensions()
+        .ok()?;
+    Some((usize::try_from(w).ok()?, usize::try_from(h).ok()?))
 }
 
 fn point(v: &Value) -> Result<[f64; 2], ZoneFileError> {
