@@ -65,48 +65,14 @@ struct ZonesInfo {
     keepout_free_m2: f64,
 }
 
-/// Flood-fills the 4-connected free pixels from `seed` (marking `seen`); returns the
-/// component's pixel count and whether it touches the image border.
-fn flood(g: &GridMap, seed: usize, seen: &mut [bool], stack: &mut Vec<usize>) -> (usize, bool) {
-    let f = *g.frame();
-    let cells = g.cells();
-    let (mut size, mut border) = (0usize, false);
-    seen[seed] = true;
-    stack.push(seed);
-    while let Some(k) = stack.pop() {
-        size += 1;
-        let (c, r) = f.col_row(k);
-        border |= c == 0 || r == 0 || c + 1 == f.width || r + 1 == f.height;
-        let mut visit = |j: usize| {
-            if cells[j] == Cell::Free && !seen[j] {
-                seen[j] = true;
-                stack.push(j);
-            }
-        };
-        if c > 0 {
-            visit(k - 1);
-        }
-        if c + 1 < f.width {
-            visit(k + 1);
-        }
-        if r > 0 {
-            visit(k - f.width);
-        }
-        if r + 1 < f.height {
-            visit(k + f.width);
-        }
-    }
-    (size, border)
-}
-
-/// [`flood`] of one component by horizontal runs, marking a bitset (an eighth of a byte per
-/// pixel; a run is found once and filled whole): same pixel count and border flag.
-fn flood_runs(g: &GridMap, seed: usize) -> (usize, bool) {
+/// Fills the 4-connected free component holding `seed` by horizontal runs, marking `seen` (an
+/// eighth of a byte per pixel; a run is found once and filled whole); returns the component's
+/// pixel count and whether it touches the image border.
+fn flood_runs(g: &GridMap, seed: usize, seen: &mut fixedbitset::FixedBitSet) -> (usize, bool) {
     let f = *g.frame();
     let (w, h) = (f.width, f.height);
     let cells = g.cells();
     let free = |i: usize| cells[i] == Cell::Free;
-    let mut seen = fixedbitset::FixedBitSet::with_capacity(f.len());
     let (mut size, mut border) = (0usize, false);
     let mut stack = vec![seed];
     while let Some(i) = stack.pop() {
@@ -150,17 +116,15 @@ fn flood_runs(g: &GridMap, seed: usize) -> (usize, bool) {
 
 /// Counts 4-connected components of free pixels and the size of the largest.
 fn free_components(g: &GridMap) -> (usize, usize) {
-    let f = *g.frame();
     let cells = g.cells();
-    let mut seen = vec![false; f.len()];
+    let mut seen = fixedbitset::FixedBitSet::with_capacity(cells.len());
     let (mut n, mut largest) = (0usize, 0usize);
-    let mut stack = Vec::new();
-    for i in 0..f.len() {
-        if cells[i] != Cell::Free || seen[i] {
+    for i in 0..cells.len() {
+        if cells[i] != Cell::Free || seen.contains(i) {
             continue;
         }
         n += 1;
-        let (size, _) = flood(g, i, &mut seen, &mut stack);
+        let (size, _) = flood_runs(g, i, &mut seen);
         largest = largest.max(size);
     }
     (n, largest)
@@ -198,7 +162,8 @@ impl StartComponent {
                 touches_border: false,
             };
         }
-        let (size, touches_border) = flood_runs(g, seed);
+        let mut seen = fixedbitset::FixedBitSet::with_capacity(f.len());
+        let (size, touches_border) = flood_runs(g, seed, &mut seen);
         Self {
             area_m2: size as f64 * res2,
             free_m2,
@@ -399,6 +364,40 @@ pub fn run(a: &InfoArgs) -> Result<()> {
 mod tests {
     use super::*;
 
+    /// The reference: flood-fills the 4-connected free pixels pixel by pixel from `seed` (marking `seen`); returns the
+    /// component's pixel count and whether it touches the image border.
+    fn flood(g: &GridMap, seed: usize, seen: &mut [bool], stack: &mut Vec<usize>) -> (usize, bool) {
+        let f = *g.frame();
+        let cells = g.cells();
+        let (mut size, mut border) = (0usize, false);
+        seen[seed] = true;
+        stack.push(seed);
+        while let Some(k) = stack.pop() {
+            size += 1;
+            let (c, r) = f.col_row(k);
+            border |= c == 0 || r == 0 || c + 1 == f.width || r + 1 == f.height;
+            let mut visit = |j: usize| {
+                if cells[j] == Cell::Free && !seen[j] {
+                    seen[j] = true;
+                    stack.push(j);
+                }
+            };
+            if c > 0 {
+                visit(k - 1);
+            }
+            if c + 1 < f.width {
+                visit(k + 1);
+            }
+            if r > 0 {
+                visit(k - f.width);
+            }
+            if r + 1 < f.height {
+                visit(k + f.width);
+            }
+        }
+        (size, border)
+    }
+
     /// The run-based fill finds the same component as the pixel-by-pixel one, on random maps
     /// with rooms, thin walls and the border.
     #[test]
@@ -421,15 +420,25 @@ mod tests {
                 art.push('\n');
             }
             let g = GridMap::from_ascii_scaled(&art, 1, 0.1).unwrap();
+            // Components counted pixel by pixel, as `free_components` counts them by runs.
             let mut seen = vec![false; w * h];
+            let (mut n, mut largest) = (0usize, 0usize);
+            for i in 0..w * h {
+                if g.cells()[i] == Cell::Free && !seen[i] {
+                    n += 1;
+                    largest = largest.max(flood(&g, i, &mut seen, &mut Vec::new()).0);
+                }
+            }
+            assert_eq!(free_components(&g), (n, largest), "trial {trial}\n{art}");
             for i in 0..w * h {
                 if g.cells()[i] != Cell::Free {
                     continue;
                 }
                 seen.fill(false);
                 let want = flood(&g, i, &mut seen, &mut Vec::new());
+                let mut bits = fixedbitset::FixedBitSet::with_capacity(w * h);
                 assert_eq!(
-                    flood_runs(&g, i),
+                    flood_runs(&g, i, &mut bits),
                     want,
                     "trial {trial} seed pixel {i}\n{art}"
                 );
