@@ -141,6 +141,8 @@ struct ExtensionSection {
     min_yield: Option<f64>,
     #[serde(default, deserialize_with = "present")]
     leave_fraction: Option<f64>,
+    #[serde(default, deserialize_with = "present")]
+    simplify_fraction: Option<f64>,
 }
 
 /// A field that is present must hold a value (`null` is refused, as for the full type).
@@ -163,6 +165,7 @@ impl ExtensionSection {
             merge_segments: self.merge_segments.unwrap_or(base.merge_segments),
             min_yield: self.min_yield.unwrap_or(base.min_yield),
             leave_fraction: self.leave_fraction.unwrap_or(base.leave_fraction),
+            simplify_fraction: self.simplify_fraction.unwrap_or(base.simplify_fraction),
         }
     }
 }
