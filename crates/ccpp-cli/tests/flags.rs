@@ -309,6 +309,11 @@ fn config_values_go_through_the_same_validation() {
             "bsa-extended",
             "bsa_extended.extension.leave_fraction",
         ),
+        (
+            "ba_star_extended: { extension: { simplify_fraction: 1.5 } }",
+            "ba-star-extended",
+            "ba_star_extended.extension.simplify_fraction",
+        ),
         // Options the rebuilt bsa-extended dropped are unknown keys now, refused by name.
         ("bsa_extended: { gap_cost: 4 }", "bsa-extended", "gap_cost"),
         (

@@ -539,3 +539,39 @@ fn low_yield_trips_are_left_within_the_budget() {
     // Shorter in all (one map alone may come out longer: the greedy order changes).
     assert!(left_len < all_len, "{left_len} {all_len}");
 }
+
+/// `simplify_fraction`: dropping wall-pass vertices that lose few pixels saves turns, stays
+/// collision-free, and leaves at most that fraction of the floor; `0` loses no pixel.
+#[test]
+fn simplified_passes_save_turns_within_the_budget() {
+    let opts = |simplify_fraction| BaStarExtendedOptions {
+        extension: ExtensionOptions {
+            reach_r: 0.0,
+            simplify_fraction,
+            ..ExtensionOptions::default()
+        },
+        ..BaStarExtendedOptions::default()
+    };
+    let d = BaStarExtendedOptions::default().extension.simplify_fraction;
+    assert!(d > 0.0);
+    let (mut turns_s, mut turns_z, mut differed) = (0, 0, 0);
+    for (art, c, r) in [(HALLS, 2, 9), (BLOCKS, 1, 1), (ROOM, 2, 4)] {
+        let wd = world(art, c, r, 0.0).unwrap();
+        let (so, sm, _) = run_ext(&wd, opts(0.01));
+        let (zo, zm, _) = run_ext(&wd, opts(0.0));
+        assert_eq!(sm.collisions, 0);
+        assert_eq!(sm.coverage_rate, Some(1.0));
+        // The order of later passes may change too: a little slack beyond the budget.
+        assert!(
+            sm.effective_coverage > zm.effective_coverage - 0.01 - 0.003,
+            "{} {}",
+            sm.effective_coverage,
+            zm.effective_coverage
+        );
+        turns_s += sm.turns;
+        turns_z += zm.turns;
+        differed += usize::from(so.trace != zo.trace);
+    }
+    assert!(differed >= 1);
+    assert!(turns_s < turns_z, "{turns_s} {turns_z}");
+}

@@ -145,6 +145,10 @@ pub struct ExtensionOptions {
     /// Most of the known free floor (a fraction) the final clean-up may leave in chunks below
     /// [`Self::min_yield`].
     pub leave_fraction: f64,
+    /// Most of the known free floor (a fraction) that simplifying the wall passes may leave:
+    /// a vertex of a pass whose straight replacement is known free and loses few of the
+    /// pixels the pass gains is dropped (one turn fewer); `0` keeps every pixel.
+    pub simplify_fraction: f64,
 }
 
 impl Default for ExtensionOptions {
@@ -155,6 +159,7 @@ impl Default for ExtensionOptions {
             merge_segments: true,
             min_yield: 0.05,
             leave_fraction: 0.002,
+            simplify_fraction: 0.0015,
         }
     }
 }
@@ -169,6 +174,7 @@ impl ExtensionOptions {
             ("extension.reach_r", self.reach_r),
             ("extension.min_yield", self.min_yield),
             ("extension.leave_fraction", self.leave_fraction),
+            ("extension.simplify_fraction", self.simplify_fraction),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(crate::options::OptionsError::new(
@@ -177,11 +183,16 @@ impl ExtensionOptions {
                 ));
             }
         }
-        if self.leave_fraction > 1.0 {
-            return Err(crate::options::OptionsError::new(
-                "extension.leave_fraction",
-                format!("must be at most 1, got {}", self.leave_fraction),
-            ));
+        for (field, v) in [
+            ("extension.leave_fraction", self.leave_fraction),
+            ("extension.simplify_fraction", self.simplify_fraction),
+        ] {
+            if v > 1.0 {
+                return Err(crate::options::OptionsError::new(
+                    field,
+                    format!("must be at most 1, got {v}"),
+                ));
+            }
         }
         Ok(())
     }
@@ -317,6 +328,10 @@ const ROUTE_WEIGHT: f64 = 1.5;
 /// Longest merged segment, in walk points (bounds the quadratic merge check).
 const MAX_MERGE: usize = 256;
 
+/// How many points past the first one a merged segment cannot reach the merge still tries
+/// (a wiggle of the wall may block one point while a farther one is in sight).
+const MERGE_LOOK: usize = 8;
+
 /// Longest walk of one chunk, in pixel steps.
 const MAX_WALK: usize = 20_000;
 
@@ -333,6 +348,8 @@ pub(crate) struct Chunk {
     claimed: Vec<usize>,
     /// Whether one of them is owed ([`Extension::owe_skipped`]).
     pub(crate) owed: bool,
+    /// Gained pixels the simplified walk leaves (counted once the chunk is driven).
+    simplified: usize,
 }
 
 impl Chunk {
@@ -401,6 +418,13 @@ pub(crate) struct Extension {
     no_gain_free: Vec<usize>,
     /// Target pixels left in chunks below [`ExtensionOptions::min_yield`].
     left: usize,
+    /// Gained pixels the simplified walks leave ([`ExtensionOptions::simplify_fraction`]).
+    simplified: usize,
+    /// Most pixels one dropped vertex may lose (a tool radius of pixels).
+    simplify_per_turn: usize,
+    /// Known free pixels, counted by [`Self::refresh_no_gain`] (valid once the final clean-up
+    /// began: `no_gain_free` is then up to date).
+    free_count: usize,
     // Dijkstra scratch (generation-stamped).
     dist: Vec<u64>,
     parent: Vec<u32>,
@@ -468,6 +492,9 @@ impl Extension {
             no_gain: FixedBitSet::with_capacity(n),
             no_gain_free: Vec::new(),
             left: 0,
+            simplified: 0,
+            simplify_per_turn: rt.ceil().max(1.0) as usize,
+            free_count: 0,
             dist: vec![0; n],
             parent: vec![u32::MAX; n],
             stamp: vec![0; n],
@@ -825,6 +852,16 @@ impl Extension {
         n
     }
 
+    /// The known free pixels: the count [`Self::refresh_no_gain`] keeps once the final
+    /// clean-up began, else counted now.
+    fn known_free_count(&self, known: &KnownMap) -> usize {
+        if self.no_gain_free.len() == known.known_free().as_slice().len() {
+            self.free_count
+        } else {
+            known.known_free().count_ones(..)
+        }
+    }
+
     /// Drops the [`Self::no_gain`] memo around every pixel that became known free since the
     /// last call (a new target there may make positions within the strip disk gain).
     fn refresh_no_gain(&mut self, known: &KnownMap) {
@@ -832,6 +869,7 @@ impl Extension {
         if self.no_gain_free.len() != free.len() {
             self.no_gain.clear();
             self.no_gain_free = free.to_vec();
+            self.free_count = known.known_free().count_ones(..);
             return;
         }
         let f = self.frame;
@@ -841,6 +879,7 @@ impl Extension {
         for b in 0..free.len() {
             let new = free[b] & !self.no_gain_free[b];
             self.no_gain_free[b] = free[b];
+            self.free_count += new.count_ones() as usize;
             let mut todo = new;
             while todo != 0 {
                 let i = b * bits + todo.trailing_zeros() as usize;
@@ -1038,6 +1077,19 @@ impl Extension {
         bounded: bool,
         wanted: Wanted,
     ) -> Chunk {
+        let chunk = self.plan_pass_inner(known, pos, bounded, wanted);
+        self.simplified += chunk.simplified;
+        chunk
+    }
+
+    /// [`Self::plan_pass`] before the chunk's simplification is counted.
+    fn plan_pass_inner(
+        &mut self,
+        known: &KnownMap,
+        pos: Point,
+        bounded: bool,
+        wanted: Wanted,
+    ) -> Chunk {
         let mut cur = self.plan_chunk(known, pos, bounded, wanted, false);
         loop {
             if bounded
@@ -1085,7 +1137,7 @@ impl Extension {
             .collect();
         let side: Vec<usize> = self.polyline_gains(known, &way).concat();
         let charged = chunk.gained + side.len();
-        let budget = self.opts.leave_fraction * known.known_free().count_ones(..) as f64;
+        let budget = self.opts.leave_fraction * self.known_free_count(known) as f64;
         if (self.left + charged) as f64 > budget {
             return false;
         }
@@ -1207,13 +1259,13 @@ impl Extension {
         // The transfer (up to the walk's first position, index `nt`) and the walk are merged
         // apart: no segment cuts across from the way there to the rim.
         let nt = transit.len();
+        let mut simplified = 0;
         let kept: Vec<usize> = if self.opts.merge_segments {
             let mut kept = self.merge(known, &pts[..=nt], &gains[..=nt]);
-            kept.extend(
-                self.merge(known, &pts[nt..], &gains[nt..])
-                    .into_iter()
-                    .map(|k| k + nt),
-            );
+            let walk = self.merge(known, &pts[nt..], &gains[nt..]);
+            let (walk, lost) = self.simplify(known, &pts[nt..], &gains[nt..], walk);
+            simplified = lost;
+            kept.extend(walk.into_iter().map(|k| k + nt));
             kept
         } else {
             (1..pts.len()).collect()
@@ -1226,6 +1278,7 @@ impl Extension {
             gained: gains.iter().map(Vec::len).sum(),
             claimed: gains.iter().flatten().copied().collect(),
             owed: self.any_owed && gains.iter().flatten().any(|&i| self.owed.contains(i)),
+            simplified,
         }
     }
 
@@ -1248,10 +1301,118 @@ impl Extension {
             while b + 1 < pts.len() && b + 1 - a <= MAX_MERGE && keeps(a, b + 1) {
                 b += 1;
             }
+            let far = (b + MERGE_LOOK).min(pts.len() - 1).min(a + MAX_MERGE);
+            if let Some(c) = (b + 2..=far).rev().find(|&c| keeps(a, c)) {
+                b = c;
+            }
             out.push(b);
             a = b;
         }
         out
+    }
+
+    /// Drops vertices of the merged walk `kept` (indices into `pts`, the first point excluded)
+    /// whose removal leaves few of the walk's gained pixels unswept: cheapest loss first
+    /// (Visvalingam-style on the pixels lost), each removal losing at most
+    /// `SIMPLIFY_PER_TURN` pixels per turn saved, all removals within the budget
+    /// ([`ExtensionOptions::simplify_fraction`] of the known free floor). The straight way
+    /// that replaces a vertex must be known free. Lost pixels stay claimed (no later pass goes
+    /// out for them alone) and count as left. Returns the kept indices and how many pixels
+    /// they leave.
+    fn simplify(
+        &mut self,
+        known: &KnownMap,
+        pts: &[Point],
+        gains: &[Vec<usize>],
+        kept: Vec<usize>,
+    ) -> (Vec<usize>, usize) {
+        if kept.len() < 2 {
+            return (kept, 0);
+        }
+        let mut spent = 0;
+        // Counted only when a removal loses a pixel (most lose none).
+        let mut budget: Option<usize> = None;
+        let per_turn = self.simplify_per_turn;
+        let rt2 = self.rt * self.rt;
+        // Vertices: the walk's start (index 0) and the kept points; a doubly linked list.
+        let verts: Vec<usize> = std::iter::once(0).chain(kept.iter().copied()).collect();
+        let n = verts.len();
+        let mut prev: Vec<usize> = (0..n).map(|k| k.wrapping_sub(1)).collect();
+        let mut next: Vec<usize> = (1..=n).collect();
+        let mut alive = vec![true; n];
+        let mut version = vec![0u32; n];
+        let mut lost: Vec<usize> = Vec::new();
+        // Pixels lost so far are marked in `scratch` (cleared before returning).
+        let cost = |s: &Self, u: usize, w: usize| -> Option<usize> {
+            let (a, b) = (verts[u], verts[w]);
+            if b - a > 4 * MAX_MERGE {
+                return None;
+            }
+            let mut c = 0;
+            for g in &gains[a + 1..=b] {
+                for &i in g {
+                    if !s.scratch.contains(i)
+                        && point_segment_dist2(s.center(s.px_of(i)), pts[a], pts[b]) > rt2
+                    {
+                        c += 1;
+                    }
+                }
+            }
+            (c <= per_turn && s.seg_free(known, pts[a], pts[b])).then_some(c)
+        };
+        let mut heap: std::collections::BinaryHeap<std::cmp::Reverse<(usize, usize, u32)>> =
+            std::collections::BinaryHeap::new();
+        for v in 1..n - 1 {
+            if let Some(c) = cost(self, v - 1, v + 1) {
+                heap.push(std::cmp::Reverse((c, v, 0)));
+            }
+        }
+        while let Some(std::cmp::Reverse((c, v, ver))) = heap.pop() {
+            if !alive[v] || ver != version[v] {
+                continue;
+            }
+            if c > 0 {
+                let b = *budget.get_or_insert_with(|| {
+                    (self.opts.simplify_fraction * self.known_free_count(known) as f64) as usize
+                });
+                if self.simplified + spent + c > b {
+                    continue;
+                }
+            }
+            let (u, w) = (prev[v], next[v]);
+            // Mark what the straight u-w no longer sweeps.
+            let (a, b) = (verts[u], verts[w]);
+            for g in &gains[a + 1..=b] {
+                for &i in g {
+                    if !self.scratch.contains(i)
+                        && point_segment_dist2(self.center(self.px_of(i)), pts[a], pts[b]) > rt2
+                    {
+                        self.scratch.insert(i);
+                        lost.push(i);
+                    }
+                }
+            }
+            spent += c;
+            alive[v] = false;
+            next[u] = w;
+            prev[w] = u;
+            for x in [u, w] {
+                if x == 0 || x == n - 1 {
+                    continue;
+                }
+                version[x] += 1;
+                if let Some(c) = cost(self, prev[x], next[x]) {
+                    heap.push(std::cmp::Reverse((c, x, version[x])));
+                }
+            }
+        }
+        for i in lost {
+            self.scratch.set(i, false);
+        }
+        (
+            (1..n).filter(|&k| alive[k]).map(|k| verts[k]).collect(),
+            spent,
+        )
     }
 
     /// Lane ends driven to the wall: the host's lane along heading `theta` ends at world point

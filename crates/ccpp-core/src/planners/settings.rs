@@ -113,6 +113,8 @@ struct ExtensionSection {
     min_yield: Option<f64>,
     #[serde(default, deserialize_with = "present")]
     leave_fraction: Option<f64>,
+    #[serde(default, deserialize_with = "present")]
+    simplify_fraction: Option<f64>,
 }
 
 impl ExtensionSection {
@@ -125,6 +127,7 @@ impl ExtensionSection {
             merge_segments: self.merge_segments.unwrap_or(base.merge_segments),
             min_yield: self.min_yield.unwrap_or(base.min_yield),
             leave_fraction: self.leave_fraction.unwrap_or(base.leave_fraction),
+            simplify_fraction: self.simplify_fraction.unwrap_or(base.simplify_fraction),
         }
     }
 }
