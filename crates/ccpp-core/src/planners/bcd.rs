@@ -79,12 +79,21 @@
 //!    by line-of-sight checks on the true map.
 //!
 //! 5. **Turn pruning** (not in the paper; [`prune`]). The finished plan's turns are cut where
-//!    that costs least floor: a run of up to six vertices is replaced by the straight move
+//!    that costs least floor: a run of up to four vertices is replaced by the straight move
 //!    across it when that move is free on the true map (a corner, a short detour into a sliver
 //!    cell and back, the wiggles of a transfer through clutter), fewest accessible pixels lost
 //!    per turn saved first, while the floor the plan sweeps (estimated with the metric's own
 //!    capsule test, so the estimate is the measured `effective_coverage`) stays at least
-//!    `min_coverage` of the accessible floor (default 0.9952).
+//!    `min_coverage` of the accessible floor (default 0.9952). Then two turns in a row become
+//!    one where the moves before and after them, extended, meet (for at most `turn_cost_m` of
+//!    extra path), and the runs are pruned once more:
+//!
+//!    ```text
+//!    u ----- v1                u ---------- x
+//!              \        ->                 |
+//!               v2                         |
+//!               |  w                       w
+//!    ```
 //!
 //! Deterministic: fixed scan orders and tie-breaks, no hashing. Regions = cells (`RegionStart`
 //! per cell); transfers between cells are marked as backtracks.
@@ -1123,7 +1132,7 @@ impl Bcd {
                 );
                 items = smooth(&ctx, repair(&ctx, &mut search, items));
             }
-            let items = prune::prune(&ctx, items, opts.min_coverage);
+            let items = prune::prune(&ctx, items, opts.min_coverage, turn_px);
             let pts: Vec<Point> = moves(&items).into_iter().map(|m| m.0).collect();
             let cost = polyline_len(&pts) + turn_px * turns(&pts) as f64;
             if best.as_ref().is_none_or(|b| cost < b.0) {
