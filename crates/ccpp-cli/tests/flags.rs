@@ -274,6 +274,7 @@ fn config_values_go_through_the_same_validation() {
         ),
         ("bcd: { lane_spacing_m: .nan }", "bcd", "bcd.lane_spacing_m"),
         ("bcd: { rim_coverage: 1.5 }", "bcd", "bcd.rim_coverage"),
+        ("bcd: { min_coverage: -0.5 }", "bcd", "bcd.min_coverage"),
         (
             "random_bounce: { budget_m: -5 }",
             "random-bounce",
@@ -364,6 +365,30 @@ fn config_values_go_through_the_same_validation() {
     );
     let len = |o: &Path| metrics(o)["path_length_m"].as_f64().unwrap();
     assert!(len(&b) <= 20.0 + 1e-9 && len(&a) > 20.0);
+    // bcd's turn pruning keeps its coverage floor and trades floor for turns.
+    let map = pillars(dir);
+    let mut runs = Vec::new();
+    for (i, floor) in [1.0, 0.95].into_iter().enumerate() {
+        let cfg = dir.join(format!("bcd{i}.yaml"));
+        std::fs::write(&cfg, format!("bcd: {{ min_coverage: {floor} }}\n")).unwrap();
+        let o = run_ok(
+            dir,
+            &format!("bcd{i}"),
+            &map,
+            "bcd",
+            &["--config", cfg.to_str().unwrap()],
+        );
+        let m = metrics(&o);
+        // 1 drops only what loses no floor; below 1 the floor holds as measured.
+        assert!(
+            floor == 1.0 || m["effective_coverage"].as_f64().unwrap() >= floor,
+            "{m}"
+        );
+        assert_eq!(m["collisions"], 0);
+        runs.push(m);
+    }
+    let turns = |m: &serde_json::Value| m["turns"].as_u64().unwrap();
+    assert!(turns(&runs[1]) < turns(&runs[0]), "{} {}", runs[0], runs[1]);
 }
 
 #[test]

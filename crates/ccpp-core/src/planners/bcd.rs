@@ -54,7 +54,7 @@
 //!    detour at the cheapest point of the path. Groups whose detour would sweep less than
 //!    `rim_min_yield` of a lane's sweep rate are skipped, and so are the lowest-yield groups
 //!    (pixels swept per pixel of pass) while what is left stays within `1 - rim_coverage` of the
-//!    accessible floor (default 0.997: the sawtooth of lane ends along a wall costs a whole
+//!    accessible floor (default 0.999: the sawtooth of lane ends along a wall costs a whole
 //!    wall-long pass for well under a percent of the floor). This step is not in the paper (a
 //!    point robot's lanes reach the boundary; a disk's do not). The passes are placed two ways
 //!    and the plan that is cheaper (length plus `turn_cost_m` per turn) is kept: as pieces of
@@ -78,6 +78,23 @@
 //!    over the C-free pixel centres (8-connected, octile costs, no corner cutting), shortened
 //!    by line-of-sight checks on the true map.
 //!
+//! 5. **Turn pruning** (not in the paper; [`prune`]). The finished plan's turns are cut where
+//!    that costs least floor: a run of up to four vertices is replaced by the straight move
+//!    across it when that move is free on the true map (a corner, a short detour into a sliver
+//!    cell and back, the wiggles of a transfer through clutter), fewest accessible pixels lost
+//!    per turn saved first, while the floor the plan sweeps (estimated with the metric's own
+//!    capsule test, so the estimate is the measured `effective_coverage`) stays at least
+//!    `min_coverage` of the accessible floor (default 0.9952). Then two turns in a row become
+//!    one where the moves before and after them, extended, meet (for at most `turn_cost_m` of
+//!    extra path), and the runs are pruned once more:
+//!
+//!    ```text
+//!    u ----- v1                u ---------- x
+//!              \        ->                 |
+//!               v2                         |
+//!               |  w                       w
+//!    ```
+//!
 //! Deterministic: fixed scan orders and tie-breaks, no hashing. Regions = cells (`RegionStart`
 //! per cell); transfers between cells are marked as backtracks.
 //!
@@ -98,6 +115,7 @@
 //! ```
 
 mod hops;
+mod prune;
 mod tsp;
 
 use std::cmp::Reverse;
@@ -136,6 +154,10 @@ pub struct BcdOptions {
     pub rim_coverage: f64,
     /// Improvement rounds of the cell tour (0 = nearest-neighbour order only).
     pub tour_rounds: u32,
+    /// Turn pruning of the finished plan (step 5 of the module docs) drops turns while the
+    /// plan's estimated effective coverage stays at least this; 1 drops only turns whose
+    /// removal loses no floor. In `[0, 1]`.
+    pub min_coverage: f64,
 }
 
 impl Default for BcdOptions {
@@ -146,8 +168,9 @@ impl Default for BcdOptions {
             turn_cost_m: 0.3,
             rim: true,
             rim_min_yield: 0.0,
-            rim_coverage: 0.997,
+            rim_coverage: 0.999,
             tour_rounds: 2,
+            min_coverage: 0.9952,
         }
     }
 }
@@ -190,6 +213,9 @@ impl BcdOptions {
         }
         if !(0.0..=1.0).contains(&self.rim_coverage) {
             return bad("rim_coverage", "in [0, 1]", self.rim_coverage);
+        }
+        if !(0.0..=1.0).contains(&self.min_coverage) {
+            return bad("min_coverage", "in [0, 1]", self.min_coverage);
         }
         Ok(())
     }
@@ -815,6 +841,11 @@ impl Bcd {
                     d.rim_coverage
                 },
                 tour_rounds: opts.tour_rounds,
+                min_coverage: if (0.0..=1.0).contains(&opts.min_coverage) {
+                    opts.min_coverage
+                } else {
+                    d.min_coverage
+                },
             };
             Self::plan(world, &fixed)
         }
@@ -1101,6 +1132,7 @@ impl Bcd {
                 );
                 items = smooth(&ctx, repair(&ctx, &mut search, items));
             }
+            let items = prune::prune(&ctx, items, opts.min_coverage, turn_px);
             let pts: Vec<Point> = moves(&items).into_iter().map(|m| m.0).collect();
             let cost = polyline_len(&pts) + turn_px * turns(&pts) as f64;
             if best.as_ref().is_none_or(|b| cost < b.0) {
@@ -1783,6 +1815,7 @@ mod tests {
             &world,
             &BcdOptions {
                 rim_coverage: 1.0,
+                min_coverage: 1.0,
                 ..BcdOptions::default()
             },
         );
@@ -1790,6 +1823,7 @@ mod tests {
             &world,
             &BcdOptions {
                 rim_coverage: 0.98,
+                min_coverage: 1.0,
                 ..BcdOptions::default()
             },
         );
@@ -1819,6 +1853,39 @@ mod tests {
     }
 
     #[test]
+    fn min_coverage_trades_floor_for_turns_and_holds_it() {
+        let world = block_room();
+        let keep = run(
+            &world,
+            &BcdOptions {
+                min_coverage: 1.0,
+                ..BcdOptions::default()
+            },
+        );
+        let mut last = keep.clone();
+        for floor in [0.995, 0.98, 0.95] {
+            let m = run(
+                &world,
+                &BcdOptions {
+                    min_coverage: floor,
+                    ..BcdOptions::default()
+                },
+            );
+            assert_eq!(m.collisions, 0);
+            // The estimate is the metric's own sweep: the floor holds as measured.
+            assert!(
+                m.effective_coverage >= floor,
+                "{floor}: {}",
+                m.effective_coverage
+            );
+            assert!(m.turns <= last.turns && m.path_length_m <= last.path_length_m + 1e-9);
+            last = m;
+        }
+        assert!(last.turns < keep.turns, "{} vs {}", last.turns, keep.turns);
+        assert!(last.effective_coverage < keep.effective_coverage);
+    }
+
+    #[test]
     fn invalid_options_are_refused() {
         let world = block_room();
         for bad in [
@@ -1840,6 +1907,10 @@ mod tests {
             },
             BcdOptions {
                 rim_coverage: -0.1,
+                ..BcdOptions::default()
+            },
+            BcdOptions {
+                min_coverage: 1.5,
                 ..BcdOptions::default()
             },
         ] {

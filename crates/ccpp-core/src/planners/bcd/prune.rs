@@ -1,0 +1,551 @@
+//! Coverage-budgeted turn pruning of the finished plan (module docs of [`super`], step 5).
+//!
+//! The plan's polyline sweeps a set of accessible pixels; every pixel keeps the number of the
+//! plan's segments whose tool capsule covers it (the metric's own capsule test). The vertices
+//! strictly between `u` and a later vertex `w` (at most [`MAX_SPAN`] of them: a lone corner, a
+//! short detour into a sliver cell and back) can be dropped when the straight move `u -> w` is
+//! free on the true map; dropping them saves the turns they and `u`, `w` make and shortens the
+//! path, and loses the accessible pixels that only the removed segments sweep and `u -> w`
+//! does not. Spans are dropped greedily, fewest lost pixels per saved turn first, while the
+//! pixels the plan still sweeps stay at least `floor` of the accessible floor. A span's loss is
+//! recomputed when it is taken (lazy greedy), so the budget is kept exactly.
+//!
+//! Then two consecutive turns `v1`, `v2` become one where the move into `v1` and the move out
+//! of `v2`, extended, meet beyond both (corner completion: a transfer bending around an
+//! obstacle in two steps bends once, on the side away from the obstacle), when both new moves
+//! are free, the path grows by at most one turn's cost and the floor still holds; the spans
+//! are dropped once more after that.
+
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+use std::ops::Sub;
+
+use fixedbitset::FixedBitSet;
+
+use super::{Ctx, Item};
+use crate::geometry::{point_segment_dist2, Point};
+
+/// Heading change at `b` between the moves `a -> b` and `b -> c` (as the simulator counts a
+/// turn).
+fn turn(a: Point, b: Point, c: Point) -> bool {
+    let (d0, d1) = (b.sub(a), c.sub(b));
+    let h0 = d0.y.atan2(d0.x);
+    let h1 = d1.y.atan2(d1.x);
+    crate::geometry::wrap_angle(h1 - h0).abs() > crate::planner::MIN_ROTATION
+}
+
+/// Most vertices one drop removes.
+const MAX_SPAN: usize = 4;
+const NONE: usize = usize::MAX;
+
+struct Pruner<'a, 'b> {
+    ctx: &'a Ctx<'b>,
+    pts: Vec<Point>,
+    prev: Vec<usize>,
+    next: Vec<usize>,
+    alive: Vec<bool>,
+    version: Vec<u32>,
+    /// Segments of the plan covering each pixel.
+    cnt: Vec<u32>,
+    /// Scratch: segments of the span under evaluation covering each pixel.
+    tmp: Vec<u32>,
+    acc: &'a FixedBitSet,
+    covered: usize,
+    scratch: FixedBitSet,
+    rt: f64,
+}
+
+/// A span to drop: the vertices strictly between `u` and `w`.
+#[derive(Clone, Copy)]
+struct Span {
+    key: u64,
+    w: usize,
+    lost: usize,
+}
+
+impl Pruner<'_, '_> {
+    /// Pixels of the capsule `a`-`b` (each once).
+    fn capsule(&mut self, a: Point, b: Point, out: &mut Vec<usize>) {
+        let start = out.len();
+        crate::raster::stamp_capsule(
+            &mut self.scratch,
+            &self.ctx.frame,
+            a,
+            b,
+            self.rt,
+            &mut |i| {
+                out.push(i);
+            },
+        );
+        for &i in &out[start..] {
+            self.scratch.set(i, false);
+        }
+    }
+
+    fn turn_at(&self, a: usize, b: usize, c: usize) -> i32 {
+        if a == NONE || c == NONE {
+            return 0;
+        }
+        i32::from(turn(self.pts[a], self.pts[b], self.pts[c]))
+    }
+
+    fn centre(&self, i: usize) -> Point {
+        let w = self.ctx.frame.width;
+        let h = self.ctx.frame.height as f64;
+        Point::new((i % w) as f64 + 0.5, h - (i / w) as f64 - 0.5)
+    }
+
+    /// The cheapest span starting at `u` (lost pixels per saved turn), if any saves a turn.
+    fn best_from(
+        &mut self,
+        u: usize,
+        touched: &mut Vec<usize>,
+        buf: &mut Vec<usize>,
+    ) -> Option<Span> {
+        if !self.alive[u] {
+            return None;
+        }
+        let pu = self.prev[u];
+        let rt2 = self.rt * self.rt;
+        touched.clear();
+        let mut best: Option<Span> = None;
+        // Turns of the chain from u: at u (with pu), and inside.
+        let mut before = 0;
+        let mut v = u;
+        let mut a = self.next[u];
+        if a == NONE {
+            return None;
+        }
+        for k in 0..=MAX_SPAN {
+            // Add segment v -> a.
+            buf.clear();
+            let (pv, pa) = (self.pts[v], self.pts[a]);
+            self.capsule(pv, pa, buf);
+            for &i in buf.iter() {
+                if self.tmp[i] == 0 {
+                    touched.push(i);
+                }
+                self.tmp[i] += 1;
+            }
+            before += self.turn_at(self.prev[v], v, a);
+            let w = a;
+            if k >= 1 {
+                let nw = self.next[w];
+                let b = before + self.turn_at(v, w, nw);
+                let after = self.turn_at(pu, u, w) + self.turn_at(u, w, nw);
+                let saved = b - after;
+                if saved > 0 {
+                    let (p0, p1) = (self.pts[u], self.pts[w]);
+                    let lost = touched
+                        .iter()
+                        .filter(|&&i| {
+                            self.acc.contains(i)
+                                && self.cnt[i] == self.tmp[i]
+                                && point_segment_dist2(self.centre(i), p0, p1) > rt2
+                        })
+                        .count();
+                    let key = (lost as u64 * 1024) / saved as u64;
+                    if best.is_none_or(|s| key < s.key) && self.ctx.free(p0, p1) {
+                        best = Some(Span { key, w, lost });
+                    }
+                }
+            }
+            v = a;
+            a = self.next[a];
+            if a == NONE {
+                break;
+            }
+        }
+        for &i in touched.iter() {
+            self.tmp[i] = 0;
+        }
+        best
+    }
+
+    fn add(&mut self, a: Point, b: Point, up: bool, buf: &mut Vec<usize>) {
+        buf.clear();
+        self.capsule(a, b, buf);
+        for &i in buf.iter() {
+            if up {
+                if self.cnt[i] == 0 && self.acc.contains(i) {
+                    self.covered += 1;
+                }
+                self.cnt[i] += 1;
+            } else {
+                self.cnt[i] -= 1;
+                if self.cnt[i] == 0 && self.acc.contains(i) {
+                    self.covered -= 1;
+                }
+            }
+        }
+    }
+}
+
+/// Corner completion: the point where the lines `u -> v1` and `w -> v2` meet beyond `v1` and
+/// `v2` (within `reach` of both), if any.
+fn corner(u: Point, v1: Point, v2: Point, w: Point, reach: f64) -> Option<Point> {
+    let d1 = v1.sub(u);
+    let d2 = v2.sub(w);
+    let den = d1.x * d2.y - d1.y * d2.x;
+    if den.abs() < 1e-9 * (d1.dot(d1) * d2.dot(d2)).sqrt().max(1e-12) {
+        return None;
+    }
+    // u + s d1 = w + t d2
+    let e = w.sub(u);
+    let s = (e.x * d2.y - e.y * d2.x) / den;
+    let t = (e.x * d1.y - e.y * d1.x) / den;
+    if !(s > 1.0 && t > 1.0 && s.is_finite() && t.is_finite()) {
+        return None;
+    }
+    let x = Point::new(u.x + s * d1.x, u.y + s * d1.y);
+    (x.dist(v1) <= reach && x.dist(v2) <= reach).then_some(x)
+}
+
+impl Pruner<'_, '_> {
+    /// The greedy span drops of the module docs while the plan sweeps at least `need` pixels.
+    fn drop_spans(&mut self, need: usize, touched: &mut Vec<usize>, buf: &mut Vec<usize>) {
+        let n = self.pts.len();
+        // (key, start vertex, its version)
+        let mut heap: BinaryHeap<Reverse<(u64, usize, u32)>> = BinaryHeap::new();
+        for u in 0..n {
+            if let Some(s) = self.best_from(u, touched, buf) {
+                heap.push(Reverse((s.key, u, self.version[u])));
+            }
+        }
+        while let Some(Reverse((k, u, ver))) = heap.pop() {
+            if !self.alive[u] || ver != self.version[u] {
+                continue;
+            }
+            let Some(s) = self.best_from(u, touched, buf) else {
+                continue;
+            };
+            if s.key > k {
+                heap.push(Reverse((s.key, u, ver)));
+                continue;
+            }
+            if s.lost > 0 && self.covered - s.lost < need {
+                continue;
+            }
+            // Drop the vertices strictly between u and w.
+            let (pu, pw) = (self.pts[u], self.pts[s.w]);
+            let mut v = u;
+            while v != s.w {
+                let a = self.next[v];
+                let (p, q) = (self.pts[v], self.pts[a]);
+                self.add(p, q, false, buf);
+                if v != u {
+                    self.alive[v] = false;
+                }
+                v = a;
+            }
+            self.add(pu, pw, true, buf);
+            self.next[u] = s.w;
+            self.prev[s.w] = u;
+            // Re-evaluate the spans whose turns or segments changed: those starting up to
+            // MAX_SPAN + 1 vertices before u, at u, and at w.
+            let mut starts = vec![s.w];
+            let mut x = u;
+            for _ in 0..=MAX_SPAN + 1 {
+                if x == NONE {
+                    break;
+                }
+                starts.push(x);
+                x = self.prev[x];
+            }
+            for x in starts {
+                self.version[x] = self.version[x].wrapping_add(1);
+                if let Some(s) = self.best_from(x, touched, buf) {
+                    heap.push(Reverse((s.key, x, self.version[x])));
+                }
+            }
+        }
+    }
+
+    /// Corner completion: two consecutive turns `v1`, `v2` become one at the point where the
+    /// moves into `v1` and out of `v2` meet, when both new moves are free, the path grows by
+    /// less than `max_extra` and the plan keeps sweeping at least `need` pixels. Returns the
+    /// number of turns saved.
+    fn merge_corners(
+        &mut self,
+        need: usize,
+        max_extra: f64,
+        touched: &mut Vec<usize>,
+        buf: &mut Vec<usize>,
+    ) -> usize {
+        let rt2 = self.rt * self.rt;
+        let mut saved = 0;
+        let mut v1 = 0;
+        while v1 != NONE {
+            let (u, v2) = (self.prev[v1], self.next[v1]);
+            let w = if v2 == NONE { NONE } else { self.next[v2] };
+            if u == NONE || w == NONE {
+                v1 = v2;
+                continue;
+            }
+            let (pu, p1, p2, pw) = (self.pts[u], self.pts[v1], self.pts[v2], self.pts[w]);
+            let before = self.turn_at(u, v1, v2) + self.turn_at(v1, v2, w);
+            let Some(x) = corner(pu, p1, p2, pw, max_extra) else {
+                v1 = v2;
+                continue;
+            };
+            let extra = p1.dist(x) + x.dist(p2) - p1.dist(p2);
+            if before < 2
+                || !turn(pu, x, pw)
+                || extra > max_extra
+                || !(self.ctx.free(pu, x) && self.ctx.free(x, pw))
+            {
+                v1 = v2;
+                continue;
+            }
+            // Pixels only the three old moves sweep and the two new ones do not.
+            touched.clear();
+            for (a, b) in [(pu, p1), (p1, p2), (p2, pw)] {
+                buf.clear();
+                self.capsule(a, b, buf);
+                for &i in buf.iter() {
+                    if self.tmp[i] == 0 {
+                        touched.push(i);
+                    }
+                    self.tmp[i] += 1;
+                }
+            }
+            let lost = touched
+                .iter()
+                .filter(|&&i| {
+                    let c = self.centre(i);
+                    self.acc.contains(i)
+                        && self.cnt[i] == self.tmp[i]
+                        && point_segment_dist2(c, pu, x) > rt2
+                        && point_segment_dist2(c, x, pw) > rt2
+                })
+                .count();
+            for &i in touched.iter() {
+                self.tmp[i] = 0;
+            }
+            if lost > 0 && self.covered - lost < need {
+                v1 = v2;
+                continue;
+            }
+            for (a, b) in [(pu, p1), (p1, p2), (p2, pw)] {
+                self.add(a, b, false, buf);
+            }
+            self.add(pu, x, true, buf);
+            self.add(x, pw, true, buf);
+            self.pts[v1] = x;
+            self.alive[v2] = false;
+            self.next[v1] = w;
+            self.prev[w] = v1;
+            saved += 1;
+            // Look again from the vertex before (its pair changed).
+            v1 = u;
+        }
+        saved
+    }
+}
+
+/// Drops turn vertices of the plan's moves while its estimated effective coverage stays at
+/// least `floor` (module docs); corners are completed where that saves a turn for at most
+/// `max_extra` (pixels) of path.
+pub(super) fn prune(ctx: &Ctx<'_>, items: Vec<Item>, floor: f64, max_extra: f64) -> Vec<Item> {
+    // The distinct consecutive points of the plan with their item indices.
+    let mut pts: Vec<Point> = Vec::new();
+    let mut at: Vec<usize> = Vec::new();
+    for (k, it) in items.iter().enumerate() {
+        if let Item::Move(p) = it {
+            if pts.last() != Some(p) {
+                pts.push(*p);
+                at.push(k);
+            }
+        }
+    }
+    let n = pts.len();
+    if n < 3 {
+        return items;
+    }
+    let acc = ctx.world.accessible();
+    let frame = ctx.frame;
+    let mut pr = Pruner {
+        ctx,
+        prev: (0..n).map(|i| if i == 0 { NONE } else { i - 1 }).collect(),
+        next: (0..n)
+            .map(|i| if i + 1 == n { NONE } else { i + 1 })
+            .collect(),
+        alive: vec![true; n],
+        version: vec![0; n],
+        cnt: vec![0; frame.len()],
+        tmp: vec![0; frame.len()],
+        acc,
+        covered: 0,
+        scratch: FixedBitSet::with_capacity(frame.len()),
+        rt: ctx.rt + crate::raster::SWEEP_EPS_PX,
+        pts,
+    };
+    let mut buf = Vec::new();
+    let mut touched = Vec::new();
+    let p0 = pr.pts[0];
+    pr.add(p0, p0, true, &mut buf);
+    for i in 0..n - 1 {
+        let (a, b) = (pr.pts[i], pr.pts[i + 1]);
+        pr.add(a, b, true, &mut buf);
+    }
+    let need = (floor * acc.count_ones(..) as f64).ceil() as usize;
+    pr.drop_spans(need, &mut touched, &mut buf);
+    if max_extra > 0.0 && pr.merge_corners(need, max_extra, &mut touched, &mut buf) > 0 {
+        // Merged corners open new straight moves.
+        pr.drop_spans(need, &mut touched, &mut buf);
+    }
+    // The items again: each vertex's first move at its (possibly moved) point, its repeats
+    // and the dropped vertices' moves left out, the marks kept.
+    let mut vertex_at = vec![NONE; items.len()];
+    for (v, &k) in at.iter().enumerate() {
+        vertex_at[k] = v;
+    }
+    items
+        .into_iter()
+        .enumerate()
+        .filter_map(|(k, it)| match it {
+            Item::Move(_) => {
+                let v = vertex_at[k];
+                (v != NONE && pr.alive[v]).then(|| Item::Move(pr.pts[v]))
+            }
+            Item::Mark(_) => Some(it),
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::world::{Robot, World};
+
+    #[test]
+    fn corners_meet_beyond_both_turns_or_not_at_all() {
+        let p = Point::new;
+        let x = corner(
+            p(0.0, 0.0),
+            p(10.0, 0.0),
+            p(12.0, -2.0),
+            p(12.0, -10.0),
+            5.0,
+        );
+        assert!(x.is_some_and(|x| x.dist(p(12.0, 0.0)) < 1e-9), "{x:?}");
+        // Too far from the turns.
+        assert!(corner(
+            p(0.0, 0.0),
+            p(10.0, 0.0),
+            p(12.0, -2.0),
+            p(12.0, -10.0),
+            1.0
+        )
+        .is_none());
+        // A U-turn: parallel moves never meet.
+        assert!(corner(p(0.0, 0.0), p(10.0, 0.0), p(10.0, -3.0), p(0.0, -3.0), 50.0).is_none());
+        // An S-bend: the lines meet behind the turns.
+        assert!(corner(
+            p(0.0, 0.0),
+            p(10.0, 0.0),
+            p(12.0, -2.0),
+            p(22.0, -2.0),
+            50.0
+        )
+        .is_none());
+    }
+
+    fn room() -> World {
+        let art =
+            "############\n#..........#\n#..........#\n#..........#\n#..........#\n############";
+        let map = crate::grid::GridMap::from_ascii_scaled(art, 10, 0.02).unwrap();
+        World::new(
+            map,
+            Robot::new(0.05),
+            Some(crate::geometry::Pose::new(0.3, 0.3, 0.0)),
+        )
+        .unwrap()
+    }
+
+    fn ctx(world: &World) -> Ctx<'_> {
+        let frame = *world.frame();
+        let reach = world.reachable();
+        let ok: Vec<bool> = (0..frame.len()).map(|i| reach.contains(i)).collect();
+        Ctx {
+            world,
+            frame,
+            safe: ok.clone(),
+            ok,
+            rt: world.robot().tool_radius / frame.resolution,
+        }
+    }
+
+    fn swept(c: &Ctx<'_>, items: &[Item]) -> FixedBitSet {
+        let pts: Vec<Point> = items
+            .iter()
+            .filter_map(|it| match it {
+                Item::Move(p) => Some(*p),
+                Item::Mark(_) => None,
+            })
+            .collect();
+        let rt = c.rt + crate::raster::SWEEP_EPS_PX;
+        let mut s = FixedBitSet::with_capacity(c.frame.len());
+        crate::raster::stamp_capsule(&mut s, &c.frame, pts[0], pts[0], rt, &mut |_| {});
+        for w in pts.windows(2) {
+            crate::raster::stamp_capsule(&mut s, &c.frame, w[0], w[1], rt, &mut |_| {});
+        }
+        s.intersect_with(c.world.accessible());
+        s
+    }
+
+    fn turns(items: &[Item]) -> usize {
+        let pts: Vec<Point> = items
+            .iter()
+            .filter_map(|it| match it {
+                Item::Move(p) => Some(*p),
+                Item::Mark(_) => None,
+            })
+            .collect();
+        super::super::turns(&pts)
+    }
+
+    #[test]
+    fn pruning_keeps_its_floor_and_the_marks() {
+        let world = room();
+        let c = ctx(&world);
+        let p = Point::new;
+        // A wiggly pass with a two-step bend, a needless detour and a mark in between.
+        let items = vec![
+            Item::Move(p(20.0, 20.0)),
+            Item::Move(p(40.0, 21.0)),
+            Item::Move(p(60.0, 20.0)),
+            Item::Mark(crate::trace::Event::BacktrackStart),
+            Item::Move(p(80.0, 20.0)),
+            Item::Move(p(84.0, 24.0)),
+            Item::Move(p(84.0, 40.0)),
+            Item::Move(p(60.0, 40.0)),
+            Item::Move(p(58.0, 42.0)),
+            Item::Move(p(56.0, 40.0)),
+            Item::Move(p(20.0, 40.0)),
+        ];
+        let before = swept(&c, &items);
+        // Floor 1: only drops and merges that lose no accessible pixel.
+        let kept = prune(&c, items.clone(), 1.0, 6.0);
+        let after = swept(&c, &kept);
+        assert!(before.is_subset(&after));
+        assert!(turns(&kept) < turns(&items), "{kept:?}");
+        assert_eq!(
+            kept.iter().filter(|i| matches!(i, Item::Mark(_))).count(),
+            1
+        );
+        // A lower floor trades floor for turns, never below the floor.
+        let acc = world.accessible().count_ones(..) as f64;
+        let base = after.count_ones(..) as f64 / acc;
+        let floor = base - 0.05;
+        let less = prune(&c, items, floor, 6.0);
+        let got = swept(&c, &less).count_ones(..) as f64 / acc;
+        assert!(got >= floor - 1e-12, "{got} < {floor}");
+        assert!(turns(&less) <= turns(&kept));
+        for w in less.windows(2) {
+            if let [Item::Move(a), Item::Move(b)] = w {
+                assert!(c.free(*a, *b));
+            }
+        }
+    }
+}
