@@ -208,8 +208,10 @@ pub struct World {
     plan_blocked: Option<FixedBitSet>,
     cfree: FixedBitSet,
     reachable: FixedBitSet,
-    accessible: FixedBitSet,
-    accessible_count: usize,
+    /// The accessible surface and its pixel count, computed on first use
+    /// ([`World::accessible`]): only the metrics, the pictures and some offline planners read
+    /// it, so a run can compute it on a second thread while the planner works.
+    accessible: std::sync::OnceLock<(FixedBitSet, usize)>,
 }
 
 impl std::fmt::Debug for World {
@@ -218,7 +220,7 @@ impl std::fmt::Debug for World {
             .field("frame", self.map.frame())
             .field("robot", &self.robot)
             .field("start", &self.start)
-            .field("accessible_px", &self.accessible_count)
+            .field("accessible_px", &self.accessible_count())
             .finish_non_exhaustive()
     }
 }
@@ -332,15 +334,13 @@ impl World {
             blocked,
             cfree,
             reachable: FixedBitSet::with_capacity(frame.len()),
-            accessible: FixedBitSet::with_capacity(frame.len()),
-            accessible_count: 0,
+            accessible: std::sync::OnceLock::new(),
         };
         match world.check_start() {
             Err(WorldError::StartOutsideArea { .. }) => world.plan_approach()?,
             r => r?,
         }
         world.reachable = world.flood_reachable();
-        world.compute_accessible();
         Ok(world)
     }
 
@@ -594,12 +594,16 @@ impl World {
         seen
     }
 
-    fn compute_accessible(&mut self) {
-        let frame = *self.map.frame();
-        let rt = self.robot.tool_radius / frame.resolution + 1e-6;
-        let acc = accessible_pixels(self.map(), &self.reachable, rt);
-        self.accessible_count = acc.count_ones(..);
-        self.accessible = acc;
+    /// The accessible surface and its pixel count, computed on the first call (a thread that
+    /// calls it while another computes it waits for that result).
+    fn accessible_and_count(&self) -> &(FixedBitSet, usize) {
+        self.accessible.get_or_init(|| {
+            let frame = *self.map.frame();
+            let rt = self.robot.tool_radius / frame.resolution + 1e-6;
+            let acc = accessible_pixels(self.map(), &self.reachable, rt);
+            let count = acc.count_ones(..);
+            (acc, count)
+        })
     }
 
     /// The map planners plan on and the sensor reads: the true map, with every pixel outside
@@ -648,19 +652,21 @@ impl World {
     /// The accessible surface `A`: free pixels whose centre lies within `r_tool` of a reachable
     /// C-free centre. With zones: free pixels of [`World::map`] (inside the area, outside every
     /// keep-out) within `r_tool` of a reachable centre of C-free under the virtual walls.
+    ///
+    /// Computed on the first call (of any thread), then kept.
     pub fn accessible(&self) -> &FixedBitSet {
-        &self.accessible
+        &self.accessible_and_count().0
     }
 
     /// Number of pixels in `A`.
     pub fn accessible_count(&self) -> usize {
-        self.accessible_count
+        self.accessible_and_count().1
     }
 
     /// Area of `A` in square metres.
     pub fn accessible_area_m2(&self) -> f64 {
         let r = self.frame().resolution;
-        self.accessible_count as f64 * r * r
+        self.accessible_count() as f64 * r * r
     }
 
     /// Clearance in metres at the centre of pixel `(col, row)`: distance to the nearest blocked

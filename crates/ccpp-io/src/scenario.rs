@@ -780,8 +780,13 @@ impl Scenario {
         // Wall time covers planning (offline planners plan in `build`) and simulation.
         let started = std::time::Instant::now();
         let mut output = crate::phase::time("plan + simulate", || {
-            let mut planner = self.planner.build(&world);
-            simulate(&world, planner.as_mut(), &self.sim)
+            std::thread::scope(|s| {
+                // The accessible surface (read by the metrics after the run) is computed on a
+                // second thread meanwhile; a planner that reads it first waits for it.
+                s.spawn(|| world.accessible().len());
+                let mut planner = self.planner.build(&world);
+                simulate(&world, planner.as_mut(), &self.sim)
+            })
         });
         output.wall_time_s = started.elapsed().as_secs_f64();
         let (metrics, swept) = crate::phase::time("metrics", || {

@@ -317,26 +317,27 @@ fn shown_with(
         ..Shown::default()
     };
     let (c0, r0, w, h) = crop;
-    for r in r0..r0 + h {
-        for c in c0..c0 + w {
-            let i = f.index(c, r);
-            match cells[i] {
-                Cell::Occupied => s.obstacle = true,
-                Cell::Unknown => s.unknown = true,
-                Cell::Free if zone_class(world, i) == 1 => s.keepout = true,
-                Cell::Free if zone_class(world, i) == 2 => s.outside_area = true,
-                Cell::Free => match (acc.contains(i), swept.contains(i)) {
-                    (true, true) => s.swept = true,
-                    (true, false) => s.missed = true,
-                    (false, true) => s.swept_outside = true,
-                    (false, false) => s.unreachable = true,
-                },
+    if world.zones().is_some() {
+        for r in r0..r0 + h {
+            for c in c0..c0 + w {
+                let i = f.index(c, r);
+                match cells[i] {
+                    Cell::Occupied => s.obstacle = true,
+                    Cell::Unknown => s.unknown = true,
+                    Cell::Free if zone_class(world, i) == 1 => s.keepout = true,
+                    Cell::Free if zone_class(world, i) == 2 => s.outside_area = true,
+                    Cell::Free => s.free_class(acc.contains(i), swept.contains(i)),
+                }
             }
         }
+    } else {
+        shown_classes(&mut s, &f, cells, acc, swept, crop);
     }
     let mut in_bt = false;
     let mut regions = std::collections::BTreeSet::new();
     let mut region = 0u32;
+    // The region last inserted: a region's poses follow one another, so most inserts repeat it.
+    let mut inserted: Option<u32> = None;
     let mut last: Option<[f64; 2]> = None;
     for r in trace.entries() {
         match r {
@@ -346,8 +347,9 @@ fn shown_with(
                 if last.is_some_and(|l| l != p) {
                     if in_bt {
                         s.backtrack = true;
-                    } else {
+                    } else if inserted != Some(region) {
                         regions.insert(region);
+                        inserted = Some(region);
                     }
                 }
                 last = Some(p);
@@ -366,6 +368,88 @@ fn shown_with(
     }
     s.regions = regions.len();
     s
+}
+
+impl Shown {
+    /// Marks the class of a free pixel outside every zone.
+    fn free_class(&mut self, accessible: bool, swept: bool) {
+        match (accessible, swept) {
+            (true, true) => self.swept = true,
+            (true, false) => self.missed = true,
+            (false, true) => self.swept_outside = true,
+            (false, false) => self.unreachable = true,
+        }
+    }
+
+    /// Whether every class a map without zones can show is already marked.
+    fn all_classes(&self) -> bool {
+        self.swept
+            && self.missed
+            && self.swept_outside
+            && self.unreachable
+            && self.obstacle
+            && self.unknown
+    }
+}
+
+/// `n <= usize::BITS` bits of `blocks` from bit `start` on, the first in the lowest bit (bits
+/// past the end read 0).
+fn bits_at(blocks: &[usize], start: usize, n: usize) -> usize {
+    let b = usize::BITS as usize;
+    let (k, off) = (start / b, start % b);
+    let mut v = blocks.get(k).copied().unwrap_or(0) >> off;
+    if off > 0 && off + n > b {
+        v |= blocks.get(k + 1).copied().unwrap_or(0) << (b - off);
+    }
+    if n < b {
+        v & ((1usize << n) - 1)
+    } else {
+        v
+    }
+}
+
+/// The area classes of the pixels of `crop` on a map without zones, a machine word of pixels
+/// at a time (the same flags as classifying pixel by pixel): the accessible pixels are all
+/// free, so a word's free, accessible and swept masks give its classes. Stops once every
+/// class is marked.
+fn shown_classes(
+    s: &mut Shown,
+    f: &ccpp_core::grid::MapFrame,
+    cells: &[Cell],
+    acc: &fixedbitset::FixedBitSet,
+    swept: &fixedbitset::FixedBitSet,
+    crop: (usize, usize, usize, usize),
+) {
+    let b = usize::BITS as usize;
+    let (c0, r0, w, h) = crop;
+    let (acc, swept) = (acc.as_slice(), swept.as_slice());
+    for r in r0..r0 + h {
+        let start = f.index(c0, r);
+        for (k, chunk) in cells[start..start + w].chunks(b).enumerate() {
+            let at = start + k * b;
+            let n = chunk.len();
+            // Which cell kinds occur (bit = the kind's discriminant) and the free mask.
+            let kinds = chunk.iter().fold(0u8, |m, c| m | (1u8 << (*c as u8)));
+            s.obstacle |= kinds & (1 << Cell::Occupied as u8) != 0;
+            s.unknown |= kinds & (1 << Cell::Unknown as u8) != 0;
+            if kinds & (1 << Cell::Free as u8) != 0 {
+                let free = chunk
+                    .iter()
+                    .enumerate()
+                    .fold(0usize, |m, (j, c)| m | (usize::from(*c == Cell::Free) << j));
+                let a = bits_at(acc, at, n) & free;
+                let sw = bits_at(swept, at, n);
+                let outside = free & !a;
+                s.swept |= a & sw != 0;
+                s.missed |= a & !sw != 0;
+                s.swept_outside |= outside & sw != 0;
+                s.unreachable |= outside & !sw != 0;
+            }
+        }
+        if s.all_classes() {
+            return;
+        }
+    }
 }
 
 fn plural(n: usize, one: &str, many: &str) -> String {
@@ -635,7 +719,13 @@ pub fn coverage_pixmap_swept(
     };
     let ch = ch_map + header + legend_h;
     let mut pm = Pixmap::new(cw, ch).ok_or(RenderError::Canvas(cw, ch))?;
-    pm.fill(Color::WHITE);
+    // White above and below the map; the map rows are all painted just below.
+    {
+        let row = cw as usize * 4;
+        let (top, rest) = pm.data_mut().split_at_mut(header as usize * row);
+        top.fill(u8::MAX);
+        rest[ch_map as usize * row..].fill(u8::MAX);
+    }
 
     // Background: classify each map pixel, then nearest-neighbour scale.
     let acc = world.accessible();
@@ -1032,6 +1122,70 @@ mod tests {
             ],
             ..CoverageStyle::default()
         }
+    }
+
+    /// The area classes found a word at a time are those of classifying pixel by pixel, for
+    /// random maps, swept sets and crops (words cut anywhere).
+    #[test]
+    fn word_classes_match_pixel_classes() {
+        let mut rng = ccpp_core::rng::SplitMix64::new(11);
+        let mut checked = 0;
+        for case in 0..60 {
+            let (w, h) = (70 + case % 7 * 13, 20 + case % 5);
+            let mut cells = vec![Cell::Free; w * h];
+            for (i, c) in cells.iter_mut().enumerate() {
+                let (x, y) = (i % w, i / w);
+                let wall = x == 0 || y == 0 || x == w - 1 || y == h - 1;
+                let u = rng.range(0.0, 1.0);
+                *c = if wall || u < 0.04 * (case % 3) as f64 {
+                    Cell::Occupied
+                } else if case % 4 == 0 && u > 0.97 {
+                    Cell::Unknown
+                } else {
+                    Cell::Free
+                };
+            }
+            cells[(h - 2) * w + 1] = Cell::Free;
+            let map = GridMap::new(MapFrame::new(w, h, 0.05), cells).unwrap();
+            let Ok(world) = World::new(map, Robot::new(0.025), Some(Pose::new(0.075, 0.075, 0.0)))
+            else {
+                continue;
+            };
+            let mut swept = fixedbitset::FixedBitSet::with_capacity(w * h);
+            for i in 0..w * h {
+                if rng.range(0.0, 1.0) < [0.0, 0.5, 0.99][case % 3] {
+                    swept.insert(i);
+                }
+            }
+            let c0 = (rng.range(0.0, 1.0) * 30.0) as usize;
+            let r0 = case % 3;
+            let crop = (c0, r0, w - c0 - case % 11, h - r0 - case % 2);
+            let mut by_words = Shown::default();
+            shown_classes(
+                &mut by_words,
+                world.frame(),
+                world.true_map().cells(),
+                world.accessible(),
+                &swept,
+                crop,
+            );
+            let mut by_pixels = Shown::default();
+            for r in crop.1..crop.1 + crop.3 {
+                for c in crop.0..crop.0 + crop.2 {
+                    let i = world.frame().index(c, r);
+                    match world.true_map().cells()[i] {
+                        Cell::Occupied => by_pixels.obstacle = true,
+                        Cell::Unknown => by_pixels.unknown = true,
+                        Cell::Free => {
+                            by_pixels.free_class(world.accessible().contains(i), swept.contains(i));
+                        }
+                    }
+                }
+            }
+            assert_eq!(by_words, by_pixels, "case {case}");
+            checked += 1;
+        }
+        assert_eq!(checked, 60);
     }
 
     #[test]
