@@ -39,8 +39,16 @@
 //! 3. **Merge** (the cheap motion; [`ExtensionOptions::merge_segments`]): the pixel walk is cut
 //!    into straight segments, each as long as the known map proves it free *and* every target
 //!    the walk gained along it stays within the tool radius of it (a Douglas–Peucker-like greedy
-//!    cut with a free-and-still-sweeps check per merged segment). A diagonal wall is then one
-//!    segment, not a staircase.
+//!    cut with a free-and-still-sweeps check per merged segment; a segment blocked by a
+//!    wiggle of the wall at one point may still reach one a few points farther). A diagonal
+//!    wall is then one segment, not a staircase.
+//!    **Simplify** ([`ExtensionOptions::simplify_fraction`]): a vertex of the merged walk is
+//!    dropped when the straight way between its neighbours is known free and leaves at most a
+//!    tool radius of the walk's pixels unswept, cheapest loss first (Visvalingam-style on the
+//!    pixels lost), within a budget of the known free floor. The pixels lost stay claimed
+//!    (no later trip goes out for them). On the 14 shared maps this saves about 4 % of the
+//!    turns for 0.06 % of the floor; most remaining vertices sit where the straight way would
+//!    touch the wall (the walk holds clearance 0), not where it would lose pixels.
 //! 4. The walk stops where nothing more is gained, or where the next position is not decided
 //!    yet (unseen pixels): the robot drives the chunk, senses, and the next chunk continues —
 //!    the component never reads the true map.
