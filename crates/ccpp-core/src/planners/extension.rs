@@ -1052,13 +1052,18 @@ impl Extension {
         let gen = self.generation;
         let d = self.dist[i] & !CLOSED;
         let p = self.px_of(i);
+        let (w, h_img) = (self.frame.width as i64, self.frame.height as i64);
         for k in 0..8 {
             let q = (p.0 + NB[k].0, p.1 + NB[k].1);
-            let Some(j) = self.idx(q) else { continue };
+            if q.0 < 0 || q.1 < 0 || q.0 >= w || q.1 >= h_img {
+                continue;
+            }
+            let j = (q.1 * w + q.0) as usize;
             if self.stamp[j] == gen && self.dist[j] & CLOSED != 0 {
                 continue;
             }
-            if !self.edge(known, p, k) {
+            // The memo first (most moves were judged by an earlier search).
+            if self.edge_free[i] & (1 << k) == 0 && !self.edge(known, p, k) {
                 continue;
             }
             let nd = d + if k % 2 == 1 { COST_DIAG } else { COST_ORTHO };
