@@ -158,6 +158,9 @@ pub struct ExtensionOptions {
     /// a vertex of a pass whose straight replacement is known free and loses few of the
     /// pixels the pass gains is dropped (one turn fewer); `0` keeps every pixel.
     pub simplify_fraction: f64,
+    /// Most pixels one dropped vertex may lose, in tool radii of pixels (see
+    /// [`Self::simplify_fraction`]).
+    pub simplify_loss: f64,
 }
 
 impl Default for ExtensionOptions {
@@ -169,6 +172,7 @@ impl Default for ExtensionOptions {
             min_yield: 0.05,
             leave_fraction: 0.002,
             simplify_fraction: 0.0015,
+            simplify_loss: 1.0,
         }
     }
 }
@@ -184,6 +188,7 @@ impl ExtensionOptions {
             ("extension.min_yield", self.min_yield),
             ("extension.leave_fraction", self.leave_fraction),
             ("extension.simplify_fraction", self.simplify_fraction),
+            ("extension.simplify_loss", self.simplify_loss),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(super::settings::OptionsError::new(
@@ -429,7 +434,8 @@ pub(crate) struct Extension {
     left: usize,
     /// Gained pixels the simplified walks leave ([`ExtensionOptions::simplify_fraction`]).
     simplified: usize,
-    /// Most pixels one dropped vertex may lose (a tool radius of pixels).
+    /// Most pixels one dropped vertex may lose ([`ExtensionOptions::simplify_loss`] tool
+    /// radii of pixels).
     simplify_per_turn: usize,
     /// Known free pixels, counted by [`Self::refresh_no_gain`] (valid once the final clean-up
     /// began: `no_gain_free` is then up to date).
@@ -476,6 +482,7 @@ impl Extension {
                 .collect()
         };
         let tool_rows = rows(rt);
+        let simplify_per_turn = (rt * opts.simplify_loss).ceil() as usize;
         let strip_rows = rows(rt + STRIP_PX);
         Self {
             opts,
@@ -502,7 +509,7 @@ impl Extension {
             no_gain_free: Vec::new(),
             left: 0,
             simplified: 0,
-            simplify_per_turn: rt.ceil().max(1.0) as usize,
+            simplify_per_turn,
             free_count: 0,
             dist: vec![0; n],
             parent: vec![u32::MAX; n],
@@ -1331,7 +1338,7 @@ impl Extension {
     /// Drops vertices of the merged chunk `kept` (indices into `pts`, the first point excluded)
     /// whose removal leaves few of the walk's gained pixels unswept: cheapest loss first
     /// (Visvalingam-style on the pixels lost), each removal losing at most
-    /// a tool radius of pixels (`simplify_per_turn`), all removals within the budget
+    /// [`ExtensionOptions::simplify_loss`] tool radii of pixels, all removals within the budget
     /// ([`ExtensionOptions::simplify_fraction`] of the known free floor). The straight way
     /// that replaces a vertex must be known free. Lost pixels stay claimed (no later pass goes
     /// out for them alone) and count as left. Returns the kept indices and how many pixels

@@ -143,6 +143,8 @@ struct ExtensionSection {
     leave_fraction: Option<f64>,
     #[serde(default, deserialize_with = "present")]
     simplify_fraction: Option<f64>,
+    #[serde(default, deserialize_with = "present")]
+    simplify_loss: Option<f64>,
 }
 
 /// A field that is present must hold a value (`null` is refused, as for the full type).
@@ -166,6 +168,7 @@ impl ExtensionSection {
             min_yield: self.min_yield.unwrap_or(base.min_yield),
             leave_fraction: self.leave_fraction.unwrap_or(base.leave_fraction),
             simplify_fraction: self.simplify_fraction.unwrap_or(base.simplify_fraction),
+            simplify_loss: self.simplify_loss.unwrap_or(base.simplify_loss),
         }
     }
 }
