@@ -315,6 +315,11 @@ fn config_values_go_through_the_same_validation() {
             "ba-star-extended",
             "ba_star_extended.extension.simplify_fraction",
         ),
+        (
+            "bsa_extended: { extension: { simplify_loss: -1 } }",
+            "bsa-extended",
+            "bsa_extended.extension.simplify_loss",
+        ),
         // Options the rebuilt bsa-extended dropped are unknown keys now, refused by name.
         ("bsa_extended: { gap_cost: 4 }", "bsa-extended", "gap_cost"),
         (

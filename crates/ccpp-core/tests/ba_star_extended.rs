@@ -575,3 +575,31 @@ fn simplified_passes_save_turns_within_the_budget() {
     assert!(differed >= 1);
     assert!(turns_s < turns_z, "{turns_s} {turns_z}");
 }
+
+/// `simplify_loss`: the most one dropped vertex may lose; `0` drops only vertices that lose
+/// nothing, a larger cap drops more (fewer turns in all).
+#[test]
+fn simplify_loss_caps_each_dropped_vertex() {
+    let opts = |simplify_loss| BaStarExtendedOptions {
+        extension: ExtensionOptions {
+            reach_r: 0.0,
+            simplify_fraction: 0.05,
+            simplify_loss,
+            ..ExtensionOptions::default()
+        },
+        ..BaStarExtendedOptions::default()
+    };
+    let (mut turns_0, mut turns_3, mut differed) = (0, 0, 0);
+    for (art, c, r) in [(HALLS, 2, 9), (BLOCKS, 1, 1), (ROOM, 2, 4)] {
+        let wd = world(art, c, r, 0.0).unwrap();
+        let (zo, zm, _) = run_ext(&wd, opts(0.0));
+        let (bo, bm, _) = run_ext(&wd, opts(3.0));
+        assert_eq!(bm.collisions, 0);
+        assert_eq!(bm.coverage_rate, Some(1.0));
+        turns_0 += zm.turns;
+        turns_3 += bm.turns;
+        differed += usize::from(zo.trace != bo.trace);
+    }
+    assert!(differed >= 1);
+    assert!(turns_3 < turns_0, "{turns_3} {turns_0}");
+}

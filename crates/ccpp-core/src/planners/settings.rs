@@ -115,6 +115,8 @@ struct ExtensionSection {
     leave_fraction: Option<f64>,
     #[serde(default, deserialize_with = "present")]
     simplify_fraction: Option<f64>,
+    #[serde(default, deserialize_with = "present")]
+    simplify_loss: Option<f64>,
 }
 
 impl ExtensionSection {
@@ -128,6 +130,7 @@ impl ExtensionSection {
             min_yield: self.min_yield.unwrap_or(base.min_yield),
             leave_fraction: self.leave_fraction.unwrap_or(base.leave_fraction),
             simplify_fraction: self.simplify_fraction.unwrap_or(base.simplify_fraction),
+            simplify_loss: self.simplify_loss.unwrap_or(base.simplify_loss),
         }
     }
 }
