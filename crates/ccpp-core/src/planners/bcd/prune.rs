@@ -52,6 +52,8 @@ struct Pruner<'a, 'b> {
     /// The pixels of the move from each vertex to the next, once computed (cleared when the
     /// move changes).
     seg: Vec<Vec<u32>>,
+    /// Scratch: the pixels of a candidate move.
+    chord: Vec<usize>,
     acc: &'a FixedBitSet,
     covered: usize,
     scratch: FixedBitSet,
@@ -109,8 +111,10 @@ impl Pruner<'_, '_> {
             return None;
         }
         let pu = self.prev[u];
-        let rt2 = self.rt * self.rt;
         touched.clear();
+        let mut chord = std::mem::take(&mut self.chord);
+        let chord = &mut chord;
+        let mut only = 0usize;
         let mut best: Option<Span> = None;
         // Turns of the chain from u: at u (with pu), and inside.
         let mut before = 0;
@@ -128,6 +132,9 @@ impl Pruner<'_, '_> {
                     touched.push(i);
                 }
                 self.tmp[i] += 1;
+                if self.tmp[i] == self.cnt[i] && self.acc.contains(i) {
+                    only += 1;
+                }
             }
             self.seg[v] = seg;
             before += self.turn_at(self.prev[v], v, a);
@@ -139,14 +146,16 @@ impl Pruner<'_, '_> {
                 let saved = b - after;
                 if saved > 0 {
                     let (p0, p1) = (self.pts[u], self.pts[w]);
-                    let lost = touched
+                    // The pixels only the span sweeps, less those the new move sweeps.
+                    chord.clear();
+                    self.capsule(p0, p1, chord);
+                    let kept = chord
                         .iter()
                         .filter(|&&i| {
-                            self.cnt[i] == self.tmp[i]
-                                && self.acc.contains(i)
-                                && point_segment_dist2(self.centre(i), p0, p1) > rt2
+                            self.tmp[i] > 0 && self.cnt[i] == self.tmp[i] && self.acc.contains(i)
                         })
                         .count();
+                    let lost = only - kept;
                     let key = (lost as u64 * 1024) / saved as u64;
                     // The shorter span on ties.
                     if best.is_none_or(|s| key < s.key) && self.ctx.free(p0, p1) {
@@ -163,6 +172,7 @@ impl Pruner<'_, '_> {
         for &i in touched.iter() {
             self.tmp[i] = 0;
         }
+        self.chord = std::mem::take(chord);
         best
     }
 
@@ -400,6 +410,7 @@ pub(super) fn prune(ctx: &Ctx<'_>, items: Vec<Item>, floor: f64, max_extra: f64)
         cnt: vec![0; frame.len()],
         tmp: vec![0; frame.len()],
         seg: vec![Vec::new(); n],
+        chord: Vec::new(),
         acc,
         covered: 0,
         scratch: FixedBitSet::with_capacity(frame.len()),
