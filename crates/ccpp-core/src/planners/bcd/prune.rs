@@ -49,6 +49,11 @@ struct Pruner<'a, 'b> {
     cnt: Vec<u32>,
     /// Scratch: segments of the span under evaluation covering each pixel.
     tmp: Vec<u32>,
+    /// The pixels of the move from each vertex to the next, once computed (cleared when the
+    /// move changes).
+    seg: Vec<Vec<u32>>,
+    /// Scratch: the pixels of a candidate move.
+    chord: Vec<usize>,
     acc: &'a FixedBitSet,
     covered: usize,
     scratch: FixedBitSet,
@@ -106,8 +111,10 @@ impl Pruner<'_, '_> {
             return None;
         }
         let pu = self.prev[u];
-        let rt2 = self.rt * self.rt;
         touched.clear();
+        let mut chord = std::mem::take(&mut self.chord);
+        let chord = &mut chord;
+        let mut only = 0usize;
         let mut best: Option<Span> = None;
         // Turns of the chain from u: at u (with pu), and inside.
         let mut before = 0;
@@ -118,15 +125,18 @@ impl Pruner<'_, '_> {
         }
         for k in 0..=MAX_SPAN {
             // Add segment v -> a.
-            buf.clear();
-            let (pv, pa) = (self.pts[v], self.pts[a]);
-            self.capsule(pv, pa, buf);
-            for &i in buf.iter() {
+            let seg = self.segment(v, buf);
+            for &i in &seg {
+                let i = i as usize;
                 if self.tmp[i] == 0 {
                     touched.push(i);
                 }
                 self.tmp[i] += 1;
+                if self.tmp[i] == self.cnt[i] && self.acc.contains(i) {
+                    only += 1;
+                }
             }
+            self.seg[v] = seg;
             before += self.turn_at(self.prev[v], v, a);
             let w = a;
             if k >= 1 {
@@ -136,15 +146,18 @@ impl Pruner<'_, '_> {
                 let saved = b - after;
                 if saved > 0 {
                     let (p0, p1) = (self.pts[u], self.pts[w]);
-                    let lost = touched
+                    // The pixels only the span sweeps, less those the new move sweeps.
+                    chord.clear();
+                    self.capsule(p0, p1, chord);
+                    let kept = chord
                         .iter()
                         .filter(|&&i| {
-                            self.acc.contains(i)
-                                && self.cnt[i] == self.tmp[i]
-                                && point_segment_dist2(self.centre(i), p0, p1) > rt2
+                            self.tmp[i] > 0 && self.cnt[i] == self.tmp[i] && self.acc.contains(i)
                         })
                         .count();
+                    let lost = only - kept;
                     let key = (lost as u64 * 1024) / saved as u64;
+                    // The shorter span on ties.
                     if best.is_none_or(|s| key < s.key) && self.ctx.free(p0, p1) {
                         best = Some(Span { key, w, lost });
                     }
@@ -159,7 +172,21 @@ impl Pruner<'_, '_> {
         for &i in touched.iter() {
             self.tmp[i] = 0;
         }
+        self.chord = std::mem::take(chord);
         best
+    }
+
+    /// The pixels of the move from `v` to the next vertex (taken out of the cache: put back
+    /// into `self.seg[v]`).
+    fn segment(&mut self, v: usize, buf: &mut Vec<usize>) -> Vec<u32> {
+        let mut seg = std::mem::take(&mut self.seg[v]);
+        if seg.is_empty() {
+            buf.clear();
+            let (p, q) = (self.pts[v], self.pts[self.next[v]]);
+            self.capsule(p, q, buf);
+            seg.extend(buf.iter().map(|&i| i as u32));
+        }
+        seg
     }
 
     fn add(&mut self, a: Point, b: Point, up: bool, buf: &mut Vec<usize>) {
@@ -203,11 +230,16 @@ fn corner(u: Point, v1: Point, v2: Point, w: Point, reach: f64) -> Option<Point>
 
 impl Pruner<'_, '_> {
     /// The greedy span drops of the module docs while the plan sweeps at least `need` pixels.
-    fn drop_spans(&mut self, need: usize, touched: &mut Vec<usize>, buf: &mut Vec<usize>) {
-        let n = self.pts.len();
+    fn drop_spans(
+        &mut self,
+        need: usize,
+        starts: impl Iterator<Item = usize>,
+        touched: &mut Vec<usize>,
+        buf: &mut Vec<usize>,
+    ) {
         // (key, start vertex, its version)
         let mut heap: BinaryHeap<Reverse<(u64, usize, u32)>> = BinaryHeap::new();
-        for u in 0..n {
+        for u in starts {
             if let Some(s) = self.best_from(u, touched, buf) {
                 heap.push(Reverse((s.key, u, self.version[u])));
             }
@@ -241,6 +273,7 @@ impl Pruner<'_, '_> {
             self.add(pu, pw, true, buf);
             self.next[u] = s.w;
             self.prev[s.w] = u;
+            self.seg[u].clear();
             // Re-evaluate the spans whose turns or segments changed: those starting up to
             // MAX_SPAN + 1 vertices before u, at u, and at w.
             let mut starts = vec![s.w];
@@ -264,16 +297,16 @@ impl Pruner<'_, '_> {
     /// Corner completion: two consecutive turns `v1`, `v2` become one at the point where the
     /// moves into `v1` and out of `v2` meet, when both new moves are free, the path grows by
     /// less than `max_extra` and the plan keeps sweeping at least `need` pixels. Returns the
-    /// number of turns saved.
+    /// merged vertices.
     fn merge_corners(
         &mut self,
         need: usize,
         max_extra: f64,
         touched: &mut Vec<usize>,
         buf: &mut Vec<usize>,
-    ) -> usize {
+    ) -> Vec<usize> {
         let rt2 = self.rt * self.rt;
-        let mut saved = 0;
+        let mut merged = Vec::new();
         let mut v1 = 0;
         while v1 != NONE {
             let (u, v2) = (self.prev[v1], self.next[v1]);
@@ -335,11 +368,13 @@ impl Pruner<'_, '_> {
             self.alive[v2] = false;
             self.next[v1] = w;
             self.prev[w] = v1;
-            saved += 1;
+            self.seg[u].clear();
+            self.seg[v1].clear();
+            merged.push(v1);
             // Look again from the vertex before (its pair changed).
             v1 = u;
         }
-        saved
+        merged
     }
 }
 
@@ -374,6 +409,8 @@ pub(super) fn prune(ctx: &Ctx<'_>, items: Vec<Item>, floor: f64, max_extra: f64)
         version: vec![0; n],
         cnt: vec![0; frame.len()],
         tmp: vec![0; frame.len()],
+        seg: vec![Vec::new(); n],
+        chord: Vec::new(),
         acc,
         covered: 0,
         scratch: FixedBitSet::with_capacity(frame.len()),
@@ -389,10 +426,29 @@ pub(super) fn prune(ctx: &Ctx<'_>, items: Vec<Item>, floor: f64, max_extra: f64)
         pr.add(a, b, true, &mut buf);
     }
     let need = (floor * acc.count_ones(..) as f64).ceil() as usize;
-    pr.drop_spans(need, &mut touched, &mut buf);
-    if max_extra > 0.0 && pr.merge_corners(need, max_extra, &mut touched, &mut buf) > 0 {
-        // Merged corners open new straight moves.
-        pr.drop_spans(need, &mut touched, &mut buf);
+    pr.drop_spans(need, 0..n, &mut touched, &mut buf);
+    if max_extra > 0.0 {
+        let merged = pr.merge_corners(need, max_extra, &mut touched, &mut buf);
+        // Merged corners open new straight moves: the spans starting near them.
+        let mut starts = Vec::new();
+        for v in merged {
+            if !pr.alive[v] {
+                continue;
+            }
+            starts.push(pr.next[v]);
+            let mut x = v;
+            for _ in 0..=MAX_SPAN + 1 {
+                if x == NONE {
+                    break;
+                }
+                starts.push(x);
+                x = pr.prev[x];
+            }
+        }
+        starts.sort_unstable();
+        starts.dedup();
+        starts.retain(|&x| x != NONE);
+        pr.drop_spans(need, starts.into_iter(), &mut touched, &mut buf);
     }
     // The items again: each vertex's first move at its (possibly moved) point, its repeats
     // and the dropped vertices' moves left out, the marks kept.
