@@ -823,7 +823,11 @@ mod tests {
         let mut prev: Vec<[f64; 2]> = Vec::new();
         for round in 0..300 {
             // Short lists, and lists longer than the scan before the sorted index.
-            let len = rnd(if round % 2 == 0 { 40 } else { 4 * DELTA_SCAN as u64 }) as usize;
+            let len = rnd(if round % 2 == 0 {
+                40
+            } else {
+                4 * DELTA_SCAN as u64
+            }) as usize;
             let mut points: Vec<[f64; 2]> = Vec::with_capacity(len);
             for _ in 0..len {
                 if !prev.is_empty() && rnd(3) > 0 {
