@@ -280,7 +280,14 @@ impl World {
         // C-free at a pixel centre: distance to every blocked centre >= contact radius.
         let rc = contact_radius_px(r_px);
         let rc2 = rc * rc;
-        let cfree = bitset_where(frame.len(), |i| f64::from(obstacle_dt2.get(i)) >= rc2);
+        // `CompactDt::get` per pixel, with the storage matched once.
+        let cfree = match &obstacle_dt2 {
+            CompactDt::U16(v) => bitset_where(frame.len(), |i| {
+                let d = v[i];
+                f64::from(if d == u16::MAX { INF } else { u32::from(d) }) >= rc2
+            }),
+            CompactDt::U32(v) => bitset_where(frame.len(), |i| f64::from(v[i]) >= rc2),
+        };
         if cfree.is_clear() && zones.is_some() {
             let free_px = cells.iter().filter(|c| c.is_free()).count();
             let fits_without = squared_edt(
