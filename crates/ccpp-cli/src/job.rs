@@ -71,6 +71,9 @@ pub struct JobResult {
     pub metrics: Metrics,
     /// The pixels the tool swept (computed with the metrics, reused by the picture).
     pub swept: fixedbitset::FixedBitSet,
+    /// The free area holding the start, when [`Job::execute_with`] was asked for it (found
+    /// while the planner worked).
+    pub start_area: Option<crate::info::StartComponent>,
 }
 
 /// The recipe of `args`: paths made absolute so that `run.json` works from any folder.
@@ -353,8 +356,17 @@ impl Job {
     /// scenario's start becomes the start actually used, so that `run.json` replays exactly.
     /// The prepared map becomes the world's (no copy): a job runs once.
     pub fn execute(&mut self) -> Result<JobResult> {
+        self.execute_with(false)
+    }
+
+    /// [`Job::execute`], also finding the free area holding the start
+    /// ([`JobResult::start_area`]) when `start_area`, on a second thread while the planner
+    /// works.
+    pub fn execute_with(&mut self, start_area: bool) -> Result<JobResult> {
         let map = self.map.take().context("the job has already run")?;
-        let run = self.scenario.run_owned(map)?;
+        let (run, start_area) = self.scenario.run_owned_beside(map, |w| {
+            start_area.then(|| crate::info::StartComponent::of(w.map(), w.start().position()))
+        })?;
         let s = run.world.initial_pose();
         if !run.world.approach().is_empty() {
             let e = run.world.start();
@@ -371,6 +383,7 @@ impl Job {
             run: run.output,
             metrics: run.metrics,
             swept: run.swept,
+            start_area,
         })
     }
 }

@@ -87,13 +87,13 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Run(a) => {
             let mut job = job::Job::from_run_args(&a)?;
             staging::check_target(&job.out)?;
-            let result = job.execute()?;
+            let result = job.execute_with(true)?;
             output::emit(&job, &result, a.json, a.replay, &a.export)
         }
         Command::Demo(a) => {
             let mut job = job::Job::demo(&a)?;
             staging::check_target(&job.out)?;
-            let result = job.execute()?;
+            let result = job.execute_with(true)?;
             output::emit(&job, &result, false, true, &[])
         }
         Command::Planners => {

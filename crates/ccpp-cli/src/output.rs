@@ -114,14 +114,19 @@ pub fn emit(
         exports,
         &ccpp_io::export::zone_features(r.world.zones()),
     )?;
-    // The start's free area (a flood fill over the map) is found while the files are written:
-    // the picture's thread outlasts the text files', leaving a core idle.
+    // The start's free area (a flood fill over the map), unless found while the planner
+    // worked, is found while the files are written.
     let (metrics, comp) = std::thread::scope(|s| {
-        let comp = s.spawn(|| StartComponent::of(r.world.map(), r.world.start().position()));
+        let found = r.start_area;
+        let comp = found
+            .is_none()
+            .then(|| s.spawn(|| StartComponent::of(r.world.map(), r.world.start().position())));
         let metrics = write_run_files(&job.out, job, r, replay, &export_files);
-        let comp = match comp.join() {
-            Ok(c) => c,
-            Err(panic) => std::panic::resume_unwind(panic),
+        let comp = match comp.map(std::thread::ScopedJoinHandle::join) {
+            None => found
+                .unwrap_or_else(|| StartComponent::of(r.world.map(), r.world.start().position())),
+            Some(Ok(c)) => c,
+            Some(Err(panic)) => std::panic::resume_unwind(panic),
         };
         (metrics, comp)
     });

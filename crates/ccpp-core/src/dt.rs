@@ -18,7 +18,7 @@ const NONE: u32 = u32::MAX / 4;
 pub fn squared_edt(
     width: usize,
     height: usize,
-    is_feature: impl Fn(usize) -> bool,
+    is_feature: impl Fn(usize) -> bool + Sync,
     border_is_feature: bool,
 ) -> Vec<u32> {
     let n = width * height;
@@ -128,7 +128,7 @@ impl CompactDt {
 pub fn squared_edt_compact(
     width: usize,
     height: usize,
-    is_feature: impl Fn(usize) -> bool,
+    is_feature: impl Fn(usize) -> bool + Sync,
     border_is_feature: bool,
 ) -> CompactDt {
     if width * height == 0 {
@@ -186,44 +186,87 @@ impl Store for u32 {
 
 /// Phase 1 (Meijster et al.): distance to the nearest feature in the same column, in two
 /// row-order sweeps (cache friendly); `T::NONE` = no feature in the column. `T` must hold
-/// `height + 1`.
+/// `height + 1`. Columns are independent: large images split them (left and right halves of
+/// every row) between two threads.
 fn column_pass<T: Store>(
     width: usize,
     height: usize,
-    is_feature: &impl Fn(usize) -> bool,
+    is_feature: &(impl Fn(usize) -> bool + Sync),
     border_is_feature: bool,
 ) -> Vec<T> {
     let n = width * height;
-    let none = T::NONE.to_u32();
     let mut g = vec![T::NONE; n];
+    if n >= PARALLEL_MIN_PIXELS && width >= 2 {
+        let half = width / 2;
+        let (mut left, mut right): (Vec<&mut [T]>, Vec<&mut [T]>) = g
+            .chunks_exact_mut(width)
+            .map(|row| row.split_at_mut(half))
+            .unzip();
+        std::thread::scope(|s| {
+            s.spawn(|| column_strip(&mut right, half, width, is_feature, border_is_feature));
+            column_strip(&mut left, 0, width, is_feature, border_is_feature);
+        });
+    } else {
+        let mut rows: Vec<&mut [T]> = g.chunks_exact_mut(width).collect();
+        column_strip(&mut rows, 0, width, is_feature, border_is_feature);
+    }
+    g
+}
+
+/// [`column_pass`] on a strip of columns: `rows[r]` holds row `r` from column `c0` on.
+fn column_strip<T: Store>(
+    rows: &mut [&mut [T]],
+    c0: usize,
+    width: usize,
+    is_feature: &impl Fn(usize) -> bool,
+    border_is_feature: bool,
+) {
+    let none = T::NONE.to_u32();
     let edge = if border_is_feature { 0 } else { none };
     let step = |v: u32| v.saturating_add(1).min(none);
-    for r in 0..height {
-        for c in 0..width {
-            let i = r * width + c;
-            g[i] = T::from_u32(if is_feature(i) {
-                0
-            } else if r == 0 {
-                step(edge)
-            } else {
-                step(g[i - width].to_u32())
-            });
-        }
-    }
-    for r in (0..height).rev() {
-        for c in 0..width {
-            let i = r * width + c;
-            let below = if r + 1 == height {
-                step(edge)
-            } else {
-                step(g[i + width].to_u32())
-            };
-            if T::from_u32(below) < g[i] {
-                g[i] = T::from_u32(below);
+    for r in 0..rows.len() {
+        let (above, rest) = rows.split_at_mut(r);
+        let row = &mut *rest[0];
+        let base = r * width + c0;
+        match above.last() {
+            None => {
+                for (c, v) in row.iter_mut().enumerate() {
+                    *v = T::from_u32(if is_feature(base + c) { 0 } else { step(edge) });
+                }
+            }
+            Some(prev) => {
+                for (c, (v, p)) in row.iter_mut().zip(prev.iter()).enumerate() {
+                    *v = T::from_u32(if is_feature(base + c) {
+                        0
+                    } else {
+                        step(p.to_u32())
+                    });
+                }
             }
         }
     }
-    g
+    for r in (0..rows.len()).rev() {
+        let (upto, below) = rows.split_at_mut(r + 1);
+        let row = &mut *upto[r];
+        match below.first() {
+            None => {
+                let b = T::from_u32(step(edge));
+                for v in row.iter_mut() {
+                    if b < *v {
+                        *v = b;
+                    }
+                }
+            }
+            Some(next) => {
+                for (v, nx) in row.iter_mut().zip(next.iter()) {
+                    let b = T::from_u32(step(nx.to_u32()));
+                    if b < *v {
+                        *v = b;
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// An upper bound on every pixel's distance to its nearest feature, from the column distances
@@ -231,6 +274,25 @@ fn column_pass<T: Store>(
 /// the distance to the nearest feature (or, with `border_is_feature`, border) in the same row.
 /// `None` when some pixel may have no feature at all.
 fn distance_bound<T: Store>(g: &[T], width: usize, border_is_feature: bool) -> Option<u64> {
+    let height = g.len() / width;
+    if g.len() >= PARALLEL_MIN_PIXELS && height >= 2 {
+        // Rows are independent: two halves on two threads.
+        let (g0, g1) = g.split_at(height / 2 * width);
+        let (b0, b1) = std::thread::scope(|s| {
+            let b1 = s.spawn(|| rows_bound(g1, width, border_is_feature));
+            let b0 = rows_bound(g0, width, border_is_feature);
+            match b1.join() {
+                Ok(b1) => (b0, b1),
+                Err(panic) => std::panic::resume_unwind(panic),
+            }
+        });
+        return Some(b0?.max(b1?));
+    }
+    rows_bound(g, width, border_is_feature)
+}
+
+/// [`distance_bound`] over the rows of `g`.
+fn rows_bound<T: Store>(g: &[T], width: usize, border_is_feature: bool) -> Option<u64> {
     let none = T::NONE.to_u32();
     let far = u32::MAX;
     let start = if border_is_feature { 0 } else { far };
@@ -408,6 +470,32 @@ mod tests {
                     "w={w} h={h} border={border}"
                 );
             }
+        }
+    }
+
+    /// Large images split the column pass and the distance bound between two threads: the
+    /// same values as one pass over the whole image (featureless columns included).
+    #[test]
+    fn split_passes_match_one_pass() {
+        let (w, h) = (1031, 1025);
+        assert!(w * h >= PARALLEL_MIN_PIXELS);
+        let mut seed = 99u64;
+        let feat: Vec<bool> = (0..w * h)
+            .map(|i| {
+                seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+                i % w != 700 && (seed >> 33).is_multiple_of(997)
+            })
+            .collect();
+        for border in [false, true] {
+            let split = column_pass::<u16>(w, h, &|i: usize| feat[i], border);
+            let mut one = vec![u16::NONE; w * h];
+            let mut rows: Vec<&mut [u16]> = one.chunks_exact_mut(w).collect();
+            column_strip(&mut rows, 0, w, &|i: usize| feat[i], border);
+            assert!(split == one, "border {border}");
+            assert_eq!(
+                distance_bound(&split, w, border),
+                rows_bound(&one, w, border)
+            );
         }
     }
 

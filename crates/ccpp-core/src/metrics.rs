@@ -355,6 +355,40 @@ pub fn compute(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
 /// [`compute`], also returning the swept pixels it computed ([`swept_pixels`]), for the
 /// coverage picture to reuse instead of sweeping the trace again.
 pub fn compute_swept(world: &World, run: &RunOutput, map_name: &str) -> (Metrics, FixedBitSet) {
+    compute_prepared(world, run, map_name, None)
+}
+
+/// What the metrics read of the world alone, before any run: the accessible surface (kept in
+/// the world) and the tiles reachable on a tiling of a given side. A caller computes it while
+/// the planner works (on a second thread), so that [`compute_prepared`] has less left to do.
+#[derive(Clone, Debug)]
+pub struct WorldPart {
+    /// The tile side the reachable tiles are for, metres.
+    side: f64,
+    /// [`reachable_tiles`] on the tiling of `side` anchored at the world's start.
+    reach: TileSet,
+}
+
+impl WorldPart {
+    /// Computes the accessible surface of `world` and, with a `tile_side`, its reachable tiles
+    /// on that tiling (the planner's, when it has one).
+    pub fn of(world: &World, tile_side: Option<f64>) -> Option<Self> {
+        let _ = world.accessible();
+        tile_side.map(|side| Self {
+            side,
+            reach: reachable_tiles(world, &TileGrid::new(world.start().position(), side)),
+        })
+    }
+}
+
+/// [`compute_swept`] reusing `part` ([`WorldPart::of`] of the same world) when it was computed
+/// for the run's tile side (it is computed here otherwise): the same metrics.
+pub fn compute_prepared(
+    world: &World,
+    run: &RunOutput,
+    map_name: &str,
+    part: Option<WorldPart>,
+) -> (Metrics, FixedBitSet) {
     let frame = *world.frame();
     let robot = world.robot();
     let trace = &run.trace;
@@ -369,7 +403,10 @@ pub fn compute_swept(world: &World, run: &RunOutput, map_name: &str) -> (Metrics
             let exec_tol = execution_tolerance(trace);
             run.tile_side.map(|side| {
                 let grid = TileGrid::new(start, side);
-                let reach = reachable_tiles(world, &grid);
+                let reach = match part {
+                    Some(p) if p.side.to_bits() == side.to_bits() => p.reach,
+                    _ => reachable_tiles(world, &grid),
+                };
                 if reach.is_empty() {
                     return 0.0;
                 }
@@ -647,6 +684,31 @@ mod tests {
             }
         }
         GridMap::new(crate::grid::MapFrame::new(w, h, 0.01), cells).unwrap()
+    }
+
+    /// Metrics from a [`WorldPart`] computed before the run equal those computed after it,
+    /// and a part for another tile side is not used (the tiles are computed again).
+    #[test]
+    fn metrics_with_a_prepared_world_part_are_the_same() {
+        let world =
+            World::new(open_room(), Robot::new(0.2), Some(Pose::new(1.0, 1.0, 0.0))).unwrap();
+        let config = crate::planners::PlannerConfig::new(crate::planners::PlannerKind::BaStar);
+        let out = simulate(&world, config.build(&world).as_mut(), &SimConfig::default());
+        let side = out.tile_side.expect("BA* has tiles");
+        let (want, swept) = compute_swept(&world, &out, "room");
+        assert!(want.coverage_rate.is_some_and(|c| c > 0.9));
+        for part_side in [side, 2.0 * side] {
+            let part = WorldPart::of(&world, Some(part_side));
+            let (got, got_swept) = compute_prepared(&world, &out, "room", part);
+            assert_eq!(got, want, "part for side {part_side}");
+            assert_eq!(got_swept, swept);
+        }
+        // A part for a coarser tiling holds other tiles: used as is it would change the rate.
+        let coarse = WorldPart::of(&world, Some(2.0 * side)).expect("a side was given");
+        assert_ne!(
+            coarse.reach.len(),
+            reachable_tiles(&world, &TileGrid::new(world.start().position(), side)).len()
+        );
     }
 
     #[test]

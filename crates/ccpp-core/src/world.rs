@@ -207,7 +207,8 @@ pub struct World {
     /// Non-free pixels of the planning map (with zones only).
     plan_blocked: Option<FixedBitSet>,
     cfree: FixedBitSet,
-    reachable: FixedBitSet,
+    /// The start's C-free component, found on first use ([`World::reachable`]).
+    reachable: std::sync::OnceLock<FixedBitSet>,
     /// The accessible surface and its pixel count, computed on first use
     /// ([`World::accessible`]): only the metrics, the pictures and some offline planners read
     /// it, so a run can compute it on a second thread while the planner works.
@@ -279,7 +280,14 @@ impl World {
         // C-free at a pixel centre: distance to every blocked centre >= contact radius.
         let rc = contact_radius_px(r_px);
         let rc2 = rc * rc;
-        let cfree = bitset_where(frame.len(), |i| f64::from(obstacle_dt2.get(i)) >= rc2);
+        // `CompactDt::get` per pixel, with the storage matched once.
+        let cfree = match &obstacle_dt2 {
+            CompactDt::U16(v) => bitset_where(frame.len(), |i| {
+                let d = v[i];
+                f64::from(if d == u16::MAX { INF } else { u32::from(d) }) >= rc2
+            }),
+            CompactDt::U32(v) => bitset_where(frame.len(), |i| f64::from(v[i]) >= rc2),
+        };
         if cfree.is_clear() && zones.is_some() {
             let free_px = cells.iter().filter(|c| c.is_free()).count();
             let fits_without = squared_edt(
@@ -333,14 +341,13 @@ impl World {
             obstacle_dt2,
             blocked,
             cfree,
-            reachable: FixedBitSet::with_capacity(frame.len()),
+            reachable: std::sync::OnceLock::new(),
             accessible: std::sync::OnceLock::new(),
         };
         match world.check_start() {
             Err(WorldError::StartOutsideArea { .. }) => world.plan_approach()?,
             r => r?,
         }
-        world.reachable = world.flood_reachable();
         Ok(world)
     }
 
@@ -600,7 +607,7 @@ impl World {
         self.accessible.get_or_init(|| {
             let frame = *self.map.frame();
             let rt = self.robot.tool_radius / frame.resolution + 1e-6;
-            let acc = accessible_pixels(self.map(), &self.reachable, rt);
+            let acc = accessible_pixels(self.map(), self.reachable(), rt);
             let count = acc.count_ones(..);
             (acc, count)
         })
@@ -645,8 +652,10 @@ impl World {
     }
 
     /// C-free pixel centres of the start's 8-connected component.
+    ///
+    /// Found on the first call (of any thread), then kept.
     pub fn reachable(&self) -> &FixedBitSet {
-        &self.reachable
+        self.reachable.get_or_init(|| self.flood_reachable())
     }
 
     /// The accessible surface `A`: free pixels whose centre lies within `r_tool` of a reachable

@@ -746,7 +746,7 @@ impl Scenario {
     /// As [`world`](Self::world).
     pub fn run_on(&self, map: &PreparedMap) -> Result<Run, ScenarioError> {
         let world = crate::phase::time("world", || self.world(map))?;
-        Ok(self.run_in(world, &map.name))
+        Ok(self.run_in(world, &map.name, |_| ()).0)
     }
 
     /// [`run_on`](Self::run_on) taking the prepared map, whose grid becomes the world's
@@ -755,6 +755,20 @@ impl Scenario {
     /// # Errors
     /// As [`world`](Self::world).
     pub fn run_owned(&self, map: PreparedMap) -> Result<Run, ScenarioError> {
+        Ok(self.run_owned_beside(map, |_| ())?.0)
+    }
+
+    /// [`run_owned`](Self::run_owned), also calling `beside` on the world on a second thread
+    /// while the planner works (the planner reads the world, never writes it), for work of the
+    /// caller's that needs the world but not the run: same run, same results.
+    ///
+    /// # Errors
+    /// As [`world`](Self::world).
+    pub fn run_owned_beside<T: Send>(
+        &self,
+        map: PreparedMap,
+        beside: impl FnOnce(&World) -> T + Send,
+    ) -> Result<(Run, T), ScenarioError> {
         let PreparedMap {
             grid,
             name,
@@ -772,32 +786,45 @@ impl Scenario {
             let zones = self.world_checks(&prepared)?;
             self.world_on(prepared.grid, &prepared.source, zones)
         })?;
-        Ok(self.run_in(world, &name))
+        Ok(self.run_in(world, &name, beside))
     }
 
-    /// Plans and simulates in `world`, then computes the metrics.
-    fn run_in(&self, world: World, map_name: &str) -> Run {
-        // Wall time covers planning (offline planners plan in `build`) and simulation.
-        let started = std::time::Instant::now();
-        let mut output = crate::phase::time("plan + simulate", || {
+    /// Plans and simulates in `world`, then computes the metrics. What the metrics need of the
+    /// world alone ([`metrics::WorldPart`]) and `beside` are computed on a second thread while
+    /// the planner works.
+    fn run_in<T: Send>(
+        &self,
+        world: World,
+        map_name: &str,
+        beside: impl FnOnce(&World) -> T + Send,
+    ) -> (Run, T) {
+        let side = self.tile_side();
+        let (output, part, extra) = crate::phase::time("plan + simulate", || {
             std::thread::scope(|s| {
-                // The accessible surface (read by the metrics after the run) is computed on a
-                // second thread meanwhile; a planner that reads it first waits for it.
-                s.spawn(|| world.accessible().len());
+                // A planner that reads the accessible surface first waits for it.
+                let other = s.spawn(|| (metrics::WorldPart::of(&world, side), beside(&world)));
+                // Wall time covers planning (offline planners plan in `build`) and simulation.
+                let started = std::time::Instant::now();
                 let mut planner = self.planner.build(&world);
-                simulate(&world, planner.as_mut(), &self.sim)
+                let mut output = simulate(&world, planner.as_mut(), &self.sim);
+                output.wall_time_s = started.elapsed().as_secs_f64();
+                let (part, extra) = match other.join() {
+                    Ok(v) => v,
+                    Err(panic) => std::panic::resume_unwind(panic),
+                };
+                (output, part, extra)
             })
         });
-        output.wall_time_s = started.elapsed().as_secs_f64();
         let (metrics, swept) = crate::phase::time("metrics", || {
-            metrics::compute_swept(&world, &output, map_name)
+            metrics::compute_prepared(&world, &output, map_name, part)
         });
-        Run {
+        let run = Run {
             world,
             output,
             metrics,
             swept,
-        }
+        };
+        (run, extra)
     }
 
     /// Loads the map and runs the scenario.

@@ -154,9 +154,11 @@ enum DeltaItem {
 fn list_delta(prev: &[[f64; 2]], points: &[[f64; 2]]) -> Vec<DeltaItem> {
     let key = |p: &[f64; 2]| (p[0].to_bits(), p[1].to_bits());
     // `prev`'s points sorted by (point, index): the occurrences of a point are one stretch, in
-    // index order (one sort instead of a map of lists). Sorted only when a look-up needs it: a
-    // list mostly repeats the previous one, so most look-ups end in the short scan below.
+    // index order (one sort instead of a map of lists). A list mostly repeats the previous
+    // one, so it needs few look-ups: they scan `prev` until the scans have read a few times
+    // its length, and only then is it sorted.
     let mut index: Option<Vec<((u64, u64), usize)>> = None;
+    let mut scan_budget = DELTA_SCANS * prev.len() + 64;
     let mut out: Vec<DeltaItem> = Vec::new();
     // The index in `prev` that the current copy continues with.
     let mut next = usize::MAX;
@@ -170,15 +172,15 @@ fn list_delta(prev: &[[f64; 2]], points: &[[f64; 2]]) -> Vec<DeltaItem> {
         }
         let at = next.min(prev.len());
         let kp = key(p);
-        // The first occurrence at or after `at`, else the first one: a scan of the next few
-        // points from `at` (or from the start when `at` is the end) finds it when it lies
-        // there; the sorted index otherwise.
-        let from = if at < prev.len() { at } else { 0 };
-        let near = prev[from..prev.len().min(from + DELTA_SCAN)]
-            .iter()
-            .position(|q| key(q) == kp)
-            .map(|j| from + j);
-        let found = near.or_else(|| {
+        // The first occurrence at or after `at`, else the first one.
+        let found = if index.is_none() && scan_budget >= prev.len() {
+            scan_budget -= prev.len();
+            let is_p = |q: &[f64; 2]| key(q) == kp;
+            match prev[at..].iter().position(is_p) {
+                Some(j) => Some(at + j),
+                None => prev[..at].iter().position(is_p),
+            }
+        } else {
             let index = index.get_or_insert_with(|| {
                 let mut v: Vec<((u64, u64), usize)> =
                     prev.iter().enumerate().map(|(k, p)| (key(p), k)).collect();
@@ -195,7 +197,7 @@ fn list_delta(prev: &[[f64; 2]], points: &[[f64; 2]]) -> Vec<DeltaItem> {
             } else {
                 None
             }
-        });
+        };
         if let Some(k) = found {
             out.push(DeltaItem::Copy { prev: k, n: 1 });
             next = k + 1;
@@ -207,8 +209,9 @@ fn list_delta(prev: &[[f64; 2]], points: &[[f64; 2]]) -> Vec<DeltaItem> {
     out
 }
 
-/// Points of the previous list [`list_delta`] scans for a point before it sorts that list.
-const DELTA_SCAN: usize = 16;
+/// How many times the length of the previous list [`list_delta`] scans it, looking points up,
+/// before it sorts that list instead.
+const DELTA_SCANS: usize = 8;
 
 /// Resolves a delta against the previous list.
 fn apply_delta(
@@ -811,8 +814,9 @@ mod tests {
 
     #[test]
     fn the_sorted_delta_index_picks_the_same_copies_as_a_map_of_occurrences() {
-        // Lists over few distinct points (many repeats) and edits between them; the scan of
-        // the next points and the sorted index must pick the same copies.
+        // Lists over few distinct points (many repeats) and edits between them; the scans of
+        // the previous list and its sorted index (once the scans used their budget) must pick
+        // the same copies.
         let mut state = 0x9e37_79b9_7f4a_7c15_u64;
         let mut rnd = |m: u64| {
             state ^= state << 13;
@@ -822,8 +826,8 @@ mod tests {
         };
         let mut prev: Vec<[f64; 2]> = Vec::new();
         for round in 0..300 {
-            // Short lists, and lists longer than the scan before the sorted index.
-            let len = rnd(if round % 2 == 0 { 40 } else { 4 * DELTA_SCAN as u64 }) as usize;
+            // Short lists, and long ones (more look-ups than the scans' budget allows).
+            let len = rnd(if round % 2 == 0 { 40 } else { 200 }) as usize;
             let mut points: Vec<[f64; 2]> = Vec::with_capacity(len);
             for _ in 0..len {
                 if !prev.is_empty() && rnd(3) > 0 {
