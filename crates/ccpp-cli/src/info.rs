@@ -4,6 +4,7 @@ use std::fmt::Write as _;
 
 use anyhow::Result;
 use ccpp_core::grid::{Cell, GridMap};
+use ccpp_core::search::{fill_runs, Connectivity};
 use ccpp_core::world::{World, WorldError};
 use ccpp_core::Point;
 use serde::Serialize;
@@ -65,52 +66,26 @@ struct ZonesInfo {
     keepout_free_m2: f64,
 }
 
-/// Fills the 4-connected free component holding `seed` by horizontal runs, marking `seen` (an
-/// eighth of a byte per pixel; a run is found once and filled whole); returns the component's
-/// pixel count and whether it touches the image border.
+/// Fills the 4-connected free component holding `seed` by horizontal runs
+/// ([`ccpp_core::search::fill_runs`]), marking `seen`; returns the component's pixel count and
+/// whether it touches the image border.
 fn flood_runs(g: &GridMap, seed: usize, seen: &mut fixedbitset::FixedBitSet) -> (usize, bool) {
     let f = *g.frame();
     let (w, h) = (f.width, f.height);
     let cells = g.cells();
-    let free = |i: usize| cells[i] == Cell::Free;
     let (mut size, mut border) = (0usize, false);
-    let mut stack = vec![seed];
-    while let Some(i) = stack.pop() {
-        if seen.contains(i) {
-            continue;
-        }
-        let (col, row) = (i % w, i / w);
-        let base = row * w;
-        let mut lo = col;
-        while lo > 0 && free(base + lo - 1) {
-            lo -= 1;
-        }
-        let mut hi = col;
-        while hi + 1 < w && free(base + hi + 1) {
-            hi += 1;
-        }
-        seen.insert_range(base + lo..base + hi + 1);
-        size += hi - lo + 1;
-        border |= lo == 0 || hi + 1 == w || row == 0 || row + 1 == h;
-        // 4-connected: the pixels right above and below the run.
-        for nrow in [row.wrapping_sub(1), row + 1] {
-            if nrow >= h {
-                continue;
-            }
-            let nb = nrow * w;
-            let mut c = lo;
-            while c <= hi {
-                if free(nb + c) && !seen.contains(nb + c) {
-                    stack.push(nb + c);
-                    while c <= hi && free(nb + c) {
-                        c += 1;
-                    }
-                } else {
-                    c += 1;
-                }
-            }
-        }
-    }
+    fill_runs(
+        w,
+        h,
+        |i| cells[i] == Cell::Free,
+        seed,
+        Connectivity::Four,
+        seen,
+        |row, lo, hi| {
+            size += hi - lo + 1;
+            border |= lo == 0 || hi + 1 == w || row == 0 || row + 1 == h;
+        },
+    );
     (size, border)
 }
 

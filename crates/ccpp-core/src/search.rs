@@ -496,6 +496,90 @@ impl<C: Cost, T: TieBreak<C>> SearchSpace<C, T> {
     }
 }
 
+/// Which neighbours a pixel has in a grid flood fill ([`fill_runs`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Connectivity {
+    /// Left, right, up, down.
+    Four,
+    /// The four and the diagonals.
+    Eight,
+}
+
+/// Flood-fills the component holding `seed` of the pixels for which `inside` holds, on a `w` x
+/// `h` row-major grid, by horizontal runs: each run is found once, marked in `visited` whole and
+/// reported once as `on_run(row, first column, last column)`. Pixels already in `visited` are
+/// not entered, so one `visited` set serves to count every component of a grid. Memory: the
+/// caller's bitset (an eighth of a byte a pixel) and a stack of run seeds.
+///
+/// ```
+/// use ccpp_core::search::{fill_runs, Connectivity};
+/// use fixedbitset::FixedBitSet;
+/// // .#.
+/// // #..   the top-left pixel touches the rest only diagonally
+/// let free = [true, false, true, false, true, true];
+/// let count = |c: Connectivity| {
+///     let mut seen = FixedBitSet::with_capacity(6);
+///     let mut n = 0;
+///     fill_runs(3, 2, |i| free[i], 0, c, &mut seen, |_, lo, hi| n += hi - lo + 1);
+///     n
+/// };
+/// assert_eq!(count(Connectivity::Four), 1);
+/// assert_eq!(count(Connectivity::Eight), 4);
+/// ```
+pub fn fill_runs(
+    w: usize,
+    h: usize,
+    inside: impl Fn(usize) -> bool,
+    seed: usize,
+    connectivity: Connectivity,
+    visited: &mut fixedbitset::FixedBitSet,
+    mut on_run: impl FnMut(usize, usize, usize),
+) {
+    if w == 0 || seed >= w * h || !inside(seed) {
+        return;
+    }
+    let wider = usize::from(connectivity == Connectivity::Eight);
+    let mut stack = vec![seed];
+    while let Some(i) = stack.pop() {
+        if visited.contains(i) {
+            continue;
+        }
+        let (row, col) = (i / w, i % w);
+        let base = row * w;
+        // The whole run holding `i` is unvisited: runs are always filled whole.
+        let mut lo = col;
+        while lo > 0 && inside(base + lo - 1) {
+            lo -= 1;
+        }
+        let mut hi = col;
+        while hi + 1 < w && inside(base + hi + 1) {
+            hi += 1;
+        }
+        visited.insert_range(base + lo..base + hi + 1);
+        on_run(row, lo, hi);
+        // The rows above and below: the run's columns, one wider on each side for 8-connected.
+        let (c0, c1) = (lo.saturating_sub(wider), (hi + wider).min(w - 1));
+        for nrow in [row.wrapping_sub(1), row + 1] {
+            if nrow >= h {
+                continue;
+            }
+            let nb = nrow * w;
+            let mut c = c0;
+            while c <= c1 {
+                if inside(nb + c) && !visited.contains(nb + c) {
+                    stack.push(nb + c);
+                    // One seed per run: skip the rest of it.
+                    while c <= c1 && inside(nb + c) {
+                        c += 1;
+                    }
+                } else {
+                    c += 1;
+                }
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -11,6 +11,7 @@ use crate::display::Compact;
 use crate::dt::{squared_edt, squared_edt_compact, CompactDt, INF};
 use crate::geometry::{Point, Pose};
 use crate::grid::{Cell, GridMap, MapFrame};
+use crate::search::{fill_runs, Connectivity};
 use crate::zones::{MaskOccupancy, ZoneMasks};
 
 /// The robot model: a disk of radius `radius` carrying a cleaning tool of radius `tool_radius`.
@@ -589,11 +590,12 @@ impl World {
             }
         }
         if let Some(&s) = seeds.first() {
-            fill_component(
-                &self.cfree,
+            fill_runs(
                 frame.width,
                 frame.height,
+                |i| self.cfree.contains(i),
                 s,
+                Connectivity::Eight,
                 &mut seen,
                 |_, _, _| {},
             );
@@ -865,16 +867,25 @@ fn default_start(frame: &MapFrame, cfree: &FixedBitSet, dt2: &CompactDt) -> Pose
         }
         let mut size = 0usize;
         let mut top = (0u32, usize::MAX);
-        fill_component(cfree, w, h, i, &mut visited, |row, lo, hi| {
-            size += hi - lo + 1;
-            let base = row * w;
-            // The run's largest value at its first index, merged by the same rule as pixel
-            // by pixel (largest, then smallest index).
-            let (d, idx) = dt2.first_max(base + lo..base + hi + 1);
-            if top.1 == usize::MAX || d > top.0 || (d == top.0 && idx < top.1) {
-                top = (d, idx);
-            }
-        });
+        let inside = |j: usize| cfree.contains(j);
+        fill_runs(
+            w,
+            h,
+            inside,
+            i,
+            Connectivity::Eight,
+            &mut visited,
+            |row, lo, hi| {
+                size += hi - lo + 1;
+                let base = row * w;
+                // The run's largest value at its first index, merged by the same rule as pixel
+                // by pixel (largest, then smallest index).
+                let (d, idx) = dt2.first_max(base + lo..base + hi + 1);
+                if top.1 == usize::MAX || d > top.0 || (d == top.0 && idx < top.1) {
+                    top = (d, idx);
+                }
+            },
+        );
         if best.is_none_or(|b| size > b.0) {
             best = Some((size, top.0, top.1));
         }
@@ -883,59 +894,6 @@ fn default_start(frame: &MapFrame, cfree: &FixedBitSet, dt2: &CompactDt) -> Pose
     let (c, r) = frame.col_row(idx);
     let p = frame.pixel_center(c, r);
     Pose::new(p.x, p.y, 0.0)
-}
-
-/// Scanline flood fill of the 8-connected component of `set` (a `w` x `h` row-major bitset)
-/// holding `seed`: marks it in `visited` (which must not hold any of it yet) and calls
-/// `on_run(row, lo, hi)` once for each maximal horizontal run `lo..=hi` of it.
-fn fill_component(
-    set: &FixedBitSet,
-    w: usize,
-    h: usize,
-    seed: usize,
-    visited: &mut FixedBitSet,
-    mut on_run: impl FnMut(usize, usize, usize),
-) {
-    let mut stack = vec![seed];
-    while let Some(i) = stack.pop() {
-        if visited.contains(i) {
-            continue;
-        }
-        let (row, col) = (i / w, i % w);
-        let base = row * w;
-        // The whole run holding `i` is unvisited: runs are always filled whole.
-        let mut lo = col;
-        while lo > 0 && set.contains(base + lo - 1) {
-            lo -= 1;
-        }
-        let mut hi = col;
-        while hi + 1 < w && set.contains(base + hi + 1) {
-            hi += 1;
-        }
-        visited.insert_range(base + lo..base + hi + 1);
-        on_run(row, lo, hi);
-        // 8-connected: the rows above and below, one column wider on each side.
-        let (c0, c1) = (lo.saturating_sub(1), (hi + 1).min(w - 1));
-        for nrow in [row.wrapping_sub(1), row + 1] {
-            if nrow >= h {
-                continue;
-            }
-            let nb = nrow * w;
-            let mut c = c0;
-            while c <= c1 {
-                let j = nb + c;
-                if set.contains(j) && !visited.contains(j) {
-                    stack.push(j);
-                    // Skip the rest of this run.
-                    while c <= c1 && set.contains(nb + c) {
-                        c += 1;
-                    }
-                } else {
-                    c += 1;
-                }
-            }
-        }
-    }
 }
 
 /// The accessible surface: free pixels whose centre lies within `rt` pixels of a `reachable`
