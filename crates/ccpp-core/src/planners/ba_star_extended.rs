@@ -43,12 +43,10 @@
 //! assert_eq!(m.coverage_rate, Some(1.0));
 //! ```
 
-use std::collections::VecDeque;
-
 use serde::{Deserialize, Serialize};
 
 use super::ba_star::{BaStar, BaStarOptions};
-use super::extension::{Chunk, Extension, ExtensionOptions};
+use super::extension::{Chunk, Drive, Extension, ExtensionOptions};
 use crate::geometry::Point;
 use crate::planner::{Planner, Sensor, Step};
 use crate::trace::Event;
@@ -96,14 +94,10 @@ pub struct BaStarExtended {
     opts: ExtensionOptions,
     ext: Option<Extension>,
     mode: Mode,
-    queue: VecDeque<Step>,
-    last_pos: Option<Point>,
-    /// Inside a `wall_follow_start` / `wall_follow_end` pair.
-    in_pass: bool,
+    /// Queued steps, trail and open wall pass.
+    drive: Drive,
     /// Heading of the host's last lane move, while the host is in a lane.
     lane: Option<f64>,
-    /// Waypoints driven since the region's cleaning began (its start first), to retreat by.
-    trail: Vec<Point>,
 }
 
 impl BaStarExtended {
@@ -114,10 +108,7 @@ impl BaStarExtended {
             opts: opts.extension,
             ext: None,
             mode: Mode::Host,
-            queue: VecDeque::new(),
-            last_pos: None,
-            in_pass: false,
-            trail: Vec::new(),
+            drive: Drive::default(),
             lane: None,
         }
     }
@@ -150,56 +141,20 @@ impl BaStarExtended {
                 (!last).then_some(&wanted as &dyn Fn(Point) -> bool),
             )
         };
-        if !(chunk.transfer.is_empty() && chunk.sweep.is_empty()) {
-            // A transfer of a robot diameter or more is a backtracking transfer (drawn dashed,
-            // counted in `backtrack_length`); a shorter one belongs to the pass.
-            let mut at = pos;
-            let len: f64 = chunk
-                .transfer
-                .iter()
-                .map(|&p| {
-                    let d = at.dist(p);
-                    at = p;
-                    d
-                })
-                .sum();
-            let transfer = len >= 2.0 * ext.radius();
-            if transfer {
-                if self.in_pass {
-                    self.in_pass = false;
-                    self.queue.push_back(Step::Mark(Event::WallFollowEnd));
-                }
-                self.queue.push_back(Step::Mark(Event::BacktrackStart));
-            }
-            for &p in &chunk.transfer {
-                self.queue.push_back(Step::MoveTo(p));
-                self.trail.push(p);
-            }
-            if transfer {
-                self.queue.push_back(Step::Mark(Event::BacktrackEnd));
-            }
-            if !self.in_pass && !chunk.sweep.is_empty() {
-                self.in_pass = true;
-                self.queue.push_back(Step::Mark(Event::WallFollowStart));
-            }
-            for &p in &chunk.sweep {
-                self.queue.push_back(Step::MoveTo(p));
-                self.trail.push(p);
-            }
+        if self.drive.queue_chunk(pos, &chunk, ext.radius()) {
             return;
         }
-        if self.in_pass {
-            self.in_pass = false;
-            self.queue.push_back(Step::Mark(Event::WallFollowEnd));
-        }
+        self.drive.end_pass();
         if last {
             self.mode = Mode::Done;
             return;
         }
         // Transfer to BA*'s start point: direct when the robot moved, else BA*'s own path.
-        self.queue.push_back(Step::Mark(Event::BacktrackStart));
+        self.drive
+            .queue
+            .push_back(Step::Mark(Event::BacktrackStart));
         self.mode = Mode::Host;
-        if self.trail.len() <= 1 {
+        if self.drive.trail.len() <= 1 {
             return;
         }
         let Some(goal) = self.ba.backtrack_goal() else {
@@ -207,11 +162,11 @@ impl BaStarExtended {
         };
         let route = ext.route(known, pos, goal).unwrap_or_else(|| {
             // Retreat the way the passes came (every segment known free); BA* goes on from there.
-            self.trail.iter().rev().skip(1).copied().collect()
+            self.drive.trail.iter().rev().skip(1).copied().collect()
         });
         let direct = route.last() == Some(&goal);
         for p in route {
-            self.queue.push_back(Step::MoveTo(p));
+            self.drive.queue.push_back(Step::MoveTo(p));
         }
         if direct {
             self.ba.skip_backtrack();
@@ -229,26 +184,10 @@ impl Planner for BaStarExtended {
     }
 
     fn next(&mut self, sensor: &dyn Sensor) -> Step {
-        let pos = sensor.pose().position();
-        if let (Some(ext), Some(prev)) = (&mut self.ext, self.last_pos) {
-            if prev != pos {
-                ext.record(prev, pos);
-            }
-        } else {
-            let robot = sensor.robot();
-            let mut ext = Extension::new(
-                self.opts.clone(),
-                *sensor.frame(),
-                robot.radius,
-                robot.tool_radius,
-            );
-            ext.record(pos, pos);
-            self.ext = Some(ext);
-        }
-        self.last_pos = Some(pos);
+        let pos = self.drive.observe(&mut self.ext, &self.opts, sensor);
         self.ba.observe(sensor);
         loop {
-            if let Some(s) = self.queue.pop_front() {
+            if let Some(s) = self.drive.queue.pop_front() {
                 return s;
             }
             match self.mode {
@@ -257,11 +196,11 @@ impl Planner for BaStarExtended {
                 Mode::Host => match self.ba.next(sensor) {
                     Step::Mark(Event::BacktrackStart) => {
                         self.lane = None;
-                        self.trail = vec![pos];
+                        self.drive.trail = vec![pos];
                         self.mode = Mode::Clean { last: false };
                     }
                     Step::Done => {
-                        self.trail = vec![pos];
+                        self.drive.trail = vec![pos];
                         self.mode = Mode::Clean { last: true };
                     }
                     Step::MoveTo(target) if !self.ba.is_backtracking() => {
@@ -288,7 +227,7 @@ impl Planner for BaStarExtended {
                         match lane_end {
                             Some(pts) => {
                                 for p in pts {
-                                    self.queue.push_back(Step::MoveTo(p));
+                                    self.drive.queue.push_back(Step::MoveTo(p));
                                 }
                             }
                             None => return Step::MoveTo(target),

@@ -84,12 +84,10 @@
 //! assert!(me.effective_coverage > 0.99);
 //! ```
 
-use std::collections::VecDeque;
-
 use serde::{Deserialize, Serialize};
 
 use super::bsa::{Bsa, BsaOptions, Side};
-use super::extension::{polyline_len, Chunk, Extension, ExtensionOptions};
+use super::extension::{polyline_len, Chunk, Drive, Extension, ExtensionOptions};
 use crate::geometry::Point;
 use crate::planner::{Planner, Sensor, Step};
 use crate::trace::Event;
@@ -141,12 +139,8 @@ pub struct BsaExtended {
     opts: ExtensionOptions,
     ext: Option<Extension>,
     mode: Mode,
-    queue: VecDeque<Step>,
-    last_pos: Option<Point>,
-    /// Inside a `wall_follow_start` / `wall_follow_end` pair.
-    in_pass: bool,
-    /// Waypoints driven since the spiral's cleaning began (its start first), to retreat by.
-    trail: Vec<Point>,
+    /// Queued steps, trail and open wall pass.
+    drive: Drive,
 }
 
 impl BsaExtended {
@@ -157,10 +151,7 @@ impl BsaExtended {
             opts: opts.extension,
             ext: None,
             mode: Mode::Host,
-            queue: VecDeque::new(),
-            last_pos: None,
-            in_pass: false,
-            trail: Vec::new(),
+            drive: Drive::default(),
         }
     }
 
@@ -188,38 +179,10 @@ impl BsaExtended {
                 (!last).then_some(&wanted as &dyn Fn(Point) -> bool),
             )
         };
-        if !(chunk.transfer.is_empty() && chunk.sweep.is_empty()) {
-            // As in ba-star-extended: a trip of a robot diameter or more between rims is a
-            // backtracking transfer (drawn dashed, counted in `backtrack_length`).
-            let transfer = polyline_len(pos, &chunk.transfer) >= 2.0 * ext.radius();
-            if transfer {
-                if self.in_pass {
-                    self.in_pass = false;
-                    self.queue.push_back(Step::Mark(Event::WallFollowEnd));
-                }
-                self.queue.push_back(Step::Mark(Event::BacktrackStart));
-            }
-            for &p in &chunk.transfer {
-                self.queue.push_back(Step::MoveTo(p));
-                self.trail.push(p);
-            }
-            if transfer {
-                self.queue.push_back(Step::Mark(Event::BacktrackEnd));
-            }
-            if !self.in_pass && !chunk.sweep.is_empty() {
-                self.in_pass = true;
-                self.queue.push_back(Step::Mark(Event::WallFollowStart));
-            }
-            for &p in &chunk.sweep {
-                self.queue.push_back(Step::MoveTo(p));
-                self.trail.push(p);
-            }
+        if self.drive.queue_chunk(pos, &chunk, ext.radius()) {
             return;
         }
-        if self.in_pass {
-            self.in_pass = false;
-            self.queue.push_back(Step::Mark(Event::WallFollowEnd));
-        }
+        self.drive.end_pass();
         if last {
             self.mode = Mode::Done;
             return;
@@ -232,7 +195,7 @@ impl BsaExtended {
             return;
         };
         let goal = *own.last().expect("a transfer has moves");
-        let moved = self.trail.len() > 1;
+        let moved = self.drive.trail.len() > 1;
         match ext.route(known, pos, goal) {
             Some(route)
                 if route.last() == Some(&goal)
@@ -248,8 +211,8 @@ impl BsaExtended {
             }
             _ => {
                 if moved {
-                    for &p in self.trail.iter().rev().skip(1) {
-                        self.queue.push_back(Step::MoveTo(p));
+                    for &p in self.drive.trail.iter().rev().skip(1) {
+                        self.drive.queue.push_back(Step::MoveTo(p));
                     }
                 }
             }
@@ -267,26 +230,10 @@ impl Planner for BsaExtended {
     }
 
     fn next(&mut self, sensor: &dyn Sensor) -> Step {
-        let pos = sensor.pose().position();
-        if let (Some(ext), Some(prev)) = (&mut self.ext, self.last_pos) {
-            if prev != pos {
-                ext.record(prev, pos);
-            }
-        } else {
-            let robot = sensor.robot();
-            let mut ext = Extension::new(
-                self.opts.clone(),
-                *sensor.frame(),
-                robot.radius,
-                robot.tool_radius,
-            );
-            ext.record(pos, pos);
-            self.ext = Some(ext);
-        }
-        self.last_pos = Some(pos);
+        let pos = self.drive.observe(&mut self.ext, &self.opts, sensor);
         self.bsa.observe(sensor);
         loop {
-            if let Some(s) = self.queue.pop_front() {
+            if let Some(s) = self.drive.queue.pop_front() {
                 return s;
             }
             match self.mode {
@@ -295,13 +242,13 @@ impl Planner for BsaExtended {
                 Mode::Host => match self.bsa.next(sensor) {
                     s @ Step::Mark(Event::RegionEnd { .. }) => {
                         if self.bsa.transfer().is_some() {
-                            self.trail = vec![pos];
+                            self.drive.trail = vec![pos];
                             self.mode = Mode::Clean { last: false };
                         }
                         return s;
                     }
                     Step::Done => {
-                        self.trail = vec![pos];
+                        self.drive.trail = vec![pos];
                         self.mode = Mode::Clean { last: true };
                     }
                     s => return s,
