@@ -337,6 +337,60 @@ fn nearest_of_gives_the_dijkstra_answer() {
     assert!(compared > 300, "{compared}");
 }
 
+/// Covered tiles of a pseudo-random 170 x 150 field (about 85 % covered, from -5): many
+/// blocks and super-blocks of the target lists of `nearest_of`.
+struct Field {
+    covered: Vec<bool>,
+}
+
+impl TileGraph for Field {
+    fn bounds(&self) -> (i32, i32, i32, i32) {
+        (-5, 164, -5, 144)
+    }
+    fn covered(&self, t: Tile) -> bool {
+        (-5..165).contains(&t.0)
+            && (-5..145).contains(&t.1)
+            && self.covered[((t.1 + 5) * 170 + t.0 + 5) as usize]
+    }
+    fn move_free(&self, _: Tile, _: usize) -> bool {
+        true
+    }
+}
+
+#[test]
+fn nearest_of_gives_the_dijkstra_answer_over_many_blocks() {
+    let mut x: u64 = 0x2545_f491_4f6c_dd1d;
+    let mut next = move || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        x
+    };
+    let mut found = 0;
+    for _ in 0..6 {
+        let g = Field {
+            covered: (0..170 * 150).map(|_| next() % 100 < 85).collect(),
+        };
+        let tiles: Vec<Tile> = (0..170 * 150)
+            .map(|k| (k % 170 - 5, k / 170 - 5))
+            .filter(|&t| g.covered(t))
+            .collect();
+        let mut s = TileSearch::new(g.bounds());
+        for every in [3, 40, 400, 3000] {
+            let skip = (next() % 50) as usize;
+            let targets: Vec<Tile> = tiles.iter().copied().skip(skip).step_by(every).collect();
+            for _ in 0..4 {
+                let from = tiles[(next() % tiles.len() as u64) as usize];
+                let want = s.nearest(&g, from, |t| targets.contains(&t));
+                let got = s.nearest_of(&g, from, &targets, |t| targets.contains(&t));
+                assert_eq!(got, want, "every {every}, from {from:?}");
+                found += usize::from(want.is_some());
+            }
+        }
+    }
+    assert!(found > 60, "{found}");
+}
+
 #[test]
 fn astar_needs_both_orthogonal_tiles_for_a_diagonal() {
     // (0,0) and (1,1) covered, (1,0) covered, (0,1) not: the diagonal is not an edge.

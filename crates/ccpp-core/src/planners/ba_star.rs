@@ -404,6 +404,11 @@ const TARGET_BLOCK: usize = 16;
 /// `U = min over l' of` the cost from the farthest tile of `X` (a corner: the octile cost is a
 /// norm, hence convex). Any other target is farther from every tile of `X` than the target
 /// achieving `U`, so the minimum over the list is the minimum over all targets: exact.
+///
+/// A block's list is taken from the list of its super-block (4 x 4 blocks, built from all
+/// targets the same way), which holds it: for `X` inside `Y`, the cost from the nearest tile
+/// of `Y` is at most that from the nearest of `X`, and `U` of `X` at most `U` of `Y`. So each
+/// target is looked at once per super-block, not once per block.
 #[derive(Clone, Debug, Default)]
 struct TargetBlocks {
     /// Blocks per row and per column of the search rectangle.
@@ -416,7 +421,15 @@ struct TargetBlocks {
     arena: Vec<Tile>,
     generation: u32,
     targets: Vec<Tile>,
+    /// The same per super-block (`SUPER_BLOCKS` blocks a side).
+    sbw: usize,
+    sstamp: Vec<u32>,
+    srange: Vec<(u32, u32)>,
+    sarena: Vec<Tile>,
 }
+
+/// Blocks a side of a super-block of [`TargetBlocks`].
+const SUPER_BLOCKS: usize = 4;
 
 /// The cost of the cheapest 8-neighbour path from `a` to `b` on an unobstructed grid
 /// ([`COST_ORTHO`] / [`COST_DIAG`] steps): a lower bound of the search cost, and consistent
@@ -707,11 +720,7 @@ impl TileSearch {
     fn target_h(&mut self, t: Tile) -> u64 {
         let bi = (t.0 - self.i0) as usize / TARGET_BLOCK;
         let bj = (t.1 - self.j0) as usize / TARGET_BLOCK;
-        let x0 = self.i0 + (bi * TARGET_BLOCK) as i32;
-        let y0 = self.j0 + (bj * TARGET_BLOCK) as i32;
-        let x1 = (x0 + TARGET_BLOCK as i32 - 1).min(self.i0 + self.w as i32 - 1);
-        let y1 = (y0 + TARGET_BLOCK as i32 - 1).min(self.j0 + self.h as i32 - 1);
-        let (lo, hi) = self.blocks.list(bj * self.blocks.bw + bi, (x0, x1, y0, y1));
+        let (lo, hi) = self.blocks.list(bi, bj, (self.i0, self.j0));
         self.blocks.arena[lo..hi]
             .iter()
             .map(|&l| octile(t, l))
@@ -861,52 +870,89 @@ impl TargetBlocks {
         if self.stamp.len() != self.bw * self.bh {
             self.stamp = vec![0; self.bw * self.bh];
             self.range = vec![(0, 0); self.bw * self.bh];
+            self.sbw = self.bw.div_ceil(SUPER_BLOCKS);
+            let n = self.sbw * self.bh.div_ceil(SUPER_BLOCKS);
+            self.sstamp = vec![0; n];
+            self.srange = vec![(0, 0); n];
         }
         self.generation = self.generation.wrapping_add(1);
         if self.generation == 0 {
             self.stamp.fill(0);
+            self.sstamp.fill(0);
             self.generation = 1;
         }
         self.arena.clear();
+        self.sarena.clear();
         self.targets.clear();
         self.targets.extend_from_slice(targets);
     }
 
-    /// The arena range of block `b` (tiles `x0..=x1`, `y0..=y1`), built on first use.
+    /// The arena range of block `(bi, bj)` of a search rectangle whose first tile is
+    /// `origin`, built on first use.
     #[inline]
-    fn list(&mut self, b: usize, rect: (i32, i32, i32, i32)) -> (usize, usize) {
+    fn list(&mut self, bi: usize, bj: usize, origin: Tile) -> (usize, usize) {
+        let b = bj * self.bw + bi;
         if self.stamp[b] != self.generation {
-            self.build(b, rect);
+            self.build(bi, bj, origin);
         }
         let (lo, hi) = self.range[b];
         (lo as usize, hi as usize)
     }
 
-    fn build(&mut self, b: usize, (x0, x1, y0, y1): (i32, i32, i32, i32)) {
-        let gap = |v: i32, lo: i32, hi: i32| {
-            u64::from(
-                lo.saturating_sub(v)
-                    .max(v.saturating_sub(hi))
-                    .max(0)
-                    .unsigned_abs(),
-            )
-        };
-        let near = |l: Tile| octile_gap(gap(l.0, x0, x1), gap(l.1, y0, y1));
-        let far = |l: Tile| {
-            let dx = u64::from(l.0.abs_diff(x0).max(l.0.abs_diff(x1)));
-            let dy = u64::from(l.1.abs_diff(y0).max(l.1.abs_diff(y1)));
-            octile_gap(dx, dy)
-        };
-        let u = self.targets.iter().map(|&l| far(l)).min().unwrap_or(0);
-        let lo = self.arena.len();
-        for &l in &self.targets {
-            if near(l) <= u {
-                self.arena.push(l);
-            }
+    fn build(&mut self, bi: usize, bj: usize, origin: Tile) {
+        let (si, sj) = (bi / SUPER_BLOCKS, bj / SUPER_BLOCKS);
+        let sb = sj * self.sbw + si;
+        if self.sstamp[sb] != self.generation {
+            let side = TARGET_BLOCK * SUPER_BLOCKS;
+            let lo = self.sarena.len();
+            candidates(
+                &self.targets,
+                block_rect(origin, si, sj, side),
+                &mut self.sarena,
+            );
+            self.srange[sb] = (lo as u32, self.sarena.len() as u32);
+            self.sstamp[sb] = self.generation;
         }
+        let (slo, shi) = self.srange[sb];
+        let lo = self.arena.len();
+        candidates(
+            &self.sarena[slo as usize..shi as usize],
+            block_rect(origin, bi, bj, TARGET_BLOCK),
+            &mut self.arena,
+        );
+        let b = bj * self.bw + bi;
         self.range[b] = (lo as u32, self.arena.len() as u32);
         self.stamp[b] = self.generation;
     }
+}
+
+/// The tiles `(x0, x1, y0, y1)` of block `(bi, bj)` of side `side` from `origin` (not clipped
+/// to the search rectangle: a larger block keeps every list exact).
+fn block_rect(origin: Tile, bi: usize, bj: usize, side: usize) -> (i32, i32, i32, i32) {
+    let x0 = origin.0 + (bi * side) as i32;
+    let y0 = origin.1 + (bj * side) as i32;
+    (x0, x0 + side as i32 - 1, y0, y0 + side as i32 - 1)
+}
+
+/// Appends to `out` the targets of `src` kept for the block `(x0, x1, y0, y1)` (see
+/// [`TargetBlocks`]), in the order of `src`.
+fn candidates(src: &[Tile], (x0, x1, y0, y1): (i32, i32, i32, i32), out: &mut Vec<Tile>) {
+    let gap = |v: i32, lo: i32, hi: i32| {
+        u64::from(
+            lo.saturating_sub(v)
+                .max(v.saturating_sub(hi))
+                .max(0)
+                .unsigned_abs(),
+        )
+    };
+    let near = |l: Tile| octile_gap(gap(l.0, x0, x1), gap(l.1, y0, y1));
+    let far = |l: Tile| {
+        let dx = u64::from(l.0.abs_diff(x0).max(l.0.abs_diff(x1)));
+        let dy = u64::from(l.1.abs_diff(y0).max(l.1.abs_diff(y1)));
+        octile_gap(dx, dy)
+    };
+    let u = src.iter().map(|&l| far(l)).min().unwrap_or(0);
+    out.extend(src.iter().copied().filter(|&l| near(l) <= u));
 }
 
 /// Euclidean distance between tiles in the fixed-point unit of [`COST_ORTHO`], rounded down
