@@ -4,6 +4,9 @@
 //!
 //! * `dijkstra/*`: the nearest of a set of far targets (BA*'s backtracking selection shape):
 //!   [`TileSearch::nearest`] (BA*'s own scratch) against [`SearchSpace`] driven the same way.
+//! * `nearest_sparse/*`: the nearest of a sparse listed set (every 101st free pixel of the far
+//!   rows, as sparse as BA*'s backtracking list `L`): [`TileSearch::nearest`] (Dijkstra)
+//!   against [`TileSearch::nearest_of`] (A* towards the set, the same answer).
 //! * `astar/*`: corner to corner: [`TileSearch::astar`] against [`SearchSpace`], and
 //!   [`TileSearch::astar_bounded`] given the path's cost (as BA* calls it after its nearest
 //!   search), which labels no tile keyed above that cost.
@@ -200,6 +203,19 @@ fn bench(c: &mut Criterion) {
         module_flood_driver(&mut new_bfs, &g, from)
     );
 
+    let sparse: Vec<Tile> = (0..g.free.len() as u32)
+        .filter(|&k| g.free[k as usize] && k % 101 == 0)
+        .map(|k| g.tile(k))
+        .filter(|&t| target(t))
+        .collect();
+    let is_sparse = |t: Tile| target(t) && g.idx(t).is_some_and(|k| k % 101 == 0);
+    let a = old.nearest(&g, from, is_sparse).expect("reachable target");
+    assert_eq!(
+        old.nearest_of(&g, from, &sparse, is_sparse),
+        Some(a),
+        "nearest_of differs"
+    );
+
     let mut grp = c.benchmark_group("search_office_2000");
     grp.sample_size(10);
     grp.bench_function("dijkstra/ba_star_tile_search", |bch| {
@@ -207,6 +223,12 @@ fn bench(c: &mut Criterion) {
     });
     grp.bench_function("dijkstra/search_space", |bch| {
         bch.iter(|| module_search(&mut new, &g, from, None, &target));
+    });
+    grp.bench_function("nearest_sparse/dijkstra", |bch| {
+        bch.iter(|| old.nearest(&g, from, is_sparse));
+    });
+    grp.bench_function("nearest_sparse/astar_to_set", |bch| {
+        bch.iter(|| old.nearest_of(&g, from, &sparse, is_sparse));
     });
     grp.bench_function("astar/ba_star_tile_search", |bch| {
         bch.iter(|| old.astar(&g, corner, far));

@@ -291,6 +291,106 @@ fn bounded_astar_gives_the_full_search_answer() {
     assert!(checked > 500, "{checked}");
 }
 
+/// The A* towards a listed target set answers exactly as the Dijkstra search: the same tile
+/// (least cost, then smaller `j`, then smaller `i`) and cost, over sparse and dense target sets,
+/// ties on the cost, sources among the targets, and unreachable targets.
+#[test]
+fn nearest_of_gives_the_dijkstra_answer() {
+    let mut compared = 0;
+    for seed in 0..40u64 {
+        let g = Patch::new(seed);
+        let mut s = TileSearch::new(g.bounds());
+        let tiles: Vec<Tile> = (0..24 * 24)
+            .map(|k| (k % 24, k / 24))
+            .filter(|&t| g.covered(t))
+            .collect();
+        let mut x = seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1;
+        for round in 0..12 {
+            // Targets: every `every`-th covered tile from a pseudo-random offset.
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let every = [1, 2, 7, 23, 61, 150][round % 6];
+            let targets: Vec<Tile> = tiles
+                .iter()
+                .copied()
+                .skip((x % 13) as usize)
+                .step_by(every)
+                .collect();
+            let from = tiles[(x >> 20) as usize % tiles.len()];
+            let want = s.nearest(&g, from, |t| targets.contains(&t));
+            let got = s.nearest_of(&g, from, &targets, |t| targets.contains(&t));
+            assert_eq!(got, want, "seed {seed} round {round}: from {from:?}");
+            compared += usize::from(want.is_some());
+        }
+        // Symmetric targets around the source: equal costs, the (j, i) order decides.
+        let from = (12, 12);
+        if g.covered(from) {
+            let ring: Vec<Tile> = [(10, 12), (14, 12), (12, 10), (12, 14)]
+                .into_iter()
+                .filter(|&t| g.covered(t))
+                .collect();
+            let want = s.nearest(&g, from, |t| ring.contains(&t));
+            assert_eq!(s.nearest_of(&g, from, &ring, |t| ring.contains(&t)), want);
+        }
+    }
+    assert!(compared > 300, "{compared}");
+}
+
+/// Covered tiles of a pseudo-random 170 x 150 field (about 85 % covered, from -5): many
+/// blocks and super-blocks of the target lists of `nearest_of`.
+struct Field {
+    covered: Vec<bool>,
+}
+
+impl TileGraph for Field {
+    fn bounds(&self) -> (i32, i32, i32, i32) {
+        (-5, 164, -5, 144)
+    }
+    fn covered(&self, t: Tile) -> bool {
+        (-5..165).contains(&t.0)
+            && (-5..145).contains(&t.1)
+            && self.covered[((t.1 + 5) * 170 + t.0 + 5) as usize]
+    }
+    fn move_free(&self, _: Tile, _: usize) -> bool {
+        true
+    }
+}
+
+#[test]
+fn nearest_of_gives_the_dijkstra_answer_over_many_blocks() {
+    let mut x: u64 = 0x2545_f491_4f6c_dd1d;
+    let mut next = move || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        x
+    };
+    let mut found = 0;
+    for _ in 0..6 {
+        let g = Field {
+            covered: (0..170 * 150).map(|_| next() % 100 < 85).collect(),
+        };
+        let tiles: Vec<Tile> = (0..170 * 150)
+            .map(|k| (k % 170 - 5, k / 170 - 5))
+            .filter(|&t| g.covered(t))
+            .collect();
+        let mut s = TileSearch::new(g.bounds());
+        for every in [3, 40, 400, 3000] {
+            let skip = (next() % 50) as usize;
+            let targets: Vec<Tile> = tiles.iter().copied().skip(skip).step_by(every).collect();
+            for _ in 0..4 {
+                let from = tiles[(next() % tiles.len() as u64) as usize];
+                let want = s.nearest(&g, from, |t| targets.contains(&t));
+                let got = s.nearest_of(&g, from, &targets, |t| targets.contains(&t));
+                assert_eq!(got, want, "every {every}, from {from:?}");
+                found += usize::from(want.is_some());
+            }
+        }
+    }
+    assert!(found > 60, "{found}");
+}
+
 #[test]
 fn astar_needs_both_orthogonal_tiles_for_a_diagonal() {
     // (0,0) and (1,1) covered, (1,0) covered, (0,1) not: the diagonal is not an edge.

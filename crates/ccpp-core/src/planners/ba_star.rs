@@ -389,6 +389,60 @@ pub struct TileSearch {
     nodes: Vec<SearchNode>,
     generation: u32,
     heap: MonotoneQueue,
+    /// Scratch of [`Self::nearest_of`]: the targets' candidate lists per block.
+    blocks: TargetBlocks,
+}
+
+/// Side, in tiles, of the blocks of [`TargetBlocks`].
+const TARGET_BLOCK: usize = 16;
+
+/// The heuristic of [`TileSearch::nearest_of`]: the least [`octile`] cost from a tile to any
+/// of a set of targets, computed from a per-block candidate list (built when the search first
+/// reaches the block, reused by every tile of it).
+///
+/// Block `X` keeps the targets `l` whose octile cost from the nearest tile of `X` is at most
+/// `U = min over l' of` the cost from the farthest tile of `X` (a corner: the octile cost is a
+/// norm, hence convex). Any other target is farther from every tile of `X` than the target
+/// achieving `U`, so the minimum over the list is the minimum over all targets: exact.
+///
+/// A block's list is taken from the list of its super-block (4 x 4 blocks, built from all
+/// targets the same way), which holds it: for `X` inside `Y`, the cost from the nearest tile
+/// of `Y` is at most that from the nearest of `X`, and `U` of `X` at most `U` of `Y`. So each
+/// target is looked at once per super-block, not once per block.
+#[derive(Clone, Debug, Default)]
+struct TargetBlocks {
+    /// Blocks per row and per column of the search rectangle.
+    bw: usize,
+    bh: usize,
+    /// Per block: the generation its list was built in (0: never).
+    stamp: Vec<u32>,
+    /// Per block: its list, `arena[range.0..range.1]`.
+    range: Vec<(u32, u32)>,
+    arena: Vec<Tile>,
+    generation: u32,
+    targets: Vec<Tile>,
+    /// The same per super-block (`SUPER_BLOCKS` blocks a side).
+    sbw: usize,
+    sstamp: Vec<u32>,
+    srange: Vec<(u32, u32)>,
+    sarena: Vec<Tile>,
+}
+
+/// Blocks a side of a super-block of [`TargetBlocks`].
+const SUPER_BLOCKS: usize = 4;
+
+/// The cost of the cheapest 8-neighbour path from `a` to `b` on an unobstructed grid
+/// ([`COST_ORTHO`] / [`COST_DIAG`] steps): a lower bound of the search cost, and consistent
+/// (it is the path metric of a supergraph with the same edge costs).
+#[inline]
+pub fn octile(a: Tile, b: Tile) -> u64 {
+    octile_gap(u64::from(a.0.abs_diff(b.0)), u64::from(a.1.abs_diff(b.1)))
+}
+
+#[inline]
+fn octile_gap(dx: u64, dy: u64) -> u64 {
+    let (lo, hi) = if dx < dy { (dx, dy) } else { (dy, dx) };
+    COST_ORTHO * (hi - lo) + COST_DIAG * lo
 }
 
 /// A priority queue of `(key, index)` pairs popping the smallest pair (key, then index) for
@@ -519,6 +573,11 @@ impl TileSearch {
             nodes: vec![SearchNode::default(); w * h],
             generation: 0,
             heap: MonotoneQueue::new(),
+            blocks: TargetBlocks {
+                bw: w.div_ceil(TARGET_BLOCK),
+                bh: h.div_ceil(TARGET_BLOCK),
+                ..TargetBlocks::default()
+            },
         }
     }
 
@@ -606,6 +665,91 @@ impl TileSearch {
             self.expand(g, t, k, d, None);
         }
         None
+    }
+
+    /// [`Self::nearest`] when the targets are listed (`targets`: exactly the tiles with
+    /// `is_target`): the same tile and cost, found by A* towards the set.
+    ///
+    /// The heuristic is the least [`octile`] cost to a target ([`TargetBlocks`]): consistent,
+    /// and zero at the targets, whose key is then their cost. Popping in `(key, index)` order,
+    /// every tile on a cheapest path to a target of the least cost `d*` is popped, with its
+    /// exact cost, before any key above `d*`; so once a target is popped the search goes on
+    /// through the key `d*` and answers with the smallest-index target popped at that key:
+    /// the first target of the Dijkstra order `(cost, index)`. Targets are not expanded, as
+    /// in [`Self::nearest`] (a cheapest path to a target of cost `d*` passes through no other
+    /// target: costs are positive). Far targets cost a search of the region between, not of
+    /// the disc of radius `d*`.
+    pub fn nearest_of(
+        &mut self,
+        g: &impl TileGraph,
+        from: Tile,
+        targets: &[Tile],
+        is_target: impl Fn(Tile) -> bool,
+    ) -> Option<(Tile, u64)> {
+        let s = self.idx(from)?;
+        self.begin();
+        self.blocks.begin(targets);
+        self.relax(s, 0, u32::MAX);
+        let h0 = self.target_h(from);
+        self.heap.push(h0, s as u32);
+        let mut best: Option<(usize, u64)> = None;
+        while let Some((key, k)) = self.heap.pop() {
+            if best.is_some_and(|(_, d)| key > d) {
+                break;
+            }
+            let k = k as usize;
+            if self.closed(k) {
+                continue;
+            }
+            self.nodes[k].stamp = self.generation + 1;
+            let d = self.nodes[k].dist;
+            let t = self.tile(k);
+            if is_target(t) {
+                if best.is_none_or(|(b, _)| k < b) {
+                    best = Some((k, d));
+                }
+                continue;
+            }
+            self.expand_to_targets(g, t, k, d);
+        }
+        best.map(|(k, d)| (self.tile(k), d))
+    }
+
+    /// The heuristic of [`Self::nearest_of`] at tile `t` (in the search rectangle).
+    #[inline]
+    fn target_h(&mut self, t: Tile) -> u64 {
+        let bi = (t.0 - self.i0) as usize / TARGET_BLOCK;
+        let bj = (t.1 - self.j0) as usize / TARGET_BLOCK;
+        let (lo, hi) = self.blocks.list(bi, bj, (self.i0, self.j0));
+        self.blocks.arena[lo..hi]
+            .iter()
+            .map(|&l| octile(t, l))
+            .min()
+            .unwrap_or(u64::MAX / 4)
+    }
+
+    /// [`Self::expand_within`] for [`Self::nearest_of`]: keys `cost + target_h`.
+    fn expand_to_targets(&mut self, g: &impl TileGraph, t: Tile, k: usize, d: u64) {
+        let mut mask = g.edge_mask(t);
+        let gen = self.generation;
+        while mask != 0 {
+            let n = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            let (di, dj) = N8[n];
+            let v = (t.0 + di, t.1 + dj);
+            let Some(kv) = self.idx(v) else { continue };
+            let nd = d + if n % 2 == 1 { COST_DIAG } else { COST_ORTHO };
+            let node = self.nodes[kv];
+            if node.stamp == gen + 1 || (node.stamp == gen && nd >= node.dist) {
+                continue;
+            }
+            let f = nd + self.target_h(v);
+            let node = &mut self.nodes[kv];
+            node.stamp = gen;
+            node.dist = nd;
+            node.parent = k as u32;
+            self.heap.push(f, kv as u32);
+        }
     }
 
     fn expand(&mut self, g: &impl TileGraph, t: Tile, k: usize, d: u64, goal: Option<Tile>) {
@@ -718,6 +862,97 @@ impl TileSearch {
         }
         None
     }
+}
+
+impl TargetBlocks {
+    /// A new search towards `targets`: every block's list is stale.
+    fn begin(&mut self, targets: &[Tile]) {
+        if self.stamp.len() != self.bw * self.bh {
+            self.stamp = vec![0; self.bw * self.bh];
+            self.range = vec![(0, 0); self.bw * self.bh];
+            self.sbw = self.bw.div_ceil(SUPER_BLOCKS);
+            let n = self.sbw * self.bh.div_ceil(SUPER_BLOCKS);
+            self.sstamp = vec![0; n];
+            self.srange = vec![(0, 0); n];
+        }
+        self.generation = self.generation.wrapping_add(1);
+        if self.generation == 0 {
+            self.stamp.fill(0);
+            self.sstamp.fill(0);
+            self.generation = 1;
+        }
+        self.arena.clear();
+        self.sarena.clear();
+        self.targets.clear();
+        self.targets.extend_from_slice(targets);
+    }
+
+    /// The arena range of block `(bi, bj)` of a search rectangle whose first tile is
+    /// `origin`, built on first use.
+    #[inline]
+    fn list(&mut self, bi: usize, bj: usize, origin: Tile) -> (usize, usize) {
+        let b = bj * self.bw + bi;
+        if self.stamp[b] != self.generation {
+            self.build(bi, bj, origin);
+        }
+        let (lo, hi) = self.range[b];
+        (lo as usize, hi as usize)
+    }
+
+    fn build(&mut self, bi: usize, bj: usize, origin: Tile) {
+        let (si, sj) = (bi / SUPER_BLOCKS, bj / SUPER_BLOCKS);
+        let sb = sj * self.sbw + si;
+        if self.sstamp[sb] != self.generation {
+            let side = TARGET_BLOCK * SUPER_BLOCKS;
+            let lo = self.sarena.len();
+            candidates(
+                &self.targets,
+                block_rect(origin, si, sj, side),
+                &mut self.sarena,
+            );
+            self.srange[sb] = (lo as u32, self.sarena.len() as u32);
+            self.sstamp[sb] = self.generation;
+        }
+        let (slo, shi) = self.srange[sb];
+        let lo = self.arena.len();
+        candidates(
+            &self.sarena[slo as usize..shi as usize],
+            block_rect(origin, bi, bj, TARGET_BLOCK),
+            &mut self.arena,
+        );
+        let b = bj * self.bw + bi;
+        self.range[b] = (lo as u32, self.arena.len() as u32);
+        self.stamp[b] = self.generation;
+    }
+}
+
+/// The tiles `(x0, x1, y0, y1)` of block `(bi, bj)` of side `side` from `origin` (not clipped
+/// to the search rectangle: a larger block keeps every list exact).
+fn block_rect(origin: Tile, bi: usize, bj: usize, side: usize) -> (i32, i32, i32, i32) {
+    let x0 = origin.0 + (bi * side) as i32;
+    let y0 = origin.1 + (bj * side) as i32;
+    (x0, x0 + side as i32 - 1, y0, y0 + side as i32 - 1)
+}
+
+/// Appends to `out` the targets of `src` kept for the block `(x0, x1, y0, y1)` (see
+/// [`TargetBlocks`]), in the order of `src`.
+fn candidates(src: &[Tile], (x0, x1, y0, y1): (i32, i32, i32, i32), out: &mut Vec<Tile>) {
+    let gap = |v: i32, lo: i32, hi: i32| {
+        u64::from(
+            lo.saturating_sub(v)
+                .max(v.saturating_sub(hi))
+                .max(0)
+                .unsigned_abs(),
+        )
+    };
+    let near = |l: Tile| octile_gap(gap(l.0, x0, x1), gap(l.1, y0, y1));
+    let far = |l: Tile| {
+        let dx = u64::from(l.0.abs_diff(x0).max(l.0.abs_diff(x1)));
+        let dy = u64::from(l.1.abs_diff(y0).max(l.1.abs_diff(y1)));
+        octile_gap(dx, dy)
+    };
+    let u = src.iter().map(|&l| far(l)).min().unwrap_or(0);
+    out.extend(src.iter().copied().filter(|&l| near(l) <= u));
 }
 
 /// Euclidean distance between tiles in the fixed-point unit of [`COST_ORTHO`], rounded down
@@ -1763,7 +1998,8 @@ impl BaStar {
             return self.pending.pop_front().unwrap_or(Step::Done);
         }
         let tiles = &m.tiles;
-        let found = m.search.nearest(tiles, c, |t| tiles.in_l(t));
+        let targets = tiles.l_tiles();
+        let found = m.search.nearest_of(tiles, c, &targets, |t| tiles.in_l(t));
         let Some((sp, sp_cost)) = found else {
             // Cannot happen: covered tiles form one connected graph.
             self.pending.push_back(Step::Mark(Event::Note {
