@@ -1141,18 +1141,45 @@ impl Bcd {
         }
         let items = best.map(|b| b.1).unwrap_or_default();
 
+        // A region whose moves the smoothing and pruning merged into the moves around it (or
+        // a cell whose lane is a single point) has nothing left between its start and end: it
+        // is not reported (marks inside it are kept), and the regions left are numbered 1, 2,
+        // ... in order.
         let mut steps = VecDeque::with_capacity(items.len());
         let mut at = start;
+        // Marks since a region's start while it has no move yet (`None`: no region pending).
+        let mut pending: Option<Vec<Event>> = None;
+        let mut region = 0u32;
         for it in items {
             match it {
                 Item::Move(p) => {
                     if p != at {
+                        if let Some(marks) = pending.take() {
+                            region += 1;
+                            steps.push_back(Step::Mark(Event::RegionStart { region }));
+                            steps.extend(marks.into_iter().map(Step::Mark));
+                        }
                         steps.push_back(Step::MoveTo(frame.grid_to_world(p)));
                         at = p;
                     }
                 }
-                Item::Mark(e) => steps.push_back(Step::Mark(e)),
+                Item::Mark(Event::RegionStart { .. }) => {
+                    if let Some(marks) = pending.replace(Vec::new()) {
+                        steps.extend(marks.into_iter().map(Step::Mark));
+                    }
+                }
+                Item::Mark(Event::RegionEnd { .. }) => match pending.take() {
+                    Some(marks) => steps.extend(marks.into_iter().map(Step::Mark)),
+                    None => steps.push_back(Step::Mark(Event::RegionEnd { region })),
+                },
+                Item::Mark(e) => match pending.as_mut() {
+                    Some(marks) => marks.push(e),
+                    None => steps.push_back(Step::Mark(e)),
+                },
             }
+        }
+        if let Some(marks) = pending {
+            steps.extend(marks.into_iter().map(Step::Mark));
         }
         Self {
             steps,
@@ -1991,6 +2018,60 @@ mod tests {
             ),
         ];
         assert_eq!(drop_covered(cells, 30, 10, 3.0).len(), 2);
+    }
+
+    /// A room speckled with single-pixel obstacles at scattered offsets (as scanned maps are):
+    /// many small cells, some of whose moves the smoothing and pruning merge into their
+    /// neighbours'. Every region the plan reports has a move, and regions count 1, 2, ...
+    #[test]
+    fn every_reported_region_has_moves_and_regions_count_up() {
+        let (w, h) = (90usize, 60usize);
+        let mut art = String::new();
+        let mut seed = 0x5eed_u64;
+        for r in 0..h {
+            for c in 0..w {
+                seed = seed
+                    .wrapping_mul(6_364_136_223_846_793_005)
+                    .wrapping_add(1_442_695_040_888_963_407);
+                let border = r == 0 || c == 0 || r + 1 == h || c + 1 == w;
+                art.push(if border || (seed >> 33) % 97 == 0 {
+                    '#'
+                } else {
+                    '.'
+                });
+            }
+            art.push('\n');
+        }
+        let map = crate::grid::GridMap::from_ascii_scaled(&art, 1, 0.05).unwrap();
+        let world = World::new(
+            map,
+            crate::world::Robot::new(0.1),
+            Some(crate::geometry::Pose::new(0.5, 0.5, 0.0)),
+        )
+        .unwrap();
+        let plan = Bcd::new(&world, &BcdOptions::default());
+        let (mut open, mut moved, mut ended) = (None, false, 0u32);
+        for s in &plan.steps {
+            match s {
+                Step::Mark(Event::RegionStart { region }) => {
+                    assert_eq!(open, None, "region {region} starts inside another");
+                    assert_eq!(*region, ended + 1, "regions count up");
+                    open = Some(*region);
+                    moved = false;
+                }
+                Step::MoveTo(_) => moved = true,
+                Step::Mark(Event::RegionEnd { region }) => {
+                    assert_eq!(open.take(), Some(*region));
+                    assert!(moved, "region {region} has no move");
+                    ended += 1;
+                }
+                _ => {}
+            }
+        }
+        assert!(
+            ended > 5,
+            "{ended} regions: the specks should split the room"
+        );
     }
 
     #[test]
