@@ -2034,7 +2034,7 @@ mod tests {
                     .wrapping_mul(6_364_136_223_846_793_005)
                     .wrapping_add(1_442_695_040_888_963_407);
                 let border = r == 0 || c == 0 || r + 1 == h || c + 1 == w;
-                art.push(if border || (seed >> 33) % 97 == 0 {
+                art.push(if border || (seed >> 33).is_multiple_of(97) {
                     '#'
                 } else {
                     '.'
