@@ -306,25 +306,28 @@ impl BucketQueue {
     }
 }
 
-/// One pixel's search state ([`Extension::search`]; generation-stamped).
-#[derive(Clone, Copy)]
-struct Node {
-    /// Search cost ([`CLOSED`] set once settled); valid when `stamp` is the generation.
-    dist: u64,
-    /// The position it was reached from (`u32::MAX`: a first step from the start).
-    parent: u32,
-    /// The search generation that wrote `dist` and `parent`.
-    stamp: u32,
+/// One pixel's search state ([`Extension::search`]; generation-stamped): the search cost
+/// ([`CLOSED`] set once settled) and `(parent + 1) << 32 | generation` (parent 0: a first
+/// step from the start). All zero is "never reached", so the table starts as zeroed memory the
+/// system maps only where a search goes.
+type Node = [u64; 2];
+
+/// The [`Node`] of a position reached at cost `dist` from `parent` (`None`: from the start)
+/// in generation `gen`.
+fn node(dist: u64, parent: Option<usize>, gen: u32) -> Node {
+    let p = parent.map_or(0, |p| p as u64 + 1);
+    [dist, p << 32 | u64::from(gen)]
 }
 
-impl Default for Node {
-    fn default() -> Self {
-        Self {
-            dist: 0,
-            parent: u32::MAX,
-            stamp: 0,
-        }
-    }
+/// The generation that wrote `n`.
+fn node_gen(n: Node) -> u32 {
+    n[1] as u32
+}
+
+/// The parent recorded in `n`.
+fn node_parent(n: Node) -> Option<usize> {
+    let p = n[1] >> 32;
+    (p != 0).then(|| (p - 1) as usize)
 }
 
 #[derive(Default)]
@@ -465,8 +468,8 @@ pub(crate) struct Extension {
     /// began: `no_gain_free` is then up to date).
     free_count: usize,
     // Dijkstra scratch (generation-stamped).
-    /// Per pixel: search cost, parent and generation, side by side (one cache line serves
-    /// a relaxation's reads and writes of a neighbour).
+    /// Per pixel: search cost, parent and generation side by side ([`Node`]; one cache line
+    /// serves a relaxation's reads and writes of a neighbour).
     nodes: Vec<Node>,
     generation: u32,
     /// Reused search queue.
@@ -535,7 +538,7 @@ impl Extension {
             simplified: 0,
             simplify_per_turn,
             free_count: 0,
-            nodes: vec![Node::default(); n],
+            nodes: vec![[0; 2]; n],
             generation: 0,
             heap: BucketQueue::default(),
             win: Window::default(),
@@ -974,7 +977,7 @@ impl Extension {
     fn begin(&mut self) {
         self.generation = self.generation.wrapping_add(1);
         if self.generation == 0 {
-            self.nodes.fill(Node::default());
+            self.nodes.fill([0; 2]);
             self.generation = 1;
         }
     }
@@ -1030,21 +1033,21 @@ impl Extension {
             self.seed(known, from, p0, h, heap);
         }
         while let Some(i) = heap.pop() {
-            if self.nodes[i].dist & CLOSED != 0 {
+            if self.nodes[i][0] & CLOSED != 0 {
                 continue;
             }
-            let d = self.nodes[i].dist;
+            let d = self.nodes[i][0];
             if limit.is_some_and(|l| d > l) {
                 return None;
             }
-            self.nodes[i].dist |= CLOSED;
+            self.nodes[i][0] |= CLOSED;
             let p = self.px_of(i);
             if done(self, p) {
                 self.resume_at = Some(i);
                 let mut path = vec![i];
                 let mut c = i;
-                while self.nodes[c].parent != u32::MAX {
-                    c = self.nodes[c].parent as usize;
+                while let Some(up) = node_parent(self.nodes[c]) {
+                    c = up;
                     path.push(c);
                 }
                 path.reverse();
@@ -1074,10 +1077,9 @@ impl Extension {
                     continue;
                 }
                 let d = (from.dist(self.center(p)) * COST_ORTHO as f64).round() as u64;
-                if self.nodes[i].stamp != gen || d < self.nodes[i].dist {
-                    self.nodes[i].stamp = gen;
-                    self.nodes[i].dist = d;
-                    self.nodes[i].parent = u32::MAX;
+                let n = self.nodes[i];
+                if node_gen(n) != gen || d < n[0] {
+                    self.nodes[i] = node(d, None, gen);
                     heap.push(d + h(self, p), i);
                 }
             }
@@ -1093,7 +1095,7 @@ impl Extension {
         heap: &mut BucketQueue,
     ) {
         let gen = self.generation;
-        let d = self.nodes[i].dist & !CLOSED;
+        let d = self.nodes[i][0] & !CLOSED;
         let p = self.px_of(i);
         let (w, h_img) = (self.frame.width as i64, self.frame.height as i64);
         let edges = self.edge_free[i];
@@ -1105,19 +1107,15 @@ impl Extension {
             let j = (q.1 * w + q.0) as usize;
             let nd = d + if k % 2 == 1 { COST_DIAG } else { COST_ORTHO };
             // Settled or no better: skip before judging the move (judging only fills memos).
-            let node = self.nodes[j];
-            if node.stamp == gen && (node.dist & CLOSED != 0 || nd >= node.dist) {
+            let n = self.nodes[j];
+            if node_gen(n) == gen && (n[0] & CLOSED != 0 || nd >= n[0]) {
                 continue;
             }
             // The memo first (most moves were judged by an earlier search).
             if edges & (1 << k) == 0 && !self.edge(known, p, k) {
                 continue;
             }
-            self.nodes[j] = Node {
-                dist: nd,
-                parent: i as u32,
-                stamp: gen,
-            };
+            self.nodes[j] = node(nd, Some(i), gen);
             heap.push(nd + h(self, q), j);
         }
     }
