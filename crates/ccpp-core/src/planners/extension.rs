@@ -306,6 +306,30 @@ impl BucketQueue {
     }
 }
 
+/// One pixel's search state ([`Extension::search`]; generation-stamped): the search cost
+/// ([`CLOSED`] set once settled) and `(parent + 1) << 32 | generation` (parent 0: a first
+/// step from the start). All zero is "never reached", so the table starts as zeroed memory the
+/// system maps only where a search goes.
+type Node = [u64; 2];
+
+/// The [`Node`] of a position reached at cost `dist` from `parent` (`None`: from the start)
+/// in generation `gen`.
+fn node(dist: u64, parent: Option<usize>, gen: u32) -> Node {
+    let p = parent.map_or(0, |p| p as u64 + 1);
+    [dist, p << 32 | u64::from(gen)]
+}
+
+/// The generation that wrote `n`.
+fn node_gen(n: Node) -> u32 {
+    n[1] as u32
+}
+
+/// The parent recorded in `n`.
+fn node_parent(n: Node) -> Option<usize> {
+    let p = n[1] >> 32;
+    (p != 0).then(|| (p - 1) as usize)
+}
+
 #[derive(Default)]
 struct Window {
     c0: i64,
@@ -444,9 +468,9 @@ pub(crate) struct Extension {
     /// began: `no_gain_free` is then up to date).
     free_count: usize,
     // Dijkstra scratch (generation-stamped).
-    dist: Vec<u64>,
-    parent: Vec<u32>,
-    stamp: Vec<u32>,
+    /// Per pixel: search cost, parent and generation side by side ([`Node`]; one cache line
+    /// serves a relaxation's reads and writes of a neighbour).
+    nodes: Vec<Node>,
     generation: u32,
     /// Reused search queue.
     heap: BucketQueue,
@@ -514,9 +538,7 @@ impl Extension {
             simplified: 0,
             simplify_per_turn,
             free_count: 0,
-            dist: vec![0; n],
-            parent: vec![u32::MAX; n],
-            stamp: vec![0; n],
+            nodes: vec![[0; 2]; n],
             generation: 0,
             heap: BucketQueue::default(),
             win: Window::default(),
@@ -895,9 +917,16 @@ impl Extension {
         let (w, h) = (f.width as i64, f.height as i64);
         let reach = self.strip_rows.len() as i64 - 1;
         let bits = crate::bits::BLOCK_BITS;
+        // The memo is dropped in the square of side `2 reach + 1` around every new pixel: per
+        // image row, the new pixels' columns widened by `reach` and merged into runs, each run
+        // then cleared in the rows within `reach` (one range per run and row, not per pixel).
+        let mut runs: Vec<(i64, i64, i64)> = Vec::new();
         for b in 0..free.len() {
             let new = free[b] & !self.no_gain_free[b];
             self.no_gain_free[b] = free[b];
+            if new == 0 {
+                continue;
+            }
             self.free_count += new.count_ones() as usize;
             let mut todo = new;
             while todo != 0 {
@@ -906,11 +935,18 @@ impl Extension {
                 let (c, r) = f.col_row(i);
                 let (c, r) = (c as i64, r as i64);
                 let (c0, c1) = ((c - reach).max(0), (c + reach).min(w - 1));
-                for row in (r - reach).max(0)..=(r + reach).min(h - 1) {
-                    let base = row as usize * f.width;
-                    self.no_gain
-                        .remove_range(base + c0 as usize..base + c1 as usize + 1);
+                // Pixels come in index order: a run grows while it stays on its row and overlaps.
+                match runs.last_mut() {
+                    Some(last) if last.0 == r && c0 <= last.2 + 1 => last.2 = last.2.max(c1),
+                    _ => runs.push((r, c0, c1)),
                 }
+            }
+        }
+        for (r, c0, c1) in runs {
+            for row in (r - reach).max(0)..=(r + reach).min(h - 1) {
+                let base = row as usize * f.width;
+                self.no_gain
+                    .remove_range(base + c0 as usize..base + c1 as usize + 1);
             }
         }
     }
@@ -941,7 +977,7 @@ impl Extension {
     fn begin(&mut self) {
         self.generation = self.generation.wrapping_add(1);
         if self.generation == 0 {
-            self.stamp.fill(0);
+            self.nodes.fill([0; 2]);
             self.generation = 1;
         }
     }
@@ -997,21 +1033,21 @@ impl Extension {
             self.seed(known, from, p0, h, heap);
         }
         while let Some(i) = heap.pop() {
-            if self.dist[i] & CLOSED != 0 {
+            if self.nodes[i][0] & CLOSED != 0 {
                 continue;
             }
-            let d = self.dist[i];
+            let d = self.nodes[i][0];
             if limit.is_some_and(|l| d > l) {
                 return None;
             }
-            self.dist[i] |= CLOSED;
+            self.nodes[i][0] |= CLOSED;
             let p = self.px_of(i);
             if done(self, p) {
                 self.resume_at = Some(i);
                 let mut path = vec![i];
                 let mut c = i;
-                while self.parent[c] != u32::MAX {
-                    c = self.parent[c] as usize;
+                while let Some(up) = node_parent(self.nodes[c]) {
+                    c = up;
                     path.push(c);
                 }
                 path.reverse();
@@ -1041,10 +1077,9 @@ impl Extension {
                     continue;
                 }
                 let d = (from.dist(self.center(p)) * COST_ORTHO as f64).round() as u64;
-                if self.stamp[i] != gen || d < self.dist[i] {
-                    self.stamp[i] = gen;
-                    self.dist[i] = d;
-                    self.parent[i] = u32::MAX;
+                let n = self.nodes[i];
+                if node_gen(n) != gen || d < n[0] {
+                    self.nodes[i] = node(d, None, gen);
                     heap.push(d + h(self, p), i);
                 }
             }
@@ -1060,29 +1095,28 @@ impl Extension {
         heap: &mut BucketQueue,
     ) {
         let gen = self.generation;
-        let d = self.dist[i] & !CLOSED;
+        let d = self.nodes[i][0] & !CLOSED;
         let p = self.px_of(i);
         let (w, h_img) = (self.frame.width as i64, self.frame.height as i64);
+        let edges = self.edge_free[i];
         for k in 0..8 {
             let q = (p.0 + NB[k].0, p.1 + NB[k].1);
             if q.0 < 0 || q.1 < 0 || q.0 >= w || q.1 >= h_img {
                 continue;
             }
             let j = (q.1 * w + q.0) as usize;
-            if self.stamp[j] == gen && self.dist[j] & CLOSED != 0 {
+            let nd = d + if k % 2 == 1 { COST_DIAG } else { COST_ORTHO };
+            // Settled or no better: skip before judging the move (judging only fills memos).
+            let n = self.nodes[j];
+            if node_gen(n) == gen && (n[0] & CLOSED != 0 || nd >= n[0]) {
                 continue;
             }
             // The memo first (most moves were judged by an earlier search).
-            if self.edge_free[i] & (1 << k) == 0 && !self.edge(known, p, k) {
+            if edges & (1 << k) == 0 && !self.edge(known, p, k) {
                 continue;
             }
-            let nd = d + if k % 2 == 1 { COST_DIAG } else { COST_ORTHO };
-            if self.stamp[j] != gen || nd < self.dist[j] {
-                self.stamp[j] = gen;
-                self.dist[j] = nd;
-                self.parent[j] = i as u32;
-                heap.push(nd + h(self, q), j);
-            }
+            self.nodes[j] = node(nd, Some(i), gen);
+            heap.push(nd + h(self, q), j);
         }
     }
 
