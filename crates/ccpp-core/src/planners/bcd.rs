@@ -1270,6 +1270,11 @@ fn smooth(ctx: &Ctx<'_>, items: Vec<Item>) -> Vec<Item> {
 }
 
 /// Number of heading changes along the polyline `pts` (as the simulator counts turns).
+/// Whether turning from heading `from` to heading `to` is a rotation the simulator counts.
+fn is_turn(from: f64, to: f64) -> bool {
+    crate::geometry::wrap_angle(to - from).abs() > crate::planner::MIN_ROTATION
+}
+
 fn turns(pts: &[Point]) -> usize {
     let mut n = 0;
     let mut heading: Option<f64> = None;
@@ -1279,9 +1284,7 @@ fn turns(pts: &[Point]) -> usize {
             continue;
         }
         let h = d.y.atan2(d.x);
-        if heading.is_some_and(|g| {
-            crate::geometry::wrap_angle(h - g).abs() > crate::planner::MIN_ROTATION
-        }) {
+        if heading.is_some_and(|g| is_turn(g, h)) {
             n += 1;
         }
         heading = Some(h);

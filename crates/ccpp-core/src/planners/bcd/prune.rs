@@ -22,16 +22,14 @@ use std::ops::Sub;
 
 use fixedbitset::FixedBitSet;
 
-use super::{Ctx, Item};
+use super::{is_turn, Ctx, Item};
 use crate::geometry::{point_segment_dist2, Point};
 
 /// Heading change at `b` between the moves `a -> b` and `b -> c` (as the simulator counts a
 /// turn).
 fn turn(a: Point, b: Point, c: Point) -> bool {
     let (d0, d1) = (b.sub(a), c.sub(b));
-    let h0 = d0.y.atan2(d0.x);
-    let h1 = d1.y.atan2(d1.x);
-    crate::geometry::wrap_angle(h1 - h0).abs() > crate::planner::MIN_ROTATION
+    is_turn(d0.y.atan2(d0.x), d1.y.atan2(d1.x))
 }
 
 /// Most vertices one drop removes.
@@ -532,14 +530,16 @@ mod tests {
         }
     }
 
+    /// The points of the moves of `items`.
+    fn points(items: &[Item]) -> Vec<Point> {
+        super::super::moves(items)
+            .into_iter()
+            .map(|m| m.0)
+            .collect()
+    }
+
     fn swept(c: &Ctx<'_>, items: &[Item]) -> FixedBitSet {
-        let pts: Vec<Point> = items
-            .iter()
-            .filter_map(|it| match it {
-                Item::Move(p) => Some(*p),
-                Item::Mark(_) => None,
-            })
-            .collect();
+        let pts = points(items);
         let rt = c.rt + crate::raster::SWEEP_EPS_PX;
         let mut s = FixedBitSet::with_capacity(c.frame.len());
         crate::raster::stamp_capsule(&mut s, &c.frame, pts[0], pts[0], rt, &mut |_| {});
@@ -551,14 +551,7 @@ mod tests {
     }
 
     fn turns(items: &[Item]) -> usize {
-        let pts: Vec<Point> = items
-            .iter()
-            .filter_map(|it| match it {
-                Item::Move(p) => Some(*p),
-                Item::Mark(_) => None,
-            })
-            .collect();
-        super::super::turns(&pts)
+        super::super::turns(&points(items))
     }
 
     #[test]
