@@ -394,6 +394,35 @@ fn config_values_go_through_the_same_validation() {
     }
     let turns = |m: &serde_json::Value| m["turns"].as_u64().unwrap();
     assert!(turns(&runs[1]) < turns(&runs[0]), "{} {}", runs[0], runs[1]);
+    // The extension's wall-pass simplification, through the same file: switching it off
+    // (`simplify_fraction: 0`, or `simplify_loss: 0`) changes the run of each extended planner.
+    let mut by_cfg = |planner: &str, name: &str, text: &str| {
+        let cfg = dir.join(format!("{name}.yaml"));
+        std::fs::write(&cfg, text).unwrap();
+        let o = run_ok(
+            dir,
+            name,
+            &map,
+            planner,
+            &["--config", cfg.to_str().unwrap()],
+        );
+        (metrics(&o), trace(&o))
+    };
+    for (planner, section) in [
+        ("ba-star-extended", "ba_star_extended"),
+        ("bsa-extended", "bsa_extended"),
+    ] {
+        let base = by_cfg(planner, &format!("{section}_default"), "");
+        for field in ["simplify_fraction", "simplify_loss"] {
+            let off = by_cfg(
+                planner,
+                &format!("{section}_{field}"),
+                &format!("{section}: {{ extension: {{ {field}: 0 }} }}\n"),
+            );
+            assert_ne!(off.1, base.1, "{planner} {field}: 0 changed nothing");
+            assert_eq!(off.0["collisions"], 0);
+        }
+    }
 }
 
 #[test]
