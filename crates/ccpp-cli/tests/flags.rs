@@ -396,7 +396,7 @@ fn config_values_go_through_the_same_validation() {
     assert!(turns(&runs[1]) < turns(&runs[0]), "{} {}", runs[0], runs[1]);
     // The extension's wall-pass simplification, through the same file: switching it off
     // (`simplify_fraction: 0`, or `simplify_loss: 0`) changes the run of each extended planner.
-    let mut by_cfg = |planner: &str, name: &str, text: &str| {
+    let by_cfg = |planner: &str, name: &str, text: &str| {
         let cfg = dir.join(format!("{name}.yaml"));
         std::fs::write(&cfg, text).unwrap();
         let o = run_ok(
