@@ -81,6 +81,21 @@ pub struct RobotArgs {
     pub start: Option<[f64; 3]>,
 }
 
+/// Work area and keep-out zones, shared by `run`, `plan` and `info` (every planner honours them).
+#[derive(Args, Debug, Clone, Default)]
+pub struct ZoneArgs {
+    /// Work area: a polygon file (`GeoJSON`, or YAML list of x,y points; map coordinates) or a
+    /// rectangle `X0,Y0,X1,Y1`. The robot stays inside it (virtual walls) and coverage is
+    /// measured on the floor inside it. Default: the whole map.
+    #[arg(long, value_name = "FILE|X0,Y0,X1,Y1", value_parser = parse_zone, allow_hyphen_values = true)]
+    pub area: Option<ZoneSpec>,
+    /// Keep-out zone (repeatable): a Nav2 keepout filter mask (`map_server` YAML + image in the
+    /// map's frame, occupied = forbidden), a polygon file (`GeoJSON` or YAML) or a rectangle
+    /// `X0,Y0,X1,Y1`. Never entered; entries are counted as `keepout_violations`.
+    #[arg(long, value_name = "FILE|X0,Y0,X1,Y1", value_parser = parse_zone, allow_hyphen_values = true)]
+    pub keepout: Vec<ZoneSpec>,
+}
+
 /// `ccpp run`.
 #[derive(Args, Debug)]
 #[command(allow_negative_numbers = true)]
@@ -119,16 +134,9 @@ pub struct RunArgs {
     /// Rectangular robot width in metres (rect-boustrophedon: lane spacing).
     #[arg(long, value_name = "M")]
     pub width: Option<f64>,
-    /// Work area, every planner: a polygon file (`GeoJSON`, or YAML list of x,y points; map
-    /// coordinates) or a rectangle `X0,Y0,X1,Y1`. The robot stays inside it (virtual walls)
-    /// and coverage is measured on the floor inside it. Default: the whole map.
-    #[arg(long, value_name = "FILE|X0,Y0,X1,Y1", value_parser = parse_zone, allow_hyphen_values = true)]
-    pub area: Option<ZoneSpec>,
-    /// Keep-out zone, every planner (repeatable): a Nav2 keepout filter mask (`map_server` YAML +
-    /// image in the map's frame, occupied = forbidden), a polygon file (`GeoJSON` or YAML) or a
-    /// rectangle `X0,Y0,X1,Y1`. Never entered; entries are counted as `keepout_violations`.
-    #[arg(long, value_name = "FILE|X0,Y0,X1,Y1", value_parser = parse_zone, allow_hyphen_values = true)]
-    pub keepout: Vec<ZoneSpec>,
+    /// Work area and keep-out zones.
+    #[command(flatten)]
+    pub zones: ZoneArgs,
     /// Motion execution: `ideal` (exact rotate/translate) or `pid` (unicycle with PID
     /// tracking). Default: the planner's choice (bsa-bfs and rect-boustrophedon: pid).
     #[arg(long, value_name = "ideal|pid")]
@@ -181,14 +189,9 @@ pub struct PlanArgs {
     /// Rectangular robot width in metres (rect-boustrophedon: lane spacing).
     #[arg(long, value_name = "M")]
     pub width: Option<f64>,
-    /// Work area (as for `run`): a polygon file (`GeoJSON`, or YAML list of x,y points; map
-    /// coordinates) or a rectangle `X0,Y0,X1,Y1`; the path stays inside it.
-    #[arg(long, value_name = "FILE|X0,Y0,X1,Y1", value_parser = parse_zone, allow_hyphen_values = true)]
-    pub area: Option<ZoneSpec>,
-    /// Keep-out zone (as for `run`, repeatable): a Nav2 keepout filter mask, a polygon file or
-    /// a rectangle `X0,Y0,X1,Y1`; the path never enters it.
-    #[arg(long, value_name = "FILE|X0,Y0,X1,Y1", value_parser = parse_zone, allow_hyphen_values = true)]
-    pub keepout: Vec<ZoneSpec>,
+    /// Work area and keep-out zones (the path stays inside the area, outside the keep-outs).
+    #[command(flatten)]
+    pub zones: ZoneArgs,
     /// Refuse plans whose estimated memory exceeds this many MB (default 4096).
     #[arg(long, value_name = "MB")]
     pub max_memory: Option<u64>,
@@ -326,12 +329,9 @@ pub struct InfoArgs {
     /// The robot.
     #[command(flatten)]
     pub robot: RobotArgs,
-    /// Work area (as for `run`): shows its size and the accessible floor inside it.
-    #[arg(long, value_name = "FILE|X0,Y0,X1,Y1", value_parser = parse_zone, allow_hyphen_values = true)]
-    pub area: Option<ZoneSpec>,
-    /// Keep-out zone (as for `run`, repeatable).
-    #[arg(long, value_name = "FILE|X0,Y0,X1,Y1", value_parser = parse_zone, allow_hyphen_values = true)]
-    pub keepout: Vec<ZoneSpec>,
+    /// Work area and keep-out zones (shown with their size and the accessible floor inside).
+    #[command(flatten)]
+    pub zones: ZoneArgs,
     /// Print JSON.
     #[arg(long)]
     pub json: bool,

@@ -180,8 +180,8 @@ pub fn run(a: &InfoArgs) -> Result<()> {
     let (ncomp, largest) = free_components(g);
     let mut zs =
         ccpp_io::scenario::Scenario::new(map.recipe.clone(), ccpp_core::planners::PlannerKind::Bcd);
-    zs.area.clone_from(&a.area);
-    zs.keepout.clone_from(&a.keepout);
+    zs.area.clone_from(&a.zones.area);
+    zs.keepout.clone_from(&a.zones.keepout);
     zs.robot = robot;
     zs.validate()?;
     let zones = zs.zone_masks(&map)?;

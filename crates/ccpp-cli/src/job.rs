@@ -325,7 +325,7 @@ impl Job {
             .start_pose(start.map(|p| [p.x, p.y, p.theta]))
             .sim(sim)
             .memory_limit(a.max_memory)
-            .zones(a.area.clone(), a.keepout.clone())
+            .zones(a.zones.area.clone(), a.zones.keepout.clone())
             .build()
             .map_err(|e| name_flag(e, &given))?;
         let map = load_recipe(&scenario.map)?;

@@ -57,7 +57,7 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         .robot(robot)
         .start_pose(start.map(|p| [p.x, p.y, p.theta]))
         .memory_limit(a.max_memory)
-        .zones(a.area.clone(), a.keepout.clone())
+        .zones(a.zones.area.clone(), a.zones.keepout.clone())
         .build()
         .map_err(flag)?;
     check_target(&a.out)?;
