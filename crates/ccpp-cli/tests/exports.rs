@@ -12,39 +12,13 @@ use ccpp_io::export::{parse_waypoints_csv, read_waypoints};
 use serde::Deserialize;
 
 mod common;
-use common::{ccpp, pgm};
+use common::{ccpp, pgm, plan_ok, run_ok};
 
 /// A 5 x 4 m room with one pillar.
 fn room(dir: &Path) -> PathBuf {
     pgm(dir, "room.pgm", 100, 80, |x, y| {
         (40..55).contains(&x) && (20..50).contains(&y)
     })
-}
-
-fn run(dir: &Path, sub: &str, map: &Path, planner: &str, args: &[&str]) -> PathBuf {
-    let out = dir.join(sub);
-    ccpp()
-        .args(["run", "--planner", planner, "--map"])
-        .arg(map)
-        .args(args)
-        .arg("--out")
-        .arg(&out)
-        .assert()
-        .success();
-    out
-}
-
-fn plan(dir: &Path, sub: &str, map: &Path, planner: &str, args: &[&str]) -> PathBuf {
-    let out = dir.join(sub);
-    ccpp()
-        .args(["plan", "--planner", planner, "--map"])
-        .arg(map)
-        .args(args)
-        .arg("--out")
-        .arg(&out)
-        .assert()
-        .success();
-    out
 }
 
 fn files(dir: &Path) -> Vec<String> {
@@ -183,7 +157,7 @@ fn check_geojson(text: &str, route: &Route, metrics: Option<&serde_json::Value>)
 fn run_export_writes_each_format_beside_the_other_files() {
     let d = tempfile::tempdir().unwrap();
     let map = room(d.path());
-    let base = run(d.path(), "base", &map, "bsa", &[]);
+    let base = run_ok(d.path(), "base", &map, "bsa", &[]);
     assert_eq!(
         files(&base),
         [
@@ -197,7 +171,7 @@ fn run_export_writes_each_format_beside_the_other_files() {
     let all = [
         "--export", "geojson", "--export", "nav-path", "--export", "json", "--export", "csv",
     ];
-    let ex = run(d.path(), "ex", &map, "bsa", &all);
+    let ex = run_ok(d.path(), "ex", &map, "bsa", &all);
     assert_eq!(
         files(&ex),
         [
@@ -238,7 +212,7 @@ fn run_export_writes_each_format_beside_the_other_files() {
     let metrics: serde_json::Value = serde_json::from_str(&read(&ex.join("metrics.json"))).unwrap();
     check_geojson(&read(&ex.join("path.geojson")), &csv, Some(&metrics));
     // One format alone writes one file; the same run twice gives the same bytes.
-    let one = run(d.path(), "one", &map, "bsa", &["--export", "nav-path"]);
+    let one = run_ok(d.path(), "one", &map, "bsa", &["--export", "nav-path"]);
     assert!(files(&one).contains(&"nav_path.yaml".to_string()));
     assert!(!files(&one).contains(&"waypoints.csv".to_string()));
     assert_eq!(
@@ -252,7 +226,7 @@ fn path_csv_grows_with_segments_not_control_steps() {
     // bsa-bfs runs under PID execution: one trace pose per control step.
     let d = tempfile::tempdir().unwrap();
     let map = room(d.path());
-    let out = run(d.path(), "pid", &map, "bsa-bfs", &[]);
+    let out = run_ok(d.path(), "pid", &map, "bsa-bfs", &[]);
     let trace = read(&out.join("trace.jsonl"));
     let pose_lines = trace.lines().filter(|l| l.contains("\"pose\"")).count();
     let segments = trace
@@ -312,16 +286,16 @@ fn export_is_refused_where_it_does_not_apply() {
 fn plan_writes_only_the_path_of_a_known_map_planner() {
     let d = tempfile::tempdir().unwrap();
     let map = room(d.path());
-    let p = plan(d.path(), "bcd", &map, "bcd", &[]);
+    let p = plan_ok(d.path(), "bcd", &map, "bcd", &[]);
     assert_eq!(files(&p), ["nav_path.yaml", "waypoints.csv"]);
     let route = read_waypoints(&p.join("waypoints.csv")).unwrap();
     check_nav_path(&read(&p.join("nav_path.yaml")), &route);
     // The planned route is the path a simulated run of the same planner executes (bcd runs
     // ideally by default).
-    let r = run(d.path(), "bcd-run", &map, "bcd", &[]);
+    let r = run_ok(d.path(), "bcd-run", &map, "bcd", &[]);
     assert_eq!(read(&r.join("path.csv")), read(&p.join("waypoints.csv")));
     // --export replaces the default set.
-    let g = plan(
+    let g = plan_ok(
         d.path(),
         "geo",
         &map,
@@ -333,8 +307,8 @@ fn plan_writes_only_the_path_of_a_known_map_planner() {
     assert_eq!(read_waypoints(&g.join("waypoints.json")).unwrap(), route);
     // rect-boustrophedon: planned ideally even though its runs default to PID; --length and
     // --width change the plan.
-    let rect = plan(d.path(), "rect", &map, "rect-boustrophedon", &[]);
-    let rect_run = run(
+    let rect = plan_ok(d.path(), "rect", &map, "rect-boustrophedon", &[]);
+    let rect_run = run_ok(
         d.path(),
         "rect-run",
         &map,
@@ -346,7 +320,7 @@ fn plan_writes_only_the_path_of_a_known_map_planner() {
         read(&rect.join("waypoints.csv"))
     );
     for (flag, v) in [("--length", "0.5"), ("--width", "0.5")] {
-        let other = plan(
+        let other = plan_ok(
             d.path(),
             &format!("rect{flag}"),
             &map,
@@ -419,7 +393,7 @@ fn route_samples(route: &Route) -> Vec<[f64; 2]> {
 fn plan_takes_zones_and_exports_them() {
     let d = tempfile::tempdir().unwrap();
     let map = room(d.path());
-    let free = plan(d.path(), "free", &map, "bcd", &["--export", "csv"]);
+    let free = plan_ok(d.path(), "free", &map, "bcd", &["--export", "csv"]);
     let free_route = read_waypoints(&free.join("waypoints.csv")).unwrap();
     let inside =
         |p: &[f64; 2], r: [f64; 4]| p[0] > r[0] && p[0] < r[2] && p[1] > r[1] && p[1] < r[3];
@@ -429,7 +403,7 @@ fn plan_takes_zones_and_exports_them() {
         "without the keep-out the path crosses the rectangle"
     );
     // --keepout: the path never enters it, the GeoJSON carries it as a closed ring.
-    let k = plan(
+    let k = plan_ok(
         d.path(),
         "keep",
         &map,
@@ -458,7 +432,7 @@ fn plan_takes_zones_and_exports_them() {
     assert_eq!(ring[0], ring[4]);
     // --area: the path stays inside it.
     let area = [0.1, 0.1, 1.9, 3.9];
-    let a = plan(
+    let a = plan_ok(
         d.path(),
         "area",
         &map,

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 mod common;
-use common::{ccpp, pgm, pillars, ALL};
+use common::{ccpp, pgm, pillars, run_ok, ALL};
 
 /// The 60 x 60 px (3 x 3 m) box of the issue, as a YAML map.
 fn box60(dir: &Path) -> PathBuf {
@@ -20,20 +20,6 @@ fn box60(dir: &Path) -> PathBuf {
     )
     .unwrap();
     y
-}
-
-/// Runs `ccpp run --planner P --map MAP ARGS --out DIR/SUB` and returns the output folder.
-fn run_ok(dir: &Path, sub: &str, map: &Path, planner: &str, args: &[&str]) -> PathBuf {
-    let out = dir.join(sub);
-    ccpp()
-        .args(["run", "--planner", planner, "--map"])
-        .arg(map)
-        .args(args)
-        .arg("--out")
-        .arg(&out)
-        .assert()
-        .success();
-    out
 }
 
 fn metrics(out: &Path) -> serde_json::Value {

@@ -71,3 +71,35 @@ pub fn pillars(dir: &Path) -> PathBuf {
             || ((120..132).contains(&x) && (10..40).contains(&y))
     })
 }
+
+/// Runs `ccpp SUBCOMMAND --planner P --map MAP ARGS --out DIR/SUB`, asserts success and returns
+/// the output folder (`SUBCOMMAND` is `run` or `plan`).
+pub fn ccpp_ok(
+    subcommand: &str,
+    dir: &Path,
+    sub: &str,
+    map: &Path,
+    planner: &str,
+    args: &[&str],
+) -> PathBuf {
+    let out = dir.join(sub);
+    ccpp()
+        .args([subcommand, "--planner", planner, "--map"])
+        .arg(map)
+        .args(args)
+        .arg("--out")
+        .arg(&out)
+        .assert()
+        .success();
+    out
+}
+
+/// [`ccpp_ok`] for `ccpp run`.
+pub fn run_ok(dir: &Path, sub: &str, map: &Path, planner: &str, args: &[&str]) -> PathBuf {
+    ccpp_ok("run", dir, sub, map, planner, args)
+}
+
+/// [`ccpp_ok`] for `ccpp plan`.
+pub fn plan_ok(dir: &Path, sub: &str, map: &Path, planner: &str, args: &[&str]) -> PathBuf {
+    ccpp_ok("plan", dir, sub, map, planner, args)
+}
