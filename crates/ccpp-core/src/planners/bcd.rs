@@ -24,7 +24,11 @@
 //!    rounded C-free corners beside an obstacle) is first cut into its two ends (at most
 //!    `2 sp` lines each) and a middle that can take lanes across, so a corridor cell gets a few
 //!    long lanes instead of many short ones (not in the paper, whose cells keep one
-//!    direction). Lanes are evenly spaced at most `2 r_tool` apart (`lane_spacing_m`). The
+//!    direction). A cell whose runs change length abruptly from one line to the next (more
+//!    than `sp / 2`, as where a corridor leaves a room inside one cell) is cut there when the
+//!    two parts, each with its own cheaper direction, are estimated cheaper than the whole
+//!    (the room's lanes along the room, the corridor's along the corridor, instead of one
+//!    direction for both). Lanes are evenly spaced at most `2 r_tool` apart (`lane_spacing_m`). The
 //!    first and last lanes lie on the cell's edge where the edge is an obstacle (the lane at clearance sweeps the wall's
 //!    rim) and `r_tool` inside it where the edge is shared with neighbouring cells (whose own
 //!    lanes sweep up to the shared edge), so neighbours do not drive two lanes side by side.
@@ -255,23 +259,20 @@ impl Cell {
     fn transposed(&self) -> Option<Cell> {
         let lo = self.runs.iter().map(|r| r.0).min()?;
         let hi = self.runs.iter().map(|r| r.1).max()?;
-        let mut runs = Vec::with_capacity(hi - lo + 1);
-        for v in lo..=hi {
-            let mut first: Option<usize> = None;
-            let mut last = 0;
-            for (k, &(a, b)) in self.runs.iter().enumerate() {
-                if a <= v && v <= b {
-                    let u = self.u0 + k;
-                    match first {
-                        None => first = Some(u),
-                        Some(_) if u != last + 1 => return None,
-                        Some(_) => {}
-                    }
-                    last = u;
+        // Per position `v`: the first and last line whose run holds it; a line that holds it
+        // after a gap makes it two runs.
+        let mut runs: Vec<Option<(usize, usize)>> = vec![None; hi - lo + 1];
+        for (k, &(a, b)) in self.runs.iter().enumerate() {
+            let u = self.u0 + k;
+            for r in &mut runs[a - lo..=b - lo] {
+                match r {
+                    None => *r = Some((u, u)),
+                    Some((_, last)) if *last + 1 == u => *last = u,
+                    Some(_) => return None,
                 }
             }
-            runs.push((first?, last));
         }
+        let runs = runs.into_iter().collect::<Option<Vec<_>>>()?;
         Some(Cell {
             cols: !self.cols,
             u0: lo,
@@ -316,6 +317,49 @@ fn split_ends(cells: Vec<Cell>, max: usize) -> Vec<Cell> {
                 if b > 0 {
                     out.push(sub(n - b, n));
                 }
+            }
+            None => out.push(c),
+        }
+    }
+    out
+}
+
+/// Cuts cells whose runs change length abruptly (by more than `jump` pixels from one line to
+/// the next, as where a corridor leaves a room inside one cell) into the parts on either side
+/// where that lowers the estimated cost, so that each part takes its own lane direction
+/// (module docs, step 2). `cost` prices a cell (its cheaper view plus the cost of reaching
+/// it); the cheapest cut is taken first and both parts are cut again.
+fn split_jumps(cells: Vec<Cell>, jump: usize, cost: &dyn Fn(&Cell) -> f64) -> Vec<Cell> {
+    let mut out = Vec::with_capacity(cells.len());
+    let mut todo: Vec<Cell> = cells.into_iter().rev().collect();
+    while let Some(c) = todo.pop() {
+        let n = c.runs.len();
+        let len = |k: usize| c.runs[k].1 - c.runs[k].0;
+        let cuts: Vec<usize> = (1..n)
+            .filter(|&k| len(k).abs_diff(len(k - 1)) > jump)
+            .collect();
+        if cuts.is_empty() {
+            out.push(c);
+            continue;
+        }
+        let sub = |a: usize, b: usize| Cell {
+            cols: c.cols,
+            u0: c.u0 + a,
+            runs: c.runs[a..b].to_vec(),
+        };
+        let whole = cost(&c);
+        let mut best: Option<(f64, usize)> = None;
+        for &k in &cuts {
+            let e = cost(&sub(0, k)) + cost(&sub(k, n));
+            if e < whole - 1e-9 && best.is_none_or(|b| e < b.0) {
+                best = Some((e, k));
+            }
+        }
+        match best {
+            Some((_, k)) => {
+                // Second part first on the stack's far side: parts stay in line order.
+                todo.push(sub(k, n));
+                todo.push(sub(0, k));
             }
             None => out.push(c),
         }
@@ -911,10 +955,28 @@ impl Bcd {
                 })
                 .collect()
         };
+        // A cell's estimated cost: its cheaper view plus reaching it.
+        let cell_cost = |c: &Cell| -> f64 {
+            let view = |c: &Cell| {
+                let lo = side_open(&ctx, c, c.u0, -1, &|_| true);
+                let hi = side_open(&ctx, c, c.u1(), 1, &|_| true);
+                let lanes = lanes_of(c, sp, 0.0, lo, hi);
+                estimate(c, &lanes, turn_px) + 2.0 * turn_px + sp
+            };
+            let along = view(c);
+            c.transposed().map_or(along, |t| along.min(view(&t)))
+        };
         let trim_max = (2.0 * sp).ceil() as usize;
+        let jump = (sp / 2.0).ceil() as usize;
+        let part_cost = |c: &Cell| -> f64 {
+            split_ends(vec![c.clone()], trim_max)
+                .iter()
+                .map(cell_cost)
+                .sum()
+        };
         let decs = [
-            views(split_ends(by_cols, trim_max)),
-            views(split_ends(by_rows, trim_max)),
+            views(split_ends(split_jumps(by_cols, jump, &part_cost), trim_max)),
+            views(split_ends(split_jumps(by_rows, jump, &part_cost), trim_max)),
         ];
         let mut best: Option<(f64, usize, f64, Vec<usize>)> = None;
         for (d, dec) in decs.iter().enumerate() {
@@ -2074,6 +2136,33 @@ mod tests {
         assert!(
             ended > 5,
             "{ended} regions: the specks should split the room"
+        );
+    }
+
+    #[test]
+    fn abrupt_cells_are_cut_where_the_parts_are_cheaper() {
+        // An L: ten long lines (a room), then ninety short ones (a corridor along the lines).
+        let mut runs = vec![(0, 99); 10];
+        runs.extend(std::iter::repeat_n((90, 99), 90));
+        let l = Cell {
+            cols: true,
+            u0: 5,
+            runs,
+        };
+        // Price: the fewer lines of the two views (lanes), plus one per cell.
+        let cost = |c: &Cell| {
+            let t = c.transposed().map_or(usize::MAX, |t| t.runs.len());
+            c.runs.len().min(t) as f64 + 1.0
+        };
+        let parts = split_jumps(vec![l.clone()], 3, &cost);
+        assert_eq!(parts.len(), 2);
+        assert_eq!((parts[0].u0, parts[0].runs.len()), (5, 10));
+        assert_eq!((parts[1].u0, parts[1].runs.len()), (15, 90));
+        // No cut where the jump is within the tolerance, nor where it does not pay.
+        assert_eq!(split_jumps(vec![l.clone()], 90, &cost).len(), 1);
+        assert_eq!(
+            split_jumps(vec![l], 3, &|c: &Cell| c.runs.len() as f64 + 1.0).len(),
+            1
         );
     }
 
