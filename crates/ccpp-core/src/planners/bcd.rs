@@ -1065,7 +1065,7 @@ impl Bcd {
         // or inserted into the finished tour where they cost least; the cheaper plan is kept.
         let cell_pieces = pieces;
         let cell_paths_all = paths;
-        let mut best: Option<(f64, Vec<Item>)> = None;
+        let mut best: Option<(usize, f64, Vec<Item>)> = None;
         for in_tour in [true, false] {
             if !opts.rim && !in_tour {
                 break;
@@ -1131,6 +1131,9 @@ impl Bcd {
             let mut items: Vec<Item> = vec![Item::Move(start)];
             let mut here = start;
             let mut region = 0u32;
+            // Pieces and moves this plan had to skip because no route reached them: a plan
+            // that skips less is kept before a shorter one (a skip loses floor silently).
+            let mut skipped = 0usize;
             for &(cid, v) in &tour {
                 if cid >= ncells {
                     let c = &contours[cid - ncells];
@@ -1141,6 +1144,7 @@ impl Bcd {
                     };
                     if pts[0] != here {
                         let Some(hop) = ctx.route(&mut search, here, pts[0]) else {
+                            skipped += 1;
                             continue;
                         };
                         items.push(Item::Mark(Event::BacktrackStart));
@@ -1160,6 +1164,7 @@ impl Bcd {
                 let entry = pts[0];
                 if entry != here {
                     let Some(hop) = ctx.route(&mut search, here, entry) else {
+                        skipped += 1;
                         continue;
                     };
                     items.push(Item::Mark(Event::BacktrackStart));
@@ -1182,7 +1187,7 @@ impl Bcd {
                     opts.rim_coverage,
                 );
             }
-            let mut items = smooth(&ctx, repair(&ctx, &mut search, items));
+            let mut items = smooth(&ctx, repair(&ctx, &mut search, items, &mut skipped));
             if opts.rim && !in_tour {
                 // A second mop-up of what the inserted passes and the smoothing left.
                 rim_pass(
@@ -1192,16 +1197,16 @@ impl Bcd {
                     opts.rim_min_yield,
                     opts.rim_coverage,
                 );
-                items = smooth(&ctx, repair(&ctx, &mut search, items));
+                items = smooth(&ctx, repair(&ctx, &mut search, items, &mut skipped));
             }
             let items = prune::prune(&ctx, items, opts.min_coverage, turn_px);
             let pts: Vec<Point> = moves(&items).into_iter().map(|m| m.0).collect();
             let cost = polyline_len(&pts) + turn_px * turns(&pts) as f64;
-            if best.as_ref().is_none_or(|b| cost < b.0) {
-                best = Some((cost, items));
+            if best.as_ref().is_none_or(|b| (skipped, cost) < (b.0, b.1)) {
+                best = Some((skipped, cost, items));
             }
         }
-        let items = best.map(|b| b.1).unwrap_or_default();
+        let items = best.map(|b| b.2).unwrap_or_default();
 
         // A region whose moves the smoothing and pruning merged into the moves around it (or
         // a cell whose lane is a single point) has nothing left between its start and end: it
@@ -1251,8 +1256,9 @@ impl Bcd {
 }
 
 /// Re-checks every move of the plan on the true map and routes the ones that are not free
-/// (dropping a move that has no route, and skipping to the next reachable point).
-fn repair(ctx: &Ctx<'_>, search: &mut Search, items: Vec<Item>) -> Vec<Item> {
+/// (dropping a move that has no route, and skipping to the next reachable point; `skipped`
+/// counts the dropped moves).
+fn repair(ctx: &Ctx<'_>, search: &mut Search, items: Vec<Item>, skipped: &mut usize) -> Vec<Item> {
     let mut out = Vec::with_capacity(items.len());
     let mut at: Option<Point> = None;
     for it in items {
@@ -1269,6 +1275,8 @@ fn repair(ctx: &Ctx<'_>, search: &mut Search, items: Vec<Item>) -> Vec<Item> {
                     } else if let Some(v) = ctx.route(search, a, p) {
                         out.extend(v.into_iter().map(Item::Move));
                         at = Some(p);
+                    } else {
+                        *skipped += 1;
                     }
                 }
             },
@@ -1825,6 +1833,42 @@ mod tests {
             Item::Move(Point::new(60.0, 43.8)),
         ];
         assert_eq!(moves(&smooth(&ctx, around)).len(), 3);
+    }
+
+    #[test]
+    fn repair_counts_the_moves_it_cannot_route() {
+        let world = block_room();
+        let frame = *world.frame();
+        let n = frame.width * frame.height;
+        let ctx = Ctx {
+            world: &world,
+            frame,
+            ok: vec![true; n],
+            safe: vec![true; n],
+            rt: 4.0,
+        };
+        let mut search = Search::new(frame.width, frame.height);
+        // A move into the middle of the block has no route: it is dropped and counted, and
+        // the plan goes on from where it was.
+        let items = vec![
+            Item::Move(Point::new(14.0, 15.0)),
+            Item::Move(Point::new(40.0, 30.0)),
+            Item::Move(Point::new(84.0, 15.0)),
+        ];
+        let mut skipped = 0;
+        let out = repair(&ctx, &mut search, items, &mut skipped);
+        let pts: Vec<Point> = moves(&out).into_iter().map(|m| m.0).collect();
+        assert_eq!(skipped, 1);
+        assert_eq!(pts, vec![Point::new(14.0, 15.0), Point::new(84.0, 15.0)]);
+        // A plan whose moves are all reachable counts nothing.
+        let mut none = 0;
+        let ok = vec![
+            Item::Move(Point::new(14.0, 15.0)),
+            Item::Move(Point::new(84.0, 45.0)),
+        ];
+        let routed = moves(&repair(&ctx, &mut search, ok, &mut none));
+        assert_eq!(routed.last().map(|m| m.0), Some(Point::new(84.0, 45.0)));
+        assert_eq!(none, 0);
     }
 
     fn run(world: &World, opts: &BcdOptions) -> crate::metrics::Metrics {
