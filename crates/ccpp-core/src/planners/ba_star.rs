@@ -1306,10 +1306,41 @@ impl TileModel {
             .count() as u32
     }
 
-    /// Recomputes the L membership of `t`.
+    /// The 3 x 3 block of tile states and move bytes centred on `s` (see [`Block3`]).
+    #[inline]
+    fn block3(&self, s: Tile) -> Block3 {
+        let di = s.0 - self.i0;
+        let dj = s.1 - self.j0;
+        let mut b = Block3 {
+            state: [BLOCK3_OUTSIDE_STATE; 9],
+            moves: [BLOCK3_OUTSIDE_MOVES; 9],
+        };
+        if di >= 1 && dj >= 1 && di as usize + 1 < self.w && dj as usize + 1 < self.h {
+            let sw = (dj as usize - 1) * self.w + di as usize - 1;
+            for r in 0..3 {
+                let k = sw + r * self.w;
+                b.state[3 * r..3 * r + 3].copy_from_slice(&self.state[k..k + 3]);
+                b.moves[3 * r..3 * r + 3].copy_from_slice(&self.moves[k..k + 3]);
+            }
+        } else {
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    if let Some(k) = self.idx((s.0 + dx, s.1 + dy)) {
+                        let at = Block3::at((dx, dy));
+                        b.state[at] = self.state[k];
+                        b.moves[at] = self.moves[k];
+                    }
+                }
+            }
+        }
+        b
+    }
+
+    /// Recomputes the L membership of `t` (`mu` read off the [`Block3`] around `t`: the same
+    /// value as [`TileModel::mu`], which tests check through [`BaStar::backtrack_list_full`]).
     fn update_l(&mut self, t: Tile) {
         let Some(k) = self.idx(t) else { return };
-        if self.state[k] & ST_COVERED != 0 && self.mu(t) >= 1 {
+        if self.state[k] & ST_COVERED != 0 && self.block3(t).mu(self.lane_end_corners) >= 1 {
             self.l.insert(k);
         } else {
             self.l.remove(k);
@@ -1328,6 +1359,87 @@ impl TileModel {
         self.l
             .for_each(|k| v.push((self.i0 + (k % self.w) as i32, self.j0 + (k / self.w) as i32)));
         v
+    }
+}
+
+/// State of a tile outside the tiling's range in a [`Block3`]: an obstacle, not covered (as
+/// [`TileModel::stand`] and [`TileModel::covered`] read it).
+const BLOCK3_OUTSIDE_STATE: u8 = Judgement::Blocked as u8;
+/// Move byte of a tile outside the range in a [`Block3`]: all four moves blocked (as
+/// [`TileModel::cached_move`] reads it).
+const BLOCK3_OUTSIDE_MOVES: u8 = 0b1010_1010;
+
+/// A copy of the tile states and move bytes of the 3 x 3 tiles around a tile `s` (index
+/// `(dj + 1) * 3 + di + 1` for the offset `(di, dj)`): everything `mu(s)` reads, so `mu` runs on
+/// a few registers instead of bounds-checked lookups into the dense arrays.
+struct Block3 {
+    state: [u8; 9],
+    moves: [u8; 9],
+}
+
+impl Block3 {
+    #[inline]
+    fn at(d: Tile) -> usize {
+        ((d.1 + 1) * 3 + d.0 + 1) as usize
+    }
+
+    #[inline]
+    fn covered(&self, d: Tile) -> bool {
+        self.state[Self::at(d)] & ST_COVERED != 0
+    }
+
+    #[inline]
+    fn stand_blocked(&self, d: Tile) -> bool {
+        Judgement::from_bits(self.state[Self::at(d)] & ST_STAND) == Judgement::Blocked
+    }
+
+    /// [`TileModel::cached_move`] of the move `d -> d + N8[k]` is free (its owner tile must lie
+    /// in the block: true for every move `mu` reads).
+    #[inline]
+    fn move_free(&self, d: Tile, k: usize) -> bool {
+        let (o, slot) = TileModel::move_slot(d, k);
+        Judgement::from_bits(self.moves[Self::at(o)] >> (2 * slot)) == Judgement::Free
+    }
+
+    /// [`TileModel::free_uncovered`] for the neighbour `k` of the block tile `d`.
+    #[inline]
+    fn free_uncovered(&self, d: Tile, k: usize) -> bool {
+        !self.covered((d.0 + N8[k].0, d.1 + N8[k].1)) && self.move_free(d, k)
+    }
+
+    /// [`TileModel::mu`] of the centre tile.
+    fn mu(&self, lane_end_corners: bool) -> u32 {
+        let s = (0, 0);
+        let mut free = [false; 8];
+        for k in [0, 4, 6] {
+            free[k] = self.free_uncovered(s, k);
+        }
+        if !(free[0] || free[4] || free[6]) {
+            return 0;
+        }
+        let mut blocked = [false; 8];
+        for (k, &d) in N8.iter().enumerate() {
+            blocked[k] = self.covered(d) || self.stand_blocked(d);
+        }
+        let mut mu = corner_score(free, blocked);
+        if lane_end_corners {
+            let mut obstacle = [false; 8];
+            for k in [2, 6] {
+                obstacle[k] = self.stand_blocked(N8[k]);
+            }
+            mu += lane_end_score(free, obstacle, blocked);
+            mu += SIDE_END_PAIRS
+                .iter()
+                .filter(|&&(a, b)| {
+                    free[a] && !self.free_uncovered(s, b) && {
+                        // Not [`TileModel::side_continues`].
+                        let n = N8[b];
+                        !(self.covered(n) && self.move_free(s, b) && self.free_uncovered(n, a))
+                    }
+                })
+                .count() as u32;
+        }
+        mu
     }
 }
 
@@ -1430,13 +1542,15 @@ struct Mind {
 /// The contact disk of each tile as pixel spans: `rows` slots per tile of `[lo, hi]` column
 /// offsets from `col0[k]` for rows `row0[k]..` (`lo > hi`: no pixel in that row). Valid only
 /// for tiles with [`ST_DISK`] set; the slots of the others are never read (zero-initialised:
-/// pages of tiles never judged cost no memory).
+/// pages of tiles never left undetermined by a judgement cost no memory).
 #[derive(Clone)]
 struct DiskCache {
     rows: usize,
     row0: Vec<i32>,
     col0: Vec<i32>,
     spans: Vec<[u8; 2]>,
+    /// One tile's slots while it is judged for the first time.
+    scratch: Vec<[u8; 2]>,
 }
 
 impl DiskCache {
@@ -1448,6 +1562,7 @@ impl DiskCache {
             row0: vec![0; n_tiles],
             col0: vec![0; n_tiles],
             spans: vec![[0, 0]; n_tiles * rows],
+            scratch: Vec::with_capacity(rows),
         }
     }
 }
@@ -1649,44 +1764,64 @@ impl Mind {
     }
 
     /// [`judge_point`] for tile `k` (`t`), with the disk's pixel spans computed once per tile
-    /// by the same predicate and cached (a tile is judged again each time new pixels reach its
-    /// disk, until it is decided).
+    /// by the same predicate and, while the tile stays undetermined, cached (a tile is judged
+    /// again each time new pixels reach its disk, until it is decided). A tile decided at its
+    /// first judgement (the common case for small tiles) never writes the cache, whose pages
+    /// then cost no memory.
     fn judge_tile(&mut self, k: usize, t: Tile) -> Judgement {
         let n = self.disk.rows;
-        if self.tiles.state[k] & ST_DISK == 0 {
-            let frame = *self.known.frame();
-            let g = frame.world_to_grid(self.center(t));
-            let rc = self.rc_px;
-            let (w, hh) = (frame.width as i64, frame.height as i64);
-            let rows = disk_rows(&frame, g, rc);
-            let row1 = *rows.end();
-            let (row0, col0) = self.disk_origin(t);
-            if row1 - row0 + 1 > n as i64 || !(0..=i64::from(i32::MAX)).contains(&row0) {
+        if self.tiles.state[k] & ST_DISK != 0 {
+            let (row0, col0) = (i64::from(self.disk.row0[k]), i64::from(self.disk.col0[k]));
+            return Self::spans_state(
+                &self.known,
+                &self.disk.spans[k * n..(k + 1) * n],
+                row0,
+                col0,
+            );
+        }
+        let frame = *self.known.frame();
+        let g = frame.world_to_grid(self.center(t));
+        let rc = self.rc_px;
+        let (w, hh) = (frame.width as i64, frame.height as i64);
+        let rows = disk_rows(&frame, g, rc);
+        let row1 = *rows.end();
+        let (row0, col0) = self.disk_origin(t);
+        if row1 - row0 + 1 > n as i64 || !(0..=i64::from(i32::MAX)).contains(&row0) {
+            return judge_point(&self.known, g, rc);
+        }
+        let slots = &mut self.disk.scratch;
+        slots.clear();
+        slots.resize(n, [1, 0]);
+        for (slot, row) in slots.iter_mut().zip(rows) {
+            let Some((lo, hi)) = disk_row_span(&frame, g, rc, row) else {
+                continue;
+            };
+            if row >= hh || lo < 0 || hi >= w || hi - col0 > 250 {
+                // Reaches outside the image (blocked), or too wide to cache.
                 return judge_point(&self.known, g, rc);
             }
-            let slots = &mut self.disk.spans[k * n..(k + 1) * n];
-            slots.fill([1, 0]);
-            for (slot, row) in slots.iter_mut().zip(rows) {
-                let Some((lo, hi)) = disk_row_span(&frame, g, rc, row) else {
-                    continue;
-                };
-                if row >= hh || lo < 0 || hi >= w || hi - col0 > 250 {
-                    // Reaches outside the image (blocked), or too wide to cache.
-                    return judge_point(&self.known, g, rc);
-                }
-                *slot = [(lo - col0) as u8, (hi - col0) as u8];
-            }
+            *slot = [(lo - col0) as u8, (hi - col0) as u8];
+        }
+        let j = Self::spans_state(&self.known, slots, row0, col0);
+        if j == Judgement::Undetermined {
+            self.disk.spans[k * n..(k + 1) * n].copy_from_slice(&self.disk.scratch);
             self.disk.row0[k] = row0 as i32;
             self.disk.col0[k] = col0 as i32;
             self.tiles.state[k] |= ST_DISK;
         }
-        let (row0, col0) = (i64::from(self.disk.row0[k]), i64::from(self.disk.col0[k]));
-        let runs = self.disk.spans[k * n..(k + 1) * n]
+        j
+    }
+
+    /// What `known` says of the disk given as [`DiskCache`] slots from image row `row0`, column
+    /// offsets from `col0`.
+    #[inline]
+    fn spans_state(known: &KnownMap, slots: &[[u8; 2]], row0: i64, col0: i64) -> Judgement {
+        let runs = slots
             .iter()
             .zip(row0..)
             .filter(|(&[a, b], _)| a <= b)
             .map(|(&[a, b], row)| (row, col0 + i64::from(a), col0 + i64::from(b)));
-        self.known.runs_state(runs).into()
+        known.runs_state(runs).into()
     }
 
     /// Marks `t` covered (the robot stands on it), decides its moves and updates L.
