@@ -171,9 +171,11 @@ pub fn judge_motion(known: &KnownMap, a: Point, b: Point, r: f64) -> Judgement {
     let row1 = ceil_i64(h - ylo - 0.5) + 1;
     let (w, hh) = (frame.width as i64, frame.height as i64);
     // Fast path: every pixel that can touch has its centre within `rc` of the segment, so in
-    // the capsule's bounding box grown by `rc` (boundary pixels kept, with a margin for
-    // rounding). That box inside the image and entirely known free: free.
-    let eps = 1e-6;
+    // the capsule's bounding box grown by `rc` (with a margin for rounding far below the
+    // contact epsilon, so the pixels at exactly `r + 1/2` from a tile centre, which never
+    // touch, stay out: for one-pixel tiles the box of a move is then just its two pixels).
+    // That box inside the image and entirely known free: free.
+    let eps = 1e-7;
     let cmin = ceil_i64(ga.x.min(gb.x) - rc - 0.5 - eps);
     let cmax = floor_i64(ga.x.max(gb.x) + rc - 0.5 + eps);
     let rmin = ceil_i64(h - yhi - 0.5 - eps);
@@ -961,7 +963,9 @@ fn candidates(src: &[Tile], (x0, x1, y0, y1): (i32, i32, i32, i32), out: &mut Ve
 pub fn heuristic(a: Tile, b: Tile) -> u64 {
     let di = f64::from(a.0 - b.0);
     let dj = f64::from(a.1 - b.1);
-    (di.hypot(dj) * COST_ORTHO as f64).floor() as u64
+    // The product is finite and >= 0, where the truncating cast is the floor (without a call
+    // into libm).
+    (di.hypot(dj) * COST_ORTHO as f64) as u64
 }
 
 /// Squared distance between segment `a`-`b` and the axis-aligned box `lo`-`hi` (0 when they
@@ -1021,6 +1025,29 @@ pub fn for_each_swept_tile(a: Tile, b: Tile, rho: f64, mut f: impl FnMut(Tile) -
     let pb = Point::new(f64::from(b.0), f64::from(b.1));
     let lim = (rho * rho) * (1.0 - 1e-9) - 1e-12;
     let (dx, dy) = (pb.x - pa.x, pb.y - pa.y);
+    // Shortcuts from the squared distance of a tile's centre to the segment, exact with wide
+    // margins (the unit square holds the disk of radius 1/2 around its centre and lies in the
+    // disk of radius sqrt(1/2)): clearly below 1/4, the segment crosses the square (box
+    // distance 0 < `lim`); clearly above `(rho + sqrt(1/2))^2`, the square is farther than
+    // `rho`. Only the tiles between take the box distance.
+    let accept2 = if lim > 1e-9 {
+        0.25 * (1.0 - 1e-6)
+    } else {
+        -1.0
+    };
+    let reject2 = (rho + std::f64::consts::FRAC_1_SQRT_2 + 1e-6).powi(2);
+    let touches = |i: i32, y: f64| {
+        let dc2 = point_segment_dist2(Point::new(f64::from(i), y), pa, pb);
+        if dc2 < accept2 {
+            true
+        } else if dc2 >= reject2 {
+            false
+        } else {
+            let lo = Point::new(f64::from(i) - 0.5, y - 0.5);
+            let hi = Point::new(f64::from(i) + 0.5, y + 0.5);
+            segment_box_dist2(pa, pb, lo, hi) < lim
+        }
+    };
     let step: i32 = if b.1 >= a.1 { 1 } else { -1 };
     let reach = rho + 0.5;
     let j_first = if step > 0 {
@@ -1054,9 +1081,7 @@ pub fn for_each_swept_tile(a: Tile, b: Tile, rho: f64, mut f: impl FnMut(Tile) -
                 (i_hi, i_lo, -1)
             };
             loop {
-                let lo = Point::new(f64::from(i) - 0.5, y - 0.5);
-                let hi = Point::new(f64::from(i) + 0.5, y + 0.5);
-                if segment_box_dist2(pa, pb, lo, hi) < lim && !f((i, j)) {
+                if touches(i, y) && !f((i, j)) {
                     return false;
                 }
                 if i == i_end {
@@ -1347,10 +1372,50 @@ impl TileModel {
         }
     }
 
+    /// [`TileModel::update_l`] of `t` and its eight neighbours. Away from the border of the
+    /// range the 5 x 5 block of states and moves they read is copied once, and each tile's
+    /// [`Block3`] taken from the copy.
     fn update_l_around(&mut self, t: Tile) {
-        self.update_l(t);
-        for (di, dj) in N8 {
-            self.update_l((t.0 + di, t.1 + dj));
+        let di = t.0 - self.i0;
+        let dj = t.1 - self.j0;
+        if !(di >= 2 && dj >= 2 && di as usize + 2 < self.w && dj as usize + 2 < self.h) {
+            self.update_l(t);
+            for (di, dj) in N8 {
+                self.update_l((t.0 + di, t.1 + dj));
+            }
+            return;
+        }
+        let w = self.w;
+        let k = dj as usize * w + di as usize;
+        let mut state = [0u8; 25];
+        let mut moves = [0u8; 25];
+        for r in 0..5 {
+            let base = k - 2 * w - 2 + r * w;
+            state[5 * r..5 * r + 5].copy_from_slice(&self.state[base..base + 5]);
+            moves[5 * r..5 * r + 5].copy_from_slice(&self.moves[base..base + 5]);
+        }
+        for (dx, dy) in std::iter::once((0, 0)).chain(N8) {
+            // The tile's index in the copy and in the dense arrays.
+            let c = ((dy + 2) * 5 + dx + 2) as usize;
+            let kc = (k as isize + dy as isize * w as isize + dx as isize) as usize;
+            if state[c] & ST_COVERED == 0 {
+                self.l.remove(kc);
+                continue;
+            }
+            let mut b = Block3 {
+                state: [0; 9],
+                moves: [0; 9],
+            };
+            for r in 0..3 {
+                let sw = c - 6 + 5 * r;
+                b.state[3 * r..3 * r + 3].copy_from_slice(&state[sw..sw + 3]);
+                b.moves[3 * r..3 * r + 3].copy_from_slice(&moves[sw..sw + 3]);
+            }
+            if b.mu(self.lane_end_corners) >= 1 {
+                self.l.insert(kc);
+            } else {
+                self.l.remove(kc);
+            }
         }
     }
 
@@ -1535,7 +1600,8 @@ struct Mind {
     candidate_rows: Vec<(i32, i32)>,
     /// Rows of new pixels per candidate band in [`Mind::sense`]: about one tile side.
     band_rows: usize,
-    /// Per-tile cache of the contact disk's pixel spans for [`Mind::judge_tile`].
+    /// Per-tile cache of the contact disk's pixel spans for [`Mind::judge_tile_first`] and
+    /// [`Mind::sense`].
     disk: DiskCache,
 }
 
@@ -1706,7 +1772,7 @@ impl Mind {
                 if self.tiles.state[k] & ST_STAND != Judgement::Undetermined as u8 {
                     continue;
                 }
-                let hit = if self.tiles.state[k] & ST_DISK == 0 {
+                let judged = if self.tiles.state[k] & ST_DISK == 0 {
                     // Not cached yet: the rows and columns the disk can reach (one pixel of
                     // margin).
                     let g = frame.world_to_grid(self.center(t));
@@ -1715,18 +1781,20 @@ impl Mind {
                     let c_hi = ceil_i64(g.x + rc - 0.5) + 1;
                     let rows =
                         (*rows.start()).max(first_row as i64)..=(*rows.end()).min(last_row as i64);
-                    rows.into_iter().any(|row| {
+                    let hit = rows.into_iter().any(|row| {
                         let s = spans[(row - first_row as i64) as usize];
                         s.0 <= s.1 && (s.0 as i64) <= c_hi && (s.1 as i64) >= c_lo
-                    })
+                    });
+                    if !hit {
+                        continue;
+                    }
+                    self.judge_tile_first(k, g)
                 } else {
                     // Cached: the disk's own pixel runs against the new ones.
                     let n = self.disk.rows;
                     let (row0, col0) = (self.disk.row0[k] as usize, self.disk.col0[k] as usize);
-                    self.disk.spans[k * n..(k + 1) * n]
-                        .iter()
-                        .enumerate()
-                        .any(|(i, &[a, b])| {
+                    let hit = self.disk.spans[k * n..(k + 1) * n].iter().enumerate().any(
+                        |(i, &[a, b])| {
                             let row = row0 + i;
                             a <= b && (first_row..=last_row).contains(&row) && {
                                 let s = spans[row - first_row];
@@ -1734,12 +1802,19 @@ impl Mind {
                                     && s.0 <= col0 + usize::from(b)
                                     && s.1 >= col0 + usize::from(a)
                             }
-                        })
+                        },
+                    );
+                    if !hit {
+                        continue;
+                    }
+                    let (row0, col0) = (i64::from(self.disk.row0[k]), i64::from(self.disk.col0[k]));
+                    Self::spans_state(
+                        &self.known,
+                        &self.disk.spans[k * n..(k + 1) * n],
+                        row0,
+                        col0,
+                    )
                 };
-                if !hit {
-                    continue;
-                }
-                let judged = self.judge_tile(k, t);
                 if judged != Judgement::Undetermined {
                     self.set_stand(k, t, judged);
                 }
@@ -1749,43 +1824,24 @@ impl Mind {
         self.candidate_rows = ranges;
     }
 
-    /// The first image row and the column offsets are taken from in the [`DiskCache`] slots of
-    /// tile `t` (signed): the first row of [`disk_rows`] at its centre, and one column of
-    /// margin left of its disk (clamped at 0: any touching column is >= 0, else blocked).
-    #[inline]
-    fn disk_origin(&self, t: Tile) -> (i64, i64) {
-        let frame = self.known.frame();
-        let g = frame.world_to_grid(self.center(t));
-        let rc = self.rc_px;
-        (
-            *disk_rows(frame, g, rc).start(),
-            (floor_i64(g.x - rc - 0.5) - 1).max(0),
-        )
-    }
-
-    /// [`judge_point`] for tile `k` (`t`), with the disk's pixel spans computed once per tile
-    /// by the same predicate and, while the tile stays undetermined, cached (a tile is judged
-    /// again each time new pixels reach its disk, until it is decided). A tile decided at its
-    /// first judgement (the common case for small tiles) never writes the cache, whose pages
-    /// then cost no memory.
-    fn judge_tile(&mut self, k: usize, t: Tile) -> Judgement {
+    /// [`judge_point`] for tile `k`, not in the [`DiskCache`] yet, whose centre is at grid
+    /// point `g`: the disk's pixel spans are computed by the same predicate and, while the
+    /// tile stays undetermined, cached (a tile is judged again each time new pixels reach its
+    /// disk, until it is decided; [`Mind::sense`] then reads the cached spans). A tile decided
+    /// at its first judgement (the common case for small tiles) never writes the cache, whose
+    /// pages then cost no memory.
+    ///
+    /// The slots start at the first row of [`disk_rows`] and take their column offsets from
+    /// one column of margin left of the disk (clamped at 0: any touching column is >= 0, else
+    /// blocked).
+    fn judge_tile_first(&mut self, k: usize, g: Point) -> Judgement {
         let n = self.disk.rows;
-        if self.tiles.state[k] & ST_DISK != 0 {
-            let (row0, col0) = (i64::from(self.disk.row0[k]), i64::from(self.disk.col0[k]));
-            return Self::spans_state(
-                &self.known,
-                &self.disk.spans[k * n..(k + 1) * n],
-                row0,
-                col0,
-            );
-        }
         let frame = *self.known.frame();
-        let g = frame.world_to_grid(self.center(t));
         let rc = self.rc_px;
         let (w, hh) = (frame.width as i64, frame.height as i64);
         let rows = disk_rows(&frame, g, rc);
-        let row1 = *rows.end();
-        let (row0, col0) = self.disk_origin(t);
+        let (row0, row1) = (*rows.start(), *rows.end());
+        let col0 = (floor_i64(g.x - rc - 0.5) - 1).max(0);
         if row1 - row0 + 1 > n as i64 || !(0..=i64::from(i32::MAX)).contains(&row0) {
             return judge_point(&self.known, g, rc);
         }
@@ -2348,6 +2404,53 @@ mod tests {
         let d = segment_box_dist2(Point::new(2.0, 3.0), Point::new(3.0, 2.0), lo, hi);
         // Nearest: corner (1,1) to the line x + y = 5: distance 3/sqrt2.
         assert!((d - 4.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn heuristic_is_the_floored_euclidean_distance() {
+        for di in -60..=60 {
+            for dj in -60..=60 {
+                let e = (f64::from(di).hypot(f64::from(dj)) * COST_ORTHO as f64).floor() as u64;
+                assert_eq!(heuristic((di, dj), (0, 0)), e, "({di}, {dj})");
+            }
+        }
+    }
+
+    /// The shortcuts of [`for_each_swept_tile`] change nothing: the same tiles as the box
+    /// distance alone, for segments in every direction and several radii.
+    #[test]
+    fn swept_tiles_match_the_box_distance() {
+        for rho in [0.0, 1e-12, 0.25, 0.5, 0.5 + 1e-12, 0.7071, 1.0, 1.5, 2.3] {
+            let lim = (rho * rho) * (1.0 - 1e-9) - 1e-12;
+            for bx in -7..=7 {
+                for by in -7..=7 {
+                    let (a, b) = ((0, 0), (bx, by));
+                    let mut got = Vec::new();
+                    for_each_swept_tile(a, b, rho, |t| {
+                        got.push(t);
+                        true
+                    });
+                    got.sort_unstable();
+                    let (pa, pb) = (
+                        Point::new(0.0, 0.0),
+                        Point::new(f64::from(bx), f64::from(by)),
+                    );
+                    let mut want = Vec::new();
+                    for j in -12..=12 {
+                        for i in -12..=12 {
+                            let (x, y) = (f64::from(i), f64::from(j));
+                            let lo = Point::new(x - 0.5, y - 0.5);
+                            let hi = Point::new(x + 0.5, y + 0.5);
+                            if segment_box_dist2(pa, pb, lo, hi) < lim {
+                                want.push((i, j));
+                            }
+                        }
+                    }
+                    want.sort_unstable();
+                    assert_eq!(got, want, "rho {rho}, to ({bx}, {by})");
+                }
+            }
+        }
     }
 
     #[test]
