@@ -2420,7 +2420,7 @@ mod tests {
     /// distance alone, for segments in every direction and several radii.
     #[test]
     fn swept_tiles_match_the_box_distance() {
-        for rho in [0.0, 1e-12, 0.25, 0.5, 0.5 + 1e-12, 0.7071, 1.0, 1.5, 2.3] {
+        for rho in [0.0, 1e-12, 0.25, 0.5, 0.5 + 1e-12, 0.7, 1.0, 1.5, 2.3] {
             let lim = (rho * rho) * (1.0 - 1e-9) - 1e-12;
             for bx in -7..=7 {
                 for by in -7..=7 {
