@@ -103,7 +103,12 @@ pub fn wrap_angle(a: f64) -> f64 {
     if !a.is_finite() {
         return a;
     }
-    let mut w = a % (2.0 * PI);
+    // `fmod` returns its argument exactly when it is smaller than the modulus: skip the call.
+    let mut w = if a.abs() < 2.0 * PI {
+        a
+    } else {
+        a % (2.0 * PI)
+    };
     if w <= -PI {
         w += 2.0 * PI;
     } else if w > PI {
@@ -278,6 +283,29 @@ mod tests {
         assert!((wrap_angle(-PI) - PI).abs() < 1e-12);
         assert!((wrap_angle(-PI / 2.0) + PI / 2.0).abs() < 1e-12);
         assert_eq!(wrap_angle(0.0), 0.0);
+        // Bit for bit the `fmod` form, on both sides of the skipped call.
+        let fmod_form = |a: f64| {
+            let mut w = a % (2.0 * PI);
+            if w <= -PI {
+                w += 2.0 * PI;
+            } else if w > PI {
+                w -= 2.0 * PI;
+            }
+            w
+        };
+        let tau = 2.0 * PI;
+        let mut xs = vec![-0.0, 0.0, PI, -PI, tau, -tau, 3.0 * PI, -7.5, 1e9];
+        for x in [tau, -tau, PI, -PI] {
+            // The two neighbouring doubles.
+            xs.extend([
+                f64::from_bits(x.to_bits() + 1),
+                f64::from_bits(x.to_bits() - 1),
+            ]);
+        }
+        xs.extend((-2000..=2000).map(|k| f64::from(k) * 0.00731));
+        for x in xs {
+            assert_eq!(wrap_angle(x).to_bits(), fmod_form(x).to_bits(), "{x:e}");
+        }
     }
 
     #[test]

@@ -94,6 +94,32 @@ pub struct RunOutput {
     pub wall_time_s: f64,
 }
 
+/// The cosine and sine of the last few headings translated along (a lawnmower run uses a
+/// handful), keyed by the heading's bits: the same values as computing them anew.
+#[derive(Clone, Debug, Default)]
+struct TrigMemo {
+    /// `(heading bits, cos, sin)`; `None` slots are empty.
+    slots: [Option<(u64, f64, f64)>; 4],
+    /// The slot the next miss overwrites.
+    next: usize,
+}
+
+impl TrigMemo {
+    #[inline]
+    fn cos_sin(&mut self, a: f64) -> (f64, f64) {
+        let key = a.to_bits();
+        for &(k, c, s) in self.slots.iter().flatten() {
+            if k == key {
+                return (c, s);
+            }
+        }
+        let (c, s) = (a.cos(), a.sin());
+        self.slots[self.next] = Some((key, c, s));
+        self.next = (self.next + 1) % self.slots.len();
+        (c, s)
+    }
+}
+
 /// PID execution state.
 struct PidState {
     opts: PidOptions,
@@ -120,6 +146,7 @@ pub struct Simulator<'w> {
     pid: Option<PidState>,
     landmarks: LandmarkConfig,
     exec_set: bool,
+    trig: TrigMemo,
 }
 
 impl<'w> Simulator<'w> {
@@ -142,6 +169,7 @@ impl<'w> Simulator<'w> {
             pid: None,
             landmarks: config.landmarks.clone(),
             exec_set: false,
+            trig: TrigMemo::default(),
         };
         sim.drive_approach();
         if let Some(e) = config.exec {
@@ -264,7 +292,8 @@ impl<'w> Simulator<'w> {
             self.pose.theta + std::f64::consts::PI
         };
         let a = self.pose.position();
-        let b = Point::new(a.x + d.abs() * dir.cos(), a.y + d.abs() * dir.sin());
+        let (c, s) = self.trig.cos_sin(dir);
+        let b = Point::new(a.x + d.abs() * c, a.y + d.abs() * s);
         match self.world.true_first_contact(a, b) {
             None => {
                 self.pose.x = b.x;

@@ -714,6 +714,50 @@ proptest::proptest! {
         }
     }
 
+    /// Moves between pixel centres, the tile centres of tiles one pixel (or a few) wide, put
+    /// the pixels at exactly `r + 1/2` from the ends, which never touch, at the edge of
+    /// `judge_motion`'s fast path: its verdict must still be the known map's.
+    #[test]
+    fn judge_motion_matches_known_map_between_pixel_centres(
+        seed in proptest::prelude::any::<u64>(),
+        half_px in 1u32..6,
+    ) {
+        use ccpp_core::planner::{KnownMap, Scan};
+        use ccpp_core::planners::ba_star::{judge_motion, Judgement};
+        let mut rng = ccpp_core::rng::SplitMix64::new(seed);
+        let (w, h) = (24usize, 20usize);
+        let res = 0.05;
+        let mut cells = vec![Cell::Free; w * h];
+        for c in &mut cells {
+            if rng.next_f64() < 0.08 {
+                *c = Cell::Occupied;
+            }
+        }
+        let truth = GridMap::new(ccpp_core::grid::MapFrame::new(w, h, res), cells).unwrap();
+        let mut known = KnownMap::new(truth.frame());
+        known.integrate(&Scan::new(&truth, Point::new(0.6, 0.5), 2.0));
+        // Robot radius r = half_px / 2 pixels: tiles of side 2 r are `half_px` pixels wide.
+        let r = f64::from(half_px) * 0.5 * res;
+        let centre = |col: usize, row: usize| {
+            Point::new((col as f64 + 0.5) * res, (h as f64 - row as f64 - 0.5) * res)
+        };
+        for _ in 0..60 {
+            let (col, row) = ((rng.next_u64() % w as u64) as usize, (rng.next_u64() % h as u64) as usize);
+            let a = centre(col, row);
+            for (di, dj) in N8 {
+                let steps = 1 + (rng.next_u64() % 3) as i32;
+                let (c2, r2) = (col as i32 + di * steps, row as i32 - dj * steps);
+                if c2 < 0 || r2 < 0 || c2 >= w as i32 || r2 >= h as i32 {
+                    continue;
+                }
+                let b = centre(c2 as usize, r2 as usize);
+                let j = judge_motion(&known, a, b, r);
+                let free = known.segment_free(a, b, r);
+                proptest::prop_assert_eq!(j == Judgement::Free, free, "{:?} {:?} r {}", a, b, r);
+            }
+        }
+    }
+
     #[test]
     fn astar_cost_equals_dijkstra(seed in proptest::prelude::any::<u64>()) {
         let mut rng = ccpp_core::rng::SplitMix64::new(seed);

@@ -171,9 +171,11 @@ pub fn judge_motion(known: &KnownMap, a: Point, b: Point, r: f64) -> Judgement {
     let row1 = ceil_i64(h - ylo - 0.5) + 1;
     let (w, hh) = (frame.width as i64, frame.height as i64);
     // Fast path: every pixel that can touch has its centre within `rc` of the segment, so in
-    // the capsule's bounding box grown by `rc` (boundary pixels kept, with a margin for
-    // rounding). That box inside the image and entirely known free: free.
-    let eps = 1e-6;
+    // the capsule's bounding box grown by `rc` (with a margin for rounding far below the
+    // contact epsilon, so the pixels at exactly `r + 1/2` from a tile centre, which never
+    // touch, stay out: for one-pixel tiles the box of a move is then just its two pixels).
+    // That box inside the image and entirely known free: free.
+    let eps = 1e-7;
     let cmin = ceil_i64(ga.x.min(gb.x) - rc - 0.5 - eps);
     let cmax = floor_i64(ga.x.max(gb.x) + rc - 0.5 + eps);
     let rmin = ceil_i64(h - yhi - 0.5 - eps);
@@ -961,7 +963,9 @@ fn candidates(src: &[Tile], (x0, x1, y0, y1): (i32, i32, i32, i32), out: &mut Ve
 pub fn heuristic(a: Tile, b: Tile) -> u64 {
     let di = f64::from(a.0 - b.0);
     let dj = f64::from(a.1 - b.1);
-    (di.hypot(dj) * COST_ORTHO as f64).floor() as u64
+    // The product is finite and >= 0, where the truncating cast is the floor (without a call
+    // into libm).
+    (di.hypot(dj) * COST_ORTHO as f64) as u64
 }
 
 /// Squared distance between segment `a`-`b` and the axis-aligned box `lo`-`hi` (0 when they
@@ -1021,6 +1025,29 @@ pub fn for_each_swept_tile(a: Tile, b: Tile, rho: f64, mut f: impl FnMut(Tile) -
     let pb = Point::new(f64::from(b.0), f64::from(b.1));
     let lim = (rho * rho) * (1.0 - 1e-9) - 1e-12;
     let (dx, dy) = (pb.x - pa.x, pb.y - pa.y);
+    // Shortcuts from the squared distance of a tile's centre to the segment, exact with wide
+    // margins (the unit square holds the disk of radius 1/2 around its centre and lies in the
+    // disk of radius sqrt(1/2)): clearly below 1/4, the segment crosses the square (box
+    // distance 0 < `lim`); clearly above `(rho + sqrt(1/2))^2`, the square is farther than
+    // `rho`. Only the tiles between take the box distance.
+    let accept2 = if lim > 1e-9 {
+        0.25 * (1.0 - 1e-6)
+    } else {
+        -1.0
+    };
+    let reject2 = (rho + std::f64::consts::FRAC_1_SQRT_2 + 1e-6).powi(2);
+    let touches = |i: i32, y: f64| {
+        let dc2 = point_segment_dist2(Point::new(f64::from(i), y), pa, pb);
+        if dc2 < accept2 {
+            true
+        } else if dc2 >= reject2 {
+            false
+        } else {
+            let lo = Point::new(f64::from(i) - 0.5, y - 0.5);
+            let hi = Point::new(f64::from(i) + 0.5, y + 0.5);
+            segment_box_dist2(pa, pb, lo, hi) < lim
+        }
+    };
     let step: i32 = if b.1 >= a.1 { 1 } else { -1 };
     let reach = rho + 0.5;
     let j_first = if step > 0 {
@@ -1054,9 +1081,7 @@ pub fn for_each_swept_tile(a: Tile, b: Tile, rho: f64, mut f: impl FnMut(Tile) -
                 (i_hi, i_lo, -1)
             };
             loop {
-                let lo = Point::new(f64::from(i) - 0.5, y - 0.5);
-                let hi = Point::new(f64::from(i) + 0.5, y + 0.5);
-                if segment_box_dist2(pa, pb, lo, hi) < lim && !f((i, j)) {
+                if touches(i, y) && !f((i, j)) {
                     return false;
                 }
                 if i == i_end {
@@ -1306,20 +1331,91 @@ impl TileModel {
             .count() as u32
     }
 
-    /// Recomputes the L membership of `t`.
+    /// The 3 x 3 block of tile states and move bytes centred on `s` (see [`Block3`]).
+    #[inline]
+    fn block3(&self, s: Tile) -> Block3 {
+        let di = s.0 - self.i0;
+        let dj = s.1 - self.j0;
+        let mut b = Block3 {
+            state: [BLOCK3_OUTSIDE_STATE; 9],
+            moves: [BLOCK3_OUTSIDE_MOVES; 9],
+        };
+        if di >= 1 && dj >= 1 && di as usize + 1 < self.w && dj as usize + 1 < self.h {
+            let sw = (dj as usize - 1) * self.w + di as usize - 1;
+            for r in 0..3 {
+                let k = sw + r * self.w;
+                b.state[3 * r..3 * r + 3].copy_from_slice(&self.state[k..k + 3]);
+                b.moves[3 * r..3 * r + 3].copy_from_slice(&self.moves[k..k + 3]);
+            }
+        } else {
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    if let Some(k) = self.idx((s.0 + dx, s.1 + dy)) {
+                        let at = Block3::at((dx, dy));
+                        b.state[at] = self.state[k];
+                        b.moves[at] = self.moves[k];
+                    }
+                }
+            }
+        }
+        b
+    }
+
+    /// Recomputes the L membership of `t` (`mu` read off the [`Block3`] around `t`: the same
+    /// value as [`TileModel::mu`], which tests check through [`BaStar::backtrack_list_full`]).
     fn update_l(&mut self, t: Tile) {
         let Some(k) = self.idx(t) else { return };
-        if self.state[k] & ST_COVERED != 0 && self.mu(t) >= 1 {
+        if self.state[k] & ST_COVERED != 0 && self.block3(t).mu(self.lane_end_corners) >= 1 {
             self.l.insert(k);
         } else {
             self.l.remove(k);
         }
     }
 
+    /// [`TileModel::update_l`] of `t` and its eight neighbours. Away from the border of the
+    /// range the 5 x 5 block of states and moves they read is copied once, and each tile's
+    /// [`Block3`] taken from the copy.
     fn update_l_around(&mut self, t: Tile) {
-        self.update_l(t);
-        for (di, dj) in N8 {
-            self.update_l((t.0 + di, t.1 + dj));
+        let di = t.0 - self.i0;
+        let dj = t.1 - self.j0;
+        if !(di >= 2 && dj >= 2 && di as usize + 2 < self.w && dj as usize + 2 < self.h) {
+            self.update_l(t);
+            for (di, dj) in N8 {
+                self.update_l((t.0 + di, t.1 + dj));
+            }
+            return;
+        }
+        let w = self.w;
+        let k = dj as usize * w + di as usize;
+        let mut state = [0u8; 25];
+        let mut moves = [0u8; 25];
+        for r in 0..5 {
+            let base = k - 2 * w - 2 + r * w;
+            state[5 * r..5 * r + 5].copy_from_slice(&self.state[base..base + 5]);
+            moves[5 * r..5 * r + 5].copy_from_slice(&self.moves[base..base + 5]);
+        }
+        for (dx, dy) in std::iter::once((0, 0)).chain(N8) {
+            // The tile's index in the copy and in the dense arrays.
+            let c = ((dy + 2) * 5 + dx + 2) as usize;
+            let kc = (k as isize + dy as isize * w as isize + dx as isize) as usize;
+            if state[c] & ST_COVERED == 0 {
+                self.l.remove(kc);
+                continue;
+            }
+            let mut b = Block3 {
+                state: [0; 9],
+                moves: [0; 9],
+            };
+            for r in 0..3 {
+                let sw = c - 6 + 5 * r;
+                b.state[3 * r..3 * r + 3].copy_from_slice(&state[sw..sw + 3]);
+                b.moves[3 * r..3 * r + 3].copy_from_slice(&moves[sw..sw + 3]);
+            }
+            if b.mu(self.lane_end_corners) >= 1 {
+                self.l.insert(kc);
+            } else {
+                self.l.remove(kc);
+            }
         }
     }
 
@@ -1328,6 +1424,87 @@ impl TileModel {
         self.l
             .for_each(|k| v.push((self.i0 + (k % self.w) as i32, self.j0 + (k / self.w) as i32)));
         v
+    }
+}
+
+/// State of a tile outside the tiling's range in a [`Block3`]: an obstacle, not covered (as
+/// [`TileModel::stand`] and [`TileModel::covered`] read it).
+const BLOCK3_OUTSIDE_STATE: u8 = Judgement::Blocked as u8;
+/// Move byte of a tile outside the range in a [`Block3`]: all four moves blocked (as
+/// [`TileModel::cached_move`] reads it).
+const BLOCK3_OUTSIDE_MOVES: u8 = 0b1010_1010;
+
+/// A copy of the tile states and move bytes of the 3 x 3 tiles around a tile `s` (index
+/// `(dj + 1) * 3 + di + 1` for the offset `(di, dj)`): everything `mu(s)` reads, so `mu` runs on
+/// a few registers instead of bounds-checked lookups into the dense arrays.
+struct Block3 {
+    state: [u8; 9],
+    moves: [u8; 9],
+}
+
+impl Block3 {
+    #[inline]
+    fn at(d: Tile) -> usize {
+        ((d.1 + 1) * 3 + d.0 + 1) as usize
+    }
+
+    #[inline]
+    fn covered(&self, d: Tile) -> bool {
+        self.state[Self::at(d)] & ST_COVERED != 0
+    }
+
+    #[inline]
+    fn stand_blocked(&self, d: Tile) -> bool {
+        Judgement::from_bits(self.state[Self::at(d)] & ST_STAND) == Judgement::Blocked
+    }
+
+    /// [`TileModel::cached_move`] of the move `d -> d + N8[k]` is free (its owner tile must lie
+    /// in the block: true for every move `mu` reads).
+    #[inline]
+    fn move_free(&self, d: Tile, k: usize) -> bool {
+        let (o, slot) = TileModel::move_slot(d, k);
+        Judgement::from_bits(self.moves[Self::at(o)] >> (2 * slot)) == Judgement::Free
+    }
+
+    /// [`TileModel::free_uncovered`] for the neighbour `k` of the block tile `d`.
+    #[inline]
+    fn free_uncovered(&self, d: Tile, k: usize) -> bool {
+        !self.covered((d.0 + N8[k].0, d.1 + N8[k].1)) && self.move_free(d, k)
+    }
+
+    /// [`TileModel::mu`] of the centre tile.
+    fn mu(&self, lane_end_corners: bool) -> u32 {
+        let s = (0, 0);
+        let mut free = [false; 8];
+        for k in [0, 4, 6] {
+            free[k] = self.free_uncovered(s, k);
+        }
+        if !(free[0] || free[4] || free[6]) {
+            return 0;
+        }
+        let mut blocked = [false; 8];
+        for (k, &d) in N8.iter().enumerate() {
+            blocked[k] = self.covered(d) || self.stand_blocked(d);
+        }
+        let mut mu = corner_score(free, blocked);
+        if lane_end_corners {
+            let mut obstacle = [false; 8];
+            for k in [2, 6] {
+                obstacle[k] = self.stand_blocked(N8[k]);
+            }
+            mu += lane_end_score(free, obstacle, blocked);
+            mu += SIDE_END_PAIRS
+                .iter()
+                .filter(|&&(a, b)| {
+                    free[a] && !self.free_uncovered(s, b) && {
+                        // Not [`TileModel::side_continues`].
+                        let n = N8[b];
+                        !(self.covered(n) && self.move_free(s, b) && self.free_uncovered(n, a))
+                    }
+                })
+                .count() as u32;
+        }
+        mu
     }
 }
 
@@ -1423,20 +1600,23 @@ struct Mind {
     candidate_rows: Vec<(i32, i32)>,
     /// Rows of new pixels per candidate band in [`Mind::sense`]: about one tile side.
     band_rows: usize,
-    /// Per-tile cache of the contact disk's pixel spans for [`Mind::judge_tile`].
+    /// Per-tile cache of the contact disk's pixel spans for [`Mind::judge_tile_first`] and
+    /// [`Mind::sense`].
     disk: DiskCache,
 }
 
 /// The contact disk of each tile as pixel spans: `rows` slots per tile of `[lo, hi]` column
 /// offsets from `col0[k]` for rows `row0[k]..` (`lo > hi`: no pixel in that row). Valid only
 /// for tiles with [`ST_DISK`] set; the slots of the others are never read (zero-initialised:
-/// pages of tiles never judged cost no memory).
+/// pages of tiles never left undetermined by a judgement cost no memory).
 #[derive(Clone)]
 struct DiskCache {
     rows: usize,
     row0: Vec<i32>,
     col0: Vec<i32>,
     spans: Vec<[u8; 2]>,
+    /// One tile's slots while it is judged for the first time.
+    scratch: Vec<[u8; 2]>,
 }
 
 impl DiskCache {
@@ -1448,6 +1628,7 @@ impl DiskCache {
             row0: vec![0; n_tiles],
             col0: vec![0; n_tiles],
             spans: vec![[0, 0]; n_tiles * rows],
+            scratch: Vec::with_capacity(rows),
         }
     }
 }
@@ -1591,7 +1772,7 @@ impl Mind {
                 if self.tiles.state[k] & ST_STAND != Judgement::Undetermined as u8 {
                     continue;
                 }
-                let hit = if self.tiles.state[k] & ST_DISK == 0 {
+                let judged = if self.tiles.state[k] & ST_DISK == 0 {
                     // Not cached yet: the rows and columns the disk can reach (one pixel of
                     // margin).
                     let g = frame.world_to_grid(self.center(t));
@@ -1600,18 +1781,20 @@ impl Mind {
                     let c_hi = ceil_i64(g.x + rc - 0.5) + 1;
                     let rows =
                         (*rows.start()).max(first_row as i64)..=(*rows.end()).min(last_row as i64);
-                    rows.into_iter().any(|row| {
+                    let hit = rows.into_iter().any(|row| {
                         let s = spans[(row - first_row as i64) as usize];
                         s.0 <= s.1 && (s.0 as i64) <= c_hi && (s.1 as i64) >= c_lo
-                    })
+                    });
+                    if !hit {
+                        continue;
+                    }
+                    self.judge_tile_first(k, g)
                 } else {
                     // Cached: the disk's own pixel runs against the new ones.
                     let n = self.disk.rows;
                     let (row0, col0) = (self.disk.row0[k] as usize, self.disk.col0[k] as usize);
-                    self.disk.spans[k * n..(k + 1) * n]
-                        .iter()
-                        .enumerate()
-                        .any(|(i, &[a, b])| {
+                    let hit = self.disk.spans[k * n..(k + 1) * n].iter().enumerate().any(
+                        |(i, &[a, b])| {
                             let row = row0 + i;
                             a <= b && (first_row..=last_row).contains(&row) && {
                                 let s = spans[row - first_row];
@@ -1619,12 +1802,19 @@ impl Mind {
                                     && s.0 <= col0 + usize::from(b)
                                     && s.1 >= col0 + usize::from(a)
                             }
-                        })
+                        },
+                    );
+                    if !hit {
+                        continue;
+                    }
+                    let (row0, col0) = (i64::from(self.disk.row0[k]), i64::from(self.disk.col0[k]));
+                    Self::spans_state(
+                        &self.known,
+                        &self.disk.spans[k * n..(k + 1) * n],
+                        row0,
+                        col0,
+                    )
                 };
-                if !hit {
-                    continue;
-                }
-                let judged = self.judge_tile(k, t);
                 if judged != Judgement::Undetermined {
                     self.set_stand(k, t, judged);
                 }
@@ -1634,59 +1824,60 @@ impl Mind {
         self.candidate_rows = ranges;
     }
 
-    /// The first image row and the column offsets are taken from in the [`DiskCache`] slots of
-    /// tile `t` (signed): the first row of [`disk_rows`] at its centre, and one column of
-    /// margin left of its disk (clamped at 0: any touching column is >= 0, else blocked).
-    #[inline]
-    fn disk_origin(&self, t: Tile) -> (i64, i64) {
-        let frame = self.known.frame();
-        let g = frame.world_to_grid(self.center(t));
-        let rc = self.rc_px;
-        (
-            *disk_rows(frame, g, rc).start(),
-            (floor_i64(g.x - rc - 0.5) - 1).max(0),
-        )
-    }
-
-    /// [`judge_point`] for tile `k` (`t`), with the disk's pixel spans computed once per tile
-    /// by the same predicate and cached (a tile is judged again each time new pixels reach its
-    /// disk, until it is decided).
-    fn judge_tile(&mut self, k: usize, t: Tile) -> Judgement {
+    /// [`judge_point`] for tile `k`, not in the [`DiskCache`] yet, whose centre is at grid
+    /// point `g`: the disk's pixel spans are computed by the same predicate and, while the
+    /// tile stays undetermined, cached (a tile is judged again each time new pixels reach its
+    /// disk, until it is decided; [`Mind::sense`] then reads the cached spans). A tile decided
+    /// at its first judgement (the common case for small tiles) never writes the cache, whose
+    /// pages then cost no memory.
+    ///
+    /// The slots start at the first row of [`disk_rows`] and take their column offsets from
+    /// one column of margin left of the disk (clamped at 0: any touching column is >= 0, else
+    /// blocked).
+    fn judge_tile_first(&mut self, k: usize, g: Point) -> Judgement {
         let n = self.disk.rows;
-        if self.tiles.state[k] & ST_DISK == 0 {
-            let frame = *self.known.frame();
-            let g = frame.world_to_grid(self.center(t));
-            let rc = self.rc_px;
-            let (w, hh) = (frame.width as i64, frame.height as i64);
-            let rows = disk_rows(&frame, g, rc);
-            let row1 = *rows.end();
-            let (row0, col0) = self.disk_origin(t);
-            if row1 - row0 + 1 > n as i64 || !(0..=i64::from(i32::MAX)).contains(&row0) {
+        let frame = *self.known.frame();
+        let rc = self.rc_px;
+        let (w, hh) = (frame.width as i64, frame.height as i64);
+        let rows = disk_rows(&frame, g, rc);
+        let (row0, row1) = (*rows.start(), *rows.end());
+        let col0 = (floor_i64(g.x - rc - 0.5) - 1).max(0);
+        if row1 - row0 + 1 > n as i64 || !(0..=i64::from(i32::MAX)).contains(&row0) {
+            return judge_point(&self.known, g, rc);
+        }
+        let slots = &mut self.disk.scratch;
+        slots.clear();
+        slots.resize(n, [1, 0]);
+        for (slot, row) in slots.iter_mut().zip(rows) {
+            let Some((lo, hi)) = disk_row_span(&frame, g, rc, row) else {
+                continue;
+            };
+            if row >= hh || lo < 0 || hi >= w || hi - col0 > 250 {
+                // Reaches outside the image (blocked), or too wide to cache.
                 return judge_point(&self.known, g, rc);
             }
-            let slots = &mut self.disk.spans[k * n..(k + 1) * n];
-            slots.fill([1, 0]);
-            for (slot, row) in slots.iter_mut().zip(rows) {
-                let Some((lo, hi)) = disk_row_span(&frame, g, rc, row) else {
-                    continue;
-                };
-                if row >= hh || lo < 0 || hi >= w || hi - col0 > 250 {
-                    // Reaches outside the image (blocked), or too wide to cache.
-                    return judge_point(&self.known, g, rc);
-                }
-                *slot = [(lo - col0) as u8, (hi - col0) as u8];
-            }
+            *slot = [(lo - col0) as u8, (hi - col0) as u8];
+        }
+        let j = Self::spans_state(&self.known, slots, row0, col0);
+        if j == Judgement::Undetermined {
+            self.disk.spans[k * n..(k + 1) * n].copy_from_slice(&self.disk.scratch);
             self.disk.row0[k] = row0 as i32;
             self.disk.col0[k] = col0 as i32;
             self.tiles.state[k] |= ST_DISK;
         }
-        let (row0, col0) = (i64::from(self.disk.row0[k]), i64::from(self.disk.col0[k]));
-        let runs = self.disk.spans[k * n..(k + 1) * n]
+        j
+    }
+
+    /// What `known` says of the disk given as [`DiskCache`] slots from image row `row0`, column
+    /// offsets from `col0`.
+    #[inline]
+    fn spans_state(known: &KnownMap, slots: &[[u8; 2]], row0: i64, col0: i64) -> Judgement {
+        let runs = slots
             .iter()
             .zip(row0..)
             .filter(|(&[a, b], _)| a <= b)
             .map(|(&[a, b], row)| (row, col0 + i64::from(a), col0 + i64::from(b)));
-        self.known.runs_state(runs).into()
+        known.runs_state(runs).into()
     }
 
     /// Marks `t` covered (the robot stands on it), decides its moves and updates L.
@@ -2213,6 +2404,53 @@ mod tests {
         let d = segment_box_dist2(Point::new(2.0, 3.0), Point::new(3.0, 2.0), lo, hi);
         // Nearest: corner (1,1) to the line x + y = 5: distance 3/sqrt2.
         assert!((d - 4.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn heuristic_is_the_floored_euclidean_distance() {
+        for di in -60..=60 {
+            for dj in -60..=60 {
+                let e = (f64::from(di).hypot(f64::from(dj)) * COST_ORTHO as f64).floor() as u64;
+                assert_eq!(heuristic((di, dj), (0, 0)), e, "({di}, {dj})");
+            }
+        }
+    }
+
+    /// The shortcuts of [`for_each_swept_tile`] change nothing: the same tiles as the box
+    /// distance alone, for segments in every direction and several radii.
+    #[test]
+    fn swept_tiles_match_the_box_distance() {
+        for rho in [0.0, 1e-12, 0.25, 0.5, 0.5 + 1e-12, 0.7, 1.0, 1.5, 2.3] {
+            let lim = (rho * rho) * (1.0 - 1e-9) - 1e-12;
+            for bx in -7..=7 {
+                for by in -7..=7 {
+                    let (a, b) = ((0, 0), (bx, by));
+                    let mut got = Vec::new();
+                    for_each_swept_tile(a, b, rho, |t| {
+                        got.push(t);
+                        true
+                    });
+                    got.sort_unstable();
+                    let (pa, pb) = (
+                        Point::new(0.0, 0.0),
+                        Point::new(f64::from(bx), f64::from(by)),
+                    );
+                    let mut want = Vec::new();
+                    for j in -12..=12 {
+                        for i in -12..=12 {
+                            let (x, y) = (f64::from(i), f64::from(j));
+                            let lo = Point::new(x - 0.5, y - 0.5);
+                            let hi = Point::new(x + 0.5, y + 0.5);
+                            if segment_box_dist2(pa, pb, lo, hi) < lim {
+                                want.push((i, j));
+                            }
+                        }
+                    }
+                    want.sort_unstable();
+                    assert_eq!(got, want, "rho {rho}, to ({bx}, {by})");
+                }
+            }
+        }
     }
 
     #[test]
