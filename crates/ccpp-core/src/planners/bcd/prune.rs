@@ -140,6 +140,9 @@ impl Pruner<'_, '_> {
         {
             return j;
         }
+        // Forget the moves to dropped vertices or from or to moved points.
+        let (alive, pts) = (&self.alive, &self.pts);
+        self.chords[u].retain(|c| alive[c.w] && c.p0 == p0 && c.p1 == pts[c.w]);
         let mut runs = Vec::new();
         self.capsule(p0, p1, &mut runs);
         self.chords[u].push(Chord {
@@ -324,18 +327,24 @@ impl Pruner<'_, '_> {
         }
     }
 
+    /// Adds (`up`) or removes the move `a -> b` from the counts.
     fn add(&mut self, a: Point, b: Point, up: bool, buf: &mut Vec<Run>) {
         buf.clear();
         self.capsule(a, b, buf);
+        self.apply(buf, up);
+    }
+
+    /// Adds (`up`) or removes a move with the pixels `runs` from the counts.
+    fn apply(&mut self, runs: &[Run], up: bool) {
         let w = self.ctx.frame.width;
-        for r in buf.iter() {
+        for r in runs {
             let i = r.base as usize;
             let (row, c0) = (i / w, i % w);
             let c1 = c0 + r.len as usize - 1;
             let at = row / BLOCK * self.blocks_w;
             self.changed[at + c0 / BLOCK..=at + c1 / BLOCK].fill(self.epoch);
         }
-        for i in buf.iter().flat_map(|r| r.pixels()) {
+        for i in runs.iter().flat_map(|r| r.pixels()) {
             if up {
                 if self.cnt[i] == 0 {
                     if self.acc.contains(i) {
@@ -378,7 +387,7 @@ fn corner(u: Point, v1: Point, v2: Point, w: Point, reach: f64) -> Option<Point>
 
 impl Pruner<'_, '_> {
     /// The greedy span drops of the module docs while the plan sweeps at least `need` pixels.
-    fn drop_spans(&mut self, need: usize, starts: impl Iterator<Item = usize>, buf: &mut Vec<Run>) {
+    fn drop_spans(&mut self, need: usize, starts: impl Iterator<Item = usize>) {
         // A new round: forget the evaluations of the last one (points may have moved).
         self.memo.fill(None);
         self.epoch += 1;
@@ -405,21 +414,24 @@ impl Pruner<'_, '_> {
             }
             self.epoch += 1;
             // Drop the vertices strictly between u and w.
-            let (pu, pw) = (self.pts[u], self.pts[s.w]);
             let mut v = u;
             while v != s.w {
                 let a = self.next[v];
-                let (p, q) = (self.pts[v], self.pts[a]);
-                self.add(p, q, false, buf);
+                let seg = self.segment(v);
+                self.apply(&seg, false);
                 if v != u {
                     self.alive[v] = false;
+                    self.chords[v] = Vec::new();
                 }
                 v = a;
             }
-            self.add(pu, pw, true, buf);
+            let j = self.chord(u, s.w);
+            let runs = self.chords[u][j].runs.clone();
+            self.apply(&runs, true);
             self.next[u] = s.w;
             self.prev[s.w] = u;
-            self.seg[u].clear();
+            self.seg_box[u] = self.blocks_of(&runs);
+            self.seg[u] = runs;
             // Re-evaluate the spans whose turns or segments changed: those starting up to
             // MAX_SPAN + 1 vertices before u, at u, and at w.
             let mut starts = vec![s.w];
@@ -571,11 +583,12 @@ pub(super) fn prune(ctx: &Ctx<'_>, items: Vec<Item>, floor: f64, max_extra: f64)
     let p0 = pr.pts[0];
     pr.add(p0, p0, true, &mut buf);
     for i in 0..n - 1 {
-        let (a, b) = (pr.pts[i], pr.pts[i + 1]);
-        pr.add(a, b, true, &mut buf);
+        let seg = pr.segment(i);
+        pr.apply(&seg, true);
+        pr.seg[i] = seg;
     }
     let need = (floor * acc.count_ones(..) as f64).ceil() as usize;
-    pr.drop_spans(need, 0..n, &mut buf);
+    pr.drop_spans(need, 0..n);
     if max_extra > 0.0 {
         let merged = pr.merge_corners(need, max_extra, &mut touched, &mut buf);
         // Merged corners open new straight moves: the spans starting near them.
@@ -597,7 +610,7 @@ pub(super) fn prune(ctx: &Ctx<'_>, items: Vec<Item>, floor: f64, max_extra: f64)
         starts.sort_unstable();
         starts.dedup();
         starts.retain(|&x| x != NONE);
-        pr.drop_spans(need, starts.into_iter(), &mut buf);
+        pr.drop_spans(need, starts.into_iter());
     }
     // The items again: each vertex's first move at its (possibly moved) point, its repeats
     // and the dropped vertices' moves left out, the marks kept.
