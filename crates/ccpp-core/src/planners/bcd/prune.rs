@@ -15,6 +15,12 @@
 //! obstacle in two steps bends once, on the side away from the obstacle), when both new moves
 //! are free, the path grows by at most one turn's cost and the floor still holds; the spans
 //! are dropped once more after that.
+//!
+//! Cost: capsules are kept as row runs ([`crate::raster::capsule_runs`], the pixels the metric
+//! stamps), once per move of the plan and per candidate move (with its free-move check); a
+//! span's loss is counted over those runs; and a start's best span is evaluated again only when
+//! its chain changed (its version) or a count under its moves changed (tracked per block of
+//! [`BLOCK`] x [`BLOCK`] pixels), since otherwise the evaluation would give the same span.
 
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
