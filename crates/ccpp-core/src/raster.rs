@@ -26,6 +26,27 @@ pub fn stamp_capsule(
     rt: f64,
     on_new: &mut impl FnMut(usize),
 ) {
+    capsule_runs(frame, a, b, rt, |row, c_lo, c_hi| {
+        let base = row * frame.width;
+        crate::bits::insert_range(
+            bits.as_mut_slice(),
+            base + c_lo,
+            base + c_hi + 1,
+            &mut *on_new,
+        );
+    });
+}
+
+/// The pixels of [`stamp_capsule`]'s capsule as row runs: `on_run(row, c_lo, c_hi)` for every
+/// image row holding pixels of the capsule (in increasing row order, each row once), the run
+/// being the columns `c_lo..=c_hi`. [`stamp_capsule`] marks exactly these runs.
+pub fn capsule_runs(
+    frame: &crate::grid::MapFrame,
+    a: Point,
+    b: Point,
+    rt: f64,
+    mut on_run: impl FnMut(usize, usize, usize),
+) {
     let rt2 = rt * rt;
     let h = frame.height as f64;
     let w = frame.width as i64;
@@ -110,12 +131,70 @@ pub fn stamp_capsule(
         if c_lo > c_hi {
             continue;
         }
-        let base = row as usize * frame.width;
-        crate::bits::insert_range(
-            bits.as_mut_slice(),
-            base + c_lo as usize,
-            base + c_hi as usize + 1,
-            &mut *on_new,
-        );
+        on_run(row as usize, c_lo as usize, c_hi as usize);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::Pose;
+    use proptest::prelude::*;
+
+    fn frame() -> crate::grid::MapFrame {
+        crate::grid::MapFrame {
+            width: 37,
+            height: 29,
+            resolution: 0.05,
+            origin: Pose::new(0.0, 0.0, 0.0),
+        }
+    }
+
+    /// A segment of kind `kind`: a point, horizontal, vertical, 45-degree diagonal or any.
+    fn segment(kind: u8, a: (f64, f64), b: (f64, f64)) -> (Point, Point) {
+        let a = Point::new(a.0, a.1);
+        let b = match kind {
+            0 => a,
+            1 => Point::new(b.0, a.y),
+            2 => Point::new(a.x, b.1),
+            3 => Point::new(b.0, a.y + (b.0 - a.x)),
+            _ => Point::new(b.0, b.1),
+        };
+        (a, b)
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 512, rng_seed: proptest::test_runner::RngSeed::Fixed(0x5eed_0131), ..ProptestConfig::default() })]
+
+        /// The runs of `capsule_runs` are the pixels `stamp_capsule` marks and the pixel centres
+        /// within `rt` of the segment, one run per row in increasing row order.
+        #[test]
+        fn capsule_runs_are_the_stamped_pixels(
+            kind in 0u8..5,
+            a in (-4.0f64..41.0, -4.0f64..33.0),
+            b in (-4.0f64..41.0, -4.0f64..33.0),
+            rt in 0.3f64..7.0,
+        ) {
+            let f = frame();
+            let (a, b) = segment(kind, a, b);
+            let mut stamped = FixedBitSet::with_capacity(f.len());
+            stamp_capsule(&mut stamped, &f, a, b, rt, &mut |_| {});
+            let mut runs = FixedBitSet::with_capacity(f.len());
+            let mut last_row = None;
+            capsule_runs(&f, a, b, rt, |row, c0, c1| {
+                assert!(last_row.is_none_or(|r| r < row), "rows out of order");
+                assert!(c0 <= c1 && c1 < f.width && row < f.height);
+                last_row = Some(row);
+                runs.insert_range(row * f.width + c0..row * f.width + c1 + 1);
+            });
+            prop_assert_eq!(&runs, &stamped);
+            for row in 0..f.height {
+                for col in 0..f.width {
+                    let q = f.pixel_center_grid(col, row);
+                    let inside = point_segment_dist2(q, a, b) <= rt * rt;
+                    prop_assert_eq!(runs.contains(f.index(col, row)), inside, "pixel {} {}", col, row);
+                }
+            }
+        }
     }
 }

@@ -15,6 +15,12 @@
 //! obstacle in two steps bends once, on the side away from the obstacle), when both new moves
 //! are free, the path grows by at most one turn's cost and the floor still holds; the spans
 //! are dropped once more after that.
+//!
+//! Cost: capsules are kept as row runs ([`crate::raster::capsule_runs`], the pixels the metric
+//! stamps), once per move of the plan and per candidate move (with its free-move check); a
+//! span's loss is counted over those runs; and a start's best span is evaluated again only when
+//! its chain changed (its version) or a count under its moves changed (tracked per block of
+//! [`BLOCK`] x [`BLOCK`] pixels), since otherwise the evaluation would give the same span.
 
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
@@ -43,19 +49,71 @@ struct Pruner<'a, 'b> {
     next: Vec<usize>,
     alive: Vec<bool>,
     version: Vec<u32>,
-    /// Segments of the plan covering each pixel.
+    /// Segments of the plan covering each pixel, plus [`OFF_FLOOR`] for the pixels off the
+    /// accessible floor once touched (so a count equals a span's count only on the floor).
     cnt: Vec<u32>,
-    /// Scratch: segments of the span under evaluation covering each pixel.
+    /// Scratch: segments of the span under evaluation covering each pixel (zero between
+    /// evaluations).
     tmp: Vec<u32>,
-    /// The pixels of the move from each vertex to the next, once computed (cleared when the
-    /// move changes).
-    seg: Vec<Vec<u32>>,
-    /// Scratch: the pixels of a candidate move.
-    chord: Vec<usize>,
+    /// The pixels of the move from each vertex to the next as row runs, once computed (cleared
+    /// when the move changes).
+    seg: Vec<Vec<Run>>,
+    /// The blocks ([`BLOCK`] pixels square) `[row0, row1, col0, col1]` (inclusive) holding
+    /// each cached `seg`.
+    seg_box: Vec<[u32; 4]>,
+    /// Blocks per block row.
+    blocks_w: usize,
+    /// The drop during which each block's counts last changed (see `epoch`).
+    changed: Vec<u32>,
+    /// Drops so far in this round of [`Pruner::drop_spans`] (plus one per round).
+    epoch: u32,
+    /// Each vertex's last evaluated span: its `version`, the `epoch` it saw, the blocks it read
+    /// and the result (valid while its version holds and no block of it changed).
+    memo: Vec<Option<Memo>>,
+    /// Each vertex's candidate moves evaluated so far (their points may have changed since).
+    chords: Vec<Vec<Chord>>,
     acc: &'a FixedBitSet,
     covered: usize,
-    scratch: FixedBitSet,
     rt: f64,
+}
+
+/// A candidate move from a vertex to a later one `w`: its points, its pixels, and whether it is
+/// free on the map once asked.
+struct Chord {
+    w: usize,
+    p0: Point,
+    p1: Point,
+    runs: Vec<Run>,
+    free: Option<bool>,
+}
+
+/// The pixels `base..base + len` (one row's run of a capsule).
+#[derive(Clone, Copy)]
+struct Run {
+    base: u32,
+    len: u32,
+}
+
+impl Run {
+    fn pixels(self) -> std::ops::Range<usize> {
+        let b = self.base as usize;
+        b..b + self.len as usize
+    }
+}
+
+/// Added to the count of a pixel off the accessible floor (more than any count of segments).
+const OFF_FLOOR: u32 = 1 << 31;
+
+/// Side of the square blocks of pixels whose count changes are tracked.
+const BLOCK: usize = 16;
+
+/// A remembered [`Pruner::best_from`] result (see `Pruner::memo`).
+#[derive(Clone, Copy)]
+struct Memo {
+    version: u32,
+    epoch: u32,
+    bbox: [u32; 4],
+    best: Option<Span>,
 }
 
 /// A span to drop: the vertices strictly between `u` and `w`.
@@ -67,22 +125,51 @@ struct Span {
 }
 
 impl Pruner<'_, '_> {
-    /// Pixels of the capsule `a`-`b` (each once).
-    fn capsule(&mut self, a: Point, b: Point, out: &mut Vec<usize>) {
-        let start = out.len();
-        crate::raster::stamp_capsule(
-            &mut self.scratch,
-            &self.ctx.frame,
-            a,
-            b,
-            self.rt,
-            &mut |i| {
-                out.push(i);
-            },
-        );
-        for &i in &out[start..] {
-            self.scratch.set(i, false);
+    /// Pixels of the capsule `a`-`b` as row runs (each pixel once), appended to `out`.
+    fn capsule(&self, a: Point, b: Point, out: &mut Vec<Run>) {
+        let w = self.ctx.frame.width;
+        crate::raster::capsule_runs(&self.ctx.frame, a, b, self.rt, |row, c0, c1| {
+            out.push(Run {
+                base: (row * w + c0) as u32,
+                len: (c1 - c0 + 1) as u32,
+            });
+        });
+    }
+
+    /// The index in `chords[u]` of the move from `u` to `w` at their current points (added
+    /// when new).
+    fn chord(&mut self, u: usize, w: usize) -> usize {
+        let (p0, p1) = (self.pts[u], self.pts[w]);
+        if let Some(j) = self.chords[u]
+            .iter()
+            .position(|c| c.w == w && c.p0 == p0 && c.p1 == p1)
+        {
+            return j;
         }
+        // Forget the moves to dropped vertices or from or to moved points.
+        let (alive, pts) = (&self.alive, &self.pts);
+        self.chords[u].retain(|c| alive[c.w] && c.p0 == p0 && c.p1 == pts[c.w]);
+        let mut runs = Vec::new();
+        self.capsule(p0, p1, &mut runs);
+        self.chords[u].push(Chord {
+            w,
+            p0,
+            p1,
+            runs,
+            free: None,
+        });
+        self.chords[u].len() - 1
+    }
+
+    /// Is the move `chords[u][j]` free on the true map (asked once)?
+    fn chord_free(&mut self, u: usize, j: usize) -> bool {
+        let c = &self.chords[u][j];
+        if let Some(f) = c.free {
+            return f;
+        }
+        let f = self.ctx.free(c.p0, c.p1);
+        self.chords[u][j].free = Some(f);
+        f
     }
 
     fn turn_at(&self, a: usize, b: usize, c: usize) -> i32 {
@@ -99,19 +186,43 @@ impl Pruner<'_, '_> {
     }
 
     /// The cheapest span starting at `u` (lost pixels per saved turn), if any saves a turn.
-    fn best_from(
-        &mut self,
-        u: usize,
-        touched: &mut Vec<usize>,
-        buf: &mut Vec<usize>,
-    ) -> Option<Span> {
+    ///
+    /// The result depends on the chain around `u` (its `version` changes with it) and on the
+    /// counts of the pixels of its segments: it is evaluated again only when one of those
+    /// changed since the last evaluation.
+    fn best_from(&mut self, u: usize) -> Option<Span> {
         if !self.alive[u] {
             return None;
         }
+        if let Some(m) = self.memo[u] {
+            if m.version == self.version[u] && !self.changed_since(m.bbox, m.epoch) {
+                return m.best;
+            }
+        }
+        let (best, bbox) = self.eval_from(u);
+        self.memo[u] = Some(Memo {
+            version: self.version[u],
+            epoch: self.epoch,
+            bbox,
+            best,
+        });
+        best
+    }
+
+    /// Has any block of `bbox` changed after `epoch`?
+    fn changed_since(&self, bbox: [u32; 4], epoch: u32) -> bool {
+        let [r0, r1, c0, c1] = bbox.map(|x| x as usize);
+        (r0..=r1).any(|r| {
+            self.changed[r * self.blocks_w + c0..=r * self.blocks_w + c1]
+                .iter()
+                .any(|&e| e > epoch)
+        })
+    }
+
+    /// [`Pruner::best_from`] evaluated, with the blocks of the pixels it read.
+    fn eval_from(&mut self, u: usize) -> (Option<Span>, [u32; 4]) {
+        let mut bbox = [u32::MAX, 0, u32::MAX, 0];
         let pu = self.prev[u];
-        touched.clear();
-        let mut chord = std::mem::take(&mut self.chord);
-        let chord = &mut chord;
         let mut only = 0usize;
         let mut best: Option<Span> = None;
         // Turns of the chain from u: at u (with pu), and inside.
@@ -119,22 +230,27 @@ impl Pruner<'_, '_> {
         let mut v = u;
         let mut a = self.next[u];
         if a == NONE {
-            return None;
+            return (None, [0, 0, 0, 0]);
         }
         for k in 0..=MAX_SPAN {
             // Add segment v -> a.
-            let seg = self.segment(v, buf);
-            for &i in &seg {
-                let i = i as usize;
-                if self.tmp[i] == 0 {
-                    touched.push(i);
-                }
-                self.tmp[i] += 1;
-                if self.tmp[i] == self.cnt[i] && self.acc.contains(i) {
-                    only += 1;
+            let seg = self.segment(v);
+            for r in &seg {
+                let px = r.pixels();
+                for (t, &c) in self.tmp[px.clone()].iter_mut().zip(&self.cnt[px]) {
+                    *t += 1;
+                    only += usize::from(*t == c);
                 }
             }
+
             self.seg[v] = seg;
+            let sb = self.seg_box[v];
+            bbox = [
+                bbox[0].min(sb[0]),
+                bbox[1].max(sb[1]),
+                bbox[2].min(sb[2]),
+                bbox[3].max(sb[3]),
+            ];
             before += self.turn_at(self.prev[v], v, a);
             let w = a;
             if k >= 1 {
@@ -143,62 +259,111 @@ impl Pruner<'_, '_> {
                 let after = self.turn_at(pu, u, w) + self.turn_at(u, w, nw);
                 let saved = b - after;
                 if saved > 0 {
-                    let (p0, p1) = (self.pts[u], self.pts[w]);
                     // The pixels only the span sweeps, less those the new move sweeps.
-                    chord.clear();
-                    self.capsule(p0, p1, chord);
-                    let kept = chord
-                        .iter()
-                        .filter(|&&i| {
-                            self.tmp[i] > 0 && self.cnt[i] == self.tmp[i] && self.acc.contains(i)
-                        })
-                        .count();
+                    let j = self.chord(u, w);
+                    let mut kept = 0;
+                    for r in &self.chords[u][j].runs {
+                        let px = r.pixels();
+                        for (&t, &c) in self.tmp[px.clone()].iter().zip(&self.cnt[px]) {
+                            kept += usize::from(t == c) & usize::from(t != 0);
+                        }
+                    }
                     let lost = only - kept;
                     let key = (lost as u64 * 1024) / saved as u64;
                     // The shorter span on ties.
-                    if best.is_none_or(|s| key < s.key) && self.ctx.free(p0, p1) {
+                    if best.is_none_or(|s| key < s.key) && self.chord_free(u, j) {
                         best = Some(Span { key, w, lost });
                     }
                 }
             }
             v = a;
             a = self.next[a];
-            if a == NONE {
+            // No longer span beats a span that loses nothing (ties go to the shorter).
+            if a == NONE || best.is_some_and(|s| s.key == 0) {
                 break;
             }
         }
-        for &i in touched.iter() {
-            self.tmp[i] = 0;
+        // Clear the scratch counts over the segments just added (u up to v, exclusive).
+        let mut x = u;
+        while x != v {
+            for r in &self.seg[x] {
+                self.tmp[r.pixels()].fill(0);
+            }
+            x = self.next[x];
         }
-        self.chord = std::mem::take(chord);
-        best
+        if bbox[0] > bbox[1] {
+            // No pixel read.
+            bbox = [0, 0, 0, 0];
+        }
+        (best, bbox)
     }
 
     /// The pixels of the move from `v` to the next vertex (taken out of the cache: put back
     /// into `self.seg[v]`).
-    fn segment(&mut self, v: usize, buf: &mut Vec<usize>) -> Vec<u32> {
+    fn segment(&mut self, v: usize) -> Vec<Run> {
         let mut seg = std::mem::take(&mut self.seg[v]);
         if seg.is_empty() {
-            buf.clear();
             let (p, q) = (self.pts[v], self.pts[self.next[v]]);
-            self.capsule(p, q, buf);
-            seg.extend(buf.iter().map(|&i| i as u32));
+            self.capsule(p, q, &mut seg);
+            self.seg_box[v] = self.blocks_of(&seg);
         }
         seg
     }
 
-    fn add(&mut self, a: Point, b: Point, up: bool, buf: &mut Vec<usize>) {
+    /// The blocks `[row0, row1, col0, col1]` holding the pixels of `runs` (all zero when
+    /// there are none).
+    fn blocks_of(&self, runs: &[Run]) -> [u32; 4] {
+        let w = self.ctx.frame.width;
+        let mut b = [u32::MAX, 0, u32::MAX, 0];
+        for r in runs {
+            let i = r.base as usize;
+            let (row, c0) = (i / w, i % w);
+            let c1 = c0 + r.len as usize - 1;
+            let (br, b0, b1) = (
+                (row / BLOCK) as u32,
+                (c0 / BLOCK) as u32,
+                (c1 / BLOCK) as u32,
+            );
+            b = [b[0].min(br), b[1].max(br), b[2].min(b0), b[3].max(b1)];
+        }
+        if b[0] > b[1] {
+            [0, 0, 0, 0]
+        } else {
+            b
+        }
+    }
+
+    /// Adds (`up`) or removes the move `a -> b` from the counts.
+    fn add(&mut self, a: Point, b: Point, up: bool, buf: &mut Vec<Run>) {
         buf.clear();
         self.capsule(a, b, buf);
-        for &i in buf.iter() {
+        self.apply(buf, up);
+    }
+
+    /// Adds (`up`) or removes a move with the pixels `runs` from the counts.
+    fn apply(&mut self, runs: &[Run], up: bool) {
+        let w = self.ctx.frame.width;
+        for r in runs {
+            let i = r.base as usize;
+            let (row, c0) = (i / w, i % w);
+            let c1 = c0 + r.len as usize - 1;
+            let at = row / BLOCK * self.blocks_w;
+            self.changed[at + c0 / BLOCK..=at + c1 / BLOCK].fill(self.epoch);
+        }
+        for i in runs.iter().flat_map(|r| r.pixels()) {
             if up {
-                if self.cnt[i] == 0 && self.acc.contains(i) {
-                    self.covered += 1;
+                if self.cnt[i] == 0 {
+                    if self.acc.contains(i) {
+                        self.covered += 1;
+                    } else {
+                        self.cnt[i] = OFF_FLOOR;
+                    }
                 }
                 self.cnt[i] += 1;
             } else {
+                // Off the floor the count stays at least OFF_FLOOR.
                 self.cnt[i] -= 1;
-                if self.cnt[i] == 0 && self.acc.contains(i) {
+                if self.cnt[i] == 0 {
                     self.covered -= 1;
                 }
             }
@@ -228,17 +393,14 @@ fn corner(u: Point, v1: Point, v2: Point, w: Point, reach: f64) -> Option<Point>
 
 impl Pruner<'_, '_> {
     /// The greedy span drops of the module docs while the plan sweeps at least `need` pixels.
-    fn drop_spans(
-        &mut self,
-        need: usize,
-        starts: impl Iterator<Item = usize>,
-        touched: &mut Vec<usize>,
-        buf: &mut Vec<usize>,
-    ) {
+    fn drop_spans(&mut self, need: usize, starts: impl Iterator<Item = usize>) {
+        // A new round: forget the evaluations of the last one (points may have moved).
+        self.memo.fill(None);
+        self.epoch += 1;
         // (key, start vertex, its version)
         let mut heap: BinaryHeap<Reverse<(u64, usize, u32)>> = BinaryHeap::new();
         for u in starts {
-            if let Some(s) = self.best_from(u, touched, buf) {
+            if let Some(s) = self.best_from(u) {
                 heap.push(Reverse((s.key, u, self.version[u])));
             }
         }
@@ -246,7 +408,7 @@ impl Pruner<'_, '_> {
             if !self.alive[u] || ver != self.version[u] {
                 continue;
             }
-            let Some(s) = self.best_from(u, touched, buf) else {
+            let Some(s) = self.best_from(u) else {
                 continue;
             };
             if s.key > k {
@@ -256,22 +418,26 @@ impl Pruner<'_, '_> {
             if s.lost > 0 && self.covered - s.lost < need {
                 continue;
             }
+            self.epoch += 1;
             // Drop the vertices strictly between u and w.
-            let (pu, pw) = (self.pts[u], self.pts[s.w]);
             let mut v = u;
             while v != s.w {
                 let a = self.next[v];
-                let (p, q) = (self.pts[v], self.pts[a]);
-                self.add(p, q, false, buf);
+                let seg = self.segment(v);
+                self.apply(&seg, false);
                 if v != u {
                     self.alive[v] = false;
+                    self.chords[v] = Vec::new();
                 }
                 v = a;
             }
-            self.add(pu, pw, true, buf);
+            let j = self.chord(u, s.w);
+            let runs = self.chords[u][j].runs.clone();
+            self.apply(&runs, true);
             self.next[u] = s.w;
             self.prev[s.w] = u;
-            self.seg[u].clear();
+            self.seg_box[u] = self.blocks_of(&runs);
+            self.seg[u] = runs;
             // Re-evaluate the spans whose turns or segments changed: those starting up to
             // MAX_SPAN + 1 vertices before u, at u, and at w.
             let mut starts = vec![s.w];
@@ -285,7 +451,7 @@ impl Pruner<'_, '_> {
             }
             for x in starts {
                 self.version[x] = self.version[x].wrapping_add(1);
-                if let Some(s) = self.best_from(x, touched, buf) {
+                if let Some(s) = self.best_from(x) {
                     heap.push(Reverse((s.key, x, self.version[x])));
                 }
             }
@@ -301,7 +467,7 @@ impl Pruner<'_, '_> {
         need: usize,
         max_extra: f64,
         touched: &mut Vec<usize>,
-        buf: &mut Vec<usize>,
+        buf: &mut Vec<Run>,
     ) -> Vec<usize> {
         let rt2 = self.rt * self.rt;
         let mut merged = Vec::new();
@@ -333,7 +499,7 @@ impl Pruner<'_, '_> {
             for (a, b) in [(pu, p1), (p1, p2), (p2, pw)] {
                 buf.clear();
                 self.capsule(a, b, buf);
-                for &i in buf.iter() {
+                for i in buf.iter().flat_map(|r| r.pixels()) {
                     if self.tmp[i] == 0 {
                         touched.push(i);
                     }
@@ -344,8 +510,7 @@ impl Pruner<'_, '_> {
                 .iter()
                 .filter(|&&i| {
                     let c = self.centre(i);
-                    self.acc.contains(i)
-                        && self.cnt[i] == self.tmp[i]
+                    self.cnt[i] == self.tmp[i]
                         && point_segment_dist2(c, pu, x) > rt2
                         && point_segment_dist2(c, x, pw) > rt2
                 })
@@ -408,10 +573,14 @@ pub(super) fn prune(ctx: &Ctx<'_>, items: Vec<Item>, floor: f64, max_extra: f64)
         cnt: vec![0; frame.len()],
         tmp: vec![0; frame.len()],
         seg: vec![Vec::new(); n],
-        chord: Vec::new(),
+        seg_box: vec![[0; 4]; n],
+        blocks_w: frame.width.div_ceil(BLOCK),
+        changed: vec![0; frame.width.div_ceil(BLOCK) * frame.height.div_ceil(BLOCK)],
+        epoch: 0,
+        memo: vec![None; n],
+        chords: (0..n).map(|_| Vec::new()).collect(),
         acc,
         covered: 0,
-        scratch: FixedBitSet::with_capacity(frame.len()),
         rt: ctx.rt + crate::raster::SWEEP_EPS_PX,
         pts,
     };
@@ -420,11 +589,12 @@ pub(super) fn prune(ctx: &Ctx<'_>, items: Vec<Item>, floor: f64, max_extra: f64)
     let p0 = pr.pts[0];
     pr.add(p0, p0, true, &mut buf);
     for i in 0..n - 1 {
-        let (a, b) = (pr.pts[i], pr.pts[i + 1]);
-        pr.add(a, b, true, &mut buf);
+        let seg = pr.segment(i);
+        pr.apply(&seg, true);
+        pr.seg[i] = seg;
     }
     let need = (floor * acc.count_ones(..) as f64).ceil() as usize;
-    pr.drop_spans(need, 0..n, &mut touched, &mut buf);
+    pr.drop_spans(need, 0..n);
     if max_extra > 0.0 {
         let merged = pr.merge_corners(need, max_extra, &mut touched, &mut buf);
         // Merged corners open new straight moves: the spans starting near them.
@@ -446,7 +616,7 @@ pub(super) fn prune(ctx: &Ctx<'_>, items: Vec<Item>, floor: f64, max_extra: f64)
         starts.sort_unstable();
         starts.dedup();
         starts.retain(|&x| x != NONE);
-        pr.drop_spans(need, starts.into_iter(), &mut touched, &mut buf);
+        pr.drop_spans(need, starts.into_iter());
     }
     // The items again: each vertex's first move at its (possibly moved) point, its repeats
     // and the dropped vertices' moves left out, the marks kept.
