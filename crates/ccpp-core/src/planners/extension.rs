@@ -70,6 +70,14 @@
 //! leaving stops once it reaches [`ExtensionOptions::leave_fraction`] of the known free floor.
 //! The search for the next rim goes on where the last one stopped (the robot has not moved).
 //!
+//! Judged one at a time, a far cluster of specks is always driven: seen from the next speck,
+//! each lies on the way. So a chunk that does not pay on its own is judged together with the
+//! chunks planned after it (nearest first from the robot, up to
+//! [`ExtensionOptions::leave_group`]): the group is left when its pixels do not pay for its
+//! tour (first trip, walks, the straight ways between them) plus the way on to the chunk after
+//! it, less the direct trip there. On the 14 shared maps the final clean-up had spent 0.08 of
+//! the ideal path on trips to rims of at most 3 pixels (on `rmf_office_scan` 0.18).
+//!
 //! ```text
 //!   robot R, rims a (1 px, 9 m away, the next rim b beyond it) and c (3 px, 12 m away, last)
 //!
@@ -157,6 +165,10 @@ pub struct ExtensionOptions {
     /// Most of the known free floor (a fraction) the final clean-up may leave in chunks below
     /// [`Self::min_yield`].
     pub leave_fraction: f64,
+    /// Most chunks the final clean-up leaves together ([`Self::min_yield`] judged on their
+    /// pixels and tour as a whole): a cluster of specks far away is left as one even where
+    /// each speck, seen from the next, lies on the way; `1` judges each chunk alone.
+    pub leave_group: usize,
     /// Most of the known free floor (a fraction) that simplifying the wall passes may leave:
     /// a vertex of a pass whose straight replacement is known free and loses few of the
     /// pixels the pass gains is dropped (one turn fewer); `0` keeps every pixel.
@@ -174,6 +186,7 @@ impl Default for ExtensionOptions {
             merge_segments: true,
             min_yield: 0.05,
             leave_fraction: 0.002,
+            leave_group: 8,
             simplify_fraction: 0.0015,
             simplify_loss: 1.0,
         }
@@ -199,6 +212,12 @@ impl ExtensionOptions {
                     format!("must be a finite number >= 0, got {v}"),
                 ));
             }
+        }
+        if self.leave_group == 0 {
+            return Err(crate::options::OptionsError::new(
+                "extension.leave_group",
+                "must be at least 1, got 0".to_string(),
+            ));
         }
         for (field, v) in [
             ("extension.leave_fraction", self.leave_fraction),
@@ -1154,53 +1173,83 @@ impl Extension {
                 || cur.gained == 0
                 || cur.owed
                 || self.opts.min_yield <= 0.0
-                || self.pays(&cur, 2.0 * cur.trip_len(pos) + 2.0 * cur.walk_len(pos))
+                || self.pays(
+                    cur.gained,
+                    2.0 * cur.trip_len(pos) + 2.0 * cur.walk_len(pos),
+                )
             {
                 return cur;
             }
-            // Leave it for now and look on from here (the search goes on where it stopped).
-            let next = self.plan_chunk(known, pos, bounded, wanted, true);
-            // What leaving `cur` saves: its trip and walk and the way on from its end to the
-            // next rim (straight, a lower bound), less the longer trip to that rim from here.
-            let saving = if next.gained == 0 {
-                cur.trip_len(pos) + cur.walk_len(pos)
-            } else {
-                cur.trip_len(pos) + cur.walk_len(pos) + cur.end(pos).dist(next.start(pos))
-                    - next.trip_len(pos)
+            // Leave it, alone or together with the chunks planned after it (nearest first from
+            // here: the search goes on where it stopped) when those lie close together and far
+            // away — a cluster of specks whose trip does not pay as a whole although each
+            // speck, seen from the next one, is on the way.
+            let mut group = vec![cur];
+            let next = loop {
+                let next = self.plan_chunk(known, pos, bounded, wanted, true);
+                let gained: usize = group.iter().map(|c| c.gained).sum();
+                if !self.pays(gained, group_saving(pos, &group, &next)) {
+                    if self.charge(known, pos, &group) {
+                        break Some(next);
+                    }
+                    self.unclaim(&next);
+                    break None;
+                }
+                if group.len() >= self.opts.leave_group
+                    || next.gained == 0
+                    || next.owed
+                    || self.left + gained + next.gained > self.leave_budget(known)
+                {
+                    self.unclaim(&next);
+                    break None;
+                }
+                group.push(next);
             };
-            if self.pays(&cur, saving) || !self.charge(known, pos, &cur) {
-                self.unclaim(&next);
-                return cur;
-            }
+            let Some(next) = next else {
+                for c in &group[1..] {
+                    self.unclaim(c);
+                }
+                return group.swap_remove(0);
+            };
             cur = next;
         }
     }
 
     /// Does `chunk`'s walk gain at least [`ExtensionOptions::min_yield`] of what a full-width
     /// lane of `len` metres sweeps?
-    fn pays(&self, chunk: &Chunk, len: f64) -> bool {
+    fn pays(&self, gained: usize, len: f64) -> bool {
         let res = self.frame.resolution;
-        chunk.gained as f64 * res * res >= self.opts.min_yield * 2.0 * self.rt * res * len
+        gained as f64 * res * res >= self.opts.min_yield * 2.0 * self.rt * res * len
     }
 
-    /// Counts `chunk` (planned from world point `pos`) as left when the budget
+    /// The known free floor [`ExtensionOptions::leave_fraction`] allows the final clean-up
+    /// to leave, in pixels.
+    fn leave_budget(&self, known: &KnownMap) -> usize {
+        (self.opts.leave_fraction * self.known_free_count(known) as f64) as usize
+    }
+
+    /// Counts the chunks of `group` (planned from world point `pos`) as left when the budget
     /// ([`ExtensionOptions::leave_fraction`]) allows; whether it did.
-    fn charge(&mut self, known: &KnownMap, pos: Point, chunk: &Chunk) -> bool {
-        // Charged: the walk's pixels and the targets the way there would sweep on the side
-        // (specks too small for a pass of their own, which leaving the trip leaves as well).
+    fn charge(&mut self, known: &KnownMap, pos: Point, group: &[Chunk]) -> bool {
+        // Charged: the walks' pixels and the targets the ways there would sweep on the side
+        // (specks too small for a pass of their own, which leaving the trips leaves as well).
         let f = self.frame;
-        let way: Vec<Point> = std::iter::once(pos)
-            .chain(chunk.transfer.iter().copied())
-            .map(|p| f.world_to_grid(p))
-            .collect();
-        let side: Vec<usize> = self.polyline_gains(known, &way).concat();
-        let charged = chunk.gained + side.len();
-        let budget = self.opts.leave_fraction * self.known_free_count(known) as f64;
-        if (self.left + charged) as f64 > budget {
+        let mut side: Vec<usize> = Vec::new();
+        for chunk in group {
+            let way: Vec<Point> = std::iter::once(pos)
+                .chain(chunk.transfer.iter().copied())
+                .map(|p| f.world_to_grid(p))
+                .collect();
+            side.extend(self.polyline_gains(known, &way).concat());
+        }
+        side.sort_unstable();
+        side.dedup();
+        let charged = group.iter().map(|c| c.gained).sum::<usize>() + side.len();
+        if self.left + charged > self.leave_budget(known) {
             return false;
         }
         self.left += charged;
-        // Left with it: no later pass goes out for them alone.
+        // Left with them: no later pass goes out for them alone.
         for i in side {
             self.swept.insert(i);
         }
@@ -1209,8 +1258,19 @@ impl Extension {
 
     /// Gives the pixels `chunk` claimed back (it will not be driven now).
     fn unclaim(&mut self, chunk: &Chunk) {
+        let f = self.frame;
+        let (w, h) = (f.width as i64, f.height as i64);
+        let reach = self.strip_rows.len() as i64 - 1;
         for &i in &chunk.claimed {
             self.swept.set(i, false);
+            // Positions the searches since judged without these targets may gain again.
+            let (c, r) = self.px_of(i);
+            let (c0, c1) = ((c - reach).max(0), (c + reach).min(w - 1));
+            for row in (r - reach).max(0)..=(r + reach).min(h - 1) {
+                let base = row as usize * f.width;
+                self.no_gain
+                    .remove_range(base + c0 as usize..base + c1 as usize + 1);
+            }
         }
     }
 
@@ -1586,6 +1646,25 @@ pub(crate) fn polyline_len(from: Point, pts: &[Point]) -> f64 {
             d
         })
         .sum()
+}
+
+/// The path leaving `group` saves (chunks planned from world point `pos`, nearest first),
+/// with `next` the chunk planned after them: their tour (the first trip, the walks and the
+/// straight ways between them, a lower bound) and the way on from the last to `next`, less
+/// the (longer) trip from `pos` to `next`.
+fn group_saving(pos: Point, group: &[Chunk], next: &Chunk) -> f64 {
+    let mut tour = group[0].trip_len(pos);
+    for (k, c) in group.iter().enumerate() {
+        if k > 0 {
+            tour += group[k - 1].end(pos).dist(c.start(pos));
+        }
+        tour += c.walk_len(pos);
+    }
+    if next.gained == 0 {
+        return tour;
+    }
+    let last = group[group.len() - 1].end(pos);
+    tour + last.dist(next.start(pos)) - next.trip_len(pos)
 }
 
 /// Number of bits `a..b` set in `free` and clear in `swept`.
