@@ -321,6 +321,11 @@ fn config_values_go_through_the_same_validation() {
             "bsa_extended.extension.simplify_loss",
         ),
         (
+            "ba_star_extended: { extension: { corner_slack: -0.5 } }",
+            "ba-star-extended",
+            "ba_star_extended.extension.corner_slack",
+        ),
+        (
             "ba_star_extended: { extension: { leave_group: 0 } }",
             "ba-star-extended",
             "ba_star_extended.extension.leave_group",
@@ -411,7 +416,8 @@ fn config_values_go_through_the_same_validation() {
     let turns = |m: &serde_json::Value| m["turns"].as_u64().unwrap();
     assert!(turns(&runs[1]) < turns(&runs[0]), "{} {}", runs[0], runs[1]);
     // The extension's wall-pass simplification, through the same file: switching it off
-    // (`simplify_fraction: 0`, or `simplify_loss: 0`) changes the run of each extended planner.
+    // (`simplify_fraction: 0`, or `simplify_loss: 0`), or the squared corners
+    // (`corner_slack: 0`), changes the run of each extended planner.
     let by_cfg = |planner: &str, name: &str, text: &str| {
         let cfg = dir.join(format!("{name}.yaml"));
         std::fs::write(&cfg, text).unwrap();
@@ -438,6 +444,20 @@ fn config_values_go_through_the_same_validation() {
             assert_ne!(off.1, base.1, "{planner} {field}: 0 changed nothing");
             assert_eq!(off.0["collisions"], 0);
         }
+        // Squared corners: none (`0`) against a generous slack (`1`; the default 0.1 finds
+        // nothing to square on this small map).
+        let corners = |v: &str| {
+            by_cfg(
+                planner,
+                &format!("{section}_corner_slack_{v}"),
+                &format!("{section}: {{ extension: {{ corner_slack: {v} }} }}\n"),
+            )
+        };
+        let (off, wide) = (corners("0"), corners("1"));
+        assert_ne!(off.1, wide.1, "{planner} corner_slack changed nothing");
+        let turns = |m: &serde_json::Value| m["turns"].as_u64().unwrap();
+        assert!(turns(&wide.0) <= turns(&off.0), "{} {}", off.0, wide.0);
+        assert_eq!(wide.0["collisions"], 0);
     }
 }
 

@@ -42,6 +42,20 @@
 //!    cut with a free-and-still-sweeps check per merged segment; a segment blocked by a
 //!    wiggle of the wall at one point may still reach one a few points farther). A diagonal
 //!    wall is then one segment, not a staircase.
+//!    **Square corners** ([`ExtensionOptions::corner_slack`]): round a corner at clearance 0
+//!    and the centre draws an arc, merged into several short segments (one turn each). Up to
+//!    4 such vertices become the point where the segment before and the segment after meet
+//!    (`a..b` below becomes `a X b`), when both new segments are known free, every pixel the
+//!    pass swept along the arc stays within the tool radius, and the way grows by at most
+//!    `corner_slack` robot radii per turn saved:
+//!
+//!    ```text
+//!      a----p             a-------X
+//!            \                    |
+//!             q       ->          |
+//!             |                   |
+//!             b                   b
+//!    ```
 //!    **Simplify** ([`ExtensionOptions::simplify_fraction`]): a vertex of the merged chunk
 //!    (trip and walk, the seam between them included) is dropped when the straight way
 //!    between its neighbours is known free and leaves at most a tool radius of the walk's
@@ -176,6 +190,11 @@ pub struct ExtensionOptions {
     /// Most pixels one dropped vertex may lose, in tool radii of pixels (see
     /// [`Self::simplify_fraction`]).
     pub simplify_loss: f64,
+    /// Square corners: where a pass rounds a corner in several short segments, up to 4 of its
+    /// vertices become the one point where the straight segments before and after meet (known
+    /// free, no pixel of the pass lost), when the way grows by at most this many robot radii
+    /// per turn saved; `0` keeps the rounded corners.
+    pub corner_slack: f64,
 }
 
 impl Default for ExtensionOptions {
@@ -189,6 +208,7 @@ impl Default for ExtensionOptions {
             leave_group: 8,
             simplify_fraction: 0.0015,
             simplify_loss: 1.0,
+            corner_slack: 0.1,
         }
     }
 }
@@ -205,6 +225,7 @@ impl ExtensionOptions {
             ("extension.leave_fraction", self.leave_fraction),
             ("extension.simplify_fraction", self.simplify_fraction),
             ("extension.simplify_loss", self.simplify_loss),
+            ("extension.corner_slack", self.corner_slack),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(crate::options::OptionsError::new(
@@ -391,6 +412,9 @@ const MAX_MERGE: usize = 256;
 /// How many points past the first one a merged segment cannot reach the merge still tries
 /// (a wiggle of the wall may block one point while a farther one is in sight).
 const MERGE_LOOK: usize = 8;
+
+/// Most vertices [`Extension::square_corners`] replaces by one.
+const CORNER_RUN: usize = 4;
 
 /// Longest walk of one chunk, in pixel steps.
 const MAX_WALK: usize = 20_000;
@@ -1391,11 +1415,19 @@ impl Extension {
         } else {
             (1..pts.len()).collect()
         };
-        let split = kept.partition_point(|&k| k <= nt);
-        let (t, w) = kept.split_at(split);
+        let verts: Vec<(usize, Point)> = std::iter::once(0)
+            .chain(kept)
+            .map(|k| (k, pts[k]))
+            .collect();
+        let verts = if self.opts.merge_segments && self.opts.corner_slack > 0.0 {
+            self.square_corners(known, &gains, verts)
+        } else {
+            verts
+        };
+        let split = verts.partition_point(|v| v.0 <= nt);
         Chunk {
-            transfer: t.iter().map(|&k| self.world(pts[k])).collect(),
-            sweep: w.iter().map(|&k| self.world(pts[k])).collect(),
+            transfer: verts[1..split].iter().map(|v| self.world(v.1)).collect(),
+            sweep: verts[split..].iter().map(|v| self.world(v.1)).collect(),
             gained: gains.iter().map(Vec::len).sum(),
             claimed: gains.iter().flatten().copied().collect(),
             owed: self.any_owed && gains.iter().flatten().any(|&i| self.owed.contains(i)),
@@ -1428,6 +1460,70 @@ impl Extension {
             }
             out.push(b);
             a = b;
+        }
+        out
+    }
+
+    /// Square corners: where the merged chunk rounds a corner (the contour at clearance 0 is an
+    /// arc there, several short segments), a run of up to [`CORNER_RUN`] vertices is replaced
+    /// by the one point where the segment entering it and the segment leaving it meet, when
+    /// both new segments are known free, every pixel the walk gained along the run that the
+    /// chunk still sweeps stays within the tool radius, and the way grows by at most
+    /// [`ExtensionOptions::corner_slack`] robot radii per turn saved. Takes and returns the
+    /// vertices (index of the walk point each replaces last, grid point), the robot's position
+    /// first.
+    fn square_corners(
+        &self,
+        known: &KnownMap,
+        gains: &[Vec<usize>],
+        mut out: Vec<(usize, Point)>,
+    ) -> Vec<(usize, Point)> {
+        let rt2 = self.rt * self.rt;
+        let slack = self.opts.corner_slack * self.r / self.frame.resolution;
+        let near = |c: Point, poly: &[Point]| {
+            poly.windows(2)
+                .any(|s| point_segment_dist2(c, s[0], s[1]) <= rt2)
+        };
+        let mut i = 1;
+        while i + 2 < out.len() {
+            let mut replaced = false;
+            for j in (i + 1..=(i + CORNER_RUN - 1).min(out.len() - 2)).rev() {
+                let (a, p, q, b) = (out[i - 1].1, out[i].1, out[j].1, out[j + 1].1);
+                let (d1, d2) = (p - a, b - q);
+                let cross = d1.x * d2.y - d1.y * d2.x;
+                if cross.abs() < 1e-9 {
+                    continue;
+                }
+                // a + t d1 = q + s d2.
+                let w = q - a;
+                let t = (w.x * d2.y - w.y * d2.x) / cross;
+                let s = (w.x * d1.y - w.y * d1.x) / cross;
+                if t < 1.0 - 1e-9 || s > 1e-9 {
+                    continue;
+                }
+                let x = Point::new(a.x + t * d1.x, a.y + t * d1.y);
+                let old: Vec<Point> = out[i - 1..=j + 1].iter().map(|v| v.1).collect();
+                let old_len: f64 = old.windows(2).map(|s| s[0].dist(s[1])).sum();
+                let new = [a, x, b];
+                if a.dist(x) + x.dist(b) - old_len > slack * (j - i) as f64 {
+                    continue;
+                }
+                let keeps = gains[out[i - 1].0 + 1..=out[j + 1].0].iter().all(|g| {
+                    g.iter().all(|&k| {
+                        let c = self.center(self.px_of(k));
+                        !near(c, &old) || near(c, &new)
+                    })
+                });
+                if keeps && self.seg_free(known, a, x) && self.seg_free(known, x, b) {
+                    let last = out[j].0;
+                    out.splice(i..=j, [(last, x)]);
+                    replaced = true;
+                    break;
+                }
+            }
+            if !replaced {
+                i += 1;
+            }
         }
         out
     }

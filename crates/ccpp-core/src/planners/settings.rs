@@ -119,6 +119,8 @@ struct ExtensionSection {
     simplify_fraction: Option<f64>,
     #[serde(default, deserialize_with = "present")]
     simplify_loss: Option<f64>,
+    #[serde(default, deserialize_with = "present")]
+    corner_slack: Option<f64>,
 }
 
 impl ExtensionSection {
@@ -134,6 +136,7 @@ impl ExtensionSection {
             leave_group: self.leave_group.unwrap_or(base.leave_group),
             simplify_fraction: self.simplify_fraction.unwrap_or(base.simplify_fraction),
             simplify_loss: self.simplify_loss.unwrap_or(base.simplify_loss),
+            corner_slack: self.corner_slack.unwrap_or(base.corner_slack),
         }
     }
 }
