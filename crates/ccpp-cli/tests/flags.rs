@@ -306,6 +306,27 @@ fn config_values_go_through_the_same_validation() {
             "bsa-extended",
             "bsa_extended.extension.simplify_loss",
         ),
+        (
+            "ba_star_extended: { extension: { corner_slack: -0.5 } }",
+            "ba-star-extended",
+            "ba_star_extended.extension.corner_slack",
+        ),
+        (
+            "ba_star_extended: { extension: { leave_group: 0 } }",
+            "ba-star-extended",
+            "ba_star_extended.extension.leave_group",
+        ),
+        (
+            "bsa_extended: { extension: { leave_group: 0 } }",
+            "bsa-extended",
+            "bsa_extended.extension.leave_group",
+        ),
+        // An extension option given to a planner without the extension is an unknown key.
+        (
+            "ba_star: { extension: { leave_group: 2 } }",
+            "ba-star",
+            "extension",
+        ),
         // Options the rebuilt bsa-extended dropped are unknown keys now, refused by name.
         ("bsa_extended: { gap_cost: 4 }", "bsa-extended", "gap_cost"),
         (
@@ -381,7 +402,8 @@ fn config_values_go_through_the_same_validation() {
     let turns = |m: &serde_json::Value| m["turns"].as_u64().unwrap();
     assert!(turns(&runs[1]) < turns(&runs[0]), "{} {}", runs[0], runs[1]);
     // The extension's wall-pass simplification, through the same file: switching it off
-    // (`simplify_fraction: 0`, or `simplify_loss: 0`) changes the run of each extended planner.
+    // (`simplify_fraction: 0`, or `simplify_loss: 0`), or the squared corners
+    // (`corner_slack: 0`), changes the run of each extended planner.
     let by_cfg = |planner: &str, name: &str, text: &str| {
         let cfg = dir.join(format!("{name}.yaml"));
         std::fs::write(&cfg, text).unwrap();
@@ -408,6 +430,20 @@ fn config_values_go_through_the_same_validation() {
             assert_ne!(off.1, base.1, "{planner} {field}: 0 changed nothing");
             assert_eq!(off.0["collisions"], 0);
         }
+        // Squared corners: none (`0`) against a generous slack (`1`; the default 0.1 finds
+        // nothing to square on this small map).
+        let corners = |v: &str| {
+            by_cfg(
+                planner,
+                &format!("{section}_corner_slack_{v}"),
+                &format!("{section}: {{ extension: {{ corner_slack: {v} }} }}\n"),
+            )
+        };
+        let (off, wide) = (corners("0"), corners("1"));
+        assert_ne!(off.1, wide.1, "{planner} corner_slack changed nothing");
+        let turns = |m: &serde_json::Value| m["turns"].as_u64().unwrap();
+        assert!(turns(&wide.0) <= turns(&off.0), "{} {}", off.0, wide.0);
+        assert_eq!(wide.0["collisions"], 0);
     }
 }
 
@@ -677,4 +713,36 @@ fn bench_max_memory_turns_runs_into_error_rows() {
     let free = bench("free", &[], true);
     assert!(!free.contains("memory limit"), "{free}");
     assert_eq!(free.matches(",ok,").count(), 2, "{free}");
+}
+
+/// `leave_group` (the final clean-up judges a cluster of specks as one) changes the run end to
+/// end: on `teb_empty_box` judging each chunk alone (`leave_group: 1`) drives to specks that
+/// the default leaves, for a longer path; the floor stays above 99.5 % either way.
+#[test]
+fn leave_group_changes_the_extended_run() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = common::data("teb_empty_box.yaml");
+    let cfg = dir.join("alone.yaml");
+    std::fs::write(
+        &cfg,
+        "ba_star_extended: { extension: { leave_group: 1 } }\n",
+    )
+    .unwrap();
+    let grouped = run_ok(dir, "grouped", &map, "ba-star-extended", &[]);
+    let alone = run_ok(
+        dir,
+        "alone",
+        &map,
+        "ba-star-extended",
+        &["--config", cfg.to_str().unwrap()],
+    );
+    assert_ne!(trace(&grouped), trace(&alone));
+    let (g, a) = (metrics(&grouped), metrics(&alone));
+    let len = |m: &serde_json::Value| m["path_length_m"].as_f64().unwrap();
+    assert!(len(&g) < len(&a), "{g} {a}");
+    for m in [&g, &a] {
+        assert_eq!(m["collisions"], 0);
+        assert!(m["effective_coverage"].as_f64().unwrap() >= 0.995, "{m}");
+    }
 }

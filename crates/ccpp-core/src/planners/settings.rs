@@ -114,9 +114,13 @@ struct ExtensionSection {
     #[serde(default, deserialize_with = "present")]
     leave_fraction: Option<f64>,
     #[serde(default, deserialize_with = "present")]
+    leave_group: Option<usize>,
+    #[serde(default, deserialize_with = "present")]
     simplify_fraction: Option<f64>,
     #[serde(default, deserialize_with = "present")]
     simplify_loss: Option<f64>,
+    #[serde(default, deserialize_with = "present")]
+    corner_slack: Option<f64>,
 }
 
 impl ExtensionSection {
@@ -129,8 +133,10 @@ impl ExtensionSection {
             merge_segments: self.merge_segments.unwrap_or(base.merge_segments),
             min_yield: self.min_yield.unwrap_or(base.min_yield),
             leave_fraction: self.leave_fraction.unwrap_or(base.leave_fraction),
+            leave_group: self.leave_group.unwrap_or(base.leave_group),
             simplify_fraction: self.simplify_fraction.unwrap_or(base.simplify_fraction),
             simplify_loss: self.simplify_loss.unwrap_or(base.simplify_loss),
+            corner_slack: self.corner_slack.unwrap_or(base.corner_slack),
         }
     }
 }
