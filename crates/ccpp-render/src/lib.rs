@@ -1102,6 +1102,23 @@ impl LaneBlitter {
     }
 }
 
+/// The position of a trace's last pose, read from its last stored piece holding poses
+/// (without unrolling every pose).
+fn last_position(trace: &Trace) -> Option<Point> {
+    let lattice = trace.lattice();
+    trace
+        .pieces()
+        .filter_map(|piece| match piece {
+            Piece::Pose { pose, .. } => Some(pose.position()),
+            Piece::Run(run) => {
+                let [x, y] = run.to(lattice);
+                Some(Point::new(x, y))
+            }
+            Piece::Event { .. } => None,
+        })
+        .last()
+}
+
 fn draw_markers(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
     let rad = (world.robot().radius / world.frame().resolution) as f32 * view.scale;
     let m = rad.clamp(3.0, 14.0);
@@ -1109,49 +1126,51 @@ fn draw_markers(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
         width: (m / 4.0).max(1.5),
         ..Stroke::default()
     };
+    // Each kind of marker as one path, drawn in one call (critical squares, then restart
+    // circles, then collision crosses): thousands of markers on a large map cost one stroke.
+    let mut critical = PathBuilder::new();
+    let mut restart = PathBuilder::new();
+    let mut collision = PathBuilder::new();
     for (_, e) in trace.events() {
         match e {
             Event::CriticalPoint { x, y } => {
                 let (cx, cy) = view.to_canvas(world, Point::new(*x, *y));
                 if let Some(r) = Rect::from_xywh(cx - m * 0.4, cy - m * 0.4, m * 0.8, m * 0.8) {
-                    pm.fill_rect(
-                        r,
-                        &paint(rgb(colours::CRITICAL)),
-                        Transform::identity(),
-                        None,
-                    );
+                    critical.push_rect(r);
                 }
             }
             Event::StartPoint { x, y } => {
                 let (cx, cy) = view.to_canvas(world, Point::new(*x, *y));
-                if let Some(c) = PathBuilder::from_circle(cx, cy, m * 0.6) {
-                    pm.stroke_path(
-                        &c,
-                        &paint(rgb(colours::RESTART)),
-                        &stroke,
-                        Transform::identity(),
-                        None,
-                    );
-                }
+                restart.push_circle(cx, cy, m * 0.6);
             }
             Event::Collision { x, y } => {
                 let (cx, cy) = view.to_canvas(world, Point::new(*x, *y));
-                let mut pb = PathBuilder::new();
-                pb.move_to(cx - m, cy - m);
-                pb.line_to(cx + m, cy + m);
-                pb.move_to(cx - m, cy + m);
-                pb.line_to(cx + m, cy - m);
-                if let Some(p) = pb.finish() {
-                    pm.stroke_path(
-                        &p,
-                        &paint(rgb(colours::COLLISION)),
-                        &stroke,
-                        Transform::identity(),
-                        None,
-                    );
-                }
+                collision.move_to(cx - m, cy - m);
+                collision.line_to(cx + m, cy + m);
+                collision.move_to(cx - m, cy + m);
+                collision.line_to(cx + m, cy - m);
             }
             _ => {}
+        }
+    }
+    if let Some(p) = critical.finish() {
+        pm.fill_path(
+            &p,
+            &paint(rgb(colours::CRITICAL)),
+            FillRule::Winding,
+            Transform::identity(),
+            None,
+        );
+    }
+    for (pb, colour) in [(restart, colours::RESTART), (collision, colours::COLLISION)] {
+        if let Some(p) = pb.finish() {
+            pm.stroke_path(
+                &p,
+                &paint(rgb(colour)),
+                &stroke,
+                Transform::identity(),
+                None,
+            );
         }
     }
     // Start and end.
@@ -1181,8 +1200,8 @@ fn draw_markers(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
             None,
         );
     }
-    if let Some(end) = trace.poses().last() {
-        let (ex, ey) = view.to_canvas(world, end.position());
+    if let Some(end) = last_position(trace) {
+        let (ex, ey) = view.to_canvas(world, end);
         if let Some(c) = PathBuilder::from_circle(ex, ey, rad.max(4.0)) {
             pm.stroke_path(
                 &c,
