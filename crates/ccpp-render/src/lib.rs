@@ -966,7 +966,7 @@ struct LaneBlitter {
 }
 
 /// Largest bounding box (pixels) of a group of lane rectangles blended at once.
-const LANE_GROUP_PX: f32 = (1 << 20) as f32;
+const LANE_GROUP_PX: f32 = (1 << 18) as f32;
 
 impl LaneBlitter {
     /// Fills the axis-aligned segments of `run` (butt ends at the run's two ends, square
@@ -1102,6 +1102,54 @@ impl LaneBlitter {
     }
 }
 
+/// Markers drawn per batch (see [`MarkerBatch`]).
+const MARKER_BATCH: usize = 256;
+
+/// Markers of one kind gathered into one path, drawn (filled, or stroked with `stroke`) every
+/// [`MARKER_BATCH`] markers and at the end.
+struct MarkerBatch {
+    path: PathBuilder,
+    n: usize,
+    colour: [u8; 3],
+    stroke: Option<Stroke>,
+}
+
+impl MarkerBatch {
+    fn new(colour: [u8; 3], stroke: Option<Stroke>) -> Self {
+        Self {
+            path: PathBuilder::new(),
+            n: 0,
+            colour,
+            stroke,
+        }
+    }
+
+    /// Adds one marker (`shape` draws it into the path).
+    fn add(&mut self, pm: &mut Pixmap, shape: impl FnOnce(&mut PathBuilder)) {
+        shape(&mut self.path);
+        self.n += 1;
+        if self.n == MARKER_BATCH {
+            self.flush(pm);
+        }
+    }
+
+    fn flush(&mut self, pm: &mut Pixmap) {
+        self.n = 0;
+        let Some(path) = std::mem::take(&mut self.path).finish() else {
+            return;
+        };
+        let p = paint(rgb(self.colour));
+        match &self.stroke {
+            Some(stroke) => pm.stroke_path(&path, &p, stroke, Transform::identity(), None),
+            None => pm.fill_path(&path, &p, FillRule::Winding, Transform::identity(), None),
+        }
+    }
+
+    fn draw(mut self, pm: &mut Pixmap) {
+        self.flush(pm);
+    }
+}
+
 /// The position of a trace's last pose, read from its last stored piece holding poses
 /// (without unrolling every pose).
 fn last_position(trace: &Trace) -> Option<Point> {
@@ -1126,52 +1174,38 @@ fn draw_markers(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
         width: (m / 4.0).max(1.5),
         ..Stroke::default()
     };
-    // Each kind of marker as one path, drawn in one call (critical squares, then restart
-    // circles, then collision crosses): thousands of markers on a large map cost one stroke.
-    let mut critical = PathBuilder::new();
-    let mut restart = PathBuilder::new();
-    let mut collision = PathBuilder::new();
+    // The markers of one kind drawn a batch of [`MARKER_BATCH`] at a time, one path each
+    // (critical squares, then restart circles, then collision crosses): thousands of markers
+    // on a large map cost a few calls, and the stroker's outline stays small.
+    let mut critical = MarkerBatch::new(colours::CRITICAL, None);
+    let mut restart = MarkerBatch::new(colours::RESTART, Some(stroke.clone()));
+    let mut collision = MarkerBatch::new(colours::COLLISION, Some(stroke.clone()));
     for (_, e) in trace.events() {
         match e {
             Event::CriticalPoint { x, y } => {
                 let (cx, cy) = view.to_canvas(world, Point::new(*x, *y));
                 if let Some(r) = Rect::from_xywh(cx - m * 0.4, cy - m * 0.4, m * 0.8, m * 0.8) {
-                    critical.push_rect(r);
+                    critical.add(pm, |pb| pb.push_rect(r));
                 }
             }
             Event::StartPoint { x, y } => {
                 let (cx, cy) = view.to_canvas(world, Point::new(*x, *y));
-                restart.push_circle(cx, cy, m * 0.6);
+                restart.add(pm, |pb| pb.push_circle(cx, cy, m * 0.6));
             }
             Event::Collision { x, y } => {
                 let (cx, cy) = view.to_canvas(world, Point::new(*x, *y));
-                collision.move_to(cx - m, cy - m);
-                collision.line_to(cx + m, cy + m);
-                collision.move_to(cx - m, cy + m);
-                collision.line_to(cx + m, cy - m);
+                collision.add(pm, |pb| {
+                    pb.move_to(cx - m, cy - m);
+                    pb.line_to(cx + m, cy + m);
+                    pb.move_to(cx - m, cy + m);
+                    pb.line_to(cx + m, cy - m);
+                });
             }
             _ => {}
         }
     }
-    if let Some(p) = critical.finish() {
-        pm.fill_path(
-            &p,
-            &paint(rgb(colours::CRITICAL)),
-            FillRule::Winding,
-            Transform::identity(),
-            None,
-        );
-    }
-    for (pb, colour) in [(restart, colours::RESTART), (collision, colours::COLLISION)] {
-        if let Some(p) = pb.finish() {
-            pm.stroke_path(
-                &p,
-                &paint(rgb(colour)),
-                &stroke,
-                Transform::identity(),
-                None,
-            );
-        }
+    for batch in [critical, restart, collision] {
+        batch.draw(pm);
     }
     // Start and end.
     let s = world.initial_pose();
