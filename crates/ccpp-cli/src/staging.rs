@@ -5,7 +5,9 @@
 //! folder (if any) is renamed to `.<name>.ccpp-old-<pid>-<n>`, the staging folder is renamed to
 //! `<name>`, and the old folder is removed. A reader therefore sees the old complete set or the
 //! new complete set (for an instant, between the two renames, no folder), never a mix and never
-//! a `.tmp` file.
+//! a `.tmp` file. Each staged file is synced to disk on a thread of its own as soon as it is
+//! written (the disk's latency overlaps the work on the next file); the swap waits for all of
+//! them, so the folder that appears is on disk whole.
 //!
 //! On SIGINT/SIGTERM the handler waits for a swap in progress to finish, removes every staging
 //! folder and temporary file still registered, and exits with status 130. Folders left by a
@@ -217,6 +219,9 @@ pub struct Staging {
     parent: PathBuf,
     name: String,
     done: bool,
+    /// The files written, each being synced to disk on its own thread (so the disk's latency
+    /// overlaps the next file's work); [`Staging::commit`] waits for all before the swap.
+    syncs: Mutex<Vec<(String, std::thread::JoinHandle<std::io::Result<()>>)>>,
 }
 
 impl Staging {
@@ -256,6 +261,7 @@ impl Staging {
             parent,
             name,
             done: false,
+            syncs: Mutex::new(Vec::new()),
         })
     }
 
@@ -277,7 +283,7 @@ impl Staging {
         name: &str,
         fill: &mut dyn FnMut(&mut dyn std::io::Write) -> std::io::Result<()>,
     ) -> Result<()> {
-        write_file_with(&self.dir.join(name), fill).map_err(|e| {
+        let file = write_file_with(&self.dir.join(name), fill, true).map_err(|e| {
             // Name the file where it would have gone, not its staging copy.
             let shown = self.target.join(name);
             match e {
@@ -286,7 +292,28 @@ impl Staging {
                 }
                 other => anyhow::anyhow!("cannot write {}: {other}", shown.display()),
             }
-        })
+        })?;
+        if let Some(file) = file {
+            let sync = std::thread::spawn(move || file.sync_all());
+            lock(&self.syncs).push((name.to_string(), sync));
+        }
+        Ok(())
+    }
+
+    /// Waits until every file written is on disk.
+    fn wait_synced(&self) -> Result<()> {
+        let syncs = std::mem::take(&mut *lock(&self.syncs));
+        let mut first_error = None;
+        for (name, sync) in syncs {
+            let r = sync
+                .join()
+                .unwrap_or_else(|_| Err(std::io::Error::other("sync thread panicked")));
+            if let (Err(e), None) = (r, &first_error) {
+                let shown = self.target.join(name);
+                first_error = Some(anyhow::anyhow!("cannot write {}: {e}", shown.display()));
+            }
+        }
+        first_error.map_or(Ok(()), Err)
     }
 
     /// Moves the staging folder into place, replacing the old target folder.
@@ -294,6 +321,7 @@ impl Staging {
     /// # Errors
     /// When a rename fails; the old folder is then put back where possible.
     pub fn commit(mut self) -> Result<()> {
+        self.wait_synced()?;
         let n = COUNTER.fetch_add(1, Ordering::Relaxed);
         let old = self.parent.join(format!(
             ".{}.ccpp-old-{}-{n}",
@@ -343,25 +371,34 @@ impl Drop for Staging {
 /// # Errors
 /// When the file cannot be written.
 pub fn write_file(path: &Path, bytes: &[u8]) -> Result<(), ccpp_io::WriteError> {
-    write_file_with(path, &mut |w| w.write_all(bytes))
+    write_file_with(path, &mut |w| w.write_all(bytes), false).map(drop)
 }
 
 /// [`write_file`] of what `fill` writes.
+/// Writes the file at `path` atomically with what `fill` writes, synced before it is renamed
+/// into place; or, `deferred`, renamed unsynced and returned for the caller to sync (a file of
+/// a staging folder, which becomes visible only with the folder).
 fn write_file_with(
     path: &Path,
     fill: &mut dyn FnMut(&mut dyn std::io::Write) -> std::io::Result<()>,
-) -> Result<(), ccpp_io::WriteError> {
+    deferred: bool,
+) -> Result<Option<std::fs::File>, ccpp_io::WriteError> {
     let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+    let write = |fill: &mut dyn FnMut(&mut dyn std::io::Write) -> std::io::Result<()>| {
+        if deferred {
+            ccpp_io::write::write_atomic_unsynced_with(path, fill).map(Some)
+        } else {
+            ccpp_io::write::write_atomic_with(path, fill).map(|()| None)
+        }
+    };
     if std::env::var_os(FAIL_WRITE_ENV).is_some_and(|v| v == name) {
-        return ccpp_io::write::write_atomic_with(path, |_| {
-            Err(std::io::Error::from_raw_os_error(28))
-        });
+        return write(&mut |_| Err(std::io::Error::from_raw_os_error(28)));
     }
     let mut tmp = path.as_os_str().to_owned();
     tmp.push(".tmp");
     let tmp = PathBuf::from(tmp);
     register(&tmp);
-    let r = ccpp_io::write::write_atomic_with(path, fill);
+    let r = write(fill);
     unregister(&tmp);
     r
 }

@@ -91,6 +91,13 @@ pub struct Metrics {
 /// segment in force (the last [`Event::PlannedSegment`] before them); `None` when the trace has
 /// no planned segment (ideal execution).
 pub fn tracking_error(trace: &Trace) -> Option<(f64, f64)> {
+    // Without a planned segment no pose counts (the events alone tell, without the poses).
+    if !trace
+        .events()
+        .any(|(_, e)| matches!(e, Event::PlannedSegment { .. }))
+    {
+        return None;
+    }
     let mut seg: Option<(Point, Point)> = None;
     let (mut sum, mut max, mut n) = (0.0, 0.0f64, 0usize);
     for r in trace.entries() {
@@ -266,19 +273,24 @@ pub fn coverage_curve(world: &World, trace: &Trace, samples: usize) -> Vec<[f64;
     out
 }
 
-/// Tile entries along a polyline (Amanatides-Woo traversal); a corner crossing is one entry.
-fn tile_entries(grid: &TileGrid, trace: &Trace, mut visit: impl FnMut(Tile)) {
-    let mut poses = trace.poses();
-    let Some(first) = poses.next() else { return };
-    let mut cur = grid.tile_of(first.position());
-    visit(cur);
-    let mut prev = first.position();
-    for p in poses {
-        let a = prev;
-        let b = p.position();
-        prev = b;
+/// Tile entries along a polyline (Amanatides-Woo traversal), fed one point at a time; a
+/// corner crossing is one entry.
+struct TileWalk {
+    /// The tile of the last point and the last point (`None` before the first).
+    at: Option<(Tile, Point)>,
+}
+
+impl TileWalk {
+    /// Visits the tiles entered on the way to `b` (the first point's own tile for the first).
+    fn to(&mut self, grid: &TileGrid, b: Point, mut visit: impl FnMut(Tile)) {
+        let Some((mut cur, a)) = self.at else {
+            let t = grid.tile_of(b);
+            visit(t);
+            self.at = Some((t, b));
+            return;
+        };
         if a == b {
-            continue;
+            return;
         }
         let target = grid.tile_of(b);
         // Positions in tile units, tile (i, j) spans [i - 0.5, i + 0.5].
@@ -344,6 +356,7 @@ fn tile_entries(grid: &TileGrid, trace: &Trace, mut visit: impl FnMut(Tile)) {
             cur = target;
             visit(cur);
         }
+        self.at = Some((cur, b));
     }
 }
 
@@ -453,48 +466,55 @@ fn compute_rest(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
     let robot = world.robot();
     let trace = &run.trace;
 
-    // Path length, turns, rotation.
+    // One pass over the poses and events: path length, turns, rotation; regions, backtracks,
+    // collisions, backtrack length (poses between start/end marks); tile entries for the
+    // revisit rate (planner tile side, else 2 r_tool; the coverage rate is computed beside
+    // this).
+    let two_rt = 2.0 * robot.tool_radius;
+    let start = world.start().position();
+    let side = run.tile_side.unwrap_or(two_rt);
+    let grid = TileGrid::new(start, side);
+    let (i0, i1, j0, j1) = grid.bounds_for(world);
+    let mut distinct = TileSet::new(i0, i1, j0, j1);
+    let mut entries = 0usize;
+    let mut walk = TileWalk { at: None };
     let mut path_length = 0.0;
     let mut turns = 0u32;
     let mut rotation = 0.0;
     let mut in_turn = false;
-    let mut poses = trace.poses();
-    let mut prev = poses.next();
-    for b in poses {
-        let Some(a) = prev.replace(b) else { break };
-        let d = a.position().dist(b.position());
-        if d > 0.0 {
-            path_length += d;
-            in_turn = false;
-        } else {
-            let ang = wrap_angle(b.theta - a.theta).abs();
-            if ang > crate::sim::MIN_ROTATION {
-                rotation += ang;
-                if !in_turn {
-                    turns += 1;
-                    in_turn = true;
-                }
-            }
-        }
-    }
-
-    // Regions, backtracks, collisions, backtrack length (poses between start/end marks).
     let mut regions = 0u32;
     let mut backtracks = 0u32;
     let mut collisions = 0u32;
     let mut backtrack_length = 0.0;
     let mut in_backtrack = false;
-    let mut last: Option<Point> = None;
+    let mut prev: Option<Pose> = None;
     for r in trace.entries() {
         match r {
-            Entry::Pose { pose, .. } => {
-                let p = pose.position();
-                if in_backtrack {
-                    if let Some(l) = last {
-                        backtrack_length += l.dist(p);
+            Entry::Pose { pose: b, .. } => {
+                if let Some(a) = prev {
+                    let d = a.position().dist(b.position());
+                    if in_backtrack {
+                        backtrack_length += d;
+                    }
+                    if d > 0.0 {
+                        path_length += d;
+                        in_turn = false;
+                    } else {
+                        let ang = wrap_angle(b.theta - a.theta).abs();
+                        if ang > crate::sim::MIN_ROTATION {
+                            rotation += ang;
+                            if !in_turn {
+                                turns += 1;
+                                in_turn = true;
+                            }
+                        }
                     }
                 }
-                last = Some(p);
+                walk.to(&grid, b.position(), |t| {
+                    entries += 1;
+                    distinct.insert(t);
+                });
+                prev = Some(b);
             }
             Entry::Event { event, .. } => match event {
                 Event::RegionStart { .. } => regions += 1,
@@ -508,20 +528,6 @@ fn compute_rest(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
             },
         }
     }
-
-    // Tiles: revisit rate (planner tile side, else 2 r_tool); the coverage rate is computed
-    // beside this.
-    let two_rt = 2.0 * robot.tool_radius;
-    let start = world.start().position();
-    let side = run.tile_side.unwrap_or(two_rt);
-    let grid = TileGrid::new(start, side);
-    let (i0, i1, j0, j1) = grid.bounds_for(world);
-    let mut distinct = TileSet::new(i0, i1, j0, j1);
-    let mut entries = 0usize;
-    tile_entries(&grid, trace, |t| {
-        entries += 1;
-        distinct.insert(t);
-    });
     let nd = distinct.len();
     let revisit_rate = if nd == 0 {
         0.0

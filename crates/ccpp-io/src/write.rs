@@ -89,6 +89,37 @@ where
     Ok(())
 }
 
+/// [`write_atomic_with`] without waiting for the disk: the file is renamed into place unsynced
+/// and returned, for the caller to [`File::sync_all`] later (on another thread, or several
+/// files at once, before anything depends on the data being durable). For a file inside a
+/// folder that is itself moved into place only after that sync (the command line's staging
+/// folders), nothing is visible earlier than with [`write_atomic_with`].
+///
+/// # Errors
+/// As [`write_atomic_with`].
+pub fn write_atomic_unsynced_with<F>(path: &Path, fill: F) -> Result<File, WriteError>
+where
+    F: FnOnce(&mut dyn Write) -> io::Result<()>,
+{
+    let tmp = tmp_path(path)?;
+    let result = (|| {
+        let file = File::create(&tmp)?;
+        let mut w = BufWriter::new(file);
+        fill(&mut w)?;
+        let file = w.into_inner().map_err(io::IntoInnerError::into_error)?;
+        std::fs::rename(&tmp, path)?;
+        Ok(file)
+    })();
+    result.map_err(|source| {
+        // Best effort: the temporary may not even exist.
+        let _ = std::fs::remove_file(&tmp);
+        WriteError::Io {
+            path: path.to_path_buf(),
+            source,
+        }
+    })
+}
+
 /// Writes `bytes` to `path` atomically (see [`write_atomic_with`]).
 ///
 /// # Errors

@@ -757,17 +757,30 @@ pub fn coverage_pixmap_swept(
             .map(|x| (col0 + ((x as f32 + 0.5) / scale) as usize).min(frame.width - 1))
             .collect();
         let data = pm.data_mut();
+        let stride = cw as usize * 4;
+        // A canvas row showing the same map row as the one above, without keep-out hatching
+        // (which follows the canvas diagonal), is a copy of it.
+        let mut above: Option<(usize, bool)> = None;
         for y in 0..ch_map {
             let row = ((y as f32 + 0.5) / scale) as usize;
             let row = (row0 + row).min(frame.height - 1);
+            if above == Some((row, false)) {
+                let o = (y + header) as usize * stride;
+                data.copy_within(o - stride..o, o);
+                continue;
+            }
+            let mut hatched = false;
             for (x, &col) in (0..cw).zip(&cols) {
-                let c = colour_of(frame.index(col, row), x, y);
+                let i = frame.index(col, row);
+                hatched |= cells[i] == Cell::Free && zone_class(world, i) == 1;
+                let c = colour_of(i, x, y);
                 let o = (((y + header) * cw + x) * 4) as usize;
                 data[o] = c[0];
                 data[o + 1] = c[1];
                 data[o + 2] = c[2];
                 data[o + 3] = 255;
             }
+            above = Some((row, hatched));
         }
     }
     let view = View {
@@ -855,20 +868,21 @@ fn draw_path(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
     // Collect runs of segments with the same style, then stroke each run once.
     let mut run: Vec<(f32, f32)> = Vec::new();
     let mut run_style = (0usize, false);
-    let flush = |pm: &mut Pixmap, run: &mut Vec<(f32, f32)>, style: (usize, bool)| {
+    let mut lanes = LaneBlitter::default();
+    let mut flush = |pm: &mut Pixmap, run: &mut Vec<(f32, f32)>, style: (usize, bool)| {
         if run.len() >= 2 {
-            let mut pb = PathBuilder::new();
-            pb.move_to(run[0].0, run[0].1);
-            for &(x, y) in &run[1..] {
-                pb.line_to(x, y);
-            }
-            if let Some(path) = pb.finish() {
-                let mut stroke = Stroke {
-                    width,
-                    ..Stroke::default()
-                };
-                stroke.line_join = tiny_skia::LineJoin::Round;
-                let colour = if style.1 {
+            let mut stroke = Stroke {
+                width,
+                ..Stroke::default()
+            };
+            stroke.line_join = tiny_skia::LineJoin::Round;
+            if style.1 {
+                let mut pb = PathBuilder::new();
+                pb.move_to(run[0].0, run[0].1);
+                for &(x, y) in &run[1..] {
+                    pb.line_to(x, y);
+                }
+                if let Some(path) = pb.finish() {
                     let casing = Stroke {
                         width: width * 2.0,
                         ..stroke.clone()
@@ -881,11 +895,22 @@ fn draw_path(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
                         None,
                     );
                     stroke.dash = StrokeDash::new(vec![width * 4.0, width * 3.0], 0.0);
-                    rgb(colours::BACKTRACK)
-                } else {
-                    rgb(PALETTE[style.0.saturating_sub(1) % PALETTE.len()])
-                };
-                pm.stroke_path(&path, &paint(colour), &stroke, Transform::identity(), None);
+                    let colour = rgb(colours::BACKTRACK);
+                    pm.stroke_path(&path, &paint(colour), &stroke, Transform::identity(), None);
+                }
+            } else {
+                // A region's lanes: the axis-aligned segments (nearly all of a coverage path)
+                // are filled with their exact area coverage, the others stroked.
+                let colour = PALETTE[style.0.saturating_sub(1) % PALETTE.len()];
+                if let Some(path) = lanes.draw(pm, run, width, colour) {
+                    pm.stroke_path(
+                        &path,
+                        &paint(rgb(colour)),
+                        &stroke,
+                        Transform::identity(),
+                        None,
+                    );
+                }
             }
         }
         run.clear();
@@ -925,6 +950,223 @@ fn draw_path(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
     flush(pm, &mut run, run_style);
 }
 
+/// Draws the axis-aligned segments of a polyline stroke (a coverage path's lanes) as filled
+/// rectangles with exact area coverage: what an antialiased stroke of the same width looks
+/// like, at a fraction of the cost of stroking a polyline of thousands of turns. Consecutive
+/// segments' rectangles abut (the corner square goes to the segment before the turn), so a
+/// pixel's coverage is the sum of its parts, and each group of rectangles is blended once.
+#[derive(Default)]
+struct LaneBlitter {
+    /// Coverage of the current group's bounding box, row-major.
+    cov: Vec<f32>,
+    /// The current group: `[x0, y0, x1, y1]` canvas rectangles.
+    rects: Vec<[f32; 4]>,
+    /// The group's bounding box `[x0, y0, x1, y1]`.
+    bbox: [f32; 4],
+}
+
+/// Largest bounding box (pixels) of a group of lane rectangles blended at once.
+const LANE_GROUP_PX: f32 = (1 << 18) as f32;
+
+impl LaneBlitter {
+    /// Fills the axis-aligned segments of `run` (butt ends at the run's two ends, square
+    /// corners at its turns) in `colour`; returns the other segments as a path to stroke.
+    fn draw(
+        &mut self,
+        pm: &mut Pixmap,
+        run: &[(f32, f32)],
+        width: f32,
+        colour: [u8; 3],
+    ) -> Option<tiny_skia::Path> {
+        const AXIS_EPS: f32 = 1e-3;
+        let h = width / 2.0;
+        let mut pb = PathBuilder::new();
+        let mut pen: Option<(f32, f32)> = None;
+        let mut prev_axis = false;
+        let n = run.len() - 1;
+        for (k, w) in run.windows(2).enumerate() {
+            let (a, b) = (w[0], w[1]);
+            let horizontal = (a.1 - b.1).abs() < AXIS_EPS;
+            let vertical = (a.0 - b.0).abs() < AXIS_EPS;
+            if horizontal == vertical {
+                // A diagonal (or a point): stroked.
+                if pen != Some(a) {
+                    pb.move_to(a.0, a.1);
+                }
+                pb.line_to(b.0, b.1);
+                pen = Some(b);
+                prev_axis = false;
+                continue;
+            }
+            // Along the segment's axis: from `a` (pulled back over a diagonal's end, moved
+            // past the corner square a previous lane filled) to `b` (past the corner).
+            let (a0, b0, c) = if horizontal {
+                (a.0, b.0, a.1)
+            } else {
+                (a.1, b.1, a.0)
+            };
+            let s = if b0 > a0 { 1.0 } else { -1.0 };
+            let start = match (k, prev_axis) {
+                (0, _) => a0,
+                (_, true) => a0 + h * s,
+                (_, false) => a0 - h * s,
+            };
+            let end = if k + 1 == n { b0 } else { b0 + h * s };
+            prev_axis = true;
+            if (end - start) * s <= 0.0 {
+                continue;
+            }
+            let (lo, hi) = (start.min(end), start.max(end));
+            let rect = if horizontal {
+                [lo, c - h, hi, c + h]
+            } else {
+                [c - h, lo, c + h, hi]
+            };
+            self.push(pm, rect, colour);
+        }
+        self.blend(pm, colour);
+        pb.finish()
+    }
+
+    /// Adds a rectangle to the group (blending the group first when the box would grow
+    /// beyond [`LANE_GROUP_PX`]).
+    fn push(&mut self, pm: &mut Pixmap, r: [f32; 4], colour: [u8; 3]) {
+        let (w, h) = (pm.width() as f32, pm.height() as f32);
+        let r = [r[0].max(0.0), r[1].max(0.0), r[2].min(w), r[3].min(h)];
+        if r[0] >= r[2] || r[1] >= r[3] {
+            return;
+        }
+        if !self.rects.is_empty() {
+            let b = self.bbox;
+            let u = [
+                b[0].min(r[0]),
+                b[1].min(r[1]),
+                b[2].max(r[2]),
+                b[3].max(r[3]),
+            ];
+            if (u[2] - u[0] + 2.0) * (u[3] - u[1] + 2.0) > LANE_GROUP_PX {
+                self.blend(pm, colour);
+            } else {
+                self.bbox = u;
+            }
+        }
+        if self.rects.is_empty() {
+            self.bbox = r;
+        }
+        self.rects.push(r);
+    }
+
+    /// Blends the group's coverage in `colour` onto the canvas and empties the group.
+    fn blend(&mut self, pm: &mut Pixmap, colour: [u8; 3]) {
+        if self.rects.is_empty() {
+            return;
+        }
+        let b = self.bbox;
+        let (x0, y0) = (b[0].floor() as usize, b[1].floor() as usize);
+        let (x1, y1) = (b[2].ceil() as usize, b[3].ceil() as usize);
+        let bw = x1 - x0;
+        self.cov.clear();
+        self.cov.resize(bw * (y1 - y0), 0.0);
+        for r in &self.rects {
+            let (cx0, cx1) = (r[0].floor() as usize, r[2].ceil() as usize);
+            for py in r[1].floor() as usize..r[3].ceil() as usize {
+                let fy = r[3].min(py as f32 + 1.0) - r[1].max(py as f32);
+                let row = &mut self.cov[(py - y0) * bw..][..bw];
+                for px in cx0..cx1 {
+                    let fx = r[2].min(px as f32 + 1.0) - r[0].max(px as f32);
+                    row[px - x0] += fx * fy;
+                }
+            }
+        }
+        self.rects.clear();
+        let stride = pm.width() as usize * 4;
+        let data = pm.data_mut();
+        let c = colour.map(u32::from);
+        for (y, row) in (y0..y1).zip(self.cov.chunks_exact(bw)) {
+            let line = &mut data[y * stride + x0 * 4..][..bw * 4];
+            for (d, &a) in line.chunks_exact_mut(4).zip(row) {
+                if a <= 0.0 {
+                    continue;
+                }
+                if a >= 1.0 {
+                    d[..3].copy_from_slice(&colour);
+                    continue;
+                }
+                // Coverage in 1/255 steps; the blend rounded to nearest.
+                let a = (a * 255.0 + 0.5) as u32;
+                for (d, c) in d[..3].iter_mut().zip(c) {
+                    *d = ((u32::from(*d) * (255 - a) + c * a + 127) / 255) as u8;
+                }
+            }
+        }
+    }
+}
+
+/// Markers drawn per batch (see [`MarkerBatch`]).
+const MARKER_BATCH: usize = 256;
+
+/// Markers of one kind gathered into one path, drawn (filled, or stroked with `stroke`) every
+/// [`MARKER_BATCH`] markers and at the end.
+struct MarkerBatch {
+    path: PathBuilder,
+    n: usize,
+    colour: [u8; 3],
+    stroke: Option<Stroke>,
+}
+
+impl MarkerBatch {
+    fn new(colour: [u8; 3], stroke: Option<Stroke>) -> Self {
+        Self {
+            path: PathBuilder::new(),
+            n: 0,
+            colour,
+            stroke,
+        }
+    }
+
+    /// Adds one marker (`shape` draws it into the path).
+    fn add(&mut self, pm: &mut Pixmap, shape: impl FnOnce(&mut PathBuilder)) {
+        shape(&mut self.path);
+        self.n += 1;
+        if self.n == MARKER_BATCH {
+            self.flush(pm);
+        }
+    }
+
+    fn flush(&mut self, pm: &mut Pixmap) {
+        self.n = 0;
+        let Some(path) = std::mem::take(&mut self.path).finish() else {
+            return;
+        };
+        let p = paint(rgb(self.colour));
+        match &self.stroke {
+            Some(stroke) => pm.stroke_path(&path, &p, stroke, Transform::identity(), None),
+            None => pm.fill_path(&path, &p, FillRule::Winding, Transform::identity(), None),
+        }
+    }
+
+    fn draw(mut self, pm: &mut Pixmap) {
+        self.flush(pm);
+    }
+}
+
+/// The position of a trace's last pose, read from its last stored piece holding poses
+/// (without unrolling every pose).
+fn last_position(trace: &Trace) -> Option<Point> {
+    let lattice = trace.lattice();
+    trace
+        .pieces()
+        .filter_map(|piece| match piece {
+            Piece::Pose { pose, .. } => Some(pose.position()),
+            Piece::Run(run) => {
+                let [x, y] = run.to(lattice);
+                Some(Point::new(x, y))
+            }
+            Piece::Event { .. } => None,
+        })
+        .last()
+}
+
 fn draw_markers(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
     let rad = (world.robot().radius / world.frame().resolution) as f32 * view.scale;
     let m = rad.clamp(3.0, 14.0);
@@ -932,50 +1174,38 @@ fn draw_markers(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
         width: (m / 4.0).max(1.5),
         ..Stroke::default()
     };
+    // The markers of one kind drawn a batch of [`MARKER_BATCH`] at a time, one path each
+    // (critical squares, then restart circles, then collision crosses): thousands of markers
+    // on a large map cost a few calls, and the stroker's outline stays small.
+    let mut critical = MarkerBatch::new(colours::CRITICAL, None);
+    let mut restart = MarkerBatch::new(colours::RESTART, Some(stroke.clone()));
+    let mut collision = MarkerBatch::new(colours::COLLISION, Some(stroke.clone()));
     for (_, e) in trace.events() {
         match e {
             Event::CriticalPoint { x, y } => {
                 let (cx, cy) = view.to_canvas(world, Point::new(*x, *y));
                 if let Some(r) = Rect::from_xywh(cx - m * 0.4, cy - m * 0.4, m * 0.8, m * 0.8) {
-                    pm.fill_rect(
-                        r,
-                        &paint(rgb(colours::CRITICAL)),
-                        Transform::identity(),
-                        None,
-                    );
+                    critical.add(pm, |pb| pb.push_rect(r));
                 }
             }
             Event::StartPoint { x, y } => {
                 let (cx, cy) = view.to_canvas(world, Point::new(*x, *y));
-                if let Some(c) = PathBuilder::from_circle(cx, cy, m * 0.6) {
-                    pm.stroke_path(
-                        &c,
-                        &paint(rgb(colours::RESTART)),
-                        &stroke,
-                        Transform::identity(),
-                        None,
-                    );
-                }
+                restart.add(pm, |pb| pb.push_circle(cx, cy, m * 0.6));
             }
             Event::Collision { x, y } => {
                 let (cx, cy) = view.to_canvas(world, Point::new(*x, *y));
-                let mut pb = PathBuilder::new();
-                pb.move_to(cx - m, cy - m);
-                pb.line_to(cx + m, cy + m);
-                pb.move_to(cx - m, cy + m);
-                pb.line_to(cx + m, cy - m);
-                if let Some(p) = pb.finish() {
-                    pm.stroke_path(
-                        &p,
-                        &paint(rgb(colours::COLLISION)),
-                        &stroke,
-                        Transform::identity(),
-                        None,
-                    );
-                }
+                collision.add(pm, |pb| {
+                    pb.move_to(cx - m, cy - m);
+                    pb.line_to(cx + m, cy + m);
+                    pb.move_to(cx - m, cy + m);
+                    pb.line_to(cx + m, cy - m);
+                });
             }
             _ => {}
         }
+    }
+    for batch in [critical, restart, collision] {
+        batch.draw(pm);
     }
     // Start and end.
     let s = world.initial_pose();
@@ -1004,8 +1234,8 @@ fn draw_markers(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
             None,
         );
     }
-    if let Some(end) = trace.poses().last() {
-        let (ex, ey) = view.to_canvas(world, end.position());
+    if let Some(end) = last_position(trace) {
+        let (ex, ey) = view.to_canvas(world, end);
         if let Some(c) = PathBuilder::from_circle(ex, ey, rad.max(4.0)) {
             pm.stroke_path(
                 &c,
