@@ -1066,6 +1066,9 @@ impl Bcd {
         let cell_pieces = pieces;
         let cell_paths_all = paths;
         let mut best: Option<(usize, f64, Vec<Item>)> = None;
+        // The hop table and nearest-neighbour tour of the cells alone serve both plans.
+        let cell_table = hops::HopTable::new(&coarse, &far, &cell_pieces, start);
+        let cell_nn = cell_table.nearest_tour(&cell_pieces, start);
         for in_tour in [true, false] {
             if !opts.rim && !in_tour {
                 break;
@@ -1073,15 +1076,13 @@ impl Bcd {
             let mut pieces = cell_pieces.clone();
             let mut paths = cell_paths_all.clone();
             let contours: Vec<Vec<Point>> = if opts.rim && in_tour {
-                let table = hops::HopTable::new(&coarse, &far, &pieces, start);
-                let dist = |a: Point, b: Point| table.dist(a, b);
-                let nn = table.nearest_tour(&pieces, start);
+                let dist = |a: Point, b: Point| cell_table.dist(a, b);
                 let first = tsp::solve(
                     &pieces,
                     start,
                     opts.tour_rounds.min(FIRST_ROUNDS),
                     &dist,
-                    Some(nn),
+                    Some(cell_nn.clone()),
                 );
                 let mut keep = vec![0usize; ncells];
                 for &(c, v) in &first {
@@ -1123,9 +1124,16 @@ impl Bcd {
                     inner: vec![len, len],
                 });
             }
-            let table = hops::HopTable::new(&coarse, &far, &pieces, start);
+            // Only the rim-in-tour plan changes the pieces (one variant per cell, rim passes
+            // added); the other plan tours the cells alone.
+            let own =
+                (opts.rim && in_tour).then(|| hops::HopTable::new(&coarse, &far, &pieces, start));
+            let table = own.as_ref().unwrap_or(&cell_table);
             let dist = |a: Point, b: Point| table.dist(a, b);
-            let nn = table.nearest_tour(&pieces, start);
+            let nn = match &own {
+                Some(t) => t.nearest_tour(&pieces, start),
+                None => cell_nn.clone(),
+            };
             let tour = tsp::solve(&pieces, start, opts.tour_rounds, &dist, Some(nn));
 
             let mut items: Vec<Item> = vec![Item::Move(start)];
