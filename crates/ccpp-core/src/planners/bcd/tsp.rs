@@ -142,6 +142,29 @@ fn neighbour_lists(pieces: &[Piece], d: Dist<'_>) -> Vec<Vec<usize>> {
         }
         m
     };
+    // Bounding box of each piece's end points: its squared gap to another box is a lower
+    // bound of `gap` (rounding is monotone, so also in floating point), which skips most pairs
+    // once a piece's candidate list is full.
+    let boxes: Vec<[f64; 4]> = ends
+        .iter()
+        .map(|v| {
+            v.iter().fold(
+                [
+                    f64::INFINITY,
+                    f64::NEG_INFINITY,
+                    f64::INFINITY,
+                    f64::NEG_INFINITY,
+                ],
+                |b, p| [b[0].min(p.x), b[1].max(p.x), b[2].min(p.y), b[3].max(p.y)],
+            )
+        })
+        .collect();
+    let box_gap = |a: usize, b: usize| -> f64 {
+        let (p, q) = (&boxes[a], &boxes[b]);
+        let dx = (p[0] - q[1]).max(q[0] - p[1]).max(0.0);
+        let dy = (p[2] - q[3]).max(q[2] - p[3]).max(0.0);
+        dx * dx + dy * dy
+    };
     (0..pieces.len())
         .map(|a| {
             // The 3 * NEIGHBOURS nearest in a straight line, re-ranked by hop cost.
@@ -149,6 +172,10 @@ fn neighbour_lists(pieces: &[Piece], d: Dist<'_>) -> Vec<Vec<usize>> {
             let mut best: Vec<(f64, usize)> = Vec::with_capacity(keep + 1);
             for b in 0..pieces.len() {
                 if a == b {
+                    continue;
+                }
+                // (a pair is kept only when its gap is below the worst kept one)
+                if best.len() == keep && box_gap(a, b) >= best[keep - 1].0 {
                     continue;
                 }
                 let g = gap(a, b);
