@@ -59,16 +59,36 @@ pub(crate) fn solve(
         return tour;
     }
     let nb = neighbour_lists(pieces, d);
+    improve(pieces, start, rounds, d, &nb, &mut tour);
+    tour
+}
+
+/// The candidate neighbours of every piece that [`improve`] needs.
+pub(crate) fn neighbours(pieces: &[Piece], d: Dist<'_>) -> Vec<Vec<usize>> {
+    neighbour_lists(pieces, d)
+}
+
+/// Up to `rounds` improvement rounds of `tour` (module docs); true when a round left the cost
+/// unchanged (further rounds would change nothing), so that `k` rounds followed by `m` more
+/// (when this returned false) are the same as `k + m` rounds at once.
+pub(crate) fn improve(
+    pieces: &[Piece],
+    start: Point,
+    rounds: u32,
+    d: Dist<'_>,
+    nb: &[Vec<usize>],
+    tour: &mut Tour,
+) -> bool {
     for _ in 0..rounds {
-        let before = cost(pieces, start, &tour, d);
-        two_opt(pieces, start, &mut tour, &nb, d);
-        or_opt(pieces, start, &mut tour, &nb, d);
-        choose_variants(pieces, start, &mut tour, d);
-        if cost(pieces, start, &tour, d) >= before - EPS {
-            break;
+        let before = cost(pieces, start, tour, d);
+        two_opt(pieces, start, tour, nb, d);
+        or_opt(pieces, start, tour, nb, d);
+        choose_variants(pieces, start, tour, d);
+        if cost(pieces, start, tour, d) >= before - EPS {
+            return true;
         }
     }
-    tour
+    false
 }
 
 fn nearest_neighbour(pieces: &[Piece], start: Point, d: Dist<'_>) -> Tour {
