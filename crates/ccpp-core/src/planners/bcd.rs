@@ -1066,6 +1066,11 @@ impl Bcd {
         let cell_pieces = pieces;
         let cell_paths_all = paths;
         let mut best: Option<(usize, f64, Vec<Item>)> = None;
+        // The hop table and nearest-neighbour tour of the cells alone serve both plans.
+        let cell_table = hops::HopTable::new(&coarse, &far, &cell_pieces, start);
+        let cell_nn = cell_table.nearest_tour(&cell_pieces, start);
+        // The cells' tour after the first rounds, whether those settled it, and its neighbours.
+        let mut cell_tour: Option<(tsp::Tour, bool, Vec<Vec<usize>>)> = None;
         for in_tour in [true, false] {
             if !opts.rim && !in_tour {
                 break;
@@ -1073,16 +1078,14 @@ impl Bcd {
             let mut pieces = cell_pieces.clone();
             let mut paths = cell_paths_all.clone();
             let contours: Vec<Vec<Point>> = if opts.rim && in_tour {
-                let table = hops::HopTable::new(&coarse, &far, &pieces, start);
-                let dist = |a: Point, b: Point| table.dist(a, b);
-                let nn = table.nearest_tour(&pieces, start);
-                let first = tsp::solve(
-                    &pieces,
-                    start,
-                    opts.tour_rounds.min(FIRST_ROUNDS),
-                    &dist,
-                    Some(nn),
-                );
+                // The first rounds of the cells' tour, kept: the other plan goes on from there.
+                let dist = |a: Point, b: Point| cell_table.dist(a, b);
+                let nb = tsp::neighbours(&pieces, &dist);
+                let mut first = cell_nn.clone();
+                let rounds = opts.tour_rounds.min(FIRST_ROUNDS);
+                let settled =
+                    rounds > 0 && tsp::improve(&pieces, start, rounds, &dist, &nb, &mut first);
+                cell_tour = Some((first.clone(), settled, nb));
                 let mut keep = vec![0usize; ncells];
                 for &(c, v) in &first {
                     keep[c] = v / 2;
@@ -1123,10 +1126,45 @@ impl Bcd {
                     inner: vec![len, len],
                 });
             }
-            let table = hops::HopTable::new(&coarse, &far, &pieces, start);
+            // Only the rim-in-tour plan changes the pieces (one variant per cell, rim passes
+            // added); the other plan tours the cells alone.
+            let own =
+                (opts.rim && in_tour).then(|| hops::HopTable::new(&coarse, &far, &pieces, start));
+            let table = own.as_ref().unwrap_or(&cell_table);
             let dist = |a: Point, b: Point| table.dist(a, b);
-            let nn = table.nearest_tour(&pieces, start);
-            let tour = tsp::solve(&pieces, start, opts.tour_rounds, &dist, Some(nn));
+            let cont = if own.is_none() {
+                cell_tour.take()
+            } else {
+                None
+            };
+            let tour = match (&own, cont) {
+                (Some(t), _) => {
+                    let nn = t.nearest_tour(&pieces, start);
+                    tsp::solve(&pieces, start, opts.tour_rounds, &dist, Some(nn))
+                }
+                // (the rounds left after the first ones; none when they settled the tour)
+                (None, Some((mut tour, settled, nb))) => {
+                    let done = opts.tour_rounds.min(FIRST_ROUNDS);
+                    if !settled && opts.tour_rounds > done {
+                        tsp::improve(
+                            &pieces,
+                            start,
+                            opts.tour_rounds - done,
+                            &dist,
+                            &nb,
+                            &mut tour,
+                        );
+                    }
+                    tour
+                }
+                (None, None) => tsp::solve(
+                    &pieces,
+                    start,
+                    opts.tour_rounds,
+                    &dist,
+                    Some(cell_nn.clone()),
+                ),
+            };
 
             let mut items: Vec<Item> = vec![Item::Move(start)];
             let mut here = start;

@@ -15,9 +15,6 @@
 //! each of its end-point blocks: the path there less two far-block diagonals (the points can
 //! sit anywhere in their blocks), at least the radius and the straight line.
 
-use std::cmp::Reverse;
-use std::collections::BinaryHeap;
-
 use super::tsp;
 use super::Ctx;
 use crate::geometry::Point;
@@ -36,10 +33,24 @@ pub(super) struct Coarse {
     bw: usize,
     bh: usize,
     open: Vec<bool>,
-    /// Block joined to its east / south neighbour.
-    east: Vec<bool>,
-    south: Vec<bool>,
+    /// Per block: bit `i` set when the step [`DIRS`]`[i]` is allowed (see [`Coarse::step_mask`]).
+    mask: Vec<u8>,
 }
+
+/// The eight block steps (column, row): four side steps (cost 10), then four diagonals (14).
+const DIRS: [(i64, i64); 8] = [
+    (1, 0),
+    (0, 1),
+    (-1, 0),
+    (0, -1),
+    (1, 1),
+    (1, -1),
+    (-1, 1),
+    (-1, -1),
+];
+
+/// Buckets of the circular bucket queue: more than the largest step cost.
+const BUCKETS: usize = 16;
 
 impl Coarse {
     /// The grid of `ctx`'s C-free set in blocks of about `sp` pixels (at least 4).
@@ -65,14 +76,23 @@ impl Coarse {
                 }
             }
         }
-        Self {
+        let mut grid = Self {
             b,
             bw,
             bh,
             open,
-            east,
-            south,
-        }
+            mask: Vec::new(),
+        };
+        grid.mask = (0..bw * bh)
+            .map(|k| {
+                if grid.open[k] {
+                    grid.step_mask(k, &east, &south)
+                } else {
+                    0
+                }
+            })
+            .collect();
+        grid
     }
 
     /// The block of grid point `p` (grid y up; blocks count rows from the top).
@@ -86,32 +106,24 @@ impl Coarse {
         r * self.bw + c
     }
 
-    fn linked(&self, k: usize, dc: i64, dr: i64) -> bool {
+    fn linked(&self, east: &[bool], south: &[bool], k: usize, dc: i64, dr: i64) -> bool {
         match (dc, dr) {
-            (1, 0) => self.east[k],
-            (-1, 0) => self.east[k - 1],
-            (0, 1) => self.south[k],
-            (0, -1) => self.south[k - self.bw],
+            (1, 0) => east[k],
+            (-1, 0) => east[k - 1],
+            (0, 1) => south[k],
+            (0, -1) => south[k - self.bw],
             _ => false,
         }
     }
 
-    /// Block steps from block `k` (neighbour, cost in tenths of a block) that the grid allows.
-    fn steps(&self, k: usize, out: &mut Vec<(usize, u32)>) {
-        out.clear();
+    /// The block steps from block `k` that the grid allows, as a bit set over [`DIRS`]: a
+    /// side step needs the two blocks joined, a diagonal step one of its two side paths.
+    fn step_mask(&self, k: usize, east: &[bool], south: &[bool]) -> u8 {
         let bw = self.bw;
         let (c, r) = ((k % bw) as i64, (k / bw) as i64);
         let at = |c: i64, r: i64| r as usize * bw + c as usize;
-        for (dc, dr) in [
-            (1, 0),
-            (0, 1),
-            (-1, 0),
-            (0, -1),
-            (1, 1),
-            (1, -1),
-            (-1, 1),
-            (-1, -1),
-        ] {
+        let mut mask = 0u8;
+        for (i, &(dc, dr)) in DIRS.iter().enumerate() {
             let (nc, nr) = (c + dc, r + dr);
             if nc < 0 || nr < 0 || nc >= bw as i64 || nr >= self.bh as i64 {
                 continue;
@@ -120,17 +132,76 @@ impl Coarse {
             if !self.open[j] {
                 continue;
             }
-            if dc != 0 && dr != 0 {
+            let ok = if dc != 0 && dr != 0 {
                 let (vh, vv) = (at(nc, r), at(c, nr));
-                let a = self.open[vh] && self.linked(k, dc, 0) && self.linked(vh, 0, dr);
-                let b = self.open[vv] && self.linked(k, 0, dr) && self.linked(vv, dc, 0);
-                if a || b {
-                    out.push((j, 14));
-                }
-            } else if self.linked(k, dc, dr) {
-                out.push((j, 10));
+                let a = self.open[vh]
+                    && self.linked(east, south, k, dc, 0)
+                    && self.linked(east, south, vh, 0, dr);
+                let b = self.open[vv]
+                    && self.linked(east, south, k, 0, dr)
+                    && self.linked(east, south, vv, dc, 0);
+                a || b
+            } else {
+                self.linked(east, south, k, dc, dr)
+            };
+            if ok {
+                mask |= 1 << i;
             }
         }
+        mask
+    }
+
+    /// Shortest path costs (tenths of a block) from block `s` over the allowed block steps, up
+    /// to `cap`: `visit(k, g)` is called once for every block reached, in non-decreasing `g`.
+    /// `g` must hold `u32::MAX` everywhere and is left so; `touched` and `buckets` are scratch.
+    /// (Costs are small integers, so a circular bucket queue gives the exact Dijkstra costs.)
+    fn search(
+        &self,
+        s: usize,
+        cap: u32,
+        g: &mut [u32],
+        touched: &mut Vec<usize>,
+        buckets: &mut [Vec<usize>; BUCKETS],
+        mut visit: impl FnMut(usize, u32),
+    ) {
+        let bw = self.bw as isize;
+        let offs: [isize; 8] = DIRS.map(|(dc, dr)| dr as isize * bw + dc as isize);
+        g[s] = 0;
+        touched.push(s);
+        buckets[0].push(s);
+        let mut queued = 1usize;
+        let mut d = 0u32;
+        while queued > 0 {
+            // Pushes go to `d + 10` or `d + 14`, never to the bucket of `d` itself.
+            let Some(k) = buckets[d as usize % BUCKETS].pop() else {
+                d += 1;
+                continue;
+            };
+            queued -= 1;
+            if g[k] != d {
+                continue;
+            }
+            visit(k, d);
+            let mut m = self.mask[k];
+            while m != 0 {
+                let i = m.trailing_zeros() as usize;
+                m &= m - 1;
+                let ng = d + if i < 4 { 10 } else { 14 };
+                let j = k.wrapping_add_signed(offs[i]);
+                if ng <= cap && ng < g[j] {
+                    if g[j] == u32::MAX {
+                        touched.push(j);
+                    }
+                    g[j] = ng;
+                    buckets[ng as usize % BUCKETS].push(j);
+                    queued += 1;
+                }
+            }
+        }
+        for &k in touched.iter() {
+            g[k] = u32::MAX;
+        }
+        touched.clear();
     }
 }
 
@@ -181,37 +252,15 @@ impl<'a> HopTable<'a> {
         let cap = RADIUS_BLOCKS * 10;
         let mut g = vec![u32::MAX; n];
         let mut touched: Vec<usize> = Vec::new();
-        let mut heap = BinaryHeap::new();
-        let mut nbrs = Vec::with_capacity(8);
+        let mut buckets: [Vec<usize>; BUCKETS] = std::array::from_fn(|_| Vec::new());
         let mut rows = Vec::with_capacity(blocks.len());
         for &s in &blocks {
             let mut row: Vec<(u32, u32)> = Vec::new();
-            g[s] = 0;
-            touched.push(s);
-            heap.push(Reverse((0u32, s)));
-            while let Some(Reverse((gk, k))) = heap.pop() {
-                if gk > g[k] {
-                    continue;
-                }
+            coarse.search(s, cap, &mut g, &mut touched, &mut buckets, |k, gk| {
                 if row_of[k] != u32::MAX {
                     row.push((k as u32, gk));
                 }
-                coarse.steps(k, &mut nbrs);
-                for &(j, w) in &nbrs {
-                    let ng = gk + w;
-                    if ng <= cap && ng < g[j] {
-                        if g[j] == u32::MAX {
-                            touched.push(j);
-                        }
-                        g[j] = ng;
-                        heap.push(Reverse((ng, j)));
-                    }
-                }
-            }
-            for &k in &touched {
-                g[k] = u32::MAX;
-            }
-            touched.clear();
+            });
             row.sort_unstable();
             rows.push(row);
         }
@@ -383,28 +432,22 @@ impl<'a> Far<'a> {
         let m = blocks.len();
         let mut dense = vec![u16::MAX; m * m];
         let mut g = vec![u32::MAX; n];
-        let mut heap = BinaryHeap::new();
-        let mut nbrs = Vec::with_capacity(8);
+        let mut touched: Vec<usize> = Vec::new();
+        let mut buckets: [Vec<usize>; BUCKETS] = std::array::from_fn(|_| Vec::new());
         for (i, &s) in blocks.iter().enumerate() {
-            g.fill(u32::MAX);
-            g[s] = 0;
-            heap.push(Reverse((0u32, s)));
-            while let Some(Reverse((gk, k))) = heap.pop() {
-                if gk > g[k] {
-                    continue;
-                }
-                if row_of[k] != u32::MAX {
-                    dense[i * m + row_of[k] as usize] = gk.min(u32::from(u16::MAX) - 1) as u16;
-                }
-                coarse.steps(k, &mut nbrs);
-                for &(j, w) in &nbrs {
-                    let ng = gk + w;
-                    if ng < g[j] {
-                        g[j] = ng;
-                        heap.push(Reverse((ng, j)));
+            let out = &mut dense[i * m..(i + 1) * m];
+            coarse.search(
+                s,
+                u32::MAX - 14,
+                &mut g,
+                &mut touched,
+                &mut buckets,
+                |k, gk| {
+                    if row_of[k] != u32::MAX {
+                        out[row_of[k] as usize] = gk.min(u32::from(u16::MAX) - 1) as u16;
                     }
-                }
-            }
+                },
+            );
         }
         Self {
             coarse,

@@ -59,16 +59,36 @@ pub(crate) fn solve(
         return tour;
     }
     let nb = neighbour_lists(pieces, d);
+    improve(pieces, start, rounds, d, &nb, &mut tour);
+    tour
+}
+
+/// The candidate neighbours of every piece that [`improve`] needs.
+pub(crate) fn neighbours(pieces: &[Piece], d: Dist<'_>) -> Vec<Vec<usize>> {
+    neighbour_lists(pieces, d)
+}
+
+/// Up to `rounds` improvement rounds of `tour` (module docs); true when a round left the cost
+/// unchanged (further rounds would change nothing), so that `k` rounds followed by `m` more
+/// (when this returned false) are the same as `k + m` rounds at once.
+pub(crate) fn improve(
+    pieces: &[Piece],
+    start: Point,
+    rounds: u32,
+    d: Dist<'_>,
+    nb: &[Vec<usize>],
+    tour: &mut Tour,
+) -> bool {
     for _ in 0..rounds {
-        let before = cost(pieces, start, &tour, d);
-        two_opt(pieces, start, &mut tour, &nb, d);
-        or_opt(pieces, start, &mut tour, &nb, d);
-        choose_variants(pieces, start, &mut tour, d);
-        if cost(pieces, start, &tour, d) >= before - EPS {
-            break;
+        let before = cost(pieces, start, tour, d);
+        two_opt(pieces, start, tour, nb, d);
+        or_opt(pieces, start, tour, nb, d);
+        choose_variants(pieces, start, tour, d);
+        if cost(pieces, start, tour, d) >= before - EPS {
+            return true;
         }
     }
-    tour
+    false
 }
 
 fn nearest_neighbour(pieces: &[Piece], start: Point, d: Dist<'_>) -> Tour {
@@ -142,6 +162,29 @@ fn neighbour_lists(pieces: &[Piece], d: Dist<'_>) -> Vec<Vec<usize>> {
         }
         m
     };
+    // Bounding box of each piece's end points: its squared gap to another box is a lower
+    // bound of `gap` (rounding is monotone, so also in floating point), which skips most pairs
+    // once a piece's candidate list is full.
+    let boxes: Vec<[f64; 4]> = ends
+        .iter()
+        .map(|v| {
+            v.iter().fold(
+                [
+                    f64::INFINITY,
+                    f64::NEG_INFINITY,
+                    f64::INFINITY,
+                    f64::NEG_INFINITY,
+                ],
+                |b, p| [b[0].min(p.x), b[1].max(p.x), b[2].min(p.y), b[3].max(p.y)],
+            )
+        })
+        .collect();
+    let box_gap = |a: usize, b: usize| -> f64 {
+        let (p, q) = (&boxes[a], &boxes[b]);
+        let dx = (p[0] - q[1]).max(q[0] - p[1]).max(0.0);
+        let dy = (p[2] - q[3]).max(q[2] - p[3]).max(0.0);
+        dx * dx + dy * dy
+    };
     (0..pieces.len())
         .map(|a| {
             // The 3 * NEIGHBOURS nearest in a straight line, re-ranked by hop cost.
@@ -149,6 +192,10 @@ fn neighbour_lists(pieces: &[Piece], d: Dist<'_>) -> Vec<Vec<usize>> {
             let mut best: Vec<(f64, usize)> = Vec::with_capacity(keep + 1);
             for b in 0..pieces.len() {
                 if a == b {
+                    continue;
+                }
+                // (a pair is kept only when its gap is below the worst kept one)
+                if best.len() == keep && box_gap(a, b) >= best[keep - 1].0 {
                     continue;
                 }
                 let g = gap(a, b);
