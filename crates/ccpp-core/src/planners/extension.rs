@@ -716,6 +716,19 @@ impl Extension {
             2 => return Some(false),
             _ => {}
         }
+        // The `S1` disk holds the `S0` disk: where it is free (most positions, away from
+        // walls) both are decided by one look, and `S1` is memoised as `in_s1` would.
+        if self.s1[i] == 0 {
+            match known.disk_state_px(p.0, p.1, &self.s1_disk) {
+                DiskState::Free => {
+                    self.s1[i] = 1;
+                    self.s0[i] = 1;
+                    return Some(true);
+                }
+                DiskState::Blocked => self.s1[i] = 2,
+                DiskState::Unseen => {}
+            }
+        }
         match known.disk_state_px(p.0, p.1, &self.s0_disk) {
             DiskState::Free => {
                 self.s0[i] = 1;
@@ -1440,12 +1453,20 @@ impl Extension {
     /// point indices (the first point, the robot, excluded).
     fn merge(&self, known: &KnownMap, pts: &[Point], gains: &[Vec<usize>]) -> Vec<usize> {
         let rt2 = self.rt * self.rt;
+        // The gained pixels' centres, once (each is checked against many segments), flat
+        // with `at[m]..at[m + 1]` those of point `m`.
+        let mut at = Vec::with_capacity(gains.len() + 1);
+        let mut centres = Vec::with_capacity(gains.iter().map(Vec::len).sum());
+        for g in gains {
+            at.push(centres.len());
+            centres.extend(g.iter().map(|&i| self.center(self.px_of(i))));
+        }
+        at.push(centres.len());
         let keeps = |a: usize, b: usize| -> bool {
-            (a + 1..=b).all(|m| {
-                gains[m].iter().all(|&i| {
-                    point_segment_dist2(self.center(self.px_of(i)), pts[a], pts[b]) <= rt2
-                })
-            }) && self.seg_free(known, pts[a], pts[b])
+            centres[at[a + 1]..at[b + 1]]
+                .iter()
+                .all(|&c| point_segment_dist2(c, pts[a], pts[b]) <= rt2)
+                && self.seg_free(known, pts[a], pts[b])
         };
         let mut out = Vec::new();
         let mut a = 0;
