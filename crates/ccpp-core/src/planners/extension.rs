@@ -977,7 +977,18 @@ impl Extension {
         // image row, the new pixels' columns widened by `reach` and merged into runs, each run
         // then cleared in the rows within `reach` (one range per run and row, not per pixel).
         let mut runs: Vec<(i64, i64, i64)> = Vec::new();
-        for b in 0..free.len() {
+        // Most of the map did not change since the last call: compare a stretch of blocks at
+        // a time (one slice comparison) and look into the stretches that differ only.
+        const STRETCH: usize = 64;
+        let changed = (0..free.len()).step_by(STRETCH).filter(|&s| {
+            let e = (s + STRETCH).min(free.len());
+            free[s..e] != self.no_gain_free[s..e]
+        });
+        let changed: Vec<usize> = changed.collect();
+        for b in changed
+            .into_iter()
+            .flat_map(|s| s..(s + STRETCH).min(free.len()))
+        {
             let new = free[b] & !self.no_gain_free[b];
             self.no_gain_free[b] = free[b];
             if new == 0 {
@@ -1792,7 +1803,11 @@ fn count_range(free: &[usize], swept: &[usize], a: usize, b: usize) -> usize {
     while blk * BLOCK_BITS < b {
         let start = blk * BLOCK_BITS;
         let mask = range_mask(a.max(start) - start, b.min(start + BLOCK_BITS) - start);
-        n += (free[blk] & !swept[blk] & mask).count_ones() as usize;
+        // Mostly none (the target is built without a popcount instruction): test first.
+        let bits = free[blk] & !swept[blk] & mask;
+        if bits != 0 {
+            n += bits.count_ones() as usize;
+        }
         blk += 1;
     }
     n
