@@ -777,8 +777,18 @@ impl Extension {
         if self.edge_free[i] & (1 << k) != 0 {
             return true;
         }
-        if self.edge_blocked[i] & (1 << k) != 0 || self.in_s0(known, q) != Some(true) {
+        if self.edge_blocked[i] & (1 << k) != 0 {
             return false;
+        }
+        match self.in_s0(known, q) {
+            Some(true) => {}
+            Some(false) => {
+                // The robot never fits at `q` (a seen obstacle stays one): the move stays
+                // blocked.
+                self.edge_blocked[i] |= 1 << k;
+                return false;
+            }
+            None => return false,
         }
         // Between two `S1` positions a move is free; else check it on the known map (once free
         // or blocked, it stays so).
@@ -1166,15 +1176,34 @@ impl Extension {
         let p = self.px_of(i);
         let (w, h_img) = (self.frame.width as i64, self.frame.height as i64);
         let edges = self.edge_free[i];
-        for k in 0..8 {
+        // Moves known blocked (walls, positions where the robot does not fit) are left out
+        // before their neighbour's state is read.
+        let blocked = self.edge_blocked[i];
+        // The neighbours' states are read first, all at once (independent loads, mostly
+        // cache misses, overlap); the loop below writes only neighbours, each once.
+        let mut js = [usize::MAX; 8];
+        for (k, jk) in js.iter_mut().enumerate() {
             let q = (p.0 + NB[k].0, p.1 + NB[k].1);
-            if q.0 < 0 || q.1 < 0 || q.0 >= w || q.1 >= h_img {
+            if blocked & (1 << k) == 0 && q.0 >= 0 && q.1 >= 0 && q.0 < w && q.1 < h_img {
+                *jk = (q.1 * w + q.0) as usize;
+            }
+        }
+        let ns: [Node; 8] = std::array::from_fn(|k| {
+            if js[k] == usize::MAX {
+                [0; 2]
+            } else {
+                self.nodes[js[k]]
+            }
+        });
+        for k in 0..8 {
+            let j = js[k];
+            if j == usize::MAX {
                 continue;
             }
-            let j = (q.1 * w + q.0) as usize;
+            let q = (p.0 + NB[k].0, p.1 + NB[k].1);
             let nd = d + if k % 2 == 1 { COST_DIAG } else { COST_ORTHO };
             // Settled or no better: skip before judging the move (judging only fills memos).
-            let n = self.nodes[j];
+            let n = ns[k];
             if node_gen(n) == gen && (n[0] & CLOSED != 0 || nd >= n[0]) {
                 continue;
             }
