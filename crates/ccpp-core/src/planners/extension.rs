@@ -419,6 +419,9 @@ const CORNER_RUN: usize = 4;
 /// Longest walk of one chunk, in pixel steps.
 const MAX_WALK: usize = 20_000;
 
+/// Blocks of the known-free map [`Extension::refresh_no_gain`] compares at a time.
+const STRETCH: usize = 64;
+
 /// One chunk of a cleaning pass ([`Extension::plan_pass`]), world waypoints.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub(crate) struct Chunk {
@@ -989,12 +992,13 @@ impl Extension {
         let mut runs: Vec<(i64, i64, i64)> = Vec::new();
         // Most of the map did not change since the last call: compare a stretch of blocks at
         // a time (one slice comparison) and look into the stretches that differ only.
-        const STRETCH: usize = 64;
-        let changed = (0..free.len()).step_by(STRETCH).filter(|&s| {
-            let e = (s + STRETCH).min(free.len());
-            free[s..e] != self.no_gain_free[s..e]
-        });
-        let changed: Vec<usize> = changed.collect();
+        let changed: Vec<usize> = (0..free.len())
+            .step_by(STRETCH)
+            .filter(|&s| {
+                let e = (s + STRETCH).min(free.len());
+                free[s..e] != self.no_gain_free[s..e]
+            })
+            .collect();
         for b in changed
             .into_iter()
             .flat_map(|s| s..(s + STRETCH).min(free.len()))
