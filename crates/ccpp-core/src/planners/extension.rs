@@ -1376,7 +1376,8 @@ impl Extension {
         let g_start = if bounded { tool } else { tool.max(2) };
         let g_int = tool;
         let g_con = 1;
-        if !bounded {
+        // A resumed search follows a chunk left in the same pass: the known map is the same.
+        if !bounded && !resume {
             self.refresh_no_gain(known);
         }
         if let Some(l) = limit {
