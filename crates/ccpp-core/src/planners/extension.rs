@@ -419,6 +419,9 @@ const CORNER_RUN: usize = 4;
 /// Longest walk of one chunk, in pixel steps.
 const MAX_WALK: usize = 20_000;
 
+/// Blocks of the known-free map [`Extension::refresh_no_gain`] compares at a time.
+const STRETCH: usize = 64;
+
 /// One chunk of a cleaning pass ([`Extension::plan_pass`]), world waypoints.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub(crate) struct Chunk {
@@ -716,6 +719,19 @@ impl Extension {
             2 => return Some(false),
             _ => {}
         }
+        // The `S1` disk holds the `S0` disk: where it is free (most positions, away from
+        // walls) both are decided by one look, and `S1` is memoised as `in_s1` would.
+        if self.s1[i] == 0 {
+            match known.disk_state_px(p.0, p.1, &self.s1_disk) {
+                DiskState::Free => {
+                    self.s1[i] = 1;
+                    self.s0[i] = 1;
+                    return Some(true);
+                }
+                DiskState::Blocked => self.s1[i] = 2,
+                DiskState::Unseen => {}
+            }
+        }
         match known.disk_state_px(p.0, p.1, &self.s0_disk) {
             DiskState::Free => {
                 self.s0[i] = 1;
@@ -764,8 +780,18 @@ impl Extension {
         if self.edge_free[i] & (1 << k) != 0 {
             return true;
         }
-        if self.edge_blocked[i] & (1 << k) != 0 || self.in_s0(known, q) != Some(true) {
+        if self.edge_blocked[i] & (1 << k) != 0 {
             return false;
+        }
+        match self.in_s0(known, q) {
+            Some(true) => {}
+            Some(false) => {
+                // The robot never fits at `q` (a seen obstacle stays one): the move stays
+                // blocked.
+                self.edge_blocked[i] |= 1 << k;
+                return false;
+            }
+            None => return false,
         }
         // Between two `S1` positions a move is free; else check it on the known map (once free
         // or blocked, it stays so).
@@ -964,7 +990,19 @@ impl Extension {
         // image row, the new pixels' columns widened by `reach` and merged into runs, each run
         // then cleared in the rows within `reach` (one range per run and row, not per pixel).
         let mut runs: Vec<(i64, i64, i64)> = Vec::new();
-        for b in 0..free.len() {
+        // Most of the map did not change since the last call: compare a stretch of blocks at
+        // a time (one slice comparison) and look into the stretches that differ only.
+        let changed: Vec<usize> = (0..free.len())
+            .step_by(STRETCH)
+            .filter(|&s| {
+                let e = (s + STRETCH).min(free.len());
+                free[s..e] != self.no_gain_free[s..e]
+            })
+            .collect();
+        for b in changed
+            .into_iter()
+            .flat_map(|s| s..(s + STRETCH).min(free.len()))
+        {
             let new = free[b] & !self.no_gain_free[b];
             self.no_gain_free[b] = free[b];
             if new == 0 {
@@ -1142,15 +1180,34 @@ impl Extension {
         let p = self.px_of(i);
         let (w, h_img) = (self.frame.width as i64, self.frame.height as i64);
         let edges = self.edge_free[i];
-        for k in 0..8 {
+        // Moves known blocked (walls, positions where the robot does not fit) are left out
+        // before their neighbour's state is read.
+        let blocked = self.edge_blocked[i];
+        // The neighbours' states are read first, all at once (independent loads, mostly
+        // cache misses, overlap); the loop below writes only neighbours, each once.
+        let mut js = [usize::MAX; 8];
+        for (k, jk) in js.iter_mut().enumerate() {
             let q = (p.0 + NB[k].0, p.1 + NB[k].1);
-            if q.0 < 0 || q.1 < 0 || q.0 >= w || q.1 >= h_img {
+            if blocked & (1 << k) == 0 && q.0 >= 0 && q.1 >= 0 && q.0 < w && q.1 < h_img {
+                *jk = (q.1 * w + q.0) as usize;
+            }
+        }
+        let ns: [Node; 8] = std::array::from_fn(|k| {
+            if js[k] == usize::MAX {
+                [0; 2]
+            } else {
+                self.nodes[js[k]]
+            }
+        });
+        for k in 0..8 {
+            let j = js[k];
+            if j == usize::MAX {
                 continue;
             }
-            let j = (q.1 * w + q.0) as usize;
+            let q = (p.0 + NB[k].0, p.1 + NB[k].1);
             let nd = d + if k % 2 == 1 { COST_DIAG } else { COST_ORTHO };
             // Settled or no better: skip before judging the move (judging only fills memos).
-            let n = self.nodes[j];
+            let n = ns[k];
             if node_gen(n) == gen && (n[0] & CLOSED != 0 || nd >= n[0]) {
                 continue;
             }
@@ -1319,7 +1376,8 @@ impl Extension {
         let g_start = if bounded { tool } else { tool.max(2) };
         let g_int = tool;
         let g_con = 1;
-        if !bounded {
+        // A resumed search follows a chunk left in the same pass: the known map is the same.
+        if !bounded && !resume {
             self.refresh_no_gain(known);
         }
         if let Some(l) = limit {
@@ -1440,12 +1498,20 @@ impl Extension {
     /// point indices (the first point, the robot, excluded).
     fn merge(&self, known: &KnownMap, pts: &[Point], gains: &[Vec<usize>]) -> Vec<usize> {
         let rt2 = self.rt * self.rt;
+        // The gained pixels' centres, once (each is checked against many segments), flat
+        // with `at[m]..at[m + 1]` those of point `m`.
+        let mut at = Vec::with_capacity(gains.len() + 1);
+        let mut centres = Vec::with_capacity(gains.iter().map(Vec::len).sum());
+        for g in gains {
+            at.push(centres.len());
+            centres.extend(g.iter().map(|&i| self.center(self.px_of(i))));
+        }
+        at.push(centres.len());
         let keeps = |a: usize, b: usize| -> bool {
-            (a + 1..=b).all(|m| {
-                gains[m].iter().all(|&i| {
-                    point_segment_dist2(self.center(self.px_of(i)), pts[a], pts[b]) <= rt2
-                })
-            }) && self.seg_free(known, pts[a], pts[b])
+            centres[at[a + 1]..at[b + 1]]
+                .iter()
+                .all(|&c| point_segment_dist2(c, pts[a], pts[b]) <= rt2)
+                && self.seg_free(known, pts[a], pts[b])
         };
         let mut out = Vec::new();
         let mut a = 0;
@@ -1771,7 +1837,11 @@ fn count_range(free: &[usize], swept: &[usize], a: usize, b: usize) -> usize {
     while blk * BLOCK_BITS < b {
         let start = blk * BLOCK_BITS;
         let mask = range_mask(a.max(start) - start, b.min(start + BLOCK_BITS) - start);
-        n += (free[blk] & !swept[blk] & mask).count_ones() as usize;
+        // Mostly none (the target is built without a popcount instruction): test first.
+        let bits = free[blk] & !swept[blk] & mask;
+        if bits != 0 {
+            n += bits.count_ones() as usize;
+        }
         blk += 1;
     }
     n
