@@ -13,6 +13,25 @@ pub struct Point {
     pub y: f64,
 }
 
+/// Length of the polyline `from -> pts[0] -> pts[1] -> ...`, summed in that order (in the
+/// points' units).
+pub fn polyline_length(from: Point, pts: &[Point]) -> f64 {
+    let mut at = from;
+    pts.iter()
+        .map(|&p| {
+            let d = at.dist(p);
+            at = p;
+            d
+        })
+        .sum()
+}
+
+/// Length of the polyline through `pts` (0 for fewer than two points).
+pub fn path_length(pts: &[Point]) -> f64 {
+    pts.split_first()
+        .map_or(0.0, |(&first, rest)| polyline_length(first, rest))
+}
+
 impl Point {
     /// A new point.
     #[inline]
@@ -221,6 +240,20 @@ pub fn round_i32(x: f64) -> i32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn polyline_lengths() {
+        let pts = [
+            Point::new(0.0, 0.0),
+            Point::new(3.0, 4.0),
+            Point::new(3.0, 6.0),
+        ];
+        assert_eq!(path_length(&pts), 7.0);
+        assert_eq!(polyline_length(Point::new(0.0, -1.0), &pts), 8.0);
+        assert_eq!(path_length(&pts[..1]), 0.0);
+        assert_eq!(path_length(&[]), 0.0);
+        assert_eq!(polyline_length(pts[0], &[]), 0.0);
+    }
 
     #[test]
     fn fast_floor_and_ceil_match_std() {

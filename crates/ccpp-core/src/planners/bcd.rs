@@ -129,7 +129,7 @@ use std::ops::{Add, Sub};
 use fixedbitset::FixedBitSet;
 use serde::{Deserialize, Serialize};
 
-use crate::geometry::{point_segment_dist2, Point};
+use crate::geometry::{path_length, point_segment_dist2, Point};
 use crate::grid::MapFrame;
 use crate::planner::{Planner, Sensor, Step};
 use crate::trace::Event;
@@ -841,10 +841,6 @@ fn cell_paths(ctx: &Ctx<'_>, search: &mut Search, cell: &Cell, lanes: &[f64]) ->
     out
 }
 
-fn polyline_len(p: &[Point]) -> f64 {
-    p.windows(2).map(|w| w[0].dist(w[1])).sum()
-}
-
 /// One step of the plan.
 #[derive(Clone, Debug)]
 enum Item {
@@ -1050,7 +1046,7 @@ impl Bcd {
             };
             for p in &ps {
                 let (f, l) = (p[0], p[p.len() - 1]);
-                let len = polyline_len(p);
+                let len = path_length(p);
                 piece.entry.extend([f, l]);
                 piece.exit.extend([l, f]);
                 piece.inner.extend([len, len]);
@@ -1096,7 +1092,7 @@ impl Bcd {
                     }
                     let p = &paths[c][0];
                     let (f, l) = (p[0], p[p.len() - 1]);
-                    let len = polyline_len(p);
+                    let len = path_length(p);
                     pieces[c] = tsp::Piece {
                         entry: vec![f, l],
                         exit: vec![l, f],
@@ -1119,7 +1115,7 @@ impl Bcd {
             };
             for c in &contours {
                 let (f, l) = (c[0], c[c.len() - 1]);
-                let len = polyline_len(c);
+                let len = path_length(c);
                 pieces.push(tsp::Piece {
                     entry: vec![f, l],
                     exit: vec![l, f],
@@ -1239,7 +1235,7 @@ impl Bcd {
             }
             let items = prune::prune(&ctx, items, opts.min_coverage, turn_px);
             let pts: Vec<Point> = moves(&items).into_iter().map(|m| m.0).collect();
-            let cost = polyline_len(&pts) + turn_px * turns(&pts) as f64;
+            let cost = path_length(&pts) + turn_px * turns(&pts) as f64;
             if best.as_ref().is_none_or(|b| (skipped, cost) < (b.0, b.1)) {
                 best = Some((skipped, cost, items));
             }
@@ -1532,7 +1528,7 @@ fn rim_contours(
         };
         let mut contour = vec![chain[0]];
         contour.extend(tail);
-        let clen = polyline_len(&contour);
+        let clen = path_length(&contour);
         if (members.len() as f64) < min_yield * clen.max(1.0) * 2.0 * ctx.rt {
             continue;
         }
@@ -1546,7 +1542,7 @@ fn rim_contours(
     if budget > 0 {
         // Lowest yield (pixels per pixel of contour) first; ties by group order.
         let mut order: Vec<usize> = (0..out.len()).collect();
-        let yield_of = |c: &(Vec<Point>, usize)| c.1 as f64 / polyline_len(&c.0).max(1.0);
+        let yield_of = |c: &(Vec<Point>, usize)| c.1 as f64 / path_length(&c.0).max(1.0);
         order.sort_by(|&a, &b| {
             yield_of(&out[a])
                 .total_cmp(&yield_of(&out[b]))
@@ -1606,7 +1602,7 @@ fn rim_pass(
     // (insert after path segment s, at parameter t along it, the detour points)
     let mut inserts: Vec<(usize, f64, Vec<Point>)> = Vec::new();
     for (contour, _) in contours {
-        let clen = polyline_len(&contour);
+        let clen = path_length(&contour);
         let (cs, ce) = (contour[0], contour[contour.len() - 1]);
         // Cheapest insertion: segments near the contour's start, widening the search.
         let mut best: Option<(f64, usize, f64, bool)> = None;

@@ -87,7 +87,8 @@
 use serde::{Deserialize, Serialize};
 
 use super::bsa::{Bsa, BsaOptions, Side};
-use super::extension::{polyline_len, Chunk, Drive, Extension, ExtensionOptions};
+use super::extension::{Chunk, Drive, Extension, ExtensionOptions};
+use crate::geometry::polyline_length;
 use crate::geometry::Point;
 use crate::planner::{Planner, Sensor, Step};
 use crate::trace::Event;
@@ -202,7 +203,8 @@ impl BsaExtended {
         match ext.route(known, pos, goal) {
             Some(route)
                 if route.last() == Some(&goal)
-                    && (moved || polyline_len(pos, &route) < polyline_len(pos, &own) - 1e-9) =>
+                    && (moved
+                        || polyline_length(pos, &route) < polyline_length(pos, &own) - 1e-9) =>
             {
                 // What BSA's cell path would have swept on the way and this one does not is
                 // fetched by the final clean-up (a transfer over a spiral's turns sweeps the

@@ -153,7 +153,7 @@ use fixedbitset::FixedBitSet;
 use serde::{Deserialize, Serialize};
 
 use super::ba_star::{judge_motion, Judgement};
-use crate::geometry::{point_segment_dist2, Point};
+use crate::geometry::{point_segment_dist2, polyline_length, Point};
 use crate::grid::MapFrame;
 use crate::planner::{pixel_disk_spans, DiskState, KnownMap, Sensor, Step};
 use crate::trace::Event;
@@ -442,12 +442,12 @@ pub(crate) struct Chunk {
 impl Chunk {
     /// Length of the way to the rim from world point `pos` (metres).
     pub(crate) fn trip_len(&self, pos: Point) -> f64 {
-        polyline_len(pos, &self.transfer)
+        polyline_length(pos, &self.transfer)
     }
 
     /// Length of the sweep along the rim (metres).
     pub(crate) fn walk_len(&self, pos: Point) -> f64 {
-        polyline_len(self.start(pos), &self.sweep)
+        polyline_length(self.start(pos), &self.sweep)
     }
 
     /// Where the sweep starts (the transfer's end; `pos` without one).
@@ -1798,18 +1798,6 @@ impl Extension {
     }
 }
 
-/// Length of the polyline from `from` through `pts` (metres).
-pub(crate) fn polyline_len(from: Point, pts: &[Point]) -> f64 {
-    let mut at = from;
-    pts.iter()
-        .map(|&p| {
-            let d = at.dist(p);
-            at = p;
-            d
-        })
-        .sum()
-}
-
 /// The path leaving `group` saves (chunks planned from world point `pos`, nearest first),
 /// with `next` the chunk planned after them: their tour (the first trip, the walks and the
 /// straight ways between them, a lower bound) and the way on from the last to `next`, less
@@ -1898,7 +1886,7 @@ impl Drive {
         if chunk.transfer.is_empty() && chunk.sweep.is_empty() {
             return false;
         }
-        let transfer = polyline_len(pos, &chunk.transfer) >= 2.0 * radius;
+        let transfer = polyline_length(pos, &chunk.transfer) >= 2.0 * radius;
         if transfer {
             self.end_pass();
             self.queue.push_back(Step::Mark(Event::BacktrackStart));
