@@ -374,7 +374,6 @@ pub fn write_file(path: &Path, bytes: &[u8]) -> Result<(), ccpp_io::WriteError> 
     write_file_with(path, &mut |w| w.write_all(bytes), false).map(drop)
 }
 
-/// [`write_file`] of what `fill` writes.
 /// Writes the file at `path` atomically with what `fill` writes, synced before it is renamed
 /// into place; or, `deferred`, renamed unsynced and returned for the caller to sync (a file of
 /// a staging folder, which becomes visible only with the folder).

@@ -67,26 +67,7 @@ pub fn write_atomic_with<F>(path: &Path, fill: F) -> Result<(), WriteError>
 where
     F: FnOnce(&mut dyn Write) -> io::Result<()>,
 {
-    let tmp = tmp_path(path)?;
-    let io_err = |source| WriteError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let result = (|| {
-        let file = File::create(&tmp)?;
-        let mut w = BufWriter::new(file);
-        fill(&mut w)?;
-        let file = w.into_inner().map_err(io::IntoInnerError::into_error)?;
-        file.sync_all()?;
-        drop(file);
-        std::fs::rename(&tmp, path)
-    })();
-    if let Err(e) = result {
-        // Best effort: the temporary may not even exist.
-        let _ = std::fs::remove_file(&tmp);
-        return Err(io_err(e));
-    }
-    Ok(())
+    write_via_tmp(path, fill, true).map(drop)
 }
 
 /// [`write_atomic_with`] without waiting for the disk: the file is renamed into place unsynced
@@ -101,12 +82,25 @@ pub fn write_atomic_unsynced_with<F>(path: &Path, fill: F) -> Result<File, Write
 where
     F: FnOnce(&mut dyn Write) -> io::Result<()>,
 {
+    write_via_tmp(path, fill, false)
+}
+
+/// `fill` into a buffered `<name>.tmp` beside `path`, synced first when `sync`, then renamed
+/// over `path` (still open: std opens files with delete sharing, so this holds on Windows too)
+/// and returned. On any failure the temporary is removed and `path` is left untouched.
+fn write_via_tmp<F>(path: &Path, fill: F, sync: bool) -> Result<File, WriteError>
+where
+    F: FnOnce(&mut dyn Write) -> io::Result<()>,
+{
     let tmp = tmp_path(path)?;
     let result = (|| {
         let file = File::create(&tmp)?;
         let mut w = BufWriter::new(file);
         fill(&mut w)?;
         let file = w.into_inner().map_err(io::IntoInnerError::into_error)?;
+        if sync {
+            file.sync_all()?;
+        }
         std::fs::rename(&tmp, path)?;
         Ok(file)
     })();
