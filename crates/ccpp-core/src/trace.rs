@@ -32,7 +32,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::geometry::Pose;
+use crate::geometry::{Point, Pose};
 
 /// Something that happened during a run (a mark in the trace). Planners emit most of these;
 /// the simulator emits [`Event::Collision`] and [`Event::Finished`].
@@ -657,6 +657,19 @@ impl Trace {
         })
     }
 
+    /// The position of the last executed pose, read from the last stored piece holding poses
+    /// (without unrolling the runs before it); `None` for a trace without poses.
+    pub fn last_position(&self) -> Option<Point> {
+        self.items.iter().rev().find_map(|it| match self.piece(it) {
+            Piece::Pose { pose, .. } => Some(pose.position()),
+            Piece::Run(run) => {
+                let [x, y] = run.to(self.lattice);
+                Some(Point::new(x, y))
+            }
+            Piece::Event { .. } => None,
+        })
+    }
+
     /// The executed poses, in order.
     pub fn poses(&self) -> impl Iterator<Item = Pose> + '_ {
         self.entries().filter_map(|e| match e {
@@ -757,5 +770,34 @@ impl<'de> Deserialize<'de> for Trace {
             .records
             .into_iter()
             .collect())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn last_position_is_the_last_poses_position() {
+        let mut tr = Trace::default();
+        assert_eq!(tr.last_position(), None);
+        tr.push_event(0, Event::RegionStart { region: 1 });
+        assert_eq!(tr.last_position(), None);
+        // A lattice run, a turn in place, a run off the lattice, then events.
+        let mut t = 0;
+        for k in 0..6 {
+            tr.push_pose(t, Pose::new(0.5 + 0.3 * f64::from(k), 1.0, 0.0));
+            t += 1;
+        }
+        tr.push_pose(t, Pose::new(2.0, 1.0, 1.5));
+        t += 1;
+        for k in 1..5 {
+            tr.push_pose(t, Pose::new(2.0, 1.0 + 0.07 * f64::from(k), 1.5));
+            t += 1;
+        }
+        tr.push_event(t, Event::RegionEnd { region: 1 });
+        let last = tr.poses().last().map(|p| p.position());
+        assert_eq!(tr.last_position(), last);
+        assert_eq!(last, Some(Point::new(2.0, 1.0 + 0.07 * 4.0)));
     }
 }

@@ -1150,23 +1150,6 @@ impl MarkerBatch {
     }
 }
 
-/// The position of a trace's last pose, read from its last stored piece holding poses
-/// (without unrolling every pose).
-fn last_position(trace: &Trace) -> Option<Point> {
-    let lattice = trace.lattice();
-    trace
-        .pieces()
-        .filter_map(|piece| match piece {
-            Piece::Pose { pose, .. } => Some(pose.position()),
-            Piece::Run(run) => {
-                let [x, y] = run.to(lattice);
-                Some(Point::new(x, y))
-            }
-            Piece::Event { .. } => None,
-        })
-        .last()
-}
-
 fn draw_markers(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
     let rad = (world.robot().radius / world.frame().resolution) as f32 * view.scale;
     let m = rad.clamp(3.0, 14.0);
@@ -1234,7 +1217,7 @@ fn draw_markers(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
             None,
         );
     }
-    if let Some(end) = last_position(trace) {
+    if let Some(end) = trace.last_position() {
         let (ex, ey) = view.to_canvas(world, end);
         if let Some(c) = PathBuilder::from_circle(ex, ey, rad.max(4.0)) {
             pm.stroke_path(
