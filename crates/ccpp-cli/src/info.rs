@@ -3,13 +3,12 @@
 use std::fmt::Write as _;
 
 use anyhow::Result;
-use ccpp_core::grid::{Cell, GridMap};
-use ccpp_core::search::{fill_runs, Connectivity};
+use ccpp_core::grid::Cell;
 use ccpp_core::world::{World, WorldError};
-use ccpp_core::Point;
 use serde::Serialize;
 
 use crate::args::InfoArgs;
+use crate::components::{free_components, StartComponent};
 use crate::job::{prepare_map, robot_from};
 
 /// The report. Robot-dependent fields are `null` when the robot does not fit on the map.
@@ -64,110 +63,6 @@ struct ZonesInfo {
     keepout_m2: f64,
     /// Free floor in the keep-out zones, m^2.
     keepout_free_m2: f64,
-}
-
-/// Fills the 4-connected free component holding `seed` by horizontal runs
-/// ([`ccpp_core::search::fill_runs`]), marking `seen`; returns the component's pixel count and
-/// whether it touches the image border.
-fn flood_runs(g: &GridMap, seed: usize, seen: &mut fixedbitset::FixedBitSet) -> (usize, bool) {
-    let f = *g.frame();
-    let (w, h) = (f.width, f.height);
-    let cells = g.cells();
-    let (mut size, mut border) = (0usize, false);
-    fill_runs(
-        w,
-        h,
-        |i| cells[i] == Cell::Free,
-        seed,
-        Connectivity::Four,
-        seen,
-        |row, lo, hi| {
-            size += hi - lo + 1;
-            border |= lo == 0 || hi + 1 == w || row == 0 || row + 1 == h;
-        },
-    );
-    (size, border)
-}
-
-/// Counts 4-connected components of free pixels and the size of the largest.
-fn free_components(g: &GridMap) -> (usize, usize) {
-    let cells = g.cells();
-    let mut seen = fixedbitset::FixedBitSet::with_capacity(cells.len());
-    let (mut n, mut largest) = (0usize, 0usize);
-    for i in 0..cells.len() {
-        if cells[i] != Cell::Free || seen.contains(i) {
-            continue;
-        }
-        n += 1;
-        let (size, _) = flood_runs(g, i, &mut seen);
-        largest = largest.max(size);
-    }
-    (n, largest)
-}
-
-/// The free component holding a start position.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct StartComponent {
-    /// Its area, m^2 (0 when the start pixel is not free).
-    pub area_m2: f64,
-    /// All free area of the map, m^2.
-    pub free_m2: f64,
-    /// Whether it reaches the image border.
-    pub touches_border: bool,
-}
-
-impl StartComponent {
-    /// The 4-connected free component of `g` holding `start`.
-    pub fn of(g: &GridMap, start: Point) -> Self {
-        let f = *g.frame();
-        let res2 = f.resolution * f.resolution;
-        let free_m2 = g.counts().0 as f64 * res2;
-        let Some((c, r)) = f.pixel_of(start) else {
-            return Self {
-                area_m2: 0.0,
-                free_m2,
-                touches_border: false,
-            };
-        };
-        let seed = f.index(c, r);
-        if g.cells()[seed] != Cell::Free {
-            return Self {
-                area_m2: 0.0,
-                free_m2,
-                touches_border: false,
-            };
-        }
-        let mut seen = fixedbitset::FixedBitSet::with_capacity(f.len());
-        let (size, touches_border) = flood_runs(g, seed, &mut seen);
-        Self {
-            area_m2: size as f64 * res2,
-            free_m2,
-            touches_border,
-        }
-    }
-
-    /// One line: the component's area next to all free area.
-    pub fn line(&self) -> String {
-        let share = if self.free_m2 > 0.0 {
-            100.0 * self.area_m2 / self.free_m2
-        } else {
-            0.0
-        };
-        format!(
-            "{:.1} m2 of {:.1} m2 free ({share:.0} %) in the free area holding the start",
-            self.area_m2, self.free_m2
-        )
-    }
-
-    /// The warning to print when the start's free area reaches the image border.
-    pub fn warning(&self) -> Option<String> {
-        self.touches_border.then(|| {
-            "warning: the free area holding the start reaches the map's border, so the start \
-             may be outside the building (only that area is covered); pass --start X,Y to \
-             start inside"
-                .to_string()
-        })
-    }
 }
 
 /// Runs `ccpp info`.
@@ -333,91 +228,4 @@ pub fn run(a: &InfoArgs) -> Result<()> {
         }
     }
     crate::print_stdout(&t)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The reference: flood-fills the 4-connected free pixels pixel by pixel from `seed` (marking `seen`); returns the
-    /// component's pixel count and whether it touches the image border.
-    fn flood(g: &GridMap, seed: usize, seen: &mut [bool], stack: &mut Vec<usize>) -> (usize, bool) {
-        let f = *g.frame();
-        let cells = g.cells();
-        let (mut size, mut border) = (0usize, false);
-        seen[seed] = true;
-        stack.push(seed);
-        while let Some(k) = stack.pop() {
-            size += 1;
-            let (c, r) = f.col_row(k);
-            border |= c == 0 || r == 0 || c + 1 == f.width || r + 1 == f.height;
-            let mut visit = |j: usize| {
-                if cells[j] == Cell::Free && !seen[j] {
-                    seen[j] = true;
-                    stack.push(j);
-                }
-            };
-            if c > 0 {
-                visit(k - 1);
-            }
-            if c + 1 < f.width {
-                visit(k + 1);
-            }
-            if r > 0 {
-                visit(k - f.width);
-            }
-            if r + 1 < f.height {
-                visit(k + f.width);
-            }
-        }
-        (size, border)
-    }
-
-    /// The run-based fill finds the same component as the pixel-by-pixel one, on random maps
-    /// with rooms, thin walls and the border.
-    #[test]
-    fn run_flood_matches_pixel_flood() {
-        let mut seed = 0x00c0_ffeeu64;
-        let mut next = || {
-            seed = seed
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            seed >> 33
-        };
-        for trial in 0..60usize {
-            let (w, h) = (1 + (trial % 23), 1 + (trial * 7 % 19));
-            let density = 2 + (trial % 5) as u64;
-            let mut art = String::new();
-            for _ in 0..h {
-                for _ in 0..w {
-                    art.push(if next() % density == 0 { '#' } else { '.' });
-                }
-                art.push('\n');
-            }
-            let g = GridMap::from_ascii_scaled(&art, 1, 0.1).unwrap();
-            // Components counted pixel by pixel, as `free_components` counts them by runs.
-            let mut seen = vec![false; w * h];
-            let (mut n, mut largest) = (0usize, 0usize);
-            for i in 0..w * h {
-                if g.cells()[i] == Cell::Free && !seen[i] {
-                    n += 1;
-                    largest = largest.max(flood(&g, i, &mut seen, &mut Vec::new()).0);
-                }
-            }
-            assert_eq!(free_components(&g), (n, largest), "trial {trial}\n{art}");
-            for i in 0..w * h {
-                if g.cells()[i] != Cell::Free {
-                    continue;
-                }
-                seen.fill(false);
-                let want = flood(&g, i, &mut seen, &mut Vec::new());
-                let mut bits = fixedbitset::FixedBitSet::with_capacity(w * h);
-                assert_eq!(
-                    flood_runs(&g, i, &mut bits),
-                    want,
-                    "trial {trial} seed pixel {i}\n{art}"
-                );
-            }
-        }
-    }
 }

@@ -73,7 +73,7 @@ pub struct JobResult {
     pub swept: fixedbitset::FixedBitSet,
     /// The free area holding the start, when [`Job::execute_with`] was asked for it (found
     /// while the planner worked).
-    pub start_area: Option<crate::info::StartComponent>,
+    pub start_area: Option<crate::components::StartComponent>,
 }
 
 /// The recipe of `args`: paths made absolute so that `run.json` works from any folder.
@@ -365,7 +365,7 @@ impl Job {
     pub fn execute_with(&mut self, start_area: bool) -> Result<JobResult> {
         let map = self.map.take().context("the job has already run")?;
         let (run, start_area) = self.scenario.run_owned_beside(map, |w| {
-            start_area.then(|| crate::info::StartComponent::of(w.map(), w.start().position()))
+            start_area.then(|| crate::components::StartComponent::of(w.map(), w.start().position()))
         })?;
         let s = run.world.initial_pose();
         if !run.world.approach().is_empty() {

@@ -5,6 +5,7 @@
 
 mod args;
 mod bench;
+mod components;
 mod errors;
 mod info;
 mod job;

@@ -11,7 +11,7 @@ use ccpp_core::world::World;
 use ccpp_io::export::ExportFormat;
 use ccpp_io::scenario::Scenario;
 
-use crate::info::StartComponent;
+use crate::components::StartComponent;
 use crate::job::{Job, JobResult};
 use crate::staging::{write_file, Staging};
 

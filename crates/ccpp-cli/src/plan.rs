@@ -12,7 +12,7 @@ use ccpp_io::plan::{offline_planners, plan_route, PlanError};
 use ccpp_io::scenario::{Scenario, ScenarioError};
 
 use crate::args::PlanArgs;
-use crate::info::StartComponent;
+use crate::components::StartComponent;
 use crate::job::{load_recipe, parse_planner, planner_options, recipe_from, robot_from};
 use crate::staging::{check_target, Staging};
 
