@@ -293,6 +293,21 @@ impl TileWalk {
             return;
         }
         let target = grid.tile_of(b);
+        // Fast paths, the same visits as the traversal below: staying in the tile visits
+        // nothing, and an axis-parallel move (one coordinate equal bit for bit, so the other
+        // component of the direction is exactly 0) into the next tile along that axis crosses
+        // exactly one boundary, visiting that tile (the traversal's one step, or its fallback).
+        if target == cur {
+            self.at = Some((cur, b));
+            return;
+        }
+        let along_x = a.y == b.y && target.1 == cur.1 && (target.0 - cur.0).abs() == 1;
+        let along_y = a.x == b.x && target.0 == cur.0 && (target.1 - cur.1).abs() == 1;
+        if along_x || along_y {
+            visit(target);
+            self.at = Some((target, b));
+            return;
+        }
         // Positions in tile units, tile (i, j) spans [i - 0.5, i + 0.5].
         let ua = Point::new(
             (a.x - grid.anchor.x) / grid.side,
@@ -488,35 +503,43 @@ fn compute_rest(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
     let mut backtrack_length = 0.0;
     let mut in_backtrack = false;
     let mut prev: Option<Pose> = None;
-    for r in trace.entries() {
-        match r {
-            Entry::Pose { pose: b, .. } => {
-                if let Some(a) = prev {
-                    let d = a.position().dist(b.position());
-                    if in_backtrack {
-                        backtrack_length += d;
-                    }
-                    if d > 0.0 {
-                        path_length += d;
-                        in_turn = false;
-                    } else {
-                        let ang = wrap_angle(b.theta - a.theta).abs();
-                        if ang > crate::sim::MIN_ROTATION {
-                            rotation += ang;
-                            if !in_turn {
-                                turns += 1;
-                                in_turn = true;
-                            }
-                        }
+    let mut on_pose = |b: Pose, in_backtrack: bool| {
+        if let Some(a) = prev {
+            let d = step_dist(a.position(), b.position());
+            if in_backtrack {
+                backtrack_length += d;
+            }
+            if d > 0.0 {
+                path_length += d;
+                in_turn = false;
+            } else {
+                let ang = wrap_angle(b.theta - a.theta).abs();
+                if ang > crate::sim::MIN_ROTATION {
+                    rotation += ang;
+                    if !in_turn {
+                        turns += 1;
+                        in_turn = true;
                     }
                 }
-                walk.to(&grid, b.position(), |t| {
-                    entries += 1;
-                    distinct.insert(t);
-                });
-                prev = Some(b);
             }
-            Entry::Event { event, .. } => match event {
+        }
+        walk.to(&grid, b.position(), |t| {
+            entries += 1;
+            distinct.insert(t);
+        });
+        prev = Some(b);
+    };
+    // The entries in order, each straight run expanded in a loop of its own.
+    let lattice = trace.lattice();
+    for piece in trace.pieces() {
+        match piece {
+            Piece::Pose { pose, .. } => on_pose(pose, in_backtrack),
+            Piece::Run(run) => {
+                for (_, pose) in run.poses(lattice) {
+                    on_pose(pose, in_backtrack);
+                }
+            }
+            Piece::Event { event, .. } => match event {
                 Event::RegionStart { .. } => regions += 1,
                 Event::BacktrackStart => {
                     backtracks += 1;
@@ -586,37 +609,64 @@ fn visited_tile_centres(
     tol: Option<f64>,
 ) -> usize {
     let eps = (1e-6 * grid.side).max(tol.map_or(0.0, |t| t + 1e-9));
+    // A tolerance may reach one tile beyond the segment's own tiles.
+    let m = i32::from(eps > 0.25 * grid.side);
     let (i0, i1, j0, j1) = reach.bounds();
+    // The visited tiles of `reach` (a visited tile outside it is not counted).
     let mut hit = TileSet::new(i0, i1, j0, j1);
-    let mut poses = trace.poses();
-    let Some(first) = poses.next() else {
-        return 0;
-    };
-    let t = grid.tile_of(first.position());
-    if grid.center(t).dist(first.position()) <= eps {
-        hit.insert(t);
-    }
-    let mut prev = first.position();
-    for p in poses {
-        let a = prev;
-        let b = p.position();
-        prev = b;
+    // The previous position and its tile.
+    let mut prev: Option<(Point, Tile)> = None;
+    let mut on_pose = |b: Point| {
+        let Some((a, ta)) = prev else {
+            let t = grid.tile_of(b);
+            if grid.center(t).dist(b) <= eps && reach.contains(t) {
+                hit.insert(t);
+            }
+            prev = Some((b, t));
+            return;
+        };
         if a == b {
-            continue;
+            return;
         }
-        let ta = grid.tile_of(a);
         let tb = grid.tile_of(b);
-        // A tolerance may reach one tile beyond the segment's own tiles.
-        let m = i32::from(eps > 0.25 * grid.side);
+        prev = Some((b, tb));
         for j in ta.1.min(tb.1) - m..=ta.1.max(tb.1) + m {
             for i in ta.0.min(tb.0) - m..=ta.0.max(tb.0) + m {
-                if point_segment_dist2(grid.center((i, j)), a, b) <= eps * eps {
+                if point_segment_dist2(grid.center((i, j)), a, b) <= eps * eps
+                    && reach.contains((i, j))
+                {
                     hit.insert((i, j));
                 }
             }
         }
+    };
+    let lattice = trace.lattice();
+    for piece in trace.pieces() {
+        match piece {
+            Piece::Pose { pose, .. } => on_pose(pose.position()),
+            Piece::Run(run) => {
+                for (_, pose) in run.poses(lattice) {
+                    on_pose(pose.position());
+                }
+            }
+            Piece::Event { .. } => {}
+        }
     }
-    hit.iter().filter(|&t| reach.contains(t)).count()
+    hit.len()
+}
+
+/// `a.dist(b)` ([`Point::dist`], a `hypot`), bit for bit, without the `hypot` call for an
+/// axis-parallel step between finite points: `hypot(x, ±0) = |x|` exactly (IEC 60559, C
+/// Annex F).
+#[inline]
+fn step_dist(a: Point, b: Point) -> f64 {
+    if a.y == b.y && a.y.is_finite() {
+        (a.x - b.x).abs()
+    } else if a.x == b.x && a.x.is_finite() {
+        (a.y - b.y).abs()
+    } else {
+        a.dist(b)
+    }
 }
 
 #[cfg(test)]
