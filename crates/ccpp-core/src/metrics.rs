@@ -10,7 +10,7 @@ use fixedbitset::FixedBitSet;
 use serde::{Deserialize, Serialize};
 use std::ops::Sub;
 
-use crate::geometry::{point_segment_dist2, wrap_angle, Point, Pose};
+use crate::geometry::{dist_exact, point_segment_dist2, wrap_angle, Point, Pose};
 pub(crate) use crate::raster::stamp_capsule;
 use crate::sim::RunOutput;
 use crate::tiles::{reachable_tiles, Tile, TileGrid, TileSet};
@@ -505,7 +505,7 @@ fn compute_rest(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
     let mut prev: Option<Pose> = None;
     let mut on_pose = |b: Pose, in_backtrack: bool| {
         if let Some(a) = prev {
-            let d = step_dist(a.position(), b.position());
+            let d = dist_exact(a.position(), b.position());
             if in_backtrack {
                 backtrack_length += d;
             }
@@ -653,20 +653,6 @@ fn visited_tile_centres(
         }
     }
     hit.len()
-}
-
-/// `a.dist(b)` ([`Point::dist`], a `hypot`), bit for bit, without the `hypot` call for an
-/// axis-parallel step between finite points: `hypot(x, ±0) = |x|` exactly (IEC 60559, C
-/// Annex F).
-#[inline]
-fn step_dist(a: Point, b: Point) -> f64 {
-    if a.y == b.y && a.y.is_finite() {
-        (a.x - b.x).abs()
-    } else if a.x == b.x && a.x.is_finite() {
-        (a.y - b.y).abs()
-    } else {
-        a.dist(b)
-    }
 }
 
 #[cfg(test)]

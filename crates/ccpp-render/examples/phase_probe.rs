@@ -45,6 +45,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     timed("metrics", reps, || {
         ccpp_core::metrics::compute(&world, &run.output, "probe")
     });
+    let part = ccpp_core::metrics::WorldPart::of(&world, run.output.tile_side);
+    timed("metrics prepared", reps, || {
+        ccpp_core::metrics::compute_prepared(&world, &run.output, "probe", part.clone())
+    });
     let swept = timed("  swept_pixels", reps, || {
         ccpp_core::metrics::swept_pixels(&world, trace)
     });
