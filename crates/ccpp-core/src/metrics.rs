@@ -612,47 +612,117 @@ fn visited_tile_centres(
     // A tolerance may reach one tile beyond the segment's own tiles.
     let m = i32::from(eps > 0.25 * grid.side);
     let (i0, i1, j0, j1) = reach.bounds();
-    // The visited tiles of `reach` (a visited tile outside it is not counted).
-    let mut hit = TileSet::new(i0, i1, j0, j1);
-    // The previous position and its tile.
-    let mut prev: Option<(Point, Tile)> = None;
-    let mut on_pose = |b: Point| {
-        let Some((a, ta)) = prev else {
+    let mut v = Visits {
+        grid,
+        reach,
+        eps,
+        m,
+        hit: TileSet::new(i0, i1, j0, j1),
+        prev: None,
+    };
+    let lattice = trace.lattice();
+    for piece in trace.pieces() {
+        match piece {
+            Piece::Pose { pose, .. } => v.pose(pose.position()),
+            Piece::Run(run) => match (m, lattice_tiles(&run, lattice, grid)) {
+                (0, Some((t0, (di, dj)))) => {
+                    // Each step's box holds its two tiles only (no tolerance margin), both
+                    // visited: the step starts on the one's centre and ends on the other's.
+                    v.pose(Point::new(run.from[0], run.from[1]));
+                    let mut t = t0;
+                    for _ in 0..run.n {
+                        if reach.contains(t) {
+                            v.hit.insert(t);
+                        }
+                        t = (t.0 + di, t.1 + dj);
+                    }
+                    let [x, y] = run.to(lattice);
+                    v.prev = Some((Point::new(x, y), (t.0 - di, t.1 - dj)));
+                }
+                _ => {
+                    for (_, pose) in run.poses(lattice) {
+                        v.pose(pose.position());
+                    }
+                }
+            },
+            Piece::Event { .. } => {}
+        }
+    }
+    v.hit.len()
+}
+
+/// The state of [`visited_tile_centres`].
+struct Visits<'a> {
+    grid: &'a TileGrid,
+    reach: &'a TileSet,
+    /// Visit tolerance, metres.
+    eps: f64,
+    /// Tile margin around a segment's tiles.
+    m: i32,
+    /// The visited tiles of `reach` (a visited tile outside it is not counted).
+    hit: TileSet,
+    /// The previous position and its tile.
+    prev: Option<(Point, Tile)>,
+}
+
+impl Visits<'_> {
+    /// Marks the tile centres visited on the way from the previous position to `b`.
+    fn pose(&mut self, b: Point) {
+        let (grid, eps, m) = (self.grid, self.eps, self.m);
+        let Some((a, ta)) = self.prev else {
             let t = grid.tile_of(b);
-            if grid.center(t).dist(b) <= eps && reach.contains(t) {
-                hit.insert(t);
+            if grid.center(t).dist(b) <= eps && self.reach.contains(t) {
+                self.hit.insert(t);
             }
-            prev = Some((b, t));
+            self.prev = Some((b, t));
             return;
         };
         if a == b {
             return;
         }
         let tb = grid.tile_of(b);
-        prev = Some((b, tb));
+        self.prev = Some((b, tb));
         for j in ta.1.min(tb.1) - m..=ta.1.max(tb.1) + m {
             for i in ta.0.min(tb.0) - m..=ta.0.max(tb.0) + m {
-                if point_segment_dist2(grid.center((i, j)), a, b) <= eps * eps
-                    && reach.contains((i, j))
+                // A tile already visited stays so (the segment's first tile usually is).
+                if !self.hit.contains((i, j))
+                    && self.reach.contains((i, j))
+                    && point_segment_dist2(grid.center((i, j)), a, b) <= eps * eps
                 {
-                    hit.insert((i, j));
+                    self.hit.insert((i, j));
                 }
             }
-        }
-    };
-    let lattice = trace.lattice();
-    for piece in trace.pieces() {
-        match piece {
-            Piece::Pose { pose, .. } => on_pose(pose.position()),
-            Piece::Run(run) => {
-                for (_, pose) in run.poses(lattice) {
-                    on_pose(pose.position());
-                }
-            }
-            Piece::Event { .. } => {}
         }
     }
-    hit.len()
+}
+
+/// The first tile and the step of a lattice run whose poses are exactly centres of `grid`
+/// (the trace's lattice is the grid: same anchor and side, bit for bit) moving one tile along
+/// an axis per pose, and small enough (indices and anchor within `1e6` tiles) that the tile
+/// of each pose is its lattice index and a step's end lies within `1e-9` tile of the segment
+/// it ends; `None` otherwise.
+fn lattice_tiles(
+    run: &crate::trace::Run,
+    lattice: Option<crate::trace::Lattice>,
+    grid: &TileGrid,
+) -> Option<(Tile, Tile)> {
+    let l = lattice?;
+    let crate::trace::Advance::Lattice { i, j, di, dj } = run.advance else {
+        return None;
+    };
+    let same = l.anchor[0] == grid.anchor.x && l.anchor[1] == grid.anchor.y && l.side == grid.side;
+    let bound = 1e6 * grid.side;
+    let small = l.anchor[0].abs() < bound && l.anchor[1].abs() < bound;
+    let k = i64::from(run.n) - 1;
+    let ends = [
+        i64::from(i),
+        i64::from(j),
+        i64::from(i) + k * i64::from(di),
+        i64::from(j) + k * i64::from(dj),
+    ];
+    let in_range = ends.iter().all(|e| e.abs() < 1_000_000);
+    (same && small && in_range && di.abs() + dj.abs() == 1 && grid.side > 0.0)
+        .then_some(((i, j), (di, dj)))
 }
 
 #[cfg(test)]
@@ -730,6 +800,69 @@ mod tests {
 
     /// Metrics from a [`WorldPart`] computed before the run equal those computed after it,
     /// and a part for another tile side is not used (the tiles are computed again).
+    /// The visited tile centres, walked pose by pose over the expanded trace (what
+    /// [`visited_tile_centres`] computes with its lattice-run shortcut).
+    fn visited_pose_by_pose(
+        grid: &TileGrid,
+        trace: &Trace,
+        reach: &TileSet,
+        tol: Option<f64>,
+    ) -> usize {
+        let eps = (1e-6 * grid.side).max(tol.map_or(0.0, |t| t + 1e-9));
+        let m = i32::from(eps > 0.25 * grid.side);
+        let (i0, i1, j0, j1) = reach.bounds();
+        let mut hit = TileSet::new(i0, i1, j0, j1);
+        let poses: Vec<Point> = trace.poses().map(|p| p.position()).collect();
+        let t = grid.tile_of(poses[0]);
+        if grid.center(t).dist(poses[0]) <= eps {
+            hit.insert(t);
+        }
+        for w in poses.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            if a == b {
+                continue;
+            }
+            let (ta, tb) = (grid.tile_of(a), grid.tile_of(b));
+            for j in ta.1.min(tb.1) - m..=ta.1.max(tb.1) + m {
+                for i in ta.0.min(tb.0) - m..=ta.0.max(tb.0) + m {
+                    if point_segment_dist2(grid.center((i, j)), a, b) <= eps * eps {
+                        hit.insert((i, j));
+                    }
+                }
+            }
+        }
+        hit.iter().filter(|&t| reach.contains(t)).count()
+    }
+
+    #[test]
+    fn visited_centres_of_lattice_runs_are_those_of_their_poses() {
+        let world =
+            World::new(open_room(), Robot::new(0.2), Some(Pose::new(1.0, 1.0, 0.0))).unwrap();
+        let config = crate::planners::PlannerConfig::new(crate::planners::PlannerKind::BaStar);
+        let out = simulate(&world, config.build(&world).as_mut(), &SimConfig::default());
+        assert!(
+            out.trace.pieces().any(|p| matches!(p, Piece::Run(_))),
+            "the trace has runs"
+        );
+        let side = out.tile_side.expect("BA* has tiles");
+        // The run's own tiling (the shortcut applies), a shifted one and a finer one (it does
+        // not), each with and without a tolerance.
+        let start = world.start().position();
+        for (anchor, s) in [
+            (start, side),
+            (Point::new(start.x + 0.3 * side, start.y), side),
+            (start, 0.5 * side),
+        ] {
+            let grid = TileGrid::new(anchor, s);
+            let reach = reachable_tiles(&world, &grid);
+            for tol in [None, Some(0.01 * s), Some(0.4 * s)] {
+                let want = visited_pose_by_pose(&grid, &out.trace, &reach, tol);
+                assert!(want > 0);
+                assert_eq!(visited_tile_centres(&grid, &out.trace, &reach, tol), want);
+            }
+        }
+    }
+
     #[test]
     fn metrics_with_a_prepared_world_part_are_the_same() {
         let world =
