@@ -364,9 +364,7 @@ fn shown_with(
                 // A run whose ends differ holds a move; otherwise its poses are compared one
                 // by one.
                 let to = run.to(lattice);
-                if run.from != to {
-                    moved(in_bt, region, &mut s);
-                } else {
+                if run.from == to {
                     for (_, pose) in run.poses(lattice) {
                         let p = [pose.x, pose.y];
                         if last.is_some_and(|l| l != p) {
@@ -374,6 +372,8 @@ fn shown_with(
                         }
                         last = Some(p);
                     }
+                } else {
+                    moved(in_bt, region, &mut s);
                 }
                 last = Some(to);
                 s.poses += run.n as usize;
