@@ -503,7 +503,9 @@ fn compute_rest(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
     let mut backtrack_length = 0.0;
     let mut in_backtrack = false;
     let mut prev: Option<Pose> = None;
-    let mut on_pose = |b: Pose, in_backtrack: bool| {
+    // `tile`: the tile entered, when known (a lattice run's step to the next tile along an
+    // axis, where the walk visits exactly that tile).
+    let mut on_pose = |b: Pose, in_backtrack: bool, tile: Option<Tile>| {
         if let Some(a) = prev {
             let d = dist_exact(a.position(), b.position());
             if in_backtrack {
@@ -523,20 +525,33 @@ fn compute_rest(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
                 }
             }
         }
-        walk.to(&grid, b.position(), |t| {
+        if let Some(t) = tile {
             entries += 1;
             distinct.insert(t);
-        });
+            walk.at = Some((t, b.position()));
+        } else {
+            walk.to(&grid, b.position(), |t| {
+                entries += 1;
+                distinct.insert(t);
+            });
+        }
         prev = Some(b);
     };
     // The entries in order, each straight run expanded in a loop of its own.
     let lattice = trace.lattice();
     for piece in trace.pieces() {
         match piece {
-            Piece::Pose { pose, .. } => on_pose(pose, in_backtrack),
+            Piece::Pose { pose, .. } => on_pose(pose, in_backtrack, None),
             Piece::Run(run) => {
-                for (_, pose) in run.poses(lattice) {
-                    on_pose(pose, in_backtrack);
+                // On the metrics' own tiling a lattice run's poses after its first enter its
+                // tiles one by one (see `lattice_tiles`; the walk would find the same).
+                let tiles = lattice_tiles(&run, lattice, &grid);
+                for (k, (_, pose)) in run.poses(lattice).enumerate() {
+                    let tile = tiles.filter(|_| k > 0).and_then(|((i, j), (di, dj))| {
+                        let k = i32::try_from(k).ok()?;
+                        Some((i + k * di, j + k * dj))
+                    });
+                    on_pose(pose, in_backtrack, tile);
                 }
             }
             Piece::Event { event, .. } => match event {
