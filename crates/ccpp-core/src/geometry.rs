@@ -116,6 +116,37 @@ impl Pose {
     }
 }
 
+/// `a.dist(b)` ([`Point::dist`], a `hypot`) bit for bit, without the call for an axis-parallel
+/// pair of finite points: `hypot(x, ±0) = |x|` exactly (IEC 60559, C Annex F).
+#[inline]
+pub(crate) fn dist_exact(a: Point, b: Point) -> f64 {
+    if a.y == b.y && a.y.is_finite() {
+        (a.x - b.x).abs()
+    } else if a.x == b.x && a.x.is_finite() {
+        (a.y - b.y).abs()
+    } else {
+        a.dist(b)
+    }
+}
+
+/// `y.atan2(x)` bit for bit, without the call on the axes (finite, nonzero other component):
+/// `atan2(±0, x > 0) = ±0`, `atan2(±0, x < 0) = ±pi`, `atan2(y > 0, ±0) = pi/2`,
+/// `atan2(y < 0, ±0) = -pi/2` (C Annex F).
+#[inline]
+pub(crate) fn atan2_exact(y: f64, x: f64) -> f64 {
+    if y == 0.0 && x.is_finite() && x != 0.0 {
+        if x > 0.0 {
+            y
+        } else {
+            std::f64::consts::PI.copysign(y)
+        }
+    } else if x == 0.0 && y.is_finite() && y != 0.0 {
+        std::f64::consts::FRAC_PI_2.copysign(y)
+    } else {
+        y.atan2(x)
+    }
+}
+
 /// Wraps an angle into (-pi, pi].
 #[inline]
 pub fn wrap_angle(a: f64) -> f64 {
@@ -239,6 +270,45 @@ pub fn round_i32(x: f64) -> i32 {
 
 #[cfg(test)]
 mod tests {
+    /// The axis fast paths give the library's results bit for bit (and the general case is the
+    /// library call).
+    #[test]
+    fn exact_fast_paths_match_the_library() {
+        let vals = [
+            0.0,
+            -0.0,
+            1e-300,
+            0.05,
+            -0.05,
+            0.15,
+            3.0,
+            -7.25,
+            56.075,
+            59.775_000_000_000_006,
+            1e12,
+            -1e-9,
+            f64::MIN_POSITIVE,
+        ];
+        for &u in &vals {
+            for &v in &vals {
+                let y = v * 0.7 + 0.1;
+                for (a, b) in [
+                    (Point::new(u, y), Point::new(v, y)),
+                    (Point::new(y, u), Point::new(y, v)),
+                    (Point::new(u, v), Point::new(v, u)),
+                ] {
+                    assert_eq!(
+                        dist_exact(a, b).to_bits(),
+                        a.dist(b).to_bits(),
+                        "{a:?} {b:?}"
+                    );
+                }
+                assert_eq!(atan2_exact(u, v).to_bits(), u.atan2(v).to_bits(), "{u} {v}");
+                assert_eq!(atan2_exact(v, u).to_bits(), v.atan2(u).to_bits(), "{v} {u}");
+            }
+        }
+    }
+
     use super::*;
 
     #[test]

@@ -10,7 +10,7 @@ use fixedbitset::FixedBitSet;
 use serde::{Deserialize, Serialize};
 use std::ops::Sub;
 
-use crate::geometry::{point_segment_dist2, wrap_angle, Point, Pose};
+use crate::geometry::{dist_exact, point_segment_dist2, wrap_angle, Point, Pose};
 pub(crate) use crate::raster::stamp_capsule;
 use crate::sim::RunOutput;
 use crate::tiles::{reachable_tiles, Tile, TileGrid, TileSet};
@@ -293,6 +293,21 @@ impl TileWalk {
             return;
         }
         let target = grid.tile_of(b);
+        // Fast paths, the same visits as the traversal below: staying in the tile visits
+        // nothing, and an axis-parallel move (one coordinate equal bit for bit, so the other
+        // component of the direction is exactly 0) into the next tile along that axis crosses
+        // exactly one boundary, visiting that tile (the traversal's one step, or its fallback).
+        if target == cur {
+            self.at = Some((cur, b));
+            return;
+        }
+        let along_x = a.y == b.y && target.1 == cur.1 && (target.0 - cur.0).abs() == 1;
+        let along_y = a.x == b.x && target.0 == cur.0 && (target.1 - cur.1).abs() == 1;
+        if along_x || along_y {
+            visit(target);
+            self.at = Some((target, b));
+            return;
+        }
         // Positions in tile units, tile (i, j) spans [i - 0.5, i + 0.5].
         let ua = Point::new(
             (a.x - grid.anchor.x) / grid.side,
@@ -488,35 +503,58 @@ fn compute_rest(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
     let mut backtrack_length = 0.0;
     let mut in_backtrack = false;
     let mut prev: Option<Pose> = None;
-    for r in trace.entries() {
-        match r {
-            Entry::Pose { pose: b, .. } => {
-                if let Some(a) = prev {
-                    let d = a.position().dist(b.position());
-                    if in_backtrack {
-                        backtrack_length += d;
-                    }
-                    if d > 0.0 {
-                        path_length += d;
-                        in_turn = false;
-                    } else {
-                        let ang = wrap_angle(b.theta - a.theta).abs();
-                        if ang > crate::sim::MIN_ROTATION {
-                            rotation += ang;
-                            if !in_turn {
-                                turns += 1;
-                                in_turn = true;
-                            }
-                        }
+    // `tile`: the tile entered, when known (a lattice run's step to the next tile along an
+    // axis, where the walk visits exactly that tile).
+    let mut on_pose = |b: Pose, in_backtrack: bool, tile: Option<Tile>| {
+        if let Some(a) = prev {
+            let d = dist_exact(a.position(), b.position());
+            if in_backtrack {
+                backtrack_length += d;
+            }
+            if d > 0.0 {
+                path_length += d;
+                in_turn = false;
+            } else {
+                let ang = wrap_angle(b.theta - a.theta).abs();
+                if ang > crate::sim::MIN_ROTATION {
+                    rotation += ang;
+                    if !in_turn {
+                        turns += 1;
+                        in_turn = true;
                     }
                 }
-                walk.to(&grid, b.position(), |t| {
-                    entries += 1;
-                    distinct.insert(t);
-                });
-                prev = Some(b);
             }
-            Entry::Event { event, .. } => match event {
+        }
+        if let Some(t) = tile {
+            entries += 1;
+            distinct.insert(t);
+            walk.at = Some((t, b.position()));
+        } else {
+            walk.to(&grid, b.position(), |t| {
+                entries += 1;
+                distinct.insert(t);
+            });
+        }
+        prev = Some(b);
+    };
+    // The entries in order, each straight run expanded in a loop of its own.
+    let lattice = trace.lattice();
+    for piece in trace.pieces() {
+        match piece {
+            Piece::Pose { pose, .. } => on_pose(pose, in_backtrack, None),
+            Piece::Run(run) => {
+                // On the metrics' own tiling a lattice run's poses after its first enter its
+                // tiles one by one (see `lattice_tiles`; the walk would find the same).
+                let tiles = lattice_tiles(&run, lattice, &grid);
+                for (k, (_, pose)) in run.poses(lattice).enumerate() {
+                    let tile = tiles.filter(|_| k > 0).and_then(|((i, j), (di, dj))| {
+                        let k = i32::try_from(k).ok()?;
+                        Some((i + k * di, j + k * dj))
+                    });
+                    on_pose(pose, in_backtrack, tile);
+                }
+            }
+            Piece::Event { event, .. } => match event {
                 Event::RegionStart { .. } => regions += 1,
                 Event::BacktrackStart => {
                     backtracks += 1;
@@ -586,37 +624,120 @@ fn visited_tile_centres(
     tol: Option<f64>,
 ) -> usize {
     let eps = (1e-6 * grid.side).max(tol.map_or(0.0, |t| t + 1e-9));
+    // A tolerance may reach one tile beyond the segment's own tiles.
+    let m = i32::from(eps > 0.25 * grid.side);
     let (i0, i1, j0, j1) = reach.bounds();
-    let mut hit = TileSet::new(i0, i1, j0, j1);
-    let mut poses = trace.poses();
-    let Some(first) = poses.next() else {
-        return 0;
+    let mut v = Visits {
+        grid,
+        reach,
+        eps,
+        m,
+        hit: TileSet::new(i0, i1, j0, j1),
+        prev: None,
     };
-    let t = grid.tile_of(first.position());
-    if grid.center(t).dist(first.position()) <= eps {
-        hit.insert(t);
-    }
-    let mut prev = first.position();
-    for p in poses {
-        let a = prev;
-        let b = p.position();
-        prev = b;
-        if a == b {
-            continue;
+    let lattice = trace.lattice();
+    for piece in trace.pieces() {
+        match piece {
+            Piece::Pose { pose, .. } => v.pose(pose.position()),
+            Piece::Run(run) => match (m, lattice_tiles(&run, lattice, grid)) {
+                (0, Some((t0, (di, dj)))) => {
+                    // Each step's box holds its two tiles only (no tolerance margin), both
+                    // visited: the step starts on the one's centre and ends on the other's.
+                    v.pose(Point::new(run.from[0], run.from[1]));
+                    let mut t = t0;
+                    for _ in 0..run.n {
+                        if reach.contains(t) {
+                            v.hit.insert(t);
+                        }
+                        t = (t.0 + di, t.1 + dj);
+                    }
+                    let [x, y] = run.to(lattice);
+                    v.prev = Some((Point::new(x, y), (t.0 - di, t.1 - dj)));
+                }
+                _ => {
+                    for (_, pose) in run.poses(lattice) {
+                        v.pose(pose.position());
+                    }
+                }
+            },
+            Piece::Event { .. } => {}
         }
-        let ta = grid.tile_of(a);
+    }
+    v.hit.len()
+}
+
+/// The state of [`visited_tile_centres`].
+struct Visits<'a> {
+    grid: &'a TileGrid,
+    reach: &'a TileSet,
+    /// Visit tolerance, metres.
+    eps: f64,
+    /// Tile margin around a segment's tiles.
+    m: i32,
+    /// The visited tiles of `reach` (a visited tile outside it is not counted).
+    hit: TileSet,
+    /// The previous position and its tile.
+    prev: Option<(Point, Tile)>,
+}
+
+impl Visits<'_> {
+    /// Marks the tile centres visited on the way from the previous position to `b`.
+    fn pose(&mut self, b: Point) {
+        let (grid, eps, m) = (self.grid, self.eps, self.m);
+        let Some((a, ta)) = self.prev else {
+            let t = grid.tile_of(b);
+            if grid.center(t).dist(b) <= eps && self.reach.contains(t) {
+                self.hit.insert(t);
+            }
+            self.prev = Some((b, t));
+            return;
+        };
+        if a == b {
+            return;
+        }
         let tb = grid.tile_of(b);
-        // A tolerance may reach one tile beyond the segment's own tiles.
-        let m = i32::from(eps > 0.25 * grid.side);
+        self.prev = Some((b, tb));
         for j in ta.1.min(tb.1) - m..=ta.1.max(tb.1) + m {
             for i in ta.0.min(tb.0) - m..=ta.0.max(tb.0) + m {
-                if point_segment_dist2(grid.center((i, j)), a, b) <= eps * eps {
-                    hit.insert((i, j));
+                // A tile already visited stays so (the segment's first tile usually is).
+                if !self.hit.contains((i, j))
+                    && self.reach.contains((i, j))
+                    && point_segment_dist2(grid.center((i, j)), a, b) <= eps * eps
+                {
+                    self.hit.insert((i, j));
                 }
             }
         }
     }
-    hit.iter().filter(|&t| reach.contains(t)).count()
+}
+
+/// The first tile and the step of a lattice run whose poses are exactly centres of `grid`
+/// (the trace's lattice is the grid: same anchor and side, bit for bit) moving one tile along
+/// an axis per pose, and small enough (indices and anchor within `1e6` tiles) that the tile
+/// of each pose is its lattice index and a step's end lies within `1e-9` tile of the segment
+/// it ends; `None` otherwise.
+fn lattice_tiles(
+    run: &crate::trace::Run,
+    lattice: Option<crate::trace::Lattice>,
+    grid: &TileGrid,
+) -> Option<(Tile, Tile)> {
+    let l = lattice?;
+    let crate::trace::Advance::Lattice { i, j, di, dj } = run.advance else {
+        return None;
+    };
+    let same = l.anchor[0] == grid.anchor.x && l.anchor[1] == grid.anchor.y && l.side == grid.side;
+    let bound = 1e6 * grid.side;
+    let small = l.anchor[0].abs() < bound && l.anchor[1].abs() < bound;
+    let k = i64::from(run.n) - 1;
+    let ends = [
+        i64::from(i),
+        i64::from(j),
+        i64::from(i) + k * i64::from(di),
+        i64::from(j) + k * i64::from(dj),
+    ];
+    let in_range = ends.iter().all(|e| e.abs() < 1_000_000);
+    (same && small && in_range && di.abs() + dj.abs() == 1 && grid.side > 0.0)
+        .then_some(((i, j), (di, dj)))
 }
 
 #[cfg(test)]
@@ -694,6 +815,69 @@ mod tests {
 
     /// Metrics from a [`WorldPart`] computed before the run equal those computed after it,
     /// and a part for another tile side is not used (the tiles are computed again).
+    /// The visited tile centres, walked pose by pose over the expanded trace (what
+    /// [`visited_tile_centres`] computes with its lattice-run shortcut).
+    fn visited_pose_by_pose(
+        grid: &TileGrid,
+        trace: &Trace,
+        reach: &TileSet,
+        tol: Option<f64>,
+    ) -> usize {
+        let eps = (1e-6 * grid.side).max(tol.map_or(0.0, |t| t + 1e-9));
+        let m = i32::from(eps > 0.25 * grid.side);
+        let (i0, i1, j0, j1) = reach.bounds();
+        let mut hit = TileSet::new(i0, i1, j0, j1);
+        let poses: Vec<Point> = trace.poses().map(|p| p.position()).collect();
+        let t = grid.tile_of(poses[0]);
+        if grid.center(t).dist(poses[0]) <= eps {
+            hit.insert(t);
+        }
+        for w in poses.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            if a == b {
+                continue;
+            }
+            let (ta, tb) = (grid.tile_of(a), grid.tile_of(b));
+            for j in ta.1.min(tb.1) - m..=ta.1.max(tb.1) + m {
+                for i in ta.0.min(tb.0) - m..=ta.0.max(tb.0) + m {
+                    if point_segment_dist2(grid.center((i, j)), a, b) <= eps * eps {
+                        hit.insert((i, j));
+                    }
+                }
+            }
+        }
+        hit.iter().filter(|&t| reach.contains(t)).count()
+    }
+
+    #[test]
+    fn visited_centres_of_lattice_runs_are_those_of_their_poses() {
+        let world =
+            World::new(open_room(), Robot::new(0.2), Some(Pose::new(1.0, 1.0, 0.0))).unwrap();
+        let config = crate::planners::PlannerConfig::new(crate::planners::PlannerKind::BaStar);
+        let out = simulate(&world, config.build(&world).as_mut(), &SimConfig::default());
+        assert!(
+            out.trace.pieces().any(|p| matches!(p, Piece::Run(_))),
+            "the trace has runs"
+        );
+        let side = out.tile_side.expect("BA* has tiles");
+        // The run's own tiling (the shortcut applies), a shifted one and a finer one (it does
+        // not), each with and without a tolerance.
+        let start = world.start().position();
+        for (anchor, s) in [
+            (start, side),
+            (Point::new(start.x + 0.3 * side, start.y), side),
+            (start, 0.5 * side),
+        ] {
+            let grid = TileGrid::new(anchor, s);
+            let reach = reachable_tiles(&world, &grid);
+            for tol in [None, Some(0.01 * s), Some(0.4 * s)] {
+                let want = visited_pose_by_pose(&grid, &out.trace, &reach, tol);
+                assert!(want > 0);
+                assert_eq!(visited_tile_centres(&grid, &out.trace, &reach, tol), want);
+            }
+        }
+    }
+
     #[test]
     fn metrics_with_a_prepared_world_part_are_the_same() {
         let world =

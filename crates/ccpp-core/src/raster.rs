@@ -58,7 +58,8 @@ pub fn capsule_runs(
     let d = b.sub(a);
     let l2 = d.dot(d);
     let len = l2.sqrt();
-    for row in r0..=r1 {
+    // The run of one row, `None` when the row holds no pixel of the capsule.
+    let row_run = |row: i64| -> Option<(usize, usize)> {
         let gy = h - row as f64 - 0.5;
         let inside = |c: i64| point_segment_dist2(Point::new(c as f64 + 0.5, gy), a, b) <= rt2;
         // Closed-form x-extent of the capsule on this row (slightly generous is fine: the
@@ -98,7 +99,7 @@ pub fn capsule_runs(
             hi = hi.max(a.x.max(b.x));
         }
         if lo > hi {
-            continue;
+            return None;
         }
         let mut c_lo = ceil_i64(lo - 0.5).clamp(-1, w);
         let mut c_hi = floor_i64(hi - 0.5).clamp(-1, w);
@@ -110,10 +111,8 @@ pub fn capsule_runs(
         if c_lo > c_hi {
             // The estimate holds no pixel of the run (rounding at a tangent row): the run, if
             // any, is a pixel just outside it.
-            match [first - 1, c_hi + 1].into_iter().find(|&c| inside(c)) {
-                Some(c) => (c_lo, c_hi) = (c, c),
-                None => continue,
-            }
+            let c = [first - 1, c_hi + 1].into_iter().find(|&c| inside(c))?;
+            (c_lo, c_hi) = (c, c);
         }
         while c_lo > 0 && inside(c_lo - 1) {
             c_lo -= 1;
@@ -128,10 +127,31 @@ pub fn capsule_runs(
             }
         }
         let (c_lo, c_hi) = (c_lo.max(0), c_hi.min(w - 1));
-        if c_lo > c_hi {
-            continue;
+        (c_lo <= c_hi).then_some((c_lo as usize, c_hi as usize))
+    };
+    // A vertical segment's rows between its end disks all have the same run: there the
+    // nearest point of the segment is the pixel centre's projection, at the segment's x
+    // exactly, and the rounding of its y (a few ulps of the map's extent, squared) lies below
+    // half an ulp of `rt2` (guaranteed by `extent < 1e6 rt`), so the exact predicate is
+    // `(c + 0.5 - a.x)^2 <= rt2` on every such row, and the closed-form estimate does not
+    // depend on the row either. Those rows reuse the first one's run (same runs as row by row).
+    let extent = h.max(a.y.abs()).max(b.y.abs());
+    let vertical = d.x == 0.0 && d.y.abs() >= 1e-6 && extent < 1e6 * rt && rt2 > 0.0;
+    let mut shared: Option<Option<(usize, usize)>> = None;
+    for row in r0..=r1 {
+        if vertical {
+            let gy = h - row as f64 - 0.5;
+            let (dya, dyb) = (gy - a.y, gy - b.y);
+            if rt2 - dya * dya < 0.0 && rt2 - dyb * dyb < 0.0 && (0.0..=l2).contains(&(dya * d.y)) {
+                if let Some((c_lo, c_hi)) = *shared.get_or_insert_with(|| row_run(row)) {
+                    on_run(row as usize, c_lo, c_hi);
+                }
+                continue;
+            }
         }
-        on_run(row as usize, c_lo as usize, c_hi as usize);
+        if let Some((c_lo, c_hi)) = row_run(row) {
+            on_run(row as usize, c_lo, c_hi);
+        }
     }
 }
 

@@ -26,7 +26,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::geometry::{wrap_angle, Point, Pose};
+use crate::geometry::{atan2_exact, dist_exact, wrap_angle, Point, Pose};
 use crate::trace::Trace;
 
 /// The default merging tolerance, metres: 1 mm, far below a map pixel (5 cm on the shared
@@ -70,7 +70,7 @@ impl Sleeve {
     /// Whether `p` continues the straight segment from `start` within `tol`; if so the
     /// sleeve is narrowed by it.
     fn accept(&mut self, start: Point, p: Point, tol: f64) -> bool {
-        let d = start.dist(p);
+        let d = dist_exact(start, p);
         if d + tol < self.far {
             return false;
         }
@@ -79,7 +79,7 @@ impl Sleeve {
             self.far = self.far.max(d);
             return true;
         }
-        let dir = (p.y - start.y).atan2(p.x - start.x);
+        let dir = atan2_exact(p.y - start.y, p.x - start.x);
         let reference = *self.reference.get_or_insert(dir);
         let off = wrap_angle(dir - reference);
         if off < self.lo || off > self.hi {
@@ -115,8 +115,8 @@ impl Route {
                 last = Some(p);
                 continue;
             };
-            let at_start = prev.position().dist(start.position()) <= SAME_POSITION_M;
-            if p.position().dist(prev.position()) <= SAME_POSITION_M {
+            let at_start = dist_exact(prev.position(), start.position()) <= SAME_POSITION_M;
+            if dist_exact(p.position(), prev.position()) <= SAME_POSITION_M {
                 // A rotation in place (or a repeated pose): merged into one waypoint.
                 if at_start {
                     if let Some(w) = waypoints.last_mut() {

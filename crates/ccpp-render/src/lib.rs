@@ -339,23 +339,46 @@ fn shown_with(
     // The region last inserted: a region's poses follow one another, so most inserts repeat it.
     let mut inserted: Option<u32> = None;
     let mut last: Option<[f64; 2]> = None;
-    for r in trace.entries() {
-        match r {
-            Entry::Pose { pose, .. } => {
-                let pose = [pose.x, pose.y, pose.theta];
-                let p = [pose[0], pose[1]];
+    // A move (a pose at another position than the one before) marks the backtracking or the
+    // region in force; marking twice changes nothing.
+    let mut moved = |in_bt: bool, region: u32, s: &mut Shown| {
+        if in_bt {
+            s.backtrack = true;
+        } else if inserted != Some(region) {
+            regions.insert(region);
+            inserted = Some(region);
+        }
+    };
+    let lattice = trace.lattice();
+    for piece in trace.pieces() {
+        match piece {
+            Piece::Pose { pose, .. } => {
+                let p = [pose.x, pose.y];
                 if last.is_some_and(|l| l != p) {
-                    if in_bt {
-                        s.backtrack = true;
-                    } else if inserted != Some(region) {
-                        regions.insert(region);
-                        inserted = Some(region);
-                    }
+                    moved(in_bt, region, &mut s);
                 }
                 last = Some(p);
                 s.poses += 1;
             }
-            Entry::Event { event, .. } => match event {
+            Piece::Run(run) => {
+                // A run whose ends differ holds a move; otherwise its poses are compared one
+                // by one.
+                let to = run.to(lattice);
+                if run.from == to {
+                    for (_, pose) in run.poses(lattice) {
+                        let p = [pose.x, pose.y];
+                        if last.is_some_and(|l| l != p) {
+                            moved(in_bt, region, &mut s);
+                        }
+                        last = Some(p);
+                    }
+                } else {
+                    moved(in_bt, region, &mut s);
+                }
+                last = Some(to);
+                s.poses += run.n as usize;
+            }
+            Piece::Event { event, .. } => match event {
                 Event::RegionStart { region: k } => region = *k,
                 Event::BacktrackStart => in_bt = true,
                 Event::BacktrackEnd => in_bt = false,
@@ -963,6 +986,8 @@ struct LaneBlitter {
     rects: Vec<[f32; 4]>,
     /// The group's bounding box `[x0, y0, x1, y1]`.
     bbox: [f32; 4],
+    /// Scratch: the horizontal coverage of a rectangle's columns.
+    fx: Vec<f32>,
 }
 
 /// Largest bounding box (pixels) of a group of lane rectangles blended at once.
@@ -1069,12 +1094,15 @@ impl LaneBlitter {
         self.cov.resize(bw * (y1 - y0), 0.0);
         for r in &self.rects {
             let (cx0, cx1) = (r[0].floor() as usize, r[2].ceil() as usize);
+            // Each column's horizontal coverage, computed once for all the rows (same values).
+            self.fx.clear();
+            self.fx
+                .extend((cx0..cx1).map(|px| r[2].min(px as f32 + 1.0) - r[0].max(px as f32)));
             for py in r[1].floor() as usize..r[3].ceil() as usize {
                 let fy = r[3].min(py as f32 + 1.0) - r[1].max(py as f32);
-                let row = &mut self.cov[(py - y0) * bw..][..bw];
-                for px in cx0..cx1 {
-                    let fx = r[2].min(px as f32 + 1.0) - r[0].max(px as f32);
-                    row[px - x0] += fx * fy;
+                let row = &mut self.cov[(py - y0) * bw + cx0 - x0..][..cx1 - cx0];
+                for (c, &fx) in row.iter_mut().zip(&self.fx) {
+                    *c += fx * fy;
                 }
             }
         }
