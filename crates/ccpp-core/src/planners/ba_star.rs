@@ -154,10 +154,17 @@ impl Judgement {
 /// Visits only the pixels near the segment (row spans of the swept capsule), so long segments
 /// cost `O(length * r)`, not the area of their bounding box.
 pub fn judge_motion(known: &KnownMap, a: Point, b: Point, r: f64) -> Judgement {
-    let frame = *known.frame();
+    let frame = known.frame();
     let ga = frame.world_to_grid(a);
     let gb = frame.world_to_grid(b);
     let rc = contact_radius_px(r / frame.resolution);
+    judge_motion_px(known, ga, gb, rc)
+}
+
+/// [`judge_motion`] between grid points `ga` and `gb` (continuous grid coordinates of the two
+/// world points) for the contact radius `rc` pixels of the robot.
+fn judge_motion_px(known: &KnownMap, ga: Point, gb: Point, rc: f64) -> Judgement {
+    let frame = *known.frame();
     let rc2 = rc * rc;
     let h = frame.height as f64;
     if ga == gb {
@@ -1124,6 +1131,12 @@ pub fn smooth_path(path: &[Tile], mut visible: impl FnMut(Tile, Tile) -> bool) -
 /// follows; a larger margin only costs time).
 const CANDIDATE_MARGIN_PX: f64 = 0.01;
 
+/// Margin (pixels) of the box of pixels that can touch a tile's contact disk in
+/// [`Mind::sense`] (a pixel centre `q` touches when `|q - g|^2 < rc^2`, so `|q.x - g.x| < rc`
+/// and `|q.y - g.y| < rc` up to rounding): far above the rounding of grid coordinates of a
+/// few thousand pixels, far below a pixel.
+const TIGHT_BOX_MARGIN_PX: f64 = 1e-7;
+
 // Tile state bits.
 const ST_STAND: u8 = 0b0011; // Judgement of standing at the centre
 const ST_COVERED: u8 = 0b0100;
@@ -1603,6 +1616,56 @@ struct Mind {
     /// Per-tile cache of the contact disk's pixel spans for [`Mind::judge_tile_first`] and
     /// [`Mind::sense`].
     disk: DiskCache,
+    /// Grid x of the centre of each tile column (from the tiling's first column) and grid y
+    /// of each tile row, when the frame is not rotated (a centre's grid x then depends on its
+    /// world x alone, its y on its world y alone); empty otherwise. Exactly
+    /// `frame.world_to_grid(center(t))`, computed once.
+    gx: Vec<f64>,
+    gy: Vec<f64>,
+    /// [`Mind::touch_box`] per tile column and per tile row (from `gx`, `gy`).
+    touch_cols: Vec<(i64, i64)>,
+    touch_rows: Vec<(i64, i64)>,
+    /// Per image column `c`: the tile columns `i` (inclusive) whose touch box can hold `c`,
+    /// as `(first i whose box ends at or after c, last i whose box starts at or before c)`
+    /// (boxes move right with `i`); per image row the same for tile rows. Empty when the
+    /// frame is rotated.
+    col_tiles: Vec<(i32, i32)>,
+    row_tiles: Vec<(i32, i32)>,
+}
+
+/// [`Mind::col_tiles`] / [`Mind::row_tiles`]: for each of `n` pixel indices `p`, the range of
+/// tile indices (from `first`) whose pixel range `boxes[k]` can hold `p`: `lo(k)` and `hi(k)`
+/// must be non-decreasing in `k` (`rev`: non-increasing, the rows).
+fn pixel_to_tiles(boxes: &[(i64, i64)], n: usize, first: i32, rev: bool) -> Vec<(i32, i32)> {
+    (0..n as i64)
+        .map(|p| {
+            if rev {
+                // Boxes move up (to smaller rows) with k: the first k starting at or above p,
+                // the last k ending at or below p.
+                let a = boxes.partition_point(|b| b.0 > p);
+                let b = boxes.partition_point(|b| b.1 >= p);
+                (first + a as i32, first + b as i32 - 1)
+            } else {
+                let a = boxes.partition_point(|b| b.1 < p);
+                let b = boxes.partition_point(|b| b.0 <= p);
+                (first + a as i32, first + b as i32 - 1)
+            }
+        })
+        .collect()
+}
+
+/// The rows and columns of [`Mind::touch_box`] for a disk of contact radius `rc` pixels at grid
+/// point `g` in an image of height `h` pixels: `((row_lo, row_hi), (col_lo, col_hi))`.
+#[inline]
+fn touch_box_of(g: Point, rc: f64, h: f64) -> ((i64, i64), (i64, i64)) {
+    let m = TIGHT_BOX_MARGIN_PX;
+    (
+        (
+            ceil_i64(h - g.y - rc - 0.5 - m),
+            floor_i64(h - g.y + rc - 0.5 + m),
+        ),
+        (ceil_i64(g.x - rc - 0.5 - m), floor_i64(g.x + rc - 0.5 + m)),
+    )
 }
 
 /// The contact disk of each tile as pixel spans: `rows` slots per tile of `[lo, hi]` column
@@ -1648,6 +1711,70 @@ impl Mind {
         self.tiles.grid.center(t)
     }
 
+    /// The image rows and columns (inclusive, signed) whose pixel centres lie within the
+    /// contact radius of tile `t`'s centre in each coordinate, with a margin of
+    /// [`TIGHT_BOX_MARGIN_PX`]: every pixel that can touch the tile's disk lies in them.
+    #[inline]
+    fn touch_box(&self, t: Tile) -> ((i64, i64), (i64, i64)) {
+        let (di, dj) = (t.0 - self.tiles.i0, t.1 - self.tiles.j0);
+        if let (Some(&c), Some(&r)) = (
+            usize::try_from(di)
+                .ok()
+                .and_then(|i| self.touch_cols.get(i)),
+            usize::try_from(dj)
+                .ok()
+                .and_then(|j| self.touch_rows.get(j)),
+        ) {
+            return (r, c);
+        }
+        let h = self.known.frame().height as f64;
+        touch_box_of(self.grid_center(t), self.rc_px, h)
+    }
+
+    /// [`judge_motion`] from the centre of tile `t` to that of its neighbour `n`. First the
+    /// fast path of [`judge_motion_px`] on the union of the two tiles' [`Mind::touch_box`]es
+    /// (every pixel that touches the swept disk lies within the contact radius of the segment
+    /// in each coordinate, so in that box): inside the image and all known free, the move is
+    /// free, as the exact test would find.
+    fn judge_step(&self, t: Tile, n: Tile) -> Judgement {
+        let ((ra, rb), (ca, cb)) = self.touch_box(t);
+        let ((rc, rd), (cc, cd)) = self.touch_box(n);
+        let (r0, r1, c0, c1) = (ra.min(rc), rb.max(rd), ca.min(cc), cb.max(cd));
+        let frame = self.known.frame();
+        if 0 <= r0
+            && r0 <= r1
+            && r1 < frame.height as i64
+            && 0 <= c0
+            && c0 <= c1
+            && c1 < frame.width as i64
+            && (r1 - r0 + 1) * (c1 - c0 + 1) <= 1024
+            && self
+                .known
+                .rect_known_free(r0 as usize, r1 as usize, c0 as usize, c1 as usize)
+        {
+            return Judgement::Free;
+        }
+        judge_motion_px(
+            &self.known,
+            self.grid_center(t),
+            self.grid_center(n),
+            self.rc_px,
+        )
+    }
+
+    /// The centre of tile `t` in continuous grid coordinates: `world_to_grid(center(t))`.
+    #[inline]
+    fn grid_center(&self, t: Tile) -> Point {
+        let (di, dj) = (t.0 - self.tiles.i0, t.1 - self.tiles.j0);
+        if let (Some(&x), Some(&y)) = (
+            usize::try_from(di).ok().and_then(|i| self.gx.get(i)),
+            usize::try_from(dj).ok().and_then(|j| self.gy.get(j)),
+        ) {
+            return Point::new(x, y);
+        }
+        self.known.frame().world_to_grid(self.center(t))
+    }
+
     /// Judges move `t -> t + N8[k]` (cached once decided).
     fn judge_move(&mut self, t: Tile, k: usize) -> Judgement {
         let c = self.tiles.cached_move(t, k);
@@ -1660,7 +1787,7 @@ impl Mind {
         {
             Judgement::Blocked
         } else {
-            judge_motion(&self.known, self.center(t), self.center(n), self.r)
+            self.judge_step(t, n)
         };
         if j != Judgement::Undetermined {
             self.tiles.set_move(t, k, j);
@@ -1743,28 +1870,39 @@ impl Mind {
             }
             (i0, i1, j0, j1)
         };
-        let (c0, c1) = spans
-            .iter()
-            .fold((usize::MAX, 0), |(a, b), s| (a.min(s.0), b.max(s.1)));
-        let (_, _, j0, j1) = tile_box(c0, c1, first_row, last_row);
         let mut ranges = std::mem::take(&mut self.candidate_rows);
         ranges.clear();
-        ranges.resize((j1 - j0 + 1) as usize, (i32::MAX, i32::MIN));
-        for (b, band) in spans.chunks(self.band_rows).enumerate() {
-            let (bc0, bc1) = band
+        let j0 = if self.row_tiles.is_empty() {
+            let (c0, c1) = spans
                 .iter()
                 .fold((usize::MAX, 0), |(a, b), s| (a.min(s.0), b.max(s.1)));
-            if bc0 > bc1 {
-                continue;
+            let (_, _, j0, j1) = tile_box(c0, c1, first_row, last_row);
+            ranges.resize((j1 - j0 + 1) as usize, (i32::MAX, i32::MIN));
+            self.band_candidates(&spans, first_row, j0, &mut ranges, tile_box);
+            j0
+        } else {
+            // Unrotated: the tiles whose touch box meets a row's new span, from the tables.
+            let (j0, j1) = (self.row_tiles[last_row].0, self.row_tiles[first_row].1);
+            if j0 <= j1 {
+                ranges.resize((j1 - j0 + 1) as usize, (i32::MAX, i32::MIN));
+                for (row, &(lo, hi)) in (first_row..).zip(spans.iter()) {
+                    if lo > hi {
+                        continue;
+                    }
+                    let (bj0, bj1) = self.row_tiles[row];
+                    let (bi0, bi1) = (self.col_tiles[lo].0, self.col_tiles[hi].1);
+                    if bi0 > bi1 {
+                        continue;
+                    }
+                    for j in bj0.max(j0)..=bj1.min(j1) {
+                        let r = &mut ranges[(j - j0) as usize];
+                        r.0 = r.0.min(bi0);
+                        r.1 = r.1.max(bi1);
+                    }
+                }
             }
-            let r0 = first_row + b * self.band_rows;
-            let (bi0, bi1, bj0, bj1) = tile_box(bc0, bc1, r0, r0 + band.len() - 1);
-            for j in bj0.max(j0)..=bj1.min(j1) {
-                let r = &mut ranges[(j - j0) as usize];
-                r.0 = r.0.min(bi0);
-                r.1 = r.1.max(bi1);
-            }
-        }
+            j0
+        };
         for (j, &(i0, i1)) in (j0..).zip(ranges.iter()) {
             for i in i0..=i1 {
                 let t = (i, j);
@@ -1773,14 +1911,12 @@ impl Mind {
                     continue;
                 }
                 let judged = if self.tiles.state[k] & ST_DISK == 0 {
-                    // Not cached yet: the rows and columns the disk can reach (one pixel of
-                    // margin).
-                    let g = frame.world_to_grid(self.center(t));
-                    let rows = disk_rows(&frame, g, rc);
-                    let c_lo = floor_i64(g.x - rc - 0.5) - 1;
-                    let c_hi = ceil_i64(g.x + rc - 0.5) + 1;
-                    let rows =
-                        (*rows.start()).max(first_row as i64)..=(*rows.end()).min(last_row as i64);
+                    // Not cached yet: the rows and columns whose pixel centres lie within
+                    // `rc` of the centre in each coordinate (every pixel that touches the disk
+                    // does), with a margin far above the rounding of the centre and of the
+                    // touch test.
+                    let ((r_lo, r_hi), (c_lo, c_hi)) = self.touch_box(t);
+                    let rows = r_lo.max(first_row as i64)..=r_hi.min(last_row as i64);
                     let hit = rows.into_iter().any(|row| {
                         let s = spans[(row - first_row as i64) as usize];
                         s.0 <= s.1 && (s.0 as i64) <= c_hi && (s.1 as i64) >= c_lo
@@ -1788,7 +1924,7 @@ impl Mind {
                     if !hit {
                         continue;
                     }
-                    self.judge_tile_first(k, g)
+                    self.judge_tile_first(k, self.grid_center(t))
                 } else {
                     // Cached: the disk's own pixel runs against the new ones.
                     let n = self.disk.rows;
@@ -1822,6 +1958,36 @@ impl Mind {
         }
         self.new_spans = spans;
         self.candidate_rows = ranges;
+    }
+
+    /// The candidate tiles of [`Mind::sense`] for a rotated frame: the new pixels of `spans`
+    /// (from image row `first_row`) in bands of rows about one tile high, each band's box
+    /// given by `tile_box` as tile ranges; the hull per tile row (from tile row `j0`) is kept
+    /// in `ranges`.
+    fn band_candidates(
+        &self,
+        spans: &[(usize, usize)],
+        first_row: usize,
+        j0: i32,
+        ranges: &mut [(i32, i32)],
+        tile_box: impl Fn(usize, usize, usize, usize) -> (i32, i32, i32, i32),
+    ) {
+        let j1 = j0 + ranges.len() as i32 - 1;
+        for (b, band) in spans.chunks(self.band_rows).enumerate() {
+            let (bc0, bc1) = band
+                .iter()
+                .fold((usize::MAX, 0), |(a, b), s| (a.min(s.0), b.max(s.1)));
+            if bc0 > bc1 {
+                continue;
+            }
+            let r0 = first_row + b * self.band_rows;
+            let (bi0, bi1, bj0, bj1) = tile_box(bc0, bc1, r0, r0 + band.len() - 1);
+            for j in bj0.max(j0)..=bj1.min(j1) {
+                let r = &mut ranges[(j - j0) as usize];
+                r.0 = r.0.min(bi0);
+                r.1 = r.1.max(bi1);
+            }
+        }
     }
 
     /// [`judge_point`] for tile `k`, not in the [`DiskCache`] yet, whose centre is at grid
@@ -1901,7 +2067,12 @@ impl Mind {
         let rho = self.r / self.tiles.grid.side;
         let tiles = &self.tiles;
         for_each_swept_tile(a, b, rho, |t| tiles.covered(t))
-            && judge_motion(&self.known, self.center(a), self.center(b), self.r) == Judgement::Free
+            && judge_motion_px(
+                &self.known,
+                self.grid_center(a),
+                self.grid_center(b),
+                self.rc_px,
+            ) == Judgement::Free
     }
 }
 
@@ -2127,6 +2298,28 @@ impl BaStar {
         let search = TileSearch::new(tiles.bounds());
         let n_tiles = tiles.state.len();
         let rc_px = contact_radius_px(r / frame.resolution);
+        let (gx, gy) = if frame.origin.theta == 0.0 {
+            let (i0, i1, j0, j1) = tiles.bounds();
+            (
+                (i0..=i1)
+                    .map(|i| frame.world_to_grid(grid.center((i, j0))).x)
+                    .collect(),
+                (j0..=j1)
+                    .map(|j| frame.world_to_grid(grid.center((i0, j))).y)
+                    .collect(),
+            )
+        } else {
+            (Vec::new(), Vec::new())
+        };
+        let touch_cols: Vec<(i64, i64)> = gx
+            .iter()
+            .map(|&x| touch_box_of(Point::new(x, 0.0), rc_px, 0.0).1)
+            .collect();
+        let touch_rows: Vec<(i64, i64)> = gy
+            .iter()
+            .map(|&y| touch_box_of(Point::new(0.0, y), rc_px, frame.height as f64).0)
+            .collect();
+        let (i0, _, j0, _) = tiles.bounds();
         let range = sensor.sensor_range();
         if range < side + r + frame.resolution {
             self.pending.push_back(Step::Mark(Event::Note {
@@ -2149,6 +2342,20 @@ impl BaStar {
             candidate_rows: Vec::new(),
             band_rows: ((side / frame.resolution).floor() as usize).clamp(1, 64),
             disk: DiskCache::new(n_tiles, rc_px),
+            col_tiles: if gx.is_empty() {
+                Vec::new()
+            } else {
+                pixel_to_tiles(&touch_cols, frame.width, i0, false)
+            },
+            row_tiles: if gy.is_empty() {
+                Vec::new()
+            } else {
+                pixel_to_tiles(&touch_rows, frame.height, j0, true)
+            },
+            touch_cols,
+            touch_rows,
+            gx,
+            gy,
         }));
     }
 
