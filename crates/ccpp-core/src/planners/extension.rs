@@ -1119,7 +1119,8 @@ impl Extension {
         if let Some(i) = self.resume_at.take() {
             // Go on where the last search from `from` stopped: its settled positions and queue
             // are still valid (the graph has not changed); expand the position it stopped at.
-            self.relax(known, i, h, heap);
+            let p = self.px_of(i);
+            self.relax(known, i, p, h, heap);
         } else {
             self.seed(known, from, p0, h, heap);
         }
@@ -1147,7 +1148,7 @@ impl Extension {
                 path.reverse();
                 return Some(path);
             }
-            self.relax(known, i, h, heap);
+            self.relax(known, i, p, h, heap);
         }
         None
     }
@@ -1180,17 +1181,17 @@ impl Extension {
         }
     }
 
-    /// Queues the neighbours of settled position `i` (search cost in `dist`).
+    /// Queues the neighbours of settled position `i` (pixel `p`; search cost in `dist`).
     fn relax(
         &mut self,
         known: &KnownMap,
         i: usize,
+        p: Px,
         h: &dyn Fn(&Self, Px) -> u64,
         heap: &mut BucketQueue,
     ) {
         let gen = self.generation;
         let d = node_cost(self.nodes[i]);
-        let p = self.px_of(i);
         let (w, h_img) = (self.frame.width as i64, self.frame.height as i64);
         let edges = self.edge_free[i];
         // Moves known blocked (walls, positions where the robot does not fit) are left out
@@ -1442,7 +1443,8 @@ impl Extension {
                     continue;
                 }
                 let q = (cur.0 + NB[k].0, cur.1 + NB[k].1);
-                let g = self.gain(known, q, wanted, usize::MAX);
+                // Counted up to `walk_cap` (>= `g_int` >= `g_con`): every test below reads no more.
+                let g = self.gain(known, q, wanted, walk_cap);
                 if g < g_con {
                     continue;
                 }
