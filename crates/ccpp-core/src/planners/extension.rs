@@ -361,6 +361,12 @@ const NODE_GENS: u32 = 1 << 16;
 /// The [`Node`] of a position reached at cost `dist` by the move `NB[k]` (`None`: from the
 /// start) in generation `gen`.
 fn node(dist: u64, k: Option<usize>, gen: u32) -> Node {
+    // 43 bits of cost: over 8e9 pixel steps, far beyond any map that fits in memory.
+    debug_assert!(
+        dist < 1 << (63 - NODE_COST_SHIFT),
+        "search cost overflows a node"
+    );
+    debug_assert!(gen < NODE_GENS);
     let m = k.map_or(0, |k| k as u64 + 1);
     dist << NODE_COST_SHIFT | m << 16 | u64::from(gen)
 }
@@ -1935,7 +1941,10 @@ impl Drive {
 
 #[cfg(test)]
 mod tests {
-    use super::{BucketQueue, BUCKET_MAX, BUCKET_SHIFT};
+    use super::{
+        node, node_cost, node_gen, node_move, BucketQueue, BUCKET_MAX, BUCKET_SHIFT, CLOSED,
+        NODE_COST_SHIFT, NODE_GENS,
+    };
     use proptest::prelude::*;
     use std::cmp::Reverse;
     use std::collections::BinaryHeap;
@@ -1946,6 +1955,26 @@ mod tests {
             8 => 0u64..20_000,
             1 => Just((BUCKET_MAX as u64) << BUCKET_SHIFT).prop_flat_map(|b| b..b + 5_000),
         ]
+    }
+
+    /// A node gives back the cost, move and generation it was made of, with or without the
+    /// settled bit, at the extremes of every field.
+    #[test]
+    fn node_fields_round_trip() {
+        let max_cost = (1u64 << (63 - NODE_COST_SHIFT)) - 1;
+        for dist in [0, 1, 1414, 123_456_789, max_cost] {
+            for k in [None, Some(0), Some(3), Some(7)] {
+                for gen in [1, 2, NODE_GENS - 1] {
+                    for closed in [0, CLOSED] {
+                        let n = node(dist, k, gen) | closed;
+                        assert_eq!(node_cost(n), dist);
+                        assert_eq!(node_move(n), k);
+                        assert_eq!(node_gen(n), gen);
+                        assert_eq!(n & CLOSED, closed);
+                    }
+                }
+            }
+        }
     }
 
     proptest! {
