@@ -346,28 +346,45 @@ impl BucketQueue {
     }
 }
 
-/// One pixel's search state ([`Extension::search`]; generation-stamped): the search cost
-/// ([`CLOSED`] set once settled) and `(parent + 1) << 32 | generation` (parent 0: a first
-/// step from the start). All zero is "never reached", so the table starts as zeroed memory the
-/// system maps only where a search goes.
-type Node = [u64; 2];
+/// One pixel's search state ([`Extension::search`]; generation-stamped), one word: the
+/// search cost in bits 20..63 ([`CLOSED`] set once settled), the move from the parent in bits
+/// 16..20 (`k + 1` for a step `NB[k]`, 0: a first step from the start) and the generation in
+/// bits 0..16. All zero is "never reached", so the table starts as zeroed memory the system
+/// maps only where a search goes. (Eight bytes a pixel: the search is bound by memory traffic.)
+type Node = u64;
 
-/// The [`Node`] of a position reached at cost `dist` from `parent` (`None`: from the start)
-/// in generation `gen`.
-fn node(dist: u64, parent: Option<usize>, gen: u32) -> Node {
-    let p = parent.map_or(0, |p| p as u64 + 1);
-    [dist, p << 32 | u64::from(gen)]
+/// Bits of [`Node`] below the search cost.
+const NODE_COST_SHIFT: u32 = 20;
+/// Generations a [`Node`] tells apart (the table is cleared when they wrap).
+const NODE_GENS: u32 = 1 << 16;
+
+/// The [`Node`] of a position reached at cost `dist` by the move `NB[k]` (`None`: from the
+/// start) in generation `gen`.
+fn node(dist: u64, k: Option<usize>, gen: u32) -> Node {
+    // 43 bits of cost: over 8e9 pixel steps, far beyond any map that fits in memory.
+    debug_assert!(
+        dist < 1 << (63 - NODE_COST_SHIFT),
+        "search cost overflows a node"
+    );
+    debug_assert!(gen < NODE_GENS);
+    let m = k.map_or(0, |k| k as u64 + 1);
+    dist << NODE_COST_SHIFT | m << 16 | u64::from(gen)
+}
+
+/// The search cost recorded in `n`.
+fn node_cost(n: Node) -> u64 {
+    (n & !CLOSED) >> NODE_COST_SHIFT
 }
 
 /// The generation that wrote `n`.
 fn node_gen(n: Node) -> u32 {
-    n[1] as u32
+    (n & 0xFFFF) as u32
 }
 
-/// The parent recorded in `n`.
-fn node_parent(n: Node) -> Option<usize> {
-    let p = n[1] >> 32;
-    (p != 0).then(|| (p - 1) as usize)
+/// The move from the parent recorded in `n` (an index into [`NB`]).
+fn node_move(n: Node) -> Option<usize> {
+    let m = (n >> 16) & 0xF;
+    (m != 0).then(|| (m - 1) as usize)
 }
 
 #[derive(Default)]
@@ -514,8 +531,7 @@ pub(crate) struct Extension {
     /// began: `no_gain_free` is then up to date).
     free_count: usize,
     // Dijkstra scratch (generation-stamped).
-    /// Per pixel: search cost, parent and generation side by side ([`Node`]; one cache line
-    /// serves a relaxation's reads and writes of a neighbour).
+    /// Per pixel: search cost, parent move and generation in one word ([`Node`]).
     nodes: Vec<Node>,
     generation: u32,
     /// Reused search queue.
@@ -584,7 +600,7 @@ impl Extension {
             simplified: 0,
             simplify_per_turn,
             free_count: 0,
-            nodes: vec![[0; 2]; n],
+            nodes: vec![0; n],
             generation: 0,
             heap: BucketQueue::default(),
             win: Window::default(),
@@ -1056,9 +1072,9 @@ impl Extension {
     }
 
     fn begin(&mut self) {
-        self.generation = self.generation.wrapping_add(1);
+        self.generation = (self.generation + 1) % NODE_GENS;
         if self.generation == 0 {
-            self.nodes.fill([0; 2]);
+            self.nodes.fill(0);
             self.generation = 1;
         }
     }
@@ -1109,32 +1125,36 @@ impl Extension {
         if let Some(i) = self.resume_at.take() {
             // Go on where the last search from `from` stopped: its settled positions and queue
             // are still valid (the graph has not changed); expand the position it stopped at.
-            self.relax(known, i, h, heap);
+            let p = self.px_of(i);
+            self.relax(known, i, p, h, heap);
         } else {
             self.seed(known, from, p0, h, heap);
         }
         while let Some(i) = heap.pop() {
-            if self.nodes[i][0] & CLOSED != 0 {
+            if self.nodes[i] & CLOSED != 0 {
                 continue;
             }
-            let d = self.nodes[i][0];
+            let d = node_cost(self.nodes[i]);
             if limit.is_some_and(|l| d > l) {
                 return None;
             }
-            self.nodes[i][0] |= CLOSED;
+            self.nodes[i] |= CLOSED;
             let p = self.px_of(i);
             if done(self, p) {
                 self.resume_at = Some(i);
                 let mut path = vec![i];
                 let mut c = i;
-                while let Some(up) = node_parent(self.nodes[c]) {
-                    c = up;
+                while let Some(k) = node_move(self.nodes[c]) {
+                    let (col, row) = self.px_of(c);
+                    c = self
+                        .idx((col - NB[k].0, row - NB[k].1))
+                        .expect("parents are in the image");
                     path.push(c);
                 }
                 path.reverse();
                 return Some(path);
             }
-            self.relax(known, i, h, heap);
+            self.relax(known, i, p, h, heap);
         }
         None
     }
@@ -1159,7 +1179,7 @@ impl Extension {
                 }
                 let d = (from.dist(self.center(p)) * COST_ORTHO as f64).round() as u64;
                 let n = self.nodes[i];
-                if node_gen(n) != gen || d < n[0] {
+                if node_gen(n) != gen || d < node_cost(n) {
                     self.nodes[i] = node(d, None, gen);
                     heap.push(d + h(self, p), i);
                 }
@@ -1167,17 +1187,17 @@ impl Extension {
         }
     }
 
-    /// Queues the neighbours of settled position `i` (search cost in `dist`).
+    /// Queues the neighbours of settled position `i` (pixel `p`; search cost in `dist`).
     fn relax(
         &mut self,
         known: &KnownMap,
         i: usize,
+        p: Px,
         h: &dyn Fn(&Self, Px) -> u64,
         heap: &mut BucketQueue,
     ) {
         let gen = self.generation;
-        let d = self.nodes[i][0] & !CLOSED;
-        let p = self.px_of(i);
+        let d = node_cost(self.nodes[i]);
         let (w, h_img) = (self.frame.width as i64, self.frame.height as i64);
         let edges = self.edge_free[i];
         // Moves known blocked (walls, positions where the robot does not fit) are left out
@@ -1194,7 +1214,7 @@ impl Extension {
         }
         let ns: [Node; 8] = std::array::from_fn(|k| {
             if js[k] == usize::MAX {
-                [0; 2]
+                0
             } else {
                 self.nodes[js[k]]
             }
@@ -1208,14 +1228,14 @@ impl Extension {
             let nd = d + if k % 2 == 1 { COST_DIAG } else { COST_ORTHO };
             // Settled or no better: skip before judging the move (judging only fills memos).
             let n = ns[k];
-            if node_gen(n) == gen && (n[0] & CLOSED != 0 || nd >= n[0]) {
+            if node_gen(n) == gen && (n & CLOSED != 0 || nd >= node_cost(n)) {
                 continue;
             }
             // The memo first (most moves were judged by an earlier search).
             if edges & (1 << k) == 0 && !self.edge(known, p, k) {
                 continue;
             }
-            self.nodes[j] = node(nd, Some(i), gen);
+            self.nodes[j] = node(nd, Some(k), gen);
             heap.push(nd + h(self, q), j);
         }
     }
@@ -1429,7 +1449,8 @@ impl Extension {
                     continue;
                 }
                 let q = (cur.0 + NB[k].0, cur.1 + NB[k].1);
-                let g = self.gain(known, q, wanted, usize::MAX);
+                // Counted up to `walk_cap` (>= `g_int` >= `g_con`): every test below reads no more.
+                let g = self.gain(known, q, wanted, walk_cap);
                 if g < g_con {
                     continue;
                 }
@@ -1920,7 +1941,10 @@ impl Drive {
 
 #[cfg(test)]
 mod tests {
-    use super::{BucketQueue, BUCKET_MAX, BUCKET_SHIFT};
+    use super::{
+        node, node_cost, node_gen, node_move, BucketQueue, BUCKET_MAX, BUCKET_SHIFT, CLOSED,
+        NODE_COST_SHIFT, NODE_GENS,
+    };
     use proptest::prelude::*;
     use std::cmp::Reverse;
     use std::collections::BinaryHeap;
@@ -1931,6 +1955,26 @@ mod tests {
             8 => 0u64..20_000,
             1 => Just((BUCKET_MAX as u64) << BUCKET_SHIFT).prop_flat_map(|b| b..b + 5_000),
         ]
+    }
+
+    /// A node gives back the cost, move and generation it was made of, with or without the
+    /// settled bit, at the extremes of every field.
+    #[test]
+    fn node_fields_round_trip() {
+        let max_cost = (1u64 << (63 - NODE_COST_SHIFT)) - 1;
+        for dist in [0, 1, 1414, 123_456_789, max_cost] {
+            for k in [None, Some(0), Some(3), Some(7)] {
+                for gen in [1, 2, NODE_GENS - 1] {
+                    for closed in [0, CLOSED] {
+                        let n = node(dist, k, gen) | closed;
+                        assert_eq!(node_cost(n), dist);
+                        assert_eq!(node_move(n), k);
+                        assert_eq!(node_gen(n), gen);
+                        assert_eq!(n & CLOSED, closed);
+                    }
+                }
+            }
+        }
     }
 
     proptest! {
