@@ -321,6 +321,18 @@ fn config_values_go_through_the_same_validation() {
             "bsa-extended",
             "bsa_extended.extension.leave_group",
         ),
+        // `shorter_backtrack` belongs to ba-star-extended only (bsa-extended and ba-star
+        // refuse it as an unknown key).
+        (
+            "bsa_extended: { shorter_backtrack: false }",
+            "bsa-extended",
+            "shorter_backtrack",
+        ),
+        (
+            "ba_star: { shorter_backtrack: false }",
+            "ba-star",
+            "shorter_backtrack",
+        ),
         // An extension option given to a planner without the extension is an unknown key.
         (
             "ba_star: { extension: { leave_group: 2 } }",
@@ -742,6 +754,35 @@ fn leave_group_changes_the_extended_run() {
     let len = |m: &serde_json::Value| m["path_length_m"].as_f64().unwrap();
     assert!(len(&g) < len(&a), "{g} {a}");
     for m in [&g, &a] {
+        assert_eq!(m["collisions"], 0);
+        assert!(m["effective_coverage"].as_f64().unwrap() >= 0.995, "{m}");
+    }
+}
+
+/// `shorter_backtrack` (ba-star-extended drives BA*'s backtracking on the extension's straight
+/// known-free way where that is shorter) changes the run end to end: on `teb_maze` switching
+/// it off drives BA*'s own smoothed tile paths, for a longer path; the floor stays above
+/// 99.5 % either way.
+#[test]
+fn shorter_backtrack_changes_the_extended_run() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = common::data("teb_maze.yaml");
+    let cfg = dir.join("own.yaml");
+    std::fs::write(&cfg, "ba_star_extended: { shorter_backtrack: false }\n").unwrap();
+    let short = run_ok(dir, "short", &map, "ba-star-extended", &[]);
+    let own = run_ok(
+        dir,
+        "own",
+        &map,
+        "ba-star-extended",
+        &["--config", cfg.to_str().unwrap()],
+    );
+    assert_ne!(trace(&short), trace(&own));
+    let (s, o) = (metrics(&short), metrics(&own));
+    let len = |m: &serde_json::Value| m["path_length_m"].as_f64().unwrap();
+    assert!(len(&s) < len(&o), "{s} {o}");
+    for m in [&s, &o] {
         assert_eq!(m["collisions"], 0);
         assert!(m["effective_coverage"].as_f64().unwrap() >= 0.995, "{m}");
     }
