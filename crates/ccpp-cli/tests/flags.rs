@@ -321,6 +321,18 @@ fn config_values_go_through_the_same_validation() {
             "bsa-extended",
             "bsa_extended.extension.leave_group",
         ),
+        // `shorter_backtrack` belongs to ba-star-extended only (bsa-extended and ba-star
+        // refuse it as an unknown key).
+        (
+            "bsa_extended: { shorter_backtrack: false }",
+            "bsa-extended",
+            "shorter_backtrack",
+        ),
+        (
+            "ba_star: { shorter_backtrack: false }",
+            "ba-star",
+            "shorter_backtrack",
+        ),
         // An extension option given to a planner without the extension is an unknown key.
         (
             "ba_star: { extension: { leave_group: 2 } }",
@@ -745,4 +757,25 @@ fn leave_group_changes_the_extended_run() {
         assert_eq!(m["collisions"], 0);
         assert!(m["effective_coverage"].as_f64().unwrap() >= 0.995, "{m}");
     }
+}
+
+/// `shorter_backtrack` is read from the `ba_star_extended` section (the plan change it makes
+/// is shown end to end in `ccpp-core`'s `ba_star_extended` tests, on a map with several halls).
+#[test]
+fn shorter_backtrack_is_read_from_the_config() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = common::data("teb_empty_box.yaml");
+    let cfg = dir.join("own.yaml");
+    std::fs::write(&cfg, "ba_star_extended: { shorter_backtrack: false }\n").unwrap();
+    let own = run_ok(
+        dir,
+        "own",
+        &map,
+        "ba-star-extended",
+        &["--config", cfg.to_str().unwrap()],
+    );
+    let m = metrics(&own);
+    assert_eq!(m["collisions"], 0);
+    assert!(m["effective_coverage"].as_f64().unwrap() >= 0.995, "{m}");
 }

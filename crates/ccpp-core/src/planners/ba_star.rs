@@ -2268,6 +2268,21 @@ impl BaStar {
         }
     }
 
+    /// Hook for extensions: the rest of the current backtracking path (tile centres still to
+    /// drive, the last one [`Self::backtrack_goal`]), while backtracking.
+    pub fn backtrack_rest(&self) -> Option<Vec<Point>> {
+        match (&self.phase, self.mind.as_ref()) {
+            (Phase::Backtrack { path, next }, Some(m)) => Some(
+                path.get(*next..)
+                    .unwrap_or_default()
+                    .iter()
+                    .map(|&t| m.center(t))
+                    .collect(),
+            ),
+            _ => None,
+        }
+    }
+
     /// Hook for extensions: drops the rest of the current backtracking path; the caller has
     /// driven the robot to [`Self::backtrack_goal`] and the next call arrives there.
     pub fn skip_backtrack(&mut self) {

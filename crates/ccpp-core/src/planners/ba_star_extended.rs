@@ -10,7 +10,12 @@
 //!   obstacles) are left to BA*. Then, instead of returning to the critical point, the robot
 //!   drives a known-free transfer ([`super::extension`]'s A* over positions, merged into
 //!   straight segments) straight to BA*'s chosen start point `s_sp`, and BA* resumes there.
-//!   When nothing was cleaned, BA*'s own smoothed backtracking path is driven.
+//!   When nothing was cleaned (the default, `reach_r` 0), the extension's known-free
+//!   transfer is driven too wherever it is shorter than BA*'s A*SPT-smoothed path over
+//!   covered tiles ([`BaStarExtendedOptions::shorter_backtrack`]; BA*'s own path otherwise):
+//!   the positions may cut across known-free floor BA* has not covered and corners its tile
+//!   line of sight cannot. On the 14 shared maps the mean path ratio went from 1.337 to
+//!   1.324 and the turns from 2039 to 2013, every map still at or above 99.5 % swept.
 //! * **End of BA*** (`L` empty): passes over every rim left, wherever it is, nearest first;
 //!   a trip that does not pay for itself ([`ExtensionOptions::min_yield`]) is left, within
 //!   [`ExtensionOptions::leave_fraction`] of the known floor.
@@ -47,7 +52,7 @@ use serde::{Deserialize, Serialize};
 
 use super::ba_star::{BaStar, BaStarOptions};
 use super::extension::{Chunk, Drive, Extension, ExtensionOptions};
-use crate::geometry::Point;
+use crate::geometry::{polyline_length, Point};
 use crate::planner::{Planner, Sensor, Step};
 use crate::trace::Event;
 
@@ -70,6 +75,10 @@ pub struct BaStarExtendedOptions {
     /// component's.
     #[serde(deserialize_with = "super::settings::ba_star_extended_extension")]
     pub extension: ExtensionOptions,
+    /// Drive BA*'s backtracking transfers on the extension's known-free straight segments
+    /// (A* over positions, merged by lines of sight) wherever that way is shorter than BA*'s
+    /// A*SPT-smoothed path over covered tiles (`false`: BA*'s path, as `ba-star`).
+    pub shorter_backtrack: bool,
 }
 
 impl Default for BaStarExtendedOptions {
@@ -82,6 +91,7 @@ impl Default for BaStarExtendedOptions {
                 leave_fraction: 0.003,
                 ..ExtensionOptions::default()
             },
+            shorter_backtrack: true,
         }
     }
 }
@@ -106,6 +116,8 @@ pub struct BaStarExtended {
     drive: Drive,
     /// Heading of the host's last lane move, while the host is in a lane.
     lane: Option<f64>,
+    /// [`BaStarExtendedOptions::shorter_backtrack`].
+    shorter_backtrack: bool,
 }
 
 impl BaStarExtended {
@@ -118,6 +130,7 @@ impl BaStarExtended {
             mode: Mode::Host,
             drive: Drive::default(),
             lane: None,
+            shorter_backtrack: opts.shorter_backtrack,
         }
     }
 
@@ -162,12 +175,26 @@ impl BaStarExtended {
             .queue
             .push_back(Step::Mark(Event::BacktrackStart));
         self.mode = Mode::Host;
-        if self.drive.trail.len() <= 1 {
-            return;
-        }
         let Some(goal) = self.ba.backtrack_goal() else {
             return;
         };
+        if self.drive.trail.len() <= 1 {
+            // The robot is where BA* backtracks from: the extension's straight known-free way
+            // when it is shorter than BA*'s smoothed tile path.
+            if !self.shorter_backtrack {
+                return;
+            }
+            let own = self.ba.backtrack_rest().unwrap_or_default();
+            if let Some(route) = ext.route(known, pos, goal) {
+                if route.last() == Some(&goal)
+                    && polyline_length(pos, &route) < polyline_length(pos, &own) - 1e-9
+                {
+                    self.drive.queue.extend(route.into_iter().map(Step::MoveTo));
+                    self.ba.skip_backtrack();
+                }
+            }
+            return;
+        }
         let route = ext.route(known, pos, goal).unwrap_or_else(|| {
             // Retreat the way the passes came (every segment known free); BA* goes on from there.
             self.drive.trail.iter().rev().skip(1).copied().collect()
