@@ -2026,6 +2026,83 @@ mod tests {
         .unwrap()
     }
 
+    /// A 60 x 30 px room turned by `deg` degrees in a 90 x 90 px map (0.05 m/px).
+    fn turned_room(deg: f64) -> World {
+        let (si, co) = deg.to_radians().sin_cos();
+        let mut art = String::new();
+        for r in 0..90 {
+            for c in 0..90 {
+                let (x, y) = (f64::from(c) - 44.5, f64::from(r) - 44.5);
+                let (u, v) = (co * x + si * y, -si * x + co * y);
+                art.push(if u.abs() < 30.0 && v.abs() < 15.0 {
+                    '.'
+                } else {
+                    '#'
+                });
+            }
+            art.push('\n');
+        }
+        let map = crate::grid::GridMap::from_ascii_scaled(art.trim_end(), 1, 0.05).unwrap();
+        World::new(
+            map,
+            crate::world::Robot::new(0.15),
+            Some(crate::geometry::Pose::new(2.25, 2.25, 0.0)),
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn walls_at_an_angle_get_a_turned_lattice() {
+        for deg in [0.0, 30.0] {
+            let world = turned_room(deg);
+            let frame = *world.frame();
+            let n = frame.width * frame.height;
+            let reach = world.reachable();
+            let ok: Vec<bool> = (0..n).map(|i| reach.contains(i)).collect();
+            let ctx = Ctx {
+                world: &world,
+                frame,
+                safe: ok.clone(),
+                ok,
+                rt: 3.0,
+            };
+            let a = dominant_angles(&ctx)[0].to_degrees();
+            // The image's rows run down: a room turned by +30 degrees there has walls at
+            // 30 or 60 degrees (mod 90), whichever way the turn is read.
+            let off = [deg, 90.0 - deg]
+                .iter()
+                .map(|d| (a - d).abs().min(90.0 - (a - d).abs()))
+                .fold(f64::INFINITY, f64::min);
+            assert!(off < 1.5, "{deg}: found {a}");
+        }
+        // The turned room's plan covers it without contact and with few turns (lanes along
+        // its walls, not staircases across them).
+        let world = turned_room(30.0);
+        let m = run(&world, &BcdOptions::default());
+        assert_eq!(m.collisions, 0);
+        assert!(m.effective_coverage >= 0.99, "{}", m.effective_coverage);
+        // Its plan on the lattice turned to its walls reaches every piece and costs about what
+        // the pixel lattice's does (here the pixels' is kept: the room is small).
+        let frame = *world.frame();
+        let n = frame.width * frame.height;
+        let reach = world.reachable();
+        let ok: Vec<bool> = (0..n).map(|i| reach.contains(i)).collect();
+        let ctx = Ctx {
+            world: &world,
+            frame,
+            safe: ok.clone(),
+            ok,
+            rt: 3.0,
+        };
+        let mut search = Search::new(frame.width, frame.height);
+        let opts = BcdOptions::default();
+        let a = dominant_angles(&ctx)[0];
+        let turned = Bcd::plan_on(&ctx, &Lattice::turned(&ctx, a), &opts, &mut search);
+        let pixels = Bcd::plan_on(&ctx, &Lattice::pixels(&ctx), &opts, &mut search);
+        assert_eq!(turned.0, 0);
+        assert!(turned.1 < 1.2 * pixels.1, "{} vs {}", turned.1, pixels.1);
+    }
+
     #[test]
     fn smoothing_straightens_wiggles_but_keeps_corners_and_marks() {
         let world = block_room();
