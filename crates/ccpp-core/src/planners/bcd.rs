@@ -19,7 +19,8 @@
 //!    whose cells are estimated cheaper (path length plus `turn_cost_m` per turn) is used.
 //!    **Turned lattice** (not in the paper): when the walls run at an angle to the pixel axes
 //!    (the C-free boundary's projections are most concentrated at an angle more than 4
-//!    degrees off them; the best such angle and the best other one at least 10 degrees away),
+//!    degrees off them; then that angle and, when also off the axes, the best other one at
+//!    least 10 degrees away),
 //!    the whole plan is made again with the sweep lines on a lattice of points one pixel apart
 //!    turned by that angle (a point is free where its pixel is reachable C-free and the
 //!    robot's disk there touches nothing), and the plan that skips fewer moves, then costs
@@ -1100,9 +1101,19 @@ impl Bcd {
         // The plan on the pixel lattice and, when the walls run at an angle to the pixel
         // axes, on the lattice turned to them; the cheaper is kept (module docs, step 1).
         let mut best = Self::plan_on(&ctx, &Lattice::pixels(&ctx), opts, &mut search);
-        for a in dominant_angles(&ctx) {
+        let off_axis = |a: &f64| {
             let deg = a.to_degrees();
-            if deg.min(90.0 - deg) > AXIS_TOL_DEG {
+            deg.min(90.0 - deg) > AXIS_TOL_DEG
+        };
+        let angles = dominant_angles(&ctx);
+        // A map whose dominant walls run along the axes is planned on the pixels only.
+        let angles: &[f64] = if angles.first().is_some_and(off_axis) {
+            &angles
+        } else {
+            &[]
+        };
+        for a in angles.iter().copied() {
+            if off_axis(&a) {
                 let turned = Self::plan_on(&ctx, &Lattice::turned(&ctx, a), opts, &mut search);
                 if (turned.0, turned.1) < (best.0, best.1) {
                     best = turned;
