@@ -17,6 +17,15 @@
 //!    polygonal map) the involved cells close and new ones open. Both a west-to-east sweep
 //!    (vertical lines) and a north-to-south sweep (horizontal lines) are decomposed; the one
 //!    whose cells are estimated cheaper (path length plus `turn_cost_m` per turn) is used.
+//!    **Turned lattice** (not in the paper): when the walls run at an angle to the pixel axes
+//!    (the C-free boundary's projections are most concentrated at an angle more than 4
+//!    degrees off them; then that angle and, when also off the axes, the best other one at
+//!    least 10 degrees away),
+//!    the whole plan is made again with the sweep lines on a lattice of points one pixel apart
+//!    turned by that angle (a point is free where its pixel is reachable C-free and the
+//!    robot's disk there touches nothing), and the plan that skips fewer moves, then costs
+//!    less (length plus `turn_cost_m` per turn), is kept. Maps drawn along the axes get the
+//!    pixel lattice's plan unchanged.
 //! 2. **Lanes fitted to each cell** (the paper's boustrophedon motions). Per cell, lanes run
 //!    along the sweep line or, when the cell is monotone the other way too, across it — the
 //!    direction with the lower estimated cost (fewer, longer lanes: fewer turns). A cell
@@ -429,6 +438,166 @@ struct Ctx<'a> {
     rt: f64,
 }
 
+/// The lattice the cells are decomposed on: points `(c, r)` one pixel apart (`c` to the right,
+/// `r` down, as in the image), either the map's own pixel centres or the same lattice turned
+/// by an angle about the map's centre (module docs, step 1).
+struct Lattice {
+    /// Lattice points per row.
+    w: usize,
+    /// Rows.
+    h: usize,
+    /// `(cos, sin)` of the angle the lattice is turned by in the image; `None`: the pixels.
+    rot: Option<(f64, f64)>,
+    /// Map height in pixels (grid `y` of an image row).
+    map_h: f64,
+    /// The map's centre in image coordinates.
+    centre: (f64, f64),
+    /// Lattice points that are reachable and free for the robot's disk.
+    ok: Vec<bool>,
+}
+
+impl Lattice {
+    /// The map's own pixel centres.
+    fn pixels(ctx: &Ctx<'_>) -> Self {
+        let (w, h) = (ctx.frame.width, ctx.frame.height);
+        Self {
+            w,
+            h,
+            rot: None,
+            map_h: h as f64,
+            centre: (w as f64 / 2.0, h as f64 / 2.0),
+            ok: ctx.ok.clone(),
+        }
+    }
+
+    /// The pixel lattice turned by `angle` (radians, in the image) about the map's centre,
+    /// large enough to hold the whole map; a point is free where the pixel holding it is
+    /// reachable C-free and the robot's disk centred on it touches no obstacle.
+    fn turned(ctx: &Ctx<'_>, angle: f64) -> Self {
+        let (mw, mh) = (ctx.frame.width as f64, ctx.frame.height as f64);
+        let (co, si) = (angle.cos(), angle.sin());
+        let w = (mw * co.abs() + mh * si.abs()).ceil() as usize + 2;
+        let h = (mw * si.abs() + mh * co.abs()).ceil() as usize + 2;
+        let mut lat = Self {
+            w,
+            h,
+            rot: Some((co, si)),
+            map_h: mh,
+            centre: (mw / 2.0, mh / 2.0),
+            ok: Vec::new(),
+        };
+        let mut ok = vec![false; w * h];
+        for r in 0..h {
+            for c in 0..w {
+                let g = lat.grid(c as f64, r as f64);
+                let (pc, pr) = ctx.frame.grid_to_pixel_signed(g);
+                ok[r * w + c] =
+                    ctx.ok_at(pc, pr) && !ctx.world.disk_collides(ctx.frame.grid_to_world(g));
+            }
+        }
+        lat.ok = ok;
+        lat
+    }
+
+    /// Grid point (pixels, y up) of the lattice position `(c, r)` (may be fractional).
+    fn grid(&self, c: f64, r: f64) -> Point {
+        match self.rot {
+            None => Point::new(c + 0.5, self.map_h - r - 0.5),
+            Some((co, si)) => {
+                let x = c + 0.5 - self.w as f64 / 2.0;
+                let y = r + 0.5 - self.h as f64 / 2.0;
+                Point::new(
+                    self.centre.0 + co * x - si * y,
+                    self.map_h - (self.centre.1 + si * x + co * y),
+                )
+            }
+        }
+    }
+
+    fn ok_at(&self, c: i64, r: i64) -> bool {
+        c >= 0
+            && r >= 0
+            && (c as usize) < self.w
+            && (r as usize) < self.h
+            && self.ok[r as usize * self.w + c as usize]
+    }
+}
+
+/// The dominant direction of the map's walls, in radians in `[0, pi/2)` (image frame): the
+/// angle whose projections of the C-free boundary (reachable C-free pixels beside a blocked
+/// one) onto it and onto its normal are most concentrated (the largest sum of squared counts
+/// of one-pixel bins: walls along the angle pile up in few bins), searched in whole degrees
+/// and then in tenths around the best; the same for the best local maximum at least
+/// [`SECOND_PEAK_DEG`] away (walls of a wing turned against the rest). Empty when the C-free
+/// set has no boundary.
+fn dominant_angles(ctx: &Ctx<'_>) -> Vec<f64> {
+    let (w, h) = (ctx.frame.width, ctx.frame.height);
+    let mut pts: Vec<(f64, f64)> = Vec::new();
+    for r in 0..h {
+        for c in 0..w {
+            if !ctx.ok[r * w + c] {
+                continue;
+            }
+            let (ci, ri) = (c as i64, r as i64);
+            if [(1, 0), (-1, 0), (0, 1), (0, -1)]
+                .iter()
+                .any(|&(dc, dr)| !ctx.ok_at(ci + dc, ri + dr))
+            {
+                pts.push((c as f64 + 0.5, r as f64 + 0.5));
+            }
+        }
+    }
+    if pts.is_empty() {
+        return Vec::new();
+    }
+    let span = (w + h) as f64 * std::f64::consts::SQRT_2;
+    let nb = span.ceil() as usize + 2;
+    let mut bins = vec![0u32; 2 * nb];
+    let mut score = |deg: f64| -> u64 {
+        let (si, co) = deg.to_radians().sin_cos();
+        bins.fill(0);
+        for &(x, y) in &pts {
+            let p = x * co + y * si + span / 2.0;
+            let q = -x * si + y * co + span / 2.0;
+            bins[(p.max(0.0) as usize).min(nb - 1)] += 1;
+            bins[nb + (q.max(0.0) as usize).min(nb - 1)] += 1;
+        }
+        bins.iter().map(|&b| u64::from(b) * u64::from(b)).sum()
+    };
+    let coarse: Vec<u64> = (0..90).map(|k| score(f64::from(k))).collect();
+    let first = (0..90)
+        .max_by_key(|&k| (coarse[k], Reverse(k)))
+        .unwrap_or(0);
+    let away = |k: usize| {
+        let d = k.abs_diff(first);
+        d.min(90 - d) >= SECOND_PEAK_DEG
+    };
+    let peak = |k: usize| coarse[k] >= coarse[(k + 1) % 90] && coarse[k] >= coarse[(k + 89) % 90];
+    let second = (0..90)
+        .filter(|&k| away(k) && peak(k))
+        .max_by_key(|&k| (coarse[k], Reverse(k)));
+    let mut out = Vec::new();
+    for k in std::iter::once(first).chain(second) {
+        let mut best = (coarse[k], k as f64);
+        for j in -9..=9 {
+            let d = k as f64 + f64::from(j) / 10.0;
+            let v = score(d);
+            if v > best.0 {
+                best = (v, d);
+            }
+        }
+        out.push(best.1.to_radians().rem_euclid(std::f64::consts::FRAC_PI_2));
+    }
+    out
+}
+
+/// Degrees (at least) between the two wall directions [`dominant_angles`] returns.
+const SECOND_PEAK_DEG: usize = 10;
+
+/// A dominant wall direction within this many degrees of the pixel axes is taken as the axes:
+/// no turned lattice is tried.
+const AXIS_TOL_DEG: f64 = 4.0;
+
 /// Improvement rounds of the first tour (which only picks each cell's path for the rim step).
 const FIRST_ROUNDS: u32 = 1;
 /// Gap kept between a pushed lane end and the exact contact (pixels).
@@ -453,14 +622,13 @@ impl Ctx<'_> {
             .segment_free(self.frame.grid_to_world(a), self.frame.grid_to_world(b))
     }
 
-    /// Grid point of continuous line coordinate `t` (pixel centres at integers) and pixel
-    /// position `v` (may be fractional or outside the image) of `cell`'s orientation.
-    fn at(&self, cols: bool, t: f64, v: f64) -> Point {
-        let h = self.frame.height as f64;
+    /// Grid point of continuous line coordinate `t` (lattice points at integers) and lattice
+    /// position `v` (may be fractional or outside the lattice) of `cell`'s orientation.
+    fn at(lat: &Lattice, cols: bool, t: f64, v: f64) -> Point {
         if cols {
-            Point::new(t + 0.5, h - v - 0.5)
+            lat.grid(t, v)
         } else {
-            Point::new(v + 0.5, h - t - 0.5)
+            lat.grid(v, t)
         }
     }
 
@@ -468,7 +636,7 @@ impl Ctx<'_> {
     /// `floor t` and `ceil t`): from the end of the two runs' common part, pushed along the
     /// lane to the exact contact (minus [`BACKOFF_PX`]) or, where nothing is hit, to the end
     /// of the longer run.
-    fn lane_end(&self, cell: &Cell, t: f64, hi: bool) -> Point {
+    fn lane_end(&self, lat: &Lattice, cell: &Cell, t: f64, hi: bool) -> Point {
         let (u0, u1) = (cell.u0, cell.u1());
         let a = (t.floor().max(u0 as f64) as usize).min(u1);
         let b = (t.ceil().max(u0 as f64) as usize).min(u1);
@@ -485,8 +653,8 @@ impl Ctx<'_> {
         } else {
             (i0 as f64, n0 as f64 - 1.0, n0 as f64)
         };
-        let p = self.at(cell.cols, t, v_in);
-        let q = self.at(cell.cols, t, v_out);
+        let p = Self::at(lat, cell.cols, t, v_in);
+        let q = Self::at(lat, cell.cols, t, v_out);
         let len = (v_out - v_in).abs();
         match self
             .world
@@ -494,7 +662,7 @@ impl Ctx<'_> {
         {
             Some(s) if s * len > BACKOFF_PX => p.add(q.sub(p).scale(s - BACKOFF_PX / len)),
             Some(_) => p,
-            None => self.at(cell.cols, t, v_end),
+            None => Self::at(lat, cell.cols, t, v_end),
         }
     }
 
@@ -618,14 +786,14 @@ impl Ctx<'_> {
 /// Share of the pixels of `cell`'s line `u` whose outer neighbour (towards `out` = -1 or +1
 /// along the lines) passes `other`, at least one half?
 fn side_open(
-    ctx: &Ctx<'_>,
+    lat: &Lattice,
     cell: &Cell,
     u: usize,
     out: i64,
     other: &dyn Fn(usize) -> bool,
 ) -> bool {
     let (a, b) = cell.runs[u - cell.u0];
-    let w = ctx.frame.width;
+    let w = lat.w;
     let n = (a..=b)
         .filter(|&v| {
             let (c, r) = cell.px(u, v);
@@ -634,7 +802,7 @@ fn side_open(
             } else {
                 (c as i64, r as i64 + out)
             };
-            ctx.ok_at(c, r) && other(r as usize * w + c as usize)
+            lat.ok_at(c, r) && other(r as usize * w + c as usize)
         })
         .count();
     2 * n > b - a
@@ -798,14 +966,20 @@ fn estimate(cell: &Cell, lanes: &[f64], turn_px: f64) -> f64 {
 
 /// A cell's two boustrophedon paths (grid points), starting at the first lane's low end and at
 /// its high end.
-fn cell_paths(ctx: &Ctx<'_>, search: &mut Search, cell: &Cell, lanes: &[f64]) -> [Vec<Point>; 2] {
+fn cell_paths(
+    ctx: &Ctx<'_>,
+    lat: &Lattice,
+    search: &mut Search,
+    cell: &Cell,
+    lanes: &[f64],
+) -> [Vec<Point>; 2] {
     let mut out = [Vec::new(), Vec::new()];
     for (k, start_hi) in [false, true].into_iter().enumerate() {
         let mut pts: Vec<Point> = Vec::new();
         let mut hi = start_hi;
         for (i, &u) in lanes.iter().enumerate() {
-            let a = ctx.lane_end(cell, u, hi);
-            let b = ctx.lane_end(cell, u, !hi);
+            let a = ctx.lane_end(lat, cell, u, hi);
+            let b = ctx.lane_end(lat, cell, u, !hi);
             if i == 0 {
                 pts.push(a);
             } else {
@@ -814,7 +988,7 @@ fn cell_paths(ctx: &Ctx<'_>, search: &mut Search, cell: &Cell, lanes: &[f64]) ->
                 let mut chain = vec![*pts.last().unwrap_or(&a)];
                 let mut w = prev.floor() + 1.0;
                 while w < u - 1e-9 {
-                    chain.push(ctx.lane_end(cell, w, hi));
+                    chain.push(ctx.lane_end(lat, cell, w, hi));
                     w += 1.0;
                 }
                 chain.push(a);
@@ -923,14 +1097,98 @@ impl Bcd {
             safe,
             rt: robot.tool_radius / res,
         };
+        let mut search = Search::new(w, h);
+        // The plan on the pixel lattice and, when the walls run at an angle to the pixel
+        // axes, on the lattice turned to them; the cheaper is kept (module docs, step 1).
+        let mut best = Self::plan_on(&ctx, &Lattice::pixels(&ctx), opts, &mut search);
+        let off_axis = |a: &f64| {
+            let deg = a.to_degrees();
+            deg.min(90.0 - deg) > AXIS_TOL_DEG
+        };
+        let angles = dominant_angles(&ctx);
+        // A map whose dominant walls run along the axes is planned on the pixels only.
+        let angles: &[f64] = if angles.first().is_some_and(off_axis) {
+            &angles
+        } else {
+            &[]
+        };
+        for a in angles.iter().copied() {
+            if off_axis(&a) {
+                let turned = Self::plan_on(&ctx, &Lattice::turned(&ctx, a), opts, &mut search);
+                if (turned.0, turned.1) < (best.0, best.1) {
+                    best = turned;
+                }
+            }
+        }
+        let (_, _, items, ncells) = best;
+        let start = frame.world_to_grid(world.start().position());
+
+        // A region whose moves the smoothing and pruning merged into the moves around it (or
+        // a cell whose lane is a single point) has nothing left between its start and end: it
+        // is not reported (marks inside it are kept), and the regions left are numbered 1, 2,
+        // ... in order.
+        let mut steps = VecDeque::with_capacity(items.len());
+        let mut at = start;
+        // Marks since a region's start while it has no move yet (`None`: no region pending).
+        let mut pending: Option<Vec<Event>> = None;
+        let mut region = 0u32;
+        for it in items {
+            match it {
+                Item::Move(p) => {
+                    if p != at {
+                        if let Some(marks) = pending.take() {
+                            region += 1;
+                            steps.push_back(Step::Mark(Event::RegionStart { region }));
+                            steps.extend(marks.into_iter().map(Step::Mark));
+                        }
+                        steps.push_back(Step::MoveTo(frame.grid_to_world(p)));
+                        at = p;
+                    }
+                }
+                Item::Mark(Event::RegionStart { .. }) => {
+                    if let Some(marks) = pending.replace(Vec::new()) {
+                        steps.extend(marks.into_iter().map(Step::Mark));
+                    }
+                }
+                Item::Mark(Event::RegionEnd { .. }) => match pending.take() {
+                    Some(marks) => steps.extend(marks.into_iter().map(Step::Mark)),
+                    None => steps.push_back(Step::Mark(Event::RegionEnd { region })),
+                },
+                Item::Mark(e) => match pending.as_mut() {
+                    Some(marks) => marks.push(e),
+                    None => steps.push_back(Step::Mark(e)),
+                },
+            }
+        }
+        if let Some(marks) = pending {
+            steps.extend(marks.into_iter().map(Step::Mark));
+        }
+        Self {
+            steps,
+            cells: ncells,
+        }
+    }
+
+    /// Steps 1-5 of the module docs on the lattice `lat`: the plan's items with the moves it
+    /// had to skip, its cost (length plus `turn_cost_m` per turn, pixels) and its cells.
+    fn plan_on(
+        ctx: &Ctx<'_>,
+        lat: &Lattice,
+        opts: &BcdOptions,
+        search: &mut Search,
+    ) -> (usize, f64, Vec<Item>, usize) {
+        let world = ctx.world;
+        let frame = ctx.frame;
+        let robot = world.robot();
+        let res = frame.resolution;
+        let (w, h) = (lat.w, lat.h);
         let spacing = opts.lane_spacing_m.unwrap_or(2.0 * robot.tool_radius);
         let sp = (spacing / res).max(1.0);
         let turn_px = opts.turn_cost_m / res;
-        let mut search = Search::new(w, h);
         let start = frame.world_to_grid(world.start().position());
 
         // 1-2. Both decompositions, each cell's cheaper lane direction, the cheaper total.
-        let ok = &ctx.ok;
+        let ok = &lat.ok;
         let by_cols = decompose(w, h, true, &|c, r| ok[r * w + c]);
         let by_rows = decompose(h, w, false, &|r, c| ok[r * w + c]);
         // Each cell's views (along its lines; across them when monotone) with their sides'
@@ -943,8 +1201,8 @@ impl Bcd {
                     let t = c.transposed();
                     let mut v = Vec::with_capacity(2);
                     for c in std::iter::once(c).chain(t) {
-                        let lo = side_open(&ctx, &c, c.u0, -1, &|_| true);
-                        let hi = side_open(&ctx, &c, c.u1(), 1, &|_| true);
+                        let lo = side_open(lat, &c, c.u0, -1, &|_| true);
+                        let hi = side_open(lat, &c, c.u1(), 1, &|_| true);
                         v.push((c, lo, hi));
                     }
                     v
@@ -954,8 +1212,8 @@ impl Bcd {
         // A cell's estimated cost: its cheaper view plus reaching it.
         let cell_cost = |c: &Cell| -> f64 {
             let view = |c: &Cell| {
-                let lo = side_open(&ctx, c, c.u0, -1, &|_| true);
-                let hi = side_open(&ctx, c, c.u1(), 1, &|_| true);
+                let lo = side_open(lat, c, c.u0, -1, &|_| true);
+                let hi = side_open(lat, c, c.u1(), 1, &|_| true);
                 let lanes = lanes_of(c, sp, 0.0, lo, hi);
                 estimate(c, &lanes, turn_px) + 2.0 * turn_px + sp
             };
@@ -1023,8 +1281,8 @@ impl Bcd {
             .map(|c| {
                 let mine = if c.cols { 1 } else { 2 };
                 let same = |i: usize| cols_at[i] == mine;
-                let lo = side_open(&ctx, &c, c.u0, -1, &same);
-                let hi = side_open(&ctx, &c, c.u1(), 1, &same);
+                let lo = side_open(lat, &c, c.u0, -1, &same);
+                let hi = side_open(lat, &c, c.u1(), 1, &same);
                 let lanes = lanes_of(&c, sp, phase, lo, hi);
                 (c, lanes)
             })
@@ -1038,7 +1296,7 @@ impl Bcd {
         let mut paths: Vec<[Vec<Point>; 2]> = Vec::with_capacity(cells.len());
         let mut pieces = Vec::with_capacity(cells.len());
         for (cell, lanes) in &cells {
-            let ps = cell_paths(&ctx, &mut search, cell, lanes);
+            let ps = cell_paths(ctx, lat, search, cell, lanes);
             let mut piece = tsp::Piece {
                 entry: Vec::new(),
                 exit: Vec::new(),
@@ -1054,8 +1312,8 @@ impl Bcd {
             pieces.push(piece);
             paths.push(ps);
         }
-        let coarse = hops::Coarse::new(&ctx, sp);
-        let far = hops::Coarse::new(&ctx, sp * f64::from(hops::FAR_FACTOR));
+        let coarse = hops::Coarse::new(ctx, sp);
+        let far = hops::Coarse::new(ctx, sp * f64::from(hops::FAR_FACTOR));
         let ncells = paths.len();
         // Two ways to sweep the rim (module docs, step 3): its passes as pieces of the tour,
         // or inserted into the finished tour where they cost least; the cheaper plan is kept.
@@ -1100,16 +1358,10 @@ impl Bcd {
                     };
                 }
                 let lines: Vec<&[Point]> = paths.iter().map(|p| p[0].as_slice()).collect();
-                rim_contours(
-                    &ctx,
-                    &mut search,
-                    &lines,
-                    opts.rim_min_yield,
-                    opts.rim_coverage,
-                )
-                .into_iter()
-                .map(|c| c.0)
-                .collect()
+                rim_contours(ctx, search, &lines, opts.rim_min_yield, opts.rim_coverage)
+                    .into_iter()
+                    .map(|c| c.0)
+                    .collect()
             } else {
                 Vec::new()
             };
@@ -1177,7 +1429,7 @@ impl Bcd {
                         c.iter().rev().copied().collect()
                     };
                     if pts[0] != here {
-                        let Some(hop) = ctx.route(&mut search, here, pts[0]) else {
+                        let Some(hop) = ctx.route(search, here, pts[0]) else {
                             skipped += 1;
                             continue;
                         };
@@ -1197,7 +1449,7 @@ impl Bcd {
                 };
                 let entry = pts[0];
                 if entry != here {
-                    let Some(hop) = ctx.route(&mut search, here, entry) else {
+                    let Some(hop) = ctx.route(search, here, entry) else {
                         skipped += 1;
                         continue;
                     };
@@ -1214,78 +1466,34 @@ impl Bcd {
 
             if opts.rim {
                 rim_pass(
-                    &ctx,
-                    &mut search,
+                    ctx,
+                    search,
                     &mut items,
                     opts.rim_min_yield,
                     opts.rim_coverage,
                 );
             }
-            let mut items = smooth(&ctx, repair(&ctx, &mut search, items, &mut skipped));
+            let mut items = smooth(ctx, repair(ctx, search, items, &mut skipped));
             if opts.rim && !in_tour {
                 // A second mop-up of what the inserted passes and the smoothing left.
                 rim_pass(
-                    &ctx,
-                    &mut search,
+                    ctx,
+                    search,
                     &mut items,
                     opts.rim_min_yield,
                     opts.rim_coverage,
                 );
-                items = smooth(&ctx, repair(&ctx, &mut search, items, &mut skipped));
+                items = smooth(ctx, repair(ctx, search, items, &mut skipped));
             }
-            let items = prune::prune(&ctx, items, opts.min_coverage, turn_px);
+            let items = prune::prune(ctx, items, opts.min_coverage, turn_px);
             let pts: Vec<Point> = moves(&items).into_iter().map(|m| m.0).collect();
             let cost = path_length(&pts) + turn_px * turns(&pts) as f64;
             if best.as_ref().is_none_or(|b| (skipped, cost) < (b.0, b.1)) {
                 best = Some((skipped, cost, items));
             }
         }
-        let items = best.map(|b| b.2).unwrap_or_default();
-
-        // A region whose moves the smoothing and pruning merged into the moves around it (or
-        // a cell whose lane is a single point) has nothing left between its start and end: it
-        // is not reported (marks inside it are kept), and the regions left are numbered 1, 2,
-        // ... in order.
-        let mut steps = VecDeque::with_capacity(items.len());
-        let mut at = start;
-        // Marks since a region's start while it has no move yet (`None`: no region pending).
-        let mut pending: Option<Vec<Event>> = None;
-        let mut region = 0u32;
-        for it in items {
-            match it {
-                Item::Move(p) => {
-                    if p != at {
-                        if let Some(marks) = pending.take() {
-                            region += 1;
-                            steps.push_back(Step::Mark(Event::RegionStart { region }));
-                            steps.extend(marks.into_iter().map(Step::Mark));
-                        }
-                        steps.push_back(Step::MoveTo(frame.grid_to_world(p)));
-                        at = p;
-                    }
-                }
-                Item::Mark(Event::RegionStart { .. }) => {
-                    if let Some(marks) = pending.replace(Vec::new()) {
-                        steps.extend(marks.into_iter().map(Step::Mark));
-                    }
-                }
-                Item::Mark(Event::RegionEnd { .. }) => match pending.take() {
-                    Some(marks) => steps.extend(marks.into_iter().map(Step::Mark)),
-                    None => steps.push_back(Step::Mark(Event::RegionEnd { region })),
-                },
-                Item::Mark(e) => match pending.as_mut() {
-                    Some(marks) => marks.push(e),
-                    None => steps.push_back(Step::Mark(e)),
-                },
-            }
-        }
-        if let Some(marks) = pending {
-            steps.extend(marks.into_iter().map(Step::Mark));
-        }
-        Self {
-            steps,
-            cells: cells.len(),
-        }
+        let ncells = cells.len();
+        best.map_or((0, 0.0, Vec::new(), ncells), |b| (b.0, b.1, b.2, ncells))
     }
 }
 
@@ -1827,6 +2035,83 @@ mod tests {
             Some(crate::geometry::Pose::new(0.3, 0.3, 0.0)),
         )
         .unwrap()
+    }
+
+    /// A 60 x 30 px room turned by `deg` degrees in a 90 x 90 px map (0.05 m/px).
+    fn turned_room(deg: f64) -> World {
+        let (si, co) = deg.to_radians().sin_cos();
+        let mut art = String::new();
+        for r in 0..90 {
+            for c in 0..90 {
+                let (x, y) = (f64::from(c) - 44.5, f64::from(r) - 44.5);
+                let (u, v) = (co * x + si * y, -si * x + co * y);
+                art.push(if u.abs() < 30.0 && v.abs() < 15.0 {
+                    '.'
+                } else {
+                    '#'
+                });
+            }
+            art.push('\n');
+        }
+        let map = crate::grid::GridMap::from_ascii_scaled(art.trim_end(), 1, 0.05).unwrap();
+        World::new(
+            map,
+            crate::world::Robot::new(0.15),
+            Some(crate::geometry::Pose::new(2.25, 2.25, 0.0)),
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn walls_at_an_angle_get_a_turned_lattice() {
+        for deg in [0.0, 30.0] {
+            let world = turned_room(deg);
+            let frame = *world.frame();
+            let n = frame.width * frame.height;
+            let reach = world.reachable();
+            let ok: Vec<bool> = (0..n).map(|i| reach.contains(i)).collect();
+            let ctx = Ctx {
+                world: &world,
+                frame,
+                safe: ok.clone(),
+                ok,
+                rt: 3.0,
+            };
+            let a = dominant_angles(&ctx)[0].to_degrees();
+            // The image's rows run down: a room turned by +30 degrees there has walls at
+            // 30 or 60 degrees (mod 90), whichever way the turn is read.
+            let off = [deg, 90.0 - deg]
+                .iter()
+                .map(|d| (a - d).abs().min(90.0 - (a - d).abs()))
+                .fold(f64::INFINITY, f64::min);
+            assert!(off < 1.5, "{deg}: found {a}");
+        }
+        // The turned room's plan covers it without contact and with few turns (lanes along
+        // its walls, not staircases across them).
+        let world = turned_room(30.0);
+        let m = run(&world, &BcdOptions::default());
+        assert_eq!(m.collisions, 0);
+        assert!(m.effective_coverage >= 0.99, "{}", m.effective_coverage);
+        // Its plan on the lattice turned to its walls reaches every piece and costs about what
+        // the pixel lattice's does (here the pixels' is kept: the room is small).
+        let frame = *world.frame();
+        let n = frame.width * frame.height;
+        let reach = world.reachable();
+        let ok: Vec<bool> = (0..n).map(|i| reach.contains(i)).collect();
+        let ctx = Ctx {
+            world: &world,
+            frame,
+            safe: ok.clone(),
+            ok,
+            rt: 3.0,
+        };
+        let mut search = Search::new(frame.width, frame.height);
+        let opts = BcdOptions::default();
+        let a = dominant_angles(&ctx)[0];
+        let turned = Bcd::plan_on(&ctx, &Lattice::turned(&ctx, a), &opts, &mut search);
+        let pixels = Bcd::plan_on(&ctx, &Lattice::pixels(&ctx), &opts, &mut search);
+        assert_eq!(turned.0, 0);
+        assert!(turned.1 < 1.2 * pixels.1, "{} vs {}", turned.1, pixels.1);
     }
 
     #[test]
