@@ -131,6 +131,7 @@ mod hops;
 mod prune;
 mod tsp;
 
+use std::borrow::Cow;
 use std::cmp::Reverse;
 use std::collections::{BinaryHeap, VecDeque};
 use std::ops::{Add, Sub};
@@ -441,7 +442,7 @@ struct Ctx<'a> {
 /// The lattice the cells are decomposed on: points `(c, r)` one pixel apart (`c` to the right,
 /// `r` down, as in the image), either the map's own pixel centres or the same lattice turned
 /// by an angle about the map's centre (module docs, step 1).
-struct Lattice {
+struct Lattice<'a> {
     /// Lattice points per row.
     w: usize,
     /// Rows.
@@ -452,13 +453,14 @@ struct Lattice {
     map_h: f64,
     /// The map's centre in image coordinates.
     centre: (f64, f64),
-    /// Lattice points that are reachable and free for the robot's disk.
-    ok: Vec<bool>,
+    /// Lattice points that are reachable and free for the robot's disk (the pixel lattice
+    /// borrows the context's mask; a turned one owns its own).
+    ok: Cow<'a, [bool]>,
 }
 
-impl Lattice {
+impl<'a> Lattice<'a> {
     /// The map's own pixel centres.
-    fn pixels(ctx: &Ctx<'_>) -> Self {
+    fn pixels(ctx: &'a Ctx<'_>) -> Self {
         let (w, h) = (ctx.frame.width, ctx.frame.height);
         Self {
             w,
@@ -466,7 +468,7 @@ impl Lattice {
             rot: None,
             map_h: h as f64,
             centre: (w as f64 / 2.0, h as f64 / 2.0),
-            ok: ctx.ok.clone(),
+            ok: Cow::Borrowed(&ctx.ok),
         }
     }
 
@@ -484,7 +486,7 @@ impl Lattice {
             rot: Some((co, si)),
             map_h: mh,
             centre: (mw / 2.0, mh / 2.0),
-            ok: Vec::new(),
+            ok: Cow::Borrowed(&[]),
         };
         let mut ok = vec![false; w * h];
         for r in 0..h {
@@ -495,7 +497,7 @@ impl Lattice {
                     ctx.ok_at(pc, pr) && !ctx.world.disk_collides(ctx.frame.grid_to_world(g));
             }
         }
-        lat.ok = ok;
+        lat.ok = Cow::Owned(ok);
         lat
     }
 
