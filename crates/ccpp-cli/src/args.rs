@@ -96,6 +96,24 @@ pub struct ZoneArgs {
     pub keepout: Vec<ZoneSpec>,
 }
 
+/// The planner options file, shared by `run`, `plan` and `bench`.
+#[derive(Args, Debug, Clone, Default)]
+pub struct OptionsArgs {
+    /// Planner options file (YAML or JSON), sections named after the planners, e.g.
+    /// `random_bounce: { budget_m: 200 }`.
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
+}
+
+/// The memory budget, shared by every command that plans (`run`, `plan`, `waypoints`, `bench`).
+#[derive(Args, Debug, Clone, Default)]
+pub struct LimitArgs {
+    /// Refuse work whose estimated memory exceeds this many MB (default 4096; `bench` checks
+    /// each run).
+    #[arg(long, value_name = "MB")]
+    pub max_memory: Option<u64>,
+}
+
 /// `ccpp run`.
 #[derive(Args, Debug)]
 #[command(allow_negative_numbers = true)]
@@ -112,10 +130,9 @@ pub struct RunArgs {
     /// Seed for planners that use randomness.
     #[arg(long, value_name = "N")]
     pub seed: Option<u64>,
-    /// Planner options file (YAML or JSON), sections named after the planners, e.g.
-    /// `random_bounce: { budget_m: 200 }`.
-    #[arg(long, value_name = "FILE")]
-    pub config: Option<PathBuf>,
+    /// Planner options.
+    #[command(flatten)]
+    pub options: OptionsArgs,
     /// Sensor range in metres (default 4 r).
     #[arg(long, value_name = "M")]
     pub sensor_range: Option<f64>,
@@ -148,9 +165,9 @@ pub struct RunArgs {
     /// Landmarks for pose correction under PID (CSV `id,x,y[,theta]` or a JSON array).
     #[arg(long, value_name = "FILE")]
     pub landmarks: Option<PathBuf>,
-    /// Refuse runs whose estimated memory exceeds this many MB (default 4096).
-    #[arg(long, value_name = "MB")]
-    pub max_memory: Option<u64>,
+    /// Memory budget.
+    #[command(flatten)]
+    pub limits: LimitArgs,
     /// Output folder.
     #[arg(long, value_name = "DIR", default_value = "ccpp-out")]
     pub out: PathBuf,
@@ -180,9 +197,9 @@ pub struct PlanArgs {
     /// A known-map planner: `bcd` or `rect-boustrophedon` (online planners are refused).
     #[arg(long, value_name = "NAME")]
     pub planner: String,
-    /// Planner options file (YAML or JSON), sections named after the planners.
-    #[arg(long, value_name = "FILE")]
-    pub config: Option<PathBuf>,
+    /// Planner options.
+    #[command(flatten)]
+    pub options: OptionsArgs,
     /// Rectangular robot length in metres (rect-boustrophedon: waypoint spacing).
     #[arg(long, value_name = "M")]
     pub length: Option<f64>,
@@ -192,9 +209,9 @@ pub struct PlanArgs {
     /// Work area and keep-out zones (the path stays inside the area, outside the keep-outs).
     #[command(flatten)]
     pub zones: ZoneArgs,
-    /// Refuse plans whose estimated memory exceeds this many MB (default 4096).
-    #[arg(long, value_name = "MB")]
-    pub max_memory: Option<u64>,
+    /// Memory budget.
+    #[command(flatten)]
+    pub limits: LimitArgs,
     /// Write the path as FORMAT (repeatable; default `nav-path` and `csv`): `csv`
     /// (waypoints.csv), `json` (waypoints.json), `nav-path` (`nav_path.yaml`) or `geojson`
     /// (path.geojson).
@@ -229,9 +246,9 @@ pub struct WaypointsArgs {
     /// waypoint or connection enters it.
     #[arg(long, value_name = "FILE|X0,Y0,X1,Y1", value_parser = parse_zone, allow_hyphen_values = true)]
     pub keepout: Vec<ZoneSpec>,
-    /// Refuse plans whose estimated memory exceeds this many MB (default 4096).
-    #[arg(long, value_name = "MB")]
-    pub max_memory: Option<u64>,
+    /// Memory budget.
+    #[command(flatten)]
+    pub limits: LimitArgs,
     /// Output format.
     #[arg(long, value_name = "csv|json", default_value = "csv")]
     pub format: String,
@@ -278,12 +295,12 @@ pub struct BenchArgs {
     /// Seed for planners that use randomness.
     #[arg(long, value_name = "N")]
     pub seed: Option<u64>,
-    /// Planner options file (YAML or JSON).
-    #[arg(long, value_name = "FILE")]
-    pub config: Option<PathBuf>,
-    /// Refuse each run whose estimated memory exceeds this many MB (default 4096).
-    #[arg(long, value_name = "MB")]
-    pub max_memory: Option<u64>,
+    /// Planner options.
+    #[command(flatten)]
+    pub options: OptionsArgs,
+    /// Memory budget.
+    #[command(flatten)]
+    pub limits: LimitArgs,
     /// Output folder.
     #[arg(long, value_name = "DIR", default_value = "ccpp-bench")]
     pub out: PathBuf,

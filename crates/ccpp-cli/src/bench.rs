@@ -195,7 +195,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         parse_planner(p)?;
     }
     let (robot, _) = robot_from(&(&a.robot).into())?;
-    let options = planner_options(a.config.as_deref(), a.seed)?;
+    let options = planner_options(a.options.config.as_deref(), a.seed)?;
     let maps = name_maps(expand_maps(&a.maps)?);
     std::fs::create_dir_all(&a.out)
         .with_context(|| format!("cannot create output folder {}", a.out.display()))?;
@@ -337,7 +337,7 @@ fn run_one(
         scenario: Scenario::configure(map.recipe.clone(), options.config(kind))
             .robot(robot)
             .sim(sim)
-            .memory_limit(a.max_memory)
+            .memory_limit(a.limits.max_memory)
             .build()
             .map_err(|e| crate::errors::one_line(&e.into()))?,
         map_name: map.name.clone(),

@@ -314,7 +314,7 @@ impl Job {
     pub fn from_run_args(a: &RunArgs) -> Result<Self> {
         let kind = parse_planner(&a.planner)?;
         let (robot, start) = robot_from(&a.robot)?;
-        let mut planner = planner_options(a.config.as_deref(), None)?.config(kind);
+        let mut planner = planner_options(a.options.config.as_deref(), None)?.config(kind);
         let mut given = apply_planner_flags(a, &mut planner)?;
         let sim = sim_from(a, &mut planner)?;
         if a.sensor_range.is_some() {
@@ -324,7 +324,7 @@ impl Job {
             .robot(robot)
             .start_pose(start.map(|p| [p.x, p.y, p.theta]))
             .sim(sim)
-            .memory_limit(a.max_memory)
+            .memory_limit(a.limits.max_memory)
             .zones(a.zones.area.clone(), a.zones.keepout.clone())
             .build()
             .map_err(|e| name_flag(e, &given))?;

@@ -27,7 +27,7 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         return Err(PlanError::Online(kind.name(), offline_planners()).into());
     }
     let (robot, start) = robot_from(&a.robot)?;
-    let mut planner = planner_options(a.config.as_deref(), None)?.config(kind);
+    let mut planner = planner_options(a.options.config.as_deref(), None)?.config(kind);
     let mut given = Vec::new();
     for (flag, v) in [("--length", a.length), ("--width", a.width)] {
         let Some(v) = v else { continue };
@@ -56,7 +56,7 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     let scenario = Scenario::configure(recipe_from(&a.map), planner)
         .robot(robot)
         .start_pose(start.map(|p| [p.x, p.y, p.theta]))
-        .memory_limit(a.max_memory)
+        .memory_limit(a.limits.max_memory)
         .zones(a.zones.area.clone(), a.zones.keepout.clone())
         .build()
         .map_err(flag)?;

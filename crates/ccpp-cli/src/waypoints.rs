@@ -37,7 +37,7 @@ pub fn run(a: &WaypointsArgs) -> Result<()> {
     )
     .robot(robot)
     .start_pose(start.map(|p| [p.x, p.y, p.theta]))
-    .memory_limit(a.max_memory)
+    .memory_limit(a.limits.max_memory)
     .zones(None, a.keepout.clone())
     .build()
     .map_err(flag)?;
