@@ -605,6 +605,72 @@ fn fmt_tick(v: f64, step: f64) -> String {
     }
 }
 
+/// The plotting box of a chart, in pixels from the top-left corner.
+#[derive(Clone, Copy, Debug)]
+struct Frame {
+    /// Left edge.
+    l: f32,
+    /// Top edge.
+    t: f32,
+    /// Width.
+    w: f32,
+    /// Height.
+    h: f32,
+}
+
+/// Colours, label size and label gap of a chart's grid lines and tick labels.
+#[derive(Clone, Copy, Debug)]
+struct TickStyle {
+    grid: [u8; 3],
+    text: [u8; 3],
+    px: u32,
+    gap: f32,
+}
+
+/// Ticks of a full-size chart.
+const CHART_TICKS: TickStyle = TickStyle {
+    grid: [225, 225, 225],
+    text: [60, 60, 60],
+    px: 12,
+    gap: 6.0,
+};
+
+/// Ticks of a small panel.
+const PANEL_TICKS: TickStyle = TickStyle {
+    grid: [230, 230, 230],
+    text: [80, 80, 80],
+    px: 11,
+    gap: 4.0,
+};
+
+impl Chart {
+    /// The chart's title, centred at the top.
+    fn title(&mut self, title: &str) {
+        self.text(
+            self.width as f32 / 2.0,
+            10.0,
+            20,
+            title,
+            [20, 20, 20],
+            Anchor::Middle,
+        );
+    }
+
+    /// A vertical grid line at `frac` (0 = left, 1 = right) of the frame, labelled below it.
+    fn x_tick(&mut self, f: Frame, frac: f64, label: String, s: TickStyle) {
+        let x = f.l + frac as f32 * f.w;
+        self.line(vec![(x, f.t), (x, f.t + f.h)], s.grid, 1.0, false);
+        self.text(x, f.t + f.h + 5.0, s.px, label, s.text, Anchor::Middle);
+    }
+
+    /// A horizontal grid line at `frac` (0 = bottom, 1 = top) of the frame, labelled at its left.
+    fn y_tick(&mut self, f: Frame, frac: f64, label: String, s: TickStyle) {
+        let y = f.t + f.h - frac as f32 * f.h;
+        self.line(vec![(f.l, y), (f.l + f.w, y)], s.grid, 1.0, false);
+        self.text(f.l - s.gap, y - 7.0, s.px, label, s.text, Anchor::End);
+    }
+}
+
 /// A line chart: one polyline per named series of `[x, y]` points.
 pub fn line_chart(
     title: &str,
@@ -630,43 +696,19 @@ pub fn line_chart(
             .fold(0.0f64, f64::max)
             .max(1e-9)
     });
-    c.text(
-        w as f32 / 2.0,
-        10.0,
-        20,
-        title,
-        [20, 20, 20],
-        Anchor::Middle,
-    );
+    c.title(title);
     // Grid and ticks.
     let xs = nice_step(xmax, 6);
     let ys = nice_step(ymax, 5);
+    let frame = Frame { l, t, w: pw, h: ph };
     let mut v = 0.0;
     while v <= xmax + 1e-9 {
-        let x = l + (v / xmax) as f32 * pw;
-        c.line(vec![(x, t), (x, t + ph)], [225, 225, 225], 1.0, false);
-        c.text(
-            x,
-            t + ph + 5.0,
-            12,
-            fmt_tick(v, xs),
-            [60, 60, 60],
-            Anchor::Middle,
-        );
+        c.x_tick(frame, v / xmax, fmt_tick(v, xs), CHART_TICKS);
         v += xs;
     }
     let mut v = 0.0;
     while v <= ymax + 1e-9 {
-        let y = t + ph - (v / ymax) as f32 * ph;
-        c.line(vec![(l, y), (l + pw, y)], [225, 225, 225], 1.0, false);
-        c.text(
-            l - 6.0,
-            y - 7.0,
-            12,
-            fmt_tick(v, ys),
-            [60, 60, 60],
-            Anchor::End,
-        );
+        c.y_tick(frame, v / ymax, fmt_tick(v, ys), CHART_TICKS);
         v += ys;
     }
     c.rect(l, t, pw, ph, None, Some([120, 120, 120]));
@@ -718,14 +760,7 @@ pub fn bar_panels(title: &str, planners: &[String], metrics: &[(String, Vec<f64>
     let w = (cols as f32 * pw) as u32;
     let h = (rows as f32 * ph + 60.0 + 24.0 * planners.len().div_ceil(4) as f32) as u32;
     let mut c = Chart::new(w, h);
-    c.text(
-        w as f32 / 2.0,
-        10.0,
-        20,
-        title,
-        [20, 20, 20],
-        Anchor::Middle,
-    );
+    c.title(title);
     for (m, (name, vals)) in metrics.iter().enumerate() {
         let ox = (m % cols) as f32 * pw;
         let oy = 40.0 + (m / cols) as f32 * ph;
@@ -746,18 +781,10 @@ pub fn bar_panels(title: &str, planners: &[String], metrics: &[(String, Vec<f64>
             .max(1e-9);
         let step = nice_step(vmax, 4);
         let top = (vmax / step).ceil() * step;
+        let frame = Frame { l, t, w: iw, h: ih };
         let mut v = 0.0;
         while v <= top + 1e-9 {
-            let y = t + ih - (v / top) as f32 * ih;
-            c.line(vec![(l, y), (l + iw, y)], [230, 230, 230], 1.0, false);
-            c.text(
-                l - 4.0,
-                y - 7.0,
-                11,
-                fmt_tick(v, step),
-                [80, 80, 80],
-                Anchor::End,
-            );
+            c.y_tick(frame, v / top, fmt_tick(v, step), PANEL_TICKS);
             v += step;
         }
         let n = vals.len().max(1) as f32;
@@ -996,14 +1023,7 @@ pub fn tradeoff_chart(
             t + ph - ya.frac(p[1]) as f32 * ph,
         )
     };
-    c.text(
-        w as f32 / 2.0,
-        10.0,
-        20,
-        title,
-        [20, 20, 20],
-        Anchor::Middle,
-    );
+    c.title(title);
     // The better corner: pale green with an arrow into the corner (kept free of labels; the
     // legend names it).
     let green = [0, 130, 60];
@@ -1042,30 +1062,13 @@ pub fn tradeoff_chart(
         }
         out
     };
+    let frame = Frame { l, t, w: pw, h: ph };
     for v in xticks {
-        let x = l + xa.frac(v) as f32 * pw;
-        c.line(vec![(x, t), (x, t + ph)], [225, 225, 225], 1.0, false);
-        c.text(
-            x,
-            t + ph + 5.0,
-            12,
-            fmt_short(v),
-            [60, 60, 60],
-            Anchor::Middle,
-        );
+        c.x_tick(frame, xa.frac(v), fmt_short(v), CHART_TICKS);
     }
     let mut v = (ya.lo / ystep).ceil() * ystep;
     while v <= ya.hi + 1e-9 {
-        let y = t + ph - ya.frac(v) as f32 * ph;
-        c.line(vec![(l, y), (l + pw, y)], [225, 225, 225], 1.0, false);
-        c.text(
-            l - 6.0,
-            y - 7.0,
-            12,
-            fmt_tick(v, ystep),
-            [60, 60, 60],
-            Anchor::End,
-        );
+        c.y_tick(frame, ya.frac(v), fmt_tick(v, ystep), CHART_TICKS);
         v += ystep;
     }
     c.rect(l, t, pw, ph, None, Some([120, 120, 120]));
@@ -1217,14 +1220,7 @@ pub fn image_grid(
     let w = cols as u32 * cell_w;
     let h = rows as u32 * (cell_h + 24) + 40;
     let mut c = Chart::new(w, h);
-    c.text(
-        w as f32 / 2.0,
-        10.0,
-        20,
-        title,
-        [20, 20, 20],
-        Anchor::Middle,
-    );
+    c.title(title);
     for (k, (label, png)) in items.iter().enumerate() {
         let x = (k % cols) as f32 * cell_w as f32;
         let y = 40.0 + (k / cols) as f32 * (cell_h + 24) as f32;
@@ -1307,14 +1303,7 @@ pub fn image_grid_captioned(
     let top = 44u32;
     let h = top + rows as u32 * row_h + legend_h + 16;
     let mut c = Chart::new(w, h);
-    c.text(
-        w as f32 / 2.0,
-        10.0,
-        20,
-        title,
-        [20, 20, 20],
-        Anchor::Middle,
-    );
+    c.title(title);
     for (k, p) in panels.iter().enumerate() {
         let x = (k % cols) as f32 * cell_w as f32;
         let y = (top + (k / cols) as u32 * row_h) as f32;
