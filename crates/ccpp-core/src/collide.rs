@@ -139,7 +139,8 @@ impl Band {
 }
 
 /// Does a robot disk of radius `r_px` (pixels) centred at grid point `p` overlap a blocked pixel?
-/// A disk centred beyond the examined band of outside pixels does (see [`Band`]).
+/// Outside the image every pixel blocks; only a band of `ceil(rc) + 2` outside pixels is
+/// examined (`rc` = [`contact_radius_px`]), and a disk centred beyond it hits.
 pub fn disk_hits(occ: &impl Occupancy, p: Point, r_px: f64) -> bool {
     let rc = contact_radius_px(r_px);
     let rc2 = rc * rc;
@@ -163,8 +164,8 @@ pub fn disk_hits(occ: &impl Occupancy, p: Point, r_px: f64) -> bool {
 /// (grid coordinates) comes into contact with a blocked pixel; `None` when the whole motion is
 /// free. Brute force over the swept capsule's bounding box: use for short motions, or call
 /// through a distance-transform accelerated caller ([`crate::world::World::first_contact`]).
-/// Only a band of outside pixels is examined (see [`Band`]): a motion starting beyond it is in
-/// contact at `t = 0`.
+/// Only a band of `ceil(rc) + 2` outside pixels is examined (as in [`disk_hits`]): a motion
+/// starting beyond it is in contact at `t = 0`.
 pub fn segment_first_contact(occ: &impl Occupancy, a: Point, b: Point, r_px: f64) -> Option<f64> {
     let rc = contact_radius_px(r_px);
     let rc2 = rc * rc;

@@ -16,7 +16,7 @@
 //!   YAML, `GeoJSON`) and the waypoint readers;
 //! * [`plan`]: a known-map planner's route without simulation overhead or metrics;
 //! * [`phase`]: optional phase timing (`CCPP_PHASES`);
-//! * [`file`]: opening user files (regular files only: a FIFO is refused, not read forever).
+//! * [`mod@file`]: opening user files (regular files only: a FIFO is refused, not read forever).
 //!
 //! Errors are [`thiserror`] enums that always name the file concerned; nothing here panics on
 //! user data.
