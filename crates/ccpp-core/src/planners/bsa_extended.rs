@@ -29,6 +29,10 @@
 //! * **At the end of BSA** (no backtracking point left): passes over every rim left,
 //!   wherever it is, also behind gaps BSA's cells could not cross (the extension's positions
 //!   fit through any gap the robot disk fits through: the virtual pipe of seed 002, III.D).
+//!   At fine pixels the outer corners of the spiral's rings leave small triangles along its
+//!   diagonals, reached only from positions off the obstacle contour; with
+//!   [`BsaExtendedOptions::strip_walk`] a pass follows such a strip instead of fetching it one
+//!   position (one pixel step, often a turn) at a time.
 //!
 //! The passes are marked `wall_follow_start` / `wall_follow_end` in the trace, trips of a
 //! robot diameter or more between rims `backtrack_start` / `backtrack_end`. Everything is
@@ -110,7 +114,8 @@ pub struct BsaExtendedOptions {
     /// 0.003; the component's is 0.002). Its wall passes square a rounded corner where the way
     /// grows by at most 0.8 robot radii per turn saved (`corner_slack` 0.8; the component's is
     /// 0.1): with [`Self::strip_walk`] the mean turns on the 14 shared maps went from 2006 to
-    /// 1876 for a mean path ratio 0.007 higher (1.318 -> 1.325), no pixel lost.
+    /// 1876 for a mean path ratio 0.007 higher (1.318 -> 1.325), the mean effective coverage
+    /// 0.9952 either way.
     #[serde(deserialize_with = "super::settings::bsa_extended_extension")]
     pub extension: ExtensionOptions,
     /// Let the final clean-up's wall pass follow a strip of rim away from the walls: a step
