@@ -333,6 +333,19 @@ fn config_values_go_through_the_same_validation() {
             "ba-star",
             "shorter_backtrack",
         ),
+        // `strip_walk` belongs to bsa-extended only (not to its extension section, not to
+        // ba-star-extended or bsa).
+        (
+            "ba_star_extended: { strip_walk: false }",
+            "ba-star-extended",
+            "strip_walk",
+        ),
+        (
+            "bsa_extended: { extension: { strip_walk: false } }",
+            "bsa-extended",
+            "strip_walk",
+        ),
+        ("bsa: { strip_walk: false }", "bsa", "strip_walk"),
         // An extension option given to a planner without the extension is an unknown key.
         (
             "ba_star: { extension: { leave_group: 2 } }",
@@ -778,4 +791,36 @@ fn shorter_backtrack_is_read_from_the_config() {
     let m = metrics(&own);
     assert_eq!(m["collisions"], 0);
     assert!(m["effective_coverage"].as_f64().unwrap() >= 0.995, "{m}");
+}
+
+/// `strip_walk` is read from the `bsa_extended` section and changes the plan: in a room at
+/// 0.01 m pixels the corners of BSA's spiral rings leave small triangles that the final
+/// clean-up reaches off the obstacle contour; switched off, every position there is a chunk of
+/// its own and the run has more turns.
+#[test]
+fn strip_walk_is_read_from_the_config() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    pgm(dir, "fine.pgm", 240, 200, |_, _| false);
+    let map = dir.join("fine.yaml");
+    std::fs::write(
+        &map,
+        "image: fine.pgm\nresolution: 0.01\norigin: [0.0, 0.0, 0.0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n",
+    )
+    .unwrap();
+    let cfg = dir.join("off.yaml");
+    std::fs::write(&cfg, "bsa_extended: { strip_walk: false }\n").unwrap();
+    let args = ["--radius", "0.1", "--start", "0.3,0.3"];
+    let on = run_ok(dir, "on", &map, "bsa-extended", &args);
+    let mut with_cfg = args.to_vec();
+    with_cfg.extend(["--config", cfg.to_str().unwrap()]);
+    let off = run_ok(dir, "off", &map, "bsa-extended", &with_cfg);
+    assert_ne!(trace(&on), trace(&off));
+    let (m_on, m_off) = (metrics(&on), metrics(&off));
+    let turns = |m: &serde_json::Value| m["turns"].as_u64().unwrap();
+    assert!(turns(&m_on) < turns(&m_off), "{m_on} {m_off}");
+    for m in [&m_on, &m_off] {
+        assert_eq!(m["collisions"], 0);
+        assert!(m["effective_coverage"].as_f64().unwrap() >= 0.99, "{m}");
+    }
 }

@@ -29,6 +29,10 @@
 //! * **At the end of BSA** (no backtracking point left): passes over every rim left,
 //!   wherever it is, also behind gaps BSA's cells could not cross (the extension's positions
 //!   fit through any gap the robot disk fits through: the virtual pipe of seed 002, III.D).
+//!   At fine pixels the outer corners of the spiral's rings leave small triangles along its
+//!   diagonals, reached only from positions off the obstacle contour; with
+//!   [`BsaExtendedOptions::strip_walk`] a pass follows such a strip instead of fetching it one
+//!   position (one pixel step, often a turn) at a time.
 //!
 //! The passes are marked `wall_follow_start` / `wall_follow_end` in the trace, trips of a
 //! robot diameter or more between rims `backtrack_start` / `backtrack_end`. Everything is
@@ -107,9 +111,21 @@ pub struct BsaExtendedOptions {
     /// 0.6 % of the floor (`simplify_loss` 2, `simplify_fraction` 0.006; the component's are
     /// 1 and 0.0015): on the shared maps 5 % fewer turns for 0.16 % of the floor. Its final
     /// clean-up may leave 0.3 % of the floor in trips that do not pay (`leave_fraction`
-    /// 0.003; the component's is 0.002).
+    /// 0.003; the component's is 0.002). Its wall passes square a rounded corner where the way
+    /// grows by at most 0.8 robot radii per turn saved (`corner_slack` 0.8; the component's is
+    /// 0.1): with [`Self::strip_walk`] the mean turns on the 14 shared maps went from 2006 to
+    /// 1876 for a mean path ratio 0.007 higher (1.318 -> 1.325), the mean effective coverage
+    /// 0.9952 either way.
     #[serde(deserialize_with = "super::settings::bsa_extended_extension")]
     pub extension: ExtensionOptions,
+    /// Let the final clean-up's wall pass follow a strip of rim away from the walls: a step
+    /// off the obstacle contour onto a position that gains a single pixel is taken when that
+    /// position lies on a strip (the rule by which such a position may start a pass), so the
+    /// strip is one pass merged into straight segments (`false`: such a step must gain a tool
+    /// radius of pixels, and the strip is fetched one position per chunk, one pixel step and
+    /// often a turn each). On `aws_small_warehouse_002` (0.02 m pixels) 1 576 chunks of 1-3
+    /// pixels became passes: 496 turns fewer (2 081 -> 1 585), the same floor swept.
+    pub strip_walk: bool,
 }
 
 impl Default for BsaExtendedOptions {
@@ -121,8 +137,10 @@ impl Default for BsaExtendedOptions {
                 simplify_fraction: 0.006,
                 simplify_loss: 2.0,
                 leave_fraction: 0.003,
+                corner_slack: 0.8,
                 ..ExtensionOptions::default()
             },
+            strip_walk: true,
         }
     }
 }
@@ -145,6 +163,8 @@ pub struct BsaExtended {
     mode: Mode,
     /// Queued steps, trail and open wall pass.
     drive: Drive,
+    /// [`BsaExtendedOptions::strip_walk`].
+    strip_walk: bool,
 }
 
 impl BsaExtended {
@@ -156,6 +176,7 @@ impl BsaExtended {
             ext: None,
             mode: Mode::Host,
             drive: Drive::default(),
+            strip_walk: opts.strip_walk,
         }
     }
 
@@ -236,6 +257,9 @@ impl Planner for BsaExtended {
 
     fn next(&mut self, sensor: &dyn Sensor) -> Step {
         let pos = self.drive.observe(&mut self.ext, &self.opts, sensor);
+        if let Some(ext) = self.ext.as_mut() {
+            ext.set_strip_walk(self.strip_walk);
+        }
         self.bsa.observe(sensor);
         loop {
             if let Some(s) = self.drive.queue.pop_front() {

@@ -541,6 +541,9 @@ pub(crate) struct Extension {
     win_on: bool,
     /// Where the last search stopped (see `search_with`), while its state is valid.
     resume_at: Option<usize>,
+    /// The final clean-up's walk follows a strip of rim off the contour too (see
+    /// [`Self::set_strip_walk`]).
+    strip_walk: bool,
 }
 
 impl Extension {
@@ -606,7 +609,16 @@ impl Extension {
             win: Window::default(),
             win_on: false,
             resume_at: None,
+            strip_walk: false,
         }
+    }
+
+    /// Lets the final clean-up's walk step off the contour onto a position on a strip of rim
+    /// (at least 4 targets within the tool radius plus 3 pixels) that gains a single pixel, as
+    /// a pass may start there; off (the default) such a step must gain a tool radius of
+    /// pixels, and a strip away from the walls is fetched one position per chunk.
+    pub(crate) fn set_strip_walk(&mut self, on: bool) {
+        self.strip_walk = on;
     }
 
     /// The options.
@@ -1455,7 +1467,15 @@ impl Extension {
                     continue;
                 }
                 let contour = self.on_contour(known, q);
-                if !contour && g < g_int {
+                // Off the contour a step must gain a tool radius of pixels; with `strip_walk`
+                // (final clean-up only) also a step onto a strip of rim, as a pass may start.
+                if !contour
+                    && g < g_int
+                    && !(self.strip_walk
+                        && !bounded
+                        && self.count_targets(known, q, wanted, STRIP_N, &self.strip_rows)
+                            >= STRIP_N)
+                {
                     continue;
                 }
                 let turn = dir.map_or(0, |d| {
