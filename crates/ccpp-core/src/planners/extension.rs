@@ -306,6 +306,7 @@ impl BucketQueue {
     }
 
     /// Queues position `i` at `key`.
+    #[inline]
     fn push(&mut self, key: u64, i: usize) {
         let b = usize::try_from(key >> BUCKET_SHIFT).map_or(BUCKET_MAX, |b| b.min(BUCKET_MAX));
         if b >= self.buckets.len() {
