@@ -306,6 +306,7 @@ impl BucketQueue {
     }
 
     /// Queues position `i` at `key`.
+    #[inline]
     fn push(&mut self, key: u64, i: usize) {
         let b = usize::try_from(key >> BUCKET_SHIFT).map_or(BUCKET_MAX, |b| b.min(BUCKET_MAX));
         if b >= self.buckets.len() {
@@ -730,6 +731,11 @@ impl Extension {
     }
 
     fn px_of(&self, i: usize) -> Px {
+        // Searches turn every settled index back into a pixel: a 32-bit division where the
+        // index fits (any image up to 4 G pixels) is several times cheaper than a 64-bit one.
+        if let (Ok(i), Ok(w)) = (u32::try_from(i), u32::try_from(self.frame.width)) {
+            return (i64::from(i % w), i64::from(i / w));
+        }
         let (c, r) = self.frame.col_row(i);
         (c as i64, r as i64)
     }
@@ -1113,23 +1119,28 @@ impl Extension {
         }
         // Transfers need a short known-free way, not the shortest: an inflated heuristic
         // (weighted A*) settles far fewer positions; the way is straightened afterwards.
-        let h = |s: &Self, p: Px| -> u64 {
-            goal.map_or(0, |g| {
-                (s.center(p).dist(g) * ROUTE_WEIGHT * COST_ORTHO as f64).floor() as u64
-            })
+        // Without a goal the heuristic is 0 and compiled away (a search settles up to millions
+        // of positions, each queuing up to 8 neighbours).
+        let found = match goal {
+            None => self.search_with(known, from, limit, &|_: &Self, _: Px| 0, &mut heap, done),
+            Some(g) => {
+                let h = move |s: &Self, p: Px| -> u64 {
+                    (s.center(p).dist(g) * ROUTE_WEIGHT * COST_ORTHO as f64).floor() as u64
+                };
+                self.search_with(known, from, limit, &h, &mut heap, done)
+            }
         };
-        let found = self.search_with(known, from, limit, &h, &mut heap, done);
         self.heap = heap;
         found
     }
 
     /// [`Self::search`]'s body, on the queue `heap`.
-    fn search_with(
+    fn search_with<H: Fn(&Self, Px) -> u64>(
         &mut self,
         known: &KnownMap,
         from: Point,
         limit: Option<u64>,
-        h: &dyn Fn(&Self, Px) -> u64,
+        h: &H,
         heap: &mut BucketQueue,
         done: &mut dyn FnMut(&mut Self, Px) -> bool,
     ) -> Option<Vec<usize>> {
@@ -1172,12 +1183,12 @@ impl Extension {
     }
 
     /// The positions next to grid point `from` that it reaches by a known-free move, queued.
-    fn seed(
+    fn seed<H: Fn(&Self, Px) -> u64>(
         &mut self,
         known: &KnownMap,
         from: Point,
         p0: Px,
-        h: &dyn Fn(&Self, Px) -> u64,
+        h: &H,
         heap: &mut BucketQueue,
     ) {
         let gen = self.generation;
@@ -1200,12 +1211,12 @@ impl Extension {
     }
 
     /// Queues the neighbours of settled position `i` (pixel `p`; search cost in `dist`).
-    fn relax(
+    fn relax<H: Fn(&Self, Px) -> u64>(
         &mut self,
         known: &KnownMap,
         i: usize,
         p: Px,
-        h: &dyn Fn(&Self, Px) -> u64,
+        h: &H,
         heap: &mut BucketQueue,
     ) {
         let gen = self.generation;
@@ -1218,10 +1229,19 @@ impl Extension {
         // The neighbours' states are read first, all at once (independent loads, mostly
         // cache misses, overlap); the loop below writes only neighbours, each once.
         let mut js = [usize::MAX; 8];
-        for (k, jk) in js.iter_mut().enumerate() {
-            let q = (p.0 + NB[k].0, p.1 + NB[k].1);
-            if blocked & (1 << k) == 0 && q.0 >= 0 && q.1 >= 0 && q.0 < w && q.1 < h_img {
-                *jk = (q.1 * w + q.0) as usize;
+        if p.0 > 0 && p.1 > 0 && p.0 < w - 1 && p.1 < h_img - 1 {
+            // Inside the image's rim every neighbour is in it: index offsets only.
+            for (k, jk) in js.iter_mut().enumerate() {
+                if blocked & (1 << k) == 0 {
+                    *jk = i.wrapping_add_signed((NB[k].1 * w + NB[k].0) as isize);
+                }
+            }
+        } else {
+            for (k, jk) in js.iter_mut().enumerate() {
+                let q = (p.0 + NB[k].0, p.1 + NB[k].1);
+                if blocked & (1 << k) == 0 && q.0 >= 0 && q.1 >= 0 && q.0 < w && q.1 < h_img {
+                    *jk = (q.1 * w + q.0) as usize;
+                }
             }
         }
         let ns: [Node; 8] = std::array::from_fn(|k| {
