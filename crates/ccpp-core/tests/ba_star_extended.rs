@@ -680,7 +680,7 @@ fn backtrack_sweep_sweeps_rims_on_the_way_back() {
     // point (a wall pass before BA*'s last region); `0` cleans only after BA*. The rim swept
     // on the way is not swept again: the final clean-up is shorter. (Whether the whole path
     // is shorter depends on the map: on the 14 shared maps the mean path ratio fell from
-    // 1.3218 to 1.3150; on this corridor it grows by 2 %.)
+    // 1.3218 to 1.3128; on this small corridor it grows by 2.5 %.)
     let wd = world(CORRIDOR, 8, 6, 0.0).unwrap();
     let opts = |backtrack_sweep| BaStarExtendedOptions {
         backtrack_sweep,

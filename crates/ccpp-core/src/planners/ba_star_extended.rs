@@ -14,11 +14,11 @@
 //!   transfer is driven too wherever it is shorter than BA*'s A*SPT-smoothed path over
 //!   covered tiles ([`BaStarExtendedOptions::shorter_backtrack`]; BA*'s own path otherwise):
 //!   the positions may cut across known-free floor BA* has not covered and corners its tile
-//!   line of sight cannot. Before that transfer, the rim next to the robot (found within
+//!   line of sight cannot. Before that transfer, rims next to the robot (each found within
 //!   [`ON_WAY_REACH_R`] robot radii) may be swept whole on the way
-//!   ([`BaStarExtendedOptions::backtrack_sweep`]): when the pass along it and the way on
-//!   from its end to `s_sp` make the way back longer by less than the rim swept divided by
-//!   `backtrack_sweep`, the robot drives that pass first. On `teb_corridor` BA*'s first
+//!   ([`BaStarExtendedOptions::backtrack_sweep`]): while the pass along the next one and
+//!   the way on from its end to `s_sp` make the way back longer by less than the rim swept
+//!   divided by `backtrack_sweep`, the robot drives that pass first. On `teb_corridor` BA*'s first
 //!   region ends at the far end of the corridor; the way back along the wall sweeps the
 //!   rim the final clean-up would have walked.
 //! * **End of BA*** (`L` empty): passes over every rim left, wherever it is, nearest first;
@@ -90,11 +90,12 @@ pub struct BaStarExtendedOptions {
     pub shorter_backtrack: bool,
     /// Rims swept on the way back: when BA* starts backtracking, the robot may first sweep
     /// the rim next to it (one pass of the extension, its start found within
-    /// [`ON_WAY_REACH_R`] robot radii; pixels BA* will still sweep are left to BA*) and
-    /// transfer to BA*'s start point from the pass's end. A pass of `s` metres that makes the
-    /// way to the start point `e` metres longer than the transfer alone is driven when
-    /// `s > backtrack_sweep * e` (the way on judged on the known-free transfer); `0` never
-    /// sweeps on the way back. The pass is driven whole or not at all (a rim cut short would
+    /// [`ON_WAY_REACH_R`] robot radii; pixels BA* will still sweep are left to BA*), then the
+    /// next one from there, and so on, and transfer to BA*'s start point from the last pass's
+    /// end. A pass of `s` metres that makes the way to the start point `e` metres longer than
+    /// the transfer from where the robot is would be is driven when `s > backtrack_sweep * e`
+    /// (the way on judged on the known-free transfer); the first pass that does not pay ends
+    /// the sweeping. `0` never sweeps on the way back. The pass is driven whole or not at all (a rim cut short would
     /// leave a piece the final clean-up walks past anyway; cutting it at the best point made
     /// the mean path ratio on the shared maps 1.328 instead of 1.320).
     pub backtrack_sweep: f64,
@@ -145,6 +146,8 @@ pub struct BaStarExtended {
     shorter_backtrack: bool,
     /// [`BaStarExtendedOptions::backtrack_sweep`].
     backtrack_sweep: f64,
+    /// Whether the robot may still sweep a rim on its way back to BA*'s start point.
+    on_way: bool,
 }
 
 impl BaStarExtended {
@@ -159,6 +162,7 @@ impl BaStarExtended {
             lane: None,
             shorter_backtrack: opts.shorter_backtrack,
             backtrack_sweep: opts.backtrack_sweep,
+            on_way: false,
         }
     }
 
@@ -169,12 +173,16 @@ impl BaStarExtended {
 
     /// One cleaning chunk, or the end of the cleaning.
     fn clean(&mut self, pos: Point, last: bool) {
-        // At a region's end (the robot has not moved since): the rim swept on the way back.
-        let on_way = (!last
-            && self.opts.reach_r <= 0.0
-            && self.backtrack_sweep > 0.0
-            && self.drive.trail.len() <= 1)
-            .then(|| self.on_way_chunk(pos));
+        // At a region's end, and after each pass swept on the way back: the next rim swept on
+        // the way, while one pays.
+        let on_way =
+            (!last && self.opts.reach_r <= 0.0 && self.backtrack_sweep > 0.0 && self.on_way).then(
+                || {
+                    let chunk = self.on_way_chunk(pos);
+                    self.on_way = !chunk.sweep.is_empty();
+                    chunk
+                },
+            );
         let Some(ext) = self.ext.as_mut() else {
             self.mode = Mode::Host;
             return;
@@ -263,9 +271,15 @@ impl BaStarExtended {
             ext.drop_chunk(&chunk);
             return Chunk::default();
         };
-        // The transfer BA*'s backtracking drives without the sweep.
-        let mut plain = polyline_length(pos, &self.ba.backtrack_rest().unwrap_or_default());
-        if self.shorter_backtrack {
+        // The transfer driven without the sweep: BA*'s backtracking (where it starts) or the
+        // known-free way.
+        let moved = self.drive.trail.len() > 1;
+        let mut plain = if moved {
+            f64::INFINITY
+        } else {
+            polyline_length(pos, &self.ba.backtrack_rest().unwrap_or_default())
+        };
+        if self.shorter_backtrack || moved {
             if let Some(route) = ext.route(known, pos, goal) {
                 plain = plain.min(polyline_length(pos, &route));
             }
@@ -307,6 +321,7 @@ impl Planner for BaStarExtended {
                 Mode::Host => match self.ba.next(sensor) {
                     Step::Mark(Event::BacktrackStart) => {
                         self.lane = None;
+                        self.on_way = true;
                         self.drive.trail = vec![pos];
                         self.mode = Mode::Clean { last: false };
                     }
