@@ -346,6 +346,22 @@ fn config_values_go_through_the_same_validation() {
             "strip_walk",
         ),
         ("bsa: { strip_walk: false }", "bsa", "strip_walk"),
+        // `backtrack_sweep` too (ba-star-extended only), and it must be a number >= 0.
+        (
+            "bsa_extended: { backtrack_sweep: 2 }",
+            "bsa-extended",
+            "backtrack_sweep",
+        ),
+        (
+            "ba_star: { backtrack_sweep: 2 }",
+            "ba-star",
+            "backtrack_sweep",
+        ),
+        (
+            "ba_star_extended: { backtrack_sweep: -1 }",
+            "ba-star-extended",
+            "backtrack_sweep",
+        ),
         // An extension option given to a planner without the extension is an unknown key.
         (
             "ba_star: { extension: { leave_group: 2 } }",

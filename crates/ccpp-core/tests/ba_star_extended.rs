@@ -176,6 +176,28 @@ fn room_rims_are_swept() {
     );
 }
 
+/// Length of the moves after trace record `from` from the first wall pass on (the final
+/// clean-up when `from` is BA*'s last region end).
+fn length_after(trace: &Trace, from: usize) -> f64 {
+    let (mut on, mut last, mut len) = (false, None::<[f64; 2]>, 0.0);
+    for r in trace.entries().skip(from) {
+        match r {
+            Entry::Event {
+                event: Event::WallFollowStart,
+                ..
+            } => on = true,
+            Entry::Pose { pose, .. } => {
+                if let (true, Some(l)) = (on, last) {
+                    len += (pose.x - l[0]).hypot(pose.y - l[1]);
+                }
+                last = Some([pose.x, pose.y]);
+            }
+            Entry::Event { .. } => {}
+        }
+    }
+    len
+}
+
 /// Length of the moves inside backtrack sections after trace record `from`.
 fn backtrack_length_after(trace: &Trace, from: usize) -> f64 {
     let (mut inside, mut last, mut len) = (false, None::<[f64; 2]>, 0.0);
@@ -632,4 +654,55 @@ fn shorter_backtrack_changes_the_plan() {
         assert_eq!(m.collisions, 0);
         assert!(m.effective_coverage > 0.99);
     }
+}
+
+/// A corridor entered near its west end: BA*'s first region sweeps everything east of the
+/// start and ends at the far end, then BA* backtracks west.
+const CORRIDOR: &str = "\
+    ######################################################################\n\
+    #....................................................................#\n\
+    #....................................................................#\n\
+    #....................................................................#\n\
+    #....................................................................#\n\
+    #....................................................................#\n\
+    #....................................................................#\n\
+    #....................................................................#\n\
+    #....................................................................#\n\
+    #....................................................................#\n\
+    #....................................................................#\n\
+    #....................................................................#\n\
+    #....................................................................#\n\
+    ######################################################################";
+
+#[test]
+fn backtrack_sweep_sweeps_rims_on_the_way_back() {
+    // With the default, the robot sweeps the rim along the wall on its way back to BA*'s start
+    // point (a wall pass before BA*'s last region); `0` cleans only after BA*. The rim swept
+    // on the way is not swept again: the final clean-up is shorter. (Whether the whole path
+    // is shorter depends on the map: on the 14 shared maps the mean path ratio fell from
+    // 1.3218 to 1.3128; on this small corridor it grows by 2.5 %.)
+    let wd = world(CORRIDOR, 8, 6, 0.0).unwrap();
+    let opts = |backtrack_sweep| BaStarExtendedOptions {
+        backtrack_sweep,
+        ..BaStarExtendedOptions::default()
+    };
+    let (on, m_on, _) = run_ext(&wd, BaStarExtendedOptions::default());
+    let (off, m_off, _) = run_ext(&wd, opts(0.0));
+    let (first_on, last_on) = first_pass_last_region_end(&on.trace);
+    let (first_off, last_off) = first_pass_last_region_end(&off.trace);
+    assert!(first_on < last_on, "{first_on} {last_on}");
+    assert!(first_off > last_off && first_off != usize::MAX);
+    let (final_on, final_off) = (
+        length_after(&on.trace, last_on),
+        length_after(&off.trace, last_off),
+    );
+    assert!(final_on < final_off, "{final_on} {final_off}");
+    for m in [&m_on, &m_off] {
+        assert_eq!(m.collisions, 0);
+        assert_eq!(m.coverage_rate, Some(1.0));
+        assert!(m.effective_coverage > 0.99, "{m:?}");
+    }
+    // A sweep that must pay for itself many times over is not driven here.
+    let (strict, _, _) = run_ext(&wd, opts(1e9));
+    assert_eq!(strict.trace, off.trace);
 }

@@ -90,6 +90,12 @@ fn a_partial_extension_section_changes_only_its_fields() {
         d.ba_star_extended.extension.reach_r
     );
     assert!(o.ba_star_extended.extension.lane_ends);
+    // ba-star-extended's own clean-up defaults, not the component's.
+    assert_eq!(o.ba_star_extended.extension.leave_group, 12);
+    assert_ne!(
+        o.ba_star_extended.extension.leave_group,
+        ccpp_core::planners::extension::ExtensionOptions::default().leave_group
+    );
     // A PID controller section keeps that controller's defaults (not `PidGains::default`).
     let o: PlannerOptions =
         serde_json::from_str(r#"{"bsa_bfs": {"exec": {"pid": {"angular": {"kp": 5.0}}}}}"#)

@@ -1292,6 +1292,31 @@ impl Extension {
         chunk
     }
 
+    /// One chunk planned from world point `pos` as at the end of a host region but within
+    /// `reach_r` robot radii whatever [`ExtensionOptions::reach_r`] says (used by
+    /// `ba-star-extended`'s rims swept on the way back, [`Self::drop_chunk`] when it is not
+    /// driven as planned).
+    pub(crate) fn plan_near(
+        &mut self,
+        known: &KnownMap,
+        pos: Point,
+        reach_r: f64,
+        wanted: Wanted,
+    ) -> Chunk {
+        let keep = self.opts.reach_r;
+        self.opts.reach_r = reach_r;
+        let chunk = self.plan_pass(known, pos, true, wanted);
+        self.opts.reach_r = keep;
+        chunk
+    }
+
+    /// Forgets a planned chunk that will not be driven as planned: its claims are given back
+    /// (what the robot drives is stamped as it goes) and its simplification is not counted.
+    pub(crate) fn drop_chunk(&mut self, chunk: &Chunk) {
+        self.unclaim(chunk);
+        self.simplified -= chunk.simplified;
+    }
+
     /// [`Self::plan_pass`] before the chunk's simplification is counted.
     fn plan_pass_inner(
         &mut self,

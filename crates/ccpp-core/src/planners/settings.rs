@@ -438,6 +438,13 @@ impl PlannerSettings for BaStarExtendedOptions {
         self.ba_star
             .validate()
             .map_err(|e| e.in_section("ba_star"))?;
+        let k = self.backtrack_sweep;
+        if !(k.is_finite() && k >= 0.0) {
+            return Err(OptionsError::new(
+                "backtrack_sweep",
+                format!("must be a finite number >= 0, got {k}"),
+            ));
+        }
         self.extension.validate()
     }
 
