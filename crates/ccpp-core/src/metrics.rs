@@ -11,10 +11,11 @@ use serde::{Deserialize, Serialize};
 use std::ops::Sub;
 
 use crate::geometry::{dist_exact, point_segment_dist2, wrap_angle, Point, Pose};
+use crate::grid::MapFrame;
 pub(crate) use crate::raster::stamp_capsule;
 use crate::sim::RunOutput;
 use crate::tiles::{reachable_tiles, Tile, TileGrid, TileSet};
-use crate::trace::{Entry, Event, Piece, Trace};
+use crate::trace::{Chunk, Entry, Event, Piece, Trace};
 use crate::world::World;
 
 pub use crate::raster::SWEEP_EPS_PX;
@@ -180,6 +181,64 @@ pub fn swept_pixels(world: &World, trace: &Trace) -> FixedBitSet {
         }
         swept
     })
+}
+
+/// [`swept_pixels`] fed a trace piece by piece (the [`Chunk`]s of a trace taken while the run
+/// goes on, in order): the same pixels.
+pub struct TraceSweep {
+    frame: MapFrame,
+    /// Tool radius in pixels, with [`SWEEP_EPS_PX`].
+    rt: f64,
+    swept: FixedBitSet,
+    /// The last point of the executed polyline (grid coordinates).
+    last: Option<Point>,
+}
+
+impl TraceSweep {
+    /// Nothing swept yet, in `world`.
+    pub fn new(world: &World) -> Self {
+        let frame = *world.frame();
+        Self {
+            frame,
+            rt: world.robot().tool_radius / frame.resolution + SWEEP_EPS_PX,
+            swept: FixedBitSet::with_capacity(frame.len()),
+            last: None,
+        }
+    }
+
+    /// The next point of the polyline: the first sweeps its disk, each other one the segment
+    /// from the point before when they differ.
+    fn point(&mut self, g: Point) {
+        let from = match self.last {
+            None => g,
+            Some(l) if l != g => l,
+            Some(_) => return,
+        };
+        stamp_capsule(&mut self.swept, &self.frame, from, g, self.rt, &mut |_| {});
+        self.last = Some(g);
+    }
+
+    /// The pieces of `chunk`, in order.
+    pub fn chunk(&mut self, chunk: &Chunk) {
+        let lattice = chunk.lattice();
+        for piece in chunk.pieces() {
+            match piece {
+                Piece::Pose { pose, .. } => self.point(self.frame.world_to_grid(pose.position())),
+                Piece::Run(run) => {
+                    let [x0, y0] = run.from;
+                    let [x1, y1] = run.to(lattice);
+                    self.point(self.frame.world_to_grid(Point::new(x0, y0)));
+                    self.point(self.frame.world_to_grid(Point::new(x1, y1)));
+                }
+                Piece::Event { .. } => {}
+            }
+        }
+    }
+
+    /// The swept pixels.
+    pub fn finish(self) -> FixedBitSet {
+        self.swept
+    }
 }
 
 /// Incremental sweeping: add executed segments one by one and read the swept pixels so far.
@@ -417,6 +476,18 @@ pub fn compute_prepared(
     map_name: &str,
     part: Option<WorldPart>,
 ) -> (Metrics, FixedBitSet) {
+    compute_prepared_with(world, run, map_name, part, None)
+}
+
+/// [`compute_prepared`] with the swept pixels when the caller has them (they must be
+/// [`swept_pixels`] of the run's trace, as a [`TraceSweep`] fed the whole trace finds them).
+pub fn compute_prepared_with(
+    world: &World,
+    run: &RunOutput,
+    map_name: &str,
+    part: Option<WorldPart>,
+    swept: Option<FixedBitSet>,
+) -> (Metrics, FixedBitSet) {
     let frame = *world.frame();
     let robot = world.robot();
     let trace = &run.trace;
@@ -425,7 +496,9 @@ pub fn compute_prepared(
     let two_rt = 2.0 * robot.tool_radius;
     // The swept pixels and the tile coverage are independent of the rest: on other threads.
     std::thread::scope(|scope| {
-        let swept = scope.spawn(|| swept_pixels(world, trace));
+        let sweeping = swept
+            .is_none()
+            .then(|| scope.spawn(|| swept_pixels(world, trace)));
         let coverage_rate = scope.spawn(|| {
             // Under PID execution a tile centre counts as visited within the waypoint tolerance.
             let exec_tol = execution_tolerance(trace);
@@ -443,7 +516,10 @@ pub fn compute_prepared(
             })
         });
         let mut m = compute_rest(world, run, map_name);
-        let swept: FixedBitSet = join(swept);
+        let swept: FixedBitSet = match swept {
+            Some(swept) => swept,
+            None => sweeping.map_or_else(|| swept_pixels(world, trace), join),
+        };
         m.coverage_rate = join(coverage_rate);
         let swept_count = swept.count_ones(..);
         let covered = swept.intersection(world.accessible()).count();

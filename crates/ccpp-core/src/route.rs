@@ -93,57 +93,89 @@ impl Sleeve {
     }
 }
 
-impl Route {
-    /// The route of `poses` with the merging tolerance `tolerance_m` (metres; negative or
-    /// non-finite values count as 0). Non-finite poses are skipped.
-    pub fn from_poses<I: IntoIterator<Item = Pose>>(poses: I, tolerance_m: f64) -> Self {
+/// [`Route::from_poses`] fed one pose at a time (for poses that arrive while a run goes on):
+/// the same route.
+pub struct RouteBuilder {
+    /// The merging tolerance, metres (clamped as [`Route::from_poses`] does).
+    tol: f64,
+    waypoints: Vec<Pose>,
+    /// The last pose of the segment being grown (not yet a waypoint unless it is the start).
+    last: Option<Pose>,
+    sleeve: Sleeve,
+}
+
+impl RouteBuilder {
+    /// No pose yet; `tolerance_m` as for [`Route::from_poses`].
+    pub fn new(tolerance_m: f64) -> Self {
         let tol = if tolerance_m.is_finite() {
             tolerance_m.max(0.0)
         } else {
             0.0
         };
-        let mut waypoints: Vec<Pose> = Vec::new();
-        // The last pose of the segment being grown (not yet a waypoint unless it is the start).
-        let mut last: Option<Pose> = None;
-        let mut sleeve = Sleeve::new();
-        for p in poses {
-            if !(p.x.is_finite() && p.y.is_finite() && p.theta.is_finite()) {
-                continue;
-            }
-            let (Some(start), Some(prev)) = (waypoints.last().copied(), last) else {
-                waypoints.push(p);
-                last = Some(p);
-                continue;
-            };
-            let at_start = dist_exact(prev.position(), start.position()) <= SAME_POSITION_M;
-            if dist_exact(p.position(), prev.position()) <= SAME_POSITION_M {
-                // A rotation in place (or a repeated pose): merged into one waypoint.
-                if at_start {
-                    if let Some(w) = waypoints.last_mut() {
-                        w.theta = p.theta;
-                    }
-                } else {
-                    waypoints.push(Pose::new(prev.x, prev.y, p.theta));
-                    sleeve = Sleeve::new();
+        Self {
+            tol,
+            waypoints: Vec::new(),
+            last: None,
+            sleeve: Sleeve::new(),
+        }
+    }
+
+    /// The next pose (a non-finite one is skipped).
+    pub fn push(&mut self, p: Pose) {
+        if !(p.x.is_finite() && p.y.is_finite() && p.theta.is_finite()) {
+            return;
+        }
+        let (Some(start), Some(prev)) = (self.waypoints.last().copied(), self.last) else {
+            self.waypoints.push(p);
+            self.last = Some(p);
+            return;
+        };
+        let at_start = dist_exact(prev.position(), start.position()) <= SAME_POSITION_M;
+        if dist_exact(p.position(), prev.position()) <= SAME_POSITION_M {
+            // A rotation in place (or a repeated pose): merged into one waypoint.
+            if at_start {
+                if let Some(w) = self.waypoints.last_mut() {
+                    w.theta = p.theta;
                 }
-                last = Some(p);
-                continue;
+            } else {
+                self.waypoints.push(Pose::new(prev.x, prev.y, p.theta));
+                self.sleeve = Sleeve::new();
             }
-            if !sleeve.accept(start.position(), p.position(), tol) {
-                // The segment ends at the previous pose, which starts the next one.
-                waypoints.push(prev);
-                sleeve = Sleeve::new();
-                let accepted = sleeve.accept(prev.position(), p.position(), tol);
-                debug_assert!(accepted, "a fresh sleeve takes any pose");
-            }
-            last = Some(p);
+            self.last = Some(p);
+            return;
         }
-        if let (Some(end), Some(w)) = (last, waypoints.last()) {
+        if !self.sleeve.accept(start.position(), p.position(), self.tol) {
+            // The segment ends at the previous pose, which starts the next one.
+            self.waypoints.push(prev);
+            self.sleeve = Sleeve::new();
+            let accepted = self.sleeve.accept(prev.position(), p.position(), self.tol);
+            debug_assert!(accepted, "a fresh sleeve takes any pose");
+        }
+        self.last = Some(p);
+    }
+
+    /// The route of the poses pushed.
+    pub fn finish(mut self) -> Route {
+        if let (Some(end), Some(w)) = (self.last, self.waypoints.last()) {
             if end != *w {
-                waypoints.push(end);
+                self.waypoints.push(end);
             }
         }
-        Self { waypoints }
+        Route {
+            waypoints: self.waypoints,
+        }
+    }
+}
+
+impl Route {
+    /// The route of `poses` with the merging tolerance `tolerance_m` (metres; negative or
+    /// non-finite values count as 0). Non-finite poses are skipped.
+    pub fn from_poses<I: IntoIterator<Item = Pose>>(poses: I, tolerance_m: f64) -> Self {
+        let mut b = RouteBuilder::new(tolerance_m);
+        for p in poses {
+            b.push(p);
+        }
+        b.finish()
     }
 
     /// The route of a trace's executed poses ([`Route::from_poses`]).

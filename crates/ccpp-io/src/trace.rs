@@ -33,8 +33,8 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use ccpp_core::grid::MapFrame;
-use ccpp_core::route::{Route, DEFAULT_TOLERANCE_M};
-use ccpp_core::trace::{Advance, Event, Lattice, Piece, Record, Run, Trace};
+use ccpp_core::route::{Route, RouteBuilder, DEFAULT_TOLERANCE_M};
+use ccpp_core::trace::{Advance, Chunk, Event, Lattice, Piece, Record, Run, Trace};
 use ccpp_core::Pose;
 use serde::{Deserialize, Serialize};
 
@@ -306,30 +306,50 @@ fn trace_jsonl_into(
     after_line: &mut dyn FnMut(&mut String) -> Result<(), serde_json::Error>,
 ) -> Result<(), serde_json::Error> {
     let lattice = trace.lattice();
-    let mut declared = false;
-    let mut prev_list: Option<&Vec<[f64; 2]>> = None;
+    let mut lines = JsonlLines::default();
     for piece in trace.pieces() {
         if !s.is_empty() {
             after_line(s)?;
         }
+        lines.piece(s, piece, lattice)?;
+    }
+    Ok(())
+}
+
+/// What the lines of [`trace_jsonl`] depend on beyond their own piece: whether the lattice was
+/// declared, and the last backtracking list (the next one may be written as a delta of it).
+#[derive(Default)]
+struct JsonlLines {
+    declared: bool,
+    prev_list: Option<Vec<[f64; 2]>>,
+}
+
+impl JsonlLines {
+    /// Appends the lines of `piece` to `s` (`lattice`: the trace's).
+    fn piece(
+        &mut self,
+        s: &mut String,
+        piece: Piece<'_>,
+        lattice: Option<Lattice>,
+    ) -> Result<(), serde_json::Error> {
         match piece {
             Piece::Pose { t, pose } => push_pose_line(s, t, pose),
             Piece::Event {
                 t,
                 event: event @ Event::BacktrackList { points },
             } => {
-                if let Some(prev) = prev_list {
+                if let Some(prev) = &self.prev_list {
                     let delta = list_delta(prev, points);
                     // Written as a delta when that takes fewer items than the list.
                     if delta.len() < points.len() {
                         let _ = write!(s, "{{\"t\":{t},\"event\":\"backtrack_list\",\"delta\":");
                         s.push_str(&serde_json::to_string(&delta)?);
                         s.push_str("}\n");
-                        prev_list = Some(points);
-                        continue;
+                        self.prev_list = Some(points.clone());
+                        return Ok(());
                     }
                 }
-                prev_list = Some(points);
+                self.prev_list = Some(points.clone());
                 push_event_line(s, t, event)?;
             }
             Piece::Event { t, event } => push_event_line(s, t, event)?,
@@ -339,9 +359,10 @@ fn trace_jsonl_into(
                 }
             }
             Piece::Run(run) => {
-                if let (Advance::Lattice { .. }, Some(l), false) = (run.advance, lattice, declared)
+                if let (Advance::Lattice { .. }, Some(l), false) =
+                    (run.advance, lattice, self.declared)
                 {
-                    declared = true;
+                    self.declared = true;
                     s.push_str("{\"lattice\":[");
                     push_f64(s, l.anchor[0]);
                     s.push(',');
@@ -367,8 +388,68 @@ fn trace_jsonl_into(
                 s.push_str("}\n");
             }
         }
+        Ok(())
     }
-    Ok(())
+}
+
+/// `path.csv` and `trace.jsonl` formed while a run goes on, from the [`Chunk`]s of its trace
+/// in order (see [`Trace::chunk`]): the same text as [`path_csv`] and [`trace_jsonl`] of the
+/// whole trace, ready when the run ends.
+pub struct FileFormer {
+    route: RouteBuilder,
+    lines: JsonlLines,
+    jsonl: String,
+    /// The first serialization failure (the files are then formed from the whole trace,
+    /// which reports it).
+    failed: bool,
+}
+
+impl Default for FileFormer {
+    fn default() -> Self {
+        Self {
+            route: RouteBuilder::new(DEFAULT_TOLERANCE_M),
+            lines: JsonlLines::default(),
+            jsonl: String::new(),
+            failed: false,
+        }
+    }
+}
+
+/// The text files of a run formed by a [`FileFormer`].
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct FormedFiles {
+    /// [`path_csv`] of the trace.
+    pub path_csv: String,
+    /// [`trace_jsonl`] of the trace.
+    pub trace_jsonl: String,
+}
+
+impl FileFormer {
+    /// Adds the pieces of `chunk` (the next ones of the trace).
+    pub fn chunk(&mut self, chunk: &Chunk) {
+        if self.failed {
+            return;
+        }
+        for pose in chunk.poses() {
+            self.route.push(pose);
+        }
+        let lattice = chunk.lattice();
+        for piece in chunk.pieces() {
+            if self.lines.piece(&mut self.jsonl, piece, lattice).is_err() {
+                self.failed = true;
+                return;
+            }
+        }
+    }
+
+    /// The files, or `None` when an event could not be serialized (then [`trace_jsonl`] of
+    /// the trace gives the error).
+    pub fn finish(self) -> Option<FormedFiles> {
+        (!self.failed).then(|| FormedFiles {
+            path_csv: crate::export::waypoints_csv(&self.route.finish()),
+            trace_jsonl: self.jsonl,
+        })
+    }
 }
 
 /// The trace as JSON Lines of the earlier form: one line per pose (no runs).
