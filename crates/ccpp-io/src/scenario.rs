@@ -862,8 +862,9 @@ impl Scenario {
     }
 
     /// [`run_in`](Self::run_in), a third thread reading the trace as it grows (copied out in
-    /// chunks of [`FORM_CHUNK`] sealed pieces) to sweep the tool's pixels and form
-    /// `path.csv` and `trace.jsonl`.
+    /// chunks of [`FORM_CHUNK`] sealed pieces) to sweep the tool's pixels, tally the motion
+    /// metrics ([`metrics::MotionTally`], on the scenario's tile side: the metrics recount when
+    /// the planner reports another) and form `path.csv` and `trace.jsonl`.
     fn run_forming<T: Send>(
         &self,
         world: World,
@@ -871,44 +872,55 @@ impl Scenario {
         beside: impl FnOnce(&World) -> T + Send,
     ) -> (Run, T, Option<FormedFiles>) {
         let side = self.tile_side();
-        let (output, part, extra, swept, files) = crate::phase::time("plan + simulate", || {
-            std::thread::scope(|s| {
-                let world = &world;
-                // A planner that reads the accessible surface first waits for it.
-                let other = s.spawn(|| (metrics::WorldPart::of(world, side), beside(world)));
-                let (tx, rx) = std::sync::mpsc::channel::<Chunk>();
-                let former = s.spawn(move || {
-                    let mut sweep = metrics::TraceSweep::new(world);
-                    let mut files = FileFormer::default();
-                    for chunk in rx {
-                        sweep.chunk(&chunk);
-                        files.chunk(&chunk);
-                    }
-                    (sweep.finish(), files.finish())
-                });
-                // Wall time covers planning (offline planners plan in `build`) and simulation.
-                let started = std::time::Instant::now();
-                let mut planner = self.planner.build(world);
-                let mut sent = 0usize;
-                let mut output = simulate_tapped(world, planner.as_mut(), &self.sim, &mut |t| {
-                    let n = t.sealed_count();
-                    if n >= sent + FORM_CHUNK {
-                        // A closed channel (the former panicked) shows when it is joined.
-                        let _ = tx.send(t.chunk(sent..n));
-                        sent = n;
-                    }
-                });
-                output.wall_time_s = started.elapsed().as_secs_f64();
-                let _ = tx.send(output.trace.chunk(sent..output.trace.piece_count()));
-                drop(tx);
-                let (part, extra) = join_scoped(other);
-                let (swept, files) =
-                    crate::phase::time("wait for the streamed files", || join_scoped(former));
-                (output, part, extra, swept, files)
-            })
-        });
+        let (output, part, extra, (swept, tally), files) =
+            crate::phase::time("plan + simulate", || {
+                std::thread::scope(|s| {
+                    let world = &world;
+                    // A planner that reads the accessible surface first waits for it.
+                    let other = s.spawn(|| (metrics::WorldPart::of(world, side), beside(world)));
+                    let (tx, rx) = std::sync::mpsc::channel::<Chunk>();
+                    let former = s.spawn(move || {
+                        let mut sweep = metrics::TraceSweep::new(world);
+                        let mut tally = metrics::MotionTally::new(world, side);
+                        let mut files = FileFormer::default();
+                        for chunk in rx {
+                            sweep.chunk(&chunk);
+                            tally.chunk(&chunk);
+                            files.chunk(&chunk);
+                        }
+                        ((sweep.finish(), tally), files.finish())
+                    });
+                    // Wall time covers planning (offline planners plan in `build`) and simulation.
+                    let started = std::time::Instant::now();
+                    let mut planner = self.planner.build(world);
+                    let mut sent = 0usize;
+                    let mut output =
+                        simulate_tapped(world, planner.as_mut(), &self.sim, &mut |t| {
+                            let n = t.sealed_count();
+                            if n >= sent + FORM_CHUNK {
+                                // A closed channel (the former panicked) shows when it is joined.
+                                let _ = tx.send(t.chunk(sent..n));
+                                sent = n;
+                            }
+                        });
+                    output.wall_time_s = started.elapsed().as_secs_f64();
+                    let _ = tx.send(output.trace.chunk(sent..output.trace.piece_count()));
+                    drop(tx);
+                    let (part, extra) = join_scoped(other);
+                    let (swept, files) =
+                        crate::phase::time("wait for the streamed files", || join_scoped(former));
+                    (output, part, extra, swept, files)
+                })
+            });
         let (metrics, swept) = crate::phase::time("metrics", || {
-            metrics::compute_prepared_with(&world, &output, map_name, part, Some(swept))
+            metrics::compute_prepared_with(
+                &world,
+                &output,
+                map_name,
+                part,
+                Some(swept),
+                Some(tally),
+            )
         });
         let run = Run {
             world,
