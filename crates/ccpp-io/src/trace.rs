@@ -398,6 +398,8 @@ impl JsonlLines {
 pub struct FileFormer {
     route: RouteBuilder,
     lines: JsonlLines,
+    /// The full parts of `trace.jsonl`, then the one being filled.
+    parts: Vec<String>,
     jsonl: String,
     /// The first serialization failure (the files are then formed from the whole trace,
     /// which reports it).
@@ -409,7 +411,8 @@ impl Default for FileFormer {
         Self {
             route: RouteBuilder::new(DEFAULT_TOLERANCE_M),
             lines: JsonlLines::default(),
-            jsonl: String::new(),
+            parts: Vec::new(),
+            jsonl: String::with_capacity(JSONL_PART + (JSONL_PART >> 3)),
             failed: false,
         }
     }
@@ -420,8 +423,29 @@ impl Default for FileFormer {
 pub struct FormedFiles {
     /// [`path_csv`] of the trace.
     pub path_csv: String,
-    /// [`trace_jsonl`] of the trace.
-    pub trace_jsonl: String,
+    /// [`trace_jsonl`] of the trace, in consecutive parts of about [`JSONL_PART`] bytes (no
+    /// copy of the whole text while it grows).
+    trace_jsonl: Vec<String>,
+}
+
+/// The size of the parts a [`FileFormer`] keeps `trace.jsonl` in, bytes.
+const JSONL_PART: usize = 1 << 20;
+
+impl FormedFiles {
+    /// Writes [`trace_jsonl`] of the trace to `out`.
+    ///
+    /// # Errors
+    /// Write failures of `out`.
+    pub fn write_trace_jsonl(&self, out: &mut dyn std::io::Write) -> std::io::Result<()> {
+        self.trace_jsonl
+            .iter()
+            .try_for_each(|part| out.write_all(part.as_bytes()))
+    }
+
+    /// [`trace_jsonl`] of the trace, whole.
+    pub fn trace_jsonl(&self) -> String {
+        self.trace_jsonl.concat()
+    }
 }
 
 impl FileFormer {
@@ -439,15 +463,23 @@ impl FileFormer {
                 self.failed = true;
                 return;
             }
+            if self.jsonl.len() >= JSONL_PART {
+                let next = String::with_capacity(JSONL_PART + (JSONL_PART >> 3));
+                self.parts.push(std::mem::replace(&mut self.jsonl, next));
+            }
         }
     }
 
     /// The files, or `None` when an event could not be serialized (then [`trace_jsonl`] of
     /// the trace gives the error).
-    pub fn finish(self) -> Option<FormedFiles> {
-        (!self.failed).then(|| FormedFiles {
+    pub fn finish(mut self) -> Option<FormedFiles> {
+        if self.failed {
+            return None;
+        }
+        self.parts.push(self.jsonl);
+        Some(FormedFiles {
             path_csv: crate::export::waypoints_csv(&self.route.finish()),
-            trace_jsonl: self.jsonl,
+            trace_jsonl: self.parts,
         })
     }
 }

@@ -196,9 +196,7 @@ pub fn stream_run_files<E: From<RunFilesError>>(
             put("run.json", &mut |w| w.write_all(run_json.as_bytes()))?;
             if let Some(f) = formed {
                 put("path.csv", &mut |w| w.write_all(f.path_csv.as_bytes()))?;
-                return put("trace.jsonl", &mut |w| {
-                    w.write_all(f.trace_jsonl.as_bytes())
-                });
+                return put("trace.jsonl", &mut |w| f.write_trace_jsonl(w));
             }
             let path = phase::time("path.csv", || ccpp_io::trace::path_csv(trace));
             put("path.csv", &mut |w| w.write_all(path.as_bytes()))?;
