@@ -851,10 +851,10 @@ pub fn coverage_pixmap_swept(
     };
     draw_zone_borders(&mut pm, world, view);
     ccpp_io::phase::time("coverage.png path", || {
-        draw_path(&mut pm, world, trace, view)
+        draw_path(&mut pm, world, trace, view);
     });
     ccpp_io::phase::time("coverage.png markers", || {
-        draw_markers(&mut pm, world, trace, view)
+        draw_markers(&mut pm, world, trace, view);
     });
     ccpp_io::phase::time("coverage.png text", || {
         head.draw_onto(&mut pm);
