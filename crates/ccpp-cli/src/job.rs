@@ -74,8 +74,7 @@ pub struct JobResult {
     /// The free area holding the start, when [`Job::execute_with`] was asked for it (found
     /// while the planner worked).
     pub start_area: Option<crate::components::StartComponent>,
-    /// `path.csv` and `trace.jsonl`, formed while the run went on (`None`: form them from
-    /// the trace).
+    /// `path.csv`, formed while the run went on (`None`: form it from the trace).
     pub formed: Option<ccpp_io::trace::FormedFiles>,
 }
 

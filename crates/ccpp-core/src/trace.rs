@@ -377,7 +377,7 @@ pub struct Cursor {
 }
 
 /// Consecutive pieces of a trace, copied out ([`Trace::chunk`]): the same pieces, in order,
-/// with the trace's lattice.
+/// with the trace's lattice (the events' point lists left empty).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Chunk(Trace);
 
@@ -586,7 +586,9 @@ impl Trace {
 
     /// An owned copy of the pieces `range` (piece indices, as [`Self::pieces`] yields them),
     /// with the trace's lattice: handed to another thread, it reads the trace as it grows
-    /// (pieces below [`Self::sealed_count`] are final).
+    /// (pieces below [`Self::sealed_count`] are final). The events' point lists
+    /// ([`Event::BacktrackList`], [`Event::PathRaw`], [`Event::PathSmoothed`]) are copied
+    /// empty: a chunk carries the motion and the events that mark it.
     ///
     /// # Panics
     /// When `range` is not within `0..piece_count()`.
@@ -597,7 +599,15 @@ impl Trace {
             .map(|it| match *it {
                 Item::Event { t, k } => {
                     let local = u32::try_from(events.len()).unwrap_or(u32::MAX);
-                    events.push(self.events[k as usize].clone());
+                    // The point lists are left out: a chunk's readers count, sweep and merge
+                    // the motion, and copying the backtracking lists would cost the run their
+                    // size again.
+                    events.push(match &self.events[k as usize] {
+                        Event::BacktrackList { .. } => Event::BacktrackList { points: Vec::new() },
+                        Event::PathRaw { .. } => Event::PathRaw { points: Vec::new() },
+                        Event::PathSmoothed { .. } => Event::PathSmoothed { points: Vec::new() },
+                        e => e.clone(),
+                    });
                     Item::Event { t, k: local }
                 }
                 ref other => other.clone(),

@@ -787,11 +787,11 @@ impl Scenario {
         Ok((run, extra))
     }
 
-    /// [`run_owned_beside`](Self::run_owned_beside), also forming `path.csv` and
-    /// `trace.jsonl` while the run goes on when `form_files` (on another thread, from the
-    /// trace as it grows; the swept pixels of the metrics are found the same way): the same
-    /// run, metrics and file bytes, with less left to do when the run ends. The files are
-    /// `None` when not asked for or when an event cannot be serialized.
+    /// [`run_owned_beside`](Self::run_owned_beside), also forming `path.csv` while the run
+    /// goes on when `form_files` (on another thread, from the trace as it grows; the swept
+    /// pixels and the motion figures of the metrics are found the same way): the same run,
+    /// metrics and file bytes, with less left to do when the run ends. The files are `None`
+    /// when not asked for.
     ///
     /// # Errors
     /// As [`world`](Self::world).
@@ -888,7 +888,7 @@ impl Scenario {
                             tally.chunk(&chunk);
                             files.chunk(&chunk);
                         }
-                        ((sweep.finish(), tally), files.finish())
+                        ((sweep.finish(), tally), Some(files.finish()))
                     });
                     // Wall time covers planning (offline planners plan in `build`) and simulation.
                     let started = std::time::Instant::now();

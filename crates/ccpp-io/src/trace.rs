@@ -319,17 +319,17 @@ fn trace_jsonl_into(
 /// What the lines of [`trace_jsonl`] depend on beyond their own piece: whether the lattice was
 /// declared, and the last backtracking list (the next one may be written as a delta of it).
 #[derive(Default)]
-struct JsonlLines {
+struct JsonlLines<'a> {
     declared: bool,
-    prev_list: Option<Vec<[f64; 2]>>,
+    prev_list: Option<&'a [[f64; 2]]>,
 }
 
-impl JsonlLines {
+impl<'a> JsonlLines<'a> {
     /// Appends the lines of `piece` to `s` (`lattice`: the trace's).
     fn piece(
         &mut self,
         s: &mut String,
-        piece: Piece<'_>,
+        piece: Piece<'a>,
         lattice: Option<Lattice>,
     ) -> Result<(), serde_json::Error> {
         match piece {
@@ -345,11 +345,11 @@ impl JsonlLines {
                         let _ = write!(s, "{{\"t\":{t},\"event\":\"backtrack_list\",\"delta\":");
                         s.push_str(&serde_json::to_string(&delta)?);
                         s.push_str("}\n");
-                        self.prev_list = Some(points.clone());
+                        self.prev_list = Some(points);
                         return Ok(());
                     }
                 }
-                self.prev_list = Some(points.clone());
+                self.prev_list = Some(points);
                 push_event_line(s, t, event)?;
             }
             Piece::Event { t, event } => push_event_line(s, t, event)?,
@@ -392,28 +392,18 @@ impl JsonlLines {
     }
 }
 
-/// `path.csv` and `trace.jsonl` formed while a run goes on, from the [`Chunk`]s of its trace
-/// in order (see [`Trace::chunk`]): the same text as [`path_csv`] and [`trace_jsonl`] of the
-/// whole trace, ready when the run ends.
+/// `path.csv` formed while a run goes on, from the [`Chunk`]s of its trace in order (see
+/// [`Trace::chunk`]): the same text as [`path_csv`] of the whole trace, ready when the run
+/// ends. (`trace.jsonl`, the size of the trace's lists, is streamed into its file after the
+/// run instead of being held in memory.)
 pub struct FileFormer {
     route: RouteBuilder,
-    lines: JsonlLines,
-    /// The full parts of `trace.jsonl`, then the one being filled.
-    parts: Vec<String>,
-    jsonl: String,
-    /// The first serialization failure (the files are then formed from the whole trace,
-    /// which reports it).
-    failed: bool,
 }
 
 impl Default for FileFormer {
     fn default() -> Self {
         Self {
             route: RouteBuilder::new(DEFAULT_TOLERANCE_M),
-            lines: JsonlLines::default(),
-            parts: Vec::new(),
-            jsonl: String::with_capacity(JSONL_PART + (JSONL_PART >> 3)),
-            failed: false,
         }
     }
 }
@@ -423,64 +413,21 @@ impl Default for FileFormer {
 pub struct FormedFiles {
     /// [`path_csv`] of the trace.
     pub path_csv: String,
-    /// [`trace_jsonl`] of the trace, in consecutive parts of about [`JSONL_PART`] bytes (no
-    /// copy of the whole text while it grows).
-    trace_jsonl: Vec<String>,
-}
-
-/// The size of the parts a [`FileFormer`] keeps `trace.jsonl` in, bytes.
-const JSONL_PART: usize = 1 << 20;
-
-impl FormedFiles {
-    /// Writes [`trace_jsonl`] of the trace to `out`.
-    ///
-    /// # Errors
-    /// Write failures of `out`.
-    pub fn write_trace_jsonl(&self, out: &mut dyn std::io::Write) -> std::io::Result<()> {
-        self.trace_jsonl
-            .iter()
-            .try_for_each(|part| out.write_all(part.as_bytes()))
-    }
-
-    /// [`trace_jsonl`] of the trace, whole.
-    pub fn trace_jsonl(&self) -> String {
-        self.trace_jsonl.concat()
-    }
 }
 
 impl FileFormer {
     /// Adds the pieces of `chunk` (the next ones of the trace).
     pub fn chunk(&mut self, chunk: &Chunk) {
-        if self.failed {
-            return;
-        }
         for pose in chunk.poses() {
             self.route.push(pose);
         }
-        let lattice = chunk.lattice();
-        for piece in chunk.pieces() {
-            if self.lines.piece(&mut self.jsonl, piece, lattice).is_err() {
-                self.failed = true;
-                return;
-            }
-            if self.jsonl.len() >= JSONL_PART {
-                let next = String::with_capacity(JSONL_PART + (JSONL_PART >> 3));
-                self.parts.push(std::mem::replace(&mut self.jsonl, next));
-            }
-        }
     }
 
-    /// The files, or `None` when an event could not be serialized (then [`trace_jsonl`] of
-    /// the trace gives the error).
-    pub fn finish(mut self) -> Option<FormedFiles> {
-        if self.failed {
-            return None;
-        }
-        self.parts.push(self.jsonl);
-        Some(FormedFiles {
+    /// The files.
+    pub fn finish(self) -> FormedFiles {
+        FormedFiles {
             path_csv: crate::export::waypoints_csv(&self.route.finish()),
-            trace_jsonl: self.parts,
-        })
+        }
     }
 }
 

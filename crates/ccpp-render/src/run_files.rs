@@ -173,9 +173,9 @@ pub type PutFile<'a, E> = dyn FnMut(&'static str, &mut dyn FnMut(&mut dyn Write)
 /// `trace.jsonl` streamed as it is formed instead of built whole in memory (the largest file;
 /// `coverage.png` is drawn on a second thread meanwhile). Same bytes as
 /// [`render_run_files`]. `swept`, when given, must be
-/// [`ccpp_core::metrics::swept_pixels`]`(world, trace)`; `formed`, when given, the text files
-/// of the trace formed while it ran ([`ccpp_io::scenario::Scenario::run_owned_with`]), written
-/// as they are.
+/// [`ccpp_core::metrics::swept_pixels`]`(world, trace)`; `formed`, when given, the `path.csv` of
+/// the trace formed while it ran ([`ccpp_io::scenario::Scenario::run_owned_with`]), written as
+/// it is.
 ///
 /// # Errors
 /// Serialization or rendering failures (converted into `E`), or what `put` returns.
@@ -196,11 +196,10 @@ pub fn stream_run_files<E: From<RunFilesError>>(
             put("run.json", &mut |w| w.write_all(run_json.as_bytes()))?;
             if let Some(f) = formed {
                 put("path.csv", &mut |w| w.write_all(f.path_csv.as_bytes()))?;
-                return put("trace.jsonl", &mut |w| f.write_trace_jsonl(w));
+            } else {
+                let path = phase::time("path.csv", || ccpp_io::trace::path_csv(trace));
+                put("path.csv", &mut |w| w.write_all(path.as_bytes()))?;
             }
-            let path = phase::time("path.csv", || ccpp_io::trace::path_csv(trace));
-            put("path.csv", &mut |w| w.write_all(path.as_bytes()))?;
-            drop(path);
             phase::time("trace.jsonl", || {
                 put("trace.jsonl", &mut |w| {
                     ccpp_io::trace::write_trace_jsonl(trace, w).map_err(std::io::Error::other)
