@@ -74,6 +74,8 @@ pub struct JobResult {
     /// The free area holding the start, when [`Job::execute_with`] was asked for it (found
     /// while the planner worked).
     pub start_area: Option<crate::components::StartComponent>,
+    /// `path.csv`, formed while the run went on (`None`: form it from the trace).
+    pub formed: Option<ccpp_io::trace::FormedFiles>,
 }
 
 /// The recipe of `args`: paths made absolute so that `run.json` works from any folder.
@@ -364,9 +366,14 @@ impl Job {
     /// works.
     pub fn execute_with(&mut self, start_area: bool) -> Result<JobResult> {
         let map = self.map.take().context("the job has already run")?;
-        let (run, start_area) = self.scenario.run_owned_beside(map, |w| {
-            start_area.then(|| crate::components::StartComponent::of(w.map(), w.start().position()))
-        })?;
+        let (run, start_area, formed) = self.scenario.run_owned_with(
+            map,
+            |w| {
+                start_area
+                    .then(|| crate::components::StartComponent::of(w.map(), w.start().position()))
+            },
+            true,
+        )?;
         let s = run.world.initial_pose();
         if !run.world.approach().is_empty() {
             let e = run.world.start();
@@ -384,6 +391,7 @@ impl Job {
             metrics: run.metrics,
             swept: run.swept,
             start_area,
+            formed,
         })
     }
 }

@@ -39,6 +39,7 @@ pub fn write_run_files(
         &r.run.trace,
         &r.metrics,
         Some(&r.swept),
+        r.formed.as_ref(),
         &mut |name, fill| staging.write_with(name, fill),
     )?;
     if replay {

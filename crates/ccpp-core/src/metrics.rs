@@ -11,10 +11,11 @@ use serde::{Deserialize, Serialize};
 use std::ops::Sub;
 
 use crate::geometry::{dist_exact, point_segment_dist2, wrap_angle, Point, Pose};
+use crate::grid::MapFrame;
 pub(crate) use crate::raster::stamp_capsule;
 use crate::sim::RunOutput;
 use crate::tiles::{reachable_tiles, Tile, TileGrid, TileSet};
-use crate::trace::{Entry, Event, Piece, Trace};
+use crate::trace::{Chunk, Entry, Event, Piece, Trace};
 use crate::world::World;
 
 pub use crate::raster::SWEEP_EPS_PX;
@@ -180,6 +181,64 @@ pub fn swept_pixels(world: &World, trace: &Trace) -> FixedBitSet {
         }
         swept
     })
+}
+
+/// [`swept_pixels`] fed a trace piece by piece (the [`Chunk`]s of a trace taken while the run
+/// goes on, in order): the same pixels.
+pub struct TraceSweep {
+    frame: MapFrame,
+    /// Tool radius in pixels, with [`SWEEP_EPS_PX`].
+    rt: f64,
+    swept: FixedBitSet,
+    /// The last point of the executed polyline (grid coordinates).
+    last: Option<Point>,
+}
+
+impl TraceSweep {
+    /// Nothing swept yet, in `world`.
+    pub fn new(world: &World) -> Self {
+        let frame = *world.frame();
+        Self {
+            frame,
+            rt: world.robot().tool_radius / frame.resolution + SWEEP_EPS_PX,
+            swept: FixedBitSet::with_capacity(frame.len()),
+            last: None,
+        }
+    }
+
+    /// The next point of the polyline: the first sweeps its disk, each other one the segment
+    /// from the point before when they differ.
+    fn point(&mut self, g: Point) {
+        let from = match self.last {
+            None => g,
+            Some(l) if l != g => l,
+            Some(_) => return,
+        };
+        stamp_capsule(&mut self.swept, &self.frame, from, g, self.rt, &mut |_| {});
+        self.last = Some(g);
+    }
+
+    /// The pieces of `chunk`, in order.
+    pub fn chunk(&mut self, chunk: &Chunk) {
+        let lattice = chunk.lattice();
+        for piece in chunk.pieces() {
+            match piece {
+                Piece::Pose { pose, .. } => self.point(self.frame.world_to_grid(pose.position())),
+                Piece::Run(run) => {
+                    let [x0, y0] = run.from;
+                    let [x1, y1] = run.to(lattice);
+                    self.point(self.frame.world_to_grid(Point::new(x0, y0)));
+                    self.point(self.frame.world_to_grid(Point::new(x1, y1)));
+                }
+                Piece::Event { .. } => {}
+            }
+        }
+    }
+
+    /// The swept pixels.
+    pub fn finish(self) -> FixedBitSet {
+        self.swept
+    }
 }
 
 /// Incremental sweeping: add executed segments one by one and read the swept pixels so far.
@@ -417,6 +476,20 @@ pub fn compute_prepared(
     map_name: &str,
     part: Option<WorldPart>,
 ) -> (Metrics, FixedBitSet) {
+    compute_prepared_with(world, run, map_name, part, None, None)
+}
+
+/// [`compute_prepared`] with the swept pixels when the caller has them (they must be
+/// [`swept_pixels`] of the run's trace, as a [`TraceSweep`] fed the whole trace finds them)
+/// and a [`MotionTally`] fed the whole trace (used when made for the run's tile side).
+pub fn compute_prepared_with(
+    world: &World,
+    run: &RunOutput,
+    map_name: &str,
+    part: Option<WorldPart>,
+    swept: Option<FixedBitSet>,
+    tally: Option<MotionTally>,
+) -> (Metrics, FixedBitSet) {
     let frame = *world.frame();
     let robot = world.robot();
     let trace = &run.trace;
@@ -425,7 +498,9 @@ pub fn compute_prepared(
     let two_rt = 2.0 * robot.tool_radius;
     // The swept pixels and the tile coverage are independent of the rest: on other threads.
     std::thread::scope(|scope| {
-        let swept = scope.spawn(|| swept_pixels(world, trace));
+        let sweeping = swept
+            .is_none()
+            .then(|| scope.spawn(|| swept_pixels(world, trace)));
         let coverage_rate = scope.spawn(|| {
             // Under PID execution a tile centre counts as visited within the waypoint tolerance.
             let exec_tol = execution_tolerance(trace);
@@ -442,8 +517,11 @@ pub fn compute_prepared(
                 visited as f64 / reach.len() as f64
             })
         });
-        let mut m = compute_rest(world, run, map_name);
-        let swept: FixedBitSet = join(swept);
+        let mut m = compute_rest(world, run, map_name, tally);
+        let swept: FixedBitSet = match swept {
+            Some(swept) => swept,
+            None => sweeping.map_or_else(|| swept_pixels(world, trace), join),
+        };
         m.coverage_rate = join(coverage_rate);
         let swept_count = swept.count_ones(..);
         let covered = swept.intersection(world.accessible()).count();
@@ -475,97 +553,164 @@ fn join<T>(h: std::thread::ScopedJoinHandle<'_, T>) -> T {
     }
 }
 
-/// The metrics that follow the poses and events one by one (all but the swept area and the
-/// tile coverage, left at 0 / `None`).
-fn compute_rest(world: &World, run: &RunOutput, map_name: &str) -> Metrics {
-    let robot = world.robot();
-    let trace = &run.trace;
+/// The figures of the metrics that follow the poses and events one by one: path length,
+/// turns, rotation; regions, backtracks, collisions, backtrack length (poses between start and
+/// end marks); tile entries for the revisit rate (on the planner's tiling, else one of side
+/// `2 r_tool`). Fed the trace's pieces in order, in one go or chunk by chunk while the run goes
+/// on (the same figures).
+pub struct MotionTally {
+    /// The tile side the tiles are counted on.
+    side: f64,
+    grid: TileGrid,
+    distinct: TileSet,
+    entries: usize,
+    walk: TileWalk,
+    path_length: f64,
+    turns: u32,
+    rotation: f64,
+    in_turn: bool,
+    regions: u32,
+    backtracks: u32,
+    collisions: u32,
+    backtrack_length: f64,
+    in_backtrack: bool,
+    prev: Option<Pose>,
+}
 
-    // One pass over the poses and events: path length, turns, rotation; regions, backtracks,
-    // collisions, backtrack length (poses between start/end marks); tile entries for the
-    // revisit rate (planner tile side, else 2 r_tool; the coverage rate is computed beside
-    // this).
-    let two_rt = 2.0 * robot.tool_radius;
-    let start = world.start().position();
-    let side = run.tile_side.unwrap_or(two_rt);
-    let grid = TileGrid::new(start, side);
-    let (i0, i1, j0, j1) = grid.bounds_for(world);
-    let mut distinct = TileSet::new(i0, i1, j0, j1);
-    let mut entries = 0usize;
-    let mut walk = TileWalk { at: None };
-    let mut path_length = 0.0;
-    let mut turns = 0u32;
-    let mut rotation = 0.0;
-    let mut in_turn = false;
-    let mut regions = 0u32;
-    let mut backtracks = 0u32;
-    let mut collisions = 0u32;
-    let mut backtrack_length = 0.0;
-    let mut in_backtrack = false;
-    let mut prev: Option<Pose> = None;
-    // `tile`: the tile entered, when known (a lattice run's step to the next tile along an
-    // axis, where the walk visits exactly that tile).
-    let mut on_pose = |b: Pose, in_backtrack: bool, tile: Option<Tile>| {
-        if let Some(a) = prev {
+impl MotionTally {
+    /// Nothing counted yet, in `world`, for a run of a planner with tile side `tile_side`.
+    pub fn new(world: &World, tile_side: Option<f64>) -> Self {
+        let side = tile_side.unwrap_or(2.0 * world.robot().tool_radius);
+        let grid = TileGrid::new(world.start().position(), side);
+        let (i0, i1, j0, j1) = grid.bounds_for(world);
+        Self {
+            side,
+            grid,
+            distinct: TileSet::new(i0, i1, j0, j1),
+            entries: 0,
+            walk: TileWalk { at: None },
+            path_length: 0.0,
+            turns: 0,
+            rotation: 0.0,
+            in_turn: false,
+            regions: 0,
+            backtracks: 0,
+            collisions: 0,
+            backtrack_length: 0.0,
+            in_backtrack: false,
+            prev: None,
+        }
+    }
+
+    /// The next pose; `tile`: the tile entered, when known (a lattice run's step to the next
+    /// tile along an axis, where the walk visits exactly that tile).
+    fn pose(&mut self, b: Pose, tile: Option<Tile>) {
+        if let Some(a) = self.prev {
             let d = dist_exact(a.position(), b.position());
-            if in_backtrack {
-                backtrack_length += d;
+            if self.in_backtrack {
+                self.backtrack_length += d;
             }
             if d > 0.0 {
-                path_length += d;
-                in_turn = false;
+                self.path_length += d;
+                self.in_turn = false;
             } else {
                 let ang = wrap_angle(b.theta - a.theta).abs();
                 if ang > crate::sim::MIN_ROTATION {
-                    rotation += ang;
-                    if !in_turn {
-                        turns += 1;
-                        in_turn = true;
+                    self.rotation += ang;
+                    if !self.in_turn {
+                        self.turns += 1;
+                        self.in_turn = true;
                     }
                 }
             }
         }
         if let Some(t) = tile {
-            entries += 1;
-            distinct.insert(t);
-            walk.at = Some((t, b.position()));
+            self.entries += 1;
+            self.distinct.insert(t);
+            self.walk.at = Some((t, b.position()));
         } else {
-            walk.to(&grid, b.position(), |t| {
-                entries += 1;
+            let (entries, distinct) = (&mut self.entries, &mut self.distinct);
+            self.walk.to(&self.grid, b.position(), |t| {
+                *entries += 1;
                 distinct.insert(t);
             });
         }
-        prev = Some(b);
-    };
-    // The entries in order, each straight run expanded in a loop of its own.
-    let lattice = trace.lattice();
-    for piece in trace.pieces() {
-        match piece {
-            Piece::Pose { pose, .. } => on_pose(pose, in_backtrack, None),
-            Piece::Run(run) => {
-                // On the metrics' own tiling a lattice run's poses after its first enter its
-                // tiles one by one (see `lattice_tiles`; the walk would find the same).
-                let tiles = lattice_tiles(&run, lattice, &grid);
-                for (k, (_, pose)) in run.poses(lattice).enumerate() {
-                    let tile = tiles.filter(|_| k > 0).and_then(|((i, j), (di, dj))| {
-                        let k = i32::try_from(k).ok()?;
-                        Some((i + k * di, j + k * dj))
-                    });
-                    on_pose(pose, in_backtrack, tile);
+        self.prev = Some(b);
+    }
+
+    /// The next pieces of the trace, in order (`lattice`: the trace's).
+    pub fn pieces<'a>(
+        &mut self,
+        pieces: impl Iterator<Item = Piece<'a>>,
+        lattice: Option<crate::trace::Lattice>,
+    ) {
+        for piece in pieces {
+            match piece {
+                Piece::Pose { pose, .. } => self.pose(pose, None),
+                Piece::Run(run) => {
+                    // On the metrics' own tiling a lattice run's poses after its first enter
+                    // its tiles one by one (see `lattice_tiles`; the walk would find the same).
+                    let tiles = lattice_tiles(&run, lattice, &self.grid);
+                    for (k, (_, pose)) in run.poses(lattice).enumerate() {
+                        let tile = tiles.filter(|_| k > 0).and_then(|((i, j), (di, dj))| {
+                            let k = i32::try_from(k).ok()?;
+                            Some((i + k * di, j + k * dj))
+                        });
+                        self.pose(pose, tile);
+                    }
                 }
+                Piece::Event { event, .. } => match event {
+                    Event::RegionStart { .. } => self.regions += 1,
+                    Event::BacktrackStart => {
+                        self.backtracks += 1;
+                        self.in_backtrack = true;
+                    }
+                    Event::BacktrackEnd => self.in_backtrack = false,
+                    Event::Collision { .. } => self.collisions += 1,
+                    _ => {}
+                },
             }
-            Piece::Event { event, .. } => match event {
-                Event::RegionStart { .. } => regions += 1,
-                Event::BacktrackStart => {
-                    backtracks += 1;
-                    in_backtrack = true;
-                }
-                Event::BacktrackEnd => in_backtrack = false,
-                Event::Collision { .. } => collisions += 1,
-                _ => {}
-            },
         }
     }
+
+    /// The pieces of `chunk` (the next ones of the trace).
+    pub fn chunk(&mut self, chunk: &Chunk) {
+        self.pieces(chunk.pieces(), chunk.lattice());
+    }
+}
+
+/// The metrics that follow the poses and events one by one (all but the swept area and the
+/// tile coverage, left at 0 / `None`); `tally`, when given, must be a [`MotionTally`] fed the
+/// whole trace (it is used when made for the run's tile side).
+fn compute_rest(
+    world: &World,
+    run: &RunOutput,
+    map_name: &str,
+    tally: Option<MotionTally>,
+) -> Metrics {
+    let robot = world.robot();
+    let trace = &run.trace;
+    let side = run.tile_side.unwrap_or(2.0 * robot.tool_radius);
+    let tally = match tally {
+        Some(t) if t.side.to_bits() == side.to_bits() => t,
+        _ => {
+            let mut t = MotionTally::new(world, run.tile_side);
+            t.pieces(trace.pieces(), trace.lattice());
+            t
+        }
+    };
+    let MotionTally {
+        distinct,
+        entries,
+        path_length,
+        turns,
+        rotation,
+        regions,
+        backtracks,
+        collisions,
+        backtrack_length,
+        ..
+    } = tally;
     let nd = distinct.len();
     let revisit_rate = if nd == 0 {
         0.0

@@ -55,6 +55,9 @@ struct Sleeve {
     hi: f64,
     /// Largest distance from the segment start seen so far.
     far: f64,
+    /// The largest distance of the poses straight along `reference` (offset exactly 0) whose
+    /// narrowing is not applied yet (see [`Sleeve::accept`]).
+    pending: Option<f64>,
 }
 
 impl Sleeve {
@@ -64,6 +67,16 @@ impl Sleeve {
             lo: f64::NEG_INFINITY,
             hi: f64::INFINITY,
             far: 0.0,
+            pending: None,
+        }
+    }
+
+    /// Narrows the sleeve by the pending pose straight along the reference.
+    fn flush(&mut self, tol: f64) {
+        if let Some(d) = self.pending.take() {
+            let half = (tol / d).asin();
+            self.lo = self.lo.max(0.0 - half);
+            self.hi = self.hi.min(0.0 + half);
         }
     }
 
@@ -82,6 +95,21 @@ impl Sleeve {
         let dir = atan2_exact(p.y - start.y, p.x - start.x);
         let reference = *self.reference.get_or_insert(dir);
         let off = wrap_angle(dir - reference);
+        if off == 0.0 {
+            // A pose straight along the reference (every step of an axis-aligned lane): the
+            // test below reads only the signs of `lo` and `hi`, which narrowing by
+            // `0 -/+ asin(tol / d)` never changes, and the narrowing of the farthest such pose
+            // is the tightest (`asin(tol / d)` shrinks as `d` grows), so one `asin` for the farthest
+            // of them, when a pose in another direction comes, narrows the sleeve as one per
+            // pose would.
+            if 0.0 < self.lo || 0.0 > self.hi {
+                return false;
+            }
+            self.pending = Some(self.pending.map_or(d, |p| p.max(d)));
+            self.far = self.far.max(d);
+            return true;
+        }
+        self.flush(tol);
         if off < self.lo || off > self.hi {
             return false;
         }
@@ -93,57 +121,89 @@ impl Sleeve {
     }
 }
 
-impl Route {
-    /// The route of `poses` with the merging tolerance `tolerance_m` (metres; negative or
-    /// non-finite values count as 0). Non-finite poses are skipped.
-    pub fn from_poses<I: IntoIterator<Item = Pose>>(poses: I, tolerance_m: f64) -> Self {
+/// [`Route::from_poses`] fed one pose at a time (for poses that arrive while a run goes on):
+/// the same route.
+pub struct RouteBuilder {
+    /// The merging tolerance, metres (clamped as [`Route::from_poses`] does).
+    tol: f64,
+    waypoints: Vec<Pose>,
+    /// The last pose of the segment being grown (not yet a waypoint unless it is the start).
+    last: Option<Pose>,
+    sleeve: Sleeve,
+}
+
+impl RouteBuilder {
+    /// No pose yet; `tolerance_m` as for [`Route::from_poses`].
+    pub fn new(tolerance_m: f64) -> Self {
         let tol = if tolerance_m.is_finite() {
             tolerance_m.max(0.0)
         } else {
             0.0
         };
-        let mut waypoints: Vec<Pose> = Vec::new();
-        // The last pose of the segment being grown (not yet a waypoint unless it is the start).
-        let mut last: Option<Pose> = None;
-        let mut sleeve = Sleeve::new();
-        for p in poses {
-            if !(p.x.is_finite() && p.y.is_finite() && p.theta.is_finite()) {
-                continue;
-            }
-            let (Some(start), Some(prev)) = (waypoints.last().copied(), last) else {
-                waypoints.push(p);
-                last = Some(p);
-                continue;
-            };
-            let at_start = dist_exact(prev.position(), start.position()) <= SAME_POSITION_M;
-            if dist_exact(p.position(), prev.position()) <= SAME_POSITION_M {
-                // A rotation in place (or a repeated pose): merged into one waypoint.
-                if at_start {
-                    if let Some(w) = waypoints.last_mut() {
-                        w.theta = p.theta;
-                    }
-                } else {
-                    waypoints.push(Pose::new(prev.x, prev.y, p.theta));
-                    sleeve = Sleeve::new();
+        Self {
+            tol,
+            waypoints: Vec::new(),
+            last: None,
+            sleeve: Sleeve::new(),
+        }
+    }
+
+    /// The next pose (a non-finite one is skipped).
+    pub fn push(&mut self, p: Pose) {
+        if !(p.x.is_finite() && p.y.is_finite() && p.theta.is_finite()) {
+            return;
+        }
+        let (Some(start), Some(prev)) = (self.waypoints.last().copied(), self.last) else {
+            self.waypoints.push(p);
+            self.last = Some(p);
+            return;
+        };
+        let at_start = dist_exact(prev.position(), start.position()) <= SAME_POSITION_M;
+        if dist_exact(p.position(), prev.position()) <= SAME_POSITION_M {
+            // A rotation in place (or a repeated pose): merged into one waypoint.
+            if at_start {
+                if let Some(w) = self.waypoints.last_mut() {
+                    w.theta = p.theta;
                 }
-                last = Some(p);
-                continue;
+            } else {
+                self.waypoints.push(Pose::new(prev.x, prev.y, p.theta));
+                self.sleeve = Sleeve::new();
             }
-            if !sleeve.accept(start.position(), p.position(), tol) {
-                // The segment ends at the previous pose, which starts the next one.
-                waypoints.push(prev);
-                sleeve = Sleeve::new();
-                let accepted = sleeve.accept(prev.position(), p.position(), tol);
-                debug_assert!(accepted, "a fresh sleeve takes any pose");
-            }
-            last = Some(p);
+            self.last = Some(p);
+            return;
         }
-        if let (Some(end), Some(w)) = (last, waypoints.last()) {
+        if !self.sleeve.accept(start.position(), p.position(), self.tol) {
+            // The segment ends at the previous pose, which starts the next one.
+            self.waypoints.push(prev);
+            self.sleeve = Sleeve::new();
+            let accepted = self.sleeve.accept(prev.position(), p.position(), self.tol);
+            debug_assert!(accepted, "a fresh sleeve takes any pose");
+        }
+        self.last = Some(p);
+    }
+
+    /// The route of the poses pushed.
+    pub fn finish(mut self) -> Route {
+        if let (Some(end), Some(w)) = (self.last, self.waypoints.last()) {
             if end != *w {
-                waypoints.push(end);
+                self.waypoints.push(end);
             }
         }
-        Self { waypoints }
+        Route {
+            waypoints: self.waypoints,
+        }
+    }
+}
+
+impl Route {
+    /// The route of `poses` with the merging tolerance `tolerance_m` (metres; negative or
+    /// non-finite values count as 0). Non-finite poses are skipped.
+    pub fn from_poses<I: IntoIterator<Item = Pose>>(poses: I, tolerance_m: f64) -> Self {
+        let mut b = RouteBuilder::new(tolerance_m);
+        for p in poses {
+            b.push(p);
+        }
+        b.finish()
     }
 
     /// The route of a trace's executed poses ([`Route::from_poses`]).
@@ -266,6 +326,113 @@ mod tests {
         }
         // Deterministic.
         assert_eq!(Route::from_poses(poses, tol), r);
+    }
+
+    /// The route with one `asin` per pose (the sleeve narrowed at every pose), as
+    /// [`Route::from_poses`] was first written: the deferred narrowing must give the same.
+    fn eager_route(poses: &[Pose], tol: f64) -> Vec<Pose> {
+        struct Eager {
+            reference: Option<f64>,
+            lo: f64,
+            hi: f64,
+            far: f64,
+        }
+        let fresh = || Eager {
+            reference: None,
+            lo: f64::NEG_INFINITY,
+            hi: f64::INFINITY,
+            far: 0.0,
+        };
+        let accept = |s: &mut Eager, start: Point, p: Point| {
+            let d = dist_exact(start, p);
+            if d + tol < s.far {
+                return false;
+            }
+            if d <= tol {
+                s.far = s.far.max(d);
+                return true;
+            }
+            let dir = atan2_exact(p.y - start.y, p.x - start.x);
+            let reference = *s.reference.get_or_insert(dir);
+            let off = wrap_angle(dir - reference);
+            if off < s.lo || off > s.hi {
+                return false;
+            }
+            let half = (tol / d).asin();
+            s.lo = s.lo.max(off - half);
+            s.hi = s.hi.min(off + half);
+            s.far = s.far.max(d);
+            true
+        };
+        let mut waypoints: Vec<Pose> = Vec::new();
+        let mut last: Option<Pose> = None;
+        let mut sleeve = fresh();
+        for &p in poses {
+            let (Some(start), Some(prev)) = (waypoints.last().copied(), last) else {
+                waypoints.push(p);
+                last = Some(p);
+                continue;
+            };
+            let at_start = dist_exact(prev.position(), start.position()) <= SAME_POSITION_M;
+            if dist_exact(p.position(), prev.position()) <= SAME_POSITION_M {
+                if at_start {
+                    if let Some(w) = waypoints.last_mut() {
+                        w.theta = p.theta;
+                    }
+                } else {
+                    waypoints.push(Pose::new(prev.x, prev.y, p.theta));
+                    sleeve = fresh();
+                }
+                last = Some(p);
+                continue;
+            }
+            if !accept(&mut sleeve, start.position(), p.position()) {
+                waypoints.push(prev);
+                sleeve = fresh();
+                accept(&mut sleeve, prev.position(), p.position());
+            }
+            last = Some(p);
+        }
+        if let (Some(end), Some(w)) = (last, waypoints.last()) {
+            if end != *w {
+                waypoints.push(end);
+            }
+        }
+        waypoints
+    }
+
+    #[test]
+    fn deferred_narrowing_matches_narrowing_at_every_pose() {
+        let mut rng = crate::rng::SplitMix64::new(13);
+        for case in 0..400 {
+            // Lattice lanes, diagonal steps, small wobbles, turns back and rotations in place.
+            let side = [0.05, 0.025, 0.1][case % 3];
+            let mut poses = vec![Pose::new(1.0, 2.0, 0.0)];
+            for _ in 0..60 {
+                let last = *poses.last().unwrap();
+                let steps = 1 + (rng.next_u64() % 40) as usize;
+                let (dx, dy) = match rng.next_u64() % 7 {
+                    0 => (side, 0.0),
+                    1 => (-side, 0.0),
+                    2 => (0.0, side),
+                    3 => (0.0, -side),
+                    4 => (side, side),
+                    5 => (side, rng.range(-0.0004, 0.0004)),
+                    _ => {
+                        poses.push(Pose::new(last.x, last.y, rng.range(-3.0, 3.0)));
+                        continue;
+                    }
+                };
+                for k in 1..=steps {
+                    let k = k as f64;
+                    poses.push(Pose::new(last.x + k * dx, last.y + k * dy, last.theta));
+                }
+            }
+            for tol in [0.0, 0.001, 0.01, 0.2] {
+                let got = Route::from_poses(poses.iter().copied(), tol).waypoints;
+                assert_eq!(got, eager_route(&poses, tol), "case {case} tol {tol}");
+            }
+        }
     }
 
     #[test]

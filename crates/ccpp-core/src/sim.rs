@@ -483,7 +483,19 @@ impl<'w> Simulator<'w> {
     }
 
     /// Runs `planner` to completion (or the step cap).
-    pub fn run(mut self, planner: &mut dyn Planner, config: &SimConfig) -> RunOutput {
+    pub fn run(self, planner: &mut dyn Planner, config: &SimConfig) -> RunOutput {
+        self.run_tapped(planner, config, &mut |_| {})
+    }
+
+    /// [`Self::run`], calling `tap` with the trace after every executed step (to copy out its
+    /// [sealed](Trace::sealed_count) pieces while the run goes on). The tap only reads: the
+    /// run is the same.
+    pub fn run_tapped(
+        mut self,
+        planner: &mut dyn Planner,
+        config: &SimConfig,
+        tap: &mut dyn FnMut(&Trace),
+    ) -> RunOutput {
         let started = std::time::Instant::now();
         if !self.exec_set {
             let e = config
@@ -500,6 +512,7 @@ impl<'w> Simulator<'w> {
                 break;
             }
             self.execute(step);
+            tap(&self.trace);
         }
         let reason = match stop {
             StopReason::Done => "done",
@@ -547,6 +560,16 @@ impl Sensor for Simulator<'_> {
 /// Convenience: simulate `planner` on `world` with `config`.
 pub fn simulate(world: &World, planner: &mut dyn Planner, config: &SimConfig) -> RunOutput {
     Simulator::new(world, config).run(planner, config)
+}
+
+/// [`simulate`] with a tap on the growing trace ([`Simulator::run_tapped`]).
+pub fn simulate_tapped(
+    world: &World,
+    planner: &mut dyn Planner,
+    config: &SimConfig,
+    tap: &mut dyn FnMut(&Trace),
+) -> RunOutput {
+    Simulator::new(world, config).run_tapped(planner, config, tap)
 }
 
 #[cfg(test)]

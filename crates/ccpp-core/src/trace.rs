@@ -376,6 +376,38 @@ pub struct Cursor {
     within: u32,
 }
 
+/// Consecutive pieces of a trace, copied out ([`Trace::chunk`]): the same pieces, in order,
+/// with the trace's lattice (the events' point lists left empty).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Chunk(Trace);
+
+impl Chunk {
+    /// The pieces, in order.
+    pub fn pieces(&self) -> impl Iterator<Item = Piece<'_>> + '_ {
+        self.0.pieces()
+    }
+
+    /// The trace's lattice when the chunk was taken (fixed before its first lattice run).
+    pub fn lattice(&self) -> Option<Lattice> {
+        self.0.lattice
+    }
+
+    /// Number of pieces.
+    pub fn len(&self) -> usize {
+        self.0.items.len()
+    }
+
+    /// Whether it holds no piece.
+    pub fn is_empty(&self) -> bool {
+        self.0.items.is_empty()
+    }
+
+    /// The executed poses, in order (runs unrolled).
+    pub fn poses(&self) -> impl Iterator<Item = Pose> + '_ {
+        self.0.poses()
+    }
+}
+
 /// A whole run's record.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Trace {
@@ -544,6 +576,49 @@ impl Trace {
     /// Number of stored pieces (lone poses, runs and events): what the trace costs.
     pub fn piece_count(&self) -> usize {
         self.items.len()
+    }
+
+    /// Number of stored pieces no later push can change: all but the last (a later pose may
+    /// extend the last piece).
+    pub fn sealed_count(&self) -> usize {
+        self.items.len().saturating_sub(1)
+    }
+
+    /// An owned copy of the pieces `range` (piece indices, as [`Self::pieces`] yields them),
+    /// with the trace's lattice: handed to another thread, it reads the trace as it grows
+    /// (pieces below [`Self::sealed_count`] are final). The events' point lists
+    /// ([`Event::BacktrackList`], [`Event::PathRaw`], [`Event::PathSmoothed`]) are copied
+    /// empty: a chunk carries the motion and the events that mark it.
+    ///
+    /// # Panics
+    /// When `range` is not within `0..piece_count()`.
+    pub fn chunk(&self, range: std::ops::Range<usize>) -> Chunk {
+        let mut events = Vec::new();
+        let items = self.items[range]
+            .iter()
+            .map(|it| match *it {
+                Item::Event { t, k } => {
+                    let local = u32::try_from(events.len()).unwrap_or(u32::MAX);
+                    // The point lists are left out: a chunk's readers count, sweep and merge
+                    // the motion, and copying the backtracking lists would cost the run their
+                    // size again.
+                    events.push(match &self.events[k as usize] {
+                        Event::BacktrackList { .. } => Event::BacktrackList { points: Vec::new() },
+                        Event::PathRaw { .. } => Event::PathRaw { points: Vec::new() },
+                        Event::PathSmoothed { .. } => Event::PathSmoothed { points: Vec::new() },
+                        e => e.clone(),
+                    });
+                    Item::Event { t, k: local }
+                }
+                ref other => other.clone(),
+            })
+            .collect();
+        Chunk(Self {
+            items,
+            events,
+            lattice: self.lattice,
+            ..Self::default()
+        })
     }
 
     /// Bytes held by the trace's own vectors (not counting what events own on the heap).

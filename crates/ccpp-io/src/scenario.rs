@@ -35,13 +35,15 @@ use ccpp_core::grid::{GridError, GridMap};
 use ccpp_core::metrics::{self, Metrics};
 use ccpp_core::planners::settings::{estimate_run, estimate_zones, validate_execution, ZoneLoad};
 use ccpp_core::planners::{OptionsError, PlannerConfig, PlannerKind, ResourceEstimate, Setup};
-use ccpp_core::sim::{simulate, RunOutput, SimConfig};
+use ccpp_core::sim::{simulate, simulate_tapped, RunOutput, SimConfig};
+use ccpp_core::trace::Chunk;
 use ccpp_core::world::{Robot, World, WorldError};
 use ccpp_core::Pose;
 use fixedbitset::FixedBitSet;
 use serde::{Deserialize, Serialize};
 
 use crate::map::{load_map, LoadOptions, LoadedMap, MapError};
+use crate::trace::{FileFormer, FormedFiles};
 use crate::zones::{ZoneData, ZoneSpec};
 use ccpp_core::zones::ZoneMasks;
 
@@ -374,6 +376,18 @@ pub struct Run {
     /// The pixels the tool swept ([`metrics::swept_pixels`], computed with the metrics; the
     /// coverage picture reuses them).
     pub swept: FixedBitSet,
+}
+
+/// Sealed trace pieces copied out at a time while a run forms its files
+/// ([`Scenario::run_owned_with`]).
+const FORM_CHUNK: usize = 512;
+
+/// The result of a scoped thread (its panic passed on).
+fn join_scoped<T>(h: std::thread::ScopedJoinHandle<'_, T>) -> T {
+    match h.join() {
+        Ok(v) => v,
+        Err(panic) => std::panic::resume_unwind(panic),
+    }
 }
 
 fn invalid(msg: String) -> ScenarioError {
@@ -769,6 +783,24 @@ impl Scenario {
         map: PreparedMap,
         beside: impl FnOnce(&World) -> T + Send,
     ) -> Result<(Run, T), ScenarioError> {
+        let (run, extra, _) = self.run_owned_with(map, beside, false)?;
+        Ok((run, extra))
+    }
+
+    /// [`run_owned_beside`](Self::run_owned_beside), also forming `path.csv` while the run
+    /// goes on when `form_files` (on another thread, from the trace as it grows; the swept
+    /// pixels and the motion figures of the metrics are found the same way): the same run,
+    /// metrics and file bytes, with less left to do when the run ends. The files are `None`
+    /// when not asked for.
+    ///
+    /// # Errors
+    /// As [`world`](Self::world).
+    pub fn run_owned_with<T: Send>(
+        &self,
+        map: PreparedMap,
+        beside: impl FnOnce(&World) -> T + Send,
+        form_files: bool,
+    ) -> Result<(Run, T, Option<FormedFiles>), ScenarioError> {
         let PreparedMap {
             grid,
             name,
@@ -786,7 +818,12 @@ impl Scenario {
             let zones = self.world_checks(&prepared)?;
             self.world_on(prepared.grid, &prepared.source, zones)
         })?;
-        Ok(self.run_in(world, &name, beside))
+        if form_files {
+            Ok(self.run_forming(world, &name, beside))
+        } else {
+            let (run, extra) = self.run_in(world, &name, beside);
+            Ok((run, extra, None))
+        }
     }
 
     /// Plans and simulates in `world`, then computes the metrics. What the metrics need of the
@@ -808,10 +845,7 @@ impl Scenario {
                 let mut planner = self.planner.build(&world);
                 let mut output = simulate(&world, planner.as_mut(), &self.sim);
                 output.wall_time_s = started.elapsed().as_secs_f64();
-                let (part, extra) = match other.join() {
-                    Ok(v) => v,
-                    Err(panic) => std::panic::resume_unwind(panic),
-                };
+                let (part, extra) = join_scoped(other);
                 (output, part, extra)
             })
         });
@@ -825,6 +859,76 @@ impl Scenario {
             swept,
         };
         (run, extra)
+    }
+
+    /// [`run_in`](Self::run_in), a third thread reading the trace as it grows (copied out in
+    /// chunks of [`FORM_CHUNK`] sealed pieces) to sweep the tool's pixels, tally the motion
+    /// metrics ([`metrics::MotionTally`], on the scenario's tile side: the metrics recount when
+    /// the planner reports another) and form `path.csv` and `trace.jsonl`.
+    fn run_forming<T: Send>(
+        &self,
+        world: World,
+        map_name: &str,
+        beside: impl FnOnce(&World) -> T + Send,
+    ) -> (Run, T, Option<FormedFiles>) {
+        let side = self.tile_side();
+        let (output, part, extra, (swept, tally), files) =
+            crate::phase::time("plan + simulate", || {
+                std::thread::scope(|s| {
+                    let world = &world;
+                    // A planner that reads the accessible surface first waits for it.
+                    let other = s.spawn(|| (metrics::WorldPart::of(world, side), beside(world)));
+                    let (tx, rx) = std::sync::mpsc::channel::<Chunk>();
+                    let former = s.spawn(move || {
+                        let mut sweep = metrics::TraceSweep::new(world);
+                        let mut tally = metrics::MotionTally::new(world, side);
+                        let mut files = FileFormer::default();
+                        for chunk in rx {
+                            sweep.chunk(&chunk);
+                            tally.chunk(&chunk);
+                            files.chunk(&chunk);
+                        }
+                        ((sweep.finish(), tally), Some(files.finish()))
+                    });
+                    // Wall time covers planning (offline planners plan in `build`) and simulation.
+                    let started = std::time::Instant::now();
+                    let mut planner = self.planner.build(world);
+                    let mut sent = 0usize;
+                    let mut output =
+                        simulate_tapped(world, planner.as_mut(), &self.sim, &mut |t| {
+                            let n = t.sealed_count();
+                            if n >= sent + FORM_CHUNK {
+                                // A closed channel (the former panicked) shows when it is joined.
+                                let _ = tx.send(t.chunk(sent..n));
+                                sent = n;
+                            }
+                        });
+                    output.wall_time_s = started.elapsed().as_secs_f64();
+                    let _ = tx.send(output.trace.chunk(sent..output.trace.piece_count()));
+                    drop(tx);
+                    let (part, extra) = join_scoped(other);
+                    let (swept, files) =
+                        crate::phase::time("wait for the streamed files", || join_scoped(former));
+                    (output, part, extra, swept, files)
+                })
+            });
+        let (metrics, swept) = crate::phase::time("metrics", || {
+            metrics::compute_prepared_with(
+                &world,
+                &output,
+                map_name,
+                part,
+                Some(swept),
+                Some(tally),
+            )
+        });
+        let run = Run {
+            world,
+            output,
+            metrics,
+            swept,
+        };
+        (run, extra, files)
     }
 
     /// Loads the map and runs the scenario.

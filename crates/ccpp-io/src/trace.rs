@@ -33,8 +33,8 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use ccpp_core::grid::MapFrame;
-use ccpp_core::route::{Route, DEFAULT_TOLERANCE_M};
-use ccpp_core::trace::{Advance, Event, Lattice, Piece, Record, Run, Trace};
+use ccpp_core::route::{Route, RouteBuilder, DEFAULT_TOLERANCE_M};
+use ccpp_core::trace::{Advance, Chunk, Event, Lattice, Piece, Record, Run, Trace};
 use ccpp_core::Pose;
 use serde::{Deserialize, Serialize};
 
@@ -306,30 +306,50 @@ fn trace_jsonl_into(
     after_line: &mut dyn FnMut(&mut String) -> Result<(), serde_json::Error>,
 ) -> Result<(), serde_json::Error> {
     let lattice = trace.lattice();
-    let mut declared = false;
-    let mut prev_list: Option<&Vec<[f64; 2]>> = None;
+    let mut lines = JsonlLines::default();
     for piece in trace.pieces() {
         if !s.is_empty() {
             after_line(s)?;
         }
+        lines.piece(s, piece, lattice)?;
+    }
+    Ok(())
+}
+
+/// What the lines of [`trace_jsonl`] depend on beyond their own piece: whether the lattice was
+/// declared, and the last backtracking list (the next one may be written as a delta of it).
+#[derive(Default)]
+struct JsonlLines<'a> {
+    declared: bool,
+    prev_list: Option<&'a [[f64; 2]]>,
+}
+
+impl<'a> JsonlLines<'a> {
+    /// Appends the lines of `piece` to `s` (`lattice`: the trace's).
+    fn piece(
+        &mut self,
+        s: &mut String,
+        piece: Piece<'a>,
+        lattice: Option<Lattice>,
+    ) -> Result<(), serde_json::Error> {
         match piece {
             Piece::Pose { t, pose } => push_pose_line(s, t, pose),
             Piece::Event {
                 t,
                 event: event @ Event::BacktrackList { points },
             } => {
-                if let Some(prev) = prev_list {
+                if let Some(prev) = &self.prev_list {
                     let delta = list_delta(prev, points);
                     // Written as a delta when that takes fewer items than the list.
                     if delta.len() < points.len() {
                         let _ = write!(s, "{{\"t\":{t},\"event\":\"backtrack_list\",\"delta\":");
                         s.push_str(&serde_json::to_string(&delta)?);
                         s.push_str("}\n");
-                        prev_list = Some(points);
-                        continue;
+                        self.prev_list = Some(points);
+                        return Ok(());
                     }
                 }
-                prev_list = Some(points);
+                self.prev_list = Some(points);
                 push_event_line(s, t, event)?;
             }
             Piece::Event { t, event } => push_event_line(s, t, event)?,
@@ -339,9 +359,10 @@ fn trace_jsonl_into(
                 }
             }
             Piece::Run(run) => {
-                if let (Advance::Lattice { .. }, Some(l), false) = (run.advance, lattice, declared)
+                if let (Advance::Lattice { .. }, Some(l), false) =
+                    (run.advance, lattice, self.declared)
                 {
-                    declared = true;
+                    self.declared = true;
                     s.push_str("{\"lattice\":[");
                     push_f64(s, l.anchor[0]);
                     s.push(',');
@@ -367,8 +388,47 @@ fn trace_jsonl_into(
                 s.push_str("}\n");
             }
         }
+        Ok(())
     }
-    Ok(())
+}
+
+/// `path.csv` formed while a run goes on, from the [`Chunk`]s of its trace in order (see
+/// [`Trace::chunk`]): the same text as [`path_csv`] of the whole trace, ready when the run
+/// ends. (`trace.jsonl`, the size of the trace's lists, is streamed into its file after the
+/// run instead of being held in memory.)
+pub struct FileFormer {
+    route: RouteBuilder,
+}
+
+impl Default for FileFormer {
+    fn default() -> Self {
+        Self {
+            route: RouteBuilder::new(DEFAULT_TOLERANCE_M),
+        }
+    }
+}
+
+/// The text files of a run formed by a [`FileFormer`].
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct FormedFiles {
+    /// [`path_csv`] of the trace.
+    pub path_csv: String,
+}
+
+impl FileFormer {
+    /// Adds the pieces of `chunk` (the next ones of the trace).
+    pub fn chunk(&mut self, chunk: &Chunk) {
+        for pose in chunk.poses() {
+            self.route.push(pose);
+        }
+    }
+
+    /// The files.
+    pub fn finish(self) -> FormedFiles {
+        FormedFiles {
+            path_csv: crate::export::waypoints_csv(&self.route.finish()),
+        }
+    }
 }
 
 /// The trace as JSON Lines of the earlier form: one line per pose (no runs).

@@ -236,8 +236,10 @@ pub fn coverage_png_swept(
     style: &CoverageStyle,
     swept: &fixedbitset::FixedBitSet,
 ) -> Result<Vec<u8>, RenderError> {
-    let pixmap = coverage_pixmap_swept(world, trace, style, swept)?;
-    encode_png(&pixmap)
+    let pixmap = ccpp_io::phase::time("coverage.png draw", || {
+        coverage_pixmap_swept(world, trace, style, swept)
+    })?;
+    ccpp_io::phase::time("coverage.png encode", || encode_png(&pixmap))
 }
 
 /// Encodes a picture as PNG bytes, fast: an opaque canvas (every picture of this crate) is
@@ -637,6 +639,12 @@ pub fn coverage_verdict_colour(coverage: f64) -> [u8; 3] {
     }
 }
 
+/// Canvases of at least this many map pixels paint their background in bands on several
+/// threads.
+const BAND_MIN_PX: usize = 1 << 16;
+/// At most this many background bands.
+const MAX_BANDS: usize = 4;
+
 /// Draws the coverage picture of a run.
 ///
 /// # Errors
@@ -660,7 +668,7 @@ pub fn coverage_pixmap_swept(
     swept: &fixedbitset::FixedBitSet,
 ) -> Result<Pixmap, RenderError> {
     let frame = *world.frame();
-    let crop = crop_box(world, trace);
+    let crop = ccpp_io::phase::time("coverage.png crop", || crop_box(world, trace));
     let (col0, row0, cols, rows) = crop;
     let (w, h) = (cols as u32, rows as u32);
     let scale = if w < style.min_width {
@@ -734,7 +742,9 @@ pub fn coverage_pixmap_swept(
     }
     let mut foot = Chart::new(cw, 0);
     let legend_h = if style.legend {
-        let entries = entries_of(&shown_with(world, trace, crop, swept));
+        let entries = ccpp_io::phase::time("coverage.png shown", || {
+            entries_of(&shown_with(world, trace, crop, swept))
+        });
         let top = ch_map + header + 8;
         (foot.legend(8.0, top as f32, cw as f32 - 16.0, px as u32, &entries) + 8.0).ceil() as u32
     } else {
@@ -774,38 +784,64 @@ pub fn coverage_pixmap_swept(
             },
         }
     };
-    {
+    ccpp_io::phase::time("coverage.png background", || {
         // The map column of each canvas column, computed once (same formula per pixel).
         let cols: Vec<usize> = (0..cw)
             .map(|x| (col0 + ((x as f32 + 0.5) / scale) as usize).min(frame.width - 1))
             .collect();
-        let data = pm.data_mut();
         let stride = cw as usize * 4;
-        // A canvas row showing the same map row as the one above, without keep-out hatching
-        // (which follows the canvas diagonal), is a copy of it.
-        let mut above: Option<(usize, bool)> = None;
-        for y in 0..ch_map {
-            let row = ((y as f32 + 0.5) / scale) as usize;
-            let row = (row0 + row).min(frame.height - 1);
-            if above == Some((row, false)) {
-                let o = (y + header) as usize * stride;
-                data.copy_within(o - stride..o, o);
-                continue;
+        // Paints the canvas map rows `y0..` into `rows` (those rows, `stride` bytes each).
+        let paint = |y0: u32, rows: &mut [u8]| {
+            // A canvas row showing the same map row as the one above, without keep-out
+            // hatching (which follows the canvas diagonal), is a copy of it.
+            let mut above: Option<(usize, bool)> = None;
+            for (y, line) in (y0..).zip(0..rows.len() / stride) {
+                let row = ((y as f32 + 0.5) / scale) as usize;
+                let row = (row0 + row).min(frame.height - 1);
+                let o = line * stride;
+                if above == Some((row, false)) {
+                    rows.copy_within(o - stride..o, o);
+                    continue;
+                }
+                let mut hatched = false;
+                let out = &mut rows[o..o + stride];
+                for ((x, &col), d) in (0..cw).zip(&cols).zip(out.chunks_exact_mut(4)) {
+                    let i = frame.index(col, row);
+                    hatched |= cells[i] == Cell::Free && zone_class(world, i) == 1;
+                    let c = colour_of(i, x, y);
+                    d.copy_from_slice(&[c[0], c[1], c[2], 255]);
+                }
+                above = Some((row, hatched));
             }
-            let mut hatched = false;
-            for (x, &col) in (0..cw).zip(&cols) {
-                let i = frame.index(col, row);
-                hatched |= cells[i] == Cell::Free && zone_class(world, i) == 1;
-                let c = colour_of(i, x, y);
-                let o = (((y + header) * cw + x) * 4) as usize;
-                data[o] = c[0];
-                data[o + 1] = c[1];
-                data[o + 2] = c[2];
-                data[o + 3] = 255;
+        };
+        let map_rows = &mut pm.data_mut()[header as usize * stride..][..ch_map as usize * stride];
+        // Horizontal bands on the machine's cores (each pixel's colour is a function of its
+        // own position: the same bytes however the rows are split).
+        let bands = if cw as usize * ch_map as usize >= BAND_MIN_PX {
+            std::thread::available_parallelism().map_or(1, |n| n.get().min(MAX_BANDS))
+        } else {
+            1
+        };
+        let band_rows = (ch_map as usize).div_ceil(bands).max(1);
+        std::thread::scope(|s| {
+            let mut chunks = map_rows.chunks_mut(band_rows * stride).enumerate();
+            let first = chunks.next();
+            let others: Vec<_> = chunks
+                .map(|(k, rows)| {
+                    let paint = &paint;
+                    s.spawn(move || paint((k * band_rows) as u32, rows))
+                })
+                .collect();
+            if let Some((_, rows)) = first {
+                paint(0, rows);
             }
-            above = Some((row, hatched));
-        }
-    }
+            for h in others {
+                if let Err(panic) = h.join() {
+                    std::panic::resume_unwind(panic);
+                }
+            }
+        });
+    });
     let view = View {
         scale,
         height: frame.height as f64,
@@ -814,10 +850,16 @@ pub fn coverage_pixmap_swept(
         row0: row0 as f64,
     };
     draw_zone_borders(&mut pm, world, view);
-    draw_path(&mut pm, world, trace, view);
-    draw_markers(&mut pm, world, trace, view);
-    head.draw_onto(&mut pm);
-    foot.draw_onto(&mut pm);
+    ccpp_io::phase::time("coverage.png path", || {
+        draw_path(&mut pm, world, trace, view);
+    });
+    ccpp_io::phase::time("coverage.png markers", || {
+        draw_markers(&mut pm, world, trace, view);
+    });
+    ccpp_io::phase::time("coverage.png text", || {
+        head.draw_onto(&mut pm);
+        foot.draw_onto(&mut pm);
+    });
     Ok(pm)
 }
 

@@ -12,6 +12,7 @@ use ccpp_core::world::World;
 use ccpp_io::export::{render_exports, ExportFormat, ExportMeta, PolygonFeature};
 use ccpp_io::phase;
 use ccpp_io::scenario::Scenario;
+use ccpp_io::trace::FormedFiles;
 use ccpp_io::write::WriteError;
 use ccpp_io::write_atomic;
 
@@ -172,7 +173,9 @@ pub type PutFile<'a, E> = dyn FnMut(&'static str, &mut dyn FnMut(&mut dyn Write)
 /// `trace.jsonl` streamed as it is formed instead of built whole in memory (the largest file;
 /// `coverage.png` is drawn on a second thread meanwhile). Same bytes as
 /// [`render_run_files`]. `swept`, when given, must be
-/// [`ccpp_core::metrics::swept_pixels`]`(world, trace)`.
+/// [`ccpp_core::metrics::swept_pixels`]`(world, trace)`; `formed`, when given, the `path.csv` of
+/// the trace formed while it ran ([`ccpp_io::scenario::Scenario::run_owned_with`]), written as
+/// it is.
 ///
 /// # Errors
 /// Serialization or rendering failures (converted into `E`), or what `put` returns.
@@ -182,6 +185,7 @@ pub fn stream_run_files<E: From<RunFilesError>>(
     trace: &Trace,
     metrics: &Metrics,
     swept: Option<&fixedbitset::FixedBitSet>,
+    formed: Option<&FormedFiles>,
     put: &mut PutFile<'_, E>,
 ) -> Result<(), E> {
     let run_json = run_json(scenario, world).map_err(RunFilesError::from)?;
@@ -190,9 +194,12 @@ pub fn stream_run_files<E: From<RunFilesError>>(
         let png = s.spawn(|| coverage_picture(world, trace, &style, swept));
         let text = (|| -> Result<(), E> {
             put("run.json", &mut |w| w.write_all(run_json.as_bytes()))?;
-            let path = phase::time("path.csv", || ccpp_io::trace::path_csv(trace));
-            put("path.csv", &mut |w| w.write_all(path.as_bytes()))?;
-            drop(path);
+            if let Some(f) = formed {
+                put("path.csv", &mut |w| w.write_all(f.path_csv.as_bytes()))?;
+            } else {
+                let path = phase::time("path.csv", || ccpp_io::trace::path_csv(trace));
+                put("path.csv", &mut |w| w.write_all(path.as_bytes()))?;
+            }
             phase::time("trace.jsonl", || {
                 put("trace.jsonl", &mut |w| {
                     ccpp_io::trace::write_trace_jsonl(trace, w).map_err(std::io::Error::other)
