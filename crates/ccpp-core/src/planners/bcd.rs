@@ -612,7 +612,7 @@ const SECOND_PEAK_DEG: usize = 10;
 const AXIS_TOL_DEG: f64 = 4.0;
 
 /// Improvement rounds of the first tour (which only picks each cell's path for the rim step).
-const FIRST_ROUNDS: u32 = 1;
+const FIRST_ROUNDS: u32 = 2;
 /// Gap kept between a pushed lane end and the exact contact (pixels).
 const BACKOFF_PX: f64 = 0.05;
 /// How far a merged boundary segment may stray from the boundary points it replaces (pixels).
