@@ -368,6 +368,13 @@ fn config_values_go_through_the_same_validation() {
             "ba-star",
             "extension",
         ),
+        // bcd's turned-lattice tries belong to bcd only.
+        ("ba_star: { angle_tries: 3 }", "ba-star", "angle_tries"),
+        (
+            "rect_boustrophedon: { angle_tries: 3 }",
+            "rect-boustrophedon",
+            "angle_tries",
+        ),
         // Options the rebuilt bsa-extended dropped are unknown keys now, refused by name.
         ("bsa_extended: { gap_cost: 4 }", "bsa-extended", "gap_cost"),
         (
@@ -839,4 +846,59 @@ fn strip_walk_is_read_from_the_config() {
         assert_eq!(m["collisions"], 0);
         assert!(m["effective_coverage"].as_f64().unwrap() >= 0.99, "{m}");
     }
+}
+
+/// bcd's `angle_tries`: on a room turned by 25 degrees, the pixel lattice alone (0), the
+/// lattice turned to the walls (1) and the lattices half a degree beside it too (3, the
+/// default) give three different plans, the last the cheapest; every one covers the room
+/// without contact.
+#[test]
+fn angle_tries_changes_the_bcd_plan() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let (si, co) = 25f64.to_radians().sin_cos();
+    pgm(dir, "turned.pgm", 200, 200, |c, r| {
+        let (x, y) = (c as f64 + 0.5 - 100.0, r as f64 + 0.5 - 100.0);
+        let (u, v) = (co * x + si * y, -si * x + co * y);
+        !(u.abs() < 90.0 && v.abs() < 55.0)
+    });
+    let map = dir.join("turned.yaml");
+    std::fs::write(
+        &map,
+        "image: turned.pgm\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n",
+    )
+    .unwrap();
+    let mut runs = Vec::new();
+    for tries in [0, 1, 3] {
+        let cfg = dir.join(format!("tries{tries}.yaml"));
+        std::fs::write(&cfg, format!("bcd: {{ angle_tries: {tries} }}\n")).unwrap();
+        let o = run_ok(
+            dir,
+            &format!("tries{tries}"),
+            &map,
+            "bcd",
+            &["--config", cfg.to_str().unwrap()],
+        );
+        let m = metrics(&o);
+        assert_eq!(m["collisions"], 0, "{m}");
+        assert!(m["effective_coverage"].as_f64().unwrap() >= 0.995, "{m}");
+        runs.push((m, trace(&o)));
+    }
+    assert_ne!(runs[0].1, runs[1].1);
+    assert_ne!(runs[1].1, runs[2].1);
+    let cost = |m: &serde_json::Value| {
+        m["path_length_m"].as_f64().unwrap() + 0.3 * m["turns"].as_f64().unwrap()
+    };
+    assert!(
+        cost(&runs[2].0) < cost(&runs[1].0),
+        "{} {}",
+        runs[1].0,
+        runs[2].0
+    );
+    assert!(
+        cost(&runs[1].0) < cost(&runs[0].0),
+        "{} {}",
+        runs[0].0,
+        runs[1].0
+    );
 }

@@ -23,8 +23,10 @@
 //!    least 10 degrees away),
 //!    the whole plan is made again with the sweep lines on a lattice of points one pixel apart
 //!    turned by that angle (a point is free where its pixel is reachable C-free and the
-//!    robot's disk there touches nothing), and the plan that skips fewer moves, then costs
-//!    less (length plus `turn_cost_m` per turn), is kept. Maps drawn along the axes get the
+//!    robot's disk there touches nothing) and by angles half a degree, one degree, ... beside
+//!    it (`angle_tries` lattices per angle: a plan's cost reacts strongly to where the lattice
+//!    lines fall), and the plan that skips fewer moves, then costs less (length plus
+//!    `turn_cost_m` per turn), is kept. Maps drawn along the axes get the
 //!    pixel lattice's plan unchanged.
 //! 2. **Lanes fitted to each cell** (the paper's boustrophedon motions). Per cell, lanes run
 //!    along the sweep line or, when the cell is monotone the other way too, across it — the
@@ -172,6 +174,11 @@ pub struct BcdOptions {
     /// plan's estimated effective coverage stays at least this; 1 drops only turns whose
     /// removal loses no floor. In `[0, 1]`.
     pub min_coverage: f64,
+    /// Turned lattices tried per off-axis wall angle (step 1 of the module docs): at the
+    /// angle, then half a degree above and below it, one degree, ...; the cheapest plan of
+    /// all is kept (a plan's cost reacts strongly to where the lattice's lines fall). 0 plans
+    /// on the pixel lattice only.
+    pub angle_tries: u32,
 }
 
 impl Default for BcdOptions {
@@ -185,6 +192,7 @@ impl Default for BcdOptions {
             rim_coverage: 0.999,
             tour_rounds: 2,
             min_coverage: 0.9952,
+            angle_tries: 3,
         }
     }
 }
@@ -593,6 +601,9 @@ fn dominant_angles(ctx: &Ctx<'_>) -> Vec<f64> {
     out
 }
 
+/// Degrees between the turned lattices tried around a wall angle (`angle_tries`).
+const ANGLE_STEP_DEG: f64 = 0.5;
+
 /// Degrees (at least) between the two wall directions [`dominant_angles`] returns.
 const SECOND_PEAK_DEG: usize = 10;
 
@@ -601,7 +612,7 @@ const SECOND_PEAK_DEG: usize = 10;
 const AXIS_TOL_DEG: f64 = 4.0;
 
 /// Improvement rounds of the first tour (which only picks each cell's path for the rim step).
-const FIRST_ROUNDS: u32 = 1;
+const FIRST_ROUNDS: u32 = 2;
 /// Gap kept between a pushed lane end and the exact contact (pixels).
 const BACKOFF_PX: f64 = 0.05;
 /// How far a merged boundary segment may stray from the boundary points it replaces (pixels).
@@ -1057,6 +1068,7 @@ impl Bcd {
                     d.rim_coverage
                 },
                 tour_rounds: opts.tour_rounds,
+                angle_tries: opts.angle_tries,
                 min_coverage: if (0.0..=1.0).contains(&opts.min_coverage) {
                     opts.min_coverage
                 } else {
@@ -1115,8 +1127,15 @@ impl Bcd {
             &[]
         };
         for a in angles.iter().copied() {
-            if off_axis(&a) {
-                let turned = Self::plan_on(&ctx, &Lattice::turned(&ctx, a), opts, &mut search);
+            if !off_axis(&a) {
+                continue;
+            }
+            for j in 0..opts.angle_tries {
+                // 0, +1/2, -1/2, +1, -1, ... degrees around the wall angle.
+                let step = f64::from(j.div_ceil(2)) * ANGLE_STEP_DEG;
+                let d = if j % 2 == 1 { step } else { -step };
+                let t = a + d.to_radians();
+                let turned = Self::plan_on(&ctx, &Lattice::turned(&ctx, t), opts, &mut search);
                 if (turned.0, turned.1) < (best.0, best.1) {
                     best = turned;
                 }
