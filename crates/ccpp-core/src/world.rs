@@ -9,7 +9,7 @@ use std::ops::{Add, Sub};
 use crate::collide::{self, contact_radius_px};
 use crate::display::Compact;
 use crate::dt::{squared_edt, squared_edt_compact, CompactDt, INF};
-use crate::geometry::{Point, Pose};
+use crate::geometry::{ceil_i64, floor_i64, Point, Pose};
 use crate::grid::{Cell, GridMap, MapFrame};
 use crate::search::{fill_runs, Connectivity};
 use crate::zones::{MaskOccupancy, ZoneMasks};
@@ -755,6 +755,9 @@ impl World {
         let len = ga.dist(gb);
         let r_px = self.r_px();
         let rc = contact_radius_px(r_px);
+        if box_clear(frame, ga, gb, rc, blocked) {
+            return None;
+        }
         if len == 0.0 {
             return if collide::disk_hits(map, ga, r_px) {
                 Some(0.0)
@@ -788,6 +791,46 @@ impl World {
         self.first_contact(a, b).is_none()
     }
 }
+
+/// Is every pixel that can touch the disk of contact radius `rc` pixels moving from grid point
+/// `a` to `b` inside the image and not in `blocked`? A pixel touches only when its centre lies
+/// within `rc` of the segment ([`collide::segment_first_contact`], [`collide::disk_hits`]),
+/// so within `rc` of the segment's bounding box in each coordinate; the box of those pixels is
+/// taken with a margin far below the contact tolerance and far above the rounding of grid
+/// coordinates. `true` means no contact (the exact tests would find none); `false` means
+/// "ask them" (also for boxes of more than [`BOX_CLEAR_MAX_PX`] pixels and non-finite points).
+#[inline]
+fn box_clear(frame: &MapFrame, a: Point, b: Point, rc: f64, blocked: &FixedBitSet) -> bool {
+    let eps = 1e-7;
+    let h = frame.height as f64;
+    if !(a.x.is_finite() && a.y.is_finite() && b.x.is_finite() && b.y.is_finite()) {
+        return false;
+    }
+    let cmin = ceil_i64(a.x.min(b.x) - rc - 0.5 - eps);
+    let cmax = floor_i64(a.x.max(b.x) + rc - 0.5 + eps);
+    let rmin = ceil_i64(h - a.y.max(b.y) - rc - 0.5 - eps);
+    let rmax = floor_i64(h - a.y.min(b.y) + rc - 0.5 + eps);
+    let (w, hh) = (frame.width as i64, frame.height as i64);
+    if !(0 <= cmin && cmin <= cmax && cmax < w && 0 <= rmin && rmin <= rmax && rmax < hh)
+        || (cmax - cmin + 1) * (rmax - rmin + 1) > BOX_CLEAR_MAX_PX
+    {
+        return false;
+    }
+    let words = blocked.as_slice();
+    (rmin..=rmax).all(|row| {
+        let base = row as usize * frame.width;
+        crate::bits::for_each_set(
+            base + cmin as usize,
+            base + cmax as usize + 1,
+            |k| words[k],
+            |_| false,
+        )
+    })
+}
+
+/// The largest pixel box [`box_clear`] looks at (larger ones go to the exact tests, which
+/// skip open space by the distance transform).
+const BOX_CLEAR_MAX_PX: i64 = 64;
 
 /// The true map plus keep-out pixels (the approach's obstacles).
 struct Approach<'a> {

@@ -806,7 +806,18 @@ impl TileSearch {
             if node.stamp == gen + 1 || (node.stamp == gen && nd >= node.dist) {
                 continue;
             }
-            let f = nd + goal.map_or(0, |gl| heuristic(v, gl));
+            let f = match goal {
+                Some(gl) => {
+                    // The octile cost to the goal bounds the remaining cost from below and
+                    // is at least the Euclidean heuristic: a label beyond `bound` by it lies
+                    // on no path of cost `<= bound` (see [`Self::astar_bounded`]).
+                    if bound != u64::MAX && nd + octile(v, gl) > bound {
+                        continue;
+                    }
+                    nd + heuristic(v, gl)
+                }
+                None => nd,
+            };
             if f > bound {
                 continue;
             }
@@ -1739,9 +1750,23 @@ impl Mind {
     fn judge_step(&self, t: Tile, n: Tile) -> Judgement {
         let ((ra, rb), (ca, cb)) = self.touch_box(t);
         let ((rc, rd), (cc, cd)) = self.touch_box(n);
-        let (r0, r1, c0, c1) = (ra.min(rc), rb.max(rd), ca.min(cc), cb.max(cd));
+        if self.box_known_free((ra.min(rc), rb.max(rd)), (ca.min(cc), cb.max(cd))) {
+            return Judgement::Free;
+        }
+        judge_motion_px(
+            &self.known,
+            self.grid_center(t),
+            self.grid_center(n),
+            self.rc_px,
+        )
+    }
+
+    /// Are the image rows `r0..=r1` and columns `c0..=c1` (signed) inside the image, at most
+    /// 1024 pixels, and all known free?
+    #[inline]
+    fn box_known_free(&self, (r0, r1): (i64, i64), (c0, c1): (i64, i64)) -> bool {
         let frame = self.known.frame();
-        if 0 <= r0
+        0 <= r0
             && r0 <= r1
             && r1 < frame.height as i64
             && 0 <= c0
@@ -1751,15 +1776,6 @@ impl Mind {
             && self
                 .known
                 .rect_known_free(r0 as usize, r1 as usize, c0 as usize, c1 as usize)
-        {
-            return Judgement::Free;
-        }
-        judge_motion_px(
-            &self.known,
-            self.grid_center(t),
-            self.grid_center(n),
-            self.rc_px,
-        )
     }
 
     /// The centre of tile `t` in continuous grid coordinates: `world_to_grid(center(t))`.
@@ -1924,7 +1940,13 @@ impl Mind {
                     if !hit {
                         continue;
                     }
-                    self.judge_tile_first(k, self.grid_center(t))
+                    if self.box_known_free((r_lo, r_hi), (c_lo, c_hi)) {
+                        // Every pixel that can touch the disk is known free: free, as the
+                        // exact test finds (nothing to cache: the judgement is final).
+                        Judgement::Free
+                    } else {
+                        self.judge_tile_first(k, self.grid_center(t))
+                    }
                 } else {
                     // Cached: the disk's own pixel runs against the new ones.
                     let n = self.disk.rows;
@@ -2053,10 +2075,22 @@ impl Mind {
             return;
         }
         self.tiles.state[k] |= ST_COVERED;
+        // The touch boxes of the 3 x 3 tiles around `t` hold every pixel any of its moves can
+        // touch: all known free (and inside the image), every move is free, as
+        // `Mind::judge_move` would find (no neighbour can be judged blocked then).
+        let ((r0, _), (c0, _)) = self.touch_box((t.0 - 1, t.1 + 1));
+        let ((_, r1), (_, c1)) = self.touch_box((t.0 + 1, t.1 - 1));
+        let all_free = self.box_known_free((r0, r1), (c0, c1));
         for n in 0..8 {
             let v = (t.0 + N8[n].0, t.1 + N8[n].1);
             if n % 2 == 0 || self.tiles.covered(v) {
-                self.judge_move(t, n);
+                if all_free {
+                    if self.tiles.cached_move(t, n) == Judgement::Undetermined {
+                        self.tiles.set_move(t, n, Judgement::Free);
+                    }
+                } else {
+                    self.judge_move(t, n);
+                }
             }
         }
         self.tiles.update_l_around(t);
