@@ -752,12 +752,12 @@ impl World {
         let frame = self.frame();
         let ga = frame.world_to_grid(a);
         let gb = frame.world_to_grid(b);
-        let len = ga.dist(gb);
         let r_px = self.r_px();
         let rc = contact_radius_px(r_px);
         if box_clear(frame, ga, gb, rc, blocked) {
             return None;
         }
+        let len = ga.dist(gb);
         if len == 0.0 {
             return if collide::disk_hits(map, ga, r_px) {
                 Some(0.0)

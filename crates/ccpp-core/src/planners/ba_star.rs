@@ -1389,7 +1389,7 @@ impl TileModel {
     /// value as [`TileModel::mu`], which tests check through [`BaStar::backtrack_list_full`]).
     fn update_l(&mut self, t: Tile) {
         let Some(k) = self.idx(t) else { return };
-        if self.state[k] & ST_COVERED != 0 && self.block3(t).mu(self.lane_end_corners) >= 1 {
+        if self.state[k] & ST_COVERED != 0 && self.block3(t).in_l(self.lane_end_corners) {
             self.l.insert(k);
         } else {
             self.l.remove(k);
@@ -1435,7 +1435,7 @@ impl TileModel {
                 b.state[3 * r..3 * r + 3].copy_from_slice(&state[sw..sw + 3]);
                 b.moves[3 * r..3 * r + 3].copy_from_slice(&moves[sw..sw + 3]);
             }
-            if b.mu(self.lane_end_corners) >= 1 {
+            if b.in_l(self.lane_end_corners) {
                 self.l.insert(kc);
             } else {
                 self.l.remove(kc);
@@ -1496,7 +1496,47 @@ impl Block3 {
         !self.covered((d.0 + N8[k].0, d.1 + N8[k].1)) && self.move_free(d, k)
     }
 
+    /// `mu >= 1` for the centre tile ([`TileModel::mu`]): the same pairs, stopping at the
+    /// first that counts.
+    #[inline]
+    fn in_l(&self, lane_end_corners: bool) -> bool {
+        let s = (0, 0);
+        let f0 = self.free_uncovered(s, 0);
+        let f4 = self.free_uncovered(s, 4);
+        let f6 = self.free_uncovered(s, 6);
+        if !(f0 || f4 || f6) {
+            return false;
+        }
+        let blocked = |k: usize| self.covered(N8[k]) || self.stand_blocked(N8[k]);
+        // corner_score: (s1,s8), (s1,s2), (s5,s6), (s5,s4), (s7,s6), (s7,s8).
+        if (f0 && (blocked(7) || blocked(1)))
+            || (f4 && (blocked(5) || blocked(3)))
+            || (f6 && (blocked(5) || blocked(7)))
+        {
+            return true;
+        }
+        if !lane_end_corners {
+            return false;
+        }
+        // lane_end_score: (s1,s3), (s1,s7), (s5,s3), (s5,s7) against obstacles; (s7,s1),
+        // (s7,s5) against blocked tiles.
+        if ((f0 || f4) && (self.stand_blocked(N8[2]) || self.stand_blocked(N8[6])))
+            || (f6 && (blocked(0) || blocked(4)))
+        {
+            return true;
+        }
+        let free = [f0, false, false, false, f4, false, f6, false];
+        SIDE_END_PAIRS.iter().any(|&(a, b)| {
+            free[a] && !self.free_uncovered(s, b) && {
+                // Not [`TileModel::side_continues`].
+                let n = N8[b];
+                !(self.covered(n) && self.move_free(s, b) && self.free_uncovered(n, a))
+            }
+        })
+    }
+
     /// [`TileModel::mu`] of the centre tile.
+    #[cfg(test)]
     fn mu(&self, lane_end_corners: bool) -> u32 {
         let s = (0, 0);
         let mut free = [false; 8];
@@ -2609,6 +2649,46 @@ mod tests {
             }
             assert_eq!(q.pop(), None);
         }
+    }
+
+    /// `Block3::in_l` (the early-stopping test the incremental L uses) is `mu >= 1`, over
+    /// random blocks of tile states and move judgements.
+    #[test]
+    fn block_in_l_is_mu_at_least_one() {
+        let mut seed: u64 = 0x2545_f491_4f6c_dd1d;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        };
+        let mut fired = [0usize; 2];
+        for _ in 0..200_000 {
+            let mut b = Block3 {
+                state: [0; 9],
+                moves: [0; 9],
+            };
+            for k in 0..9 {
+                let r = next();
+                // Standability 0..=2, covered about half the time; each move slot 0..=2.
+                b.state[k] = (r % 3) as u8 | if r >> 8 & 1 == 1 { ST_COVERED } else { 0 };
+                b.moves[k] = (0..4).fold(0u8, |m, s| {
+                    m | ((((r >> (16 + 2 * s)) % 3) as u8) << (2 * s))
+                });
+            }
+            for lane in [false, true] {
+                let want = b.mu(lane) >= 1;
+                assert_eq!(
+                    b.in_l(lane),
+                    want,
+                    "{:?} {:?} lane {lane}",
+                    b.state,
+                    b.moves
+                );
+                fired[usize::from(lane)] += usize::from(want);
+            }
+        }
+        assert!(fired[0] > 10_000 && fired[1] > fired[0], "{fired:?}");
     }
 
     #[test]
