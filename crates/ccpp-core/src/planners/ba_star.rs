@@ -1361,21 +1361,22 @@ impl TileModel {
         let di = s.0 - self.i0;
         let dj = s.1 - self.j0;
         let mut b = Block3 {
-            state: [BLOCK3_OUTSIDE_STATE; 9],
-            moves: [BLOCK3_OUTSIDE_MOVES; 9],
+            state: [BLOCK3_OUTSIDE_STATE; 25],
+            moves: [BLOCK3_OUTSIDE_MOVES; 25],
+            c: 12,
         };
         if di >= 1 && dj >= 1 && di as usize + 1 < self.w && dj as usize + 1 < self.h {
             let sw = (dj as usize - 1) * self.w + di as usize - 1;
             for r in 0..3 {
                 let k = sw + r * self.w;
-                b.state[3 * r..3 * r + 3].copy_from_slice(&self.state[k..k + 3]);
-                b.moves[3 * r..3 * r + 3].copy_from_slice(&self.moves[k..k + 3]);
+                b.state[6 + 5 * r..9 + 5 * r].copy_from_slice(&self.state[k..k + 3]);
+                b.moves[6 + 5 * r..9 + 5 * r].copy_from_slice(&self.moves[k..k + 3]);
             }
         } else {
             for dy in -1..=1 {
                 for dx in -1..=1 {
                     if let Some(k) = self.idx((s.0 + dx, s.1 + dy)) {
-                        let at = Block3::at((dx, dy));
+                        let at = b.at((dx, dy));
                         b.state[at] = self.state[k];
                         b.moves[at] = self.moves[k];
                     }
@@ -1411,30 +1412,25 @@ impl TileModel {
         }
         let w = self.w;
         let k = dj as usize * w + di as usize;
-        let mut state = [0u8; 25];
-        let mut moves = [0u8; 25];
+        let mut b = Block3 {
+            state: [0; 25],
+            moves: [0; 25],
+            c: 12,
+        };
         for r in 0..5 {
             let base = k - 2 * w - 2 + r * w;
-            state[5 * r..5 * r + 5].copy_from_slice(&self.state[base..base + 5]);
-            moves[5 * r..5 * r + 5].copy_from_slice(&self.moves[base..base + 5]);
+            b.state[5 * r..5 * r + 5].copy_from_slice(&self.state[base..base + 5]);
+            b.moves[5 * r..5 * r + 5].copy_from_slice(&self.moves[base..base + 5]);
         }
         for (dx, dy) in std::iter::once((0, 0)).chain(N8) {
             // The tile's index in the copy and in the dense arrays.
             let c = ((dy + 2) * 5 + dx + 2) as usize;
             let kc = (k as isize + dy as isize * w as isize + dx as isize) as usize;
-            if state[c] & ST_COVERED == 0 {
+            if b.state[c] & ST_COVERED == 0 {
                 self.l.remove(kc);
                 continue;
             }
-            let mut b = Block3 {
-                state: [0; 9],
-                moves: [0; 9],
-            };
-            for r in 0..3 {
-                let sw = c - 6 + 5 * r;
-                b.state[3 * r..3 * r + 3].copy_from_slice(&state[sw..sw + 3]);
-                b.moves[3 * r..3 * r + 3].copy_from_slice(&moves[sw..sw + 3]);
-            }
+            b.c = c;
             if b.in_l(self.lane_end_corners) {
                 self.l.insert(kc);
             } else {
@@ -1458,28 +1454,31 @@ const BLOCK3_OUTSIDE_STATE: u8 = Judgement::Blocked as u8;
 /// [`TileModel::cached_move`] reads it).
 const BLOCK3_OUTSIDE_MOVES: u8 = 0b1010_1010;
 
-/// A copy of the tile states and move bytes of the 3 x 3 tiles around a tile `s` (index
-/// `(dj + 1) * 3 + di + 1` for the offset `(di, dj)`): everything `mu(s)` reads, so `mu` runs on
-/// a few registers instead of bounds-checked lookups into the dense arrays.
+/// A copy of the tile states and move bytes of a 5 x 5 block of tiles (index
+/// `(dj + 2) * 5 + di + 2` for the offset `(di, dj)` from the middle tile), read around the
+/// tile at index `c` (whose 3 x 3 tiles must lie in the block): everything `mu` of that tile
+/// reads, so `mu` runs on a small local copy instead of bounds-checked lookups into the dense
+/// arrays, and the nine tiles around a newly covered one share one copy.
 struct Block3 {
-    state: [u8; 9],
-    moves: [u8; 9],
+    state: [u8; 25],
+    moves: [u8; 25],
+    c: usize,
 }
 
 impl Block3 {
     #[inline]
-    fn at(d: Tile) -> usize {
-        ((d.1 + 1) * 3 + d.0 + 1) as usize
+    fn at(&self, d: Tile) -> usize {
+        (self.c as isize + (d.1 * 5 + d.0) as isize) as usize
     }
 
     #[inline]
     fn covered(&self, d: Tile) -> bool {
-        self.state[Self::at(d)] & ST_COVERED != 0
+        self.state[self.at(d)] & ST_COVERED != 0
     }
 
     #[inline]
     fn stand_blocked(&self, d: Tile) -> bool {
-        Judgement::from_bits(self.state[Self::at(d)] & ST_STAND) == Judgement::Blocked
+        Judgement::from_bits(self.state[self.at(d)] & ST_STAND) == Judgement::Blocked
     }
 
     /// [`TileModel::cached_move`] of the move `d -> d + N8[k]` is free (its owner tile must lie
@@ -1487,7 +1486,7 @@ impl Block3 {
     #[inline]
     fn move_free(&self, d: Tile, k: usize) -> bool {
         let (o, slot) = TileModel::move_slot(d, k);
-        Judgement::from_bits(self.moves[Self::at(o)] >> (2 * slot)) == Judgement::Free
+        Judgement::from_bits(self.moves[self.at(o)] >> (2 * slot)) == Judgement::Free
     }
 
     /// [`TileModel::free_uncovered`] for the neighbour `k` of the block tile `d`.
@@ -2665,10 +2664,11 @@ mod tests {
         let mut fired = [0usize; 2];
         for _ in 0..200_000 {
             let mut b = Block3 {
-                state: [0; 9],
-                moves: [0; 9],
+                state: [0; 25],
+                moves: [0; 25],
+                c: 12,
             };
-            for k in 0..9 {
+            for k in 0..25 {
                 let r = next();
                 // Standability 0..=2, covered about half the time; each move slot 0..=2.
                 b.state[k] = (r % 3) as u8 | if r >> 8 & 1 == 1 { ST_COVERED } else { 0 };
