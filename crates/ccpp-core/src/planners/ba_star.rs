@@ -835,15 +835,23 @@ impl TileSearch {
     }
 
     /// [`Self::astar`] when the cost of the best path is known to be `cost` (say from
-    /// [`Self::nearest`] on the same graph): the same answer, without labelling the tiles whose
-    /// key `cost + heuristic` exceeds `cost`.
+    /// [`Self::nearest`] on the same graph): the same answer, without labelling a tile whose
+    /// label plus the [`octile`] cost to the goal exceeds `cost` (the keys stay `cost +`
+    /// Euclidean heuristic; the octile cost is at least that heuristic).
     ///
-    /// Why it is the same: the queue pops pairs in `(key, index)` order, so leaving out pairs
-    /// keyed above `cost` changes neither the order of the others nor any label at or below it
-    /// (a later, better label of a left-out tile is pushed as it would have been). The goal's
-    /// key is its cost; while the full search pops only keys `<= cost` it runs exactly as this
-    /// one. Should it pop a larger key before the goal (only possible with an inconsistent
-    /// heuristic), this one runs dry first and the full search is run instead.
+    /// Why it is the same: the octile cost is a lower bound of the remaining cost, so a
+    /// left-out label is either worse than its tile's best cost or belongs to a tile on no
+    /// cheapest path to the goal. Call the tiles on cheapest paths *optimal*. With a consistent
+    /// heuristic every tile is settled through the label of its best cost, and an optimal
+    /// tile's best label is pushed when the first of its optimal predecessors (in settling
+    /// order) is expanded, with that predecessor as parent; no left-out or other label of
+    /// another tile can set or block it (they are worse, or from tiles that are not optimal
+    /// predecessors). So the best labels of optimal tiles are pushed at the same points of the
+    /// sequence of optimal settlings in both searches, and as the queue pops pairs in
+    /// `(key, index)` order, both settle the optimal tiles in the same order, with the same
+    /// parents, up to the goal: the same path and cost. Should the bound be too low (or the
+    /// heuristic inconsistent), this search runs dry before the goal and the full search is
+    /// run instead.
     pub fn astar_bounded(
         &mut self,
         g: &impl TileGraph,
@@ -2116,9 +2124,14 @@ impl Mind {
         self.tiles.state[k] |= ST_COVERED;
         // The touch boxes of the 3 x 3 tiles around `t` hold every pixel any of its moves can
         // touch: all known free (and inside the image), every move is free, as
-        // `Mind::judge_move` would find (no neighbour can be judged blocked then).
-        let ((r0, _), (c0, _)) = self.touch_box((t.0 - 1, t.1 + 1));
-        let ((_, r1), (_, c1)) = self.touch_box((t.0 + 1, t.1 - 1));
+        // `Mind::judge_move` would find (no neighbour can be judged blocked then). The boxes
+        // are one box moved with the tile centre, so their hull is that of the four corner
+        // tiles' boxes (in a rotated frame too).
+        let (mut r0, mut r1, mut c0, mut c1) = (i64::MAX, i64::MIN, i64::MAX, i64::MIN);
+        for (di, dj) in [(-1, -1), (1, -1), (-1, 1), (1, 1)] {
+            let ((ra, rb), (ca, cb)) = self.touch_box((t.0 + di, t.1 + dj));
+            (r0, r1, c0, c1) = (r0.min(ra), r1.max(rb), c0.min(ca), c1.max(cb));
+        }
         let all_free = self.box_known_free((r0, r1), (c0, c1));
         for n in 0..8 {
             let v = (t.0 + N8[n].0, t.1 + N8[n].1);
