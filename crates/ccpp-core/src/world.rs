@@ -803,7 +803,8 @@ impl World {
 fn box_clear(frame: &MapFrame, a: Point, b: Point, rc: f64, blocked: &FixedBitSet) -> bool {
     let eps = 1e-7;
     let h = frame.height as f64;
-    if !(a.x.is_finite() && a.y.is_finite() && b.x.is_finite() && b.y.is_finite()) {
+    if !(a.x.is_finite() && a.y.is_finite() && b.x.is_finite() && b.y.is_finite() && rc.is_finite())
+    {
         return false;
     }
     let cmin = ceil_i64(a.x.min(b.x) - rc - 0.5 - eps);
@@ -1010,6 +1011,60 @@ mod tests {
             s.push('\n');
         }
         GridMap::from_ascii_scaled(&s, 1, res).unwrap()
+    }
+
+    /// Whenever the free-box test clears a short motion, the exact tests find no contact:
+    /// random clutter, motions between pixel centres and anywhere, several radii.
+    #[test]
+    fn free_box_agrees_with_the_exact_contact_tests() {
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (w, h) = (40usize, 30usize);
+        let mut art = String::new();
+        for _ in 0..h {
+            for _ in 0..w {
+                art.push(if next() < 0.12 { '#' } else { '.' });
+            }
+            art.push('\n');
+        }
+        let map: GridMap = art.trim_end().parse().expect("map");
+        let cells = map.cells();
+        let blocked = bitset_where(map.frame().len(), |i| !cells[i].is_free());
+        let truth = Truth {
+            map: &map,
+            blocked: &blocked,
+        };
+        let frame = *map.frame();
+        let mut cleared = 0;
+        for k in 0..40_000 {
+            let centred = k % 2 == 0;
+            let mut p = || {
+                let (x, y) = (next() * w as f64, next() * h as f64);
+                if centred {
+                    Point::new(x.floor() + 0.5, y.floor() + 0.5)
+                } else {
+                    Point::new(x, y)
+                }
+            };
+            let a = p();
+            let b = match k % 3 {
+                0 => a,
+                1 => Point::new(a.x + (next() * 4.0 - 2.0).round(), a.y),
+                _ => Point::new(a.x + next() * 3.0 - 1.5, a.y + next() * 3.0 - 1.5),
+            };
+            let r_px = [0.5, 1.0, 1.5, next() * 2.0][k % 4];
+            if box_clear(&frame, a, b, contact_radius_px(r_px), &blocked) {
+                cleared += 1;
+                assert_eq!(collide::segment_first_contact(&truth, a, b, r_px), None);
+                assert!(!collide::disk_hits(&map, a, r_px) && !collide::disk_hits(&map, b, r_px));
+            }
+        }
+        assert!(cleared > 2000, "{cleared}");
     }
 
     #[test]
