@@ -145,6 +145,43 @@ impl<'a> Scan<'a> {
         }
     }
 
+    /// [`Self::for_each_row_span`] for scans whose pixel box is at most [`SMALL_SCAN_COLS`]
+    /// columns wide (`false`, and no call, otherwise): the squared column offsets are computed
+    /// once for the box and each row's interval is read off them by the same in-range test,
+    /// without a square root per row.
+    pub(crate) fn small_row_spans(&self, mut f: impl FnMut(usize, usize, usize)) -> bool {
+        let r2 = self.range_px * self.range_px;
+        let h = self.map.frame().height as f64;
+        let (c0, c1, r0, r1) = self.pixel_box();
+        if c0 > c1 {
+            return true;
+        }
+        let n = c1 - c0 + 1;
+        if n > SMALL_SCAN_COLS {
+            return false;
+        }
+        let mut dx2 = [0.0f64; SMALL_SCAN_COLS];
+        for (k, v) in dx2[..n].iter_mut().enumerate() {
+            let dx = (c0 + k) as f64 + 0.5 - self.center.x;
+            *v = dx * dx;
+        }
+        let dx2 = &dx2[..n];
+        for row in r0..=r1 {
+            let gy = h - row as f64 - 0.5;
+            let dy2 = (gy - self.center.y).powi(2);
+            if dy2 > r2 {
+                continue;
+            }
+            // The in-range columns of a row are one interval (see `row_spans_beyond`).
+            let Some(lo) = dx2.iter().position(|&v| v + dy2 <= r2) else {
+                continue;
+            };
+            let hi = dx2.iter().rposition(|&v| v + dy2 <= r2).unwrap_or(lo);
+            f(row, c0 + lo, c0 + hi);
+        }
+        true
+    }
+
     /// The columns `c0..=c1` and rows `r0..=r1` of the image that can hold in-range pixels
     /// (`c0 > c1` when none can).
     fn pixel_box(&self) -> (usize, usize, usize, usize) {
@@ -181,6 +218,9 @@ impl<'a> Scan<'a> {
         }
     }
 }
+
+/// The widest pixel box (columns) [`Scan::small_row_spans`] takes.
+const SMALL_SCAN_COLS: usize = 16;
 
 /// Margin (pixels) by which a row of a scan must lie inside an earlier scan's disk to be left
 /// out of [`Scan::row_spans_beyond`]: far above the rounding of the in-range tests.
@@ -346,7 +386,9 @@ impl KnownMap {
     /// The same pixels are stored as by [`Self::integrate_with`], without a call per pixel.
     ///
     /// `prev`: the [`Scan::disk_px`] of the scan integrated last into this map (of the same
-    /// true map), if any; the rows already in its range are skipped (the leading edge).
+    /// true map), if any; the rows already in its range are skipped (the leading edge). Small
+    /// scans ([`Scan::small_row_spans`]) visit every row instead: a row with nothing new costs
+    /// a word of the seen bitset, less than deciding to skip it.
     pub(crate) fn integrate_rows(
         &mut self,
         scan: &Scan<'_>,
@@ -358,7 +400,7 @@ impl KnownMap {
         let cells = self.grid.cells_mut();
         let seen = self.seen.as_mut_slice();
         let free = self.free.as_mut_slice();
-        scan.row_spans_beyond(prev, |row, lo, hi| {
+        let mut row_span = |row: usize, lo: usize, hi: usize| {
             let base = row * w;
             let (mut first, mut last) = (usize::MAX, 0);
             crate::bits::insert_range(seen, base + lo, base + hi + 1, |i| {
@@ -373,7 +415,10 @@ impl KnownMap {
             if first <= last {
                 new_in_row(row, first - base, last - base);
             }
-        });
+        };
+        if !scan.small_row_spans(&mut row_span) {
+            scan.row_spans_beyond(prev, row_span);
+        }
     }
 
     /// The frame.
@@ -571,6 +616,7 @@ mod tests {
             seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
             (seed >> 11) as f64 / (1u64 << 53) as f64
         };
+        let mut small = 0;
         for k in 0..3000 {
             let center = Point::new(next() * 2.4 - 0.3, next() * 1.6 - 0.3);
             // Ranges on and off pixel-centre distances, down to nothing.
@@ -585,7 +631,14 @@ mod tests {
             let mut b = Vec::new();
             scan.for_each_row_span(|r, lo, hi| b.extend((lo..=hi).map(|c| (c, r))));
             assert_eq!(a, b, "centre {center:?} range {range}");
+            let mut c = Vec::new();
+            if scan.small_row_spans(|r, lo, hi| c.extend((lo..=hi).map(|c| (c, r)))) {
+                assert_eq!(a, c, "small: centre {center:?} range {range}");
+                small += 1;
+            }
         }
+        // Ranges up to 0.6 m are at most 25 px wide: most scans take the small path too.
+        assert!(small > 1000, "{small}");
     }
 
     /// The leading edge: the rows `row_spans_beyond` leaves out hold only pixels in range of

@@ -9,7 +9,7 @@ use std::ops::{Add, Sub};
 use crate::collide::{self, contact_radius_px};
 use crate::display::Compact;
 use crate::dt::{squared_edt, squared_edt_compact, CompactDt, INF};
-use crate::geometry::{Point, Pose};
+use crate::geometry::{ceil_i64, floor_i64, Point, Pose};
 use crate::grid::{Cell, GridMap, MapFrame};
 use crate::search::{fill_runs, Connectivity};
 use crate::zones::{MaskOccupancy, ZoneMasks};
@@ -752,9 +752,12 @@ impl World {
         let frame = self.frame();
         let ga = frame.world_to_grid(a);
         let gb = frame.world_to_grid(b);
-        let len = ga.dist(gb);
         let r_px = self.r_px();
         let rc = contact_radius_px(r_px);
+        if box_clear(frame, ga, gb, rc, blocked) {
+            return None;
+        }
+        let len = ga.dist(gb);
         if len == 0.0 {
             return if collide::disk_hits(map, ga, r_px) {
                 Some(0.0)
@@ -788,6 +791,47 @@ impl World {
         self.first_contact(a, b).is_none()
     }
 }
+
+/// Is every pixel that can touch the disk of contact radius `rc` pixels moving from grid point
+/// `a` to `b` inside the image and not in `blocked`? A pixel touches only when its centre lies
+/// within `rc` of the segment ([`collide::segment_first_contact`], [`collide::disk_hits`]),
+/// so within `rc` of the segment's bounding box in each coordinate; the box of those pixels is
+/// taken with a margin far below the contact tolerance and far above the rounding of grid
+/// coordinates. `true` means no contact (the exact tests would find none); `false` means
+/// "ask them" (also for boxes of more than [`BOX_CLEAR_MAX_PX`] pixels and non-finite points).
+#[inline]
+fn box_clear(frame: &MapFrame, a: Point, b: Point, rc: f64, blocked: &FixedBitSet) -> bool {
+    let eps = 1e-7;
+    let h = frame.height as f64;
+    if !(a.x.is_finite() && a.y.is_finite() && b.x.is_finite() && b.y.is_finite() && rc.is_finite())
+    {
+        return false;
+    }
+    let cmin = ceil_i64(a.x.min(b.x) - rc - 0.5 - eps);
+    let cmax = floor_i64(a.x.max(b.x) + rc - 0.5 + eps);
+    let rmin = ceil_i64(h - a.y.max(b.y) - rc - 0.5 - eps);
+    let rmax = floor_i64(h - a.y.min(b.y) + rc - 0.5 + eps);
+    let (w, hh) = (frame.width as i64, frame.height as i64);
+    if !(0 <= cmin && cmin <= cmax && cmax < w && 0 <= rmin && rmin <= rmax && rmax < hh)
+        || (cmax - cmin + 1) * (rmax - rmin + 1) > BOX_CLEAR_MAX_PX
+    {
+        return false;
+    }
+    let words = blocked.as_slice();
+    (rmin..=rmax).all(|row| {
+        let base = row as usize * frame.width;
+        crate::bits::for_each_set(
+            base + cmin as usize,
+            base + cmax as usize + 1,
+            |k| words[k],
+            |_| false,
+        )
+    })
+}
+
+/// The largest pixel box [`box_clear`] looks at (larger ones go to the exact tests, which
+/// skip open space by the distance transform).
+const BOX_CLEAR_MAX_PX: i64 = 64;
 
 /// The true map plus keep-out pixels (the approach's obstacles).
 struct Approach<'a> {
@@ -967,6 +1011,60 @@ mod tests {
             s.push('\n');
         }
         GridMap::from_ascii_scaled(&s, 1, res).unwrap()
+    }
+
+    /// Whenever the free-box test clears a short motion, the exact tests find no contact:
+    /// random clutter, motions between pixel centres and anywhere, several radii.
+    #[test]
+    fn free_box_agrees_with_the_exact_contact_tests() {
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (w, h) = (40usize, 30usize);
+        let mut art = String::new();
+        for _ in 0..h {
+            for _ in 0..w {
+                art.push(if next() < 0.12 { '#' } else { '.' });
+            }
+            art.push('\n');
+        }
+        let map: GridMap = art.trim_end().parse().expect("map");
+        let cells = map.cells();
+        let blocked = bitset_where(map.frame().len(), |i| !cells[i].is_free());
+        let truth = Truth {
+            map: &map,
+            blocked: &blocked,
+        };
+        let frame = *map.frame();
+        let mut cleared = 0;
+        for k in 0..40_000 {
+            let centred = k % 2 == 0;
+            let mut p = || {
+                let (x, y) = (next() * w as f64, next() * h as f64);
+                if centred {
+                    Point::new(x.floor() + 0.5, y.floor() + 0.5)
+                } else {
+                    Point::new(x, y)
+                }
+            };
+            let a = p();
+            let b = match k % 3 {
+                0 => a,
+                1 => Point::new(a.x + (next() * 4.0 - 2.0).round(), a.y),
+                _ => Point::new(a.x + next() * 3.0 - 1.5, a.y + next() * 3.0 - 1.5),
+            };
+            let r_px = [0.5, 1.0, 1.5, next() * 2.0][k % 4];
+            if box_clear(&frame, a, b, contact_radius_px(r_px), &blocked) {
+                cleared += 1;
+                assert_eq!(collide::segment_first_contact(&truth, a, b, r_px), None);
+                assert!(!collide::disk_hits(&map, a, r_px) && !collide::disk_hits(&map, b, r_px));
+            }
+        }
+        assert!(cleared > 2000, "{cleared}");
     }
 
     #[test]

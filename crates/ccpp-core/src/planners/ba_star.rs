@@ -806,7 +806,18 @@ impl TileSearch {
             if node.stamp == gen + 1 || (node.stamp == gen && nd >= node.dist) {
                 continue;
             }
-            let f = nd + goal.map_or(0, |gl| heuristic(v, gl));
+            let f = match goal {
+                Some(gl) => {
+                    // The octile cost to the goal bounds the remaining cost from below and
+                    // is at least the Euclidean heuristic: a label beyond `bound` by it lies
+                    // on no path of cost `<= bound` (see [`Self::astar_bounded`]).
+                    if bound != u64::MAX && nd + octile(v, gl) > bound {
+                        continue;
+                    }
+                    nd + heuristic(v, gl)
+                }
+                None => nd,
+            };
             if f > bound {
                 continue;
             }
@@ -824,15 +835,23 @@ impl TileSearch {
     }
 
     /// [`Self::astar`] when the cost of the best path is known to be `cost` (say from
-    /// [`Self::nearest`] on the same graph): the same answer, without labelling the tiles whose
-    /// key `cost + heuristic` exceeds `cost`.
+    /// [`Self::nearest`] on the same graph): the same answer, without labelling a tile whose
+    /// label plus the [`octile`] cost to the goal exceeds `cost` (the keys stay `cost +`
+    /// Euclidean heuristic; the octile cost is at least that heuristic).
     ///
-    /// Why it is the same: the queue pops pairs in `(key, index)` order, so leaving out pairs
-    /// keyed above `cost` changes neither the order of the others nor any label at or below it
-    /// (a later, better label of a left-out tile is pushed as it would have been). The goal's
-    /// key is its cost; while the full search pops only keys `<= cost` it runs exactly as this
-    /// one. Should it pop a larger key before the goal (only possible with an inconsistent
-    /// heuristic), this one runs dry first and the full search is run instead.
+    /// Why it is the same: the octile cost is a lower bound of the remaining cost, so a
+    /// left-out label is either worse than its tile's best cost or belongs to a tile on no
+    /// cheapest path to the goal. Call the tiles on cheapest paths *optimal*. With a consistent
+    /// heuristic every tile is settled through the label of its best cost, and an optimal
+    /// tile's best label is pushed when the first of its optimal predecessors (in settling
+    /// order) is expanded, with that predecessor as parent; no left-out or other label of
+    /// another tile can set or block it (they are worse, or from tiles that are not optimal
+    /// predecessors). So the best labels of optimal tiles are pushed at the same points of the
+    /// sequence of optimal settlings in both searches, and as the queue pops pairs in
+    /// `(key, index)` order, both settle the optimal tiles in the same order, with the same
+    /// parents, up to the goal: the same path and cost. Should the bound be too low (or the
+    /// heuristic inconsistent), this search runs dry before the goal and the full search is
+    /// run instead.
     pub fn astar_bounded(
         &mut self,
         g: &impl TileGraph,
@@ -1350,21 +1369,22 @@ impl TileModel {
         let di = s.0 - self.i0;
         let dj = s.1 - self.j0;
         let mut b = Block3 {
-            state: [BLOCK3_OUTSIDE_STATE; 9],
-            moves: [BLOCK3_OUTSIDE_MOVES; 9],
+            state: [BLOCK3_OUTSIDE_STATE; 25],
+            moves: [BLOCK3_OUTSIDE_MOVES; 25],
+            c: 12,
         };
         if di >= 1 && dj >= 1 && di as usize + 1 < self.w && dj as usize + 1 < self.h {
             let sw = (dj as usize - 1) * self.w + di as usize - 1;
             for r in 0..3 {
                 let k = sw + r * self.w;
-                b.state[3 * r..3 * r + 3].copy_from_slice(&self.state[k..k + 3]);
-                b.moves[3 * r..3 * r + 3].copy_from_slice(&self.moves[k..k + 3]);
+                b.state[6 + 5 * r..9 + 5 * r].copy_from_slice(&self.state[k..k + 3]);
+                b.moves[6 + 5 * r..9 + 5 * r].copy_from_slice(&self.moves[k..k + 3]);
             }
         } else {
             for dy in -1..=1 {
                 for dx in -1..=1 {
                     if let Some(k) = self.idx((s.0 + dx, s.1 + dy)) {
-                        let at = Block3::at((dx, dy));
+                        let at = b.at((dx, dy));
                         b.state[at] = self.state[k];
                         b.moves[at] = self.moves[k];
                     }
@@ -1378,7 +1398,7 @@ impl TileModel {
     /// value as [`TileModel::mu`], which tests check through [`BaStar::backtrack_list_full`]).
     fn update_l(&mut self, t: Tile) {
         let Some(k) = self.idx(t) else { return };
-        if self.state[k] & ST_COVERED != 0 && self.block3(t).mu(self.lane_end_corners) >= 1 {
+        if self.state[k] & ST_COVERED != 0 && self.block3(t).in_l(self.lane_end_corners) {
             self.l.insert(k);
         } else {
             self.l.remove(k);
@@ -1400,31 +1420,26 @@ impl TileModel {
         }
         let w = self.w;
         let k = dj as usize * w + di as usize;
-        let mut state = [0u8; 25];
-        let mut moves = [0u8; 25];
+        let mut b = Block3 {
+            state: [0; 25],
+            moves: [0; 25],
+            c: 12,
+        };
         for r in 0..5 {
             let base = k - 2 * w - 2 + r * w;
-            state[5 * r..5 * r + 5].copy_from_slice(&self.state[base..base + 5]);
-            moves[5 * r..5 * r + 5].copy_from_slice(&self.moves[base..base + 5]);
+            b.state[5 * r..5 * r + 5].copy_from_slice(&self.state[base..base + 5]);
+            b.moves[5 * r..5 * r + 5].copy_from_slice(&self.moves[base..base + 5]);
         }
         for (dx, dy) in std::iter::once((0, 0)).chain(N8) {
             // The tile's index in the copy and in the dense arrays.
             let c = ((dy + 2) * 5 + dx + 2) as usize;
             let kc = (k as isize + dy as isize * w as isize + dx as isize) as usize;
-            if state[c] & ST_COVERED == 0 {
+            if b.state[c] & ST_COVERED == 0 {
                 self.l.remove(kc);
                 continue;
             }
-            let mut b = Block3 {
-                state: [0; 9],
-                moves: [0; 9],
-            };
-            for r in 0..3 {
-                let sw = c - 6 + 5 * r;
-                b.state[3 * r..3 * r + 3].copy_from_slice(&state[sw..sw + 3]);
-                b.moves[3 * r..3 * r + 3].copy_from_slice(&moves[sw..sw + 3]);
-            }
-            if b.mu(self.lane_end_corners) >= 1 {
+            b.c = c;
+            if b.in_l(self.lane_end_corners) {
                 self.l.insert(kc);
             } else {
                 self.l.remove(kc);
@@ -1447,28 +1462,31 @@ const BLOCK3_OUTSIDE_STATE: u8 = Judgement::Blocked as u8;
 /// [`TileModel::cached_move`] reads it).
 const BLOCK3_OUTSIDE_MOVES: u8 = 0b1010_1010;
 
-/// A copy of the tile states and move bytes of the 3 x 3 tiles around a tile `s` (index
-/// `(dj + 1) * 3 + di + 1` for the offset `(di, dj)`): everything `mu(s)` reads, so `mu` runs on
-/// a few registers instead of bounds-checked lookups into the dense arrays.
+/// A copy of the tile states and move bytes of a 5 x 5 block of tiles (index
+/// `(dj + 2) * 5 + di + 2` for the offset `(di, dj)` from the middle tile), read around the
+/// tile at index `c` (whose 3 x 3 tiles must lie in the block): everything `mu` of that tile
+/// reads, so `mu` runs on a small local copy instead of bounds-checked lookups into the dense
+/// arrays, and the nine tiles around a newly covered one share one copy.
 struct Block3 {
-    state: [u8; 9],
-    moves: [u8; 9],
+    state: [u8; 25],
+    moves: [u8; 25],
+    c: usize,
 }
 
 impl Block3 {
     #[inline]
-    fn at(d: Tile) -> usize {
-        ((d.1 + 1) * 3 + d.0 + 1) as usize
+    fn at(&self, d: Tile) -> usize {
+        (self.c as isize + (d.1 * 5 + d.0) as isize) as usize
     }
 
     #[inline]
     fn covered(&self, d: Tile) -> bool {
-        self.state[Self::at(d)] & ST_COVERED != 0
+        self.state[self.at(d)] & ST_COVERED != 0
     }
 
     #[inline]
     fn stand_blocked(&self, d: Tile) -> bool {
-        Judgement::from_bits(self.state[Self::at(d)] & ST_STAND) == Judgement::Blocked
+        Judgement::from_bits(self.state[self.at(d)] & ST_STAND) == Judgement::Blocked
     }
 
     /// [`TileModel::cached_move`] of the move `d -> d + N8[k]` is free (its owner tile must lie
@@ -1476,7 +1494,7 @@ impl Block3 {
     #[inline]
     fn move_free(&self, d: Tile, k: usize) -> bool {
         let (o, slot) = TileModel::move_slot(d, k);
-        Judgement::from_bits(self.moves[Self::at(o)] >> (2 * slot)) == Judgement::Free
+        Judgement::from_bits(self.moves[self.at(o)] >> (2 * slot)) == Judgement::Free
     }
 
     /// [`TileModel::free_uncovered`] for the neighbour `k` of the block tile `d`.
@@ -1485,7 +1503,47 @@ impl Block3 {
         !self.covered((d.0 + N8[k].0, d.1 + N8[k].1)) && self.move_free(d, k)
     }
 
+    /// `mu >= 1` for the centre tile ([`TileModel::mu`]): the same pairs, stopping at the
+    /// first that counts.
+    #[inline]
+    fn in_l(&self, lane_end_corners: bool) -> bool {
+        let s = (0, 0);
+        let f0 = self.free_uncovered(s, 0);
+        let f4 = self.free_uncovered(s, 4);
+        let f6 = self.free_uncovered(s, 6);
+        if !(f0 || f4 || f6) {
+            return false;
+        }
+        let blocked = |k: usize| self.covered(N8[k]) || self.stand_blocked(N8[k]);
+        // corner_score: (s1,s8), (s1,s2), (s5,s6), (s5,s4), (s7,s6), (s7,s8).
+        if (f0 && (blocked(7) || blocked(1)))
+            || (f4 && (blocked(5) || blocked(3)))
+            || (f6 && (blocked(5) || blocked(7)))
+        {
+            return true;
+        }
+        if !lane_end_corners {
+            return false;
+        }
+        // lane_end_score: (s1,s3), (s1,s7), (s5,s3), (s5,s7) against obstacles; (s7,s1),
+        // (s7,s5) against blocked tiles.
+        if ((f0 || f4) && (self.stand_blocked(N8[2]) || self.stand_blocked(N8[6])))
+            || (f6 && (blocked(0) || blocked(4)))
+        {
+            return true;
+        }
+        let free = [f0, false, false, false, f4, false, f6, false];
+        SIDE_END_PAIRS.iter().any(|&(a, b)| {
+            free[a] && !self.free_uncovered(s, b) && {
+                // Not [`TileModel::side_continues`].
+                let n = N8[b];
+                !(self.covered(n) && self.move_free(s, b) && self.free_uncovered(n, a))
+            }
+        })
+    }
+
     /// [`TileModel::mu`] of the centre tile.
+    #[cfg(test)]
     fn mu(&self, lane_end_corners: bool) -> u32 {
         let s = (0, 0);
         let mut free = [false; 8];
@@ -1739,9 +1797,23 @@ impl Mind {
     fn judge_step(&self, t: Tile, n: Tile) -> Judgement {
         let ((ra, rb), (ca, cb)) = self.touch_box(t);
         let ((rc, rd), (cc, cd)) = self.touch_box(n);
-        let (r0, r1, c0, c1) = (ra.min(rc), rb.max(rd), ca.min(cc), cb.max(cd));
+        if self.box_known_free((ra.min(rc), rb.max(rd)), (ca.min(cc), cb.max(cd))) {
+            return Judgement::Free;
+        }
+        judge_motion_px(
+            &self.known,
+            self.grid_center(t),
+            self.grid_center(n),
+            self.rc_px,
+        )
+    }
+
+    /// Are the image rows `r0..=r1` and columns `c0..=c1` (signed) inside the image, at most
+    /// 1024 pixels, and all known free?
+    #[inline]
+    fn box_known_free(&self, (r0, r1): (i64, i64), (c0, c1): (i64, i64)) -> bool {
         let frame = self.known.frame();
-        if 0 <= r0
+        0 <= r0
             && r0 <= r1
             && r1 < frame.height as i64
             && 0 <= c0
@@ -1751,15 +1823,6 @@ impl Mind {
             && self
                 .known
                 .rect_known_free(r0 as usize, r1 as usize, c0 as usize, c1 as usize)
-        {
-            return Judgement::Free;
-        }
-        judge_motion_px(
-            &self.known,
-            self.grid_center(t),
-            self.grid_center(n),
-            self.rc_px,
-        )
     }
 
     /// The centre of tile `t` in continuous grid coordinates: `world_to_grid(center(t))`.
@@ -1924,7 +1987,13 @@ impl Mind {
                     if !hit {
                         continue;
                     }
-                    self.judge_tile_first(k, self.grid_center(t))
+                    if self.box_known_free((r_lo, r_hi), (c_lo, c_hi)) {
+                        // Every pixel that can touch the disk is known free: free, as the
+                        // exact test finds (nothing to cache: the judgement is final).
+                        Judgement::Free
+                    } else {
+                        self.judge_tile_first(k, self.grid_center(t))
+                    }
                 } else {
                     // Cached: the disk's own pixel runs against the new ones.
                     let n = self.disk.rows;
@@ -2053,10 +2122,27 @@ impl Mind {
             return;
         }
         self.tiles.state[k] |= ST_COVERED;
+        // The touch boxes of the 3 x 3 tiles around `t` hold every pixel any of its moves can
+        // touch: all known free (and inside the image), every move is free, as
+        // `Mind::judge_move` would find (no neighbour can be judged blocked then). The boxes
+        // are one box moved with the tile centre, so their hull is that of the four corner
+        // tiles' boxes (in a rotated frame too).
+        let (mut r0, mut r1, mut c0, mut c1) = (i64::MAX, i64::MIN, i64::MAX, i64::MIN);
+        for (di, dj) in [(-1, -1), (1, -1), (-1, 1), (1, 1)] {
+            let ((ra, rb), (ca, cb)) = self.touch_box((t.0 + di, t.1 + dj));
+            (r0, r1, c0, c1) = (r0.min(ra), r1.max(rb), c0.min(ca), c1.max(cb));
+        }
+        let all_free = self.box_known_free((r0, r1), (c0, c1));
         for n in 0..8 {
             let v = (t.0 + N8[n].0, t.1 + N8[n].1);
             if n % 2 == 0 || self.tiles.covered(v) {
-                self.judge_move(t, n);
+                if all_free {
+                    if self.tiles.cached_move(t, n) == Judgement::Undetermined {
+                        self.tiles.set_move(t, n, Judgement::Free);
+                    }
+                } else {
+                    self.judge_move(t, n);
+                }
             }
         }
         self.tiles.update_l_around(t);
@@ -2575,6 +2661,47 @@ mod tests {
             }
             assert_eq!(q.pop(), None);
         }
+    }
+
+    /// `Block3::in_l` (the early-stopping test the incremental L uses) is `mu >= 1`, over
+    /// random blocks of tile states and move judgements.
+    #[test]
+    fn block_in_l_is_mu_at_least_one() {
+        let mut seed: u64 = 0x2545_f491_4f6c_dd1d;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        };
+        let mut fired = [0usize; 2];
+        for _ in 0..200_000 {
+            let mut b = Block3 {
+                state: [0; 25],
+                moves: [0; 25],
+                c: 12,
+            };
+            for k in 0..25 {
+                let r = next();
+                // Standability 0..=2, covered about half the time; each move slot 0..=2.
+                b.state[k] = (r % 3) as u8 | if r >> 8 & 1 == 1 { ST_COVERED } else { 0 };
+                b.moves[k] = (0..4).fold(0u8, |m, s| {
+                    m | ((((r >> (16 + 2 * s)) % 3) as u8) << (2 * s))
+                });
+            }
+            for lane in [false, true] {
+                let want = b.mu(lane) >= 1;
+                assert_eq!(
+                    b.in_l(lane),
+                    want,
+                    "{:?} {:?} lane {lane}",
+                    b.state,
+                    b.moves
+                );
+                fired[usize::from(lane)] += usize::from(want);
+            }
+        }
+        assert!(fired[0] > 10_000 && fired[1] > fired[0], "{fired:?}");
     }
 
     #[test]
