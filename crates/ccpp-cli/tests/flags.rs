@@ -849,8 +849,8 @@ fn strip_walk_is_read_from_the_config() {
 }
 
 /// bcd's `angle_tries`: on a room turned by 25 degrees, the pixel lattice alone (0), the
-/// lattice turned to the walls (1) and the lattices half a degree beside it too (3, the
-/// default) give three different plans, the last the cheapest; every one covers the room
+/// lattice turned to the walls (1, the default) and the lattices half a degree beside it too
+/// (3) give three different plans, the last the cheapest; every one covers the room
 /// without contact.
 #[test]
 fn angle_tries_changes_the_bcd_plan() {

@@ -177,7 +177,10 @@ pub struct BcdOptions {
     /// Turned lattices tried per off-axis wall angle (step 1 of the module docs): at the
     /// angle, then half a degree above and below it, one degree, ...; the cheapest plan of
     /// all is kept (a plan's cost reacts strongly to where the lattice's lines fall). 0 plans
-    /// on the pixel lattice only.
+    /// on the pixel lattice only; 1 (the default) on the lattice turned to the wall angle. More
+    /// tries cost one whole plan each: on `rmf_office_scan` (r = 0.15 m) 3 finds a plan of lower
+    /// cost (1263 turns instead of 1390, path ratio 1.549 instead of 1.525) in about 2.4 times
+    /// the planning time.
     pub angle_tries: u32,
 }
 
@@ -192,7 +195,7 @@ impl Default for BcdOptions {
             rim_coverage: 0.999,
             tour_rounds: 2,
             min_coverage: 0.9952,
-            angle_tries: 3,
+            angle_tries: 1,
         }
     }
 }
@@ -612,7 +615,7 @@ const SECOND_PEAK_DEG: usize = 10;
 const AXIS_TOL_DEG: f64 = 4.0;
 
 /// Improvement rounds of the first tour (which only picks each cell's path for the rim step).
-const FIRST_ROUNDS: u32 = 2;
+const FIRST_ROUNDS: u32 = 1;
 /// Gap kept between a pushed lane end and the exact contact (pixels).
 const BACKOFF_PX: f64 = 0.05;
 /// How far a merged boundary segment may stray from the boundary points it replaces (pixels).

@@ -6,10 +6,9 @@
 //! cost). The path starts at a fixed point and visits every piece once; the cost of a hop is the
 //! straight-line distance. Construction: nearest neighbour from the start. Improvement, repeated
 //! until a round changes nothing (or `rounds` is spent): 2-opt (a reversed stretch drives each of
-//! its pieces backwards), Or-opt (stretches of 1 to 8 pieces moved elsewhere, either way round; a
-//! single piece in whichever of its variants fits the new place best), both tried only where a
-//! new hop joins one of a piece's 24 nearest pieces, and an exact dynamic programme that picks
-//! every piece's variant for the current order.
+//! its pieces backwards), Or-opt (stretches of 1 to 3 pieces moved elsewhere, either way round),
+//! both tried only where a new hop joins one of a piece's 12 nearest pieces, and an exact dynamic
+//! programme that picks every piece's variant for the current order.
 //! Everything is deterministic: fixed scan orders, strict improvements only, ties to the lower
 //! index.
 
@@ -140,10 +139,7 @@ fn prev_exit(pieces: &[Piece], start: Point, tour: &Tour, i: usize) -> Point {
 }
 
 /// Number of candidate neighbours per piece in the improvement moves.
-const NEIGHBOURS: usize = 24;
-
-/// Longest stretch of pieces that Or-opt moves.
-const OR_MAX: usize = 8;
+const NEIGHBOURS: usize = 12;
 
 /// The `NEIGHBOURS` pieces nearest to each piece (by the closest pair of end points), nearest
 /// first, ties by index.
@@ -290,8 +286,8 @@ fn two_opt(pieces: &[Piece], start: Point, tour: &mut Tour, nb: &[Vec<usize>], d
     }
 }
 
-/// Or-opt over candidate neighbours: stretches of 1 to `OR_MAX` pieces moved next to a
-/// neighbour of their first or last piece, either way round (a single piece in any variant).
+/// Or-opt over candidate neighbours: stretches of 1 to 3 pieces moved next to a neighbour of
+/// their first or last piece, either way round.
 fn or_opt(pieces: &[Piece], start: Point, tour: &mut Tour, nb: &[Vec<usize>], d: Dist<'_>) {
     let entry = |t: &Tour, i: usize| pieces[t[i].0].entry[t[i].1];
     let exit = |t: &Tour, i: usize| pieces[t[i].0].exit[t[i].1];
@@ -303,7 +299,7 @@ fn or_opt(pieces: &[Piece], start: Point, tour: &mut Tour, nb: &[Vec<usize>], d:
         improved = false;
         passes += 1;
         let n = tour.len();
-        for k in 1..=OR_MAX {
+        for k in 1..=3usize {
             if k >= n {
                 break;
             }
@@ -327,40 +323,27 @@ fn or_opt(pieces: &[Piece], start: Point, tour: &mut Tour, nb: &[Vec<usize>], d:
                 cand.push(n);
                 cand.sort_unstable();
                 cand.dedup();
-                let mut best: Option<(f64, usize, usize)> = None;
+                let mut best: Option<(f64, usize, bool)> = None;
                 for &p in &cand {
                     if p > n || (p >= i && p <= j + 1) {
                         continue;
                     }
                     let before_pt = prev_exit(pieces, start, tour, p);
                     let next = if p < n { Some(entry(tour, p)) } else { None };
-                    // A single piece is tried in every variant (its inner cost counted),
-                    // a longer stretch either way round.
-                    let pc = &pieces[tour[i].0];
-                    let nv = if k == 1 { pc.entry.len() } else { 2 };
-                    for u in 0..nv {
-                        let (s_in, s_out, inner) = if k == 1 {
-                            (pc.entry[u], pc.exit[u], pc.inner[u] - pc.inner[tour[i].1])
-                        } else if u == 1 {
-                            (ej, si, 0.0)
-                        } else {
-                            (si, ej, 0.0)
+                    for rev in [false, true] {
+                        let (s_in, s_out) = if rev { (ej, si) } else { (si, ej) };
+                        let add = match next {
+                            Some(nx) => d(before_pt, s_in) + d(s_out, nx) - d(before_pt, nx),
+                            None => d(before_pt, s_in),
                         };
-                        let add = inner
-                            + match next {
-                                Some(nx) => d(before_pt, s_in) + d(s_out, nx) - d(before_pt, nx),
-                                None => d(before_pt, s_in),
-                            };
                         if add < removed - EPS && best.is_none_or(|b| add < b.0) {
-                            best = Some((add, p, u));
+                            best = Some((add, p, rev));
                         }
                     }
                 }
-                if let Some((_, p, u)) = best {
+                if let Some((_, p, rev)) = best {
                     let mut seg: Vec<(usize, usize)> = tour.drain(i..=j).collect();
-                    if k == 1 {
-                        seg[0].1 = u;
-                    } else if u == 1 {
+                    if rev {
                         seg.reverse();
                         for e in &mut seg {
                             e.1 ^= 1;
