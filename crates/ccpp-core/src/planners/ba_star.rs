@@ -679,8 +679,8 @@ impl TileSearch {
     /// [`Self::nearest`] when the targets are listed (`targets`: exactly the tiles with
     /// `is_target`): the same tile and cost, found by A* towards the set.
     ///
-    /// The heuristic is the least [`octile`] cost to a target ([`TargetBlocks`]): consistent,
-    /// and zero at the targets, whose key is then their cost. Popping in `(key, index)` order,
+    /// The heuristic is the least [`octile`] cost to a target (bounded per block of tiles):
+    /// consistent, and zero at the targets, whose key is then their cost. Popping in `(key, index)` order,
     /// every tile on a cheapest path to a target of the least cost `d*` is popped, with its
     /// exact cost, before any key above `d*`; so once a target is popped the search goes on
     /// through the key `d*` and answers with the smallest-index target popped at that key:

@@ -87,13 +87,13 @@
 //! 4. **Cell tour.** Instead of the paper's depth-first walk of the adjacency graph, the cells
 //!    are ordered as an open travelling-salesman path over their entry and exit points (each
 //!    cell can be started at any of its four corners): nearest-neighbour construction, then
-//!    2-opt, Or-opt and an exact choice of every cell's corner for the order ([`tsp`]). Hop
+//!    2-opt, Or-opt and an exact choice of every cell's corner for the order (module `bcd::tsp`). Hop
 //!    costs come from a coarse grid of the C-free set, one bounded Dijkstra per end-point block
-//!    computed once per tour ([`hops`]), not a search per pair. Transfers are straight when collision-free, else A*
-//!    over the C-free pixel centres (8-connected, octile costs, no corner cutting), shortened
+//!    computed once per tour (module `bcd::hops`), not a search per pair. Transfers are
+//!    straight when collision-free, else A* over the C-free pixel centres (8-connected, octile costs, no corner cutting), shortened
 //!    by line-of-sight checks on the true map.
 //!
-//! 5. **Turn pruning** (not in the paper; [`prune`]). The finished plan's turns are cut where
+//! 5. **Turn pruning** (not in the paper; module `bcd::prune`). The finished plan's turns are cut where
 //!    that costs least floor: a run of up to four vertices is replaced by the straight move
 //!    across it when that move is free on the true map (a corner, a short detour into a sliver
 //!    cell and back, the wiggles of a transfer through clutter), fewest accessible pixels lost
