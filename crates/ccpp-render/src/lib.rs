@@ -1030,6 +1030,10 @@ struct LaneBlitter {
     bbox: [f32; 4],
     /// Scratch: the horizontal coverage of a rectangle's columns.
     fx: Vec<f32>,
+    /// Scratch: the blend weight of each byte of a row of the box.
+    weight_row: Vec<u8>,
+    /// Scratch: the colour of each byte of a row of the box.
+    colour_row: Vec<u8>,
 }
 
 /// Largest bounding box (pixels) of a group of lane rectangles blended at once.
@@ -1151,25 +1155,43 @@ impl LaneBlitter {
         self.rects.clear();
         let stride = pm.width() as usize * 4;
         let data = pm.data_mut();
-        let c = colour.map(u32::from);
+        // The colour of each byte of a row (the alpha byte's is never used: its weight is 0).
+        self.colour_row.clear();
+        self.colour_row
+            .extend((0..bw).flat_map(|_| [colour[0], colour[1], colour[2], 0]));
+        // The weight of each byte of a row: the alpha bytes weigh 0 (and keep their value).
+        self.weight_row.clear();
+        self.weight_row.resize(bw * 4, 0);
         for (y, row) in (y0..y1).zip(self.cov.chunks_exact(bw)) {
+            // Coverage in 1/255 steps (none at or below 0, all at or above 1).
+            for (q, &a) in self.weight_row.chunks_exact_mut(4).zip(row) {
+                let w = lane_weight(a);
+                q[..3].copy_from_slice(&[w, w, w]);
+            }
             let line = &mut data[y * stride + x0 * 4..][..bw * 4];
-            for (d, &a) in line.chunks_exact_mut(4).zip(row) {
-                if a <= 0.0 {
-                    continue;
-                }
-                if a >= 1.0 {
-                    d[..3].copy_from_slice(&colour);
-                    continue;
-                }
-                // Coverage in 1/255 steps; the blend rounded to nearest.
-                let a = (a * 255.0 + 0.5) as u32;
-                for (d, c) in d[..3].iter_mut().zip(c) {
-                    *d = ((u32::from(*d) * (255 - a) + c * a + 127) / 255) as u8;
-                }
+            for ((d, &w), &c) in line.iter_mut().zip(&self.weight_row).zip(&self.colour_row) {
+                *d = blend_255(*d, c, w);
             }
         }
     }
+}
+
+/// A lane pixel's coverage `a` as a weight in 1/255 steps: 0 at or below 0, 255 at or above 1,
+/// rounded to nearest between.
+#[inline]
+fn lane_weight(a: f32) -> u8 {
+    // In (0, 1) the clamp keeps `a`; the product and sum are the unclamped ones.
+    (a.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
+}
+
+/// `(d * (255 - w) + c * w) / 255` rounded to nearest: `d` at weight 0, `c` at 255. In 16 bits
+/// (at most 255 * 255 + 127 before the division, which is exact as `(x + 1 + (x >> 8)) >> 8`
+/// for every such `x`), so that a row of bytes blends in wide vector steps.
+#[inline]
+fn blend_255(d: u8, c: u8, w: u8) -> u8 {
+    let (d, c, w) = (u16::from(d), u16::from(c), u16::from(w));
+    let x = d * (255 - w) + c * w + 127;
+    ((x + 1 + (x >> 8)) >> 8) as u8
 }
 
 /// Markers drawn per batch (see [`MarkerBatch`]).
@@ -1546,5 +1568,29 @@ mod tests {
         .unwrap();
         assert_eq!(full.width(), bare.width());
         assert!(bare.height() + 80 < full.height());
+    }
+
+    #[test]
+    fn the_lane_blend_is_the_rounded_weighted_mean_for_every_byte_and_weight() {
+        for w in 0..=255u32 {
+            for d in 0..=255u32 {
+                for c in [0u32, 1, 30, 127, 128, 200, 254, 255] {
+                    let want = (d * (255 - w) + c * w + 127) / 255;
+                    assert_eq!(u32::from(blend_255(d as u8, c as u8, w as u8)), want);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_lane_weight_is_none_at_or_below_zero_all_at_or_above_one_and_rounded_between() {
+        assert_eq!(lane_weight(-0.25), 0);
+        assert_eq!(lane_weight(0.0), 0);
+        assert_eq!(lane_weight(1.0), 255);
+        assert_eq!(lane_weight(1.75), 255);
+        assert_eq!(lane_weight(0.5), 128);
+        assert_eq!(lane_weight(0.4), 102);
+        assert_eq!(lane_weight(0.001), 0);
+        assert_eq!(lane_weight(0.999), 255);
     }
 }
