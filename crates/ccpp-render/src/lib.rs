@@ -253,7 +253,12 @@ pub fn coverage_png_swept(
 pub fn encode_png(pixmap: &Pixmap) -> Result<Vec<u8>, RenderError> {
     use std::io::Write as _;
     let err = |e: &dyn std::fmt::Display| RenderError::Encode(e.to_string());
-    if pixmap.pixels().iter().any(|p| p.alpha() != u8::MAX) {
+    // Every pixel's alpha ANDed (no early exit: a reduction the compiler vectorizes).
+    let alpha = pixmap
+        .data()
+        .chunks_exact(4)
+        .fold(u8::MAX, |all, p| all & p[3]);
+    if alpha != u8::MAX {
         return pixmap.encode_png().map_err(|e| err(&e));
     }
     let (w, h) = (pixmap.width(), pixmap.height());
@@ -265,13 +270,16 @@ pub fn encode_png(pixmap: &Pixmap) -> Result<Vec<u8>, RenderError> {
     let mut writer = encoder.write_header().map_err(|e| err(&e))?;
     {
         let mut stream = writer.stream_writer().map_err(|e| err(&e))?;
-        let mut row = vec![0u8; w as usize * 3];
+        // One spare byte: each pixel is copied whole (4 bytes, one store), its alpha byte
+        // then overwritten by the next pixel's red (the last one's lands in the spare byte).
+        let n = w as usize * 3;
+        let mut row = vec![0u8; n + 1];
         // Opaque premultiplied pixels are their straight colours.
         for src in pixmap.data().chunks_exact(w as usize * 4) {
-            for (d, s) in row.chunks_exact_mut(3).zip(src.chunks_exact(4)) {
-                d.copy_from_slice(&s[..3]);
+            for (k, s) in src.chunks_exact(4).enumerate() {
+                row[3 * k..3 * k + 4].copy_from_slice(s);
             }
-            stream.write_all(&row).map_err(|e| err(&e))?;
+            stream.write_all(&row[..n]).map_err(|e| err(&e))?;
         }
         stream.finish().map_err(|e| err(&e))?;
     }
@@ -1030,6 +1038,8 @@ struct LaneBlitter {
     bbox: [f32; 4],
     /// Scratch: the horizontal coverage of a rectangle's columns.
     fx: Vec<f32>,
+    /// Scratch: the blend weight of each pixel of a row of the box.
+    pixel_weight: Vec<u8>,
     /// Scratch: the blend weight of each byte of a row of the box.
     weight_row: Vec<u8>,
     /// Scratch: the colour of each byte of a row of the box.
@@ -1163,10 +1173,13 @@ impl LaneBlitter {
         self.weight_row.clear();
         self.weight_row.resize(bw * 4, 0);
         for (y, row) in (y0..y1).zip(self.cov.chunks_exact(bw)) {
-            // Coverage in 1/255 steps (none at or below 0, all at or above 1).
-            for (q, &a) in self.weight_row.chunks_exact_mut(4).zip(row) {
-                let w = lane_weight(a);
-                q[..3].copy_from_slice(&[w, w, w]);
+            // Coverage in 1/255 steps (none at or below 0, all at or above 1), per pixel, then
+            // per byte (`[w, w, w, 0]` in one store).
+            self.pixel_weight.clear();
+            self.pixel_weight
+                .extend(row.iter().map(|&a| lane_weight(a)));
+            for (q, &w) in self.weight_row.chunks_exact_mut(4).zip(&self.pixel_weight) {
+                q.copy_from_slice(&(u32::from(w) * 0x01_01_01).to_le_bytes());
             }
             let line = &mut data[y * stride + x0 * 4..][..bw * 4];
             for ((d, &w), &c) in line.iter_mut().zip(&self.weight_row).zip(&self.colour_row) {
@@ -1592,5 +1605,37 @@ mod tests {
         assert_eq!(lane_weight(0.4), 102);
         assert_eq!(lane_weight(0.001), 0);
         assert_eq!(lane_weight(0.999), 255);
+    }
+
+    #[test]
+    fn an_opaque_picture_encodes_as_its_rgb_bytes_row_by_row() {
+        // Odd width: each row's last pixel is copied into the spare byte of the row buffer.
+        let (w, h) = (5u32, 3u32);
+        let mut pm = Pixmap::new(w, h).unwrap();
+        for (k, p) in pm.data_mut().chunks_exact_mut(4).enumerate() {
+            let k = k as u8;
+            p.copy_from_slice(&[k, k.wrapping_mul(7), k.wrapping_mul(31), u8::MAX]);
+        }
+        let bytes = encode_png(&pm).unwrap();
+        let mut dec = png::Decoder::new(std::io::Cursor::new(bytes))
+            .read_info()
+            .unwrap();
+        let mut buf = vec![0u8; dec.output_buffer_size().unwrap()];
+        let info = dec.next_frame(&mut buf).unwrap();
+        assert_eq!(info.color_type, png::ColorType::Rgb);
+        let want: Vec<u8> = pm
+            .data()
+            .chunks_exact(4)
+            .flat_map(|p| [p[0], p[1], p[2]])
+            .collect();
+        assert_eq!(&buf[..info.buffer_size()], &want[..]);
+        // One pixel not opaque: the picture keeps its alpha channel.
+        pm.data_mut()[7] = 128;
+        pm.data_mut()[4..7].fill(0);
+        let bytes = encode_png(&pm).unwrap();
+        let dec = png::Decoder::new(std::io::Cursor::new(bytes))
+            .read_info()
+            .unwrap();
+        assert_eq!(dec.info().color_type, png::ColorType::Rgba);
     }
 }
