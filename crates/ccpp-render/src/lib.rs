@@ -813,11 +813,24 @@ pub fn coverage_pixmap_swept(
                 }
                 let mut hatched = false;
                 let out = &mut rows[o..o + stride];
+                // The last map pixel classified and its colour, when it is not hatched (its
+                // colour then depends on the pixel alone): the canvas pixels showing the same
+                // map pixel next to it take that colour.
+                let mut last: Option<(usize, [u8; 4])> = None;
                 for ((x, &col), d) in (0..cw).zip(&cols).zip(out.chunks_exact_mut(4)) {
                     let i = frame.index(col, row);
-                    hatched |= cells[i] == Cell::Free && zone_class(world, i) == 1;
+                    if let Some((j, c)) = last {
+                        if j == i {
+                            d.copy_from_slice(&c);
+                            continue;
+                        }
+                    }
+                    let hatch = cells[i] == Cell::Free && zone_class(world, i) == 1;
+                    hatched |= hatch;
                     let c = colour_of(i, x, y);
-                    d.copy_from_slice(&[c[0], c[1], c[2], 255]);
+                    let c = [c[0], c[1], c[2], 255];
+                    last = (!hatch).then_some((i, c));
+                    d.copy_from_slice(&c);
                 }
                 above = Some((row, hatched));
             }
