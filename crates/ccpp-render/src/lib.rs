@@ -253,7 +253,12 @@ pub fn coverage_png_swept(
 pub fn encode_png(pixmap: &Pixmap) -> Result<Vec<u8>, RenderError> {
     use std::io::Write as _;
     let err = |e: &dyn std::fmt::Display| RenderError::Encode(e.to_string());
-    if pixmap.pixels().iter().any(|p| p.alpha() != u8::MAX) {
+    // Every pixel's alpha ANDed (no early exit: a reduction the compiler vectorizes).
+    let alpha = pixmap
+        .data()
+        .chunks_exact(4)
+        .fold(u8::MAX, |all, p| all & p[3]);
+    if alpha != u8::MAX {
         return pixmap.encode_png().map_err(|e| err(&e));
     }
     let (w, h) = (pixmap.width(), pixmap.height());
@@ -265,13 +270,16 @@ pub fn encode_png(pixmap: &Pixmap) -> Result<Vec<u8>, RenderError> {
     let mut writer = encoder.write_header().map_err(|e| err(&e))?;
     {
         let mut stream = writer.stream_writer().map_err(|e| err(&e))?;
-        let mut row = vec![0u8; w as usize * 3];
+        // One spare byte: each pixel is copied whole (4 bytes, one store), its alpha byte
+        // then overwritten by the next pixel's red (the last one's lands in the spare byte).
+        let n = w as usize * 3;
+        let mut row = vec![0u8; n + 1];
         // Opaque premultiplied pixels are their straight colours.
         for src in pixmap.data().chunks_exact(w as usize * 4) {
-            for (d, s) in row.chunks_exact_mut(3).zip(src.chunks_exact(4)) {
-                d.copy_from_slice(&s[..3]);
+            for (k, s) in src.chunks_exact(4).enumerate() {
+                row[3 * k..3 * k + 4].copy_from_slice(s);
             }
-            stream.write_all(&row).map_err(|e| err(&e))?;
+            stream.write_all(&row[..n]).map_err(|e| err(&e))?;
         }
         stream.finish().map_err(|e| err(&e))?;
     }
@@ -805,11 +813,24 @@ pub fn coverage_pixmap_swept(
                 }
                 let mut hatched = false;
                 let out = &mut rows[o..o + stride];
+                // The last map pixel classified and its colour, when it is not hatched (its
+                // colour then depends on the pixel alone): the canvas pixels showing the same
+                // map pixel next to it take that colour.
+                let mut last: Option<(usize, [u8; 4])> = None;
                 for ((x, &col), d) in (0..cw).zip(&cols).zip(out.chunks_exact_mut(4)) {
                     let i = frame.index(col, row);
-                    hatched |= cells[i] == Cell::Free && zone_class(world, i) == 1;
+                    if let Some((j, c)) = last {
+                        if j == i {
+                            d.copy_from_slice(&c);
+                            continue;
+                        }
+                    }
+                    let hatch = cells[i] == Cell::Free && zone_class(world, i) == 1;
+                    hatched |= hatch;
                     let c = colour_of(i, x, y);
-                    d.copy_from_slice(&[c[0], c[1], c[2], 255]);
+                    let c = [c[0], c[1], c[2], 255];
+                    last = (!hatch).then_some((i, c));
+                    d.copy_from_slice(&c);
                 }
                 above = Some((row, hatched));
             }
@@ -1030,6 +1051,12 @@ struct LaneBlitter {
     bbox: [f32; 4],
     /// Scratch: the horizontal coverage of a rectangle's columns.
     fx: Vec<f32>,
+    /// Scratch: the blend weight of each pixel of a row of the box.
+    pixel_weight: Vec<u8>,
+    /// Scratch: the blend weight of each byte of a row of the box.
+    weight_row: Vec<u8>,
+    /// Scratch: the colour of each byte of a row of the box.
+    colour_row: Vec<u8>,
 }
 
 /// Largest bounding box (pixels) of a group of lane rectangles blended at once.
@@ -1151,25 +1178,46 @@ impl LaneBlitter {
         self.rects.clear();
         let stride = pm.width() as usize * 4;
         let data = pm.data_mut();
-        let c = colour.map(u32::from);
+        // The colour of each byte of a row (the alpha byte's is never used: its weight is 0).
+        self.colour_row.clear();
+        self.colour_row
+            .extend((0..bw).flat_map(|_| [colour[0], colour[1], colour[2], 0]));
+        // The weight of each byte of a row: the alpha bytes weigh 0 (and keep their value).
+        self.weight_row.clear();
+        self.weight_row.resize(bw * 4, 0);
         for (y, row) in (y0..y1).zip(self.cov.chunks_exact(bw)) {
+            // Coverage in 1/255 steps (none at or below 0, all at or above 1), per pixel, then
+            // per byte (`[w, w, w, 0]` in one store).
+            self.pixel_weight.clear();
+            self.pixel_weight
+                .extend(row.iter().map(|&a| lane_weight(a)));
+            for (q, &w) in self.weight_row.chunks_exact_mut(4).zip(&self.pixel_weight) {
+                q.copy_from_slice(&(u32::from(w) * 0x01_01_01).to_le_bytes());
+            }
             let line = &mut data[y * stride + x0 * 4..][..bw * 4];
-            for (d, &a) in line.chunks_exact_mut(4).zip(row) {
-                if a <= 0.0 {
-                    continue;
-                }
-                if a >= 1.0 {
-                    d[..3].copy_from_slice(&colour);
-                    continue;
-                }
-                // Coverage in 1/255 steps; the blend rounded to nearest.
-                let a = (a * 255.0 + 0.5) as u32;
-                for (d, c) in d[..3].iter_mut().zip(c) {
-                    *d = ((u32::from(*d) * (255 - a) + c * a + 127) / 255) as u8;
-                }
+            for ((d, &w), &c) in line.iter_mut().zip(&self.weight_row).zip(&self.colour_row) {
+                *d = blend_255(*d, c, w);
             }
         }
     }
+}
+
+/// A lane pixel's coverage `a` as a weight in 1/255 steps: 0 at or below 0, 255 at or above 1,
+/// rounded to nearest between.
+#[inline]
+fn lane_weight(a: f32) -> u8 {
+    // In (0, 1) the clamp keeps `a`; the product and sum are the unclamped ones.
+    (a.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
+}
+
+/// `(d * (255 - w) + c * w) / 255` rounded to nearest: `d` at weight 0, `c` at 255. In 16 bits
+/// (at most 255 * 255 + 127 before the division, which is exact as `(x + 1 + (x >> 8)) >> 8`
+/// for every such `x`), so that a row of bytes blends in wide vector steps.
+#[inline]
+fn blend_255(d: u8, c: u8, w: u8) -> u8 {
+    let (d, c, w) = (u16::from(d), u16::from(c), u16::from(w));
+    let x = d * (255 - w) + c * w + 127;
+    ((x + 1 + (x >> 8)) >> 8) as u8
 }
 
 /// Markers drawn per batch (see [`MarkerBatch`]).
@@ -1546,5 +1594,61 @@ mod tests {
         .unwrap();
         assert_eq!(full.width(), bare.width());
         assert!(bare.height() + 80 < full.height());
+    }
+
+    #[test]
+    fn the_lane_blend_is_the_rounded_weighted_mean_for_every_byte_and_weight() {
+        for w in 0..=255u32 {
+            for d in 0..=255u32 {
+                for c in [0u32, 1, 30, 127, 128, 200, 254, 255] {
+                    let want = (d * (255 - w) + c * w + 127) / 255;
+                    assert_eq!(u32::from(blend_255(d as u8, c as u8, w as u8)), want);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_lane_weight_is_none_at_or_below_zero_all_at_or_above_one_and_rounded_between() {
+        assert_eq!(lane_weight(-0.25), 0);
+        assert_eq!(lane_weight(0.0), 0);
+        assert_eq!(lane_weight(1.0), 255);
+        assert_eq!(lane_weight(1.75), 255);
+        assert_eq!(lane_weight(0.5), 128);
+        assert_eq!(lane_weight(0.4), 102);
+        assert_eq!(lane_weight(0.001), 0);
+        assert_eq!(lane_weight(0.999), 255);
+    }
+
+    #[test]
+    fn an_opaque_picture_encodes_as_its_rgb_bytes_row_by_row() {
+        // Odd width: each row's last pixel is copied into the spare byte of the row buffer.
+        let (w, h) = (5u32, 3u32);
+        let mut pm = Pixmap::new(w, h).unwrap();
+        for (k, p) in pm.data_mut().chunks_exact_mut(4).enumerate() {
+            let k = k as u8;
+            p.copy_from_slice(&[k, k.wrapping_mul(7), k.wrapping_mul(31), u8::MAX]);
+        }
+        let bytes = encode_png(&pm).unwrap();
+        let mut dec = png::Decoder::new(std::io::Cursor::new(bytes))
+            .read_info()
+            .unwrap();
+        let mut buf = vec![0u8; dec.output_buffer_size().unwrap()];
+        let info = dec.next_frame(&mut buf).unwrap();
+        assert_eq!(info.color_type, png::ColorType::Rgb);
+        let want: Vec<u8> = pm
+            .data()
+            .chunks_exact(4)
+            .flat_map(|p| [p[0], p[1], p[2]])
+            .collect();
+        assert_eq!(&buf[..info.buffer_size()], &want[..]);
+        // One pixel not opaque: the picture keeps its alpha channel.
+        pm.data_mut()[7] = 128;
+        pm.data_mut()[4..7].fill(0);
+        let bytes = encode_png(&pm).unwrap();
+        let dec = png::Decoder::new(std::io::Cursor::new(bytes))
+            .read_info()
+            .unwrap();
+        assert_eq!(dec.info().color_type, png::ColorType::Rgba);
     }
 }
