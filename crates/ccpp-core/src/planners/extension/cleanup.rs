@@ -1,0 +1,189 @@
+//! A cleaning pass, chunk by chunk, and the final clean-up's judgement of which chunks to
+//! leave: yield, groups of chunks planned together, and the leave budget.
+
+#[cfg(doc)]
+use super::ExtensionOptions;
+use super::{Chunk, Extension, Wanted};
+use crate::geometry::Point;
+use crate::planner::KnownMap;
+
+impl Extension {
+    /// Plans the next chunk of a cleaning pass from world point `pos`: the transfer to the rim
+    /// (waypoints that reach the first sweeping position) and the sweep along it; both empty
+    /// when no rim within `reach_r` robot radii (`bounded`; else anywhere) gains.
+    ///
+    /// After the host's coverage (`!bounded`) a chunk whose yield is below
+    /// [`ExtensionOptions::min_yield`] is left (its pixels stay claimed, so no later search
+    /// returns to them) while the pixels left stay within [`ExtensionOptions::leave_fraction`]
+    /// of the known free floor, and the next chunk is planned from `pos` instead.
+    pub(crate) fn plan_pass(
+        &mut self,
+        known: &KnownMap,
+        pos: Point,
+        bounded: bool,
+        wanted: Wanted,
+    ) -> Chunk {
+        let chunk = self.plan_pass_inner(known, pos, bounded, wanted);
+        self.simplified += chunk.simplified;
+        chunk
+    }
+
+    /// One chunk planned from world point `pos` as at the end of a host region but within
+    /// `reach_r` robot radii whatever [`ExtensionOptions::reach_r`] says (used by
+    /// `ba-star-extended`'s rims swept on the way back, [`Self::drop_chunk`] when it is not
+    /// driven as planned).
+    pub(crate) fn plan_near(
+        &mut self,
+        known: &KnownMap,
+        pos: Point,
+        reach_r: f64,
+        wanted: Wanted,
+    ) -> Chunk {
+        let keep = self.opts.reach_r;
+        self.opts.reach_r = reach_r;
+        let chunk = self.plan_pass(known, pos, true, wanted);
+        self.opts.reach_r = keep;
+        chunk
+    }
+
+    /// Forgets a planned chunk that will not be driven as planned: its claims are given back
+    /// (what the robot drives is stamped as it goes) and its simplification is not counted.
+    pub(crate) fn drop_chunk(&mut self, chunk: &Chunk) {
+        self.unclaim(chunk);
+        self.simplified -= chunk.simplified;
+    }
+
+    /// [`Self::plan_pass`] before the chunk's simplification is counted.
+    fn plan_pass_inner(
+        &mut self,
+        known: &KnownMap,
+        pos: Point,
+        bounded: bool,
+        wanted: Wanted,
+    ) -> Chunk {
+        let mut cur = self.plan_chunk(known, pos, bounded, wanted, false);
+        loop {
+            if bounded
+                || cur.gained == 0
+                || cur.owed
+                || self.opts.min_yield <= 0.0
+                || self.pays(
+                    cur.gained,
+                    2.0 * cur.trip_len(pos) + 2.0 * cur.walk_len(pos),
+                )
+            {
+                return cur;
+            }
+            // Leave it, alone or together with the chunks planned after it (nearest first from
+            // here: the search goes on where it stopped) when those lie close together and far
+            // away — a cluster of specks whose trip does not pay as a whole although each
+            // speck, seen from the next one, is on the way.
+            let mut group = vec![cur];
+            let next = loop {
+                let next = self.plan_chunk(known, pos, bounded, wanted, true);
+                let gained: usize = group.iter().map(|c| c.gained).sum();
+                if !self.pays(gained, group_saving(pos, &group, &next)) {
+                    if self.charge(known, pos, &group) {
+                        break Some(next);
+                    }
+                    self.unclaim(&next);
+                    break None;
+                }
+                if group.len() >= self.opts.leave_group
+                    || next.gained == 0
+                    || next.owed
+                    || self.left + gained + next.gained > self.leave_budget(known)
+                {
+                    self.unclaim(&next);
+                    break None;
+                }
+                group.push(next);
+            };
+            let Some(next) = next else {
+                for c in &group[1..] {
+                    self.unclaim(c);
+                }
+                return group.swap_remove(0);
+            };
+            cur = next;
+        }
+    }
+
+    /// Does `chunk`'s walk gain at least [`ExtensionOptions::min_yield`] of what a full-width
+    /// lane of `len` metres sweeps?
+    fn pays(&self, gained: usize, len: f64) -> bool {
+        let res = self.frame.resolution;
+        gained as f64 * res * res >= self.opts.min_yield * 2.0 * self.rt * res * len
+    }
+
+    /// The known free floor [`ExtensionOptions::leave_fraction`] allows the final clean-up
+    /// to leave, in pixels.
+    fn leave_budget(&self, known: &KnownMap) -> usize {
+        (self.opts.leave_fraction * self.known_free_count(known) as f64) as usize
+    }
+
+    /// Counts the chunks of `group` (planned from world point `pos`) as left when the budget
+    /// ([`ExtensionOptions::leave_fraction`]) allows; whether it did.
+    fn charge(&mut self, known: &KnownMap, pos: Point, group: &[Chunk]) -> bool {
+        // Charged: the walks' pixels and the targets the ways there would sweep on the side
+        // (specks too small for a pass of their own, which leaving the trips leaves as well).
+        let f = self.frame;
+        let mut side: Vec<usize> = Vec::new();
+        for chunk in group {
+            let way: Vec<Point> = std::iter::once(pos)
+                .chain(chunk.transfer.iter().copied())
+                .map(|p| f.world_to_grid(p))
+                .collect();
+            side.extend(self.polyline_gains(known, &way).concat());
+        }
+        side.sort_unstable();
+        side.dedup();
+        let charged = group.iter().map(|c| c.gained).sum::<usize>() + side.len();
+        if self.left + charged > self.leave_budget(known) {
+            return false;
+        }
+        self.left += charged;
+        // Left with them: no later pass goes out for them alone.
+        for i in side {
+            self.swept.insert(i);
+        }
+        true
+    }
+
+    /// Gives the pixels `chunk` claimed back (it will not be driven now).
+    fn unclaim(&mut self, chunk: &Chunk) {
+        let f = self.frame;
+        let (w, h) = (f.width as i64, f.height as i64);
+        let reach = self.strip_rows.len() as i64 - 1;
+        for &i in &chunk.claimed {
+            self.swept.set(i, false);
+            // Positions the searches since judged without these targets may gain again.
+            let (c, r) = self.px_of(i);
+            let (c0, c1) = ((c - reach).max(0), (c + reach).min(w - 1));
+            for row in (r - reach).max(0)..=(r + reach).min(h - 1) {
+                let base = row as usize * f.width;
+                self.no_gain
+                    .remove_range(base + c0 as usize..base + c1 as usize + 1);
+            }
+        }
+    }
+}
+
+/// The path leaving `group` saves (chunks planned from world point `pos`, nearest first),
+/// with `next` the chunk planned after them: their tour (the first trip, the walks and the
+/// straight ways between them, a lower bound) and the way on from the last to `next`, less
+/// the (longer) trip from `pos` to `next`.
+fn group_saving(pos: Point, group: &[Chunk], next: &Chunk) -> f64 {
+    let mut tour = group[0].trip_len(pos);
+    for (k, c) in group.iter().enumerate() {
+        if k > 0 {
+            tour += group[k - 1].end(pos).dist(c.start(pos));
+        }
+        tour += c.walk_len(pos);
+    }
+    if next.gained == 0 {
+        return tour;
+    }
+    let last = group[group.len() - 1].end(pos);
+    tour + last.dist(next.start(pos)) - next.trip_len(pos)
+}

@@ -1,0 +1,91 @@
+//! What a host planner plus the extension keep while they drive.
+
+use std::collections::VecDeque;
+
+use super::{Chunk, Extension, ExtensionOptions};
+use crate::geometry::{polyline_length, Point};
+use crate::planner::{Sensor, Step};
+use crate::trace::Event;
+
+/// What a host planner plus the extension keep while they drive (shared by `ba-star-extended`
+/// and `bsa-extended`): the steps queued, the waypoints driven since the cleaning began (to
+/// retreat by), whether a wall pass is open, and the last position seen (to record each move
+/// into the extension).
+#[derive(Debug, Default)]
+pub(crate) struct Drive {
+    /// Steps to return before asking anyone.
+    pub queue: VecDeque<Step>,
+    /// Waypoints driven since the cleaning began (its start first).
+    pub trail: Vec<Point>,
+    /// Inside a `wall_follow_start` / `wall_follow_end` pair.
+    in_pass: bool,
+    last_pos: Option<Point>,
+}
+
+impl Drive {
+    /// Records the move since the last step into `ext` (made at the first step, when the
+    /// sensor tells the robot's size); returns the robot's position.
+    pub fn observe(
+        &mut self,
+        ext: &mut Option<Extension>,
+        opts: &ExtensionOptions,
+        sensor: &dyn Sensor,
+    ) -> Point {
+        let pos = sensor.pose().position();
+        if let (Some(ext), Some(prev)) = (ext.as_mut(), self.last_pos) {
+            if prev != pos {
+                ext.record(prev, pos);
+            }
+        } else {
+            let robot = sensor.robot();
+            let mut made = Extension::new(
+                opts.clone(),
+                *sensor.frame(),
+                robot.radius,
+                robot.tool_radius,
+            );
+            made.record(pos, pos);
+            *ext = Some(made);
+        }
+        self.last_pos = Some(pos);
+        pos
+    }
+
+    /// Queues a chunk from `pos`: its trip (a backtracking transfer, drawn dashed and counted in
+    /// `backtrack_length`, when it is a robot diameter (`2 radius`) or longer; else part of the
+    /// pass) and its wall pass, with their events. `false` when the chunk is empty.
+    pub fn queue_chunk(&mut self, pos: Point, chunk: &Chunk, radius: f64) -> bool {
+        if chunk.transfer.is_empty() && chunk.sweep.is_empty() {
+            return false;
+        }
+        let transfer = polyline_length(pos, &chunk.transfer) >= 2.0 * radius;
+        if transfer {
+            self.end_pass();
+            self.queue.push_back(Step::Mark(Event::BacktrackStart));
+        }
+        for &p in &chunk.transfer {
+            self.queue.push_back(Step::MoveTo(p));
+            self.trail.push(p);
+        }
+        if transfer {
+            self.queue.push_back(Step::Mark(Event::BacktrackEnd));
+        }
+        if !self.in_pass && !chunk.sweep.is_empty() {
+            self.in_pass = true;
+            self.queue.push_back(Step::Mark(Event::WallFollowStart));
+        }
+        for &p in &chunk.sweep {
+            self.queue.push_back(Step::MoveTo(p));
+            self.trail.push(p);
+        }
+        true
+    }
+
+    /// Closes an open wall pass (`wall_follow_end`).
+    pub fn end_pass(&mut self) {
+        if self.in_pass {
+            self.in_pass = false;
+            self.queue.push_back(Step::Mark(Event::WallFollowEnd));
+        }
+    }
+}

@@ -1,0 +1,126 @@
+//! Merging a pixel walk into known-free straight segments that keep its gained pixels within
+//! the tool radius, and squaring the rounded corners of the merged chunk.
+
+use super::Extension;
+#[cfg(doc)]
+use super::ExtensionOptions;
+use crate::geometry::{point_segment_dist2, Point};
+use crate::planner::KnownMap;
+
+/// Longest merged segment, in walk points (bounds the quadratic merge check).
+pub(super) const MAX_MERGE: usize = 256;
+
+/// How many points past the first one a merged segment cannot reach the merge still tries
+/// (a wiggle of the wall may block one point while a farther one is in sight).
+const MERGE_LOOK: usize = 8;
+
+/// Most vertices [`Extension::square_corners`] replaces by one.
+const CORNER_RUN: usize = 4;
+
+impl Extension {
+    /// Greedy cut of the polyline `pts` into straight segments, each known free and keeping
+    /// every pixel in `gains` of the points it replaces within the tool radius. Returns the kept
+    /// point indices (the first point, the robot, excluded).
+    pub(super) fn merge(
+        &self,
+        known: &KnownMap,
+        pts: &[Point],
+        gains: &[Vec<usize>],
+    ) -> Vec<usize> {
+        let rt2 = self.rt * self.rt;
+        // The gained pixels' centres, once (each is checked against many segments), flat
+        // with `at[m]..at[m + 1]` those of point `m`.
+        let mut at = Vec::with_capacity(gains.len() + 1);
+        let mut centres = Vec::with_capacity(gains.iter().map(Vec::len).sum());
+        for g in gains {
+            at.push(centres.len());
+            centres.extend(g.iter().map(|&i| self.center(self.px_of(i))));
+        }
+        at.push(centres.len());
+        let keeps = |a: usize, b: usize| -> bool {
+            centres[at[a + 1]..at[b + 1]]
+                .iter()
+                .all(|&c| point_segment_dist2(c, pts[a], pts[b]) <= rt2)
+                && self.seg_free(known, pts[a], pts[b])
+        };
+        let mut out = Vec::new();
+        let mut a = 0;
+        while a + 1 < pts.len() {
+            let mut b = a + 1;
+            while b + 1 < pts.len() && b + 1 - a <= MAX_MERGE && keeps(a, b + 1) {
+                b += 1;
+            }
+            let far = (b + MERGE_LOOK).min(pts.len() - 1).min(a + MAX_MERGE);
+            if let Some(c) = (b + 2..=far).rev().find(|&c| keeps(a, c)) {
+                b = c;
+            }
+            out.push(b);
+            a = b;
+        }
+        out
+    }
+
+    /// Square corners: where the merged chunk rounds a corner (the contour at clearance 0 is an
+    /// arc there, several short segments), a run of up to [`CORNER_RUN`] vertices is replaced
+    /// by the one point where the segment entering it and the segment leaving it meet, when
+    /// both new segments are known free, every pixel the walk gained along the run that the
+    /// chunk still sweeps stays within the tool radius, and the way grows by at most
+    /// [`ExtensionOptions::corner_slack`] robot radii per turn saved. Takes and returns the
+    /// vertices (index of the walk point each replaces last, grid point), the robot's position
+    /// first.
+    pub(super) fn square_corners(
+        &self,
+        known: &KnownMap,
+        gains: &[Vec<usize>],
+        mut out: Vec<(usize, Point)>,
+    ) -> Vec<(usize, Point)> {
+        let rt2 = self.rt * self.rt;
+        let slack = self.opts.corner_slack * self.r / self.frame.resolution;
+        let near = |c: Point, poly: &[Point]| {
+            poly.windows(2)
+                .any(|s| point_segment_dist2(c, s[0], s[1]) <= rt2)
+        };
+        let mut i = 1;
+        while i + 2 < out.len() {
+            let mut replaced = false;
+            for j in (i + 1..=(i + CORNER_RUN - 1).min(out.len() - 2)).rev() {
+                let (a, p, q, b) = (out[i - 1].1, out[i].1, out[j].1, out[j + 1].1);
+                let (d1, d2) = (p - a, b - q);
+                let cross = d1.x * d2.y - d1.y * d2.x;
+                if cross.abs() < 1e-9 {
+                    continue;
+                }
+                // a + t d1 = q + s d2.
+                let w = q - a;
+                let t = (w.x * d2.y - w.y * d2.x) / cross;
+                let s = (w.x * d1.y - w.y * d1.x) / cross;
+                if t < 1.0 - 1e-9 || s > 1e-9 {
+                    continue;
+                }
+                let x = Point::new(a.x + t * d1.x, a.y + t * d1.y);
+                let old: Vec<Point> = out[i - 1..=j + 1].iter().map(|v| v.1).collect();
+                let old_len: f64 = old.windows(2).map(|s| s[0].dist(s[1])).sum();
+                let new = [a, x, b];
+                if a.dist(x) + x.dist(b) - old_len > slack * (j - i) as f64 {
+                    continue;
+                }
+                let keeps = gains[out[i - 1].0 + 1..=out[j + 1].0].iter().all(|g| {
+                    g.iter().all(|&k| {
+                        let c = self.center(self.px_of(k));
+                        !near(c, &old) || near(c, &new)
+                    })
+                });
+                if keeps && self.seg_free(known, a, x) && self.seg_free(known, x, b) {
+                    let last = out[j].0;
+                    out.splice(i..=j, [(last, x)]);
+                    replaced = true;
+                    break;
+                }
+            }
+            if !replaced {
+                i += 1;
+            }
+        }
+        out
+    }
+}

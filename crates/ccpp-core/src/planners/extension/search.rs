@@ -1,0 +1,439 @@
+//! The position search: Dijkstra (A* for transfers) over the positions from a grid point, on
+//! a bucket queue with one-word, generation-stamped node states; and the transfers
+//! (`Extension::route`) built on it.
+
+use super::graph::NB;
+use super::{Extension, Px};
+use crate::geometry::Point;
+use crate::planner::KnownMap;
+
+/// log2 of the key range one [`BucketQueue`] bucket holds (a sixteenth of an orthogonal step).
+const BUCKET_SHIFT: u32 = 6;
+/// The last [`BucketQueue`] bucket holds every larger key too (bounds its memory; the order
+/// stays exact, only slower, for keys beyond about 65 000 pixel steps).
+const BUCKET_MAX: usize = 1 << 20;
+
+/// The position search's priority queue: pops the smallest `(key, index)` first, exactly the
+/// order of a binary min-heap on that pair (so plans are unchanged), but cheaper. Keys are
+/// search costs (plus a heuristic), integers in steps of about [`COST_ORTHO`]: entries go to
+/// the bucket `key >> BUCKET_SHIFT` by a plain push, and a bucket is sorted once, when the
+/// queue first pops from it (later pushes into a sorted bucket are inserted in order). The
+/// weighted-A* heuristic is not consistent, so a key may fall below the bucket being popped:
+/// the cursor then moves back to it.
+#[derive(Default)]
+pub(super) struct BucketQueue {
+    /// Entries per bucket; a sorted bucket is in descending order (smallest last).
+    buckets: Vec<Vec<(u64, u32)>>,
+    /// Whether each bucket is sorted.
+    sorted: Vec<bool>,
+    /// No non-empty bucket lies below this one.
+    cur: usize,
+    /// One past the highest bucket used since the last clear.
+    top: usize,
+    /// Entries queued.
+    len: usize,
+}
+
+impl BucketQueue {
+    /// Empties the queue (keeps the buckets' storage).
+    fn clear(&mut self) {
+        let top = self.top.min(self.buckets.len());
+        for b in self.cur.min(top)..top {
+            self.buckets[b].clear();
+            self.sorted[b] = false;
+        }
+        self.cur = usize::MAX;
+        self.top = 0;
+        self.len = 0;
+    }
+
+    /// Queues position `i` at `key`.
+    #[inline]
+    fn push(&mut self, key: u64, i: usize) {
+        let b = usize::try_from(key >> BUCKET_SHIFT).map_or(BUCKET_MAX, |b| b.min(BUCKET_MAX));
+        if b >= self.buckets.len() {
+            self.buckets.resize_with(b + 1, Vec::new);
+            self.sorted.resize(b + 1, false);
+        }
+        let e = (key, i as u32);
+        let v = &mut self.buckets[b];
+        if self.sorted[b] {
+            let at = v.partition_point(|x| *x > e);
+            v.insert(at, e);
+        } else {
+            v.push(e);
+        }
+        if self.len == 0 || b < self.cur {
+            self.cur = b;
+        }
+        self.top = self.top.max(b + 1);
+        self.len += 1;
+    }
+
+    /// Removes and returns the position with the smallest `(key, index)`.
+    fn pop(&mut self) -> Option<usize> {
+        if self.len == 0 {
+            return None;
+        }
+        while self.buckets[self.cur].is_empty() {
+            self.sorted[self.cur] = false;
+            self.cur += 1;
+        }
+        let b = self.cur;
+        if !self.sorted[b] {
+            self.buckets[b].sort_unstable_by(|x, y| y.cmp(x));
+            self.sorted[b] = true;
+        }
+        self.len -= 1;
+        self.buckets[b].pop().map(|(_, i)| i as usize)
+    }
+}
+
+/// One pixel's search state ([`Extension::search`]; generation-stamped), one word: the
+/// search cost in bits 20..63 ([`CLOSED`] set once settled), the move from the parent in bits
+/// 16..20 (`k + 1` for a step `NB[k]`, 0: a first step from the start) and the generation in
+/// bits 0..16. All zero is "never reached", so the table starts as zeroed memory the system
+/// maps only where a search goes. (Eight bytes a pixel: the search is bound by memory traffic.)
+pub(super) type Node = u64;
+
+/// Bits of [`Node`] below the search cost.
+const NODE_COST_SHIFT: u32 = 20;
+
+/// Generations a [`Node`] tells apart (the table is cleared when they wrap).
+const NODE_GENS: u32 = 1 << 16;
+
+/// The [`Node`] of a position reached at cost `dist` by the move `NB[k]` (`None`: from the
+/// start) in generation `gen`.
+fn node(dist: u64, k: Option<usize>, gen: u32) -> Node {
+    // 43 bits of cost: over 8e9 pixel steps, far beyond any map that fits in memory.
+    debug_assert!(
+        dist < 1 << (63 - NODE_COST_SHIFT),
+        "search cost overflows a node"
+    );
+    debug_assert!(gen < NODE_GENS);
+    let m = k.map_or(0, |k| k as u64 + 1);
+    dist << NODE_COST_SHIFT | m << 16 | u64::from(gen)
+}
+
+/// The search cost recorded in `n`.
+fn node_cost(n: Node) -> u64 {
+    (n & !CLOSED) >> NODE_COST_SHIFT
+}
+
+/// The generation that wrote `n`.
+fn node_gen(n: Node) -> u32 {
+    (n & 0xFFFF) as u32
+}
+
+/// The move from the parent recorded in `n` (an index into [`NB`]).
+fn node_move(n: Node) -> Option<usize> {
+    let m = (n >> 16) & 0xF;
+    (m != 0).then(|| (m - 1) as usize)
+}
+
+/// Fixed-point step costs (one pixel = 1000).
+pub(super) const COST_ORTHO: u64 = 1000;
+const COST_DIAG: u64 = 1414;
+
+/// Settled positions carry this bit in their search cost.
+const CLOSED: u64 = 1 << 63;
+
+/// Heuristic weight of transfer searches.
+const ROUTE_WEIGHT: f64 = 1.5;
+
+impl Extension {
+    fn begin(&mut self) {
+        self.generation = (self.generation + 1) % NODE_GENS;
+        if self.generation == 0 {
+            self.nodes.fill(0);
+            self.generation = 1;
+        }
+    }
+
+    /// Dijkstra (A* with `goal`) over positions from grid point `from`. Stops at the first
+    /// settled position for which `done` holds, or when the cost exceeds `limit`. Returns the
+    /// position path (pixel indices), starting next to `from`. With `resume`, goes on from
+    /// where the last search (same `from`, `limit` and no `goal`, nothing changed since but
+    /// the targets) stopped, when it found a position.
+    pub(super) fn search(
+        &mut self,
+        known: &KnownMap,
+        from: Point,
+        limit: Option<u64>,
+        goal: Option<Point>,
+        resume: bool,
+        done: &mut dyn FnMut(&mut Self, Px) -> bool,
+    ) -> Option<Vec<usize>> {
+        let mut heap = std::mem::take(&mut self.heap);
+        if !resume || self.resume_at.is_none() {
+            self.begin();
+            self.resume_at = None;
+            heap.clear();
+        }
+        // Transfers need a short known-free way, not the shortest: an inflated heuristic
+        // (weighted A*) settles far fewer positions; the way is straightened afterwards.
+        // Without a goal the heuristic is 0 and compiled away (a search settles up to millions
+        // of positions, each queuing up to 8 neighbours).
+        let found = match goal {
+            None => self.search_with(known, from, limit, &|_: &Self, _: Px| 0, &mut heap, done),
+            Some(g) => {
+                let h = move |s: &Self, p: Px| -> u64 {
+                    (s.center(p).dist(g) * ROUTE_WEIGHT * COST_ORTHO as f64).floor() as u64
+                };
+                self.search_with(known, from, limit, &h, &mut heap, done)
+            }
+        };
+        self.heap = heap;
+        found
+    }
+
+    /// [`Self::search`]'s body, on the queue `heap`.
+    fn search_with<H: Fn(&Self, Px) -> u64>(
+        &mut self,
+        known: &KnownMap,
+        from: Point,
+        limit: Option<u64>,
+        h: &H,
+        heap: &mut BucketQueue,
+        done: &mut dyn FnMut(&mut Self, Px) -> bool,
+    ) -> Option<Vec<usize>> {
+        let p0 = self.frame.grid_to_pixel_signed(from);
+        if let Some(i) = self.resume_at.take() {
+            // Go on where the last search from `from` stopped: its settled positions and queue
+            // are still valid (the graph has not changed); expand the position it stopped at.
+            let p = self.px_of(i);
+            self.relax(known, i, p, h, heap);
+        } else {
+            self.seed(known, from, p0, h, heap);
+        }
+        while let Some(i) = heap.pop() {
+            if self.nodes[i] & CLOSED != 0 {
+                continue;
+            }
+            let d = node_cost(self.nodes[i]);
+            if limit.is_some_and(|l| d > l) {
+                return None;
+            }
+            self.nodes[i] |= CLOSED;
+            let p = self.px_of(i);
+            if done(self, p) {
+                self.resume_at = Some(i);
+                let mut path = vec![i];
+                let mut c = i;
+                while let Some(k) = node_move(self.nodes[c]) {
+                    let (col, row) = self.px_of(c);
+                    c = self
+                        .idx((col - NB[k].0, row - NB[k].1))
+                        .expect("parents are in the image");
+                    path.push(c);
+                }
+                path.reverse();
+                return Some(path);
+            }
+            self.relax(known, i, p, h, heap);
+        }
+        None
+    }
+
+    /// The positions next to grid point `from` that it reaches by a known-free move, queued.
+    fn seed<H: Fn(&Self, Px) -> u64>(
+        &mut self,
+        known: &KnownMap,
+        from: Point,
+        p0: Px,
+        h: &H,
+        heap: &mut BucketQueue,
+    ) {
+        let gen = self.generation;
+        for dr in -1..=1 {
+            for dc in -1..=1 {
+                let p = (p0.0 + dc, p0.1 + dr);
+                let Some(i) = self.idx(p) else { continue };
+                if self.in_s0(known, p) != Some(true) || !self.seg_free(known, from, self.center(p))
+                {
+                    continue;
+                }
+                let d = (from.dist(self.center(p)) * COST_ORTHO as f64).round() as u64;
+                let n = self.nodes[i];
+                if node_gen(n) != gen || d < node_cost(n) {
+                    self.nodes[i] = node(d, None, gen);
+                    heap.push(d + h(self, p), i);
+                }
+            }
+        }
+    }
+
+    /// Queues the neighbours of settled position `i` (pixel `p`; search cost in `dist`).
+    fn relax<H: Fn(&Self, Px) -> u64>(
+        &mut self,
+        known: &KnownMap,
+        i: usize,
+        p: Px,
+        h: &H,
+        heap: &mut BucketQueue,
+    ) {
+        let gen = self.generation;
+        let d = node_cost(self.nodes[i]);
+        let (w, h_img) = (self.frame.width as i64, self.frame.height as i64);
+        let edges = self.edge_free[i];
+        // Moves known blocked (walls, positions where the robot does not fit) are left out
+        // before their neighbour's state is read.
+        let blocked = self.edge_blocked[i];
+        // The neighbours' states are read first, all at once (independent loads, mostly
+        // cache misses, overlap); the loop below writes only neighbours, each once.
+        let mut js = [usize::MAX; 8];
+        if p.0 > 0 && p.1 > 0 && p.0 < w - 1 && p.1 < h_img - 1 {
+            // Inside the image's rim every neighbour is in it: index offsets only.
+            for (k, jk) in js.iter_mut().enumerate() {
+                if blocked & (1 << k) == 0 {
+                    *jk = i.wrapping_add_signed((NB[k].1 * w + NB[k].0) as isize);
+                }
+            }
+        } else {
+            for (k, jk) in js.iter_mut().enumerate() {
+                let q = (p.0 + NB[k].0, p.1 + NB[k].1);
+                if blocked & (1 << k) == 0 && q.0 >= 0 && q.1 >= 0 && q.0 < w && q.1 < h_img {
+                    *jk = (q.1 * w + q.0) as usize;
+                }
+            }
+        }
+        let ns: [Node; 8] = std::array::from_fn(|k| {
+            if js[k] == usize::MAX {
+                0
+            } else {
+                self.nodes[js[k]]
+            }
+        });
+        for k in 0..8 {
+            let j = js[k];
+            if j == usize::MAX {
+                continue;
+            }
+            let q = (p.0 + NB[k].0, p.1 + NB[k].1);
+            let nd = d + if k % 2 == 1 { COST_DIAG } else { COST_ORTHO };
+            // Settled or no better: skip before judging the move (judging only fills memos).
+            let n = ns[k];
+            if node_gen(n) == gen && (n & CLOSED != 0 || nd >= node_cost(n)) {
+                continue;
+            }
+            // The memo first (most moves were judged by an earlier search).
+            if edges & (1 << k) == 0 && !self.edge(known, p, k) {
+                continue;
+            }
+            self.nodes[j] = node(nd, Some(k), gen);
+            heap.push(nd + h(self, q), j);
+        }
+    }
+
+    /// A transfer from world point `from` to world point `to` over positions (A*), merged into
+    /// known-free straight segments; `None` when no known-free way exists.
+    pub(crate) fn route(&mut self, known: &KnownMap, from: Point, to: Point) -> Option<Vec<Point>> {
+        let (gf, gt) = (self.frame.world_to_grid(from), self.frame.world_to_grid(to));
+        if self.seg_free(known, gf, gt) {
+            return Some(vec![to]);
+        }
+        let path = self.search(known, gf, None, Some(gt), false, &mut |s, p| {
+            s.center(p).dist(gt) < 1.5 && s.seg_free(known, s.center(p), gt)
+        })?;
+        let mut pts = vec![gf];
+        pts.extend(path.iter().map(|&i| self.center(self.px_of(i))));
+        pts.push(gt);
+        // Long known-free lines of sight: gallop forward, then bisect back to a free one.
+        let mut out = Vec::new();
+        let mut a = 0;
+        let n = pts.len();
+        while a + 1 < n {
+            let (mut good, mut step) = (a + 1, 1);
+            let mut bad = n;
+            while good + step < n && self.seg_free(known, pts[a], pts[good + step]) {
+                good += step;
+                step *= 2;
+            }
+            if good + step < n {
+                bad = good + step;
+            }
+            while bad - good > 1 {
+                let mid = good + (bad - good) / 2;
+                if self.seg_free(known, pts[a], pts[mid]) {
+                    good = mid;
+                } else {
+                    bad = mid;
+                }
+            }
+            out.push(self.world(pts[good]));
+            a = good;
+        }
+        if let Some(last) = out.last_mut() {
+            *last = to;
+        }
+        Some(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{
+        node, node_cost, node_gen, node_move, BucketQueue, BUCKET_MAX, BUCKET_SHIFT, CLOSED,
+        NODE_COST_SHIFT, NODE_GENS,
+    };
+    use proptest::prelude::*;
+    use std::cmp::Reverse;
+    use std::collections::BinaryHeap;
+
+    /// A key: mostly a few pixel steps of search cost, sometimes past the last bucket.
+    fn key() -> impl Strategy<Value = u64> {
+        prop_oneof![
+            8 => 0u64..20_000,
+            1 => Just((BUCKET_MAX as u64) << BUCKET_SHIFT).prop_flat_map(|b| b..b + 5_000),
+        ]
+    }
+
+    /// A node gives back the cost, move and generation it was made of, with or without the
+    /// settled bit, at the extremes of every field.
+    #[test]
+    fn node_fields_round_trip() {
+        let max_cost = (1u64 << (63 - NODE_COST_SHIFT)) - 1;
+        for dist in [0, 1, 1414, 123_456_789, max_cost] {
+            for k in [None, Some(0), Some(3), Some(7)] {
+                for gen in [1, 2, NODE_GENS - 1] {
+                    for closed in [0, CLOSED] {
+                        let n = node(dist, k, gen) | closed;
+                        assert_eq!(node_cost(n), dist);
+                        assert_eq!(node_move(n), k);
+                        assert_eq!(node_gen(n), gen);
+                        assert_eq!(n & CLOSED, closed);
+                    }
+                }
+            }
+        }
+    }
+
+    proptest! {
+        /// The bucket queue pops exactly what a binary min-heap on `(key, index)` pops, for any
+        /// mix of pushes (keys below already popped ones included), pops and clears.
+        #[test]
+        fn bucket_queue_pops_in_heap_order(
+            ops in proptest::collection::vec((0u8..10, key(), 0usize..64), 0..400)
+        ) {
+            let mut q = BucketQueue::default();
+            let mut h: BinaryHeap<Reverse<(u64, usize)>> = BinaryHeap::new();
+            for (op, k, i) in ops {
+                match op {
+                    0..=5 => {
+                        q.push(k, i);
+                        h.push(Reverse((k, i)));
+                    }
+                    6..=8 => prop_assert_eq!(q.pop(), h.pop().map(|Reverse((_, i))| i)),
+                    _ => {
+                        q.clear();
+                        h.clear();
+                    }
+                }
+            }
+            while let Some(Reverse((_, i))) = h.pop() {
+                prop_assert_eq!(q.pop(), Some(i));
+            }
+            prop_assert_eq!(q.pop(), None);
+        }
+    }
+}
