@@ -158,6 +158,8 @@ impl TileModel {
 
     /// Recomputes the L membership of `t` (`mu` read off the [`Block3`] around `t`: the same
     /// value as [`TileModel::mu`], which tests check through [`BaStar::backtrack_list_full`]).
+    ///
+    /// [`BaStar::backtrack_list_full`]: super::BaStar::backtrack_list_full
     fn update_l(&mut self, t: Tile) {
         let Some(k) = self.idx(t) else { return };
         if self.state[k] & ST_COVERED != 0 && self.block3(t).in_l(self.lane_end_corners) {

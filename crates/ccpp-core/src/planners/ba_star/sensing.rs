@@ -172,6 +172,8 @@ impl Mind {
     /// (every pixel that touches the swept disk lies within the contact radius of the segment
     /// in each coordinate, so in that box): inside the image and all known free, the move is
     /// free, as the exact test would find.
+    ///
+    /// [`judge_motion`]: super::judge_motion
     fn judge_step(&self, t: Tile, n: Tile) -> Judgement {
         let ((ra, rb), (ca, cb)) = self.touch_box(t);
         let ((rc, rd), (cc, cd)) = self.touch_box(n);
@@ -253,6 +255,8 @@ impl Mind {
     /// definition itself (tests check the cache against it after every step) — only when its
     /// cached disk runs (before the first judgement: the bounding box of its disk) meet one of
     /// those spans.
+    ///
+    /// [`judge_motion`]: super::judge_motion
     pub(super) fn sense(&mut self, sensor: &dyn Sensor) {
         // The sensor sees a disk around the robot: turning in place shows nothing new.
         let at = sensor.pose().position();
@@ -494,6 +498,7 @@ impl Mind {
     }
 
     /// Marks `t` covered (the robot stands on it), decides its moves and updates L.
+    #[inline]
     pub(super) fn cover(&mut self, t: Tile) {
         let Some(k) = self.tiles.idx(t) else { return };
         if self.tiles.state[k] & ST_COVERED != 0 {

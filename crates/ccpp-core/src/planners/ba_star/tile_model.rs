@@ -13,7 +13,7 @@ use super::search::{graph_edge, TileGraph};
 // Tile state bits.
 pub(super) const ST_STAND: u8 = 0b0011; // Judgement of standing at the centre
 pub(super) const ST_COVERED: u8 = 0b0100;
-/// The tile's contact disk is in the [`DiskCache`].
+/// The tile's contact disk is in the [`DiskCache`](super::sensing::DiskCache).
 pub(super) const ST_DISK: u8 = 0b1000;
 
 /// The discovered tiling `M̂` with cached judgements, dense over the frame's tile extent.
@@ -31,7 +31,7 @@ pub(super) struct TileModel {
     pub(super) moves: Vec<u8>,
     /// The backtracking list `L` (row-major tile indices), listed in `O(|L|)`.
     pub(super) l: IndexSet,
-    /// Add [`lane_end_score`] to `mu`.
+    /// Add [`lane_end_score`](super::lane_end_score) to `mu`.
     pub(super) lane_end_corners: bool,
 }
 
@@ -130,6 +130,7 @@ impl TileModel {
         }
     }
 
+    #[inline]
     pub(super) fn set_move(&mut self, t: Tile, k: usize, j: Judgement) {
         let (o, s) = Self::move_slot(t, k);
         if let Some(i) = self.idx(o) {
