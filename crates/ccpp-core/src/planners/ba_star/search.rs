@@ -1,0 +1,660 @@
+//! The backtracking searches over covered tiles: the nearest tile of `L` (Dijkstra, or A* to
+//! the nearest of a target set with [`TargetBlocks`]) and the bounded A* path.
+
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+
+use crate::tiles::{Tile, N8};
+
+/// Fixed-point cost of an orthogonal tile step (one tile = 1 000 000).
+pub const COST_ORTHO: u64 = 1_000_000;
+/// Fixed-point cost of a diagonal tile step (`sqrt 2` rounded up, which keeps the Euclidean
+/// heuristic consistent).
+pub const COST_DIAG: u64 = 1_414_214;
+
+/// The graph BA* searches: covered tiles, joined when the straight move is free.
+pub trait TileGraph {
+    /// Inclusive tile bounds `(i0, i1, j0, j1)`; tiles outside are never covered.
+    fn bounds(&self) -> (i32, i32, i32, i32);
+    /// Is tile `t` covered?
+    fn covered(&self, t: Tile) -> bool;
+    /// Is the straight move from `t` to its neighbour `t + N8[k]` known to be free?
+    fn move_free(&self, t: Tile, k: usize) -> bool;
+    /// The edges of `t` as a mask: bit `k` set when [`graph_edge`]`(self, t, k)` holds.
+    /// Implementors may override it with a faster equivalent (the searches call it once per
+    /// settled tile).
+    fn edge_mask(&self, t: Tile) -> u8
+    where
+        Self: Sized,
+    {
+        (0..8).fold(0, |m, k| {
+            if graph_edge(self, t, k) {
+                m | 1 << k
+            } else {
+                m
+            }
+        })
+    }
+}
+
+/// Is the step `t -> t + N8[k]` an edge of the backtracking graph: both tiles covered, a
+/// diagonal only when both orthogonal tiles are covered (no corner cutting), the move free.
+pub fn graph_edge(g: &impl TileGraph, t: Tile, k: usize) -> bool {
+    let (di, dj) = N8[k];
+    let v = (t.0 + di, t.1 + dj);
+    if !g.covered(v) {
+        return false;
+    }
+    if k % 2 == 1 && !(g.covered((t.0 + di, t.1)) && g.covered((t.0, t.1 + dj))) {
+        return false;
+    }
+    g.move_free(t, k)
+}
+
+/// Reusable dense scratch for Dijkstra and A* over a tile rectangle (no hashing; generation
+/// stamps avoid clearing between searches). One record per tile, so a visit touches one cache
+/// line; heap entries carry the row-major tile index, whose order is the `(j, i)` tie-break.
+#[derive(Clone, Debug)]
+pub struct TileSearch {
+    i0: i32,
+    j0: i32,
+    w: usize,
+    h: usize,
+    nodes: Vec<SearchNode>,
+    generation: u32,
+    heap: MonotoneQueue,
+    /// Scratch of [`Self::nearest_of`]: the targets' candidate lists per block.
+    blocks: TargetBlocks,
+}
+
+/// Side, in tiles, of the blocks of [`TargetBlocks`].
+const TARGET_BLOCK: usize = 16;
+
+/// The heuristic of [`TileSearch::nearest_of`]: the least [`octile`] cost from a tile to any
+/// of a set of targets, computed from a per-block candidate list (built when the search first
+/// reaches the block, reused by every tile of it).
+///
+/// Block `X` keeps the targets `l` whose octile cost from the nearest tile of `X` is at most
+/// `U = min over l' of` the cost from the farthest tile of `X` (a corner: the octile cost is a
+/// norm, hence convex). Any other target is farther from every tile of `X` than the target
+/// achieving `U`, so the minimum over the list is the minimum over all targets: exact.
+///
+/// A block's list is taken from the list of its super-block (4 x 4 blocks, built from all
+/// targets the same way), which holds it: for `X` inside `Y`, the cost from the nearest tile
+/// of `Y` is at most that from the nearest of `X`, and `U` of `X` at most `U` of `Y`. So each
+/// target is looked at once per super-block, not once per block.
+#[derive(Clone, Debug, Default)]
+struct TargetBlocks {
+    /// Blocks per row and per column of the search rectangle.
+    bw: usize,
+    bh: usize,
+    /// Per block: the generation its list was built in (0: never).
+    stamp: Vec<u32>,
+    /// Per block: its list, `arena[range.0..range.1]`.
+    range: Vec<(u32, u32)>,
+    arena: Vec<Tile>,
+    generation: u32,
+    targets: Vec<Tile>,
+    /// The same per super-block (`SUPER_BLOCKS` blocks a side).
+    sbw: usize,
+    sstamp: Vec<u32>,
+    srange: Vec<(u32, u32)>,
+    sarena: Vec<Tile>,
+}
+
+/// Blocks a side of a super-block of [`TargetBlocks`].
+const SUPER_BLOCKS: usize = 4;
+
+/// The cost of the cheapest 8-neighbour path from `a` to `b` on an unobstructed grid
+/// ([`COST_ORTHO`] / [`COST_DIAG`] steps): a lower bound of the search cost, and consistent
+/// (it is the path metric of a supergraph with the same edge costs).
+#[inline]
+pub fn octile(a: Tile, b: Tile) -> u64 {
+    octile_gap(u64::from(a.0.abs_diff(b.0)), u64::from(a.1.abs_diff(b.1)))
+}
+
+#[inline]
+fn octile_gap(dx: u64, dy: u64) -> u64 {
+    let (lo, hi) = if dx < dy { (dx, dy) } else { (dy, dx) };
+    COST_ORTHO * (hi - lo) + COST_DIAG * lo
+}
+
+/// A priority queue of `(key, index)` pairs popping the smallest pair (key, then index) for
+/// keys that never go below the last popped key (Dijkstra costs, A* `f` with a consistent
+/// heuristic): a radix heap over the keys, plus a binary heap of the indices whose key equals
+/// the current minimum. Every pair in a search is distinct, so the pop order is exactly that of
+/// a binary heap of the pairs.
+#[derive(Clone, Debug)]
+pub(super) struct MonotoneQueue {
+    /// The key of the current group (the last popped minimum).
+    last: u64,
+    /// Indices whose key is `last`.
+    current: BinaryHeap<Reverse<u32>>,
+    /// Bucket `b` (1..=64) holds the pairs whose key's highest bit differing from `last` is
+    /// bit `b - 1`; bucket 0 is unused.
+    buckets: Vec<Vec<(u64, u32)>>,
+    /// Bit `b` set when bucket `b` may be non-empty.
+    nonempty: u128,
+}
+
+impl MonotoneQueue {
+    pub(super) fn new() -> Self {
+        Self {
+            last: 0,
+            current: BinaryHeap::new(),
+            buckets: vec![Vec::new(); 65],
+            nonempty: 0,
+        }
+    }
+
+    pub(super) fn clear(&mut self) {
+        self.last = 0;
+        self.current.clear();
+        while self.nonempty != 0 {
+            let b = self.nonempty.trailing_zeros() as usize;
+            self.nonempty &= self.nonempty - 1;
+            self.buckets[b].clear();
+        }
+    }
+
+    #[inline]
+    fn bucket(last: u64, key: u64) -> usize {
+        64 - (key ^ last).leading_zeros() as usize
+    }
+
+    #[inline]
+    pub(super) fn push(&mut self, key: u64, index: u32) {
+        if key < self.last {
+            self.lower(key);
+        }
+        if key == self.last {
+            self.current.push(Reverse(index));
+        } else {
+            let b = Self::bucket(self.last, key);
+            self.buckets[b].push((key, index));
+            self.nonempty |= 1 << b;
+        }
+    }
+
+    /// Makes `key` (below the current minimum) the current key, redistributing every pair:
+    /// keeps the exact order should a key ever go below the minimum (a heuristic rounding).
+    #[cold]
+    fn lower(&mut self, key: u64) {
+        let mut all: Vec<(u64, u32)> = self
+            .current
+            .drain()
+            .map(|Reverse(i)| (self.last, i))
+            .collect();
+        for b in &mut self.buckets {
+            all.append(b);
+        }
+        self.nonempty = 0;
+        self.last = key;
+        for (k, i) in all {
+            self.push(k, i);
+        }
+    }
+
+    #[inline]
+    pub(super) fn pop(&mut self) -> Option<(u64, u32)> {
+        if let Some(Reverse(i)) = self.current.pop() {
+            return Some((self.last, i));
+        }
+        if self.nonempty == 0 {
+            return None;
+        }
+        // The lowest non-empty bucket holds the smallest keys: its minimum becomes the new
+        // current key and the rest spread into lower buckets.
+        let b = self.nonempty.trailing_zeros() as usize;
+        self.nonempty &= !(1u128 << b);
+        let mut items = std::mem::take(&mut self.buckets[b]);
+        let min = items.iter().map(|&(k, _)| k).min().unwrap_or(self.last);
+        self.last = min;
+        for &(k, i) in &items {
+            if k == min {
+                self.current.push(Reverse(i));
+            } else {
+                let nb = Self::bucket(min, k);
+                self.buckets[nb].push((k, i));
+                self.nonempty |= 1 << nb;
+            }
+        }
+        items.clear();
+        self.buckets[b] = items;
+        self.current.pop().map(|Reverse(i)| (self.last, i))
+    }
+}
+
+/// Per-tile search state (16 bytes): labelled in this search when `stamp` is the current
+/// generation (even), settled when it is the generation + 1; stamp 0 is "never labelled".
+#[derive(Clone, Copy, Debug, Default)]
+struct SearchNode {
+    dist: u64,
+    parent: u32,
+    stamp: u32,
+}
+
+impl TileSearch {
+    /// Scratch for tiles `i0..=i1`, `j0..=j1`.
+    pub fn new((i0, i1, j0, j1): (i32, i32, i32, i32)) -> Self {
+        let w = (i1 - i0 + 1).max(0) as usize;
+        let h = (j1 - j0 + 1).max(0) as usize;
+        Self {
+            i0,
+            j0,
+            w,
+            h,
+            nodes: vec![SearchNode::default(); w * h],
+            generation: 0,
+            heap: MonotoneQueue::new(),
+            blocks: TargetBlocks {
+                bw: w.div_ceil(TARGET_BLOCK),
+                bh: h.div_ceil(TARGET_BLOCK),
+                ..TargetBlocks::default()
+            },
+        }
+    }
+
+    #[inline]
+    fn idx(&self, t: Tile) -> Option<usize> {
+        let di = t.0 - self.i0;
+        let dj = t.1 - self.j0;
+        if di < 0 || dj < 0 || di as usize >= self.w || dj as usize >= self.h {
+            None
+        } else {
+            Some(dj as usize * self.w + di as usize)
+        }
+    }
+
+    #[inline]
+    fn tile(&self, k: usize) -> Tile {
+        (self.i0 + (k % self.w) as i32, self.j0 + (k / self.w) as i32)
+    }
+
+    fn begin(&mut self) {
+        self.generation = self.generation.wrapping_add(2);
+        if self.generation == 0 {
+            for n in &mut self.nodes {
+                n.stamp = 0;
+            }
+            self.generation = 2;
+        }
+        self.heap.clear();
+    }
+
+    /// Is node `k` settled in the current search?
+    #[inline]
+    fn closed(&self, k: usize) -> bool {
+        self.nodes[k].stamp == self.generation + 1
+    }
+
+    /// Relaxes the label of node `k` (never called on a settled node).
+    #[inline]
+    fn relax(&mut self, k: usize, d: u64, parent: u32) -> bool {
+        let gen = self.generation;
+        let n = &mut self.nodes[k];
+        if n.stamp != gen || d < n.dist {
+            n.stamp = gen;
+            n.dist = d;
+            n.parent = parent;
+            true
+        } else {
+            false
+        }
+    }
+
+    fn path_to(&self, k: usize) -> Vec<Tile> {
+        let mut path = vec![self.tile(k)];
+        let mut c = k;
+        while self.nodes[c].parent != u32::MAX {
+            c = self.nodes[c].parent as usize;
+            path.push(self.tile(c));
+        }
+        path.reverse();
+        path
+    }
+
+    /// Dijkstra from `from` over the graph of [`graph_edge`]; returns the first settled tile
+    /// with `is_target` (smallest cost, then smaller `j`, then smaller `i`) and its cost.
+    pub fn nearest(
+        &mut self,
+        g: &impl TileGraph,
+        from: Tile,
+        is_target: impl Fn(Tile) -> bool,
+    ) -> Option<(Tile, u64)> {
+        let s = self.idx(from)?;
+        self.begin();
+        self.relax(s, 0, u32::MAX);
+        self.heap.push(0, s as u32);
+        while let Some((d, k)) = self.heap.pop() {
+            let k = k as usize;
+            if self.closed(k) || d > self.nodes[k].dist {
+                continue;
+            }
+            self.nodes[k].stamp = self.generation + 1;
+            let t = self.tile(k);
+            if is_target(t) {
+                return Some((t, d));
+            }
+            self.expand(g, t, k, d, None);
+        }
+        None
+    }
+
+    /// [`Self::nearest`] when the targets are listed (`targets`: exactly the tiles with
+    /// `is_target`): the same tile and cost, found by A* towards the set.
+    ///
+    /// The heuristic is the least [`octile`] cost to a target (bounded per block of tiles):
+    /// consistent, and zero at the targets, whose key is then their cost. Popping in `(key, index)` order,
+    /// every tile on a cheapest path to a target of the least cost `d*` is popped, with its
+    /// exact cost, before any key above `d*`; so once a target is popped the search goes on
+    /// through the key `d*` and answers with the smallest-index target popped at that key:
+    /// the first target of the Dijkstra order `(cost, index)`. Targets are not expanded, as
+    /// in [`Self::nearest`] (a cheapest path to a target of cost `d*` passes through no other
+    /// target: costs are positive). Far targets cost a search of the region between, not of
+    /// the disc of radius `d*`.
+    pub fn nearest_of(
+        &mut self,
+        g: &impl TileGraph,
+        from: Tile,
+        targets: &[Tile],
+        is_target: impl Fn(Tile) -> bool,
+    ) -> Option<(Tile, u64)> {
+        let s = self.idx(from)?;
+        self.begin();
+        self.blocks.begin(targets);
+        self.relax(s, 0, u32::MAX);
+        let h0 = self.target_h(from);
+        self.heap.push(h0, s as u32);
+        let mut best: Option<(usize, u64)> = None;
+        while let Some((key, k)) = self.heap.pop() {
+            if best.is_some_and(|(_, d)| key > d) {
+                break;
+            }
+            let k = k as usize;
+            if self.closed(k) {
+                continue;
+            }
+            self.nodes[k].stamp = self.generation + 1;
+            let d = self.nodes[k].dist;
+            let t = self.tile(k);
+            if is_target(t) {
+                if best.is_none_or(|(b, _)| k < b) {
+                    best = Some((k, d));
+                }
+                continue;
+            }
+            self.expand_to_targets(g, t, k, d);
+        }
+        best.map(|(k, d)| (self.tile(k), d))
+    }
+
+    /// The heuristic of [`Self::nearest_of`] at tile `t` (in the search rectangle).
+    #[inline]
+    fn target_h(&mut self, t: Tile) -> u64 {
+        let bi = (t.0 - self.i0) as usize / TARGET_BLOCK;
+        let bj = (t.1 - self.j0) as usize / TARGET_BLOCK;
+        let (lo, hi) = self.blocks.list(bi, bj, (self.i0, self.j0));
+        self.blocks.arena[lo..hi]
+            .iter()
+            .map(|&l| octile(t, l))
+            .min()
+            .unwrap_or(u64::MAX / 4)
+    }
+
+    /// [`Self::expand_within`] for [`Self::nearest_of`]: keys `cost + target_h`.
+    fn expand_to_targets(&mut self, g: &impl TileGraph, t: Tile, k: usize, d: u64) {
+        let mut mask = g.edge_mask(t);
+        let gen = self.generation;
+        while mask != 0 {
+            let n = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            let (di, dj) = N8[n];
+            let v = (t.0 + di, t.1 + dj);
+            let Some(kv) = self.idx(v) else { continue };
+            let nd = d + if n % 2 == 1 { COST_DIAG } else { COST_ORTHO };
+            let node = self.nodes[kv];
+            if node.stamp == gen + 1 || (node.stamp == gen && nd >= node.dist) {
+                continue;
+            }
+            let f = nd + self.target_h(v);
+            let node = &mut self.nodes[kv];
+            node.stamp = gen;
+            node.dist = nd;
+            node.parent = k as u32;
+            self.heap.push(f, kv as u32);
+        }
+    }
+
+    fn expand(&mut self, g: &impl TileGraph, t: Tile, k: usize, d: u64, goal: Option<Tile>) {
+        self.expand_within(g, t, k, d, goal, u64::MAX);
+    }
+
+    /// Relaxes the edges of the settled tile `t` (index `k`, cost `d`), pushing each improved
+    /// neighbour with key `cost + heuristic`; a neighbour whose key would exceed `bound` is left
+    /// unlabelled (see [`Self::astar_within`]).
+    #[inline]
+    fn expand_within(
+        &mut self,
+        g: &impl TileGraph,
+        t: Tile,
+        k: usize,
+        d: u64,
+        goal: Option<Tile>,
+        bound: u64,
+    ) {
+        let mut mask = g.edge_mask(t);
+        if mask == 0 {
+            return;
+        }
+        // Interior tiles of the search rectangle reach their neighbours by a fixed index
+        // offset; the others go through `idx` (a neighbour outside the rectangle is skipped).
+        let (di0, dj0) = (t.0 - self.i0, t.1 - self.j0);
+        let interior =
+            di0 >= 1 && dj0 >= 1 && (di0 as usize) + 1 < self.w && (dj0 as usize) + 1 < self.h;
+        let w = self.w as isize;
+        let gen = self.generation;
+        while mask != 0 {
+            let n = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            let (di, dj) = N8[n];
+            let v = (t.0 + di, t.1 + dj);
+            let kv = if interior {
+                (k as isize + di as isize + dj as isize * w) as usize
+            } else {
+                let Some(kv) = self.idx(v) else { continue };
+                kv
+            };
+            let nd = d + if n % 2 == 1 { COST_DIAG } else { COST_ORTHO };
+            let node = &mut self.nodes[kv];
+            // Settled (stamp gen + 1), or labelled at least as well: nothing to do.
+            if node.stamp == gen + 1 || (node.stamp == gen && nd >= node.dist) {
+                continue;
+            }
+            let f = match goal {
+                Some(gl) => {
+                    // The octile cost to the goal bounds the remaining cost from below and
+                    // is at least the Euclidean heuristic: a label beyond `bound` by it lies
+                    // on no path of cost `<= bound` (see [`Self::astar_bounded`]).
+                    if bound != u64::MAX && nd + octile(v, gl) > bound {
+                        continue;
+                    }
+                    nd + heuristic(v, gl)
+                }
+                None => nd,
+            };
+            if f > bound {
+                continue;
+            }
+            node.stamp = gen;
+            node.dist = nd;
+            node.parent = k as u32;
+            self.heap.push(f, kv as u32);
+        }
+    }
+
+    /// A* from `from` to `to` over the graph of [`graph_edge`] (costs [`COST_ORTHO`] /
+    /// [`COST_DIAG`], Euclidean heuristic); the tile path (both ends included) and its cost.
+    pub fn astar(&mut self, g: &impl TileGraph, from: Tile, to: Tile) -> Option<(Vec<Tile>, u64)> {
+        self.astar_within(g, from, to, u64::MAX)
+    }
+
+    /// [`Self::astar`] when the cost of the best path is known to be `cost` (say from
+    /// [`Self::nearest`] on the same graph): the same answer, without labelling a tile whose
+    /// label plus the [`octile`] cost to the goal exceeds `cost` (the keys stay `cost +`
+    /// Euclidean heuristic; the octile cost is at least that heuristic).
+    ///
+    /// Why it is the same: the octile cost is a lower bound of the remaining cost, so a
+    /// left-out label is either worse than its tile's best cost or belongs to a tile on no
+    /// cheapest path to the goal. Call the tiles on cheapest paths *optimal*. With a consistent
+    /// heuristic every tile is settled through the label of its best cost, and an optimal
+    /// tile's best label is pushed when the first of its optimal predecessors (in settling
+    /// order) is expanded, with that predecessor as parent; no left-out or other label of
+    /// another tile can set or block it (they are worse, or from tiles that are not optimal
+    /// predecessors). So the best labels of optimal tiles are pushed at the same points of the
+    /// sequence of optimal settlings in both searches, and as the queue pops pairs in
+    /// `(key, index)` order, both settle the optimal tiles in the same order, with the same
+    /// parents, up to the goal: the same path and cost. Should the bound be too low (or the
+    /// heuristic inconsistent), this search runs dry before the goal and the full search is
+    /// run instead.
+    pub fn astar_bounded(
+        &mut self,
+        g: &impl TileGraph,
+        from: Tile,
+        to: Tile,
+        cost: u64,
+    ) -> Option<(Vec<Tile>, u64)> {
+        self.astar_within(g, from, to, cost)
+            .or_else(|| self.astar_within(g, from, to, u64::MAX))
+    }
+
+    fn astar_within(
+        &mut self,
+        g: &impl TileGraph,
+        from: Tile,
+        to: Tile,
+        bound: u64,
+    ) -> Option<(Vec<Tile>, u64)> {
+        let s = self.idx(from)?;
+        self.idx(to)?;
+        self.begin();
+        self.relax(s, 0, u32::MAX);
+        self.heap.push(heuristic(from, to), s as u32);
+        while let Some((_, k)) = self.heap.pop() {
+            let k = k as usize;
+            if self.closed(k) {
+                continue;
+            }
+            self.nodes[k].stamp = self.generation + 1;
+            let d = self.nodes[k].dist;
+            let t = self.tile(k);
+            if t == to {
+                return Some((self.path_to(k), d));
+            }
+            self.expand_within(g, t, k, d, Some(to), bound);
+        }
+        None
+    }
+}
+
+impl TargetBlocks {
+    /// A new search towards `targets`: every block's list is stale.
+    fn begin(&mut self, targets: &[Tile]) {
+        if self.stamp.len() != self.bw * self.bh {
+            self.stamp = vec![0; self.bw * self.bh];
+            self.range = vec![(0, 0); self.bw * self.bh];
+            self.sbw = self.bw.div_ceil(SUPER_BLOCKS);
+            let n = self.sbw * self.bh.div_ceil(SUPER_BLOCKS);
+            self.sstamp = vec![0; n];
+            self.srange = vec![(0, 0); n];
+        }
+        self.generation = self.generation.wrapping_add(1);
+        if self.generation == 0 {
+            self.stamp.fill(0);
+            self.sstamp.fill(0);
+            self.generation = 1;
+        }
+        self.arena.clear();
+        self.sarena.clear();
+        self.targets.clear();
+        self.targets.extend_from_slice(targets);
+    }
+
+    /// The arena range of block `(bi, bj)` of a search rectangle whose first tile is
+    /// `origin`, built on first use.
+    #[inline]
+    fn list(&mut self, bi: usize, bj: usize, origin: Tile) -> (usize, usize) {
+        let b = bj * self.bw + bi;
+        if self.stamp[b] != self.generation {
+            self.build(bi, bj, origin);
+        }
+        let (lo, hi) = self.range[b];
+        (lo as usize, hi as usize)
+    }
+
+    fn build(&mut self, bi: usize, bj: usize, origin: Tile) {
+        let (si, sj) = (bi / SUPER_BLOCKS, bj / SUPER_BLOCKS);
+        let sb = sj * self.sbw + si;
+        if self.sstamp[sb] != self.generation {
+            let side = TARGET_BLOCK * SUPER_BLOCKS;
+            let lo = self.sarena.len();
+            candidates(
+                &self.targets,
+                block_rect(origin, si, sj, side),
+                &mut self.sarena,
+            );
+            self.srange[sb] = (lo as u32, self.sarena.len() as u32);
+            self.sstamp[sb] = self.generation;
+        }
+        let (slo, shi) = self.srange[sb];
+        let lo = self.arena.len();
+        candidates(
+            &self.sarena[slo as usize..shi as usize],
+            block_rect(origin, bi, bj, TARGET_BLOCK),
+            &mut self.arena,
+        );
+        let b = bj * self.bw + bi;
+        self.range[b] = (lo as u32, self.arena.len() as u32);
+        self.stamp[b] = self.generation;
+    }
+}
+
+/// The tiles `(x0, x1, y0, y1)` of block `(bi, bj)` of side `side` from `origin` (not clipped
+/// to the search rectangle: a larger block keeps every list exact).
+fn block_rect(origin: Tile, bi: usize, bj: usize, side: usize) -> (i32, i32, i32, i32) {
+    let x0 = origin.0 + (bi * side) as i32;
+    let y0 = origin.1 + (bj * side) as i32;
+    (x0, x0 + side as i32 - 1, y0, y0 + side as i32 - 1)
+}
+
+/// Appends to `out` the targets of `src` kept for the block `(x0, x1, y0, y1)` (see
+/// [`TargetBlocks`]), in the order of `src`.
+fn candidates(src: &[Tile], (x0, x1, y0, y1): (i32, i32, i32, i32), out: &mut Vec<Tile>) {
+    let gap = |v: i32, lo: i32, hi: i32| {
+        u64::from(
+            lo.saturating_sub(v)
+                .max(v.saturating_sub(hi))
+                .max(0)
+                .unsigned_abs(),
+        )
+    };
+    let near = |l: Tile| octile_gap(gap(l.0, x0, x1), gap(l.1, y0, y1));
+    let far = |l: Tile| {
+        let dx = u64::from(l.0.abs_diff(x0).max(l.0.abs_diff(x1)));
+        let dy = u64::from(l.1.abs_diff(y0).max(l.1.abs_diff(y1)));
+        octile_gap(dx, dy)
+    };
+    let u = src.iter().map(|&l| far(l)).min().unwrap_or(0);
+    out.extend(src.iter().copied().filter(|&l| near(l) <= u));
+}
+
+/// Euclidean distance between tiles in the fixed-point unit of [`COST_ORTHO`], rounded down
+/// (admissible and consistent with the rounded-up diagonal cost).
+#[inline]
+pub fn heuristic(a: Tile, b: Tile) -> u64 {
+    let di = f64::from(a.0 - b.0);
+    let dj = f64::from(a.1 - b.1);
+    // The product is finite and >= 0, where the truncating cast is the floor (without a call
+    // into libm).
+    (di.hypot(dj) * COST_ORTHO as f64) as u64
+}

@@ -1,0 +1,202 @@
+//! Unit tests of the BA* internals.
+
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+
+use super::backtrack_list::Block3;
+use super::search::MonotoneQueue;
+use super::smoothing::segment_box_dist2;
+use super::*;
+
+/// The monotone queue pops exactly what a binary heap of the pairs pops, over a
+/// Dijkstra-like run (pushes at or above the last popped key, ties on the key, keys below
+/// the minimum, reuse after `clear`).
+#[test]
+fn monotone_queue_matches_binary_heap() {
+    let mut q = MonotoneQueue::new();
+    let mut seed: u64 = 0x9e37_79b9_7f4a_7c15;
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        seed
+    };
+    for round in 0..4 {
+        q.clear();
+        let mut heap = BinaryHeap::new();
+        let mut last = 0u64;
+        let mut id = 0u32;
+        for step in 0..5000 {
+            for _ in 0..(next() % 4) {
+                let r = next();
+                let key = match r % 5 {
+                    0 => last,
+                    1 if round == 3 && last > 0 => last - 1 - r % last.min(7),
+                    _ => last + (r >> 8) % [3, 1_000, 1_414_214, 1 << 40][round],
+                };
+                id = id.wrapping_add(1 + (r >> 40) as u32 % 3) % 100_000;
+                // Every pair distinct, as in a search.
+                let pair = (key, id ^ step);
+                q.push(pair.0, pair.1);
+                heap.push(Reverse(pair));
+            }
+            if next() % 3 != 0 {
+                let got = q.pop();
+                assert_eq!(got, heap.pop().map(|Reverse(p)| p));
+                if let Some((k, _)) = got {
+                    last = k;
+                }
+            }
+        }
+        while let Some(Reverse(p)) = heap.pop() {
+            assert_eq!(q.pop(), Some(p));
+        }
+        assert_eq!(q.pop(), None);
+    }
+}
+
+/// `Block3::in_l` (the early-stopping test the incremental L uses) is `mu >= 1`, over
+/// random blocks of tile states and move judgements.
+#[test]
+fn block_in_l_is_mu_at_least_one() {
+    let mut seed: u64 = 0x2545_f491_4f6c_dd1d;
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        seed
+    };
+    let mut fired = [0usize; 2];
+    for _ in 0..200_000 {
+        let mut b = Block3 {
+            state: [0; 25],
+            moves: [0; 25],
+            c: 12,
+        };
+        for k in 0..25 {
+            let r = next();
+            // Standability 0..=2, covered about half the time; each move slot 0..=2.
+            b.state[k] = (r % 3) as u8 | if r >> 8 & 1 == 1 { ST_COVERED } else { 0 };
+            b.moves[k] = (0..4).fold(0u8, |m, s| {
+                m | ((((r >> (16 + 2 * s)) % 3) as u8) << (2 * s))
+            });
+        }
+        for lane in [false, true] {
+            let want = b.mu(lane) >= 1;
+            assert_eq!(
+                b.in_l(lane),
+                want,
+                "{:?} {:?} lane {lane}",
+                b.state,
+                b.moves
+            );
+            fired[usize::from(lane)] += usize::from(want);
+        }
+    }
+    assert!(fired[0] > 10_000 && fired[1] > fired[0], "{fired:?}");
+}
+
+#[test]
+fn corner_score_pairs() {
+    let mut free = [false; 8];
+    let mut blocked = [false; 8];
+    assert_eq!(corner_score(free, blocked), 0);
+    free[4] = true;
+    blocked[3] = true;
+    assert_eq!(corner_score(free, blocked), 1);
+    blocked[5] = true;
+    assert_eq!(corner_score(free, blocked), 2);
+    // s3 (north) never starts a pair.
+    free[2] = true;
+    blocked[1] = true;
+    blocked[3] = true;
+    assert_eq!(corner_score(free, blocked), 2);
+}
+
+#[test]
+fn swept_tiles_of_straight_and_diagonal_moves() {
+    let collect = |a, b| {
+        let mut v = Vec::new();
+        for_each_swept_tile(a, b, 0.5, |t| {
+            v.push(t);
+            true
+        });
+        v.sort_unstable();
+        v
+    };
+    assert_eq!(collect((0, 0), (1, 0)), vec![(0, 0), (1, 0)]);
+    assert_eq!(collect((0, 0), (0, -2)), vec![(0, -2), (0, -1), (0, 0)]);
+    assert_eq!(
+        collect((0, 0), (1, 1)),
+        vec![(0, 0), (0, 1), (1, 0), (1, 1)]
+    );
+    let v = collect((0, 0), (2, 1));
+    assert!(v.contains(&(1, 0)) && v.contains(&(1, 1)) && v.len() >= 4);
+}
+
+#[test]
+fn segment_box_distance() {
+    let lo = Point::new(0.0, 0.0);
+    let hi = Point::new(1.0, 1.0);
+    let d = segment_box_dist2(Point::new(-1.0, 0.5), Point::new(2.0, 0.5), lo, hi);
+    assert_eq!(d, 0.0);
+    let d = segment_box_dist2(Point::new(-1.0, 2.0), Point::new(2.0, 2.0), lo, hi);
+    assert!((d - 1.0).abs() < 1e-12);
+    let d = segment_box_dist2(Point::new(2.0, 3.0), Point::new(3.0, 2.0), lo, hi);
+    // Nearest: corner (1,1) to the line x + y = 5: distance 3/sqrt2.
+    assert!((d - 4.5).abs() < 1e-12);
+}
+
+#[test]
+fn heuristic_is_the_floored_euclidean_distance() {
+    for di in -60..=60 {
+        for dj in -60..=60 {
+            let e = (f64::from(di).hypot(f64::from(dj)) * COST_ORTHO as f64).floor() as u64;
+            assert_eq!(heuristic((di, dj), (0, 0)), e, "({di}, {dj})");
+        }
+    }
+}
+
+/// The shortcuts of [`for_each_swept_tile`] change nothing: the same tiles as the box
+/// distance alone, for segments in every direction and several radii.
+#[test]
+fn swept_tiles_match_the_box_distance() {
+    for rho in [0.0, 1e-12, 0.25, 0.5, 0.5 + 1e-12, 0.7, 1.0, 1.5, 2.3] {
+        let lim = (rho * rho) * (1.0 - 1e-9) - 1e-12;
+        for bx in -7..=7 {
+            for by in -7..=7 {
+                let (a, b) = ((0, 0), (bx, by));
+                let mut got = Vec::new();
+                for_each_swept_tile(a, b, rho, |t| {
+                    got.push(t);
+                    true
+                });
+                got.sort_unstable();
+                let (pa, pb) = (
+                    Point::new(0.0, 0.0),
+                    Point::new(f64::from(bx), f64::from(by)),
+                );
+                let mut want = Vec::new();
+                for j in -12..=12 {
+                    for i in -12..=12 {
+                        let (x, y) = (f64::from(i), f64::from(j));
+                        let lo = Point::new(x - 0.5, y - 0.5);
+                        let hi = Point::new(x + 0.5, y + 0.5);
+                        if segment_box_dist2(pa, pb, lo, hi) < lim {
+                            want.push((i, j));
+                        }
+                    }
+                }
+                want.sort_unstable();
+                assert_eq!(got, want, "rho {rho}, to ({bx}, {by})");
+            }
+        }
+    }
+}
+
+#[test]
+fn heuristic_is_consistent() {
+    assert_eq!(heuristic((0, 0), (1, 0)), COST_ORTHO);
+    assert!(heuristic((0, 0), (1, 1)) <= COST_DIAG);
+    assert!(heuristic((0, 0), (3, 4)) == 5 * COST_ORTHO);
+}
