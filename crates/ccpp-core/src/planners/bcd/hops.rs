@@ -15,8 +15,8 @@
 //! each of its end-point blocks: the path there less two far-block diagonals (the points can
 //! sit anywhere in their blocks), at least the radius and the straight line.
 
+use super::lattice::Ctx;
 use super::tsp;
-use super::Ctx;
 use crate::geometry::Point;
 
 /// Search radius of each end point's Dijkstra, in blocks of path.

@@ -28,7 +28,9 @@ use std::ops::Sub;
 
 use fixedbitset::FixedBitSet;
 
-use super::{is_turn, Ctx, Item};
+use super::finish::is_turn;
+use super::lattice::Ctx;
+use super::plan::Item;
 use crate::geometry::{point_segment_dist2, Point};
 
 /// Heading change at `b` between the moves `a -> b` and `b -> c` (as the simulator counts a
@@ -702,7 +704,7 @@ mod tests {
 
     /// The points of the moves of `items`.
     fn points(items: &[Item]) -> Vec<Point> {
-        super::super::moves(items)
+        super::super::finish::moves(items)
             .into_iter()
             .map(|m| m.0)
             .collect()
@@ -721,7 +723,7 @@ mod tests {
     }
 
     fn turns(items: &[Item]) -> usize {
-        super::super::turns(&points(items))
+        super::super::finish::turns(&points(items))
     }
 
     #[test]

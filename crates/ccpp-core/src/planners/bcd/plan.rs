@@ -1,0 +1,454 @@
+//! The planning pipeline (steps 1-5 of the module docs): lattices, decompositions, lanes,
+//! cell tour, rim passes, repair, smoothing and turn pruning.
+
+use std::collections::VecDeque;
+
+use super::angles::{dominant_angles, ANGLE_STEP_DEG, AXIS_TOL_DEG};
+use super::cells::{decompose, split_ends, split_jumps, Cell};
+use super::finish::{moves, repair, smooth, turns};
+use super::lanes::{cell_paths, drop_covered, estimate, lanes_of, side_open};
+use super::lattice::{Ctx, Lattice};
+use super::rim::{rim_contours, rim_pass};
+use super::transfer::Search;
+use super::{hops, prune, tsp};
+use super::{Bcd, BcdOptions};
+use crate::geometry::{path_length, Point};
+use crate::planner::Step;
+use crate::trace::Event;
+use crate::world::World;
+
+/// Improvement rounds of the first tour (which only picks each cell's path for the rim step).
+const FIRST_ROUNDS: u32 = 1;
+
+/// One step of the plan.
+#[derive(Clone, Debug)]
+pub(super) enum Item {
+    Move(Point),
+    Mark(Event),
+}
+
+impl Bcd {
+    pub(super) fn plan(world: &World, opts: &BcdOptions) -> Self {
+        let frame = *world.frame();
+        let (w, h) = (frame.width, frame.height);
+        let robot = world.robot();
+        let res = frame.resolution;
+        let reach = world.reachable();
+        let ok: Vec<bool> = (0..w * h).map(|i| reach.contains(i)).collect();
+        let need = crate::collide::contact_radius_px(robot.radius / res) + opts.margin_px;
+        let safe: Vec<bool> = (0..w * h)
+            .map(|i| ok[i] && world.pixel_clearance(i % w, i / w) / res + 0.5 >= need)
+            .collect();
+        let ctx = Ctx {
+            world,
+            frame,
+            ok,
+            safe,
+            rt: robot.tool_radius / res,
+        };
+        let mut search = Search::new(w, h);
+        // The plan on the pixel lattice and, when the walls run at an angle to the pixel
+        // axes, on the lattice turned to them; the cheaper is kept (module docs, step 1).
+        let mut best = Self::plan_on(&ctx, &Lattice::pixels(&ctx), opts, &mut search);
+        let off_axis = |a: &f64| {
+            let deg = a.to_degrees();
+            deg.min(90.0 - deg) > AXIS_TOL_DEG
+        };
+        let angles = dominant_angles(&ctx);
+        // A map whose dominant walls run along the axes is planned on the pixels only.
+        let angles: &[f64] = if angles.first().is_some_and(off_axis) {
+            &angles
+        } else {
+            &[]
+        };
+        for a in angles.iter().copied() {
+            if !off_axis(&a) {
+                continue;
+            }
+            for j in 0..opts.angle_tries {
+                // 0, +1/2, -1/2, +1, -1, ... degrees around the wall angle.
+                let step = f64::from(j.div_ceil(2)) * ANGLE_STEP_DEG;
+                let d = if j % 2 == 1 { step } else { -step };
+                let t = a + d.to_radians();
+                let turned = Self::plan_on(&ctx, &Lattice::turned(&ctx, t), opts, &mut search);
+                if (turned.0, turned.1) < (best.0, best.1) {
+                    best = turned;
+                }
+            }
+        }
+        let (_, _, items, ncells) = best;
+        let start = frame.world_to_grid(world.start().position());
+
+        // A region whose moves the smoothing and pruning merged into the moves around it (or
+        // a cell whose lane is a single point) has nothing left between its start and end: it
+        // is not reported (marks inside it are kept), and the regions left are numbered 1, 2,
+        // ... in order.
+        let mut steps = VecDeque::with_capacity(items.len());
+        let mut at = start;
+        // Marks since a region's start while it has no move yet (`None`: no region pending).
+        let mut pending: Option<Vec<Event>> = None;
+        let mut region = 0u32;
+        for it in items {
+            match it {
+                Item::Move(p) => {
+                    if p != at {
+                        if let Some(marks) = pending.take() {
+                            region += 1;
+                            steps.push_back(Step::Mark(Event::RegionStart { region }));
+                            steps.extend(marks.into_iter().map(Step::Mark));
+                        }
+                        steps.push_back(Step::MoveTo(frame.grid_to_world(p)));
+                        at = p;
+                    }
+                }
+                Item::Mark(Event::RegionStart { .. }) => {
+                    if let Some(marks) = pending.replace(Vec::new()) {
+                        steps.extend(marks.into_iter().map(Step::Mark));
+                    }
+                }
+                Item::Mark(Event::RegionEnd { .. }) => match pending.take() {
+                    Some(marks) => steps.extend(marks.into_iter().map(Step::Mark)),
+                    None => steps.push_back(Step::Mark(Event::RegionEnd { region })),
+                },
+                Item::Mark(e) => match pending.as_mut() {
+                    Some(marks) => marks.push(e),
+                    None => steps.push_back(Step::Mark(e)),
+                },
+            }
+        }
+        if let Some(marks) = pending {
+            steps.extend(marks.into_iter().map(Step::Mark));
+        }
+        Self {
+            steps,
+            cells: ncells,
+        }
+    }
+
+    /// Steps 1-5 of the module docs on the lattice `lat`: the plan's items with the moves it
+    /// had to skip, its cost (length plus `turn_cost_m` per turn, pixels) and its cells.
+    pub(super) fn plan_on(
+        ctx: &Ctx<'_>,
+        lat: &Lattice,
+        opts: &BcdOptions,
+        search: &mut Search,
+    ) -> (usize, f64, Vec<Item>, usize) {
+        let world = ctx.world;
+        let frame = ctx.frame;
+        let robot = world.robot();
+        let res = frame.resolution;
+        let (w, h) = (lat.w, lat.h);
+        let spacing = opts.lane_spacing_m.unwrap_or(2.0 * robot.tool_radius);
+        let sp = (spacing / res).max(1.0);
+        let turn_px = opts.turn_cost_m / res;
+        let start = frame.world_to_grid(world.start().position());
+
+        // 1-2. Both decompositions, each cell's cheaper lane direction, the cheaper total.
+        let ok = &lat.ok;
+        let by_cols = decompose(w, h, true, &|c, r| ok[r * w + c]);
+        let by_rows = decompose(h, w, false, &|r, c| ok[r * w + c]);
+        // Each cell's views (along its lines; across them when monotone) with their sides'
+        // openness where C-free continues; per decomposition and lattice phase, the cheaper
+        // view of every cell and the estimated total.
+        let views = |cells: Vec<Cell>| -> Vec<Vec<(Cell, bool, bool)>> {
+            cells
+                .into_iter()
+                .map(|c| {
+                    let t = c.transposed();
+                    let mut v = Vec::with_capacity(2);
+                    for c in std::iter::once(c).chain(t) {
+                        let lo = side_open(lat, &c, c.u0, -1, &|_| true);
+                        let hi = side_open(lat, &c, c.u1(), 1, &|_| true);
+                        v.push((c, lo, hi));
+                    }
+                    v
+                })
+                .collect()
+        };
+        // A cell's estimated cost: its cheaper view plus reaching it.
+        let cell_cost = |c: &Cell| -> f64 {
+            let view = |c: &Cell| {
+                let lo = side_open(lat, c, c.u0, -1, &|_| true);
+                let hi = side_open(lat, c, c.u1(), 1, &|_| true);
+                let lanes = lanes_of(c, sp, 0.0, lo, hi);
+                estimate(c, &lanes, turn_px) + 2.0 * turn_px + sp
+            };
+            let along = view(c);
+            c.transposed().map_or(along, |t| along.min(view(&t)))
+        };
+        let trim_max = (2.0 * sp).ceil() as usize;
+        let jump = (sp / 2.0).ceil() as usize;
+        let part_cost = |c: &Cell| -> f64 {
+            split_ends(vec![c.clone()], trim_max)
+                .iter()
+                .map(cell_cost)
+                .sum()
+        };
+        let decs = [
+            views(split_ends(split_jumps(by_cols, jump, &part_cost), trim_max)),
+            views(split_ends(split_jumps(by_rows, jump, &part_cost), trim_max)),
+        ];
+        let mut best: Option<(f64, usize, f64, Vec<usize>)> = None;
+        for (d, dec) in decs.iter().enumerate() {
+            for k in 0..6 {
+                let phase = sp * f64::from(k) / 6.0;
+                let mut total = 0.0;
+                let mut pick = Vec::with_capacity(dec.len());
+                for vs in dec {
+                    let mut b: Option<(f64, usize)> = None;
+                    for (j, (c, lo, hi)) in vs.iter().enumerate() {
+                        let lanes = lanes_of(c, sp, phase, *lo, *hi);
+                        let mut e = estimate(c, &lanes, turn_px);
+                        if !lanes.is_empty() {
+                            e += 2.0 * turn_px + sp;
+                        }
+                        if b.is_none_or(|b| e < b.0) {
+                            b = Some((e, j));
+                        }
+                    }
+                    let (e, j) = b.unwrap_or((0.0, 0));
+                    total += e;
+                    pick.push(j);
+                }
+                if best.as_ref().is_none_or(|b| total < b.0) {
+                    best = Some((total, d, phase, pick));
+                }
+            }
+        }
+        let (_, d, phase, pick) = best.unwrap_or((0.0, 0, 0.0, Vec::new()));
+        let chosen: Vec<Cell> = decs[d]
+            .iter()
+            .zip(&pick)
+            .map(|(vs, &j)| vs[j].0.clone())
+            .collect();
+        // Lanes: a side is open where the neighbouring pixels belong to cells with lanes the
+        // same way (their lattice lines continue this cell's).
+        let mut cols_at = vec![0u8; w * h];
+        for c in &chosen {
+            for (k, &(a, b)) in c.runs.iter().enumerate() {
+                for v in a..=b {
+                    let (cc, rr) = c.px(c.u0 + k, v);
+                    cols_at[rr * w + cc] = if c.cols { 1 } else { 2 };
+                }
+            }
+        }
+        let cells: Vec<(Cell, Vec<f64>)> = chosen
+            .into_iter()
+            .map(|c| {
+                let mine = if c.cols { 1 } else { 2 };
+                let same = |i: usize| cols_at[i] == mine;
+                let lo = side_open(lat, &c, c.u0, -1, &same);
+                let hi = side_open(lat, &c, c.u1(), 1, &same);
+                let lanes = lanes_of(&c, sp, phase, lo, hi);
+                (c, lanes)
+            })
+            .filter(|(_, l)| !l.is_empty())
+            .collect();
+        let cells = drop_covered(cells, w, h, ctx.rt);
+
+        // Cell paths; a first tour over the cells picks each cell's path (corner), the rim
+        // contours of what those paths miss join the cells in the final tour, where each cell
+        // keeps its path (driven either way).
+        let mut paths: Vec<[Vec<Point>; 2]> = Vec::with_capacity(cells.len());
+        let mut pieces = Vec::with_capacity(cells.len());
+        for (cell, lanes) in &cells {
+            let ps = cell_paths(ctx, lat, search, cell, lanes);
+            let mut piece = tsp::Piece {
+                entry: Vec::new(),
+                exit: Vec::new(),
+                inner: Vec::new(),
+            };
+            for p in &ps {
+                let (f, l) = (p[0], p[p.len() - 1]);
+                let len = path_length(p);
+                piece.entry.extend([f, l]);
+                piece.exit.extend([l, f]);
+                piece.inner.extend([len, len]);
+            }
+            pieces.push(piece);
+            paths.push(ps);
+        }
+        let coarse = hops::Coarse::new(ctx, sp);
+        let far = hops::Coarse::new(ctx, sp * f64::from(hops::FAR_FACTOR));
+        let ncells = paths.len();
+        // Two ways to sweep the rim (module docs, step 3): its passes as pieces of the tour,
+        // or inserted into the finished tour where they cost least; the cheaper plan is kept.
+        let cell_pieces = pieces;
+        let cell_paths_all = paths;
+        let mut best: Option<(usize, f64, Vec<Item>)> = None;
+        // The hop table and nearest-neighbour tour of the cells alone serve both plans.
+        let cell_table = hops::HopTable::new(&coarse, &far, &cell_pieces, start);
+        let cell_nn = cell_table.nearest_tour(&cell_pieces, start);
+        // The cells' tour after the first rounds, whether those settled it, and its neighbours.
+        let mut cell_tour: Option<(tsp::Tour, bool, Vec<Vec<usize>>)> = None;
+        for in_tour in [true, false] {
+            if !opts.rim && !in_tour {
+                break;
+            }
+            let mut pieces = cell_pieces.clone();
+            let mut paths = cell_paths_all.clone();
+            let contours: Vec<Vec<Point>> = if opts.rim && in_tour {
+                // The first rounds of the cells' tour, kept: the other plan goes on from there.
+                let dist = |a: Point, b: Point| cell_table.dist(a, b);
+                let nb = tsp::neighbours(&pieces, &dist);
+                let mut first = cell_nn.clone();
+                let rounds = opts.tour_rounds.min(FIRST_ROUNDS);
+                let settled =
+                    rounds > 0 && tsp::improve(&pieces, start, rounds, &dist, &nb, &mut first);
+                cell_tour = Some((first.clone(), settled, nb));
+                let mut keep = vec![0usize; ncells];
+                for &(c, v) in &first {
+                    keep[c] = v / 2;
+                }
+                for (c, k) in keep.iter().enumerate() {
+                    if *k == 1 {
+                        paths[c].swap(0, 1);
+                    }
+                    let p = &paths[c][0];
+                    let (f, l) = (p[0], p[p.len() - 1]);
+                    let len = path_length(p);
+                    pieces[c] = tsp::Piece {
+                        entry: vec![f, l],
+                        exit: vec![l, f],
+                        inner: vec![len, len],
+                    };
+                }
+                let lines: Vec<&[Point]> = paths.iter().map(|p| p[0].as_slice()).collect();
+                rim_contours(ctx, search, &lines, opts.rim_min_yield, opts.rim_coverage)
+                    .into_iter()
+                    .map(|c| c.0)
+                    .collect()
+            } else {
+                Vec::new()
+            };
+            for c in &contours {
+                let (f, l) = (c[0], c[c.len() - 1]);
+                let len = path_length(c);
+                pieces.push(tsp::Piece {
+                    entry: vec![f, l],
+                    exit: vec![l, f],
+                    inner: vec![len, len],
+                });
+            }
+            // Only the rim-in-tour plan changes the pieces (one variant per cell, rim passes
+            // added); the other plan tours the cells alone.
+            let own =
+                (opts.rim && in_tour).then(|| hops::HopTable::new(&coarse, &far, &pieces, start));
+            let table = own.as_ref().unwrap_or(&cell_table);
+            let dist = |a: Point, b: Point| table.dist(a, b);
+            let cont = if own.is_none() {
+                cell_tour.take()
+            } else {
+                None
+            };
+            let tour = match (&own, cont) {
+                (Some(t), _) => {
+                    let nn = t.nearest_tour(&pieces, start);
+                    tsp::solve(&pieces, start, opts.tour_rounds, &dist, Some(nn))
+                }
+                // (the rounds left after the first ones; none when they settled the tour)
+                (None, Some((mut tour, settled, nb))) => {
+                    let done = opts.tour_rounds.min(FIRST_ROUNDS);
+                    if !settled && opts.tour_rounds > done {
+                        tsp::improve(
+                            &pieces,
+                            start,
+                            opts.tour_rounds - done,
+                            &dist,
+                            &nb,
+                            &mut tour,
+                        );
+                    }
+                    tour
+                }
+                (None, None) => tsp::solve(
+                    &pieces,
+                    start,
+                    opts.tour_rounds,
+                    &dist,
+                    Some(cell_nn.clone()),
+                ),
+            };
+
+            let mut items: Vec<Item> = vec![Item::Move(start)];
+            let mut here = start;
+            let mut region = 0u32;
+            // Pieces and moves this plan had to skip because no route reached them: a plan
+            // that skips less is kept before a shorter one (a skip loses floor silently).
+            let mut skipped = 0usize;
+            for &(cid, v) in &tour {
+                if cid >= ncells {
+                    let c = &contours[cid - ncells];
+                    let pts: Vec<Point> = if v == 0 {
+                        c.clone()
+                    } else {
+                        c.iter().rev().copied().collect()
+                    };
+                    if pts[0] != here {
+                        let Some(hop) = ctx.route(search, here, pts[0]) else {
+                            skipped += 1;
+                            continue;
+                        };
+                        items.push(Item::Mark(Event::BacktrackStart));
+                        items.extend(hop.into_iter().map(Item::Move));
+                        items.push(Item::Mark(Event::BacktrackEnd));
+                    }
+                    items.extend(pts[1..].iter().copied().map(Item::Move));
+                    here = pts[pts.len() - 1];
+                    continue;
+                }
+                let path = &paths[cid][v / 2];
+                let pts: Vec<Point> = if v % 2 == 0 {
+                    path.clone()
+                } else {
+                    path.iter().rev().copied().collect()
+                };
+                let entry = pts[0];
+                if entry != here {
+                    let Some(hop) = ctx.route(search, here, entry) else {
+                        skipped += 1;
+                        continue;
+                    };
+                    items.push(Item::Mark(Event::BacktrackStart));
+                    items.extend(hop.into_iter().map(Item::Move));
+                    items.push(Item::Mark(Event::BacktrackEnd));
+                }
+                region += 1;
+                items.push(Item::Mark(Event::RegionStart { region }));
+                items.extend(pts[1..].iter().copied().map(Item::Move));
+                items.push(Item::Mark(Event::RegionEnd { region }));
+                here = pts[pts.len() - 1];
+            }
+
+            if opts.rim {
+                rim_pass(
+                    ctx,
+                    search,
+                    &mut items,
+                    opts.rim_min_yield,
+                    opts.rim_coverage,
+                );
+            }
+            let mut items = smooth(ctx, repair(ctx, search, items, &mut skipped));
+            if opts.rim && !in_tour {
+                // A second mop-up of what the inserted passes and the smoothing left.
+                rim_pass(
+                    ctx,
+                    search,
+                    &mut items,
+                    opts.rim_min_yield,
+                    opts.rim_coverage,
+                );
+                items = smooth(ctx, repair(ctx, search, items, &mut skipped));
+            }
+            let items = prune::prune(ctx, items, opts.min_coverage, turn_px);
+            let pts: Vec<Point> = moves(&items).into_iter().map(|m| m.0).collect();
+            let cost = path_length(&pts) + turn_px * turns(&pts) as f64;
+            if best.as_ref().is_none_or(|b| (skipped, cost) < (b.0, b.1)) {
+                best = Some((skipped, cost, items));
+            }
+        }
+        let ncells = cells.len();
+        best.map_or((0, 0.0, Vec::new(), ncells), |b| (b.0, b.1, b.2, ncells))
+    }
+}

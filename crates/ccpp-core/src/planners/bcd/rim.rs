@@ -1,0 +1,277 @@
+//! Rim passes (step 3 of the module docs): contour passes over what the lanes miss, placed
+//! in the tour or inserted as detours.
+
+use std::ops::{Add, Sub};
+
+use fixedbitset::FixedBitSet;
+
+use super::finish::moves;
+use super::lattice::Ctx;
+use super::plan::Item;
+use super::transfer::Search;
+use crate::geometry::{path_length, Point};
+
+/// Step 3 of the module docs: the contour passes (grid polylines) that sweep the accessible
+/// pixels the polylines `lines` miss, one per 8-connected group of missed pixels, with the
+/// number of pixels each is meant to sweep; groups below `min_yield` are left out, and so are
+/// the lowest-yield groups that fit in the budget `1 - target` of the accessible pixels.
+pub(super) fn rim_contours(
+    ctx: &Ctx<'_>,
+    search: &mut Search,
+    lines: &[&[Point]],
+    min_yield: f64,
+    target: f64,
+) -> Vec<(Vec<Point>, usize)> {
+    let frame = ctx.frame;
+    let (w, h) = (frame.width, frame.height);
+    let rt = ctx.rt + crate::raster::SWEEP_EPS_PX;
+    let mut swept = FixedBitSet::with_capacity(frame.len());
+    for line in lines {
+        if let Some(&p) = line.first() {
+            crate::raster::stamp_capsule(&mut swept, &frame, p, p, rt, &mut |_| {});
+        }
+        for s in line.windows(2) {
+            if s[0] != s[1] {
+                crate::raster::stamp_capsule(&mut swept, &frame, s[0], s[1], rt, &mut |_| {});
+            }
+        }
+    }
+    let acc = ctx.world.accessible();
+    let mut missed = acc.clone();
+    missed.difference_with(&swept);
+    if missed.is_clear() {
+        return Vec::new();
+    }
+    // Witness of each missed pixel: the nearest C-free pixel centre within reach of the tool.
+    let k = rt.floor() as i64;
+    let rt2 = rt * rt;
+    let mut offsets: Vec<(i64, i64, i64)> = Vec::new();
+    for dr in -k..=k {
+        for dc in -k..=k {
+            let d2 = dc * dc + dr * dr;
+            if (d2 as f64) <= rt2 {
+                offsets.push((d2, dr, dc));
+            }
+        }
+    }
+    offsets.sort_unstable();
+    let mut witness = vec![u32::MAX; frame.len()];
+    for i in missed.ones() {
+        let (c, r) = ((i % w) as i64, (i / w) as i64);
+        for &(_, dr, dc) in &offsets {
+            if ctx.ok_at(c + dc, r + dr) {
+                witness[i] = ((r + dr) as usize * w + (c + dc) as usize) as u32;
+                break;
+            }
+        }
+    }
+    // Groups: 8-connected components of missed pixels.
+    let mut group_of = vec![u32::MAX; frame.len()];
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    for i in missed.ones() {
+        if group_of[i] != u32::MAX || witness[i] == u32::MAX {
+            continue;
+        }
+        let g = groups.len() as u32;
+        let mut members = vec![i];
+        group_of[i] = g;
+        let mut q = 0;
+        while q < members.len() {
+            let j = members[q];
+            q += 1;
+            let (c, r) = ((j % w) as i64, (j / w) as i64);
+            for dr in -1..=1 {
+                for dc in -1..=1 {
+                    let (nc, nr) = (c + dc, r + dr);
+                    if nc < 0 || nr < 0 || nc >= w as i64 || nr >= h as i64 {
+                        continue;
+                    }
+                    let n = nr as usize * w + nc as usize;
+                    if missed.contains(n) && group_of[n] == u32::MAX && witness[n] != u32::MAX {
+                        group_of[n] = g;
+                        members.push(n);
+                    }
+                }
+            }
+        }
+        groups.push(members);
+    }
+    let mut out = Vec::with_capacity(groups.len());
+    for members in &groups {
+        let mut ws: Vec<usize> = members.iter().map(|&i| witness[i] as usize).collect();
+        ws.sort_unstable();
+        ws.dedup();
+        let pts: Vec<Point> = ws.iter().map(|&i| ctx.centre(i % w, i / w)).collect();
+        // Chain: from the witness farthest from the first one, nearest neighbour onwards.
+        let far = (0..pts.len())
+            .max_by(|&a, &b| {
+                pts[a]
+                    .dist2(pts[0])
+                    .total_cmp(&pts[b].dist2(pts[0]))
+                    .then(b.cmp(&a))
+            })
+            .unwrap_or(0);
+        let mut used = vec![false; pts.len()];
+        let mut chain = vec![pts[far]];
+        used[far] = true;
+        for _ in 1..pts.len() {
+            let last = chain[chain.len() - 1];
+            let mut best: Option<(f64, usize)> = None;
+            for (j, p) in pts.iter().enumerate() {
+                if !used[j] && best.is_none_or(|b| p.dist2(last) < b.0) {
+                    best = Some((p.dist2(last), j));
+                }
+            }
+            let Some((_, j)) = best else { break };
+            used[j] = true;
+            chain.push(pts[j]);
+        }
+        let Some(tail) = ctx.follow(search, &chain) else {
+            continue;
+        };
+        let mut contour = vec![chain[0]];
+        contour.extend(tail);
+        let clen = path_length(&contour);
+        if (members.len() as f64) < min_yield * clen.max(1.0) * 2.0 * ctx.rt {
+            continue;
+        }
+        out.push((contour, members.len()));
+    }
+
+    // The budget: missed pixels allowed by `target`, less those no group holds.
+    let grouped: usize = out.iter().map(|c| c.1).sum();
+    let allowed = ((1.0 - target) * acc.count_ones(..) as f64).floor() as usize;
+    let mut budget = allowed.saturating_sub(missed.count_ones(..) - grouped);
+    if budget > 0 {
+        // Lowest yield (pixels per pixel of contour) first; ties by group order.
+        let mut order: Vec<usize> = (0..out.len()).collect();
+        let yield_of = |c: &(Vec<Point>, usize)| c.1 as f64 / path_length(&c.0).max(1.0);
+        order.sort_by(|&a, &b| {
+            yield_of(&out[a])
+                .total_cmp(&yield_of(&out[b]))
+                .then(a.cmp(&b))
+        });
+        let mut drop = vec![false; out.len()];
+        for i in order {
+            if out[i].1 <= budget {
+                budget -= out[i].1;
+                drop[i] = true;
+            }
+        }
+        let mut k = 0;
+        out.retain(|_| {
+            k += 1;
+            !drop[k - 1]
+        });
+    }
+    out
+}
+
+/// Final mop-up of step 3: sweeps what the assembled plan still misses with contour detours
+/// inserted at the cheapest point of the path (out and back).
+pub(super) fn rim_pass(
+    ctx: &Ctx<'_>,
+    search: &mut Search,
+    items: &mut Vec<Item>,
+    min_yield: f64,
+    target: f64,
+) {
+    const B: f64 = 16.0;
+    let frame = ctx.frame;
+    let (w, h) = (frame.width, frame.height);
+    let path = moves(items);
+    let line: Vec<Point> = path.iter().map(|m| m.0).collect();
+    let contours = rim_contours(ctx, search, &[&line], min_yield, target);
+    // Spatial index of the path's segments (buckets of 16 px).
+    let (bw, bh) = (
+        (w as f64 / B).ceil() as usize + 1,
+        (h as f64 / B).ceil() as usize + 1,
+    );
+    let mut buckets: Vec<Vec<u32>> = vec![Vec::new(); bw * bh];
+    let bucket = |p: Point| -> (usize, usize) {
+        (
+            ((p.x / B).floor().max(0.0) as usize).min(bw - 1),
+            ((p.y / B).floor().max(0.0) as usize).min(bh - 1),
+        )
+    };
+    for (s, seg) in path.windows(2).enumerate() {
+        let (a, b) = (bucket(seg[0].0), bucket(seg[1].0));
+        for by in a.1.min(b.1)..=a.1.max(b.1) {
+            for bx in a.0.min(b.0)..=a.0.max(b.0) {
+                buckets[by * bw + bx].push(s as u32);
+            }
+        }
+    }
+    // (insert after path segment s, at parameter t along it, the detour points)
+    let mut inserts: Vec<(usize, f64, Vec<Point>)> = Vec::new();
+    for (contour, _) in contours {
+        let clen = path_length(&contour);
+        let (cs, ce) = (contour[0], contour[contour.len() - 1]);
+        // Cheapest insertion: segments near the contour's start, widening the search.
+        let mut best: Option<(f64, usize, f64, bool)> = None;
+        let (bx, by) = bucket(cs);
+        for ring in 0..bw.max(bh) {
+            let ring_i = ring as i64;
+            for y in by as i64 - ring_i..=by as i64 + ring_i {
+                for x in bx as i64 - ring_i..=bx as i64 + ring_i {
+                    if (y - by as i64).abs() != ring_i && (x - bx as i64).abs() != ring_i {
+                        continue;
+                    }
+                    if x < 0 || y < 0 || x >= bw as i64 || y >= bh as i64 {
+                        continue;
+                    }
+                    for &s in &buckets[y as usize * bw + x as usize] {
+                        let s = s as usize;
+                        let (a, b) = (path[s].0, path[s + 1].0);
+                        for rev in [false, true] {
+                            let (i0, i1) = if rev { (ce, cs) } else { (cs, ce) };
+                            let t = proj(a, b, i0);
+                            let q = a.add(b.sub(a).scale(t));
+                            let c = q.dist(i0) + clen + i1.dist(q);
+                            if best.is_none_or(|bb| c < bb.0) {
+                                best = Some((c, s, t, rev));
+                            }
+                        }
+                    }
+                }
+            }
+            // Stop once the ring is farther than the best detour's approach.
+            if let Some(bb) = best {
+                if (ring as f64 - 1.0) * B > bb.0 - clen {
+                    break;
+                }
+            }
+        }
+        let Some((_, s, t, rev)) = best else {
+            continue;
+        };
+        let (a, b) = (path[s].0, path[s + 1].0);
+        let q = a.add(b.sub(a).scale(t));
+        let mut det: Vec<Point> = vec![q];
+        if rev {
+            det.extend(contour.iter().rev().copied());
+        } else {
+            det.extend(contour.iter().copied());
+        }
+        det.push(q);
+        inserts.push((s, t, det));
+    }
+    // Apply: later segments first so indices stay valid; along a segment, by parameter.
+    inserts.sort_by(|x, y| y.0.cmp(&x.0).then(y.1.total_cmp(&x.1)));
+    for (s, _, det) in inserts {
+        let at = path[s + 1].1;
+        let new: Vec<Item> = det.into_iter().map(Item::Move).collect();
+        items.splice(at..at, new);
+    }
+}
+
+/// Parameter in `[0, 1]` of the point of segment `a`-`b` nearest to `p`.
+fn proj(a: Point, b: Point, p: Point) -> f64 {
+    let d = b.sub(a);
+    let l2 = d.dot(d);
+    if l2 == 0.0 {
+        0.0
+    } else {
+        (p.sub(a).dot(d) / l2).clamp(0.0, 1.0)
+    }
+}

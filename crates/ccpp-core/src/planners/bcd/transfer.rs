@@ -1,0 +1,245 @@
+//! Transfers between points: straight moves where free, else A* over the C-free pixel centres
+//! ([`Search`]), shortened by line-of-sight checks on the true map.
+
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+
+use super::lattice::Ctx;
+use crate::geometry::{point_segment_dist2, Point};
+
+/// How far a merged boundary segment may stray from the boundary points it replaces (pixels).
+const CONTOUR_TOL_PX: f64 = 1.0;
+
+impl Ctx<'_> {
+    /// A C-free pixel centre joined to `p` by a free straight move (nearest first).
+    fn anchor(&self, p: Point) -> Option<(usize, usize)> {
+        let (c0, r0) = self.frame.grid_to_pixel_signed(p);
+        let mut best: Option<(f64, (usize, usize))> = None;
+        for dr in -2..=2 {
+            for dc in -2..=2 {
+                let (c, r) = (c0 + dc, r0 + dr);
+                if !self.ok_at(c, r) {
+                    continue;
+                }
+                let (c, r) = (c as usize, r as usize);
+                let q = self.centre(c, r);
+                let d = q.dist(p);
+                if best.is_none_or(|b| d < b.0) && self.free(p, q) {
+                    best = Some((d, (c, r)));
+                }
+            }
+        }
+        best.map(|b| b.1)
+    }
+
+    /// Moves from `a` to `b` (excluding `a`): straight when free, else an A* pixel path
+    /// shortened by line of sight; `None` when no verified path exists.
+    pub(super) fn route(&self, search: &mut Search, a: Point, b: Point) -> Option<Vec<Point>> {
+        if self.free(a, b) {
+            return Some(vec![b]);
+        }
+        let pa = self.anchor(a)?;
+        let pb = self.anchor(b)?;
+        let diag = |i: usize, j: usize| {
+            let w = self.frame.width;
+            self.free(self.centre(i % w, i / w), self.centre(j % w, j / w))
+        };
+        let path = search
+            .path(&self.safe, pa, pb, &diag)
+            .or_else(|| search.path(&self.ok, pa, pb, &diag))?;
+        let mut pts = Vec::with_capacity(path.len() + 2);
+        pts.push(a);
+        pts.extend(path.iter().map(|&(c, r)| self.centre(c, r)));
+        pts.push(b);
+        pts.dedup();
+        self.shorten(&pts)
+    }
+
+    /// Line-of-sight shortening of a chain whose consecutive points are joined by free moves
+    /// (not checked: a failing link gives `None`). Returns the points after the first.
+    fn shorten(&self, pts: &[Point]) -> Option<Vec<Point>> {
+        let mut out = Vec::new();
+        let mut i = 0;
+        while i + 1 < pts.len() {
+            let mut lo = i + 1;
+            let mut step = 1;
+            let mut hi = None;
+            loop {
+                let j = (i + step).min(pts.len() - 1);
+                if self.free(pts[i], pts[j]) {
+                    lo = j;
+                    if j == pts.len() - 1 {
+                        break;
+                    }
+                    step *= 2;
+                } else {
+                    hi = Some(j);
+                    break;
+                }
+            }
+            if let Some(mut hi) = hi {
+                if hi == i + 1 {
+                    return None;
+                }
+                while hi - lo > 1 {
+                    let mid = usize::midpoint(lo, hi);
+                    if self.free(pts[i], pts[mid]) {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+            }
+            out.push(pts[lo]);
+            i = lo;
+        }
+        Some(out)
+    }
+
+    /// Follows the chain `pts` (from `pts[0]`, excluded) with straight free moves that stay
+    /// within [`CONTOUR_TOL_PX`] of every point they replace; links that are not free are
+    /// routed. Returns the points after the first (`None`: some link has no route).
+    pub(super) fn follow(&self, search: &mut Search, pts: &[Point]) -> Option<Vec<Point>> {
+        let mut out = Vec::new();
+        let mut i = 0;
+        let tol2 = CONTOUR_TOL_PX * CONTOUR_TOL_PX;
+        while i + 1 < pts.len() {
+            // Farthest j whose chord keeps every point in between within the tolerance.
+            let mut jmax = i + 1;
+            for j in i + 2..pts.len() {
+                if (i + 1..j).all(|m| point_segment_dist2(pts[m], pts[i], pts[j]) <= tol2) {
+                    jmax = j;
+                } else {
+                    break;
+                }
+            }
+            let mut j = jmax;
+            while j > i + 1 && !self.free(pts[i], pts[j]) {
+                j -= 1;
+            }
+            if j == i + 1 && !self.free(pts[i], pts[j]) {
+                out.extend(self.route(search, pts[i], pts[j])?);
+            } else {
+                out.push(pts[j]);
+            }
+            i = j;
+        }
+        Some(out)
+    }
+}
+
+/// Pixel path search (A*, 8-connected, octile integer costs, no corner cutting).
+pub(super) struct Search {
+    width: usize,
+    height: usize,
+    stamp: Vec<u32>,
+    gen: u32,
+    g: Vec<u32>,
+    parent: Vec<u32>,
+}
+
+impl Search {
+    pub(super) fn new(width: usize, height: usize) -> Self {
+        Self {
+            width,
+            height,
+            stamp: vec![0; width * height],
+            gen: 0,
+            g: vec![0; width * height],
+            parent: vec![u32::MAX; width * height],
+        }
+    }
+
+    fn octile(a: (usize, usize), b: (usize, usize)) -> u32 {
+        let dx = a.0.abs_diff(b.0) as u32;
+        let dy = a.1.abs_diff(b.1) as u32;
+        10 * dx.max(dy) + 4 * dx.min(dy)
+    }
+
+    /// A* from `s` to `t` over `ok` (the end pixels need not be in it). A diagonal step whose
+    /// two side pixels are not both in `ok` is taken only when `diag(from, to)` allows it. Ties
+    /// by cost, then pixel index.
+    fn path(
+        &mut self,
+        ok: &[bool],
+        s: (usize, usize),
+        t: (usize, usize),
+        diag_ok: &dyn Fn(usize, usize) -> bool,
+    ) -> Option<Vec<(usize, usize)>> {
+        self.gen = self.gen.wrapping_add(1);
+        if self.gen == 0 {
+            self.stamp.iter_mut().for_each(|x| *x = 0);
+            self.gen = 1;
+        }
+        let w = self.width;
+        let ti = t.1 * w + t.0;
+        let passable = |j: usize| ok[j] || j == ti;
+        let mut heap = BinaryHeap::new();
+        let si = s.1 * w + s.0;
+        self.stamp[si] = self.gen;
+        self.g[si] = 0;
+        self.parent[si] = u32::MAX;
+        heap.push(Reverse((Self::octile(s, t), 0u32, si as u32)));
+        let mut found = false;
+        while let Some(Reverse((_, g, i))) = heap.pop() {
+            let i = i as usize;
+            if g > self.g[i] {
+                continue;
+            }
+            if i == ti {
+                found = true;
+                break;
+            }
+            let (c, r) = ((i % w) as i64, (i / w) as i64);
+            for (dc, dr) in [
+                (1, 0),
+                (0, -1),
+                (-1, 0),
+                (0, 1),
+                (1, -1),
+                (-1, -1),
+                (-1, 1),
+                (1, 1),
+            ] {
+                let (nc, nr) = (c + dc, r + dr);
+                if nc < 0 || nr < 0 || nc >= self.width as i64 || nr >= self.height as i64 {
+                    continue;
+                }
+                let j = nr as usize * w + nc as usize;
+                if !passable(j) {
+                    continue;
+                }
+                let diag = dc != 0 && dr != 0;
+                if diag
+                    && !(passable(r as usize * w + nc as usize)
+                        && passable(nr as usize * w + c as usize))
+                    && !diag_ok(i, j)
+                {
+                    continue;
+                }
+                let ng = g + if diag { 14 } else { 10 };
+                if self.stamp[j] != self.gen || ng < self.g[j] {
+                    self.stamp[j] = self.gen;
+                    self.g[j] = ng;
+                    self.parent[j] = i as u32;
+                    heap.push(Reverse((
+                        ng + Self::octile((nc as usize, nr as usize), t),
+                        ng,
+                        j as u32,
+                    )));
+                }
+            }
+        }
+        if !found {
+            return None;
+        }
+        let mut out = vec![t];
+        let mut k = ti;
+        while self.parent[k] != u32::MAX {
+            k = self.parent[k] as usize;
+            out.push((k % w, k / w));
+        }
+        out.reverse();
+        Some(out)
+    }
+}
