@@ -1,11 +1,19 @@
-//! Finishing the plan's path: repair of moves that are not free, smoothing, turn counting.
+//! The plan's steps and finishing its path: repair of moves that are not free, smoothing, turn
+//! counting.
 
 use std::ops::Sub;
 
 use super::lattice::Ctx;
-use super::plan::Item;
 use super::transfer::Search;
 use crate::geometry::{point_segment_dist2, Point};
+use crate::trace::Event;
+
+/// One step of the plan.
+#[derive(Clone, Debug)]
+pub(super) enum Item {
+    Move(Point),
+    Mark(Event),
+}
 
 /// Re-checks every move of the plan on the true map and routes the ones that are not free
 /// (dropping a move that has no route, and skipping to the next reachable point; `skipped`

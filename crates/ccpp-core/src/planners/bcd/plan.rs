@@ -5,7 +5,7 @@ use std::collections::VecDeque;
 
 use super::angles::{dominant_angles, ANGLE_STEP_DEG, AXIS_TOL_DEG};
 use super::cells::{decompose, split_ends, split_jumps, Cell};
-use super::finish::{moves, repair, smooth, turns};
+use super::finish::{moves, repair, smooth, turns, Item};
 use super::lanes::{cell_paths, drop_covered, estimate, lanes_of, side_open};
 use super::lattice::{Ctx, Lattice};
 use super::rim::{rim_contours, rim_pass};
@@ -19,13 +19,6 @@ use crate::world::World;
 
 /// Improvement rounds of the first tour (which only picks each cell's path for the rim step).
 const FIRST_ROUNDS: u32 = 1;
-
-/// One step of the plan.
-#[derive(Clone, Debug)]
-pub(super) enum Item {
-    Move(Point),
-    Mark(Event),
-}
 
 impl Bcd {
     pub(super) fn plan(world: &World, opts: &BcdOptions) -> Self {

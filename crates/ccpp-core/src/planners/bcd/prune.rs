@@ -29,8 +29,8 @@ use std::ops::Sub;
 use fixedbitset::FixedBitSet;
 
 use super::finish::is_turn;
+use super::finish::Item;
 use super::lattice::Ctx;
-use super::plan::Item;
 use crate::geometry::{point_segment_dist2, Point};
 
 /// Heading change at `b` between the moves `a -> b` and `b -> c` (as the simulator counts a

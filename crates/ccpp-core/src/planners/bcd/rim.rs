@@ -6,8 +6,8 @@ use std::ops::{Add, Sub};
 use fixedbitset::FixedBitSet;
 
 use super::finish::moves;
+use super::finish::Item;
 use super::lattice::Ctx;
-use super::plan::Item;
 use super::transfer::Search;
 use crate::geometry::{path_length, Point};
 

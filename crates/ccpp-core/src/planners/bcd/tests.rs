@@ -2,10 +2,10 @@
 
 use super::angles::dominant_angles;
 use super::cells::{decompose, split_ends, split_jumps, Cell};
+use super::finish::Item;
 use super::finish::{moves, repair, smooth};
 use super::lanes::{drop_covered, lanes_of};
 use super::lattice::{Ctx, Lattice};
-use super::plan::Item;
 use super::transfer::Search;
 use super::{Bcd, BcdOptions};
 use crate::geometry::Point;
