@@ -321,6 +321,18 @@ fn nearest_of_gives_the_dijkstra_answer() {
             let want = s.nearest(&g, from, |t| targets.contains(&t));
             let got = s.nearest_of(&g, from, &targets, |t| targets.contains(&t));
             assert_eq!(got, want, "seed {seed} round {round}: from {from:?}");
+            // The path search restricted to the tiles on cheapest paths read off that search
+            // (one-way moves: the edges are walked back in the right direction).
+            if let Some((t, c)) = got {
+                let restricted = s.astar_nearest(&g, from, t, c);
+                assert_eq!(
+                    restricted,
+                    s.astar(&g, from, t),
+                    "seed {seed} round {round}"
+                );
+                // No `nearest_of` just before: the plain bounded search answers.
+                assert_eq!(s.astar_nearest(&g, from, t, c), restricted);
+            }
             compared += usize::from(want.is_some());
         }
         // Symmetric targets around the source: equal costs, the (j, i) order decides.
@@ -384,6 +396,10 @@ fn nearest_of_gives_the_dijkstra_answer_over_many_blocks() {
                 let want = s.nearest(&g, from, |t| targets.contains(&t));
                 let got = s.nearest_of(&g, from, &targets, |t| targets.contains(&t));
                 assert_eq!(got, want, "every {every}, from {from:?}");
+                if let Some((t, c)) = got {
+                    let restricted = s.astar_nearest(&g, from, t, c);
+                    assert_eq!(restricted, s.astar(&g, from, t), "every {every}");
+                }
                 found += usize::from(want.is_some());
             }
         }

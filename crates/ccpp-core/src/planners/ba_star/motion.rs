@@ -147,7 +147,7 @@ impl BaStar {
         };
         let raw = m
             .search
-            .astar_bounded(&m.tiles, c, sp, sp_cost)
+            .astar_nearest(&m.tiles, c, sp, sp_cost)
             .map_or_else(|| vec![c, sp], |(p, _)| p);
         let smoothed = if self.opts.smoothing {
             let mm = &*m;

@@ -65,6 +65,11 @@ pub struct TileSearch {
     heap: MonotoneQueue,
     /// Scratch of [`Self::nearest_of`]: the targets' candidate lists per block.
     blocks: TargetBlocks,
+    /// The last answer of [`Self::nearest_of`] while its labels are intact: start and target
+    /// indices, cost, generation (see [`Self::astar_bounded`]).
+    last_nearest: Option<(usize, usize, u64, u32)>,
+    /// Scratch of [`Self::mark_optimal`].
+    stack: Vec<u32>,
 }
 
 /// Side, in tiles, of the blocks of [`TargetBlocks`].
@@ -252,6 +257,8 @@ impl TileSearch {
                 bh: h.div_ceil(TARGET_BLOCK),
                 ..TargetBlocks::default()
             },
+            last_nearest: None,
+            stack: Vec::new(),
         }
     }
 
@@ -362,6 +369,7 @@ impl TileSearch {
     ) -> Option<(Tile, u64)> {
         let s = self.idx(from)?;
         self.begin();
+        self.last_nearest = None;
         self.blocks.begin(targets);
         self.relax(s, 0, u32::MAX);
         let h0 = self.target_h(from);
@@ -385,6 +393,9 @@ impl TileSearch {
                 continue;
             }
             self.expand_to_targets(g, t, k, d);
+        }
+        if let Some((k, d)) = best {
+            self.last_nearest = Some((s, k, d, self.generation));
         }
         best.map(|(k, d)| (self.tile(k), d))
     }
@@ -427,13 +438,15 @@ impl TileSearch {
     }
 
     fn expand(&mut self, g: &impl TileGraph, t: Tile, k: usize, d: u64, goal: Option<Tile>) {
-        self.expand_within(g, t, k, d, goal, u64::MAX);
+        self.expand_within(g, t, k, d, goal, u64::MAX, false);
     }
 
     /// Relaxes the edges of the settled tile `t` (index `k`, cost `d`), pushing each improved
     /// neighbour with key `cost + heuristic`; a neighbour whose key would exceed `bound` is left
-    /// unlabelled (see [`Self::astar_within`]).
+    /// unlabelled (see [`Self::astar_within`]); with `only_marked`, so is a neighbour neither
+    /// labelled in this search nor marked by [`Self::mark_optimal`].
     #[inline]
+    #[allow(clippy::too_many_arguments)]
     fn expand_within(
         &mut self,
         g: &impl TileGraph,
@@ -442,6 +455,7 @@ impl TileSearch {
         d: u64,
         goal: Option<Tile>,
         bound: u64,
+        only_marked: bool,
     ) {
         let mut mask = g.edge_mask(t);
         if mask == 0 {
@@ -471,6 +485,10 @@ impl TileSearch {
             if node.stamp == gen + 1 || (node.stamp == gen && nd >= node.dist) {
                 continue;
             }
+            // Marked tiles carry the stamp `gen - 1` (see [`Self::astar_nearest`]).
+            if only_marked && node.stamp != gen && node.stamp != gen.wrapping_sub(1) {
+                continue;
+            }
             let f = match goal {
                 Some(gl) => {
                     // The octile cost to the goal bounds the remaining cost from below and
@@ -496,7 +514,7 @@ impl TileSearch {
     /// A* from `from` to `to` over the graph of [`graph_edge`] (costs [`COST_ORTHO`] /
     /// [`COST_DIAG`], Euclidean heuristic); the tile path (both ends included) and its cost.
     pub fn astar(&mut self, g: &impl TileGraph, from: Tile, to: Tile) -> Option<(Vec<Tile>, u64)> {
-        self.astar_within(g, from, to, u64::MAX)
+        self.astar_within(g, from, to, u64::MAX, false)
     }
 
     /// [`Self::astar`] when the cost of the best path is known to be `cost` (say from
@@ -524,8 +542,78 @@ impl TileSearch {
         to: Tile,
         cost: u64,
     ) -> Option<(Vec<Tile>, u64)> {
-        self.astar_within(g, from, to, cost)
-            .or_else(|| self.astar_within(g, from, to, u64::MAX))
+        self.astar_within(g, from, to, cost, false)
+            .or_else(|| self.astar_within(g, from, to, u64::MAX, false))
+    }
+
+    /// [`Self::astar_bounded`] right after [`Self::nearest_of`] on the same graph answered
+    /// `(to, cost)` from `from`: the same answer, settling only the tiles on cheapest paths
+    /// from `from` to `to` (otherwise, or should that search run dry, it is
+    /// [`Self::astar_bounded`]).
+    ///
+    /// Why it is the same: the proof of [`Self::astar_bounded`] holds for leaving out any
+    /// label of a tile on no cheapest path to the goal (a non-optimal tile never gives an
+    /// optimal one its best label: it would then be optimal). Every optimal tile `v` was
+    /// settled by [`Self::nearest_of`] with its exact cost (its key there is at most the cost,
+    /// and that search went through every key up to it), and its optimal predecessors are
+    /// exactly the settled neighbours `u` with an edge `u -> v` and `cost(u) + step = cost(v)`:
+    /// [`Self::mark_optimal`] finds them all walking back from the goal, before the labels are
+    /// overwritten.
+    pub fn astar_nearest(
+        &mut self,
+        g: &impl TileGraph,
+        from: Tile,
+        to: Tile,
+        cost: u64,
+    ) -> Option<(Vec<Tile>, u64)> {
+        if self.mark_optimal(g, from, to, cost) {
+            // Two generations on: the marks (stamp old generation + 3) read `gen - 1`.
+            self.begin();
+            if let Some(r) = self.astar_within(g, from, to, cost, true) {
+                return Some(r);
+            }
+        }
+        self.astar_bounded(g, from, to, cost)
+    }
+
+    /// Marks (stamp generation + 3) the tiles on cheapest paths from `from` to `to`, read off
+    /// the labels of the last [`Self::nearest_of`] if it answered `(to, cost)` from `from`
+    /// and no search ran since; false (nothing marked) otherwise.
+    fn mark_optimal(&mut self, g: &impl TileGraph, from: Tile, to: Tile, cost: u64) -> bool {
+        let (Some(s), Some(t)) = (self.idx(from), self.idx(to)) else {
+            return false;
+        };
+        if self.last_nearest.take() != Some((s, t, cost, self.generation)) {
+            return false;
+        }
+        let settled = self.generation + 1;
+        let mark = self.generation.wrapping_add(3);
+        let mut stack = std::mem::take(&mut self.stack);
+        stack.clear();
+        self.nodes[t].stamp = mark;
+        stack.push(t as u32);
+        while let Some(kv) = stack.pop() {
+            let kv = kv as usize;
+            let v = self.tile(kv);
+            let dv = self.nodes[kv].dist;
+            for (n, &(di, dj)) in N8.iter().enumerate() {
+                let u = (v.0 + di, v.1 + dj);
+                let Some(ku) = self.idx(u) else { continue };
+                let step = if n % 2 == 1 { COST_DIAG } else { COST_ORTHO };
+                let node = self.nodes[ku];
+                if node.stamp != settled || node.dist + step != dv {
+                    continue;
+                }
+                // The edge `u -> v` goes the opposite way of `N8[n]`.
+                if g.edge_mask(u) & (1 << ((n + 4) % 8)) == 0 {
+                    continue;
+                }
+                self.nodes[ku].stamp = mark;
+                stack.push(ku as u32);
+            }
+        }
+        self.stack = stack;
+        true
     }
 
     fn astar_within(
@@ -534,6 +622,7 @@ impl TileSearch {
         from: Tile,
         to: Tile,
         bound: u64,
+        only_marked: bool,
     ) -> Option<(Vec<Tile>, u64)> {
         let s = self.idx(from)?;
         self.idx(to)?;
@@ -551,7 +640,7 @@ impl TileSearch {
             if t == to {
                 return Some((self.path_to(k), d));
             }
-            self.expand_within(g, t, k, d, Some(to), bound);
+            self.expand_within(g, t, k, d, Some(to), bound, only_marked);
         }
         None
     }
