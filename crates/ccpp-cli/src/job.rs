@@ -357,14 +357,24 @@ impl Job {
     /// Builds the world, runs the planner in the simulator and computes the metrics. The
     /// scenario's start becomes the start actually used, so that `run.json` replays exactly.
     /// The prepared map becomes the world's (no copy): a job runs once.
+    ///
+    /// This is a bench job's run: the files are formed from the trace after the run, not on a
+    /// thread beside the planner (a bench already keeps every core busy with jobs, and such a
+    /// thread would only compete with the planner and inflate its `wall_time_s`).
     pub fn execute(&mut self) -> Result<JobResult> {
-        self.execute_with(false)
+        self.execute_as(false, false)
     }
 
-    /// [`Job::execute`], also finding the free area holding the start
-    /// ([`JobResult::start_area`]) when `start_area`, on a second thread while the planner
-    /// works.
+    /// [`Job::execute`] for `ccpp run` and `ccpp demo`: `path.csv`, the swept pixels and the
+    /// motion metrics are formed on another thread while the planner works (the same bytes),
+    /// and the free area holding the start ([`JobResult::start_area`]) is found beside it when
+    /// `start_area`.
     pub fn execute_with(&mut self, start_area: bool) -> Result<JobResult> {
+        self.execute_as(start_area, true)
+    }
+
+    /// The run behind [`Job::execute`] and [`Job::execute_with`].
+    fn execute_as(&mut self, start_area: bool, form_files: bool) -> Result<JobResult> {
         let map = self.map.take().context("the job has already run")?;
         let (run, start_area, formed) = self.scenario.run_owned_with(
             map,
@@ -372,7 +382,7 @@ impl Job {
                 start_area
                     .then(|| crate::components::StartComponent::of(w.map(), w.start().position()))
             },
-            true,
+            form_files,
         )?;
         let s = run.world.initial_pose();
         if !run.world.approach().is_empty() {
