@@ -557,8 +557,8 @@ impl TileSearch {
     /// settled by [`Self::nearest_of`] with its exact cost (its key there is at most the cost,
     /// and that search went through every key up to it), and its optimal predecessors are
     /// exactly the settled neighbours `u` with an edge `u -> v` and `cost(u) + step = cost(v)`:
-    /// [`Self::mark_optimal`] finds them all walking back from the goal, before the labels are
-    /// overwritten.
+    /// `mark_optimal` (a private helper) finds them all walking back from the goal, before
+    /// the labels are overwritten.
     pub fn astar_nearest(
         &mut self,
         g: &impl TileGraph,
