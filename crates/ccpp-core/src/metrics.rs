@@ -15,7 +15,7 @@ use crate::grid::MapFrame;
 pub(crate) use crate::raster::stamp_capsule;
 use crate::sim::RunOutput;
 use crate::tiles::{reachable_tiles, Tile, TileGrid, TileSet};
-use crate::trace::{Chunk, Entry, Event, Piece, Trace};
+use crate::trace::{Chunk, Entry, Event, Lattice, Piece, Trace};
 use crate::world::World;
 
 pub use crate::raster::SWEEP_EPS_PX;
@@ -130,6 +130,28 @@ pub fn execution_tolerance(trace: &Trace) -> Option<f64> {
     })
 }
 
+/// The points of the executed centre polyline (grid coordinates) that trace piece `piece`
+/// adds, to `add`: a pose's position, a straight run's two ends (its poses lie in order on
+/// the segment between them, so the capsules of its steps make up that segment's capsule),
+/// nothing for an event.
+fn piece_points(
+    frame: &MapFrame,
+    lattice: Option<Lattice>,
+    piece: Piece<'_>,
+    mut add: impl FnMut(Point),
+) {
+    match piece {
+        Piece::Pose { pose, .. } => add(frame.world_to_grid(pose.position())),
+        Piece::Run(run) => {
+            let [x0, y0] = run.from;
+            let [x1, y1] = run.to(lattice);
+            add(frame.world_to_grid(Point::new(x0, y0)));
+            add(frame.world_to_grid(Point::new(x1, y1)));
+        }
+        Piece::Event { .. } => {}
+    }
+}
+
 /// The swept pixels of a trace: pixel centres within `r_tool` of the executed centre polyline
 /// (inclusive, with [`SWEEP_EPS_PX`]). The start position alone sweeps a disk.
 pub fn swept_pixels(world: &World, trace: &Trace) -> FixedBitSet {
@@ -141,16 +163,7 @@ pub fn swept_pixels(world: &World, trace: &Trace) -> FixedBitSet {
     let lattice = trace.lattice();
     let mut points: Vec<Point> = Vec::with_capacity(trace.piece_count() + 1);
     for piece in trace.pieces() {
-        match piece {
-            Piece::Pose { pose, .. } => points.push(frame.world_to_grid(pose.position())),
-            Piece::Run(run) => {
-                let [x0, y0] = run.from;
-                let [x1, y1] = run.to(lattice);
-                points.push(frame.world_to_grid(Point::new(x0, y0)));
-                points.push(frame.world_to_grid(Point::new(x1, y1)));
-            }
-            Piece::Event { .. } => {}
-        }
+        piece_points(&frame, lattice, piece, |g| points.push(g));
     }
     // Segments between consecutive distinct points (a lone first point sweeps its disk).
     let sweep = |pts: &[Point], first: bool| {
@@ -220,18 +233,9 @@ impl TraceSweep {
 
     /// The pieces of `chunk`, in order.
     pub fn chunk(&mut self, chunk: &Chunk) {
-        let lattice = chunk.lattice();
+        let (frame, lattice) = (self.frame, chunk.lattice());
         for piece in chunk.pieces() {
-            match piece {
-                Piece::Pose { pose, .. } => self.point(self.frame.world_to_grid(pose.position())),
-                Piece::Run(run) => {
-                    let [x0, y0] = run.from;
-                    let [x1, y1] = run.to(lattice);
-                    self.point(self.frame.world_to_grid(Point::new(x0, y0)));
-                    self.point(self.frame.world_to_grid(Point::new(x1, y1)));
-                }
-                Piece::Event { .. } => {}
-            }
+            piece_points(&frame, lattice, piece, |g| self.point(g));
         }
     }
 
