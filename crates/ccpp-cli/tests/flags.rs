@@ -261,6 +261,9 @@ fn config_values_go_through_the_same_validation() {
         ("bcd: { lane_spacing_m: .nan }", "bcd", "bcd.lane_spacing_m"),
         ("bcd: { rim_coverage: 1.5 }", "bcd", "bcd.rim_coverage"),
         ("bcd: { min_coverage: -0.5 }", "bcd", "bcd.min_coverage"),
+        // Each angle try is a whole plan: a huge count must be refused, not planned.
+        ("bcd: { angle_tries: 41 }", "bcd", "bcd.angle_tries"),
+        ("bcd: { angle_tries: 4000000000 }", "bcd", "bcd.angle_tries"),
         (
             "random_bounce: { budget_m: -5 }",
             "random-bounce",

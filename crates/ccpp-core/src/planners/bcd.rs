@@ -187,6 +187,11 @@ pub struct BcdOptions {
     pub angle_tries: u32,
 }
 
+/// Most turned lattices [`BcdOptions::angle_tries`] may ask for per wall angle: half-degree
+/// steps up to 10 degrees either side, where the second wall direction may begin. Each try is
+/// a whole plan, so the bound also bounds the planning time.
+pub const MAX_ANGLE_TRIES: u32 = 40;
+
 impl Default for BcdOptions {
     fn default() -> Self {
         Self {
@@ -245,6 +250,13 @@ impl BcdOptions {
         if !(0.0..=1.0).contains(&self.min_coverage) {
             return bad("min_coverage", "in [0, 1]", self.min_coverage);
         }
+        if self.angle_tries > MAX_ANGLE_TRIES {
+            return bad(
+                "angle_tries",
+                "at most 40 (up to 10 degrees either side of a wall angle)",
+                f64::from(self.angle_tries),
+            );
+        }
         Ok(())
     }
 }
@@ -288,7 +300,11 @@ impl Bcd {
                     d.rim_coverage
                 },
                 tour_rounds: opts.tour_rounds,
-                angle_tries: opts.angle_tries,
+                angle_tries: if opts.angle_tries <= MAX_ANGLE_TRIES {
+                    opts.angle_tries
+                } else {
+                    d.angle_tries
+                },
                 min_coverage: if (0.0..=1.0).contains(&opts.min_coverage) {
                     opts.min_coverage
                 } else {
