@@ -297,7 +297,11 @@ struct Shown {
     unreachable: bool,
     obstacle: bool,
     unknown: bool,
+    /// Regions with at least one move (each drawn in its colour).
     regions: usize,
+    /// Regions started (`RegionStart` events), as `metrics.json` counts them; a region can
+    /// end without a move (an online planner finding its start already covered or blocked).
+    regions_started: usize,
     backtrack: bool,
     critical: usize,
     restart: usize,
@@ -389,7 +393,10 @@ fn shown_with(
                 s.poses += run.n as usize;
             }
             Piece::Event { event, .. } => match event {
-                Event::RegionStart { region: k } => region = *k,
+                Event::RegionStart { region: k } => {
+                    region = *k;
+                    s.regions_started += 1;
+                }
                 Event::BacktrackStart => in_bt = true,
                 Event::BacktrackEnd => in_bt = false,
                 Event::CriticalPoint { .. } => s.critical += 1,
@@ -485,6 +492,54 @@ fn shown_classes(
     }
 }
 
+/// Greedy wrap of `lines` (one line, or none) at size `px`: the first output line at most
+/// `first_width` wide, the others at most `width`. Lines break between fields (runs of two
+/// spaces, as in "planner on map  r=0.15 m"), inside a field at single spaces only when the
+/// field alone is too wide; a single word wider than its line stays whole.
+fn wrap_words(lines: &[String], first_width: f32, width: f32, px: f32) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    let fits = |text: &str, out: &Vec<String>| {
+        let limit = if out.is_empty() { first_width } else { width };
+        font::text_width(text, px) <= limit
+    };
+    for line in lines {
+        let mut cur = String::new();
+        for field in line.split("  ").filter(|f| !f.trim().is_empty()) {
+            let field = field.trim();
+            let joined = if cur.is_empty() {
+                field.to_string()
+            } else {
+                format!("{cur}  {field}")
+            };
+            if fits(&joined, &out) {
+                cur = joined;
+                continue;
+            }
+            if !cur.is_empty() {
+                out.push(std::mem::take(&mut cur));
+                if fits(field, &out) {
+                    cur = field.to_string();
+                    continue;
+                }
+            }
+            for word in field.split(' ').filter(|w| !w.is_empty()) {
+                let joined = if cur.is_empty() {
+                    word.to_string()
+                } else {
+                    format!("{cur} {word}")
+                };
+                if cur.is_empty() || fits(&joined, &out) {
+                    cur = joined;
+                } else {
+                    out.push(std::mem::replace(&mut cur, word.to_string()));
+                }
+            }
+        }
+        out.push(cur);
+    }
+    out
+}
+
 fn plural(n: usize, one: &str, many: &str) -> String {
     if n == 1 {
         format!("{n} {one}")
@@ -533,6 +588,7 @@ pub fn legend_entries_union_of(runs: &[LegendShown]) -> Vec<LegendEntry> {
         all.obstacle |= s.obstacle;
         all.unknown |= s.unknown;
         all.regions = all.regions.max(s.regions);
+        all.regions_started = all.regions_started.max(s.regions_started);
         all.backtrack |= s.backtrack;
         all.critical = all.critical.max(s.critical.min(1));
         all.restart = all.restart.max(s.restart.min(1));
@@ -595,7 +651,14 @@ fn entries_of(s: &Shown) -> Vec<LegendEntry> {
     add(
         s.regions > 0,
         Swatch::Regions(PALETTE[..s.regions.clamp(1, 5)].to_vec()),
-        if s.regions > 1 {
+        if s.regions_started > s.regions && s.regions_started > 1 {
+            // Said so that the count matches metrics.json's `regions`.
+            let empty = s.regions_started - s.regions;
+            format!(
+                "path, one colour per region ({} regions, {} without a move)",
+                s.regions_started, empty
+            )
+        } else if s.regions > 1 {
             format!("path, one colour per region ({} regions)", s.regions)
         } else {
             "path".into()
@@ -730,12 +793,18 @@ pub fn coverage_pixmap_swept(
             );
             bx -= 8.0;
         }
-        for (k, line) in style.title.iter().enumerate() {
-            let size = if k == 0 { title_px } else { px };
+        // The first title line wraps at spaces so that no word runs under the badges; its
+        // continuation lines take the whole width.
+        let first = style
+            .title
+            .first()
+            .map_or(&[][..], |t| std::slice::from_ref(t));
+        let wrapped = wrap_words(first, bx - 12.0, cw as f32 - 16.0, title_px);
+        for (k, line) in wrapped.iter().enumerate() {
             head.text(
                 8.0,
-                y + if k == 0 { 1.0 } else { 0.0 },
-                size as u32,
+                y + 1.0,
+                title_px as u32,
                 line.clone(),
                 [20, 20, 20],
                 chart::Anchor::Start,
@@ -743,8 +812,19 @@ pub fn coverage_pixmap_swept(
             y += if k == 0 {
                 bh + 4.0
             } else {
-                font::line_height(px)
+                font::line_height(title_px)
             };
+        }
+        for line in style.title.iter().skip(1) {
+            head.text(
+                8.0,
+                y,
+                px as u32,
+                line.clone(),
+                [20, 20, 20],
+                chart::Anchor::Start,
+            );
+            y += font::line_height(px);
         }
         header = (y + 6.0).ceil() as u32;
     }
@@ -1577,6 +1657,82 @@ mod tests {
             .map(|e| e.label)
             .collect();
         assert!(labels.iter().any(|l| l == "collision (1)"), "{labels:?}");
+    }
+
+    #[test]
+    fn a_region_ended_without_a_move_is_counted_as_metrics_count_it() {
+        let (world, mut trace) = run(12);
+        let end = trace.len() as u64;
+        trace.push_event(end, Event::RegionStart { region: 3 });
+        trace.push_event(end, Event::RegionEnd { region: 3 });
+        let labels: Vec<String> = legend_entries(&world, &trace)
+            .into_iter()
+            .map(|e| e.label)
+            .collect();
+        assert!(
+            labels
+                .iter()
+                .any(|l| l == "path, one colour per region (3 regions, 1 without a move)"),
+            "{labels:?}"
+        );
+        let (world, trace) = run(12);
+        let labels: Vec<String> = legend_entries(&world, &trace)
+            .into_iter()
+            .map(|e| e.label)
+            .collect();
+        assert!(
+            labels
+                .iter()
+                .any(|l| l == "path, one colour per region (2 regions)"),
+            "{labels:?}"
+        );
+    }
+
+    #[test]
+    fn a_long_title_wraps_between_fields_before_it_reaches_the_badges() {
+        let px = 20.0;
+        let line = "bsa-extended on aws_small_warehouse_002  r=0.15 m  tool=0.15 m".to_string();
+        let whole = font::text_width(&line, px);
+        // Room for everything: one line, unchanged.
+        assert_eq!(
+            wrap_words(std::slice::from_ref(&line), whole + 1.0, whole + 1.0, px),
+            vec![line.clone()]
+        );
+        // Room on the first line for the first two fields only: the third moves down whole.
+        let two = font::text_width("bsa-extended on aws_small_warehouse_002  r=0.15 m", px);
+        let out = wrap_words(std::slice::from_ref(&line), two + 1.0, whole + 1.0, px);
+        assert_eq!(
+            out,
+            vec![
+                "bsa-extended on aws_small_warehouse_002  r=0.15 m".to_string(),
+                "tool=0.15 m".to_string()
+            ]
+        );
+        // A field wider than the line breaks at single spaces; every line fits its limit
+        // unless it is a single word.
+        let narrow = font::text_width("bsa-extended on", px) + 1.0;
+        let out = wrap_words(std::slice::from_ref(&line), narrow, narrow, px);
+        assert_eq!(out[0], "bsa-extended on");
+        for l in &out {
+            assert!(
+                font::text_width(l, px) <= narrow || !l.contains(' '),
+                "{out:?}"
+            );
+        }
+        assert_eq!(out.join(" ").split_whitespace().count(), 7);
+        assert!(wrap_words(&[], 10.0, 10.0, px).is_empty());
+        // In the picture, a title that runs into the badges makes the header taller instead.
+        let (world, trace) = run(12);
+        let short = coverage_pixmap(&world, &trace, &style()).unwrap();
+        let mut long = style();
+        long.title[0] = format!("{} {}", long.title[0], "and a very long name ".repeat(4));
+        let tall = coverage_pixmap(&world, &trace, &long).unwrap();
+        assert!(
+            tall.height() > short.height(),
+            "{} vs {}",
+            tall.height(),
+            short.height()
+        );
     }
 
     #[test]
