@@ -252,6 +252,18 @@ fn sim_from(a: &RunArgs, config: &mut PlannerConfig) -> Result<SimConfig> {
         Some(Execution::Pid(p)) => p,
         _ => PidOptions::default(),
     };
+    // `--exec ideal` replaces the planner's execution: PID settings given for it in the
+    // options file would be read, validated and then dropped, so the two are refused together.
+    if exec == Some(false) && pid != PidOptions::default() {
+        let file = a.options.config.as_ref().map_or_else(
+            || "the options file".to_string(),
+            |p| p.display().to_string(),
+        );
+        bail!(
+            "--exec ideal drops the PID settings given for {kind} in {file} ({}.exec); remove one of them",
+            kind.info().section
+        );
+    }
     let mut noise_given = false;
     if let Some(n) = &a.odometry_noise {
         let v: Vec<f64> = n

@@ -99,7 +99,7 @@ fn planner_flags_apply_where_they_should() {
     flag_applies(
         dir,
         m,
-        &["--tile-side", "0.45"],
+        &["--tile-side", "0.4"],
         &["ba-star", "ba-star-extended", "bsa-bfs"],
         &[],
     );
@@ -117,22 +117,46 @@ fn planner_flags_apply_where_they_should() {
     flag_applies(dir, m, &["--area", "0.5,0.5,4,4"], &ALL, &[]);
     flag_applies(dir, m, &["--keepout", "5.5,1,6.5,5"], &ALL, &[]);
     flag_applies(dir, m, &["--seed", "5"], &["random-bounce"], &[]);
-    // The sensor range applies to the online planners only (the shortest range that still
-    // sees a neighbour tile: less is known when choosing where to go).
-    flag_applies(
-        dir,
-        m,
-        &["--sensor-range", "0.45"],
-        &[
-            "random-bounce",
-            "ba-star",
-            "ba-star-extended",
-            "bsa",
-            "bsa-extended",
-            "bsa-bfs",
-        ],
-        &[],
-    );
+    // The sensor range applies to the online planners only; offline planners refuse it. At
+    // the shortest range that still sees a neighbour tile's contact disk (2 r + r + half a
+    // pixel = 0.475 m; the default is 4 r = 0.6 m) less is known when choosing where to go, and
+    // the planners that look beyond their neighbours plan differently. bsa and bsa-bfs decide
+    // from the neighbour cells alone: any range that sees them gives the same run, and the
+    // range reaches them through run.json and the sight check below.
+    let sensor = ["--sensor-range", "0.475"];
+    for p in ALL {
+        let offline = ["bcd", "rect-boustrophedon"].contains(&p);
+        if offline {
+            run_fails(dir, m, p, &sensor, &["--sensor-range", "does not apply", p]);
+            continue;
+        }
+        let a = run_ok(dir, &format!("{p}-range-base"), m, p, &[]);
+        let b = run_ok(dir, &format!("{p}-range"), m, p, &sensor);
+        let run_json = common::read_json(&b.join("run.json"));
+        assert_eq!(run_json["sim"]["sensor_range"], 0.475, "{p}");
+        let changed = metrics(&a) != metrics(&b) || trace(&a) != trace(&b);
+        assert_eq!(changed, !["bsa", "bsa-bfs"].contains(&p), "{p}");
+    }
+    // At that range every online tile or cell planner still covers the whole free area; just
+    // below it, where part of each neighbour's disk is out of sight and the robot would stay
+    // where it started, the range is refused.
+    for p in ["ba-star", "bsa", "bsa-bfs"] {
+        let out = run_ok(
+            dir,
+            &format!("{p}-edge"),
+            m,
+            p,
+            &["--sensor-range", "0.475"],
+        );
+        assert_eq!(metrics(&out)["coverage_rate"], 1.0, "{p}");
+        run_fails(
+            dir,
+            m,
+            p,
+            &["--sensor-range", "0.47"],
+            &["sensor range 0.47 m", "half a pixel = 0.475 m"],
+        );
+    }
 }
 
 #[test]
@@ -185,6 +209,29 @@ fn execution_flags_reach_the_simulator() {
         &["--odometry-noise", "PID"],
     );
     run_fails(dir, &map, "bsa", &["--exec", "fast"], &["--exec"]);
+    // PID settings from the options file and `--exec ideal` together: the flag would drop
+    // them, so the pair is refused, naming the file and the section.
+    let pid_cfg = dir.join("pid.yaml");
+    std::fs::write(&pid_cfg, "bsa_bfs: { exec: { pid: { dt_s: 0.1 } } }\n").unwrap();
+    run_fails(
+        dir,
+        &map,
+        "bsa-bfs",
+        &["--exec", "ideal", "--config", pid_cfg.to_str().unwrap()],
+        &["--exec ideal", "pid.yaml", "bsa_bfs.exec"],
+    );
+    // The same file without the flag is read: its control period changes the run.
+    let pid_run = run_ok(
+        dir,
+        "bfs-pid-cfg",
+        &map,
+        "bsa-bfs",
+        &["--config", pid_cfg.to_str().unwrap()],
+    );
+    assert!(
+        trace(&pid_run) != trace(&bfs),
+        "bsa_bfs.exec.pid.dt_s changed nothing"
+    );
 
     // Landmarks correct the noisy estimate: the run changes; refused under ideal execution.
     let lm = dir.join("landmarks.csv");
@@ -264,6 +311,8 @@ fn config_values_go_through_the_same_validation() {
         // Each angle try is a whole plan: a huge count must be refused, not planned.
         ("bcd: { angle_tries: 41 }", "bcd", "bcd.angle_tries"),
         ("bcd: { angle_tries: 4000000000 }", "bcd", "bcd.angle_tries"),
+        // Tour rounds stop when one changes nothing, but a huge bound is still refused.
+        ("bcd: { tour_rounds: 101 }", "bcd", "bcd.tour_rounds"),
         (
             "random_bounce: { budget_m: -5 }",
             "random-bounce",
@@ -537,7 +586,7 @@ fn absurd_sizes_end_within_seconds() {
         dir,
         &map,
         "ba-star",
-        &["--radius", "1e-9"],
+        &["--radius", "1e-9", "--sensor-range", "1"],
         &["memory limit", "tiles"],
     );
     for p in [
@@ -547,7 +596,15 @@ fn absurd_sizes_end_within_seconds() {
         "rect-boustrophedon",
         "bsa-extended",
     ] {
-        run_fails(dir, &map, p, &["--radius", "1e-6"], &["memory limit"]);
+        // A sensor range that sees the neighbours, so that the size is what is refused (the
+        // default 4 r cannot see past half a pixel).
+        let online = !["bcd", "rect-boustrophedon"].contains(&p);
+        let args: &[&str] = if online {
+            &["--radius", "1e-6", "--sensor-range", "1"]
+        } else {
+            &["--radius", "1e-6"]
+        };
+        run_fails(dir, &map, p, args, &["memory limit"]);
     }
     // random-bounce's sensor (4 r) sees nothing beyond its footprint at this radius.
     run_fails(
@@ -561,7 +618,7 @@ fn absurd_sizes_end_within_seconds() {
         dir,
         &map,
         "ba-star",
-        &["--radius", "1e-4"],
+        &["--radius", "1e-4", "--sensor-range", "1"],
         &["memory limit"],
     );
     run_fails(

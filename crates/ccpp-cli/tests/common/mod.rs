@@ -72,6 +72,29 @@ pub fn pillars(dir: &Path) -> PathBuf {
     })
 }
 
+/// A 10 x 7 m flat (0.05 m/px) like a real scan: two rooms joined by a 0.8 m door, a pillar
+/// and a table at pixel offsets off any tile lattice, a one-pixel diagonal wall and 25 specks of
+/// salt noise.
+pub fn rooms(dir: &Path) -> PathBuf {
+    let mut salt = Vec::new();
+    let mut x = 0x2545_f491_4f6c_dd1d_u64;
+    for _ in 0..25 {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        salt.push((5 + (x % 190) as usize, 5 + ((x >> 32) % 130) as usize));
+    }
+    pgm(dir, "rooms.pgm", 200, 140, |x, y| {
+        let (fx, fy) = (x as f64, y as f64);
+        ((99..=100).contains(&x) && !(61..77).contains(&y))
+            || ((30..43).contains(&x) && (23..57).contains(&y))
+            || ((140..151).contains(&x) && (87..121).contains(&y))
+            || ((157..181).contains(&x) && (17..29).contains(&y))
+            || ((20..70).contains(&x) && ((fy - 80.0) - (fx - 20.0) * 0.6).abs() < 1.0)
+            || salt.contains(&(x, y))
+    })
+}
+
 /// Runs `ccpp SUBCOMMAND --planner P --map MAP ARGS --out DIR/SUB`, asserts success and returns
 /// the output folder (`SUBCOMMAND` is `run` or `plan`).
 pub fn ccpp_ok(

@@ -171,7 +171,8 @@ pub struct BcdOptions {
     /// are left out while the pixels they hold (with whatever no pass can reach) stay within
     /// `1 - rim_coverage` of it, as estimated on the plan. 1 sweeps every group. In `[0, 1]`.
     pub rim_coverage: f64,
-    /// Improvement rounds of the cell tour (0 = nearest-neighbour order only).
+    /// Improvement rounds of the cell tour (0 = nearest-neighbour order only); the rounds stop
+    /// early once one changes nothing. At most [`MAX_TOUR_ROUNDS`].
     pub tour_rounds: u32,
     /// Turn pruning of the finished plan (step 5 of the module docs) drops turns while the
     /// plan's estimated effective coverage stays at least this; 1 drops only turns whose
@@ -191,6 +192,11 @@ pub struct BcdOptions {
 /// steps up to 10 degrees either side, where the second wall direction may begin. Each try is
 /// a whole plan, so the bound also bounds the planning time.
 pub const MAX_ANGLE_TRIES: u32 = 40;
+
+/// Most improvement rounds [`BcdOptions::tour_rounds`] may ask for. Each round costs a pass of
+/// 2-opt and Or-opt moves over every cell of the tour; on the shared maps the tour settles
+/// within 2-6 rounds, so the bound only keeps a mistyped count from planning for hours.
+pub const MAX_TOUR_ROUNDS: u32 = 100;
 
 impl Default for BcdOptions {
     fn default() -> Self {
@@ -250,6 +256,9 @@ impl BcdOptions {
         if !(0.0..=1.0).contains(&self.min_coverage) {
             return bad("min_coverage", "in [0, 1]", self.min_coverage);
         }
+        if self.tour_rounds > MAX_TOUR_ROUNDS {
+            return bad("tour_rounds", "at most 100", f64::from(self.tour_rounds));
+        }
         if self.angle_tries > MAX_ANGLE_TRIES {
             return bad(
                 "angle_tries",
@@ -299,7 +308,7 @@ impl Bcd {
                 } else {
                     d.rim_coverage
                 },
-                tour_rounds: opts.tour_rounds,
+                tour_rounds: opts.tour_rounds.min(MAX_TOUR_ROUNDS),
                 angle_tries: if opts.angle_tries <= MAX_ANGLE_TRIES {
                     opts.angle_tries
                 } else {

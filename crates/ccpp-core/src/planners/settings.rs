@@ -292,14 +292,18 @@ fn pid_records(e: Option<&Execution>, path_m: f64) -> f64 {
     }
 }
 
-/// The sensor must see a neighbour tile's whole contact disk: `side + r`.
+/// The sensor must see a neighbour tile's whole contact disk: the pixels whose centres lie
+/// within `r + half a pixel` of the tile centre ([`crate::collide::contact_radius_px`]), so up
+/// to `side + r + res / 2` from the robot. A shorter range leaves part of every neighbour's
+/// disk unknown, the planner reads every neighbour as blocked and the run ends where it
+/// started.
 fn check_neighbour_sight(setup: &Setup, side: f64, what: &str) -> Result<(), OptionsError> {
-    let need = side + setup.robot.radius;
+    let need = side + setup.robot.radius + 0.5 * setup.frame.resolution;
     if setup.sensor_range < need * (1.0 - 1e-9) {
         return Err(OptionsError::new(
             "",
             format!(
-                "the sensor range {} m cannot see a neighbour {what}'s disk (needs >= {what} side + r = {} m); raise the sensor range",
+                "the sensor range {} m cannot see a neighbour {what}'s disk (needs >= {what} side + r + half a pixel = {} m); raise the sensor range",
                 fmt_m(setup.sensor_range), fmt_m(need)
             ),
         ));
