@@ -321,6 +321,7 @@ fn bcd_and_rect_options_change_the_run() {
             Less("path_length_m"),
         ),
         ("bcd", "bcd: { tour_rounds: 0 }", Rooms, Differs),
+        ("bcd", "bcd: { margin_px: 2 }", Pillars, Differs),
         (
             "bcd",
             "bcd: { min_coverage: 1.0 }",

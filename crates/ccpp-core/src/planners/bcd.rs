@@ -157,7 +157,8 @@ pub struct BcdOptions {
     /// Largest lane spacing in metres (lanes are spread evenly, at most this far apart);
     /// `None` = `2 r_tool`. Must be > 0.
     pub lane_spacing_m: Option<f64>,
-    /// Extra clearance (pixels, >= 0) that transfer paths keep from obstacles when they can;
+    /// Extra clearance (pixels, >= 0) that transfer paths keep from obstacles when they can,
+    /// apart from the stretches next to their ends (a lane end may sit at plain clearance);
     /// where no such path exists they fall back to the plain C-free set.
     pub margin_px: f64,
     /// Cost of one turn, in metres of path, when choosing sweep directions (>= 0).

@@ -15,6 +15,9 @@ pub(super) struct Ctx<'a> {
     pub(super) ok: Vec<bool>,
     /// Transfer set: `ok` with the extra margin.
     pub(super) safe: Vec<bool>,
+    /// With a margin ([`super::BcdOptions::margin_px`] > 0): the clearance in pixels that
+    /// transfers keep from obstacles where they can (contact radius + margin); `None` without.
+    pub(super) keep_px: Option<f64>,
     /// Tool radius in pixels.
     pub(super) rt: f64,
 }
@@ -114,6 +117,28 @@ impl Ctx<'_> {
 
     pub(super) fn centre(&self, c: usize, r: usize) -> Point {
         self.frame.pixel_center_grid(c, r)
+    }
+
+    /// Does the straight move from `a` to `b` keep the transfer margin ([`Ctx::keep_px`]): is
+    /// every point of it in a `safe` pixel, apart from the points within the kept clearance of
+    /// either end of the whole transfer, `ends` (an end may sit closer to a wall, at a lane
+    /// end)? True without a margin.
+    pub(super) fn keeps_margin(&self, a: Point, b: Point, ends: [Point; 2]) -> bool {
+        let Some(keep) = self.keep_px else {
+            return true;
+        };
+        let n = (a.dist(b) * 2.0).ceil() as usize;
+        (1..n).all(|k| {
+            let t = k as f64 / n as f64;
+            let p = Point::new(a.x + (b.x - a.x) * t, a.y + (b.y - a.y) * t);
+            if ends.iter().any(|e| e.dist(p) <= keep) {
+                return true;
+            }
+            let (c, r) = self.frame.grid_to_pixel_signed(p);
+            self.frame
+                .checked(c, r)
+                .is_some_and(|(c, r)| self.safe[r * self.frame.width + c])
+        })
     }
 
     /// Is the straight move between grid points `a` and `b` free on the true map?

@@ -37,6 +37,7 @@ impl Bcd {
             frame,
             ok,
             safe,
+            keep_px: (opts.margin_px > 0.0).then_some(need),
             rt: robot.tool_radius / res,
         };
         let mut search = Search::new(w, h);

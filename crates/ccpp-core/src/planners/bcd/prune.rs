@@ -697,6 +697,7 @@ mod tests {
             world,
             frame,
             safe: ok.clone(),
+            keep_px: None,
             ok,
             rt: world.robot().tool_radius / frame.resolution,
         }

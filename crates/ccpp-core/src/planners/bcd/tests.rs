@@ -74,6 +74,7 @@ fn walls_at_an_angle_get_a_turned_lattice() {
             world: &world,
             frame,
             safe: ok.clone(),
+            keep_px: None,
             ok,
             rt: 3.0,
         };
@@ -102,6 +103,7 @@ fn walls_at_an_angle_get_a_turned_lattice() {
         world: &world,
         frame,
         safe: ok.clone(),
+        keep_px: None,
         ok,
         rt: 3.0,
     };
@@ -124,6 +126,7 @@ fn smoothing_straightens_wiggles_but_keeps_corners_and_marks() {
         frame,
         ok: vec![true; n],
         safe: vec![true; n],
+        keep_px: None,
         rt: 4.0,
     };
     // A wiggle of 0.3 px along a free row, then a corner, then a mark.
@@ -164,6 +167,7 @@ fn repair_counts_the_moves_it_cannot_route() {
         frame,
         ok: vec![true; n],
         safe: vec![true; n],
+        keep_px: None,
         rt: 4.0,
     };
     let mut search = Search::new(frame.width, frame.height);
@@ -547,4 +551,69 @@ fn transposed_cell_needs_one_run_per_line() {
         runs: vec![(0, 2), (0, 0), (0, 2)],
     };
     assert!(u.transposed().is_none());
+}
+
+/// `margin_px`: a transfer around the block keeps the extra clearance along its whole length
+/// (apart from the stretches next to its ends), where without it the shortened path grazes
+/// the block's corners.
+#[test]
+fn transfers_keep_the_margin_they_are_given() {
+    // A 100 x 80 px room (0.02 m/px) with a 20 x 20 px block in the middle, 30 px from the walls.
+    let art = "##########\n#........#\n#........#\n#...##...#\n#...##...#\n#........#\n#........#\n##########";
+    let map = crate::grid::GridMap::from_ascii_scaled(art, 10, 0.02).unwrap();
+    let world = World::new(
+        map,
+        crate::world::Robot::new(0.08),
+        Some(crate::geometry::Pose::new(0.3, 0.3, 0.0)),
+    )
+    .unwrap();
+    let frame = *world.frame();
+    let (w, h) = (frame.width, frame.height);
+    let res = frame.resolution;
+    let reach = world.reachable();
+    let ok: Vec<bool> = (0..w * h).map(|i| reach.contains(i)).collect();
+    let clear = |p: Point| {
+        let (c, r) = frame.grid_to_pixel_signed(p);
+        let (c, r) = frame.checked(c, r).unwrap();
+        world.pixel_clearance(c, r) / res
+    };
+    // Least clearance (pixels) along the route, away from its ends.
+    let least = |margin: f64| {
+        let need = crate::collide::contact_radius_px(world.robot().radius / res) + margin;
+        let ctx = Ctx {
+            world: &world,
+            frame,
+            ok: ok.clone(),
+            safe: (0..w * h)
+                .map(|i| ok[i] && world.pixel_clearance(i % w, i / w) / res + 0.5 >= need)
+                .collect(),
+            keep_px: (margin > 0.0).then_some(need),
+            rt: 4.0,
+        };
+        let (a, b) = (Point::new(30.0, 20.0), Point::new(70.0, 60.0));
+        let mut pts = vec![a];
+        pts.extend(ctx.route(&mut Search::new(w, h), a, b).unwrap());
+        assert_eq!(pts.last(), Some(&b));
+        let mut low = f64::INFINITY;
+        for s in pts.windows(2) {
+            for k in 0..=20 {
+                let t = f64::from(k) / 20.0;
+                let p = Point::new(
+                    s[0].x + (s[1].x - s[0].x) * t,
+                    s[0].y + (s[1].y - s[0].y) * t,
+                );
+                if p.dist(a) > need && p.dist(b) > need {
+                    low = low.min(clear(p));
+                }
+            }
+        }
+        (low, need)
+    };
+    let (bare, contact) = least(0.0);
+    let (kept, need) = least(3.0);
+    assert!(
+        bare < contact + 1.0,
+        "without a margin the route grazes the block: {bare}"
+    );
+    assert!(kept >= need - 1.0, "with 3 px it keeps {kept} px of {need}");
 }

@@ -35,7 +35,7 @@ impl Ctx<'_> {
     /// Moves from `a` to `b` (excluding `a`): straight when free, else an A* pixel path
     /// shortened by line of sight; `None` when no verified path exists.
     pub(super) fn route(&self, search: &mut Search, a: Point, b: Point) -> Option<Vec<Point>> {
-        if self.free(a, b) {
+        if self.free(a, b) && self.keeps_margin(a, b, [a, b]) {
             return Some(vec![b]);
         }
         let pa = self.anchor(a)?;
@@ -44,20 +44,43 @@ impl Ctx<'_> {
             let w = self.frame.width;
             self.free(self.centre(i % w, i / w), self.centre(j % w, j / w))
         };
-        let path = search
-            .path(&self.safe, pa, pb, &diag)
-            .or_else(|| search.path(&self.ok, pa, pb, &diag))?;
+        // Through the margin where a path keeps it (then shortened without giving it up),
+        // else through the plain C-free set.
+        let w = self.frame.width;
+        let plain = |j: usize| self.ok[j];
+        let (path, kept) = if let Some(keep) = self.keep_px {
+            // The ends may sit closer to a wall (a lane end): the pixels within the kept
+            // clearance of either end are open too, as in `keeps_margin`.
+            let near = |j: usize, p: (usize, usize)| {
+                let (dc, dr) = ((j % w) as f64 - p.0 as f64, (j / w) as f64 - p.1 as f64);
+                dc * dc + dr * dr <= keep * keep
+            };
+            let kept = |j: usize| self.safe[j] || (self.ok[j] && (near(j, pa) || near(j, pb)));
+            match search.path(&kept, pa, pb, &diag) {
+                Some(p) => (p, true),
+                None => (search.path(&plain, pa, pb, &diag)?, false),
+            }
+        } else {
+            (search.path(&plain, pa, pb, &diag)?, false)
+        };
         let mut pts = Vec::with_capacity(path.len() + 2);
         pts.push(a);
         pts.extend(path.iter().map(|&(c, r)| self.centre(c, r)));
         pts.push(b);
         pts.dedup();
-        self.shorten(&pts)
+        self.shorten(&pts, kept)
     }
 
     /// Line-of-sight shortening of a chain whose consecutive points are joined by free moves
-    /// (not checked: a failing link gives `None`). Returns the points after the first.
-    fn shorten(&self, pts: &[Point]) -> Option<Vec<Point>> {
+    /// (not checked: a failing link gives `None`); with `margin`, a shortcut over more than one
+    /// link must also keep the transfer margin ([`Ctx::keeps_margin`]). Returns the points
+    /// after the first.
+    fn shorten(&self, pts: &[Point], margin: bool) -> Option<Vec<Point>> {
+        let ends = [pts[0], pts[pts.len() - 1]];
+        let link = |i: usize, j: usize| {
+            self.free(pts[i], pts[j])
+                && (!margin || j == i + 1 || self.keeps_margin(pts[i], pts[j], ends))
+        };
         let mut out = Vec::new();
         let mut i = 0;
         while i + 1 < pts.len() {
@@ -66,7 +89,7 @@ impl Ctx<'_> {
             let mut hi = None;
             loop {
                 let j = (i + step).min(pts.len() - 1);
-                if self.free(pts[i], pts[j]) {
+                if link(i, j) {
                     lo = j;
                     if j == pts.len() - 1 {
                         break;
@@ -83,7 +106,7 @@ impl Ctx<'_> {
                 }
                 while hi - lo > 1 {
                     let mid = usize::midpoint(lo, hi);
-                    if self.free(pts[i], pts[mid]) {
+                    if link(i, mid) {
                         lo = mid;
                     } else {
                         hi = mid;
@@ -156,12 +179,12 @@ impl Search {
         10 * dx.max(dy) + 4 * dx.min(dy)
     }
 
-    /// A* from `s` to `t` over `ok` (the end pixels need not be in it). A diagonal step whose
-    /// two side pixels are not both in `ok` is taken only when `diag(from, to)` allows it. Ties
-    /// by cost, then pixel index.
+    /// A* from `s` to `t` over the pixels `ok` admits (the end pixels need not be in it). A
+    /// diagonal step whose two side pixels are not both admitted is taken only when
+    /// `diag(from, to)` allows it. Ties by cost, then pixel index.
     fn path(
         &mut self,
-        ok: &[bool],
+        ok: &dyn Fn(usize) -> bool,
         s: (usize, usize),
         t: (usize, usize),
         diag_ok: &dyn Fn(usize, usize) -> bool,
@@ -173,7 +196,7 @@ impl Search {
         }
         let w = self.width;
         let ti = t.1 * w + t.0;
-        let passable = |j: usize| ok[j] || j == ti;
+        let passable = |j: usize| ok(j) || j == ti;
         let mut heap = BinaryHeap::new();
         let si = s.1 * w + s.0;
         self.stamp[si] = self.gen;
