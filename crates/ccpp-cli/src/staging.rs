@@ -375,8 +375,8 @@ pub fn write_file(path: &Path, bytes: &[u8]) -> Result<(), ccpp_io::WriteError> 
 }
 
 /// Writes the file at `path` atomically with what `fill` writes, synced before it is renamed
-/// into place; or, `deferred`, renamed unsynced and returned for the caller to sync (a file of
-/// a staging folder, which becomes visible only with the folder).
+/// into place; or, `deferred` (a file of a staging folder, which becomes visible only with the
+/// folder), written under its name unsynced and returned for the caller to sync.
 fn write_file_with(
     path: &Path,
     fill: &mut dyn FnMut(&mut dyn std::io::Write) -> std::io::Result<()>,
@@ -385,13 +385,19 @@ fn write_file_with(
     let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
     let write = |fill: &mut dyn FnMut(&mut dyn std::io::Write) -> std::io::Result<()>| {
         if deferred {
-            ccpp_io::write::write_atomic_unsynced_with(path, fill).map(Some)
+            write_staged(path, fill).map(Some)
         } else {
             ccpp_io::write::write_atomic_with(path, fill).map(|()| None)
         }
     };
     if std::env::var_os(FAIL_WRITE_ENV).is_some_and(|v| v == name) {
         return write(&mut |_| Err(std::io::Error::from_raw_os_error(28)));
+    }
+    if deferred {
+        // A file of a staging folder: written under its own name (the folder is private until
+        // it is moved into place, so no reader can see the file half written; the folder is
+        // registered, and removed whole on failure or interrupt).
+        return write(fill);
     }
     let mut tmp = path.as_os_str().to_owned();
     tmp.push(".tmp");
@@ -400,6 +406,27 @@ fn write_file_with(
     let r = write(fill);
     unregister(&tmp);
     r
+}
+
+/// Writes what `fill` writes into a new file `path` of a staging folder, unsynced, and returns
+/// it for the caller to sync; on failure the file is removed.
+fn write_staged(
+    path: &Path,
+    fill: &mut dyn FnMut(&mut dyn std::io::Write) -> std::io::Result<()>,
+) -> Result<std::fs::File, ccpp_io::WriteError> {
+    let result = (|| {
+        let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);
+        fill(&mut w)?;
+        w.into_inner().map_err(std::io::IntoInnerError::into_error)
+    })();
+    result.map_err(|source| {
+        // Best effort: the file may not even exist.
+        let _ = std::fs::remove_file(path);
+        ccpp_io::WriteError::Io {
+            path: path.to_path_buf(),
+            source,
+        }
+    })
 }
 
 #[cfg(test)]
