@@ -243,14 +243,22 @@ pub fn coverage_png_swept(
 }
 
 /// Encodes a picture as PNG bytes, fast: an opaque canvas (every picture of this crate) is
-/// written as 8-bit RGB, streamed row by row from the pixmap (no copy of the canvas), with
-/// `png`'s fast DEFLATE mode and its fixed filter; a canvas with any translucent pixel goes
-/// through tiny-skia's RGBA encoder. Same pixels as [`Pixmap::encode_png`] decodes to; the
-/// bytes are a pure function of the pixels.
+/// written as 8-bit RGB with `png`'s fast DEFLATE mode and its fixed filter; a canvas with any
+/// translucent pixel goes through tiny-skia's RGBA encoder. Same pixels as
+/// [`Pixmap::encode_png`] decodes to; the bytes are a pure function of the pixels. A large
+/// canvas has its rows converted to RGB (and checked opaque) in bands on a second thread while
+/// this one filters and compresses the bands before (the same rows in the same order: the same
+/// bytes).
 ///
 /// # Errors
 /// When encoding fails.
 pub fn encode_png(pixmap: &Pixmap) -> Result<Vec<u8>, RenderError> {
+    let large = pixmap.width() as usize * pixmap.height() as usize >= 2 * ENCODE_BAND_PX;
+    encode_png_on(pixmap, large)
+}
+
+/// [`encode_png`], converting the bands on a second thread when `threaded`.
+fn encode_png_on(pixmap: &Pixmap, threaded: bool) -> Result<Vec<u8>, RenderError> {
     use std::io::Write as _;
     let err = |e: &dyn std::fmt::Display| RenderError::Encode(e.to_string());
     let (w, h) = (pixmap.width(), pixmap.height());
@@ -260,35 +268,86 @@ pub fn encode_png(pixmap: &Pixmap) -> Result<Vec<u8>, RenderError> {
     encoder.set_depth(png::BitDepth::Eight);
     encoder.set_compression(png::Compression::Fast);
     let mut writer = encoder.write_header().map_err(|e| err(&e))?;
-    // Every pixel's alpha ANDed while its row is copied (no early exit: a reduction the
-    // compiler vectorizes). A canvas with a translucent pixel is encoded again as RGBA below.
-    let mut alpha = u8::MAX;
-    {
+    let n = w as usize * 3;
+    let opaque = {
         let mut stream = writer.stream_writer().map_err(|e| err(&e))?;
-        // One spare byte: each pixel is copied whole (4 bytes, one store), its alpha byte
-        // then overwritten by the next pixel's red (the last one's lands in the spare byte).
-        let n = w as usize * 3;
-        let mut row = vec![0u8; n + 1];
-        // Opaque premultiplied pixels are their straight colours.
-        for src in pixmap.data().chunks_exact(w as usize * 4) {
-            alpha &= src.chunks_exact(4).fold(u8::MAX, |all, p| all & p[3]);
-            if alpha != u8::MAX {
-                break;
+        let mut put = |band: &[u8]| -> Result<(), RenderError> {
+            for row in band.chunks_exact(n) {
+                stream.write_all(row).map_err(|e| err(&e))?;
             }
-            for (k, s) in src.chunks_exact(4).enumerate() {
-                row[3 * k..3 * k + 4].copy_from_slice(s);
+            Ok(())
+        };
+        let band_rows = (ENCODE_BAND_PX / w as usize).max(1);
+        let bands = pixmap.data().chunks(band_rows * w as usize * 4);
+        let opaque = if threaded {
+            std::thread::scope(|s| {
+                // Bands go over a bounded channel (at most a few converted bands in memory);
+                // their buffers come back to be reused. `None`: a translucent pixel.
+                let (tx, rx) = std::sync::mpsc::sync_channel::<Option<Vec<u8>>>(4);
+                let (back_tx, back_rx) = std::sync::mpsc::channel::<Vec<u8>>();
+                s.spawn(move || {
+                    for band in bands {
+                        let mut buf = back_rx.try_recv().unwrap_or_default();
+                        let msg = rgb_band(band, &mut buf).then_some(buf);
+                        let stop = msg.is_none();
+                        // A closed channel: the encoder failed and stopped reading.
+                        if tx.send(msg).is_err() || stop {
+                            return;
+                        }
+                    }
+                });
+                for msg in rx {
+                    let Some(buf) = msg else { return Ok(false) };
+                    put(&buf)?;
+                    let _ = back_tx.send(buf);
+                }
+                Ok(true)
+            })?
+        } else {
+            let mut buf = Vec::new();
+            let mut opaque = true;
+            for band in bands {
+                opaque = rgb_band(band, &mut buf);
+                if !opaque {
+                    break;
+                }
+                put(&buf)?;
             }
-            stream.write_all(&row[..n]).map_err(|e| err(&e))?;
-        }
-        if alpha == u8::MAX {
+            opaque
+        };
+        if opaque {
             stream.finish().map_err(|e| err(&e))?;
         }
-    }
-    if alpha != u8::MAX {
+        opaque
+    };
+    if !opaque {
         return pixmap.encode_png().map_err(|e| err(&e));
     }
     writer.finish().map_err(|e| err(&e))?;
     Ok(out)
+}
+
+/// Canvas pixels per band of [`encode_png`]'s RGB conversion.
+const ENCODE_BAND_PX: usize = 1 << 15;
+
+/// The RGB bytes of `band` (whole RGBA rows) into `buf`; false (and `buf` unspecified) when a
+/// pixel is not opaque.
+fn rgb_band(band: &[u8], buf: &mut Vec<u8>) -> bool {
+    // Every pixel's alpha ANDed (no early exit: a reduction the compiler vectorizes).
+    if band.chunks_exact(4).fold(u8::MAX, |all, p| all & p[3]) != u8::MAX {
+        return false;
+    }
+    // One spare byte: each pixel is copied whole (4 bytes, one store), its alpha byte then
+    // overwritten by the next pixel's red (the last one's lands in the spare byte).
+    let n = band.len() / 4 * 3;
+    buf.clear();
+    buf.resize(n + 1, 0);
+    // Opaque premultiplied pixels are their straight colours.
+    for (k, s) in band.chunks_exact(4).enumerate() {
+        buf[3 * k..3 * k + 4].copy_from_slice(s);
+    }
+    buf.truncate(n);
+    true
 }
 
 /// Counts of what a run's picture shows, for its legend.
@@ -771,6 +830,8 @@ pub fn coverage_pixmap_swept(
         top.fill(u8::MAX);
         rest[ch_map as usize * row..].fill(u8::MAX);
     }
+    // The title and the legend are drawn on another thread meanwhile (see `TextLayer`).
+    let text = TextLayer::start(head, foot, (cw, ch), header, ch_map + header);
 
     // Background: classify each map pixel, then nearest-neighbour scale.
     let acc = world.accessible();
@@ -881,11 +942,100 @@ pub fn coverage_pixmap_swept(
     ccpp_io::phase::time("coverage.png markers", || {
         draw_markers(&mut pm, world, trace, view);
     });
-    ccpp_io::phase::time("coverage.png text", || {
-        head.draw_onto(&mut pm);
-        foot.draw_onto(&mut pm);
-    });
+    ccpp_io::phase::time("coverage.png text", || text.finish(&mut pm));
     Ok(pm)
+}
+
+/// Rows above and below the map of a text layer that must stay untouched (see [`TextLayer`]).
+const TEXT_GUARD_ROWS: usize = 64;
+
+/// The title (`head`, on the rows above the map) and the legend (`foot`, on the rows below it),
+/// drawn on a thread of their own while the map is painted, onto a canvas of the picture's size
+/// whose map rows are never written (so never backed by memory). When the text stayed out of
+/// the map rows (the rows next to them are untouched) and the picture's rows above and below
+/// the map are still white when the map is done, those rows are the text drawn on white either
+/// way: they are copied in, the same bytes as drawing the text last onto the picture. Otherwise
+/// the text is drawn onto the picture as before.
+struct TextLayer {
+    head_rows: usize,
+    foot_row: usize,
+    work: TextWork,
+}
+
+/// Where a [`TextLayer`]'s text is.
+enum TextWork {
+    /// Being drawn on another thread.
+    Drawing(std::thread::JoinHandle<(Chart, Chart, Option<Pixmap>)>),
+    /// Not started (a picture without text rows): drawn onto the picture at the end.
+    Charts(Chart, Chart),
+}
+
+impl TextLayer {
+    /// Starts drawing `head` and `foot` (charts in canvas coordinates) for a canvas of `size`
+    /// whose map rows are `head_rows..foot_row`.
+    fn start(head: Chart, foot: Chart, size: (u32, u32), head_rows: u32, foot_row: u32) -> Self {
+        let (head_rows, foot_row) = (head_rows as usize, foot_row as usize);
+        let work = if head_rows == 0 && foot_row == size.1 as usize {
+            TextWork::Charts(head, foot)
+        } else {
+            TextWork::Drawing(std::thread::spawn(move || {
+                let layer = Self::draw(&head, &foot, size, head_rows, foot_row);
+                (head, foot, layer)
+            }))
+        };
+        Self {
+            head_rows,
+            foot_row,
+            work,
+        }
+    }
+
+    /// The layer, when the text stayed out of the guard rows of the map.
+    fn draw(
+        head: &Chart,
+        foot: &Chart,
+        (cw, ch): (u32, u32),
+        head_rows: usize,
+        foot_row: usize,
+    ) -> Option<Pixmap> {
+        let mut t = Pixmap::new(cw, ch)?;
+        let stride = cw as usize * 4;
+        {
+            let (top, rest) = t.data_mut().split_at_mut(head_rows * stride);
+            top.fill(u8::MAX);
+            rest[(foot_row - head_rows) * stride..].fill(u8::MAX);
+        }
+        head.draw_onto(&mut t);
+        foot.draw_onto(&mut t);
+        let map = &t.data()[head_rows * stride..foot_row * stride];
+        let g = (TEXT_GUARD_ROWS * stride).min(map.len());
+        let untouched = |b: &[u8]| b.iter().all(|&v| v == 0);
+        (untouched(&map[..g]) && untouched(&map[map.len() - g..])).then_some(t)
+    }
+
+    /// Puts the text onto `pm` (the finished map and the white rows around it).
+    fn finish(self, pm: &mut Pixmap) {
+        let (head, foot, layer) = match self.work {
+            TextWork::Charts(head, foot) => (head, foot, None),
+            TextWork::Drawing(worker) => match worker.join() {
+                Ok(r) => r,
+                Err(panic) => std::panic::resume_unwind(panic),
+            },
+        };
+        let stride = pm.width() as usize * 4;
+        let (top, bottom) = (self.head_rows * stride, self.foot_row * stride);
+        let white = |b: &[u8]| b.iter().all(|&v| v == u8::MAX);
+        match layer {
+            Some(t) if white(&pm.data()[..top]) && white(&pm.data()[bottom..]) => {
+                pm.data_mut()[..top].copy_from_slice(&t.data()[..top]);
+                pm.data_mut()[bottom..].copy_from_slice(&t.data()[bottom..]);
+            }
+            _ => {
+                head.draw_onto(pm);
+                foot.draw_onto(pm);
+            }
+        }
+    }
 }
 
 /// Outlines of the area polygons (solid) and keep-out polygons (hatch colour).
@@ -1636,6 +1786,95 @@ mod tests {
         assert_eq!(lane_weight(0.4), 102);
         assert_eq!(lane_weight(0.001), 0);
         assert_eq!(lane_weight(0.999), 255);
+    }
+
+    #[test]
+    fn the_text_layer_gives_the_bytes_of_drawing_the_text_last() {
+        let (cw, ch, head_rows, foot_row) = (240u32, 200u32, 40u32, 150u32);
+        let charts = || {
+            let mut head = Chart::new(cw, 0);
+            head.rect(150.0, 4.0, 80.0, 24.0, Some([20, 130, 60]), None);
+            head.text(
+                8.0,
+                6.0,
+                20,
+                "Title gj".to_string(),
+                [20, 20, 20],
+                chart::Anchor::Start,
+            );
+            let mut foot = Chart::new(cw, 0);
+            foot.text(
+                8.0,
+                160.0,
+                14,
+                "legend".to_string(),
+                [20, 20, 20],
+                chart::Anchor::Start,
+            );
+            foot.rect(120.0, 162.0, 14.0, 14.0, Some([200, 30, 30]), None);
+            (head, foot)
+        };
+        // The map rows painted, white above and below; then a stroke into the head rows.
+        let mut pm = Pixmap::new(cw, ch).unwrap();
+        pm.fill(Color::WHITE);
+        let stride = cw as usize * 4;
+        for (k, b) in pm.data_mut()[head_rows as usize * stride..foot_row as usize * stride]
+            .iter_mut()
+            .enumerate()
+        {
+            *b = if k % 4 == 3 { 255 } else { (k % 249) as u8 };
+        }
+        for spill in [false, true] {
+            if spill {
+                let mut pb = PathBuilder::new();
+                pb.move_to(10.0, 45.0);
+                pb.line_to(200.0, 20.0);
+                let stroke = Stroke {
+                    width: 3.0,
+                    ..Stroke::default()
+                };
+                let path = pb.finish().unwrap();
+                pm.stroke_path(
+                    &path,
+                    &paint(rgb([0, 0, 200])),
+                    &stroke,
+                    Transform::identity(),
+                    None,
+                );
+            }
+            let mut want = pm.clone();
+            let (head, foot) = charts();
+            head.draw_onto(&mut want);
+            foot.draw_onto(&mut want);
+            let mut got = pm.clone();
+            let (head, foot) = charts();
+            TextLayer::start(head, foot, (cw, ch), head_rows, foot_row).finish(&mut got);
+            assert!(got.data() == want.data(), "spill {spill}");
+            assert!(got.data() != pm.data(), "the text is drawn");
+        }
+    }
+
+    #[test]
+    fn a_large_picture_encodes_the_same_with_its_bands_converted_on_a_second_thread() {
+        // Several bands (the last one short), odd width.
+        let (w, h) = (301u32, 4 * (ENCODE_BAND_PX as u32 / 301) + 7);
+        let mut pm = Pixmap::new(w, h).unwrap();
+        for (k, p) in pm.data_mut().chunks_exact_mut(4).enumerate() {
+            let k = k as u32;
+            p.copy_from_slice(&[(k % 251) as u8, (k / 7 % 253) as u8, (k / 301) as u8, 255]);
+        }
+        let threaded = encode_png_on(&pm, true).unwrap();
+        assert_eq!(threaded, encode_png_on(&pm, false).unwrap());
+        assert_eq!(threaded, encode_png(&pm).unwrap());
+        // A translucent pixel in the last band: RGBA, as on one thread.
+        let at = pm.data().len() - 8;
+        pm.data_mut()[at..at + 4].copy_from_slice(&[0, 0, 0, 0]);
+        let threaded = encode_png_on(&pm, true).unwrap();
+        assert_eq!(threaded, encode_png_on(&pm, false).unwrap());
+        let dec = png::Decoder::new(std::io::Cursor::new(threaded))
+            .read_info()
+            .unwrap();
+        assert_eq!(dec.info().color_type, png::ColorType::Rgba);
     }
 
     #[test]
