@@ -832,102 +832,6 @@ pub fn coverage_pixmap_swept(
     }
     // The title and the legend are drawn on another thread meanwhile (see `TextLayer`).
     let text = TextLayer::start(head, foot, (cw, ch), header, ch_map + header);
-
-    // Background: classify each map pixel, then nearest-neighbour scale.
-    let acc = world.accessible();
-    let cells = world.true_map().cells();
-    let colour_of = |i: usize, x: u32, y: u32| -> [u8; 3] {
-        match cells[i] {
-            Cell::Occupied => colours::OBSTACLE,
-            Cell::Unknown => colours::UNKNOWN,
-            Cell::Free if zone_class(world, i) == 1 => {
-                // Diagonal hatching in canvas pixels, 3 of every 9 on.
-                if (x + y) % 9 < 3 {
-                    colours::KEEPOUT_HATCH
-                } else {
-                    colours::KEEPOUT
-                }
-            }
-            Cell::Free if zone_class(world, i) == 2 => colours::OUTSIDE_AREA,
-            Cell::Free => match (acc.contains(i), swept.contains(i)) {
-                (true, true) => colours::SWEPT,
-                (true, false) => colours::MISSED,
-                (false, true) => colours::SWEPT_OUTSIDE,
-                (false, false) => colours::UNREACHABLE,
-            },
-        }
-    };
-    ccpp_io::phase::time("coverage.png background", || {
-        // The map column of each canvas column, computed once (same formula per pixel).
-        let cols: Vec<usize> = (0..cw)
-            .map(|x| (col0 + ((x as f32 + 0.5) / scale) as usize).min(frame.width - 1))
-            .collect();
-        let stride = cw as usize * 4;
-        // Paints the canvas map rows `y0..` into `rows` (those rows, `stride` bytes each).
-        let paint = |y0: u32, rows: &mut [u8]| {
-            // A canvas row showing the same map row as the one above, without keep-out
-            // hatching (which follows the canvas diagonal), is a copy of it.
-            let mut above: Option<(usize, bool)> = None;
-            for (y, line) in (y0..).zip(0..rows.len() / stride) {
-                let row = ((y as f32 + 0.5) / scale) as usize;
-                let row = (row0 + row).min(frame.height - 1);
-                let o = line * stride;
-                if above == Some((row, false)) {
-                    rows.copy_within(o - stride..o, o);
-                    continue;
-                }
-                let mut hatched = false;
-                let out = &mut rows[o..o + stride];
-                // The last map pixel classified and its colour, when it is not hatched (its
-                // colour then depends on the pixel alone): the canvas pixels showing the same
-                // map pixel next to it take that colour.
-                let mut last: Option<(usize, [u8; 4])> = None;
-                for ((x, &col), d) in (0..cw).zip(&cols).zip(out.chunks_exact_mut(4)) {
-                    let i = frame.index(col, row);
-                    if let Some((j, c)) = last {
-                        if j == i {
-                            d.copy_from_slice(&c);
-                            continue;
-                        }
-                    }
-                    let hatch = cells[i] == Cell::Free && zone_class(world, i) == 1;
-                    hatched |= hatch;
-                    let c = colour_of(i, x, y);
-                    let c = [c[0], c[1], c[2], 255];
-                    last = (!hatch).then_some((i, c));
-                    d.copy_from_slice(&c);
-                }
-                above = Some((row, hatched));
-            }
-        };
-        let map_rows = &mut pm.data_mut()[header as usize * stride..][..ch_map as usize * stride];
-        // Horizontal bands on the machine's cores (each pixel's colour is a function of its
-        // own position: the same bytes however the rows are split).
-        let bands = if cw as usize * ch_map as usize >= BAND_MIN_PX {
-            std::thread::available_parallelism().map_or(1, |n| n.get().min(MAX_BANDS))
-        } else {
-            1
-        };
-        let band_rows = (ch_map as usize).div_ceil(bands).max(1);
-        std::thread::scope(|s| {
-            let mut chunks = map_rows.chunks_mut(band_rows * stride).enumerate();
-            let first = chunks.next();
-            let others: Vec<_> = chunks
-                .map(|(k, rows)| {
-                    let paint = &paint;
-                    s.spawn(move || paint((k * band_rows) as u32, rows))
-                })
-                .collect();
-            if let Some((_, rows)) = first {
-                paint(0, rows);
-            }
-            for h in others {
-                if let Err(panic) = h.join() {
-                    std::panic::resume_unwind(panic);
-                }
-            }
-        });
-    });
     let view = View {
         scale,
         height: frame.height as f64,
@@ -935,9 +839,120 @@ pub fn coverage_pixmap_swept(
         col0: col0 as f64,
         row0: row0 as f64,
     };
-    draw_zone_borders(&mut pm, world, view);
-    ccpp_io::phase::time("coverage.png path", || {
-        draw_path(&mut pm, world, trace, view);
+    // The path's drawing steps are formed on another thread while the background is painted
+    // (they do not depend on the pixels), then drawn over it here in order: the same bytes.
+    std::thread::scope(|steps_thread| {
+        let (tx, path_steps) = std::sync::mpsc::sync_channel(PATH_OPS_BUFFERED);
+        steps_thread.spawn(move || {
+            // A closed channel (the drawing side failed) only ends the sending.
+            path_ops(world, trace, view, (cw, ch), &mut |op| {
+                let _ = tx.send(op);
+            });
+        });
+
+        // Background: classify each map pixel, then nearest-neighbour scale.
+        let acc = world.accessible();
+        let cells = world.true_map().cells();
+        let colour_of = |i: usize, x: u32, y: u32| -> [u8; 3] {
+            match cells[i] {
+                Cell::Occupied => colours::OBSTACLE,
+                Cell::Unknown => colours::UNKNOWN,
+                Cell::Free if zone_class(world, i) == 1 => {
+                    // Diagonal hatching in canvas pixels, 3 of every 9 on.
+                    if (x + y) % 9 < 3 {
+                        colours::KEEPOUT_HATCH
+                    } else {
+                        colours::KEEPOUT
+                    }
+                }
+                Cell::Free if zone_class(world, i) == 2 => colours::OUTSIDE_AREA,
+                Cell::Free => match (acc.contains(i), swept.contains(i)) {
+                    (true, true) => colours::SWEPT,
+                    (true, false) => colours::MISSED,
+                    (false, true) => colours::SWEPT_OUTSIDE,
+                    (false, false) => colours::UNREACHABLE,
+                },
+            }
+        };
+        ccpp_io::phase::time("coverage.png background", || {
+            // The map column of each canvas column, computed once (same formula per pixel).
+            let cols: Vec<usize> = (0..cw)
+                .map(|x| (col0 + ((x as f32 + 0.5) / scale) as usize).min(frame.width - 1))
+                .collect();
+            let stride = cw as usize * 4;
+            // Paints the canvas map rows `y0..` into `rows` (those rows, `stride` bytes each).
+            let paint = |y0: u32, rows: &mut [u8]| {
+                // A canvas row showing the same map row as the one above, without keep-out
+                // hatching (which follows the canvas diagonal), is a copy of it.
+                let mut above: Option<(usize, bool)> = None;
+                for (y, line) in (y0..).zip(0..rows.len() / stride) {
+                    let row = ((y as f32 + 0.5) / scale) as usize;
+                    let row = (row0 + row).min(frame.height - 1);
+                    let o = line * stride;
+                    if above == Some((row, false)) {
+                        rows.copy_within(o - stride..o, o);
+                        continue;
+                    }
+                    let mut hatched = false;
+                    let out = &mut rows[o..o + stride];
+                    // The last map pixel classified and its colour, when it is not hatched (its
+                    // colour then depends on the pixel alone): the canvas pixels showing the same
+                    // map pixel next to it take that colour.
+                    let mut last: Option<(usize, [u8; 4])> = None;
+                    for ((x, &col), d) in (0..cw).zip(&cols).zip(out.chunks_exact_mut(4)) {
+                        let i = frame.index(col, row);
+                        if let Some((j, c)) = last {
+                            if j == i {
+                                d.copy_from_slice(&c);
+                                continue;
+                            }
+                        }
+                        let hatch = cells[i] == Cell::Free && zone_class(world, i) == 1;
+                        hatched |= hatch;
+                        let c = colour_of(i, x, y);
+                        let c = [c[0], c[1], c[2], 255];
+                        last = (!hatch).then_some((i, c));
+                        d.copy_from_slice(&c);
+                    }
+                    above = Some((row, hatched));
+                }
+            };
+            let map_rows =
+                &mut pm.data_mut()[header as usize * stride..][..ch_map as usize * stride];
+            // Horizontal bands on the machine's cores (each pixel's colour is a function of its
+            // own position: the same bytes however the rows are split).
+            let bands = if cw as usize * ch_map as usize >= BAND_MIN_PX {
+                std::thread::available_parallelism().map_or(1, |n| n.get().min(MAX_BANDS))
+            } else {
+                1
+            };
+            let band_rows = (ch_map as usize).div_ceil(bands).max(1);
+            std::thread::scope(|s| {
+                let mut chunks = map_rows.chunks_mut(band_rows * stride).enumerate();
+                let first = chunks.next();
+                let others: Vec<_> = chunks
+                    .map(|(k, rows)| {
+                        let paint = &paint;
+                        s.spawn(move || paint((k * band_rows) as u32, rows))
+                    })
+                    .collect();
+                if let Some((_, rows)) = first {
+                    paint(0, rows);
+                }
+                for h in others {
+                    if let Err(panic) = h.join() {
+                        std::panic::resume_unwind(panic);
+                    }
+                }
+            });
+        });
+        draw_zone_borders(&mut pm, world, view);
+        ccpp_io::phase::time("coverage.png path", || {
+            let mut scratch = (Vec::new(), Vec::new());
+            for op in path_steps {
+                op.apply(&mut pm, &mut scratch);
+            }
+        });
     });
     ccpp_io::phase::time("coverage.png markers", || {
         draw_markers(&mut pm, world, trace, view);
@@ -1100,7 +1115,91 @@ fn path_entries(trace: &Trace) -> impl Iterator<Item = Entry<'_>> + '_ {
     })
 }
 
-fn draw_path(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
+/// One step of drawing the path layer ([`path_ops`]); applied in order by [`PathOp::apply`].
+enum PathOp {
+    /// `path` stroked with `stroke` in `colour` (tiny-skia, antialiased).
+    Stroke {
+        path: tiny_skia::Path,
+        colour: Color,
+        stroke: Stroke,
+    },
+    /// A group of lane rectangles ([`LaneBlitter`]): from row `y0` on, each row's touched
+    /// columns `[x0 + lo, x0 + hi)` (`spans`) blended in `colour` with one weight per pixel
+    /// (`weights`, the rows' spans one after the other).
+    Blend {
+        x0: usize,
+        y0: usize,
+        spans: Vec<(usize, usize)>,
+        weights: Vec<u8>,
+        colour: [u8; 3],
+    },
+}
+
+impl PathOp {
+    /// Draws this step onto `pm`. `scratch` holds rows of byte weights and colours.
+    fn apply(self, pm: &mut Pixmap, scratch: &mut (Vec<u8>, Vec<u8>)) {
+        match self {
+            Self::Stroke {
+                path,
+                colour,
+                stroke,
+            } => pm.stroke_path(&path, &paint(colour), &stroke, Transform::identity(), None),
+            Self::Blend {
+                x0,
+                y0,
+                spans,
+                weights,
+                colour,
+            } => {
+                let (weight_row, colour_row) = scratch;
+                let widest = spans.iter().map(|&(lo, hi)| hi.saturating_sub(lo)).max();
+                let widest = widest.unwrap_or(0) * 4;
+                // The colour of each byte of a row (the alpha byte's is never used: its weight
+                // is 0); the weight of each byte: the alpha bytes weigh 0 (and keep their value).
+                colour_row.clear();
+                colour_row
+                    .extend((0..widest / 4).flat_map(|_| [colour[0], colour[1], colour[2], 0]));
+                weight_row.clear();
+                weight_row.resize(widest, 0);
+                let stride = pm.width() as usize * 4;
+                let data = pm.data_mut();
+                let mut at = 0;
+                for (y, &(lo, hi)) in (y0..).zip(&spans) {
+                    if lo >= hi {
+                        continue;
+                    }
+                    // Only the touched columns: a weight of 0 keeps a byte as it is.
+                    let n = hi - lo;
+                    let row = &weights[at..at + n];
+                    at += n;
+                    // Per byte (`[w, w, w, 0]` in one store).
+                    let bytes = &mut weight_row[..n * 4];
+                    for (q, &w) in bytes.chunks_exact_mut(4).zip(row) {
+                        q.copy_from_slice(&(u32::from(w) * 0x01_01_01).to_le_bytes());
+                    }
+                    let line = &mut data[y * stride + (x0 + lo) * 4..][..n * 4];
+                    for ((d, &w), &c) in line.iter_mut().zip(&*bytes).zip(&*colour_row) {
+                        *d = blend_255(*d, c, w);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Path layer steps buffered between the thread that forms them and the one drawing them.
+const PATH_OPS_BUFFERED: usize = 64;
+
+/// The steps drawing the path on a canvas of `size`, in drawing order, handed to `emit`. They
+/// depend on the path and the view only, not on the pixels under them, so they can be formed on
+/// one thread while another paints the background and then draws them.
+fn path_ops(
+    world: &World,
+    trace: &Trace,
+    view: View,
+    size: (u32, u32),
+    emit: &mut dyn FnMut(PathOp),
+) {
     let width = (view.scale * 0.6).clamp(1.0, 3.0);
     let mut region = 0usize;
     let mut in_backtrack = false;
@@ -1109,52 +1208,53 @@ fn draw_path(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
     let mut run: Vec<(f32, f32)> = Vec::new();
     let mut run_style = (0usize, false);
     let mut lanes = LaneBlitter::default();
-    let mut flush = |pm: &mut Pixmap, run: &mut Vec<(f32, f32)>, style: (usize, bool)| {
-        if run.len() >= 2 {
-            let mut stroke = Stroke {
-                width,
-                ..Stroke::default()
-            };
-            stroke.line_join = tiny_skia::LineJoin::Round;
-            if style.1 {
-                let mut pb = PathBuilder::new();
-                pb.move_to(run[0].0, run[0].1);
-                for &(x, y) in &run[1..] {
-                    pb.line_to(x, y);
-                }
-                if let Some(path) = pb.finish() {
-                    let casing = Stroke {
-                        width: width * 2.0,
-                        ..stroke.clone()
-                    };
-                    pm.stroke_path(
-                        &path,
-                        &paint(Color::WHITE),
-                        &casing,
-                        Transform::identity(),
-                        None,
-                    );
-                    stroke.dash = StrokeDash::new(vec![width * 4.0, width * 3.0], 0.0);
-                    let colour = rgb(colours::BACKTRACK);
-                    pm.stroke_path(&path, &paint(colour), &stroke, Transform::identity(), None);
-                }
-            } else {
-                // A region's lanes: the axis-aligned segments (nearly all of a coverage path)
-                // are filled with their exact area coverage, the others stroked.
-                let colour = PALETTE[style.0.saturating_sub(1) % PALETTE.len()];
-                if let Some(path) = lanes.draw(pm, run, width, colour) {
-                    pm.stroke_path(
-                        &path,
-                        &paint(rgb(colour)),
-                        &stroke,
-                        Transform::identity(),
-                        None,
-                    );
+    let mut flush =
+        |emit: &mut dyn FnMut(PathOp), run: &mut Vec<(f32, f32)>, style: (usize, bool)| {
+            if run.len() >= 2 {
+                let mut stroke = Stroke {
+                    width,
+                    ..Stroke::default()
+                };
+                stroke.line_join = tiny_skia::LineJoin::Round;
+                if style.1 {
+                    let mut pb = PathBuilder::new();
+                    pb.move_to(run[0].0, run[0].1);
+                    for &(x, y) in &run[1..] {
+                        pb.line_to(x, y);
+                    }
+                    if let Some(path) = pb.finish() {
+                        let casing = Stroke {
+                            width: width * 2.0,
+                            ..stroke.clone()
+                        };
+                        emit(PathOp::Stroke {
+                            path: path.clone(),
+                            colour: Color::WHITE,
+                            stroke: casing,
+                        });
+                        stroke.dash = StrokeDash::new(vec![width * 4.0, width * 3.0], 0.0);
+                        let colour = rgb(colours::BACKTRACK);
+                        emit(PathOp::Stroke {
+                            path,
+                            colour,
+                            stroke,
+                        });
+                    }
+                } else {
+                    // A region's lanes: the axis-aligned segments (nearly all of a coverage path)
+                    // are filled with their exact area coverage, the others stroked.
+                    let colour = PALETTE[style.0.saturating_sub(1) % PALETTE.len()];
+                    if let Some(path) = lanes.draw(size, run, width, colour, emit) {
+                        emit(PathOp::Stroke {
+                            path,
+                            colour: rgb(colour),
+                            stroke,
+                        });
+                    }
                 }
             }
-        }
-        run.clear();
-    };
+            run.clear();
+        };
     for r in path_entries(trace) {
         match r {
             Entry::Pose { pose, .. } => {
@@ -1165,7 +1265,7 @@ fn draw_path(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
                 let style = (region, in_backtrack);
                 if style != run_style {
                     let keep = run.last().copied();
-                    flush(pm, &mut run, run_style);
+                    flush(emit, &mut run, run_style);
                     if let Some(k) = keep {
                         run.push(k);
                     }
@@ -1187,7 +1287,7 @@ fn draw_path(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
             },
         }
     }
-    flush(pm, &mut run, run_style);
+    flush(emit, &mut run, run_style);
 }
 
 /// Draws the axis-aligned segments of a polyline stroke (a coverage path's lanes) as filled
@@ -1205,15 +1305,6 @@ struct LaneBlitter {
     bbox: [f32; 4],
     /// Scratch: the horizontal coverage of a rectangle's columns.
     fx: Vec<f32>,
-    /// Scratch: the blend weight of each pixel of a row of the box.
-    pixel_weight: Vec<u8>,
-    /// Scratch: the blend weight of each byte of a row of the box.
-    weight_row: Vec<u8>,
-    /// Scratch: the colour of each byte of a row of the box.
-    colour_row: Vec<u8>,
-    /// Scratch: per row of the box, the columns `[lo, hi)` (box-relative) any rectangle
-    /// touches; the pixels outside have no coverage and keep their colour.
-    spans: Vec<(usize, usize)>,
 }
 
 /// Largest bounding box (pixels) of a group of lane rectangles blended at once.
@@ -1221,13 +1312,15 @@ const LANE_GROUP_PX: f32 = (1 << 18) as f32;
 
 impl LaneBlitter {
     /// Fills the axis-aligned segments of `run` (butt ends at the run's two ends, square
-    /// corners at its turns) in `colour`; returns the other segments as a path to stroke.
+    /// corners at its turns) in `colour` on a canvas of `size` (as [`PathOp::Blend`] steps);
+    /// returns the other segments as a path to stroke.
     fn draw(
         &mut self,
-        pm: &mut Pixmap,
+        size: (u32, u32),
         run: &[(f32, f32)],
         width: f32,
         colour: [u8; 3],
+        emit: &mut dyn FnMut(PathOp),
     ) -> Option<tiny_skia::Path> {
         const AXIS_EPS: f32 = 1e-3;
         let h = width / 2.0;
@@ -1273,16 +1366,22 @@ impl LaneBlitter {
             } else {
                 [c - h, lo, c + h, hi]
             };
-            self.push(pm, rect, colour);
+            self.push(size, rect, colour, emit);
         }
-        self.blend(pm, colour);
+        self.blend(colour, emit);
         pb.finish()
     }
 
     /// Adds a rectangle to the group (blending the group first when the box would grow
     /// beyond [`LANE_GROUP_PX`]).
-    fn push(&mut self, pm: &mut Pixmap, r: [f32; 4], colour: [u8; 3]) {
-        let (w, h) = (pm.width() as f32, pm.height() as f32);
+    fn push(
+        &mut self,
+        size: (u32, u32),
+        r: [f32; 4],
+        colour: [u8; 3],
+        emit: &mut dyn FnMut(PathOp),
+    ) {
+        let (w, h) = (size.0 as f32, size.1 as f32);
         let r = [r[0].max(0.0), r[1].max(0.0), r[2].min(w), r[3].min(h)];
         if r[0] >= r[2] || r[1] >= r[3] {
             return;
@@ -1296,7 +1395,7 @@ impl LaneBlitter {
                 b[3].max(r[3]),
             ];
             if (u[2] - u[0] + 2.0) * (u[3] - u[1] + 2.0) > LANE_GROUP_PX {
-                self.blend(pm, colour);
+                self.blend(colour, emit);
             } else {
                 self.bbox = u;
             }
@@ -1307,8 +1406,8 @@ impl LaneBlitter {
         self.rects.push(r);
     }
 
-    /// Blends the group's coverage in `colour` onto the canvas and empties the group.
-    fn blend(&mut self, pm: &mut Pixmap, colour: [u8; 3]) {
+    /// The group's coverage in `colour` as one [`PathOp::Blend`]; empties the group.
+    fn blend(&mut self, colour: [u8; 3], emit: &mut dyn FnMut(PathOp)) {
         if self.rects.is_empty() {
             return;
         }
@@ -1318,11 +1417,12 @@ impl LaneBlitter {
         let bw = x1 - x0;
         self.cov.clear();
         self.cov.resize(bw * (y1 - y0), 0.0);
-        self.spans.clear();
-        self.spans.resize(y1 - y0, (usize::MAX, 0));
+        // Per row of the box, the columns `[lo, hi)` (box-relative) any rectangle touches; the
+        // pixels outside have no coverage and keep their colour.
+        let mut spans = vec![(usize::MAX, 0); y1 - y0];
         for r in &self.rects {
             let (cx0, cx1) = (r[0].floor() as usize, r[2].ceil() as usize);
-            for span in &mut self.spans[r[1].floor() as usize - y0..r[3].ceil() as usize - y0] {
+            for span in &mut spans[r[1].floor() as usize - y0..r[3].ceil() as usize - y0] {
                 *span = (span.0.min(cx0 - x0), span.1.max(cx1 - x0));
             }
             // Each column's horizontal coverage, computed once for all the rows (same values).
@@ -1338,35 +1438,20 @@ impl LaneBlitter {
             }
         }
         self.rects.clear();
-        let stride = pm.width() as usize * 4;
-        let data = pm.data_mut();
-        // The colour of each byte of a row (the alpha byte's is never used: its weight is 0).
-        self.colour_row.clear();
-        self.colour_row
-            .extend((0..bw).flat_map(|_| [colour[0], colour[1], colour[2], 0]));
-        // The weight of each byte of a row: the alpha bytes weigh 0 (and keep their value).
-        self.weight_row.clear();
-        self.weight_row.resize(bw * 4, 0);
-        for ((y, row), &(lo, hi)) in (y0..y1).zip(self.cov.chunks_exact(bw)).zip(&self.spans) {
-            if lo >= hi {
-                continue;
-            }
-            // Only the touched columns: a weight of 0 keeps a byte as it is.
-            let row = &row[lo..hi];
-            // Coverage in 1/255 steps (none at or below 0, all at or above 1), per pixel, then
-            // per byte (`[w, w, w, 0]` in one store).
-            self.pixel_weight.clear();
-            self.pixel_weight
-                .extend(row.iter().map(|&a| lane_weight(a)));
-            let weights = &mut self.weight_row[..row.len() * 4];
-            for (q, &w) in weights.chunks_exact_mut(4).zip(&self.pixel_weight) {
-                q.copy_from_slice(&(u32::from(w) * 0x01_01_01).to_le_bytes());
-            }
-            let line = &mut data[y * stride + (x0 + lo) * 4..][..row.len() * 4];
-            for ((d, &w), &c) in line.iter_mut().zip(&*weights).zip(&self.colour_row) {
-                *d = blend_255(*d, c, w);
+        // Coverage in 1/255 steps (none at or below 0, all at or above 1), per touched pixel.
+        let mut weights = Vec::with_capacity(self.cov.len());
+        for (row, &(lo, hi)) in self.cov.chunks_exact(bw).zip(&spans) {
+            if lo < hi {
+                weights.extend(row[lo..hi].iter().map(|&a| lane_weight(a)));
             }
         }
+        emit(PathOp::Blend {
+            x0,
+            y0,
+            spans,
+            weights,
+            colour,
+        });
     }
 }
 
