@@ -5,9 +5,18 @@
 //! folder (if any) is renamed to `.<name>.ccpp-old-<pid>-<n>`, the staging folder is renamed to
 //! `<name>`, and the old folder is removed. A reader therefore sees the old complete set or the
 //! new complete set (for an instant, between the two renames, no folder), never a mix and never
-//! a `.tmp` file. Each staged file is synced to disk on a thread of its own as soon as it is
-//! written (the disk's latency overlaps the work on the next file); the swap waits for all of
+//! a half-written file. Inside the staging folder, which no reader looks into, files are written
+//! under their own names (no `.tmp` and rename each). Each staged file is synced to disk on a
+//! thread of its own as soon as it is written (the disk's latency overlaps the work on the next
+//! file; small files known early, such as `metrics.json`, go first); the swap waits for all of
 //! them, so the folder that appears is on disk whole.
+//!
+//! What a crash (power loss) can leave: the file contents are durable before the swap, the two
+//! renames of the swap are not synced themselves (that would add a wait for the disk after the
+//! last file). After a crash the target therefore holds the old complete set or the new
+//! complete set, never a mix or a half-written file; when the crash fell between the two
+//! renames, the target is missing and the next run into it puts the old folder back (see
+//! below). A run that exited may, after a crash, show the old set again until it is repeated.
 //!
 //! On SIGINT/SIGTERM the handler waits for a swap in progress to finish, removes every staging
 //! folder and temporary file still registered, and exits with status 130. Folders left by a
