@@ -243,22 +243,14 @@ pub fn coverage_png_swept(
 }
 
 /// Encodes a picture as PNG bytes, fast: an opaque canvas (every picture of this crate) is
-/// written as 8-bit RGB with `png`'s fast DEFLATE mode and its fixed filter; a canvas with any
-/// translucent pixel goes through tiny-skia's RGBA encoder. Same pixels as
-/// [`Pixmap::encode_png`] decodes to; the bytes are a pure function of the pixels. A large
-/// canvas has its rows converted to RGB (and checked opaque) in bands on a second thread while
-/// this one filters and compresses the bands before (the same rows in the same order: the same
-/// bytes).
+/// written as 8-bit RGB, streamed row by row from the pixmap (no copy of the canvas), with
+/// `png`'s fast DEFLATE mode and its fixed filter; a canvas with any translucent pixel goes
+/// through tiny-skia's RGBA encoder. Same pixels as [`Pixmap::encode_png`] decodes to; the
+/// bytes are a pure function of the pixels.
 ///
 /// # Errors
 /// When encoding fails.
 pub fn encode_png(pixmap: &Pixmap) -> Result<Vec<u8>, RenderError> {
-    let large = pixmap.width() as usize * pixmap.height() as usize >= 2 * ENCODE_BAND_PX;
-    encode_png_on(pixmap, large)
-}
-
-/// [`encode_png`], converting the bands on a second thread when `threaded`.
-fn encode_png_on(pixmap: &Pixmap, threaded: bool) -> Result<Vec<u8>, RenderError> {
     use std::io::Write as _;
     let err = |e: &dyn std::fmt::Display| RenderError::Encode(e.to_string());
     let (w, h) = (pixmap.width(), pixmap.height());
@@ -268,86 +260,35 @@ fn encode_png_on(pixmap: &Pixmap, threaded: bool) -> Result<Vec<u8>, RenderError
     encoder.set_depth(png::BitDepth::Eight);
     encoder.set_compression(png::Compression::Fast);
     let mut writer = encoder.write_header().map_err(|e| err(&e))?;
-    let n = w as usize * 3;
-    let opaque = {
+    // Every pixel's alpha ANDed while its row is copied (no early exit: a reduction the
+    // compiler vectorizes). A canvas with a translucent pixel is encoded again as RGBA below.
+    let mut alpha = u8::MAX;
+    {
         let mut stream = writer.stream_writer().map_err(|e| err(&e))?;
-        let mut put = |band: &[u8]| -> Result<(), RenderError> {
-            for row in band.chunks_exact(n) {
-                stream.write_all(row).map_err(|e| err(&e))?;
+        // One spare byte: each pixel is copied whole (4 bytes, one store), its alpha byte
+        // then overwritten by the next pixel's red (the last one's lands in the spare byte).
+        let n = w as usize * 3;
+        let mut row = vec![0u8; n + 1];
+        // Opaque premultiplied pixels are their straight colours.
+        for src in pixmap.data().chunks_exact(w as usize * 4) {
+            alpha &= src.chunks_exact(4).fold(u8::MAX, |all, p| all & p[3]);
+            if alpha != u8::MAX {
+                break;
             }
-            Ok(())
-        };
-        let band_rows = (ENCODE_BAND_PX / w as usize).max(1);
-        let bands = pixmap.data().chunks(band_rows * w as usize * 4);
-        let opaque = if threaded {
-            std::thread::scope(|s| {
-                // Bands go over a bounded channel (at most a few converted bands in memory);
-                // their buffers come back to be reused. `None`: a translucent pixel.
-                let (tx, rx) = std::sync::mpsc::sync_channel::<Option<Vec<u8>>>(4);
-                let (back_tx, back_rx) = std::sync::mpsc::channel::<Vec<u8>>();
-                s.spawn(move || {
-                    for band in bands {
-                        let mut buf = back_rx.try_recv().unwrap_or_default();
-                        let msg = rgb_band(band, &mut buf).then_some(buf);
-                        let stop = msg.is_none();
-                        // A closed channel: the encoder failed and stopped reading.
-                        if tx.send(msg).is_err() || stop {
-                            return;
-                        }
-                    }
-                });
-                for msg in rx {
-                    let Some(buf) = msg else { return Ok(false) };
-                    put(&buf)?;
-                    let _ = back_tx.send(buf);
-                }
-                Ok(true)
-            })?
-        } else {
-            let mut buf = Vec::new();
-            let mut opaque = true;
-            for band in bands {
-                opaque = rgb_band(band, &mut buf);
-                if !opaque {
-                    break;
-                }
-                put(&buf)?;
+            for (k, s) in src.chunks_exact(4).enumerate() {
+                row[3 * k..3 * k + 4].copy_from_slice(s);
             }
-            opaque
-        };
-        if opaque {
+            stream.write_all(&row[..n]).map_err(|e| err(&e))?;
+        }
+        if alpha == u8::MAX {
             stream.finish().map_err(|e| err(&e))?;
         }
-        opaque
-    };
-    if !opaque {
+    }
+    if alpha != u8::MAX {
         return pixmap.encode_png().map_err(|e| err(&e));
     }
     writer.finish().map_err(|e| err(&e))?;
     Ok(out)
-}
-
-/// Canvas pixels per band of [`encode_png`]'s RGB conversion.
-const ENCODE_BAND_PX: usize = 1 << 15;
-
-/// The RGB bytes of `band` (whole RGBA rows) into `buf`; false (and `buf` unspecified) when a
-/// pixel is not opaque.
-fn rgb_band(band: &[u8], buf: &mut Vec<u8>) -> bool {
-    // Every pixel's alpha ANDed (no early exit: a reduction the compiler vectorizes).
-    if band.chunks_exact(4).fold(u8::MAX, |all, p| all & p[3]) != u8::MAX {
-        return false;
-    }
-    // One spare byte: each pixel is copied whole (4 bytes, one store), its alpha byte then
-    // overwritten by the next pixel's red (the last one's lands in the spare byte).
-    let n = band.len() / 4 * 3;
-    buf.clear();
-    buf.resize(n + 1, 0);
-    // Opaque premultiplied pixels are their straight colours.
-    for (k, s) in band.chunks_exact(4).enumerate() {
-        buf[3 * k..3 * k + 4].copy_from_slice(s);
-    }
-    buf.truncate(n);
-    true
 }
 
 /// Counts of what a run's picture shows, for its legend.
@@ -830,8 +771,102 @@ pub fn coverage_pixmap_swept(
         top.fill(u8::MAX);
         rest[ch_map as usize * row..].fill(u8::MAX);
     }
-    // The title and the legend are drawn on another thread meanwhile (see `TextLayer`).
-    let text = TextLayer::start(head, foot, (cw, ch), header, ch_map + header);
+
+    // Background: classify each map pixel, then nearest-neighbour scale.
+    let acc = world.accessible();
+    let cells = world.true_map().cells();
+    let colour_of = |i: usize, x: u32, y: u32| -> [u8; 3] {
+        match cells[i] {
+            Cell::Occupied => colours::OBSTACLE,
+            Cell::Unknown => colours::UNKNOWN,
+            Cell::Free if zone_class(world, i) == 1 => {
+                // Diagonal hatching in canvas pixels, 3 of every 9 on.
+                if (x + y) % 9 < 3 {
+                    colours::KEEPOUT_HATCH
+                } else {
+                    colours::KEEPOUT
+                }
+            }
+            Cell::Free if zone_class(world, i) == 2 => colours::OUTSIDE_AREA,
+            Cell::Free => match (acc.contains(i), swept.contains(i)) {
+                (true, true) => colours::SWEPT,
+                (true, false) => colours::MISSED,
+                (false, true) => colours::SWEPT_OUTSIDE,
+                (false, false) => colours::UNREACHABLE,
+            },
+        }
+    };
+    ccpp_io::phase::time("coverage.png background", || {
+        // The map column of each canvas column, computed once (same formula per pixel).
+        let cols: Vec<usize> = (0..cw)
+            .map(|x| (col0 + ((x as f32 + 0.5) / scale) as usize).min(frame.width - 1))
+            .collect();
+        let stride = cw as usize * 4;
+        // Paints the canvas map rows `y0..` into `rows` (those rows, `stride` bytes each).
+        let paint = |y0: u32, rows: &mut [u8]| {
+            // A canvas row showing the same map row as the one above, without keep-out
+            // hatching (which follows the canvas diagonal), is a copy of it.
+            let mut above: Option<(usize, bool)> = None;
+            for (y, line) in (y0..).zip(0..rows.len() / stride) {
+                let row = ((y as f32 + 0.5) / scale) as usize;
+                let row = (row0 + row).min(frame.height - 1);
+                let o = line * stride;
+                if above == Some((row, false)) {
+                    rows.copy_within(o - stride..o, o);
+                    continue;
+                }
+                let mut hatched = false;
+                let out = &mut rows[o..o + stride];
+                // The last map pixel classified and its colour, when it is not hatched (its
+                // colour then depends on the pixel alone): the canvas pixels showing the same
+                // map pixel next to it take that colour.
+                let mut last: Option<(usize, [u8; 4])> = None;
+                for ((x, &col), d) in (0..cw).zip(&cols).zip(out.chunks_exact_mut(4)) {
+                    let i = frame.index(col, row);
+                    if let Some((j, c)) = last {
+                        if j == i {
+                            d.copy_from_slice(&c);
+                            continue;
+                        }
+                    }
+                    let hatch = cells[i] == Cell::Free && zone_class(world, i) == 1;
+                    hatched |= hatch;
+                    let c = colour_of(i, x, y);
+                    let c = [c[0], c[1], c[2], 255];
+                    last = (!hatch).then_some((i, c));
+                    d.copy_from_slice(&c);
+                }
+                above = Some((row, hatched));
+            }
+        };
+        let map_rows = &mut pm.data_mut()[header as usize * stride..][..ch_map as usize * stride];
+        // Horizontal bands on the machine's cores (each pixel's colour is a function of its
+        // own position: the same bytes however the rows are split).
+        let bands = if cw as usize * ch_map as usize >= BAND_MIN_PX {
+            std::thread::available_parallelism().map_or(1, |n| n.get().min(MAX_BANDS))
+        } else {
+            1
+        };
+        let band_rows = (ch_map as usize).div_ceil(bands).max(1);
+        std::thread::scope(|s| {
+            let mut chunks = map_rows.chunks_mut(band_rows * stride).enumerate();
+            let first = chunks.next();
+            let others: Vec<_> = chunks
+                .map(|(k, rows)| {
+                    let paint = &paint;
+                    s.spawn(move || paint((k * band_rows) as u32, rows))
+                })
+                .collect();
+            if let Some((_, rows)) = first {
+                paint(0, rows);
+            }
+            for h in others {
+                if let Err(panic) = h.join() {
+                    std::panic::resume_unwind(panic);
+                }
+            }
+        });
+    });
     let view = View {
         scale,
         height: frame.height as f64,
@@ -839,218 +874,18 @@ pub fn coverage_pixmap_swept(
         col0: col0 as f64,
         row0: row0 as f64,
     };
-    // The path's drawing steps are formed on another thread while the background is painted
-    // (they do not depend on the pixels), then drawn over it here in order: the same bytes.
-    std::thread::scope(|steps_thread| {
-        let (tx, path_steps) = std::sync::mpsc::sync_channel(PATH_OPS_BUFFERED);
-        steps_thread.spawn(move || {
-            // A closed channel (the drawing side failed) only ends the sending.
-            path_ops(world, trace, view, (cw, ch), &mut |op| {
-                let _ = tx.send(op);
-            });
-        });
-
-        // Background: classify each map pixel, then nearest-neighbour scale.
-        let acc = world.accessible();
-        let cells = world.true_map().cells();
-        let colour_of = |i: usize, x: u32, y: u32| -> [u8; 3] {
-            match cells[i] {
-                Cell::Occupied => colours::OBSTACLE,
-                Cell::Unknown => colours::UNKNOWN,
-                Cell::Free if zone_class(world, i) == 1 => {
-                    // Diagonal hatching in canvas pixels, 3 of every 9 on.
-                    if (x + y) % 9 < 3 {
-                        colours::KEEPOUT_HATCH
-                    } else {
-                        colours::KEEPOUT
-                    }
-                }
-                Cell::Free if zone_class(world, i) == 2 => colours::OUTSIDE_AREA,
-                Cell::Free => match (acc.contains(i), swept.contains(i)) {
-                    (true, true) => colours::SWEPT,
-                    (true, false) => colours::MISSED,
-                    (false, true) => colours::SWEPT_OUTSIDE,
-                    (false, false) => colours::UNREACHABLE,
-                },
-            }
-        };
-        ccpp_io::phase::time("coverage.png background", || {
-            // The map column of each canvas column, computed once (same formula per pixel).
-            let cols: Vec<usize> = (0..cw)
-                .map(|x| (col0 + ((x as f32 + 0.5) / scale) as usize).min(frame.width - 1))
-                .collect();
-            let stride = cw as usize * 4;
-            // Paints the canvas map rows `y0..` into `rows` (those rows, `stride` bytes each).
-            let paint = |y0: u32, rows: &mut [u8]| {
-                // A canvas row showing the same map row as the one above, without keep-out
-                // hatching (which follows the canvas diagonal), is a copy of it.
-                let mut above: Option<(usize, bool)> = None;
-                for (y, line) in (y0..).zip(0..rows.len() / stride) {
-                    let row = ((y as f32 + 0.5) / scale) as usize;
-                    let row = (row0 + row).min(frame.height - 1);
-                    let o = line * stride;
-                    if above == Some((row, false)) {
-                        rows.copy_within(o - stride..o, o);
-                        continue;
-                    }
-                    let mut hatched = false;
-                    let out = &mut rows[o..o + stride];
-                    // The last map pixel classified and its colour, when it is not hatched (its
-                    // colour then depends on the pixel alone): the canvas pixels showing the same
-                    // map pixel next to it take that colour.
-                    let mut last: Option<(usize, [u8; 4])> = None;
-                    for ((x, &col), d) in (0..cw).zip(&cols).zip(out.chunks_exact_mut(4)) {
-                        let i = frame.index(col, row);
-                        if let Some((j, c)) = last {
-                            if j == i {
-                                d.copy_from_slice(&c);
-                                continue;
-                            }
-                        }
-                        let hatch = cells[i] == Cell::Free && zone_class(world, i) == 1;
-                        hatched |= hatch;
-                        let c = colour_of(i, x, y);
-                        let c = [c[0], c[1], c[2], 255];
-                        last = (!hatch).then_some((i, c));
-                        d.copy_from_slice(&c);
-                    }
-                    above = Some((row, hatched));
-                }
-            };
-            let map_rows =
-                &mut pm.data_mut()[header as usize * stride..][..ch_map as usize * stride];
-            // Horizontal bands on the machine's cores (each pixel's colour is a function of its
-            // own position: the same bytes however the rows are split).
-            let bands = if cw as usize * ch_map as usize >= BAND_MIN_PX {
-                std::thread::available_parallelism().map_or(1, |n| n.get().min(MAX_BANDS))
-            } else {
-                1
-            };
-            let band_rows = (ch_map as usize).div_ceil(bands).max(1);
-            std::thread::scope(|s| {
-                let mut chunks = map_rows.chunks_mut(band_rows * stride).enumerate();
-                let first = chunks.next();
-                let others: Vec<_> = chunks
-                    .map(|(k, rows)| {
-                        let paint = &paint;
-                        s.spawn(move || paint((k * band_rows) as u32, rows))
-                    })
-                    .collect();
-                if let Some((_, rows)) = first {
-                    paint(0, rows);
-                }
-                for h in others {
-                    if let Err(panic) = h.join() {
-                        std::panic::resume_unwind(panic);
-                    }
-                }
-            });
-        });
-        draw_zone_borders(&mut pm, world, view);
-        ccpp_io::phase::time("coverage.png path", || {
-            let mut scratch = (Vec::new(), Vec::new());
-            for op in path_steps {
-                op.apply(&mut pm, &mut scratch);
-            }
-        });
+    draw_zone_borders(&mut pm, world, view);
+    ccpp_io::phase::time("coverage.png path", || {
+        draw_path(&mut pm, world, trace, view);
     });
     ccpp_io::phase::time("coverage.png markers", || {
         draw_markers(&mut pm, world, trace, view);
     });
-    ccpp_io::phase::time("coverage.png text", || text.finish(&mut pm));
+    ccpp_io::phase::time("coverage.png text", || {
+        head.draw_onto(&mut pm);
+        foot.draw_onto(&mut pm);
+    });
     Ok(pm)
-}
-
-/// Rows above and below the map of a text layer that must stay untouched (see [`TextLayer`]).
-const TEXT_GUARD_ROWS: usize = 64;
-
-/// The title (`head`, on the rows above the map) and the legend (`foot`, on the rows below it),
-/// drawn on a thread of their own while the map is painted, onto a canvas of the picture's size
-/// whose map rows are never written (so never backed by memory). When the text stayed out of
-/// the map rows (the rows next to them are untouched) and the picture's rows above and below
-/// the map are still white when the map is done, those rows are the text drawn on white either
-/// way: they are copied in, the same bytes as drawing the text last onto the picture. Otherwise
-/// the text is drawn onto the picture as before.
-struct TextLayer {
-    head_rows: usize,
-    foot_row: usize,
-    work: TextWork,
-}
-
-/// Where a [`TextLayer`]'s text is.
-enum TextWork {
-    /// Being drawn on another thread.
-    Drawing(std::thread::JoinHandle<(Chart, Chart, Option<Pixmap>)>),
-    /// Not started (a picture without text rows): drawn onto the picture at the end.
-    Charts(Chart, Chart),
-}
-
-impl TextLayer {
-    /// Starts drawing `head` and `foot` (charts in canvas coordinates) for a canvas of `size`
-    /// whose map rows are `head_rows..foot_row`.
-    fn start(head: Chart, foot: Chart, size: (u32, u32), head_rows: u32, foot_row: u32) -> Self {
-        let (head_rows, foot_row) = (head_rows as usize, foot_row as usize);
-        let work = if head_rows == 0 && foot_row == size.1 as usize {
-            TextWork::Charts(head, foot)
-        } else {
-            TextWork::Drawing(std::thread::spawn(move || {
-                let layer = Self::draw(&head, &foot, size, head_rows, foot_row);
-                (head, foot, layer)
-            }))
-        };
-        Self {
-            head_rows,
-            foot_row,
-            work,
-        }
-    }
-
-    /// The layer, when the text stayed out of the guard rows of the map.
-    fn draw(
-        head: &Chart,
-        foot: &Chart,
-        (cw, ch): (u32, u32),
-        head_rows: usize,
-        foot_row: usize,
-    ) -> Option<Pixmap> {
-        let mut t = Pixmap::new(cw, ch)?;
-        let stride = cw as usize * 4;
-        {
-            let (top, rest) = t.data_mut().split_at_mut(head_rows * stride);
-            top.fill(u8::MAX);
-            rest[(foot_row - head_rows) * stride..].fill(u8::MAX);
-        }
-        head.draw_onto(&mut t);
-        foot.draw_onto(&mut t);
-        let map = &t.data()[head_rows * stride..foot_row * stride];
-        let g = (TEXT_GUARD_ROWS * stride).min(map.len());
-        let untouched = |b: &[u8]| b.iter().all(|&v| v == 0);
-        (untouched(&map[..g]) && untouched(&map[map.len() - g..])).then_some(t)
-    }
-
-    /// Puts the text onto `pm` (the finished map and the white rows around it).
-    fn finish(self, pm: &mut Pixmap) {
-        let (head, foot, layer) = match self.work {
-            TextWork::Charts(head, foot) => (head, foot, None),
-            TextWork::Drawing(worker) => match worker.join() {
-                Ok(r) => r,
-                Err(panic) => std::panic::resume_unwind(panic),
-            },
-        };
-        let stride = pm.width() as usize * 4;
-        let (top, bottom) = (self.head_rows * stride, self.foot_row * stride);
-        let white = |b: &[u8]| b.iter().all(|&v| v == u8::MAX);
-        match layer {
-            Some(t) if white(&pm.data()[..top]) && white(&pm.data()[bottom..]) => {
-                pm.data_mut()[..top].copy_from_slice(&t.data()[..top]);
-                pm.data_mut()[bottom..].copy_from_slice(&t.data()[bottom..]);
-            }
-            _ => {
-                head.draw_onto(pm);
-                foot.draw_onto(pm);
-            }
-        }
-    }
 }
 
 /// Outlines of the area polygons (solid) and keep-out polygons (hatch colour).
@@ -1115,91 +950,7 @@ fn path_entries(trace: &Trace) -> impl Iterator<Item = Entry<'_>> + '_ {
     })
 }
 
-/// One step of drawing the path layer ([`path_ops`]); applied in order by [`PathOp::apply`].
-enum PathOp {
-    /// `path` stroked with `stroke` in `colour` (tiny-skia, antialiased).
-    Stroke {
-        path: tiny_skia::Path,
-        colour: Color,
-        stroke: Stroke,
-    },
-    /// A group of lane rectangles ([`LaneBlitter`]): from row `y0` on, each row's touched
-    /// columns `[x0 + lo, x0 + hi)` (`spans`) blended in `colour` with one weight per pixel
-    /// (`weights`, the rows' spans one after the other).
-    Blend {
-        x0: usize,
-        y0: usize,
-        spans: Vec<(usize, usize)>,
-        weights: Vec<u8>,
-        colour: [u8; 3],
-    },
-}
-
-impl PathOp {
-    /// Draws this step onto `pm`. `scratch` holds rows of byte weights and colours.
-    fn apply(self, pm: &mut Pixmap, scratch: &mut (Vec<u8>, Vec<u8>)) {
-        match self {
-            Self::Stroke {
-                path,
-                colour,
-                stroke,
-            } => pm.stroke_path(&path, &paint(colour), &stroke, Transform::identity(), None),
-            Self::Blend {
-                x0,
-                y0,
-                spans,
-                weights,
-                colour,
-            } => {
-                let (weight_row, colour_row) = scratch;
-                let widest = spans.iter().map(|&(lo, hi)| hi.saturating_sub(lo)).max();
-                let widest = widest.unwrap_or(0) * 4;
-                // The colour of each byte of a row (the alpha byte's is never used: its weight
-                // is 0); the weight of each byte: the alpha bytes weigh 0 (and keep their value).
-                colour_row.clear();
-                colour_row
-                    .extend((0..widest / 4).flat_map(|_| [colour[0], colour[1], colour[2], 0]));
-                weight_row.clear();
-                weight_row.resize(widest, 0);
-                let stride = pm.width() as usize * 4;
-                let data = pm.data_mut();
-                let mut at = 0;
-                for (y, &(lo, hi)) in (y0..).zip(&spans) {
-                    if lo >= hi {
-                        continue;
-                    }
-                    // Only the touched columns: a weight of 0 keeps a byte as it is.
-                    let n = hi - lo;
-                    let row = &weights[at..at + n];
-                    at += n;
-                    // Per byte (`[w, w, w, 0]` in one store).
-                    let bytes = &mut weight_row[..n * 4];
-                    for (q, &w) in bytes.chunks_exact_mut(4).zip(row) {
-                        q.copy_from_slice(&(u32::from(w) * 0x01_01_01).to_le_bytes());
-                    }
-                    let line = &mut data[y * stride + (x0 + lo) * 4..][..n * 4];
-                    for ((d, &w), &c) in line.iter_mut().zip(&*bytes).zip(&*colour_row) {
-                        *d = blend_255(*d, c, w);
-                    }
-                }
-            }
-        }
-    }
-}
-
-/// Path layer steps buffered between the thread that forms them and the one drawing them.
-const PATH_OPS_BUFFERED: usize = 64;
-
-/// The steps drawing the path on a canvas of `size`, in drawing order, handed to `emit`. They
-/// depend on the path and the view only, not on the pixels under them, so they can be formed on
-/// one thread while another paints the background and then draws them.
-fn path_ops(
-    world: &World,
-    trace: &Trace,
-    view: View,
-    size: (u32, u32),
-    emit: &mut dyn FnMut(PathOp),
-) {
+fn draw_path(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
     let width = (view.scale * 0.6).clamp(1.0, 3.0);
     let mut region = 0usize;
     let mut in_backtrack = false;
@@ -1208,53 +959,52 @@ fn path_ops(
     let mut run: Vec<(f32, f32)> = Vec::new();
     let mut run_style = (0usize, false);
     let mut lanes = LaneBlitter::default();
-    let mut flush =
-        |emit: &mut dyn FnMut(PathOp), run: &mut Vec<(f32, f32)>, style: (usize, bool)| {
-            if run.len() >= 2 {
-                let mut stroke = Stroke {
-                    width,
-                    ..Stroke::default()
-                };
-                stroke.line_join = tiny_skia::LineJoin::Round;
-                if style.1 {
-                    let mut pb = PathBuilder::new();
-                    pb.move_to(run[0].0, run[0].1);
-                    for &(x, y) in &run[1..] {
-                        pb.line_to(x, y);
-                    }
-                    if let Some(path) = pb.finish() {
-                        let casing = Stroke {
-                            width: width * 2.0,
-                            ..stroke.clone()
-                        };
-                        emit(PathOp::Stroke {
-                            path: path.clone(),
-                            colour: Color::WHITE,
-                            stroke: casing,
-                        });
-                        stroke.dash = StrokeDash::new(vec![width * 4.0, width * 3.0], 0.0);
-                        let colour = rgb(colours::BACKTRACK);
-                        emit(PathOp::Stroke {
-                            path,
-                            colour,
-                            stroke,
-                        });
-                    }
-                } else {
-                    // A region's lanes: the axis-aligned segments (nearly all of a coverage path)
-                    // are filled with their exact area coverage, the others stroked.
-                    let colour = PALETTE[style.0.saturating_sub(1) % PALETTE.len()];
-                    if let Some(path) = lanes.draw(size, run, width, colour, emit) {
-                        emit(PathOp::Stroke {
-                            path,
-                            colour: rgb(colour),
-                            stroke,
-                        });
-                    }
+    let mut flush = |pm: &mut Pixmap, run: &mut Vec<(f32, f32)>, style: (usize, bool)| {
+        if run.len() >= 2 {
+            let mut stroke = Stroke {
+                width,
+                ..Stroke::default()
+            };
+            stroke.line_join = tiny_skia::LineJoin::Round;
+            if style.1 {
+                let mut pb = PathBuilder::new();
+                pb.move_to(run[0].0, run[0].1);
+                for &(x, y) in &run[1..] {
+                    pb.line_to(x, y);
+                }
+                if let Some(path) = pb.finish() {
+                    let casing = Stroke {
+                        width: width * 2.0,
+                        ..stroke.clone()
+                    };
+                    pm.stroke_path(
+                        &path,
+                        &paint(Color::WHITE),
+                        &casing,
+                        Transform::identity(),
+                        None,
+                    );
+                    stroke.dash = StrokeDash::new(vec![width * 4.0, width * 3.0], 0.0);
+                    let colour = rgb(colours::BACKTRACK);
+                    pm.stroke_path(&path, &paint(colour), &stroke, Transform::identity(), None);
+                }
+            } else {
+                // A region's lanes: the axis-aligned segments (nearly all of a coverage path)
+                // are filled with their exact area coverage, the others stroked.
+                let colour = PALETTE[style.0.saturating_sub(1) % PALETTE.len()];
+                if let Some(path) = lanes.draw(pm, run, width, colour) {
+                    pm.stroke_path(
+                        &path,
+                        &paint(rgb(colour)),
+                        &stroke,
+                        Transform::identity(),
+                        None,
+                    );
                 }
             }
-            run.clear();
-        };
+        }
+        run.clear();
+    };
     for r in path_entries(trace) {
         match r {
             Entry::Pose { pose, .. } => {
@@ -1265,7 +1015,7 @@ fn path_ops(
                 let style = (region, in_backtrack);
                 if style != run_style {
                     let keep = run.last().copied();
-                    flush(emit, &mut run, run_style);
+                    flush(pm, &mut run, run_style);
                     if let Some(k) = keep {
                         run.push(k);
                     }
@@ -1287,7 +1037,7 @@ fn path_ops(
             },
         }
     }
-    flush(emit, &mut run, run_style);
+    flush(pm, &mut run, run_style);
 }
 
 /// Draws the axis-aligned segments of a polyline stroke (a coverage path's lanes) as filled
@@ -1305,6 +1055,15 @@ struct LaneBlitter {
     bbox: [f32; 4],
     /// Scratch: the horizontal coverage of a rectangle's columns.
     fx: Vec<f32>,
+    /// Scratch: the blend weight of each pixel of a row of the box.
+    pixel_weight: Vec<u8>,
+    /// Scratch: the blend weight of each byte of a row of the box.
+    weight_row: Vec<u8>,
+    /// Scratch: the colour of each byte of a row of the box.
+    colour_row: Vec<u8>,
+    /// Scratch: per row of the box, the columns `[lo, hi)` (box-relative) any rectangle
+    /// touches; the pixels outside have no coverage and keep their colour.
+    spans: Vec<(usize, usize)>,
 }
 
 /// Largest bounding box (pixels) of a group of lane rectangles blended at once.
@@ -1312,15 +1071,13 @@ const LANE_GROUP_PX: f32 = (1 << 18) as f32;
 
 impl LaneBlitter {
     /// Fills the axis-aligned segments of `run` (butt ends at the run's two ends, square
-    /// corners at its turns) in `colour` on a canvas of `size` (as [`PathOp::Blend`] steps);
-    /// returns the other segments as a path to stroke.
+    /// corners at its turns) in `colour`; returns the other segments as a path to stroke.
     fn draw(
         &mut self,
-        size: (u32, u32),
+        pm: &mut Pixmap,
         run: &[(f32, f32)],
         width: f32,
         colour: [u8; 3],
-        emit: &mut dyn FnMut(PathOp),
     ) -> Option<tiny_skia::Path> {
         const AXIS_EPS: f32 = 1e-3;
         let h = width / 2.0;
@@ -1366,22 +1123,16 @@ impl LaneBlitter {
             } else {
                 [c - h, lo, c + h, hi]
             };
-            self.push(size, rect, colour, emit);
+            self.push(pm, rect, colour);
         }
-        self.blend(colour, emit);
+        self.blend(pm, colour);
         pb.finish()
     }
 
     /// Adds a rectangle to the group (blending the group first when the box would grow
     /// beyond [`LANE_GROUP_PX`]).
-    fn push(
-        &mut self,
-        size: (u32, u32),
-        r: [f32; 4],
-        colour: [u8; 3],
-        emit: &mut dyn FnMut(PathOp),
-    ) {
-        let (w, h) = (size.0 as f32, size.1 as f32);
+    fn push(&mut self, pm: &mut Pixmap, r: [f32; 4], colour: [u8; 3]) {
+        let (w, h) = (pm.width() as f32, pm.height() as f32);
         let r = [r[0].max(0.0), r[1].max(0.0), r[2].min(w), r[3].min(h)];
         if r[0] >= r[2] || r[1] >= r[3] {
             return;
@@ -1395,7 +1146,7 @@ impl LaneBlitter {
                 b[3].max(r[3]),
             ];
             if (u[2] - u[0] + 2.0) * (u[3] - u[1] + 2.0) > LANE_GROUP_PX {
-                self.blend(colour, emit);
+                self.blend(pm, colour);
             } else {
                 self.bbox = u;
             }
@@ -1406,8 +1157,8 @@ impl LaneBlitter {
         self.rects.push(r);
     }
 
-    /// The group's coverage in `colour` as one [`PathOp::Blend`]; empties the group.
-    fn blend(&mut self, colour: [u8; 3], emit: &mut dyn FnMut(PathOp)) {
+    /// Blends the group's coverage in `colour` onto the canvas and empties the group.
+    fn blend(&mut self, pm: &mut Pixmap, colour: [u8; 3]) {
         if self.rects.is_empty() {
             return;
         }
@@ -1417,12 +1168,11 @@ impl LaneBlitter {
         let bw = x1 - x0;
         self.cov.clear();
         self.cov.resize(bw * (y1 - y0), 0.0);
-        // Per row of the box, the columns `[lo, hi)` (box-relative) any rectangle touches; the
-        // pixels outside have no coverage and keep their colour.
-        let mut spans = vec![(usize::MAX, 0); y1 - y0];
+        self.spans.clear();
+        self.spans.resize(y1 - y0, (usize::MAX, 0));
         for r in &self.rects {
             let (cx0, cx1) = (r[0].floor() as usize, r[2].ceil() as usize);
-            for span in &mut spans[r[1].floor() as usize - y0..r[3].ceil() as usize - y0] {
+            for span in &mut self.spans[r[1].floor() as usize - y0..r[3].ceil() as usize - y0] {
                 *span = (span.0.min(cx0 - x0), span.1.max(cx1 - x0));
             }
             // Each column's horizontal coverage, computed once for all the rows (same values).
@@ -1438,20 +1188,35 @@ impl LaneBlitter {
             }
         }
         self.rects.clear();
-        // Coverage in 1/255 steps (none at or below 0, all at or above 1), per touched pixel.
-        let mut weights = Vec::with_capacity(self.cov.len());
-        for (row, &(lo, hi)) in self.cov.chunks_exact(bw).zip(&spans) {
-            if lo < hi {
-                weights.extend(row[lo..hi].iter().map(|&a| lane_weight(a)));
+        let stride = pm.width() as usize * 4;
+        let data = pm.data_mut();
+        // The colour of each byte of a row (the alpha byte's is never used: its weight is 0).
+        self.colour_row.clear();
+        self.colour_row
+            .extend((0..bw).flat_map(|_| [colour[0], colour[1], colour[2], 0]));
+        // The weight of each byte of a row: the alpha bytes weigh 0 (and keep their value).
+        self.weight_row.clear();
+        self.weight_row.resize(bw * 4, 0);
+        for ((y, row), &(lo, hi)) in (y0..y1).zip(self.cov.chunks_exact(bw)).zip(&self.spans) {
+            if lo >= hi {
+                continue;
+            }
+            // Only the touched columns: a weight of 0 keeps a byte as it is.
+            let row = &row[lo..hi];
+            // Coverage in 1/255 steps (none at or below 0, all at or above 1), per pixel, then
+            // per byte (`[w, w, w, 0]` in one store).
+            self.pixel_weight.clear();
+            self.pixel_weight
+                .extend(row.iter().map(|&a| lane_weight(a)));
+            let weights = &mut self.weight_row[..row.len() * 4];
+            for (q, &w) in weights.chunks_exact_mut(4).zip(&self.pixel_weight) {
+                q.copy_from_slice(&(u32::from(w) * 0x01_01_01).to_le_bytes());
+            }
+            let line = &mut data[y * stride + (x0 + lo) * 4..][..row.len() * 4];
+            for ((d, &w), &c) in line.iter_mut().zip(&*weights).zip(&self.colour_row) {
+                *d = blend_255(*d, c, w);
             }
         }
-        emit(PathOp::Blend {
-            x0,
-            y0,
-            spans,
-            weights,
-            colour,
-        });
     }
 }
 
@@ -1871,95 +1636,6 @@ mod tests {
         assert_eq!(lane_weight(0.4), 102);
         assert_eq!(lane_weight(0.001), 0);
         assert_eq!(lane_weight(0.999), 255);
-    }
-
-    #[test]
-    fn the_text_layer_gives_the_bytes_of_drawing_the_text_last() {
-        let (cw, ch, head_rows, foot_row) = (240u32, 200u32, 40u32, 150u32);
-        let charts = || {
-            let mut head = Chart::new(cw, 0);
-            head.rect(150.0, 4.0, 80.0, 24.0, Some([20, 130, 60]), None);
-            head.text(
-                8.0,
-                6.0,
-                20,
-                "Title gj".to_string(),
-                [20, 20, 20],
-                chart::Anchor::Start,
-            );
-            let mut foot = Chart::new(cw, 0);
-            foot.text(
-                8.0,
-                160.0,
-                14,
-                "legend".to_string(),
-                [20, 20, 20],
-                chart::Anchor::Start,
-            );
-            foot.rect(120.0, 162.0, 14.0, 14.0, Some([200, 30, 30]), None);
-            (head, foot)
-        };
-        // The map rows painted, white above and below; then a stroke into the head rows.
-        let mut pm = Pixmap::new(cw, ch).unwrap();
-        pm.fill(Color::WHITE);
-        let stride = cw as usize * 4;
-        for (k, b) in pm.data_mut()[head_rows as usize * stride..foot_row as usize * stride]
-            .iter_mut()
-            .enumerate()
-        {
-            *b = if k % 4 == 3 { 255 } else { (k % 249) as u8 };
-        }
-        for spill in [false, true] {
-            if spill {
-                let mut pb = PathBuilder::new();
-                pb.move_to(10.0, 45.0);
-                pb.line_to(200.0, 20.0);
-                let stroke = Stroke {
-                    width: 3.0,
-                    ..Stroke::default()
-                };
-                let path = pb.finish().unwrap();
-                pm.stroke_path(
-                    &path,
-                    &paint(rgb([0, 0, 200])),
-                    &stroke,
-                    Transform::identity(),
-                    None,
-                );
-            }
-            let mut want = pm.clone();
-            let (head, foot) = charts();
-            head.draw_onto(&mut want);
-            foot.draw_onto(&mut want);
-            let mut got = pm.clone();
-            let (head, foot) = charts();
-            TextLayer::start(head, foot, (cw, ch), head_rows, foot_row).finish(&mut got);
-            assert!(got.data() == want.data(), "spill {spill}");
-            assert!(got.data() != pm.data(), "the text is drawn");
-        }
-    }
-
-    #[test]
-    fn a_large_picture_encodes_the_same_with_its_bands_converted_on_a_second_thread() {
-        // Several bands (the last one short), odd width.
-        let (w, h) = (301u32, 4 * (ENCODE_BAND_PX as u32 / 301) + 7);
-        let mut pm = Pixmap::new(w, h).unwrap();
-        for (k, p) in pm.data_mut().chunks_exact_mut(4).enumerate() {
-            let k = k as u32;
-            p.copy_from_slice(&[(k % 251) as u8, (k / 7 % 253) as u8, (k / 301) as u8, 255]);
-        }
-        let threaded = encode_png_on(&pm, true).unwrap();
-        assert_eq!(threaded, encode_png_on(&pm, false).unwrap());
-        assert_eq!(threaded, encode_png(&pm).unwrap());
-        // A translucent pixel in the last band: RGBA, as on one thread.
-        let at = pm.data().len() - 8;
-        pm.data_mut()[at..at + 4].copy_from_slice(&[0, 0, 0, 0]);
-        let threaded = encode_png_on(&pm, true).unwrap();
-        assert_eq!(threaded, encode_png_on(&pm, false).unwrap());
-        let dec = png::Decoder::new(std::io::Cursor::new(threaded))
-            .read_info()
-            .unwrap();
-        assert_eq!(dec.info().color_type, png::ColorType::Rgba);
     }
 
     #[test]
