@@ -19,8 +19,10 @@ use crate::staging::{write_file, Staging};
 /// beside `out`, which then replaces `out` whole (see [`crate::staging`]). A failure or an
 /// interrupt leaves `out` as it was. The files are those of the library's
 /// [`ccpp_render::run_files::render_run_files`] (the Python package's `save` writes the same
-/// bytes), `trace.jsonl` streamed into its staging file as it is formed; the replay files go
-/// before `metrics.json`, written last (it marks a complete run). Returns the metrics JSON.
+/// bytes), `trace.jsonl` streamed into its staging file as it is formed. `metrics.json` (which
+/// marks a complete run where files are written one by one) is written first here: the staging
+/// folder shows all files or none, and its sync then overlaps the drawing of the picture.
+/// Returns the metrics JSON.
 pub fn write_run_files(
     out: &Path,
     job: &Job,
@@ -30,6 +32,9 @@ pub fn write_run_files(
 ) -> Result<String> {
     let metrics = ccpp_render::run_files::metrics_json(&r.metrics)?;
     let staging = Staging::new(out)?;
+    // The folder appears whole or not at all, so the order inside it does not matter: the
+    // small files known now go first, and their syncs run while the picture is drawn.
+    staging.write("metrics.json", metrics.as_bytes())?;
     for (name, bytes) in extra {
         staging.write(name, bytes)?;
     }
@@ -48,10 +53,7 @@ pub fn write_run_files(
         staging.write("replay.html", html.as_bytes())?;
         staging.write("replay.gif", &gif)?;
     }
-    ccpp_io::phase::time("write files", || -> Result<()> {
-        staging.write("metrics.json", metrics.as_bytes())?;
-        staging.commit()
-    })?;
+    ccpp_io::phase::time("write files", || staging.commit())?;
     Ok(metrics)
 }
 

@@ -5,9 +5,18 @@
 //! folder (if any) is renamed to `.<name>.ccpp-old-<pid>-<n>`, the staging folder is renamed to
 //! `<name>`, and the old folder is removed. A reader therefore sees the old complete set or the
 //! new complete set (for an instant, between the two renames, no folder), never a mix and never
-//! a `.tmp` file. Each staged file is synced to disk on a thread of its own as soon as it is
-//! written (the disk's latency overlaps the work on the next file); the swap waits for all of
+//! a half-written file. Inside the staging folder, which no reader looks into, files are written
+//! under their own names (no `.tmp` and rename each). Each staged file is synced to disk on a
+//! thread of its own as soon as it is written (the disk's latency overlaps the work on the next
+//! file; small files known early, such as `metrics.json`, go first); the swap waits for all of
 //! them, so the folder that appears is on disk whole.
+//!
+//! What a crash (power loss) can leave: the file contents are durable before the swap, the two
+//! renames of the swap are not synced themselves (that would add a wait for the disk after the
+//! last file). After a crash the target therefore holds the old complete set or the new
+//! complete set, never a mix or a half-written file; when the crash fell between the two
+//! renames, the target is missing and the next run into it puts the old folder back (see
+//! below). A run that exited may, after a crash, show the old set again until it is repeated.
 //!
 //! On SIGINT/SIGTERM the handler waits for a swap in progress to finish, removes every staging
 //! folder and temporary file still registered, and exits with status 130. Folders left by a
@@ -375,8 +384,8 @@ pub fn write_file(path: &Path, bytes: &[u8]) -> Result<(), ccpp_io::WriteError> 
 }
 
 /// Writes the file at `path` atomically with what `fill` writes, synced before it is renamed
-/// into place; or, `deferred`, renamed unsynced and returned for the caller to sync (a file of
-/// a staging folder, which becomes visible only with the folder).
+/// into place; or, `deferred` (a file of a staging folder, which becomes visible only with the
+/// folder), written under its name unsynced and returned for the caller to sync.
 fn write_file_with(
     path: &Path,
     fill: &mut dyn FnMut(&mut dyn std::io::Write) -> std::io::Result<()>,
@@ -385,13 +394,19 @@ fn write_file_with(
     let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
     let write = |fill: &mut dyn FnMut(&mut dyn std::io::Write) -> std::io::Result<()>| {
         if deferred {
-            ccpp_io::write::write_atomic_unsynced_with(path, fill).map(Some)
+            write_staged(path, fill).map(Some)
         } else {
             ccpp_io::write::write_atomic_with(path, fill).map(|()| None)
         }
     };
     if std::env::var_os(FAIL_WRITE_ENV).is_some_and(|v| v == name) {
         return write(&mut |_| Err(std::io::Error::from_raw_os_error(28)));
+    }
+    if deferred {
+        // A file of a staging folder: written under its own name (the folder is private until
+        // it is moved into place, so no reader can see the file half written; the folder is
+        // registered, and removed whole on failure or interrupt).
+        return write(fill);
     }
     let mut tmp = path.as_os_str().to_owned();
     tmp.push(".tmp");
@@ -400,6 +415,27 @@ fn write_file_with(
     let r = write(fill);
     unregister(&tmp);
     r
+}
+
+/// Writes what `fill` writes into a new file `path` of a staging folder, unsynced, and returns
+/// it for the caller to sync; on failure the file is removed.
+fn write_staged(
+    path: &Path,
+    fill: &mut dyn FnMut(&mut dyn std::io::Write) -> std::io::Result<()>,
+) -> Result<std::fs::File, ccpp_io::WriteError> {
+    let result = (|| {
+        let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);
+        fill(&mut w)?;
+        w.into_inner().map_err(std::io::IntoInnerError::into_error)
+    })();
+    result.map_err(|source| {
+        // Best effort: the file may not even exist.
+        let _ = std::fs::remove_file(path);
+        ccpp_io::WriteError::Io {
+            path: path.to_path_buf(),
+            source,
+        }
+    })
 }
 
 #[cfg(test)]

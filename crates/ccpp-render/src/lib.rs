@@ -253,14 +253,6 @@ pub fn coverage_png_swept(
 pub fn encode_png(pixmap: &Pixmap) -> Result<Vec<u8>, RenderError> {
     use std::io::Write as _;
     let err = |e: &dyn std::fmt::Display| RenderError::Encode(e.to_string());
-    // Every pixel's alpha ANDed (no early exit: a reduction the compiler vectorizes).
-    let alpha = pixmap
-        .data()
-        .chunks_exact(4)
-        .fold(u8::MAX, |all, p| all & p[3]);
-    if alpha != u8::MAX {
-        return pixmap.encode_png().map_err(|e| err(&e));
-    }
     let (w, h) = (pixmap.width(), pixmap.height());
     let mut out = Vec::new();
     let mut encoder = png::Encoder::new(&mut out, w, h);
@@ -268,6 +260,9 @@ pub fn encode_png(pixmap: &Pixmap) -> Result<Vec<u8>, RenderError> {
     encoder.set_depth(png::BitDepth::Eight);
     encoder.set_compression(png::Compression::Fast);
     let mut writer = encoder.write_header().map_err(|e| err(&e))?;
+    // Every pixel's alpha ANDed while its row is copied (no early exit: a reduction the
+    // compiler vectorizes). A canvas with a translucent pixel is encoded again as RGBA below.
+    let mut alpha = u8::MAX;
     {
         let mut stream = writer.stream_writer().map_err(|e| err(&e))?;
         // One spare byte: each pixel is copied whole (4 bytes, one store), its alpha byte
@@ -276,12 +271,21 @@ pub fn encode_png(pixmap: &Pixmap) -> Result<Vec<u8>, RenderError> {
         let mut row = vec![0u8; n + 1];
         // Opaque premultiplied pixels are their straight colours.
         for src in pixmap.data().chunks_exact(w as usize * 4) {
+            alpha &= src.chunks_exact(4).fold(u8::MAX, |all, p| all & p[3]);
+            if alpha != u8::MAX {
+                break;
+            }
             for (k, s) in src.chunks_exact(4).enumerate() {
                 row[3 * k..3 * k + 4].copy_from_slice(s);
             }
             stream.write_all(&row[..n]).map_err(|e| err(&e))?;
         }
-        stream.finish().map_err(|e| err(&e))?;
+        if alpha == u8::MAX {
+            stream.finish().map_err(|e| err(&e))?;
+        }
+    }
+    if alpha != u8::MAX {
+        return pixmap.encode_png().map_err(|e| err(&e));
     }
     writer.finish().map_err(|e| err(&e))?;
     Ok(out)
@@ -1137,6 +1141,9 @@ struct LaneBlitter {
     weight_row: Vec<u8>,
     /// Scratch: the colour of each byte of a row of the box.
     colour_row: Vec<u8>,
+    /// Scratch: per row of the box, the columns `[lo, hi)` (box-relative) any rectangle
+    /// touches; the pixels outside have no coverage and keep their colour.
+    spans: Vec<(usize, usize)>,
 }
 
 /// Largest bounding box (pixels) of a group of lane rectangles blended at once.
@@ -1241,8 +1248,13 @@ impl LaneBlitter {
         let bw = x1 - x0;
         self.cov.clear();
         self.cov.resize(bw * (y1 - y0), 0.0);
+        self.spans.clear();
+        self.spans.resize(y1 - y0, (usize::MAX, 0));
         for r in &self.rects {
             let (cx0, cx1) = (r[0].floor() as usize, r[2].ceil() as usize);
+            for span in &mut self.spans[r[1].floor() as usize - y0..r[3].ceil() as usize - y0] {
+                *span = (span.0.min(cx0 - x0), span.1.max(cx1 - x0));
+            }
             // Each column's horizontal coverage, computed once for all the rows (same values).
             self.fx.clear();
             self.fx
@@ -1265,17 +1277,23 @@ impl LaneBlitter {
         // The weight of each byte of a row: the alpha bytes weigh 0 (and keep their value).
         self.weight_row.clear();
         self.weight_row.resize(bw * 4, 0);
-        for (y, row) in (y0..y1).zip(self.cov.chunks_exact(bw)) {
+        for ((y, row), &(lo, hi)) in (y0..y1).zip(self.cov.chunks_exact(bw)).zip(&self.spans) {
+            if lo >= hi {
+                continue;
+            }
+            // Only the touched columns: a weight of 0 keeps a byte as it is.
+            let row = &row[lo..hi];
             // Coverage in 1/255 steps (none at or below 0, all at or above 1), per pixel, then
             // per byte (`[w, w, w, 0]` in one store).
             self.pixel_weight.clear();
             self.pixel_weight
                 .extend(row.iter().map(|&a| lane_weight(a)));
-            for (q, &w) in self.weight_row.chunks_exact_mut(4).zip(&self.pixel_weight) {
+            let weights = &mut self.weight_row[..row.len() * 4];
+            for (q, &w) in weights.chunks_exact_mut(4).zip(&self.pixel_weight) {
                 q.copy_from_slice(&(u32::from(w) * 0x01_01_01).to_le_bytes());
             }
-            let line = &mut data[y * stride + x0 * 4..][..bw * 4];
-            for ((d, &w), &c) in line.iter_mut().zip(&self.weight_row).zip(&self.colour_row) {
+            let line = &mut data[y * stride + (x0 + lo) * 4..][..row.len() * 4];
+            for ((d, &w), &c) in line.iter_mut().zip(&*weights).zip(&self.colour_row) {
                 *d = blend_255(*d, c, w);
             }
         }
@@ -1798,13 +1816,19 @@ mod tests {
             .flat_map(|p| [p[0], p[1], p[2]])
             .collect();
         assert_eq!(&buf[..info.buffer_size()], &want[..]);
-        // One pixel not opaque: the picture keeps its alpha channel.
-        pm.data_mut()[7] = 128;
-        pm.data_mut()[4..7].fill(0);
-        let bytes = encode_png(&pm).unwrap();
-        let dec = png::Decoder::new(std::io::Cursor::new(bytes))
-            .read_info()
-            .unwrap();
-        assert_eq!(dec.info().color_type, png::ColorType::Rgba);
+        // One pixel not opaque, in the last row (found after the rows above were encoded as
+        // RGB) or the first: the picture keeps its alpha channel.
+        for at in [(w * h - 1) as usize * 4, 4] {
+            pm.data_mut()[at + 3] = 128;
+            pm.data_mut()[at..at + 3].fill(0);
+            let bytes = encode_png(&pm).unwrap();
+            let mut dec = png::Decoder::new(std::io::Cursor::new(bytes))
+                .read_info()
+                .unwrap();
+            assert_eq!(dec.info().color_type, png::ColorType::Rgba);
+            let mut buf = vec![0u8; dec.output_buffer_size().unwrap()];
+            let info = dec.next_frame(&mut buf).unwrap();
+            assert_eq!(buf[..info.buffer_size()][at + 3], 128);
+        }
     }
 }
