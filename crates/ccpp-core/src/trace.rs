@@ -32,7 +32,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::geometry::{Point, Pose};
+use crate::geometry::{round_i64, Point, Pose};
 
 /// Something that happened during a run (a mark in the trace). Planners emit most of these;
 /// the simulator emits [`Event::Collision`] and [`Event::Finished`].
@@ -221,11 +221,18 @@ impl Lattice {
     /// a lattice coordinate, else `None`.
     #[inline]
     fn index_1d(a: f64, x: f64, side: f64) -> Option<i32> {
-        let f = ((x - a) / side).round();
-        if f.is_nan() || f.abs() > f64::from(i32::MAX - 1) {
-            return None;
-        }
-        let i = f as i32;
+        let q = (x - a) / side;
+        let i = if q.abs() <= f64::from(i32::MAX - 1) {
+            // `q.round() as i32` without the call into libm: the rounded value lies in range.
+            round_i64(q) as i32
+        } else {
+            // NaN, or out of range (up to rounding at the bound).
+            let f = q.round();
+            if f.is_nan() || f.abs() > f64::from(i32::MAX - 1) {
+                return None;
+            }
+            f as i32
+        };
         (Self::coord(a, i, side).to_bits() == x.to_bits()).then_some(i)
     }
 
@@ -850,6 +857,49 @@ impl<'de> Deserialize<'de> for Trace {
 
 #[cfg(test)]
 mod tests {
+
+    /// `Lattice::index` without the libm `round` finds exactly the indices of the rounding
+    /// definition: halves either way, negative indices, the range bound, NaN and infinities.
+    #[test]
+    fn lattice_index_matches_rounding_definition() {
+        fn reference(a: f64, x: f64, side: f64) -> Option<i32> {
+            let f = ((x - a) / side).round();
+            if f.is_nan() || f.abs() > f64::from(i32::MAX - 1) {
+                return None;
+            }
+            let i = f as i32;
+            (Lattice::coord(a, i, side).to_bits() == x.to_bits()).then_some(i)
+        }
+        let mut seed: u64 = 0x9e37_79b9_7f4a_7c15;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        };
+        let mut hits = 0;
+        for k in 0..200_000u32 {
+            let r = next();
+            let side = [0.05, 0.1, 0.03, 1.0, 0.3][(r % 5) as usize];
+            let a = ((r >> 8) % 20_000) as f64 * 0.0137 - 100.0;
+            let i = ((next() % 400_000) as i64 - 200_000) as f64;
+            let x = match k % 6 {
+                0 | 1 => a + i * side,
+                2 => a + (i + 0.5) * side,
+                3 => a + i * side + f64::from(k % 7) * 1e-13,
+                4 => {
+                    a + [2147483646.0, 2147483646.5, -2147483646.4, 2147483647.0, 3e9]
+                        [(r >> 20) as usize % 5]
+                        * side
+                }
+                _ => [f64::NAN, f64::INFINITY, -f64::INFINITY, 1e300, -0.0][(r >> 30) as usize % 5],
+            };
+            let got = Lattice::index_1d(a, x, side);
+            assert_eq!(got, reference(a, x, side), "a {a} x {x} side {side}");
+            hits += usize::from(got.is_some());
+        }
+        assert!(hits > 50_000, "{hits}");
+    }
     use super::*;
 
     #[test]

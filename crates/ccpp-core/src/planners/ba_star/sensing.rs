@@ -163,6 +163,15 @@ impl Mind {
         ) {
             return (r, c);
         }
+        self.touch_box_far(t)
+    }
+
+    /// [`Mind::touch_box`] off the tables (a rotated frame, or a tile outside the tiling):
+    /// out of line, so that the hot callers do not evaluate the rotation's sine and cosine
+    /// ahead of the table lookup.
+    #[cold]
+    #[inline(never)]
+    fn touch_box_far(&self, t: Tile) -> ((i64, i64), (i64, i64)) {
         let h = self.known.frame().height as f64;
         touch_box_of(self.grid_center(t), self.rc_px, h)
     }
@@ -215,6 +224,13 @@ impl Mind {
         ) {
             return Point::new(x, y);
         }
+        self.grid_center_far(t)
+    }
+
+    /// [`Mind::grid_center`] off the tables (out of line, as [`Mind::touch_box_far`]).
+    #[cold]
+    #[inline(never)]
+    fn grid_center_far(&self, t: Tile) -> Point {
         self.known.frame().world_to_grid(self.center(t))
     }
 
