@@ -245,6 +245,29 @@ impl Lattice {
         ))
     }
 
+    /// `self.index(p) == Some((i, j))`, without the two divisions for a lattice of the kind
+    /// [`Trace`] fixes (finite anchor and side below 1e15, side above 1e-9 of the anchor's
+    /// larger coordinate or of 1, indices below 2^30 in magnitude): there the quotient
+    /// `(x - a) / side` of a coordinate `x` equal to `coord(a, i, side)` lies within 1e-6 of
+    /// `i` (rounding errors of a few ulps of `i` and of `a / side < 1e9`), so it rounds to `i`,
+    /// and the index is `i` exactly when the coordinate is.
+    #[inline]
+    pub(crate) fn index_is(&self, p: [f64; 2], i: i32, j: i32) -> bool {
+        let [a0, a1] = self.anchor;
+        let scale = a0.abs().max(a1.abs()).max(1.0);
+        let usual = a0.abs() < 1e15
+            && a1.abs() < 1e15
+            && self.side < 1e15
+            && self.side > scale * 1e-9
+            && i.unsigned_abs() < 1 << 30
+            && j.unsigned_abs() < 1 << 30;
+        if !usual {
+            return self.index(p) == Some((i, j));
+        }
+        Self::coord(a0, i, self.side).to_bits() == p[0].to_bits()
+            && Self::coord(a1, j, self.side).to_bits() == p[1].to_bits()
+    }
+
     /// A lattice anchored at `anchor` whose side is `d` rounded to 12 significant digits, when
     /// that is a usable spacing.
     fn guess(anchor: [f64; 2], d: f64) -> Option<Self> {
@@ -481,7 +504,7 @@ impl Trace {
                 ) else {
                     return false;
                 };
-                if lat.index([p.x, p.y]) == Some((ni, nj)) && *n < u32::MAX {
+                if lat.index_is([p.x, p.y], ni, nj) && *n < u32::MAX {
                     *n += 1;
                     return true;
                 }
@@ -857,6 +880,66 @@ impl<'de> Deserialize<'de> for Trace {
 
 #[cfg(test)]
 mod tests {
+
+    /// `Lattice::index_is` says what `Lattice::index` says: lattice points and near misses by
+    /// an ulp, anchors and sides of every magnitude (the fast path and the bounds around it),
+    /// indices near 2^30 and the `i32` bound, non-finite coordinates.
+    #[test]
+    fn lattice_index_is_matches_index() {
+        let mut seed: u64 = 0x853c_49e6_748f_ea9b;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        };
+        let mut yes = 0;
+        for k in 0..200_000u32 {
+            let r = next();
+            let mag = [1.0, 1e-3, 1e3, 1e9, 1e14, 1e16, 1e300][(r % 7) as usize];
+            let a = [
+                ((r >> 8) % 2001) as f64 * 0.0371 * mag - mag * 37.0,
+                ((r >> 20) % 2001) as f64 * -0.0193 * mag,
+            ];
+            let side =
+                [0.05, 0.1, 0.025, 1.0, 7.3e-4, 1e-9, 1e12, 1e16, 1e-12][(r >> 32) as usize % 9];
+            let lat = Lattice { anchor: a, side };
+            let big = [
+                3,
+                200_000,
+                1 << 29,
+                (1 << 30) - 1,
+                1 << 30,
+                i32::MAX - 2,
+                i32::MAX,
+            ];
+            let pick = |v: u64| -> i32 {
+                let m = big[(v % 7) as usize];
+                let x = (v >> 8) as i64 % (i64::from(m) + 1);
+                let x = if v >> 63 == 1 { -x } else { x };
+                x.clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32
+            };
+            let (i, j) = (pick(next()), pick(next()));
+            let mut p = lat.point(i, j);
+            match k % 5 {
+                0 => p[0] = f64::from_bits(p[0].to_bits() ^ 1),
+                1 => p[1] = f64::from_bits(p[1].to_bits().wrapping_add(1)),
+                2 if k % 15 == 2 => {
+                    p[(r >> 40) as usize % 2] = [f64::NAN, f64::INFINITY][(r >> 41) as usize % 2]
+                }
+                _ => {}
+            }
+            let (ti, tj) = match (r >> 44) % 4 {
+                0 => (i, j + 1),
+                1 => (i.wrapping_sub(1), j),
+                _ => (i, j),
+            };
+            let want = lat.index(p) == Some((ti, tj));
+            assert_eq!(lat.index_is(p, ti, tj), want, "{lat:?} {p:?} {ti} {tj}");
+            yes += usize::from(want);
+        }
+        assert!(yes > 20_000, "{yes}");
+    }
 
     /// `Lattice::index` without the libm `round` finds exactly the indices of the rounding
     /// definition: halves either way, negative indices, the range bound, NaN and infinities.

@@ -241,3 +241,50 @@ fn frame_edges_by_lines_match_tile_by_tile() {
     }
     assert!(judged > 100, "{judged}");
 }
+
+/// Every tile of the centre line (`for_each_centre_tile`) is a tile the swept disk touches
+/// (`for_each_swept_tile`), for any direction, length and radius above 1e-3 tiles; so an
+/// uncovered centre tile refuses line of sight exactly when the full test would.
+#[test]
+fn centre_line_tiles_are_swept_tiles() {
+    use super::smoothing::for_each_centre_tile;
+    let mut seed: u64 = 0xd1b5_4a32_d192_ed03;
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        seed
+    };
+    let mut seen = 0usize;
+    for k in 0..4000 {
+        let r = next();
+        let a = ((r % 41) as i32 - 20, ((r >> 8) % 41) as i32 - 20);
+        let b = if k % 4 == 0 {
+            // Axis and diagonal moves, as most backtracking segments.
+            let d = ((r >> 16) % 30) as i32;
+            [
+                (a.0 + d, a.1),
+                (a.0, a.1 - d),
+                (a.0 - d, a.1 + d),
+                (a.0 + d, a.1 + d),
+            ][(r >> 24) as usize % 4]
+        } else {
+            (((r >> 16) % 81) as i32 - 40, ((r >> 24) % 81) as i32 - 40)
+        };
+        let rho = [0.5, 1e-3 * 1.01, 0.2, 0.7071, 1.3, 2.9][(r >> 40) as usize % 6];
+        let mut swept = Vec::new();
+        for_each_swept_tile(a, b, rho, |t| {
+            swept.push(t);
+            true
+        });
+        for_each_centre_tile(a, b, |t| {
+            assert!(
+                swept.contains(&t),
+                "{a:?} -> {b:?} rho {rho}: centre tile {t:?} not swept"
+            );
+            seen += 1;
+            true
+        });
+    }
+    assert!(seen > 40_000, "{seen}");
+}
