@@ -62,6 +62,25 @@ pub(super) struct Mind {
     /// frame is rotated.
     pub(super) col_tiles: Vec<(i32, i32)>,
     pub(super) row_tiles: Vec<(i32, i32)>,
+    /// The tile of the last BM move sent ([`Mind::robot_tile`]).
+    pub(super) sent_to: Option<Tile>,
+    /// The tiling is one where a tile centre lies in its own tile by the rounding of
+    /// [`TileGrid::tile_of`] ([`centres_round_home`]).
+    ///
+    /// [`TileGrid::tile_of`]: crate::tiles::TileGrid::tile_of
+    pub(super) centres_home: bool,
+}
+
+/// Does `grid.tile_of(grid.center(t)) == t` hold for every tile `t` with `|i|, |j| < 2^30`?
+/// Sufficient (and checked here): a finite anchor below 1e15 in magnitude and a side in
+/// `(1e-9 max(|anchor|, 1), 1e15)`. Then `center(t).x = a + i side` (two roundings) and
+/// `tile_of` divides `center(t).x - a` (one more) by `side` (one more): the quotient is `i`
+/// within a few ulps of `2^30` plus a few ulps of `a / side < 1e9`, below 1e-6, so it rounds to
+/// `i`. The same for `j`.
+pub(super) fn centres_round_home(grid: &crate::tiles::TileGrid) -> bool {
+    let (a, s) = (grid.anchor, grid.side);
+    let scale = a.x.abs().max(a.y.abs()).max(1.0);
+    a.x.abs() < 1e15 && a.y.abs() < 1e15 && s < 1e15 && s > scale * 1e-9
 }
 
 /// [`Mind::col_tiles`] / [`Mind::row_tiles`]: for each of `n` pixel indices `p`, the range of
@@ -145,6 +164,27 @@ impl std::fmt::Debug for Mind {
 impl Mind {
     pub(super) fn center(&self, t: Tile) -> Point {
         self.tiles.grid.center(t)
+    }
+
+    /// The tile holding the robot at `p` ([`TileGrid::tile_of`]): without the divisions when
+    /// `p` is exactly the centre of the tile of the last BM move (`tile_of` gives that tile
+    /// there, see [`centres_round_home`]).
+    ///
+    /// [`TileGrid::tile_of`]: crate::tiles::TileGrid::tile_of
+    #[inline]
+    pub(super) fn robot_tile(&self, p: Point) -> Tile {
+        if let Some(t) = self.sent_to {
+            let c = self.center(t);
+            if self.centres_home
+                && t.0.unsigned_abs() < 1 << 30
+                && t.1.unsigned_abs() < 1 << 30
+                && c.x.to_bits() == p.x.to_bits()
+                && c.y.to_bits() == p.y.to_bits()
+            {
+                return t;
+            }
+        }
+        self.tiles.grid.tile_of(p)
     }
 
     /// The image rows and columns (inclusive, signed) whose pixel centres lie within the

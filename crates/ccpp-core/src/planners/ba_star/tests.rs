@@ -288,3 +288,52 @@ fn centre_line_tiles_are_swept_tiles() {
     }
     assert!(seen > 40_000, "{seen}");
 }
+
+/// Where `centres_round_home` holds, a tile centre lies in its own tile (`tile_of`) for
+/// anchors and sides of every magnitude it admits and tiles up to its index bound; the
+/// shortcut of `Mind::robot_tile` returns exactly what `tile_of` does.
+#[test]
+fn tile_centres_round_home() {
+    use super::sensing::centres_round_home;
+    use crate::tiles::TileGrid;
+    let mut seed: u64 = 0x6a09_e667_f3bc_c909;
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        seed
+    };
+    let mut checked = 0;
+    for _ in 0..200_000 {
+        let r = next();
+        let mag = [1.0, 1e-3, 1e3, 1e6, 1e9, 1e14, 9e14][(r % 7) as usize];
+        let anchor = Point::new(
+            ((r >> 8) % 100_003) as f64 * 1.7e-5 * mag - 0.8 * mag,
+            ((r >> 28) % 100_003) as f64 * -1.3e-5 * mag,
+        );
+        let scale = anchor.x.abs().max(anchor.y.abs()).max(1.0);
+        let side = [
+            0.05,
+            0.1,
+            0.025,
+            0.3,
+            1.7e-3,
+            2e-9 * scale,
+            1.01e-9 * scale,
+            9e14,
+        ][(r >> 48) as usize % 8];
+        let grid = TileGrid::new(anchor, side);
+        if !centres_round_home(&grid) {
+            continue;
+        }
+        let lim = [1_000i64, 1 << 20, (1 << 30) - 1][(next() % 3) as usize];
+        let v = next();
+        let t = (
+            ((v % (2 * lim as u64 + 1)) as i64 - lim) as i32,
+            (((v >> 32) % (2 * lim as u64 + 1)) as i64 - lim) as i32,
+        );
+        assert_eq!(grid.tile_of(grid.center(t)), t, "{grid:?} {t:?}");
+        checked += 1;
+    }
+    assert!(checked > 100_000, "{checked}");
+}
