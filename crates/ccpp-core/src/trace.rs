@@ -925,7 +925,7 @@ mod tests {
                 0 => p[0] = f64::from_bits(p[0].to_bits() ^ 1),
                 1 => p[1] = f64::from_bits(p[1].to_bits().wrapping_add(1)),
                 2 if k % 15 == 2 => {
-                    p[(r >> 40) as usize % 2] = [f64::NAN, f64::INFINITY][(r >> 41) as usize % 2]
+                    p[(r >> 40) as usize % 2] = [f64::NAN, f64::INFINITY][(r >> 41) as usize % 2];
                 }
                 _ => {}
             }
@@ -971,8 +971,13 @@ mod tests {
                 2 => a + (i + 0.5) * side,
                 3 => a + i * side + f64::from(k % 7) * 1e-13,
                 4 => {
-                    a + [2147483646.0, 2147483646.5, -2147483646.4, 2147483647.0, 3e9]
-                        [(r >> 20) as usize % 5]
+                    a + [
+                        2_147_483_646.0,
+                        2_147_483_646.5,
+                        -2_147_483_646.4,
+                        2_147_483_647.0,
+                        3e9,
+                    ][(r >> 20) as usize % 5]
                         * side
                 }
                 _ => [f64::NAN, f64::INFINITY, -f64::INFINITY, 1e300, -0.0][(r >> 30) as usize % 5],

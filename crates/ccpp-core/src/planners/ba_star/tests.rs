@@ -271,7 +271,7 @@ fn centre_line_tiles_are_swept_tiles() {
         } else {
             (((r >> 16) % 81) as i32 - 40, ((r >> 24) % 81) as i32 - 40)
         };
-        let rho = [0.5, 1e-3 * 1.01, 0.2, 0.7071, 1.3, 2.9][(r >> 40) as usize % 6];
+        let rho = [0.5, 1e-3 * 1.01, 0.2, 0.7, 1.3, 2.9][(r >> 40) as usize % 6];
         let mut swept = Vec::new();
         for_each_swept_tile(a, b, rho, |t| {
             swept.push(t);
