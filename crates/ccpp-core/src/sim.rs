@@ -25,7 +25,7 @@ use serde::{Deserialize, Serialize};
 use std::ops::{Add, Sub};
 
 use crate::exec::{Execution, Goal, PidOptions, Tracker, Unicycle};
-use crate::geometry::{wrap_angle, Point, Pose};
+use crate::geometry::{atan2_exact, dist_exact, wrap_angle, Point, Pose};
 use crate::grid::MapFrame;
 use crate::landmarks::{choose_pose, nearest_in_range, observe, LandmarkConfig};
 use crate::planner::{Planner, Scan, Sensor, Step};
@@ -260,10 +260,14 @@ impl<'w> Simulator<'w> {
             Step::Rotate(a) => self.rotate(a),
             Step::Translate(d) => self.translate(d),
             Step::MoveTo(p) => {
-                let d = p.sub(self.pose.position());
-                let dist = d.norm();
+                // `|p - pose|` and its heading, bit for bit, without the calls for the axis
+                // moves of tile-based planners.
+                let a = self.pose.position();
+                let dist = dist_exact(p, a);
                 if dist > 1e-12 {
-                    self.rotate(wrap_angle(d.y.atan2(d.x) - self.pose.theta));
+                    self.rotate(wrap_angle(
+                        atan2_exact(p.y - a.y, p.x - a.x) - self.pose.theta,
+                    ));
                     self.translate(dist);
                 }
             }

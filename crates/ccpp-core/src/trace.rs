@@ -32,7 +32,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::geometry::{Point, Pose};
+use crate::geometry::{round_i64, Point, Pose};
 
 /// Something that happened during a run (a mark in the trace). Planners emit most of these;
 /// the simulator emits [`Event::Collision`] and [`Event::Finished`].
@@ -221,11 +221,18 @@ impl Lattice {
     /// a lattice coordinate, else `None`.
     #[inline]
     fn index_1d(a: f64, x: f64, side: f64) -> Option<i32> {
-        let f = ((x - a) / side).round();
-        if f.is_nan() || f.abs() > f64::from(i32::MAX - 1) {
-            return None;
-        }
-        let i = f as i32;
+        let q = (x - a) / side;
+        let i = if q.abs() <= f64::from(i32::MAX - 1) {
+            // `q.round() as i32` without the call into libm: the rounded value lies in range.
+            round_i64(q) as i32
+        } else {
+            // NaN, or out of range (up to rounding at the bound).
+            let f = q.round();
+            if f.is_nan() || f.abs() > f64::from(i32::MAX - 1) {
+                return None;
+            }
+            f as i32
+        };
         (Self::coord(a, i, side).to_bits() == x.to_bits()).then_some(i)
     }
 
@@ -236,6 +243,29 @@ impl Lattice {
             Self::index_1d(self.anchor[0], p[0], self.side)?,
             Self::index_1d(self.anchor[1], p[1], self.side)?,
         ))
+    }
+
+    /// `self.index(p) == Some((i, j))`, without the two divisions for a lattice of the kind
+    /// [`Trace`] fixes (finite anchor and side below 1e15, side above 1e-9 of the anchor's
+    /// larger coordinate or of 1, indices below 2^30 in magnitude): there the quotient
+    /// `(x - a) / side` of a coordinate `x` equal to `coord(a, i, side)` lies within 1e-6 of
+    /// `i` (rounding errors of a few ulps of `i` and of `a / side < 1e9`), so it rounds to `i`,
+    /// and the index is `i` exactly when the coordinate is.
+    #[inline]
+    pub(crate) fn index_is(&self, p: [f64; 2], i: i32, j: i32) -> bool {
+        let [a0, a1] = self.anchor;
+        let scale = a0.abs().max(a1.abs()).max(1.0);
+        let usual = a0.abs() < 1e15
+            && a1.abs() < 1e15
+            && self.side < 1e15
+            && self.side > scale * 1e-9
+            && i.unsigned_abs() < 1 << 30
+            && j.unsigned_abs() < 1 << 30;
+        if !usual {
+            return self.index(p) == Some((i, j));
+        }
+        Self::coord(a0, i, self.side).to_bits() == p[0].to_bits()
+            && Self::coord(a1, j, self.side).to_bits() == p[1].to_bits()
     }
 
     /// A lattice anchored at `anchor` whose side is `d` rounded to 12 significant digits, when
@@ -474,7 +504,7 @@ impl Trace {
                 ) else {
                     return false;
                 };
-                if lat.index([p.x, p.y]) == Some((ni, nj)) && *n < u32::MAX {
+                if lat.index_is([p.x, p.y], ni, nj) && *n < u32::MAX {
                     *n += 1;
                     return true;
                 }
@@ -850,6 +880,114 @@ impl<'de> Deserialize<'de> for Trace {
 
 #[cfg(test)]
 mod tests {
+
+    /// `Lattice::index_is` says what `Lattice::index` says: lattice points and near misses by
+    /// an ulp, anchors and sides of every magnitude (the fast path and the bounds around it),
+    /// indices near 2^30 and the `i32` bound, non-finite coordinates.
+    #[test]
+    fn lattice_index_is_matches_index() {
+        let mut seed: u64 = 0x853c_49e6_748f_ea9b;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        };
+        let mut yes = 0;
+        for k in 0..200_000u32 {
+            let r = next();
+            let mag = [1.0, 1e-3, 1e3, 1e9, 1e14, 1e16, 1e300][(r % 7) as usize];
+            let a = [
+                ((r >> 8) % 2001) as f64 * 0.0371 * mag - mag * 37.0,
+                ((r >> 20) % 2001) as f64 * -0.0193 * mag,
+            ];
+            let side =
+                [0.05, 0.1, 0.025, 1.0, 7.3e-4, 1e-9, 1e12, 1e16, 1e-12][(r >> 32) as usize % 9];
+            let lat = Lattice { anchor: a, side };
+            let big = [
+                3,
+                200_000,
+                1 << 29,
+                (1 << 30) - 1,
+                1 << 30,
+                i32::MAX - 2,
+                i32::MAX,
+            ];
+            let pick = |v: u64| -> i32 {
+                let m = big[(v % 7) as usize];
+                let x = (v >> 8) as i64 % (i64::from(m) + 1);
+                let x = if v >> 63 == 1 { -x } else { x };
+                x.clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32
+            };
+            let (i, j) = (pick(next()), pick(next()));
+            let mut p = lat.point(i, j);
+            match k % 5 {
+                0 => p[0] = f64::from_bits(p[0].to_bits() ^ 1),
+                1 => p[1] = f64::from_bits(p[1].to_bits().wrapping_add(1)),
+                2 if k % 15 == 2 => {
+                    p[(r >> 40) as usize % 2] = [f64::NAN, f64::INFINITY][(r >> 41) as usize % 2];
+                }
+                _ => {}
+            }
+            let (ti, tj) = match (r >> 44) % 4 {
+                0 => (i, j + 1),
+                1 => (i.wrapping_sub(1), j),
+                _ => (i, j),
+            };
+            let want = lat.index(p) == Some((ti, tj));
+            assert_eq!(lat.index_is(p, ti, tj), want, "{lat:?} {p:?} {ti} {tj}");
+            yes += usize::from(want);
+        }
+        assert!(yes > 20_000, "{yes}");
+    }
+
+    /// `Lattice::index` without the libm `round` finds exactly the indices of the rounding
+    /// definition: halves either way, negative indices, the range bound, NaN and infinities.
+    #[test]
+    fn lattice_index_matches_rounding_definition() {
+        fn reference(a: f64, x: f64, side: f64) -> Option<i32> {
+            let f = ((x - a) / side).round();
+            if f.is_nan() || f.abs() > f64::from(i32::MAX - 1) {
+                return None;
+            }
+            let i = f as i32;
+            (Lattice::coord(a, i, side).to_bits() == x.to_bits()).then_some(i)
+        }
+        let mut seed: u64 = 0x9e37_79b9_7f4a_7c15;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        };
+        let mut hits = 0;
+        for k in 0..200_000u32 {
+            let r = next();
+            let side = [0.05, 0.1, 0.03, 1.0, 0.3][(r % 5) as usize];
+            let a = ((r >> 8) % 20_000) as f64 * 0.0137 - 100.0;
+            let i = ((next() % 400_000) as i64 - 200_000) as f64;
+            let x = match k % 6 {
+                0 | 1 => a + i * side,
+                2 => a + (i + 0.5) * side,
+                3 => a + i * side + f64::from(k % 7) * 1e-13,
+                4 => {
+                    a + [
+                        2_147_483_646.0,
+                        2_147_483_646.5,
+                        -2_147_483_646.4,
+                        2_147_483_647.0,
+                        3e9,
+                    ][(r >> 20) as usize % 5]
+                        * side
+                }
+                _ => [f64::NAN, f64::INFINITY, -f64::INFINITY, 1e300, -0.0][(r >> 30) as usize % 5],
+            };
+            let got = Lattice::index_1d(a, x, side);
+            assert_eq!(got, reference(a, x, side), "a {a} x {x} side {side}");
+            hits += usize::from(got.is_some());
+        }
+        assert!(hits > 50_000, "{hits}");
+    }
     use super::*;
 
     #[test]

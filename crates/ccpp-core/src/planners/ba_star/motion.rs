@@ -9,7 +9,7 @@ use crate::trace::Event;
 
 use super::judge::Judgement;
 use super::search::TileSearch;
-use super::sensing::{pixel_to_tiles, touch_box_of, DiskCache, Mind};
+use super::sensing::{centres_round_home, pixel_to_tiles, touch_box_of, DiskCache, Mind};
 use super::smoothing::smooth_path;
 use super::tile_model::TileModel;
 use super::{BaStar, Phase};
@@ -95,6 +95,8 @@ impl BaStar {
             touch_rows,
             gx,
             gy,
+            sent_to: None,
+            centres_home: centres_round_home(&grid),
         }));
     }
 
@@ -102,11 +104,12 @@ impl BaStar {
         let Some(m) = self.mind.as_deref_mut() else {
             return Step::Done;
         };
-        let c = m.tiles.grid.tile_of(sensor.pose().position());
+        let c = m.robot_tile(sensor.pose().position());
         m.cover(c);
         for k in [2, 6, 0, 4] {
             let n = (c.0 + N8[k].0, c.1 + N8[k].1);
             if !m.tiles.covered(n) && m.judge_move(c, k) == Judgement::Free {
+                m.sent_to = Some(n);
                 return Step::MoveTo(m.center(n));
             }
         }

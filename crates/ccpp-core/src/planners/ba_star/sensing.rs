@@ -8,7 +8,7 @@ use crate::tiles::{Tile, N8};
 
 use super::judge::{judge_motion_px, judge_point, Judgement};
 use super::search::TileSearch;
-use super::smoothing::for_each_swept_tile;
+use super::smoothing::{for_each_centre_tile, for_each_swept_tile};
 use super::tile_model::{TileModel, ST_COVERED, ST_DISK, ST_STAND};
 
 /// Margin (pixels) added to the contact radius when [`Mind::sense`] bounds the tiles a new
@@ -62,6 +62,25 @@ pub(super) struct Mind {
     /// frame is rotated.
     pub(super) col_tiles: Vec<(i32, i32)>,
     pub(super) row_tiles: Vec<(i32, i32)>,
+    /// The tile of the last BM move sent ([`Mind::robot_tile`]).
+    pub(super) sent_to: Option<Tile>,
+    /// The tiling is one where a tile centre lies in its own tile by the rounding of
+    /// [`TileGrid::tile_of`] ([`centres_round_home`]).
+    ///
+    /// [`TileGrid::tile_of`]: crate::tiles::TileGrid::tile_of
+    pub(super) centres_home: bool,
+}
+
+/// Does `grid.tile_of(grid.center(t)) == t` hold for every tile `t` with `|i|, |j| < 2^30`?
+/// Sufficient (and checked here): a finite anchor below 1e15 in magnitude and a side in
+/// `(1e-9 max(|anchor|, 1), 1e15)`. Then `center(t).x = a + i side` (two roundings) and
+/// `tile_of` divides `center(t).x - a` (one more) by `side` (one more): the quotient is `i`
+/// within a few ulps of `2^30` plus a few ulps of `a / side < 1e9`, below 1e-6, so it rounds to
+/// `i`. The same for `j`.
+pub(super) fn centres_round_home(grid: &crate::tiles::TileGrid) -> bool {
+    let (a, s) = (grid.anchor, grid.side);
+    let scale = a.x.abs().max(a.y.abs()).max(1.0);
+    a.x.abs() < 1e15 && a.y.abs() < 1e15 && s < 1e15 && s > scale * 1e-9
 }
 
 /// [`Mind::col_tiles`] / [`Mind::row_tiles`]: for each of `n` pixel indices `p`, the range of
@@ -147,6 +166,27 @@ impl Mind {
         self.tiles.grid.center(t)
     }
 
+    /// The tile holding the robot at `p` ([`TileGrid::tile_of`]): without the divisions when
+    /// `p` is exactly the centre of the tile of the last BM move (`tile_of` gives that tile
+    /// there, see [`centres_round_home`]).
+    ///
+    /// [`TileGrid::tile_of`]: crate::tiles::TileGrid::tile_of
+    #[inline]
+    pub(super) fn robot_tile(&self, p: Point) -> Tile {
+        if let Some(t) = self.sent_to {
+            let c = self.center(t);
+            if self.centres_home
+                && t.0.unsigned_abs() < 1 << 30
+                && t.1.unsigned_abs() < 1 << 30
+                && c.x.to_bits() == p.x.to_bits()
+                && c.y.to_bits() == p.y.to_bits()
+            {
+                return t;
+            }
+        }
+        self.tiles.grid.tile_of(p)
+    }
+
     /// The image rows and columns (inclusive, signed) whose pixel centres lie within the
     /// contact radius of tile `t`'s centre in each coordinate, with a margin of
     /// [`TIGHT_BOX_MARGIN_PX`]: every pixel that can touch the tile's disk lies in them.
@@ -163,6 +203,15 @@ impl Mind {
         ) {
             return (r, c);
         }
+        self.touch_box_far(t)
+    }
+
+    /// [`Mind::touch_box`] off the tables (a rotated frame, or a tile outside the tiling):
+    /// out of line, so that the hot callers do not evaluate the rotation's sine and cosine
+    /// ahead of the table lookup.
+    #[cold]
+    #[inline(never)]
+    fn touch_box_far(&self, t: Tile) -> ((i64, i64), (i64, i64)) {
         let h = self.known.frame().height as f64;
         touch_box_of(self.grid_center(t), self.rc_px, h)
     }
@@ -215,6 +264,13 @@ impl Mind {
         ) {
             return Point::new(x, y);
         }
+        self.grid_center_far(t)
+    }
+
+    /// [`Mind::grid_center`] off the tables (out of line, as [`Mind::touch_box_far`]).
+    #[cold]
+    #[inline(never)]
+    fn grid_center_far(&self, t: Tile) -> Point {
         self.known.frame().world_to_grid(self.center(t))
     }
 
@@ -535,6 +591,10 @@ impl Mind {
     pub(super) fn visible(&self, a: Tile, b: Tile) -> bool {
         let rho = self.r / self.tiles.grid.side;
         let tiles = &self.tiles;
+        // The tiles along the centre line first: one of them uncovered, a swept tile is.
+        if rho > 1e-3 && !for_each_centre_tile(a, b, |t| tiles.covered(t)) {
+            return false;
+        }
         for_each_swept_tile(a, b, rho, |t| tiles.covered(t))
             && judge_motion_px(
                 &self.known,

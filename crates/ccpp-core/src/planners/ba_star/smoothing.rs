@@ -1,6 +1,6 @@
 //! A*SPT path smoothing and its line-of-sight geometry (the tiles a moving disk sweeps).
 
-use crate::geometry::{ceil_i32, floor_i32, point_segment_dist2, Point};
+use crate::geometry::{ceil_i32, floor_i32, point_segment_dist2, round_i32, Point};
 use crate::tiles::Tile;
 
 /// Squared distance between segment `a`-`b` and the axis-aligned box `lo`-`hi` (0 when they
@@ -129,6 +129,35 @@ pub fn for_each_swept_tile(a: Tile, b: Tile, rho: f64, mut f: impl FnMut(Tile) -
             break;
         }
         j += step;
+    }
+    true
+}
+
+/// Calls `f` for tiles that [`for_each_swept_tile`] with the same `a`, `b` and a radius
+/// `rho > 1e-3` surely visits: the tiles holding the points `a + (k / n) (b - a)`, `k = 0..=n`,
+/// `n` the larger of `|b - a|`'s coordinates (tile units), each point rounded to its tile. The
+/// centre passes through each such (closed) square, so the square's distance to the segment is
+/// zero (up to rounding far below `rho^2`) and the swept disk touches it. Stops early when `f`
+/// returns `false` (and then returns `false`). A cheap first test of line of sight: one tile per
+/// step along the longer axis, no distances.
+pub(super) fn for_each_centre_tile(a: Tile, b: Tile, mut f: impl FnMut(Tile) -> bool) -> bool {
+    let (dx, dy) = (
+        i64::from(b.0) - i64::from(a.0),
+        i64::from(b.1) - i64::from(a.1),
+    );
+    let n = dx.abs().max(dy.abs());
+    if n == 0 {
+        return f(a);
+    }
+    let (ax, ay) = (f64::from(a.0), f64::from(a.1));
+    let (fx, fy) = (dx as f64, dy as f64);
+    let nf = n as f64;
+    for k in 0..=n {
+        let t = k as f64 / nf;
+        let t = (round_i32(ax + t * fx), round_i32(ay + t * fy));
+        if !f(t) {
+            return false;
+        }
     }
     true
 }

@@ -200,3 +200,140 @@ fn heuristic_is_consistent() {
     assert!(heuristic((0, 0), (1, 1)) <= COST_DIAG);
     assert!(heuristic((0, 0), (3, 4)) == 5 * COST_ORTHO);
 }
+
+/// The column-and-row pass of `judge_frame_edges` (unrotated frames) judges exactly the
+/// tiles the tile-by-tile pass judges, the same way: frames of odd sizes, resolutions that
+/// are not binary fractions, start points anywhere in a pixel and tile sides from below a
+/// pixel to many pixels.
+#[test]
+fn frame_edges_by_lines_match_tile_by_tile() {
+    use super::tile_model::TileModel;
+    use crate::grid::MapFrame;
+    use crate::tiles::TileGrid;
+    let mut seed: u64 = 0x2545_f491_4f6c_dd1d;
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut judged = 0;
+    for _ in 0..60 {
+        let w = 3 + (next() * 60.0) as usize;
+        let h = 3 + (next() * 60.0) as usize;
+        let res = [0.05, 0.03, 0.1, 0.07][(next() * 4.0) as usize];
+        let mut frame = MapFrame::new(w, h, res);
+        frame.origin = crate::geometry::Pose::new(next() * 7.0 - 3.0, next() * 7.0 - 3.0, 0.0);
+        let r = res * (0.3 + next() * 4.0);
+        let start = Point::new(
+            frame.origin.x + next() * w as f64 * res,
+            frame.origin.y + next() * h as f64 * res,
+        );
+        let side = [2.0 * r, res, r * 1.3][(next() * 3.0) as usize];
+        let grid = TileGrid::new(start, side);
+        let known = KnownMap::new(&frame);
+        let mut a = TileModel::new(grid, &frame);
+        let mut b = TileModel::new(grid, &frame);
+        a.judge_frame_edges_with(&known, r, true);
+        b.judge_frame_edges_with(&known, r, false);
+        assert_eq!(a.state, b.state, "frame {frame:?} r {r} side {side}");
+        judged += a.state.iter().filter(|&&s| s != 0).count();
+    }
+    assert!(judged > 100, "{judged}");
+}
+
+/// Every tile of the centre line (`for_each_centre_tile`) is a tile the swept disk touches
+/// (`for_each_swept_tile`), for any direction, length and radius above 1e-3 tiles; so an
+/// uncovered centre tile refuses line of sight exactly when the full test would.
+#[test]
+fn centre_line_tiles_are_swept_tiles() {
+    use super::smoothing::for_each_centre_tile;
+    let mut seed: u64 = 0xd1b5_4a32_d192_ed03;
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        seed
+    };
+    let mut seen = 0usize;
+    for k in 0..4000 {
+        let r = next();
+        let a = ((r % 41) as i32 - 20, ((r >> 8) % 41) as i32 - 20);
+        let b = if k % 4 == 0 {
+            // Axis and diagonal moves, as most backtracking segments.
+            let d = ((r >> 16) % 30) as i32;
+            [
+                (a.0 + d, a.1),
+                (a.0, a.1 - d),
+                (a.0 - d, a.1 + d),
+                (a.0 + d, a.1 + d),
+            ][(r >> 24) as usize % 4]
+        } else {
+            (((r >> 16) % 81) as i32 - 40, ((r >> 24) % 81) as i32 - 40)
+        };
+        let rho = [0.5, 1e-3 * 1.01, 0.2, 0.7, 1.3, 2.9][(r >> 40) as usize % 6];
+        let mut swept = Vec::new();
+        for_each_swept_tile(a, b, rho, |t| {
+            swept.push(t);
+            true
+        });
+        for_each_centre_tile(a, b, |t| {
+            assert!(
+                swept.contains(&t),
+                "{a:?} -> {b:?} rho {rho}: centre tile {t:?} not swept"
+            );
+            seen += 1;
+            true
+        });
+    }
+    assert!(seen > 40_000, "{seen}");
+}
+
+/// Where `centres_round_home` holds, a tile centre lies in its own tile (`tile_of`) for
+/// anchors and sides of every magnitude it admits and tiles up to its index bound; the
+/// shortcut of `Mind::robot_tile` returns exactly what `tile_of` does.
+#[test]
+fn tile_centres_round_home() {
+    use super::sensing::centres_round_home;
+    use crate::tiles::TileGrid;
+    let mut seed: u64 = 0x6a09_e667_f3bc_c909;
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        seed
+    };
+    let mut checked = 0;
+    for _ in 0..200_000 {
+        let r = next();
+        let mag = [1.0, 1e-3, 1e3, 1e6, 1e9, 1e14, 9e14][(r % 7) as usize];
+        let anchor = Point::new(
+            ((r >> 8) % 100_003) as f64 * 1.7e-5 * mag - 0.8 * mag,
+            ((r >> 28) % 100_003) as f64 * -1.3e-5 * mag,
+        );
+        let scale = anchor.x.abs().max(anchor.y.abs()).max(1.0);
+        let side = [
+            0.05,
+            0.1,
+            0.025,
+            0.3,
+            1.7e-3,
+            2e-9 * scale,
+            1.01e-9 * scale,
+            9e14,
+        ][(r >> 48) as usize % 8];
+        let grid = TileGrid::new(anchor, side);
+        if !centres_round_home(&grid) {
+            continue;
+        }
+        let lim = [1_000i64, 1 << 20, (1 << 30) - 1][(next() % 3) as usize];
+        let v = next();
+        let t = (
+            ((v % (2 * lim as u64 + 1)) as i64 - lim) as i32,
+            (((v >> 32) % (2 * lim as u64 + 1)) as i64 - lim) as i32,
+        );
+        assert_eq!(grid.tile_of(grid.center(t)), t, "{grid:?} {t:?}");
+        checked += 1;
+    }
+    assert!(checked > 100_000, "{checked}");
+}

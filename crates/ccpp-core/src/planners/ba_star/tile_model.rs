@@ -58,18 +58,51 @@ impl TileModel {
     /// Tiles whose disk reaches outside the image are obstacles from the frame alone (the
     /// outside of the map is occupied): judge them once, before any scan.
     pub(super) fn judge_frame_edges(&mut self, known: &KnownMap, r: f64) {
+        let by_lines = known.frame().origin.theta == 0.0;
+        self.judge_frame_edges_with(known, r, by_lines);
+    }
+
+    /// [`TileModel::judge_frame_edges`]; `by_lines` (only for an unrotated frame) takes the
+    /// test a column and a row at a time instead of tile by tile (tests compare the two).
+    pub(super) fn judge_frame_edges_with(&mut self, known: &KnownMap, r: f64, by_lines: bool) {
         let frame = *known.frame();
         let rc = contact_radius_px(r / frame.resolution) + 1.0;
         let (w, h) = (frame.width as f64, frame.height as f64);
-        for k in 0..self.state.len() {
-            let t = (self.i0 + (k % self.w) as i32, self.j0 + (k / self.w) as i32);
-            let p = self.grid.center(t);
-            let g = frame.world_to_grid(p);
-            if g.x - rc > 0.0 && g.y - rc > 0.0 && g.x + rc < w && g.y + rc < h {
-                continue;
-            }
+        let inner_x = |x: f64| x - rc > 0.0 && x + rc < w;
+        let inner_y = |y: f64| y - rc > 0.0 && y + rc < h;
+        let grid = self.grid;
+        let state = &mut self.state;
+        let mut judge = |k: usize, t: Tile| {
+            let p = grid.center(t);
             let j = judge_motion(known, p, p, r);
-            self.state[k] = (self.state[k] & !ST_STAND) | j as u8;
+            state[k] = (state[k] & !ST_STAND) | j as u8;
+        };
+        if by_lines {
+            // Unrotated: a centre's grid x depends on its tile column alone and its y on its
+            // row alone (as `Mind::gx`, `Mind::gy`), so the test splits into one per column
+            // and one per row, and only the tiles failing one are visited.
+            let (i0, j0, w) = (self.i0, self.j0, self.w);
+            let cols: Vec<bool> = (0..w)
+                .map(|di| inner_x(frame.world_to_grid(grid.center((i0 + di as i32, j0))).x))
+                .collect();
+            for dj in 0..self.h {
+                let j = j0 + dj as i32;
+                let row_inner = inner_y(frame.world_to_grid(grid.center((i0, j))).y);
+                for (di, &col_inner) in cols.iter().enumerate() {
+                    if !(row_inner && col_inner) {
+                        judge(dj * w + di, (i0 + di as i32, j));
+                    }
+                }
+            }
+            return;
+        }
+        let (i0, j0, w) = (self.i0, self.j0, self.w);
+        for k in 0..w * self.h {
+            let t = (i0 + (k % w) as i32, j0 + (k / w) as i32);
+            let g = frame.world_to_grid(grid.center(t));
+            if !(inner_x(g.x) && inner_y(g.y)) {
+                judge(k, t);
+            }
         }
     }
 
