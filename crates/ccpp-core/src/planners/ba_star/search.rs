@@ -478,7 +478,10 @@ impl TileSearch {
                 }
                 continue;
             }
-            self.expand_to_targets(g, t, k, d);
+            // Once a target is found at `d*`, labels with keys above it are never popped
+            // (nor read by `mark_optimal`, which reads settled tiles only): not pushed.
+            let bound = best.map_or(u64::MAX, |(_, bd)| bd);
+            self.expand_to_targets(g, t, k, d, bound);
         }
         if let Some((k, d)) = best {
             self.last_nearest = Some((s, k, d, self.generation));
@@ -512,8 +515,9 @@ impl TileSearch {
         Some((y * self.w + x, self.slot(x, y)))
     }
 
-    /// [`Self::expand_within`] for [`Self::nearest_of`]: keys `cost + target_h`.
-    fn expand_to_targets(&mut self, g: &impl TileGraph, t: Tile, k: usize, d: u64) {
+    /// [`Self::expand_within`] for [`Self::nearest_of`]: keys `cost + target_h`, none above
+    /// `bound`.
+    fn expand_to_targets(&mut self, g: &impl TileGraph, t: Tile, k: usize, d: u64, bound: u64) {
         let mut mask = g.edge_mask(t);
         while mask != 0 {
             let n = mask.trailing_zeros() as usize;
@@ -528,6 +532,9 @@ impl TileSearch {
             }
             let (di, dj) = N8[n];
             let f = nd + self.target_h((t.0 + di, t.1 + dj));
+            if f > bound {
+                continue;
+            }
             self.nodes[sv] = word(nd, n as NodeWord);
             self.heap.push(f, kv as u32);
         }
