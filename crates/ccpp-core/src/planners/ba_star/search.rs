@@ -52,8 +52,8 @@ pub fn graph_edge(g: &impl TileGraph, t: Tile, k: usize) -> bool {
 }
 
 /// Reusable dense scratch for Dijkstra and A* over a tile rectangle (no hashing, nothing
-/// cleared per search). One 8-byte word per tile ([`NodeWord`]: cost, settled flag, direction
-/// from the parent), stored in blocks of [`NODE_BLOCK`] x [`NODE_BLOCK`] tiles (512 bytes) so a
+/// cleared per search). One 8-byte word per tile (`NodeWord`: cost, settled flag, direction
+/// from the parent), stored in blocks of 8 x 8 tiles (`NODE_BLOCK`, 512 bytes) so a
 /// search over a compact area touches few cache lines and pages; a block is reset the first
 /// time a search touches it (a generation stamp per block). Heap entries carry the row-major
 /// tile index, whose order is the `(j, i)` tie-break.
