@@ -280,7 +280,9 @@ impl TileSearch {
             w,
             h,
             bw,
-            nodes: vec![UNLABELLED; nb * NODE_BLOCK * NODE_BLOCK],
+            // Zeros (pages the system maps on first touch): every block is reset before its
+            // first use, as no block stamp matches a search's generation (from 1) yet.
+            nodes: vec![0; nb * NODE_BLOCK * NODE_BLOCK],
             bstamp: vec![0; nb],
             generation: 0,
             heap: MonotoneQueue::new(),
