@@ -8,7 +8,7 @@ use ccpp_core::grid::{Cell, GridMap};
 use ccpp_core::metrics::{compute, Metrics};
 use ccpp_core::planner::{Planner, Sensor, Step};
 use ccpp_core::planners::ba_star::{
-    corner_score, motion_to, BaStar, BaStarOptions, TileGraph, TileSearch, COST_ORTHO,
+    corner_score, motion_to, BaStar, BaStarOptions, TileGraph, TileSearch, COST_DIAG, COST_ORTHO,
 };
 use ccpp_core::sim::{simulate, RunOutput, SimConfig};
 use ccpp_core::tiles::{Tile, N8};
@@ -837,4 +837,210 @@ fn start_tile_south_neighbour_is_a_candidate() {
     // The smallest form: a start in a 1-wide N-S corridor, in the middle.
     let art = "#.#\n#.#\n#.#\n#.#\n#.#";
     check_run(art, 1, 2, 0.0);
+}
+
+/// Covered tiles like BA*'s late in a run on a cluttered map: a rectangle at a pseudo-random
+/// offset (negative corners, sides not multiples of the search's storage blocks), thin walls
+/// with gaps, salt noise, and some one-way blocked moves; every fourth seed an open rectangle
+/// (all moves free), where many tiles share the cost of the nearest target (ties).
+struct Clutter {
+    i0: i32,
+    j0: i32,
+    w: i32,
+    h: i32,
+    covered: Vec<bool>,
+    seed: u64,
+}
+
+impl Clutter {
+    fn new(seed: u64) -> Self {
+        let mut x = seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1;
+        let mut next = move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let (w, h) = (29 + (next() % 40) as i32, 23 + (next() % 40) as i32);
+        let (i0, j0) = (-((next() % 17) as i32), -((next() % 13) as i32));
+        let open = seed % 4 == 3;
+        let noise = if open { 0 } else { 6 };
+        let mut covered: Vec<bool> = (0..w * h).map(|_| next() % 100 >= noise).collect();
+        // Thin walls, a row or a column each, with a gap or two.
+        for _ in 0..if open { 0 } else { 4 } {
+            let vertical = next() % 2 == 0;
+            let at = (next() % 1000) as i32;
+            let gap = (next() % 1000) as i32;
+            let n = if vertical { h } else { w };
+            for s in 0..n {
+                if (s - gap % n).abs() <= 1 || s == (gap * 7) % n {
+                    continue;
+                }
+                let (i, j) = if vertical { (at % w, s) } else { (s, at % h) };
+                covered[(j * w + i) as usize] = false;
+            }
+        }
+        Self {
+            i0,
+            j0,
+            w,
+            h,
+            covered,
+            seed,
+        }
+    }
+
+    fn tiles(&self) -> Vec<Tile> {
+        (0..self.w * self.h)
+            .map(|k| (self.i0 + k % self.w, self.j0 + k / self.w))
+            .filter(|&t| self.covered(t))
+            .collect()
+    }
+
+    /// The row-major index of `t` in the bounds (the searches' tie-break order).
+    fn index(&self, t: Tile) -> usize {
+        ((t.1 - self.j0) * self.w + t.0 - self.i0) as usize
+    }
+}
+
+impl TileGraph for Clutter {
+    fn bounds(&self) -> (i32, i32, i32, i32) {
+        (self.i0, self.i0 + self.w - 1, self.j0, self.j0 + self.h - 1)
+    }
+    fn covered(&self, t: Tile) -> bool {
+        let (i, j) = (t.0 - self.i0, t.1 - self.j0);
+        (0..self.w).contains(&i)
+            && (0..self.h).contains(&j)
+            && self.covered[(j * self.w + i) as usize]
+    }
+    fn move_free(&self, t: Tile, k: usize) -> bool {
+        self.seed % 4 == 3 || (t.0 * 5 + t.1 * 11 + k as i32 + self.seed as i32).rem_euclid(23) != 0
+    }
+}
+
+/// A plain best-first search written independently of [`TileSearch`] (a binary heap of
+/// `(key, row-major index)`, labels in a vector, parent set on a strict improvement): with
+/// `goal`, A* with the Euclidean heuristic to it; without, Dijkstra stopping at the first
+/// settled tile with `is_target`. Returns the tile, its cost and the path to it.
+fn reference_search(
+    g: &Clutter,
+    from: Tile,
+    goal: Option<Tile>,
+    is_target: impl Fn(Tile) -> bool,
+) -> Option<(Tile, u64, Vec<Tile>)> {
+    use std::cmp::Reverse;
+    use std::collections::BinaryHeap;
+    let n = (g.w * g.h) as usize;
+    let tile = |k: usize| {
+        (
+            g.i0 + (k % g.w as usize) as i32,
+            g.j0 + (k / g.w as usize) as i32,
+        )
+    };
+    let h = |t: Tile| goal.map_or(0, |gl| ccpp_core::planners::ba_star::heuristic(t, gl));
+    let mut dist = vec![u64::MAX; n];
+    let mut parent = vec![usize::MAX; n];
+    let mut done = vec![false; n];
+    let s = g.index(from);
+    dist[s] = 0;
+    let mut heap = BinaryHeap::new();
+    heap.push(Reverse((h(from), s)));
+    while let Some(Reverse((_, k))) = heap.pop() {
+        if done[k] {
+            continue;
+        }
+        done[k] = true;
+        let t = tile(k);
+        if goal.map_or_else(|| is_target(t), |gl| gl == t) {
+            let mut path = vec![t];
+            let mut c = k;
+            while parent[c] != usize::MAX {
+                c = parent[c];
+                path.push(tile(c));
+            }
+            path.reverse();
+            return Some((t, dist[k], path));
+        }
+        for (m, &(di, dj)) in N8.iter().enumerate() {
+            if !ccpp_core::planners::ba_star::graph_edge(g, t, m) {
+                continue;
+            }
+            let v = (t.0 + di, t.1 + dj);
+            let kv = g.index(v);
+            let nd = dist[k] + if m % 2 == 1 { COST_DIAG } else { COST_ORTHO };
+            if !done[kv] && nd < dist[kv] {
+                dist[kv] = nd;
+                parent[kv] = k;
+                heap.push(Reverse((nd + h(v), kv)));
+            }
+        }
+    }
+    None
+}
+
+/// Every search of [`TileSearch`] answers as the independent [`reference_search`], over
+/// many searches on one scratch (generations and storage blocks reused), sparse and dense
+/// target sets, maps at pseudo-random offsets with thin walls and noise. (Seed 29 catches a
+/// `nearest_of` that drops labels at the key of the target found first.)
+#[test]
+fn tile_searches_answer_as_an_independent_search() {
+    let (mut found, mut paths) = (0, 0);
+    for seed in 0..64u64 {
+        let g = Clutter::new(seed);
+        let tiles = g.tiles();
+        let mut s = TileSearch::new(g.bounds());
+        let mut x = seed | 0x51;
+        for round in 0..20 {
+            x = x
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            let every = [1, 3, 17, 97, 400][round % 5];
+            let from = tiles[(x >> 20) as usize % tiles.len()];
+            let targets: Vec<Tile> = if round % 3 == 2 {
+                // Targets on a square or diamond around the source: many at the same cost.
+                let r = 2 + (x >> 50) as i32 % 9;
+                tiles
+                    .iter()
+                    .copied()
+                    .filter(|&(i, j)| {
+                        let (a, b) = ((i - from.0).abs(), (j - from.1).abs());
+                        (a.max(b) == r || a + b == r + 3) && (i + 2 * j) % 3 != 0
+                    })
+                    .collect()
+            } else {
+                tiles
+                    .iter()
+                    .copied()
+                    .skip((x >> 40) as usize % 11)
+                    .step_by(every)
+                    .collect()
+            };
+            let is_target = |t: Tile| targets.contains(&t);
+            let want = reference_search(&g, from, None, is_target).map(|(t, c, _)| (t, c));
+            assert_eq!(
+                s.nearest(&g, from, is_target),
+                want,
+                "seed {seed} round {round}"
+            );
+            let got = s.nearest_of(&g, from, &targets, is_target);
+            assert_eq!(got, want, "seed {seed} round {round}");
+            if let Some((t, c)) = got {
+                found += 1;
+                let (_, rc, rpath) = reference_search(&g, from, Some(t), |_| false).unwrap();
+                assert_eq!(rc, c);
+                assert_eq!(
+                    s.astar_nearest(&g, from, t, c),
+                    Some((rpath.clone(), c)),
+                    "seed {seed} round {round}"
+                );
+                assert_eq!(s.astar(&g, from, t), Some((rpath, c)));
+            }
+            // A path to an arbitrary tile (often through the walls' gaps, or unreachable).
+            let to = tiles[(x >> 8) as usize % tiles.len()];
+            let want = reference_search(&g, from, Some(to), |_| false).map(|(_, c, p)| (p, c));
+            paths += usize::from(want.is_some());
+            assert_eq!(s.astar(&g, from, to), want, "seed {seed} round {round}");
+        }
+    }
+    assert!(found > 300 && paths > 300, "{found} {paths}");
 }

@@ -51,16 +51,24 @@ pub fn graph_edge(g: &impl TileGraph, t: Tile, k: usize) -> bool {
     g.move_free(t, k)
 }
 
-/// Reusable dense scratch for Dijkstra and A* over a tile rectangle (no hashing; generation
-/// stamps avoid clearing between searches). One record per tile, so a visit touches one cache
-/// line; heap entries carry the row-major tile index, whose order is the `(j, i)` tie-break.
+/// Reusable dense scratch for Dijkstra and A* over a tile rectangle (no hashing, nothing
+/// cleared per search). One 8-byte word per tile (`NodeWord`: cost, settled flag, direction
+/// from the parent), stored in blocks of 8 x 8 tiles (`NODE_BLOCK`, 512 bytes) so a
+/// search over a compact area touches few cache lines and pages; a block is reset the first
+/// time a search touches it (a generation stamp per block). Heap entries carry the row-major
+/// tile index, whose order is the `(j, i)` tie-break.
 #[derive(Clone, Debug)]
 pub struct TileSearch {
     i0: i32,
     j0: i32,
     w: usize,
     h: usize,
-    nodes: Vec<SearchNode>,
+    /// Storage blocks per row.
+    bw: usize,
+    /// The node words, block after block (row-major inside a block).
+    nodes: Vec<u64>,
+    /// Per storage block: the generation its words belong to (older: all unlabelled).
+    bstamp: Vec<u32>,
     generation: u32,
     heap: MonotoneQueue,
     /// Scratch of [`Self::nearest_of`]: the targets' candidate lists per block.
@@ -70,6 +78,35 @@ pub struct TileSearch {
     last_nearest: Option<(usize, usize, u64, u32)>,
     /// Scratch of [`Self::mark_optimal`].
     stack: Vec<u32>,
+    /// The tiles marked by [`Self::mark_optimal`]: a bit per row-major index, and the list of
+    /// the set bits (to clear them).
+    marks: Vec<u64>,
+    marked: Vec<u32>,
+}
+
+/// Side, in tiles, of the storage blocks of [`TileSearch`].
+const NODE_BLOCK: usize = 8;
+
+/// A search node in one word: the cost in the bits from [`DIST_SHIFT`] up, [`SETTLED`], and in
+/// the low bits the index `n` of [`N8`] with `tile = parent + N8[n]` ([`NO_PARENT`] at the
+/// source). Costs stay far below `2^59` (a path visits a tile at most once, each step costs at
+/// most [`COST_DIAG`]).
+type NodeWord = u64;
+const DIR_MASK: NodeWord = 0xF;
+const NO_PARENT: NodeWord = 8;
+const SETTLED: NodeWord = 1 << 4;
+const DIST_SHIFT: u32 = 5;
+/// A node not labelled in the current search: the largest cost, not settled, no parent.
+const UNLABELLED: NodeWord = (NodeWord::MAX << DIST_SHIFT) | NO_PARENT;
+
+#[inline]
+fn word_dist(n: NodeWord) -> u64 {
+    n >> DIST_SHIFT
+}
+
+#[inline]
+fn word(dist: u64, dir: NodeWord) -> NodeWord {
+    (dist << DIST_SHIFT) | dir
 }
 
 /// Side, in tiles, of the blocks of [`TargetBlocks`].
@@ -230,26 +267,23 @@ impl MonotoneQueue {
     }
 }
 
-/// Per-tile search state (16 bytes): labelled in this search when `stamp` is the current
-/// generation (even), settled when it is the generation + 1; stamp 0 is "never labelled".
-#[derive(Clone, Copy, Debug, Default)]
-struct SearchNode {
-    dist: u64,
-    parent: u32,
-    stamp: u32,
-}
-
 impl TileSearch {
     /// Scratch for tiles `i0..=i1`, `j0..=j1`.
     pub fn new((i0, i1, j0, j1): (i32, i32, i32, i32)) -> Self {
         let w = (i1 - i0 + 1).max(0) as usize;
         let h = (j1 - j0 + 1).max(0) as usize;
+        let bw = w.div_ceil(NODE_BLOCK);
+        let nb = bw * h.div_ceil(NODE_BLOCK);
         Self {
             i0,
             j0,
             w,
             h,
-            nodes: vec![SearchNode::default(); w * h],
+            bw,
+            // Zeros (pages the system maps on first touch): every block is reset before its
+            // first use, as no block stamp matches a search's generation (from 1) yet.
+            nodes: vec![0; nb * NODE_BLOCK * NODE_BLOCK],
+            bstamp: vec![0; nb],
             generation: 0,
             heap: MonotoneQueue::new(),
             blocks: TargetBlocks {
@@ -259,6 +293,8 @@ impl TileSearch {
             },
             last_nearest: None,
             stack: Vec::new(),
+            marks: vec![0; (w * h).div_ceil(64)],
+            marked: Vec::new(),
         }
     }
 
@@ -278,44 +314,101 @@ impl TileSearch {
         (self.i0 + (k % self.w) as i32, self.j0 + (k / self.w) as i32)
     }
 
+    /// The storage block of the tile at offset `(x, y)` and the word's place in it.
+    #[inline]
+    fn block_of(&self, x: usize, y: usize) -> (usize, usize) {
+        (
+            (y / NODE_BLOCK) * self.bw + x / NODE_BLOCK,
+            (y % NODE_BLOCK) * NODE_BLOCK + x % NODE_BLOCK,
+        )
+    }
+
+    /// The word index of the tile at offset `(x, y)` (in the rectangle), resetting its block
+    /// to unlabelled words when the current search touches it first.
+    // Measured: left to the compiler, this hot accessor stays an out-of-line call.
+    #[allow(clippy::inline_always)]
+    #[inline(always)]
+    fn slot(&mut self, x: usize, y: usize) -> usize {
+        let (b, o) = self.block_of(x, y);
+        if self.bstamp[b] != self.generation {
+            self.reset_block(b);
+        }
+        b * NODE_BLOCK * NODE_BLOCK + o
+    }
+
+    /// Makes the words of storage block `b` unlabelled in the current search.
+    #[cold]
+    #[inline(never)]
+    fn reset_block(&mut self, b: usize) {
+        self.bstamp[b] = self.generation;
+        let base = b * NODE_BLOCK * NODE_BLOCK;
+        self.nodes[base..base + NODE_BLOCK * NODE_BLOCK].fill(UNLABELLED);
+    }
+
+    /// The word of the tile at offset `(x, y)` in the current search (read only).
+    #[inline]
+    fn peek(&self, x: usize, y: usize) -> NodeWord {
+        let (b, o) = self.block_of(x, y);
+        if self.bstamp[b] == self.generation {
+            self.nodes[b * NODE_BLOCK * NODE_BLOCK + o]
+        } else {
+            UNLABELLED
+        }
+    }
+
+    #[inline]
+    fn is_marked(&self, k: usize) -> bool {
+        self.marks[k / 64] & (1 << (k % 64)) != 0
+    }
+
+    fn clear_marks(&mut self) {
+        for &k in &self.marked {
+            self.marks[k as usize / 64] = 0;
+        }
+        self.marked.clear();
+    }
+
     fn begin(&mut self) {
-        self.generation = self.generation.wrapping_add(2);
+        self.generation = self.generation.wrapping_add(1);
         if self.generation == 0 {
-            for n in &mut self.nodes {
-                n.stamp = 0;
-            }
-            self.generation = 2;
+            self.bstamp.fill(0);
+            self.generation = 1;
         }
         self.heap.clear();
     }
 
-    /// Is node `k` settled in the current search?
-    #[inline]
-    fn closed(&self, k: usize) -> bool {
-        self.nodes[k].stamp == self.generation + 1
+    /// Labels the source (row-major index `s`) with cost 0.
+    fn start(&mut self, s: usize, key: u64) {
+        let ss = self.slot(s % self.w, s / self.w);
+        self.nodes[ss] = word(0, NO_PARENT);
+        self.heap.push(key, s as u32);
     }
 
-    /// Relaxes the label of node `k` (never called on a settled node).
+    /// Settles the node of a popped pair (row-major `k`): its word index and cost, or `None`
+    /// when it was settled already or (with `check_dist`) the pair's key is above its cost.
     #[inline]
-    fn relax(&mut self, k: usize, d: u64, parent: u32) -> bool {
-        let gen = self.generation;
-        let n = &mut self.nodes[k];
-        if n.stamp != gen || d < n.dist {
-            n.stamp = gen;
-            n.dist = d;
-            n.parent = parent;
-            true
-        } else {
-            false
+    fn settle(&mut self, k: usize, key: u64, check_dist: bool) -> Option<(usize, u64)> {
+        let sk = self.slot(k % self.w, k / self.w);
+        let n = self.nodes[sk];
+        if n & SETTLED != 0 || (check_dist && key > word_dist(n)) {
+            return None;
         }
+        self.nodes[sk] = n | SETTLED;
+        Some((sk, word_dist(n)))
     }
 
     fn path_to(&self, k: usize) -> Vec<Tile> {
         let mut path = vec![self.tile(k)];
-        let mut c = k;
-        while self.nodes[c].parent != u32::MAX {
-            c = self.nodes[c].parent as usize;
-            path.push(self.tile(c));
+        let (mut x, mut y) = (k % self.w, k / self.w);
+        loop {
+            let dir = self.peek(x, y) & DIR_MASK;
+            if dir == NO_PARENT {
+                break;
+            }
+            let (di, dj) = N8[dir as usize];
+            x = x.wrapping_add_signed(-di as isize);
+            y = y.wrapping_add_signed(-dj as isize);
+            path.push(self.tile(y * self.w + x));
         }
         path.reverse();
         path
@@ -331,19 +424,17 @@ impl TileSearch {
     ) -> Option<(Tile, u64)> {
         let s = self.idx(from)?;
         self.begin();
-        self.relax(s, 0, u32::MAX);
-        self.heap.push(0, s as u32);
+        self.start(s, 0);
         while let Some((d, k)) = self.heap.pop() {
             let k = k as usize;
-            if self.closed(k) || d > self.nodes[k].dist {
+            if self.settle(k, d, true).is_none() {
                 continue;
             }
-            self.nodes[k].stamp = self.generation + 1;
             let t = self.tile(k);
             if is_target(t) {
                 return Some((t, d));
             }
-            self.expand(g, t, k, d, None);
+            self.expand_within(g, t, k, d, None, u64::MAX, false);
         }
         None
     }
@@ -371,20 +462,17 @@ impl TileSearch {
         self.begin();
         self.last_nearest = None;
         self.blocks.begin(targets);
-        self.relax(s, 0, u32::MAX);
         let h0 = self.target_h(from);
-        self.heap.push(h0, s as u32);
+        self.start(s, h0);
         let mut best: Option<(usize, u64)> = None;
         while let Some((key, k)) = self.heap.pop() {
             if best.is_some_and(|(_, d)| key > d) {
                 break;
             }
             let k = k as usize;
-            if self.closed(k) {
+            let Some((_, d)) = self.settle(k, key, false) else {
                 continue;
-            }
-            self.nodes[k].stamp = self.generation + 1;
-            let d = self.nodes[k].dist;
+            };
             let t = self.tile(k);
             if is_target(t) {
                 if best.is_none_or(|(b, _)| k < b) {
@@ -392,7 +480,10 @@ impl TileSearch {
                 }
                 continue;
             }
-            self.expand_to_targets(g, t, k, d);
+            // Once a target is found at `d*`, labels with keys above it are never popped
+            // (nor read by `mark_optimal`, which reads settled tiles only): not pushed.
+            let bound = best.map_or(u64::MAX, |(_, bd)| bd);
+            self.expand_to_targets(g, t, k, d, bound);
         }
         if let Some((k, d)) = best {
             self.last_nearest = Some((s, k, d, self.generation));
@@ -413,32 +504,42 @@ impl TileSearch {
             .unwrap_or(u64::MAX / 4)
     }
 
-    /// [`Self::expand_within`] for [`Self::nearest_of`]: keys `cost + target_h`.
-    fn expand_to_targets(&mut self, g: &impl TileGraph, t: Tile, k: usize, d: u64) {
+    /// The neighbour `N8[n]` of the tile at row-major `k`: its row-major index and word index
+    /// (`None` outside the rectangle).
+    #[inline]
+    fn neighbour(&mut self, k: usize, n: usize) -> Option<(usize, usize)> {
+        let (di, dj) = N8[n];
+        let x = (k % self.w).wrapping_add_signed(di as isize);
+        let y = (k / self.w).wrapping_add_signed(dj as isize);
+        if x >= self.w || y >= self.h {
+            return None;
+        }
+        Some((y * self.w + x, self.slot(x, y)))
+    }
+
+    /// [`Self::expand_within`] for [`Self::nearest_of`]: keys `cost + target_h`, none above
+    /// `bound`.
+    fn expand_to_targets(&mut self, g: &impl TileGraph, t: Tile, k: usize, d: u64, bound: u64) {
         let mut mask = g.edge_mask(t);
-        let gen = self.generation;
         while mask != 0 {
             let n = mask.trailing_zeros() as usize;
             mask &= mask - 1;
-            let (di, dj) = N8[n];
-            let v = (t.0 + di, t.1 + dj);
-            let Some(kv) = self.idx(v) else { continue };
+            let Some((kv, sv)) = self.neighbour(k, n) else {
+                continue;
+            };
             let nd = d + if n % 2 == 1 { COST_DIAG } else { COST_ORTHO };
-            let node = self.nodes[kv];
-            if node.stamp == gen + 1 || (node.stamp == gen && nd >= node.dist) {
+            let node = self.nodes[sv];
+            if node & SETTLED != 0 || nd >= word_dist(node) {
                 continue;
             }
-            let f = nd + self.target_h(v);
-            let node = &mut self.nodes[kv];
-            node.stamp = gen;
-            node.dist = nd;
-            node.parent = k as u32;
+            let (di, dj) = N8[n];
+            let f = nd + self.target_h((t.0 + di, t.1 + dj));
+            if f > bound {
+                continue;
+            }
+            self.nodes[sv] = word(nd, n as NodeWord);
             self.heap.push(f, kv as u32);
         }
-    }
-
-    fn expand(&mut self, g: &impl TileGraph, t: Tile, k: usize, d: u64, goal: Option<Tile>) {
-        self.expand_within(g, t, k, d, goal, u64::MAX, false);
     }
 
     /// Relaxes the edges of the settled tile `t` (index `k`, cost `d`), pushing each improved
@@ -458,37 +559,23 @@ impl TileSearch {
         only_marked: bool,
     ) {
         let mut mask = g.edge_mask(t);
-        if mask == 0 {
-            return;
-        }
-        // Interior tiles of the search rectangle reach their neighbours by a fixed index
-        // offset; the others go through `idx` (a neighbour outside the rectangle is skipped).
-        let (di0, dj0) = (t.0 - self.i0, t.1 - self.j0);
-        let interior =
-            di0 >= 1 && dj0 >= 1 && (di0 as usize) + 1 < self.w && (dj0 as usize) + 1 < self.h;
-        let w = self.w as isize;
-        let gen = self.generation;
         while mask != 0 {
             let n = mask.trailing_zeros() as usize;
             mask &= mask - 1;
-            let (di, dj) = N8[n];
-            let v = (t.0 + di, t.1 + dj);
-            let kv = if interior {
-                (k as isize + di as isize + dj as isize * w) as usize
-            } else {
-                let Some(kv) = self.idx(v) else { continue };
-                kv
+            let Some((kv, sv)) = self.neighbour(k, n) else {
+                continue;
             };
             let nd = d + if n % 2 == 1 { COST_DIAG } else { COST_ORTHO };
-            let node = &mut self.nodes[kv];
-            // Settled (stamp gen + 1), or labelled at least as well: nothing to do.
-            if node.stamp == gen + 1 || (node.stamp == gen && nd >= node.dist) {
+            let node = self.nodes[sv];
+            // Settled, or labelled at least as well: nothing to do.
+            if node & SETTLED != 0 || nd >= word_dist(node) {
                 continue;
             }
-            // Marked tiles carry the stamp `gen - 1` (see [`Self::astar_nearest`]).
-            if only_marked && node.stamp != gen && node.stamp != gen.wrapping_sub(1) {
+            if only_marked && node == UNLABELLED && !self.is_marked(kv) {
                 continue;
             }
+            let (di, dj) = N8[n];
+            let v = (t.0 + di, t.1 + dj);
             let f = match goal {
                 Some(gl) => {
                     // The octile cost to the goal bounds the remaining cost from below and
@@ -504,9 +591,7 @@ impl TileSearch {
             if f > bound {
                 continue;
             }
-            node.stamp = gen;
-            node.dist = nd;
-            node.parent = k as u32;
+            self.nodes[sv] = word(nd, n as NodeWord);
             self.heap.push(f, kv as u32);
         }
     }
@@ -567,18 +652,18 @@ impl TileSearch {
         cost: u64,
     ) -> Option<(Vec<Tile>, u64)> {
         if self.mark_optimal(g, from, to, cost) {
-            // Two generations on: the marks (stamp old generation + 3) read `gen - 1`.
-            self.begin();
-            if let Some(r) = self.astar_within(g, from, to, cost, true) {
-                return Some(r);
+            let r = self.astar_within(g, from, to, cost, true);
+            self.clear_marks();
+            if r.is_some() {
+                return r;
             }
         }
         self.astar_bounded(g, from, to, cost)
     }
 
-    /// Marks (stamp generation + 3) the tiles on cheapest paths from `from` to `to`, read off
-    /// the labels of the last [`Self::nearest_of`] if it answered `(to, cost)` from `from`
-    /// and no search ran since; false (nothing marked) otherwise.
+    /// Marks the tiles on cheapest paths from `from` to `to` (in `marks`), read off the labels
+    /// of the last [`Self::nearest_of`] if it answered `(to, cost)` from `from` and no search
+    /// ran since; false (nothing marked) otherwise.
     fn mark_optimal(&mut self, g: &impl TileGraph, from: Tile, to: Tile, cost: u64) -> bool {
         let (Some(s), Some(t)) = (self.idx(from), self.idx(to)) else {
             return false;
@@ -586,34 +671,44 @@ impl TileSearch {
         if self.last_nearest.take() != Some((s, t, cost, self.generation)) {
             return false;
         }
-        let settled = self.generation + 1;
-        let mark = self.generation.wrapping_add(3);
         let mut stack = std::mem::take(&mut self.stack);
         stack.clear();
-        self.nodes[t].stamp = mark;
+        self.mark(t);
         stack.push(t as u32);
         while let Some(kv) = stack.pop() {
             let kv = kv as usize;
             let v = self.tile(kv);
-            let dv = self.nodes[kv].dist;
+            let (x, y) = (kv % self.w, kv / self.w);
+            let dv = word_dist(self.peek(x, y));
             for (n, &(di, dj)) in N8.iter().enumerate() {
-                let u = (v.0 + di, v.1 + dj);
-                let Some(ku) = self.idx(u) else { continue };
+                let ux = x.wrapping_add_signed(di as isize);
+                let uy = y.wrapping_add_signed(dj as isize);
+                if ux >= self.w || uy >= self.h {
+                    continue;
+                }
+                let ku = uy * self.w + ux;
                 let step = if n % 2 == 1 { COST_DIAG } else { COST_ORTHO };
-                let node = self.nodes[ku];
-                if node.stamp != settled || node.dist + step != dv {
+                let node = self.peek(ux, uy);
+                if node & SETTLED == 0 || word_dist(node) + step != dv || self.is_marked(ku) {
                     continue;
                 }
                 // The edge `u -> v` goes the opposite way of `N8[n]`.
+                let u = (v.0 + di, v.1 + dj);
                 if g.edge_mask(u) & (1 << ((n + 4) % 8)) == 0 {
                     continue;
                 }
-                self.nodes[ku].stamp = mark;
+                self.mark(ku);
                 stack.push(ku as u32);
             }
         }
         self.stack = stack;
         true
+    }
+
+    #[inline]
+    fn mark(&mut self, k: usize) {
+        self.marks[k / 64] |= 1 << (k % 64);
+        self.marked.push(k as u32);
     }
 
     fn astar_within(
@@ -627,15 +722,12 @@ impl TileSearch {
         let s = self.idx(from)?;
         self.idx(to)?;
         self.begin();
-        self.relax(s, 0, u32::MAX);
-        self.heap.push(heuristic(from, to), s as u32);
-        while let Some((_, k)) = self.heap.pop() {
+        self.start(s, heuristic(from, to));
+        while let Some((key, k)) = self.heap.pop() {
             let k = k as usize;
-            if self.closed(k) {
+            let Some((_, d)) = self.settle(k, key, false) else {
                 continue;
-            }
-            self.nodes[k].stamp = self.generation + 1;
-            let d = self.nodes[k].dist;
+            };
             let t = self.tile(k);
             if t == to {
                 return Some((self.path_to(k), d));
@@ -645,7 +737,6 @@ impl TileSearch {
         None
     }
 }
-
 impl TargetBlocks {
     /// A new search towards `targets`: every block's list is stale.
     fn begin(&mut self, targets: &[Tile]) {

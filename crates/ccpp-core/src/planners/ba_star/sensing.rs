@@ -8,7 +8,7 @@ use crate::tiles::{Tile, N8};
 
 use super::judge::{judge_motion_px, judge_point, Judgement};
 use super::search::TileSearch;
-use super::smoothing::{for_each_centre_tile, for_each_swept_tile};
+use super::smoothing::{all_swept_tiles, for_each_centre_tile};
 use super::tile_model::{TileModel, ST_COVERED, ST_DISK, ST_STAND};
 
 /// Margin (pixels) added to the contact radius when [`Mind::sense`] bounds the tiles a new
@@ -595,7 +595,7 @@ impl Mind {
         if rho > 1e-3 && !for_each_centre_tile(a, b, |t| tiles.covered(t)) {
             return false;
         }
-        for_each_swept_tile(a, b, rho, |t| tiles.covered(t))
+        all_swept_tiles(a, b, rho, |t| tiles.covered(t))
             && judge_motion_px(
                 &self.known,
                 self.grid_center(a),

@@ -55,7 +55,27 @@ pub(super) fn segment_box_dist2(a: Point, b: Point, lo: Point, hi: Point) -> f64
 /// `false` (and then returns `false`). Tiles merely touching the swept disk's boundary (distance
 /// exactly `rho`, as for the side neighbours of a straight move between centres at `rho = 1/2`)
 /// are not touched.
-pub fn for_each_swept_tile(a: Tile, b: Tile, rho: f64, mut f: impl FnMut(Tile) -> bool) -> bool {
+pub fn for_each_swept_tile(a: Tile, b: Tile, rho: f64, f: impl FnMut(Tile) -> bool) -> bool {
+    sweep(a, b, rho, |_| false, f)
+}
+
+/// Does `ok` hold for every tile [`for_each_swept_tile`] touches from `a` to `b`? The same
+/// answer as `for_each_swept_tile(a, b, rho, ok)` for a pure `ok`, reading `ok` first: the
+/// touching test (the geometry) is done only for the tiles near the swept disk where `ok`
+/// fails, not for all of them.
+pub fn all_swept_tiles(a: Tile, b: Tile, rho: f64, ok: impl Fn(Tile) -> bool) -> bool {
+    sweep(a, b, rho, ok, |_| false)
+}
+
+/// [`for_each_swept_tile`], passing over the tiles with `skip` without testing whether the
+/// disk touches them.
+fn sweep(
+    a: Tile,
+    b: Tile,
+    rho: f64,
+    skip: impl Fn(Tile) -> bool,
+    mut f: impl FnMut(Tile) -> bool,
+) -> bool {
     let pa = Point::new(f64::from(a.0), f64::from(a.1));
     let pb = Point::new(f64::from(b.0), f64::from(b.1));
     let lim = (rho * rho) * (1.0 - 1e-9) - 1e-12;
@@ -116,7 +136,7 @@ pub fn for_each_swept_tile(a: Tile, b: Tile, rho: f64, mut f: impl FnMut(Tile) -
                 (i_hi, i_lo, -1)
             };
             loop {
-                if touches(i, y) && !f((i, j)) {
+                if !skip((i, j)) && touches(i, y) && !f((i, j)) {
                     return false;
                 }
                 if i == i_end {

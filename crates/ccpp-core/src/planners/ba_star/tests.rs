@@ -5,7 +5,7 @@ use std::collections::BinaryHeap;
 
 use super::backtrack_list::Block3;
 use super::search::MonotoneQueue;
-use super::smoothing::segment_box_dist2;
+use super::smoothing::{all_swept_tiles, segment_box_dist2};
 use super::*;
 
 /// The monotone queue pops exactly what a binary heap of the pairs pops, over a
@@ -336,4 +336,49 @@ fn tile_centres_round_home() {
         checked += 1;
     }
     assert!(checked > 100_000, "{checked}");
+}
+
+/// [`all_swept_tiles`] (the predicate read first, the geometry only where it fails) answers
+/// as [`for_each_swept_tile`] with the same predicate: over pseudo-random sets of good tiles
+/// (dense, as the covered tiles around a backtracking path, and sparse), segments in every
+/// direction and several radii; both answers occur.
+#[test]
+fn all_swept_tiles_answers_as_the_full_sweep() {
+    let mut x: u64 = 0x9e37_79b9_7f4a_7c15;
+    let (mut yes, mut no) = (0, 0);
+    for rho in [0.0, 0.25, 0.5, 0.7, 1.0, 2.3] {
+        for density in [70, 97, 100] {
+            let good: Vec<bool> = (0..31 * 31)
+                .map(|_| {
+                    x ^= x << 13;
+                    x ^= x >> 7;
+                    x ^= x << 17;
+                    x % 100 < density
+                })
+                .collect();
+            let ok = |t: Tile| {
+                (-15..=15).contains(&t.0)
+                    && (-15..=15).contains(&t.1)
+                    && good[((t.1 + 15) * 31 + t.0 + 15) as usize]
+            };
+            for bx in -9..=9 {
+                for by in -9..=9 {
+                    let a = (bx / 3, -by / 2);
+                    let b = (bx, by);
+                    let want = for_each_swept_tile(a, b, rho, ok);
+                    assert_eq!(
+                        all_swept_tiles(a, b, rho, ok),
+                        want,
+                        "rho {rho} {a:?} {b:?}"
+                    );
+                    if want {
+                        yes += 1;
+                    } else {
+                        no += 1;
+                    }
+                }
+            }
+        }
+    }
+    assert!(yes > 100 && no > 100, "{yes} {no}");
 }
