@@ -194,6 +194,25 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     for p in &planners {
         parse_planner(p)?;
     }
+    // A planner named twice runs once, as a map named twice does: two runs of it would
+    // write the same run folder at the same time.
+    let mut planners = planners;
+    let mut seen = Vec::new();
+    planners.retain(|p| {
+        let first = !seen.contains(p);
+        seen.push(p.clone());
+        first
+    });
+    if a.seed.is_some()
+        && !planners
+            .iter()
+            .any(|p| p == planners::PlannerKind::RandomBounce.name())
+    {
+        bail!("--seed does not apply to the planners of this bench (it applies to random-bounce)");
+    }
+    if a.jobs == Some(0) {
+        bail!("--jobs must be at least 1, got 0");
+    }
     let (robot, _) = robot_from(&(&a.robot).into())?;
     let options = planner_options(a.options.config.as_deref(), a.seed)?;
     let maps = name_maps(expand_maps(&a.maps)?);
@@ -202,7 +221,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     if let Some(j) = a.jobs {
         // Ignore the error when a global pool already exists (tests).
         let _ = rayon::ThreadPoolBuilder::new()
-            .num_threads(j.max(1))
+            .num_threads(j)
             .build_global();
     }
 

@@ -226,6 +226,14 @@ fn apply_planner_flags(a: &RunArgs, config: &mut PlannerConfig) -> Result<Vec<&'
     Ok(given)
 }
 
+/// The options file of `a`, for messages.
+fn options_file(a: &RunArgs) -> String {
+    a.options.config.as_ref().map_or_else(
+        || "the options file".to_string(),
+        |p| p.display().to_string(),
+    )
+}
+
 /// The simulator settings of `a` for `config` (execution, odometry noise, landmarks, sensor
 /// range), refusing flags that do not apply.
 fn sim_from(a: &RunArgs, config: &mut PlannerConfig) -> Result<SimConfig> {
@@ -255,12 +263,9 @@ fn sim_from(a: &RunArgs, config: &mut PlannerConfig) -> Result<SimConfig> {
     // `--exec ideal` replaces the planner's execution: PID settings given for it in the
     // options file would be read, validated and then dropped, so the two are refused together.
     if exec == Some(false) && pid != PidOptions::default() {
-        let file = a.options.config.as_ref().map_or_else(
-            || "the options file".to_string(),
-            |p| p.display().to_string(),
-        );
         bail!(
-            "--exec ideal drops the PID settings given for {kind} in {file} ({}.exec); remove one of them",
+            "--exec ideal drops the PID settings given for {kind} in {} ({}.exec); remove one of them",
+            options_file(a),
             kind.info().section
         );
     }
@@ -270,18 +275,29 @@ fn sim_from(a: &RunArgs, config: &mut PlannerConfig) -> Result<SimConfig> {
             .split(',')
             .map(|x| x.trim().parse::<f64>())
             .collect::<Result<_, _>>()
-            .map_err(|_| anyhow::anyhow!("--odometry-noise expects LIN[,ANG], got {n:?}"))?;
-        if v.is_empty() || v.len() > 2 || v.iter().any(|x| !x.is_finite() || *x < 0.0) {
-            bail!("--odometry-noise expects one or two finite numbers >= 0, got {n:?}");
+            .map_err(|_| {
+                anyhow::anyhow!("--odometry-noise expects LIN[,ANG[,DRIFT]], got {n:?}")
+            })?;
+        if v.is_empty() || v.len() > 3 || v.iter().any(|x| !x.is_finite() || *x < 0.0) {
+            bail!("--odometry-noise expects one to three finite numbers >= 0, got {n:?}");
         }
         if exec == Some(false) {
             bail!("--odometry-noise needs PID execution, not --exec ideal");
         }
+        if pid.noise.is_some() {
+            bail!(
+                "--odometry-noise replaces the odometry noise given for {kind} in {} ({}.exec.pid.noise); remove one of them",
+                options_file(a),
+                kind.info().section
+            );
+        }
+        // Exactly the noise asked for: a heading drift left out is 0, not the library's
+        // default (`--odometry-noise 0` used to drift 0.2 rad per metre).
         pid.noise = Some(OdometryNoise {
             seed: a.seed.unwrap_or(0),
             linear_rel_std: v[0],
             angular_rel_std: v.get(1).copied().unwrap_or(v[0]),
-            ..OdometryNoise::default()
+            heading_drift_std: v.get(2).copied().unwrap_or(0.0),
         });
         noise_given = true;
     }

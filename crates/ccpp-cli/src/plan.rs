@@ -3,8 +3,8 @@
 
 use std::fmt::Write as _;
 
-use anyhow::{anyhow, Result};
-use ccpp_core::planners::PlannerConfig;
+use anyhow::{anyhow, bail, Result};
+use ccpp_core::planners::{PlannerConfig, PlannerKind};
 use ccpp_core::route::DEFAULT_TOLERANCE_M;
 use ccpp_core::sim::StopReason;
 use ccpp_io::export::{render_exports, zone_features, ExportFormat, ExportMeta};
@@ -25,6 +25,11 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     if !kind.info().offline {
         // Refused before the map is read.
         return Err(PlanError::Online(kind.name(), offline_planners()).into());
+    }
+    if a.robot.tool_radius.is_some() && kind == PlannerKind::RectBoustrophedon {
+        // Its lanes follow --width and a plan has no coverage metrics: the value would be
+        // validated and then change nothing.
+        bail!("--tool-radius does not apply to {kind} in `ccpp plan` (its lanes follow --width)");
     }
     let (robot, start) = robot_from(&a.robot)?;
     let mut planner = planner_options(a.options.config.as_deref(), None)?.config(kind);

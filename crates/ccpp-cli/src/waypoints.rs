@@ -17,6 +17,10 @@ pub fn run(a: &WaypointsArgs) -> Result<()> {
     if format != "csv" && format != "json" {
         bail!("--format must be csv or json, got {:?}", a.format);
     }
+    if a.robot.tool_radius.is_some() {
+        // The lanes follow --width: the value would be validated and then change nothing.
+        bail!("--tool-radius does not apply to `ccpp waypoints` (its lanes follow --width)");
+    }
     let (robot, start) = robot_from(&a.robot)?;
     let opts = RectOptions {
         length_m: a.length,
