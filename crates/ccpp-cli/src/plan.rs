@@ -37,15 +37,32 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     for (flag, v) in [("--length", a.length), ("--width", a.width)] {
         let Some(v) = v else { continue };
         given.push(flag);
-        match &mut planner {
-            PlannerConfig::RectBoustrophedon(o) if flag == "--length" => o.length_m = v,
-            PlannerConfig::RectBoustrophedon(o) => o.width_m = v,
+        let d = ccpp_core::planners::rect_boustrophedon::RectOptions::default();
+        let (slot, field, d) = match &mut planner {
+            PlannerConfig::RectBoustrophedon(o) if flag == "--length" => {
+                (&mut o.length_m, "rect_boustrophedon.length_m", d.length_m)
+            }
+            PlannerConfig::RectBoustrophedon(o) => {
+                (&mut o.width_m, "rect_boustrophedon.width_m", d.width_m)
+            }
             _ => {
                 return Err(anyhow!(
                     "{flag} does not apply to {kind} (it applies to rect-boustrophedon)"
                 ))
             }
+        };
+        // A different value for the same option in the options file would be dropped.
+        if slot.to_bits() != d.to_bits() && slot.to_bits() != v.to_bits() {
+            bail!(
+                "{flag} {v} and {field}: {} in {} set the same option; remove one of them",
+                *slot,
+                a.options
+                    .config
+                    .as_ref()
+                    .map_or_else(|| "the options file".into(), |p| p.display().to_string())
+            );
         }
+        *slot = v;
     }
     let flag = |e: ScenarioError| match &e {
         ScenarioError::Options(o)

@@ -280,3 +280,224 @@ fn georef_refuses_a_resolution_or_origin_it_would_replace() {
     let v: serde_json::Value = serde_json::from_slice(&a.get_output().stdout).unwrap();
     assert_eq!(v["origin"][0], 10.0);
 }
+
+/// Options that another option switches off were read, validated and then changed nothing
+/// (the runs were byte-identical): bcd's rim limits without the rim pass, the extension's
+/// leave limits with `min_yield: 0`, its simplification and corner squaring without merged
+/// segments, `simplify_loss` and `simplify_fraction` with the other at 0, and
+/// ba-star-extended's `backtrack_sweep` with `reach_r` above 0. Such a pair is refused, naming
+/// both; the switch alone (or with the option at its default) runs.
+#[test]
+fn an_option_another_switches_off_is_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let out = dir.join("out");
+    for (planner, text, field, because) in [
+        (
+            "bcd",
+            "bcd: { rim: false, rim_coverage: 0.5 }",
+            "bcd.rim_coverage",
+            "rim is false",
+        ),
+        (
+            "bcd",
+            "bcd: { rim: false, rim_min_yield: 0.3 }",
+            "bcd.rim_min_yield",
+            "rim is false",
+        ),
+        (
+            "bsa-extended",
+            "bsa_extended: { extension: { min_yield: 0, leave_fraction: 0.5 } }",
+            "bsa_extended.extension.leave_fraction",
+            "min_yield is 0",
+        ),
+        (
+            "ba-star-extended",
+            "ba_star_extended: { extension: { min_yield: 0, leave_group: 2 } }",
+            "ba_star_extended.extension.leave_group",
+            "min_yield is 0",
+        ),
+        (
+            "bsa-extended",
+            "bsa_extended: { extension: { merge_segments: false, corner_slack: 3 } }",
+            "bsa_extended.extension.corner_slack",
+            "merge_segments is false",
+        ),
+        (
+            "ba-star-extended",
+            "ba_star_extended: { extension: { merge_segments: false, simplify_fraction: 0.1 } }",
+            "ba_star_extended.extension.simplify_fraction",
+            "merge_segments is false",
+        ),
+        (
+            "bsa-extended",
+            "bsa_extended: { extension: { simplify_fraction: 0, simplify_loss: 5 } }",
+            "bsa_extended.extension.simplify_loss",
+            "simplify_fraction is 0",
+        ),
+        (
+            "bsa-extended",
+            "bsa_extended: { extension: { simplify_loss: 0, simplify_fraction: 0.1 } }",
+            "bsa_extended.extension.simplify_fraction",
+            "simplify_loss is 0",
+        ),
+        (
+            "ba-star-extended",
+            "ba_star_extended: { extension: { reach_r: 4 }, backtrack_sweep: 5 }",
+            "ba_star_extended.backtrack_sweep",
+            "reach_r is above 0",
+        ),
+    ] {
+        let cfg = dir.join("opts.yaml");
+        std::fs::write(&cfg, format!("{text}\n")).unwrap();
+        refused(
+            &[
+                "run",
+                "--planner",
+                planner,
+                "--map",
+                s(&map),
+                "--config",
+                s(&cfg),
+                "--out",
+                s(&out),
+            ],
+            &["opts.yaml", field, "changes nothing while", because],
+        );
+        assert!(!out.exists());
+    }
+    for (i, (planner, text)) in [
+        ("bcd", "bcd: { rim: false }"),
+        (
+            "bsa-extended",
+            "bsa_extended: { extension: { min_yield: 0, merge_segments: false } }",
+        ),
+        (
+            "ba-star-extended",
+            "ba_star_extended: { extension: { reach_r: 4, simplify_fraction: 0 } }",
+        ),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let cfg = dir.join(format!("ok{i}.yaml"));
+        std::fs::write(&cfg, format!("{text}\n")).unwrap();
+        run_ok(
+            dir,
+            &format!("ok{i}"),
+            &map,
+            planner,
+            &["--config", s(&cfg)],
+        );
+    }
+}
+
+/// A flag and a different value for the same option in the `--config` file: the flag replaced
+/// the file's value without a word. Refused, naming both; the same value twice is accepted.
+#[test]
+fn a_flag_and_the_file_setting_the_same_option_differently_are_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let cfg = dir.join("both.yaml");
+    std::fs::write(
+        &cfg,
+        "ba_star: { tile_side_m: 0.4, smoothing: false }\nbsa_bfs: { cell_side_m: 0.4 }\n\
+         bsa: { side: right }\nrect_boustrophedon: { length_m: 0.5, width_m: 0.4 }\n\
+         random_bounce: { seed: 5 }\n",
+    )
+    .unwrap();
+    let out = dir.join("out");
+    for (cmd, planner, flag, value, field) in [
+        (
+            "run",
+            "ba-star",
+            "--tile-side",
+            "0.5",
+            "ba_star.tile_side_m",
+        ),
+        (
+            "run",
+            "bsa-bfs",
+            "--tile-side",
+            "0.5",
+            "bsa_bfs.cell_side_m",
+        ),
+        ("run", "ba-star", "--smoothing", "on", "ba_star.smoothing"),
+        ("run", "bsa", "--side", "left", "bsa.side"),
+        (
+            "run",
+            "rect-boustrophedon",
+            "--length",
+            "0.4",
+            "rect_boustrophedon.length_m",
+        ),
+        (
+            "plan",
+            "rect-boustrophedon",
+            "--width",
+            "0.5",
+            "rect_boustrophedon.width_m",
+        ),
+        ("run", "random-bounce", "--seed", "7", "random_bounce.seed"),
+    ] {
+        refused(
+            &[
+                cmd,
+                "--planner",
+                planner,
+                "--map",
+                s(&map),
+                "--config",
+                s(&cfg),
+                flag,
+                value,
+                "--out",
+                s(&out),
+            ],
+            &[flag, field, "both.yaml", "set the same option"],
+        );
+        assert!(!out.exists());
+    }
+    refused(
+        &[
+            "bench",
+            "--quiet",
+            "--maps",
+            s(&map),
+            "--planners",
+            "random-bounce",
+            "--config",
+            s(&cfg),
+            "--seed",
+            "7",
+            "--out",
+            s(&out),
+        ],
+        &["--seed", "random_bounce.seed", "both.yaml"],
+    );
+    assert!(!out.exists());
+    // The same value in both places, or a flag for an option the file leaves out, runs.
+    run_ok(
+        dir,
+        "same",
+        &map,
+        "ba-star",
+        &[
+            "--config",
+            s(&cfg),
+            "--tile-side",
+            "0.4",
+            "--smoothing",
+            "off",
+        ],
+    );
+    run_ok(
+        dir,
+        "other",
+        &map,
+        "bsa-extended",
+        &["--config", s(&cfg), "--side", "left"],
+    );
+}
