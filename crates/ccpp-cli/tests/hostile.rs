@@ -501,3 +501,38 @@ fn a_flag_and_the_file_setting_the_same_option_differently_are_refused() {
         &["--config", s(&cfg), "--side", "left"],
     );
 }
+
+/// `ccpp plan` and `ccpp waypoints` wrote the same files whatever THETA `--start` gave.
+#[test]
+fn a_start_heading_is_refused_where_nothing_uses_it() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let out = dir.join("out");
+    for planner in ["bcd", "rect-boustrophedon"] {
+        refused(
+            &[
+                "plan",
+                "--planner",
+                planner,
+                "--map",
+                s(&map),
+                "--start",
+                "1,1,2",
+                "--out",
+                s(&out),
+            ],
+            &["--start THETA", "plan"],
+        );
+        assert!(!out.exists());
+        plan_ok(dir, planner, &map, planner, &["--start", "1,1"]);
+    }
+    refused(
+        &["waypoints", "--map", s(&map), "--start", "1,1,2"],
+        &["--start THETA", "waypoints"],
+    );
+    // `run` uses it: the robot first turns from that heading.
+    let a = run_ok(dir, "a", &map, "bcd", &["--start", "1,1"]);
+    let b = run_ok(dir, "b", &map, "bcd", &["--start", "1,1,2"]);
+    assert_ne!(trace(&a), trace(&b));
+}
