@@ -536,3 +536,38 @@ fn a_start_heading_is_refused_where_nothing_uses_it() {
     let b = run_ok(dir, "b", &map, "bcd", &["--start", "1,1,2"]);
     assert_ne!(trace(&a), trace(&b));
 }
+
+/// A landmarks file without a landmark (empty, comments only, `[]`) was accepted: the run was
+/// the run without it.
+#[test]
+fn a_landmarks_file_without_a_landmark_is_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let out = dir.join("out");
+    for (name, text) in [
+        ("empty.csv", ""),
+        ("comments.csv", "# tags\n"),
+        ("none.json", "[]"),
+    ] {
+        let lm = dir.join(name);
+        std::fs::write(&lm, text).unwrap();
+        refused(
+            &[
+                "run",
+                "--planner",
+                "bcd",
+                "--map",
+                s(&map),
+                "--odometry-noise",
+                "0.1",
+                "--landmarks",
+                s(&lm),
+                "--out",
+                s(&out),
+            ],
+            &["landmarks", name, "no landmark"],
+        );
+        assert!(!out.exists());
+    }
+}
