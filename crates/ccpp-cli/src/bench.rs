@@ -216,6 +216,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     let (robot, _) = robot_from(&(&a.robot).into())?;
     let options = planner_options(a.options.config.as_deref(), a.seed)?;
     let maps = name_maps(expand_maps(&a.maps)?);
+    check_bench_target(&a.out)?;
     std::fs::create_dir_all(&a.out)
         .with_context(|| format!("cannot create output folder {}", a.out.display()))?;
     if let Some(j) = a.jobs {
@@ -292,6 +293,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         .collect();
     bar.finish_and_clear();
 
+    clear_plots(&a.out)?;
     write_file(&a.out.join("results.csv"), results_csv(&rows).as_bytes())?;
     write_file(&a.out.join("results.md"), results_md(&rows).as_bytes())?;
     crate::plots::write_all(&a.out, &rows, &prepared, robot)?;
@@ -310,6 +312,65 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             rows.len(),
             a.out.join("results.csv").display()
         );
+    }
+    Ok(())
+}
+
+/// Checks that `out` is absent or a folder holding only what a bench writes (`results.csv`,
+/// `results.md`, `plots/`, `runs/`): a bench rewrites those, so another file there (a user's
+/// own `results.csv` in a folder of theirs) would be overwritten.
+///
+/// # Errors
+/// When `out` is a file, or a folder holding anything else.
+fn check_bench_target(out: &Path) -> Result<()> {
+    let Ok(meta) = std::fs::symlink_metadata(out) else {
+        return Ok(());
+    };
+    if !meta.is_dir() {
+        bail!(
+            "output folder {} exists and is not a plain folder",
+            out.display()
+        );
+    }
+    let entries = std::fs::read_dir(out)
+        .with_context(|| format!("cannot read output folder {}", out.display()))?;
+    for e in entries {
+        let e = e.with_context(|| format!("cannot read output folder {}", out.display()))?;
+        let name = e.file_name();
+        let name = name.to_string_lossy();
+        let Ok(t) = e.file_type() else { continue };
+        let known = match name.as_ref() {
+            "results.csv" | "results.md" => t.is_file(),
+            "plots" | "runs" => t.is_dir(),
+            n => n.ends_with(".tmp") && t.is_file(),
+        };
+        if !known {
+            bail!(
+                "output folder {} holds {name}, which ccpp bench did not write; a bench rewrites \
+                 its results there, so choose a new or bench-only folder",
+                out.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Removes the plots of an earlier bench in `out/plots/` (maps it had and this one has not
+/// would stay beside this bench's results otherwise).
+fn clear_plots(out: &Path) -> Result<()> {
+    let dir = out.join("plots");
+    let Ok(entries) = std::fs::read_dir(&dir) else {
+        return Ok(());
+    };
+    for e in entries.flatten() {
+        let p = e.path();
+        let plot = p
+            .extension()
+            .is_some_and(|x| x.eq_ignore_ascii_case("png") || x.eq_ignore_ascii_case("svg"));
+        if plot && e.file_type().is_ok_and(|t| t.is_file()) {
+            std::fs::remove_file(&p)
+                .with_context(|| format!("cannot remove the old plot {}", p.display()))?;
+        }
     }
     Ok(())
 }

@@ -571,3 +571,54 @@ fn a_landmarks_file_without_a_landmark_is_refused() {
         assert!(!out.exists());
     }
 }
+
+/// `ccpp bench --out` into a folder of the user's overwrote their `results.csv` (a run refuses
+/// such a folder), and a second bench into a bench folder left the first one's plots of maps it
+/// did not have beside its own results.
+#[test]
+fn a_bench_folder_is_never_mixed() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let a = pillars(dir);
+    let b = common::rooms(dir);
+    let out = dir.join("bench");
+    std::fs::create_dir(&out).unwrap();
+    std::fs::write(out.join("results.csv"), "precious\n").unwrap();
+    std::fs::write(out.join("notes.txt"), "mine\n").unwrap();
+    refused(
+        &[
+            "bench",
+            "--quiet",
+            "--planners",
+            "bcd",
+            "--maps",
+            s(&a),
+            "--out",
+            s(&out),
+        ],
+        &["output folder", "notes.txt", "did not write"],
+    );
+    assert_eq!(
+        std::fs::read_to_string(out.join("results.csv")).unwrap(),
+        "precious\n"
+    );
+    std::fs::remove_dir_all(&out).unwrap();
+    let bench = |map: &Path| {
+        ccpp()
+            .args(["bench", "--quiet", "--planners", "bcd", "--maps"])
+            .arg(map)
+            .arg("--out")
+            .arg(&out)
+            .assert()
+            .success();
+    };
+    bench(&a);
+    assert!(out.join("plots/coverage_pillars.png").is_file());
+    bench(&b);
+    let plots: Vec<String> = std::fs::read_dir(out.join("plots"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(plots.iter().any(|p| p.contains("rooms")), "{plots:?}");
+    assert!(!plots.iter().any(|p| p.contains("pillars")), "{plots:?}");
+}
