@@ -342,7 +342,13 @@ fn check_bench_target(out: &Path) -> Result<()> {
         let known = match name.as_ref() {
             "results.csv" | "results.md" => t.is_file(),
             "plots" | "runs" => t.is_dir(),
-            n => n.ends_with(".tmp") && t.is_file(),
+            // A write cut short leaves `<file>.tmp` (see `staging::write_file`).
+            _ => {
+                Path::new(name.as_ref())
+                    .extension()
+                    .is_some_and(|x| x == "tmp")
+                    && t.is_file()
+            }
         };
         if !known {
             bail!(
