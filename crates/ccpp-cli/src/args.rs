@@ -158,9 +158,10 @@ pub struct RunArgs {
     /// tracking). Default: the planner's choice (bsa-bfs and rect-boustrophedon: pid).
     #[arg(long, value_name = "ideal|pid")]
     pub exec: Option<String>,
-    /// Odometry noise under PID execution: relative std of linear and angular speed
-    /// `LIN[,ANG]` (seeded by --seed).
-    #[arg(long, value_name = "LIN[,ANG]")]
+    /// Odometry noise under PID execution: relative std of linear and angular speed and the
+    /// heading drift while driving, rad per metre, `LIN[,ANG[,DRIFT]]` (ANG defaults to LIN,
+    /// DRIFT to 0; seeded by --seed).
+    #[arg(long, value_name = "LIN[,ANG[,DRIFT]]")]
     pub odometry_noise: Option<String>,
     /// Landmarks for pose correction under PID (CSV `id,x,y[,theta]` or a JSON array).
     #[arg(long, value_name = "FILE")]

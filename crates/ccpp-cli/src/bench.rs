@@ -194,15 +194,35 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     for p in &planners {
         parse_planner(p)?;
     }
+    // A planner named twice runs once, as a map named twice does: two runs of it would
+    // write the same run folder at the same time.
+    let mut planners = planners;
+    let mut seen = Vec::new();
+    planners.retain(|p| {
+        let first = !seen.contains(p);
+        seen.push(p.clone());
+        first
+    });
+    if a.seed.is_some()
+        && !planners
+            .iter()
+            .any(|p| p == planners::PlannerKind::RandomBounce.name())
+    {
+        bail!("--seed does not apply to the planners of this bench (it applies to random-bounce)");
+    }
+    if a.jobs == Some(0) {
+        bail!("--jobs must be at least 1, got 0");
+    }
     let (robot, _) = robot_from(&(&a.robot).into())?;
     let options = planner_options(a.options.config.as_deref(), a.seed)?;
     let maps = name_maps(expand_maps(&a.maps)?);
+    check_bench_target(&a.out)?;
     std::fs::create_dir_all(&a.out)
         .with_context(|| format!("cannot create output folder {}", a.out.display()))?;
     if let Some(j) = a.jobs {
         // Ignore the error when a global pool already exists (tests).
         let _ = rayon::ThreadPoolBuilder::new()
-            .num_threads(j.max(1))
+            .num_threads(j)
             .build_global();
     }
 
@@ -273,6 +293,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         .collect();
     bar.finish_and_clear();
 
+    clear_plots(&a.out)?;
     write_file(&a.out.join("results.csv"), results_csv(&rows).as_bytes())?;
     write_file(&a.out.join("results.md"), results_md(&rows).as_bytes())?;
     crate::plots::write_all(&a.out, &rows, &prepared, robot)?;
@@ -291,6 +312,71 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             rows.len(),
             a.out.join("results.csv").display()
         );
+    }
+    Ok(())
+}
+
+/// Checks that `out` is absent or a folder holding only what a bench writes (`results.csv`,
+/// `results.md`, `plots/`, `runs/`): a bench rewrites those, so another file there (a user's
+/// own `results.csv` in a folder of theirs) would be overwritten.
+///
+/// # Errors
+/// When `out` is a file, or a folder holding anything else.
+fn check_bench_target(out: &Path) -> Result<()> {
+    let Ok(meta) = std::fs::symlink_metadata(out) else {
+        return Ok(());
+    };
+    if !meta.is_dir() {
+        bail!(
+            "output folder {} exists and is not a plain folder",
+            out.display()
+        );
+    }
+    let entries = std::fs::read_dir(out)
+        .with_context(|| format!("cannot read output folder {}", out.display()))?;
+    for e in entries {
+        let e = e.with_context(|| format!("cannot read output folder {}", out.display()))?;
+        let name = e.file_name();
+        let name = name.to_string_lossy();
+        let Ok(t) = e.file_type() else { continue };
+        let known = match name.as_ref() {
+            "results.csv" | "results.md" => t.is_file(),
+            "plots" | "runs" => t.is_dir(),
+            // A write cut short leaves `<file>.tmp` (see `staging::write_file`).
+            _ => {
+                Path::new(name.as_ref())
+                    .extension()
+                    .is_some_and(|x| x == "tmp")
+                    && t.is_file()
+            }
+        };
+        if !known {
+            bail!(
+                "output folder {} holds {name}, which ccpp bench did not write; a bench rewrites \
+                 its results there, so choose a new or bench-only folder",
+                out.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Removes the plots of an earlier bench in `out/plots/` (maps it had and this one has not
+/// would stay beside this bench's results otherwise).
+fn clear_plots(out: &Path) -> Result<()> {
+    let dir = out.join("plots");
+    let Ok(entries) = std::fs::read_dir(&dir) else {
+        return Ok(());
+    };
+    for e in entries.flatten() {
+        let p = e.path();
+        let plot = p
+            .extension()
+            .is_some_and(|x| x.eq_ignore_ascii_case("png") || x.eq_ignore_ascii_case("svg"));
+        if plot && e.file_type().is_ok_and(|t| t.is_file()) {
+            std::fs::remove_file(&p)
+                .with_context(|| format!("cannot remove the old plot {}", p.display()))?;
+        }
     }
     Ok(())
 }

@@ -3,12 +3,14 @@
 //! flags apply to which planner; every value check lives in `ccpp_io::scenario` and the
 //! planners' `PlannerSettings`.
 
+use std::fmt::Display;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use ccpp_core::exec::{Execution, OdometryNoise, PidOptions};
 use ccpp_core::metrics::Metrics;
 use ccpp_core::planners::bsa::Side;
+use ccpp_core::planners::rect_boustrophedon::RectOptions;
 use ccpp_core::planners::{PlannerConfig, PlannerKind, PlannerOptions};
 use ccpp_core::sim::{RunOutput, SimConfig};
 use ccpp_core::world::{Robot, World};
@@ -121,6 +123,13 @@ pub fn planner_options(config: Option<&Path>, seed: Option<u64>) -> Result<Plann
         None => PlannerOptions::default(),
     };
     if let Some(seed) = seed {
+        let file_seed = options.random_bounce.seed;
+        if file_seed != PlannerOptions::default().random_bounce.seed && file_seed != seed {
+            bail!(
+                "--seed {seed} and random_bounce.seed: {file_seed} in {} set the same option; remove one of them",
+                config.map_or_else(|| "the options file".into(), |p| p.display().to_string())
+            );
+        }
         options.random_bounce.seed = seed;
     }
     Ok(options)
@@ -170,16 +179,29 @@ const FLAG_FIELDS: [(&str, &[&str]); 4] = [
     ("--sensor-range", &["sim.sensor_range"]),
 ];
 
-/// Applies the planner flags of `a` to `config`, refusing flags the planner does not use.
+/// "`flag` and `field` in the options file set the same option": the flag would replace the
+/// file's value, read and validated, without a word.
+fn clash(a: &RunArgs, flag: &str, v: impl Display, field: &str, w: impl Display) -> anyhow::Error {
+    anyhow::anyhow!(
+        "{flag} {v} and {field}: {w} in {} set the same option; remove one of them",
+        options_file(a)
+    )
+}
+
+/// Applies the planner flags of `a` to `config`, refusing flags the planner does not use and
+/// flags that would replace a different value the options file gives for the same option.
 fn apply_planner_flags(a: &RunArgs, config: &mut PlannerConfig) -> Result<Vec<&'static str>> {
     let kind = config.kind();
     let mut given = Vec::new();
     if let Some(t) = a.tile_side {
         given.push("--tile-side");
-        match config {
-            PlannerConfig::BaStar(o) => o.tile_side_m = Some(t),
-            PlannerConfig::BaStarExtended(o) => o.ba_star.tile_side_m = Some(t),
-            PlannerConfig::BsaBfs(o) => o.cell_side_m = Some(t),
+        let (slot, field) = match config {
+            PlannerConfig::BaStar(o) => (&mut o.tile_side_m, "ba_star.tile_side_m"),
+            PlannerConfig::BaStarExtended(o) => (
+                &mut o.ba_star.tile_side_m,
+                "ba_star_extended.ba_star.tile_side_m",
+            ),
+            PlannerConfig::BsaBfs(o) => (&mut o.cell_side_m, "bsa_bfs.cell_side_m"),
             _ => {
                 return Err(not_applicable(
                     "--tile-side",
@@ -187,12 +209,19 @@ fn apply_planner_flags(a: &RunArgs, config: &mut PlannerConfig) -> Result<Vec<&'
                     "ba-star, ba-star-extended, bsa-bfs",
                 ))
             }
+        };
+        if let Some(w) = slot.filter(|w| w.to_bits() != t.to_bits()) {
+            return Err(clash(a, "--tile-side", t, field, w));
         }
+        *slot = Some(t);
     }
     if let Some(s) = a.smoothing {
-        match config {
-            PlannerConfig::BaStar(o) => o.smoothing = s,
-            PlannerConfig::BaStarExtended(o) => o.ba_star.smoothing = s,
+        let (slot, field) = match config {
+            PlannerConfig::BaStar(o) => (&mut o.smoothing, "ba_star.smoothing"),
+            PlannerConfig::BaStarExtended(o) => (
+                &mut o.ba_star.smoothing,
+                "ba_star_extended.ba_star.smoothing",
+            ),
             _ => {
                 return Err(not_applicable(
                     "--smoothing",
@@ -200,7 +229,12 @@ fn apply_planner_flags(a: &RunArgs, config: &mut PlannerConfig) -> Result<Vec<&'
                     "ba-star, ba-star-extended",
                 ))
             }
+        };
+        // The default is on: a file that turned it off and the flag that turns it on clash.
+        if !*slot && s {
+            return Err(clash(a, "--smoothing", "on", field, "false"));
         }
+        *slot = s;
     }
     if let Some(side) = &a.side {
         let side = match side.to_ascii_lowercase().as_str() {
@@ -208,22 +242,47 @@ fn apply_planner_flags(a: &RunArgs, config: &mut PlannerConfig) -> Result<Vec<&'
             "right" => Side::Right,
             other => bail!("--side must be left or right, got {other:?}"),
         };
-        match config {
-            PlannerConfig::Bsa(o) => o.side = side,
-            PlannerConfig::BsaExtended(o) => o.side = side,
+        let (slot, field) = match config {
+            PlannerConfig::Bsa(o) => (&mut o.side, "bsa.side"),
+            PlannerConfig::BsaExtended(o) => (&mut o.side, "bsa_extended.side"),
             _ => return Err(not_applicable("--side", kind, "bsa, bsa-extended")),
+        };
+        if *slot != Side::default() && *slot != side {
+            return Err(clash(a, "--side", "left", field, "right"));
         }
+        *slot = side;
     }
+    let rect_default = RectOptions::default();
     for (flag, v) in [("--length", a.length), ("--width", a.width)] {
         let Some(v) = v else { continue };
         given.push(flag);
-        match config {
-            PlannerConfig::RectBoustrophedon(o) if flag == "--length" => o.length_m = v,
-            PlannerConfig::RectBoustrophedon(o) => o.width_m = v,
+        let (slot, field, d) = match config {
+            PlannerConfig::RectBoustrophedon(o) if flag == "--length" => (
+                &mut o.length_m,
+                "rect_boustrophedon.length_m",
+                rect_default.length_m,
+            ),
+            PlannerConfig::RectBoustrophedon(o) => (
+                &mut o.width_m,
+                "rect_boustrophedon.width_m",
+                rect_default.width_m,
+            ),
             _ => return Err(not_applicable(flag, kind, "rect-boustrophedon")),
+        };
+        if slot.to_bits() != d.to_bits() && slot.to_bits() != v.to_bits() {
+            return Err(clash(a, flag, v, field, *slot));
         }
+        *slot = v;
     }
     Ok(given)
+}
+
+/// The options file of `a`, for messages.
+fn options_file(a: &RunArgs) -> String {
+    a.options.config.as_ref().map_or_else(
+        || "the options file".to_string(),
+        |p| p.display().to_string(),
+    )
 }
 
 /// The simulator settings of `a` for `config` (execution, odometry noise, landmarks, sensor
@@ -255,12 +314,9 @@ fn sim_from(a: &RunArgs, config: &mut PlannerConfig) -> Result<SimConfig> {
     // `--exec ideal` replaces the planner's execution: PID settings given for it in the
     // options file would be read, validated and then dropped, so the two are refused together.
     if exec == Some(false) && pid != PidOptions::default() {
-        let file = a.options.config.as_ref().map_or_else(
-            || "the options file".to_string(),
-            |p| p.display().to_string(),
-        );
         bail!(
-            "--exec ideal drops the PID settings given for {kind} in {file} ({}.exec); remove one of them",
+            "--exec ideal drops the PID settings given for {kind} in {} ({}.exec); remove one of them",
+            options_file(a),
             kind.info().section
         );
     }
@@ -270,18 +326,29 @@ fn sim_from(a: &RunArgs, config: &mut PlannerConfig) -> Result<SimConfig> {
             .split(',')
             .map(|x| x.trim().parse::<f64>())
             .collect::<Result<_, _>>()
-            .map_err(|_| anyhow::anyhow!("--odometry-noise expects LIN[,ANG], got {n:?}"))?;
-        if v.is_empty() || v.len() > 2 || v.iter().any(|x| !x.is_finite() || *x < 0.0) {
-            bail!("--odometry-noise expects one or two finite numbers >= 0, got {n:?}");
+            .map_err(|_| {
+                anyhow::anyhow!("--odometry-noise expects LIN[,ANG[,DRIFT]], got {n:?}")
+            })?;
+        if v.is_empty() || v.len() > 3 || v.iter().any(|x| !x.is_finite() || *x < 0.0) {
+            bail!("--odometry-noise expects one to three finite numbers >= 0, got {n:?}");
         }
         if exec == Some(false) {
             bail!("--odometry-noise needs PID execution, not --exec ideal");
         }
+        if pid.noise.is_some() {
+            bail!(
+                "--odometry-noise replaces the odometry noise given for {kind} in {} ({}.exec.pid.noise); remove one of them",
+                options_file(a),
+                kind.info().section
+            );
+        }
+        // Exactly the noise asked for: a heading drift left out is 0, not the library's
+        // default (`--odometry-noise 0` used to drift 0.2 rad per metre).
         pid.noise = Some(OdometryNoise {
             seed: a.seed.unwrap_or(0),
             linear_rel_std: v[0],
             angular_rel_std: v.get(1).copied().unwrap_or(v[0]),
-            ..OdometryNoise::default()
+            heading_drift_std: v.get(2).copied().unwrap_or(0.0),
         });
         noise_given = true;
     }
@@ -293,7 +360,13 @@ fn sim_from(a: &RunArgs, config: &mut PlannerConfig) -> Result<SimConfig> {
     };
     if let Some(seed) = a.seed {
         match config {
-            PlannerConfig::RandomBounce(o) => o.seed = seed,
+            PlannerConfig::RandomBounce(o) => {
+                let d = ccpp_core::planners::random_bounce::RandomBounceOptions::default().seed;
+                if o.seed != d && o.seed != seed {
+                    return Err(clash(a, "--seed", seed, "random_bounce.seed", o.seed));
+                }
+                o.seed = seed;
+            }
             _ if noise_given => {}
             _ => {
                 return Err(not_applicable(
@@ -307,6 +380,10 @@ fn sim_from(a: &RunArgs, config: &mut PlannerConfig) -> Result<SimConfig> {
     if let Some(p) = &a.landmarks {
         sim.landmarks.landmarks = ccpp_io::landmarks::load_landmarks(p)
             .map_err(|e| anyhow::anyhow!("landmarks {}: {e}", p.display()))?;
+        if sim.landmarks.landmarks.is_empty() {
+            // Read and then nothing to correct with: the run would be the run without it.
+            bail!("landmarks {}: the file holds no landmark", p.display());
+        }
     }
     Ok(sim)
 }

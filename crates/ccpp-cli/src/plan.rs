@@ -3,8 +3,8 @@
 
 use std::fmt::Write as _;
 
-use anyhow::{anyhow, Result};
-use ccpp_core::planners::PlannerConfig;
+use anyhow::{anyhow, bail, Result};
+use ccpp_core::planners::{PlannerConfig, PlannerKind};
 use ccpp_core::route::DEFAULT_TOLERANCE_M;
 use ccpp_core::sim::StopReason;
 use ccpp_io::export::{render_exports, zone_features, ExportFormat, ExportMeta};
@@ -26,21 +26,47 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         // Refused before the map is read.
         return Err(PlanError::Online(kind.name(), offline_planners()).into());
     }
+    if a.robot.tool_radius.is_some() && kind == PlannerKind::RectBoustrophedon {
+        // Its lanes follow --width and a plan has no coverage metrics: the value would be
+        // validated and then change nothing.
+        bail!("--tool-radius does not apply to {kind} in `ccpp plan` (its lanes follow --width)");
+    }
+    if a.robot.start.is_some_and(|s| s[2] != 0.0) {
+        // Nothing a plan writes depends on the start heading: it would be dropped.
+        bail!("--start THETA does not apply to `ccpp plan` (the path heads from the start to its first waypoint); give X,Y");
+    }
     let (robot, start) = robot_from(&a.robot)?;
     let mut planner = planner_options(a.options.config.as_deref(), None)?.config(kind);
     let mut given = Vec::new();
     for (flag, v) in [("--length", a.length), ("--width", a.width)] {
         let Some(v) = v else { continue };
         given.push(flag);
-        match &mut planner {
-            PlannerConfig::RectBoustrophedon(o) if flag == "--length" => o.length_m = v,
-            PlannerConfig::RectBoustrophedon(o) => o.width_m = v,
+        let d = ccpp_core::planners::rect_boustrophedon::RectOptions::default();
+        let (slot, field, d) = match &mut planner {
+            PlannerConfig::RectBoustrophedon(o) if flag == "--length" => {
+                (&mut o.length_m, "rect_boustrophedon.length_m", d.length_m)
+            }
+            PlannerConfig::RectBoustrophedon(o) => {
+                (&mut o.width_m, "rect_boustrophedon.width_m", d.width_m)
+            }
             _ => {
                 return Err(anyhow!(
                     "{flag} does not apply to {kind} (it applies to rect-boustrophedon)"
                 ))
             }
+        };
+        // A different value for the same option in the options file would be dropped.
+        if slot.to_bits() != d.to_bits() && slot.to_bits() != v.to_bits() {
+            bail!(
+                "{flag} {v} and {field}: {} in {} set the same option; remove one of them",
+                *slot,
+                a.options
+                    .config
+                    .as_ref()
+                    .map_or_else(|| "the options file".into(), |p| p.display().to_string())
+            );
         }
+        *slot = v;
     }
     let flag = |e: ScenarioError| match &e {
         ScenarioError::Options(o)

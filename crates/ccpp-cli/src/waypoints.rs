@@ -17,6 +17,14 @@ pub fn run(a: &WaypointsArgs) -> Result<()> {
     if format != "csv" && format != "json" {
         bail!("--format must be csv or json, got {:?}", a.format);
     }
+    if a.robot.tool_radius.is_some() {
+        // The lanes follow --width: the value would be validated and then change nothing.
+        bail!("--tool-radius does not apply to `ccpp waypoints` (its lanes follow --width)");
+    }
+    if a.robot.start.is_some_and(|s| s[2] != 0.0) {
+        // Nothing a plan writes depends on the start heading: it would be dropped.
+        bail!("--start THETA does not apply to `ccpp waypoints` (waypoints have no heading); give X,Y");
+    }
     let (robot, start) = robot_from(&a.robot)?;
     let opts = RectOptions {
         length_m: a.length,

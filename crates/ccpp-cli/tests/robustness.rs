@@ -384,11 +384,19 @@ fn bench_resume_reruns_when_anything_that_defines_a_run_changed() {
             "{key}"
         );
     }
-    // A different seed or a changed map content reruns.
+    // A different seed (taken by random-bounce; part of every run's key) or a changed map
+    // content reruns.
     bench(
         &out,
         &maps,
-        &["--planners", "bcd", "--radius", "0.3", "--seed", "9"],
+        &[
+            "--planners",
+            "bcd,random-bounce",
+            "--radius",
+            "0.3",
+            "--seed",
+            "9",
+        ],
     )
     .assert()
     .success();
@@ -404,7 +412,14 @@ fn bench_resume_reruns_when_anything_that_defines_a_run_changed() {
     bench(
         &out,
         &m2,
-        &["--planners", "bcd", "--radius", "0.3", "--seed", "9"],
+        &[
+            "--planners",
+            "bcd,random-bounce",
+            "--radius",
+            "0.3",
+            "--seed",
+            "9",
+        ],
     )
     .assert()
     .success();
@@ -420,7 +435,14 @@ fn bench_resume_reruns_when_anything_that_defines_a_run_changed() {
     bench(
         &out,
         &m2,
-        &["--planners", "bcd", "--radius", "0.3", "--seed", "9"],
+        &[
+            "--planners",
+            "bcd,random-bounce",
+            "--radius",
+            "0.3",
+            "--seed",
+            "9",
+        ],
     )
     .assert()
     .success();

@@ -210,6 +210,24 @@ impl MapRecipe {
                 )));
             }
         }
+        if let Some(g) = &self.georef {
+            // The fit places the image: a resolution or origin given beside it would be
+            // validated and then replaced.
+            let given: Vec<&str> = [
+                self.resolution.map(|_| "--resolution / map.resolution"),
+                self.origin.map(|_| "--origin / map.origin"),
+            ]
+            .into_iter()
+            .flatten()
+            .collect();
+            if !given.is_empty() {
+                return Err(ScenarioError::Invalid(format!(
+                    "{} cannot be used with --georef {}, whose fit sets the resolution and origin; remove one of them",
+                    given.join(" and "),
+                    g.display()
+                )));
+            }
+        }
         if let Some(m) = self.inflate {
             if !(m.is_finite() && m >= 0.0) {
                 return Err(ScenarioError::Invalid(format!(
@@ -251,6 +269,17 @@ impl MapRecipe {
         }
         if let Some(m) = self.inflate {
             if m > 0.0 {
+                // Inflation turns pixels whose centre is within `m` of an obstacle's centre:
+                // below one pixel it would be validated and then grow nothing.
+                let res = grid.frame().resolution;
+                if (m / res).powi(2) + 1e-9 < 1.0 {
+                    return Err(ScenarioError::Invalid(format!(
+                        "--inflate / map.inflate {} m grows nothing on the map {}: it is less than one pixel ({} m)",
+                        Compact(m),
+                        loaded.source.display(),
+                        Compact(res)
+                    )));
+                }
                 grid = ccpp_core::inflate::inflate(&grid, m);
             }
         }
@@ -577,9 +606,29 @@ impl Scenario {
         let mut polys = Vec::new();
         let mut masks = Vec::new();
         for spec in &self.keepout {
-            match load("keepout", spec, true)? {
-                ZoneData::Polygons(p) => polys.extend(p),
-                ZoneData::Mask(m) => masks.push(m),
+            // A keep-out that marks no pixel would be read, validated and then keep nothing
+            // out: refused, as an area holding no pixel is.
+            let marks_nothing = match load("keepout", spec, true)? {
+                ZoneData::Polygons(p) => {
+                    let empty = ccpp_core::zones::rasterize(&frame, &p).is_clear();
+                    polys.extend(p);
+                    empty
+                }
+                ZoneData::Mask(m) => {
+                    let empty = m.is_clear();
+                    masks.push(m);
+                    empty
+                }
+            };
+            if marks_nothing {
+                return Err(ScenarioError::Zone {
+                    kind: "keepout",
+                    label: spec.label(),
+                    message: format!(
+                        "keeps out no pixel of the map {} (it lies outside the map, is thinner than a pixel or, for a mask, has no occupied pixel)",
+                        map.source.display()
+                    ),
+                });
             }
         }
         let z = ZoneMasks::new(&frame, area.as_deref(), &polys, &masks);

@@ -437,6 +437,71 @@ impl PlannerSettings for BaStarOptions {
     }
 }
 
+/// Refuses option `field` set to `v`, not its default `d`, while `off` (described by
+/// `because`) keeps it from doing anything: it would be validated and then change nothing.
+fn unused_option<T: PartialEq + Copy + std::fmt::Display>(
+    field: &str,
+    v: T,
+    d: T,
+    off: bool,
+    because: &str,
+) -> Result<(), OptionsError> {
+    if off && v != d {
+        return Err(OptionsError::new(
+            field,
+            format!("{v} changes nothing while {because}; leave it out or change that"),
+        ));
+    }
+    Ok(())
+}
+
+/// The extension options that another one turns off, set anyway (`d`: the host's defaults).
+fn extension_unused(e: &ExtensionOptions, d: &ExtensionOptions) -> Result<(), OptionsError> {
+    let no_yield = e.min_yield <= 0.0;
+    let why = "extension.min_yield is 0 (every chunk is driven)";
+    unused_option(
+        "extension.leave_fraction",
+        e.leave_fraction,
+        d.leave_fraction,
+        no_yield,
+        why,
+    )?;
+    unused_option(
+        "extension.leave_group",
+        e.leave_group,
+        d.leave_group,
+        no_yield,
+        why,
+    )?;
+    let unmerged = !e.merge_segments;
+    let why = "extension.merge_segments is false (passes are neither simplified nor squared)";
+    for (field, v, dv) in [
+        (
+            "extension.simplify_fraction",
+            e.simplify_fraction,
+            d.simplify_fraction,
+        ),
+        ("extension.simplify_loss", e.simplify_loss, d.simplify_loss),
+        ("extension.corner_slack", e.corner_slack, d.corner_slack),
+    ] {
+        unused_option(field, v, dv, unmerged, why)?;
+    }
+    unused_option(
+        "extension.simplify_loss",
+        e.simplify_loss,
+        d.simplify_loss,
+        e.simplify_fraction <= 0.0,
+        "extension.simplify_fraction is 0 (no vertex that loses a pixel is dropped)",
+    )?;
+    unused_option(
+        "extension.simplify_fraction",
+        e.simplify_fraction,
+        d.simplify_fraction,
+        e.simplify_loss <= 0.0,
+        "extension.simplify_loss is 0 (no vertex that loses a pixel is dropped)",
+    )
+}
+
 impl PlannerSettings for BaStarExtendedOptions {
     fn validate(&self) -> Result<(), OptionsError> {
         self.ba_star
@@ -449,7 +514,16 @@ impl PlannerSettings for BaStarExtendedOptions {
                 format!("must be a finite number >= 0, got {k}"),
             ));
         }
-        self.extension.validate()
+        self.extension.validate()?;
+        let d = Self::default();
+        unused_option(
+            "backtrack_sweep",
+            k,
+            d.backtrack_sweep,
+            self.extension.reach_r > 0.0,
+            "extension.reach_r is above 0 (rims are swept around each region's end instead)",
+        )?;
+        extension_unused(&self.extension, &d.extension)
     }
 
     fn check(&self, s: &Setup) -> Result<(), OptionsError> {
@@ -515,7 +589,8 @@ impl PlannerSettings for BsaExtendedOptions {
                 "does not apply to bsa-extended (BSA has no lanes)",
             ));
         }
-        self.extension.validate()
+        self.extension.validate()?;
+        extension_unused(&self.extension, &Self::default().extension)
     }
 
     fn check(&self, s: &Setup) -> Result<(), OptionsError> {
@@ -582,7 +657,23 @@ impl PlannerSettings for BcdOptions {
             super::bcd::BcdOptionsError::OutOfRange { name, what, value } => {
                 OptionsError::new(name, format!("must be {what}, got {value}"))
             }
-        })
+        })?;
+        let d = Self::default();
+        let why = "rim is false (no rim pass)";
+        unused_option(
+            "rim_min_yield",
+            self.rim_min_yield,
+            d.rim_min_yield,
+            !self.rim,
+            why,
+        )?;
+        unused_option(
+            "rim_coverage",
+            self.rim_coverage,
+            d.rim_coverage,
+            !self.rim,
+            why,
+        )
     }
 
     fn check(&self, _: &Setup) -> Result<(), OptionsError> {

@@ -1,0 +1,624 @@
+//! Values that were accepted and then silently did nothing (or something else than asked),
+//! found by hostile testing of every subcommand: each is now either honoured or refused with
+//! one `error:` line naming the flag and the file, and no output folder is left behind.
+#![allow(clippy::unwrap_used)]
+
+use std::path::{Path, PathBuf};
+
+mod common;
+use common::{ccpp, pillars, plan_ok, read_json, run_ok};
+
+/// Runs `ccpp ARGS`, expects exit 1 with one `error:` line holding every needle.
+fn refused(args: &[&str], needles: &[&str]) {
+    let a = ccpp().args(args).assert().failure();
+    let o = a.get_output();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
+    assert!(err.starts_with("error: "), "{err}");
+    for n in needles {
+        assert!(err.contains(n), "{err:?} should contain {n:?}");
+    }
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn trace(out: &Path) -> String {
+    std::fs::read_to_string(out.join("trace.jsonl")).unwrap()
+}
+
+/// A keep-out that marks no pixel of the map (outside it, thinner than a pixel, or a Nav2 mask
+/// without an occupied pixel) kept nothing out and the run went on as if it was not given.
+#[test]
+fn a_keepout_that_keeps_nothing_out_is_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir); // 8 x 6 m from (0, 0)
+                            // A mask in the map's frame with no occupied pixel.
+    common::pgm(dir, "empty_mask.pgm", 160, 120, |_, _| false);
+    let empty: Vec<u8> = std::fs::read(dir.join("empty_mask.pgm")).unwrap();
+    // Clear the walls `pgm` draws, so that the mask marks nothing.
+    let header = b"P5\n160 120\n255\n".len();
+    let mut clear = empty[..header].to_vec();
+    clear.extend(std::iter::repeat_n(254u8, 160 * 120));
+    std::fs::write(dir.join("empty_mask.pgm"), clear).unwrap();
+    let mask = dir.join("empty_mask.yaml");
+    std::fs::write(
+        &mask,
+        "image: empty_mask.pgm\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n",
+    )
+    .unwrap();
+    let out = dir.join("out");
+    for zone in ["20,20,30,30", "2,2,2.001,2.001", s(&mask)] {
+        refused(
+            &[
+                "run",
+                "--planner",
+                "bcd",
+                "--map",
+                s(&map),
+                "--keepout",
+                zone,
+                "--out",
+                s(&out),
+            ],
+            &["keepout", "keeps out no pixel", "pillars.pgm"],
+        );
+        assert!(!out.exists(), "{zone}: an output folder was left");
+        refused(
+            &["info", "--map", s(&map), "--keepout", zone],
+            &["keeps out no pixel"],
+        );
+        refused(
+            &["waypoints", "--map", s(&map), "--keepout", zone],
+            &["keeps out no pixel"],
+        );
+    }
+    // One pixel centre is enough: the zone is used.
+    run_ok(dir, "one", &map, "bcd", &["--keepout", "2,2,2.05,2.05"]);
+}
+
+/// `ccpp bench --planners bcd,bcd` ran bcd twice at once into the same run folder (two rows,
+/// one folder written by two processes).
+#[test]
+fn bench_runs_a_repeated_planner_once() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let out = dir.join("bench");
+    ccpp()
+        .args(["bench", "--quiet", "--planners", "bcd,bcd", "--maps"])
+        .arg(&map)
+        .arg("--out")
+        .arg(&out)
+        .assert()
+        .success();
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 2, "{csv}");
+}
+
+/// `ccpp bench --seed` without random-bounce, and `--jobs 0` (silently one thread), were
+/// accepted and changed nothing.
+#[test]
+fn bench_refuses_a_seed_no_planner_uses_and_zero_jobs() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let out = dir.join("bench");
+    let base = ["bench", "--quiet", "--maps", s(&map), "--out", s(&out)];
+    let with = |extra: &[&'static str]| {
+        let mut v = base.to_vec();
+        v.extend_from_slice(extra);
+        v
+    };
+    refused(
+        &with(&["--planners", "bcd,bsa", "--seed", "3"]),
+        &["--seed", "random-bounce"],
+    );
+    refused(&with(&["--planners", "bcd", "--jobs", "0"]), &["--jobs"]);
+    assert!(!out.exists());
+    // With random-bounce in the bench the seed is taken.
+    ccpp()
+        .args(with(&["--planners", "random-bounce", "--seed", "3"]))
+        .assert()
+        .success();
+    let run = read_json(&out.join("runs/pillars/random-bounce/run.json"));
+    assert_eq!(run["options"]["seed"], 3);
+}
+
+/// `--odometry-noise 0` kept the library's default heading drift (0.2 rad per metre): a run
+/// asked to have no noise drifted into the walls. The drift is now the optional third value.
+#[test]
+fn odometry_noise_is_exactly_what_is_asked() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let clean = run_ok(dir, "clean", &map, "bcd", &["--exec", "pid"]);
+    let zero = run_ok(dir, "zero", &map, "bcd", &["--odometry-noise", "0"]);
+    assert_eq!(trace(&clean), trace(&zero), "zero noise is not clean");
+    let drift = run_ok(dir, "drift", &map, "bcd", &["--odometry-noise", "0,0,0.2"]);
+    assert_ne!(trace(&clean), trace(&drift), "the drift changed nothing");
+    let run = read_json(&drift.join("run.json"));
+    assert_eq!(run["sim"]["exec"]["pid"]["noise"]["heading_drift_std"], 0.2);
+    let out = dir.join("refused");
+    refused(
+        &[
+            "run",
+            "--planner",
+            "bcd",
+            "--map",
+            s(&map),
+            "--odometry-noise",
+            "0.1,0.1,0.1,0.1",
+            "--out",
+            s(&out),
+        ],
+        &["--odometry-noise"],
+    );
+    // Noise in the options file and the flag: the flag would drop the file's noise.
+    let cfg = dir.join("noise.yaml");
+    std::fs::write(&cfg, "bsa_bfs: { exec: { pid: { noise: { seed: 4 } } } }\n").unwrap();
+    refused(
+        &[
+            "run",
+            "--planner",
+            "bsa-bfs",
+            "--map",
+            s(&map),
+            "--config",
+            s(&cfg),
+            "--odometry-noise",
+            "0.1",
+            "--out",
+            s(&out),
+        ],
+        &["--odometry-noise", "noise.yaml", "bsa_bfs.exec.pid.noise"],
+    );
+    assert!(!out.exists());
+}
+
+/// `--inflate` below one pixel turned no pixel: validated, then nothing.
+#[test]
+fn inflation_below_one_pixel_is_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir); // 0.05 m/px
+    let out = dir.join("out");
+    for m in ["0.02", "0.0499"] {
+        refused(
+            &[
+                "run",
+                "--planner",
+                "bcd",
+                "--map",
+                s(&map),
+                "--inflate",
+                m,
+                "--out",
+                s(&out),
+            ],
+            &["--inflate", "grows nothing", "pillars.pgm", "0.05"],
+        );
+        refused(
+            &["info", "--map", s(&map), "--inflate", m],
+            &["grows nothing"],
+        );
+    }
+    assert!(!out.exists());
+    // One pixel grows the obstacles; 0 is no inflation.
+    let base = run_ok(dir, "base", &map, "bcd", &[]);
+    let one = run_ok(dir, "one", &map, "bcd", &["--inflate", "0.05"]);
+    assert_ne!(trace(&base), trace(&one));
+    let zero = run_ok(dir, "zero", &map, "bcd", &["--inflate", "0"]);
+    assert_eq!(trace(&base), trace(&zero));
+}
+
+/// `--tool-radius` with `ccpp plan --planner rect-boustrophedon` and with `ccpp waypoints`
+/// wrote byte-identical files: its lanes follow `--width` and neither writes metrics.
+#[test]
+fn tool_radius_is_refused_where_it_changes_nothing() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let out: PathBuf = dir.join("out");
+    refused(
+        &[
+            "plan",
+            "--planner",
+            "rect-boustrophedon",
+            "--map",
+            s(&map),
+            "--tool-radius",
+            "0.05",
+            "--out",
+            s(&out),
+        ],
+        &["--tool-radius", "rect-boustrophedon"],
+    );
+    refused(
+        &["waypoints", "--map", s(&map), "--tool-radius", "0.05"],
+        &["--tool-radius", "waypoints"],
+    );
+    assert!(!out.exists());
+    // bcd's lanes follow the tool: there it changes the plan.
+    let a = plan_ok(dir, "a", &map, "bcd", &[]);
+    let b = plan_ok(dir, "b", &map, "bcd", &["--tool-radius", "0.08"]);
+    let csv = |p: &Path| std::fs::read_to_string(p.join("waypoints.csv")).unwrap();
+    assert_ne!(csv(&a), csv(&b));
+}
+
+/// `--georef` with `--resolution` or `--origin`: the fit replaced them without a word.
+#[test]
+fn georef_refuses_a_resolution_or_origin_it_would_replace() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir); // 160 x 120 px
+    let g = dir.join("fit.csv");
+    std::fs::write(&g, "0,0,10,16\n160,0,18,16\n0,120,10,10\n").unwrap();
+    for extra in [["--resolution", "0.1"], ["--origin", "1,1"]] {
+        refused(
+            &[
+                "info",
+                "--map",
+                s(&map),
+                "--georef",
+                s(&g),
+                extra[0],
+                extra[1],
+            ],
+            &[extra[0], "--georef", "fit.csv"],
+        );
+    }
+    // Alone, the fit places the map.
+    let a = ccpp()
+        .args(["info", "--json", "--map", s(&map), "--georef", s(&g)])
+        .assert()
+        .success();
+    let v: serde_json::Value = serde_json::from_slice(&a.get_output().stdout).unwrap();
+    assert_eq!(v["origin"][0], 10.0);
+}
+
+/// Options that another option switches off were read, validated and then changed nothing
+/// (the runs were byte-identical): bcd's rim limits without the rim pass, the extension's
+/// leave limits with `min_yield: 0`, its simplification and corner squaring without merged
+/// segments, `simplify_loss` and `simplify_fraction` with the other at 0, and
+/// ba-star-extended's `backtrack_sweep` with `reach_r` above 0. Such a pair is refused, naming
+/// both; the switch alone (or with the option at its default) runs.
+#[test]
+fn an_option_another_switches_off_is_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let out = dir.join("out");
+    for (planner, text, field, because) in [
+        (
+            "bcd",
+            "bcd: { rim: false, rim_coverage: 0.5 }",
+            "bcd.rim_coverage",
+            "rim is false",
+        ),
+        (
+            "bcd",
+            "bcd: { rim: false, rim_min_yield: 0.3 }",
+            "bcd.rim_min_yield",
+            "rim is false",
+        ),
+        (
+            "bsa-extended",
+            "bsa_extended: { extension: { min_yield: 0, leave_fraction: 0.5 } }",
+            "bsa_extended.extension.leave_fraction",
+            "min_yield is 0",
+        ),
+        (
+            "ba-star-extended",
+            "ba_star_extended: { extension: { min_yield: 0, leave_group: 2 } }",
+            "ba_star_extended.extension.leave_group",
+            "min_yield is 0",
+        ),
+        (
+            "bsa-extended",
+            "bsa_extended: { extension: { merge_segments: false, corner_slack: 3 } }",
+            "bsa_extended.extension.corner_slack",
+            "merge_segments is false",
+        ),
+        (
+            "ba-star-extended",
+            "ba_star_extended: { extension: { merge_segments: false, simplify_fraction: 0.1 } }",
+            "ba_star_extended.extension.simplify_fraction",
+            "merge_segments is false",
+        ),
+        (
+            "bsa-extended",
+            "bsa_extended: { extension: { simplify_fraction: 0, simplify_loss: 5 } }",
+            "bsa_extended.extension.simplify_loss",
+            "simplify_fraction is 0",
+        ),
+        (
+            "bsa-extended",
+            "bsa_extended: { extension: { simplify_loss: 0, simplify_fraction: 0.1 } }",
+            "bsa_extended.extension.simplify_fraction",
+            "simplify_loss is 0",
+        ),
+        (
+            "ba-star-extended",
+            "ba_star_extended: { extension: { reach_r: 4 }, backtrack_sweep: 5 }",
+            "ba_star_extended.backtrack_sweep",
+            "reach_r is above 0",
+        ),
+    ] {
+        let cfg = dir.join("opts.yaml");
+        std::fs::write(&cfg, format!("{text}\n")).unwrap();
+        refused(
+            &[
+                "run",
+                "--planner",
+                planner,
+                "--map",
+                s(&map),
+                "--config",
+                s(&cfg),
+                "--out",
+                s(&out),
+            ],
+            &["opts.yaml", field, "changes nothing while", because],
+        );
+        assert!(!out.exists());
+    }
+    for (i, (planner, text)) in [
+        ("bcd", "bcd: { rim: false }"),
+        (
+            "bsa-extended",
+            "bsa_extended: { extension: { min_yield: 0, merge_segments: false } }",
+        ),
+        (
+            "ba-star-extended",
+            "ba_star_extended: { extension: { reach_r: 4, simplify_fraction: 0 } }",
+        ),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let cfg = dir.join(format!("ok{i}.yaml"));
+        std::fs::write(&cfg, format!("{text}\n")).unwrap();
+        run_ok(
+            dir,
+            &format!("ok{i}"),
+            &map,
+            planner,
+            &["--config", s(&cfg)],
+        );
+    }
+}
+
+/// A flag and a different value for the same option in the `--config` file: the flag replaced
+/// the file's value without a word. Refused, naming both; the same value twice is accepted.
+#[test]
+fn a_flag_and_the_file_setting_the_same_option_differently_are_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let cfg = dir.join("both.yaml");
+    std::fs::write(
+        &cfg,
+        "ba_star: { tile_side_m: 0.4, smoothing: false }\nbsa_bfs: { cell_side_m: 0.4 }\n\
+         bsa: { side: right }\nrect_boustrophedon: { length_m: 0.5, width_m: 0.4 }\n\
+         random_bounce: { seed: 5 }\n",
+    )
+    .unwrap();
+    let out = dir.join("out");
+    for (cmd, planner, flag, value, field) in [
+        (
+            "run",
+            "ba-star",
+            "--tile-side",
+            "0.5",
+            "ba_star.tile_side_m",
+        ),
+        (
+            "run",
+            "bsa-bfs",
+            "--tile-side",
+            "0.5",
+            "bsa_bfs.cell_side_m",
+        ),
+        ("run", "ba-star", "--smoothing", "on", "ba_star.smoothing"),
+        ("run", "bsa", "--side", "left", "bsa.side"),
+        (
+            "run",
+            "rect-boustrophedon",
+            "--length",
+            "0.4",
+            "rect_boustrophedon.length_m",
+        ),
+        (
+            "plan",
+            "rect-boustrophedon",
+            "--width",
+            "0.5",
+            "rect_boustrophedon.width_m",
+        ),
+        ("run", "random-bounce", "--seed", "7", "random_bounce.seed"),
+    ] {
+        refused(
+            &[
+                cmd,
+                "--planner",
+                planner,
+                "--map",
+                s(&map),
+                "--config",
+                s(&cfg),
+                flag,
+                value,
+                "--out",
+                s(&out),
+            ],
+            &[flag, field, "both.yaml", "set the same option"],
+        );
+        assert!(!out.exists());
+    }
+    refused(
+        &[
+            "bench",
+            "--quiet",
+            "--maps",
+            s(&map),
+            "--planners",
+            "random-bounce",
+            "--config",
+            s(&cfg),
+            "--seed",
+            "7",
+            "--out",
+            s(&out),
+        ],
+        &["--seed", "random_bounce.seed", "both.yaml"],
+    );
+    assert!(!out.exists());
+    // The same value in both places, or a flag for an option the file leaves out, runs.
+    run_ok(
+        dir,
+        "same",
+        &map,
+        "ba-star",
+        &[
+            "--config",
+            s(&cfg),
+            "--tile-side",
+            "0.4",
+            "--smoothing",
+            "off",
+        ],
+    );
+    run_ok(
+        dir,
+        "other",
+        &map,
+        "bsa-extended",
+        &["--config", s(&cfg), "--side", "left"],
+    );
+}
+
+/// `ccpp plan` and `ccpp waypoints` wrote the same files whatever THETA `--start` gave.
+#[test]
+fn a_start_heading_is_refused_where_nothing_uses_it() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let out = dir.join("out");
+    for planner in ["bcd", "rect-boustrophedon"] {
+        refused(
+            &[
+                "plan",
+                "--planner",
+                planner,
+                "--map",
+                s(&map),
+                "--start",
+                "1,1,2",
+                "--out",
+                s(&out),
+            ],
+            &["--start THETA", "plan"],
+        );
+        assert!(!out.exists());
+        plan_ok(dir, planner, &map, planner, &["--start", "1,1"]);
+    }
+    refused(
+        &["waypoints", "--map", s(&map), "--start", "1,1,2"],
+        &["--start THETA", "waypoints"],
+    );
+    // `run` uses it: the robot first turns from that heading.
+    let a = run_ok(dir, "a", &map, "bcd", &["--start", "1,1"]);
+    let b = run_ok(dir, "b", &map, "bcd", &["--start", "1,1,2"]);
+    assert_ne!(trace(&a), trace(&b));
+}
+
+/// A landmarks file without a landmark (empty, comments only, `[]`) was accepted: the run was
+/// the run without it.
+#[test]
+fn a_landmarks_file_without_a_landmark_is_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let out = dir.join("out");
+    for (name, text) in [
+        ("empty.csv", ""),
+        ("comments.csv", "# tags\n"),
+        ("none.json", "[]"),
+    ] {
+        let lm = dir.join(name);
+        std::fs::write(&lm, text).unwrap();
+        refused(
+            &[
+                "run",
+                "--planner",
+                "bcd",
+                "--map",
+                s(&map),
+                "--odometry-noise",
+                "0.1",
+                "--landmarks",
+                s(&lm),
+                "--out",
+                s(&out),
+            ],
+            &["landmarks", name, "no landmark"],
+        );
+        assert!(!out.exists());
+    }
+}
+
+/// `ccpp bench --out` into a folder of the user's overwrote their `results.csv` (a run refuses
+/// such a folder), and a second bench into a bench folder left the first one's plots of maps it
+/// did not have beside its own results.
+#[test]
+fn a_bench_folder_is_never_mixed() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let a = pillars(dir);
+    let b = common::rooms(dir);
+    let out = dir.join("bench");
+    std::fs::create_dir(&out).unwrap();
+    std::fs::write(out.join("results.csv"), "precious\n").unwrap();
+    std::fs::write(out.join("notes.txt"), "mine\n").unwrap();
+    refused(
+        &[
+            "bench",
+            "--quiet",
+            "--planners",
+            "bcd",
+            "--maps",
+            s(&a),
+            "--out",
+            s(&out),
+        ],
+        &["output folder", "notes.txt", "did not write"],
+    );
+    assert_eq!(
+        std::fs::read_to_string(out.join("results.csv")).unwrap(),
+        "precious\n"
+    );
+    std::fs::remove_dir_all(&out).unwrap();
+    let bench = |map: &Path| {
+        ccpp()
+            .args(["bench", "--quiet", "--planners", "bcd", "--maps"])
+            .arg(map)
+            .arg("--out")
+            .arg(&out)
+            .assert()
+            .success();
+    };
+    bench(&a);
+    assert!(out.join("plots/coverage_pillars.png").is_file());
+    bench(&b);
+    let plots: Vec<String> = std::fs::read_dir(out.join("plots"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(plots.iter().any(|p| p.contains("rooms")), "{plots:?}");
+    assert!(!plots.iter().any(|p| p.contains("pillars")), "{plots:?}");
+}
