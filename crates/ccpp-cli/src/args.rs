@@ -127,7 +127,7 @@ pub struct RunArgs {
     /// Planner name (see `ccpp planners`).
     #[arg(long, value_name = "NAME")]
     pub planner: String,
-    /// Seed for planners that use randomness.
+    /// Seed of random-bounce's turns and of --odometry-noise (refused for other runs).
     #[arg(long, value_name = "N")]
     pub seed: Option<u64>,
     /// Planner options.
@@ -136,7 +136,7 @@ pub struct RunArgs {
     /// Sensor range in metres (default 4 r).
     #[arg(long, value_name = "M")]
     pub sensor_range: Option<f64>,
-    /// Tile side in metres for tile planners (default 2 r).
+    /// Tile side in metres: ba-star and ba-star-extended tiles, bsa-bfs cells (default 2 r).
     #[arg(long, value_name = "M")]
     pub tile_side: Option<f64>,
     /// BA* backtracking path smoothing (A*SPT): `on` (default) or `off` to compare.
@@ -160,7 +160,8 @@ pub struct RunArgs {
     pub exec: Option<String>,
     /// Odometry noise under PID execution: relative std of linear and angular speed and the
     /// heading drift while driving, rad per metre, `LIN[,ANG[,DRIFT]]` (ANG defaults to LIN,
-    /// DRIFT to 0; seeded by --seed).
+    /// DRIFT to 0; seeded by --seed). Without --exec it switches the run to PID execution;
+    /// refused with --exec ideal.
     #[arg(long, value_name = "LIN[,ANG[,DRIFT]]")]
     pub odometry_noise: Option<String>,
     /// Landmarks for pose correction under PID (CSV `id,x,y[,theta]` or a JSON array).
@@ -293,7 +294,7 @@ pub struct BenchArgs {
     /// Grow obstacles by this many metres before planning.
     #[arg(long, value_name = "M")]
     pub inflate: Option<f64>,
-    /// Seed for planners that use randomness.
+    /// Seed of random-bounce's turns.
     #[arg(long, value_name = "N")]
     pub seed: Option<u64>,
     /// Planner options.
