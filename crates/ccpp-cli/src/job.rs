@@ -10,6 +10,7 @@ use anyhow::{bail, Context, Result};
 use ccpp_core::exec::{Execution, OdometryNoise, PidOptions};
 use ccpp_core::metrics::Metrics;
 use ccpp_core::planners::bsa::Side;
+use ccpp_core::planners::random_bounce::RandomBounceOptions;
 use ccpp_core::planners::rect_boustrophedon::RectOptions;
 use ccpp_core::planners::{PlannerConfig, PlannerKind, PlannerOptions};
 use ccpp_core::sim::{RunOutput, SimConfig};
@@ -123,14 +124,7 @@ pub fn planner_options(config: Option<&Path>, seed: Option<u64>) -> Result<Plann
         None => PlannerOptions::default(),
     };
     if let Some(seed) = seed {
-        let file_seed = options.random_bounce.seed;
-        if file_seed != PlannerOptions::default().random_bounce.seed && file_seed != seed {
-            bail!(
-                "--seed {seed} and random_bounce.seed: {file_seed} in {} set the same option; remove one of them",
-                config.map_or_else(|| "the options file".into(), |p| p.display().to_string())
-            );
-        }
-        options.random_bounce.seed = seed;
+        set_seed(&mut options.random_bounce, seed, config)?;
     }
     Ok(options)
 }
@@ -181,11 +175,64 @@ const FLAG_FIELDS: [(&str, &[&str]); 4] = [
 
 /// "`flag` and `field` in the options file set the same option": the flag would replace the
 /// file's value, read and validated, without a word.
-fn clash(a: &RunArgs, flag: &str, v: impl Display, field: &str, w: impl Display) -> anyhow::Error {
+fn clash(
+    file: Option<&Path>,
+    flag: &str,
+    v: impl Display,
+    field: &str,
+    w: impl Display,
+) -> anyhow::Error {
     anyhow::anyhow!(
         "{flag} {v} and {field}: {w} in {} set the same option; remove one of them",
-        options_file(a)
+        options_file(file)
     )
+}
+
+/// `--seed` into random-bounce's options, refused beside a different `random_bounce.seed`
+/// from the options file `file` (`run` and `bench` alike).
+fn set_seed(o: &mut RandomBounceOptions, seed: u64, file: Option<&Path>) -> Result<()> {
+    let file_seed = o.seed;
+    if file_seed != RandomBounceOptions::default().seed && file_seed != seed {
+        return Err(clash(file, "--seed", seed, "random_bounce.seed", file_seed));
+    }
+    o.seed = seed;
+    Ok(())
+}
+
+/// `--length` / `--width` into rect-boustrophedon's options (`run` and `plan` alike), refused
+/// for other planners and beside a different value for the same option in `file`. Returns the
+/// flags given.
+pub(crate) fn apply_rect_flags(
+    length: Option<f64>,
+    width: Option<f64>,
+    config: &mut PlannerConfig,
+    file: Option<&Path>,
+) -> Result<Vec<&'static str>> {
+    let kind = config.kind();
+    let rect_default = RectOptions::default();
+    let mut given = Vec::new();
+    for (flag, v) in [("--length", length), ("--width", width)] {
+        let Some(v) = v else { continue };
+        given.push(flag);
+        let (slot, field, d) = match config {
+            PlannerConfig::RectBoustrophedon(o) if flag == "--length" => (
+                &mut o.length_m,
+                "rect_boustrophedon.length_m",
+                rect_default.length_m,
+            ),
+            PlannerConfig::RectBoustrophedon(o) => (
+                &mut o.width_m,
+                "rect_boustrophedon.width_m",
+                rect_default.width_m,
+            ),
+            _ => return Err(not_applicable(flag, kind, "rect-boustrophedon")),
+        };
+        if slot.to_bits() != d.to_bits() && slot.to_bits() != v.to_bits() {
+            return Err(clash(file, flag, v, field, *slot));
+        }
+        *slot = v;
+    }
+    Ok(given)
 }
 
 /// Applies the planner flags of `a` to `config`, refusing flags the planner does not use and
@@ -211,7 +258,13 @@ fn apply_planner_flags(a: &RunArgs, config: &mut PlannerConfig) -> Result<Vec<&'
             }
         };
         if let Some(w) = slot.filter(|w| w.to_bits() != t.to_bits()) {
-            return Err(clash(a, "--tile-side", t, field, w));
+            return Err(clash(
+                a.options.config.as_deref(),
+                "--tile-side",
+                t,
+                field,
+                w,
+            ));
         }
         *slot = Some(t);
     }
@@ -232,7 +285,13 @@ fn apply_planner_flags(a: &RunArgs, config: &mut PlannerConfig) -> Result<Vec<&'
         };
         // The default is on: a file that turned it off and the flag that turns it on clash.
         if !*slot && s {
-            return Err(clash(a, "--smoothing", "on", field, "false"));
+            return Err(clash(
+                a.options.config.as_deref(),
+                "--smoothing",
+                "on",
+                field,
+                "false",
+            ));
         }
         *slot = s;
     }
@@ -248,38 +307,28 @@ fn apply_planner_flags(a: &RunArgs, config: &mut PlannerConfig) -> Result<Vec<&'
             _ => return Err(not_applicable("--side", kind, "bsa, bsa-extended")),
         };
         if *slot != Side::default() && *slot != side {
-            return Err(clash(a, "--side", "left", field, "right"));
+            return Err(clash(
+                a.options.config.as_deref(),
+                "--side",
+                "left",
+                field,
+                "right",
+            ));
         }
         *slot = side;
     }
-    let rect_default = RectOptions::default();
-    for (flag, v) in [("--length", a.length), ("--width", a.width)] {
-        let Some(v) = v else { continue };
-        given.push(flag);
-        let (slot, field, d) = match config {
-            PlannerConfig::RectBoustrophedon(o) if flag == "--length" => (
-                &mut o.length_m,
-                "rect_boustrophedon.length_m",
-                rect_default.length_m,
-            ),
-            PlannerConfig::RectBoustrophedon(o) => (
-                &mut o.width_m,
-                "rect_boustrophedon.width_m",
-                rect_default.width_m,
-            ),
-            _ => return Err(not_applicable(flag, kind, "rect-boustrophedon")),
-        };
-        if slot.to_bits() != d.to_bits() && slot.to_bits() != v.to_bits() {
-            return Err(clash(a, flag, v, field, *slot));
-        }
-        *slot = v;
-    }
+    given.extend(apply_rect_flags(
+        a.length,
+        a.width,
+        config,
+        a.options.config.as_deref(),
+    )?);
     Ok(given)
 }
 
-/// The options file of `a`, for messages.
-fn options_file(a: &RunArgs) -> String {
-    a.options.config.as_ref().map_or_else(
+/// The options file `file`, for messages.
+fn options_file(file: Option<&Path>) -> String {
+    file.map_or_else(
         || "the options file".to_string(),
         |p| p.display().to_string(),
     )
@@ -316,7 +365,7 @@ fn sim_from(a: &RunArgs, config: &mut PlannerConfig) -> Result<SimConfig> {
     if exec == Some(false) && pid != PidOptions::default() {
         bail!(
             "--exec ideal drops the PID settings given for {kind} in {} ({}.exec); remove one of them",
-            options_file(a),
+            options_file(a.options.config.as_deref()),
             kind.info().section
         );
     }
@@ -338,7 +387,7 @@ fn sim_from(a: &RunArgs, config: &mut PlannerConfig) -> Result<SimConfig> {
         if pid.noise.is_some() {
             bail!(
                 "--odometry-noise replaces the odometry noise given for {kind} in {} ({}.exec.pid.noise); remove one of them",
-                options_file(a),
+                options_file(a.options.config.as_deref()),
                 kind.info().section
             );
         }
@@ -360,13 +409,7 @@ fn sim_from(a: &RunArgs, config: &mut PlannerConfig) -> Result<SimConfig> {
     };
     if let Some(seed) = a.seed {
         match config {
-            PlannerConfig::RandomBounce(o) => {
-                let d = ccpp_core::planners::random_bounce::RandomBounceOptions::default().seed;
-                if o.seed != d && o.seed != seed {
-                    return Err(clash(a, "--seed", seed, "random_bounce.seed", o.seed));
-                }
-                o.seed = seed;
-            }
+            PlannerConfig::RandomBounce(o) => set_seed(o, seed, a.options.config.as_deref())?,
             _ if noise_given => {}
             _ => {
                 return Err(not_applicable(

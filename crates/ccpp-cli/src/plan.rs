@@ -4,7 +4,7 @@
 use std::fmt::Write as _;
 
 use anyhow::{anyhow, bail, Result};
-use ccpp_core::planners::{PlannerConfig, PlannerKind};
+use ccpp_core::planners::PlannerKind;
 use ccpp_core::route::DEFAULT_TOLERANCE_M;
 use ccpp_core::sim::StopReason;
 use ccpp_io::export::{render_exports, zone_features, ExportFormat, ExportMeta};
@@ -37,37 +37,8 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     }
     let (robot, start) = robot_from(&a.robot)?;
     let mut planner = planner_options(a.options.config.as_deref(), None)?.config(kind);
-    let mut given = Vec::new();
-    for (flag, v) in [("--length", a.length), ("--width", a.width)] {
-        let Some(v) = v else { continue };
-        given.push(flag);
-        let d = ccpp_core::planners::rect_boustrophedon::RectOptions::default();
-        let (slot, field, d) = match &mut planner {
-            PlannerConfig::RectBoustrophedon(o) if flag == "--length" => {
-                (&mut o.length_m, "rect_boustrophedon.length_m", d.length_m)
-            }
-            PlannerConfig::RectBoustrophedon(o) => {
-                (&mut o.width_m, "rect_boustrophedon.width_m", d.width_m)
-            }
-            _ => {
-                return Err(anyhow!(
-                    "{flag} does not apply to {kind} (it applies to rect-boustrophedon)"
-                ))
-            }
-        };
-        // A different value for the same option in the options file would be dropped.
-        if slot.to_bits() != d.to_bits() && slot.to_bits() != v.to_bits() {
-            bail!(
-                "{flag} {v} and {field}: {} in {} set the same option; remove one of them",
-                *slot,
-                a.options
-                    .config
-                    .as_ref()
-                    .map_or_else(|| "the options file".into(), |p| p.display().to_string())
-            );
-        }
-        *slot = v;
-    }
+    let given =
+        crate::job::apply_rect_flags(a.length, a.width, &mut planner, a.options.config.as_deref())?;
     let flag = |e: ScenarioError| match &e {
         ScenarioError::Options(o)
             if given.contains(&"--length") && o.field.ends_with("length_m") =>
