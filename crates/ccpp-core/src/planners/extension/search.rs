@@ -20,10 +20,18 @@ const BUCKET_MAX: usize = 1 << 20;
 /// queue first pops from it (later pushes into a sorted bucket are inserted in order). The
 /// weighted-A* heuristic is not consistent, so a key may fall below the bucket being popped:
 /// the cursor then moves back to it.
+///
+/// A search's keys sweep upwards through tens of thousands of buckets on a large map, while
+/// only the few buckets within a step's cost of the cursor hold entries at a time. So a bucket
+/// the cursor leaves empty gives its storage to a pool, and a bucket that receives its first
+/// entry takes storage from there: a handful of buffers, warm in the cache, serve the whole
+/// search instead of one allocation (grown, and faulted in, step by step) per bucket.
 #[derive(Default)]
 pub(super) struct BucketQueue {
     /// Entries per bucket; a sorted bucket is in descending order (smallest last).
     buckets: Vec<Vec<(u64, u32)>>,
+    /// Empty buffers for buckets that receive entries (see the type's docs).
+    pool: Vec<Vec<(u64, u32)>>,
     /// Whether each bucket is sorted.
     sorted: Vec<bool>,
     /// No non-empty bucket lies below this one.
@@ -39,7 +47,7 @@ impl BucketQueue {
     fn clear(&mut self) {
         let top = self.top.min(self.buckets.len());
         for b in self.cur.min(top)..top {
-            self.buckets[b].clear();
+            self.recycle(b);
             self.sorted[b] = false;
         }
         self.cur = usize::MAX;
@@ -56,6 +64,11 @@ impl BucketQueue {
             self.sorted.resize(b + 1, false);
         }
         let e = (key, i as u32);
+        if self.buckets[b].capacity() == 0 {
+            if let Some(v) = self.pool.pop() {
+                self.buckets[b] = v;
+            }
+        }
         let v = &mut self.buckets[b];
         if self.sorted[b] {
             let at = v.partition_point(|x| *x > e);
@@ -70,12 +83,23 @@ impl BucketQueue {
         self.len += 1;
     }
 
+    /// Empties bucket `b` and gives its storage (if any) to the pool.
+    #[inline]
+    fn recycle(&mut self, b: usize) {
+        if self.buckets[b].capacity() > 0 {
+            let mut v = std::mem::take(&mut self.buckets[b]);
+            v.clear();
+            self.pool.push(v);
+        }
+    }
+
     /// Removes and returns the position with the smallest `(key, index)`.
     fn pop(&mut self) -> Option<usize> {
         if self.len == 0 {
             return None;
         }
         while self.buckets[self.cur].is_empty() {
+            self.recycle(self.cur);
             self.sorted[self.cur] = false;
             self.cur += 1;
         }
