@@ -840,3 +840,39 @@ fn georef_errors_name_the_file_once() {
         assert_eq!(err.trim_end().lines().count(), 1, "{err}");
     }
 }
+
+/// A rectangular robot longer or wider than the map: `ccpp waypoints --width 1e300` printed
+/// nothing and exited 0 (an empty route as a success), and `run` refused it with an absurd
+/// memory need and the advice to use a *larger* robot. Now refused by what is wrong.
+#[test]
+fn a_rect_robot_larger_than_the_map_is_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir); // 8 x 6 m
+    let out = dir.join("out");
+    for (flag, value, field) in [
+        ("--width", "1e300", "rect_boustrophedon.width_m"),
+        ("--width", "10", "rect_boustrophedon.width_m"),
+        ("--length", "1e300", "rect_boustrophedon.length_m"),
+    ] {
+        let needles = [field, "larger than the map (8 x 6 m)", "pillars.pgm"];
+        refused(&["waypoints", "--map", s(&map), flag, value], &needles);
+        for cmd in ["run", "plan"] {
+            refused(
+                &[
+                    cmd,
+                    "--planner",
+                    "rect-boustrophedon",
+                    "--map",
+                    s(&map),
+                    flag,
+                    value,
+                    "--out",
+                    s(&out),
+                ],
+                &needles,
+            );
+            assert!(!out.exists());
+        }
+    }
+}

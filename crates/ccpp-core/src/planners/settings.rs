@@ -747,7 +747,21 @@ impl PlannerSettings for RectOptions {
 
     fn check(&self, s: &Setup) -> Result<(), OptionsError> {
         let res = s.frame.resolution;
+        let (w, h) = (s.frame.width_m(), s.frame.height_m());
         for (f, v) in [("length_m", self.length_m), ("width_m", self.width_m)] {
+            // A robot longer or wider than the map fits nowhere: its lanes would be empty (an
+            // empty waypoint list) or its estimate absurd.
+            if v > w.max(h) {
+                return Err(OptionsError::new(
+                    f,
+                    format!(
+                        "{} m is larger than the map ({} x {} m): the robot fits nowhere",
+                        crate::display::Compact(v),
+                        fmt_m(w),
+                        fmt_m(h)
+                    ),
+                ));
+            }
             if v < res {
                 return Err(OptionsError::new(
                     f,
