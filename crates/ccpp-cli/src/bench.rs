@@ -597,7 +597,8 @@ pub fn results_csv(rows: &[Row]) -> String {
         let mut f: Vec<String> = vec![csv_field(&r.map), csv_field(&r.planner)];
         match &r.outcome {
             Ok(m) => {
-                f.push("ok".into());
+                // A run stopped early (`stalled`, `max_steps`) says so instead of `ok`.
+                f.push(m.stop_reason.clone().unwrap_or_else(|| "ok".into()));
                 f.push(String::new());
                 f.push(m.robot_radius_m.to_string());
                 f.push(m.tool_radius_m.to_string());

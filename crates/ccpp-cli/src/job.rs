@@ -310,9 +310,9 @@ fn apply_planner_flags(a: &RunArgs, config: &mut PlannerConfig) -> Result<Vec<&'
             return Err(clash(
                 a.options.config.as_deref(),
                 "--side",
-                "left",
+                side.as_str(),
                 field,
-                "right",
+                slot.as_str(),
             ));
         }
         *slot = side;

@@ -138,6 +138,9 @@ pub fn emit(
         eprintln!("{w}");
     }
     if json_only {
+        if let Some(why) = &r.metrics.stop_reason {
+            eprintln!("warning: {}", stop_warning(why));
+        }
         return crate::print_stdout(&metrics);
     }
     let mut s = summary(&r.metrics);
@@ -193,5 +196,21 @@ pub fn summary(m: &Metrics) -> String {
     for (k, v) in rows {
         let _ = writeln!(s, "  {k:<20} {v:>12}");
     }
+    if let Some(why) = &m.stop_reason {
+        let _ = writeln!(s, "  {:<20} {why:>12}", "stop_reason");
+        let _ = writeln!(s, "  warning: {}", stop_warning(why));
+    }
     s
+}
+
+/// What an early stop (`Metrics::stop_reason`) means, for the summary.
+pub fn stop_warning(why: &str) -> String {
+    match why {
+        "stalled" => format!(
+            "the run was stopped: the robot made no progress for {} motions in a row (its true position stayed within half a map pixel, as when it keeps driving into a wall its drifted pose estimate does not show); the coverage is incomplete",
+            ccpp_core::sim::STALL_STEPS
+        ),
+        "max_steps" => "the planner hit the simulator's step cap; the coverage is incomplete".to_string(),
+        other => format!("the run ended early ({other}); the coverage is incomplete"),
+    }
 }

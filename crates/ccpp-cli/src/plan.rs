@@ -102,10 +102,11 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         plan.route.length_m(),
         plan.wall_time_s
     );
-    if plan.stop == StopReason::MaxSteps {
+    if plan.stop != StopReason::Done {
         let _ = writeln!(
             s,
-            "  warning: the planner hit the step cap; the path is incomplete"
+            "  warning: {}",
+            crate::output::stop_warning(plan.stop.as_str()).replace("coverage", "path")
         );
     }
     let names: Vec<&str> = files.iter().map(|(n, _)| *n).collect();

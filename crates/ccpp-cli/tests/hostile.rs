@@ -460,6 +460,23 @@ fn a_flag_and_the_file_setting_the_same_option_differently_are_refused() {
         );
         assert!(!out.exists());
     }
+    // The clash names each value where it was given (derived from them, not spelled out).
+    refused(
+        &[
+            "run",
+            "--planner",
+            "bsa",
+            "--map",
+            s(&map),
+            "--config",
+            s(&cfg),
+            "--side",
+            "LEFT",
+            "--out",
+            s(&out),
+        ],
+        &["--side left and bsa.side: right in"],
+    );
     refused(
         &[
             "bench",
@@ -621,4 +638,241 @@ fn a_bench_folder_is_never_mixed() {
         .collect();
     assert!(plots.iter().any(|p| p.contains("rooms")), "{plots:?}");
     assert!(!plots.iter().any(|p| p.contains("pillars")), "{plots:?}");
+}
+
+/// BA* under odometry noise drifted until it drove into a wall it did not see where it was,
+/// and then repeated that motion, each one meeting the wall at once, up to the simulator's 50
+/// million step cap: minutes of work and gigabytes of trace for 50 million collisions, and no
+/// word of it in the results. The run now stops after 1000 motions without progress, and says
+/// why in `metrics.json`, the summary and the trace.
+#[test]
+fn a_robot_that_stops_making_progress_is_stopped_and_says_so() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let out = dir.join("noisy");
+    let a = ccpp()
+        .args([
+            "run",
+            "--planner",
+            "ba-star",
+            "--odometry-noise",
+            "0.1",
+            "--map",
+        ])
+        .arg(&map)
+        .arg("--out")
+        .arg(&out)
+        .timeout(std::time::Duration::from_mins(1))
+        .assert()
+        .success();
+    let stdout = String::from_utf8_lossy(&a.get_output().stdout).into_owned();
+    assert!(
+        stdout.contains("stop_reason") && stdout.contains("stalled"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("no progress for 1000 motions"), "{stdout}");
+    let m = read_json(&out.join("metrics.json"));
+    assert_eq!(m["stop_reason"], "stalled");
+    let collisions = m["collisions"].as_u64().unwrap();
+    assert!((1000..1100).contains(&collisions), "{collisions}");
+    assert!(trace(&out)
+        .trim_end()
+        .ends_with(r#""event":"finished","reason":"stalled"}"#));
+    // A run the planner finishes has no stop reason.
+    let clean = run_ok(dir, "clean", &map, "ba-star", &[]);
+    assert!(read_json(&clean.join("metrics.json"))
+        .get("stop_reason")
+        .is_none());
+}
+
+/// A memory refusal printed `inf MB` (`inf strides`) for an overflowing estimate and always
+/// advised a larger `--max-memory`, robot, tile or spacing: for a random-bounce budget of
+/// 1e300 m no limit helps, and only a smaller `budget_m` does; for a map whose pixels dominate
+/// a robot changes nothing.
+#[test]
+fn memory_refusals_give_finite_numbers_and_the_right_advice() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let out = dir.join("out");
+    let run = |planner: &str, extra: &[&str], needles: &[&str], absent: &[&str]| {
+        let mut args = vec![
+            "run",
+            "--planner",
+            planner,
+            "--map",
+            s(&map),
+            "--out",
+            s(&out),
+        ];
+        args.extend_from_slice(extra);
+        let a = ccpp().args(&args).assert().failure();
+        let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
+        refused(&args, needles);
+        for n in absent {
+            assert!(!err.contains(n), "{err:?} should not contain {n:?}");
+        }
+        assert!(!out.exists());
+    };
+    for (budget, needles) in [
+        ("1.7e308", &["unbounded memory", "over 1e308 strides"][..]),
+        ("1e300", &["about 1.0e297 MB"][..]),
+    ] {
+        let cfg = dir.join("budget.yaml");
+        std::fs::write(&cfg, format!("random_bounce: {{ budget_m: {budget} }}\n")).unwrap();
+        let mut all = needles.to_vec();
+        all.extend([
+            "pillars.pgm",
+            "no machine has that much",
+            "random_bounce.budget_m",
+        ]);
+        run(
+            "random-bounce",
+            &["--config", s(&cfg)],
+            &all,
+            &["inf", "--max-memory MB", "larger robot"],
+        );
+    }
+    run(
+        "bcd",
+        &["--radius", "1e-300"],
+        &["unbounded memory", "lane squares", "larger tool radius"],
+        &["inf", "--max-memory MB"],
+    );
+    // Within reach of a real machine the limit may be raised; the map's pixels dominate here.
+    run(
+        "bcd",
+        &["--max-memory", "1"],
+        &[
+            "about 2 MB",
+            "map pixels",
+            "raise it with --max-memory",
+            "smaller map",
+        ],
+        &["larger robot"],
+    );
+}
+
+/// `ccpp info` (and `plan`) described a map of 1600 km that `run` refused, and a map placed
+/// 1e9 m or more from the world's origin ran with results changed by rounding (at 1e300 m
+/// every start was "in an obstacle"). Every subcommand now refuses both, naming the file.
+#[test]
+fn every_subcommand_refuses_a_map_too_large_or_too_far_out() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir); // 160 x 120 px
+    let out = dir.join("out");
+    for (flag, value, needles) in [
+        (
+            "--resolution",
+            "1e4",
+            &[
+                "pillars.pgm",
+                "1.6e6 x 1.2e6 m",
+                "larger than the 1e6 m side",
+            ][..],
+        ),
+        (
+            "--origin",
+            "1e9,0",
+            &["pillars.pgm", "from the world's origin", "check the origin"][..],
+        ),
+        (
+            "--origin",
+            "1e300,0",
+            &["pillars.pgm", "from the world's origin"][..],
+        ),
+    ] {
+        let with = |head: &[&'static str]| {
+            let mut v: Vec<&str> = head.to_vec();
+            v.extend(["--map", s(&map), flag, value]);
+            v
+        };
+        refused(&with(&["info"]), needles);
+        refused(&with(&["waypoints"]), needles);
+        let mut plan = with(&["plan", "--planner", "bcd"]);
+        plan.extend(["--out", s(&out)]);
+        refused(&plan, needles);
+        let mut run = with(&["run", "--planner", "ba-star"]);
+        run.extend(["--out", s(&out)]);
+        refused(&run, needles);
+        assert!(!out.exists());
+    }
+    // Far, but within 1e8 m (UTM-sized coordinates): accepted, the same floor covered.
+    let near = run_ok(dir, "near", &map, "bcd", &[]);
+    let far = run_ok(dir, "far", &map, "bcd", &["--origin", "5e7,5e7"]);
+    let cov = |o: &Path| read_json(&o.join("metrics.json"))["effective_coverage"].clone();
+    assert_eq!(cov(&near), cov(&far));
+}
+
+/// `--georef` errors named the file twice (`georef F: georef file F: ...`, `georef F: cannot
+/// read georef file F: ...`).
+#[test]
+fn georef_errors_name_the_file_once() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let one = dir.join("one_pair.csv");
+    std::fs::write(&one, "px,py,wx,wy\n0,0,0,0\n").unwrap();
+    let short = dir.join("short_line.csv");
+    std::fs::write(&short, "0,0,0,0\n1,2,3\n").unwrap();
+    let huge = dir.join("huge.csv");
+    std::fs::write(&huge, "0,0,0,0\n100,0,1e300,0\n0,100,0,-1e300\n").unwrap();
+    let missing = dir.join("missing.csv");
+    for (file, needle) in [
+        (&one, "at least 3 point pairs"),
+        (&short, "line 2"),
+        (&huge, "degenerate transform"),
+        (&missing, "cannot read it"),
+        (&dir.to_path_buf(), "cannot read it"),
+    ] {
+        let a = ccpp()
+            .args(["info", "--map", s(&map), "--georef", s(file)])
+            .assert()
+            .failure();
+        let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
+        assert_eq!(err.matches(s(file)).count(), 1, "{err}");
+        assert!(
+            err.starts_with("error: georef ") && err.contains(needle),
+            "{err}"
+        );
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    }
+}
+
+/// A rectangular robot longer or wider than the map: `ccpp waypoints --width 1e300` printed
+/// nothing and exited 0 (an empty route as a success), and `run` refused it with an absurd
+/// memory need and the advice to use a *larger* robot. Now refused by what is wrong.
+#[test]
+fn a_rect_robot_larger_than_the_map_is_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir); // 8 x 6 m
+    let out = dir.join("out");
+    for (flag, value, field) in [
+        ("--width", "1e300", "rect_boustrophedon.width_m"),
+        ("--width", "10", "rect_boustrophedon.width_m"),
+        ("--length", "1e300", "rect_boustrophedon.length_m"),
+    ] {
+        let needles = [field, "larger than the map (8 x 6 m)", "pillars.pgm"];
+        refused(&["waypoints", "--map", s(&map), flag, value], &needles);
+        for cmd in ["run", "plan"] {
+            refused(
+                &[
+                    cmd,
+                    "--planner",
+                    "rect-boustrophedon",
+                    "--map",
+                    s(&map),
+                    flag,
+                    value,
+                    "--out",
+                    s(&out),
+                ],
+                &needles,
+            );
+            assert!(!out.exists());
+        }
+    }
 }

@@ -86,6 +86,11 @@ pub struct Metrics {
     /// waypoint tolerance ([`Event::Execution`]), 0 under ideal execution; clamped to [0, 1].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rect_guarantee: Option<f64>,
+    /// Why the run ended when the planner did not finish it: `stalled` (the robot made no
+    /// progress for [`crate::sim::STALL_STEPS`] motions in a row) or `max_steps` (the
+    /// simulator's step cap). Absent for a finished run.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stop_reason: Option<String>,
 }
 
 /// Tracking error of a PID run: `(mean, max)` distance of the pose records from the planned
@@ -761,6 +766,8 @@ fn compute_rest(
         tracking_error_mean_m: tracking.map(|t| t.0),
         tracking_error_max_m: tracking.map(|t| t.1),
         rect_guarantee,
+        stop_reason: (run.stop != crate::sim::StopReason::Done)
+            .then(|| run.stop.as_str().to_string()),
     }
 }
 

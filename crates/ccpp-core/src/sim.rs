@@ -41,7 +41,10 @@ pub use crate::planner::MIN_ROTATION;
 pub struct SimConfig {
     /// Sensor range in metres; `None` = `4 r` (enough to classify all 8 neighbour tiles).
     pub sensor_range: Option<f64>,
-    /// Safety cap on planner steps.
+    /// Safety cap on planner steps (default 50 million): a bound on the run's time and trace
+    /// that no finishing planner comes near (the bench's longest run, random-bounce on the
+    /// largest map, takes about half a million steps). A robot that stops making progress is
+    /// ended long before it, after [`STALL_STEPS`] motions ([`StopReason::Stalled`]).
     pub max_steps: u64,
     /// How motions are executed; `None` = the planner's
     /// [`preferred_execution`](Planner::preferred_execution), else [`Execution::Ideal`].
@@ -69,6 +72,16 @@ impl Default for SimConfig {
     }
 }
 
+/// Motion steps in a row (rotations, translations, moves; marks do not count) after which a
+/// robot whose true position has stayed within half a map pixel of where they began is
+/// stopped as [`StopReason::Stalled`]. A planner that keeps driving into a wall it does not
+/// see where it is (its pose estimate drifted under odometry noise, so each motion meets the
+/// wall at once) would otherwise repeat that motion up to [`SimConfig::max_steps`] times: tens
+/// of millions of collisions and gigabytes of trace before an answer. A working run moves at
+/// least every few steps (a turn, then a stride of at least a tile or a lane), so the rule never
+/// ends one.
+pub const STALL_STEPS: u64 = 1000;
+
 /// Why a run ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -77,6 +90,20 @@ pub enum StopReason {
     Done,
     /// The step cap was reached.
     MaxSteps,
+    /// The robot made no progress for [`STALL_STEPS`] motions in a row.
+    Stalled,
+}
+
+impl StopReason {
+    /// The name used in the trace's `finished` event and in the metrics: `done`, `max_steps`,
+    /// `stalled`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Done => "done",
+            Self::MaxSteps => "max_steps",
+            Self::Stalled => "stalled",
+        }
+    }
 }
 
 /// The outcome of a simulated run.
@@ -509,23 +536,38 @@ impl<'w> Simulator<'w> {
             self.set_execution(e);
         }
         let mut stop = StopReason::MaxSteps;
+        // The stall rule: motions since the true position last left half a pixel around
+        // `anchor`.
+        let near = 0.5 * self.world.frame().resolution;
+        let mut anchor = self.pose.position();
+        let mut still = 0u64;
         for _ in 0..config.max_steps {
             let step = planner.next(&self);
             if step == Step::Done {
                 stop = StopReason::Done;
                 break;
             }
+            let motion = !matches!(step, Step::Mark(_));
             self.execute(step);
             tap(&self.trace);
+            if motion {
+                let p = self.pose.position();
+                if p.sub(anchor).norm() > near {
+                    anchor = p;
+                    still = 0;
+                } else {
+                    still += 1;
+                    if still >= STALL_STEPS {
+                        stop = StopReason::Stalled;
+                        break;
+                    }
+                }
+            }
         }
-        let reason = match stop {
-            StopReason::Done => "done",
-            StopReason::MaxSteps => "max_steps",
-        };
         self.trace.push_event(
             self.t,
             Event::Finished {
-                reason: reason.to_string(),
+                reason: stop.as_str().to_string(),
             },
         );
         RunOutput {

@@ -47,6 +47,19 @@ pub enum GeorefFileError {
     },
 }
 
+impl GeorefFileError {
+    /// What is wrong, without the file's name (for a message that names the file already).
+    pub fn reason(&self) -> String {
+        match self {
+            Self::Io { source, .. } => format!("cannot read it: {source}"),
+            Self::BadLine { line, text } => {
+                format!("line {line}: expected `px,py,wx,wy` (four numbers), got {text:?}")
+            }
+            Self::Fit { source, .. } => source.to_string(),
+        }
+    }
+}
+
 /// Splits a line into fields on commas, semicolons or whitespace.
 pub(crate) fn fields(line: &str) -> impl Iterator<Item = &str> {
     line.split(|c: char| c == ',' || c == ';' || c.is_whitespace())

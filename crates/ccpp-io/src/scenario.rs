@@ -55,6 +55,16 @@ pub const DEFAULT_MAX_MEMORY_MB: u64 = 4096;
 /// resolution, and their tile and distance arithmetic would lose all precision.
 pub const MAX_MAP_SIDE_M: f64 = 1e6;
 
+/// Largest need, MB, for which a memory refusal suggests raising `--max-memory` (a
+/// petabyte): beyond it only a larger robot, tile, spacing or smaller budget helps.
+const MAX_SENSIBLE_MB: f64 = 1e9;
+
+/// Largest world coordinate of a map's corners ccpp accepts, metres (100 000 km, beyond any
+/// UTM or Earth-centred coordinate): farther out, `f64` keeps too few digits for the pixel
+/// arithmetic (at 1e9 m the same run covered 0.893 instead of 0.900 of the floor, at 1e300 m
+/// every start looked like a wall), so the results would change without a word.
+pub const MAX_COORD_M: f64 = 1e8;
+
 fn default_max_memory_mb() -> u64 {
     DEFAULT_MAX_MEMORY_MB
 }
@@ -108,7 +118,7 @@ pub enum ScenarioError {
     },
     /// The run would need more memory than allowed.
     #[error(
-        "map {}: {planner} would need about {needed_mb} MB ({detail}), more than the memory limit of {limit_mb} MB (raise it with --max-memory MB / max_memory_mb, or use a larger robot, tile or spacing)",
+        "map {}: {planner} would need {needed} ({detail}), more than the memory limit of {limit_mb} MB ({advice})",
         path.display()
     )]
     Memory {
@@ -116,12 +126,16 @@ pub enum ScenarioError {
         path: PathBuf,
         /// The planner.
         planner: &'static str,
-        /// Estimated need, MB (rounded up; may be astronomically large).
-        needed_mb: String,
+        /// Estimated need: `about 1234 MB` (rounded up), `about 1.0e297 MB`, or `unbounded
+        /// memory` when the estimate overflowed.
+        needed: String,
         /// The dominant quantity.
         detail: String,
         /// The limit, MB.
         limit_mb: u64,
+        /// What to do: raise the limit (when a machine could have that much) and what would
+        /// shrink the dominant quantity.
+        advice: String,
     },
     /// A scenario file cannot be read or parsed.
     #[error("scenario {}: {message}", path.display())]
@@ -267,6 +281,7 @@ impl MapRecipe {
         if let Some(g) = &self.georef {
             grid = apply_georef(grid, g)?;
         }
+        check_extent(&grid, &loaded.source)?;
         if let Some(m) = self.inflate {
             if m > 0.0 {
                 // Inflation turns pixels whose centre is within `m` of an obstacle's centre:
@@ -298,6 +313,42 @@ impl MapRecipe {
     }
 }
 
+/// Refuses a map frame wider or taller than [`MAX_MAP_SIDE_M`], or placed with a corner farther
+/// than [`MAX_COORD_M`] from the world's origin (every subcommand prepares its
+/// map through [`MapRecipe::prepare`], so `info`, `waypoints` and `plan` refuse what `run`
+/// refuses).
+///
+/// # Errors
+/// [`ScenarioError::Invalid`] naming the file.
+pub fn check_extent(grid: &GridMap, source: &Path) -> Result<(), ScenarioError> {
+    let f = grid.frame();
+    let fits = |v: f64| v.is_finite() && v <= MAX_MAP_SIDE_M;
+    if fits(f.width_m()) && fits(f.height_m()) {
+        let (lo, hi) = f.world_bounds();
+        let far = [lo.x, lo.y, hi.x, hi.y]
+            .into_iter()
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        if far <= MAX_COORD_M {
+            return Ok(());
+        }
+        return Err(ScenarioError::Invalid(format!(
+            "map {}: the map lies {far:.2e} m from the world's origin (origin {}, {}), farther than the {MAX_COORD_M:e} m ccpp handles precisely; check the origin",
+            source.display(),
+            Compact(f.origin.x),
+            Compact(f.origin.y)
+        )));
+    }
+    Err(ScenarioError::Invalid(format!(
+        "map {}: the map is {:e} x {:e} m ({} x {} px at {:e} m/px), larger than the {MAX_MAP_SIDE_M:e} m side ccpp handles; check the resolution",
+        source.display(),
+        f.width_m(),
+        f.height_m(),
+        f.width,
+        f.height,
+        f.resolution
+    )))
+}
+
 /// Places `grid` by the affine fit of the point pairs in `path` (pixel coordinates from the
 /// image's top-left corner, y down). ccpp frames are similarities (rotation + uniform scale),
 /// so a fit with more than 1 % shear or anisotropy is refused.
@@ -309,11 +360,15 @@ pub fn apply_georef(grid: GridMap, path: &Path) -> Result<GridMap, ScenarioError
         path: path.to_path_buf(),
         message,
     };
-    let fit = crate::georef::load_georef(path).map_err(|e| err(e.to_string()))?;
+    // `reason`: the message names the file once (`georef FILE: ...`).
+    let fit = crate::georef::load_georef(path).map_err(|e| err(e.reason()))?;
     let [a, b, c, d] = fit.affine.m;
     let res = (a * d - b * c).abs().sqrt();
     if !(res.is_finite() && res > 0.0) {
-        return Err(err("degenerate transform".into()));
+        return Err(err(format!(
+            "degenerate transform (its scale is {} m/px); check the world coordinates",
+            Compact(res)
+        )));
     }
     let yaw = c.atan2(a);
     // Pixel y grows downwards, so the second column is res * (sin yaw, -cos yaw).
@@ -332,11 +387,9 @@ pub fn apply_georef(grid: GridMap, path: &Path) -> Result<GridMap, ScenarioError
     }
     let h = grid.frame().height as f64;
     let o = fit.affine.apply(ccpp_core::Point::new(0.0, h));
+    // A placement the grid refuses is the georef file's fault: named as such (not `map FILE`).
     grid.with_placement(res, Pose::new(o.x, o.y, yaw))
-        .map_err(|source| ScenarioError::Grid {
-            path: path.to_path_buf(),
-            source,
-        })
+        .map_err(|e| err(e.to_string()))
 }
 
 /// One coverage run, fully described. `run.json` is this, serialized.
@@ -604,23 +657,22 @@ impl Scenario {
             None => None,
         };
         let mut polys = Vec::new();
-        let mut masks = Vec::new();
+        // The keep-out pixels, each file's rasterised once: checked on its own, then united
+        // (a pixel is kept out when any polygon or mask holds it, so the union of the files'
+        // rasters is the raster of all their polygons).
+        let mut keepout = FixedBitSet::with_capacity(frame.len());
         for spec in &self.keepout {
+            let bits = match load("keepout", spec, true)? {
+                ZoneData::Polygons(p) => {
+                    let bits = ccpp_core::zones::rasterize(&frame, &p);
+                    polys.extend(p);
+                    bits
+                }
+                ZoneData::Mask(m) => m,
+            };
             // A keep-out that marks no pixel would be read, validated and then keep nothing
             // out: refused, as an area holding no pixel is.
-            let marks_nothing = match load("keepout", spec, true)? {
-                ZoneData::Polygons(p) => {
-                    let empty = ccpp_core::zones::rasterize(&frame, &p).is_clear();
-                    polys.extend(p);
-                    empty
-                }
-                ZoneData::Mask(m) => {
-                    let empty = m.is_clear();
-                    masks.push(m);
-                    empty
-                }
-            };
-            if marks_nothing {
+            if bits.is_clear() {
                 return Err(ScenarioError::Zone {
                     kind: "keepout",
                     label: spec.label(),
@@ -630,8 +682,16 @@ impl Scenario {
                     ),
                 });
             }
+            keepout.union_with(&bits);
         }
-        let z = ZoneMasks::new(&frame, area.as_deref(), &polys, &masks);
+        let z = ZoneMasks {
+            area: area
+                .as_deref()
+                .map(|a| ccpp_core::zones::rasterize(&frame, a)),
+            keepout,
+            area_polygons: area.unwrap_or_default(),
+            keepout_polygons: polys,
+        };
         if let (Some(spec), Some(a)) = (&self.area, &z.area) {
             if a.is_clear() {
                 return Err(ScenarioError::Zone {
@@ -694,22 +754,8 @@ impl Scenario {
     pub fn check_map(&self, map: &PreparedMap) -> Result<ResourceEstimate, ScenarioError> {
         let setup = self.setup(map);
         let planner = self.planner.name();
-        let f = setup.frame;
-        let fits = |v: f64| v.is_finite() && v <= MAX_MAP_SIDE_M;
-        if !(fits(f.width_m()) && fits(f.height_m())) {
-            return Err(ScenarioError::Degenerate {
-                path: map.source.clone(),
-                planner,
-                message: format!(
-                    "the map is {:e} x {:e} m ({} x {} px at {:e} m/px), larger than the {MAX_MAP_SIDE_M:e} m side ccpp handles; check the resolution",
-                    f.width_m(),
-                    f.height_m(),
-                    f.width,
-                    f.height,
-                    f.resolution
-                ),
-            });
-        }
+        // Also checked when the map is prepared; again here for a map the caller built.
+        check_extent(&map.grid, &map.source)?;
         self.planner.settings().check(&setup).map_err(|e| {
             let e = e.in_section(self.planner.kind().info().section);
             ScenarioError::Degenerate {
@@ -731,17 +777,29 @@ impl Scenario {
         let limit = self.max_memory_mb as f64 * 1024.0 * 1024.0;
         if est.bytes.is_nan() || est.bytes > limit {
             let mb = est.bytes / (1024.0 * 1024.0);
-            let needed_mb = if mb < 1e9 {
-                format!("{:.0}", mb.ceil())
+            let needed = if !mb.is_finite() {
+                "unbounded memory".to_string()
+            } else if mb < 1e9 {
+                format!("about {:.0} MB", mb.ceil())
             } else {
-                format!("{mb:.1e}")
+                format!("about {mb:.1e} MB")
+            };
+            // Beyond a petabyte no limit is the answer: only the cause can be changed.
+            let advice = if mb <= MAX_SENSIBLE_MB {
+                format!(
+                    "raise it with --max-memory MB / max_memory_mb, or use {}",
+                    est.remedy
+                )
+            } else {
+                format!("no machine has that much; use {}", est.remedy)
             };
             return Err(ScenarioError::Memory {
                 path: map.source.clone(),
                 planner,
-                needed_mb,
+                needed,
                 detail: est.detail,
                 limit_mb: self.max_memory_mb,
+                advice,
             });
         }
         Ok(est)

@@ -672,13 +672,11 @@ impl RunResult {
         to_py(py, &ev)
     }
 
-    /// Why the run ended: `"done"` or `"max_steps"`.
+    /// Why the run ended: `"done"`, `"stalled"` (no progress for 1000 motions in a row) or
+    /// `"max_steps"`.
     #[getter]
     fn stop(&self) -> &'static str {
-        match self.output.stop {
-            StopReason::Done => "done",
-            StopReason::MaxSteps => "max_steps",
-        }
+        self.output.stop.as_str()
     }
 
     /// The start pose used, `(x, y, theta)`.
@@ -1285,7 +1283,8 @@ impl Env {
         let trace: Trace = ep.borrow_dependent().sim.trace().clone();
         let out = RunOutput {
             trace,
-            stop: StopReason::MaxSteps,
+            // The episode so far: no early-stop reason in its metrics.
+            stop: StopReason::Done,
             tile_side: None,
             planner: "env",
             wall_time_s: 0.0,

@@ -87,6 +87,14 @@ pub enum Side {
 }
 
 impl Side {
+    /// The name in option files and on the command line: `left` or `right`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Side::Left => "left",
+            Side::Right => "right",
+        }
+    }
+
     /// The RLS heading of heading `h` (0 E, 1 N, 2 W, 3 S).
     #[inline]
     pub(crate) fn rls(self, h: usize) -> usize {

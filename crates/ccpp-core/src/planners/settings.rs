@@ -75,7 +75,16 @@ pub struct ResourceEstimate {
     pub bytes: f64,
     /// The dominant quantity, for messages (`"9.0e6 tiles of 0.001 m"`).
     pub detail: String,
+    /// What would shrink the dominant quantity, for messages (`"a larger robot or tile
+    /// side"`): the advice of a refusal.
+    pub remedy: String,
 }
+
+/// The remedy of an estimate that does not name its own.
+pub const GENERIC_REMEDY: &str = "a larger robot, tile or spacing";
+
+/// The remedy when the map's pixels dominate: a robot or tile changes nothing.
+const PIXELS_REMEDY: &str = "a smaller map (crop the image or downsample it)";
 
 impl ResourceEstimate {
     /// `count` units of `bytes_each`, described as `count what`.
@@ -83,13 +92,24 @@ impl ResourceEstimate {
         Self {
             bytes: count * bytes_each,
             detail: format!("{} {what}", fmt_count(count)),
+            remedy: GENERIC_REMEDY.to_string(),
         }
+    }
+
+    /// The same estimate with `remedy` as its advice.
+    #[must_use]
+    pub fn remedy(mut self, remedy: &str) -> Self {
+        self.remedy = remedy.to_string();
+        self
     }
 }
 
-/// A count as `123456` or `1.2e18`.
+/// A count as `123456` or `1.2e18`; `over 1e308` when it overflowed (an infinite count of a
+/// degenerate input, never `inf`).
 pub fn fmt_count(n: f64) -> String {
-    if n < 1e7 {
+    if !n.is_finite() {
+        "over 1e308".to_string()
+    } else if n < 1e7 {
         format!("{n:.0}")
     } else {
         format!("{n:.1e}")
@@ -376,7 +396,12 @@ impl PlannerSettings for RandomBounceOptions {
         let res = s.frame.resolution;
         let stride = (s.sensor_range - s.robot.radius - 1.5 * res).max(0.5 * res);
         // A stride and a turn per stride.
-        ResourceEstimate::units(budget / stride, 2.0 * RECORD_BYTES, "strides")
+        let e = ResourceEstimate::units(budget / stride, 2.0 * RECORD_BYTES, "strides");
+        if self.budget_m.is_some() {
+            e.remedy("a smaller random_bounce.budget_m")
+        } else {
+            e.remedy("a larger tool radius or a random_bounce.budget_m (the default budget is 3 x the map frame's area over the tool width)")
+        }
     }
 
     fn tile_side(&self, _: &Robot) -> Option<f64> {
@@ -419,7 +444,8 @@ impl PlannerSettings for BaStarOptions {
         let t = self.tile_side_m.unwrap_or(2.0 * s.robot.radius);
         // Cached disk spans: 2 bytes per row of the contact disk.
         let rows = 2.0 * (s.robot.radius / s.frame.resolution + 1.0) + 4.0;
-        let mut e = ResourceEstimate::units(s.tiles(t), TILE_BYTES + 2.0 * rows, "tiles");
+        let mut e = ResourceEstimate::units(s.tiles(t), TILE_BYTES + 2.0 * rows, "tiles")
+            .remedy("a larger robot or tile side");
         e.detail = format!("{} of {} m", e.detail, fmt_m(t));
         e
     }
@@ -553,7 +579,8 @@ impl PlannerSettings for BaStarExtendedOptions {
 
 fn bsa_cells(s: &Setup) -> ResourceEstimate {
     let c = 2.0 * s.robot.radius;
-    let mut e = ResourceEstimate::units(s.tiles(c), TILE_BYTES, "cells");
+    let mut e = ResourceEstimate::units(s.tiles(c), TILE_BYTES, "cells")
+        .remedy("a larger robot (the cells are 2 r wide)");
     e.detail = format!("{} of {} m", e.detail, fmt_m(c));
     e
 }
@@ -630,7 +657,8 @@ impl PlannerSettings for BsaBfsOptions {
         let c = self.cell_side_m.unwrap_or(2.0 * s.robot.radius);
         let cells = s.tiles(c);
         // Cell state and return stacks; the trace is counted by PID records below.
-        let mut e = ResourceEstimate::units(cells, TILE_BYTES / 3.0, "cells");
+        let mut e = ResourceEstimate::units(cells, TILE_BYTES / 3.0, "cells")
+            .remedy("a larger robot or cell side");
         e.detail = format!("{} of {} m", e.detail, fmt_m(c));
         // The lane-by-lane length of the whole frame.
         let path = s.frame_area_m2() / c;
@@ -683,7 +711,8 @@ impl PlannerSettings for BcdOptions {
     fn estimate(&self, s: &Setup) -> ResourceEstimate {
         let sp = self.lane_spacing_m.unwrap_or(2.0 * s.robot.tool_radius);
         // Lane pieces and their waypoints: at most one per lane-spacing square of the frame.
-        let mut e = ResourceEstimate::units(s.tiles(sp), TILE_BYTES / 2.0, "lane squares");
+        let mut e = ResourceEstimate::units(s.tiles(sp), TILE_BYTES / 2.0, "lane squares")
+            .remedy("a larger tool radius or bcd.lane_spacing_m");
         e.detail = format!("{} of {} m", e.detail, fmt_m(sp));
         e
     }
@@ -718,7 +747,21 @@ impl PlannerSettings for RectOptions {
 
     fn check(&self, s: &Setup) -> Result<(), OptionsError> {
         let res = s.frame.resolution;
+        let (w, h) = (s.frame.width_m(), s.frame.height_m());
         for (f, v) in [("length_m", self.length_m), ("width_m", self.width_m)] {
+            // A robot longer or wider than the map fits nowhere: its lanes would be empty (an
+            // empty waypoint list) or its estimate absurd.
+            if v > w.max(h) {
+                return Err(OptionsError::new(
+                    f,
+                    format!(
+                        "{} m is larger than the map ({} x {} m): the robot fits nowhere",
+                        crate::display::Compact(v),
+                        fmt_m(w),
+                        fmt_m(h)
+                    ),
+                ));
+            }
             if v < res {
                 return Err(OptionsError::new(
                     f,
@@ -755,7 +798,8 @@ impl PlannerSettings for RectOptions {
             h = h.min(a[3] - a[1]);
         }
         let n = (w / self.width_m + 2.0) * (h / self.length_m + 2.0);
-        let mut e = ResourceEstimate::units(n, RECORD_BYTES, "waypoints");
+        let mut e = ResourceEstimate::units(n, RECORD_BYTES, "waypoints")
+            .remedy("a larger robot length and width, or a smaller area");
         let path = n * self.length_m;
         e.bytes += pid_records(Some(&self.exec), path) * RECORD_BYTES;
         e
@@ -781,13 +825,15 @@ pub fn estimate_run(s: &Setup, planner: &dyn PlannerSettings) -> ResourceEstimat
     let metrics_side = planner
         .tile_side(&s.robot)
         .unwrap_or(2.0 * s.robot.tool_radius);
-    let mut metric_tiles = ResourceEstimate::units(s.tiles(metrics_side), 1.0 / 8.0, "tiles");
+    let mut metric_tiles = ResourceEstimate::units(s.tiles(metrics_side), 1.0 / 8.0, "tiles")
+        .remedy("a larger robot, tool or tile");
     metric_tiles.detail = format!(
         "{} of {} m for the metrics",
         metric_tiles.detail,
         fmt_m(metrics_side)
     );
-    let pixels = ResourceEstimate::units(s.pixels(), PIXEL_BYTES, "map pixels");
+    let pixels =
+        ResourceEstimate::units(s.pixels(), PIXEL_BYTES, "map pixels").remedy(PIXELS_REMEDY);
     let bytes = own.bytes + metric_tiles.bytes + pixels.bytes;
     let mut parts = [own, metric_tiles, pixels];
     parts.sort_by(|a, b| b.bytes.total_cmp(&a.bytes));
@@ -795,6 +841,7 @@ pub fn estimate_run(s: &Setup, planner: &dyn PlannerSettings) -> ResourceEstimat
     ResourceEstimate {
         bytes,
         detail: largest.detail,
+        remedy: largest.remedy,
     }
 }
 
@@ -826,13 +873,14 @@ pub fn estimate_zones(s: &Setup, z: ZoneLoad) -> ResourceEstimate {
         return ResourceEstimate {
             bytes: 0.0,
             detail: String::new(),
+            remedy: String::new(),
         };
     }
     let mut per_px = ZONE_PIXEL_BYTES + MASK_PIXEL_BYTES * z.mask_files as f64;
     if z.approach {
         per_px += APPROACH_PIXEL_BYTES;
     }
-    let mut e = ResourceEstimate::units(s.pixels(), per_px, "map pixels");
+    let mut e = ResourceEstimate::units(s.pixels(), per_px, "map pixels").remedy(PIXELS_REMEDY);
     e.detail = format!("{} for the zones", e.detail);
     e
 }

@@ -62,7 +62,7 @@ class RunResult:
         """Trace events as in trace.jsonl (with the step counter ``t``)."""
     @property
     def stop(self) -> str:
-        """``"done"`` or ``"max_steps"``."""
+        """``"done"``, ``"stalled"`` (no progress for 1000 motions in a row) or ``"max_steps"``."""
     @property
     def start(self) -> tuple[float, float, float]: ...
     @property
