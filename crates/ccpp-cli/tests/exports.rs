@@ -375,7 +375,11 @@ fn plan_refuses_online_planners_and_foreign_flags() {
     // A plan executes the steps ideally: the planner's own PID settings from the options file
     // would be read, validated and then dropped.
     let cfg = d.path().join("pid.yaml");
-    std::fs::write(&cfg, "rect_boustrophedon: { exec: { pid: { dt_s: 0.1 } } }\n").unwrap();
+    std::fs::write(
+        &cfg,
+        "rect_boustrophedon: { exec: { pid: { dt_s: 0.1 } } }\n",
+    )
+    .unwrap();
     refused(
         &[
             "plan",
