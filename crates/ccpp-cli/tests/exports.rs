@@ -372,6 +372,27 @@ fn plan_refuses_online_planners_and_foreign_flags() {
         Some(&map),
         &["--exec"],
     );
+    // A plan executes the steps ideally: the planner's own PID settings from the options file
+    // would be read, validated and then dropped.
+    let cfg = d.path().join("pid.yaml");
+    std::fs::write(
+        &cfg,
+        "rect_boustrophedon: { exec: { pid: { dt_s: 0.1 } } }\n",
+    )
+    .unwrap();
+    refused(
+        &[
+            "plan",
+            "--planner",
+            "rect-boustrophedon",
+            "--config",
+            cfg.to_str().unwrap(),
+            "--out",
+            o,
+        ],
+        Some(&map),
+        &["rect_boustrophedon.exec", "does not apply to a plan"],
+    );
     assert!(!out.exists());
 }
 

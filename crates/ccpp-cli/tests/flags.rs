@@ -220,6 +220,16 @@ fn execution_flags_reach_the_simulator() {
         &["--exec", "ideal", "--config", pid_cfg.to_str().unwrap()],
         &["--exec ideal", "pid.yaml", "bsa_bfs.exec"],
     );
+    // A file that runs the planner ideally and `--exec pid` disagree the same way.
+    let ideal_cfg = dir.join("ideal.yaml");
+    std::fs::write(&ideal_cfg, "bsa_bfs: { exec: ideal }\n").unwrap();
+    run_fails(
+        dir,
+        &map,
+        "bsa-bfs",
+        &["--exec", "pid", "--config", ideal_cfg.to_str().unwrap()],
+        &["sim.exec pid", "bsa_bfs.exec", "remove one of them"],
+    );
     // The same file without the flag is read: its control period changes the run.
     let pid_run = run_ok(
         dir,

@@ -10,6 +10,7 @@
 //! has discovered the map ([`Scenario::run_on`] and the route of its trace).
 
 use ccpp_core::exec::Execution;
+use ccpp_core::planners::PlannerConfig;
 use ccpp_core::route::Route;
 use ccpp_core::sim::{simulate, StopReason};
 use ccpp_core::world::World;
@@ -49,6 +50,32 @@ pub fn offline_planners() -> String {
         .join(", ")
 }
 
+/// Refuses the simulator settings a plan would read and then drop: it executes the planner's
+/// steps ideally, so an execution (the simulator's or the planner's own, when not its default)
+/// and landmarks (which correct PID execution) would change nothing.
+fn check_dropped(scenario: &Scenario) -> Result<(), ScenarioError> {
+    let dropped = |what: String| {
+        ScenarioError::Invalid(format!(
+            "{what} does not apply to a plan: it executes the planner's steps ideally (use a run to simulate an execution)"
+        ))
+    };
+    if scenario.sim.exec.is_some() {
+        return Err(dropped("sim.exec (exec=)".into()));
+    }
+    let kind = scenario.planner.kind();
+    let own = scenario.planner.settings().preferred_execution();
+    if own != PlannerConfig::new(kind).settings().preferred_execution() {
+        return Err(dropped(format!(
+            "the execution given for {kind} in {}.exec",
+            kind.info().section
+        )));
+    }
+    if !scenario.sim.landmarks.landmarks.is_empty() {
+        return Err(dropped("sim.landmarks".into()));
+    }
+    Ok(())
+}
+
 /// Plans `scenario` on `map` with a known-map planner and returns its route (waypoints merged
 /// with `tolerance_m`, see [`ccpp_core::route`]).
 ///
@@ -63,6 +90,7 @@ pub fn plan_route(
     if !kind.info().offline {
         return Err(PlanError::Online(kind.name(), offline_planners()));
     }
+    check_dropped(scenario)?;
     let world = scenario.world(map)?;
     let started = std::time::Instant::now();
     let mut planner = scenario.planner.build(&world);
@@ -76,4 +104,41 @@ pub fn plan_route(
         stop: output.stop,
         wall_time_s: started.elapsed().as_secs_f64(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ccpp_core::exec::PidOptions;
+    use ccpp_core::planners::rect_boustrophedon::RectOptions;
+    use ccpp_core::planners::PlannerKind;
+
+    use crate::scenario::MapRecipe;
+
+    #[test]
+    fn a_plan_refuses_the_execution_it_would_drop() {
+        let mut s = Scenario::builder("m.yaml", PlannerKind::RectBoustrophedon)
+            .build()
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert!(check_dropped(&s).is_ok());
+        s.planner = PlannerConfig::RectBoustrophedon(RectOptions {
+            exec: Execution::Pid(PidOptions {
+                dt_s: 0.1,
+                ..PidOptions::default()
+            }),
+            ..RectOptions::default()
+        });
+        let e = check_dropped(&s)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(e.contains("rect_boustrophedon.exec"), "{e}");
+        let mut s = Scenario::new(MapRecipe::file("m.yaml"), PlannerKind::Bcd);
+        s.sim.exec = Some(Execution::Ideal);
+        let e = check_dropped(&s)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(e.contains("sim.exec"), "{e}");
+    }
 }

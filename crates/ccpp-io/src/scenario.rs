@@ -30,7 +30,7 @@
 use std::path::{Path, PathBuf};
 
 use ccpp_core::display::Compact;
-use ccpp_core::exec::Execution;
+use ccpp_core::exec::{Execution, PidOptions};
 use ccpp_core::grid::{GridError, GridMap};
 use ccpp_core::metrics::{self, Metrics};
 use ccpp_core::planners::settings::{estimate_run, estimate_zones, validate_execution, ZoneLoad};
@@ -576,6 +576,7 @@ impl Scenario {
         if let Some(e) = &self.sim.exec {
             validate_execution("sim.exec", e).map_err(|e| invalid(e.to_string()))?;
         }
+        self.check_exec_override()?;
         let lm = &self.sim.landmarks;
         for (f, v) in [("range_m", lm.range_m), ("period_s", lm.period_s)] {
             if !(v.is_finite() && v > 0.0) {
@@ -606,6 +607,39 @@ impl Scenario {
         self.planner.validate()?;
         self.validate_zones()?;
         Ok(())
+    }
+
+    /// `sim.exec` replaces the planner's own execution (`bsa_bfs.exec`,
+    /// `rect_boustrophedon.exec`): when the planner's was set to something other than its
+    /// default, a different `sim.exec` would read, validate and then drop it, so the pair is
+    /// refused. A PID execution that only adds odometry noise to the planner's PID settings
+    /// (`--odometry-noise`) keeps them and is accepted.
+    fn check_exec_override(&self) -> Result<(), ScenarioError> {
+        let settings = self.planner.settings();
+        let (Some(sim), Some(own)) = (self.sim.exec, settings.preferred_execution()) else {
+            return Ok(());
+        };
+        let kind = self.planner.kind();
+        let default = PlannerConfig::new(kind).settings().preferred_execution();
+        let keeps = match (sim, own) {
+            _ if Some(own) == default || sim == own => true,
+            (Execution::Pid(s), Execution::Pid(o)) => {
+                o.noise.is_none() && PidOptions { noise: None, ..s } == o
+            }
+            _ => false,
+        };
+        if keeps {
+            return Ok(());
+        }
+        let what = match (sim, own) {
+            (Execution::Ideal, _) => "ideal",
+            (Execution::Pid(_), Execution::Ideal) => "pid",
+            (Execution::Pid(_), Execution::Pid(_)) => "pid with other PID settings",
+        };
+        Err(invalid(format!(
+            "sim.exec {what} (--exec / exec=) would drop the execution given for {kind} in {}.exec; remove one of them",
+            kind.info().section
+        )))
     }
 
     /// The zone values that can be checked without the map (rectangles, inline polygons).
@@ -1278,5 +1312,51 @@ mod tests {
             .map(|e| e.to_string())
             .unwrap_or_default();
         assert!(e.contains("PID"), "{e}");
+    }
+
+    #[test]
+    fn sim_exec_never_drops_the_planners_own_execution() {
+        use ccpp_core::exec::OdometryNoise;
+        use ccpp_core::planners::bsa_bfs::BsaBfsOptions;
+        let own = PidOptions {
+            dt_s: 0.1,
+            ..PidOptions::default()
+        };
+        let with = |planner_exec: Option<Execution>, sim: Option<Execution>| {
+            let mut s = Scenario::new(MapRecipe::file("m.yaml"), PlannerKind::BsaBfs);
+            if let Some(e) = planner_exec {
+                s.planner = PlannerConfig::BsaBfs(BsaBfsOptions {
+                    exec: e,
+                    ..BsaBfsOptions::default()
+                });
+            }
+            s.sim.exec = sim;
+            s.validate().err().map(|e| e.to_string())
+        };
+        let noisy = PidOptions {
+            noise: Some(OdometryNoise::default()),
+            ..own
+        };
+        // The planner's default execution may be replaced; its own settings only by the same
+        // settings (or the same with odometry noise added).
+        assert_eq!(with(None, Some(Execution::Ideal)), None);
+        assert_eq!(with(None, Some(Execution::Pid(own))), None);
+        assert_eq!(with(Some(Execution::Pid(own)), None), None);
+        assert_eq!(
+            with(Some(Execution::Pid(own)), Some(Execution::Pid(own))),
+            None
+        );
+        assert_eq!(
+            with(Some(Execution::Pid(own)), Some(Execution::Pid(noisy))),
+            None
+        );
+        for (planner, sim) in [
+            (Execution::Pid(own), Execution::Ideal),
+            (Execution::Pid(own), Execution::Pid(PidOptions::default())),
+            (Execution::Ideal, Execution::Pid(PidOptions::default())),
+        ] {
+            let e = with(Some(planner), Some(sim)).unwrap_or_default();
+            assert!(e.contains("bsa_bfs.exec") && e.contains("drop"), "{e}");
+        }
     }
 }

@@ -108,7 +108,14 @@ fn py_to_json(o: &Bound<'_, PyAny>) -> PyResult<Value> {
         return Ok(Value::Bool(o.extract()?));
     }
     if o.is_instance_of::<PyInt>() {
-        return Ok(Value::from(o.extract::<i64>()?));
+        // Seeds reach 2^64 - 1.
+        if let Ok(u) = o.extract::<u64>() {
+            return Ok(Value::from(u));
+        }
+        return o
+            .extract::<i64>()
+            .map(Value::from)
+            .map_err(|_| msg(format!("option value {} is out of range", repr(o))));
     }
     if o.is_instance_of::<PyFloat>() {
         let f: f64 = o.extract()?;
@@ -346,38 +353,103 @@ fn parse_keepout(v: &Bound<'_, PyAny>) -> PyResult<Vec<ZoneSpec>> {
     }
 }
 
-/// Builds the scenario of `ccpp.run`: keyword options -> scenario fields (validated later,
-/// once, by [`Scenario::run_on`]).
+/// What a scenario is built for: a simulated run (`ccpp.run`) or a known-map plan
+/// (`ccpp.plan`, as `ccpp plan`).
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Purpose {
+    Run,
+    Plan,
+}
+
+/// The `repr` of a Python value, for messages.
+fn repr(v: &Bound<'_, PyAny>) -> String {
+    v.repr().map_or_else(|_| "?".to_string(), |r| r.to_string())
+}
+
+/// A keyword option that must be a number (its range is the scenario's to check).
+fn float_arg(key: &str, v: &Bound<'_, PyAny>) -> PyResult<f64> {
+    v.extract()
+        .map_err(|_| msg(format!("{key} must be a number, got {}", repr(v))))
+}
+
+/// A keyword option that must be a whole number >= 0.
+fn uint_arg(key: &str, v: &Bound<'_, PyAny>) -> PyResult<u64> {
+    if v.is_instance_of::<PyBool>() {
+        return Err(msg(format!(
+            "{key} must be a whole number, got {}",
+            repr(v)
+        )));
+    }
+    v.extract().map_err(|_| {
+        msg(format!(
+            "{key} must be a whole number >= 0, got {}",
+            repr(v)
+        ))
+    })
+}
+
+/// A start pose `(x, y)` or `(x, y, theta)`.
+fn start_arg(v: &Bound<'_, PyAny>) -> PyResult<[f64; 3]> {
+    let p: Vec<f64> = v.extract().map_err(|_| {
+        msg(format!(
+            "start expects (x, y) or (x, y, theta), got {}",
+            repr(v)
+        ))
+    })?;
+    match p.as_slice() {
+        [x, y] => Ok([*x, *y, 0.0]),
+        [x, y, t] => Ok([*x, *y, *t]),
+        _ => Err(msg(format!(
+            "start expects (x, y) or (x, y, theta), got {} values",
+            p.len()
+        ))),
+    }
+}
+
+/// Builds the scenario of `ccpp.run` / `ccpp.plan`: keyword options -> scenario fields
+/// (validated later, once, by the scenario). The rules are the command line's:
+/// * an option that does not apply to the planner (or to a plan) is refused, not ignored;
+/// * a planner option given both as a keyword and inside `options=` must have one value (the
+///   CLI's flag beside the same option in `--config`);
+/// * `exec="pid"` keeps the planner's own PID settings; `exec="ideal"` beside PID settings
+///   given for the planner is refused by the scenario (`--exec ideal` beside them in
+///   `--config`).
 fn scenario_from(
     map: &PreparedMap,
     planner: &str,
     radius: f64,
     options: Option<&Bound<'_, PyDict>>,
+    purpose: Purpose,
 ) -> PyResult<Scenario> {
     let kind = parse_kind(planner)?;
     let mut s = Scenario::new(map.recipe.clone(), kind);
     s.robot = Robot::new(radius);
-    let mut planner_opts = serde_json::Map::new();
-    let Some(options) = options else {
-        s.robot.validate().map_err(|e| err(&e))?;
-        return Ok(s);
-    };
-    for (k, v) in options.iter() {
+    // Planner options given as keywords, and the `options=` dict: kept apart to find clashes.
+    let mut direct: Vec<(String, Bound<'_, PyAny>)> = Vec::new();
+    let mut in_options: Option<Bound<'_, PyDict>> = None;
+    let mut exec: Option<String> = None;
+    for (k, v) in options.into_iter().flat_map(PyDictMethods::iter) {
         let key: String = k.extract()?;
         match key.as_str() {
-            "tool_radius" => s.robot.tool_radius = v.extract()?,
+            "tool_radius" => {
+                if purpose == Purpose::Plan && kind == PlannerKind::RectBoustrophedon {
+                    // As `ccpp plan --tool-radius`: its lanes follow width_m and a plan has no
+                    // coverage metrics, so the value would change nothing.
+                    return Err(msg(format!(
+                        "tool_radius does not apply to {kind} in plan (its lanes follow width_m)"
+                    )));
+                }
+                s.robot.tool_radius = float_arg(&key, &v)?;
+            }
             "start" => {
-                let p: Vec<f64> = v.extract()?;
-                s.start = match p.as_slice() {
-                    [x, y] => Some([*x, *y, 0.0]),
-                    [x, y, t] => Some([*x, *y, *t]),
-                    _ => {
-                        return Err(msg(format!(
-                            "start expects (x, y) or (x, y, theta), got {} values",
-                            p.len()
-                        )))
-                    }
-                };
+                let p = start_arg(&v)?;
+                if purpose == Purpose::Plan && p[2] != 0.0 {
+                    // As `ccpp plan --start X,Y,THETA`: nothing a plan gives depends on it.
+                    return Err(msg(
+                        "start theta does not apply to plan (the path heads from the start to its first waypoint); give (x, y)",
+                    ));
+                }
+                s.start = Some(p);
             }
             "sensor_range" => {
                 if kind.info().offline {
@@ -387,46 +459,67 @@ fn scenario_from(
                         "the online planners; offline planners read the whole map",
                     ));
                 }
-                s.sim.sensor_range = Some(v.extract()?);
+                s.sim.sensor_range = Some(float_arg(&key, &v)?);
             }
-            "max_memory_mb" => s.max_memory_mb = v.extract()?,
-            "max_steps" => s.sim.max_steps = v.extract()?,
+            "max_memory_mb" => s.max_memory_mb = uint_arg(&key, &v)?,
+            "max_steps" => s.sim.max_steps = uint_arg(&key, &v)?,
             "exec" => {
-                let e: String = v.extract()?;
-                s.sim.exec = Some(match e.to_ascii_lowercase().as_str() {
-                    "ideal" => Execution::Ideal,
-                    "pid" => match s.planner.settings().preferred_execution() {
-                        Some(Execution::Pid(p)) => Execution::Pid(p),
-                        _ => Execution::Pid(PidOptions::default()),
-                    },
-                    other => return Err(msg(format!("exec must be ideal or pid, got {other:?}"))),
-                });
+                let e: String = v.extract().map_err(|_| {
+                    msg(format!(
+                        "exec must be \"ideal\" or \"pid\", got {} (the planner's own execution settings go in options={{\"exec\": ...}})",
+                        repr(&v)
+                    ))
+                })?;
+                exec = Some(e);
             }
             "seed" => {
-                let seed: u64 = v.extract()?;
-                match &mut s.planner {
-                    PlannerConfig::RandomBounce(o) => o.seed = seed,
-                    _ => return Err(not_applicable("seed", kind, "random-bounce")),
+                // random-bounce's own option `seed`: a planner option like the others (so
+                // `seed=` and `options={"seed": ...}` must agree).
+                if kind != PlannerKind::RandomBounce {
+                    return Err(not_applicable("seed", kind, "random-bounce"));
                 }
+                uint_arg(&key, &v)?;
+                direct.push((key, v));
             }
             "options" => {
-                let Value::Object(o) = py_to_json(&v)? else {
-                    return Err(msg("options must be a dict of planner options"));
-                };
-                planner_opts.extend(o);
+                let d = v
+                    .cast::<PyDict>()
+                    .map_err(|_| msg("options must be a dict of planner options"))?;
+                in_options = Some(d.clone());
             }
             "name" => s.map.name = Some(v.extract()?),
             // Zones: a file name, [x0, y0, x1, y1] or a list of polygons (`Scenario::area`);
             // keepout: one zone or a list of zones (`Scenario::keepout`).
             "area" => s.area = Some(parse_area(&v)?),
             "keepout" => s.keepout = parse_keepout(&v)?,
-            _ => {
-                planner_opts.insert(key, py_to_json(&v)?);
-            }
+            _ => direct.push((key, v)),
         }
     }
     // The robot first, as the command line does (same message).
     s.robot.validate().map_err(|e| err(&e))?;
+    let mut planner_opts = serde_json::Map::new();
+    if let Some(o) = &in_options {
+        for (k, v) in o.iter() {
+            planner_opts.insert(k.extract::<String>()?, py_to_json(&v)?);
+        }
+    }
+    for (k, v) in &direct {
+        if let Some(w) = in_options
+            .as_ref()
+            .map(|o| o.get_item(k))
+            .transpose()?
+            .flatten()
+        {
+            if !v.eq(&w)? {
+                return Err(msg(format!(
+                    "{k}={} and options[{k:?}]={} set the same option; remove one of them",
+                    repr(v),
+                    repr(&w)
+                )));
+            }
+        }
+        planner_opts.insert(k.clone(), py_to_json(v)?);
+    }
     if !planner_opts.is_empty() {
         let mut cfg = serde_json::to_value(&s.planner).map_err(|e| err(&e))?;
         if let Some(Value::Object(o)) = cfg.get_mut("options") {
@@ -439,6 +532,18 @@ fn scenario_from(
                 RUN_KEYS.join(", ")
             ))
         })?;
+    }
+    // After the planner's options: `pid` runs the planner's own PID settings (as `--exec pid`
+    // beside `--config`); the scenario refuses an execution that would drop them.
+    if let Some(e) = exec {
+        s.sim.exec = Some(match e.to_ascii_lowercase().as_str() {
+            "ideal" => Execution::Ideal,
+            "pid" => match s.planner.settings().preferred_execution() {
+                Some(Execution::Pid(p)) => Execution::Pid(p),
+                _ => Execution::Pid(PidOptions::default()),
+            },
+            other => return Err(msg(format!("exec must be ideal or pid, got {other:?}"))),
+        });
     }
     Ok(s)
 }
@@ -597,8 +702,11 @@ impl PlanResult {
 }
 
 /// Plans a path with a known-map planner (`bcd`, `rect-boustrophedon`) on `map`, as
-/// `ccpp plan`: the same keyword options as `run` (zones included), no simulation metrics.
-/// The GIL is released while planning.
+/// `ccpp plan`: the keyword options of `run` (zones included) that apply to a plan, no
+/// simulation metrics. As `ccpp plan` refuses them, so does this: `exec` and the planner's own
+/// execution settings (a plan executes the steps ideally), `sensor_range` (offline planners),
+/// a start heading (`start=(x, y)` only), and `tool_radius` for `rect-boustrophedon` (its lanes
+/// follow `width_m`). The GIL is released while planning.
 #[pyfunction]
 #[pyo3(signature = (map, planner="bcd", radius=0.15, **options))]
 fn plan(
@@ -608,8 +716,9 @@ fn plan(
     radius: f64,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<PlanResult> {
-    let prepared = as_map(py, map)?;
-    let scenario = scenario_from(&prepared, planner, radius, options)?;
+    let mut prepared = as_map(py, map)?;
+    let scenario = scenario_from(&prepared, planner, radius, options, Purpose::Plan)?;
+    name_map(&mut prepared, &scenario);
     let p = py
         .detach(|| ccpp_io::plan::plan_route(&scenario, &prepared, DEFAULT_TOLERANCE_M))
         .map_err(|e| err(&e))?;
@@ -754,8 +863,12 @@ impl RunResult {
 
 /// Runs `planner` on `map` with robot radius `radius`; the other keyword options are scenario
 /// fields (`tool_radius`, `start`, `sensor_range`, `exec`, `seed`, `max_steps`,
-/// `max_memory_mb`, `name`) or the planner's own options (`options={...}` or directly, e.g.
-/// `smoothing=False`). The GIL is released during the run.
+/// `max_memory_mb`, `name`, `area`, `keepout`) or the planner's own options (`options={...}`
+/// or directly, e.g. `smoothing=False`). The command line's rules hold: an option that does
+/// not apply to the planner is refused; a planner option given both directly and in
+/// `options` must have one value; `exec="pid"` runs the planner's own PID settings
+/// (`options={"exec": {"pid": {...}}}` of bsa-bfs, rect-boustrophedon) and `exec="ideal"`
+/// beside such settings is refused. The GIL is released during the run.
 #[pyfunction]
 #[pyo3(signature = (map, planner="ba-star", radius=0.15, **options))]
 fn run(
@@ -765,8 +878,9 @@ fn run(
     radius: f64,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<RunResult> {
-    let prepared = as_map(py, map)?;
-    let scenario = scenario_from(&prepared, planner, radius, options)?;
+    let mut prepared = as_map(py, map)?;
+    let scenario = scenario_from(&prepared, planner, radius, options, Purpose::Run)?;
+    name_map(&mut prepared, &scenario);
     let run = py
         .detach(|| scenario.run_on(&prepared))
         .map_err(|e| err(&e))?;
@@ -776,6 +890,14 @@ fn run(
         output: run.output,
         metrics: run.metrics,
     })
+}
+
+/// Gives the prepared map the scenario's map name (`name=`), which the metrics, the exports
+/// and `run.json` all report.
+fn name_map(map: &mut PreparedMap, scenario: &Scenario) {
+    if let Some(n) = &scenario.map.name {
+        map.name.clone_from(n);
+    }
 }
 
 /// A `Map`, or a path loaded as one.
@@ -794,7 +916,8 @@ fn as_map(py: Python<'_>, map: &Bound<'_, PyAny>) -> PyResult<PreparedMap> {
 /// the error message the bench's `results.csv` records. With `out`, the run's files are
 /// written there.
 #[pyfunction]
-#[pyo3(signature = (map_path, planner, radius=0.15, tool_radius=None, inflate=None, max_memory_mb=None, out=None))]
+#[pyo3(signature = (map_path, planner, radius=0.15, tool_radius=None, inflate=None, max_memory_mb=None, out=None, name=None))]
+#[allow(clippy::too_many_arguments)] // keyword arguments of a Python function
 fn bench_run(
     py: Python<'_>,
     map_path: PathBuf,
@@ -804,16 +927,21 @@ fn bench_run(
     inflate: Option<f64>,
     max_memory_mb: Option<u64>,
     out: Option<PathBuf>,
+    name: Option<String>,
 ) -> PyResult<(Option<Py<PyAny>>, Option<String>)> {
     let kind = parse_kind(planner)?;
+    check_robot(radius, tool_radius)?;
     let robot = Robot {
         radius,
         tool_radius: tool_radius.unwrap_or(radius),
     };
-    robot.validate().map_err(|e| err(&e))?;
     let outcome: Result<Metrics, String> = py.detach(|| {
         let mut recipe = recipe_for(&map_path);
         recipe.inflate = inflate;
+        if name.is_some() {
+            // The bench's distinct name of the map (two maps sharing a file stem).
+            recipe.name.clone_from(&name);
+        }
         let map = recipe.load().map_err(|e| chain(&e))?;
         let scenario = Scenario::configure(map.recipe.clone(), PlannerConfig::new(kind))
             .robot(robot)
@@ -837,6 +965,19 @@ fn bench_run(
         Ok(m) => (Some(to_py(py, &m)?), None),
         Err(e) => (None, Some(e)),
     })
+}
+
+/// Checks a robot of radius `radius` and tool radius `tool_radius` (default the radius) as
+/// runs do (`sweep` checks its radii before it starts any task).
+#[pyfunction]
+#[pyo3(signature = (radius, tool_radius=None))]
+fn check_robot(radius: f64, tool_radius: Option<f64>) -> PyResult<()> {
+    Robot {
+        radius,
+        tool_radius: tool_radius.unwrap_or(radius),
+    }
+    .validate()
+    .map_err(|e| err(&e))
 }
 
 /// The planners: a list of dicts with `name`, `offline` (reads the whole map up front),
@@ -1096,7 +1237,8 @@ impl Env {
         };
         let area = area.map(parse_area).transpose()?;
         let keepout = keepout.map(parse_keepout).transpose()?.unwrap_or_default();
-        // The scenario validates the robot, the sensor range, the execution and the zones.
+        // The scenario validates the robot, the sensor range, the execution, the episode cap
+        // and the zones.
         let s = Scenario::configure(map.recipe.clone(), PlannerConfig::new(PlannerKind::BaStar))
             .robot(Robot {
                 radius,
@@ -1106,6 +1248,9 @@ impl Env {
             .sim(SimConfig {
                 sensor_range,
                 exec: Some(exec),
+                // The episode cap, validated as a run's (the simulator steps one action at a
+                // time here, so only `step` truncates on it).
+                max_steps: max_steps.unwrap_or(SimConfig::default().max_steps),
                 ..SimConfig::default()
             })
             .zones(area, keepout)
@@ -1306,6 +1451,7 @@ fn _ccpp(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(load_map, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(bench_run, m)?)?;
+    m.add_function(wrap_pyfunction!(check_robot, m)?)?;
     m.add_function(wrap_pyfunction!(planners, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

@@ -34,3 +34,13 @@ def test_episode(room: Path) -> None:
     assert total > 0 and 0 < info["coverage"] <= 1
     img = env.render()
     assert img is not None and img.shape == (40, 60, 3)
+
+
+def test_refuses_what_it_would_ignore(room: Path) -> None:
+    for kw in ({"step_m": 0.0}, {"step_m": -0.1}, {"turn_rad": float("nan")}, {"turn_rad": 0}):
+        with pytest.raises(ValueError, match=next(iter(kw))):
+            CoverageEnv(str(room), **kw)
+    env = CoverageEnv(str(room), max_steps=5)
+    env.reset(seed=1, options={})
+    with pytest.raises(ValueError, match="no options"):
+        env.reset(seed=1, options={"start": (1.0, 1.0)})

@@ -71,3 +71,32 @@ def test_sweep_radii_and_errors(room: Path, tmp_path: Path, client) -> None:
     assert err["effective_coverage"].isna().all()
     with pytest.raises(ccpp.CcppError, match="unknown planner"):
         ccpp.sweep([str(room)], ["nope"], client=client)
+
+
+def test_sweep_refuses_what_it_would_ignore(room: Path, tmp_path: Path, client) -> None:
+    import json
+
+    from conftest import write_room
+
+    # A scheduler beside a client would be ignored.
+    with pytest.raises(ccpp.CcppError, match="give one of them"):
+        ccpp.sweep([str(room)], ["bsa"], client=client, scheduler="tcp://127.0.0.1:1")
+    # An empty list is not "every planner".
+    with pytest.raises(ccpp.CcppError, match="planners is empty"):
+        ccpp.sweep([str(room)], [], client=client)
+    # Radii are checked before any task starts.
+    with pytest.raises(ccpp.CcppError, match="robot radius"):
+        ccpp.sweep([str(room)], ["bsa"], [0.15, float("nan")], client=client)
+    with pytest.raises(ccpp.CcppError, match="tool radius"):
+        ccpp.sweep([str(room)], ["bsa"], [0.15], tool_radius=0.2, client=client)
+    # As `ccpp bench`: a map, planner or radius named twice runs once (two runs would write the
+    # same folder), and maps sharing a file stem get distinct names, rows and folders.
+    other = tmp_path / "b"
+    other.mkdir()
+    room2 = write_room(other)
+    out = tmp_path / "out"
+    df = ccpp.sweep([str(room), str(room), str(room2)], ["bsa", "bsa"], [0.15, 0.15], client=client, out=out)
+    assert df["map"].tolist() == [f"{room.parent.name}-room", "b-room"]
+    assert (df["status"] == "ok").all() and len(set(df["dir"])) == 2
+    for row in df.itertuples():
+        assert json.loads((Path(row.dir) / "metrics.json").read_text())["map"] == row.map

@@ -105,7 +105,8 @@ class Env:
         max_steps: int | None = None,
         area: Any = None,
         keepout: Any = None,
-    ) -> None: ...
+    ) -> None:
+        """``max_steps`` (>= 1) truncates episodes; values are validated as a run's."""
     def reset(self, seed: int | None = None) -> tuple[dict[str, Any], dict[str, Any]]:
         """Starts an episode; returns (observation, info)."""
     def step(
@@ -149,12 +150,18 @@ def load_map(
 def run(
     map: Map | _Path, planner: str = "ba-star", radius: float = 0.15, **options: Any
 ) -> RunResult:
-    """Runs a planner; options are scenario fields or the planner's own options."""
+    """Runs a planner; options are scenario fields (``tool_radius``, ``start``,
+    ``sensor_range``, ``exec``, ``seed``, ``max_steps``, ``max_memory_mb``, ``name``, ``area``,
+    ``keepout``) or the planner's own options (directly or in ``options={...}``; a key given
+    both ways must have one value). Options that do not apply are refused; ``exec="pid"`` runs
+    the planner's own PID settings, ``exec="ideal"`` beside them is refused."""
 
 def plan(
     map: Map | _Path, planner: str = "bcd", radius: float = 0.15, **options: Any
 ) -> PlanResult:
-    """Plans a path with a known-map planner (``ccpp plan``); options as for ``run``."""
+    """Plans a path with a known-map planner (``ccpp plan``); options as for ``run`` where they
+    apply to a plan (refused: ``exec``, the planner's execution settings, ``sensor_range``, a
+    start heading, ``tool_radius`` for rect-boustrophedon)."""
 
 def bench_run(
     map_path: _Path,
@@ -164,8 +171,13 @@ def bench_run(
     inflate: float | None = None,
     max_memory_mb: int | None = None,
     out: _Path | None = None,
+    name: str | None = None,
 ) -> tuple[dict[str, Any] | None, str | None]:
-    """One ``ccpp bench`` run: (metrics, None) or (None, error message)."""
+    """One ``ccpp bench`` run: (metrics, None) or (None, error message); ``name`` is the
+    map's name in the results (default its file stem)."""
+
+def check_robot(radius: float, tool_radius: float | None = None) -> None:
+    """Raises CcppError for a robot a run would refuse."""
 
 def planners() -> list[dict[str, Any]]:
     """name, offline, description and default options of every planner."""

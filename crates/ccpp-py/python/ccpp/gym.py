@@ -56,6 +56,10 @@ class CoverageEnv(gym.Env):  # type: ignore[misc]
         )
         self.step_m = float(step_m if step_m is not None else radius)
         self.turn_rad = float(turn_rad)
+        for name, v in (("step_m", self.step_m), ("turn_rad", self.turn_rad)):
+            # 0 would make the action a no-op, a negative value reverse it, NaN fail each step.
+            if not (math.isfinite(v) and v > 0):
+                raise ValueError(f"{name} must be a finite number > 0, got {v}")
         self.random_start = random_start
         self.include_known = include_known
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
@@ -92,6 +96,9 @@ class CoverageEnv(gym.Env):  # type: ignore[misc]
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+        if options:
+            # Nothing here reads them: refused rather than ignored.
+            raise ValueError(f"CoverageEnv.reset takes no options, got {options!r}")
         super().reset(seed=seed)
         start_seed = int(self.np_random.integers(0, 2**63)) if self.random_start else None
         o, info = self._env.reset(start_seed)

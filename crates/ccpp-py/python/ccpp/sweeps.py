@@ -68,8 +68,44 @@ def expand_maps(items: Iterable[str | os.PathLike[str]] | str | os.PathLike[str]
     return out
 
 
+def _map_names(paths: list[Path]) -> list[tuple[Path, str]]:
+    """As ``ccpp bench`` names its maps: a file named twice is run once, and every map gets a
+    distinct name for its rows and run folders -- the file stem, or ``<folder>-<stem>`` when
+    maps in different folders share a stem (then ``-2``, ``-3``, ... if that still repeats)."""
+    seen: set[Path] = set()
+    kept: list[Path] = []
+    for p in paths:
+        c = p.resolve()
+        if c not in seen:
+            seen.add(c)
+            kept.append(p)
+    stems = [p.stem or "map" for p in kept]
+    names = []
+    for p, stem in zip(kept, stems):
+        folder = p.resolve().parent.name
+        names.append(f"{folder}-{stem}" if stems.count(stem) > 1 and folder else stem)
+    for i, n in enumerate(names):
+        earlier = names[:i].count(n)
+        if earlier:
+            k = earlier + 1
+            while f"{n}-{k}" in names:
+                k += 1
+            names[i] = f"{n}-{k}"
+    return list(zip(kept, names))
+
+
+def _once(items: Iterable[Any]) -> list[Any]:
+    """The items in order, each once (as ``ccpp bench`` runs a planner named twice once)."""
+    out: list[Any] = []
+    for x in items:
+        if x not in out:
+            out.append(x)
+    return out
+
+
 def _run_cell(
     map_path: str,
+    map_name: str,
     planner: str,
     radius: float,
     tool_radius: float | None,
@@ -88,8 +124,9 @@ def _run_cell(
         inflate=inflate,
         max_memory_mb=max_memory_mb,
         out=out_dir,
+        name=map_name,
     )
-    row: dict[str, Any] = {"map": Path(map_path).stem, "planner": planner}
+    row: dict[str, Any] = {"map": map_name, "planner": planner}
     if metrics is None:
         row.update(status="error", error=error)
         row.update({c: None for c in _METRIC_COLUMNS})
@@ -114,35 +151,46 @@ def sweep(
 ) -> "pandas.DataFrame":
     """Runs every planner on every map for every radius, one Dask task per run.
 
-    ``maps`` are files or folders (as ``ccpp bench --maps``); ``planners`` default to all.
-    With ``out``, each run's files are written to ``out/runs/MAP/PLANNER`` (with several radii,
-    ``out/runs/r<RADIUS>/MAP/PLANNER``), as ``ccpp bench --out`` does. Failed runs are rows with
-    ``status == "error"`` and the message in ``error``. Returns a pandas DataFrame with the
-    columns :data:`CSV_COLUMNS` (plus ``radius`` when several radii are given).
+    ``maps`` are files or folders (as ``ccpp bench --maps``; a map named twice runs once, maps
+    sharing a file stem are told apart as ``<folder>-<stem>``); ``planners`` default to all (a
+    planner named twice runs once); ``radii`` are checked (with ``tool_radius``) before any
+    task starts, and a radius given twice runs once. With ``out``, each run's files are written
+    to ``out/runs/MAP/PLANNER`` (with several radii, ``out/runs/r<RADIUS>/MAP/PLANNER``), as
+    ``ccpp bench --out`` does. The cluster is ``client`` or ``scheduler`` (not both). Failed
+    runs are rows with ``status == "error"`` and the message in ``error``. Returns a pandas
+    DataFrame with the columns :data:`CSV_COLUMNS` (plus ``radius`` when several radii are
+    given).
     """
     import pandas as pd
     from distributed import Client
 
+    if client is not None and scheduler is not None:
+        # One of them would be ignored.
+        raise _ccpp.CcppError("client and scheduler both name the cluster to use; give one of them")
     known = [p["name"] for p in _ccpp.planners()]
-    names = list(planners) if planners else known
+    if planners is not None and len(planners) == 0:
+        raise _ccpp.CcppError("planners is empty (leave it out, or None, for every planner)")
+    names = _once(planners) if planners is not None else known
     for p in names:
         if p not in known:
             raise _ccpp.CcppError(f'unknown planner "{p}"; run `ccpp planners` for the list')
-    radii = list(radii)
+    radii = _once(float(r) for r in radii)
     if not radii:
         raise _ccpp.CcppError("radii is empty")
-    paths = expand_maps(maps)
+    for r in radii:
+        _ccpp.check_robot(r, tool_radius)
+    maps_named = _map_names(expand_maps(maps))
     tasks = []
     for r in radii:
-        for m in paths:
+        for m, map_name in maps_named:
             for p in names:
                 d = None
                 if out is not None:
                     base = Path(out) / "runs"
                     if len(radii) > 1:
                         base = base / f"r{r}"
-                    d = str(base / m.stem / p)
-                tasks.append((str(m), p, float(r), tool_radius, inflate, max_memory_mb, d))
+                    d = str(base / map_name / p)
+                tasks.append((str(m), map_name, p, r, tool_radius, inflate, max_memory_mb, d))
 
     own = None
     if client is None:
@@ -157,5 +205,5 @@ def sweep(
             own.close()
     df = pd.DataFrame(rows, columns=CSV_COLUMNS)
     if len(radii) > 1:
-        df.insert(2, "radius", [t[2] for t in tasks])
+        df.insert(2, "radius", [t[3] for t in tasks])
     return df

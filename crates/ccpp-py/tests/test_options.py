@@ -1,0 +1,145 @@
+"""Every keyword option changes what it should or is refused: never accepted and then dropped
+(the command line's rules, one ``Scenario`` validation)."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import ccpp
+
+PID = {"exec": {"pid": {"dt_s": 0.1}}}
+
+
+def cli(binary: str, *args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([binary, *args], capture_output=True, text=True, check=False)
+
+
+def test_exec_keeps_or_refuses_the_planners_pid_settings(room: Path, ccpp_bin: str, tmp_path: Path) -> None:
+    m = ccpp.load_map(room)
+    base = ccpp.run(m, "bsa-bfs")
+    own = ccpp.run(m, "bsa-bfs", options=PID)
+    assert not np.array_equal(own.path, base.path), "bsa_bfs.exec.pid.dt_s changed nothing"
+    # exec="pid" runs the planner's own PID settings (as `--exec pid --config`), whatever the
+    # order of the keywords.
+    for r in (ccpp.run(m, "bsa-bfs", exec="pid", options=PID), ccpp.run(m, "bsa-bfs", options=PID, exec="pid")):
+        assert np.array_equal(r.path, own.path)
+        assert json.loads(r.scenario_json)["sim"]["exec"]["pid"]["dt_s"] == 0.1
+    # exec="ideal" would drop them: refused naming the option, as `--exec ideal --config` is.
+    cfg = tmp_path / "pid.yaml"
+    cfg.write_text("bsa_bfs: { exec: { pid: { dt_s: 0.1 } } }\n")
+    p = cli(ccpp_bin, "run", "--map", str(room), "--planner", "bsa-bfs", "--exec", "ideal",
+            "--config", str(cfg), "--out", str(tmp_path / "o"))
+    assert p.returncode != 0 and "bsa_bfs.exec" in p.stderr
+    with pytest.raises(ccpp.CcppError, match=r"ideal .*bsa_bfs\.exec; remove one of them"):
+        ccpp.run(m, "bsa-bfs", exec="ideal", options=PID)
+    with pytest.raises(ccpp.CcppError, match=r"rect_boustrophedon\.exec"):
+        ccpp.run(m, "rect-boustrophedon", options=PID, exec="ideal")
+    # A planner told to run ideally and exec="pid" disagree as well.
+    with pytest.raises(ccpp.CcppError, match=r"bsa_bfs\.exec"):
+        ccpp.run(m, "bsa-bfs", exec="pid", options={"exec": "ideal"})
+    # Without settings of its own, the planner's default execution is replaced.
+    ideal = ccpp.run(m, "bsa-bfs", exec="ideal")
+    assert "tracking_error_mean_m" not in ideal.metrics or ideal.metrics["tracking_error_mean_m"] is None
+    # A string only: the planner's own settings go in options=.
+    with pytest.raises(ccpp.CcppError, match="exec must be"):
+        ccpp.run(m, "bsa-bfs", exec={"pid": {}})
+
+
+def test_a_keyword_and_the_same_key_in_options_must_agree(room: Path, ccpp_bin: str, tmp_path: Path) -> None:
+    m = ccpp.load_map(room)
+    for kw, opts in (({"smoothing": False}, {"smoothing": True}), ({"smoothing": True}, {"smoothing": False})):
+        with pytest.raises(ccpp.CcppError, match=r"smoothing=.* and options\[\"smoothing\"\]=.* set the same option"):
+            ccpp.run(m, "ba-star", **kw, options=opts)
+        with pytest.raises(ccpp.CcppError, match="set the same option"):
+            ccpp.run(m, "ba-star", options=opts, **kw)
+    # Equal values are one value (as the CLI accepts a flag equal to the file's value).
+    off = ccpp.run(m, "ba-star", smoothing=False)
+    both = ccpp.run(m, "ba-star", smoothing=False, options={"smoothing": False})
+    assert np.array_equal(both.path, off.path)
+    # random-bounce's seed is its option `seed`: seed= and options={"seed": ...} likewise.
+    with pytest.raises(ccpp.CcppError, match=r"seed=1 and options\[\"seed\"\]=2 set the same option"):
+        ccpp.run(m, "random-bounce", seed=1, options={"seed": 2})
+    assert np.array_equal(
+        ccpp.run(m, "random-bounce", seed=2, options={"seed": 2}).path, ccpp.run(m, "random-bounce", seed=2).path
+    )
+    # Seeds span the whole u64 range, as `--seed` does.
+    big = ccpp.run(m, "random-bounce", seed=2**64 - 1)
+    assert json.loads(big.scenario_json)["options"]["seed"] == 2**64 - 1
+    # The CLI refuses the same clash.
+    cfg = tmp_path / "rb.yaml"
+    cfg.write_text("random_bounce: { seed: 2 }\n")
+    p = cli(ccpp_bin, "run", "--map", str(room), "--planner", "random-bounce", "--seed", "1",
+            "--config", str(cfg), "--out", str(tmp_path / "o"))
+    assert p.returncode != 0 and "set the same option" in p.stderr
+
+
+def test_plan_refuses_what_a_plan_would_drop(room: Path, ccpp_bin: str, tmp_path: Path) -> None:
+    # `ccpp plan --planner rect-boustrophedon --tool-radius` is refused: its lanes follow width.
+    p = cli(ccpp_bin, "plan", "--map", str(room), "--planner", "rect-boustrophedon", "--tool-radius", "0.1",
+            "--out", str(tmp_path / "o"))
+    assert p.returncode != 0 and "--tool-radius does not apply" in p.stderr
+    with pytest.raises(ccpp.CcppError, match="tool_radius does not apply to rect-boustrophedon"):
+        ccpp.plan(room, "rect-boustrophedon", tool_radius=0.1)
+    # bcd's lanes follow the tool: there it applies.
+    assert ccpp.plan(room, "bcd", tool_radius=0.1).export("csv") != ccpp.plan(room, "bcd").export("csv")
+    # A start heading changes nothing a plan gives (`ccpp plan --start X,Y,THETA` is refused).
+    p = cli(ccpp_bin, "plan", "--map", str(room), "--planner", "bcd", "--start", "1,1,1",
+            "--out", str(tmp_path / "o"))
+    assert p.returncode != 0 and "THETA" in p.stderr
+    with pytest.raises(ccpp.CcppError, match="start theta does not apply to plan"):
+        ccpp.plan(room, "bcd", start=(1.0, 1.0, 1.0))
+    assert ccpp.plan(room, "bcd", start=(1.0, 1.0)).finished
+    # A plan executes the steps ideally: an execution would be dropped.
+    with pytest.raises(ccpp.CcppError, match=r"sim\.exec \(exec=\) does not apply to a plan"):
+        ccpp.plan(room, "bcd", exec="pid")
+    with pytest.raises(ccpp.CcppError, match=r"rect_boustrophedon\.exec does not apply to a plan"):
+        ccpp.plan(room, "rect-boustrophedon", options=PID)
+    cfg = tmp_path / "pid.yaml"
+    cfg.write_text("rect_boustrophedon: { exec: { pid: { dt_s: 0.1 } } }\n")
+    p = cli(ccpp_bin, "plan", "--map", str(room), "--planner", "rect-boustrophedon", "--config", str(cfg),
+            "--out", str(tmp_path / "o"))
+    assert p.returncode != 0 and "rect_boustrophedon.exec" in p.stderr
+
+
+def test_bad_values_are_ccpp_errors_naming_the_option(room: Path) -> None:
+    m = ccpp.load_map(room)
+    for kw, name in (
+        ({"max_memory_mb": -1}, "max_memory_mb"),
+        ({"max_memory_mb": 1.5}, "max_memory_mb"),
+        ({"max_steps": -3}, "max_steps"),
+        ({"max_steps": 0}, "max_steps"),
+        ({"max_memory_mb": 0}, "max_memory"),
+        ({"tool_radius": "wide"}, "tool_radius"),
+        ({"sensor_range": float("nan")}, "sensor_range"),
+        ({"sensor_range": -1.0}, "sensor_range"),
+        ({"tool_radius": float("inf")}, "tool radius"),
+        ({"start": (float("nan"), 1.0)}, "start"),
+        ({"start": (1.0,)}, "start"),
+    ):
+        with pytest.raises(ccpp.CcppError, match=name):
+            ccpp.run(m, "bsa", **kw)
+    with pytest.raises(ccpp.CcppError, match="seed"):
+        ccpp.run(m, "random-bounce", seed=-1)
+    with pytest.raises(ccpp.CcppError, match="options must be a dict"):
+        ccpp.run(m, "bsa", options=[("side", "left")])
+
+
+def test_name_is_the_name_every_output_reports(room: Path) -> None:
+    r = ccpp.run(room, "bsa", name="box")
+    assert r.metrics["map"] == "box"
+    assert json.loads(r.scenario_json)["map"]["name"] == "box"
+    p = ccpp.plan(room, "bcd", name="box")
+    assert "box" in repr(p) and "box" in p.export("json")
+
+
+def test_env_refuses_a_zero_episode_cap(room: Path) -> None:
+    with pytest.raises(ccpp.CcppError, match="max_steps must be >= 1"):
+        ccpp.Env(room, max_steps=0)
+    env = ccpp.Env(room, max_steps=1)
+    env.reset()
+    assert env.step(("rotate", 0.1))[3] is True
