@@ -238,6 +238,25 @@ pub(super) fn estimate(cell: &Cell, lanes: &[f64], turn_px: f64) -> f64 {
     len + span + turn_px * (2 * lanes.len()) as f64
 }
 
+/// The cells with every cell of an even number `n` of lanes cut into two cells of the same
+/// pixels holding its first `k` and its last `n - k` lanes, both odd (`k` = `n / 2` or the odd
+/// number just below it), so each leaves on the side opposite its entry (module docs, step 4).
+/// Other cells are kept as they are, and the order of cells and lanes is kept.
+pub(super) fn odd_runs(cells: &[(Cell, Vec<f64>)]) -> Vec<(Cell, Vec<f64>)> {
+    let mut out = Vec::with_capacity(2 * cells.len());
+    for (c, l) in cells {
+        let n = l.len();
+        if n >= 2 && n % 2 == 0 {
+            let k = if (n / 2) % 2 == 1 { n / 2 } else { n / 2 - 1 };
+            out.push((c.clone(), l[..k].to_vec()));
+            out.push((c.clone(), l[k..].to_vec()));
+        } else {
+            out.push((c.clone(), l.clone()));
+        }
+    }
+    out
+}
+
 /// A cell's two boustrophedon paths (grid points), starting at the first lane's low end and at
 /// its high end.
 pub(super) fn cell_paths(

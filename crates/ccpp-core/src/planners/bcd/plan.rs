@@ -6,7 +6,7 @@ use std::collections::VecDeque;
 use super::angles::{dominant_angles, ANGLE_STEP_DEG, AXIS_TOL_DEG};
 use super::cells::{decompose, split_ends, split_jumps, Cell};
 use super::finish::{moves, repair, smooth, turns, Item};
-use super::lanes::{cell_paths, drop_covered, estimate, lanes_of, side_open};
+use super::lanes::{cell_paths, drop_covered, estimate, lanes_of, odd_runs, side_open};
 use super::lattice::{Ctx, Lattice};
 use super::rim::{rim_contours, rim_pass};
 use super::transfer::Search;
@@ -240,12 +240,50 @@ impl Bcd {
             .collect();
         let cells = drop_covered(cells, w, h, ctx.rt);
 
+        // A cell with an even number of lanes leaves on the side it entered. The same cells
+        // with each such cell cut into two runs of an odd number of lanes (`k` and `n - k`,
+        // as even as parity allows), which the tour may drive at different times, each
+        // leaving on the side opposite its entry; when the halves are best driven one after
+        // the other the tour joins them back. Both cell sets are toured and the cheaper plan
+        // is kept (module docs, step 4).
+        let split = odd_runs(&cells);
+        let mut best: Option<(usize, f64, Vec<Item>)> = None;
+        // (no even cell: the second set is the first)
+        let sets: &[&Vec<(Cell, Vec<f64>)>] = if split.len() > cells.len() {
+            &[&cells, &split]
+        } else {
+            &[&cells]
+        };
+        for &set in sets {
+            if let Some(b) = Self::tour_cells(ctx, lat, opts, search, set, sp, start) {
+                if best.as_ref().is_none_or(|a| (b.0, b.1) < (a.0, a.1)) {
+                    best = Some(b);
+                }
+            }
+        }
+        let ncells = cells.len();
+        best.map_or((0, 0.0, Vec::new(), ncells), |b| (b.0, b.1, b.2, ncells))
+    }
+
+    /// Steps 3-5 of the module docs for the cells `cells` with their lanes: cell paths, the
+    /// tour, rim passes, repair, smoothing and pruning; the plan's skipped moves, its cost
+    /// (length plus `turn_cost_m` per turn, pixels) and items.
+    fn tour_cells(
+        ctx: &Ctx<'_>,
+        lat: &Lattice,
+        opts: &BcdOptions,
+        search: &mut Search,
+        cells: &[(Cell, Vec<f64>)],
+        sp: f64,
+        start: Point,
+    ) -> Option<(usize, f64, Vec<Item>)> {
+        let turn_px = opts.turn_cost_m / ctx.frame.resolution;
         // Cell paths; a first tour over the cells picks each cell's path (corner), the rim
         // contours of what those paths miss join the cells in the final tour, where each cell
         // keeps its path (driven either way).
         let mut paths: Vec<[Vec<Point>; 2]> = Vec::with_capacity(cells.len());
         let mut pieces = Vec::with_capacity(cells.len());
-        for (cell, lanes) in &cells {
+        for (cell, lanes) in cells {
             let ps = cell_paths(ctx, lat, search, cell, lanes);
             let mut piece = tsp::Piece {
                 entry: Vec::new(),
@@ -442,7 +480,6 @@ impl Bcd {
                 best = Some((skipped, cost, items));
             }
         }
-        let ncells = cells.len();
-        best.map_or((0, 0.0, Vec::new(), ncells), |b| (b.0, b.1, b.2, ncells))
+        best
     }
 }

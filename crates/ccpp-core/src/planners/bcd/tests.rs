@@ -4,7 +4,7 @@ use super::angles::dominant_angles;
 use super::cells::{decompose, split_ends, split_jumps, Cell};
 use super::finish::Item;
 use super::finish::{moves, repair, smooth};
-use super::lanes::{drop_covered, lanes_of};
+use super::lanes::{drop_covered, lanes_of, odd_runs};
 use super::lattice::{Ctx, Lattice};
 use super::transfer::Search;
 use super::{Bcd, BcdOptions};
@@ -616,4 +616,36 @@ fn transfers_keep_the_margin_they_are_given() {
         "without a margin the route grazes the block: {bare}"
     );
     assert!(kept >= need - 1.0, "with 3 px it keeps {kept} px of {need}");
+}
+
+#[test]
+fn even_cells_are_cut_into_two_odd_runs_of_their_lanes() {
+    let cell = |u0| Cell {
+        cols: true,
+        u0,
+        runs: vec![(0, 9); 30],
+    };
+    let lanes = |n: usize| (0..n).map(|i| 3.0 * i as f64).collect::<Vec<f64>>();
+    let cells: Vec<(Cell, Vec<f64>)> = [1, 2, 4, 5, 6, 8]
+        .iter()
+        .enumerate()
+        .map(|(i, &n)| (cell(i), lanes(n)))
+        .collect();
+    let out = odd_runs(&cells);
+    let got: Vec<(usize, Vec<f64>)> = out.iter().map(|(c, l)| (c.u0, l.clone())).collect();
+    // 1 and 5 stay; 2 -> 1 + 1, 4 -> 1 + 3, 6 -> 3 + 3, 8 -> 3 + 5; same cell, lanes in order.
+    let want: Vec<(usize, Vec<f64>)> = vec![
+        (0, lanes(1)),
+        (1, vec![0.0]),
+        (1, vec![3.0]),
+        (2, vec![0.0]),
+        (2, vec![3.0, 6.0, 9.0]),
+        (3, lanes(5)),
+        (4, vec![0.0, 3.0, 6.0]),
+        (4, vec![9.0, 12.0, 15.0]),
+        (5, vec![0.0, 3.0, 6.0]),
+        (5, vec![9.0, 12.0, 15.0, 18.0, 21.0]),
+    ];
+    assert_eq!(got, want);
+    assert!(out.iter().all(|(_, l)| l.len() % 2 == 1));
 }
