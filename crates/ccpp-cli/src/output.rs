@@ -139,7 +139,7 @@ pub fn emit(
     }
     if json_only {
         if let Some(why) = &r.metrics.stop_reason {
-            eprintln!("warning: {}", stop_warning(why));
+            eprintln!("warning: {}", stop_warning(why, "coverage"));
         }
         return crate::print_stdout(&metrics);
     }
@@ -198,19 +198,20 @@ pub fn summary(m: &Metrics) -> String {
     }
     if let Some(why) = &m.stop_reason {
         let _ = writeln!(s, "  {:<20} {why:>12}", "stop_reason");
-        let _ = writeln!(s, "  warning: {}", stop_warning(why));
+        let _ = writeln!(s, "  warning: {}", stop_warning(why, "coverage"));
     }
     s
 }
 
-/// What an early stop (`Metrics::stop_reason`) means, for the summary.
-pub fn stop_warning(why: &str) -> String {
+/// What an early stop (`Metrics::stop_reason`) means, for the summary; `what` is the
+/// incomplete result (`coverage` of a run, `path` of a plan).
+pub fn stop_warning(why: &str, what: &str) -> String {
     match why {
         "stalled" => format!(
-            "the run was stopped: the robot made no progress for {} motions in a row (its true position stayed within half a map pixel, as when it keeps driving into a wall its drifted pose estimate does not show); the coverage is incomplete",
+            "the run was stopped: the robot made no progress for {} motions in a row (its true position stayed within half a map pixel, as when it keeps driving into a wall its drifted pose estimate does not show); the {what} is incomplete",
             ccpp_core::sim::STALL_STEPS
         ),
-        "max_steps" => "the planner hit the simulator's step cap; the coverage is incomplete".to_string(),
-        other => format!("the run ended early ({other}); the coverage is incomplete"),
+        "max_steps" => format!("the planner hit the simulator's step cap; the {what} is incomplete"),
+        other => format!("the run ended early ({other}); the {what} is incomplete"),
     }
 }

@@ -106,7 +106,7 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         let _ = writeln!(
             s,
             "  warning: {}",
-            crate::output::stop_warning(plan.stop.as_str()).replace("coverage", "path")
+            crate::output::stop_warning(plan.stop.as_str(), "path")
         );
     }
     let names: Vec<&str> = files.iter().map(|(n, _)| *n).collect();

@@ -357,11 +357,24 @@ impl ZoneMasks {
         for m in masks {
             k.union_with(m);
         }
+        Self::with_keepout_pixels(frame, area, k, keepout.to_vec())
+    }
+
+    /// Rasterises `area` polygons (`None` = no area restriction) onto `frame`, with the
+    /// keep-out pixels `keepout` already rasterised (`frame`-sized: the union of every keep-out
+    /// polygon's and mask's pixels) and the keep-out polygons they came from (for pictures and
+    /// exports).
+    pub fn with_keepout_pixels(
+        frame: &MapFrame,
+        area: Option<&[Polygon]>,
+        keepout: FixedBitSet,
+        keepout_polygons: Vec<Polygon>,
+    ) -> Self {
         Self {
             area: area.map(|a| rasterize(frame, a)),
-            keepout: k,
+            keepout,
             area_polygons: area.map(<[Polygon]>::to_vec).unwrap_or_default(),
-            keepout_polygons: keepout.to_vec(),
+            keepout_polygons,
         }
     }
 

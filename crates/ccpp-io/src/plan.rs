@@ -10,7 +10,6 @@
 //! has discovered the map ([`Scenario::run_on`] and the route of its trace).
 
 use ccpp_core::exec::Execution;
-use ccpp_core::planners::PlannerConfig;
 use ccpp_core::route::Route;
 use ccpp_core::sim::{simulate, StopReason};
 use ccpp_core::world::World;
@@ -62,9 +61,8 @@ fn check_dropped(scenario: &Scenario) -> Result<(), ScenarioError> {
     if scenario.sim.exec.is_some() {
         return Err(dropped("sim.exec (exec=)".into()));
     }
-    let kind = scenario.planner.kind();
-    let own = scenario.planner.settings().preferred_execution();
-    if own != PlannerConfig::new(kind).settings().preferred_execution() {
+    if scenario.planner_sets_execution() {
+        let kind = scenario.planner.kind();
         return Err(dropped(format!(
             "the execution given for {kind} in {}.exec",
             kind.info().section
@@ -111,7 +109,7 @@ mod tests {
     use super::*;
     use ccpp_core::exec::PidOptions;
     use ccpp_core::planners::rect_boustrophedon::RectOptions;
-    use ccpp_core::planners::PlannerKind;
+    use ccpp_core::planners::{PlannerConfig, PlannerKind};
 
     use crate::scenario::MapRecipe;
 

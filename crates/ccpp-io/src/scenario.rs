@@ -609,6 +609,13 @@ impl Scenario {
         Ok(())
     }
 
+    /// Whether the planner's options set an execution of their own (`bsa_bfs.exec`,
+    /// `rect_boustrophedon.exec`) other than the planner's default one.
+    pub(crate) fn planner_sets_execution(&self) -> bool {
+        let default = PlannerConfig::new(self.planner.kind());
+        self.planner.settings().preferred_execution() != default.settings().preferred_execution()
+    }
+
     /// `sim.exec` replaces the planner's own execution (`bsa_bfs.exec`,
     /// `rect_boustrophedon.exec`): when the planner's was set to something other than its
     /// default, a different `sim.exec` would read, validate and then drop it, so the pair is
@@ -620,9 +627,8 @@ impl Scenario {
             return Ok(());
         };
         let kind = self.planner.kind();
-        let default = PlannerConfig::new(kind).settings().preferred_execution();
         let keeps = match (sim, own) {
-            _ if Some(own) == default || sim == own => true,
+            _ if !self.planner_sets_execution() || sim == own => true,
             (Execution::Pid(s), Execution::Pid(o)) => {
                 o.noise.is_none() && PidOptions { noise: None, ..s } == o
             }
@@ -718,14 +724,7 @@ impl Scenario {
             }
             keepout.union_with(&bits);
         }
-        let z = ZoneMasks {
-            area: area
-                .as_deref()
-                .map(|a| ccpp_core::zones::rasterize(&frame, a)),
-            keepout,
-            area_polygons: area.unwrap_or_default(),
-            keepout_polygons: polys,
-        };
+        let z = ZoneMasks::with_keepout_pixels(&frame, area.as_deref(), keepout, polys);
         if let (Some(spec), Some(a)) = (&self.area, &z.area) {
             if a.is_clear() {
                 return Err(ScenarioError::Zone {
