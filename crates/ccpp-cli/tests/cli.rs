@@ -5,8 +5,7 @@ use std::path::{Path, PathBuf};
 
 use assert_cmd::Command;
 
-mod common;
-use common::{ccpp, data, read_json, shared_maps};
+use crate::common::{ccpp, data, read_json, shared_maps};
 
 #[test]
 fn planners_lists_random_bounce() {

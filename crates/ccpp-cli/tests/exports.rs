@@ -11,8 +11,7 @@ use ccpp_core::route::Route;
 use ccpp_io::export::{parse_waypoints_csv, read_waypoints};
 use serde::Deserialize;
 
-mod common;
-use common::{ccpp, pgm, plan_ok, run_ok};
+use crate::common::{ccpp, pgm, plan_ok, run_ok};
 
 /// A 5 x 4 m room with one pillar.
 fn room(dir: &Path) -> PathBuf {

@@ -7,8 +7,7 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-mod common;
-use common::{ccpp, pgm, pillars, run_ok, ALL};
+use crate::common::{self, ccpp, pgm, pillars, run_ok, ALL};
 
 /// The 60 x 60 px (3 x 3 m) box of the issue, as a YAML map.
 fn box60(dir: &Path) -> PathBuf {

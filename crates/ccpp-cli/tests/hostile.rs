@@ -5,8 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-mod common;
-use common::{ccpp, pillars, plan_ok, read_json, run_ok};
+use crate::common::{self, ccpp, pillars, plan_ok, read_json, run_ok};
 
 /// Runs `ccpp ARGS`, expects exit 1 with one `error:` line holding every needle.
 fn refused(args: &[&str], needles: &[&str]) {

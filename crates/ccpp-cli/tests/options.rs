@@ -8,8 +8,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-mod common;
-use common::{pillars, rooms, run_ok};
+use crate::common::{pillars, rooms, run_ok};
 
 /// What a row expects of the run with its option against the planner's default run.
 #[derive(Clone, Copy, Debug)]

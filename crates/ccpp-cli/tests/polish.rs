@@ -5,8 +5,7 @@
 
 use std::path::Path;
 
-mod common;
-use common::{ccpp, pgm, pillars};
+use crate::common::{ccpp, pgm, pillars};
 
 /// Runs `ccpp run` with `--config` holding `config`; returns (trace, run.json).
 fn run_config(dir: &Path, map: &Path, planner: &str, config: &str) -> (String, serde_json::Value) {

@@ -8,8 +8,7 @@ use std::process::Stdio;
 
 use assert_cmd::Command;
 
-mod common;
-use common::{ccpp, data};
+use crate::common::{ccpp, data};
 
 fn stderr_of(o: &std::process::Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()

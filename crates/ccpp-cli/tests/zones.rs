@@ -6,8 +6,7 @@
 
 use std::path::{Path, PathBuf};
 
-mod common;
-use common::{ccpp, ALL};
+use crate::common::{ccpp, ALL};
 
 fn house() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/maps/aws_small_house.yaml")

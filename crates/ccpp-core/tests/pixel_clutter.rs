@@ -11,8 +11,8 @@
 //!
 //! `cargo test` runs [`DEFAULT_CASES`] cases per planner. `CCPP_PROPTEST_CASES=N` sets the count
 //! (the long run: `CCPP_PROPTEST_CASES=10000 cargo test --release -p ccpp-core --test
-//! pixel_clutter`); the `#[ignore]`d `*_10k` tests run 10 000 cases per planner
-//! (`cargo test --release -p ccpp-core --test pixel_clutter -- --ignored`).
+//! integration pixel_clutter::`); the `#[ignore]`d `*_10k` tests run 10 000 cases per planner
+//! (`cargo test --release -p ccpp-core --test integration pixel_clutter:: -- --ignored`).
 
 #![allow(clippy::unwrap_used)] // helpers of a test file
 

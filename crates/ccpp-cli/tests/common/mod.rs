@@ -1,6 +1,5 @@
-//! Helpers shared by the CLI's end-to-end test files (each test file is its own crate and uses
-//! only some of them, hence the `dead_code` allowance).
-#![allow(dead_code, clippy::unwrap_used)]
+//! Helpers shared by the CLI's end-to-end test modules (see `main.rs`).
+#![allow(clippy::unwrap_used)]
 
 use std::path::{Path, PathBuf};
 
