@@ -306,6 +306,21 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         planners.len(),
         a.out.display()
     ))?;
+    // Runs the simulator stopped before the planner finished (`stalled`, `max_steps`) are
+    // results, not failures, but incomplete ones: named here as well as in `results.csv`.
+    let stopped: Vec<String> = rows
+        .iter()
+        .filter_map(|r| {
+            let reason = r.outcome.as_ref().ok()?.stop_reason.as_ref()?;
+            Some(format!("{} / {} ({reason})", r.map, r.planner))
+        })
+        .collect();
+    if !stopped.is_empty() {
+        crate::print_stdout(&format!(
+            "warning: stopped before the planner finished, with incomplete coverage (status in results.csv): {}\n",
+            stopped.join(", ")
+        ))?;
+    }
     if failed > 0 {
         bail!(
             "{failed} of {} runs failed; see the error column of {}",

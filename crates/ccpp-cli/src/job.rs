@@ -112,6 +112,10 @@ pub fn robot_from(args: &RobotArgs) -> Result<(Robot, Option<Pose>)> {
         tool_radius: args.tool_radius.unwrap_or(args.radius),
     };
     robot.validate()?;
+    // Before `Pose::new` wraps it: a heading beyond two turns is a typo or degrees.
+    if let Some(why) = args.start.and_then(|s| ccpp_io::map::heading_problem(s[2])) {
+        anyhow::bail!("--start THETA {why}");
+    }
     let start = args.start.map(|s| Pose::new(s[0], s[1], s[2]));
     Ok((robot, start))
 }
@@ -431,16 +435,41 @@ fn sim_from(a: &RunArgs, config: &mut PlannerConfig) -> Result<SimConfig> {
     Ok(sim)
 }
 
-/// Names the flag that set an invalid option.
-fn name_flag(e: ScenarioError, given: &[&str]) -> anyhow::Error {
-    if let ScenarioError::Options(o) = &e {
-        for (flag, fields) in FLAG_FIELDS {
-            if given.contains(&flag) && fields.contains(&o.field.as_str()) {
-                return anyhow::anyhow!("{flag}: {e}");
+/// Names the flag that set an invalid option (one of `given`), or that makes the run
+/// degenerate on the map (`map FILE: PLANNER: --width: ...` instead of the option's field
+/// `rect_boustrophedon.width_m`, which the user did not type).
+pub(crate) fn name_flag(e: ScenarioError, given: &[&str]) -> anyhow::Error {
+    let flagged = FLAG_FIELDS.iter().filter(|(flag, _)| given.contains(flag));
+    match e {
+        ScenarioError::Options(o) => {
+            for (flag, fields) in flagged {
+                if fields.contains(&o.field.as_str()) {
+                    return anyhow::anyhow!("{flag}: {}", ScenarioError::Options(o));
+                }
             }
+            ScenarioError::Options(o).into()
         }
+        ScenarioError::Degenerate {
+            path,
+            planner,
+            message,
+        } => {
+            let named = flagged
+                .flat_map(|(flag, fields)| fields.iter().map(move |f| (flag, f)))
+                .find_map(|(flag, f)| {
+                    let rest = message.strip_prefix(f)?.strip_prefix(": ")?;
+                    Some(format!("{flag}: {rest}"))
+                });
+            let message = named.unwrap_or(message);
+            ScenarioError::Degenerate {
+                path,
+                planner,
+                message,
+            }
+            .into()
+        }
+        e => e.into(),
     }
-    e.into()
 }
 
 impl Job {

@@ -3,7 +3,7 @@
 
 use std::fmt::Write as _;
 
-use anyhow::{anyhow, bail, Result};
+use anyhow::{bail, Result};
 use ccpp_core::planners::PlannerKind;
 use ccpp_core::route::DEFAULT_TOLERANCE_M;
 use ccpp_core::sim::StopReason;
@@ -39,17 +39,7 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     let mut planner = planner_options(a.options.config.as_deref(), None)?.config(kind);
     let given =
         crate::job::apply_rect_flags(a.length, a.width, &mut planner, a.options.config.as_deref())?;
-    let flag = |e: ScenarioError| match &e {
-        ScenarioError::Options(o)
-            if given.contains(&"--length") && o.field.ends_with("length_m") =>
-        {
-            anyhow!("--length: {e}")
-        }
-        ScenarioError::Options(o) if given.contains(&"--width") && o.field.ends_with("width_m") => {
-            anyhow!("--width: {e}")
-        }
-        _ => e.into(),
-    };
+    let flag = |e: ScenarioError| crate::job::name_flag(e, &given);
     let scenario = Scenario::configure(recipe_from(&a.map), planner)
         .robot(robot)
         .start_pose(start.map(|p| [p.x, p.y, p.theta]))

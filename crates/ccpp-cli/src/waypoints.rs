@@ -2,7 +2,7 @@
 
 use std::fmt::Write as _;
 
-use anyhow::{anyhow, bail, Result};
+use anyhow::{bail, Result};
 use ccpp_core::planners::rect_boustrophedon::{plan, RectOptions};
 use ccpp_core::planners::PlannerConfig;
 use ccpp_io::scenario::{Scenario, ScenarioError};
@@ -34,11 +34,7 @@ pub fn run(a: &WaypointsArgs) -> Result<()> {
     };
     // The same validation, checks and memory estimate as `ccpp run --planner
     // rect-boustrophedon`.
-    let flag = |e: ScenarioError| match &e {
-        ScenarioError::Options(o) if o.field.ends_with("length_m") => anyhow!("--length: {e}"),
-        ScenarioError::Options(o) if o.field.ends_with("width_m") => anyhow!("--width: {e}"),
-        _ => e.into(),
-    };
+    let flag = |e: ScenarioError| crate::job::name_flag(e, &["--length", "--width"]);
     let scenario = Scenario::configure(
         recipe_from(&a.map),
         PlannerConfig::RectBoustrophedon(opts.clone()),

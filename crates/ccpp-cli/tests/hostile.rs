@@ -842,22 +842,38 @@ fn georef_errors_name_the_file_once() {
 
 /// A rectangular robot longer or wider than the map: `ccpp waypoints --width 1e300` printed
 /// nothing and exited 0 (an empty route as a success), and `run` refused it with an absurd
-/// memory need and the advice to use a *larger* robot. Now refused by what is wrong.
+/// memory need and the advice to use a *larger* robot. Now refused by what is wrong, naming
+/// what the user typed: the flag (`--width: ...`), not the option field behind it, which only
+/// an options file names. `--tile-side` likewise.
 #[test]
 fn a_rect_robot_larger_than_the_map_is_refused() {
     let d = tempfile::tempdir().unwrap();
     let dir = d.path();
     let map = pillars(dir); // 8 x 6 m
     let out = dir.join("out");
+    let refused_naming = |args: &[&str], flag: &str, field: &str, what: &str| {
+        let mut needles = vec![what, "pillars.pgm"];
+        let named = format!("{flag}: ");
+        needles.push(&named);
+        refused(args, &needles);
+        let err = ccpp().args(args).assert().failure();
+        let err = String::from_utf8_lossy(&err.get_output().stderr).into_owned();
+        assert!(!err.contains(field), "{err}");
+    };
     for (flag, value, field) in [
         ("--width", "1e300", "rect_boustrophedon.width_m"),
         ("--width", "10", "rect_boustrophedon.width_m"),
         ("--length", "1e300", "rect_boustrophedon.length_m"),
     ] {
-        let needles = [field, "larger than the map (8 x 6 m)", "pillars.pgm"];
-        refused(&["waypoints", "--map", s(&map), flag, value], &needles);
+        let what = "larger than the map (8 x 6 m)";
+        refused_naming(
+            &["waypoints", "--map", s(&map), flag, value],
+            flag,
+            field,
+            what,
+        );
         for cmd in ["run", "plan"] {
-            refused(
+            refused_naming(
                 &[
                     cmd,
                     "--planner",
@@ -869,9 +885,247 @@ fn a_rect_robot_larger_than_the_map_is_refused() {
                     "--out",
                     s(&out),
                 ],
-                &needles,
+                flag,
+                field,
+                what,
             );
             assert!(!out.exists());
         }
     }
+    for (planner, field) in [
+        ("ba-star", "ba_star.tile_side_m"),
+        ("bsa-bfs", "bsa_bfs.cell_side_m"),
+    ] {
+        refused_naming(
+            &[
+                "run",
+                "--planner",
+                planner,
+                "--map",
+                s(&map),
+                "--tile-side",
+                "10",
+                "--out",
+                s(&out),
+            ],
+            "--tile-side",
+            field,
+            "side 10 m is larger than the map (8 x 6 m)",
+        );
+        assert!(!out.exists());
+    }
+    // Given in an options file, the message names the file's field.
+    let config = dir.join("wide.yaml");
+    std::fs::write(&config, "rect_boustrophedon:\n  width_m: 10\n").unwrap();
+    refused(
+        &[
+            "run",
+            "--planner",
+            "rect-boustrophedon",
+            "--map",
+            s(&map),
+            "--config",
+            s(&config),
+            "--out",
+            s(&out),
+        ],
+        &["rect_boustrophedon.width_m: 10 m is larger than the map"],
+    );
+    assert!(!out.exists());
+}
+
+/// A map origin's yaw or a start heading of `1e300` (or `90`, degrees) was wrapped into
+/// (-pi, pi] without a word: `1e300 rad` is no heading (f64 steps there are 1e284 rad wide).
+/// Beyond two turns either way it is refused, naming what was typed; within them it is a
+/// heading and is kept.
+#[test]
+fn a_heading_beyond_two_turns_is_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let out = dir.join("out");
+    for (flag, value) in [
+        ("--origin", "0,0,1e300"),
+        ("--origin", "0,0,90"),
+        ("--origin", "0,0,-13"),
+        ("--start", "1,1,1e300"),
+        ("--start", "1,1,-90"),
+    ] {
+        let needles = [flag, "more than two turns", "radians"];
+        for cmd in ["run", "info"] {
+            let mut args = vec![cmd, "--map", s(&map), flag, value];
+            if cmd == "run" {
+                args.extend(["--planner", "bcd", "--out", s(&out)]);
+            }
+            refused(&args, &needles);
+            assert!(!out.exists());
+        }
+    }
+    // The map file's own origin.
+    let yaml = dir.join("turned.yaml");
+    std::fs::write(
+        &yaml,
+        "image: pillars.pgm\nresolution: 0.05\norigin: [0.0, 0.0, 1.0e300]\n",
+    )
+    .unwrap();
+    refused(
+        &["info", "--map", s(&yaml)],
+        &["turned.yaml", "origin", "more than two turns"],
+    );
+    // Within two turns: accepted and wrapped as before.
+    ccpp()
+        .args([
+            "info",
+            "--map",
+            s(&map),
+            "--start",
+            "1,1,-12",
+            "--origin",
+            "0,0,6.2",
+        ])
+        .assert()
+        .success();
+}
+
+/// `--sensor-range 1e300` ran, but not as `--sensor-range 30` on an 8 x 6 m map although both
+/// see the whole map from anywhere (random-bounce's look-ahead computed with 1e300 drifted in
+/// the last bits), and the memory estimate built on the range went to 0. Ranges beyond twice
+/// the map's diagonal now run as that: byte-identical runs.
+#[test]
+fn a_sensor_range_beyond_the_map_runs_as_the_map_wide_range() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir); // diagonal 10 m
+    let a = run_ok(dir, "a", &map, "random-bounce", &["--sensor-range", "30"]);
+    let b = run_ok(
+        dir,
+        "b",
+        &map,
+        "random-bounce",
+        &["--sensor-range", "1e300"],
+    );
+    for f in ["trace.jsonl", "path.csv"] {
+        assert!(
+            std::fs::read(a.join(f)).unwrap() == std::fs::read(b.join(f)).unwrap(),
+            "{f} differs"
+        );
+    }
+}
+
+/// `--inflate 1e300` was refused as "robot does not fit anywhere on the map", without a word
+/// of the inflation that caused it.
+#[test]
+fn an_inflation_that_leaves_no_room_is_named() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let out = dir.join("out");
+    for v in ["1e300", "3"] {
+        refused(
+            &[
+                "run",
+                "--planner",
+                "bcd",
+                "--map",
+                s(&map),
+                "--inflate",
+                v,
+                "--out",
+                s(&out),
+            ],
+            &[
+                "--inflate",
+                "pillars.pgm",
+                "does not fit anywhere",
+                "lower the inflation",
+            ],
+        );
+        assert!(!out.exists());
+    }
+    // Without an inflation the message stays as it was.
+    refused(
+        &[
+            "run",
+            "--planner",
+            "bcd",
+            "--map",
+            s(&map),
+            "--radius",
+            "4",
+            "--out",
+            s(&out),
+        ],
+        &["pillars.pgm", "does not fit anywhere"],
+    );
+}
+
+/// A run the simulator stops because the robot made no progress (`stalled`) was tested with
+/// `ccpp run` only: `bench` writes it as the run's status in `results.csv` (not `ok`) and now
+/// also names it after its summary line. rect-boustrophedon under strong odometry noise from an
+/// options file (bench has no `--odometry-noise`) stalls on `aws_small_house`.
+#[test]
+fn a_stalled_run_is_named_by_run_and_bench() {
+    let Some(maps) = common::shared_maps() else {
+        eprintln!("skipped: no shared maps");
+        return;
+    };
+    let map = maps.join("aws_small_house.yaml");
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let config = dir.join("noise.yaml");
+    std::fs::write(
+        &config,
+        "rect_boustrophedon:\n  exec:\n    pid:\n      noise:\n        seed: 1\n        linear_rel_std: 0.2\n        angular_rel_std: 0.2\n        heading_drift_std: 0.2\n",
+    )
+    .unwrap();
+    let run = run_ok(
+        dir,
+        "run",
+        &map,
+        "rect-boustrophedon",
+        &["--config", s(&config)],
+    );
+    assert_eq!(
+        read_json(&run.join("metrics.json"))["stop_reason"],
+        "stalled"
+    );
+    let out = dir.join("bench");
+    let a = ccpp()
+        .args([
+            "bench",
+            "--planners",
+            "rect-boustrophedon,bcd",
+            "--quiet",
+            "--maps",
+        ])
+        .arg(&map)
+        .args(["--config", s(&config), "--out", s(&out)])
+        .timeout(std::time::Duration::from_mins(2))
+        .assert()
+        .success();
+    let stdout = String::from_utf8_lossy(&a.get_output().stdout).into_owned();
+    assert!(
+        stdout.contains("warning: stopped before the planner finished")
+            && stdout.contains("aws_small_house / rect-boustrophedon (stalled)"),
+        "{stdout}"
+    );
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    let status = |planner: &str| {
+        csv.lines()
+            .find(|l| l.starts_with(&format!("aws_small_house,{planner},")))
+            .unwrap()
+            .split(',')
+            .nth(2)
+            .unwrap()
+            .to_string()
+    };
+    assert_eq!(status("rect-boustrophedon"), "stalled", "{csv}");
+    assert_eq!(status("bcd"), "ok", "{csv}");
+    let m = read_json(&out.join("runs/aws_small_house/rect-boustrophedon/metrics.json"));
+    assert_eq!(m["stop_reason"], "stalled");
+    // The bench run is the `ccpp run` run.
+    assert_eq!(
+        m["effective_coverage"],
+        read_json(&run.join("metrics.json"))["effective_coverage"]
+    );
 }

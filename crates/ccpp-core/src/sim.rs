@@ -40,6 +40,7 @@ pub use crate::planner::MIN_ROTATION;
 #[serde(default)]
 pub struct SimConfig {
     /// Sensor range in metres; `None` = `4 r` (enough to classify all 8 neighbour tiles).
+    /// Ranges beyond twice the map's diagonal run as that ([`SimConfig::sensor_range_on`]).
     pub sensor_range: Option<f64>,
     /// Safety cap on planner steps (default 50 million): a bound on the run's time and trace
     /// that no finishing planner comes near (the bench's longest run, random-bounce on the
@@ -55,9 +56,21 @@ pub struct SimConfig {
 }
 
 impl SimConfig {
-    /// The sensor range in force for `robot`: [`sensor_range`](Self::sensor_range) or `4 r`.
+    /// The sensor range asked for `robot`: [`sensor_range`](Self::sensor_range) or `4 r`.
     pub fn sensor_range_for(&self, robot: &Robot) -> f64 {
         self.sensor_range.unwrap_or(4.0 * robot.radius)
+    }
+
+    /// The sensor range in force for `robot` on a map of `frame`: [`sensor_range_for`]
+    /// capped at twice the frame's diagonal. From anywhere on the map such a sensor sees the
+    /// whole map, and a planner that looks ahead by the range (random-bounce's straight runs)
+    /// is not held back by it, so every larger range (up to `1e300`) runs exactly as this one,
+    /// and estimates built on the range stay finite.
+    ///
+    /// [`sensor_range_for`]: Self::sensor_range_for
+    pub fn sensor_range_on(&self, robot: &Robot, frame: &MapFrame) -> f64 {
+        let cap = 2.0 * frame.width_m().hypot(frame.height_m());
+        self.sensor_range_for(robot).min(cap)
     }
 }
 
@@ -181,7 +194,7 @@ impl<'w> Simulator<'w> {
     /// is fixed now; with `None` it is chosen at [`run`](Self::run) from the planner (ideal
     /// when stepping through [`execute`](Self::execute) directly).
     pub fn new(world: &'w World, config: &SimConfig) -> Self {
-        let range = config.sensor_range_for(&world.robot());
+        let range = config.sensor_range_on(&world.robot(), world.frame());
         let pose = world.initial_pose();
         let mut trace = Trace::default();
         trace.push_pose(0, pose);

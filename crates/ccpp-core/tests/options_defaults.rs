@@ -119,3 +119,27 @@ fn a_partial_extension_section_changes_only_its_fields() {
         );
     }
 }
+
+/// The config fuzzer's seed `fuzz/corpus/config/defaults.json` is the serialized defaults: a
+/// seed with fields that no longer exist is refused as a whole and seeds nothing. Run with
+/// `CCPP_BLESS=1` to rewrite it after an options change.
+#[test]
+fn the_fuzz_corpus_defaults_are_the_current_defaults() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fuzz/corpus/config/defaults.json");
+    let want = serde_json::to_value(PlannerOptions::default()).unwrap();
+    if std::env::var_os("CCPP_BLESS").is_some() {
+        let text = serde_json::to_string_pretty(&want).unwrap();
+        std::fs::write(&path, text + "\n").unwrap();
+    }
+    let text = std::fs::read_to_string(&path).unwrap();
+    let got: Value = serde_json::from_str(&text).unwrap();
+    assert!(
+        got == want,
+        "{} is stale; rewrite it with CCPP_BLESS=1 cargo test -p ccpp-core --test options_defaults",
+        path.display()
+    );
+    // And it reads back as the defaults.
+    let back: PlannerOptions = serde_json::from_str(&text).unwrap();
+    assert_eq!(serde_json::to_value(back).unwrap(), want);
+}

@@ -18,19 +18,15 @@ use std::path::{Path, PathBuf};
 use ccpp_core::georef::{fit_affine, AffineFit, GeorefError};
 use ccpp_core::Point;
 
-/// Errors reading a georef file.
+/// What is wrong with a georef file, without the file's name (a message that names the file
+/// already shows this alone; [`GeorefFileError`] adds the name).
 #[derive(Debug, thiserror::Error)]
-pub enum GeorefFileError {
+pub enum GeorefProblem {
     /// The file could not be read.
-    #[error("cannot read georef file {path}: {source}")]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// The cause.
-        source: std::io::Error,
-    },
+    #[error("cannot read it: {0}")]
+    Io(std::io::Error),
     /// A line is not four numbers.
-    #[error("georef line {line}: expected `px,py,wx,wy` (four numbers), got {text:?}")]
+    #[error("line {line}: expected `px,py,wx,wy` (four numbers), got {text:?}")]
     BadLine {
         /// 1-based line number.
         line: usize,
@@ -38,26 +34,18 @@ pub enum GeorefFileError {
         text: String,
     },
     /// The fit failed.
-    #[error("georef file {path}: {source}")]
-    Fit {
-        /// The file.
-        path: PathBuf,
-        /// The cause.
-        source: GeorefError,
-    },
+    #[error("{0}")]
+    Fit(GeorefError),
 }
 
-impl GeorefFileError {
-    /// What is wrong, without the file's name (for a message that names the file already).
-    pub fn reason(&self) -> String {
-        match self {
-            Self::Io { source, .. } => format!("cannot read it: {source}"),
-            Self::BadLine { line, text } => {
-                format!("line {line}: expected `px,py,wx,wy` (four numbers), got {text:?}")
-            }
-            Self::Fit { source, .. } => source.to_string(),
-        }
-    }
+/// Errors reading a georef file: the [`GeorefProblem`] and the file.
+#[derive(Debug, thiserror::Error)]
+#[error("georef file {}: {problem}", path.display())]
+pub struct GeorefFileError {
+    /// The file.
+    pub path: PathBuf,
+    /// What is wrong with it.
+    pub problem: GeorefProblem,
 }
 
 /// Splits a line into fields on commas, semicolons or whitespace.
@@ -69,9 +57,9 @@ pub(crate) fn fields(line: &str) -> impl Iterator<Item = &str> {
 /// Parses `(pixel, world)` pairs from the text of a georef file.
 ///
 /// # Errors
-/// [`GeorefFileError::BadLine`] for a line that is not four finite numbers (other than a
+/// [`GeorefProblem::BadLine`] for a line that is not four finite numbers (other than a
 /// header on the first content line).
-pub fn parse_georef(text: &str) -> Result<Vec<(Point, Point)>, GeorefFileError> {
+pub fn parse_georef(text: &str) -> Result<Vec<(Point, Point)>, GeorefProblem> {
     let mut pairs = Vec::new();
     let mut first = true;
     for (n, raw) in text.lines().enumerate() {
@@ -89,7 +77,7 @@ pub fn parse_georef(text: &str) -> Result<Vec<(Point, Point)>, GeorefFileError> 
             }
             None if header => {}
             _ => {
-                return Err(GeorefFileError::BadLine {
+                return Err(GeorefProblem::BadLine {
                     line: n + 1,
                     text: line.to_string(),
                 })
@@ -104,14 +92,13 @@ pub fn parse_georef(text: &str) -> Result<Vec<(Point, Point)>, GeorefFileError> 
 /// # Errors
 /// Unreadable file, bad line, or a fit that fails (fewer than 3 pairs, collinear points).
 pub fn load_georef(path: &Path) -> Result<AffineFit, GeorefFileError> {
-    let text = crate::file::read_text(path).map_err(|source| GeorefFileError::Io {
+    let fit = crate::file::read_text(path)
+        .map_err(GeorefProblem::Io)
+        .and_then(|text| parse_georef(&text))
+        .and_then(|pairs| fit_affine(&pairs).map_err(GeorefProblem::Fit));
+    fit.map_err(|problem| GeorefFileError {
         path: path.to_path_buf(),
-        source,
-    })?;
-    let pairs = parse_georef(&text)?;
-    fit_affine(&pairs).map_err(|source| GeorefFileError::Fit {
-        path: path.to_path_buf(),
-        source,
+        problem,
     })
 }
 
@@ -132,7 +119,7 @@ mod tests {
         let e = parse_georef("1,2,3,4\n1,2,3\n").unwrap_err();
         assert!(e.to_string().contains("line 2"), "{e}");
         let e = parse_georef("1,2,3,4\n1,2,x,4\n").unwrap_err();
-        assert!(matches!(e, GeorefFileError::BadLine { line: 2, .. }));
+        assert!(matches!(e, GeorefProblem::BadLine { line: 2, .. }));
     }
 
     #[test]
@@ -142,18 +129,22 @@ mod tests {
         std::fs::write(&f, "0,0,0,0\n1,1,1,1\n2,2,2,2\n").unwrap();
         let e = load_georef(&f).unwrap_err();
         assert!(matches!(
-            e,
-            GeorefFileError::Fit {
-                source: GeorefError::Collinear,
-                ..
-            }
+            e.problem,
+            GeorefProblem::Fit(GeorefError::Collinear)
         ));
+        assert_eq!(
+            e.to_string(),
+            format!("georef file {}: {}", f.display(), GeorefError::Collinear)
+        );
         std::fs::write(&f, "0,0,0,0\n10,0,1,0\n0,10,0,-1\n").unwrap();
         let fit = load_georef(&f).unwrap();
         assert!(fit.max_residual < 1e-12);
         assert!(matches!(
             load_georef(&dir.path().join("missing.csv")),
-            Err(GeorefFileError::Io { .. })
+            Err(GeorefFileError {
+                problem: GeorefProblem::Io(_),
+                ..
+            })
         ));
     }
 }

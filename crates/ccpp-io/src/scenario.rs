@@ -224,6 +224,15 @@ impl MapRecipe {
                 )));
             }
         }
+        if let Some(why) = self.origin.and_then(|o| crate::map::heading_problem(o[2])) {
+            let map = self
+                .path
+                .as_ref()
+                .map_or_else(String::new, |p| format!("map {}: ", p.display()));
+            return Err(ScenarioError::Invalid(format!(
+                "{map}--origin / map.origin yaw {why}"
+            )));
+        }
         if let Some(g) = &self.georef {
             // The fit places the image: a resolution or origin given beside it would be
             // validated and then replaced.
@@ -360,8 +369,8 @@ pub fn apply_georef(grid: GridMap, path: &Path) -> Result<GridMap, ScenarioError
         path: path.to_path_buf(),
         message,
     };
-    // `reason`: the message names the file once (`georef FILE: ...`).
-    let fit = crate::georef::load_georef(path).map_err(|e| err(e.reason()))?;
+    // The problem alone: the message names the file once (`georef FILE: ...`).
+    let fit = crate::georef::load_georef(path).map_err(|e| err(e.problem.to_string()))?;
     let [a, b, c, d] = fit.affine.m;
     let res = (a * d - b * c).abs().sqrt();
     if !(res.is_finite() && res > 0.0) {
@@ -560,6 +569,9 @@ impl Scenario {
         if let Some(s) = self.start {
             if s.iter().any(|v| !v.is_finite()) {
                 return Err(invalid(format!("start must be finite, got {s:?}")));
+            }
+            if let Some(why) = crate::map::heading_problem(s[2]) {
+                return Err(invalid(format!("--start / start THETA {why}")));
             }
         }
         if let Some(r) = self.sim.sensor_range {
@@ -774,7 +786,7 @@ impl Scenario {
         Setup {
             frame: *map.grid.frame(),
             robot: self.robot,
-            sensor_range: self.sim.sensor_range_for(&self.robot),
+            sensor_range: self.sim.sensor_range_on(&self.robot, map.grid.frame()),
         }
     }
 
@@ -845,7 +857,7 @@ impl Scenario {
     /// wall or a robot that fits nowhere.
     pub fn world(&self, map: &PreparedMap) -> Result<World, ScenarioError> {
         let zones = self.world_checks(map)?;
-        self.world_on(map.grid.clone(), &map.source, zones)
+        self.world_on(map.grid.clone(), &map.source, map.recipe.inflate, zones)
     }
 
     /// The checks before a world is built; returns the zone masks.
@@ -868,14 +880,16 @@ impl Scenario {
         map: &PreparedMap,
         zones: Option<ZoneMasks>,
     ) -> Result<World, ScenarioError> {
-        self.world_on(map.grid.clone(), &map.source, zones)
+        self.world_on(map.grid.clone(), &map.source, map.recipe.inflate, zones)
     }
 
-    /// Builds the world on `grid` (the prepared map's, loaded from `source`).
+    /// Builds the world on `grid` (the prepared map's, loaded from `source` and grown by
+    /// `inflate` metres).
     fn world_on(
         &self,
         grid: GridMap,
         source: &Path,
+        inflate: Option<f64>,
         zones: Option<ZoneMasks>,
     ) -> Result<World, ScenarioError> {
         let start = self.start.map(|s| Pose::new(s[0], s[1], s[2]));
@@ -886,9 +900,22 @@ impl Scenario {
                     label,
                     message: format!("{source_err} (map {})", source.display()),
                 },
-                None => ScenarioError::World {
-                    path: source.to_path_buf(),
-                    source: source_err,
+                // A robot that fits nowhere on an inflated map: the inflation is the likely
+                // cause, so the message names it.
+                None => match source_err {
+                    WorldError::RobotTooBig {
+                        radius,
+                        max_clearance,
+                    } if inflate.is_some_and(|m| m > 0.0) => ScenarioError::Invalid(format!(
+                        "map {}: robot of radius {} m does not fit anywhere once --inflate / map.inflate {} m has grown the obstacles (the widest free spot then has clearance {max_clearance:.3} m); lower the inflation",
+                        source.display(),
+                        Compact(radius),
+                        Compact(inflate.unwrap_or_default()),
+                    )),
+                    source_err => ScenarioError::World {
+                        path: source.to_path_buf(),
+                        source: source_err,
+                    },
                 },
             }
         })
@@ -956,7 +983,12 @@ impl Scenario {
                 recipe,
             };
             let zones = self.world_checks(&prepared)?;
-            self.world_on(prepared.grid, &prepared.source, zones)
+            self.world_on(
+                prepared.grid,
+                &prepared.source,
+                prepared.recipe.inflate,
+                zones,
+            )
         })?;
         if form_files {
             Ok(self.run_forming(world, &name, beside))

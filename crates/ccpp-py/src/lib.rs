@@ -324,6 +324,10 @@ fn not_applicable(opt: &str, kind: PlannerKind, applies_to: &str) -> PyErr {
     ))
 }
 
+/// The robot radius of `run`, `plan`, `Env` and `bench_run` when none (or `None`) is given, as
+/// `ccpp run --radius`'s default.
+const DEFAULT_RADIUS: f64 = 0.15;
+
 /// Keyword options of `run` that are not planner options.
 const RUN_KEYS: [&str; 11] = [
     "tool_radius",
@@ -428,8 +432,18 @@ fn scenario_from(
     let mut direct: Vec<(String, Bound<'_, PyAny>)> = Vec::new();
     let mut in_options: Option<Bound<'_, PyDict>> = None;
     let mut exec: Option<String> = None;
+    // A planner option given as `None`: its default, as if left out; the name is still
+    // checked (a misspelt option is refused, `None` or not).
+    let mut unset: Vec<String> = Vec::new();
     for (k, v) in options.into_iter().flat_map(PyDictMethods::iter) {
         let key: String = k.extract()?;
+        if v.is_none() {
+            // `None` means the default: left out, as a keyword not given.
+            if !RUN_KEYS.contains(&key.as_str()) {
+                unset.push(key);
+            }
+            continue;
+        }
         match key.as_str() {
             "tool_radius" => {
                 if purpose == Purpose::Plan && kind == PlannerKind::RectBoustrophedon {
@@ -519,6 +533,19 @@ fn scenario_from(
             }
         }
         planner_opts.insert(k.clone(), py_to_json(v)?);
+    }
+    for k in &unset {
+        let cfg = serde_json::to_value(&s.planner).map_err(|e| err(&e))?;
+        let known = cfg
+            .get("options")
+            .and_then(Value::as_object)
+            .is_some_and(|o| o.contains_key(k));
+        if !known {
+            return Err(msg(format!(
+                "{k}=None: {k} is not an option of {kind} nor a run option ({})",
+                RUN_KEYS.join(", ")
+            )));
+        }
     }
     if !planner_opts.is_empty() {
         let mut cfg = serde_json::to_value(&s.planner).map_err(|e| err(&e))?;
@@ -708,15 +735,16 @@ impl PlanResult {
 /// a start heading (`start=(x, y)` only), and `tool_radius` for `rect-boustrophedon` (its lanes
 /// follow `width_m`). The GIL is released while planning.
 #[pyfunction]
-#[pyo3(signature = (map, planner="bcd", radius=0.15, **options))]
+#[pyo3(signature = (map, planner=None, radius=None, **options))]
 fn plan(
     py: Python<'_>,
     map: &Bound<'_, PyAny>,
-    planner: &str,
-    radius: f64,
+    planner: Option<&str>,
+    radius: Option<f64>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<PlanResult> {
     let mut prepared = as_map(py, map)?;
+    let (planner, radius) = (planner.unwrap_or("bcd"), radius.unwrap_or(DEFAULT_RADIUS));
     let scenario = scenario_from(&prepared, planner, radius, options, Purpose::Plan)?;
     name_map(&mut prepared, &scenario);
     let p = py
@@ -868,17 +896,22 @@ impl RunResult {
 /// not apply to the planner is refused; a planner option given both directly and in
 /// `options` must have one value; `exec="pid"` runs the planner's own PID settings
 /// (`options={"exec": {"pid": {...}}}` of bsa-bfs, rect-boustrophedon) and `exec="ideal"`
-/// beside such settings is refused. The GIL is released during the run.
+/// beside such settings is refused. A keyword given as `None` is its default, as if left out
+/// (a name that is no option is still refused). The GIL is released during the run.
 #[pyfunction]
-#[pyo3(signature = (map, planner="ba-star", radius=0.15, **options))]
+#[pyo3(signature = (map, planner=None, radius=None, **options))]
 fn run(
     py: Python<'_>,
     map: &Bound<'_, PyAny>,
-    planner: &str,
-    radius: f64,
+    planner: Option<&str>,
+    radius: Option<f64>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<RunResult> {
     let mut prepared = as_map(py, map)?;
+    let (planner, radius) = (
+        planner.unwrap_or("ba-star"),
+        radius.unwrap_or(DEFAULT_RADIUS),
+    );
     let scenario = scenario_from(&prepared, planner, radius, options, Purpose::Run)?;
     name_map(&mut prepared, &scenario);
     let run = py
@@ -916,13 +949,13 @@ fn as_map(py: Python<'_>, map: &Bound<'_, PyAny>) -> PyResult<PreparedMap> {
 /// the error message the bench's `results.csv` records. With `out`, the run's files are
 /// written there.
 #[pyfunction]
-#[pyo3(signature = (map_path, planner, radius=0.15, tool_radius=None, inflate=None, max_memory_mb=None, out=None, name=None))]
+#[pyo3(signature = (map_path, planner, radius=None, tool_radius=None, inflate=None, max_memory_mb=None, out=None, name=None))]
 #[allow(clippy::too_many_arguments)] // keyword arguments of a Python function
 fn bench_run(
     py: Python<'_>,
     map_path: PathBuf,
     planner: &str,
-    radius: f64,
+    radius: Option<f64>,
     tool_radius: Option<f64>,
     inflate: Option<f64>,
     max_memory_mb: Option<u64>,
@@ -930,6 +963,7 @@ fn bench_run(
     name: Option<String>,
 ) -> PyResult<(Option<Py<PyAny>>, Option<String>)> {
     let kind = parse_kind(planner)?;
+    let radius = radius.unwrap_or(DEFAULT_RADIUS);
     check_robot(radius, tool_radius)?;
     let robot = Robot {
         radius,
@@ -1204,22 +1238,23 @@ impl Env {
     /// walls the sensor shows, keep-out entries counted as `keepout_violations`, coverage
     /// measured on the allowed floor; a start outside the area drives there first.
     #[new]
-    #[pyo3(signature = (map, *, radius=0.15, tool_radius=None, sensor_range=None, start=None, exec="ideal", max_steps=None, area=None, keepout=None))]
+    #[pyo3(signature = (map, *, radius=None, tool_radius=None, sensor_range=None, start=None, exec=None, max_steps=None, area=None, keepout=None))]
     #[allow(clippy::too_many_arguments)] // keyword arguments of a Python constructor
     fn new(
         py: Python<'_>,
         map: &Bound<'_, PyAny>,
-        radius: f64,
+        radius: Option<f64>,
         tool_radius: Option<f64>,
         sensor_range: Option<f64>,
         start: Option<Vec<f64>>,
-        exec: &str,
+        exec: Option<&str>,
         max_steps: Option<u64>,
         area: Option<&Bound<'_, PyAny>>,
         keepout: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let map = as_map(py, map)?;
-        let exec = match exec.to_ascii_lowercase().as_str() {
+        let radius = radius.unwrap_or(DEFAULT_RADIUS);
+        let exec = match exec.unwrap_or("ideal").to_ascii_lowercase().as_str() {
             "ideal" => Execution::Ideal,
             "pid" => Execution::Pid(PidOptions::default()),
             other => return Err(msg(format!("exec must be ideal or pid, got {other:?}"))),
@@ -1369,10 +1404,11 @@ impl Env {
         }
     }
 
-    /// The sensor range in force, metres.
+    /// The sensor range in force, metres (a range beyond twice the map's diagonal runs as
+    /// that: from anywhere the sensor sees the whole map).
     #[getter]
     fn sensor_range(&self) -> f64 {
-        self.sim.sensor_range_for(&self.robot)
+        self.sim.sensor_range_on(&self.robot, self.map.grid.frame())
     }
 
     /// The robot radius, metres.

@@ -143,3 +143,62 @@ def test_env_refuses_a_zero_episode_cap(room: Path) -> None:
     env = ccpp.Env(room, max_steps=1)
     env.reset()
     assert env.step(("rotate", 0.1))[3] is True
+
+
+def _same(a, b) -> bool:
+    """Two runs' metrics, timing aside."""
+    strip = lambda r: {k: v for k, v in r.metrics.items() if k != "wall_time_s"}  # noqa: E731
+    return strip(a) == strip(b)
+
+
+def test_none_is_the_default_of_every_optional_keyword(room: Path) -> None:
+    m = ccpp.load_map(room)
+    base = ccpp.run(m, "bsa")
+    none = ccpp.run(
+        m, None, None, tool_radius=None, start=None, sensor_range=None, max_memory_mb=None,
+        max_steps=None, exec=None, options=None, name=None, area=None, keepout=None,
+        smoothing=None,
+    )
+    assert none.metrics["planner"] == "ba-star"
+    assert _same(ccpp.run(m, "bsa", radius=None, side=None, options=None), base)
+    assert _same(ccpp.run(m, "random-bounce", seed=None, budget_m=None, max_steps=None),
+                 ccpp.run(m, "random-bounce"))
+    # A None beside the same key in options= is "not given": the options' value holds.
+    right = ccpp.run(m, "bsa", side=None, options={"side": "right"})
+    assert _same(right, ccpp.run(m, "bsa", side="right")) and not _same(right, base)
+    # A misspelt name is refused, None or not.
+    with pytest.raises(ccpp.CcppError, match="sidee"):
+        ccpp.run(m, "bsa", sidee=None)
+    with pytest.raises(ccpp.CcppError, match="smoothing"):
+        ccpp.run(m, "bsa", smoothing=None)  # a ba-star option, not bsa's
+    assert ccpp.plan(m, None, None, start=None).planner == "bcd"
+    env = ccpp.Env(m, radius=None, tool_radius=None, sensor_range=None, start=None, exec=None,
+                   max_steps=None, area=None, keepout=None)
+    assert env.radius == 0.15
+    assert ccpp.bench_run(str(room), "bcd", None)[0]["robot_radius_m"] == 0.15
+
+
+def test_headings_beyond_two_turns_and_huge_sensor_ranges(room: Path) -> None:
+    m = ccpp.load_map(room)
+    for bad in (1e300, 90.0, -13.0):
+        with pytest.raises(ccpp.CcppError, match="more than two turns"):
+            ccpp.run(m, "bsa", start=(1.0, 1.0, bad))
+        with pytest.raises(ccpp.CcppError, match="more than two turns"):
+            ccpp.load_map(room, origin=[0.0, 0.0, bad])
+    ccpp.run(m, "bsa", start=(1.0, 1.0, -6.0))
+    # Beyond twice the map's diagonal (3 x 2 m room) the sensor runs as that range.
+    far = ccpp.run(m, "random-bounce", sensor_range=1e300)
+    assert _same(far, ccpp.run(m, "random-bounce", sensor_range=8.0))
+    assert ccpp.Env(m, sensor_range=1e300).sensor_range == pytest.approx(2 * (3.0**2 + 2.0**2) ** 0.5)
+
+
+def test_the_work_area_and_rect_boustrophedons_lane_area_are_both_honoured(room: Path) -> None:
+    # `area=` is the run's work area (virtual walls, as --area); options={"area": ...} is
+    # rect-boustrophedon's lane rectangle (rect_boustrophedon.area in --config). Given
+    # together, neither replaces the other: the run differs from each alone.
+    m = ccpp.load_map(room)
+    work = [0.3, 0.3, 2.0, 1.7]
+    lanes = {"area": [1.0, 0.5, 2.7, 1.5]}
+    both = ccpp.run(m, "rect-boustrophedon", area=work, options=lanes)
+    assert not _same(both, ccpp.run(m, "rect-boustrophedon", area=work))
+    assert not _same(both, ccpp.run(m, "rect-boustrophedon", options=lanes))

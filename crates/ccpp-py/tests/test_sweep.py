@@ -59,15 +59,17 @@ def test_sweep_equals_bench(shared_maps: Path, ccpp_bin: str, tmp_path: Path, cl
 
 
 def test_sweep_radii_and_errors(room: Path, tmp_path: Path, client) -> None:
-    bad = tmp_path / "missing.yaml"
+    # A map file that does not load is a row of errors, as in `ccpp bench`.
+    bad = tmp_path / "broken.yaml"
+    bad.write_text("image: nope.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n")
     df = ccpp.sweep([str(room), str(bad)], ["bsa", "bcd"], [0.15, 0.2], client=client)
     assert list(df.columns) == ccpp.CSV_COLUMNS[:2] + ["radius"] + ccpp.CSV_COLUMNS[2:]
     assert len(df) == 2 * 2 * 2
     ok = df[df["map"] == "room"]
     assert (ok["status"] == "ok").all()
     assert sorted(ok["robot_radius_m"].unique().tolist()) == [0.15, 0.2]
-    err = df[df["map"] == "missing"]
-    assert (err["status"] == "error").all() and err["error"].str.contains("missing.yaml").all()
+    err = df[df["map"] == "broken"]
+    assert (err["status"] == "error").all() and err["error"].str.contains("broken.yaml").all()
     assert err["effective_coverage"].isna().all()
     with pytest.raises(ccpp.CcppError, match="unknown planner"):
         ccpp.sweep([str(room)], ["nope"], client=client)
@@ -100,3 +102,58 @@ def test_sweep_refuses_what_it_would_ignore(room: Path, tmp_path: Path, client) 
     assert (df["status"] == "ok").all() and len(set(df["dir"])) == 2
     for row in df.itertuples():
         assert json.loads((Path(row.dir) / "metrics.json").read_text())["map"] == row.map
+
+
+def test_sweep_refuses_a_missing_map_and_a_foreign_folder_up_front(room: Path, tmp_path: Path, client) -> None:
+    # A map that does not exist: refused before any run (`ccpp bench --maps` refuses it), not
+    # turned into rows of errors.
+    missing = tmp_path / "missing.yaml"
+    with pytest.raises(ccpp.CcppError, match=r"missing\.yaml: no such file"):
+        ccpp.sweep([str(room), str(missing)], ["bcd"], client=client)
+    # `out` holding files a sweep did not write: refused (as `ccpp bench --out`), nothing written.
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")
+    with pytest.raises(ccpp.CcppError, match="holds notes.txt"):
+        ccpp.sweep([str(room)], ["bcd"], client=client, out=out)
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
+    # A folder of a sweep (or a bench) is reused.
+    own = tmp_path / "own"
+    ccpp.sweep([str(room)], ["bcd"], client=client, out=own)
+    df = ccpp.sweep([str(room)], ["bcd"], client=client, out=own)
+    assert (df["status"] == "ok").all()
+
+
+def test_sweep_takes_one_planner_name_and_none_as_defaults(room: Path, client) -> None:
+    # A string is one planner, not its letters ("b", "s", "a" are no planners).
+    df = ccpp.sweep(str(room), "bsa", client=client)
+    assert df["planner"].tolist() == ["bsa"]
+    # One radius as a number; None for every keyword is its default.
+    one = ccpp.sweep(str(room), ["bsa"], 0.2, client=client)
+    assert one["robot_radius_m"].tolist() == [0.2]
+    d = ccpp.sweep(
+        str(room), ["bsa"], None, tool_radius=None, inflate=None, max_memory_mb=None,
+        out=None, client=client, scheduler=None,
+    )
+    assert d.drop(columns=VOLATILE).equals(df.drop(columns=VOLATILE))
+
+
+def test_sweep_status_of_a_stalled_run_is_stalled(shared_maps: Path, monkeypatch) -> None:
+    # As `ccpp bench`'s results.csv: a run the simulator stopped says why instead of "ok". A
+    # sweep has no noise settings (nor has `ccpp bench` but through --config), so the row is
+    # built from the metrics of a `ccpp.run` that stalls, in place of the worker's run.
+    r = ccpp.run(
+        str(shared_maps / "aws_small_house.yaml"), "rect-boustrophedon",
+        options={"exec": {"pid": {"noise": {
+            "seed": 1, "linear_rel_std": 0.2, "angular_rel_std": 0.2, "heading_drift_std": 0.2,
+        }}}},
+    )
+    assert r.metrics["stop_reason"] == "stalled"
+    from ccpp import _ccpp, sweeps
+
+    monkeypatch.setattr(_ccpp, "bench_run", lambda *a, **k: (r.metrics, None))
+    row = sweeps._run_cell("m.yaml", "m", "rect-boustrophedon", 0.15, None, None, None, None)
+    assert row["status"] == "stalled" and row["error"] is None
+    done = ccpp.run(str(shared_maps / "teb_maze.yaml"), "bcd")
+    monkeypatch.setattr(_ccpp, "bench_run", lambda *a, **k: (done.metrics, None))
+    assert sweeps._run_cell("m.yaml", "m", "bcd", 0.15, None, None, None, None)["status"] == "ok"

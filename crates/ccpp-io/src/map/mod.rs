@@ -38,7 +38,7 @@ use image::ImageReader;
 
 pub use classify::{classify, Thresholds, DEFAULT_FREE_THRESH, DEFAULT_OCCUPIED_THRESH};
 pub use error::MapError;
-pub use yaml::{validate_placement, MapYaml};
+pub use yaml::{heading_problem, validate_placement, MapYaml, MAX_HEADING_RAD};
 
 /// Resolution (m/px) of a bare image when no override is given.
 pub const DEFAULT_BARE_RESOLUTION: f64 = 0.05;

@@ -97,11 +97,11 @@ class Env:
         self,
         map: Map | _Path,
         *,
-        radius: float = 0.15,
+        radius: float | None = 0.15,
         tool_radius: float | None = None,
         sensor_range: float | None = None,
         start: Sequence[float] | None = None,
-        exec: str = "ideal",
+        exec: str | None = "ideal",
         max_steps: int | None = None,
         area: Any = None,
         keepout: Any = None,
@@ -148,16 +148,17 @@ def load_map(
     """Loads a ROS map_server YAML (with its image) or a bare PGM/PNG."""
 
 def run(
-    map: Map | _Path, planner: str = "ba-star", radius: float = 0.15, **options: Any
+    map: Map | _Path, planner: str | None = "ba-star", radius: float | None = 0.15, **options: Any
 ) -> RunResult:
     """Runs a planner; options are scenario fields (``tool_radius``, ``start``,
     ``sensor_range``, ``exec``, ``seed``, ``max_steps``, ``max_memory_mb``, ``name``, ``area``,
     ``keepout``) or the planner's own options (directly or in ``options={...}``; a key given
     both ways must have one value). Options that do not apply are refused; ``exec="pid"`` runs
-    the planner's own PID settings, ``exec="ideal"`` beside them is refused."""
+    the planner's own PID settings, ``exec="ideal"`` beside them is refused. A keyword given as
+    ``None`` is its default, as if left out."""
 
 def plan(
-    map: Map | _Path, planner: str = "bcd", radius: float = 0.15, **options: Any
+    map: Map | _Path, planner: str | None = "bcd", radius: float | None = 0.15, **options: Any
 ) -> PlanResult:
     """Plans a path with a known-map planner (``ccpp plan``); options as for ``run`` where they
     apply to a plan (refused: ``exec``, the planner's execution settings, ``sensor_range``, a
@@ -166,7 +167,7 @@ def plan(
 def bench_run(
     map_path: _Path,
     planner: str,
-    radius: float = 0.15,
+    radius: float | None = 0.15,
     tool_radius: float | None = None,
     inflate: float | None = None,
     max_memory_mb: int | None = None,

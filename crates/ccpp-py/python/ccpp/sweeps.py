@@ -51,12 +51,15 @@ _METRIC_COLUMNS = CSV_COLUMNS[4:19]
 
 def expand_maps(items: Iterable[str | os.PathLike[str]] | str | os.PathLike[str]) -> list[Path]:
     """Map files as ``ccpp bench --maps`` takes them: a folder gives its ``*.yaml``/``*.yml``
-    maps (or, when it has none, its PNG/PGM images), sorted; a file is taken as it is."""
+    maps (or, when it has none, its PNG/PGM images), sorted; a file is taken as it is. A name
+    that is neither is refused, as ``ccpp bench`` refuses it, before any run."""
     if isinstance(items, (str, os.PathLike)):
         items = [items]
     out: list[Path] = []
     for item in items:
         p = Path(item)
+        if not p.exists():
+            raise _ccpp.CcppError(f"maps: {p}: no such file or folder")
         if p.is_dir():
             files = sorted(p.iterdir())
             yamls = [f for f in files if f.suffix.lower() in (".yaml", ".yml")]
@@ -92,6 +95,29 @@ def _map_names(paths: list[Path]) -> list[tuple[Path, str]]:
                 k += 1
             names[i] = f"{n}-{k}"
     return list(zip(kept, names))
+
+
+def _check_out(out: str | os.PathLike[str]) -> None:
+    """As ``ccpp bench --out``: ``out`` is absent or a folder holding only what a bench writes
+    (``results.csv``, ``results.md``, ``plots/``, ``runs/``, a cut-short ``*.tmp``), so that the
+    runs are never mixed with a user's own files."""
+    p = Path(out)
+    if not p.exists() and not p.is_symlink():
+        return
+    if p.is_symlink() or not p.is_dir():
+        raise _ccpp.CcppError(f"output folder {p} exists and is not a plain folder")
+    for e in sorted(p.iterdir()):
+        if e.name in ("results.csv", "results.md"):
+            known = e.is_file() and not e.is_symlink()
+        elif e.name in ("plots", "runs"):
+            known = e.is_dir() and not e.is_symlink()
+        else:
+            known = e.suffix == ".tmp" and e.is_file()
+        if not known:
+            raise _ccpp.CcppError(
+                f"output folder {p} holds {e.name}, which a sweep or ccpp bench did not write; "
+                "a sweep writes its runs there, so choose a new or bench-only folder"
+            )
 
 
 def _once(items: Iterable[Any]) -> list[Any]:
@@ -131,7 +157,9 @@ def _run_cell(
         row.update(status="error", error=error)
         row.update({c: None for c in _METRIC_COLUMNS})
     else:
-        row.update(status="ok", error=None)
+        # A run stopped early (`stalled`, `max_steps`) says so instead of `ok`, as in
+        # `ccpp bench`'s results.csv.
+        row.update(status=metrics.get("stop_reason") or "ok", error=None)
         row.update({c: metrics[c] for c in _METRIC_COLUMNS})
     row["dir"] = out_dir or ""
     return row
@@ -139,8 +167,8 @@ def _run_cell(
 
 def sweep(
     maps: Iterable[str | os.PathLike[str]] | str | os.PathLike[str],
-    planners: Sequence[str] | None = None,
-    radii: Sequence[float] = (0.15,),
+    planners: Sequence[str] | str | None = None,
+    radii: Sequence[float] | float | None = (0.15,),
     *,
     tool_radius: float | None = None,
     inflate: float | None = None,
@@ -152,11 +180,14 @@ def sweep(
     """Runs every planner on every map for every radius, one Dask task per run.
 
     ``maps`` are files or folders (as ``ccpp bench --maps``; a map named twice runs once, maps
-    sharing a file stem are told apart as ``<folder>-<stem>``); ``planners`` default to all (a
-    planner named twice runs once); ``radii`` are checked (with ``tool_radius``) before any
-    task starts, and a radius given twice runs once. With ``out``, each run's files are written
-    to ``out/runs/MAP/PLANNER`` (with several radii, ``out/runs/r<RADIUS>/MAP/PLANNER``), as
-    ``ccpp bench --out`` does. The cluster is ``client`` or ``scheduler`` (not both). Failed
+    sharing a file stem are told apart as ``<folder>-<stem>``; a missing one is refused before
+    any run); ``planners`` default to all (a planner named twice runs once; one name as a string
+    is that planner); ``radii`` (one number, or several) are checked (with ``tool_radius``)
+    before any task starts, and a radius given twice runs once. With ``out``, each run's files
+    are written to ``out/runs/MAP/PLANNER`` (with several radii, ``out/runs/r<RADIUS>/MAP/PLANNER``),
+    as ``ccpp bench --out`` does, and ``out`` must be absent or hold only a bench's files.
+    ``None`` for any keyword is its default. A run the simulator stopped early has that reason
+    (``stalled``, ``max_steps``) as its ``status``. The cluster is ``client`` or ``scheduler`` (not both). Failed
     runs are rows with ``status == "error"`` and the message in ``error``. Returns a pandas
     DataFrame with the columns :data:`CSV_COLUMNS` (plus ``radius`` when several radii are
     given).
@@ -168,18 +199,27 @@ def sweep(
         # One of them would be ignored.
         raise _ccpp.CcppError("client and scheduler both name the cluster to use; give one of them")
     known = [p["name"] for p in _ccpp.planners()]
+    if isinstance(planners, str):
+        # One planner, not its letters.
+        planners = [planners]
     if planners is not None and len(planners) == 0:
         raise _ccpp.CcppError("planners is empty (leave it out, or None, for every planner)")
     names = _once(planners) if planners is not None else known
     for p in names:
         if p not in known:
             raise _ccpp.CcppError(f'unknown planner "{p}"; run `ccpp planners` for the list')
+    if radii is None:
+        radii = (0.15,)
+    elif isinstance(radii, (int, float)):
+        radii = (radii,)
     radii = _once(float(r) for r in radii)
     if not radii:
         raise _ccpp.CcppError("radii is empty")
     for r in radii:
         _ccpp.check_robot(r, tool_radius)
     maps_named = _map_names(expand_maps(maps))
+    if out is not None:
+        _check_out(out)
     tasks = []
     for r in radii:
         for m, map_name in maps_named:
