@@ -94,7 +94,9 @@
 //!    such cell cut into two runs of an odd number of lanes each, which the tour may drive at
 //!    different times (or one after the other, which rebuilds the cell); the cheaper plan
 //!    (length plus `turn_cost_m` per turn) is kept. On `tuw_single_corridors` (r = 0.15 m)
-//!    this takes the path ratio from 1.330 to 1.297; it costs a second tour per lattice. Hop
+//!    this takes the path ratio from 1.330 to 1.297; it costs a second tour per lattice, run in
+//!    parallel with the first (as the lattices of step 1 are planned in parallel; the plans are
+//!    compared in a fixed order, so the choice is the same as one after the other). Hop
 //!    costs come from a coarse grid of the C-free set, one bounded Dijkstra per end-point block
 //!    computed once per tour (module `bcd::hops`), not a search per pair. Transfers are
 //!    straight when collision-free, else A* over the C-free pixel centres (8-connected, octile costs, no corner cutting), shortened

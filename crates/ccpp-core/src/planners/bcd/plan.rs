@@ -3,6 +3,8 @@
 
 use std::collections::VecDeque;
 
+use rayon::prelude::*;
+
 use super::angles::{dominant_angles, ANGLE_STEP_DEG, AXIS_TOL_DEG};
 use super::cells::{decompose, split_ends, split_jumps, Cell};
 use super::finish::{moves, repair, smooth, turns, Item};
@@ -40,10 +42,10 @@ impl Bcd {
             keep_px: (opts.margin_px > 0.0).then_some(need),
             rt: robot.tool_radius / res,
         };
-        let mut search = Search::new(w, h);
         // The plan on the pixel lattice and, when the walls run at an angle to the pixel
-        // axes, on the lattice turned to them; the cheaper is kept (module docs, step 1).
-        let mut best = Self::plan_on(&ctx, &Lattice::pixels(&ctx), opts, &mut search);
+        // axes, on the lattices turned to them; the cheapest is kept (module docs, step 1).
+        // The lattices are planned in parallel (each with its own search state) and compared
+        // in their fixed order, the first of equal plans kept: the same choice as one by one.
         let off_axis = |a: &f64| {
             let deg = a.to_degrees();
             deg.min(90.0 - deg) > AXIS_TOL_DEG
@@ -55,6 +57,8 @@ impl Bcd {
         } else {
             &[]
         };
+        // `None`: the pixel lattice; `Some(t)`: the lattice turned by `t`.
+        let mut turns_by: Vec<Option<f64>> = vec![None];
         for a in angles.iter().copied() {
             if !off_axis(&a) {
                 continue;
@@ -63,13 +67,26 @@ impl Bcd {
                 // 0, +1/2, -1/2, +1, -1, ... degrees around the wall angle.
                 let step = f64::from(j.div_ceil(2)) * ANGLE_STEP_DEG;
                 let d = if j % 2 == 1 { step } else { -step };
-                let t = a + d.to_radians();
-                let turned = Self::plan_on(&ctx, &Lattice::turned(&ctx, t), opts, &mut search);
-                if (turned.0, turned.1) < (best.0, best.1) {
-                    best = turned;
-                }
+                turns_by.push(Some(a + d.to_radians()));
             }
         }
+        let plans: Vec<_> = turns_by
+            .par_iter()
+            .map(|t| {
+                let mut search = Search::new(w, h);
+                match t {
+                    None => Self::plan_on(&ctx, &Lattice::pixels(&ctx), opts, &mut search),
+                    Some(t) => Self::plan_on(&ctx, &Lattice::turned(&ctx, *t), opts, &mut search),
+                }
+            })
+            .collect();
+        let mut best: Option<(usize, f64, Vec<Item>, usize)> = None;
+        for p in plans {
+            if best.as_ref().is_none_or(|b| (p.0, p.1) < (b.0, b.1)) {
+                best = Some(p);
+            }
+        }
+        let best = best.unwrap_or((0, 0.0, Vec::new(), 0));
         let (_, _, items, ncells) = best;
         let start = frame.world_to_grid(world.start().position());
 
@@ -247,18 +264,27 @@ impl Bcd {
         // the other the tour joins them back. Both cell sets are toured and the cheaper plan
         // is kept (module docs, step 4).
         let split = odd_runs(&cells);
-        let mut best: Option<(usize, f64, Vec<Item>)> = None;
-        // (no even cell: the second set is the first)
-        let sets: &[&Vec<(Cell, Vec<f64>)>] = if split.len() > cells.len() {
-            &[&cells, &split]
+        // (no even cell: the second set is the first) Both sets are toured in parallel (the
+        // second with its own search state) and compared in order, the first of equal plans
+        // kept: the same choice as one after the other.
+        let (first, second) = if split.len() > cells.len() {
+            rayon::join(
+                || Self::tour_cells(ctx, lat, opts, search, &cells, sp, start),
+                || {
+                    let mut own = Search::new(ctx.frame.width, ctx.frame.height);
+                    Self::tour_cells(ctx, lat, opts, &mut own, &split, sp, start)
+                },
+            )
         } else {
-            &[&cells]
+            (
+                Self::tour_cells(ctx, lat, opts, search, &cells, sp, start),
+                None,
+            )
         };
-        for &set in sets {
-            if let Some(b) = Self::tour_cells(ctx, lat, opts, search, set, sp, start) {
-                if best.as_ref().is_none_or(|a| (b.0, b.1) < (a.0, a.1)) {
-                    best = Some(b);
-                }
+        let mut best: Option<(usize, f64, Vec<Item>)> = None;
+        for b in [first, second].into_iter().flatten() {
+            if best.as_ref().is_none_or(|a| (b.0, b.1) < (a.0, a.1)) {
+                best = Some(b);
             }
         }
         let ncells = cells.len();
