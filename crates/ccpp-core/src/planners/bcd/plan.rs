@@ -3,6 +3,8 @@
 
 use std::collections::VecDeque;
 
+use rayon::prelude::*;
+
 use super::angles::{dominant_angles, ANGLE_STEP_DEG, AXIS_TOL_DEG};
 use super::cells::{decompose, split_ends, split_jumps, Cell};
 use super::finish::{moves, repair, smooth, turns, Item};
@@ -16,6 +18,17 @@ use crate::geometry::{path_length, Point};
 use crate::planner::Step;
 use crate::trace::Event;
 use crate::world::World;
+
+/// Which cell sets a lattice's plan tours (step 4 of the module docs).
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Sets {
+    /// The cells as decomposed.
+    Whole,
+    /// The cells with every even cell cut into two odd runs (no plan when there is none).
+    Split,
+    /// Both, the cheaper plan kept.
+    Both,
+}
 
 /// Improvement rounds of the first tour (which only picks each cell's path for the rim step).
 const FIRST_ROUNDS: u32 = 1;
@@ -40,10 +53,10 @@ impl Bcd {
             keep_px: (opts.margin_px > 0.0).then_some(need),
             rt: robot.tool_radius / res,
         };
-        let mut search = Search::new(w, h);
         // The plan on the pixel lattice and, when the walls run at an angle to the pixel
-        // axes, on the lattice turned to them; the cheaper is kept (module docs, step 1).
-        let mut best = Self::plan_on(&ctx, &Lattice::pixels(&ctx), opts, &mut search);
+        // axes, on the lattices turned to them; the cheapest is kept (module docs, step 1).
+        // The lattices are planned in parallel (each with its own search state) and compared
+        // in their fixed order, the first of equal plans kept: the same choice as one by one.
         let off_axis = |a: &f64| {
             let deg = a.to_degrees();
             deg.min(90.0 - deg) > AXIS_TOL_DEG
@@ -55,6 +68,8 @@ impl Bcd {
         } else {
             &[]
         };
+        // `None`: the pixel lattice; `Some(t)`: the lattice turned by `t`.
+        let mut turns_by: Vec<Option<f64>> = vec![None];
         for a in angles.iter().copied() {
             if !off_axis(&a) {
                 continue;
@@ -63,13 +78,50 @@ impl Bcd {
                 // 0, +1/2, -1/2, +1, -1, ... degrees around the wall angle.
                 let step = f64::from(j.div_ceil(2)) * ANGLE_STEP_DEG;
                 let d = if j % 2 == 1 { step } else { -step };
-                let t = a + d.to_radians();
-                let turned = Self::plan_on(&ctx, &Lattice::turned(&ctx, t), opts, &mut search);
-                if (turned.0, turned.1) < (best.0, best.1) {
-                    best = turned;
-                }
+                turns_by.push(Some(a + d.to_radians()));
             }
         }
+        let lattice = |t: &Option<f64>| match t {
+            None => Lattice::pixels(&ctx),
+            Some(t) => Lattice::turned(&ctx, *t),
+        };
+        // With several lattices, the cell sets with even cells cut (step 4) are toured only on
+        // the lattice whose whole cells plan best: the split changes a plan's cost by a few
+        // percent, the lattice by more, and the second tour per lattice doubled the time.
+        let sets = if turns_by.len() > 1 {
+            Sets::Whole
+        } else {
+            Sets::Both
+        };
+        let plans: Vec<_> = turns_by
+            .par_iter()
+            .map(|t| {
+                let mut search = Search::new(w, h);
+                Self::plan_sets(&ctx, &lattice(t), opts, &mut search, sets)
+            })
+            .collect();
+        let mut best: Option<(usize, f64, Vec<Item>, usize)> = None;
+        let mut at = 0;
+        for (k, p) in plans.into_iter().enumerate() {
+            if best.as_ref().is_none_or(|b| (p.0, p.1) < (b.0, b.1)) {
+                best = Some(p);
+                at = k;
+            }
+        }
+        if sets == Sets::Whole {
+            let mut search = Search::new(w, h);
+            let p = Self::plan_sets(
+                &ctx,
+                &lattice(&turns_by[at]),
+                opts,
+                &mut search,
+                Sets::Split,
+            );
+            if best.as_ref().is_none_or(|b| (p.0, p.1) < (b.0, b.1)) {
+                best = Some(p);
+            }
+        }
+        let best = best.unwrap_or((0, 0.0, Vec::new(), 0));
         let (_, _, items, ncells) = best;
         let start = frame.world_to_grid(world.start().position());
 
@@ -121,11 +173,24 @@ impl Bcd {
 
     /// Steps 1-5 of the module docs on the lattice `lat`: the plan's items with the moves it
     /// had to skip, its cost (length plus `turn_cost_m` per turn, pixels) and its cells.
+    #[cfg(test)]
     pub(super) fn plan_on(
         ctx: &Ctx<'_>,
         lat: &Lattice,
         opts: &BcdOptions,
         search: &mut Search,
+    ) -> (usize, f64, Vec<Item>, usize) {
+        Self::plan_sets(ctx, lat, opts, search, Sets::Both)
+    }
+
+    /// [`Bcd::plan_on`] touring only the cell sets `sets` (step 4 of the module docs); with
+    /// [`Sets::Split`] and no even cell, no plan (skips `usize::MAX`).
+    fn plan_sets(
+        ctx: &Ctx<'_>,
+        lat: &Lattice,
+        opts: &BcdOptions,
+        search: &mut Search,
+        sets: Sets,
     ) -> (usize, f64, Vec<Item>, usize) {
         let world = ctx.world;
         let frame = ctx.frame;
@@ -247,22 +312,40 @@ impl Bcd {
         // the other the tour joins them back. Both cell sets are toured and the cheaper plan
         // is kept (module docs, step 4).
         let split = odd_runs(&cells);
-        let mut best: Option<(usize, f64, Vec<Item>)> = None;
-        // (no even cell: the second set is the first)
-        let sets: &[&Vec<(Cell, Vec<f64>)>] = if split.len() > cells.len() {
-            &[&cells, &split]
+        // (no even cell: the second set is the first) With both, the sets are toured in
+        // parallel (the second with its own search state) and compared in order, the first of
+        // equal plans kept: the same choice as one after the other.
+        let even = split.len() > cells.len();
+        let (first, second) = if sets == Sets::Split {
+            let b = if even {
+                Self::tour_cells(ctx, lat, opts, search, &split, sp, start)
+            } else {
+                None
+            };
+            (b, None)
+        } else if even && sets == Sets::Both {
+            rayon::join(
+                || Self::tour_cells(ctx, lat, opts, search, &cells, sp, start),
+                || {
+                    let mut own = Search::new(ctx.frame.width, ctx.frame.height);
+                    Self::tour_cells(ctx, lat, opts, &mut own, &split, sp, start)
+                },
+            )
         } else {
-            &[&cells]
+            (
+                Self::tour_cells(ctx, lat, opts, search, &cells, sp, start),
+                None,
+            )
         };
-        for &set in sets {
-            if let Some(b) = Self::tour_cells(ctx, lat, opts, search, set, sp, start) {
-                if best.as_ref().is_none_or(|a| (b.0, b.1) < (a.0, a.1)) {
-                    best = Some(b);
-                }
+        let mut best: Option<(usize, f64, Vec<Item>)> = None;
+        for b in [first, second].into_iter().flatten() {
+            if best.as_ref().is_none_or(|a| (b.0, b.1) < (a.0, a.1)) {
+                best = Some(b);
             }
         }
         let ncells = cells.len();
-        best.map_or((0, 0.0, Vec::new(), ncells), |b| (b.0, b.1, b.2, ncells))
+        let none = if sets == Sets::Split { usize::MAX } else { 0 };
+        best.map_or((none, 0.0, Vec::new(), ncells), |b| (b.0, b.1, b.2, ncells))
     }
 
     /// Steps 3-5 of the module docs for the cells `cells` with their lanes: cell paths, the
