@@ -642,12 +642,12 @@ fn absurd_sizes_end_within_seconds() {
         &map,
         "rect-boustrophedon",
         &["--length", "1e-9"],
-        &["length_m", "finer than the map resolution"],
+        &["--length: ", "finer than the map resolution"],
     );
     fails(
         &["waypoints", "--width", "1e-6", "--map"],
         &[&map],
-        &["width_m", "finer than the map resolution"],
+        &["--width: ", "finer than the map resolution"],
         10,
     );
     fails(
