@@ -6,8 +6,7 @@
 //! short detour into a sliver cell and back) can be dropped when the straight move `u -> w` is
 //! free on the true map; dropping them saves the turns they and `u`, `w` make and shortens the
 //! path, and loses the accessible pixels that only the removed segments sweep and `u -> w`
-//! does not. Spans are dropped greedily, fewest lost pixels per unit of saved cost first (the
-//! path saved plus [`TURN_WEIGHT`] turn costs per turn saved), while the
+//! does not. Spans are dropped greedily, fewest lost pixels per saved turn first, while the
 //! pixels the plan still sweeps stay at least `floor` of the accessible floor. A span's loss is
 //! recomputed when it is taken (lazy greedy), so the budget is kept exactly.
 //!
@@ -40,12 +39,6 @@ fn turn(a: Point, b: Point, c: Point) -> bool {
     let (d0, d1) = (b.sub(a), c.sub(b));
     is_turn(d0.y.atan2(d0.x), d1.y.atan2(d1.x))
 }
-
-/// Weight of a saved turn, in turn costs (`turn_px`), against the path a span saves when
-/// spans are ranked. Measured on the 14 shared maps (r = 0.15 m): 1 (the plan's own cost)
-/// lowers the mean path ratio less and raises the turns more than 3; 0 (turns only, the
-/// ranking before) leaves the path a span saves out.
-const TURN_WEIGHT: f64 = 3.0;
 
 /// Most vertices one drop removes.
 const MAX_SPAN: usize = 4;
@@ -84,9 +77,6 @@ struct Pruner<'a, 'b> {
     acc: &'a FixedBitSet,
     covered: usize,
     rt: f64,
-    /// Cost of one turn in pixels of path: a span's saving is its length saved plus this per
-    /// turn saved.
-    turn_px: f64,
 }
 
 /// A candidate move from a vertex to a later one `w`: its points, its pixels, and whether it is
@@ -197,8 +187,7 @@ impl Pruner<'_, '_> {
         Point::new((i % w) as f64 + 0.5, h - (i / w) as f64 - 0.5)
     }
 
-    /// The cheapest span starting at `u` (lost pixels per pixel of saved cost: path plus
-    /// [`TURN_WEIGHT`] `turn_px` per turn), if any saves a turn.
+    /// The cheapest span starting at `u` (lost pixels per saved turn), if any saves a turn.
     ///
     /// The result depends on the chain around `u` (its `version` changes with it) and on the
     /// counts of the pixels of its segments: it is evaluated again only when one of those
@@ -240,8 +229,6 @@ impl Pruner<'_, '_> {
         let mut best: Option<Span> = None;
         // Turns of the chain from u: at u (with pu), and inside.
         let mut before = 0;
-        // Length of the chain from u to the span's end.
-        let mut span_len = 0.0;
         let mut v = u;
         let mut a = self.next[u];
         if a == NONE {
@@ -267,7 +254,6 @@ impl Pruner<'_, '_> {
                 bbox[3].max(sb[3]),
             ];
             before += self.turn_at(self.prev[v], v, a);
-            span_len += self.pts[v].dist(self.pts[a]);
             let w = a;
             if k >= 1 {
                 let nw = self.next[w];
@@ -285,11 +271,7 @@ impl Pruner<'_, '_> {
                         }
                     }
                     let lost = only - kept;
-                    // Lost pixels per pixel of cost saved (path, and TURN_WEIGHT turn costs a
-                    // turn).
-                    let gain = f64::from(saved) * TURN_WEIGHT * self.turn_px
-                        + (span_len - self.pts[u].dist(self.pts[w])).max(0.0);
-                    let key = (lost as f64 * 65536.0 / gain.max(1e-6)).min(1e18) as u64;
+                    let key = (lost as u64 * 1024) / saved as u64;
                     // The shorter span on ties.
                     if best.is_none_or(|s| key < s.key) && self.chord_free(u, j) {
                         best = Some(Span { key, w, lost });
@@ -602,7 +584,6 @@ pub(super) fn prune(ctx: &Ctx<'_>, items: Vec<Item>, floor: f64, max_extra: f64)
         acc,
         covered: 0,
         rt: ctx.rt + crate::raster::SWEEP_EPS_PX,
-        turn_px: max_extra,
         pts,
     };
     let mut buf = Vec::new();
