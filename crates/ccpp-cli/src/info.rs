@@ -3,6 +3,7 @@
 use std::fmt::Write as _;
 
 use anyhow::Result;
+use ccpp_core::display::Compact;
 use ccpp_core::grid::Cell;
 use ccpp_core::world::{World, WorldError};
 use serde::Serialize;
@@ -95,6 +96,21 @@ pub fn run(a: &InfoArgs) -> Result<()> {
     });
     let (world, robot_error) = match World::with_zones(g.clone(), robot, start, zones) {
         Ok(w) => (Some(w), None),
+        // An inflation that grew the obstacles over every free spot is the likely cause: the
+        // report names it, as `run` does.
+        Err(WorldError::RobotTooBig {
+            radius,
+            max_clearance,
+        }) if map.recipe.inflate.is_some_and(|m| m > 0.0) => (
+            None,
+            Some(format!(
+                "robot of radius {} m does not fit anywhere once --inflate / map.inflate {} m has \
+                 grown the obstacles (the widest free spot then has clearance \
+                 {max_clearance:.3} m); lower the inflation",
+                Compact(radius),
+                Compact(map.recipe.inflate.unwrap_or_default()),
+            )),
+        ),
         Err(e @ WorldError::RobotTooBig { .. }) => (None, Some(e.to_string())),
         // A start the user gave that does not work is a user error.
         Err(e) => {

@@ -777,6 +777,17 @@ fn every_subcommand_refuses_a_map_too_large_or_too_far_out() {
             "1e9,0",
             &["pillars.pgm", "from the world's origin", "check the origin"][..],
         ),
+        // The refusal of a resolution that is no length also names the map it was given for.
+        (
+            "--resolution",
+            "0",
+            &["pillars.pgm", "--resolution", "must be a finite number > 0"][..],
+        ),
+        (
+            "--resolution",
+            "-0.05",
+            &["pillars.pgm", "--resolution", "must be a finite number > 0"][..],
+        ),
         (
             "--origin",
             "1e300,0",
@@ -1042,6 +1053,19 @@ fn an_inflation_that_leaves_no_room_is_named() {
         );
         assert!(!out.exists());
     }
+    // `info` reports (exit 0) that the robot does not fit, and names the inflation too.
+    let o = ccpp()
+        .args(["info", "--map", s(&map), "--inflate", "3"])
+        .assert()
+        .success();
+    let text = String::from_utf8_lossy(&o.get_output().stdout).into_owned();
+    let robot = text.lines().find(|l| l.starts_with("robot")).unwrap();
+    for n in ["does not fit anywhere", "--inflate", "lower the inflation"] {
+        assert!(robot.contains(n), "{robot:?} should contain {n:?}");
+    }
+    let o = ccpp().args(["info", "--map", s(&map)]).assert().success();
+    let text = String::from_utf8_lossy(&o.get_output().stdout).into_owned();
+    assert!(!text.contains("inflat"), "{text}");
     // Without an inflation the message stays as it was.
     refused(
         &[

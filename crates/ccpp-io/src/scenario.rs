@@ -216,19 +216,19 @@ impl MapRecipe {
     /// # Errors
     /// A non-finite or non-positive value.
     pub fn validate(&self) -> Result<(), ScenarioError> {
+        let map = self
+            .path
+            .as_ref()
+            .map_or_else(String::new, |p| format!("map {}: ", p.display()));
         if let Some(r) = self.resolution {
             if !(r.is_finite() && r > 0.0) {
                 return Err(ScenarioError::Invalid(format!(
-                    "--resolution / map.resolution must be a finite number > 0, got {}",
+                    "{map}--resolution / map.resolution must be a finite number > 0, got {}",
                     Compact(r)
                 )));
             }
         }
         if let Some(why) = self.origin.and_then(|o| crate::map::heading_problem(o[2])) {
-            let map = self
-                .path
-                .as_ref()
-                .map_or_else(String::new, |p| format!("map {}: ", p.display()));
             return Err(ScenarioError::Invalid(format!(
                 "{map}--origin / map.origin yaw {why}"
             )));
