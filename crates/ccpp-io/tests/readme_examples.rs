@@ -1,5 +1,5 @@
 //! The README's Rust code blocks are the bodies of `examples/library.rs` and
-//! `examples/plan_nav_path.rs` (so they compile: `cargo test` builds the examples), and both
+//! `examples/plan_nav_path.rs` (compiled here through `#[path]`), and both
 //! run on the shared maps (skipped with a note when `../shared/maps` is absent).
 
 use std::path::{Path, PathBuf};
