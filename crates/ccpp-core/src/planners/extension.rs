@@ -157,6 +157,7 @@
 //! assert!(me.effective_coverage > 0.99);
 //! ```
 
+mod bulk;
 mod cleanup;
 mod drive;
 mod graph;
@@ -325,6 +326,8 @@ impl Chunk {
 }
 
 /// The extension's state (see the module docs).
+// Independent switches of the state, not a mode: bools read best.
+#[allow(clippy::struct_excessive_bools)]
 pub(crate) struct Extension {
     opts: ExtensionOptions,
     frame: MapFrame,
@@ -384,6 +387,13 @@ pub(crate) struct Extension {
     win_on: bool,
     /// Where the last search stopped (see `search_with`), while its state is valid.
     resume_at: Option<usize>,
+    /// The running search is a final clean-up's (its `done` is false wherever `no_gain`
+    /// holds): it may stop once no position can satisfy it (`search::nothing_gains`).
+    exhaust_check: bool,
+    /// Positions the running search cannot reach, found by `search::cut_off`.
+    unreach: FixedBitSet,
+    /// Scratch of `search::cut_off` (all clear between calls).
+    met: FixedBitSet,
     /// The final clean-up's walk follows a strip of rim off the contour too (see
     /// [`Self::set_strip_walk`]).
     strip_walk: bool,
@@ -452,6 +462,9 @@ impl Extension {
             win: Window::default(),
             win_on: false,
             resume_at: None,
+            exhaust_check: false,
+            unreach: FixedBitSet::with_capacity(n),
+            met: FixedBitSet::with_capacity(n),
             strip_walk: false,
         }
     }

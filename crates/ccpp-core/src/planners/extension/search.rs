@@ -162,6 +162,13 @@ const COST_DIAG: u64 = 1414;
 /// Settled positions carry this bit in their search cost.
 const CLOSED: u64 = 1 << 63;
 
+/// Settled positions after which a final clean-up's search checks whether any position is
+/// left that could stop it ([`Extension::nothing_gains`]).
+const EXHAUST_CHECK: usize = 4096;
+
+/// Most positions [`Extension::cut_off`] walks back over before it gives up.
+const CUT_OFF_MAX: usize = 1024;
+
 /// Heuristic weight of transfer searches.
 const ROUTE_WEIGHT: f64 = 1.5;
 
@@ -191,6 +198,7 @@ impl Extension {
         let mut heap = std::mem::take(&mut self.heap);
         if !resume || self.resume_at.is_none() {
             self.begin();
+            self.unreach.clear();
             self.resume_at = None;
             heap.clear();
         }
@@ -230,6 +238,7 @@ impl Extension {
         } else {
             self.seed(known, from, p0, h, heap);
         }
+        let mut settled = 0usize;
         while let Some(i) = heap.pop() {
             if self.nodes[i] & CLOSED != 0 {
                 continue;
@@ -239,6 +248,10 @@ impl Extension {
                 return None;
             }
             self.nodes[i] |= CLOSED;
+            settled += 1;
+            if settled == EXHAUST_CHECK && self.exhaust_check && self.nothing_gains(known, done) {
+                return None;
+            }
             let p = self.px_of(i);
             if done(self, p) {
                 self.resume_at = Some(i);
@@ -257,6 +270,80 @@ impl Extension {
             self.relax(known, i, p, h, heap);
         }
         None
+    }
+
+    /// Can the running search (a final clean-up's, whose `done` is false wherever `no_gain`
+    /// holds) find nothing more? Judges every pixel outside `no_gain` where the robot may fit:
+    /// when each is not done, or cannot be reached ([`Self::cut_off`]), the search would
+    /// settle the rest of its component and find nothing, so it may stop. Stops at the first
+    /// one done and reachable.
+    fn nothing_gains(
+        &mut self,
+        known: &KnownMap,
+        done: &mut dyn FnMut(&mut Self, Px) -> bool,
+    ) -> bool {
+        let n = self.nodes.len();
+        let bits = crate::bits::BLOCK_BITS;
+        for b in 0..self.no_gain.as_slice().len() {
+            let mut todo = !self.no_gain.as_slice()[b] & !self.unreach.as_slice()[b];
+            while todo != 0 {
+                let i = b * bits + todo.trailing_zeros() as usize;
+                todo &= todo - 1;
+                if i >= n {
+                    break;
+                }
+                if self.s0[i] != 2
+                    && !self.unreach.contains(i)
+                    && done(self, self.px_of(i))
+                    && !self.cut_off(known, i)
+                {
+                    return false;
+                }
+            }
+        }
+        true
+    }
+
+    /// Is position `i` out of the running search's reach? Walks back from it over the moves
+    /// the search would make (from positions where the robot fits, known free); when that
+    /// walk ends (within [`CUT_OFF_MAX`] positions) without meeting a position the search
+    /// has reached or queued, no way leads from the search's start to `i`, and every position
+    /// met is marked in `unreach` (valid for this search and its resumptions: the known map
+    /// does not change meanwhile).
+    fn cut_off(&mut self, known: &KnownMap, i: usize) -> bool {
+        let gen = self.generation;
+        let mut stack = vec![i];
+        let mut met = vec![i];
+        self.met.insert(i);
+        let mut cut = true;
+        while let Some(v) = stack.pop() {
+            if node_gen(self.nodes[v]) == gen || met.len() > CUT_OFF_MAX {
+                cut = false;
+                break;
+            }
+            let pv = self.px_of(v);
+            for (k, d) in NB.iter().enumerate() {
+                // From `u` the move `NB[k]` leads to `v`.
+                let u = (pv.0 - d.0, pv.1 - d.1);
+                let Some(j) = self.idx(u) else { continue };
+                if self.met.contains(j)
+                    || self.in_s0(known, u) != Some(true)
+                    || !self.edge(known, u, k)
+                {
+                    continue;
+                }
+                self.met.insert(j);
+                met.push(j);
+                stack.push(j);
+            }
+        }
+        for &j in &met {
+            self.met.set(j, false);
+            if cut {
+                self.unreach.insert(j);
+            }
+        }
+        cut
     }
 
     /// The positions next to grid point `from` that it reaches by a known-free move, queued.

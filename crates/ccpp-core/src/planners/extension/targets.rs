@@ -268,6 +268,7 @@ impl Extension {
             self.no_gain.clear();
             self.no_gain_free = free.to_vec();
             self.free_count = known.known_free().count_ones(..);
+            self.fill_memos(known);
             return;
         }
         let f = self.frame;

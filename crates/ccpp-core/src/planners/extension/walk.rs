@@ -49,6 +49,7 @@ impl Extension {
             let p0 = self.frame.grid_to_pixel_signed(from);
             self.build_window(known, p0, rad, wanted);
         }
+        self.exhaust_check = !bounded;
         let transit = self.search(known, from, limit, None, resume, &mut |s, p| {
             let i = s.idx(p).expect("positions are in the image");
             if !bounded && s.no_gain.contains(i) {
@@ -68,6 +69,7 @@ impl Extension {
             gains
         });
         self.win_on = false;
+        self.exhaust_check = false;
         let Some(transit) = transit else {
             return Chunk::default();
         };
