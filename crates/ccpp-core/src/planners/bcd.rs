@@ -226,7 +226,7 @@ impl Default for BcdOptions {
             rim: true,
             rim_min_yield: 0.0,
             rim_coverage: 0.999,
-            tour_rounds: 2,
+            tour_rounds: 3,
             min_coverage: 0.9952,
             angle_tries: 1,
         }
