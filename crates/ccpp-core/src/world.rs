@@ -718,8 +718,18 @@ impl World {
         self.disk_hits_on(p, &self.map)
     }
 
+    /// [`World::disk_collides`] at the grid point `g` (pixels, y up): exact whatever the map's
+    /// origin (a world point far from the world's origin carries rounding), so planners that
+    /// plan in grid coordinates get the same answer for a map moved anywhere.
+    pub fn disk_collides_grid(&self, g: Point) -> bool {
+        self.disk_hits_grid(g, self.map())
+    }
+
     fn disk_hits_on(&self, p: Point, map: &GridMap) -> bool {
-        let g = self.frame().world_to_grid(p);
+        self.disk_hits_grid(self.frame().world_to_grid(p), map)
+    }
+
+    fn disk_hits_grid(&self, g: Point, map: &GridMap) -> bool {
         let r_px = self.r_px();
         if self.dist_lower_bound_px(g) > contact_radius_px(r_px) + 1e-9 {
             return false;
@@ -734,24 +744,42 @@ impl World {
     /// transform through open space and checks pixels exactly near obstacles, so long moves
     /// across open halls stay cheap.
     pub fn first_contact(&self, a: Point, b: Point) -> Option<f64> {
+        let frame = self.frame();
+        self.first_contact_grid(frame.world_to_grid(a), frame.world_to_grid(b))
+    }
+
+    /// [`World::first_contact`] between grid points `ga` and `gb` (pixels, y up): exact
+    /// whatever the map's origin, see [`World::disk_collides_grid`].
+    pub fn first_contact_grid(&self, ga: Point, gb: Point) -> Option<f64> {
         match (&self.plan, &self.plan_blocked) {
-            (Some(map), Some(blocked)) => self.contact_on(a, b, map, blocked),
-            _ => self.contact_on(a, b, &self.map, &self.blocked),
+            (Some(map), Some(blocked)) => self.contact_on(ga, gb, map, blocked),
+            _ => self.contact_on(ga, gb, &self.map, &self.blocked),
         }
     }
 
     /// [`World::first_contact`] against the true map (virtual walls do not stop the robot):
     /// the simulator's bumper.
     pub fn true_first_contact(&self, a: Point, b: Point) -> Option<f64> {
-        self.contact_on(a, b, &self.map, &self.blocked)
+        let frame = self.frame();
+        self.contact_on(
+            frame.world_to_grid(a),
+            frame.world_to_grid(b),
+            &self.map,
+            &self.blocked,
+        )
     }
 
-    /// First contact with `map` (whose non-free pixels are `blocked`). The distance transform
-    /// is the planning map's: a lower bound of the distance to `map`'s obstacles either way.
-    fn contact_on(&self, a: Point, b: Point, map: &GridMap, blocked: &FixedBitSet) -> Option<f64> {
+    /// First contact with `map` (whose non-free pixels are `blocked`) between grid points `ga`
+    /// and `gb`. The distance transform is the planning map's: a lower bound of the distance to
+    /// `map`'s obstacles either way.
+    fn contact_on(
+        &self,
+        ga: Point,
+        gb: Point,
+        map: &GridMap,
+        blocked: &FixedBitSet,
+    ) -> Option<f64> {
         let frame = self.frame();
-        let ga = frame.world_to_grid(a);
-        let gb = frame.world_to_grid(b);
         let r_px = self.r_px();
         let rc = contact_radius_px(r_px);
         if box_clear(frame, ga, gb, rc, blocked) {
@@ -789,6 +817,12 @@ impl World {
     /// map (virtual walls included)?
     pub fn segment_free(&self, a: Point, b: Point) -> bool {
         self.first_contact(a, b).is_none()
+    }
+
+    /// [`World::segment_free`] between grid points (pixels, y up), see
+    /// [`World::first_contact_grid`].
+    pub fn segment_free_grid(&self, ga: Point, gb: Point) -> bool {
+        self.first_contact_grid(ga, gb).is_none()
     }
 }
 

@@ -46,10 +46,7 @@ impl Ctx<'_> {
         let p = Self::at(lat, cell.cols, t, v_in);
         let q = Self::at(lat, cell.cols, t, v_out);
         let len = (v_out - v_in).abs();
-        match self
-            .world
-            .first_contact(self.frame.grid_to_world(p), self.frame.grid_to_world(q))
-        {
+        match self.world.first_contact_grid(p, q) {
             Some(s) if s * len > BACKOFF_PX => p.add(q.sub(p).scale(s - BACKOFF_PX / len)),
             Some(_) => p,
             None => Self::at(lat, cell.cols, t, v_end),

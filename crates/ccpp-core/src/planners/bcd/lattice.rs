@@ -76,8 +76,7 @@ impl<'a> Lattice<'a> {
             for c in 0..w {
                 let g = lat.grid(c as f64, r as f64);
                 let (pc, pr) = ctx.frame.grid_to_pixel_signed(g);
-                ok[r * w + c] =
-                    ctx.ok_at(pc, pr) && !ctx.world.disk_collides(ctx.frame.grid_to_world(g));
+                ok[r * w + c] = ctx.ok_at(pc, pr) && !ctx.world.disk_collides_grid(g);
             }
         }
         lat.ok = Cow::Owned(ok);
@@ -143,7 +142,6 @@ impl Ctx<'_> {
 
     /// Is the straight move between grid points `a` and `b` free on the true map?
     pub(super) fn free(&self, a: Point, b: Point) -> bool {
-        self.world
-            .segment_free(self.frame.grid_to_world(a), self.frame.grid_to_world(b))
+        self.world.segment_free_grid(a, b)
     }
 }
