@@ -3,7 +3,6 @@
 use std::fmt::Write as _;
 
 use anyhow::Result;
-use ccpp_core::display::Compact;
 use ccpp_core::grid::Cell;
 use ccpp_core::world::{World, WorldError};
 use serde::Serialize;
@@ -103,12 +102,10 @@ pub fn run(a: &InfoArgs) -> Result<()> {
             max_clearance,
         }) if map.recipe.inflate.is_some_and(|m| m > 0.0) => (
             None,
-            Some(format!(
-                "robot of radius {} m does not fit anywhere once --inflate / map.inflate {} m has \
-                 grown the obstacles (the widest free spot then has clearance \
-                 {max_clearance:.3} m); lower the inflation",
-                Compact(radius),
-                Compact(map.recipe.inflate.unwrap_or_default()),
+            Some(ccpp_io::scenario::inflation_leaves_no_room(
+                radius,
+                map.recipe.inflate.unwrap_or_default(),
+                max_clearance,
             )),
         ),
         Err(e @ WorldError::RobotTooBig { .. }) => (None, Some(e.to_string())),

@@ -322,6 +322,19 @@ impl MapRecipe {
     }
 }
 
+/// Why a robot of `radius` m fits nowhere on a map whose obstacles `--inflate` grew by
+/// `inflate` m (`max_clearance`: the widest free spot left, m). `run`'s refusal and `info`'s
+/// report both say it this way.
+pub fn inflation_leaves_no_room(radius: f64, inflate: f64, max_clearance: f64) -> String {
+    format!(
+        "robot of radius {} m does not fit anywhere once --inflate / map.inflate {} m has grown \
+         the obstacles (the widest free spot then has clearance {max_clearance:.3} m); lower the \
+         inflation",
+        Compact(radius),
+        Compact(inflate),
+    )
+}
+
 /// Refuses a map frame wider or taller than [`MAX_MAP_SIDE_M`], or placed with a corner farther
 /// than [`MAX_COORD_M`] from the world's origin (every subcommand prepares its
 /// map through [`MapRecipe::prepare`], so `info`, `waypoints` and `plan` refuse what `run`
@@ -907,10 +920,13 @@ impl Scenario {
                         radius,
                         max_clearance,
                     } if inflate.is_some_and(|m| m > 0.0) => ScenarioError::Invalid(format!(
-                        "map {}: robot of radius {} m does not fit anywhere once --inflate / map.inflate {} m has grown the obstacles (the widest free spot then has clearance {max_clearance:.3} m); lower the inflation",
+                        "map {}: {}",
                         source.display(),
-                        Compact(radius),
-                        Compact(inflate.unwrap_or_default()),
+                        inflation_leaves_no_room(
+                            radius,
+                            inflate.unwrap_or_default(),
+                            max_clearance
+                        ),
                     )),
                     source_err => ScenarioError::World {
                         path: source.to_path_buf(),
