@@ -30,6 +30,25 @@ enum Sets {
     Both,
 }
 
+/// A candidate plan and how it ranks: fewer moves the repair had to skip first, then the lower
+/// cost (length plus `turn_cost_m` per turn, pixels). Every choice between candidates (cell
+/// sets, rim variants, lattices) uses [`Plan::beats`]; of equal candidates the first is kept.
+pub(super) struct Plan {
+    /// Moves the repair could not make known-free and dropped.
+    pub(super) skipped: usize,
+    /// Length plus `turn_cost_m` per turn, in pixels.
+    pub(super) cost: f64,
+    /// The plan's moves and marks.
+    pub(super) items: Vec<Item>,
+}
+
+impl Plan {
+    /// Does this plan rank before `best` (always, when there is none yet)?
+    fn beats(&self, best: Option<&Plan>) -> bool {
+        best.is_none_or(|b| (self.skipped, self.cost) < (b.skipped, b.cost))
+    }
+}
+
 /// Improvement rounds of the first tour (which only picks each cell's path for the rim step).
 const FIRST_ROUNDS: u32 = 1;
 
@@ -100,10 +119,10 @@ impl Bcd {
                 Self::plan_sets(&ctx, &lattice(t), opts, &mut search, sets)
             })
             .collect();
-        let mut best: Option<(usize, f64, Vec<Item>, usize)> = None;
+        let mut best: Option<(Plan, usize)> = None;
         let mut at = 0;
         for (k, p) in plans.into_iter().enumerate() {
-            if best.as_ref().is_none_or(|b| (p.0, p.1) < (b.0, b.1)) {
+            if p.0.beats(best.as_ref().map(|b| &b.0)) {
                 best = Some(p);
                 at = k;
             }
@@ -117,12 +136,11 @@ impl Bcd {
                 &mut search,
                 Sets::Split,
             );
-            if best.as_ref().is_none_or(|b| (p.0, p.1) < (b.0, b.1)) {
+            if p.0.beats(best.as_ref().map(|b| &b.0)) {
                 best = Some(p);
             }
         }
-        let best = best.unwrap_or((0, 0.0, Vec::new(), 0));
-        let (_, _, items, ncells) = best;
+        let (items, ncells) = best.map_or((Vec::new(), 0), |(p, n)| (p.items, n));
         let start = frame.world_to_grid(world.start().position());
 
         // A region whose moves the smoothing and pruning merged into the moves around it (or
@@ -179,19 +197,20 @@ impl Bcd {
         lat: &Lattice,
         opts: &BcdOptions,
         search: &mut Search,
-    ) -> (usize, f64, Vec<Item>, usize) {
+    ) -> (Plan, usize) {
         Self::plan_sets(ctx, lat, opts, search, Sets::Both)
     }
 
-    /// [`Bcd::plan_on`] touring only the cell sets `sets` (step 4 of the module docs); with
-    /// [`Sets::Split`] and no even cell, no plan (skips `usize::MAX`).
+    /// [`Bcd::plan_on`] touring only the cell sets `sets` (step 4 of the module docs): the best
+    /// plan and the number of cells. With [`Sets::Split`] and no even cell, an empty plan that
+    /// never beats another (skips `usize::MAX`).
     fn plan_sets(
         ctx: &Ctx<'_>,
         lat: &Lattice,
         opts: &BcdOptions,
         search: &mut Search,
         sets: Sets,
-    ) -> (usize, f64, Vec<Item>, usize) {
+    ) -> (Plan, usize) {
         let world = ctx.world;
         let frame = ctx.frame;
         let robot = world.robot();
@@ -337,15 +356,20 @@ impl Bcd {
                 None,
             )
         };
-        let mut best: Option<(usize, f64, Vec<Item>)> = None;
+        let mut best: Option<Plan> = None;
         for b in [first, second].into_iter().flatten() {
-            if best.as_ref().is_none_or(|a| (b.0, b.1) < (a.0, a.1)) {
+            if b.beats(best.as_ref()) {
                 best = Some(b);
             }
         }
         let ncells = cells.len();
         let none = if sets == Sets::Split { usize::MAX } else { 0 };
-        best.map_or((none, 0.0, Vec::new(), ncells), |b| (b.0, b.1, b.2, ncells))
+        let best = best.unwrap_or(Plan {
+            skipped: none,
+            cost: 0.0,
+            items: Vec::new(),
+        });
+        (best, ncells)
     }
 
     /// Steps 3-5 of the module docs for the cells `cells` with their lanes: cell paths, the
@@ -359,7 +383,7 @@ impl Bcd {
         cells: &[(Cell, Vec<f64>)],
         sp: f64,
         start: Point,
-    ) -> Option<(usize, f64, Vec<Item>)> {
+    ) -> Option<Plan> {
         let turn_px = opts.turn_cost_m / ctx.frame.resolution;
         // Cell paths; a first tour over the cells picks each cell's path (corner), the rim
         // contours of what those paths miss join the cells in the final tour, where each cell
@@ -390,7 +414,7 @@ impl Bcd {
         // or inserted into the finished tour where they cost least; the cheaper plan is kept.
         let cell_pieces = pieces;
         let cell_paths_all = paths;
-        let mut best: Option<(usize, f64, Vec<Item>)> = None;
+        let mut best: Option<Plan> = None;
         // The hop table and nearest-neighbour tour of the cells alone serve both plans.
         let cell_table = hops::HopTable::new(&coarse, &far, &cell_pieces, start);
         let cell_nn = cell_table.nearest_tour(&cell_pieces, start);
@@ -559,8 +583,13 @@ impl Bcd {
             let items = prune::prune(ctx, items, opts.min_coverage, turn_px);
             let pts: Vec<Point> = moves(&items).into_iter().map(|m| m.0).collect();
             let cost = path_length(&pts) + turn_px * turns(&pts) as f64;
-            if best.as_ref().is_none_or(|b| (skipped, cost) < (b.0, b.1)) {
-                best = Some((skipped, cost, items));
+            let plan = Plan {
+                skipped,
+                cost,
+                items,
+            };
+            if plan.beats(best.as_ref()) {
+                best = Some(plan);
             }
         }
         best
