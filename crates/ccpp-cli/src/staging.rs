@@ -223,6 +223,9 @@ pub fn check_target(target: &Path) -> Result<()> {
 
 /// A staging folder that becomes `target` on [`Staging::commit`] and is removed otherwise.
 pub struct Staging {
+    /// The target as the user named it (for messages).
+    shown: PathBuf,
+    /// The target under its resolved parent folder (for the renames).
     target: PathBuf,
     dir: PathBuf,
     parent: PathBuf,
@@ -252,8 +255,21 @@ impl Staging {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
         };
+        let existed = std::fs::symlink_metadata(target).is_ok();
         std::fs::create_dir_all(&parent)
             .with_context(|| format!("cannot create output folder {}", parent.display()))?;
+        // The swap renames `parent/name` away and then renames the staging folder to it: with
+        // a `..` in `parent` (`--out a/../a`) the old folder's rename would remove the path the
+        // second rename goes through, and the run, finished, would fail and leave both staging
+        // folders behind. The resolved parent is the same folder and stays reachable.
+        let parent = parent
+            .canonicalize()
+            .with_context(|| format!("cannot create output folder {}", parent.display()))?;
+        let resolved = parent.join(&name);
+        if !existed {
+            // `create_dir_all("a/..")` creates `a`, the target itself: not a run folder.
+            let _ = std::fs::remove_dir(&resolved);
+        }
         clean_stale(&parent, &name);
         let n = COUNTER.fetch_add(1, Ordering::Relaxed);
         let dir = parent.join(format!(".{name}.ccpp-new-{}-{n}", std::process::id()));
@@ -265,7 +281,8 @@ impl Staging {
             pending.push(dir.clone());
         }
         Ok(Self {
-            target: target.to_path_buf(),
+            shown: target.to_path_buf(),
+            target: resolved,
             dir,
             parent,
             name,
@@ -294,7 +311,7 @@ impl Staging {
     ) -> Result<()> {
         let file = write_file_with(&self.dir.join(name), fill, true).map_err(|e| {
             // Name the file where it would have gone, not its staging copy.
-            let shown = self.target.join(name);
+            let shown = self.shown.join(name);
             match e {
                 ccpp_io::WriteError::Io { source, .. } => {
                     anyhow::anyhow!("cannot write {}: {source}", shown.display())
@@ -318,7 +335,7 @@ impl Staging {
                 .join()
                 .unwrap_or_else(|_| Err(std::io::Error::other("sync thread panicked")));
             if let (Err(e), None) = (r, &first_error) {
-                let shown = self.target.join(name);
+                let shown = self.shown.join(name);
                 first_error = Some(anyhow::anyhow!("cannot write {}: {e}", shown.display()));
             }
         }
@@ -342,7 +359,7 @@ impl Staging {
         if had_old {
             register(&old);
             std::fs::rename(&self.target, &old).with_context(|| {
-                format!("cannot replace output folder {}", self.target.display())
+                format!("cannot replace output folder {}", self.shown.display())
             })?;
         }
         if let Err(e) = std::fs::rename(&self.dir, &self.target) {
@@ -351,7 +368,7 @@ impl Staging {
                 unregister(&old);
             }
             return Err(e).with_context(|| {
-                format!("cannot move the new output into {}", self.target.display())
+                format!("cannot move the new output into {}", self.shown.display())
             });
         }
         unregister(&self.dir);

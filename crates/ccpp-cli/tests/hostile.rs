@@ -1153,3 +1153,54 @@ fn a_stalled_run_is_named_by_run_and_bench() {
         read_json(&run.join("metrics.json"))["effective_coverage"]
     );
 }
+
+/// The names in `dir` of staging folders (`.NAME.ccpp-new-*`, `.NAME.ccpp-old-*`).
+fn staging_left(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains(".ccpp-new-") || n.contains(".ccpp-old-"))
+        .collect()
+}
+
+/// `--out DIR/../DIR` for a new folder: the run finished, then failed to move its files into
+/// place (`cannot move the new output into ...`, exit 1) and left both staging folders
+/// behind. The swap renamed the folder that the `..` goes through.
+#[test]
+fn an_out_folder_named_through_dotdot_is_written_whole() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let out = dir.join("out/../out");
+    for planner in ["bsa", "ba-star"] {
+        ccpp()
+            .args([
+                "run",
+                "--planner",
+                planner,
+                "--map",
+                s(&map),
+                "--out",
+                s(&out),
+            ])
+            .assert()
+            .success();
+        assert_eq!(read_json(&dir.join("out/metrics.json"))["planner"], planner);
+        assert!(staging_left(dir).is_empty(), "{:?}", staging_left(dir));
+    }
+    let plan = dir.join("p/../p");
+    ccpp()
+        .args([
+            "plan",
+            "--planner",
+            "bcd",
+            "--map",
+            s(&map),
+            "--out",
+            s(&plan),
+        ])
+        .assert()
+        .success();
+    assert!(dir.join("p/waypoints.csv").is_file());
+    assert!(staging_left(dir).is_empty(), "{:?}", staging_left(dir));
+}
