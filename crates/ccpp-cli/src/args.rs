@@ -309,7 +309,7 @@ pub struct BenchArgs {
     /// Redo runs whose results already exist in the output folder.
     #[arg(long)]
     pub force: bool,
-    /// Worker threads (default: all cores).
+    /// Worker threads (default: all cores; at most one per run).
     #[arg(long, value_name = "N")]
     pub jobs: Option<usize>,
     /// No progress bar.

@@ -220,9 +220,12 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     std::fs::create_dir_all(&a.out)
         .with_context(|| format!("cannot create output folder {}", a.out.display()))?;
     if let Some(j) = a.jobs {
+        // A thread beyond one per run would only idle: `--jobs 100000` started 100000
+        // threads, which took minutes on two cores before the first run.
+        let runs = (maps.len() * planners.len()).max(1);
         // Ignore the error when a global pool already exists (tests).
         let _ = rayon::ThreadPoolBuilder::new()
-            .num_threads(j)
+            .num_threads(j.min(runs))
             .build_global();
     }
 

@@ -1204,3 +1204,20 @@ fn an_out_folder_named_through_dotdot_is_written_whole() {
     assert!(dir.join("p/waypoints.csv").is_file());
     assert!(staging_left(dir).is_empty(), "{:?}", staging_left(dir));
 }
+
+/// `ccpp bench --jobs 100000` on a bench of one run started 100000 threads first: over a
+/// minute on two cores (`--jobs 5000`: 39 s) for a run of a tenth of a second.
+#[test]
+fn bench_jobs_beyond_the_runs_start_no_idle_threads() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let out = dir.join("bench");
+    ccpp()
+        .args(["bench", "--quiet", "--planners", "bsa", "--jobs", "100000"])
+        .args(["--maps", s(&map), "--out", s(&out)])
+        .timeout(std::time::Duration::from_secs(30))
+        .assert()
+        .success();
+    assert!(out.join("runs/pillars/bsa/metrics.json").is_file());
+}
