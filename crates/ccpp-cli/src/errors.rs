@@ -100,16 +100,10 @@ pub fn clap_lines(e: &clap::Error) -> (String, String) {
     // The subcommand: from clap's usage line, else the first argument naming one.
     let from_args = || {
         let sub = std::env::args().nth(1).filter(|a| {
-            [
-                "run",
-                "demo",
-                "planners",
-                "info",
-                "bench",
-                "replay",
-                "waypoints",
-            ]
-            .contains(&a.as_str())
+            use clap::CommandFactory as _;
+            crate::args::Cli::command()
+                .get_subcommands()
+                .any(|c| c.get_name() == a)
         });
         sub.map_or_else(|| "ccpp".to_string(), |s| format!("ccpp {s}"))
     };

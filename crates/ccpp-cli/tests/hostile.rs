@@ -1221,3 +1221,24 @@ fn bench_jobs_beyond_the_runs_start_no_idle_threads() {
         .success();
     assert!(out.join("runs/pillars/bsa/metrics.json").is_file());
 }
+
+/// An argument error of `ccpp plan` pointed to `ccpp --help` instead of `ccpp plan --help`
+/// (the subcommand list of the hint lacked `plan`).
+#[test]
+fn plan_argument_errors_point_to_the_plan_help() {
+    let a = ccpp()
+        .args([
+            "plan",
+            "--planner",
+            "bcd",
+            "--map",
+            "m.yaml",
+            "--radius",
+            "abc",
+        ])
+        .assert()
+        .failure();
+    let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
+    assert!(err.starts_with("error: invalid value 'abc'"), "{err}");
+    assert!(err.contains("hint: see `ccpp plan --help`"), "{err}");
+}
