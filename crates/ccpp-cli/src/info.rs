@@ -10,6 +10,7 @@ use serde::Serialize;
 use crate::args::InfoArgs;
 use crate::components::{free_components, StartComponent};
 use crate::job::{prepare_map, robot_from};
+use crate::output::num;
 
 /// The report. Robot-dependent fields are `null` when the robot does not fit on the map.
 #[derive(Serialize)]
@@ -165,11 +166,17 @@ pub fn run(a: &InfoArgs) -> Result<()> {
     ));
     line(format!(
         "size           {} x {} px, {} m/px = {:.2} x {:.2} m",
-        f.width, f.height, f.resolution, info.width_m, info.height_m
+        f.width,
+        f.height,
+        num(f.resolution),
+        info.width_m,
+        info.height_m
     ));
     line(format!(
         "origin         ({}, {}, {})",
-        f.origin.x, f.origin.y, f.origin.theta
+        num(f.origin.x),
+        num(f.origin.y),
+        num(f.origin.theta)
     ));
     line(format!(
         "free           {free} px ({:.1} %), {:.1} m2",
@@ -186,7 +193,7 @@ pub fn run(a: &InfoArgs) -> Result<()> {
         (Some(w), Some(s), Some(comp)) => {
             line(format!(
                 "robot radius   {} m: C-free {} px",
-                robot.radius,
+                num(robot.radius),
                 w.cfree().count_ones(..)
             ));
             line(format!(

@@ -161,13 +161,26 @@ pub fn emit(
     crate::print_stdout(&s)
 }
 
+/// A user-given number as `{}` prints it (`0.15`, `50000000`), but in exponent form (`1e-300`)
+/// below 1e-4 and from 1e9 up, where `{}` would print a line of hundreds of digits.
+pub fn num(v: f64) -> String {
+    if v != 0.0 && (v.abs() < 1e-4 || v.abs() >= 1e9) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}
+
 /// A short human table of the metrics.
 pub fn summary(m: &Metrics) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
         "{} on {} (r = {} m, tool r = {} m)",
-        m.planner, m.map, m.robot_radius_m, m.tool_radius_m
+        m.planner,
+        m.map,
+        num(m.robot_radius_m),
+        num(m.tool_radius_m)
     );
     let cov = m
         .coverage_rate

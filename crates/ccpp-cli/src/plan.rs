@@ -87,7 +87,7 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         "{} on {} (r = {} m): {} waypoints, {:.2} m, planned in {:.3} s",
         kind,
         map.name,
-        robot.radius,
+        crate::output::num(robot.radius),
         plan.route.waypoints.len(),
         plan.route.length_m(),
         plan.wall_time_s

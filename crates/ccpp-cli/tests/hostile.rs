@@ -1242,3 +1242,46 @@ fn plan_argument_errors_point_to_the_plan_help() {
     assert!(err.starts_with("error: invalid value 'abc'"), "{err}");
     assert!(err.contains("hint: see `ccpp plan --help`"), "{err}");
 }
+
+/// A tiny resolution or tool radius (legal values) printed as `{}` formats them: a size line of
+/// 330 characters (`0.000...0001 m/px`) in `info`, the same in `run`'s summary header.
+#[test]
+fn tiny_values_print_in_exponent_form() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let a = ccpp()
+        .args([
+            "info",
+            "--map",
+            s(&map),
+            "--resolution",
+            "1e-300",
+            "--radius",
+            "1e-305",
+        ])
+        .assert()
+        .success();
+    let info = String::from_utf8_lossy(&a.get_output().stdout).into_owned();
+    assert!(info.contains("1e-300 m/px"), "{info}");
+    assert!(info.lines().all(|l| l.len() < 120), "{info}");
+    let out = dir.join("out");
+    let a = ccpp()
+        .args([
+            "run",
+            "--planner",
+            "bsa",
+            "--map",
+            s(&map),
+            "--tool-radius",
+            "1e-300",
+        ])
+        .args(["--out", s(&out)])
+        .assert()
+        .success();
+    let summary = String::from_utf8_lossy(&a.get_output().stdout).into_owned();
+    assert!(
+        summary.starts_with("bsa on pillars (r = 0.15 m, tool r = 1e-300 m)"),
+        "{summary}"
+    );
+}
