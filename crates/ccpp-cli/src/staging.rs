@@ -40,23 +40,6 @@ static STOPPING: AtomicBool = AtomicBool::new(false);
 /// Distinguishes the staging folders of one process.
 static COUNTER: AtomicU64 = AtomicU64::new(0);
 
-/// The files a run folder may hold; any other file makes [`Staging::new`] refuse the target.
-pub const RUN_FILES: [&str; 12] = [
-    "run.json",
-    "path.csv",
-    "trace.jsonl",
-    "coverage.png",
-    "metrics.json",
-    "replay.html",
-    "replay.gif",
-    "bench-key.txt",
-    // `--export` files (`ccpp_io::export::ExportFormat::file_name`), also `ccpp plan`'s.
-    "waypoints.csv",
-    "waypoints.json",
-    "nav_path.yaml",
-    "path.geojson",
-];
-
 /// Test hook: when this environment variable names a file, writing that file fails as on a full
 /// disk (`ENOSPC`). Used by the end-to-end tests to check that a failed run leaves no output.
 pub const FAIL_WRITE_ENV: &str = "CCPP_TEST_FAIL_WRITE";
@@ -189,36 +172,13 @@ fn clean_stale(parent: &Path, name: &str) {
     }
 }
 
-/// Checks that `target` is absent, or a folder holding only run files.
+/// Checks that `target` is absent, or a folder holding only run files
+/// ([`ccpp_io::write::check_run_folder`]).
 ///
 /// # Errors
 /// When it is a file, or a folder holding anything else.
 pub fn check_target(target: &Path) -> Result<()> {
-    let Ok(meta) = std::fs::symlink_metadata(target) else {
-        return Ok(());
-    };
-    if !meta.is_dir() {
-        bail!(
-            "output folder {} exists and is not a plain folder",
-            target.display()
-        );
-    }
-    let entries = std::fs::read_dir(target)
-        .with_context(|| format!("cannot read output folder {}", target.display()))?;
-    for e in entries {
-        let e = e.with_context(|| format!("cannot read output folder {}", target.display()))?;
-        let name = e.file_name();
-        let name = name.to_string_lossy();
-        let known = RUN_FILES.contains(&name.as_ref()) || name.ends_with(".tmp");
-        if !known || !e.file_type().is_ok_and(|t| t.is_file()) {
-            bail!(
-                "output folder {} holds {name}, which ccpp did not write; a run replaces the \
-                 whole folder, so choose a new or ccpp-only folder",
-                target.display()
-            );
-        }
-    }
-    Ok(())
+    Ok(ccpp_io::write::check_run_folder(target)?)
 }
 
 /// A staging folder that becomes `target` on [`Staging::commit`] and is removed otherwise.
@@ -464,7 +424,7 @@ mod tests {
     fn export_files_are_run_files() {
         // A folder holding exports can be replaced by the next run or plan.
         for f in ccpp_io::export::ExportFormat::ALL {
-            assert!(RUN_FILES.contains(&f.file_name()), "{f}");
+            assert!(ccpp_io::write::RUN_FILES.contains(&f.file_name()), "{f}");
         }
     }
 

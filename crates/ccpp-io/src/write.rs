@@ -122,6 +122,174 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), WriteError> {
     write_atomic_with(path, |w| w.write_all(bytes))
 }
 
+/// The files a run or plan folder may hold (`ccpp run`, `ccpp plan`, a bench's run folders,
+/// the Python package's `save`). Such a folder is replaced whole by the next run into it, so a
+/// folder holding anything else is refused rather than replaced.
+pub const RUN_FILES: [&str; 12] = [
+    "run.json",
+    "path.csv",
+    "trace.jsonl",
+    "coverage.png",
+    "metrics.json",
+    "replay.html",
+    "replay.gif",
+    "bench-key.txt",
+    // The path exports (`crate::export::ExportFormat::file_name`), also `ccpp plan`'s.
+    "waypoints.csv",
+    "waypoints.json",
+    "nav_path.yaml",
+    "path.geojson",
+];
+
+/// Error of [`check_run_folder`] and [`write_folder`].
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum FolderError {
+    /// The path names no folder (`.`, `..`, a root).
+    #[error("output folder {} must end in a folder name (not ., .. or a root)", path.display())]
+    NoName {
+        /// The output folder.
+        path: PathBuf,
+    },
+    /// The path exists and is not a folder (a file, a symbolic link).
+    #[error("output folder {} exists and is not a plain folder", path.display())]
+    NotAFolder {
+        /// The output folder.
+        path: PathBuf,
+    },
+    /// The folder holds something ccpp did not write.
+    #[error(
+        "output folder {} holds {name}, which ccpp did not write; a run replaces the whole \
+         folder, so choose a new or ccpp-only folder",
+        path.display()
+    )]
+    Foreign {
+        /// The output folder.
+        path: PathBuf,
+        /// The entry ccpp did not write.
+        name: String,
+    },
+    /// Reading, creating, writing or renaming failed.
+    #[error("cannot write output folder {}: {source}", path.display())]
+    Io {
+        /// The output folder.
+        path: PathBuf,
+        /// The underlying I/O error.
+        #[source]
+        source: io::Error,
+    },
+}
+
+/// Checks that `target` is absent, or a folder holding only [`RUN_FILES`] (and stale `.tmp`
+/// files of an interrupted atomic write).
+///
+/// # Errors
+/// [`FolderError::NotAFolder`], [`FolderError::Foreign`], or [`FolderError::Io`] when the
+/// folder cannot be read.
+pub fn check_run_folder(target: &Path) -> Result<(), FolderError> {
+    let Ok(meta) = std::fs::symlink_metadata(target) else {
+        return Ok(());
+    };
+    if !meta.is_dir() {
+        return Err(FolderError::NotAFolder {
+            path: target.to_path_buf(),
+        });
+    }
+    let io_err = |source| FolderError::Io {
+        path: target.to_path_buf(),
+        source,
+    };
+    for e in std::fs::read_dir(target).map_err(io_err)? {
+        let e = e.map_err(io_err)?;
+        let name = e.file_name().to_string_lossy().into_owned();
+        let tmp = Path::new(&name).extension().is_some_and(|x| x == "tmp");
+        let known = RUN_FILES.contains(&name.as_str()) || tmp;
+        if !known || !e.file_type().is_ok_and(|t| t.is_file()) {
+            return Err(FolderError::Foreign {
+                path: target.to_path_buf(),
+                name,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Writes `files` as the whole content of the folder `target`, all or nothing, as the command
+/// line writes a run folder: `target` must be absent or hold only [`RUN_FILES`]
+/// ([`check_run_folder`]); the files are written and synced into a staging folder
+/// `.NAME.ccpp-new-PID-N` beside it, the old folder (if any) is renamed away, the staging
+/// folder renamed to `target` and the old one removed. A failure leaves the old folder as it
+/// was and no staging folder; a reader sees the old complete set or the new one, never a mix.
+/// Parent folders are created as needed.
+///
+/// # Errors
+/// As [`check_run_folder`], [`FolderError::NoName`], or [`FolderError::Io`] naming `target`.
+pub fn write_folder(target: &Path, files: &[(&str, Vec<u8>)]) -> Result<(), FolderError> {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let name = match target.file_name().and_then(|n| n.to_str()) {
+        Some(n) if n != "." && n != ".." => n.to_string(),
+        _ => {
+            return Err(FolderError::NoName {
+                path: target.to_path_buf(),
+            })
+        }
+    };
+    check_run_folder(target)?;
+    let io_err = |source| FolderError::Io {
+        path: target.to_path_buf(),
+        source,
+    };
+    let parent = match target.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let existed = std::fs::symlink_metadata(target).is_ok();
+    std::fs::create_dir_all(&parent).map_err(io_err)?;
+    // Renames go through the resolved parent: with `a/../a` the first rename would remove the
+    // path the second goes through.
+    let parent = parent.canonicalize().map_err(io_err)?;
+    let target_in = parent.join(&name);
+    if !existed {
+        // `create_dir_all("a/..")` created `a`, the target itself (empty): not a run folder.
+        let _ = std::fs::remove_dir(&target_in);
+    }
+    let tag = |kind: &str| {
+        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+        parent.join(format!(".{name}.ccpp-{kind}-{}-{n}", std::process::id()))
+    };
+    let staging = tag("new");
+    std::fs::create_dir(&staging).map_err(io_err)?;
+    let written = files.iter().try_for_each(|(file, bytes)| {
+        let mut f = File::create(staging.join(file))?;
+        f.write_all(bytes)?;
+        f.sync_all()
+    });
+    if let Err(e) = written {
+        let _ = std::fs::remove_dir_all(&staging);
+        return Err(io_err(e));
+    }
+    let old = tag("old");
+    let had_old = std::fs::symlink_metadata(&target_in).is_ok();
+    if had_old {
+        if let Err(e) = std::fs::rename(&target_in, &old) {
+            let _ = std::fs::remove_dir_all(&staging);
+            return Err(io_err(e));
+        }
+    }
+    if let Err(e) = std::fs::rename(&staging, &target_in) {
+        if had_old {
+            let _ = std::fs::rename(&old, &target_in);
+        }
+        let _ = std::fs::remove_dir_all(&staging);
+        return Err(io_err(e));
+    }
+    if had_old {
+        let _ = std::fs::remove_dir_all(&old);
+    }
+    Ok(())
+}
+
 /// Encodes a grid as a binary (`P5`) 8-bit PGM with `map_saver`'s values: 254 free,
 /// 0 occupied, 205 unknown; row 0 of the grid is the first image row.
 pub fn encode_pgm(grid: &GridMap) -> Vec<u8> {
@@ -189,4 +357,57 @@ pub fn save_map(grid: &GridMap, yaml_path: &Path) -> Result<PathBuf, WriteError>
     let yaml = map_yaml(grid.frame(), name);
     write_atomic(yaml_path, yaml.as_bytes())?;
     Ok(image_path)
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    fn names(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    }
+
+    #[test]
+    fn write_folder_replaces_the_whole_folder() {
+        let d = tempfile::tempdir().unwrap();
+        let target = d.path().join("out");
+        write_folder(
+            &target,
+            &[("run.json", b"1".to_vec()), ("path.geojson", b"g".to_vec())],
+        )
+        .unwrap();
+        write_folder(&target, &[("run.json", b"2".to_vec())]).unwrap();
+        assert_eq!(names(&target), ["run.json"], "no file of the older set");
+        assert_eq!(std::fs::read(target.join("run.json")).unwrap(), b"2");
+        assert_eq!(names(d.path()), ["out"], "no staging folder left");
+        // Through `..`, new and then existing.
+        let dotdot = d.path().join("new/../new");
+        write_folder(&dotdot, &[("run.json", b"3".to_vec())]).unwrap();
+        write_folder(&dotdot, &[("run.json", b"4".to_vec())]).unwrap();
+        assert_eq!(std::fs::read(d.path().join("new/run.json")).unwrap(), b"4");
+        assert_eq!(names(d.path()), ["new", "out"]);
+    }
+
+    #[test]
+    fn write_folder_refuses_what_it_would_destroy() {
+        let d = tempfile::tempdir().unwrap();
+        let target = d.path().join("out");
+        std::fs::create_dir(&target).unwrap();
+        std::fs::write(target.join("notes.txt"), b"mine").unwrap();
+        let e = write_folder(&target, &[("run.json", b"1".to_vec())]).unwrap_err();
+        assert!(e.to_string().contains("holds notes.txt"), "{e}");
+        assert_eq!(names(&target), ["notes.txt"]);
+        let file = d.path().join("file");
+        std::fs::write(&file, b"x").unwrap();
+        let e = write_folder(&file, &[]).unwrap_err();
+        assert!(e.to_string().contains("not a plain folder"), "{e}");
+        assert!(write_folder(Path::new("/"), &[]).is_err());
+        assert_eq!(names(d.path()), ["file", "out"]);
+    }
 }

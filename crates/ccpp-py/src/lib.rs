@@ -42,12 +42,21 @@ create_exception!(
 );
 
 /// The message of `e` and its causes, as the command line prints them (`anyhow`'s `{:#}`).
+/// The error and its causes as one line, each cause once (as the command line prints them):
+/// a cause whose text the line already holds is skipped (`cannot read /tmp: not a regular
+/// file` was followed by `: not a regular file`), one that repeats the line and adds to it
+/// replaces it.
 fn chain(e: &(dyn std::error::Error + 'static)) -> String {
     let mut s = e.to_string();
     let mut cur = e.source();
     while let Some(c) = cur {
-        s.push_str(": ");
-        s.push_str(&c.to_string());
+        let text = c.to_string();
+        if text.starts_with(&s) {
+            s = text;
+        } else if !text.is_empty() && !s.contains(&text) {
+            s.push_str(": ");
+            s.push_str(&text);
+        }
         cur = c.source();
     }
     s
@@ -640,17 +649,11 @@ fn export_text(files: Vec<(&'static str, Vec<u8>)>) -> PyResult<String> {
     String::from_utf8(bytes).map_err(|e| err(&e))
 }
 
-/// Writes `files` into `folder` (created if needed), each atomically.
+/// Writes `files` as the whole content of `folder`, all or nothing, as `ccpp plan --out`
+/// ([`ccpp_io::write::write_folder`]: an older set there is replaced whole, a folder holding
+/// other files refused).
 fn write_files(folder: &Path, files: &[(&'static str, Vec<u8>)]) -> PyResult<()> {
-    if files.is_empty() {
-        return Ok(());
-    }
-    std::fs::create_dir_all(folder)
-        .map_err(|e| msg(format!("cannot create {}: {e}", folder.display())))?;
-    for (name, bytes) in files {
-        ccpp_io::write::write_atomic(&folder.join(name), bytes).map_err(|e| err(&e))?;
-    }
-    Ok(())
+    ccpp_io::write::write_folder(folder, files).map_err(|e| err(&e))
 }
 
 /// A path planned on a known map by `ccpp.plan` (as `ccpp plan`): its waypoints and exports.
@@ -710,7 +713,7 @@ impl PlanResult {
     }
 
     /// Writes the exports into `folder` (created if needed), as `ccpp plan --out folder`:
-    /// `export` formats, default `["csv", "nav-path"]`.
+    /// `export` formats, default `["csv", "nav-path"]`; all or nothing, as `run`'s `save`.
     #[pyo3(signature = (folder, export=None))]
     fn save(&self, folder: PathBuf, export: Option<Vec<String>>) -> PyResult<()> {
         let names = export.unwrap_or_else(|| vec!["csv".into(), "nav-path".into()]);
@@ -836,7 +839,8 @@ impl RunResult {
     /// Writes `run.json`, `path.csv`, `trace.jsonl`, `coverage.png` and `metrics.json` into
     /// `folder` (created if needed), exactly as `ccpp run --out folder`; `export` (a list of
     /// `"csv"`, `"json"`, `"nav-path"`, `"geojson"`) adds the path exports, as
-    /// `ccpp run --export FORMAT`.
+    /// `ccpp run --export FORMAT`. All or nothing, as the command line: the files of an older
+    /// run or plan in `folder` are replaced whole, a folder holding other files is refused.
     #[pyo3(signature = (folder, export=None))]
     fn save(&self, py: Python<'_>, folder: PathBuf, export: Option<Vec<String>>) -> PyResult<()> {
         let formats = parse_formats(export.as_deref().unwrap_or_default())?;
@@ -848,10 +852,11 @@ impl RunResult {
                 &self.world,
                 &self.output.trace,
                 &self.metrics,
+                &files,
             )
         })
         .map_err(|e| err(&e))?;
-        write_files(&folder, &files)
+        Ok(())
     }
 
     /// The executed path's waypoints, `float64` `(N, 3)`: x, y, theta at the ends of its
@@ -990,6 +995,7 @@ fn bench_run(
                 &run.world,
                 &run.output.trace,
                 &run.metrics,
+                &[],
             )
             .map_err(|e| chain(&e))?;
         }

@@ -139,3 +139,42 @@ def test_runs_release_the_gil(room: Path) -> None:
     with ThreadPoolExecutor(2) as ex:
         rs = list(ex.map(lambda _: ccpp.run(m, "bsa").metrics, range(2)))
     assert without_time(rs[0]) == without_time(rs[1])
+
+
+def test_save_replaces_the_folder_whole(room: Path, tmp_path: Path) -> None:
+    """`save` wrote file by file into the folder: a second run saved there kept the first run's
+    exports beside its own files (a mixed folder), and a folder of the user's files was written
+    into. It is now all or nothing, as `ccpp run --out` and `ccpp plan --out`."""
+    out = tmp_path / "out"
+    ccpp.run(room, "bsa").save(out, export=["geojson", "csv"])
+    ccpp.run(room, "bcd").save(out)
+    run_files = ["coverage.png", "metrics.json", "path.csv", "run.json", "trace.jsonl"]
+    assert sorted(p.name for p in out.iterdir()) == run_files
+    assert json.loads((out / "metrics.json").read_text())["planner"] == "bcd"
+    ccpp.plan(room, "bcd").save(out)
+    assert sorted(p.name for p in out.iterdir()) == ["nav_path.yaml", "waypoints.csv"]
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "notes.txt").write_text("mine")
+    with pytest.raises(ccpp.CcppError, match="holds notes.txt, which ccpp did not write"):
+        ccpp.run(room, "bsa").save(mine)
+    with pytest.raises(ccpp.CcppError, match="holds notes.txt, which ccpp did not write"):
+        ccpp.plan(room, "bcd").save(mine)
+    assert [p.name for p in mine.iterdir()] == ["notes.txt"]
+    # A path through `..` and no staging folder left anywhere.
+    ccpp.run(room, "bsa").save(tmp_path / "dd" / ".." / "dd")
+    assert sorted(p.name for p in (tmp_path / "dd").iterdir()) == run_files
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["dd", "mine", "out", "room.pgm", "room.yaml"]
+
+
+def test_errors_name_each_cause_once(room: Path, ccpp_bin: str, tmp_path: Path) -> None:
+    """Python's errors repeated a cause the message already held (`cannot read DIR: not a
+    regular file: not a regular file`); they are the command line's lines."""
+    with pytest.raises(ccpp.CcppError) as e:
+        ccpp.load_map(tmp_path)
+    assert str(e.value) == f"cannot read {tmp_path}: not a regular file"
+    p = cli(ccpp_bin, "run", "--map", str(room), "--planner", "bsa", "--start", "0.02,0.02", "--out", str(tmp_path / "o"))
+    assert p.returncode == 1 and p.stderr.startswith("error: ")
+    with pytest.raises(ccpp.CcppError) as e:
+        ccpp.run(room, "bsa", start=(0.02, 0.02))
+    assert str(e.value) == p.stderr.strip().removeprefix("error: ")

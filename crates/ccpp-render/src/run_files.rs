@@ -14,7 +14,6 @@ use ccpp_io::phase;
 use ccpp_io::scenario::Scenario;
 use ccpp_io::trace::FormedFiles;
 use ccpp_io::write::WriteError;
-use ccpp_io::write_atomic;
 
 use crate::{coverage_png, coverage_png_swept, CoverageStyle, RenderError};
 
@@ -38,6 +37,9 @@ pub enum RunFilesError {
     /// A file cannot be written.
     #[error(transparent)]
     Write(#[from] WriteError),
+    /// The output folder cannot be replaced (see [`ccpp_io::write::write_folder`]).
+    #[error(transparent)]
+    Output(#[from] ccpp_io::write::FolderError),
 }
 
 /// The metrics as pretty JSON (`metrics.json`).
@@ -94,8 +96,8 @@ fn coverage_style(metrics: &Metrics) -> CoverageStyle {
 /// `trace.jsonl`, `coverage.png`, `metrics.json` (last: its presence marks a complete run).
 /// `run.json` is `scenario` with the start actually used (the world's), so that
 /// [`Scenario::run`] on it reproduces the run. The command line adds its replay files before
-/// `metrics.json` and writes the set through a staging folder; [`write_run_files`] writes it
-/// directly.
+/// `metrics.json` and writes the set through its own staging folder; [`write_run_files`]
+/// through [`ccpp_io::write::write_folder`].
 ///
 /// # Errors
 /// Serialization or rendering failures.
@@ -245,31 +247,28 @@ pub fn render_export_files(
     Ok(render_exports(&route, &meta, formats, polygons)?)
 }
 
-/// Renders everything first ([`render_run_files`]), then writes each file atomically into
-/// `out`, so a failure leaves no partial file; `metrics.json` is written last. Returns the
-/// metrics JSON.
+/// Renders everything first ([`render_run_files`]), then writes the files and `extra` (path
+/// exports) as the whole content of the folder `out`, all or nothing
+/// ([`ccpp_io::write::write_folder`]): `out` must be absent or hold only run files, and the
+/// older set in it is replaced whole, never mixed with the new one. Returns the metrics JSON.
 ///
 /// # Errors
-/// Serialization, rendering or writing failures.
+/// Serialization, rendering or writing failures; an `out` holding other files.
 pub fn write_run_files(
     out: &Path,
     scenario: &Scenario,
     world: &World,
     trace: &Trace,
     metrics: &Metrics,
+    extra: &[(&'static str, Vec<u8>)],
 ) -> Result<String, RunFilesError> {
-    let files = render_run_files(scenario, world, trace, metrics)?;
-    std::fs::create_dir_all(out).map_err(|source| RunFilesError::Folder {
-        path: out.to_path_buf(),
-        source,
-    })?;
-    for (name, bytes) in &files {
-        write_atomic(&out.join(name), bytes)?;
-    }
+    let mut files = render_run_files(scenario, world, trace, metrics)?;
+    files.extend(extra.iter().cloned());
     let metrics_text = files
-        .into_iter()
+        .iter()
         .find(|(n, _)| *n == "metrics.json")
-        .map(|(_, b)| String::from_utf8_lossy(&b).into_owned())
+        .map(|(_, b)| String::from_utf8_lossy(b).into_owned())
         .unwrap_or_default();
+    ccpp_io::write::write_folder(out, &files)?;
     Ok(metrics_text)
 }

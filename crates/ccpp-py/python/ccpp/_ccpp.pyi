@@ -69,7 +69,10 @@ class RunResult:
     def scenario_json(self) -> str:
         """The run.json text."""
     def save(self, folder: _Path, export: Sequence[str] | None = None) -> None:
-        """Writes the files of ``ccpp run --out folder`` (``export``: ``--export`` formats)."""
+        """Writes the files of ``ccpp run --out folder`` (``export``: ``--export`` formats).
+
+        All or nothing: an older run's files in ``folder`` are replaced whole; a folder
+        holding files ccpp did not write is refused (``CcppError``)."""
     def waypoints(self, tolerance_m: float = 0.001) -> npt.NDArray[np.float64]:
         """Waypoints of the executed path, (N, 3): x, y, theta at segment ends."""
     def export(self, format: str) -> str:
