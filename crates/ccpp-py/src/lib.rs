@@ -393,9 +393,11 @@ fn uint_arg(key: &str, v: &Bound<'_, PyAny>) -> PyResult<u64> {
             repr(v)
         )));
     }
+    // Past u64 (`max_steps=2**70`) the value is not below 0: say what the range is.
     v.extract().map_err(|_| {
         msg(format!(
-            "{key} must be a whole number >= 0, got {}",
+            "{key} must be a whole number from 0 to {}, got {}",
+            u64::MAX,
             repr(v)
         ))
     })
@@ -1317,7 +1319,17 @@ impl Env {
     /// free, reachable positions (deterministic for a seed; with zones, inside the area and
     /// outside the keep-outs).
     #[pyo3(signature = (seed=None))]
-    fn reset(&mut self, py: Python<'_>, seed: Option<u64>) -> PyResult<(Py<PyDict>, Py<PyDict>)> {
+    fn reset(
+        &mut self,
+        py: Python<'_>,
+        seed: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<(Py<PyDict>, Py<PyDict>)> {
+        // As `run`'s seed: a `CcppError` naming the range (a negative seed was an
+        // `OverflowError`).
+        let seed = seed
+            .filter(|s| !s.is_none())
+            .map(|s| uint_arg("seed", s))
+            .transpose()?;
         let scenario = &self.scenario;
         let map = &self.map;
         let zones = &self.zones;

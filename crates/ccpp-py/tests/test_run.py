@@ -178,3 +178,15 @@ def test_errors_name_each_cause_once(room: Path, ccpp_bin: str, tmp_path: Path) 
     with pytest.raises(ccpp.CcppError) as e:
         ccpp.run(room, "bsa", start=(0.02, 0.02))
     assert str(e.value) == p.stderr.strip().removeprefix("error: ")
+
+
+def test_whole_number_options_name_their_range(room: Path) -> None:
+    """`max_steps=2**70` was refused as not `>= 0`, and `Env.reset(seed=-1)` raised an
+    `OverflowError` where `run(seed=-1)` raises `CcppError`."""
+    with pytest.raises(ccpp.CcppError, match=r"max_steps must be a whole number from 0 to 18446744073709551615, got 1180591620717411303424"):
+        ccpp.run(room, "bsa", max_steps=2**70)
+    env = ccpp.Env(room)
+    for bad in (-1, 2**70):
+        with pytest.raises(ccpp.CcppError, match=r"seed must be a whole number from 0 to 18446744073709551615"):
+            env.reset(seed=bad)
+    assert env.reset(seed=3)[1] == ccpp.Env(room).reset(seed=3)[1]
