@@ -427,9 +427,10 @@ fn run_one(
         .unwrap_or_default();
     let metrics_path = dir.join("metrics.json");
     if !a.force && dir.join("trace.jsonl").is_file() {
-        let same_key = std::fs::read_to_string(dir.join("bench-key.txt")).is_ok_and(|k| k == key);
+        // Regular files only (a FIFO would block the bench forever).
+        let same_key = ccpp_io::file::read_text(&dir.join("bench-key.txt")).is_ok_and(|k| k == key);
         if same_key {
-            if let Ok(text) = std::fs::read_to_string(&metrics_path) {
+            if let Ok(text) = ccpp_io::file::read_text(&metrics_path) {
                 if let Ok(m) = serde_json::from_str::<Metrics>(&text) {
                     return Ok(m);
                 }

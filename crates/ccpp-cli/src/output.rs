@@ -89,7 +89,8 @@ pub fn replay_dir(dir: &Path) -> Result<()> {
     let margin = scenario.robot.radius + 2.0 * world.frame().resolution;
     let trace =
         ccpp_io::trace::read_trace(&dir.join("trace.jsonl"), Some((world.frame(), margin)))?;
-    let metrics = std::fs::read_to_string(dir.join("metrics.json")).unwrap_or_default();
+    // Through `read_text`: a FIFO named metrics.json hung the replay (a regular file only).
+    let metrics = ccpp_io::file::read_text(&dir.join("metrics.json")).unwrap_or_default();
     let title = format!("{} on {}", scenario.planner.name(), map.name);
     let (html, gif) = render_replay(&world, &trace, scenario.tile_side(), &metrics, &title)?;
     write_file(&dir.join("replay.html"), html.as_bytes())?;

@@ -1285,3 +1285,82 @@ fn tiny_values_print_in_exponent_form() {
         "{summary}"
     );
 }
+
+fn strs(v: &[String]) -> Vec<&str> {
+    v.iter().map(String::as_str).collect()
+}
+
+/// A huge (here sparse) file named as options, a map YAML, a zone, landmarks or a georef was
+/// read whole into memory: 3 GB of RAM and over a minute for a 3 GB `--config`; a trace of one
+/// endless line likewise. Text inputs are now refused above 64 MiB, before they are read.
+#[test]
+fn huge_text_inputs_are_refused_before_they_are_read() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let big = dir.join("big.yaml");
+    std::fs::File::create(&big)
+        .unwrap()
+        .set_len(3 << 30) // sparse: no disk used
+        .unwrap();
+    let too_big = "the file is 3072.0 MiB, more than the 64 MiB a text input may be";
+    let out = dir.join("out");
+    let (map_s, out_s) = (s(&map).to_string(), s(&out).to_string());
+    let run = |extra: &[&str]| {
+        let mut v: Vec<String> = ["run", "--map", &map_s, "--out", &out_s]
+            .iter()
+            .map(ToString::to_string)
+            .collect();
+        v.extend(extra.iter().map(ToString::to_string));
+        v
+    };
+    refused(
+        &strs(&run(&["--planner", "bsa", "--config", s(&big)])),
+        &["big.yaml", too_big],
+    );
+    refused(
+        &strs(&run(&["--planner", "bcd", "--keepout", s(&big)])),
+        &["big.yaml", too_big],
+    );
+    refused(
+        &strs(&run(&["--planner", "bsa-bfs", "--landmarks", s(&big)])),
+        &["big.yaml", too_big],
+    );
+    refused(&["info", "--map", s(&big)], &["big.yaml", too_big]);
+    assert!(!out.exists());
+    // A run folder whose trace is one line of 1 GiB.
+    let done = run_ok(dir, "done", &map, "bsa", &[]);
+    std::fs::File::create(done.join("trace.jsonl"))
+        .unwrap()
+        .set_len(1 << 30)
+        .unwrap();
+    refused(
+        &["replay", s(&done)],
+        &["trace.jsonl", "a line is longer than 64 MiB"],
+    );
+}
+
+/// `ccpp replay DIR` read `DIR/metrics.json` with no regular-file check: a FIFO there blocked
+/// it forever.
+#[cfg(unix)]
+#[test]
+fn replay_does_not_wait_on_a_fifo_metrics_file() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let done = run_ok(dir, "done", &map, "bsa", &[]);
+    std::fs::remove_file(done.join("metrics.json")).unwrap();
+    let ok = std::process::Command::new("mkfifo")
+        .arg(done.join("metrics.json"))
+        .status();
+    if !ok.is_ok_and(|s| s.success()) {
+        eprintln!("mkfifo unavailable; skipping");
+        return;
+    }
+    ccpp()
+        .args(["replay", s(&done)])
+        .timeout(std::time::Duration::from_secs(30))
+        .assert()
+        .success();
+    assert!(done.join("replay.html").is_file());
+}

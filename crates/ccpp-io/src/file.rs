@@ -21,29 +21,76 @@ pub fn open_regular(path: &Path) -> io::Result<File> {
     File::open(path)
 }
 
-/// Reads a regular file's bytes.
+/// The largest text input read whole (a map YAML, planner options, zones, landmarks, georef,
+/// waypoints, `run.json`): 64 MiB, far above any real one (the YAML readers stop at 250 000
+/// nodes anyway), so that a huge or sparse file named by mistake is refused before it is read
+/// into memory (a 3 GB options file took 3 GB and over a minute).
+pub const MAX_TEXT_BYTES: u64 = 64 << 20;
+
+fn too_large(len: u64) -> io::Error {
+    io::Error::new(
+        io::ErrorKind::InvalidData,
+        format!(
+            "the file is {:.1} MiB, more than the {} MiB a text input may be",
+            len as f64 / (1u64 << 20) as f64,
+            MAX_TEXT_BYTES >> 20
+        ),
+    )
+}
+
+/// Reads a regular file's bytes, at most [`MAX_TEXT_BYTES`].
 ///
 /// # Errors
-/// As [`open_regular`], plus read errors.
+/// As [`open_regular`], plus read errors and a file larger than [`MAX_TEXT_BYTES`].
 pub fn read_bytes(path: &Path) -> io::Result<Vec<u8>> {
+    let file = open_regular(path)?;
+    let len = file.metadata()?.len();
+    if len > MAX_TEXT_BYTES {
+        return Err(too_large(len));
+    }
+    // A file that grows while it is read is cut just past the limit, then refused.
     let mut v = Vec::new();
-    io::Read::read_to_end(&mut open_regular(path)?, &mut v)?;
+    io::Read::read_to_end(&mut io::Read::take(file, MAX_TEXT_BYTES + 1), &mut v)?;
+    if v.len() as u64 > MAX_TEXT_BYTES {
+        return Err(too_large(v.len() as u64));
+    }
     Ok(v)
 }
 
-/// Reads a regular file as UTF-8 text.
+/// Reads a regular file as UTF-8 text, at most [`MAX_TEXT_BYTES`].
 ///
 /// # Errors
-/// As [`open_regular`], plus read errors and invalid UTF-8.
+/// As [`read_bytes`], plus invalid UTF-8.
 pub fn read_text(path: &Path) -> io::Result<String> {
-    let mut s = String::new();
-    io::Read::read_to_string(&mut open_regular(path)?, &mut s)?;
-    Ok(s)
+    String::from_utf8(read_bytes(path)?).map_err(|_| {
+        io::Error::new(
+            io::ErrorKind::InvalidData,
+            "stream did not contain valid UTF-8",
+        )
+    })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn huge_files_are_refused_before_they_are_read() {
+        let d = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+        let p = d.path().join("big.yaml");
+        let f = File::create(&p).unwrap_or_else(|e| panic!("{e}"));
+        f.set_len(3 << 30).unwrap_or_else(|e| panic!("{e}")); // sparse: no disk used
+        let e = read_text(&p).err().map(|e| e.to_string());
+        assert_eq!(
+            e.as_deref(),
+            Some("the file is 3072.0 MiB, more than the 64 MiB a text input may be")
+        );
+        f.set_len(MAX_TEXT_BYTES).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(
+            read_bytes(&p).map(|b| b.len() as u64).ok(),
+            Some(MAX_TEXT_BYTES)
+        );
+    }
 
     #[test]
     fn folders_are_refused() {

@@ -697,12 +697,42 @@ pub fn read_trace(path: &Path, frame: Option<(&MapFrame, f64)>) -> Result<Trace,
         path: path.to_path_buf(),
         source,
     };
-    // Read line by line: the file is never held whole in memory.
+    // Read line by line: the file is never held whole in memory, nor a line longer than
+    // `MAX_TEXT_BYTES` (a 3 GB file without a newline was read into one 3 GB line).
     let file = crate::file::open_regular(path).map_err(io_err)?;
     let len = file.metadata().map_err(io_err)?.len();
-    let lines = std::io::BufReader::new(file)
-        .lines()
-        .map(|l| l.map(std::borrow::Cow::Owned));
+    let mut reader = std::io::BufReader::new(file);
+    let limit = crate::file::MAX_TEXT_BYTES;
+    let lines = std::iter::from_fn(move || {
+        let mut buf = Vec::new();
+        match std::io::Read::take(&mut reader, limit + 1).read_until(b'\n', &mut buf) {
+            Ok(0) => None,
+            Ok(_) if buf.len() as u64 > limit => Some(Err(std::io::Error::new(
+                std::io::ErrorKind::InvalidData,
+                format!("a line is longer than {} MiB", limit >> 20),
+            ))),
+            Ok(_) => {
+                // As `BufRead::lines`: without the `\n` or `\r\n`.
+                if buf.last() == Some(&b'\n') {
+                    buf.pop();
+                    if buf.last() == Some(&b'\r') {
+                        buf.pop();
+                    }
+                }
+                Some(
+                    String::from_utf8(buf)
+                        .map(std::borrow::Cow::Owned)
+                        .map_err(|_| {
+                            std::io::Error::new(
+                                std::io::ErrorKind::InvalidData,
+                                "stream did not contain valid UTF-8",
+                            )
+                        }),
+                )
+            }
+            Err(e) => Some(Err(e)),
+        }
+    });
     parse_trace_lines(
         lines,
         usize::try_from(len).unwrap_or(usize::MAX),
