@@ -351,6 +351,10 @@ pub struct InfoArgs {
     /// Work area and keep-out zones (shown with their size and the accessible floor inside).
     #[command(flatten)]
     pub zones: ZoneArgs,
+    /// Memory budget (a map image whose pixels alone would need more is refused from its
+    /// header).
+    #[command(flatten)]
+    pub limits: LimitArgs,
     /// Print JSON.
     #[arg(long)]
     pub json: bool,

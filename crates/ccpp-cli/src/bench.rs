@@ -238,12 +238,17 @@ pub fn run(a: &BenchArgs) -> Result<()> {
                 inflate: a.inflate,
                 ..MapArgs::default()
             };
-            let map = prepare_map(&args)
-                .map(|mut p| {
-                    p.name.clone_from(name);
-                    p
-                })
-                .map_err(|e| crate::errors::one_line(&e));
+            let map = prepare_map(
+                &args,
+                a.limits
+                    .max_memory
+                    .unwrap_or(ccpp_io::scenario::DEFAULT_MAX_MEMORY_MB),
+            )
+            .map(|mut p| {
+                p.name.clone_from(name);
+                p
+            })
+            .map_err(|e| crate::errors::one_line(&e));
             (m.clone(), map)
         })
         .collect();
@@ -563,7 +568,7 @@ fn child_job() -> Result<String> {
     if std::env::var_os(ABORT_ENV).is_some_and(|h| h == planner) {
         std::process::abort();
     }
-    let mut map = crate::job::load_recipe(&spec.scenario.map)?;
+    let mut map = crate::job::load_recipe(&spec.scenario.map, spec.scenario.max_memory_mb)?;
     map.name.clone_from(&spec.map_name);
     let mut job = Job {
         scenario: spec.scenario,

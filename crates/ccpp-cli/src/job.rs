@@ -46,12 +46,13 @@ pub fn demo_recipe() -> MapRecipe {
     }
 }
 
-/// Loads the map of `recipe`: its file, or the bundled demo map when it names none.
-pub fn load_recipe(recipe: &MapRecipe) -> Result<PreparedMap> {
+/// Loads the map of `recipe`: its file (refused from its header when its pixels alone would
+/// need more than `max_memory_mb`), or the bundled demo map when it names none.
+pub fn load_recipe(recipe: &MapRecipe, max_memory_mb: u64) -> Result<PreparedMap> {
     if recipe.path.is_none() {
         return demo_map_with(recipe);
     }
-    Ok(recipe.load()?)
+    Ok(recipe.load_within(max_memory_mb)?)
 }
 
 /// Everything a run needs, validated.
@@ -100,9 +101,10 @@ pub fn recipe_from(args: &MapArgs) -> MapRecipe {
     }
 }
 
-/// Loads and prepares the map of `args` (validating overrides and inflation).
-pub fn prepare_map(args: &MapArgs) -> Result<PreparedMap> {
-    Ok(recipe_from(args).load()?)
+/// Loads and prepares the map of `args` (validating overrides and inflation; an image whose
+/// pixels alone would need more than `max_memory_mb` is refused from its header).
+pub fn prepare_map(args: &MapArgs, max_memory_mb: u64) -> Result<PreparedMap> {
+    Ok(recipe_from(args).load_within(max_memory_mb)?)
 }
 
 /// The robot and start of `args`, validated by the library.
@@ -491,7 +493,7 @@ impl Job {
             .zones(a.zones.area.clone(), a.zones.keepout.clone())
             .build()
             .map_err(|e| name_flag(e, &given))?;
-        let map = load_recipe(&scenario.map)?;
+        let map = load_recipe(&scenario.map, scenario.max_memory_mb)?;
         scenario.check_map(&map).map_err(|e| name_flag(e, &given))?;
         Ok(Self {
             scenario,
@@ -507,7 +509,7 @@ impl Job {
             None => FLAGSHIP,
         };
         let scenario = Scenario::configure(demo_recipe(), PlannerConfig::new(kind)).build()?;
-        let map = load_recipe(&scenario.map)?;
+        let map = load_recipe(&scenario.map, scenario.max_memory_mb)?;
         Ok(Self {
             scenario,
             map: Some(map),

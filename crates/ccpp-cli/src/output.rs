@@ -82,7 +82,7 @@ pub fn replay_dir(dir: &Path) -> Result<()> {
     })?;
     let scenario: Scenario =
         serde_json::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", rec_path.display()))?;
-    let map = crate::job::load_recipe(&scenario.map)?;
+    let map = crate::job::load_recipe(&scenario.map, scenario.max_memory_mb)?;
     let world = scenario.world(&map)?;
     // Poses must lie on the map (a robot cannot leave it): a damaged trace is refused here
     // instead of hanging the renderer.

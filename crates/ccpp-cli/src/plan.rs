@@ -48,7 +48,7 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         .build()
         .map_err(flag)?;
     check_target(&a.out)?;
-    let map = load_recipe(&scenario.map)?;
+    let map = load_recipe(&scenario.map, scenario.max_memory_mb)?;
     let plan = plan_route(&scenario, &map, DEFAULT_TOLERANCE_M).map_err(|e| match e {
         PlanError::Scenario(s) => flag(s),
         other @ PlanError::Online(..) => other.into(),

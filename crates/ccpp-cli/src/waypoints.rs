@@ -45,7 +45,7 @@ pub fn run(a: &WaypointsArgs) -> Result<()> {
     .zones(None, a.keepout.clone())
     .build()
     .map_err(flag)?;
-    let map = recipe_from(&a.map).load()?;
+    let map = recipe_from(&a.map).load_within(scenario.max_memory_mb)?;
     let world = scenario.world(&map).map_err(flag)?;
     let p = plan(&world, &opts);
     let text = if format == "csv" {

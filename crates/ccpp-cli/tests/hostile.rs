@@ -745,7 +745,7 @@ fn memory_refusals_give_finite_numbers_and_the_right_advice() {
         &["--max-memory", "1"],
         &[
             "about 2 MB",
-            "map pixels",
+            "160 x 120 px",
             "raise it with --max-memory",
             "smaller map",
         ],
@@ -1363,4 +1363,140 @@ fn replay_does_not_wait_on_a_fifo_metrics_file() {
         .assert()
         .success();
     assert!(done.join("replay.html").is_file());
+}
+
+/// A PNG whose header declares `w` x `h` 8-bit grey pixels, followed by one stored (raw) row of
+/// image data and no more: small on disk, huge once decoded.
+fn huge_png_header(path: &Path, w: u32, h: u32) {
+    fn crc32(bytes: &[u8]) -> u32 {
+        let mut c = 0xffff_ffffu32;
+        for &b in bytes {
+            c ^= u32::from(b);
+            for _ in 0..8 {
+                c = if c & 1 == 1 {
+                    0xedb8_8320 ^ (c >> 1)
+                } else {
+                    c >> 1
+                };
+            }
+        }
+        !c
+    }
+    fn chunk(out: &mut Vec<u8>, kind: [u8; 4], data: &[u8]) {
+        out.extend((data.len() as u32).to_be_bytes());
+        let mut body = kind.to_vec();
+        body.extend(data);
+        out.extend(&body);
+        out.extend(crc32(&body).to_be_bytes());
+    }
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    let mut ihdr = w.to_be_bytes().to_vec();
+    ihdr.extend(h.to_be_bytes());
+    ihdr.extend([8, 0, 0, 0, 0]); // 8-bit grey, deflate, no filter method, no interlace
+    chunk(&mut png, *b"IHDR", &ihdr);
+    // zlib header, then one non-final stored deflate block holding the first row.
+    let row = w as usize + 1;
+    let mut idat = vec![0x78, 0x01, 0x00];
+    idat.extend((row as u16).to_le_bytes());
+    idat.extend((!(row as u16)).to_le_bytes());
+    idat.extend(std::iter::repeat_n(0u8, row));
+    chunk(&mut png, *b"IDAT", &idat);
+    std::fs::write(path, png).unwrap();
+}
+
+/// A 20000 x 20000 px PNG of a few kB was decoded (786 MB with `--max-memory 100`, 3 GB and
+/// 30 s for `info`) before the memory estimate refused the run: it is now refused from its
+/// header, naming its size and the limit.
+#[test]
+fn a_map_image_too_large_for_the_memory_limit_is_refused_from_its_header() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let big = dir.join("big.png");
+    huge_png_header(&big, 20_000, 20_000);
+    let out = dir.join("out");
+    let limited = ["--max-memory", "100"];
+    let needles = |limit: &'static str| {
+        [
+            "big.png",
+            "20000 x 20000 px",
+            "64 bytes a pixel",
+            limit,
+            "--max-memory",
+        ]
+    };
+    let mut run = vec![
+        "run",
+        "--planner",
+        "ba-star",
+        "--map",
+        s(&big),
+        "--out",
+        s(&out),
+    ];
+    run.extend(limited);
+    refused(&run, &needles("memory limit of 100 MB"));
+    let mut plan = vec![
+        "plan",
+        "--planner",
+        "bcd",
+        "--map",
+        s(&big),
+        "--out",
+        s(&out),
+    ];
+    plan.extend(limited);
+    refused(&plan, &needles("memory limit of 100 MB"));
+    // Without --max-memory, the default limit (4096 MB) holds 64 Mpx: still far too large.
+    refused(
+        &["info", "--map", s(&big)],
+        &needles("memory limit of 4096 MB"),
+    );
+    // `info` takes --max-memory too: the 160 x 120 px pillars map needs 1.2 MB of pixels.
+    let pillars = pillars(dir);
+    refused(
+        &["info", "--map", s(&pillars), "--max-memory", "1"],
+        &["pillars.pgm", "160 x 120 px", "memory limit of 1 MB"],
+    );
+    refused(
+        &["info", "--map", s(&pillars), "--max-memory", "0"],
+        &["--max-memory", "must be >= 1 MB"],
+    );
+    ccpp()
+        .args(["info", "--map", s(&pillars), "--max-memory", "2"])
+        .assert()
+        .success();
+    refused(
+        &[
+            "waypoints",
+            "--map",
+            s(&big),
+            "--length",
+            "0.3",
+            "--width",
+            "0.3",
+        ],
+        &needles("memory limit of 4096 MB"),
+    );
+    let bench = dir.join("bench");
+    let b = ccpp()
+        .args([
+            "bench",
+            "--maps",
+            s(&big),
+            "--planners",
+            "ba-star",
+            "--quiet",
+        ])
+        .args(["--out", s(&bench)])
+        .args(limited)
+        .assert()
+        .get_output()
+        .clone();
+    let csv = std::fs::read_to_string(bench.join("results.csv")).unwrap_or_default();
+    assert!(
+        csv.contains("20000 x 20000 px"),
+        "{csv}\n{}",
+        String::from_utf8_lossy(&b.stderr)
+    );
+    assert!(!out.exists());
 }

@@ -76,6 +76,25 @@ pub enum ScenarioError {
     /// The map cannot be loaded.
     #[error(transparent)]
     Map(#[from] MapError),
+    /// The map image is too large for the memory limit (told by its header, before decoding).
+    #[error(
+        "map image {} is {width} x {height} px: its pixels alone would need about {needed_mb} MB in a run ({per_pixel} bytes a pixel), more than the memory limit of {limit_mb} MB (raise it with --max-memory MB / max_memory_mb, or use a smaller map: crop the image or downsample it)",
+        path.display()
+    )]
+    MapTooLarge {
+        /// The image file.
+        path: PathBuf,
+        /// Its width, px.
+        width: u32,
+        /// Its height, px.
+        height: u32,
+        /// Memory its pixels need in a run, MB (rounded up).
+        needed_mb: u64,
+        /// Bytes a pixel every run holds.
+        per_pixel: u64,
+        /// The limit, MB.
+        limit_mb: u64,
+    },
     /// The georeference file cannot be used.
     #[error("georef {}: {message}", path.display())]
     Georef {
@@ -262,21 +281,59 @@ impl MapRecipe {
         Ok(())
     }
 
-    /// Loads the map file and prepares it (georef, inflation).
+    /// Loads the map file and prepares it (georef, inflation), within the default memory limit
+    /// ([`DEFAULT_MAX_MEMORY_MB`]; see [`Self::load_within`]).
     ///
     /// # Errors
-    /// [`ScenarioError::NoMapPath`] without a path, else loading errors.
+    /// As [`Self::load_within`].
     pub fn load(&self) -> Result<PreparedMap, ScenarioError> {
+        self.load_within(DEFAULT_MAX_MEMORY_MB)
+    }
+
+    /// Loads the map file and prepares it (georef, inflation). An image whose pixels alone
+    /// would need more than `max_memory_mb` in a run (every run holds
+    /// [`PIXEL_BYTES`](ccpp_core::planners::settings::PIXEL_BYTES) bytes a pixel: grid,
+    /// distance transform, bitsets, known map, picture) is refused from its header, before it
+    /// is decoded; [`Scenario::check_map`] later checks the whole run's estimate.
+    ///
+    /// # Errors
+    /// [`ScenarioError::NoMapPath`] without a path, [`ScenarioError::MapTooLarge`], else
+    /// loading errors.
+    pub fn load_within(&self, max_memory_mb: u64) -> Result<PreparedMap, ScenarioError> {
         self.validate()?;
+        if max_memory_mb == 0 {
+            return Err(ScenarioError::Invalid(
+                "--max-memory / max_memory_mb must be >= 1 MB".into(),
+            ));
+        }
         let path = self.path.as_ref().ok_or(ScenarioError::NoMapPath)?;
+        let per_pixel = ccpp_core::planners::settings::PIXEL_BYTES as u64;
         let opts = LoadOptions {
             resolution: self.resolution,
             origin: self.origin,
             occupied_thresh: self.occupied_thresh,
             free_thresh: self.free_thresh,
             negate: None,
+            max_pixels: Some(max_memory_mb.saturating_mul(1024 * 1024) / per_pixel),
         };
-        let loaded = crate::phase::time("load map", || load_map(path, &opts))?;
+        let loaded =
+            crate::phase::time("load map", || load_map(path, &opts)).map_err(|e| match e {
+                MapError::TooLarge {
+                    path,
+                    width,
+                    height,
+                    ..
+                } => ScenarioError::MapTooLarge {
+                    path,
+                    width,
+                    height,
+                    needed_mb: (u64::from(width) * u64::from(height) * per_pixel)
+                        .div_ceil(1024 * 1024),
+                    per_pixel,
+                    limit_mb: max_memory_mb,
+                },
+                e => ScenarioError::Map(e),
+            })?;
         crate::phase::time("prepare map", || self.prepare(loaded))
     }
 
@@ -1125,7 +1182,7 @@ impl Scenario {
     /// As [`MapRecipe::load`] and [`run_on`](Self::run_on).
     pub fn run(&self) -> Result<Run, ScenarioError> {
         self.validate()?;
-        let map = self.map.load()?;
+        let map = self.map.load_within(self.max_memory_mb)?;
         self.run_on(&map)
     }
 }

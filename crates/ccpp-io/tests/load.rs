@@ -251,6 +251,7 @@ fn bare_image_defaults_and_overrides() {
         free_thresh: Some(0.25),
         occupied_thresh: Some(0.9),
         negate: Some(true),
+        max_pixels: None,
     };
     let m = load_map(&p, &opts).unwrap();
     let f = m.grid.frame();
@@ -489,4 +490,60 @@ fn unsupported_mode() {
         );
         names(&e, &name);
     }
+}
+
+#[test]
+fn an_image_with_more_pixels_than_allowed_is_refused_from_its_header() {
+    let d = tempfile::tempdir().unwrap();
+    let p = write(&d, "three.pgm", b"P5 3 1 255\n\x00\x80\xfe");
+    let with = |max| LoadOptions {
+        max_pixels: Some(max),
+        ..LoadOptions::default()
+    };
+    assert_eq!(load_map(&p, &with(3)).unwrap().grid.cells().len(), 3);
+    let e = load_map(&p, &with(2)).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            MapError::TooLarge {
+                width: 3,
+                height: 1,
+                max_pixels: 2,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    assert!(e.to_string().contains("three.pgm is 3 x 1 px"), "{e}");
+    // The header of a PNG is enough too: a 20000 x 20000 px header over a few bytes of data.
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    let mut ihdr = b"IHDR".to_vec();
+    ihdr.extend(20_000u32.to_be_bytes());
+    ihdr.extend(20_000u32.to_be_bytes());
+    ihdr.extend([8, 0, 0, 0, 0]);
+    png.extend(13u32.to_be_bytes());
+    png.extend(&ihdr);
+    png.extend(crc32(&ihdr).to_be_bytes());
+    // The decoder reads the header up to the first data chunk: an empty one.
+    png.extend(0u32.to_be_bytes());
+    png.extend(b"IDAT");
+    png.extend(crc32(b"IDAT").to_be_bytes());
+    let q = write(&d, "big.png", &png);
+    let e = load_map(&q, &with(1 << 20)).unwrap_err();
+    assert!(e.to_string().contains("big.png is 20000 x 20000 px"), "{e}");
+}
+
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut c = 0xffff_ffffu32;
+    for &b in bytes {
+        c ^= u32::from(b);
+        for _ in 0..8 {
+            c = if c & 1 == 1 {
+                0xedb8_8320 ^ (c >> 1)
+            } else {
+                c >> 1
+            };
+        }
+    }
+    !c
 }

@@ -983,7 +983,9 @@ fn bench_run(
             // The bench's distinct name of the map (two maps sharing a file stem).
             recipe.name.clone_from(&name);
         }
-        let map = recipe.load().map_err(|e| chain(&e))?;
+        let map = recipe
+            .load_within(max_memory_mb.unwrap_or(ccpp_io::scenario::DEFAULT_MAX_MEMORY_MB))
+            .map_err(|e| chain(&e))?;
         let scenario = Scenario::configure(map.recipe.clone(), PlannerConfig::new(kind))
             .robot(robot)
             .memory_limit(max_memory_mb)

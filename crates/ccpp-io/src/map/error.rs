@@ -68,6 +68,22 @@ pub enum MapError {
         /// What the decoder reported (flattened to one line).
         message: String,
     },
+    /// The image has more pixels than [`super::LoadOptions::max_pixels`] allows (told by its
+    /// header; nothing was decoded).
+    #[error(
+        "map image {} is {width} x {height} px, more than the {max_pixels} pixels allowed",
+        path.display()
+    )]
+    TooLarge {
+        /// The image file.
+        path: PathBuf,
+        /// Its width, px.
+        width: u32,
+        /// Its height, px.
+        height: u32,
+        /// The most pixels allowed.
+        max_pixels: u64,
+    },
     /// The YAML asks for a `mode` other than `trinary`.
     #[error(
         "map YAML {}: unsupported mode `{mode}` (only `trinary` is supported)",

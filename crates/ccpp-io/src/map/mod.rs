@@ -57,6 +57,9 @@ pub struct LoadOptions {
     pub free_thresh: Option<f64>,
     /// `negate`.
     pub negate: Option<bool>,
+    /// Most pixels the image may have: a larger one is refused from its header, before it is
+    /// decoded ([`MapError::TooLarge`]). `None`: only the decoder's own allocation limit.
+    pub max_pixels: Option<u64>,
 }
 
 /// A loaded map.
@@ -218,7 +221,7 @@ fn finish<R: std::io::BufRead + std::io::Seek>(
     validate_placement(resolution, origin, source)?;
     thresholds.validate(source)?;
 
-    let c = pixels::decode_and_classify(reader, &image_path, &thresholds)?;
+    let c = pixels::decode_and_classify(reader, &image_path, &thresholds, opts.max_pixels)?;
     let frame = MapFrame {
         width: c.width,
         height: c.height,

@@ -5,7 +5,7 @@
 //! is ignored; 16-bit samples are mapped to the 0..=255 scale as `v / 257` (exact, not truncated
 //! to 8 bits first); float samples as `v * 255` clamped to `[0, 255]`.
 
-use std::io::{BufRead, Seek};
+use std::io::{BufRead, Seek, SeekFrom};
 use std::path::Path;
 
 use ccpp_core::grid::Cell;
@@ -23,10 +23,13 @@ pub(crate) struct Classified {
 
 /// Decodes an image (format guessed from its content) and classifies every pixel. The decoded
 /// image buffer is dropped before returning, so at most the image plus the cells are alive.
+/// With `max_pixels`, the image's size is read from its header first and a larger image is
+/// refused before anything of its size is allocated.
 pub(crate) fn decode_and_classify<R: BufRead + Seek>(
     reader: ImageReader<R>,
     path: &Path,
     t: &Thresholds,
+    max_pixels: Option<u64>,
 ) -> Result<Classified, MapError> {
     let decode_err = |e: &dyn std::fmt::Display| MapError::Decode {
         path: path.to_path_buf(),
@@ -42,7 +45,7 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
             message: "not a PNG or PNM/PGM image (unrecognised content)".to_owned(),
         });
     }
-    let img = reader.decode().map_err(|e| match e {
+    let image_err = |e: image::ImageError| match e {
         image::ImageError::IoError(io) if io.kind() == std::io::ErrorKind::UnexpectedEof => {
             MapError::Decode {
                 path: path.to_path_buf(),
@@ -50,7 +53,41 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
             }
         }
         other => decode_err(&other),
-    })?;
+    };
+    let io_err = |e: std::io::Error| MapError::Io {
+        path: path.to_path_buf(),
+        source: e,
+    };
+    let reader = match max_pixels {
+        None => reader,
+        Some(max) => {
+            // The header alone, by a second reader over the same stream, which then goes back
+            // to where the image starts.
+            let format = reader.format();
+            let mut inner = reader.into_inner();
+            let start = inner.stream_position().map_err(io_err)?;
+            let mut peek = ImageReader::new(&mut inner);
+            if let Some(f) = format {
+                peek.set_format(f);
+            }
+            let (width, height) = peek.into_dimensions().map_err(image_err)?;
+            if u64::from(width) * u64::from(height) > max {
+                return Err(MapError::TooLarge {
+                    path: path.to_path_buf(),
+                    width,
+                    height,
+                    max_pixels: max,
+                });
+            }
+            inner.seek(SeekFrom::Start(start)).map_err(io_err)?;
+            let mut again = ImageReader::new(inner);
+            if let Some(f) = format {
+                again.set_format(f);
+            }
+            again
+        }
+    };
+    let img = reader.decode().map_err(image_err)?;
     let width = img.width() as usize;
     let height = img.height() as usize;
     let cells = classify_image(&img, t);
