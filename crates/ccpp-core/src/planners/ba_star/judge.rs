@@ -8,6 +8,9 @@ use crate::planner::{DiskState, KnownMap};
 /// segment near a row.
 const YPAD: f64 = 1e-6;
 
+/// Rows [`judge_motion_px`] first looks at together.
+const ROW_BLOCK: i64 = 8;
+
 /// A three-valued verdict from partial knowledge.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Judgement {
@@ -88,26 +91,66 @@ pub(super) fn judge_motion_px(known: &KnownMap, ga: Point, gb: Point, rc: f64) -
     // columns then need a margin only for rounding (`eps`, as the box above).
     let (rlo, rhi) = (-rc - YPAD - ga.y, rc + YPAD - ga.y);
     let inv_dy = 1.0 / dy;
-    for row in row0..=row1 {
-        let gy = h - row as f64 - 0.5;
-        // Parameter range of the segment whose y lies within rc of this row.
+    // The columns of the pixels within `rc` (in x) of the part of the segment whose y lies
+    // within `rc` of the rows with centres `gy_lo..=gy_hi`, or `None`.
+    let window = |gy_lo: f64, gy_hi: f64| -> Option<(i64, i64)> {
         let (tl, th) = if dy == 0.0 {
-            if (ga.y - gy).abs() > rc + 1e-9 {
-                continue;
+            if ga.y < gy_lo - rc - 1e-9 || ga.y > gy_hi + rc + 1e-9 {
+                return None;
             }
             (0.0, 1.0)
         } else {
-            let t1 = (gy + rlo) * inv_dy;
-            let t2 = (gy + rhi) * inv_dy;
+            let t1 = (gy_lo + rlo) * inv_dy;
+            let t2 = (gy_hi + rhi) * inv_dy;
             (t1.min(t2).max(0.0), t1.max(t2).min(1.0))
         };
         if tl > th + 1e-12 {
-            continue;
+            return None;
         }
         let xa = ga.x + tl * dx;
         let xb = ga.x + th * dx;
-        let c0 = ceil_i64(xa.min(xb) - rc - 0.5 - eps);
-        let c1 = floor_i64(xa.max(xb) + rc - 0.5 + eps);
+        Some((
+            ceil_i64(xa.min(xb) - rc - 0.5 - eps),
+            floor_i64(xa.max(xb) + rc - 0.5 + eps),
+        ))
+    };
+    let mut block_free_to = row0 - 1;
+    for row in row0..=row1 {
+        // A block of rows at a time first: the union of their windows inside the image and
+        // known free, none of them can block (long moves through the open: one look per
+        // block instead of one window per row).
+        if row > block_free_to && (row - row0) % ROW_BLOCK == 0 {
+            let last = (row + ROW_BLOCK - 1).min(row1);
+            let (gy_lo, gy_hi) = (h - last as f64 - 0.5, h - row as f64 - 0.5);
+            match window(gy_lo, gy_hi) {
+                None => {
+                    block_free_to = last;
+                }
+                Some((c0, c1)) => {
+                    if row >= 0
+                        && last < hh
+                        && c0 >= 0
+                        && c1 < w
+                        && (c0 > c1
+                            || known.rect_known_free(
+                                row as usize,
+                                last as usize,
+                                c0 as usize,
+                                c1 as usize,
+                            ))
+                    {
+                        block_free_to = last;
+                    }
+                }
+            }
+        }
+        if row <= block_free_to {
+            continue;
+        }
+        let gy = h - row as f64 - 0.5;
+        let Some((c0, c1)) = window(gy, gy) else {
+            continue;
+        };
         let touches = |col: i64| {
             let q = Point::new(col as f64 + 0.5, gy);
             point_segment_dist2(q, ga, gb) < rc2 && first_entry(ga, gb, q, rc).is_some()
