@@ -477,12 +477,31 @@ impl KnownMap {
         col0: usize,
         col1: usize,
     ) -> bool {
+        if col0 > col1 {
+            return true;
+        }
         let w = self.grid.frame().width;
         let free = self.free.as_slice();
-        (row0..=row1).all(|row| {
-            let base = row * w;
-            crate::bits::for_each_set(base + col0, base + col1 + 1, |k| !free[k], |_| false)
-        })
+        for row in row0..=row1 {
+            // Bits `a..=b` of the image: the first and last blocks masked, whole blocks between.
+            let (a, b) = (row * w + col0, row * w + col1);
+            let (ka, kb) = (a / BLOCK_BITS, b / BLOCK_BITS);
+            let lo = usize::MAX << (a % BLOCK_BITS);
+            let hi = usize::MAX >> (BLOCK_BITS - 1 - b % BLOCK_BITS);
+            if ka == kb {
+                if !free[ka] & lo & hi != 0 {
+                    return false;
+                }
+                continue;
+            }
+            if !free[ka] & lo != 0
+                || !free[kb] & hi != 0
+                || free[ka + 1..kb].iter().any(|&v| v != usize::MAX)
+            {
+                return false;
+            }
+        }
+        true
     }
 
     /// What is known of the disk of radius `rc` pixels at grid point `g`: the pixels whose

@@ -4,6 +4,13 @@ use crate::collide::contact_radius_px;
 use crate::geometry::{ceil_i64, first_entry, floor_i64, point_segment_dist2, Point};
 use crate::planner::{DiskState, KnownMap};
 
+/// How much wider than the contact radius (pixels) [`judge_motion_px`] finds the part of a
+/// segment near a row.
+const YPAD: f64 = 1e-6;
+
+/// Rows [`judge_motion_px`] first looks at together.
+const ROW_BLOCK: i64 = 8;
+
 /// A three-valued verdict from partial knowledge.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Judgement {
@@ -78,26 +85,72 @@ pub(super) fn judge_motion_px(known: &KnownMap, ga: Point, gb: Point, rc: f64) -
         return Judgement::Free;
     }
     let mut undetermined = false;
-    for row in row0..=row1 {
-        let gy = h - row as f64 - 0.5;
-        // Parameter range of the segment whose y lies within rc of this row.
+    // Each row's window: the pixels whose centre is within `rc` (in x) of the part of the
+    // segment within `rc` (in y) of the row. That part is found for a radius a hair wider
+    // (`YPAD`, far above the rounding of the parameters), so it holds the exact part; the
+    // columns then need a margin only for rounding (`eps`, as the box above).
+    let (rlo, rhi) = (-rc - YPAD - ga.y, rc + YPAD - ga.y);
+    let inv_dy = 1.0 / dy;
+    // The columns of the pixels within `rc` (in x) of the part of the segment whose y lies
+    // within `rc` of the rows with centres `gy_lo..=gy_hi`, or `None`.
+    let window = |gy_lo: f64, gy_hi: f64| -> Option<(i64, i64)> {
         let (tl, th) = if dy == 0.0 {
-            if (ga.y - gy).abs() > rc + 1e-9 {
-                continue;
+            if ga.y < gy_lo - rc - 1e-9 || ga.y > gy_hi + rc + 1e-9 {
+                return None;
             }
             (0.0, 1.0)
         } else {
-            let t1 = (gy - rc - ga.y) / dy;
-            let t2 = (gy + rc - ga.y) / dy;
+            let t1 = (gy_lo + rlo) * inv_dy;
+            let t2 = (gy_hi + rhi) * inv_dy;
             (t1.min(t2).max(0.0), t1.max(t2).min(1.0))
         };
         if tl > th + 1e-12 {
-            continue;
+            return None;
         }
         let xa = ga.x + tl * dx;
         let xb = ga.x + th * dx;
-        let c0 = floor_i64(xa.min(xb) - rc - 0.5) - 1;
-        let c1 = ceil_i64(xa.max(xb) + rc - 0.5) + 1;
+        Some((
+            ceil_i64(xa.min(xb) - rc - 0.5 - eps),
+            floor_i64(xa.max(xb) + rc - 0.5 + eps),
+        ))
+    };
+    let mut block_free_to = row0 - 1;
+    for row in row0..=row1 {
+        // A block of rows at a time first: the union of their windows inside the image and
+        // known free, none of them can block (long moves through the open: one look per
+        // block instead of one window per row).
+        if row > block_free_to && (row - row0) % ROW_BLOCK == 0 {
+            let last = (row + ROW_BLOCK - 1).min(row1);
+            let (gy_lo, gy_hi) = (h - last as f64 - 0.5, h - row as f64 - 0.5);
+            match window(gy_lo, gy_hi) {
+                None => {
+                    block_free_to = last;
+                }
+                Some((c0, c1)) => {
+                    if row >= 0
+                        && last < hh
+                        && c0 >= 0
+                        && c1 < w
+                        && (c0 > c1
+                            || known.rect_known_free(
+                                row as usize,
+                                last as usize,
+                                c0 as usize,
+                                c1 as usize,
+                            ))
+                    {
+                        block_free_to = last;
+                    }
+                }
+            }
+        }
+        if row <= block_free_to {
+            continue;
+        }
+        let gy = h - row as f64 - 0.5;
+        let Some((c0, c1)) = window(gy, gy) else {
+            continue;
+        };
         let touches = |col: i64| {
             let q = Point::new(col as f64 + 0.5, gy);
             point_segment_dist2(q, ga, gb) < rc2 && first_entry(ga, gb, q, rc).is_some()
@@ -153,5 +206,124 @@ impl From<DiskState> for Judgement {
             DiskState::Blocked => Judgement::Blocked,
             DiskState::Unseen => Judgement::Undetermined,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{judge_motion_px, Judgement};
+    use crate::geometry::{ceil_i64, first_entry, floor_i64, point_segment_dist2, Point};
+    use crate::grid::{Cell, GridMap, MapFrame};
+    use crate::planner::{KnownMap, Scan};
+
+    /// The verdict by brute force: every pixel of a box around the capsule, inside the image
+    /// or not, tested with the contact predicate.
+    fn brute(known: &KnownMap, ga: Point, gb: Point, rc: f64) -> Judgement {
+        let f = *known.frame();
+        let h = f.height as f64;
+        let (w, hh) = (f.width as i64, f.height as i64);
+        let rows = floor_i64(h - ga.y.max(gb.y) - rc - 0.5) - 2
+            ..=ceil_i64(h - ga.y.min(gb.y) + rc - 0.5) + 2;
+        let cols =
+            floor_i64(ga.x.min(gb.x) - rc - 0.5) - 2..=ceil_i64(ga.x.max(gb.x) + rc - 0.5) + 2;
+        let mut unseen = false;
+        for row in rows {
+            for col in cols.clone() {
+                let q = Point::new(col as f64 + 0.5, h - row as f64 - 0.5);
+                if point_segment_dist2(q, ga, gb) >= rc * rc || first_entry(ga, gb, q, rc).is_none()
+                {
+                    continue;
+                }
+                if row < 0 || row >= hh || col < 0 || col >= w {
+                    return Judgement::Blocked;
+                }
+                let i = f.index(col as usize, row as usize);
+                if known.known_free().contains(i) {
+                    continue;
+                }
+                if known.seen().contains(i) {
+                    return Judgement::Blocked;
+                }
+                unseen = true;
+            }
+        }
+        if unseen {
+            Judgement::Undetermined
+        } else {
+            Judgement::Free
+        }
+    }
+
+    /// The row windows give the brute-force verdict: random maps with walls, clutter and
+    /// unseen parts, moves between pixel centres (the extension's), along walls, axis-aligned
+    /// and random, for contact radii of a few pixels, out of the image too.
+    #[test]
+    fn judge_motion_px_matches_brute_force() {
+        let mut rng = crate::rng::SplitMix64::new(0x1d6e_5eed);
+        let mut counts = [0usize; 3];
+        for round in 0..60 {
+            let (w, h) = (40 + round % 7, 30 + round % 5);
+            let mut cells = vec![Cell::Free; w * h];
+            for (k, c) in cells.iter_mut().enumerate() {
+                let (col, row) = (k % w, k / w);
+                let u = rng.next_f64();
+                if col == 5 + round % 3 || row == 25 || u < 0.004 {
+                    *c = Cell::Occupied;
+                } else if u < 0.008 {
+                    *c = Cell::Unknown;
+                }
+            }
+            let truth = GridMap::new(MapFrame::new(w, h, 0.05), cells).unwrap();
+            let mut known = KnownMap::new(truth.frame());
+            for _ in 0..3 {
+                let c = Point::new(
+                    rng.range(0.0, w as f64 * 0.05),
+                    rng.range(0.0, h as f64 * 0.05),
+                );
+                known.integrate(&Scan::new(&truth, c, rng.range(0.5, 2.0)));
+            }
+            let rc = crate::collide::contact_radius_px(rng.range(0.5, 7.0));
+            for k in 0..400 {
+                let pick = |rng: &mut crate::rng::SplitMix64| {
+                    let x = rng.range(-2.0, w as f64 + 2.0);
+                    let y = rng.range(-2.0, h as f64 + 2.0);
+                    if k % 2 == 0 {
+                        Point::new(x.floor() + 0.5, y.floor() + 0.5)
+                    } else {
+                        Point::new(x, y)
+                    }
+                };
+                let ga = pick(&mut rng);
+                let mut gb = match k % 5 {
+                    0 => Point::new(ga.x + rng.range(-12.0, 12.0).round(), ga.y),
+                    1 => Point::new(ga.x, ga.y + rng.range(-12.0, 12.0).round()),
+                    2 => {
+                        let t = rng.range(-10.0, 10.0).round();
+                        Point::new(ga.x + t, ga.y + t)
+                    }
+                    _ => pick(&mut rng),
+                };
+                if k % 11 == 3 {
+                    // Axis-aligned up to a round trip through world coordinates.
+                    gb = Point::new(gb.x, ga.y + 1e-12 * rng.range(-1.0, 1.0));
+                } else if k % 11 == 4 {
+                    gb = Point::new(ga.x + 1e-12 * rng.range(-1.0, 1.0), gb.y);
+                }
+                if k % 7 == 0 {
+                    gb = Point::new(
+                        ga.x + rng.range(-1.0, 1.0).round(),
+                        ga.y + rng.range(-1.0, 1.0).round(),
+                    );
+                }
+                let want = brute(&known, ga, gb, rc);
+                assert_eq!(
+                    judge_motion_px(&known, ga, gb, rc),
+                    want,
+                    "{ga:?} {gb:?} rc {rc}"
+                );
+                counts[want as usize] += 1;
+            }
+        }
+        assert!(counts.iter().all(|&n| n > 100), "{counts:?}");
     }
 }

@@ -4,7 +4,7 @@
 
 use super::graph::NB;
 use super::{Extension, Px};
-use crate::geometry::Point;
+use crate::geometry::{floor_i64, Point};
 use crate::planner::KnownMap;
 
 /// log2 of the key range one [`BucketQueue`] bucket holds (a sixteenth of an orthogonal step).
@@ -172,6 +172,24 @@ const CUT_OFF_MAX: usize = 1024;
 /// Heuristic weight of transfer searches.
 const ROUTE_WEIGHT: f64 = 1.5;
 
+/// The transfer search's heuristic at grid point `c` for the goal `g`:
+/// `floor(|c - g| * ROUTE_WEIGHT * COST_ORTHO)` with the distance by `hypot`. A square root
+/// is within a few units in the last place of `hypot` (far cheaper than the libm call), so
+/// its floor is the same wherever the product lies more than a rounding margin from an
+/// integer; next to one, `hypot` decides.
+#[inline]
+fn route_heuristic(c: Point, g: Point) -> u64 {
+    let (dx, dy) = (c.x - g.x, c.y - g.y);
+    let v = (dx * dx + dy * dy).sqrt() * ROUTE_WEIGHT * COST_ORTHO as f64;
+    let f = floor_i64(v);
+    let frac = v - f as f64;
+    let margin = 1e-6 + v * 1e-12;
+    if f >= 0 && frac > margin && frac < 1.0 - margin {
+        return f as u64;
+    }
+    (c.dist(g) * ROUTE_WEIGHT * COST_ORTHO as f64).floor() as u64
+}
+
 impl Extension {
     fn begin(&mut self) {
         self.generation = (self.generation + 1) % NODE_GENS;
@@ -209,9 +227,7 @@ impl Extension {
         let found = match goal {
             None => self.search_with(known, from, limit, &|_: &Self, _: Px| 0, &mut heap, done),
             Some(g) => {
-                let h = move |s: &Self, p: Px| -> u64 {
-                    (s.center(p).dist(g) * ROUTE_WEIGHT * COST_ORTHO as f64).floor() as u64
-                };
+                let h = move |s: &Self, p: Px| route_heuristic(s.center(p), g);
                 self.search_with(known, from, limit, &h, &mut heap, done)
             }
         };
@@ -484,9 +500,10 @@ impl Extension {
 #[cfg(test)]
 mod tests {
     use super::{
-        node, node_cost, node_gen, node_move, BucketQueue, BUCKET_MAX, BUCKET_SHIFT, CLOSED,
-        NODE_COST_SHIFT, NODE_GENS,
+        node, node_cost, node_gen, node_move, route_heuristic, BucketQueue, BUCKET_MAX,
+        BUCKET_SHIFT, CLOSED, COST_ORTHO, NODE_COST_SHIFT, NODE_GENS, ROUTE_WEIGHT,
     };
+    use crate::geometry::Point;
     use proptest::prelude::*;
     use std::cmp::Reverse;
     use std::collections::BinaryHeap;
@@ -497,6 +514,31 @@ mod tests {
             8 => 0u64..20_000,
             1 => Just((BUCKET_MAX as u64) << BUCKET_SHIFT).prop_flat_map(|b| b..b + 5_000),
         ]
+    }
+
+    /// The heuristic's fast square root gives `hypot`'s floor: random points, points on the
+    /// same row or column as the goal, distances that are whole numbers of steps.
+    #[test]
+    fn route_heuristic_is_hypot_floor() {
+        let mut rng = crate::rng::SplitMix64::new(0x4079_0715);
+        let want =
+            |c: Point, g: Point| (c.dist(g) * ROUTE_WEIGHT * COST_ORTHO as f64).floor() as u64;
+        for k in 0..200_000 {
+            let g = Point::new(rng.range(-10.0, 3000.0), rng.range(-10.0, 3000.0));
+            let c = match k % 4 {
+                0 => Point::new(
+                    rng.range(0.0, 3000.0).floor() + 0.5,
+                    rng.range(0.0, 3000.0).floor() + 0.5,
+                ),
+                1 => Point::new(g.x, g.y + rng.range(-500.0, 500.0).round() / 3.0),
+                2 => Point::new(
+                    g.x + 3.0 * rng.range(0.0, 100.0).round(),
+                    g.y + 4.0 * rng.range(0.0, 100.0).round(),
+                ),
+                _ => Point::new(rng.range(-1e5, 1e5), rng.range(-1e5, 1e5)),
+            };
+            assert_eq!(route_heuristic(c, g), want(c, g), "{c:?} {g:?}");
+        }
     }
 
     /// A node gives back the cost, move and generation it was made of, with or without the
