@@ -144,6 +144,8 @@ fn check_geojson(text: &str, route: &Route, metrics: Option<&serde_json::Value>)
             assert_eq!(f["properties"]["planner"], m["planner"]);
             let mut got = f["properties"]["metrics"].clone();
             let mut want = m.clone();
+            // Left out: the one number that differs between identical runs.
+            assert!(got.get("wall_time_s").is_none(), "{got}");
             got["wall_time_s"] = 0.into();
             want["wall_time_s"] = 0.into();
             assert_eq!(got, want);
@@ -185,6 +187,21 @@ fn run_export_writes_each_format_beside_the_other_files() {
             "waypoints.json"
         ]
     );
+    // The same run again gives the same export files, byte for byte (path.geojson's metrics
+    // leave the wall time out).
+    let again = run_ok(d.path(), "again", &map, "bsa", &all);
+    for f in [
+        "nav_path.yaml",
+        "path.geojson",
+        "waypoints.csv",
+        "waypoints.json",
+    ] {
+        assert_eq!(
+            std::fs::read(ex.join(f)).unwrap(),
+            std::fs::read(again.join(f)).unwrap(),
+            "{f}"
+        );
+    }
     // The exports change nothing else.
     for f in ["path.csv", "trace.jsonl", "coverage.png", "run.json"] {
         assert_eq!(

@@ -390,7 +390,8 @@ fn closed_ring(ring: &[[f64; 2]]) -> Vec<[f64; 2]> {
 /// (a single waypoint is repeated so the line has the two positions `GeoJSON` requires; an empty
 /// route has a `null` geometry) with properties `kind: "path"`, `frame_id`, `planner`, `map`,
 /// `robot` (`radius_m`, `tool_radius_m`), `route` (`waypoints`, `length_m`, `tolerance_m`) and
-/// `metrics` (the run's metrics, or `null` for a plan that was not measured). Then one
+/// `metrics` (the run's metrics but `wall_time_s`, which differs between identical runs, or
+/// `null` for a plan that was not measured). Then one
 /// `Polygon` feature per entry of `polygons` with properties `kind` and `name`, rings closed.
 ///
 /// # Errors
@@ -410,10 +411,15 @@ pub fn geojson(
     } else {
         json!({ "type": "LineString", "coordinates": coords })
     };
-    let metrics = match meta.metrics {
+    let mut metrics = match meta.metrics {
         Some(m) => serde_json::to_value(m)?,
         None => Value::Null,
     };
+    // The wall time is the one number that differs between identical runs; a path export
+    // leaves it out, so that the same inputs give the same file.
+    if let Value::Object(fields) = &mut metrics {
+        fields.remove("wall_time_s");
+    }
     let mut features = vec![json!({
         "type": "Feature",
         "geometry": geometry,
