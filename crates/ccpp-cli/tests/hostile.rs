@@ -586,6 +586,25 @@ fn a_landmarks_file_without_a_landmark_is_refused() {
         );
         assert!(!out.exists());
     }
+    // A file that cannot be read is named once (it was `landmarks F: cannot read landmark
+    // file F: ...`).
+    let missing = dir.join("missing.csv");
+    let a = ccpp()
+        .args([
+            "run",
+            "--planner",
+            "bcd",
+            "--map",
+            s(&map),
+            "--odometry-noise",
+            "0.1",
+        ])
+        .args(["--landmarks", s(&missing), "--out", s(&out)])
+        .assert()
+        .failure();
+    let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
+    assert!(err.contains("missing.csv: cannot read it: "), "{err}");
+    assert_eq!(err.matches("missing.csv").count(), 1, "{err}");
 }
 
 /// `ccpp bench --out` into a folder of the user's overwrote their `results.csv` (a run refuses

@@ -22,8 +22,9 @@ use crate::georef::fields;
 /// Errors reading a landmark file.
 #[derive(Debug, thiserror::Error)]
 pub enum LandmarkFileError {
-    /// The file could not be read.
-    #[error("cannot read landmark file {path}: {source}")]
+    /// The file could not be read (the message leaves the path to the caller, which names the
+    /// file once, as `landmarks FILE: cannot read it: ...`).
+    #[error("cannot read it: {source}")]
     Io {
         /// The file.
         path: PathBuf,
