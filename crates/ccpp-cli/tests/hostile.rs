@@ -1470,6 +1470,14 @@ fn a_map_image_too_large_for_the_memory_limit_is_refused_from_its_header() {
         &["info", "--map", s(&big)],
         &needles("memory limit of 4096 MB"),
     );
+    // The largest size a PGM header can state: its need is beyond u64 bytes (it wrapped to a
+    // wrong figure), so it is told in exponent form.
+    let widest = dir.join("widest.pgm");
+    std::fs::write(&widest, b"P5 4294967295 4294967295 255\n\x00\x00").unwrap();
+    refused(
+        &["info", "--map", s(&widest)],
+        &["4294967295 x 4294967295 px", "about 1.1e15 MB"],
+    );
     // `info` takes --max-memory too: the 160 x 120 px pillars map needs 1.2 MB of pixels.
     let pillars = pillars(dir);
     refused(

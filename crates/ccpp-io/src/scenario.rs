@@ -78,7 +78,7 @@ pub enum ScenarioError {
     Map(#[from] MapError),
     /// The map image is too large for the memory limit (told by its header, before decoding).
     #[error(
-        "map image {} is {width} x {height} px: its pixels alone would need about {needed_mb} MB in a run ({per_pixel} bytes a pixel), more than the memory limit of {limit_mb} MB (raise it with --max-memory MB / max_memory_mb, or use a smaller map: crop the image or downsample it)",
+        "map image {} is {width} x {height} px: its pixels alone would need {needed} in a run ({per_pixel} bytes a pixel), more than the memory limit of {limit_mb} MB (raise it with --max-memory MB / max_memory_mb, or use a smaller map: crop the image or downsample it)",
         path.display()
     )]
     MapTooLarge {
@@ -88,8 +88,8 @@ pub enum ScenarioError {
         width: u32,
         /// Its height, px.
         height: u32,
-        /// Memory its pixels need in a run, MB (rounded up).
-        needed_mb: u64,
+        /// Memory its pixels need in a run: `about 1234 MB` (rounded up) or `about 1.2e15 MB`.
+        needed: String,
         /// Bytes a pixel every run holds.
         per_pixel: u64,
         /// The limit, MB.
@@ -327,8 +327,9 @@ impl MapRecipe {
                     path,
                     width,
                     height,
-                    needed_mb: (u64::from(width) * u64::from(height) * per_pixel)
-                        .div_ceil(1024 * 1024),
+                    // In floating point: 4e9 x 4e9 px (a PGM header may say so) times 64 bytes
+                    // is beyond u64.
+                    needed: about_mb(f64::from(width) * f64::from(height) * per_pixel as f64),
                     per_pixel,
                     limit_mb: max_memory_mb,
                 },
@@ -376,6 +377,19 @@ impl MapRecipe {
             source: loaded.source,
             recipe: self.clone(),
         })
+    }
+}
+
+/// A memory need of `bytes` as the refusals print it: `about 1234 MB` (rounded up), `about
+/// 1.0e297 MB` from 1e9 MB up, or `unbounded memory` when the estimate overflowed.
+fn about_mb(bytes: f64) -> String {
+    let mb = bytes / (1024.0 * 1024.0);
+    if !mb.is_finite() {
+        "unbounded memory".to_string()
+    } else if mb < 1e9 {
+        format!("about {:.0} MB", mb.ceil())
+    } else {
+        format!("about {mb:.1e} MB")
     }
 }
 
@@ -892,13 +906,7 @@ impl Scenario {
         let limit = self.max_memory_mb as f64 * 1024.0 * 1024.0;
         if est.bytes.is_nan() || est.bytes > limit {
             let mb = est.bytes / (1024.0 * 1024.0);
-            let needed = if !mb.is_finite() {
-                "unbounded memory".to_string()
-            } else if mb < 1e9 {
-                format!("about {:.0} MB", mb.ceil())
-            } else {
-                format!("about {mb:.1e} MB")
-            };
+            let needed = about_mb(est.bytes);
             // Beyond a petabyte no limit is the answer: only the cause can be changed.
             let advice = if mb <= MAX_SENSIBLE_MB {
                 format!(
