@@ -114,6 +114,14 @@ pub struct LimitArgs {
     pub max_memory: Option<u64>,
 }
 
+impl LimitArgs {
+    /// The limit in MB: `--max-memory`, else the library's default.
+    pub fn max_memory_mb(&self) -> u64 {
+        self.max_memory
+            .unwrap_or(ccpp_io::scenario::DEFAULT_MAX_MEMORY_MB)
+    }
+}
+
 /// `ccpp run`.
 #[derive(Args, Debug)]
 #[command(allow_negative_numbers = true)]

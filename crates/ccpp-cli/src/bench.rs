@@ -238,17 +238,12 @@ pub fn run(a: &BenchArgs) -> Result<()> {
                 inflate: a.inflate,
                 ..MapArgs::default()
             };
-            let map = prepare_map(
-                &args,
-                a.limits
-                    .max_memory
-                    .unwrap_or(ccpp_io::scenario::DEFAULT_MAX_MEMORY_MB),
-            )
-            .map(|mut p| {
-                p.name.clone_from(name);
-                p
-            })
-            .map_err(|e| crate::errors::one_line(&e));
+            let map = prepare_map(&args, a.limits.max_memory_mb())
+                .map(|mut p| {
+                    p.name.clone_from(name);
+                    p
+                })
+                .map_err(|e| crate::errors::one_line(&e));
             (m.clone(), map)
         })
         .collect();

@@ -69,12 +69,7 @@ struct ZonesInfo {
 /// Runs `ccpp info`.
 pub fn run(a: &InfoArgs) -> Result<()> {
     let (robot, start) = robot_from(&a.robot)?;
-    let map = prepare_map(
-        &a.map,
-        a.limits
-            .max_memory
-            .unwrap_or(ccpp_io::scenario::DEFAULT_MAX_MEMORY_MB),
-    )?;
+    let map = prepare_map(&a.map, a.limits.max_memory_mb())?;
     let g = &map.grid;
     let f = *g.frame();
     let (free, occ, unk) = g.counts();

@@ -301,11 +301,7 @@ impl MapRecipe {
     /// loading errors.
     pub fn load_within(&self, max_memory_mb: u64) -> Result<PreparedMap, ScenarioError> {
         self.validate()?;
-        if max_memory_mb == 0 {
-            return Err(ScenarioError::Invalid(
-                "--max-memory / max_memory_mb must be >= 1 MB".into(),
-            ));
-        }
+        check_memory_limit(max_memory_mb)?;
         let path = self.path.as_ref().ok_or(ScenarioError::NoMapPath)?;
         let per_pixel = ccpp_core::planners::settings::PIXEL_BYTES as u64;
         let opts = LoadOptions {
@@ -565,6 +561,16 @@ fn join_scoped<T>(h: std::thread::ScopedJoinHandle<'_, T>) -> T {
     }
 }
 
+/// Refuses a memory limit of 0 MB (a scenario's, or the one a map is loaded within).
+fn check_memory_limit(mb: u64) -> Result<(), ScenarioError> {
+    if mb == 0 {
+        return Err(invalid(
+            "--max-memory / max_memory_mb must be >= 1 MB".into(),
+        ));
+    }
+    Ok(())
+}
+
 fn invalid(msg: String) -> ScenarioError {
     ScenarioError::Invalid(msg)
 }
@@ -695,11 +701,7 @@ impl Scenario {
                 self.planner.name()
             )));
         }
-        if self.max_memory_mb == 0 {
-            return Err(invalid(
-                "--max-memory / max_memory_mb must be >= 1 MB".into(),
-            ));
-        }
+        check_memory_limit(self.max_memory_mb)?;
         self.planner.validate()?;
         self.validate_zones()?;
         Ok(())

@@ -41,7 +41,6 @@ create_exception!(
      The message is the one-line message of the command line."
 );
 
-/// The message of `e` and its causes, as the command line prints them (`anyhow`'s `{:#}`).
 /// The error and its causes as one line, each cause once (as the command line prints them):
 /// a cause whose text the line already holds is skipped (`cannot read /tmp: not a regular
 /// file` was followed by `: not a regular file`), one that repeats the line and adds to it

@@ -35,16 +35,17 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
         path: path.to_path_buf(),
         message: one_line(&e.to_string()),
     };
-    let reader = reader.with_guessed_format().map_err(|e| MapError::Io {
+    let io_err = |e: std::io::Error| MapError::Io {
         path: path.to_path_buf(),
         source: e,
-    })?;
-    if reader.format().is_none() {
+    };
+    let reader = reader.with_guessed_format().map_err(io_err)?;
+    let Some(format) = reader.format() else {
         return Err(MapError::Decode {
             path: path.to_path_buf(),
             message: "not a PNG or PNM/PGM image (unrecognised content)".to_owned(),
         });
-    }
+    };
     let image_err = |e: image::ImageError| match e {
         image::ImageError::IoError(io) if io.kind() == std::io::ErrorKind::UnexpectedEof => {
             MapError::Decode {
@@ -54,23 +55,16 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
         }
         other => decode_err(&other),
     };
-    let io_err = |e: std::io::Error| MapError::Io {
-        path: path.to_path_buf(),
-        source: e,
-    };
     let reader = match max_pixels {
         None => reader,
         Some(max) => {
             // The header alone, by a second reader over the same stream, which then goes back
             // to where the image starts.
-            let format = reader.format();
             let mut inner = reader.into_inner();
             let start = inner.stream_position().map_err(io_err)?;
-            let mut peek = ImageReader::new(&mut inner);
-            if let Some(f) = format {
-                peek.set_format(f);
-            }
-            let (width, height) = peek.into_dimensions().map_err(image_err)?;
+            let (width, height) = ImageReader::with_format(&mut inner, format)
+                .into_dimensions()
+                .map_err(image_err)?;
             if u64::from(width) * u64::from(height) > max {
                 return Err(MapError::TooLarge {
                     path: path.to_path_buf(),
@@ -80,11 +74,7 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
                 });
             }
             inner.seek(SeekFrom::Start(start)).map_err(io_err)?;
-            let mut again = ImageReader::new(inner);
-            if let Some(f) = format {
-                again.set_format(f);
-            }
-            again
+            ImageReader::with_format(inner, format)
         }
     };
     let img = reader.decode().map_err(image_err)?;
