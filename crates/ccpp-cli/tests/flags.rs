@@ -208,6 +208,33 @@ fn execution_flags_reach_the_simulator() {
         &["--odometry-noise", "PID"],
     );
     run_fails(dir, &map, "bsa", &["--exec", "fast"], &["--exec"]);
+    // Noise beyond what odometry measures is refused, naming the flag and the bound.
+    run_fails(
+        dir,
+        &map,
+        "bsa",
+        &["--odometry-noise", "1e300"],
+        &["--odometry-noise", "linear_rel_std", "at most 1", "1e300"],
+    );
+    run_fails(
+        dir,
+        &map,
+        "bsa",
+        &["--odometry-noise", "0.1,1.5"],
+        &["--odometry-noise", "angular_rel_std", "at most 1", "1.5"],
+    );
+    run_fails(
+        dir,
+        &map,
+        "bsa",
+        &["--odometry-noise", "0.1,0.1,7"],
+        &[
+            "--odometry-noise",
+            "heading_drift_std",
+            "at most 6",
+            "got 7",
+        ],
+    );
     // PID settings from the options file and `--exec ideal` together: the flag would drop
     // them, so the pair is refused, naming the file and the section.
     let pid_cfg = dir.join("pid.yaml");

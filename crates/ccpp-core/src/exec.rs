@@ -154,12 +154,12 @@ impl Pid {
 pub struct OdometryNoise {
     /// Seed of the noise sequence (same seed, same trace).
     pub seed: u64,
-    /// Relative standard deviation of the linear speed, per step.
+    /// Relative standard deviation of the linear speed, per step; in `[0, 1]`.
     pub linear_rel_std: f64,
-    /// Relative standard deviation of the angular speed, per step.
+    /// Relative standard deviation of the angular speed, per step; in `[0, 1]`.
     pub angular_rel_std: f64,
     /// Heading drift while driving, rad/s per m/s (i.e. rad per metre), standard deviation per
-    /// step.
+    /// step; in `[0, 6]`.
     pub heading_drift_std: f64,
 }
 

@@ -676,7 +676,14 @@ impl Scenario {
             return Err(invalid("sim.max_steps must be >= 1".into()));
         }
         if let Some(e) = &self.sim.exec {
-            validate_execution("sim.exec", e).map_err(|e| invalid(e.to_string()))?;
+            validate_execution("sim.exec", e).map_err(|e| {
+                // The CLI's --odometry-noise lands in sim.exec's noise: name the flag too.
+                if e.field.contains(".noise.") {
+                    invalid(format!("--odometry-noise / {e}"))
+                } else {
+                    invalid(e.to_string())
+                }
+            })?;
         }
         self.check_exec_override()?;
         let lm = &self.sim.landmarks;

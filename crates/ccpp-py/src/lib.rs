@@ -28,7 +28,7 @@ use fixedbitset::FixedBitSet;
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2};
 use pyo3::create_exception;
-use pyo3::exceptions::PyException;
+use pyo3::exceptions::{PyException, PyTypeError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use serde_json::Value;
@@ -286,14 +286,16 @@ fn recipe_for(path: &Path) -> MapRecipe {
 fn load_map(
     py: Python<'_>,
     path: PathBuf,
-    resolution: Option<f64>,
-    origin: Option<Vec<f64>>,
-    occupied_thresh: Option<f64>,
-    free_thresh: Option<f64>,
-    inflate: Option<f64>,
+    resolution: Option<Real>,
+    origin: Option<Vec<Real>>,
+    occupied_thresh: Option<Real>,
+    free_thresh: Option<Real>,
+    inflate: Option<Real>,
     georef: Option<PathBuf>,
     name: Option<String>,
 ) -> PyResult<Map> {
+    let (resolution, origin, inflate) = (real(resolution), reals(origin), real(inflate));
+    let (occupied_thresh, free_thresh) = (real(occupied_thresh), real(free_thresh));
     let mut recipe = recipe_for(&path);
     recipe.resolution = resolution;
     recipe.origin = match origin.as_deref() {
@@ -373,6 +375,47 @@ enum Purpose {
     Plan,
 }
 
+/// A number argument that is not a `bool`. Python's `True` is an `int`, so pyo3 would take
+/// `radius=True` as 1.0 m; a bool where a length or a count belongs is a mistake, not a value.
+#[derive(Clone, Copy, Debug)]
+struct Real(f64);
+
+impl<'a, 'py> FromPyObject<'a, 'py> for Real {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        if obj.is_instance_of::<PyBool>() {
+            return Err(PyTypeError::new_err("must be a number, not bool"));
+        }
+        obj.extract().map(Real)
+    }
+}
+
+/// A whole-number argument (>= 0) that is not a `bool` (see [`Real`]).
+#[derive(Clone, Copy, Debug)]
+struct Whole(u64);
+
+impl<'a, 'py> FromPyObject<'a, 'py> for Whole {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        if obj.is_instance_of::<PyBool>() {
+            return Err(PyTypeError::new_err("must be a whole number, not bool"));
+        }
+        obj.extract().map(Whole)
+    }
+}
+
+/// The values of optional number arguments.
+fn real(v: Option<Real>) -> Option<f64> {
+    v.map(|r| r.0)
+}
+
+/// The values of a list of number arguments.
+fn reals(v: Option<Vec<Real>>) -> Option<Vec<f64>> {
+    v.map(|v| v.into_iter().map(|r| r.0).collect())
+}
+
 /// The `repr` of a Python value, for messages.
 fn repr(v: &Bound<'_, PyAny>) -> String {
     v.repr().map_or_else(|_| "?".to_string(), |r| r.to_string())
@@ -380,7 +423,8 @@ fn repr(v: &Bound<'_, PyAny>) -> String {
 
 /// A keyword option that must be a number (its range is the scenario's to check).
 fn float_arg(key: &str, v: &Bound<'_, PyAny>) -> PyResult<f64> {
-    v.extract()
+    v.extract::<Real>()
+        .map(|r| r.0)
         .map_err(|_| msg(format!("{key} must be a number, got {}", repr(v))))
 }
 
@@ -404,15 +448,15 @@ fn uint_arg(key: &str, v: &Bound<'_, PyAny>) -> PyResult<u64> {
 
 /// A start pose `(x, y)` or `(x, y, theta)`.
 fn start_arg(v: &Bound<'_, PyAny>) -> PyResult<[f64; 3]> {
-    let p: Vec<f64> = v.extract().map_err(|_| {
+    let p: Vec<Real> = v.extract().map_err(|_| {
         msg(format!(
             "start expects (x, y) or (x, y, theta), got {}",
             repr(v)
         ))
     })?;
     match p.as_slice() {
-        [x, y] => Ok([*x, *y, 0.0]),
-        [x, y, t] => Ok([*x, *y, *t]),
+        [Real(x), Real(y)] => Ok([*x, *y, 0.0]),
+        [Real(x), Real(y), Real(t)] => Ok([*x, *y, *t]),
         _ => Err(msg(format!(
             "start expects (x, y) or (x, y, theta), got {} values",
             p.len()
@@ -744,9 +788,10 @@ fn plan(
     py: Python<'_>,
     map: &Bound<'_, PyAny>,
     planner: Option<&str>,
-    radius: Option<f64>,
+    radius: Option<Real>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<PlanResult> {
+    let radius = real(radius);
     let mut prepared = as_map(py, map)?;
     let (planner, radius) = (planner.unwrap_or("bcd"), radius.unwrap_or(DEFAULT_RADIUS));
     let scenario = scenario_from(&prepared, planner, radius, options, Purpose::Plan)?;
@@ -863,12 +908,13 @@ impl RunResult {
     /// The executed path's waypoints, `float64` `(N, 3)`: x, y, theta at the ends of its
     /// straight segments (poses merged within `tolerance_m`, as in `path.csv` and the
     /// exports).
-    #[pyo3(signature = (tolerance_m=DEFAULT_TOLERANCE_M))]
+    #[pyo3(signature = (tolerance_m=Real(DEFAULT_TOLERANCE_M)))]
     fn waypoints<'py>(
         &self,
         py: Python<'py>,
-        tolerance_m: f64,
+        tolerance_m: Real,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let tolerance_m = tolerance_m.0;
         check_tolerance(tolerance_m)?;
         Ok(route_array(
             py,
@@ -910,9 +956,10 @@ fn run(
     py: Python<'_>,
     map: &Bound<'_, PyAny>,
     planner: Option<&str>,
-    radius: Option<f64>,
+    radius: Option<Real>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<RunResult> {
+    let radius = real(radius);
     let mut prepared = as_map(py, map)?;
     let (planner, radius) = (
         planner.unwrap_or("ba-star"),
@@ -961,16 +1008,18 @@ fn bench_run(
     py: Python<'_>,
     map_path: PathBuf,
     planner: &str,
-    radius: Option<f64>,
-    tool_radius: Option<f64>,
-    inflate: Option<f64>,
-    max_memory_mb: Option<u64>,
+    radius: Option<Real>,
+    tool_radius: Option<Real>,
+    inflate: Option<Real>,
+    max_memory_mb: Option<Whole>,
     out: Option<PathBuf>,
     name: Option<String>,
 ) -> PyResult<(Option<Py<PyAny>>, Option<String>)> {
+    let (radius, tool_radius, inflate) = (real(radius), real(tool_radius), real(inflate));
+    let max_memory_mb = max_memory_mb.map(|m| m.0);
     let kind = parse_kind(planner)?;
     let radius = radius.unwrap_or(DEFAULT_RADIUS);
-    check_robot(radius, tool_radius)?;
+    check_robot(Real(radius), tool_radius.map(Real))?;
     let robot = Robot {
         radius,
         tool_radius: tool_radius.unwrap_or(radius),
@@ -1014,7 +1063,8 @@ fn bench_run(
 /// runs do (`sweep` checks its radii before it starts any task).
 #[pyfunction]
 #[pyo3(signature = (radius, tool_radius=None))]
-fn check_robot(radius: f64, tool_radius: Option<f64>) -> PyResult<()> {
+fn check_robot(radius: Real, tool_radius: Option<Real>) -> PyResult<()> {
+    let (radius, tool_radius) = (radius.0, real(tool_radius));
     Robot {
         radius,
         tool_radius: tool_radius.unwrap_or(radius),
@@ -1252,15 +1302,18 @@ impl Env {
     fn new(
         py: Python<'_>,
         map: &Bound<'_, PyAny>,
-        radius: Option<f64>,
-        tool_radius: Option<f64>,
-        sensor_range: Option<f64>,
-        start: Option<Vec<f64>>,
+        radius: Option<Real>,
+        tool_radius: Option<Real>,
+        sensor_range: Option<Real>,
+        start: Option<Vec<Real>>,
         exec: Option<&str>,
-        max_steps: Option<u64>,
+        max_steps: Option<Whole>,
         area: Option<&Bound<'_, PyAny>>,
         keepout: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
+        let (radius, tool_radius, sensor_range) =
+            (real(radius), real(tool_radius), real(sensor_range));
+        let (start, max_steps) = (reals(start), max_steps.map(|m| m.0));
         let map = as_map(py, map)?;
         let radius = radius.unwrap_or(DEFAULT_RADIUS);
         let exec = match exec.unwrap_or("ideal").to_ascii_lowercase().as_str() {

@@ -190,3 +190,26 @@ def test_whole_number_options_name_their_range(room: Path) -> None:
         with pytest.raises(ccpp.CcppError, match=r"seed must be a whole number from 0 to 18446744073709551615"):
             env.reset(seed=bad)
     assert env.reset(seed=3)[1] == ccpp.Env(room).reset(seed=3)[1]
+
+
+def test_bools_are_not_numbers(room: Path, tmp_path: Path) -> None:
+    """`radius=True` ran with a 1 m robot: a bool is an `int` in Python, and number arguments
+    took it as 1. Every number argument refuses bools; the same numbers as floats are taken."""
+    for call in (
+        lambda: ccpp.run(room, "bsa", radius=True),
+        lambda: ccpp.plan(room, "bcd", radius=True),
+        lambda: ccpp.Env(room, radius=True),
+        lambda: ccpp.Env(room, max_steps=True),
+        lambda: ccpp.Env(room, start=(True, 0.5)),
+        lambda: ccpp.load_map(room, inflate=True),
+        lambda: ccpp.load_map(room, origin=(0.0, False, 0.0)),
+        lambda: ccpp.run(room, "bsa").waypoints(tolerance_m=True),
+    ):
+        with pytest.raises(TypeError, match="not bool"):
+            call()
+    # Keyword options read as numbers (tool_radius, sensor_range) refuse bools too.
+    with pytest.raises(ccpp.CcppError, match="tool_radius must be a number, got True"):
+        ccpp.run(room, "bsa", tool_radius=True)
+    with pytest.raises(ccpp.CcppError, match="sensor_range must be a number, got False"):
+        ccpp.run(room, "bsa", sensor_range=False)
+    assert ccpp.run(room, "bsa", radius=0.1).metrics["robot_radius_m"] == 0.1

@@ -243,6 +243,32 @@ fn finite_nonneg(field: &str, v: f64) -> Result<(), OptionsError> {
     }
 }
 
+/// Largest relative standard deviation of odometry speed noise ([`OdometryNoise`]'s
+/// `linear_rel_std`, `angular_rel_std`) accepted.
+///
+/// [`OdometryNoise`]: crate::exec::OdometryNoise
+pub const MAX_REL_STD: f64 = 1.0;
+
+/// Largest heading drift standard deviation of odometry noise accepted, rad per metre.
+pub const MAX_DRIFT_STD: f64 = 6.0;
+
+/// `v` finite and in `[0, max]`; `unit` follows the bound in the message.
+fn finite_at_most(field: &str, v: f64, max: f64, unit: &str) -> Result<(), OptionsError> {
+    finite_nonneg(field, v)?;
+    if v <= max {
+        Ok(())
+    } else {
+        Err(OptionsError::new(
+            field,
+            format!(
+                "must be at most {} {unit}, got {}",
+                crate::display::Compact(max),
+                crate::display::Compact(v)
+            ),
+        ))
+    }
+}
+
 fn opt_finite_pos(field: &str, v: Option<f64>) -> Result<(), OptionsError> {
     v.map_or(Ok(()), |v| finite_pos(field, v))
 }
@@ -292,9 +318,27 @@ fn validate_pid(field: &str, p: &PidOptions) -> Result<(), OptionsError> {
         ));
     }
     if let Some(n) = &p.noise {
-        finite_nonneg(&f("noise.linear_rel_std"), n.linear_rel_std)?;
-        finite_nonneg(&f("noise.angular_rel_std"), n.angular_rel_std)?;
-        finite_nonneg(&f("noise.heading_drift_std"), n.heading_drift_std)?;
+        // A relative speed error of one standard deviation = 100 % already reverses the motion
+        // at about one control step in six; beyond it the "odometry" no longer measures motion.
+        // A heading drift std of about a full turn per metre is likewise past any odometry.
+        finite_at_most(
+            &f("noise.linear_rel_std"),
+            n.linear_rel_std,
+            MAX_REL_STD,
+            "(a relative std of 1 = 100 % of the speed)",
+        )?;
+        finite_at_most(
+            &f("noise.angular_rel_std"),
+            n.angular_rel_std,
+            MAX_REL_STD,
+            "(a relative std of 1 = 100 % of the turn rate)",
+        )?;
+        finite_at_most(
+            &f("noise.heading_drift_std"),
+            n.heading_drift_std,
+            MAX_DRIFT_STD,
+            "rad per metre (about a full turn per metre)",
+        )?;
     }
     Ok(())
 }
