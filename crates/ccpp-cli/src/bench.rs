@@ -217,8 +217,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     let options = planner_options(a.options.config.as_deref(), a.seed)?;
     let maps = name_maps(expand_maps(&a.maps)?);
     check_bench_target(&a.out)?;
-    std::fs::create_dir_all(&a.out)
-        .with_context(|| format!("cannot create output folder {}", a.out.display()))?;
+    ccpp_io::write::create_folder(&a.out, &a.out)?;
     if let Some(j) = a.jobs {
         // A thread beyond one per run would only idle: `--jobs 100000` started 100000
         // threads, which took minutes on two cores before the first run.

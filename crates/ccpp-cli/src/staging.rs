@@ -216,8 +216,7 @@ impl Staging {
             _ => PathBuf::from("."),
         };
         let existed = std::fs::symlink_metadata(target).is_ok();
-        std::fs::create_dir_all(&parent)
-            .with_context(|| format!("cannot create output folder {}", parent.display()))?;
+        ccpp_io::write::create_folder(&parent, target)?;
         // The swap renames `parent/name` away and then renames the staging folder to it: with
         // a `..` in `parent` (`--out a/../a`) the old folder's rename would remove the path the
         // second rename goes through, and the run, finished, would fail and leave both staging

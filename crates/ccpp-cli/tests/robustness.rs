@@ -143,6 +143,38 @@ fn run_refuses_an_out_folder_with_other_files() {
     assert_eq!(entries(&out), ["notes.txt"]);
 }
 
+/// `--out notes.txt/run` said only "File exists": the message names the file in the way.
+#[test]
+fn an_out_folder_under_a_file_names_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("notes.txt");
+    std::fs::write(&file, "keep me").unwrap();
+    let under = file.join("run");
+    let expect = format!(
+        "error: cannot create output folder {}: {} is a file, not a folder",
+        under.display(),
+        file.display()
+    );
+    let o = run_into(&under, "bcd", false)
+        .assert()
+        .code(1)
+        .get_output()
+        .clone();
+    assert_eq!(stderr_of(&o).trim_end(), expect);
+    let o = bench(
+        &under,
+        &[data("teb_empty_box.yaml")],
+        &["--planners", "bcd"],
+    )
+    .assert()
+    .code(1)
+    .get_output()
+    .clone();
+    assert_eq!(stderr_of(&o).trim_end(), expect);
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "keep me");
+    assert_eq!(entries(dir.path()), ["notes.txt"]);
+}
+
 #[cfg(unix)]
 #[test]
 fn an_interrupted_run_leaves_the_old_or_the_new_complete_set() {

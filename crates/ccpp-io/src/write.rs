@@ -157,6 +157,17 @@ pub enum FolderError {
         /// The output folder.
         path: PathBuf,
     },
+    /// A folder above the output folder exists as a file (`--out notes.txt/run`).
+    #[error(
+        "cannot create output folder {}: {} is a file, not a folder",
+        path.display(), blocker.display()
+    )]
+    UnderAFile {
+        /// The output folder.
+        path: PathBuf,
+        /// The part of its path that exists and is not a folder.
+        blocker: PathBuf,
+    },
     /// The folder holds something ccpp did not write.
     #[error(
         "output folder {} holds {name}, which ccpp did not write; a run replaces the whole \
@@ -214,6 +225,30 @@ pub fn check_run_folder(target: &Path) -> Result<(), FolderError> {
     Ok(())
 }
 
+/// Creates `folder` (the output folder `target` or a folder above it) and its missing
+/// ancestors. When a part of the path exists as something other than a folder, the error
+/// names that part ([`FolderError::UnderAFile`]), not only the system's "File exists".
+///
+/// # Errors
+/// [`FolderError::UnderAFile`], or [`FolderError::Io`] naming `target`.
+pub fn create_folder(folder: &Path, target: &Path) -> Result<(), FolderError> {
+    if let Some(blocker) = folder
+        .ancestors()
+        .filter(|a| !a.as_os_str().is_empty())
+        .find(|a| std::fs::symlink_metadata(a).is_ok())
+        .filter(|a| !a.is_dir())
+    {
+        return Err(FolderError::UnderAFile {
+            path: target.to_path_buf(),
+            blocker: blocker.to_path_buf(),
+        });
+    }
+    std::fs::create_dir_all(folder).map_err(|source| FolderError::Io {
+        path: target.to_path_buf(),
+        source,
+    })
+}
+
 /// Writes `files` as the whole content of the folder `target`, all or nothing, as the command
 /// line writes a run folder: `target` must be absent or hold only [`RUN_FILES`]
 /// ([`check_run_folder`]); the files are written and synced into a staging folder
@@ -223,7 +258,8 @@ pub fn check_run_folder(target: &Path) -> Result<(), FolderError> {
 /// Parent folders are created as needed.
 ///
 /// # Errors
-/// As [`check_run_folder`], [`FolderError::NoName`], or [`FolderError::Io`] naming `target`.
+/// As [`check_run_folder`] and [`create_folder`], [`FolderError::NoName`], or
+/// [`FolderError::Io`] naming `target`.
 pub fn write_folder(target: &Path, files: &[(&str, Vec<u8>)]) -> Result<(), FolderError> {
     use std::sync::atomic::{AtomicU64, Ordering};
     static COUNTER: AtomicU64 = AtomicU64::new(0);
@@ -245,7 +281,7 @@ pub fn write_folder(target: &Path, files: &[(&str, Vec<u8>)]) -> Result<(), Fold
         _ => PathBuf::from("."),
     };
     let existed = std::fs::symlink_metadata(target).is_ok();
-    std::fs::create_dir_all(&parent).map_err(io_err)?;
+    create_folder(&parent, target)?;
     // Renames go through the resolved parent: with `a/../a` the first rename would remove the
     // path the second goes through.
     let parent = parent.canonicalize().map_err(io_err)?;

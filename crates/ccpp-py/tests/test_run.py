@@ -213,3 +213,13 @@ def test_bools_are_not_numbers(room: Path, tmp_path: Path) -> None:
     with pytest.raises(ccpp.CcppError, match="sensor_range must be a number, got False"):
         ccpp.run(room, "bsa", sensor_range=False)
     assert ccpp.run(room, "bsa", radius=0.1).metrics["robot_radius_m"] == 0.1
+
+
+def test_save_under_a_file_names_the_file(room: Path, tmp_path: Path) -> None:
+    """Saving into `notes.txt/run` said only "File exists"; the message names the file."""
+    notes = tmp_path / "notes.txt"
+    notes.write_text("keep me")
+    with pytest.raises(ccpp.CcppError) as e:
+        ccpp.run(room, "bsa").save(notes / "run")
+    assert str(e.value) == f"cannot create output folder {notes / 'run'}: {notes} is a file, not a folder"
+    assert notes.read_text() == "keep me"
