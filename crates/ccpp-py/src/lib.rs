@@ -376,33 +376,28 @@ enum Purpose {
 }
 
 /// A number argument that is not a `bool`. Python's `True` is an `int`, so pyo3 would take
-/// `radius=True` as 1.0 m; a bool where a length or a count belongs is a mistake, not a value.
+/// `radius=True` as 1.0 m (or `max_steps=True` as 1); a bool where a length or a count belongs
+/// is a mistake, not a value.
 #[derive(Clone, Copy, Debug)]
-struct Real(f64);
+struct NotBool<T>(T);
 
-impl<'a, 'py> FromPyObject<'a, 'py> for Real {
+/// A real number argument ([`NotBool`]).
+type Real = NotBool<f64>;
+
+/// A whole-number argument, >= 0 ([`NotBool`]).
+type Whole = NotBool<u64>;
+
+impl<'a, 'py, T> FromPyObject<'a, 'py> for NotBool<T>
+where
+    T: FromPyObject<'a, 'py, Error = PyErr>,
+{
     type Error = PyErr;
 
     fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
         if obj.is_instance_of::<PyBool>() {
             return Err(PyTypeError::new_err("must be a number, not bool"));
         }
-        obj.extract().map(Real)
-    }
-}
-
-/// A whole-number argument (>= 0) that is not a `bool` (see [`Real`]).
-#[derive(Clone, Copy, Debug)]
-struct Whole(u64);
-
-impl<'a, 'py> FromPyObject<'a, 'py> for Whole {
-    type Error = PyErr;
-
-    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
-        if obj.is_instance_of::<PyBool>() {
-            return Err(PyTypeError::new_err("must be a whole number, not bool"));
-        }
-        obj.extract().map(Whole)
+        obj.extract().map(NotBool)
     }
 }
 
@@ -455,8 +450,8 @@ fn start_arg(v: &Bound<'_, PyAny>) -> PyResult<[f64; 3]> {
         ))
     })?;
     match p.as_slice() {
-        [Real(x), Real(y)] => Ok([*x, *y, 0.0]),
-        [Real(x), Real(y), Real(t)] => Ok([*x, *y, *t]),
+        [NotBool(x), NotBool(y)] => Ok([*x, *y, 0.0]),
+        [NotBool(x), NotBool(y), NotBool(t)] => Ok([*x, *y, *t]),
         _ => Err(msg(format!(
             "start expects (x, y) or (x, y, theta), got {} values",
             p.len()
@@ -908,7 +903,7 @@ impl RunResult {
     /// The executed path's waypoints, `float64` `(N, 3)`: x, y, theta at the ends of its
     /// straight segments (poses merged within `tolerance_m`, as in `path.csv` and the
     /// exports).
-    #[pyo3(signature = (tolerance_m=Real(DEFAULT_TOLERANCE_M)))]
+    #[pyo3(signature = (tolerance_m=NotBool(DEFAULT_TOLERANCE_M)))]
     fn waypoints<'py>(
         &self,
         py: Python<'py>,
@@ -1019,7 +1014,7 @@ fn bench_run(
     let max_memory_mb = max_memory_mb.map(|m| m.0);
     let kind = parse_kind(planner)?;
     let radius = radius.unwrap_or(DEFAULT_RADIUS);
-    check_robot(Real(radius), tool_radius.map(Real))?;
+    check_robot(NotBool(radius), tool_radius.map(NotBool))?;
     let robot = Robot {
         radius,
         tool_radius: tool_radius.unwrap_or(radius),
