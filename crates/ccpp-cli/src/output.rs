@@ -3,7 +3,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use ccpp_core::metrics::Metrics;
 use ccpp_core::trace::Trace;
 
@@ -91,6 +91,7 @@ pub fn replay_dir(dir: &Path) -> Result<()> {
         ccpp_io::trace::read_trace(&dir.join("trace.jsonl"), Some((world.frame(), margin)))?;
     // Through `read_text`: a FIFO named metrics.json hung the replay (a regular file only).
     let metrics = ccpp_io::file::read_text(&dir.join("metrics.json")).unwrap_or_default();
+    check_same_run(dir, &scenario, &map.name, &world, &trace, &metrics)?;
     let title = format!("{} on {}", scenario.planner.name(), map.name);
     let (html, gif) = render_replay(&world, &trace, scenario.tile_side(), &metrics, &title)?;
     write_file(&dir.join("replay.html"), html.as_bytes())?;
@@ -99,6 +100,54 @@ pub fn replay_dir(dir: &Path) -> Result<()> {
         "wrote {}/replay.html and replay.gif\n",
         dir.display()
     ))
+}
+
+/// Refuses a run folder whose files come from different runs (a trace or metrics copied in
+/// from another run), which the replay would draw as one: the trace must begin at the start
+/// pose of the run that `run.json` describes, and `metrics.json`, when there, must name its
+/// planner and map.
+fn check_same_run(
+    dir: &Path,
+    scenario: &Scenario,
+    map_name: &str,
+    world: &World,
+    trace: &Trace,
+    metrics: &str,
+) -> Result<()> {
+    let start = world.start();
+    if let Some(first) = trace.poses().next() {
+        // The trace records the start exactly; a thousandth of a pixel allows for nothing but
+        // another run.
+        let tol = world.frame().resolution * 1e-3;
+        if (first.x - start.x).abs() > tol || (first.y - start.y).abs() > tol {
+            bail!(
+                "{}: trace.jsonl starts at ({:.3}, {:.3}) but the run of run.json starts at \
+                 ({:.3}, {:.3}): the folder mixes files of two runs",
+                dir.display(),
+                first.x,
+                first.y,
+                start.x,
+                start.y
+            );
+        }
+    }
+    let Ok(serde_json::Value::Object(m)) = serde_json::from_str::<serde_json::Value>(metrics)
+    else {
+        return Ok(());
+    };
+    let planner = scenario.planner.name();
+    for (key, want) in [("planner", planner), ("map", map_name)] {
+        if let Some(got) = m.get(key).and_then(serde_json::Value::as_str) {
+            if got != want {
+                bail!(
+                    "{}: metrics.json is of {key} {got} but run.json of {key} {want}: the \
+                     folder mixes files of two runs",
+                    dir.display()
+                );
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Writes the run's files (with the replay when `replay`, and the path in each of `exports`)

@@ -779,6 +779,41 @@ fn replay_refuses_a_damaged_trace_quickly() {
     );
 }
 
+/// A run folder holding another run's trace or metrics (copied in by hand) was replayed as
+/// one run: the other run's path drawn on this run's map. Such folders are refused.
+#[test]
+fn replay_refuses_a_folder_that_mixes_two_runs() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = box60(dir);
+    let a = run_ok(dir, "a", &map, "ba-star", &[]);
+    let b = run_ok(dir, "b", &map, "bsa", &["--start", "1.0,1.0"]);
+    // b's trace (another start) beside a's run.json.
+    std::fs::copy(b.join("trace.jsonl"), a.join("trace.jsonl")).unwrap();
+    fails(
+        &["replay"],
+        &[&a],
+        &[
+            "trace.jsonl starts at (1.000, 1.000)",
+            "mixes files of two runs",
+        ],
+        10,
+    );
+    assert!(!a.join("replay.html").exists());
+    // b's metrics (planner bsa) beside its own trace and a's run.json (planner ba-star).
+    let c = run_ok(dir, "c", &map, "ba-star", &["--start", "1.0,1.0"]);
+    std::fs::copy(b.join("metrics.json"), c.join("metrics.json")).unwrap();
+    fails(
+        &["replay"],
+        &[&c],
+        &["metrics.json is of planner bsa but run.json of planner ba-star"],
+        10,
+    );
+    // A folder as its run wrote it replays.
+    ccpp().arg("replay").arg(&b).assert().success();
+    assert!(b.join("replay.html").exists());
+}
+
 #[test]
 fn run_json_is_the_scenario_and_replays_exactly() {
     let d = tempfile::tempdir().unwrap();
