@@ -486,41 +486,41 @@ impl Extension {
         let gen = self.generation;
         let d = node_cost(self.nodes[i]);
         let (w, h_img) = (self.frame.width as i64, self.frame.height as i64);
-        // Moves known blocked (walls, positions where the robot does not fit) are left out
-        // before their neighbour's state is read.
         let memo = self.edges[i];
         let (edges, blocked) = (memo[FREE], memo[BLOCKED]);
+        // The moves to try: those not known blocked (walls, positions where the robot does
+        // not fit) that stay in the image, one bit each, in the order of `NB`.
+        let mut todo = !blocked;
         // The neighbours' states are read first, all at once (independent loads, mostly
         // cache misses, overlap); the loop below writes only neighbours, each once.
-        let mut js = [usize::MAX; 8];
+        let mut js = [0usize; 8];
+        let mut ns = [0 as Node; 8];
         if p.0 > 0 && p.1 > 0 && p.0 < w - 1 && p.1 < h_img - 1 {
-            // Inside the image's rim every neighbour is in it: index offsets only.
-            for (k, jk) in js.iter_mut().enumerate() {
-                if blocked & (1 << k) == 0 {
-                    *jk = i.wrapping_add_signed((NB[k].1 * w + NB[k].0) as isize);
-                }
+            // Inside the image's rim every neighbour is in it: the three rows around `i`, read
+            // whole (a move known blocked leads onto the same cache lines), at fixed offsets
+            // from the first one (`i - width - 1`).
+            let wu = self.frame.width;
+            let first = i - wu - 1;
+            let at = [wu + 2, 2, 1, 0, wu, 2 * wu, 2 * wu + 1, 2 * wu + 2];
+            let rows = &self.nodes[first..=first + 2 * wu + 2];
+            for k in 0..8 {
+                js[k] = first + at[k];
+                ns[k] = rows[at[k]];
             }
         } else {
-            for (k, jk) in js.iter_mut().enumerate() {
+            for k in 0..8 {
                 let q = (p.0 + NB[k].0, p.1 + NB[k].1);
-                if blocked & (1 << k) == 0 && q.0 >= 0 && q.1 >= 0 && q.0 < w && q.1 < h_img {
-                    *jk = (q.1 * w + q.0) as usize;
+                if q.0 >= 0 && q.1 >= 0 && q.0 < w && q.1 < h_img {
+                    js[k] = (q.1 * w + q.0) as usize;
+                    ns[k] = self.nodes[js[k]];
+                } else {
+                    todo &= !(1 << k);
                 }
             }
         }
-        let ns: [Node; 8] = std::array::from_fn(|k| {
-            if js[k] == usize::MAX {
-                0
-            } else {
-                self.nodes[js[k]]
-            }
-        });
-        for k in 0..8 {
-            let j = js[k];
-            if j == usize::MAX {
-                continue;
-            }
-            let q = (p.0 + NB[k].0, p.1 + NB[k].1);
+        while todo != 0 {
+            let k = todo.trailing_zeros() as usize;
+            todo &= todo - 1;
             let nd = d + if k % 2 == 1 { COST_DIAG } else { COST_ORTHO };
             // Settled or no better: skip before judging the move (judging only fills memos).
             let n = ns[k];
@@ -531,8 +531,9 @@ impl Extension {
             if edges & (1 << k) == 0 && !self.edge(known, p, k) {
                 continue;
             }
+            let j = js[k];
             self.nodes[j] = node(nd, Some(k), gen);
-            heap.push(nd + h(self, q), j);
+            heap.push(nd + h(self, (p.0 + NB[k].0, p.1 + NB[k].1)), j);
         }
     }
 
