@@ -148,6 +148,33 @@ pub struct BaStarExtended {
     backtrack_sweep: f64,
     /// Whether the robot may still sweep a rim on its way back to BA*'s start point.
     on_way: bool,
+    /// The last transfer planned during the current [`Self::clean`] call ([`RouteMemo`]).
+    route_memo: RouteMemo,
+}
+
+/// The transfer last planned (`from`, `to`, the route) while the known map stays as it was:
+/// one [`BaStarExtended::clean`] call, in which nothing is sensed. The extension's `route`
+/// depends on the known map and its two ends only, so the way back that the rim on the way
+/// was judged against is not searched again when that rim is not driven.
+type RouteMemo = Option<(Point, Point, Option<Vec<Point>>)>;
+
+/// `ext.route(known, from, to)`, from `memo` when it holds these ends (the caller keeps the
+/// known map unchanged while `memo` lives).
+fn route_memoised(
+    memo: &mut RouteMemo,
+    ext: &mut Extension,
+    known: &crate::planner::KnownMap,
+    from: Point,
+    to: Point,
+) -> Option<Vec<Point>> {
+    if let Some((f, t, route)) = memo {
+        if *f == from && *t == to {
+            return route.clone();
+        }
+    }
+    let route = ext.route(known, from, to);
+    *memo = Some((from, to, route.clone()));
+    route
 }
 
 impl BaStarExtended {
@@ -163,6 +190,7 @@ impl BaStarExtended {
             shorter_backtrack: opts.shorter_backtrack,
             backtrack_sweep: opts.backtrack_sweep,
             on_way: false,
+            route_memo: None,
         }
     }
 
@@ -173,6 +201,8 @@ impl BaStarExtended {
 
     /// One cleaning chunk, or the end of the cleaning.
     fn clean(&mut self, pos: Point, last: bool) {
+        // The known map changed since the last call (the robot drove and sensed).
+        self.route_memo = None;
         // At a region's end, and after each pass swept on the way back: the next rim swept on
         // the way, while one pays.
         let on_way =
@@ -227,7 +257,7 @@ impl BaStarExtended {
                 return;
             }
             let own = self.ba.backtrack_rest().unwrap_or_default();
-            if let Some(route) = ext.route(known, pos, goal) {
+            if let Some(route) = route_memoised(&mut self.route_memo, ext, known, pos, goal) {
                 if route.last() == Some(&goal)
                     && polyline_length(pos, &route) < polyline_length(pos, &own) - 1e-9
                 {
@@ -237,10 +267,11 @@ impl BaStarExtended {
             }
             return;
         }
-        let route = ext.route(known, pos, goal).unwrap_or_else(|| {
-            // Retreat the way the passes came (every segment known free); BA* goes on from there.
-            self.drive.trail.iter().rev().skip(1).copied().collect()
-        });
+        let route =
+            route_memoised(&mut self.route_memo, ext, known, pos, goal).unwrap_or_else(|| {
+                // Retreat the way the passes came (every segment known free); BA* goes on from there.
+                self.drive.trail.iter().rev().skip(1).copied().collect()
+            });
         let direct = route.last() == Some(&goal);
         for p in route {
             self.drive.queue.push_back(Step::MoveTo(p));
@@ -280,7 +311,7 @@ impl BaStarExtended {
             polyline_length(pos, &self.ba.backtrack_rest().unwrap_or_default())
         };
         if self.shorter_backtrack || moved {
-            if let Some(route) = ext.route(known, pos, goal) {
+            if let Some(route) = route_memoised(&mut self.route_memo, ext, known, pos, goal) {
                 plain = plain.min(polyline_length(pos, &route));
             }
         }

@@ -341,11 +341,10 @@ pub(crate) struct Extension {
     /// two such positions free): 0 undecided, 1 fits, 2 not.
     s1: Vec<u8>,
     s1_disk: Vec<i64>,
-    /// Per pixel: bit `k` = the move to neighbour `NB[k]` is known free.
-    edge_free: Vec<u8>,
-    /// Per pixel: bit `k` = the move to neighbour `NB[k]` is known blocked (a seen obstacle
-    /// stays one, so this never changes back).
-    edge_blocked: Vec<u8>,
+    /// Per pixel, the move memo: in `[FREE]` bit `k` = the move to neighbour `NB[k]` is known
+    /// free, in `[BLOCKED]` known blocked (a seen obstacle stays one, so this never changes
+    /// back). One pair per pixel: a search reads both with one memory access.
+    edges: Vec<[u8; 2]>,
     /// The tool disk around a pixel centre, as pixel offsets.
     tool: Vec<(i64, i64)>,
     /// The same disk as row half-widths (entry `|drow|`).
@@ -441,8 +440,7 @@ impl Extension {
             // out of contact, and every pixel such a move could touch lies in one end's disk.
             s1: vec![0; n],
             s1_disk: pixel_disk_spans((rc * rc + 0.5).sqrt() + 1e-9),
-            edge_free: vec![0; n],
-            edge_blocked: vec![0; n],
+            edges: vec![[0; 2]; n],
             tool: off,
             tool_rows,
             strip_rows,

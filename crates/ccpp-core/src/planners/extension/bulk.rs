@@ -33,7 +33,7 @@
 
 use fixedbitset::FixedBitSet;
 
-use super::graph::NB;
+use super::graph::{BLOCKED, FREE, NB};
 use super::Extension;
 use crate::grid::MapFrame;
 use crate::planner::KnownMap;
@@ -194,9 +194,9 @@ impl Extension {
         // does not fit (as `edge` finds them).
         let (w, h) = (f.width as i64, f.height as i64);
         let (s0, s1) = (&self.s0, &self.s1);
-        let (eb, ef) = (&mut self.edge_blocked, &mut self.edge_free);
+        let edges = &mut self.edges;
         // Pixel `p` (index `i`) on the image's rim: neighbours checked one by one.
-        let rim = |eb: &mut [u8], ef: &mut [u8], i: usize, p: (i64, i64)| {
+        let rim = |edges: &mut [[u8; 2]], i: usize, p: (i64, i64)| {
             for (k, d) in NB.iter().enumerate() {
                 let q = (p.0 + d.0, p.1 + d.1);
                 if q.0 < 0 || q.1 < 0 || q.0 >= w || q.1 >= h {
@@ -204,37 +204,33 @@ impl Extension {
                 }
                 let j = (q.1 * w + q.0) as usize;
                 if s0[j] == 2 {
-                    eb[i] |= 1 << k;
+                    edges[i][BLOCKED] |= 1 << k;
                 } else if s1[i] == 1 && s1[j] == 1 {
-                    ef[i] |= 1 << k;
+                    edges[i][FREE] |= 1 << k;
                 }
             }
         };
         for r in 0..h {
             if r == 0 || r == h - 1 || w < 3 {
                 for c in 0..w {
-                    rim(eb, ef, (r * w + c) as usize, (c, r));
+                    rim(edges, (r * w + c) as usize, (c, r));
                 }
                 continue;
             }
             let (lo, hi) = ((r * w + 1) as usize, (r * w + w - 1) as usize);
-            rim(eb, ef, lo - 1, (0, r));
-            rim(eb, ef, hi, (w - 1, r));
+            rim(edges, lo - 1, (0, r));
+            rim(edges, hi, (w - 1, r));
             // Inside the rim, one neighbour direction at a time over the row (branch-free).
             for (k, d) in NB.iter().enumerate() {
                 let off = (d.1 * w + d.0) as isize;
                 let (jlo, jhi) = (lo.wrapping_add_signed(off), hi.wrapping_add_signed(off));
                 let (s0j, s1j) = (&s0[jlo..jhi], &s1[jlo..jhi]);
-                for ((((b, fr), &si), &s0v), &s1v) in eb[lo..hi]
-                    .iter_mut()
-                    .zip(ef[lo..hi].iter_mut())
-                    .zip(&s1[lo..hi])
-                    .zip(s0j)
-                    .zip(s1j)
+                for (((e, &si), &s0v), &s1v) in
+                    edges[lo..hi].iter_mut().zip(&s1[lo..hi]).zip(s0j).zip(s1j)
                 {
                     let blocked = u8::from(s0v == 2);
-                    *b |= blocked << k;
-                    *fr |= (u8::from(si == 1) & u8::from(s1v == 1) & (blocked ^ 1)) << k;
+                    e[BLOCKED] |= blocked << k;
+                    e[FREE] |= (u8::from(si == 1) & u8::from(s1v == 1) & (blocked ^ 1)) << k;
                 }
             }
         }

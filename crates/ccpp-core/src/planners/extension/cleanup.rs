@@ -155,11 +155,28 @@ impl Extension {
         let f = self.frame;
         let (w, h) = (f.width as i64, f.height as i64);
         let reach = self.strip_rows.len() as i64 - 1;
-        for &i in &chunk.claimed {
-            self.swept.set(i, false);
-            // Positions the searches since judged without these targets may gain again.
-            let (c, r) = self.px_of(i);
-            let (c0, c1) = ((c - reach).max(0), (c + reach).min(w - 1));
+        // Positions the searches since judged without these targets may gain again: the memo
+        // is dropped in the square of side `2 reach + 1` around each pixel, the pixels' column
+        // ranges merged per image row first (a walk's pixels crowd a few rows), so each
+        // range is cleared once per row within `reach` (the same union of squares).
+        let mut runs: Vec<(i64, i64, i64)> = chunk
+            .claimed
+            .iter()
+            .map(|&i| {
+                self.swept.set(i, false);
+                let (c, r) = self.px_of(i);
+                (r, (c - reach).max(0), (c + reach).min(w - 1))
+            })
+            .collect();
+        runs.sort_unstable();
+        let mut merged: Vec<(i64, i64, i64)> = Vec::with_capacity(runs.len());
+        for (r, c0, c1) in runs {
+            match merged.last_mut() {
+                Some(last) if last.0 == r && c0 <= last.2 + 1 => last.2 = last.2.max(c1),
+                _ => merged.push((r, c0, c1)),
+            }
+        }
+        for (r, c0, c1) in merged {
             for row in (r - reach).max(0)..=(r + reach).min(h - 1) {
                 let base = row as usize * f.width;
                 self.no_gain

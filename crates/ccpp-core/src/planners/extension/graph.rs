@@ -6,6 +6,11 @@ use crate::geometry::Point;
 use crate::planner::{DiskState, KnownMap};
 use crate::planners::ba_star::{judge_motion, Judgement};
 
+/// Index of the known-free bits in a pixel's move memo (`Extension::edges`).
+pub(super) const FREE: usize = 0;
+/// Index of the known-blocked bits in a pixel's move memo (`Extension::edges`).
+pub(super) const BLOCKED: usize = 1;
+
 /// The 8 neighbour offsets `(dcol, drow)`: E, NE, N, NW, W, SW, S, SE (rows grow downwards).
 pub(super) const NB: [(i64, i64); 8] = [
     (1, 0),
@@ -113,10 +118,10 @@ impl Extension {
         let (Some(i), Some(j)) = (self.idx(p), self.idx(q)) else {
             return false;
         };
-        if self.edge_free[i] & (1 << k) != 0 {
+        if self.edges[i][FREE] & (1 << k) != 0 {
             return true;
         }
-        if self.edge_blocked[i] & (1 << k) != 0 {
+        if self.edges[i][BLOCKED] & (1 << k) != 0 {
             return false;
         }
         match self.in_s0(known, q) {
@@ -124,7 +129,7 @@ impl Extension {
             Some(false) => {
                 // The robot never fits at `q` (a seen obstacle stays one): the move stays
                 // blocked.
-                self.edge_blocked[i] |= 1 << k;
+                self.edges[i][BLOCKED] |= 1 << k;
                 return false;
             }
             None => return false,
@@ -143,13 +148,13 @@ impl Extension {
         };
         match judged {
             Judgement::Free => {
-                self.edge_free[i] |= 1 << k;
-                self.edge_free[j] |= 1 << ((k + 4) % 8);
+                self.edges[i][FREE] |= 1 << k;
+                self.edges[j][FREE] |= 1 << ((k + 4) % 8);
                 true
             }
             Judgement::Blocked => {
-                self.edge_blocked[i] |= 1 << k;
-                self.edge_blocked[j] |= 1 << ((k + 4) % 8);
+                self.edges[i][BLOCKED] |= 1 << k;
+                self.edges[j][BLOCKED] |= 1 << ((k + 4) % 8);
                 false
             }
             Judgement::Undetermined => false,

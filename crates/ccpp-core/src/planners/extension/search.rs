@@ -2,7 +2,7 @@
 //! a bucket queue with one-word, generation-stamped node states; and the transfers
 //! (`Extension::route`) built on it.
 
-use super::graph::NB;
+use super::graph::{BLOCKED, FREE, NB};
 use super::{Extension, Px};
 use crate::geometry::{floor_i64, Point};
 use crate::planner::KnownMap;
@@ -21,6 +21,11 @@ const BUCKET_MAX: usize = 1 << 20;
 /// weighted-A* heuristic is not consistent, so a key may fall below the bucket being popped:
 /// the cursor then moves back to it.
 ///
+/// Within a bucket below [`BUCKET_MAX`] every key has the same high bits, so an entry is one
+/// word, [`pack`]ed: the key's low [`BUCKET_SHIFT`] bits above the 32-bit index. Comparing
+/// two words compares `(key, index)`; half the memory of a pair and a plain integer sort. The
+/// last bucket, which holds every larger key, keeps whole pairs.
+///
 /// A search's keys sweep upwards through tens of thousands of buckets on a large map, while
 /// only the few buckets within a step's cost of the cursor hold entries at a time. So a bucket
 /// the cursor leaves empty gives its storage to a pool, and a bucket that receives its first
@@ -28,11 +33,14 @@ const BUCKET_MAX: usize = 1 << 20;
 /// search instead of one allocation (grown, and faulted in, step by step) per bucket.
 #[derive(Default)]
 pub(super) struct BucketQueue {
-    /// Entries per bucket; a sorted bucket is in descending order (smallest last).
-    buckets: Vec<Vec<(u64, u32)>>,
+    /// Packed entries per bucket below [`BUCKET_MAX`]; a sorted bucket is in descending order
+    /// (smallest last).
+    buckets: Vec<Vec<u64>>,
+    /// The entries of bucket [`BUCKET_MAX`], whole; descending when sorted.
+    last: Vec<(u64, u32)>,
     /// Empty buffers for buckets that receive entries (see the type's docs).
-    pool: Vec<Vec<(u64, u32)>>,
-    /// Whether each bucket is sorted.
+    pool: Vec<Vec<u64>>,
+    /// Whether each bucket is sorted (index [`BUCKET_MAX`]: `last`).
     sorted: Vec<bool>,
     /// No non-empty bucket lies below this one.
     cur: usize,
@@ -40,6 +48,12 @@ pub(super) struct BucketQueue {
     top: usize,
     /// Entries queued.
     len: usize,
+}
+
+/// A bucket entry below [`BUCKET_MAX`]: key bits below [`BUCKET_SHIFT`] over index `i`.
+#[inline]
+fn pack(key: u64, i: u32) -> u64 {
+    (key & ((1 << BUCKET_SHIFT) - 1)) << 32 | u64::from(i)
 }
 
 impl BucketQueue {
@@ -50,6 +64,10 @@ impl BucketQueue {
             self.recycle(b);
             self.sorted[b] = false;
         }
+        if self.sorted.len() > BUCKET_MAX {
+            self.sorted[BUCKET_MAX] = false;
+        }
+        self.last.clear();
         self.cur = usize::MAX;
         self.top = 0;
         self.len = 0;
@@ -59,22 +77,32 @@ impl BucketQueue {
     #[inline]
     fn push(&mut self, key: u64, i: usize) {
         let b = usize::try_from(key >> BUCKET_SHIFT).map_or(BUCKET_MAX, |b| b.min(BUCKET_MAX));
-        if b >= self.buckets.len() {
-            self.buckets.resize_with(b + 1, Vec::new);
+        if b >= self.sorted.len() {
+            self.buckets.resize_with((b + 1).min(BUCKET_MAX), Vec::new);
             self.sorted.resize(b + 1, false);
         }
-        let e = (key, i as u32);
-        if self.buckets[b].capacity() == 0 {
-            if let Some(v) = self.pool.pop() {
-                self.buckets[b] = v;
+        if b == BUCKET_MAX {
+            let e = (key, i as u32);
+            if self.sorted[b] {
+                let at = self.last.partition_point(|x| *x > e);
+                self.last.insert(at, e);
+            } else {
+                self.last.push(e);
             }
-        }
-        let v = &mut self.buckets[b];
-        if self.sorted[b] {
-            let at = v.partition_point(|x| *x > e);
-            v.insert(at, e);
         } else {
-            v.push(e);
+            let e = pack(key, i as u32);
+            if self.buckets[b].capacity() == 0 {
+                if let Some(v) = self.pool.pop() {
+                    self.buckets[b] = v;
+                }
+            }
+            let v = &mut self.buckets[b];
+            if self.sorted[b] {
+                let at = v.partition_point(|x| *x > e);
+                v.insert(at, e);
+            } else {
+                v.push(e);
+            }
         }
         if self.len == 0 || b < self.cur {
             self.cur = b;
@@ -83,7 +111,7 @@ impl BucketQueue {
         self.len += 1;
     }
 
-    /// Empties bucket `b` and gives its storage (if any) to the pool.
+    /// Empties bucket `b` (below [`BUCKET_MAX`]) and gives its storage (if any) to the pool.
     #[inline]
     fn recycle(&mut self, b: usize) {
         if self.buckets[b].capacity() > 0 {
@@ -93,23 +121,45 @@ impl BucketQueue {
         }
     }
 
+    /// The position [`Self::pop`] would return next, when that is known without work (the
+    /// current bucket is sorted and holds it); else `None`.
+    #[inline]
+    fn peek(&self) -> Option<usize> {
+        let b = self.cur;
+        if b >= BUCKET_MAX || !self.sorted.get(b).copied().unwrap_or(false) {
+            return None;
+        }
+        self.buckets[b]
+            .last()
+            .map(|&e| (e & u64::from(u32::MAX)) as usize)
+    }
+
     /// Removes and returns the position with the smallest `(key, index)`.
     fn pop(&mut self) -> Option<usize> {
         if self.len == 0 {
             return None;
         }
-        while self.buckets[self.cur].is_empty() {
+        while self.cur < BUCKET_MAX && self.buckets[self.cur].is_empty() {
             self.recycle(self.cur);
             self.sorted[self.cur] = false;
             self.cur += 1;
         }
         let b = self.cur;
+        self.len -= 1;
+        if b == BUCKET_MAX {
+            if !self.sorted[b] {
+                self.last.sort_unstable_by(|x, y| y.cmp(x));
+                self.sorted[b] = true;
+            }
+            return self.last.pop().map(|(_, i)| i as usize);
+        }
         if !self.sorted[b] {
             self.buckets[b].sort_unstable_by(|x, y| y.cmp(x));
             self.sorted[b] = true;
         }
-        self.len -= 1;
-        self.buckets[b].pop().map(|(_, i)| i as usize)
+        self.buckets[b]
+            .pop()
+            .map(|e| (e & u64::from(u32::MAX)) as usize)
     }
 }
 
@@ -190,6 +240,22 @@ fn route_heuristic(c: Point, g: Point) -> u64 {
     (c.dist(g) * ROUTE_WEIGHT * COST_ORTHO as f64).floor() as u64
 }
 
+/// `c.dist(g) < 1.5` (the transfer search's goal test, at every position it settles) without
+/// the `hypot` call where the squared distance decides: it lies within a few units in the last
+/// place of the exact square, so only a square within a relative `1e-12` of `2.25` asks `hypot`.
+#[inline]
+fn within_1_5(c: Point, g: Point) -> bool {
+    let (dx, dy) = (c.x - g.x, c.y - g.y);
+    let s = dx * dx + dy * dy;
+    if s < 2.25 * (1.0 - 1e-12) {
+        return true;
+    }
+    if s > 2.25 * (1.0 + 1e-12) {
+        return false;
+    }
+    c.dist(g) < 1.5
+}
+
 impl Extension {
     fn begin(&mut self) {
         self.generation = (self.generation + 1) % NODE_GENS;
@@ -256,6 +322,9 @@ impl Extension {
         }
         let mut settled = 0usize;
         while let Some(i) = heap.pop() {
+            if let Some(j) = heap.peek() {
+                self.warm(j);
+            }
             if self.nodes[i] & CLOSED != 0 {
                 continue;
             }
@@ -286,6 +355,21 @@ impl Extension {
             self.relax(known, i, p, h, heap);
         }
         None
+    }
+
+    /// Loads the state of position `j` and of the rows above and below it (what settling it
+    /// reads) without using it: the next position popped is known one step ahead, and its
+    /// loads, mostly cache misses, then overlap with the work on the current one.
+    #[inline]
+    fn warm(&self, j: usize) {
+        let w = self.frame.width;
+        let n = |k: usize| self.nodes.get(k).copied().unwrap_or(0);
+        std::hint::black_box((
+            n(j),
+            n(j.wrapping_sub(w)),
+            n(j.wrapping_add(w)),
+            self.edges.get(j).copied(),
+        ));
     }
 
     /// Can the running search (a final clean-up's, whose `done` is false wherever `no_gain`
@@ -402,41 +486,41 @@ impl Extension {
         let gen = self.generation;
         let d = node_cost(self.nodes[i]);
         let (w, h_img) = (self.frame.width as i64, self.frame.height as i64);
-        let edges = self.edge_free[i];
-        // Moves known blocked (walls, positions where the robot does not fit) are left out
-        // before their neighbour's state is read.
-        let blocked = self.edge_blocked[i];
+        let memo = self.edges[i];
+        let (edges, blocked) = (memo[FREE], memo[BLOCKED]);
+        // The moves to try: those not known blocked (walls, positions where the robot does
+        // not fit) that stay in the image, one bit each, in the order of `NB`.
+        let mut todo = !blocked;
         // The neighbours' states are read first, all at once (independent loads, mostly
         // cache misses, overlap); the loop below writes only neighbours, each once.
-        let mut js = [usize::MAX; 8];
+        let mut js = [0usize; 8];
+        let mut ns = [0 as Node; 8];
         if p.0 > 0 && p.1 > 0 && p.0 < w - 1 && p.1 < h_img - 1 {
-            // Inside the image's rim every neighbour is in it: index offsets only.
-            for (k, jk) in js.iter_mut().enumerate() {
-                if blocked & (1 << k) == 0 {
-                    *jk = i.wrapping_add_signed((NB[k].1 * w + NB[k].0) as isize);
-                }
+            // Inside the image's rim every neighbour is in it: the three rows around `i`, read
+            // whole (a move known blocked leads onto the same cache lines), at fixed offsets
+            // from the first one (`i - width - 1`).
+            let wu = self.frame.width;
+            let first = i - wu - 1;
+            let at = [wu + 2, 2, 1, 0, wu, 2 * wu, 2 * wu + 1, 2 * wu + 2];
+            let rows = &self.nodes[first..=first + 2 * wu + 2];
+            for k in 0..8 {
+                js[k] = first + at[k];
+                ns[k] = rows[at[k]];
             }
         } else {
-            for (k, jk) in js.iter_mut().enumerate() {
+            for k in 0..8 {
                 let q = (p.0 + NB[k].0, p.1 + NB[k].1);
-                if blocked & (1 << k) == 0 && q.0 >= 0 && q.1 >= 0 && q.0 < w && q.1 < h_img {
-                    *jk = (q.1 * w + q.0) as usize;
+                if q.0 >= 0 && q.1 >= 0 && q.0 < w && q.1 < h_img {
+                    js[k] = (q.1 * w + q.0) as usize;
+                    ns[k] = self.nodes[js[k]];
+                } else {
+                    todo &= !(1 << k);
                 }
             }
         }
-        let ns: [Node; 8] = std::array::from_fn(|k| {
-            if js[k] == usize::MAX {
-                0
-            } else {
-                self.nodes[js[k]]
-            }
-        });
-        for k in 0..8 {
-            let j = js[k];
-            if j == usize::MAX {
-                continue;
-            }
-            let q = (p.0 + NB[k].0, p.1 + NB[k].1);
+        while todo != 0 {
+            let k = todo.trailing_zeros() as usize;
+            todo &= todo - 1;
             let nd = d + if k % 2 == 1 { COST_DIAG } else { COST_ORTHO };
             // Settled or no better: skip before judging the move (judging only fills memos).
             let n = ns[k];
@@ -447,8 +531,9 @@ impl Extension {
             if edges & (1 << k) == 0 && !self.edge(known, p, k) {
                 continue;
             }
+            let j = js[k];
             self.nodes[j] = node(nd, Some(k), gen);
-            heap.push(nd + h(self, q), j);
+            heap.push(nd + h(self, (p.0 + NB[k].0, p.1 + NB[k].1)), j);
         }
     }
 
@@ -460,7 +545,7 @@ impl Extension {
             return Some(vec![to]);
         }
         let path = self.search(known, gf, None, Some(gt), false, &mut |s, p| {
-            s.center(p).dist(gt) < 1.5 && s.seg_free(known, s.center(p), gt)
+            within_1_5(s.center(p), gt) && s.seg_free(known, s.center(p), gt)
         })?;
         let mut pts = vec![gf];
         pts.extend(path.iter().map(|&i| self.center(self.px_of(i))));
@@ -500,7 +585,7 @@ impl Extension {
 #[cfg(test)]
 mod tests {
     use super::{
-        node, node_cost, node_gen, node_move, route_heuristic, BucketQueue, BUCKET_MAX,
+        node, node_cost, node_gen, node_move, route_heuristic, within_1_5, BucketQueue, BUCKET_MAX,
         BUCKET_SHIFT, CLOSED, COST_ORTHO, NODE_COST_SHIFT, NODE_GENS, ROUTE_WEIGHT,
     };
     use crate::geometry::Point;
@@ -541,6 +626,29 @@ mod tests {
         }
     }
 
+    /// The goal test's squared fast path agrees with `hypot`: random points, points on the
+    /// circle of radius 1.5 (up to rounding) and at whole-pixel offsets.
+    #[test]
+    fn within_1_5_is_hypot_test() {
+        let mut rng = crate::rng::SplitMix64::new(0x0715_1500);
+        for k in 0..200_000 {
+            let g = Point::new(rng.range(-10.0, 3000.0), rng.range(-10.0, 3000.0));
+            let c = match k % 4 {
+                0 => Point::new(g.x + rng.range(-3.0, 3.0), g.y + rng.range(-3.0, 3.0)),
+                1 => {
+                    let a = rng.range(0.0, std::f64::consts::TAU);
+                    Point::new(g.x + 1.5 * a.cos(), g.y + 1.5 * a.sin())
+                }
+                2 => Point::new(
+                    g.x + rng.range(-3.0, 3.0).round(),
+                    g.y + rng.range(-3.0, 3.0).round(),
+                ),
+                _ => Point::new(g.x + 1.5, g.y + rng.range(-1e-6, 1e-6)),
+            };
+            assert_eq!(within_1_5(c, g), c.dist(g) < 1.5, "{c:?} {g:?}");
+        }
+    }
+
     /// A node gives back the cost, move and generation it was made of, with or without the
     /// settled bit, at the extremes of every field.
     #[test]
@@ -576,7 +684,12 @@ mod tests {
                         q.push(k, i);
                         h.push(Reverse((k, i)));
                     }
-                    6..=8 => prop_assert_eq!(q.pop(), h.pop().map(|Reverse((_, i))| i)),
+                    6..=8 => {
+                        if let Some(j) = q.peek() {
+                            prop_assert_eq!(Some(j), h.peek().map(|Reverse((_, i))| *i));
+                        }
+                        prop_assert_eq!(q.pop(), h.pop().map(|Reverse((_, i))| i));
+                    }
                     _ => {
                         q.clear();
                         h.clear();
