@@ -346,6 +346,7 @@ fn config_values_go_through_the_same_validation() {
         ("bcd: { min_coverage: -0.5 }", "bcd", "bcd.min_coverage"),
         // Each angle try is a whole plan: a huge count must be refused, not planned.
         ("bcd: { angle_tries: 41 }", "bcd", "bcd.angle_tries"),
+        ("bcd: { headland_min_m: -1.0 }", "bcd", "bcd.headland_min_m"),
         ("bcd: { angle_tries: 4000000000 }", "bcd", "bcd.angle_tries"),
         // Tour rounds stop when one changes nothing, but a huge bound is still refused.
         ("bcd: { tour_rounds: 101 }", "bcd", "bcd.tour_rounds"),

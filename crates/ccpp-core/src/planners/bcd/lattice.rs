@@ -98,6 +98,18 @@ impl<'a> Lattice<'a> {
         }
     }
 
+    /// The same lattice with the free points `ok` instead.
+    pub(super) fn with_ok(&self, ok: Vec<bool>) -> Lattice<'static> {
+        Lattice {
+            w: self.w,
+            h: self.h,
+            rot: self.rot,
+            map_h: self.map_h,
+            centre: self.centre,
+            ok: Cow::Owned(ok),
+        }
+    }
+
     pub(super) fn ok_at(&self, c: i64, r: i64) -> bool {
         c >= 0
             && r >= 0

@@ -2,6 +2,7 @@
 //! cell tour, rim passes, repair, smoothing and turn pruning.
 
 use std::collections::VecDeque;
+use std::ops::{Add, Sub};
 
 use rayon::prelude::*;
 
@@ -48,6 +49,9 @@ impl Plan {
         best.is_none_or(|b| (self.skipped, self.cost) < (b.skipped, b.cost))
     }
 }
+
+/// Entry points a closed headland pass offers the tour (module docs, step 3).
+const ROT: usize = 16;
 
 /// Improvement rounds of the first tour (which only picks each cell's path for the rim step).
 const FIRST_ROUNDS: u32 = 1;
@@ -107,35 +111,44 @@ impl Bcd {
         // With several lattices, the cell sets with even cells cut (step 4) are toured only on
         // the lattice whose whole cells plan best: the split changes a plan's cost by a few
         // percent, the lattice by more, and the second tour per lattice doubled the time.
-        let sets = if turns_by.len() > 1 {
-            Sets::Whole
-        } else {
-            Sets::Both
+        // With a headland (module docs, step 3), every lattice is planned with and without
+        // it, the cheaper plan kept; the plan with the headland tours its cells whole.
+        let plain = BcdOptions {
+            headland_min_m: None,
+            ..opts.clone()
         };
-        let plans: Vec<_> = turns_by
+        let mut jobs: Vec<(usize, &BcdOptions)> = Vec::new();
+        for k in 0..turns_by.len() {
+            jobs.push((k, &plain));
+            if opts.headland_min_m.is_some() {
+                jobs.push((k, opts));
+            }
+        }
+        let many = turns_by.len() > 1;
+        let plans: Vec<_> = jobs
             .par_iter()
-            .map(|t| {
+            .map(|&(k, o)| {
                 let mut search = Search::new(w, h);
-                Self::plan_sets(&ctx, &lattice(t), opts, &mut search, sets)
+                let sets = if many || o.headland_min_m.is_some() {
+                    Sets::Whole
+                } else {
+                    Sets::Both
+                };
+                Self::plan_sets(&ctx, &lattice(&turns_by[k]), o, &mut search, sets)
             })
             .collect();
         let mut best: Option<(Plan, usize)> = None;
         let mut at = 0;
-        for (k, p) in plans.into_iter().enumerate() {
+        for (j, p) in plans.into_iter().enumerate() {
             if p.0.beats(best.as_ref().map(|b| &b.0)) {
                 best = Some(p);
-                at = k;
+                at = j;
             }
         }
-        if sets == Sets::Whole {
+        if many {
+            let (k, o) = jobs[at];
             let mut search = Search::new(w, h);
-            let p = Self::plan_sets(
-                &ctx,
-                &lattice(&turns_by[at]),
-                opts,
-                &mut search,
-                Sets::Split,
-            );
+            let p = Self::plan_sets(&ctx, &lattice(&turns_by[k]), o, &mut search, Sets::Split);
             if p.0.beats(best.as_ref().map(|b| &b.0)) {
                 best = Some(p);
             }
@@ -215,6 +228,23 @@ impl Bcd {
         let frame = ctx.frame;
         let robot = world.robot();
         let res = frame.resolution;
+        let mut heads: Vec<Vec<Point>> = Vec::new();
+        let inner = opts.headland_min_m.map(|m| {
+            let sp0 = opts.lane_spacing_m.unwrap_or(2.0 * robot.tool_radius) / res;
+            // Interior points lie at least 2 r_tool from the passes, which run through the
+            // free points beside the obstacles, one lattice step from them.
+            let (ok, passes) = super::headland::headland(
+                ctx,
+                lat,
+                search,
+                2.0 * ctx.rt + 1.0,
+                m / res,
+                (2.0 * sp0).ceil() as usize,
+            );
+            heads = passes;
+            lat.with_ok(ok)
+        });
+        let lat = inner.as_ref().unwrap_or(lat);
         let (w, h) = (lat.w, lat.h);
         let spacing = opts.lane_spacing_m.unwrap_or(2.0 * robot.tool_radius);
         let sp = (spacing / res).max(1.0);
@@ -337,22 +367,22 @@ impl Bcd {
         let even = split.len() > cells.len();
         let (first, second) = if sets == Sets::Split {
             let b = if even {
-                Self::tour_cells(ctx, lat, opts, search, &split, sp, start)
+                Self::tour_cells(ctx, lat, opts, search, &split, &heads, sp, start)
             } else {
                 None
             };
             (b, None)
         } else if even && sets == Sets::Both {
             rayon::join(
-                || Self::tour_cells(ctx, lat, opts, search, &cells, sp, start),
+                || Self::tour_cells(ctx, lat, opts, search, &cells, &heads, sp, start),
                 || {
                     let mut own = Search::new(ctx.frame.width, ctx.frame.height);
-                    Self::tour_cells(ctx, lat, opts, &mut own, &split, sp, start)
+                    Self::tour_cells(ctx, lat, opts, &mut own, &split, &heads, sp, start)
                 },
             )
         } else {
             (
-                Self::tour_cells(ctx, lat, opts, search, &cells, sp, start),
+                Self::tour_cells(ctx, lat, opts, search, &cells, &heads, sp, start),
                 None,
             )
         };
@@ -375,12 +405,14 @@ impl Bcd {
     /// Steps 3-5 of the module docs for the cells `cells` with their lanes: cell paths, the
     /// tour, rim passes, repair, smoothing and pruning; the plan's skipped moves, its cost
     /// (length plus `turn_cost_m` per turn, pixels) and items.
+    #[allow(clippy::too_many_arguments)] // the pipeline's state, passed down unchanged
     fn tour_cells(
         ctx: &Ctx<'_>,
         lat: &Lattice,
         opts: &BcdOptions,
         search: &mut Search,
         cells: &[(Cell, Vec<f64>)],
+        heads: &[Vec<Point>],
         sp: f64,
         start: Point,
     ) -> Option<Plan> {
@@ -407,6 +439,49 @@ impl Bcd {
             pieces.push(piece);
             paths.push(ps);
         }
+        // Headland passes: pieces driven either way; a closed loop from any of up to
+        // `ROT` points along it.
+        let ncell0 = paths.len();
+        let mut rots: Vec<Vec<Vec<Point>>> = Vec::with_capacity(heads.len());
+        for p in heads {
+            let mut rs = vec![p.clone()];
+            if p.len() > 3 && p[0] == p[p.len() - 1] {
+                // Entry points about evenly along the loop: segments cut every `step`.
+                let step = (path_length(p) / ROT as f64).max(sp);
+                let mut q = vec![p[0]];
+                for s in p.windows(2) {
+                    let k = (s[0].dist(s[1]) / step).floor() as usize;
+                    for j in 1..=k {
+                        let t = j as f64 / (k + 1) as f64;
+                        q.push(s[0].add(s[1].sub(s[0]).scale(t)));
+                    }
+                    q.push(s[1]);
+                }
+                let n = q.len();
+                let k = (n - 1).min(ROT);
+                for j in 1..k {
+                    let i = j * (n - 1) / k;
+                    let mut r = q[i..].to_vec();
+                    r.extend_from_slice(&q[1..=i]);
+                    rs.push(r);
+                }
+            }
+            let len = path_length(p);
+            let mut piece = tsp::Piece {
+                entry: Vec::new(),
+                exit: Vec::new(),
+                inner: Vec::new(),
+            };
+            for r in &rs {
+                let (f, l) = (r[0], r[r.len() - 1]);
+                piece.entry.extend([f, l]);
+                piece.exit.extend([l, f]);
+                piece.inner.extend([len, len]);
+            }
+            pieces.push(piece);
+            paths.push([p.clone(), p.clone()]);
+            rots.push(rs);
+        }
         let coarse = hops::Coarse::new(ctx, sp);
         let far = hops::Coarse::new(ctx, sp * f64::from(hops::FAR_FACTOR));
         let ncells = paths.len();
@@ -424,6 +499,11 @@ impl Bcd {
             if !opts.rim && !in_tour {
                 break;
             }
+            // (with a headland, whose passes sweep most of the rim, the rest is only
+            // inserted as detours)
+            if !heads.is_empty() && opts.rim && in_tour {
+                continue;
+            }
             let mut pieces = cell_pieces.clone();
             let mut paths = cell_paths_all.clone();
             let contours: Vec<Vec<Point>> = if opts.rim && in_tour {
@@ -439,7 +519,7 @@ impl Bcd {
                 for &(c, v) in &first {
                     keep[c] = v / 2;
                 }
-                for (c, k) in keep.iter().enumerate() {
+                for (c, k) in keep.iter().enumerate().take(ncell0) {
                     if *k == 1 {
                         paths[c].swap(0, 1);
                     }
@@ -536,7 +616,11 @@ impl Bcd {
                     here = pts[pts.len() - 1];
                     continue;
                 }
-                let path = &paths[cid][v / 2];
+                let path = if cid >= ncell0 {
+                    &rots[cid - ncell0][v / 2]
+                } else {
+                    &paths[cid][v / 2]
+                };
                 let pts: Vec<Point> = if v % 2 == 0 {
                     path.clone()
                 } else {
