@@ -86,7 +86,7 @@
 //!    ```
 //!
 //!    **Headland** (not in the paper; the headland of field coverage planners, applied to
-//!    walls; option `headland_min_m`, off by default). The plan is made a second time with a
+//!    walls; option `headland_min_m`, default 6 m). The plan is made a second time with a
 //!    contour pass along the C-free boundary of every obstacle whose boundary is at least
 //!    `headland_min_m` long (the robot's centre on the C-free boundary sweeps the band up to
 //!    `2 r_tool` from it, with the cusps between lane ends, notches and parallel-wall rims
@@ -232,13 +232,19 @@ pub struct BcdOptions {
     /// Headland (step 3 of the module docs): `Some(m)` also plans with contour passes along
     /// the C-free boundary of every obstacle whose boundary is at least `m` metres long and
     /// lanes only in the interior at least `2 r_tool` inside those passes, and keeps that
-    /// plan where it is cheaper (length plus `turn_cost_m` per turn). `None` (the default):
-    /// no headland. Must be finite and >= 0. On the 14 shared maps (r = 0.15 m) `Some(6.0)`
-    /// takes the mean path ratio from 1.1985 to 1.1833 (`tuw_single_corridors` 1.294 to
-    /// 1.107, `teb_empty_box` 1.050 to 1.026) at about 1.5 times the planning time (the
-    /// headland plan is made beside the plain one; up to twice on the largest maps).
+    /// plan where it is cheaper (length plus `turn_cost_m` per turn). `None` (`null` in an
+    /// options file): no headland. Must be finite and >= 0. Default
+    /// `Some(`[`DEFAULT_HEADLAND_MIN_M`]`)`: on the 14 shared maps (r = 0.15 m) it takes the
+    /// mean path ratio from 1.1985 (`None`) to 1.1833 (`tuw_single_corridors` 1.294 to 1.107,
+    /// `teb_empty_box` 1.050 to 1.026; the other maps keep the plain plan) for about 1.25
+    /// times the planning time of the 14-map bench (the headland plan is made beside the
+    /// plain one; up to twice as long on the largest maps).
     pub headland_min_m: Option<f64>,
 }
+
+/// Default of [`BcdOptions::headland_min_m`], metres: walls and obstacles whose C-free
+/// boundary is at least this long get a headland pass in the second plan.
+pub const DEFAULT_HEADLAND_MIN_M: f64 = 6.0;
 
 /// Most turned lattices [`BcdOptions::angle_tries`] may ask for per wall angle: half-degree
 /// steps up to 10 degrees either side, where the second wall direction may begin. Each try is
@@ -262,7 +268,7 @@ impl Default for BcdOptions {
             tour_rounds: 3,
             min_coverage: 0.9952,
             angle_tries: 1,
-            headland_min_m: None,
+            headland_min_m: Some(DEFAULT_HEADLAND_MIN_M),
         }
     }
 }
