@@ -6,9 +6,6 @@ use super::lattice::{Ctx, Lattice};
 use super::transfer::Search;
 use crate::geometry::Point;
 
-/// Squared distance of a point no seed reaches.
-const INF: f64 = 1e20;
-
 /// The headland: the interior lattice (see [`interior`]) and the contour passes along the
 /// long obstacles' C-free boundary (grid polylines, merged into straight collision-free
 /// segments), pieces shorter than `min_piece` points left to the rim step. The passes walk the
@@ -144,82 +141,12 @@ pub(super) fn interior(lat: &Lattice, dist: f64, min_px: f64) -> (Vec<bool>, Vec
         .zip(&outer)
         .map(|(&p, &o)| o || p as f64 >= min_px)
         .collect();
-    // Exact squared Euclidean distance to the seeds (big obstacles and the lattice's outside,
-    // through a one-point frame), Felzenszwalb & Huttenlocher's two passes.
-    let (pw, ph) = (w + 2, h + 2);
-    let mut d = vec![INF; pw * ph];
-    for r in 0..ph {
-        for c in 0..pw {
-            let seed = if r == 0 || c == 0 || r == ph - 1 || c == pw - 1 {
-                true
-            } else {
-                let i = (r - 1) * w + (c - 1);
-                !ok[i] && big[comp[i] as usize]
-            };
-            if seed {
-                d[r * pw + c] = 0.0;
-            }
-        }
-    }
-    let mut f = vec![0.0; pw.max(ph)];
-    let mut out = vec![0.0; pw.max(ph)];
-    for c in 0..pw {
-        for r in 0..ph {
-            f[r] = d[r * pw + c];
-        }
-        edt_1d(&f[..ph], &mut out[..ph]);
-        for r in 0..ph {
-            d[r * pw + c] = out[r];
-        }
-    }
-    for r in 0..ph {
-        f[..pw].copy_from_slice(&d[r * pw..(r + 1) * pw]);
-        edt_1d(&f[..pw], &mut out[..pw]);
-        d[r * pw..(r + 1) * pw].copy_from_slice(&out[..pw]);
-    }
+    // Exact squared Euclidean distance (lattice steps) to the seeds: the big obstacles and the
+    // lattice's outside (the ring just beyond its border).
+    let d = crate::dt::squared_edt(w, h, |i| !ok[i] && big[comp[i] as usize], true);
     let d2 = dist * dist;
-    let at = |i: usize| d[(i / w + 1) * pw + (i % w + 1)];
+    let at = |i: usize| f64::from(d[i]);
     let inner = (0..w * h).map(|i| ok[i] && at(i) >= d2).collect();
     let on_b = (0..w * h).map(|i| ok[i] && at(i) <= 2.0).collect();
     (inner, on_b)
-}
-
-/// One-dimensional squared distance transform of `f` into `out` (lower envelope of parabolas).
-fn edt_1d(f: &[f64], out: &mut [f64]) {
-    let n = f.len();
-    let mut v = vec![0usize; n];
-    let mut z = vec![0.0f64; n + 1];
-    let mut k = 0usize;
-    z[0] = f64::NEG_INFINITY;
-    z[1] = f64::INFINITY;
-    for q in 1..n {
-        loop {
-            let p = v[k];
-            let s = ((f[q] + (q * q) as f64) - (f[p] + (p * p) as f64)) / (2.0 * (q - p) as f64);
-            if s <= z[k] && k > 0 {
-                k -= 1;
-                continue;
-            }
-            if s <= z[k] {
-                // k == 0 and the new parabola wins everywhere left of z[0] = -inf: replace.
-                v[0] = q;
-                z[1] = f64::INFINITY;
-                break;
-            }
-            k += 1;
-            v[k] = q;
-            z[k] = s;
-            z[k + 1] = f64::INFINITY;
-            break;
-        }
-    }
-    k = 0;
-    for (q, o) in out.iter_mut().enumerate() {
-        while z[k + 1] < q as f64 {
-            k += 1;
-        }
-        let p = v[k];
-        let dq = q as f64 - p as f64;
-        *o = dq * dq + f[p];
-    }
 }
