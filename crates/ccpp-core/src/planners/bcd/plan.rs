@@ -37,6 +37,9 @@ enum Sets {
 pub(super) struct Plan {
     /// Moves the repair could not make known-free and dropped.
     pub(super) skipped: usize,
+    /// Whether the plan's estimated swept floor is below `min_coverage` (pruning never takes
+    /// a plan below it, but a plan can reach pruning below it already).
+    pub(super) short: bool,
     /// Length plus `turn_cost_m` per turn, in pixels.
     pub(super) cost: f64,
     /// The plan's moves and marks.
@@ -44,9 +47,11 @@ pub(super) struct Plan {
 }
 
 impl Plan {
-    /// Does this plan rank before `best` (always, when there is none yet)?
+    /// Does this plan rank before `best` (always, when there is none yet)? Fewer skipped moves
+    /// first, then a plan that sweeps `min_coverage` of the floor before one that does not (a
+    /// cheaper plan that sweeps less is not better), then the lower cost.
     fn beats(&self, best: Option<&Plan>) -> bool {
-        best.is_none_or(|b| (self.skipped, self.cost) < (b.skipped, b.cost))
+        best.is_none_or(|b| (self.skipped, self.short, self.cost) < (b.skipped, b.short, b.cost))
     }
 }
 
@@ -396,6 +401,7 @@ impl Bcd {
         let none = if sets == Sets::Split { usize::MAX } else { 0 };
         let best = best.unwrap_or(Plan {
             skipped: none,
+            short: true,
             cost: 0.0,
             items: Vec::new(),
         });
@@ -664,11 +670,12 @@ impl Bcd {
                 );
                 items = smooth(ctx, repair(ctx, search, items, &mut skipped));
             }
-            let items = prune::prune(ctx, items, opts.min_coverage, turn_px);
+            let (items, short) = prune::prune(ctx, items, opts.min_coverage, turn_px);
             let pts: Vec<Point> = moves(&items).into_iter().map(|m| m.0).collect();
             let cost = path_length(&pts) + turn_px * turns(&pts) as f64;
             let plan = Plan {
                 skipped,
+                short,
                 cost,
                 items,
             };

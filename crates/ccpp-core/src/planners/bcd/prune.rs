@@ -572,7 +572,12 @@ impl Pruner<'_, '_> {
 /// Drops turn vertices of the plan's moves while its estimated effective coverage stays at
 /// least `floor` (module docs); corners are completed where that saves a turn for at most
 /// `max_extra` (pixels) of path.
-pub(super) fn prune(ctx: &Ctx<'_>, items: Vec<Item>, floor: f64, max_extra: f64) -> Vec<Item> {
+pub(super) fn prune(
+    ctx: &Ctx<'_>,
+    items: Vec<Item>,
+    floor: f64,
+    max_extra: f64,
+) -> (Vec<Item>, bool) {
     // The distinct consecutive points of the plan with their item indices.
     let mut pts: Vec<Point> = Vec::new();
     let mut at: Vec<usize> = Vec::new();
@@ -586,7 +591,7 @@ pub(super) fn prune(ctx: &Ctx<'_>, items: Vec<Item>, floor: f64, max_extra: f64)
     }
     let n = pts.len();
     if n < 3 {
-        return items;
+        return (items, false);
     }
     let acc = ctx.world.accessible();
     let frame = ctx.frame;
@@ -623,6 +628,8 @@ pub(super) fn prune(ctx: &Ctx<'_>, items: Vec<Item>, floor: f64, max_extra: f64)
         pr.seg[i] = seg;
     }
     let need = (floor * acc.count_ones(..) as f64).ceil() as usize;
+    // Pruning never takes the plan below the floor, but a plan may come to it below already.
+    let short = pr.covered < need;
     pr.drop_spans(need, 0..n);
     if max_extra > 0.0 {
         let merged = pr.merge_corners(need, max_extra, &mut touched, &mut buf);
@@ -653,7 +660,7 @@ pub(super) fn prune(ctx: &Ctx<'_>, items: Vec<Item>, floor: f64, max_extra: f64)
     for (v, &k) in at.iter().enumerate() {
         vertex_at[k] = v;
     }
-    items
+    let items = items
         .into_iter()
         .enumerate()
         .filter_map(|(k, it)| match it {
@@ -663,7 +670,8 @@ pub(super) fn prune(ctx: &Ctx<'_>, items: Vec<Item>, floor: f64, max_extra: f64)
             }
             Item::Mark(_) => Some(it),
         })
-        .collect()
+        .collect();
+    (items, short)
 }
 
 #[cfg(test)]
@@ -775,7 +783,7 @@ mod tests {
         ];
         let before = swept(&c, &items);
         // Floor 1: only drops and merges that lose no accessible pixel.
-        let kept = prune(&c, items.clone(), 1.0, 6.0);
+        let kept = prune(&c, items.clone(), 1.0, 6.0).0;
         let after = swept(&c, &kept);
         assert!(before.is_subset(&after));
         assert!(turns(&kept) < turns(&items), "{kept:?}");
@@ -787,7 +795,7 @@ mod tests {
         let acc = world.accessible().count_ones(..) as f64;
         let base = after.count_ones(..) as f64 / acc;
         let floor = base - 0.05;
-        let less = prune(&c, items, floor, 6.0);
+        let less = prune(&c, items, floor, 6.0).0;
         let got = swept(&c, &less).count_ones(..) as f64 / acc;
         assert!(got >= floor - 1e-12, "{got} < {floor}");
         assert!(turns(&less) <= turns(&kept));

@@ -108,7 +108,12 @@ fn walls_at_an_angle_get_a_turned_lattice() {
         rt: 3.0,
     };
     let mut search = Search::new(frame.width, frame.height);
-    let opts = BcdOptions::default();
+    // The lattices' plain plans (`plan_on` makes the plan of the options it is given: with a
+    // headland, only the headland's).
+    let opts = BcdOptions {
+        headland_min_m: None,
+        ..BcdOptions::default()
+    };
     let a = dominant_angles(&ctx)[0];
     let turned = Bcd::plan_on(&ctx, &Lattice::turned(&ctx, a), &opts, &mut search);
     let pixels = Bcd::plan_on(&ctx, &Lattice::pixels(&ctx), &opts, &mut search);
