@@ -233,25 +233,26 @@ impl Bcd {
         let frame = ctx.frame;
         let robot = world.robot();
         let res = frame.resolution;
-        let mut heads: Vec<Vec<Point>> = Vec::new();
-        let inner = opts.headland_min_m.map(|m| {
-            let sp0 = opts.lane_spacing_m.unwrap_or(2.0 * robot.tool_radius) / res;
-            // Interior points lie at least 2 r_tool from the passes, which run through the
-            // free points beside the obstacles, one lattice step from them.
-            let (ok, passes) = super::headland::headland(
-                ctx,
-                lat,
-                search,
-                2.0 * ctx.rt + 1.0,
-                m / res,
-                (2.0 * sp0).ceil() as usize,
-            );
-            heads = passes;
-            lat.with_ok(ok)
-        });
+        let spacing = opts.lane_spacing_m.unwrap_or(2.0 * robot.tool_radius);
+        // With a headland: the interior lattice and the passes (module docs, step 3).
+        let (inner, heads) = match opts.headland_min_m {
+            Some(m) => {
+                // Interior points lie at least 2 r_tool from the passes, which run through the
+                // free points beside the obstacles, one lattice step from them.
+                let (ok, passes) = super::headland::headland(
+                    ctx,
+                    lat,
+                    search,
+                    2.0 * ctx.rt + 1.0,
+                    m / res,
+                    (2.0 * (spacing / res)).ceil() as usize,
+                );
+                (Some(lat.with_ok(ok)), passes)
+            }
+            None => (None, Vec::new()),
+        };
         let lat = inner.as_ref().unwrap_or(lat);
         let (w, h) = (lat.w, lat.h);
-        let spacing = opts.lane_spacing_m.unwrap_or(2.0 * robot.tool_radius);
         let sp = (spacing / res).max(1.0);
         let turn_px = opts.turn_cost_m / res;
         let start = frame.world_to_grid(world.start().position());
@@ -450,10 +451,11 @@ impl Bcd {
         let ncell0 = paths.len();
         let mut rots: Vec<Vec<Vec<Point>>> = Vec::with_capacity(heads.len());
         for p in heads {
+            let len = path_length(p);
             let mut rs = vec![p.clone()];
             if p.len() > 3 && p[0] == p[p.len() - 1] {
                 // Entry points about evenly along the loop: segments cut every `step`.
-                let step = (path_length(p) / ROT as f64).max(sp);
+                let step = (len / ROT as f64).max(sp);
                 let mut q = vec![p[0]];
                 for s in p.windows(2) {
                     let k = (s[0].dist(s[1]) / step).floor() as usize;
@@ -472,7 +474,6 @@ impl Bcd {
                     rs.push(r);
                 }
             }
-            let len = path_length(p);
             let mut piece = tsp::Piece {
                 entry: Vec::new(),
                 exit: Vec::new(),
