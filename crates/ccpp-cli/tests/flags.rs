@@ -759,6 +759,31 @@ fn degenerate_runs_say_what_is_wrong() {
         &["--area", "10,10,20,20"],
         &["area", "outside the map"],
     );
+    // bcd lanes wider apart than the tool (2 r_tool = 0.3 m by default) leave strips unswept;
+    // a spacing of 1e25 m once overflowed the lane arithmetic (a fuzz find). With a tool wide
+    // enough, the same spacing plans.
+    for (i, v) in ["0.5", "1.0e25"].iter().enumerate() {
+        let cfg = dir.join(format!("lanes{i}.yaml"));
+        std::fs::write(&cfg, format!("bcd: {{ lane_spacing_m: {v} }}\n")).unwrap();
+        run_fails(
+            dir,
+            &map,
+            "bcd",
+            &["--config", cfg.to_str().unwrap()],
+            &[
+                "bcd.lane_spacing_m",
+                "wider than the tool (2 r_tool = 0.3 m)",
+            ],
+        );
+    }
+    let cfg = dir.join("lanes0.yaml");
+    run_ok(
+        dir,
+        "lanes-wide-tool",
+        &map,
+        "bcd",
+        &["--config", cfg.to_str().unwrap(), "--radius", "0.25"],
+    );
 }
 
 #[test]

@@ -199,7 +199,8 @@ use crate::world::World;
 #[serde(default, deny_unknown_fields)]
 pub struct BcdOptions {
     /// Largest lane spacing in metres (lanes are spread evenly, at most this far apart);
-    /// `None` = `2 r_tool`. Must be > 0.
+    /// `None` = `2 r_tool`. Must be > 0 and at most `2 r_tool` (wider lanes leave strips
+    /// unswept; the planner settings' `check` refuses them against the robot).
     pub lane_spacing_m: Option<f64>,
     /// Extra clearance (pixels, >= 0) that transfer paths keep from obstacles when they can,
     /// apart from the stretches next to their ends (a lane end may sit at plain clearance);
@@ -336,6 +337,12 @@ impl BcdOptions {
     }
 }
 
+/// Whether lanes `spacing` metres apart leave no strip between them unswept (at most the
+/// tool's width, with a relative tolerance for values computed as `2 r_tool`).
+fn fits_tool(world: &World, spacing: f64) -> bool {
+    spacing <= 2.0 * world.robot().tool_radius * (1.0 + 1e-9)
+}
+
 /// The BCD planner: a precomputed list of steps.
 pub struct Bcd {
     steps: VecDeque<Step>,
@@ -352,7 +359,9 @@ impl Bcd {
         } else {
             let d = BcdOptions::default();
             let fixed = BcdOptions {
-                lane_spacing_m: opts.lane_spacing_m.filter(|s| s.is_finite() && *s > 0.0),
+                lane_spacing_m: opts
+                    .lane_spacing_m
+                    .filter(|&s| s.is_finite() && s > 0.0 && fits_tool(world, s)),
                 margin_px: if opts.margin_px.is_finite() && opts.margin_px >= 0.0 {
                     opts.margin_px
                 } else {
@@ -397,6 +406,13 @@ impl Bcd {
     /// An option out of range.
     pub fn try_new(world: &World, opts: &BcdOptions) -> Result<Self, BcdOptionsError> {
         opts.check_ranges()?;
+        if let Some(s) = opts.lane_spacing_m.filter(|&s| !fits_tool(world, s)) {
+            return Err(BcdOptionsError::OutOfRange {
+                name: "lane_spacing_m",
+                what: "at most 2 r_tool (wider lanes leave strips unswept)",
+                value: s,
+            });
+        }
         Ok(Self::plan(world, opts))
     }
 

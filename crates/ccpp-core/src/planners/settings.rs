@@ -748,7 +748,23 @@ impl PlannerSettings for BcdOptions {
         )
     }
 
-    fn check(&self, _: &Setup) -> Result<(), OptionsError> {
+    fn check(&self, s: &Setup) -> Result<(), OptionsError> {
+        // Lanes farther apart than the tool's width leave a strip between each pair that no
+        // lane sweeps (the rim pass only mops up what is left at the walls), and a spacing far
+        // beyond the map would only reach the lane arithmetic as a huge count.
+        let tool = 2.0 * s.robot.tool_radius;
+        if let Some(sp) = self.lane_spacing_m {
+            if sp > tool * (1.0 + 1e-9) {
+                return Err(OptionsError::new(
+                    "lane_spacing_m",
+                    format!(
+                        "lane spacing {} m is wider than the tool (2 r_tool = {} m): the lanes would leave strips unswept",
+                        fmt_m(sp),
+                        fmt_m(tool)
+                    ),
+                ));
+            }
+        }
         Ok(())
     }
 

@@ -60,7 +60,10 @@ pub(super) fn split_ends(cells: Vec<Cell>, max: usize) -> Vec<Cell> {
     for c in cells {
         let n = c.runs.len();
         let longest = c.runs.iter().map(|r| r.1 - r.0 + 1).max().unwrap_or(0);
-        if n <= 2 * longest || n <= 2 * max + 1 || c.transposed().is_some() {
+        if n <= 2 * longest
+            || n <= max.saturating_mul(2).saturating_add(1)
+            || c.transposed().is_some()
+        {
             out.push(c);
             continue;
         }

@@ -362,6 +362,16 @@ fn invalid_options_are_refused() {
             lane_spacing_m: Some(0.0),
             ..BcdOptions::default()
         },
+        // Wider than the tool (2 r_tool = 0.16 m here), and far wider than any map: the fuzz
+        // input that once overflowed the lane arithmetic.
+        BcdOptions {
+            lane_spacing_m: Some(0.5),
+            ..BcdOptions::default()
+        },
+        BcdOptions {
+            lane_spacing_m: Some(8.888_888_888_888_889e24),
+            ..BcdOptions::default()
+        },
         BcdOptions {
             margin_px: -1.0,
             ..BcdOptions::default()
