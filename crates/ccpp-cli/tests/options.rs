@@ -322,7 +322,8 @@ fn bcd_and_rect_options_change_the_run() {
         ("bcd", "bcd: { tour_rounds: 0 }", Rooms, Differs),
         ("bcd", "bcd: { headland_min_m: 0.0 }", Pillars, Differs),
         ("bcd", "bcd: { headland_min_m: null }", Pillars, Differs),
-        ("bcd", "bcd: { margin_px: 2 }", Pillars, Differs),
+        // (on Pillars the peeled plan of offset loops wins, whose hops are all straight)
+        ("bcd", "bcd: { margin_px: 2 }", Rooms, Differs),
         (
             "bcd",
             "bcd: { min_coverage: 1.0 }",

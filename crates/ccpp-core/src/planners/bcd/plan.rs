@@ -58,6 +58,9 @@ impl Plan {
 /// Entry points a closed headland pass offers the tour (module docs, step 3).
 const ROT: usize = 16;
 
+/// Most offset-loop walks a peeled plan may have (module docs, step 3): beyond, it is not made.
+const PEEL_WALKS: usize = 32;
+
 /// Improvement rounds of the first tour (which only picks each cell's path for the rim step).
 const FIRST_ROUNDS: u32 = 1;
 
@@ -122,24 +125,29 @@ impl Bcd {
             headland_min_m: None,
             ..opts.clone()
         };
-        let mut jobs: Vec<(usize, &BcdOptions)> = Vec::new();
+        // With a headland, the peeled plan (offset loops from the outer walls in) too, on
+        // the pixel lattice only (offset loops follow the walls on any lattice).
+        let mut jobs: Vec<(usize, &BcdOptions, bool)> = Vec::new();
         for k in 0..turns_by.len() {
-            jobs.push((k, &plain));
+            jobs.push((k, &plain, false));
             if opts.headland_min_m.is_some() {
-                jobs.push((k, opts));
+                jobs.push((k, opts, false));
+                if k == 0 {
+                    jobs.push((k, opts, true));
+                }
             }
         }
         let many = turns_by.len() > 1;
         let plans: Vec<_> = jobs
             .par_iter()
-            .map(|&(k, o)| {
+            .map(|&(k, o, peel)| {
                 let mut search = Search::new(w, h);
                 let sets = if many || o.headland_min_m.is_some() {
                     Sets::Whole
                 } else {
                     Sets::Both
                 };
-                Self::plan_sets(&ctx, &lattice(&turns_by[k]), o, &mut search, sets)
+                Self::plan_sets(&ctx, &lattice(&turns_by[k]), o, &mut search, sets, peel)
             })
             .collect();
         let mut best: Option<(Plan, usize)> = None;
@@ -151,9 +159,16 @@ impl Bcd {
             }
         }
         if many {
-            let (k, o) = jobs[at];
+            let (k, o, peel) = jobs[at];
             let mut search = Search::new(w, h);
-            let p = Self::plan_sets(&ctx, &lattice(&turns_by[k]), o, &mut search, Sets::Split);
+            let p = Self::plan_sets(
+                &ctx,
+                &lattice(&turns_by[k]),
+                o,
+                &mut search,
+                Sets::Split,
+                peel,
+            );
             if p.0.beats(best.as_ref().map(|b| &b.0)) {
                 best = Some(p);
             }
@@ -216,7 +231,7 @@ impl Bcd {
         opts: &BcdOptions,
         search: &mut Search,
     ) -> (Plan, usize) {
-        Self::plan_sets(ctx, lat, opts, search, Sets::Both)
+        Self::plan_sets(ctx, lat, opts, search, Sets::Both, false)
     }
 
     /// [`Bcd::plan_on`] touring only the cell sets `sets` (step 4 of the module docs): the best
@@ -228,6 +243,7 @@ impl Bcd {
         opts: &BcdOptions,
         search: &mut Search,
         sets: Sets,
+        peel: bool,
     ) -> (Plan, usize) {
         let world = ctx.world;
         let frame = ctx.frame;
@@ -239,14 +255,26 @@ impl Bcd {
             Some(m) => {
                 // Interior points lie at least 2 r_tool from the passes, which run through the
                 // free points beside the obstacles, one lattice step from them.
-                let (ok, passes) = super::headland::headland(
+                let Some((ok, passes)) = super::headland::headland(
                     ctx,
                     lat,
                     search,
                     2.0 * ctx.rt + 1.0,
                     m / res,
                     (2.0 * (spacing / res)).ceil() as usize,
-                );
+                    peel.then_some((spacing / res).max(1.0)),
+                    if peel { PEEL_WALKS } else { usize::MAX },
+                ) else {
+                    return (
+                        Plan {
+                            skipped: usize::MAX,
+                            short: true,
+                            cost: 0.0,
+                            items: Vec::new(),
+                        },
+                        0,
+                    );
+                };
                 (Some(lat.with_ok(ok)), passes)
             }
             None => (None, Vec::new()),

@@ -669,3 +669,81 @@ fn even_cells_are_cut_into_two_odd_runs_of_their_lanes() {
     assert_eq!(got, want);
     assert!(out.iter().all(|(_, l)| l.len() % 2 == 1));
 }
+
+/// A 100 x 100 px map (0.05 m/px) free up to its border around a 60 x 60 px block: a ring
+/// 1 m wide, robot radius 0.15 m.
+fn ring() -> World {
+    let mut art = String::new();
+    for r in 0..100 {
+        for c in 0..100 {
+            let block = (20..80).contains(&r) && (20..80).contains(&c);
+            art.push(if block { '#' } else { '.' });
+        }
+        art.push('\n');
+    }
+    let map = crate::grid::GridMap::from_ascii_scaled(art.trim_end(), 1, 0.05).unwrap();
+    World::new(
+        map,
+        crate::world::Robot::new(0.15),
+        Some(crate::geometry::Pose::new(0.5, 0.5, 0.0)),
+    )
+    .unwrap()
+}
+
+#[test]
+fn a_ring_is_peeled_into_offset_loops_from_the_outer_wall() {
+    let world = ring();
+    let frame = *world.frame();
+    let n = frame.width * frame.height;
+    let reach = world.reachable();
+    let ok: Vec<bool> = (0..n).map(|i| reach.contains(i)).collect();
+    let ctx = Ctx {
+        world: &world,
+        frame,
+        safe: ok.clone(),
+        keep_px: None,
+        ok,
+        rt: 3.0,
+    };
+    let lat = Lattice::pixels(&ctx);
+    // Row 50 (through the block) from the left border: C-free from column 3 to 16 (the
+    // block starts at 20). Pass 1 beside the outer wall and beside the block, then the
+    // offset loops 6 columns apart from the outer wall in; no interior.
+    let (inner, pass) = super::headland::interior(&lat, 7.0, 120.0, Some(6.0));
+    assert!(inner.iter().all(|&i| !i));
+    let row: Vec<u32> = (0..20).map(|c| pass[50 * 100 + c]).collect();
+    assert_eq!(
+        row,
+        [0, 0, 0, 1, 0, 0, 0, 0, 0, 2, 0, 0, 0, 0, 0, 3, 1, 0, 0, 0]
+    );
+    // Without `peel`, the plain headland: the two passes, lanes inside.
+    let (inner, pass) = super::headland::interior(&lat, 7.0, 120.0, None);
+    let row: Vec<u32> = (0..20).map(|c| pass[50 * 100 + c]).collect();
+    assert_eq!(
+        row,
+        [0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0]
+    );
+    // (the interior: 7 columns from both walls' non-free points, columns 2 and 17)
+    let inner_row: Vec<bool> = (0..20).map(|c| inner[50 * 100 + c]).collect();
+    let at: Vec<usize> = (0..20).filter(|&c| inner_row[c]).collect();
+    assert_eq!(at, [9, 10]);
+    // The planner keeps the loops: shorter than the plain plan's lanes, the floor swept.
+    let m = run(&world, &BcdOptions::default());
+    let plain = run(
+        &world,
+        &BcdOptions {
+            headland_min_m: None,
+            ..BcdOptions::default()
+        },
+    );
+    assert_eq!(m.collisions, 0);
+    assert!(m.effective_coverage >= 0.995, "{}", m.effective_coverage);
+    assert!(
+        m.path_length_m < 0.97 * plain.path_length_m,
+        "{} vs {}",
+        m.path_length_m,
+        plain.path_length_m
+    );
+    // Four loops (outer pass, two offset loops, the block's pass), one region each.
+    assert_eq!(m.regions, 4);
+}
