@@ -341,6 +341,9 @@ impl Planner for BaStarExtended {
 
     fn next(&mut self, sensor: &dyn Sensor) -> Step {
         let pos = self.drive.observe(&mut self.ext, &self.opts, sensor);
+        if let Some(ext) = self.ext.as_mut() {
+            ext.set_speck_fields(true);
+        }
         self.ba.observe(sensor);
         loop {
             if let Some(s) = self.drive.queue.pop_front() {
