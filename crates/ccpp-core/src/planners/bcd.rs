@@ -153,7 +153,17 @@
 //!    of six tours). Parallel plans are compared in a fixed order, so the choice is the same
 //!    as one after the other. Hop
 //!    costs come from a coarse grid of the C-free set, one bounded Dijkstra per end-point block
-//!    computed once per tour (module `bcd::hops`), not a search per pair. Transfers are
+//!    computed once per tour (module `bcd::hops`), not a search per pair. **Hop correction**
+//!    (not in the paper): the coarse grid misses walls inside a block, so some hops of the
+//!    tour are far longer when routed (on `stage_willow_full` about 196 m of 1401 m of
+//!    transfers). The tour's hops are therefore routed on the true map, every hop whose route
+//!    is longer than its cost in the tour takes the route's length as its cost, and the tour is
+//!    improved once more; twice, and the tour with the lowest routed cost is kept. This is done
+//!    for the tour of the cells (and headland passes); the tour with the rim passes among its
+//!    pieces keeps its estimates (corrected, it wins on cost with fewer turns but a longer
+//!    path: `rmf_office_scan` 1.52 to 1.57). On the 14 shared maps (r = 0.15 m) the mean path
+//!    ratio goes from 1.1833 to 1.1788 and the mean turns from 1250 to 1245, for about 15 %
+//!    more planning time. Transfers are
 //!    straight when collision-free, else A* over the C-free pixel centres (8-connected, octile costs, no corner cutting), shortened
 //!    by line-of-sight checks on the true map.
 //!
