@@ -234,8 +234,8 @@ impl Bcd {
         Self::plan_sets(ctx, lat, opts, search, Sets::Both, false)
     }
 
-    /// [`Bcd::plan_on`] touring only the cell sets `sets` (step 4 of the module docs): the best
-    /// plan and the number of cells. With [`Sets::Split`] and no even cell, an empty plan that
+    /// Steps 1-5 of the module docs on the lattice `lat`, touring only the cell sets `sets`
+    /// (step 4): the best plan and the number of cells. With [`Sets::Split`] and no even cell, an empty plan that
     /// never beats another (skips `usize::MAX`).
     fn plan_sets(
         ctx: &Ctx<'_>,
