@@ -50,6 +50,61 @@ pub fn judge_motion(known: &KnownMap, a: Point, b: Point, r: f64) -> Judgement {
 /// [`judge_motion`] between grid points `ga` and `gb` (continuous grid coordinates of the two
 /// world points) for the contact radius `rc` pixels of the robot.
 pub(super) fn judge_motion_px(known: &KnownMap, ga: Point, gb: Point, rc: f64) -> Judgement {
+    scan_motion_px(known, ga, gb, rc, None)
+}
+
+/// Is the straight move between world points `a` and `b` known free ([`judge_motion`] gives
+/// [`Judgement::Free`]) for a robot of radius `r` metres? Stops at the first pixel that
+/// decides "no", seen or not, and keeps it in `witness`: a later call whose move that pixel
+/// touches too answers "no" at once (the caller keeps the known map unchanged while it reuses
+/// `witness`; `None` to begin with).
+pub fn motion_known_free(
+    known: &KnownMap,
+    a: Point,
+    b: Point,
+    r: f64,
+    witness: &mut Option<(i64, i64)>,
+) -> bool {
+    let frame = known.frame();
+    let ga = frame.world_to_grid(a);
+    let gb = frame.world_to_grid(b);
+    let rc = contact_radius_px(r / frame.resolution);
+    free_px_with(known, ga, gb, rc, witness)
+}
+
+/// [`motion_known_free`] between grid points `ga` and `gb` for the contact radius `rc` pixels.
+fn free_px_with(
+    known: &KnownMap,
+    ga: Point,
+    gb: Point,
+    rc: f64,
+    witness: &mut Option<(i64, i64)>,
+) -> bool {
+    if ga == gb {
+        return judge_point(known, ga, rc) == Judgement::Free;
+    }
+    if let Some((col, row)) = *witness {
+        let q = Point::new(
+            col as f64 + 0.5,
+            known.frame().height as f64 - row as f64 - 0.5,
+        );
+        if point_segment_dist2(q, ga, gb) < rc * rc && first_entry(ga, gb, q, rc).is_some() {
+            return false;
+        }
+    }
+    scan_motion_px(known, ga, gb, rc, Some(witness)) == Judgement::Free
+}
+
+/// [`judge_motion_px`]'s body. With `witness` it answers only "free or not": it stops at the
+/// first touching pixel that is not known free (seen or not; its verdict is then `Blocked` or
+/// `Undetermined`, not necessarily the one [`judge_motion_px`] gives) and writes it there.
+fn scan_motion_px(
+    known: &KnownMap,
+    ga: Point,
+    gb: Point,
+    rc: f64,
+    mut witness: Option<&mut Option<(i64, i64)>>,
+) -> Judgement {
     let frame = *known.frame();
     let rc2 = rc * rc;
     let h = frame.height as f64;
@@ -157,12 +212,21 @@ pub(super) fn judge_motion_px(known: &KnownMap, ga: Point, gb: Point, rc: f64) -
         };
         // Outside the image every pixel is occupied (and seen).
         if row < 0 || row >= hh {
-            if (c0..=c1).any(touches) {
+            if let Some(col) = (c0..=c1).find(|&c| touches(c)) {
+                if let Some(wit) = witness.as_deref_mut() {
+                    *wit = Some((col, row));
+                }
                 return Judgement::Blocked;
             }
             continue;
         }
-        if (c0..=c1.min(-1)).any(touches) || (c0.max(w)..=c1).any(touches) {
+        if let Some(col) = (c0..=c1.min(-1))
+            .find(|&c| touches(c))
+            .or_else(|| (c0.max(w)..=c1).find(|&c| touches(c)))
+        {
+            if let Some(wit) = witness.as_deref_mut() {
+                *wit = Some((col, row));
+            }
             return Judgement::Blocked;
         }
         let (lo, hi) = (c0.max(0), c1.min(w - 1));
@@ -171,17 +235,32 @@ pub(super) fn judge_motion_px(known: &KnownMap, ga: Point, gb: Point, rc: f64) -
         }
         // Inside: seen free pixels never matter, whatever their distance; visit the others.
         let mut blocked = false;
+        let stop_unseen = witness.is_some();
+        let mut hit = None;
         known.for_each_not_known_free(row as usize, lo as usize, hi as usize, |col, seen| {
             if !touches(col as i64) {
                 return true;
             }
             if seen {
                 blocked = true;
+                hit = Some(col);
                 return false;
             }
             undetermined = true;
+            if stop_unseen {
+                hit = Some(col);
+                return false;
+            }
             true
         });
+        if let (Some(col), Some(wit)) = (hit, witness.as_deref_mut()) {
+            *wit = Some((col as i64, row));
+            return if blocked {
+                Judgement::Blocked
+            } else {
+                Judgement::Undetermined
+            };
+        }
         if blocked {
             return Judgement::Blocked;
         }
@@ -211,7 +290,7 @@ impl From<DiskState> for Judgement {
 
 #[cfg(test)]
 mod tests {
-    use super::{judge_motion_px, Judgement};
+    use super::{free_px_with, judge_motion_px, Judgement};
     use crate::geometry::{ceil_i64, first_entry, floor_i64, point_segment_dist2, Point};
     use crate::grid::{Cell, GridMap, MapFrame};
     use crate::planner::{KnownMap, Scan};
@@ -261,6 +340,7 @@ mod tests {
     fn judge_motion_px_matches_brute_force() {
         let mut rng = crate::rng::SplitMix64::new(0x1d6e_5eed);
         let mut counts = [0usize; 3];
+        let mut witnessed = 0usize;
         for round in 0..60 {
             let (w, h) = (40 + round % 7, 30 + round % 5);
             let mut cells = vec![Cell::Free; w * h];
@@ -283,6 +363,7 @@ mod tests {
                 known.integrate(&Scan::new(&truth, c, rng.range(0.5, 2.0)));
             }
             let rc = crate::collide::contact_radius_px(rng.range(0.5, 7.0));
+            let mut witness = None;
             for k in 0..400 {
                 let pick = |rng: &mut crate::rng::SplitMix64| {
                     let x = rng.range(-2.0, w as f64 + 2.0);
@@ -321,9 +402,26 @@ mod tests {
                     want,
                     "{ga:?} {gb:?} rc {rc}"
                 );
+                // The free-or-not answer, fresh and with the pixel that decided an earlier
+                // move (same map) asked first.
+                assert_eq!(
+                    free_px_with(&known, ga, gb, rc, &mut None),
+                    want == Judgement::Free,
+                    "{ga:?} {gb:?} rc {rc}"
+                );
+                let before = witness;
+                assert_eq!(
+                    free_px_with(&known, ga, gb, rc, &mut witness),
+                    want == Judgement::Free,
+                    "{ga:?} {gb:?} rc {rc} witness {before:?}"
+                );
+                if before != witness {
+                    witnessed += 1;
+                }
                 counts[want as usize] += 1;
             }
         }
         assert!(counts.iter().all(|&n| n > 100), "{counts:?}");
+        assert!(witnessed > 100, "{witnessed}");
     }
 }

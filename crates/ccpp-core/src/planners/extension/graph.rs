@@ -4,7 +4,7 @@
 use super::{Extension, Px};
 use crate::geometry::Point;
 use crate::planner::{DiskState, KnownMap};
-use crate::planners::ba_star::{judge_motion, Judgement};
+use crate::planners::ba_star::{judge_motion, motion_known_free, Judgement};
 
 /// Index of the known-free bits in a pixel's move memo (`Extension::edges`).
 pub(super) const FREE: usize = 0;
@@ -109,7 +109,19 @@ impl Extension {
 
     /// Is the straight move between grid points `a` and `b` known free?
     pub(super) fn seg_free(&self, known: &KnownMap, a: Point, b: Point) -> bool {
-        judge_motion(known, self.world(a), self.world(b), self.r) == Judgement::Free
+        self.seg_free_with(known, a, b, &mut None)
+    }
+
+    /// [`Self::seg_free`], first asking the pixel in `witness` (one that made an earlier move
+    /// not free; the known map unchanged since), which the answer "no" then keeps.
+    pub(super) fn seg_free_with(
+        &self,
+        known: &KnownMap,
+        a: Point,
+        b: Point,
+        witness: &mut Option<(i64, i64)>,
+    ) -> bool {
+        motion_known_free(known, self.world(a), self.world(b), self.r, witness)
     }
 
     /// Is position `p` usable and the move from `p` to its neighbour `NB[k]` known free?

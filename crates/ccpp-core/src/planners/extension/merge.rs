@@ -37,11 +37,14 @@ impl Extension {
             centres.extend(g.iter().map(|&i| self.center(self.px_of(i))));
         }
         at.push(centres.len());
-        let keeps = |a: usize, b: usize| -> bool {
+        // The last pixel that made a segment not free: asked first (a wiggle of the wall
+        // often blocks the next segments tried too).
+        let mut witness = None;
+        let mut keeps = |a: usize, b: usize| -> bool {
             centres[at[a + 1]..at[b + 1]]
                 .iter()
                 .all(|&c| point_segment_dist2(c, pts[a], pts[b]) <= rt2)
-                && self.seg_free(known, pts[a], pts[b])
+                && self.seg_free_with(known, pts[a], pts[b], &mut witness)
         };
         let mut out = Vec::new();
         let mut a = 0;
