@@ -396,6 +396,9 @@ pub(crate) struct Extension {
     exhaust_check: bool,
     /// Positions the running search cannot reach, found by `search::cut_off`.
     unreach: FixedBitSet,
+    /// The positions set in `unreach` (cleared one by one: most searches mark none, and a
+    /// whole-map clear per search cost more than the rest of a short one).
+    unreach_marked: Vec<usize>,
     /// Scratch of `search::cut_off` (all clear between calls).
     met: FixedBitSet,
     /// The final clean-up's walk follows a strip of rim off the contour too (see
@@ -470,6 +473,7 @@ impl Extension {
             resume_at: None,
             exhaust_check: false,
             unreach: FixedBitSet::with_capacity(n),
+            unreach_marked: Vec::new(),
             met: FixedBitSet::with_capacity(n),
             strip_walk: false,
             speck_fields: false,

@@ -282,7 +282,9 @@ impl Extension {
         let mut heap = std::mem::take(&mut self.heap);
         if !resume || self.resume_at.is_none() {
             self.begin();
-            self.unreach.clear();
+            for j in self.unreach_marked.drain(..) {
+                self.unreach.set(j, false);
+            }
             self.resume_at = None;
             heap.clear();
         }
@@ -441,6 +443,7 @@ impl Extension {
             self.met.set(j, false);
             if cut {
                 self.unreach.insert(j);
+                self.unreach_marked.push(j);
             }
         }
         cut
