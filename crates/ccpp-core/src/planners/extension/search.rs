@@ -209,6 +209,11 @@ fn node_move(n: Node) -> Option<usize> {
 pub(super) const COST_ORTHO: u64 = 1000;
 const COST_DIAG: u64 = 1414;
 
+/// The cost of the step `NB[k]` (odd `k`: diagonal).
+const STEP_COST: [u64; 8] = [
+    COST_ORTHO, COST_DIAG, COST_ORTHO, COST_DIAG, COST_ORTHO, COST_DIAG, COST_ORTHO, COST_DIAG,
+];
+
 /// Settled positions carry this bit in their search cost.
 const CLOSED: u64 = 1 << 63;
 
@@ -521,15 +526,21 @@ impl Extension {
                 }
             }
         }
+        // Settled or no better: skip before judging the move (judging only fills memos).
+        // Judged for all eight at once, without branches (the states were read above and
+        // the loop below writes each neighbour once, so the order does not matter).
+        let mut better = 0u8;
+        for k in 0..8 {
+            let n = ns[k];
+            let nd = d + STEP_COST[k];
+            let skip = node_gen(n) == gen && (n & CLOSED != 0 || nd >= node_cost(n));
+            better |= u8::from(!skip) << k;
+        }
+        todo &= better;
         while todo != 0 {
             let k = todo.trailing_zeros() as usize;
             todo &= todo - 1;
-            let nd = d + if k % 2 == 1 { COST_DIAG } else { COST_ORTHO };
-            // Settled or no better: skip before judging the move (judging only fills memos).
-            let n = ns[k];
-            if node_gen(n) == gen && (n & CLOSED != 0 || nd >= node_cost(n)) {
-                continue;
-            }
+            let nd = d + STEP_COST[k];
             // The memo first (most moves were judged by an earlier search).
             if edges & (1 << k) == 0 && !self.edge(known, p, k) {
                 continue;
