@@ -113,7 +113,8 @@ mod tile_model;
 pub use backtrack_list::{
     corner_score, lane_end_score, LANE_END_PAIRS, MU_PAIRS, SIDE_END_PAIRS, START_PAIRS,
 };
-pub use judge::{judge_motion, motion_known_free, Judgement};
+pub(crate) use judge::motion_known_free;
+pub use judge::{judge_motion, Judgement};
 pub use motion::motion_to;
 pub use search::{graph_edge, heuristic, octile, TileGraph, TileSearch, COST_DIAG, COST_ORTHO};
 pub use smoothing::{for_each_swept_tile, smooth_path};

@@ -58,7 +58,7 @@ pub(super) fn judge_motion_px(known: &KnownMap, ga: Point, gb: Point, rc: f64) -
 /// decides "no", seen or not, and keeps it in `witness`: a later call whose move that pixel
 /// touches too answers "no" at once (the caller keeps the known map unchanged while it reuses
 /// `witness`; `None` to begin with).
-pub fn motion_known_free(
+pub(crate) fn motion_known_free(
     known: &KnownMap,
     a: Point,
     b: Point,
