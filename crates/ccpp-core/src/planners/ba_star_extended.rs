@@ -340,10 +340,11 @@ impl Planner for BaStarExtended {
     }
 
     fn next(&mut self, sensor: &dyn Sensor) -> Step {
-        let pos = self.drive.observe(&mut self.ext, &self.opts, sensor);
-        if let Some(ext) = self.ext.as_mut() {
-            ext.set_speck_fields(true);
-        }
+        let pos = self
+            .drive
+            .observe(&mut self.ext, &self.opts, sensor, |ext| {
+                ext.set_speck_fields(true);
+            });
         self.ba.observe(sensor);
         loop {
             if let Some(s) = self.drive.queue.pop_front() {

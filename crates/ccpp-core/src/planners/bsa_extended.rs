@@ -259,10 +259,12 @@ impl Planner for BsaExtended {
     }
 
     fn next(&mut self, sensor: &dyn Sensor) -> Step {
-        let pos = self.drive.observe(&mut self.ext, &self.opts, sensor);
-        if let Some(ext) = self.ext.as_mut() {
-            ext.set_strip_walk(self.strip_walk);
-        }
+        let strip_walk = self.strip_walk;
+        let pos = self
+            .drive
+            .observe(&mut self.ext, &self.opts, sensor, |ext| {
+                ext.set_strip_walk(strip_walk);
+            });
         self.bsa.observe(sensor);
         loop {
             if let Some(s) = self.drive.queue.pop_front() {

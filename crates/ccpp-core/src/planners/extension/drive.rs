@@ -24,12 +24,14 @@ pub(crate) struct Drive {
 
 impl Drive {
     /// Records the move since the last step into `ext` (made at the first step, when the
-    /// sensor tells the robot's size); returns the robot's position.
+    /// sensor tells the robot's size, and handed to the host's `configure` once then); returns
+    /// the robot's position.
     pub fn observe(
         &mut self,
         ext: &mut Option<Extension>,
         opts: &ExtensionOptions,
         sensor: &dyn Sensor,
+        configure: impl FnOnce(&mut Extension),
     ) -> Point {
         let pos = sensor.pose().position();
         if let (Some(ext), Some(prev)) = (ext.as_mut(), self.last_pos) {
@@ -44,6 +46,7 @@ impl Drive {
                 robot.radius,
                 robot.tool_radius,
             );
+            configure(&mut made);
             made.record(pos, pos);
             *ext = Some(made);
         }
