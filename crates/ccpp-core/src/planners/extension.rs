@@ -91,8 +91,9 @@
 //! tour (first trip, walks, the straight ways between them) plus the way on to the chunk after
 //! it, less the direct trip there. A host may have a field of one-pixel specks judged as one
 //! place (`Extension::set_speck_fields`; `ba-star-extended` does): a chunk within two tool
-//! radii of the one before it then does not count towards the group's size. On the 14 shared maps the final clean-up had spent 0.08 of
-//! the ideal path on trips to rims of at most 3 pixels (on `rmf_office_scan` 0.18).
+//! radii of the one before it then does not count towards the group's size. On the 14 shared
+//! maps the final clean-up had spent 0.08 of the ideal path on trips to rims of at most 3
+//! pixels (on `rmf_office_scan` 0.18).
 //!
 //! ```text
 //!   robot R, rims a (1 px, 9 m away, the next rim b beyond it) and c (3 px, 12 m away, last)

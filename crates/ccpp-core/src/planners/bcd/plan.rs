@@ -235,8 +235,8 @@ impl Bcd {
     }
 
     /// Steps 1-5 of the module docs on the lattice `lat`, touring only the cell sets `sets`
-    /// (step 4): the best plan and the number of cells. With [`Sets::Split`] and no even cell, an empty plan that
-    /// never beats another (skips `usize::MAX`).
+    /// (step 4): the best plan and the number of cells. With [`Sets::Split`] and no even cell,
+    /// an empty plan that never beats another (skips `usize::MAX`).
     fn plan_sets(
         ctx: &Ctx<'_>,
         lat: &Lattice,
@@ -818,8 +818,9 @@ impl Routes {
 /// whose route is longer than its cost in the tour gets the route's length as its cost (both
 /// ways), and the tour is improved again with the corrected costs ([`CORRECT_IMPROVE`] rounds
 /// of [`tsp::improve`], at most `rounds`; nothing is corrected when `rounds` is 0); up to
-/// [`CORRECT_ROUNDS`] times, until no hop of the tour is corrected. Of the tours seen, the one with the lowest routed cost (inner costs plus routed hops; a hop
-/// with no route at its estimate) is returned, so a correction never lengthens the tour.
+/// [`CORRECT_ROUNDS`] times, until no hop of the tour is corrected. Of the tours seen, the one
+/// with the lowest routed cost (inner costs plus routed hops; a hop with no route at its
+/// estimate) is returned, so a correction never lengthens the tour.
 #[allow(clippy::too_many_arguments)]
 fn correct_hops(
     ctx: &Ctx<'_>,

@@ -8,11 +8,11 @@ use crate::geometry::Point;
 use crate::planner::KnownMap;
 
 /// With [`Extension::set_speck_fields`], a chunk whose start lies within this many tool radii
-/// of the end of the chunk before it in a group belongs to the same field of specks and does not count towards
-/// [`ExtensionOptions::leave_group`]: on `aws_small_warehouse_002` a field of one-pixel specks
-/// filled the 12 places of a group 7.6 m away, so the group was driven (`leave_group` reached)
-/// although its 14 pixels did not pay for the trip (10 m). With the field counted once the
-/// mean path ratio on the 14 shared maps went from 1.3128 to 1.3109
+/// of the end of the chunk before it in a group belongs to the same field of specks and does
+/// not count towards [`ExtensionOptions::leave_group`]: on `aws_small_warehouse_002` a field
+/// of one-pixel specks filled the 12 places of a group 7.6 m away, so the group was driven
+/// (`leave_group` reached) although its 14 pixels did not pay for the trip (10 m). With the
+/// field counted once the mean path ratio on the 14 shared maps went from 1.3128 to 1.3109
 /// (`aws_small_warehouse_002` 1.303 -> 1.290, `mit_building_31` 1.299 -> 1.284, the other
 /// maps unchanged); 1 or 4 tool radii gave the same plans within 0.0001.
 const SAME_FIELD_R: f64 = 2.0;
