@@ -6,7 +6,8 @@
 //! cost). The path starts at a fixed point and visits every piece once; the cost of a hop is the
 //! straight-line distance. Construction: nearest neighbour from the start. Improvement, repeated
 //! until a round changes nothing (or `rounds` is spent): 2-opt (a reversed stretch drives each of
-//! its pieces backwards), Or-opt (stretches of 1 to 3 pieces moved elsewhere, either way round),
+//! its pieces backwards), Or-opt (stretches of 1 to 3 pieces moved elsewhere, either way round;
+//! a single piece in any of its variants),
 //! both tried only where a new hop joins one of a piece's 12 nearest pieces, and an exact dynamic
 //! programme that picks every piece's variant for the current order.
 //! Everything is deterministic: fixed scan orders, strict improvements only, ties to the lower
@@ -286,8 +287,20 @@ fn two_opt(pieces: &[Piece], start: Point, tour: &mut Tour, nb: &[Vec<usize>], d
     }
 }
 
+/// How an Or-opt move drives the stretch it moves.
+#[derive(Clone, Copy)]
+enum Alt {
+    /// As before.
+    Forward,
+    /// Backwards (every piece in its reversed variant).
+    Backward,
+    /// A single piece in this variant.
+    Variant(usize),
+}
+
 /// Or-opt over candidate neighbours: stretches of 1 to 3 pieces moved next to a neighbour of
-/// their first or last piece, either way round.
+/// their first or last piece, either way round; a single piece moved may also change its
+/// variant (be started at another corner) where that costs less at its new place.
 fn or_opt(pieces: &[Piece], start: Point, tour: &mut Tour, nb: &[Vec<usize>], d: Dist<'_>) {
     let entry = |t: &Tour, i: usize| pieces[t[i].0].entry[t[i].1];
     let exit = |t: &Tour, i: usize| pieces[t[i].0].exit[t[i].1];
@@ -295,6 +308,7 @@ fn or_opt(pieces: &[Piece], start: Point, tour: &mut Tour, nb: &[Vec<usize>], d:
     let mut improved = true;
     let mut passes = 0;
     let mut cand: Vec<usize> = Vec::new();
+    let mut alts: Vec<(Point, Point, f64, Alt)> = Vec::new();
     while improved && passes < 50 {
         improved = false;
         passes += 1;
@@ -323,31 +337,54 @@ fn or_opt(pieces: &[Piece], start: Point, tour: &mut Tour, nb: &[Vec<usize>], d:
                 cand.push(n);
                 cand.sort_unstable();
                 cand.dedup();
-                let mut best: Option<(f64, usize, bool)> = None;
+                // The ways the stretch can be driven at its new place: a stretch of several
+                // pieces forwards or backwards; a single piece in any of its variants (its
+                // other corners too, the change of its inner cost counted).
+                alts.clear();
+                if k == 1 {
+                    let (p, v) = tour[i];
+                    let pc = &pieces[p];
+                    alts.extend((0..pc.entry.len()).map(|w| {
+                        (
+                            pc.entry[w],
+                            pc.exit[w],
+                            pc.inner[w] - pc.inner[v],
+                            Alt::Variant(w),
+                        )
+                    }));
+                } else {
+                    alts.push((si, ej, 0.0, Alt::Forward));
+                    alts.push((ej, si, 0.0, Alt::Backward));
+                }
+                let mut best: Option<(f64, usize, Alt)> = None;
                 for &p in &cand {
                     if p > n || (p >= i && p <= j + 1) {
                         continue;
                     }
                     let before_pt = prev_exit(pieces, start, tour, p);
                     let next = if p < n { Some(entry(tour, p)) } else { None };
-                    for rev in [false, true] {
-                        let (s_in, s_out) = if rev { (ej, si) } else { (si, ej) };
-                        let add = match next {
-                            Some(nx) => d(before_pt, s_in) + d(s_out, nx) - d(before_pt, nx),
-                            None => d(before_pt, s_in),
-                        };
+                    for &(s_in, s_out, extra, alt) in &alts {
+                        let add = extra
+                            + match next {
+                                Some(nx) => d(before_pt, s_in) + d(s_out, nx) - d(before_pt, nx),
+                                None => d(before_pt, s_in),
+                            };
                         if add < removed - EPS && best.is_none_or(|b| add < b.0) {
-                            best = Some((add, p, rev));
+                            best = Some((add, p, alt));
                         }
                     }
                 }
-                if let Some((_, p, rev)) = best {
+                if let Some((_, p, alt)) = best {
                     let mut seg: Vec<(usize, usize)> = tour.drain(i..=j).collect();
-                    if rev {
-                        seg.reverse();
-                        for e in &mut seg {
-                            e.1 ^= 1;
+                    match alt {
+                        Alt::Forward => {}
+                        Alt::Backward => {
+                            seg.reverse();
+                            for e in &mut seg {
+                                e.1 ^= 1;
+                            }
                         }
+                        Alt::Variant(w) => seg[0].1 = w,
                     }
                     let at = if p > j { p - k } else { p };
                     tour.splice(at..at, seg);
@@ -446,6 +483,33 @@ mod tests {
         let tour = solve(&pieces, Point::new(0.0, 0.0), 10, &euclid, None);
         assert_eq!(tour, vec![(1, 0), (0, 1)]);
         assert!((cost(&pieces, Point::new(0.0, 0.0), &tour, &euclid) - 21.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn or_opt_moves_a_piece_into_another_variant() {
+        // Points A (x = 1) and C (x = 3) on a line from the start; B is a piece whose variants
+        // 0/1 lie far off the line (inner cost 0) and whose variants 2/3 lie between A and C
+        // (inner cost 9.5). At the end of the tour B is cheaper in variant 0 (10.05 against
+        // 10.5), so the variant choice alone keeps it there; only moving B between A and C in
+        // variant 2 lowers the cost (13.05 to 12.5).
+        let far = Point::new(2.0, 10.0);
+        let near = Point::new(2.0, 0.0);
+        let b = Piece {
+            entry: vec![far, far, near, near],
+            exit: vec![far, far, near, near],
+            inner: vec![0.0, 0.0, 9.5, 9.5],
+        };
+        let pieces = vec![point_piece(1.0, 0.0), point_piece(3.0, 0.0), b];
+        let start = Point::new(0.0, 0.0);
+        let nb = neighbours(&pieces, &euclid);
+        let mut tour = vec![(0, 0), (1, 0), (2, 0)];
+        let before = cost(&pieces, start, &tour, &euclid);
+        assert!((before - (3.0 + 101.0f64.sqrt())).abs() < 1e-9);
+        improve(&pieces, start, 5, &euclid, &nb, &mut tour);
+        let order: Vec<usize> = tour.iter().map(|e| e.0).collect();
+        assert_eq!(order, vec![0, 2, 1]);
+        assert!(tour[1].1 >= 2, "{tour:?}");
+        assert!((cost(&pieces, start, &tour, &euclid) - 12.5).abs() < 1e-9);
     }
 
     #[test]
