@@ -55,6 +55,10 @@ impl Plan {
     }
 }
 
+/// A decomposition's cheapest lane phase (module docs, step 1): its estimate, the
+/// decomposition, the phase and every cell's view.
+type Pick = (f64, usize, f64, Vec<usize>);
+
 /// Entry points a closed headland pass offers the tour (module docs, step 3).
 const ROT: usize = 16;
 
@@ -116,38 +120,41 @@ impl Bcd {
             None => Lattice::pixels(&ctx),
             Some(t) => Lattice::turned(&ctx, *t),
         };
-        // With several lattices, the cell sets with even cells cut (step 4) are toured only on
-        // the lattice whose whole cells plan best: the split changes a plan's cost by a few
-        // percent, the lattice by more, and the second tour per lattice doubled the time.
-        // With a headland (module docs, step 3), every lattice is planned with and without
-        // it, the cheaper plan kept; the plan with the headland tours its cells whole.
+        // Every job tours its cells whole; the cell sets with even cells cut (step 4) are then
+        // toured on the job whose plan is best only: the split changes a plan's cost by a few
+        // percent, the lattice or the decomposition by more, and a second tour per job doubled
+        // the time. With a headland (module docs, step 3), every lattice is planned with and
+        // without it, the cheaper plan kept.
         let plain = BcdOptions {
             headland_min_m: None,
             ..opts.clone()
         };
-        // With a headland, the peeled plan (offset loops from the outer walls in) too, on
-        // the pixel lattice only (offset loops follow the walls on any lattice).
-        let mut jobs: Vec<(usize, &BcdOptions, bool)> = Vec::new();
+        // On the pixel lattice alone (walls along the axes), the plain plan is also made on
+        // the sweep the estimate did not pick (module docs, step 1): the estimate misses the
+        // transfers, and the other sweep's plan is often the cheaper one. With a headland, the
+        // peeled plan (offset loops from the outer walls in) too, on the pixel lattice only
+        // (offset loops follow the walls on any lattice). Jobs: lattice, options, peeled,
+        // other sweep.
+        let many = turns_by.len() > 1;
+        let mut jobs: Vec<(usize, &BcdOptions, bool, bool)> = Vec::new();
         for k in 0..turns_by.len() {
-            jobs.push((k, &plain, false));
+            jobs.push((k, &plain, false, false));
+            if !many {
+                jobs.push((k, &plain, false, true));
+            }
             if opts.headland_min_m.is_some() {
-                jobs.push((k, opts, false));
+                jobs.push((k, opts, false, false));
                 if k == 0 {
-                    jobs.push((k, opts, true));
+                    jobs.push((k, opts, true, false));
                 }
             }
         }
-        let many = turns_by.len() > 1;
         let plans: Vec<_> = jobs
             .par_iter()
-            .map(|&(k, o, peel)| {
+            .map(|&(k, o, peel, other)| {
                 let mut search = Search::new(w, h);
-                let sets = if many || o.headland_min_m.is_some() {
-                    Sets::Whole
-                } else {
-                    Sets::Both
-                };
-                Self::plan_sets(&ctx, &lattice(&turns_by[k]), o, &mut search, sets, peel)
+                let lat = lattice(&turns_by[k]);
+                Self::plan_sets(&ctx, &lat, o, &mut search, Sets::Whole, peel, other)
             })
             .collect();
         let mut best: Option<(Plan, usize)> = None;
@@ -158,17 +165,10 @@ impl Bcd {
                 at = j;
             }
         }
-        if many {
-            let (k, o, peel) = jobs[at];
+        if let Some(&(k, o, peel, other)) = jobs.get(at) {
             let mut search = Search::new(w, h);
-            let p = Self::plan_sets(
-                &ctx,
-                &lattice(&turns_by[k]),
-                o,
-                &mut search,
-                Sets::Split,
-                peel,
-            );
+            let lat = lattice(&turns_by[k]);
+            let p = Self::plan_sets(&ctx, &lat, o, &mut search, Sets::Split, peel, other);
             if p.0.beats(best.as_ref().map(|b| &b.0)) {
                 best = Some(p);
             }
@@ -231,12 +231,13 @@ impl Bcd {
         opts: &BcdOptions,
         search: &mut Search,
     ) -> (Plan, usize) {
-        Self::plan_sets(ctx, lat, opts, search, Sets::Both, false)
+        Self::plan_sets(ctx, lat, opts, search, Sets::Both, false, false)
     }
 
     /// Steps 1-5 of the module docs on the lattice `lat`, touring only the cell sets `sets`
     /// (step 4): the best plan and the number of cells. With [`Sets::Split`] and no even cell,
-    /// an empty plan that never beats another (skips `usize::MAX`).
+    /// an empty plan that never beats another (skips `usize::MAX`). `other`: the cells of the
+    /// sweep (west-to-east or north-to-south, step 1) whose estimate is the higher.
     fn plan_sets(
         ctx: &Ctx<'_>,
         lat: &Lattice,
@@ -244,6 +245,7 @@ impl Bcd {
         search: &mut Search,
         sets: Sets,
         peel: bool,
+        other: bool,
     ) -> (Plan, usize) {
         let world = ctx.world;
         let frame = ctx.frame;
@@ -330,13 +332,14 @@ impl Bcd {
             views(split_ends(split_jumps(by_cols, jump, &part_cost), trim_max)),
             views(split_ends(split_jumps(by_rows, jump, &part_cost), trim_max)),
         ];
-        let mut best: Option<(f64, usize, f64, Vec<usize>)> = None;
-        for (d, dec) in decs.iter().enumerate() {
+        // Per decomposition, the cheapest phase: estimate, decomposition, phase, views.
+        let mut best: [Option<Pick>; 2] = [None, None];
+        for (d, cells) in decs.iter().enumerate() {
             for k in 0..6 {
                 let phase = sp * f64::from(k) / 6.0;
                 let mut total = 0.0;
-                let mut pick = Vec::with_capacity(dec.len());
-                for vs in dec {
+                let mut pick = Vec::with_capacity(cells.len());
+                for vs in cells {
                     let mut b: Option<(f64, usize)> = None;
                     for (j, (c, lo, hi)) in vs.iter().enumerate() {
                         let lanes = lanes_of(c, sp, phase, *lo, *hi);
@@ -352,12 +355,29 @@ impl Bcd {
                     total += e;
                     pick.push(j);
                 }
-                if best.as_ref().is_none_or(|b| total < b.0) {
-                    best = Some((total, d, phase, pick));
+                if best[d].as_ref().is_none_or(|b| total < b.0) {
+                    best[d] = Some((total, d, phase, pick));
                 }
             }
         }
-        let (_, d, phase, pick) = best.unwrap_or((0.0, 0, 0.0, Vec::new()));
+        // The estimate's pick (of equal estimates the column sweep), or the other one.
+        let [by_c, by_r] = best;
+        let pick_c = match (&by_c, &by_r) {
+            (Some(c), Some(r)) => c.0 <= r.0,
+            (c, _) => c.is_some(),
+        };
+        let chosen = if pick_c == other { by_r } else { by_c };
+        let Some((_, d, phase, pick)) = chosen else {
+            return (
+                Plan {
+                    skipped: usize::MAX,
+                    short: true,
+                    cost: 0.0,
+                    items: Vec::new(),
+                },
+                0,
+            );
+        };
         let chosen: Vec<Cell> = decs[d]
             .iter()
             .zip(&pick)
