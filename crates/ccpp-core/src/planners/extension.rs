@@ -390,6 +390,8 @@ pub(crate) struct Extension {
     /// Target counts around a bounded search's start, valid during that search only.
     win: Window,
     win_on: bool,
+    /// The cuts of the running final pass's transfers (`Extension::merge_transfer`).
+    merge_memo: Vec<merge::MergeMemo>,
     /// Where the last search stopped (see `search_with`), while its state is valid.
     resume_at: Option<usize>,
     /// The running search is a final clean-up's (its `done` is false wherever `no_gain`
@@ -471,6 +473,7 @@ impl Extension {
             heap: BucketQueue::default(),
             win: Window::default(),
             win_on: false,
+            merge_memo: Vec::new(),
             resume_at: None,
             exhaust_check: false,
             unreach: FixedBitSet::with_capacity(n),

@@ -43,6 +43,10 @@ impl Extension {
         if !bounded && !resume {
             self.refresh_no_gain(known);
         }
+        if !resume {
+            // A new search (from elsewhere, or the known map changed): other ways.
+            self.merge_memo.clear();
+        }
         if let Some(l) = limit {
             // Every position the bounded search settles lies within `l` of `from`.
             let rad = (l / COST_ORTHO) as i64 + self.tool_rows.len() as i64 + 2;
@@ -135,7 +139,11 @@ impl Extension {
         let nt = transit.len();
         let mut simplified = 0;
         let kept: Vec<usize> = if self.opts.merge_segments {
-            let mut kept = self.merge(known, &pts[..=nt], &gains[..=nt]);
+            let mut kept = if bounded {
+                self.merge(known, &pts[..=nt], &gains[..=nt])
+            } else {
+                self.merge_transfer(known, &pts[..=nt], &gains[..=nt])
+            };
             kept.extend(
                 self.merge(known, &pts[nt..], &gains[nt..])
                     .into_iter()
