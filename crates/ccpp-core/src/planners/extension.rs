@@ -304,6 +304,9 @@ pub(crate) struct Chunk {
     pub(crate) owed: bool,
     /// Gained pixels the simplified walk leaves (counted once the chunk is driven).
     simplified: usize,
+    /// [`Extension::no_gain`] entries made since the chunk claimed its pixels start at this
+    /// (logical) index of `no_gain_log`.
+    log_at: usize,
 }
 
 impl Chunk {
@@ -371,6 +374,12 @@ pub(crate) struct Extension {
     /// the memo was last brought up to date): the memo is dropped around those only.
     no_gain: FixedBitSet,
     no_gain_free: Vec<usize>,
+    /// The positions the final clean-up's searches put into `no_gain`, in order, since the
+    /// last search that started afresh; `no_gain_log_base` is the logical index of the first.
+    /// Giving a chunk's claims back drops only the entries made after it claimed them
+    /// (`Extension::unclaim`): the earlier ones were judged with its pixels still targets.
+    no_gain_log: Vec<usize>,
+    no_gain_log_base: usize,
     /// Target pixels left in chunks below [`ExtensionOptions::min_yield`].
     left: usize,
     /// Gained pixels the simplified walks leave ([`ExtensionOptions::simplify_fraction`]).
@@ -464,6 +473,8 @@ impl Extension {
             any_owed: false,
             no_gain: FixedBitSet::with_capacity(n),
             no_gain_free: Vec::new(),
+            no_gain_log: Vec::new(),
+            no_gain_log_base: 0,
             left: 0,
             simplified: 0,
             simplify_per_turn,

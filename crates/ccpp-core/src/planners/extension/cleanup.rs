@@ -179,10 +179,10 @@ impl Extension {
         let f = self.frame;
         let (w, h) = (f.width as i64, f.height as i64);
         let reach = self.strip_rows.len() as i64 - 1;
-        // Positions the searches since judged without these targets may gain again: the memo
-        // is dropped in the square of side `2 reach + 1` around each pixel, the pixels' column
-        // ranges merged per image row first (a walk's pixels crowd a few rows), so each
-        // range is cleared once per row within `reach` (the same union of squares).
+        // Positions judged without these targets may gain again: the memo is dropped in the
+        // square of side `2 reach + 1` around each pixel, the pixels' column ranges merged
+        // per image row first (a walk's pixels crowd a few rows), so each range is cleared
+        // once per row within `reach` (the same union of squares).
         let mut runs: Vec<(i64, i64, i64)> = chunk
             .claimed
             .iter()
@@ -192,6 +192,9 @@ impl Extension {
                 (r, (c - reach).max(0), (c + reach).min(w - 1))
             })
             .collect();
+        if runs.is_empty() {
+            return;
+        }
         runs.sort_unstable();
         let mut merged: Vec<(i64, i64, i64)> = Vec::with_capacity(runs.len());
         for (r, c0, c1) in runs {
@@ -200,10 +203,40 @@ impl Extension {
                 _ => merged.push((r, c0, c1)),
             }
         }
+        // Only the memo entries made since the chunk claimed its pixels were judged without
+        // them (targets only disappear meanwhile, but for chunks given back, whose own
+        // entries go the same way, and new known free pixels, `refresh_no_gain`'s): while
+        // the log reaches back that far, those entries in the squares are dropped, else every
+        // entry in the squares.
+        let logged = chunk.log_at >= self.no_gain_log_base;
+        let set = if logged {
+            &mut self.met
+        } else {
+            &mut self.no_gain
+        };
+        for &(r, c0, c1) in &merged {
+            for row in (r - reach).max(0)..=(r + reach).min(h - 1) {
+                let base = row as usize * f.width;
+                let range = base + c0 as usize..base + c1 as usize + 1;
+                if logged {
+                    set.insert_range(range);
+                } else {
+                    set.remove_range(range);
+                }
+            }
+        }
+        if !logged {
+            return;
+        }
+        for &j in &self.no_gain_log[chunk.log_at - self.no_gain_log_base..] {
+            if self.met.contains(j) {
+                self.no_gain.set(j, false);
+            }
+        }
         for (r, c0, c1) in merged {
             for row in (r - reach).max(0)..=(r + reach).min(h - 1) {
                 let base = row as usize * f.width;
-                self.no_gain
+                self.met
                     .remove_range(base + c0 as usize..base + c1 as usize + 1);
             }
         }

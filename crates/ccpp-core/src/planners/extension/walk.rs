@@ -42,6 +42,9 @@ impl Extension {
         // A resumed search follows a chunk left in the same pass: the known map is the same.
         if !bounded && !resume {
             self.refresh_no_gain(known);
+            // No chunk planned before gives its claims back selectively now (see `unclaim`).
+            self.no_gain_log_base += self.no_gain_log.len();
+            self.no_gain_log.clear();
         }
         if !resume {
             // A new search (from elsewhere, or the known map changed): other ways.
@@ -69,6 +72,7 @@ impl Extension {
                         || s.sweeps_owed(p)));
             if !gains && !bounded {
                 s.no_gain.insert(i);
+                s.no_gain_log.push(i);
             }
             gains
         });
@@ -77,6 +81,7 @@ impl Extension {
         let Some(transit) = transit else {
             return Chunk::default();
         };
+        let log_at = self.no_gain_log_base + self.no_gain_log.len();
         let mut pts: Vec<Point> = vec![from];
         let mut gains: Vec<Vec<usize>> = vec![Vec::new()];
         for &i in &transit[..transit.len() - 1] {
@@ -172,6 +177,7 @@ impl Extension {
             claimed: gains.iter().flatten().copied().collect(),
             owed: self.any_owed && gains.iter().flatten().any(|&i| self.owed.contains(i)),
             simplified,
+            log_at,
         }
     }
 
