@@ -399,6 +399,9 @@ pub(crate) struct Extension {
     /// Target counts around a bounded search's start, valid during that search only.
     win: Window,
     win_on: bool,
+    /// The grid segments of the ways to the chunks `Extension::charge` left in the running
+    /// final pass (they sweep no target any more until the pass ends).
+    charged_segs: std::collections::BTreeSet<cleanup::SegKey>,
     /// The cuts of the running final pass's transfers (`Extension::merge_transfer`).
     merge_memo: Vec<merge::MergeMemo>,
     /// Where the last search stopped (see `search_with`), while its state is valid.
@@ -484,6 +487,7 @@ impl Extension {
             heap: BucketQueue::default(),
             win: Window::default(),
             win_on: false,
+            charged_segs: std::collections::BTreeSet::new(),
             merge_memo: Vec::new(),
             resume_at: None,
             exhaust_check: false,

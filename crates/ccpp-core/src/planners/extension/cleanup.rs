@@ -151,14 +151,26 @@ impl Extension {
     fn charge(&mut self, known: &KnownMap, pos: Point, group: &[Chunk]) -> bool {
         // Charged: the walks' pixels and the targets the ways there would sweep on the side
         // (specks too small for a pass of their own, which leaving the trips leaves as well).
+        // The ways of one pass's chunks share their first segments (the search tree's, see
+        // `merge_transfer`): a segment charged before in the pass sweeps no target any more
+        // (its targets became swept then, and targets only disappear during a pass), so only
+        // the others are stamped.
         let f = self.frame;
         let mut side: Vec<usize> = Vec::new();
+        let mut segs: Vec<SegKey> = Vec::new();
         for chunk in group {
             let way: Vec<Point> = std::iter::once(pos)
                 .chain(chunk.transfer.iter().copied())
                 .map(|p| f.world_to_grid(p))
                 .collect();
-            side.extend(self.polyline_gains(known, &way).concat());
+            for s in way.windows(2) {
+                let key = seg_key(s[0], s[1]);
+                if self.charged_segs.contains(&key) || segs.contains(&key) {
+                    continue;
+                }
+                segs.push(key);
+                side.extend(self.polyline_gains(known, s).concat());
+            }
         }
         side.sort_unstable();
         side.dedup();
@@ -167,6 +179,7 @@ impl Extension {
             return false;
         }
         self.left += charged;
+        self.charged_segs.extend(segs);
         // Left with them: no later pass goes out for them alone.
         for i in side {
             self.swept.insert(i);
@@ -241,6 +254,13 @@ impl Extension {
             }
         }
     }
+}
+
+/// A grid segment, exactly (its ends' bits), for [`Extension::charge`]'s memo.
+pub(super) type SegKey = [u64; 4];
+
+fn seg_key(a: Point, b: Point) -> SegKey {
+    [a.x.to_bits(), a.y.to_bits(), b.x.to_bits(), b.y.to_bits()]
 }
 
 /// The path leaving `group` saves (chunks planned from world point `pos`, nearest first),

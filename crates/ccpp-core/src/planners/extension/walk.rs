@@ -49,6 +49,7 @@ impl Extension {
         if !resume {
             // A new search (from elsewhere, or the known map changed): other ways.
             self.merge_memo.clear();
+            self.charged_segs.clear();
         }
         if let Some(l) = limit {
             // Every position the bounded search settles lies within `l` of `from`.
