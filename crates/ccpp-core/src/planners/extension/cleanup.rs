@@ -20,6 +20,10 @@ const SAME_FIELD_R: f64 = 2.0;
 /// [`ExtensionOptions::leave_group`] chunks (2 gave 1.3116, 4 and 8 the same plans).
 const MAX_GROUP_FACTOR: usize = 4;
 
+/// Metres added to a bound on the path a group's leaving saves (rounding of the lengths
+/// summed; far below any length that decides).
+const SAVING_SLACK: f64 = 1e-6;
+
 impl Extension {
     /// Plans the next chunk of a cleaning pass from world point `pos`: the transfer to the rim
     /// (waypoints that reach the first sweeping position) and the sweep along it; both empty
@@ -94,8 +98,25 @@ impl Extension {
             let mut group = vec![cur];
             let mut places = 1;
             let next = loop {
-                let next = self.plan_chunk(known, pos, bounded, wanted, true);
                 let gained: usize = group.iter().map(|c| c.gained).sum();
+                // Whatever chunk comes next, the group pays (leaving it saves at most its tour
+                // and the way back from its end: the trip to the next chunk is at least the
+                // straight way from here) and is full: it is driven, and the next chunk would
+                // only be planned to be given back.
+                let last = &group[group.len() - 1];
+                if (places >= self.opts.leave_group
+                    || group.len() >= MAX_GROUP_FACTOR * self.opts.leave_group
+                    || self.left + gained >= self.leave_budget(known))
+                    && self.pays(
+                        gained,
+                        group_saving(pos, &group, &Chunk::default())
+                            + last.end(pos).dist(pos)
+                            + SAVING_SLACK,
+                    )
+                {
+                    break None;
+                }
+                let next = self.plan_chunk(known, pos, bounded, wanted, true);
                 if !self.pays(gained, group_saving(pos, &group, &next)) {
                     if self.charge(known, pos, &group) {
                         break Some(next);
