@@ -213,3 +213,93 @@ impl Extension {
         out
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::{Extension, ExtensionOptions};
+    use crate::geometry::Point;
+    use crate::grid::GridMap;
+    use crate::planner::{KnownMap, Scan};
+
+    /// The transfers of a pass (ways that share first parts, as a search tree's do, each
+    /// with gains at its last point only) merge to the same cuts with the memo as without,
+    /// on a partly seen map with walls; the memo is dropped now and then, as a new search
+    /// drops it.
+    #[test]
+    fn merge_transfer_is_merge() {
+        let art = "\
+################
+#..............#
+#.#..#..#..#...#
+#..............#
+#...#..#..#..#.#
+#..............#
+#.#..#..#..#...#
+#..............#
+#...#..#..#..#.#
+#..............#
+################";
+        let map = GridMap::from_ascii_scaled(art, 4, 0.05).unwrap();
+        let frame = *map.frame();
+        let mut known = KnownMap::new(&frame);
+        known.integrate(&Scan::new(&map, Point::new(0.3, 0.3), 1.6));
+        let mut ext = Extension::new(ExtensionOptions::default(), frame, 0.06, 0.06);
+        let mut rng = crate::rng::SplitMix64::new(0x6d65_7267);
+        let (w, h) = (frame.width as i64, frame.height as i64);
+        let centre = |p: (i64, i64)| Point::new(p.0 as f64 + 0.5, (h - p.1) as f64 - 0.5);
+        let mut ways: Vec<Vec<(i64, i64)>> = Vec::new();
+        let mut taken = 0;
+        for round in 0..3000 {
+            if round % 50 == 0 {
+                ext.merge_memo.clear();
+                ways.clear();
+            }
+            // A prefix of an earlier way (the shared part), then a random walk.
+            let mut way: Vec<(i64, i64)> = match ways.len() {
+                0 => vec![(6, 6)],
+                n => {
+                    let base = &ways[(rng.range(0.0, n as f64) as usize).min(n - 1)];
+                    let keep = 1 + (rng.range(0.0, base.len() as f64) as usize).min(base.len() - 1);
+                    base[..keep].to_vec()
+                }
+            };
+            let steps = rng.range(1.0, 300.0) as usize;
+            // Away from the earlier way at once (most often), or straight on.
+            let mut dir = (
+                rng.range(-1.0, 2.0).floor() as i64,
+                rng.range(-1.0, 2.0).floor() as i64,
+            );
+            for _ in 0..steps {
+                if rng.range(0.0, 1.0) < 0.15 {
+                    dir = (
+                        rng.range(-1.0, 2.0).floor() as i64,
+                        rng.range(-1.0, 2.0).floor() as i64,
+                    );
+                }
+                let last = *way.last().unwrap();
+                let next = (last.0 + dir.0, last.1 + dir.1);
+                if next != last && next.0 >= 0 && next.1 >= 0 && next.0 < w && next.1 < h {
+                    way.push(next);
+                }
+            }
+            if way.len() < 2 {
+                continue;
+            }
+            let pts: Vec<Point> = way.iter().map(|&p| centre(p)).collect();
+            let mut gains = vec![Vec::new(); pts.len()];
+            let last = *way.last().unwrap();
+            for (dc, dr) in [(0, 0), (1, 0), (0, 1), (-1, -1)] {
+                let q = (last.0 + dc, last.1 + dr);
+                if let Some(i) = ext.idx(q) {
+                    gains[pts.len() - 1].push(i);
+                }
+            }
+            let want = ext.merge(&known, &pts, &gains);
+            let got = ext.merge_transfer(&known, &pts, &gains);
+            assert_eq!(got, want, "round {round}");
+            taken += usize::from(ext.merge_memo.len() > 1);
+            ways.push(way);
+        }
+        assert!(taken > 1000, "the memo was hardly there: {taken}");
+    }
+}
