@@ -304,6 +304,9 @@ pub(crate) struct Chunk {
     pub(crate) owed: bool,
     /// Gained pixels the simplified walk leaves (counted once the chunk is driven).
     simplified: usize,
+    /// [`Extension::no_gain`] entries made since the chunk claimed its pixels start at this
+    /// (logical) index of `no_gain_log`.
+    log_at: usize,
 }
 
 impl Chunk {
@@ -371,6 +374,12 @@ pub(crate) struct Extension {
     /// the memo was last brought up to date): the memo is dropped around those only.
     no_gain: FixedBitSet,
     no_gain_free: Vec<usize>,
+    /// The positions the final clean-up's searches put into `no_gain`, in order, since the
+    /// last search that started afresh; `no_gain_log_base` is the logical index of the first.
+    /// Giving a chunk's claims back drops only the entries made after it claimed them
+    /// (`Extension::unclaim`): the earlier ones were judged with its pixels still targets.
+    no_gain_log: Vec<usize>,
+    no_gain_log_base: usize,
     /// Target pixels left in chunks below [`ExtensionOptions::min_yield`].
     left: usize,
     /// Gained pixels the simplified walks leave ([`ExtensionOptions::simplify_fraction`]).
@@ -390,6 +399,11 @@ pub(crate) struct Extension {
     /// Target counts around a bounded search's start, valid during that search only.
     win: Window,
     win_on: bool,
+    /// The grid segments of the ways to the chunks `Extension::charge` left in the running
+    /// final pass (they sweep no target any more until the pass ends).
+    charged_segs: std::collections::BTreeSet<cleanup::SegKey>,
+    /// The cuts of the running final pass's transfers (`Extension::merge_transfer`).
+    merge_memo: Vec<merge::MergeMemo>,
     /// Where the last search stopped (see `search_with`), while its state is valid.
     resume_at: Option<usize>,
     /// The running search is a final clean-up's (its `done` is false wherever `no_gain`
@@ -462,6 +476,8 @@ impl Extension {
             any_owed: false,
             no_gain: FixedBitSet::with_capacity(n),
             no_gain_free: Vec::new(),
+            no_gain_log: Vec::new(),
+            no_gain_log_base: 0,
             left: 0,
             simplified: 0,
             simplify_per_turn,
@@ -471,6 +487,8 @@ impl Extension {
             heap: BucketQueue::default(),
             win: Window::default(),
             win_on: false,
+            charged_segs: std::collections::BTreeSet::new(),
+            merge_memo: Vec::new(),
             resume_at: None,
             exhaust_check: false,
             unreach: FixedBitSet::with_capacity(n),

@@ -20,6 +20,10 @@ const SAME_FIELD_R: f64 = 2.0;
 /// [`ExtensionOptions::leave_group`] chunks (2 gave 1.3116, 4 and 8 the same plans).
 const MAX_GROUP_FACTOR: usize = 4;
 
+/// Metres added to a bound on the path a group's leaving saves (rounding of the lengths
+/// summed; far below any length that decides).
+const SAVING_SLACK: f64 = 1e-6;
+
 impl Extension {
     /// Plans the next chunk of a cleaning pass from world point `pos`: the transfer to the rim
     /// (waypoints that reach the first sweeping position) and the sweep along it; both empty
@@ -94,8 +98,25 @@ impl Extension {
             let mut group = vec![cur];
             let mut places = 1;
             let next = loop {
-                let next = self.plan_chunk(known, pos, bounded, wanted, true);
                 let gained: usize = group.iter().map(|c| c.gained).sum();
+                // Whatever chunk comes next, the group pays (leaving it saves at most its tour
+                // and the way back from its end: the trip to the next chunk is at least the
+                // straight way from here) and is full: it is driven, and the next chunk would
+                // only be planned to be given back.
+                let last = &group[group.len() - 1];
+                if (places >= self.opts.leave_group
+                    || group.len() >= MAX_GROUP_FACTOR * self.opts.leave_group
+                    || self.left + gained >= self.leave_budget(known))
+                    && self.pays(
+                        gained,
+                        group_saving(pos, &group, &Chunk::default())
+                            + last.end(pos).dist(pos)
+                            + SAVING_SLACK,
+                    )
+                {
+                    break None;
+                }
+                let next = self.plan_chunk(known, pos, bounded, wanted, true);
                 if !self.pays(gained, group_saving(pos, &group, &next)) {
                     if self.charge(known, pos, &group) {
                         break Some(next);
@@ -151,14 +172,26 @@ impl Extension {
     fn charge(&mut self, known: &KnownMap, pos: Point, group: &[Chunk]) -> bool {
         // Charged: the walks' pixels and the targets the ways there would sweep on the side
         // (specks too small for a pass of their own, which leaving the trips leaves as well).
+        // The ways of one pass's chunks share their first segments (the search tree's, see
+        // `merge_transfer`): a segment charged before in the pass sweeps no target any more
+        // (its targets became swept then, and targets only disappear during a pass), so only
+        // the others are stamped.
         let f = self.frame;
         let mut side: Vec<usize> = Vec::new();
+        let mut segs: Vec<SegKey> = Vec::new();
         for chunk in group {
             let way: Vec<Point> = std::iter::once(pos)
                 .chain(chunk.transfer.iter().copied())
                 .map(|p| f.world_to_grid(p))
                 .collect();
-            side.extend(self.polyline_gains(known, &way).concat());
+            for s in way.windows(2) {
+                let key = seg_key(s[0], s[1]);
+                if self.charged_segs.contains(&key) || segs.contains(&key) {
+                    continue;
+                }
+                segs.push(key);
+                side.extend(self.polyline_gains(known, s).concat());
+            }
         }
         side.sort_unstable();
         side.dedup();
@@ -167,6 +200,7 @@ impl Extension {
             return false;
         }
         self.left += charged;
+        self.charged_segs.extend(segs);
         // Left with them: no later pass goes out for them alone.
         for i in side {
             self.swept.insert(i);
@@ -179,10 +213,10 @@ impl Extension {
         let f = self.frame;
         let (w, h) = (f.width as i64, f.height as i64);
         let reach = self.strip_rows.len() as i64 - 1;
-        // Positions the searches since judged without these targets may gain again: the memo
-        // is dropped in the square of side `2 reach + 1` around each pixel, the pixels' column
-        // ranges merged per image row first (a walk's pixels crowd a few rows), so each
-        // range is cleared once per row within `reach` (the same union of squares).
+        // Positions judged without these targets may gain again: the memo is dropped in the
+        // square of side `2 reach + 1` around each pixel, the pixels' column ranges merged
+        // per image row first (a walk's pixels crowd a few rows), so each range is cleared
+        // once per row within `reach` (the same union of squares).
         let mut runs: Vec<(i64, i64, i64)> = chunk
             .claimed
             .iter()
@@ -192,6 +226,9 @@ impl Extension {
                 (r, (c - reach).max(0), (c + reach).min(w - 1))
             })
             .collect();
+        if runs.is_empty() {
+            return;
+        }
         runs.sort_unstable();
         let mut merged: Vec<(i64, i64, i64)> = Vec::with_capacity(runs.len());
         for (r, c0, c1) in runs {
@@ -200,14 +237,51 @@ impl Extension {
                 _ => merged.push((r, c0, c1)),
             }
         }
+        // Only the memo entries made since the chunk claimed its pixels were judged without
+        // them (targets only disappear meanwhile, but for chunks given back, whose own
+        // entries go the same way, and new known free pixels, `refresh_no_gain`'s): while
+        // the log reaches back that far, those entries in the squares are dropped, else every
+        // entry in the squares.
+        let logged = chunk.log_at >= self.no_gain_log_base;
+        let set = if logged {
+            &mut self.met
+        } else {
+            &mut self.no_gain
+        };
+        for &(r, c0, c1) in &merged {
+            for row in (r - reach).max(0)..=(r + reach).min(h - 1) {
+                let base = row as usize * f.width;
+                let range = base + c0 as usize..base + c1 as usize + 1;
+                if logged {
+                    set.insert_range(range);
+                } else {
+                    set.remove_range(range);
+                }
+            }
+        }
+        if !logged {
+            return;
+        }
+        for &j in &self.no_gain_log[chunk.log_at - self.no_gain_log_base..] {
+            if self.met.contains(j) {
+                self.no_gain.set(j, false);
+            }
+        }
         for (r, c0, c1) in merged {
             for row in (r - reach).max(0)..=(r + reach).min(h - 1) {
                 let base = row as usize * f.width;
-                self.no_gain
+                self.met
                     .remove_range(base + c0 as usize..base + c1 as usize + 1);
             }
         }
     }
+}
+
+/// A grid segment, exactly (its ends' bits), for [`Extension::charge`]'s memo.
+pub(super) type SegKey = [u64; 4];
+
+fn seg_key(a: Point, b: Point) -> SegKey {
+    [a.x.to_bits(), a.y.to_bits(), b.x.to_bits(), b.y.to_bits()]
 }
 
 /// The path leaving `group` saves (chunks planned from world point `pos`, nearest first),

@@ -14,6 +14,17 @@ pub(super) const MAX_MERGE: usize = 256;
 /// (a wiggle of the wall may block one point while a farther one is in sight).
 const MERGE_LOOK: usize = 8;
 
+/// Earlier transfers of a pass whose cuts [`Extension::merge_transfer`] keeps.
+const MERGE_MEMO_WAYS: usize = 32;
+
+/// The cuts of one transfer merged in the running pass ([`Extension::merge_transfer`]): its
+/// points and, per cut, the kept index, the highest point index the cut read and the last
+/// point its segment reached before the look past a blocked point.
+pub(super) struct MergeMemo {
+    pts: Vec<Point>,
+    cuts: Vec<(usize, usize, usize)>,
+}
+
 /// Most vertices [`Extension::square_corners`] replaces by one.
 const CORNER_RUN: usize = 4;
 
@@ -26,6 +37,79 @@ impl Extension {
         known: &KnownMap,
         pts: &[Point],
         gains: &[Vec<usize>],
+    ) -> Vec<usize> {
+        self.merge_from(known, pts, gains, Vec::new(), 0, &mut Vec::new())
+    }
+
+    /// [`Self::merge`] of a transfer (`gains` empty but at the last point) in the final
+    /// clean-up's chunks: the chunks of one pass are found by one search from the same point,
+    /// so their ways share the first part (the search tree's) and the greedy cut of that part
+    /// is the same. The cuts of the earlier transfers of the pass (`merge_memo`, dropped when
+    /// a search starts afresh) are taken over as far as they read only shared points that are
+    /// not the last of either way (the cut then asked the same questions of the same known
+    /// map), and the rest is merged as usual.
+    pub(super) fn merge_transfer(
+        &mut self,
+        known: &KnownMap,
+        pts: &[Point],
+        gains: &[Vec<usize>],
+    ) -> Vec<usize> {
+        let n = pts.len();
+        // The memo that gives most: (cuts taken over, where the next cut's first segment
+        // may start, memo).
+        let mut best: (usize, usize, Option<usize>) = (0, 0, None);
+        for (e, memo) in self.merge_memo.iter().enumerate() {
+            let m = memo.pts.iter().zip(pts).take_while(|(x, y)| x == y).count();
+            // Cuts whose every read lies in the shared points, before the last of either way.
+            let lim = m.min(n - 1).min(memo.pts.len() - 1);
+            let k = memo.cuts.iter().take_while(|c| c.1 < lim).count();
+            // The next cut's segment reached every shared point up to its `bw` (each one
+            // kept the gains, empty there, and was known free): start there.
+            let skip = memo
+                .cuts
+                .get(k)
+                .map_or(0, |c| c.2.min(lim.saturating_sub(1)));
+            if (k, skip) > (best.0, best.1) {
+                best = (k, skip, Some(e));
+            }
+        }
+        let (out, mut cuts, skip) = match best {
+            (k, skip, Some(e)) => {
+                let cuts: Vec<(usize, usize, usize)> = self.merge_memo[e].cuts[..k].to_vec();
+                (cuts.iter().map(|c| c.0).collect(), cuts, skip)
+            }
+            _ => (Vec::new(), Vec::new(), 0),
+        };
+        let mut his: Vec<(usize, usize)> = Vec::new();
+        let out = self.merge_from(known, pts, gains, out, skip, &mut his);
+        cuts.extend(
+            out[cuts.len()..]
+                .iter()
+                .zip(his)
+                .map(|(&b, (hi, bw))| (b, hi, bw)),
+        );
+        if self.merge_memo.len() >= MERGE_MEMO_WAYS {
+            self.merge_memo.remove(0);
+        }
+        self.merge_memo.push(MergeMemo {
+            pts: pts.to_vec(),
+            cuts,
+        });
+        out
+    }
+
+    /// [`Self::merge`] going on after the cuts `out` (the last one the start of the next
+    /// segment), whose first segment is known to reach every point up to `skip` (`0`: not
+    /// known); pushes, per new cut, the highest point index it read and how far its
+    /// segment reached before the look past a blocked point.
+    fn merge_from(
+        &self,
+        known: &KnownMap,
+        pts: &[Point],
+        gains: &[Vec<usize>],
+        mut out: Vec<usize>,
+        mut skip: usize,
+        his: &mut Vec<(usize, usize)>,
     ) -> Vec<usize> {
         let rt2 = self.rt * self.rt;
         // The gained pixels' centres, once (each is checked against many segments), flat
@@ -46,14 +130,16 @@ impl Extension {
                 .all(|&c| point_segment_dist2(c, pts[a], pts[b]) <= rt2)
                 && self.seg_free_with(known, pts[a], pts[b], &mut witness)
         };
-        let mut out = Vec::new();
-        let mut a = 0;
+        let mut a = out.last().copied().unwrap_or(0);
         while a + 1 < pts.len() {
-            let mut b = a + 1;
+            let mut b = (a + 1).max(skip);
+            skip = 0;
             while b + 1 < pts.len() && b + 1 - a <= MAX_MERGE && keeps(a, b + 1) {
                 b += 1;
             }
             let far = (b + MERGE_LOOK).min(pts.len() - 1).min(a + MAX_MERGE);
+            // Every point this cut read (or weighed the end of the way against).
+            his.push(((b + 1).max(far), b));
             if let Some(c) = (b + 2..=far).rev().find(|&c| keeps(a, c)) {
                 b = c;
             }
@@ -125,5 +211,95 @@ impl Extension {
             }
         }
         out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{Extension, ExtensionOptions};
+    use crate::geometry::Point;
+    use crate::grid::GridMap;
+    use crate::planner::{KnownMap, Scan};
+
+    /// The transfers of a pass (ways that share first parts, as a search tree's do, each
+    /// with gains at its last point only) merge to the same cuts with the memo as without,
+    /// on a partly seen map with walls; the memo is dropped now and then, as a new search
+    /// drops it.
+    #[test]
+    fn merge_transfer_is_merge() {
+        let art = "\
+################
+#..............#
+#.#..#..#..#...#
+#..............#
+#...#..#..#..#.#
+#..............#
+#.#..#..#..#...#
+#..............#
+#...#..#..#..#.#
+#..............#
+################";
+        let map = GridMap::from_ascii_scaled(art, 4, 0.05).unwrap();
+        let frame = *map.frame();
+        let mut known = KnownMap::new(&frame);
+        known.integrate(&Scan::new(&map, Point::new(0.3, 0.3), 1.6));
+        let mut ext = Extension::new(ExtensionOptions::default(), frame, 0.06, 0.06);
+        let mut rng = crate::rng::SplitMix64::new(0x6d65_7267);
+        let (w, h) = (frame.width as i64, frame.height as i64);
+        let centre = |p: (i64, i64)| Point::new(p.0 as f64 + 0.5, (h - p.1) as f64 - 0.5);
+        let mut ways: Vec<Vec<(i64, i64)>> = Vec::new();
+        let mut taken = 0;
+        for round in 0..3000 {
+            if round % 50 == 0 {
+                ext.merge_memo.clear();
+                ways.clear();
+            }
+            // A prefix of an earlier way (the shared part), then a random walk.
+            let mut way: Vec<(i64, i64)> = match ways.len() {
+                0 => vec![(6, 6)],
+                n => {
+                    let base = &ways[(rng.range(0.0, n as f64) as usize).min(n - 1)];
+                    let keep = 1 + (rng.range(0.0, base.len() as f64) as usize).min(base.len() - 1);
+                    base[..keep].to_vec()
+                }
+            };
+            let steps = rng.range(1.0, 300.0) as usize;
+            // Away from the earlier way at once (most often), or straight on.
+            let mut dir = (
+                rng.range(-1.0, 2.0).floor() as i64,
+                rng.range(-1.0, 2.0).floor() as i64,
+            );
+            for _ in 0..steps {
+                if rng.range(0.0, 1.0) < 0.15 {
+                    dir = (
+                        rng.range(-1.0, 2.0).floor() as i64,
+                        rng.range(-1.0, 2.0).floor() as i64,
+                    );
+                }
+                let last = *way.last().unwrap();
+                let next = (last.0 + dir.0, last.1 + dir.1);
+                if next != last && next.0 >= 0 && next.1 >= 0 && next.0 < w && next.1 < h {
+                    way.push(next);
+                }
+            }
+            if way.len() < 2 {
+                continue;
+            }
+            let pts: Vec<Point> = way.iter().map(|&p| centre(p)).collect();
+            let mut gains = vec![Vec::new(); pts.len()];
+            let last = *way.last().unwrap();
+            for (dc, dr) in [(0, 0), (1, 0), (0, 1), (-1, -1)] {
+                let q = (last.0 + dc, last.1 + dr);
+                if let Some(i) = ext.idx(q) {
+                    gains[pts.len() - 1].push(i);
+                }
+            }
+            let want = ext.merge(&known, &pts, &gains);
+            let got = ext.merge_transfer(&known, &pts, &gains);
+            assert_eq!(got, want, "round {round}");
+            taken += usize::from(ext.merge_memo.len() > 1);
+            ways.push(way);
+        }
+        assert!(taken > 1000, "the memo was hardly there: {taken}");
     }
 }

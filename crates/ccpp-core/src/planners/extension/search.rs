@@ -345,7 +345,9 @@ impl Extension {
                 return None;
             }
             let p = self.px_of(i);
-            if done(self, p) {
+            // A final clean-up's `done` is false wherever `no_gain` holds: most positions it
+            // settles (asked here without the call).
+            if !(self.exhaust_check && self.no_gain.contains(i)) && done(self, p) {
                 self.resume_at = Some(i);
                 let mut path = vec![i];
                 let mut c = i;
@@ -501,26 +503,27 @@ impl Extension {
         let mut todo = !blocked;
         // The neighbours' states are read first, all at once (independent loads, mostly
         // cache misses, overlap); the loop below writes only neighbours, each once.
-        let mut js = [0usize; 8];
         let mut ns = [0 as Node; 8];
         if p.0 > 0 && p.1 > 0 && p.0 < w - 1 && p.1 < h_img - 1 {
             // Inside the image's rim every neighbour is in it: the three rows around `i`, read
-            // whole (a move known blocked leads onto the same cache lines), at fixed offsets
-            // from the first one (`i - width - 1`).
+            // whole (a move known blocked leads onto the same cache lines) as three runs of
+            // three from the first one (`i - width - 1`; fixed-size: no check per neighbour).
             let wu = self.frame.width;
             let first = i - wu - 1;
-            let at = [wu + 2, 2, 1, 0, wu, 2 * wu, 2 * wu + 1, 2 * wu + 2];
-            let rows = &self.nodes[first..=first + 2 * wu + 2];
-            for k in 0..8 {
-                js[k] = first + at[k];
-                ns[k] = rows[at[k]];
-            }
+            let row = |o: usize| -> [Node; 3] {
+                self.nodes[first + o..first + o + 3]
+                    .try_into()
+                    .expect("three nodes")
+            };
+            let (up, mid, down) = (row(0), row(wu), row(2 * wu));
+            ns = [
+                mid[2], up[2], up[1], up[0], mid[0], down[0], down[1], down[2],
+            ];
         } else {
             for k in 0..8 {
                 let q = (p.0 + NB[k].0, p.1 + NB[k].1);
                 if q.0 >= 0 && q.1 >= 0 && q.0 < w && q.1 < h_img {
-                    js[k] = (q.1 * w + q.0) as usize;
-                    ns[k] = self.nodes[js[k]];
+                    ns[k] = self.nodes[(q.1 * w + q.0) as usize];
                 } else {
                     todo &= !(1 << k);
                 }
@@ -545,7 +548,8 @@ impl Extension {
             if edges & (1 << k) == 0 && !self.edge(known, p, k) {
                 continue;
             }
-            let j = js[k];
+            // In the image (checked above): the neighbour's index.
+            let j = (i as i64 + NB[k].1 * w + NB[k].0) as usize;
             self.nodes[j] = node(nd, Some(k), gen);
             heap.push(nd + h(self, (p.0 + NB[k].0, p.1 + NB[k].1)), j);
         }

@@ -42,6 +42,14 @@ impl Extension {
         // A resumed search follows a chunk left in the same pass: the known map is the same.
         if !bounded && !resume {
             self.refresh_no_gain(known);
+            // No chunk planned before gives its claims back selectively now (see `unclaim`).
+            self.no_gain_log_base += self.no_gain_log.len();
+            self.no_gain_log.clear();
+        }
+        if !resume {
+            // A new search (from elsewhere, or the known map changed): other ways.
+            self.merge_memo.clear();
+            self.charged_segs.clear();
         }
         if let Some(l) = limit {
             // Every position the bounded search settles lies within `l` of `from`.
@@ -65,6 +73,7 @@ impl Extension {
                         || s.sweeps_owed(p)));
             if !gains && !bounded {
                 s.no_gain.insert(i);
+                s.no_gain_log.push(i);
             }
             gains
         });
@@ -73,6 +82,7 @@ impl Extension {
         let Some(transit) = transit else {
             return Chunk::default();
         };
+        let log_at = self.no_gain_log_base + self.no_gain_log.len();
         let mut pts: Vec<Point> = vec![from];
         let mut gains: Vec<Vec<usize>> = vec![Vec::new()];
         for &i in &transit[..transit.len() - 1] {
@@ -135,7 +145,11 @@ impl Extension {
         let nt = transit.len();
         let mut simplified = 0;
         let kept: Vec<usize> = if self.opts.merge_segments {
-            let mut kept = self.merge(known, &pts[..=nt], &gains[..=nt]);
+            let mut kept = if bounded {
+                self.merge(known, &pts[..=nt], &gains[..=nt])
+            } else {
+                self.merge_transfer(known, &pts[..=nt], &gains[..=nt])
+            };
             kept.extend(
                 self.merge(known, &pts[nt..], &gains[nt..])
                     .into_iter()
@@ -164,6 +178,7 @@ impl Extension {
             claimed: gains.iter().flatten().copied().collect(),
             owed: self.any_owed && gains.iter().flatten().any(|&i| self.owed.contains(i)),
             simplified,
+            log_at,
         }
     }
 
