@@ -150,7 +150,9 @@
 //! 4. **Cell tour.** Instead of the paper's depth-first walk of the adjacency graph, the cells
 //!    are ordered as an open travelling-salesman path over their entry and exit points (each
 //!    cell can be started at any of its four corners): nearest-neighbour construction, then
-//!    2-opt, Or-opt and an exact choice of every cell's corner for the order (module `bcd::tsp`).
+//!    2-opt, Or-opt and an exact choice of every cell's corner for the order (module `bcd::tsp`;
+//!    a move whose new hops cost too much already in a straight line is not costed on the hop
+//!    table, which leaves every tour the same: `stage_willow_full` 6.9 s to 4.6 s of CPU).
 //!    An Or-opt move of a single cell also tries the cell's other corners at its new place
 //!    (not only the same path driven backwards): on the 14 shared maps (r = 0.15 m) the mean
 //!    path ratio goes from 1.1671 to 1.1656 and the mean turns from 1244 to 1242, in the same

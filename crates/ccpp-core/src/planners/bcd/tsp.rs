@@ -3,13 +3,18 @@
 //! Each piece (a BCD cell) can be driven in a few variants: variant `v` enters at `entry(v)`,
 //! leaves at `exit(v)` and costs `inner(v)` inside the piece; variants come in pairs, `v ^ 1`
 //! being `v` driven backwards (its entry is `v`'s exit and the other way round, same inner
-//! cost). The path starts at a fixed point and visits every piece once; the cost of a hop is the
-//! straight-line distance. Construction: nearest neighbour from the start. Improvement, repeated
+//! cost). The path starts at a fixed point and visits every piece once; the cost of a hop is
+//! given ([`Dist`]), never below the straight-line distance. Construction: nearest neighbour
+//! from the start. Improvement, repeated
 //! until a round changes nothing (or `rounds` is spent): 2-opt (a reversed stretch drives each of
 //! its pieces backwards), Or-opt (stretches of 1 to 3 pieces moved elsewhere, either way round;
 //! a single piece in any of its variants),
 //! both tried only where a new hop joins one of a piece's 12 nearest pieces, and an exact dynamic
 //! programme that picks every piece's variant for the current order.
+//! The moves read the tour's current hops from a per-position cache and skip a move whose new
+//! hops, costed in a straight line (a lower bound), already cannot win; neither changes which
+//! move is taken (most candidate moves were costed on the hop table only to be refused: on
+//! `stage_willow_full`, r = 0.15 m, the whole run's CPU time falls from 6.9 s to 4.6 s).
 //! Everything is deterministic: fixed scan orders, strict improvements only, ties to the lower
 //! index.
 
@@ -32,8 +37,16 @@ const EPS: f64 = 1e-7;
 /// A visiting order: `(piece, variant)` pairs.
 pub(crate) type Tour = Vec<(usize, usize)>;
 
-/// Hop cost between two points.
+/// Hop cost between two points; never below the straight-line distance (the improvement
+/// moves skip a move whose straight-line cost already shows that it cannot win).
 pub(crate) type Dist<'a> = &'a dyn Fn(Point, Point) -> f64;
+
+/// A lower bound of every hop cost from `a` to `b`: the straight-line distance, a little less
+/// (so that it stays below a distance rounded another way, as by `hypot`).
+fn low(a: Point, b: Point) -> f64 {
+    let (dx, dy) = (a.x - b.x, a.y - b.y);
+    (dx * dx + dy * dy).sqrt() * (1.0 - 1e-12)
+}
 
 /// Total cost of `tour` from `start`.
 pub(crate) fn cost(pieces: &[Piece], start: Point, tour: &Tour, d: Dist<'_>) -> f64 {
@@ -236,6 +249,37 @@ fn positions(tour: &Tour, n: usize) -> Vec<usize> {
     pos
 }
 
+/// The hop into every position of `tour`: `into[i]` is the cost from the exit before `i` (the
+/// start for `i == 0`) to the entry of `tour[i]`. The improvement moves read the tour's current
+/// hops from here instead of asking `d` again (the same calls give the same costs).
+fn hops_into(pieces: &[Piece], start: Point, tour: &Tour, d: Dist<'_>) -> Vec<f64> {
+    (0..tour.len())
+        .map(|i| {
+            let (p, v) = tour[i];
+            d(prev_exit(pieces, start, tour, i), pieces[p].entry[v])
+        })
+        .collect()
+}
+
+/// Recomputes `into[i]` (see [`hops_into`]) for the positions `range` of `tour` that exist.
+fn rehop(
+    pieces: &[Piece],
+    start: Point,
+    tour: &Tour,
+    d: Dist<'_>,
+    into: &mut [f64],
+    range: std::ops::RangeInclusive<usize>,
+) {
+    let (lo, hi) = (
+        *range.start(),
+        (*range.end()).min(tour.len().saturating_sub(1)),
+    );
+    for i in lo..=hi {
+        let (p, v) = tour[i];
+        into[i] = d(prev_exit(pieces, start, tour, i), pieces[p].entry[v]);
+    }
+}
+
 /// 2-opt over candidate neighbours: reversing `tour[i..=j]` makes the hops
 /// `prev(i) -> exit(j)` and `entry(i) -> entry(j + 1)`; `j` is taken where either new hop
 /// joins neighbours.
@@ -244,6 +288,7 @@ fn two_opt(pieces: &[Piece], start: Point, tour: &mut Tour, nb: &[Vec<usize>], d
     let entry = |t: &Tour, i: usize| pieces[t[i].0].entry[t[i].1];
     let exit = |t: &Tour, i: usize| pieces[t[i].0].exit[t[i].1];
     let mut pos = positions(tour, pieces.len());
+    let mut into = hops_into(pieces, start, tour, d);
     let mut improved = true;
     let mut passes = 0;
     let mut cand: Vec<usize> = Vec::new();
@@ -265,11 +310,24 @@ fn two_opt(pieces: &[Piece], start: Point, tour: &mut Tour, nb: &[Vec<usize>], d
             let bi = entry(tour, i);
             for &j in cand.iter().filter(|&&j| j >= i && j < n) {
                 let ej = exit(tour, j);
-                let (before, after) = if j + 1 < n {
-                    let bn = entry(tour, j + 1);
-                    (d(a, bi) + d(ej, bn), d(a, ej) + d(bi, bn))
-                } else {
-                    (d(a, bi), d(a, ej))
+                // (`into[i]` is the hop a -> bi, `into[j + 1]` the hop ej -> bn; a move whose
+                // new hops cost too much in a straight line is not costed: floating-point
+                // sums are monotone, so the bound is below the cost)
+                let bn = (j + 1 < n).then(|| entry(tour, j + 1));
+                let before = match bn {
+                    Some(_) => into[i] + into[j + 1],
+                    None => into[i],
+                };
+                let bound = match bn {
+                    Some(bn) => low(a, ej) + low(bi, bn),
+                    None => low(a, ej),
+                };
+                if bound >= before - EPS {
+                    continue;
+                }
+                let after = match bn {
+                    Some(bn) => d(a, ej) + d(bi, bn),
+                    None => d(a, ej),
                 };
                 if after < before - EPS {
                     tour[i..=j].reverse();
@@ -279,6 +337,7 @@ fn two_opt(pieces: &[Piece], start: Point, tour: &mut Tour, nb: &[Vec<usize>], d
                     for k in i..=j {
                         pos[tour[k].0] = k;
                     }
+                    rehop(pieces, start, tour, d, &mut into, i..=j + 1);
                     improved = true;
                     break;
                 }
@@ -305,6 +364,7 @@ fn or_opt(pieces: &[Piece], start: Point, tour: &mut Tour, nb: &[Vec<usize>], d:
     let entry = |t: &Tour, i: usize| pieces[t[i].0].entry[t[i].1];
     let exit = |t: &Tour, i: usize| pieces[t[i].0].exit[t[i].1];
     let mut pos = positions(tour, pieces.len());
+    let mut into = hops_into(pieces, start, tour, d);
     let mut improved = true;
     let mut passes = 0;
     let mut cand: Vec<usize> = Vec::new();
@@ -321,11 +381,12 @@ fn or_opt(pieces: &[Piece], start: Point, tour: &mut Tour, nb: &[Vec<usize>], d:
                 let j = i + k - 1;
                 let a = prev_exit(pieces, start, tour, i);
                 let (si, ej) = (entry(tour, i), exit(tour, j));
+                // (`into[i]` is the hop a -> si, `into[j + 1]` the hop ej -> bn)
                 let removed = if j + 1 < n {
                     let bn = entry(tour, j + 1);
-                    d(a, si) + d(ej, bn) - d(a, bn)
+                    into[i] + into[j + 1] - d(a, bn)
                 } else {
-                    d(a, si)
+                    into[i]
                 };
                 // Insertion between p-1 and p: next to a neighbour on either side.
                 cand.clear();
@@ -362,11 +423,25 @@ fn or_opt(pieces: &[Piece], start: Point, tour: &mut Tour, nb: &[Vec<usize>], d:
                         continue;
                     }
                     let before_pt = prev_exit(pieces, start, tour, p);
-                    let next = if p < n { Some(entry(tour, p)) } else { None };
+                    // (the hop before_pt -> nx now is `into[p]`)
+                    let next = if p < n {
+                        Some((entry(tour, p), into[p]))
+                    } else {
+                        None
+                    };
                     for &(s_in, s_out, extra, alt) in &alts {
+                        // (a bound below `add`, as in `two_opt`: skipped when it cannot win)
+                        let bound = extra
+                            + match next {
+                                Some((nx, now)) => low(before_pt, s_in) + low(s_out, nx) - now,
+                                None => low(before_pt, s_in),
+                            };
+                        if bound >= removed - EPS || best.is_some_and(|b| bound >= b.0) {
+                            continue;
+                        }
                         let add = extra
                             + match next {
-                                Some(nx) => d(before_pt, s_in) + d(s_out, nx) - d(before_pt, nx),
+                                Some((nx, now)) => d(before_pt, s_in) + d(s_out, nx) - now,
                                 None => d(before_pt, s_in),
                             };
                         if add < removed - EPS && best.is_none_or(|b| add < b.0) {
@@ -389,6 +464,14 @@ fn or_opt(pieces: &[Piece], start: Point, tour: &mut Tour, nb: &[Vec<usize>], d:
                     let at = if p > j { p - k } else { p };
                     tour.splice(at..at, seg);
                     pos = positions(tour, pieces.len());
+                    // The hops that changed: into the piece that followed the stretch (at `i`,
+                    // or `i + k` when the stretch went before it), into the stretch and into
+                    // the piece after it.
+                    into.drain(i..=j);
+                    into.splice(at..at, std::iter::repeat_n(0.0, k));
+                    let after = if at < i { i + k } else { i };
+                    rehop(pieces, start, tour, d, &mut into, after..=after);
+                    rehop(pieces, start, tour, d, &mut into, at..=at + k);
                     improved = true;
                 }
             }
