@@ -313,11 +313,14 @@ fn bcd_and_rect_options_change_the_run() {
             Rooms,
             Less("path_length_m"),
         ),
+        // More rim left unswept. The path need not get shorter: the plans are compared on
+        // length plus `turn_cost_m` per turn (on Pillars 153.0 m / 78 turns against the
+        // default's 152.5 m / 82 turns, coverage 0.9835 against 0.9953).
         (
             "bcd",
             "bcd: { rim_coverage: 0.98 }",
             Pillars,
-            Less("path_length_m"),
+            Less("effective_coverage"),
         ),
         ("bcd", "bcd: { tour_rounds: 0 }", Rooms, Differs),
         ("bcd", "bcd: { headland_min_m: 0.0 }", Pillars, Differs),
