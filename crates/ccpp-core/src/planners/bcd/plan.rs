@@ -47,6 +47,17 @@ pub(super) struct Plan {
 }
 
 impl Plan {
+    /// A plan with no moves that skips `skipped` moves (`usize::MAX`: one that never beats
+    /// another) and is short of `min_coverage`.
+    fn empty(skipped: usize) -> Self {
+        Plan {
+            skipped,
+            short: true,
+            cost: 0.0,
+            items: Vec::new(),
+        }
+    }
+
     /// Does this plan rank before `best` (always, when there is none yet)? Fewer skipped moves
     /// first, then a plan that sweeps `min_coverage` of the floor before one that does not (a
     /// cheaper plan that sweeps less is not better), then the lower cost.
@@ -267,15 +278,7 @@ impl Bcd {
                     peel.then_some((spacing / res).max(1.0)),
                     if peel { PEEL_WALKS } else { usize::MAX },
                 ) else {
-                    return (
-                        Plan {
-                            skipped: usize::MAX,
-                            short: true,
-                            cost: 0.0,
-                            items: Vec::new(),
-                        },
-                        0,
-                    );
+                    return (Plan::empty(usize::MAX), 0);
                 };
                 (Some(lat.with_ok(ok)), passes)
             }
@@ -368,15 +371,7 @@ impl Bcd {
         };
         let chosen = if pick_c == other { by_r } else { by_c };
         let Some((_, d, phase, pick)) = chosen else {
-            return (
-                Plan {
-                    skipped: usize::MAX,
-                    short: true,
-                    cost: 0.0,
-                    items: Vec::new(),
-                },
-                0,
-            );
+            return (Plan::empty(usize::MAX), 0);
         };
         let chosen: Vec<Cell> = decs[d]
             .iter()
@@ -448,12 +443,7 @@ impl Bcd {
         }
         let ncells = cells.len();
         let none = if sets == Sets::Split { usize::MAX } else { 0 };
-        let best = best.unwrap_or(Plan {
-            skipped: none,
-            short: true,
-            cost: 0.0,
-            items: Vec::new(),
-        });
+        let best = best.unwrap_or_else(|| Plan::empty(none));
         (best, ncells)
     }
 
