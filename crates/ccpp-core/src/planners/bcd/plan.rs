@@ -76,6 +76,21 @@ const ROT: usize = 16;
 /// Most offset-loop walks a peeled plan may have (module docs, step 3): beyond, it is not made.
 const PEEL_WALKS: usize = 32;
 
+/// Factors of the user's `turn_cost_m` every plan is also made with (module docs, step 6).
+const TURN_FACTORS: [f64; 3] = [1.0, 0.5, 0.0];
+
+/// The index of the plan among the first `n` of `plans` that [`Plan::beats`] the others (the
+/// first of equal ones).
+fn best_index(plans: &[(Plan, usize)], n: usize) -> Option<usize> {
+    (0..n).fold(None, |b: Option<usize>, j| {
+        if plans[j].0.beats(b.map(|i| &plans[i].0)) {
+            Some(j)
+        } else {
+            b
+        }
+    })
+}
+
 /// Improvement rounds of the first tour (which only picks each cell's path for the rim step).
 const FIRST_ROUNDS: u32 = 1;
 
@@ -136,10 +151,28 @@ impl Bcd {
         // percent, the lattice or the decomposition by more, and a second tour per job doubled
         // the time. With a headland (module docs, step 3), every lattice is planned with and
         // without it, the cheaper plan kept.
-        let plain = BcdOptions {
-            headland_min_m: None,
-            ..opts.clone()
+        let cost_turn_px = opts.turn_cost_m / res;
+        // Every job is made with the turn cost the user gave and with lower ones (module
+        // docs, step 6), each plan still judged by the user's cost.
+        let factors: &[f64] = if opts.turn_cost_m > 0.0 {
+            &TURN_FACTORS
+        } else {
+            &TURN_FACTORS[..1]
         };
+        let variants: Vec<(BcdOptions, BcdOptions)> = factors
+            .iter()
+            .map(|f| {
+                let o = BcdOptions {
+                    turn_cost_m: opts.turn_cost_m * f,
+                    ..opts.clone()
+                };
+                let plain = BcdOptions {
+                    headland_min_m: None,
+                    ..o.clone()
+                };
+                (plain, o)
+            })
+            .collect();
         // On the pixel lattice alone (walls along the axes), the plain plan is also made on
         // the sweep the estimate did not pick (module docs, step 1): the estimate misses the
         // transfers, and the other sweep's plan is often the cheaper one. With a headland, the
@@ -147,39 +180,86 @@ impl Bcd {
         // (offset loops follow the walls on any lattice). Jobs: lattice, options, peeled,
         // other sweep.
         let many = turns_by.len() > 1;
-        let mut jobs: Vec<(usize, &BcdOptions, bool, bool)> = Vec::new();
+        // Job kinds: lattice, headland, peeled, other sweep.
+        let mut kinds: Vec<(usize, bool, bool, bool)> = Vec::new();
         for k in 0..turns_by.len() {
-            jobs.push((k, &plain, false, false));
+            kinds.push((k, false, false, false));
             if !many {
-                jobs.push((k, &plain, false, true));
+                kinds.push((k, false, false, true));
             }
             if opts.headland_min_m.is_some() {
-                jobs.push((k, opts, false, false));
+                kinds.push((k, true, false, false));
                 if k == 0 {
-                    jobs.push((k, opts, true, false));
+                    kinds.push((k, true, true, false));
                 }
             }
         }
-        let plans: Vec<_> = jobs
+        // A job: its kind and the index of its options in `variants`.
+        let options = |(kind, f): (usize, usize)| {
+            let (k, head, peel, other) = kinds[kind];
+            let (plain, o) = &variants[f];
+            (k, if head { o } else { plain }, peel, other)
+        };
+        let run = |jobs: &[(usize, usize)]| -> Vec<(Plan, usize)> {
+            jobs.par_iter()
+                .map(|&job| {
+                    let (k, o, peel, other) = options(job);
+                    let mut search = Search::new(w, h);
+                    let lat = lattice(&turns_by[k]);
+                    Self::plan_sets(
+                        &ctx,
+                        &lat,
+                        o,
+                        cost_turn_px,
+                        &mut search,
+                        Sets::Whole,
+                        peel,
+                        other,
+                    )
+                })
+                .collect()
+        };
+        // (job `i` of the first round is kind `i`)
+        let mut jobs: Vec<(usize, usize)> = (0..kinds.len()).map(|i| (i, 0)).collect();
+        let mut plans = run(&jobs);
+        // The lower turn costs (step 6) on the best job's kind only: on the 14 shared maps
+        // every plan they improved came from it (those on kinds within 1 % of the best won
+        // nowhere and cost about a third more time).
+        let lead = best_index(&plans, plans.len());
+        let more: Vec<(usize, usize)> = lead
+            .into_iter()
+            .flat_map(|i| (1..variants.len()).map(move |f| (i, f)))
+            .collect();
+        plans.extend(run(&more));
+        jobs.extend(more);
+        // The cell sets with even cells cut are toured on the best job's cells and, when a
+        // lower turn cost made another job the best, on the best job of the user's turn
+        // cost too (so no plan is dearer than without step 6).
+        let mut cut: Vec<usize> = lead
+            .into_iter()
+            .chain(best_index(&plans, plans.len()))
+            .collect();
+        cut.dedup();
+        let cut_plans: Vec<(Plan, usize)> = cut
             .par_iter()
-            .map(|&(k, o, peel, other)| {
+            .map(|&j| {
+                let (k, o, peel, other) = options(jobs[j]);
                 let mut search = Search::new(w, h);
                 let lat = lattice(&turns_by[k]);
-                Self::plan_sets(&ctx, &lat, o, &mut search, Sets::Whole, peel, other)
+                Self::plan_sets(
+                    &ctx,
+                    &lat,
+                    o,
+                    cost_turn_px,
+                    &mut search,
+                    Sets::Split,
+                    peel,
+                    other,
+                )
             })
             .collect();
         let mut best: Option<(Plan, usize)> = None;
-        let mut at = 0;
-        for (j, p) in plans.into_iter().enumerate() {
-            if p.0.beats(best.as_ref().map(|b| &b.0)) {
-                best = Some(p);
-                at = j;
-            }
-        }
-        if let Some(&(k, o, peel, other)) = jobs.get(at) {
-            let mut search = Search::new(w, h);
-            let lat = lattice(&turns_by[k]);
-            let p = Self::plan_sets(&ctx, &lat, o, &mut search, Sets::Split, peel, other);
+        for p in plans.into_iter().chain(cut_plans) {
             if p.0.beats(best.as_ref().map(|b| &b.0)) {
                 best = Some(p);
             }
@@ -242,17 +322,29 @@ impl Bcd {
         opts: &BcdOptions,
         search: &mut Search,
     ) -> (Plan, usize) {
-        Self::plan_sets(ctx, lat, opts, search, Sets::Both, false, false)
+        let cost_turn_px = opts.turn_cost_m / ctx.frame.resolution;
+        Self::plan_sets(
+            ctx,
+            lat,
+            opts,
+            cost_turn_px,
+            search,
+            Sets::Both,
+            false,
+            false,
+        )
     }
 
     /// Steps 1-5 of the module docs on the lattice `lat`, touring only the cell sets `sets`
     /// (step 4): the best plan and the number of cells. With [`Sets::Split`] and no even cell,
     /// an empty plan that never beats another (skips `usize::MAX`). `other`: the cells of the
     /// sweep (west-to-east or north-to-south, step 1) whose estimate is the higher.
+    #[allow(clippy::too_many_arguments)] // the job's choices, passed down unchanged
     fn plan_sets(
         ctx: &Ctx<'_>,
         lat: &Lattice,
         opts: &BcdOptions,
+        cost_turn_px: f64,
         search: &mut Search,
         sets: Sets,
         peel: bool,
@@ -416,22 +508,64 @@ impl Bcd {
         let even = split.len() > cells.len();
         let (first, second) = if sets == Sets::Split {
             let b = if even {
-                Self::tour_cells(ctx, lat, opts, search, &split, &heads, sp, start)
+                Self::tour_cells(
+                    ctx,
+                    lat,
+                    opts,
+                    cost_turn_px,
+                    search,
+                    &split,
+                    &heads,
+                    sp,
+                    start,
+                )
             } else {
                 None
             };
             (b, None)
         } else if even && sets == Sets::Both {
             rayon::join(
-                || Self::tour_cells(ctx, lat, opts, search, &cells, &heads, sp, start),
+                || {
+                    Self::tour_cells(
+                        ctx,
+                        lat,
+                        opts,
+                        cost_turn_px,
+                        search,
+                        &cells,
+                        &heads,
+                        sp,
+                        start,
+                    )
+                },
                 || {
                     let mut own = Search::new(ctx.frame.width, ctx.frame.height);
-                    Self::tour_cells(ctx, lat, opts, &mut own, &split, &heads, sp, start)
+                    Self::tour_cells(
+                        ctx,
+                        lat,
+                        opts,
+                        cost_turn_px,
+                        &mut own,
+                        &split,
+                        &heads,
+                        sp,
+                        start,
+                    )
                 },
             )
         } else {
             (
-                Self::tour_cells(ctx, lat, opts, search, &cells, &heads, sp, start),
+                Self::tour_cells(
+                    ctx,
+                    lat,
+                    opts,
+                    cost_turn_px,
+                    search,
+                    &cells,
+                    &heads,
+                    sp,
+                    start,
+                ),
                 None,
             )
         };
@@ -455,6 +589,7 @@ impl Bcd {
         ctx: &Ctx<'_>,
         lat: &Lattice,
         opts: &BcdOptions,
+        cost_turn_px: f64,
         search: &mut Search,
         cells: &[(Cell, Vec<f64>)],
         heads: &[Vec<Point>],
@@ -730,7 +865,7 @@ impl Bcd {
             }
             let (items, short) = prune::prune(ctx, items, opts.min_coverage, turn_px);
             let pts: Vec<Point> = moves(&items).into_iter().map(|m| m.0).collect();
-            let cost = path_length(&pts) + turn_px * turns(&pts) as f64;
+            let cost = path_length(&pts) + cost_turn_px * turns(&pts) as f64;
             let plan = Plan {
                 skipped,
                 short,

@@ -744,6 +744,12 @@ fn a_ring_is_peeled_into_offset_loops_from_the_outer_wall() {
         m.path_length_m,
         plain.path_length_m
     );
-    // Four loops (outer pass, two offset loops, the block's pass), one region each.
-    assert_eq!(m.regions, 4);
+    // Four loops (outer pass, two offset loops, the block's pass), one region each; the
+    // plan made with a lower turn cost in its choices (module docs, step 6) wins here
+    // (49.7 m and 24 turns against 62.8 m and 19), and its pruning drops the loop whose
+    // floor the loops beside it sweep.
+    assert!(matches!(m.regions, 3 | 4), "{m:?}");
+    // (without step 6 the plan costs 62.8 m + 19 turns x 0.3 m = 68.5 m)
+    let cost = m.path_length_m + 0.3 * f64::from(m.turns);
+    assert!(cost < 60.0, "{m:?}");
 }
