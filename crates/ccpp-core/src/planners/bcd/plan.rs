@@ -147,7 +147,8 @@ impl Bcd {
             Some(t) => Lattice::turned(&ctx, *t),
         };
         // Every job tours its cells whole; the cell sets with even cells cut (step 4) are then
-        // toured on the job whose plan is best only: the split changes a plan's cost by a few
+        // toured on the best job only (and on the best of the user's turn cost, step 6, when
+        // that is another one, below): the split changes a plan's cost by a few
         // percent, the lattice or the decomposition by more, and a second tour per job doubled
         // the time. With a headland (module docs, step 3), every lattice is planned with and
         // without it, the cheaper plan kept.

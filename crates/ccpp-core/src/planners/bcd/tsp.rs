@@ -254,7 +254,7 @@ struct BoxGrid<'a> {
     nx: usize,
     ny: usize,
     /// The pieces whose box meets each square (row-major), in index order.
-    cells: Vec<Vec<u32>>,
+    squares: Vec<Vec<u32>>,
 }
 
 impl<'a> BoxGrid<'a> {
@@ -288,13 +288,13 @@ impl<'a> BoxGrid<'a> {
             side,
             nx,
             ny,
-            cells: vec![Vec::new(); nx * ny],
+            squares: vec![Vec::new(); nx * ny],
         };
         for (i, b) in boxes.iter().enumerate() {
             let [cx0, cx1, cy0, cy1] = grid.span(b);
             for cy in cy0..=cy1 {
                 for cx in cx0..=cx1 {
-                    grid.cells[cy * nx + cx].push(i as u32);
+                    grid.squares[cy * nx + cx].push(i as u32);
                 }
             }
         }
@@ -358,7 +358,7 @@ impl<'a> BoxGrid<'a> {
                         };
                         continue;
                     }
-                    for &b in &self.cells[cy as usize * self.nx + cx as usize] {
+                    for &b in &self.squares[cy as usize * self.nx + cx as usize] {
                         let b = b as usize;
                         if seen[b] == a {
                             continue;
