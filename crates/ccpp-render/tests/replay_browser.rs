@@ -399,3 +399,40 @@ fn the_replay_shows_the_zones_like_the_coverage_picture() {
         "{legend}"
     );
 }
+
+/// Moves before the first region (bcd's tour may start with a rim pass) are drawn but are no
+/// region: the replay's legend counts the regions `metrics.json` and `coverage.png` count
+/// (bcd on `aws_bookstore` said 101 against 100).
+#[test]
+fn a_move_before_the_first_region_is_no_region_in_the_replay_legend() {
+    let (world, plain) = run(200, 120, 400);
+    let mut trace = Trace::default();
+    trace.push_pose(0, Pose::new(0.3, 0.3, 0.0));
+    trace.push_pose(1, Pose::new(0.6, 0.3, 0.0));
+    for r in plain.records() {
+        trace.push(r);
+    }
+    let html = replay_html(&world, &trace, None, "{}", "pre-region").expect("page");
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("replay-pre-region");
+    std::fs::create_dir_all(&dir).expect("dir");
+    std::fs::write(dir.join("page.html"), &html).expect("write");
+    let Some(chrome) = require_chromium() else {
+        return;
+    };
+    let _serial = BROWSER
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    let url = format!("file://{}#selftest", dir.join("page.html").display());
+    let v = self_test(&chrome, &url, true);
+    assert_eq!(v["pass"], true, "{v}");
+    let legend: Vec<&str> = v["legend"]
+        .as_array()
+        .expect("legend")
+        .iter()
+        .filter_map(serde_json::Value::as_str)
+        .collect();
+    assert!(
+        legend.contains(&"path, colour per region (2)"),
+        "{legend:?}"
+    );
+}
