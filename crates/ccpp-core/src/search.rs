@@ -580,6 +580,116 @@ pub fn fill_runs(
     }
 }
 
+/// A priority queue of `(key, index)` pairs popping the smallest pair (key, then index) for
+/// keys that never go below the last popped key (Dijkstra costs, A* `f` with a consistent
+/// heuristic): a radix heap over the keys, plus a binary heap of the indices whose key equals
+/// the current minimum. Every pair in a search is distinct, so the pop order is exactly that of
+/// a binary heap of the pairs. A key below the minimum is still popped in order (slowly).
+///
+/// The planners' own hot searches use it where a binary heap of the pairs was the cost: BA*'s
+/// backtracking searches, and BCD's pixel A* of transfers (key `f << 32 | g`: the order
+/// `(f, g, index)`).
+#[derive(Clone, Debug)]
+pub(crate) struct MonotoneQueue {
+    /// The key of the current group (the last popped minimum).
+    last: u64,
+    /// Indices whose key is `last`.
+    current: BinaryHeap<Reverse<u32>>,
+    /// Bucket `b` (1..=64) holds the pairs whose key's highest bit differing from `last` is
+    /// bit `b - 1`; bucket 0 is unused.
+    buckets: Vec<Vec<(u64, u32)>>,
+    /// Bit `b` set when bucket `b` may be non-empty.
+    nonempty: u128,
+}
+
+impl MonotoneQueue {
+    pub(crate) fn new() -> Self {
+        Self {
+            last: 0,
+            current: BinaryHeap::new(),
+            buckets: vec![Vec::new(); 65],
+            nonempty: 0,
+        }
+    }
+
+    pub(crate) fn clear(&mut self) {
+        self.last = 0;
+        self.current.clear();
+        while self.nonempty != 0 {
+            let b = self.nonempty.trailing_zeros() as usize;
+            self.nonempty &= self.nonempty - 1;
+            self.buckets[b].clear();
+        }
+    }
+
+    #[inline]
+    fn bucket(last: u64, key: u64) -> usize {
+        64 - (key ^ last).leading_zeros() as usize
+    }
+
+    #[inline]
+    pub(crate) fn push(&mut self, key: u64, index: u32) {
+        if key < self.last {
+            self.lower(key);
+        }
+        if key == self.last {
+            self.current.push(Reverse(index));
+        } else {
+            let b = Self::bucket(self.last, key);
+            self.buckets[b].push((key, index));
+            self.nonempty |= 1 << b;
+        }
+    }
+
+    /// Makes `key` (below the current minimum) the current key, redistributing every pair:
+    /// keeps the exact order should a key ever go below the minimum (a heuristic rounding).
+    #[cold]
+    fn lower(&mut self, key: u64) {
+        let mut all: Vec<(u64, u32)> = self
+            .current
+            .drain()
+            .map(|Reverse(i)| (self.last, i))
+            .collect();
+        for b in &mut self.buckets {
+            all.append(b);
+        }
+        self.nonempty = 0;
+        self.last = key;
+        for (k, i) in all {
+            self.push(k, i);
+        }
+    }
+
+    #[inline]
+    pub(crate) fn pop(&mut self) -> Option<(u64, u32)> {
+        if let Some(Reverse(i)) = self.current.pop() {
+            return Some((self.last, i));
+        }
+        if self.nonempty == 0 {
+            return None;
+        }
+        // The lowest non-empty bucket holds the smallest keys: its minimum becomes the new
+        // current key and the rest spread into lower buckets.
+        let b = self.nonempty.trailing_zeros() as usize;
+        self.nonempty &= !(1u128 << b);
+        let mut items = std::mem::take(&mut self.buckets[b]);
+        let min = items.iter().map(|&(k, _)| k).min().unwrap_or(self.last);
+        self.last = min;
+        for &(k, i) in &items {
+            if k == min {
+                self.current.push(Reverse(i));
+            } else {
+                let nb = Self::bucket(min, k);
+                self.buckets[nb].push((k, i));
+                self.nonempty |= 1 << nb;
+            }
+        }
+        items.clear();
+        self.buckets[b] = items;
+        self.current.pop().map(|Reverse(i)| (self.last, i))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -829,5 +939,52 @@ mod tests {
         assert!(costs.windows(2).all(|w| w[0] <= w[1]));
         assert!(b.is_settled(t));
         assert_eq!(a.dist(t), b.dist(t));
+    }
+
+    /// The monotone queue pops exactly what a binary heap of the pairs pops, over a
+    /// Dijkstra-like run (pushes at or above the last popped key, ties on the key, keys below
+    /// the minimum, reuse after `clear`).
+    #[test]
+    fn monotone_queue_matches_binary_heap() {
+        let mut q = MonotoneQueue::new();
+        let mut seed: u64 = 0x9e37_79b9_7f4a_7c15;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        };
+        for round in 0..4 {
+            q.clear();
+            let mut heap = BinaryHeap::new();
+            let mut last = 0u64;
+            let mut id = 0u32;
+            for step in 0..5000 {
+                for _ in 0..(next() % 4) {
+                    let r = next();
+                    let key = match r % 5 {
+                        0 => last,
+                        1 if round == 3 && last > 0 => last - 1 - r % last.min(7),
+                        _ => last + (r >> 8) % [3, 1_000, 1_414_214, 1 << 40][round],
+                    };
+                    id = id.wrapping_add(1 + (r >> 40) as u32 % 3) % 100_000;
+                    // Every pair distinct, as in a search.
+                    let pair = (key, id ^ step);
+                    q.push(pair.0, pair.1);
+                    heap.push(Reverse(pair));
+                }
+                if next() % 3 != 0 {
+                    let got = q.pop();
+                    assert_eq!(got, heap.pop().map(|Reverse(p)| p));
+                    if let Some((k, _)) = got {
+                        last = k;
+                    }
+                }
+            }
+            while let Some(Reverse(p)) = heap.pop() {
+                assert_eq!(q.pop(), Some(p));
+            }
+            assert_eq!(q.pop(), None);
+        }
     }
 }

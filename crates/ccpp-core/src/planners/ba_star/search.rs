@@ -1,9 +1,7 @@
 //! The backtracking searches over covered tiles: the nearest tile of `L` (Dijkstra, or A* to
 //! the nearest of a target set with [`TargetBlocks`]) and the bounded A* path.
 
-use std::cmp::Reverse;
-use std::collections::BinaryHeap;
-
+use crate::search::MonotoneQueue;
 use crate::tiles::{Tile, N8};
 
 /// Fixed-point cost of an orthogonal tile step (one tile = 1 000 000).
@@ -159,112 +157,6 @@ pub fn octile(a: Tile, b: Tile) -> u64 {
 fn octile_gap(dx: u64, dy: u64) -> u64 {
     let (lo, hi) = if dx < dy { (dx, dy) } else { (dy, dx) };
     COST_ORTHO * (hi - lo) + COST_DIAG * lo
-}
-
-/// A priority queue of `(key, index)` pairs popping the smallest pair (key, then index) for
-/// keys that never go below the last popped key (Dijkstra costs, A* `f` with a consistent
-/// heuristic): a radix heap over the keys, plus a binary heap of the indices whose key equals
-/// the current minimum. Every pair in a search is distinct, so the pop order is exactly that of
-/// a binary heap of the pairs.
-#[derive(Clone, Debug)]
-pub(super) struct MonotoneQueue {
-    /// The key of the current group (the last popped minimum).
-    last: u64,
-    /// Indices whose key is `last`.
-    current: BinaryHeap<Reverse<u32>>,
-    /// Bucket `b` (1..=64) holds the pairs whose key's highest bit differing from `last` is
-    /// bit `b - 1`; bucket 0 is unused.
-    buckets: Vec<Vec<(u64, u32)>>,
-    /// Bit `b` set when bucket `b` may be non-empty.
-    nonempty: u128,
-}
-
-impl MonotoneQueue {
-    pub(super) fn new() -> Self {
-        Self {
-            last: 0,
-            current: BinaryHeap::new(),
-            buckets: vec![Vec::new(); 65],
-            nonempty: 0,
-        }
-    }
-
-    pub(super) fn clear(&mut self) {
-        self.last = 0;
-        self.current.clear();
-        while self.nonempty != 0 {
-            let b = self.nonempty.trailing_zeros() as usize;
-            self.nonempty &= self.nonempty - 1;
-            self.buckets[b].clear();
-        }
-    }
-
-    #[inline]
-    fn bucket(last: u64, key: u64) -> usize {
-        64 - (key ^ last).leading_zeros() as usize
-    }
-
-    #[inline]
-    pub(super) fn push(&mut self, key: u64, index: u32) {
-        if key < self.last {
-            self.lower(key);
-        }
-        if key == self.last {
-            self.current.push(Reverse(index));
-        } else {
-            let b = Self::bucket(self.last, key);
-            self.buckets[b].push((key, index));
-            self.nonempty |= 1 << b;
-        }
-    }
-
-    /// Makes `key` (below the current minimum) the current key, redistributing every pair:
-    /// keeps the exact order should a key ever go below the minimum (a heuristic rounding).
-    #[cold]
-    fn lower(&mut self, key: u64) {
-        let mut all: Vec<(u64, u32)> = self
-            .current
-            .drain()
-            .map(|Reverse(i)| (self.last, i))
-            .collect();
-        for b in &mut self.buckets {
-            all.append(b);
-        }
-        self.nonempty = 0;
-        self.last = key;
-        for (k, i) in all {
-            self.push(k, i);
-        }
-    }
-
-    #[inline]
-    pub(super) fn pop(&mut self) -> Option<(u64, u32)> {
-        if let Some(Reverse(i)) = self.current.pop() {
-            return Some((self.last, i));
-        }
-        if self.nonempty == 0 {
-            return None;
-        }
-        // The lowest non-empty bucket holds the smallest keys: its minimum becomes the new
-        // current key and the rest spread into lower buckets.
-        let b = self.nonempty.trailing_zeros() as usize;
-        self.nonempty &= !(1u128 << b);
-        let mut items = std::mem::take(&mut self.buckets[b]);
-        let min = items.iter().map(|&(k, _)| k).min().unwrap_or(self.last);
-        self.last = min;
-        for &(k, i) in &items {
-            if k == min {
-                self.current.push(Reverse(i));
-            } else {
-                let nb = Self::bucket(min, k);
-                self.buckets[nb].push((k, i));
-                self.nonempty |= 1 << nb;
-            }
-        }
-        items.clear();
-        self.buckets[b] = items;
-        self.current.pop().map(|Reverse(i)| (self.last, i))
-    }
 }
 
 impl TileSearch {

@@ -1,59 +1,8 @@
 //! Unit tests of the BA* internals.
 
-use std::cmp::Reverse;
-use std::collections::BinaryHeap;
-
 use super::backtrack_list::Block3;
-use super::search::MonotoneQueue;
 use super::smoothing::{all_swept_tiles, segment_box_dist2};
 use super::*;
-
-/// The monotone queue pops exactly what a binary heap of the pairs pops, over a
-/// Dijkstra-like run (pushes at or above the last popped key, ties on the key, keys below
-/// the minimum, reuse after `clear`).
-#[test]
-fn monotone_queue_matches_binary_heap() {
-    let mut q = MonotoneQueue::new();
-    let mut seed: u64 = 0x9e37_79b9_7f4a_7c15;
-    let mut next = move || {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        seed
-    };
-    for round in 0..4 {
-        q.clear();
-        let mut heap = BinaryHeap::new();
-        let mut last = 0u64;
-        let mut id = 0u32;
-        for step in 0..5000 {
-            for _ in 0..(next() % 4) {
-                let r = next();
-                let key = match r % 5 {
-                    0 => last,
-                    1 if round == 3 && last > 0 => last - 1 - r % last.min(7),
-                    _ => last + (r >> 8) % [3, 1_000, 1_414_214, 1 << 40][round],
-                };
-                id = id.wrapping_add(1 + (r >> 40) as u32 % 3) % 100_000;
-                // Every pair distinct, as in a search.
-                let pair = (key, id ^ step);
-                q.push(pair.0, pair.1);
-                heap.push(Reverse(pair));
-            }
-            if next() % 3 != 0 {
-                let got = q.pop();
-                assert_eq!(got, heap.pop().map(|Reverse(p)| p));
-                if let Some((k, _)) = got {
-                    last = k;
-                }
-            }
-        }
-        while let Some(Reverse(p)) = heap.pop() {
-            assert_eq!(q.pop(), Some(p));
-        }
-        assert_eq!(q.pop(), None);
-    }
-}
 
 /// `Block3::in_l` (the early-stopping test the incremental L uses) is `mu >= 1`, over
 /// random blocks of tile states and move judgements.

@@ -1,11 +1,9 @@
 //! Transfers between points: straight moves where free, else A* over the C-free pixel centres
 //! ([`Search`]), shortened by line-of-sight checks on the true map.
 
-use std::cmp::Reverse;
-use std::collections::BinaryHeap;
-
 use super::lattice::Ctx;
 use crate::geometry::{point_segment_dist2, Point};
+use crate::search::MonotoneQueue;
 
 /// How far a merged boundary segment may stray from the boundary points it replaces (pixels).
 const CONTOUR_TOL_PX: f64 = 1.0;
@@ -159,6 +157,7 @@ pub(super) struct Search {
     gen: u32,
     g: Vec<u32>,
     parent: Vec<u32>,
+    heap: MonotoneQueue,
 }
 
 impl Search {
@@ -170,6 +169,7 @@ impl Search {
             gen: 0,
             g: vec![0; width * height],
             parent: vec![u32::MAX; width * height],
+            heap: MonotoneQueue::new(),
         }
     }
 
@@ -181,7 +181,9 @@ impl Search {
 
     /// A* from `s` to `t` over the pixels `ok` admits (the end pixels need not be in it). A
     /// diagonal step whose two side pixels are not both admitted is taken only when
-    /// `diag(from, to)` allows it. Ties by cost, then pixel index.
+    /// `diag(from, to)` allows it. Settles in `(f, g, pixel index)` order (a
+    /// [`MonotoneQueue`] keyed `f << 32 | g`: the octile heuristic is consistent, so keys
+    /// never go below the last popped one).
     fn path(
         &mut self,
         ok: &dyn Fn(usize) -> bool,
@@ -197,14 +199,16 @@ impl Search {
         let w = self.width;
         let ti = t.1 * w + t.0;
         let passable = |j: usize| ok(j) || j == ti;
-        let mut heap = BinaryHeap::new();
+        let mut heap = std::mem::replace(&mut self.heap, MonotoneQueue::new());
+        heap.clear();
         let si = s.1 * w + s.0;
         self.stamp[si] = self.gen;
         self.g[si] = 0;
         self.parent[si] = u32::MAX;
-        heap.push(Reverse((Self::octile(s, t), 0u32, si as u32)));
+        heap.push(u64::from(Self::octile(s, t)) << 32, si as u32);
         let mut found = false;
-        while let Some(Reverse((_, g, i))) = heap.pop() {
+        while let Some((key, i)) = heap.pop() {
+            let g = key as u32;
             let i = i as usize;
             if g > self.g[i] {
                 continue;
@@ -245,14 +249,15 @@ impl Search {
                     self.stamp[j] = self.gen;
                     self.g[j] = ng;
                     self.parent[j] = i as u32;
-                    heap.push(Reverse((
-                        ng + Self::octile((nc as usize, nr as usize), t),
-                        ng,
+                    heap.push(
+                        u64::from(ng + Self::octile((nc as usize, nr as usize), t)) << 32
+                            | u64::from(ng),
                         j as u32,
-                    )));
+                    );
                 }
             }
         }
+        self.heap = heap;
         if !found {
             return None;
         }
@@ -264,5 +269,151 @@ impl Search {
         }
         out.reverse();
         Some(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::cmp::Reverse;
+    use std::collections::BinaryHeap;
+
+    use super::Search;
+
+    /// The A* of [`Search::path`] with a binary heap of `(f, g, index)` triples: the order the
+    /// planner's transfers were planned in before the monotone queue.
+    fn reference(
+        w: usize,
+        h: usize,
+        ok: &dyn Fn(usize) -> bool,
+        s: (usize, usize),
+        t: (usize, usize),
+        diag_ok: &dyn Fn(usize, usize) -> bool,
+    ) -> Option<Vec<(usize, usize)>> {
+        let ti = t.1 * w + t.0;
+        let passable = |j: usize| ok(j) || j == ti;
+        let mut g = vec![u32::MAX; w * h];
+        let mut parent = vec![u32::MAX; w * h];
+        let mut heap = BinaryHeap::new();
+        let si = s.1 * w + s.0;
+        g[si] = 0;
+        heap.push(Reverse((Search::octile(s, t), 0u32, si as u32)));
+        while let Some(Reverse((_, gi, i))) = heap.pop() {
+            let i = i as usize;
+            if gi > g[i] {
+                continue;
+            }
+            if i == ti {
+                let mut out = vec![t];
+                let mut k = ti;
+                while parent[k] != u32::MAX {
+                    k = parent[k] as usize;
+                    out.push((k % w, k / w));
+                }
+                out.reverse();
+                return Some(out);
+            }
+            let (c, r) = ((i % w) as i64, (i / w) as i64);
+            for (dc, dr) in [
+                (1, 0),
+                (0, -1),
+                (-1, 0),
+                (0, 1),
+                (1, -1),
+                (-1, -1),
+                (-1, 1),
+                (1, 1),
+            ] {
+                let (nc, nr) = (c + dc, r + dr);
+                if nc < 0 || nr < 0 || nc >= w as i64 || nr >= h as i64 {
+                    continue;
+                }
+                let j = nr as usize * w + nc as usize;
+                if !passable(j) {
+                    continue;
+                }
+                let diag = dc != 0 && dr != 0;
+                if diag
+                    && !(passable(r as usize * w + nc as usize)
+                        && passable(nr as usize * w + c as usize))
+                    && !diag_ok(i, j)
+                {
+                    continue;
+                }
+                let ng = gi + if diag { 14 } else { 10 };
+                if ng < g[j] {
+                    g[j] = ng;
+                    parent[j] = i as u32;
+                    let h = Search::octile((nc as usize, nr as usize), t);
+                    heap.push(Reverse((ng + h, ng, j as u32)));
+                }
+            }
+        }
+        None
+    }
+
+    /// Paths (with their ties) are those of the binary-heap A*, on grids like real maps:
+    /// walls at any offset with gaps, salt noise, open rooms with many equal-cost paths, and
+    /// diagonal squeezes allowed by a predicate; one `Search` reused for every query.
+    #[test]
+    fn paths_are_those_of_the_binary_heap_astar() {
+        let mut seed: u64 = 0x2545_f491_4f6c_dd1d;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        };
+        let (w, h) = (61, 47);
+        let mut search = Search::new(w, h);
+        let mut compared = 0;
+        let mut detours = 0;
+        for map in 0..40 {
+            let mut free = vec![true; w * h];
+            // Walls, vertical and horizontal, each with a gap.
+            for _ in 0..(next() % 5) {
+                let vertical = next() % 2 == 0;
+                let (len, at) = if vertical {
+                    (h, next() as usize % w)
+                } else {
+                    (w, next() as usize % h)
+                };
+                let gap = next() as usize % len;
+                for k in 0..len {
+                    if k.abs_diff(gap) > 1 {
+                        let j = if vertical { k * w + at } else { at * w + k };
+                        free[j] = false;
+                    }
+                }
+            }
+            // Salt noise, denser on some maps.
+            let salt = [0, 2, 8, 20][map % 4];
+            for j in 0..w * h {
+                if next() % 100 < salt {
+                    free[j] = false;
+                }
+            }
+            let ok = |j: usize| free[j];
+            let diag_ok = |i: usize, j: usize| (i * 31 + j * 17).is_multiple_of(3);
+            for _ in 0..25 {
+                let s = (next() as usize % w, next() as usize % h);
+                let t = (next() as usize % w, next() as usize % h);
+                if !free[s.1 * w + s.0] {
+                    continue;
+                }
+                let want = reference(w, h, &ok, s, t, &diag_ok);
+                let got = search.path(&ok, s, t, &diag_ok);
+                assert_eq!(got, want, "map {map}, {s:?} -> {t:?}");
+                compared += 1;
+                if let Some(p) = &want {
+                    let straight = s.0.abs_diff(t.0).max(s.1.abs_diff(t.1)) + 1;
+                    detours += usize::from(p.len() > straight + 4);
+                }
+            }
+        }
+        // The comparison saw real searches: many queries, some of them long detours.
+        assert!(
+            compared > 500 && detours > 20,
+            "{compared} queries, {detours} detours"
+        );
     }
 }
