@@ -184,19 +184,19 @@ impl Search {
     /// `diag(from, to)` allows it. Settles in `(f, g, pixel index)` order (a
     /// [`MonotoneQueue`] keyed `f << 32 | g`: the octile heuristic is consistent, so keys
     /// never go below the last popped one).
-    fn path(
+    fn path<O: Fn(usize) -> bool, D: Fn(usize, usize) -> bool>(
         &mut self,
-        ok: &dyn Fn(usize) -> bool,
+        ok: &O,
         s: (usize, usize),
         t: (usize, usize),
-        diag_ok: &dyn Fn(usize, usize) -> bool,
+        diag_ok: &D,
     ) -> Option<Vec<(usize, usize)>> {
         self.gen = self.gen.wrapping_add(1);
         if self.gen == 0 {
             self.stamp.iter_mut().for_each(|x| *x = 0);
             self.gen = 1;
         }
-        let w = self.width;
+        let (w, h) = (self.width, self.height);
         let ti = t.1 * w + t.0;
         let passable = |j: usize| ok(j) || j == ti;
         let mut heap = std::mem::replace(&mut self.heap, MonotoneQueue::new());
@@ -217,31 +217,52 @@ impl Search {
                 found = true;
                 break;
             }
-            let (c, r) = ((i % w) as i64, (i / w) as i64);
-            for (dc, dr) in [
-                (1, 0),
-                (0, -1),
-                (-1, 0),
-                (0, 1),
-                (1, -1),
-                (-1, -1),
-                (-1, 1),
-                (1, 1),
-            ] {
-                let (nc, nr) = (c + dc, r + dr);
-                if nc < 0 || nr < 0 || nc >= self.width as i64 || nr >= self.height as i64 {
+            let (c, r) = (i % w, i / w);
+            // The four side neighbours' passability, read once: the diagonal steps need
+            // them too. (The order of the steps decides nothing: the queue's order is total,
+            // and a neighbour's parent is the first settled position giving its cost.)
+            let (east, north) = (c + 1 < w, r > 0);
+            let (west, south) = (c > 0, r + 1 < h);
+            let pe = east && passable(i + 1);
+            let pn = north && passable(i - w);
+            let pw = west && passable(i - 1);
+            let ps = south && passable(i + w);
+            let steps = [
+                (pe, i.wrapping_add(1), false, false),
+                (pn, i.wrapping_sub(w), false, false),
+                (pw, i.wrapping_sub(1), false, false),
+                (ps, i.wrapping_add(w), false, false),
+                (
+                    east && north,
+                    i.wrapping_sub(w).wrapping_add(1),
+                    true,
+                    pe && pn,
+                ),
+                (
+                    west && north,
+                    i.wrapping_sub(w).wrapping_sub(1),
+                    true,
+                    pw && pn,
+                ),
+                (
+                    west && south,
+                    i.wrapping_add(w).wrapping_sub(1),
+                    true,
+                    pw && ps,
+                ),
+                (
+                    east && south,
+                    i.wrapping_add(w).wrapping_add(1),
+                    true,
+                    pe && ps,
+                ),
+            ];
+            for (inside, j, diag, sides) in steps {
+                // (a side step's `inside` is its passability, checked once above)
+                if !inside || (diag && !passable(j)) {
                     continue;
                 }
-                let j = nr as usize * w + nc as usize;
-                if !passable(j) {
-                    continue;
-                }
-                let diag = dc != 0 && dr != 0;
-                if diag
-                    && !(passable(r as usize * w + nc as usize)
-                        && passable(nr as usize * w + c as usize))
-                    && !diag_ok(i, j)
-                {
+                if diag && !sides && !diag_ok(i, j) {
                     continue;
                 }
                 let ng = g + if diag { 14 } else { 10 };
@@ -250,8 +271,7 @@ impl Search {
                     self.g[j] = ng;
                     self.parent[j] = i as u32;
                     heap.push(
-                        u64::from(ng + Self::octile((nc as usize, nr as usize), t)) << 32
-                            | u64::from(ng),
+                        u64::from(ng + Self::octile((j % w, j / w), t)) << 32 | u64::from(ng),
                         j as u32,
                     );
                 }
