@@ -570,6 +570,9 @@ fn child_job() -> Result<String> {
         out: spec.out,
     };
     let result = job.execute()?;
+    if let Some(note) = result.approach_note() {
+        eprintln!("{note}");
+    }
     let extra = [("bench-key.txt", spec.key.into_bytes())];
     write_run_files(&job.out, &job, &result, false, &extra)
 }

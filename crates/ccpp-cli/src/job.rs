@@ -82,6 +82,23 @@ pub struct JobResult {
     pub formed: Option<ccpp_io::trace::FormedFiles>,
 }
 
+impl JobResult {
+    /// The note telling the user that the start lies outside the area and how far the robot
+    /// drives to reach it first (`None` when it starts inside).
+    pub fn approach_note(&self) -> Option<String> {
+        if self.world.approach().is_empty() {
+            return None;
+        }
+        let e = self.world.start();
+        Some(format!(
+            "note: the start is outside the area: the robot first drives {:.2} m on the known map to reach it at ({:.3}, {:.3})",
+            self.world.approach_length_m(),
+            e.x,
+            e.y
+        ))
+    }
+}
+
 /// The recipe of `args`: paths made absolute so that `run.json` works from any folder.
 pub fn recipe_from(args: &MapArgs) -> MapRecipe {
     let abs = |p: &PathBuf| std::fs::canonicalize(p).unwrap_or_else(|_| p.clone());
@@ -548,15 +565,6 @@ impl Job {
             form_files,
         )?;
         let s = run.world.initial_pose();
-        if !run.world.approach().is_empty() {
-            let e = run.world.start();
-            eprintln!(
-                "note: the start is outside the area: the robot first drives {:.2} m on the known map to reach it at ({:.3}, {:.3})",
-                run.world.approach_length_m(),
-                e.x,
-                e.y
-            );
-        }
         self.scenario.start = Some([s.x, s.y, s.theta]);
         Ok(JobResult {
             world: run.world,

@@ -5,6 +5,7 @@
 
 mod args;
 mod bench;
+mod busy;
 mod components;
 mod errors;
 mod info;
@@ -83,18 +84,35 @@ pub fn print_stdout(text: &str) -> anyhow::Result<()> {
     }
 }
 
+/// Runs the job of `ccpp run` or `ccpp demo` with a spinner on a terminal ([`busy`]), then
+/// tells whether the robot first drove to a start outside the area.
+fn execute(job: &mut job::Job) -> anyhow::Result<job::JobResult> {
+    let busy = busy::Busy::start(format!(
+        "{} on {}: planning and simulating",
+        job.scenario.planner.kind().name(),
+        job.map.as_ref().map_or("the map", |m| m.name.as_str())
+    ));
+    let result = job.execute_with(true);
+    busy.done();
+    let result = result?;
+    if let Some(note) = result.approach_note() {
+        eprintln!("{note}");
+    }
+    Ok(result)
+}
+
 fn dispatch(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Run(a) => {
             let mut job = job::Job::from_run_args(&a)?;
             staging::check_target(&job.out)?;
-            let result = job.execute_with(true)?;
+            let result = execute(&mut job)?;
             output::emit(&job, &result, a.json, a.replay, &a.export)
         }
         Command::Demo(a) => {
             let mut job = job::Job::demo(&a)?;
             staging::check_target(&job.out)?;
-            let result = job.execute_with(true)?;
+            let result = execute(&mut job)?;
             output::emit(&job, &result, false, true, &[])
         }
         Command::Planners => {

@@ -49,7 +49,10 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         .map_err(flag)?;
     check_target(&a.out)?;
     let map = load_recipe(&scenario.map, scenario.max_memory_mb)?;
-    let plan = plan_route(&scenario, &map, DEFAULT_TOLERANCE_M).map_err(|e| match e {
+    let busy = crate::busy::Busy::start(format!("{kind} on {}: planning", map.name));
+    let plan = plan_route(&scenario, &map, DEFAULT_TOLERANCE_M);
+    busy.done();
+    let plan = plan.map_err(|e| match e {
         PlanError::Scenario(s) => flag(s),
         other @ PlanError::Online(..) => other.into(),
     })?;

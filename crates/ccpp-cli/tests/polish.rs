@@ -247,3 +247,84 @@ fn the_replay_of_a_zoned_run_carries_the_zones() {
     let html = std::fs::read_to_string(plain.join("replay.html")).unwrap();
     assert!(html.contains(r#""zones":null"#));
 }
+
+/// The output of `args` run on a terminal (`script` gives it a pseudo-terminal; its own
+/// output is the terminal's), or `None` where `script` is missing.
+fn on_terminal(args: &[&str]) -> Option<String> {
+    let bin = assert_cmd::cargo::cargo_bin("ccpp");
+    let mut line = bin.display().to_string();
+    for a in args {
+        line.push(' ');
+        line.push_str(a);
+    }
+    let out = std::process::Command::new("script")
+        .args(["-q", "-e", "-c", &line, "/dev/null"])
+        .output()
+        .ok()?;
+    assert!(out.status.success(), "{line}: {out:?}");
+    Some(String::from_utf8_lossy(&out.stdout).into_owned())
+}
+
+/// On a terminal `run` and `plan` turn a spinner naming the planner, the map and the step
+/// while the planner works, and clear it before the summary; piped, standard error stays
+/// empty and the files are the same.
+#[test]
+fn a_spinner_shows_a_long_step_on_a_terminal_only() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = pgm(dir.path(), "hall.pgm", 400, 300, |x, y| {
+        (100..140).contains(&x) && (60..200).contains(&y) || (x + y) % 97 == 0 && x > 250
+    });
+    let m = map.to_str().unwrap();
+    let tty_out = dir.path().join("tty");
+    let (t, p) = (tty_out.to_str().unwrap(), dir.path().join("piped"));
+    let Some(screen) = on_terminal(&["run", "--map", m, "--planner", "bcd", "--out", t]) else {
+        eprintln!("`script` is missing: no terminal to test on");
+        return;
+    };
+    let spin = "bcd on hall: planning and simulating (";
+    let first = screen.find(spin).expect(&screen);
+    let summary = screen.find("bcd on hall (r = ").expect(&screen);
+    assert!(first < summary, "{screen}");
+    // Cleared ("erase line") before the summary, never drawn after it.
+    let clear = screen[..summary].rfind("\u{1b}[2K").expect(&screen);
+    assert!(
+        clear > first && !screen[summary..].contains(spin),
+        "{screen}"
+    );
+    let piped = ccpp()
+        .args(["run", "--map", m, "--planner", "bcd", "--out"])
+        .arg(&p)
+        .assert()
+        .success();
+    assert!(piped.get_output().stderr.is_empty(), "{piped:?}");
+    for f in ["trace.jsonl", "metrics.json", "path.csv"] {
+        let (a, b) = (tty_out.join(f), p.join(f));
+        let strip = |s: String| {
+            s.lines()
+                .filter(|l| !l.contains("wall_time_s"))
+                .collect::<Vec<_>>()
+                .join("\n")
+        };
+        assert_eq!(
+            strip(std::fs::read_to_string(a).unwrap()),
+            strip(std::fs::read_to_string(b).unwrap()),
+            "{f}"
+        );
+    }
+    let plan_out = dir.path().join("plan");
+    let screen = on_terminal(&[
+        "plan",
+        "--map",
+        m,
+        "--planner",
+        "bcd",
+        "--out",
+        plan_out.to_str().unwrap(),
+    ])
+    .unwrap();
+    let first = screen.find("bcd on hall: planning (").expect(&screen);
+    assert!(
+        first < screen.find("waypoints,").expect(&screen),
+        "{screen}"
+    );
+}
