@@ -1,6 +1,6 @@
 //! A spinner on standard error while a long step runs, so that a run on a large map does not
-//! sit silent: `ccpp run` and `ccpp demo` while the planner plans and the simulator drives,
-//! `ccpp plan` while it plans (bcd on the 4 M pixel `cluttered_2000` bench map takes about
+//! sit silent: `ccpp run` and `ccpp demo` while the planner plans and the simulator drives and
+//! while the files are written, `ccpp plan` while it plans (bcd on the 4 M pixel `cluttered_2000` bench map takes about
 //! 30 s). Drawn only when standard error is a terminal, and cleared before anything else is
 //! printed: piped or redirected output, and every file, are the same as without it.
 
@@ -28,6 +28,9 @@ impl Busy {
                 .unwrap_or_else(|_| ProgressStyle::default_spinner()),
         );
         bar.set_message(what);
+        // The first frame now, from this thread (the ticker thread's first may come after a
+        // short step has ended).
+        bar.tick();
         bar.enable_steady_tick(TICK);
         Self(Some(bar))
     }

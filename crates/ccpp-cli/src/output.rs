@@ -160,6 +160,10 @@ pub fn emit(
     replay: bool,
     exports: &[ExportFormat],
 ) -> Result<()> {
+    let busy = crate::busy::Busy::start(format!(
+        "{} on {}: writing files",
+        r.metrics.planner, r.metrics.map
+    ));
     let export_files = ccpp_render::run_files::render_export_files(
         &job.scenario,
         &r.run.trace,
@@ -183,6 +187,7 @@ pub fn emit(
         };
         (metrics, comp)
     });
+    busy.done();
     let metrics = metrics?;
     if let Some(w) = comp.warning() {
         eprintln!("{w}");

@@ -266,7 +266,8 @@ fn on_terminal(args: &[&str]) -> Option<String> {
 }
 
 /// On a terminal `run` and `plan` turn a spinner naming the planner, the map and the step
-/// while the planner works, and clear it before the summary; piped, standard error stays
+/// while the planner works (and `run` while it writes its files), and clear it before the
+/// summary; piped, standard error stays
 /// empty and the files are the same.
 #[test]
 fn a_spinner_shows_a_long_step_on_a_terminal_only() {
@@ -284,7 +285,8 @@ fn a_spinner_shows_a_long_step_on_a_terminal_only() {
     let spin = "bcd on hall: planning and simulating (";
     let first = screen.find(spin).expect(&screen);
     let summary = screen.find("bcd on hall (r = ").expect(&screen);
-    assert!(first < summary, "{screen}");
+    let writing = screen.find("bcd on hall: writing files (").expect(&screen);
+    assert!(first < writing && writing < summary, "{screen}");
     // Cleared ("erase line") before the summary, never drawn after it.
     let clear = screen[..summary].rfind("\u{1b}[2K").expect(&screen);
     assert!(
