@@ -79,10 +79,10 @@ const PEEL_WALKS: usize = 32;
 /// Factors of the user's `turn_cost_m` every plan is also made with (module docs, step 6).
 const TURN_FACTORS: [f64; 3] = [1.0, 0.5, 0.0];
 
-/// The index of the plan among the first `n` of `plans` that [`Plan::beats`] the others (the
-/// first of equal ones).
-fn best_index(plans: &[(Plan, usize)], n: usize) -> Option<usize> {
-    (0..n).fold(None, |b: Option<usize>, j| {
+/// The index of the plan of `plans` that [`Plan::beats`] the others (the first of equal
+/// ones).
+fn best_index(plans: &[(Plan, usize)]) -> Option<usize> {
+    (0..plans.len()).fold(None, |b: Option<usize>, j| {
         if plans[j].0.beats(b.map(|i| &plans[i].0)) {
             Some(j)
         } else {
@@ -202,71 +202,38 @@ impl Bcd {
             let (plain, o) = &variants[f];
             (k, if head { o } else { plain }, peel, other)
         };
-        let run = |jobs: &[(usize, usize)]| -> Vec<(Plan, usize)> {
+        let run = |jobs: &[(usize, usize)], sets: Sets| -> Vec<(Plan, usize)> {
             jobs.par_iter()
                 .map(|&job| {
                     let (k, o, peel, other) = options(job);
                     let mut search = Search::new(w, h);
                     let lat = lattice(&turns_by[k]);
-                    Self::plan_sets(
-                        &ctx,
-                        &lat,
-                        o,
-                        cost_turn_px,
-                        &mut search,
-                        Sets::Whole,
-                        peel,
-                        other,
-                    )
+                    Self::plan_sets(&ctx, &lat, o, cost_turn_px, &mut search, sets, peel, other)
                 })
                 .collect()
         };
         // (job `i` of the first round is kind `i`)
         let mut jobs: Vec<(usize, usize)> = (0..kinds.len()).map(|i| (i, 0)).collect();
-        let mut plans = run(&jobs);
+        let mut plans = run(&jobs, Sets::Whole);
         // The lower turn costs (step 6) on the best job's kind only: on the 14 shared maps
         // every plan they improved came from it (made on every kind within 1 % of the best
         // too, they won nowhere else and the bcd bench took about a tenth more time; on
         // every kind, the same plans in about 1.6 times the time).
-        let lead = best_index(&plans, plans.len());
+        let lead = best_index(&plans);
         let more: Vec<(usize, usize)> = lead
             .into_iter()
             .flat_map(|i| (1..variants.len()).map(move |f| (i, f)))
             .collect();
-        plans.extend(run(&more));
+        plans.extend(run(&more, Sets::Whole));
         jobs.extend(more);
         // The cell sets with even cells cut are toured on the best job's cells and, when a
         // lower turn cost made another job the best, on the best job of the user's turn
         // cost too (so no plan is dearer than without step 6).
-        let mut cut: Vec<usize> = lead
-            .into_iter()
-            .chain(best_index(&plans, plans.len()))
-            .collect();
+        let mut cut: Vec<usize> = lead.into_iter().chain(best_index(&plans)).collect();
         cut.dedup();
-        let cut_plans: Vec<(Plan, usize)> = cut
-            .par_iter()
-            .map(|&j| {
-                let (k, o, peel, other) = options(jobs[j]);
-                let mut search = Search::new(w, h);
-                let lat = lattice(&turns_by[k]);
-                Self::plan_sets(
-                    &ctx,
-                    &lat,
-                    o,
-                    cost_turn_px,
-                    &mut search,
-                    Sets::Split,
-                    peel,
-                    other,
-                )
-            })
-            .collect();
-        let mut best: Option<(Plan, usize)> = None;
-        for p in plans.into_iter().chain(cut_plans) {
-            if p.0.beats(best.as_ref().map(|b| &b.0)) {
-                best = Some(p);
-            }
-        }
+        let cut_jobs: Vec<(usize, usize)> = cut.into_iter().map(|j| jobs[j]).collect();
+        plans.extend(run(&cut_jobs, Sets::Split));
+        let best = best_index(&plans).map(|i| plans.swap_remove(i));
         let (items, ncells) = best.map_or((Vec::new(), 0), |(p, n)| (p.items, n));
         let start = frame.world_to_grid(world.start().position());
 
