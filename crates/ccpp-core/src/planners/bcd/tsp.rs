@@ -259,18 +259,9 @@ struct BoxGrid<'a> {
 
 impl<'a> BoxGrid<'a> {
     fn new(boxes: &'a [[f64; 4]]) -> Self {
-        let fold = |f: fn(&[f64; 4]) -> f64, min: bool| {
-            boxes.iter().map(f).fold(
-                if min {
-                    f64::INFINITY
-                } else {
-                    f64::NEG_INFINITY
-                },
-                |m, v| if min { m.min(v) } else { m.max(v) },
-            )
-        };
-        let (x0, x1) = (fold(|b| b[0], true), fold(|b| b[1], false));
-        let (y0, y1) = (fold(|b| b[2], true), fold(|b| b[3], false));
+        let low = |k: usize| boxes.iter().map(|b| b[k]).fold(f64::INFINITY, f64::min);
+        let high = |k: usize| boxes.iter().map(|b| b[k]).fold(f64::NEG_INFINITY, f64::max);
+        let (x0, x1, y0, y1) = (low(0), high(1), low(2), high(3));
         let (wx, wy) = ((x1 - x0).max(0.0), (y1 - y0).max(0.0));
         // About one piece per square; at least a unit side (grid points are pixels).
         let n = boxes.len().max(1) as f64;
