@@ -436,3 +436,48 @@ fn a_move_before_the_first_region_is_no_region_in_the_replay_legend() {
         "{legend:?}"
     );
 }
+
+/// Region numbers are not bounded by 16 bits: a run whose second region is number 65 537 (a
+/// bcd plan of many cells, a long random run cut into regions) keeps two regions in the
+/// legend, not one (65 537 read back as 1).
+#[test]
+fn region_numbers_beyond_sixteen_bits_stay_apart() {
+    use ccpp_core::trace::Record;
+    let (world, plain) = run(200, 120, 400);
+    let mut trace = Trace::default();
+    for r in plain.records() {
+        trace.push(match r {
+            Record::Event {
+                t,
+                event: Event::RegionStart { region: 2 },
+            } => Record::Event {
+                t,
+                event: Event::RegionStart { region: 65_537 },
+            },
+            other => other,
+        });
+    }
+    let html = replay_html(&world, &trace, None, "{}", "many-regions").expect("page");
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("replay-many-regions");
+    std::fs::create_dir_all(&dir).expect("dir");
+    std::fs::write(dir.join("page.html"), &html).expect("write");
+    let Some(chrome) = require_chromium() else {
+        return;
+    };
+    let _serial = BROWSER
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    let url = format!("file://{}#selftest", dir.join("page.html").display());
+    let v = self_test(&chrome, &url, true);
+    assert_eq!(v["pass"], true, "{v}");
+    let legend: Vec<&str> = v["legend"]
+        .as_array()
+        .expect("legend")
+        .iter()
+        .filter_map(serde_json::Value::as_str)
+        .collect();
+    assert!(
+        legend.contains(&"path, colour per region (2)"),
+        "{legend:?}"
+    );
+}
