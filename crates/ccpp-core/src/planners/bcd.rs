@@ -171,11 +171,15 @@
 //!    plan's cost more than the cut; on `rmf_office_scan` this saves two of six tours).
 //!    Parallel plans are compared in a fixed order, so the choice is the same as one after
 //!    the other. Hop
-//!    costs come from a coarse grid of the C-free set, one bounded Dijkstra per end-point block
-//!    computed once per tour (module `bcd::hops`), not a search per pair. **Hop correction**
-//!    (not in the paper): the coarse grid misses walls inside a block, so some hops of the
-//!    tour are far longer when routed (on `stage_willow_full` about 196 m of 1401 m of
-//!    transfers). The tour's hops are therefore routed on the true map, every hop whose route
+//!    costs come from a coarse grid of the C-free set, one bounded Dijkstra per end-point node
+//!    computed once per tour (module `bcd::hops`), not a search per pair. The grid's blocks
+//!    are split into their connected C-free parts, so a wall or a squeeze inside a block is
+//!    gone round: on the 14 shared maps this took the mean path ratio from 1.1470 to 1.1350
+//!    and the mean turns from 1249 to 1203, and on the bench map `cluttered_2000` (where a
+//!    block-level grid costed some hops of a few pixels that are thousands when routed) the
+//!    planning time from 27.7 s to 14.3 s. **Hop correction**
+//!    (not in the paper): a path over blocks is still only an estimate of one over pixels,
+//!    so some hops of the tour are longer when routed. The tour's hops are therefore routed on the true map, every hop whose route
 //!    is longer than its cost in the tour takes the route's length as its cost, and the tour is
 //!    improved once more; twice, and the tour with the lowest routed cost is kept. This is done
 //!    for the tour of the cells (and headland passes); the tour with the rim passes among its

@@ -1,19 +1,26 @@
 //! Hop costs for the cell tour, computed once per tour.
 //!
 //! A hop between two points costs the straight-line distance, or the length of a shortest path
-//! over a coarse grid of the C-free set when that is longer (walls between the points). Blocks
-//! of `b` pixels are open when they hold a C-free pixel and joined to a side neighbour when
-//! C-free pixels touch across their common edge; a diagonal block step needs one of its two
-//! side paths. Costs are integers (10 per side step, 14 per diagonal step), so every search
-//! has a fixed order and ties break on the block index.
+//! over a coarse grid of the C-free set when that is longer (walls between the points). The
+//! grid's blocks of `b` pixels are split into the connected parts of their C-free pixels, with
+//! the steps of the transfers' pixel search ([`Coarse`]); each part is a node, and two nodes
+//! are joined when a pixel step crosses from one into the other (a diagonal block step also by
+//! way of a side block). So two points in one block but on either side of a thin wall, or of a
+//! squeeze the robot cannot pass, are two nodes, and their hop is costed by the way round; on
+//! the bench map `cluttered_2000` a grid of whole blocks costed hops of 3 to 50 pixels that
+//! are 160 to 3100 pixels when routed. Costs are integers (10 per side step, 14 per diagonal
+//! step), so every search has a fixed order and ties break on the node index.
 //!
 //! Instead of searching each queried pair (the tour's improvement moves ask for the same hops
-//! many times), [`HopTable`] runs one Dijkstra per block that holds an end point of some piece,
+//! many times), [`HopTable`] runs one Dijkstra per node that holds an end point of some piece,
 //! bounded to [`RADIUS_BLOCKS`] blocks of path, and keeps the costs to the other end-point
-//! blocks in a sorted row. A pair beyond the radius (or not joined by the coarse grid within
+//! nodes in a sorted row. A pair beyond the radius (or not joined by the coarse grid within
 //! it) is costed on a second grid of blocks [`FAR_FACTOR`] times larger, searched whole from
-//! each of its end-point blocks: the path there less two far-block diagonals (the points can
-//! sit anywhere in their blocks), at least the radius and the straight line.
+//! each of its end-point nodes: the path there less two far-block diagonals (the points can
+//! sit anywhere in their blocks), at least the radius and the straight line. Both grids depend
+//! on the C-free set alone and are made once per plan ([`CoarseCache`]).
+
+use std::sync::{Arc, Mutex};
 
 use super::lattice::Ctx;
 use super::tsp;
@@ -27,27 +34,65 @@ pub(super) const FAR_FACTOR: u32 = 4;
 /// Largest hop matrix kept dense (bytes).
 const DENSE_MAX: usize = 16 << 20;
 
-/// The coarse grid of the C-free set.
+/// The coarse grid of the C-free set: blocks of `b` x `b` pixels, each split into the connected
+/// parts of its C-free pixels (the *nodes*), joined where a pixel step crosses from one block's
+/// part into the next block's.
+///
+/// Pixel steps are those of the transfers' pixel search ([`super::transfer`]'s `Search`): a
+/// side step between C-free pixels, a diagonal one when both side pixels are C-free or the
+/// straight move is free on the map. So two points whose nodes are not joined are not joined
+/// by any transfer either, and a block holding C-free pixels on both sides of a thin wall (or
+/// of a squeeze the robot cannot pass, a line of C-free pixels no step joins) is two nodes,
+/// not one: such a hop is costed by the way round, not by the straight line.
 pub(super) struct Coarse {
     b: usize,
     bw: usize,
-    bh: usize,
-    open: Vec<bool>,
-    /// Per block: bit `i` set when the step [`DIRS`]`[i]` is allowed (see [`Coarse::step_mask`]).
-    mask: Vec<u8>,
+    width: usize,
+    height: usize,
+    /// Per pixel: the number of its part within its block ([`NOT_FREE`]: not C-free). A block
+    /// of more than 254 parts counts the rest as its part 254 (costs stay estimates).
+    label: Vec<u8>,
+    /// Per block: its first node (a block's nodes are consecutive); one more entry at the end.
+    first: Vec<u32>,
+    /// Per node: its first neighbour in `adj`; one more entry at the end.
+    adj_start: Vec<u32>,
+    /// Neighbours of the nodes: the node, with [`DIAG`] set when its block is a diagonal
+    /// neighbour (a step of cost 14; 10 to a side block).
+    adj: Vec<u32>,
 }
 
-/// The eight block steps (column, row): four side steps (cost 10), then four diagonals (14).
-const DIRS: [(i64, i64); 8] = [
-    (1, 0),
-    (0, 1),
-    (-1, 0),
-    (0, -1),
-    (1, 1),
-    (1, -1),
-    (-1, 1),
-    (-1, -1),
-];
+/// The coarse grids of one plan's C-free set, made once per block size and shared by the
+/// plan's parallel jobs (a grid depends on the C-free set and the block size alone, so which
+/// job makes it changes nothing).
+#[derive(Default)]
+pub(super) struct CoarseCache(Mutex<Vec<(usize, Arc<Coarse>)>>);
+
+impl CoarseCache {
+    /// The grid of `ctx`'s C-free set in blocks of about `sp` pixels ([`Coarse::new`]).
+    pub(super) fn get(&self, ctx: &Ctx<'_>, sp: f64) -> Arc<Coarse> {
+        let b = Coarse::side(sp);
+        // (a job that panicked while holding the lock left no half-made grid in it)
+        let mut grids = self
+            .0
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        if let Some((_, g)) = grids.iter().find(|g| g.0 == b) {
+            return Arc::clone(g);
+        }
+        let g = Arc::new(Coarse::new(ctx, sp));
+        grids.push((b, Arc::clone(&g)));
+        g
+    }
+}
+
+/// Marks a link to a diagonal block in [`Coarse::adj`] (node numbers stay below it: there are
+/// fewer nodes than pixels).
+const DIAG: u32 = 1 << 31;
+
+/// [`Coarse::label`] of a pixel that is not C-free.
+const NOT_FREE: u8 = u8::MAX;
+/// Most parts a block keeps apart ([`Coarse::label`]).
+const MAX_PARTS: u8 = NOT_FREE - 1;
 
 /// Buckets of the circular bucket queue: more than the largest step cost.
 const BUCKETS: usize = 16;
@@ -56,117 +101,304 @@ impl Coarse {
     /// The grid of `ctx`'s C-free set in blocks of about `sp` pixels (at least 4).
     pub(super) fn new(ctx: &Ctx<'_>, sp: f64) -> Self {
         let (w, h) = (ctx.frame.width, ctx.frame.height);
-        let b = (sp.round() as usize).max(4);
+        let b = Self::side(sp);
         let (bw, bh) = (w.div_ceil(b), h.div_ceil(b));
-        let mut open = vec![false; bw * bh];
-        let mut east = vec![false; bw * bh];
-        let mut south = vec![false; bw * bh];
-        for r in 0..h {
-            for c in 0..w {
-                if !ctx.ok[r * w + c] {
+        let ok = &ctx.ok;
+        // A diagonal pixel step from `i` to `j` (both C-free): as the transfers' search.
+        let diag = |i: usize, j: usize| {
+            let (ci, ri, cj, rj) = (i % w, i / w, j % w, j / w);
+            (ok[ri * w + cj] && ok[rj * w + ci]) || ctx.free(ctx.centre(ci, ri), ctx.centre(cj, rj))
+        };
+        // Parts of each block: first joined by side steps and by the diagonal steps whose side
+        // pixels are both C-free (no map test), then by the other diagonal steps, each tested
+        // only when it would join two parts not joined yet (union-find over the block).
+        let mut label = vec![NOT_FREE; w * h];
+        let mut first = Vec::with_capacity(bw * bh + 1);
+        let mut nodes = 0u32;
+        let mut stack: Vec<usize> = Vec::new();
+        let mut parent: Vec<u32> = Vec::new();
+        let mut pix: Vec<(usize, u32)> = Vec::new();
+        for br in 0..bh {
+            for bc in 0..bw {
+                first.push(nodes);
+                let (r0, r1) = (br * b, ((br + 1) * b).min(h));
+                let (c0, c1) = (bc * b, ((bc + 1) * b).min(w));
+                let inside = |c: i64, r: i64| {
+                    c >= c0 as i64 && c < c1 as i64 && r >= r0 as i64 && r < r1 as i64
+                };
+                parent.clear();
+                pix.clear();
+                for r in r0..r1 {
+                    for c in c0..c1 {
+                        let i = r * w + c;
+                        if !ok[i] || label[i] != NOT_FREE {
+                            continue;
+                        }
+                        // (provisional labels count up from 0 in `parent`; at most b * b)
+                        let part = parent.len() as u32;
+                        parent.push(part);
+                        label[i] = 0;
+                        pix.push((i, part));
+                        stack.push(i);
+                        while let Some(k) = stack.pop() {
+                            let (c, r) = ((k % w) as i64, (k / w) as i64);
+                            for (dc, dr) in DIRS {
+                                let (nc, nr) = (c + dc, r + dr);
+                                if !inside(nc, nr) {
+                                    continue;
+                                }
+                                let j = nr as usize * w + nc as usize;
+                                if !ok[j] || label[j] != NOT_FREE {
+                                    continue;
+                                }
+                                if dc != 0 && dr != 0 {
+                                    let (sa, sb) = (
+                                        r as usize * w + nc as usize,
+                                        nr as usize * w + c as usize,
+                                    );
+                                    if !(ok[sa] && ok[sb]) {
+                                        continue;
+                                    }
+                                }
+                                label[j] = 0;
+                                pix.push((j, part));
+                                stack.push(j);
+                            }
+                        }
+                    }
+                }
+                let find = |parent: &mut Vec<u32>, mut x: u32| {
+                    while parent[x as usize] != x {
+                        let up = parent[parent[x as usize] as usize];
+                        parent[x as usize] = up;
+                        x = up;
+                    }
+                    x
+                };
+                if parent.len() > 1 {
+                    // The part of each pixel (sorted by pixel), to find the diagonal steps
+                    // between parts.
+                    pix.sort_unstable();
+                    let part_of =
+                        |i: usize| pix.binary_search_by_key(&i, |e| e.0).map(|k| pix[k].1);
+                    for k in 0..pix.len() {
+                        let (i, pa) = pix[k];
+                        let (c, r) = ((i % w) as i64, (i / w) as i64);
+                        for (dc, dr) in [(1i64, 1i64), (-1, 1)] {
+                            let (nc, nr) = (c + dc, r + dr);
+                            if !inside(nc, nr) {
+                                continue;
+                            }
+                            let j = nr as usize * w + nc as usize;
+                            if !ok[j] {
+                                continue;
+                            }
+                            let Ok(pb) = part_of(j) else { continue };
+                            let (ra, rb) = (find(&mut parent, pa), find(&mut parent, pb));
+                            if ra != rb && diag(i, j) {
+                                parent[ra.max(rb) as usize] = ra.min(rb);
+                            }
+                        }
+                    }
+                }
+                // Compact part numbers, in the order of their smallest pixel.
+                let mut number: Vec<u32> = vec![u32::MAX; parent.len()];
+                let mut parts = 0u32;
+                pix.sort_unstable();
+                for &(i, part) in &pix {
+                    let root = find(&mut parent, part) as usize;
+                    if number[root] == u32::MAX {
+                        number[root] = parts;
+                        parts += 1;
+                    }
+                    label[i] = number[root].min(u32::from(MAX_PARTS)) as u8;
+                }
+                nodes += parts.min(u32::from(MAX_PARTS) + 1);
+            }
+        }
+        first.push(nodes);
+        let node = |i: usize| {
+            let (c, r) = (i % w, i / w);
+            first[(r / b) * bw + c / b] + u32::from(label[i])
+        };
+        // Links: every pixel step that crosses into another block joins the two parts. Only
+        // the pixels on a block's last column or row step out of it east, south, south-east or
+        // south-west (the other four steps are these reversed); a block's links are made
+        // unique before they are kept (a border of `b` pixels mostly repeats one link).
+        let mut links: Vec<(u32, u32)> = Vec::new();
+        let mut local: Vec<(u32, u32)> = Vec::new();
+        for br in 0..bh {
+            for bc in 0..bw {
+                let (r0, r1) = (br * b, ((br + 1) * b).min(h));
+                let (c0, c1) = (bc * b, ((bc + 1) * b).min(w));
+                local.clear();
+                let border = (r0..r1)
+                    .map(|r| (c1 - 1, r))
+                    .chain((c0..c1 - 1).map(|c| (c, r1 - 1)))
+                    .chain((r0..r1 - 1).map(|r| (c0, r)));
+                for (c, r) in border {
+                    let i = r * w + c;
+                    if !ok[i] {
+                        continue;
+                    }
+                    for (dc, dr) in [(1i64, 0i64), (0, 1), (1, 1), (-1, 1)] {
+                        let (nc, nr) = (c as i64 + dc, r as i64 + dr);
+                        if nc < 0 || nc >= w as i64 || nr >= h as i64 {
+                            continue;
+                        }
+                        let (nc, nr) = (nc as usize, nr as usize);
+                        let (sc, sr) = (nc / b != bc, nr / b != br);
+                        if !sc && !sr {
+                            continue;
+                        }
+                        let j = nr * w + nc;
+                        if !ok[j] {
+                            continue;
+                        }
+                        let link = (node(i), node(j) | if sc && sr { DIAG } else { 0 });
+                        if dc != 0 && dr != 0 && !local.contains(&link) && !diag(i, j) {
+                            continue;
+                        }
+                        local.push(link);
+                    }
+                }
+                local.sort_unstable();
+                local.dedup();
+                links.extend_from_slice(&local);
+            }
+        }
+        // Both ways of every link, per node (counting sort).
+        let n = nodes as usize;
+        let mut start = vec![0u32; n + 1];
+        for &(a, e) in &links {
+            start[a as usize + 1] += 1;
+            start[(e & !DIAG) as usize + 1] += 1;
+        }
+        for k in 0..n {
+            start[k + 1] += start[k];
+        }
+        let mut fill = start.clone();
+        let mut direct = vec![0u32; start[n] as usize];
+        for &(a, e) in &links {
+            let (bn, d) = (e & !DIAG, e & DIAG);
+            direct[fill[a as usize] as usize] = e;
+            fill[a as usize] += 1;
+            direct[fill[bn as usize] as usize] = a | d;
+            fill[bn as usize] += 1;
+        }
+        drop(links);
+        drop(fill);
+        // A diagonal block step also goes round by a side block: part `a` to part `c` of a
+        // diagonal block when a part `m` of a side block joins both by side links. Each node's
+        // neighbours, made unique (a neighbour by one link only, the side or the diagonal one
+        // its blocks make it).
+        let slice = |k: u32| &direct[start[k as usize] as usize..start[k as usize + 1] as usize];
+        let mut adj_start = Vec::with_capacity(n + 1);
+        let mut adj: Vec<u32> = Vec::with_capacity(direct.len());
+        let mut mine: Vec<u32> = Vec::new();
+        for a in 0..nodes {
+            adj_start.push(adj.len() as u32);
+            mine.clear();
+            mine.extend_from_slice(slice(a));
+            let ba = block_of(&first, a);
+            for &m in slice(a) {
+                if m & DIAG != 0 {
                     continue;
                 }
-                let k = (r / b) * bw + c / b;
-                open[k] = true;
-                if c + 1 < w && (c + 1) % b == 0 && ctx.ok[r * w + c + 1] {
-                    east[k] = true;
-                }
-                if r + 1 < h && (r + 1) % b == 0 && ctx.ok[(r + 1) * w + c] {
-                    south[k] = true;
+                for &c in slice(m) {
+                    if c & DIAG != 0 || c == a {
+                        continue;
+                    }
+                    let bc = block_of(&first, c);
+                    if (ba % bw).abs_diff(bc % bw) == 1 && (ba / bw).abs_diff(bc / bw) == 1 {
+                        mine.push(c | DIAG);
+                    }
                 }
             }
+            mine.sort_unstable_by_key(|&e| e & !DIAG);
+            mine.dedup_by_key(|e| *e & !DIAG);
+            adj.extend(mine.iter().filter(|&&e| e & !DIAG != a));
         }
-        let mut grid = Self {
+        adj_start.push(adj.len() as u32);
+        adj.shrink_to_fit();
+        Self {
             b,
             bw,
-            bh,
-            open,
-            mask: Vec::new(),
+            width: w,
+            height: h,
+            label,
+            first,
+            adj_start,
+            adj,
+        }
+    }
+
+    /// The block side for about `sp` pixels (at least 4).
+    fn side(sp: f64) -> usize {
+        (sp.round() as usize).max(4)
+    }
+
+    /// Nodes of the grid.
+    fn nodes(&self) -> usize {
+        self.adj_start.len() - 1
+    }
+
+    /// The block of node `n`.
+    fn block_of(&self, n: u32) -> usize {
+        block_of(&self.first, n)
+    }
+
+    /// The node of grid point `p` (grid y up): that of its pixel when C-free, else of the
+    /// nearest C-free pixel centre within two pixels (ties: the first in row-major order);
+    /// `None` when there is none.
+    fn node(&self, p: Point) -> Option<u32> {
+        let (w, h) = (self.width as i64, self.height as i64);
+        let col = p.x.floor();
+        let row = h as f64 - 1.0 - p.y.floor();
+        if !(col.is_finite() && row.is_finite()) {
+            return None;
+        }
+        let (c0, r0) = (col as i64, row as i64);
+        let at = |c: i64, r: i64| -> Option<u32> {
+            if c < 0 || r < 0 || c >= w || r >= h {
+                return None;
+            }
+            let (c, r) = (c as usize, r as usize);
+            let l = self.label[r * self.width + c];
+            (l != NOT_FREE).then(|| self.first[(r / self.b) * self.bw + c / self.b] + u32::from(l))
         };
-        grid.mask = (0..bw * bh)
-            .map(|k| {
-                if grid.open[k] {
-                    grid.step_mask(k, &east, &south)
-                } else {
-                    0
+        if let Some(n) = at(c0, r0) {
+            return Some(n);
+        }
+        let mut best: Option<(f64, u32)> = None;
+        for r in r0 - 2..=r0 + 2 {
+            for c in c0 - 2..=c0 + 2 {
+                if let Some(n) = at(c, r) {
+                    let (x, y) = (c as f64 + 0.5, (h - r) as f64 - 0.5);
+                    let d = (x - p.x).powi(2) + (y - p.y).powi(2);
+                    if best.is_none_or(|b| d < b.0) {
+                        best = Some((d, n));
+                    }
                 }
-            })
-            .collect();
-        grid
-    }
-
-    /// The block of grid point `p` (grid y up; blocks count rows from the top).
-    fn block(&self, p: Point) -> usize {
-        let bf = self.b as f64;
-        // (`as usize` truncates: the floor of a non-negative value)
-        let c = ((p.x / bf).max(0.0) as usize).min(self.bw - 1);
-        let rows = self.bh * self.b;
-        let r_px = (rows as f64 - p.y).max(0.0) as usize;
-        let r = (r_px / self.b).min(self.bh - 1);
-        r * self.bw + c
-    }
-
-    fn linked(&self, east: &[bool], south: &[bool], k: usize, dc: i64, dr: i64) -> bool {
-        match (dc, dr) {
-            (1, 0) => east[k],
-            (-1, 0) => east[k - 1],
-            (0, 1) => south[k],
-            (0, -1) => south[k - self.bw],
-            _ => false,
-        }
-    }
-
-    /// The block steps from block `k` that the grid allows, as a bit set over [`DIRS`]: a
-    /// side step needs the two blocks joined, a diagonal step one of its two side paths.
-    fn step_mask(&self, k: usize, east: &[bool], south: &[bool]) -> u8 {
-        let bw = self.bw;
-        let (c, r) = ((k % bw) as i64, (k / bw) as i64);
-        let at = |c: i64, r: i64| r as usize * bw + c as usize;
-        let mut mask = 0u8;
-        for (i, &(dc, dr)) in DIRS.iter().enumerate() {
-            let (nc, nr) = (c + dc, r + dr);
-            if nc < 0 || nr < 0 || nc >= bw as i64 || nr >= self.bh as i64 {
-                continue;
-            }
-            let j = at(nc, nr);
-            if !self.open[j] {
-                continue;
-            }
-            let ok = if dc != 0 && dr != 0 {
-                let (vh, vv) = (at(nc, r), at(c, nr));
-                let a = self.open[vh]
-                    && self.linked(east, south, k, dc, 0)
-                    && self.linked(east, south, vh, 0, dr);
-                let b = self.open[vv]
-                    && self.linked(east, south, k, 0, dr)
-                    && self.linked(east, south, vv, dc, 0);
-                a || b
-            } else {
-                self.linked(east, south, k, dc, dr)
-            };
-            if ok {
-                mask |= 1 << i;
             }
         }
-        mask
+        best.map(|b| b.1)
     }
 
-    /// Shortest path costs (tenths of a block) from block `s` over the allowed block steps, up
-    /// to `cap`: `visit(k, g)` is called once for every block reached, in non-decreasing `g`.
-    /// `g` must hold `u32::MAX` everywhere and is left so; `touched` and `buckets` are scratch.
-    /// (Costs are small integers, so a circular bucket queue gives the exact Dijkstra costs.)
+    /// Shortest path costs (tenths of a block) from node `s` over the links, up to `cap`:
+    /// `visit(n, g)` is called once for every node reached, in non-decreasing `g`. `g` must
+    /// hold `u32::MAX` everywhere and is left so; `touched` and `buckets` are scratch. (Costs
+    /// are small integers, so a circular bucket queue gives the exact Dijkstra costs.)
     fn search(
         &self,
-        s: usize,
+        s: u32,
         cap: u32,
         g: &mut [u32],
-        touched: &mut Vec<usize>,
-        buckets: &mut [Vec<usize>; BUCKETS],
-        mut visit: impl FnMut(usize, u32),
+        touched: &mut Vec<u32>,
+        buckets: &mut [Vec<u32>; BUCKETS],
+        mut visit: impl FnMut(u32, u32),
     ) {
-        let bw = self.bw as isize;
-        let offs: [isize; 8] = DIRS.map(|(dc, dr)| dr as isize * bw + dc as isize);
-        g[s] = 0;
+        g[s as usize] = 0;
         touched.push(s);
         buckets[0].push(s);
         let mut queued = 1usize;
@@ -178,47 +410,84 @@ impl Coarse {
                 continue;
             };
             queued -= 1;
-            if g[k] != d {
+            if g[k as usize] != d {
                 continue;
             }
             visit(k, d);
-            let mut m = self.mask[k];
-            while m != 0 {
-                let i = m.trailing_zeros() as usize;
-                m &= m - 1;
-                let ng = d + if i < 4 { 10 } else { 14 };
-                let j = k.wrapping_add_signed(offs[i]);
-                if ng <= cap && ng < g[j] {
-                    if g[j] == u32::MAX {
+            let (a, z) = (
+                self.adj_start[k as usize] as usize,
+                self.adj_start[k as usize + 1] as usize,
+            );
+            for &e in &self.adj[a..z] {
+                let (j, ng) = (e & !DIAG, d + if e & DIAG != 0 { 14 } else { 10 });
+                if ng <= cap && ng < g[j as usize] {
+                    if g[j as usize] == u32::MAX {
                         touched.push(j);
                     }
-                    g[j] = ng;
+                    g[j as usize] = ng;
                     buckets[ng as usize % BUCKETS].push(j);
                     queued += 1;
                 }
             }
         }
         for &k in touched.iter() {
-            g[k] = u32::MAX;
+            g[k as usize] = u32::MAX;
         }
         touched.clear();
     }
 }
 
+/// The block of node `n`, from the blocks' first nodes.
+fn block_of(first: &[u32], n: u32) -> usize {
+    first.partition_point(|&f| f <= n) - 1
+}
+
+/// The eight pixel steps (column, row): four side steps, then four diagonals.
+const DIRS: [(i64, i64); 8] = [
+    (1, 0),
+    (0, 1),
+    (-1, 0),
+    (0, -1),
+    (1, 1),
+    (1, -1),
+    (-1, 1),
+    (-1, -1),
+];
+
 /// Hop costs between the end points of a set of pieces (module docs).
 pub(super) struct HopTable<'a> {
     coarse: &'a Coarse,
     far: Far<'a>,
-    /// Per block: its row in `rows`, or `u32::MAX` when no end point lies in it.
+    /// Per node: its row in `rows`, or `u32::MAX` when no end point lies in it.
     row_of: Vec<u32>,
-    /// Per end-point block: (other end-point block, path cost in tenths of a block), sorted by
-    /// block.
+    /// Per end-point node: (other end-point node, path cost in tenths of a block), sorted by
+    /// node.
     rows: Vec<Vec<(u32, u32)>>,
-    /// The block of each row.
-    blocks: Vec<usize>,
+    /// The node of each row.
+    nodes: Vec<u32>,
     /// `rows` as a square matrix (`u8::MAX`: beyond the radius), when it has at most
     /// [`DENSE_MAX`] entries; empty otherwise.
     dense: Vec<u8>,
+}
+
+/// The nodes of `coarse` holding the entries and exits of `pieces` and `start` (once each, in
+/// no particular order) and a row index per node (`u32::MAX` for the others, 0 for these).
+fn end_nodes(coarse: &Coarse, pieces: &[tsp::Piece], start: Point) -> (Vec<u32>, Vec<u32>) {
+    let mut row_of = vec![u32::MAX; coarse.nodes()];
+    let mut nodes: Vec<u32> = Vec::new();
+    let mut add = |p: Point| {
+        if let Some(k) = coarse.node(p) {
+            if row_of[k as usize] == u32::MAX {
+                row_of[k as usize] = 0;
+                nodes.push(k);
+            }
+        }
+    };
+    add(start);
+    for piece in pieces {
+        piece.entry.iter().chain(&piece.exit).for_each(|&p| add(p));
+    }
+    (nodes, row_of)
 }
 
 impl<'a> HopTable<'a> {
@@ -229,43 +498,33 @@ impl<'a> HopTable<'a> {
         pieces: &[tsp::Piece],
         start: Point,
     ) -> Self {
-        let n = coarse.bw * coarse.bh;
-        let mut row_of = vec![u32::MAX; n];
-        let mut blocks: Vec<usize> = Vec::new();
-        let mut add = |p: Point| {
-            let k = coarse.block(p);
-            if row_of[k] == u32::MAX {
-                row_of[k] = 0;
-                blocks.push(k);
-            }
-        };
-        add(start);
-        for piece in pieces {
-            piece.entry.iter().chain(&piece.exit).for_each(|&p| add(p));
-        }
-        // Z-order, so that the rows and columns of nearby blocks (the hops asked for most)
-        // lie close together in the table.
-        blocks.sort_unstable_by_key(|&k| morton(k % coarse.bw, k / coarse.bw));
-        for (i, &k) in blocks.iter().enumerate() {
-            row_of[k] = i as u32;
+        let (mut nodes, mut row_of) = end_nodes(coarse, pieces, start);
+        // Z-order of their blocks, so that the rows and columns of nearby nodes (the hops
+        // asked for most) lie close together in the table.
+        nodes.sort_unstable_by_key(|&k| {
+            let blk = coarse.block_of(k);
+            (morton(blk % coarse.bw, blk / coarse.bw), k)
+        });
+        for (i, &k) in nodes.iter().enumerate() {
+            row_of[k as usize] = i as u32;
         }
         let cap = RADIUS_BLOCKS * 10;
-        let mut g = vec![u32::MAX; n];
-        let mut touched: Vec<usize> = Vec::new();
-        let mut buckets: [Vec<usize>; BUCKETS] = std::array::from_fn(|_| Vec::new());
-        let mut rows = Vec::with_capacity(blocks.len());
-        for &s in &blocks {
+        let mut g = vec![u32::MAX; coarse.nodes()];
+        let mut touched: Vec<u32> = Vec::new();
+        let mut buckets: [Vec<u32>; BUCKETS] = std::array::from_fn(|_| Vec::new());
+        let mut rows = Vec::with_capacity(nodes.len());
+        for &s in &nodes {
             let mut row: Vec<(u32, u32)> = Vec::new();
             coarse.search(s, cap, &mut g, &mut touched, &mut buckets, |k, gk| {
-                if row_of[k] != u32::MAX {
-                    row.push((k as u32, gk));
+                if row_of[k as usize] != u32::MAX {
+                    row.push((k, gk));
                 }
             });
             row.sort_unstable();
             rows.push(row);
         }
         // Dense copy when small enough: one byte per pair (costs are at most 10 * radius).
-        let m = blocks.len();
+        let m = nodes.len();
         let dense = if m * m <= DENSE_MAX {
             let mut d = vec![u8::MAX; m * m];
             for (i, row) in rows.iter().enumerate() {
@@ -282,39 +541,43 @@ impl<'a> HopTable<'a> {
             far: Far::new(far, pieces, start),
             row_of,
             rows,
-            blocks,
+            nodes,
             dense,
         }
     }
 
-    /// Path cost (pixels) between the blocks of `a` and `b` when within the radius.
-    fn path_px(&self, a: Point, b: Point) -> Option<f64> {
-        let (ka, kb) = (self.coarse.block(a), self.coarse.block(b));
-        let ra = self.row_of[ka];
-        if ra == u32::MAX {
-            return None;
-        }
+    /// The row of the node of `p`, if it holds an end point.
+    fn row(&self, p: Point) -> Option<u32> {
+        let k = self.coarse.node(p)?;
+        let r = self.row_of[k as usize];
+        (r != u32::MAX).then_some(r)
+    }
+
+    /// Path cost (pixels) between the nodes of rows `ra` and `rb` when within the radius.
+    fn path_px(&self, ra: u32, rb: u32) -> Option<f64> {
         if !self.dense.is_empty() {
-            let rb = self.row_of[kb];
-            if rb == u32::MAX {
-                return None;
-            }
-            let m = self.blocks.len();
+            let m = self.nodes.len();
             let g = self.dense[ra as usize * m + rb as usize];
             return (g != u8::MAX).then(|| f64::from(g) / 10.0 * self.coarse.b as f64);
         }
+        let kb = self.nodes[rb as usize];
         let row = &self.rows[ra as usize];
-        let i = row.binary_search_by_key(&(kb as u32), |e| e.0).ok()?;
+        let i = row.binary_search_by_key(&kb, |e| e.0).ok()?;
         Some(f64::from(row[i].1) / 10.0 * self.coarse.b as f64)
     }
 
-    /// The hop cost from `a` to `b` (pixels; module docs).
+    /// The hop cost from `a` to `b` (pixels; module docs): the straight line within one
+    /// node (or where a point lies in none), else the longer of the straight line and the way
+    /// over the coarse grid.
     pub(super) fn dist(&self, a: Point, b: Point) -> f64 {
         let e = euclid(a, b);
-        if e < self.coarse.b as f64 {
+        let (Some(ra), Some(rb)) = (self.row(a), self.row(b)) else {
+            return e;
+        };
+        if ra == rb {
             return e;
         }
-        match self.path_px(a, b) {
+        match self.path_px(ra, rb) {
             Some(g) => e.max(g),
             None => e
                 .max(f64::from(RADIUS_BLOCKS) * self.coarse.b as f64)
@@ -326,14 +589,17 @@ impl<'a> HopTable<'a> {
     /// by hop cost plus the variant's extra inner cost over the piece's cheapest variant (ties:
     /// piece, then variant); where none is left within it, every remaining entry the same way.
     pub(super) fn nearest_tour(&self, pieces: &[tsp::Piece], start: Point) -> tsp::Tour {
-        let mut at_row: Vec<Vec<(usize, usize)>> = vec![Vec::new(); self.blocks.len()];
+        let mut at_row: Vec<Vec<(usize, usize)>> = vec![Vec::new(); self.nodes.len()];
+        // Entries in no node are only reached by the fallback below.
         for (p, piece) in pieces.iter().enumerate() {
             for (v, &e) in piece.entry.iter().enumerate() {
-                at_row[self.row_of[self.coarse.block(e)] as usize].push((p, v));
+                if let Some(r) = self.row(e) {
+                    at_row[r as usize].push((p, v));
+                }
             }
         }
         let mut done = vec![false; pieces.len()];
-        // Undone entries per row, so exhausted blocks are skipped in O(1).
+        // Undone entries per row, so exhausted rows are skipped in O(1).
         let mut left: Vec<usize> = at_row.iter().map(Vec::len).collect();
         let mut tour = Vec::with_capacity(pieces.len());
         let mut here = start;
@@ -348,8 +614,7 @@ impl<'a> HopTable<'a> {
         };
         for _ in 0..pieces.len() {
             let mut best: Option<(f64, usize, usize)> = None;
-            let r = self.row_of[self.coarse.block(here)];
-            if r != u32::MAX {
+            if let Some(r) = self.row(here) {
                 for &(k, g) in &self.rows[r as usize] {
                     let kr = self.row_of[k as usize] as usize;
                     if left[kr] == 0 {
@@ -361,7 +626,8 @@ impl<'a> HopTable<'a> {
                             continue;
                         }
                         let e = euclid(here, pieces[p].entry[v]);
-                        let hop = if e < bpx { e } else { e.max(g_px) };
+                        // (as `dist`: the straight line within one node)
+                        let hop = if kr == r as usize { e } else { e.max(g_px) };
                         let c = hop + extra(p, v);
                         if better(c, p, v, best) {
                             best = Some((c, p, v));
@@ -385,7 +651,9 @@ impl<'a> HopTable<'a> {
             let Some((_, p, v)) = best else { break };
             done[p] = true;
             for &e in &pieces[p].entry {
-                left[self.row_of[self.coarse.block(e)] as usize] -= 1;
+                if let Some(r) = self.row(e) {
+                    left[r as usize] -= 1;
+                }
             }
             tour.push((p, v));
             here = pieces[p].exit[v];
@@ -400,7 +668,7 @@ fn euclid(a: Point, b: Point) -> f64 {
     (dx * dx + dy * dy).sqrt()
 }
 
-/// Whole-map path costs between the far blocks holding end points (module docs).
+/// Whole-map path costs between the far nodes holding end points (module docs).
 struct Far<'a> {
     coarse: &'a Coarse,
     row_of: Vec<u32>,
@@ -411,30 +679,17 @@ struct Far<'a> {
 
 impl<'a> Far<'a> {
     fn new(coarse: &'a Coarse, pieces: &[tsp::Piece], start: Point) -> Self {
-        let n = coarse.bw * coarse.bh;
-        let mut row_of = vec![u32::MAX; n];
-        let mut blocks: Vec<usize> = Vec::new();
-        let mut add = |p: Point| {
-            let k = coarse.block(p);
-            if row_of[k] == u32::MAX {
-                row_of[k] = 0;
-                blocks.push(k);
-            }
-        };
-        add(start);
-        for piece in pieces {
-            piece.entry.iter().chain(&piece.exit).for_each(|&p| add(p));
+        let (mut nodes, mut row_of) = end_nodes(coarse, pieces, start);
+        nodes.sort_unstable();
+        for (i, &k) in nodes.iter().enumerate() {
+            row_of[k as usize] = i as u32;
         }
-        blocks.sort_unstable();
-        for (i, &k) in blocks.iter().enumerate() {
-            row_of[k] = i as u32;
-        }
-        let m = blocks.len();
+        let m = nodes.len();
         let mut dense = vec![u16::MAX; m * m];
-        let mut g = vec![u32::MAX; n];
-        let mut touched: Vec<usize> = Vec::new();
-        let mut buckets: [Vec<usize>; BUCKETS] = std::array::from_fn(|_| Vec::new());
-        for (i, &s) in blocks.iter().enumerate() {
+        let mut g = vec![u32::MAX; coarse.nodes()];
+        let mut touched: Vec<u32> = Vec::new();
+        let mut buckets: [Vec<u32>; BUCKETS] = std::array::from_fn(|_| Vec::new());
+        for (i, &s) in nodes.iter().enumerate() {
             let out = &mut dense[i * m..(i + 1) * m];
             coarse.search(
                 s,
@@ -443,8 +698,8 @@ impl<'a> Far<'a> {
                 &mut touched,
                 &mut buckets,
                 |k, gk| {
-                    if row_of[k] != u32::MAX {
-                        out[row_of[k] as usize] = gk.min(u32::from(u16::MAX) - 1) as u16;
+                    if row_of[k as usize] != u32::MAX {
+                        out[row_of[k as usize] as usize] = gk.min(u32::from(u16::MAX) - 1) as u16;
                     }
                 },
             );
@@ -459,10 +714,10 @@ impl<'a> Far<'a> {
 
     /// Estimated path cost (pixels) between `a` and `b`; 0 when unknown.
     fn path_px(&self, a: Point, b: Point) -> f64 {
-        let (ra, rb) = (
-            self.row_of[self.coarse.block(a)],
-            self.row_of[self.coarse.block(b)],
-        );
+        let (Some(ka), Some(kb)) = (self.coarse.node(a), self.coarse.node(b)) else {
+            return 0.0;
+        };
+        let (ra, rb) = (self.row_of[ka as usize], self.row_of[kb as usize]);
         if ra == u32::MAX || rb == u32::MAX {
             return 0.0;
         }
@@ -486,4 +741,256 @@ fn morton(c: usize, r: usize) -> u64 {
         (x | (x << 1)) & 0x5555_5555_5555_5555
     };
     spread(c) | (spread(r) << 1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Coarse, CoarseCache, HopTable, BUCKETS};
+    use crate::geometry::{Point, Pose};
+    use crate::grid::{Cell, GridMap, MapFrame};
+    use crate::planners::bcd::lattice::Ctx;
+    use crate::planners::bcd::transfer::Search;
+    use crate::planners::bcd::tsp;
+    use crate::world::{Robot, World};
+
+    fn ctx(world: &World) -> Ctx<'_> {
+        let frame = *world.frame();
+        let reach = world.reachable();
+        let ok: Vec<bool> = (0..frame.len()).map(|i| reach.contains(i)).collect();
+        Ctx {
+            world,
+            frame,
+            safe: ok.clone(),
+            keep_px: None,
+            ok,
+            rt: world.robot().tool_radius / frame.resolution,
+            coarse: CoarseCache::default(),
+        }
+    }
+
+    /// Are the nodes of pixels `a` and `b` joined by the grid's links (unbounded search)?
+    fn joined(grid: &Coarse, ctx: &Ctx<'_>, a: usize, b: usize) -> bool {
+        let w = ctx.frame.width;
+        let node = |i: usize| grid.node(ctx.centre(i % w, i / w)).expect("a C-free pixel");
+        let (na, nb) = (node(a), node(b));
+        let mut g = vec![u32::MAX; grid.nodes()];
+        let mut touched = Vec::new();
+        let mut buckets: [Vec<u32>; BUCKETS] = std::array::from_fn(|_| Vec::new());
+        let mut hit = false;
+        grid.search(
+            na,
+            u32::MAX - 14,
+            &mut g,
+            &mut touched,
+            &mut buckets,
+            |k, _| {
+                hit |= k == nb;
+            },
+        );
+        hit
+    }
+
+    /// A wall down the middle of a room with a gap at the bottom: two points either side of
+    /// it at the top lie in one block of the coarse grid, and the hop between them is costed
+    /// by the way round through the gap, not by the straight line across the wall.
+    ///
+    /// ```text
+    ///   ##########
+    ///   #...#....#    a: left of the wall, b: right of it, both in one block
+    ///   #...#....#
+    ///   #...#....#
+    ///   #...#....#
+    ///   #........#    the gap
+    ///   ##########
+    /// ```
+    #[test]
+    fn a_wall_inside_a_block_is_gone_round() {
+        let art =
+            "##########\n#...#....#\n#...#....#\n#...#....#\n#...#....#\n#........#\n##########";
+        let map = GridMap::from_ascii_scaled(art, 6, 0.02).expect("map");
+        let world =
+            World::new(map, Robot::new(0.03), Some(Pose::new(0.2, 0.2, 0.0))).expect("world");
+        let ctx = ctx(&world);
+        // (6 pixels a character, robot radius 1.5 pixels: the wall covers columns 24-29 and
+        // the robot's centre keeps clear of columns 23-30.) Blocks of 20 pixels: columns
+        // 20-39 are one block, holding C-free pixels of both sides.
+        let grid = Coarse::new(&ctx, 20.0);
+        let h = world.frame().height as f64;
+        let a = Point::new(22.5, h - 8.5);
+        let b = Point::new(33.5, h - 8.5);
+        assert_eq!(
+            grid.block_of(grid.node(a).unwrap()),
+            grid.block_of(grid.node(b).unwrap())
+        );
+        assert_ne!(grid.node(a), grid.node(b), "two parts of one block");
+        let far = Coarse::new(&ctx, 80.0);
+        let piece = |p: Point| tsp::Piece {
+            entry: vec![p],
+            exit: vec![p],
+            inner: vec![0.0],
+        };
+        let table = HopTable::new(&grid, &far, &[piece(a), piece(b)], a);
+        let d = table.dist(a, b);
+        // The way round: down the wall (about 4 rows of 6 pixels) and up again.
+        assert!(d > 3.0 * a.dist(b), "hop {d} px, straight {} px", a.dist(b));
+        let mut search = Search::new(ctx.frame.width, ctx.frame.height);
+        let route = ctx.route(&mut search, a, b).expect("a way through the gap");
+        let len = crate::geometry::polyline_length(a, &route);
+        assert!(d <= 1.2 * len, "hop {d} px against the route's {len} px");
+    }
+
+    /// The grid's nodes are joined exactly when the transfers' pixel search finds a way
+    /// between their pixels, on maps like real ones (walls at any offset with gaps narrower
+    /// than the robot at some places, salt noise, several block sizes).
+    #[test]
+    fn nodes_are_joined_exactly_when_pixels_are() {
+        let mut seed: u64 = 0x9e37_79b9_7f4a_7c15;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        };
+        let (w, h) = (90, 70);
+        let (mut pairs, mut apart, mut in_block_apart) = (0, 0, 0);
+        for map in 0..24 {
+            let mut cells = vec![Cell::Free; w * h];
+            for r in 0..h {
+                for c in 0..w {
+                    if r == 0 || c == 0 || r == h - 1 || c == w - 1 {
+                        cells[r * w + c] = Cell::Occupied;
+                    }
+                }
+            }
+            // Walls with a gap of 4 to 9 pixels (the robot needs about 6).
+            for _ in 0..(2 + next() % 4) {
+                let vertical = next() % 2 == 0;
+                let (len, at) = if vertical {
+                    (h, 5 + next() as usize % (w - 10))
+                } else {
+                    (w, 5 + next() as usize % (h - 10))
+                };
+                let thick = 1 + next() as usize % 2;
+                let gap = next() as usize % len;
+                let gw = 4 + next() as usize % 6;
+                for k in 0..len {
+                    if k < gap || k >= gap + gw {
+                        for t in 0..thick {
+                            let j = if vertical {
+                                k * w + (at + t).min(w - 1)
+                            } else {
+                                (at + t).min(h - 1) * w + k
+                            };
+                            cells[j] = Cell::Occupied;
+                        }
+                    }
+                }
+            }
+            // Walls at a slant (steps of one pixel and the next), with a gap: the robot's
+            // centre squeezes along them at single pixels, diagonally.
+            for _ in 0..(1 + next() % 3) {
+                let (c0, r0) = (next() as usize % w, next() as usize % h);
+                let (dc, dr) = (
+                    [1i64, -1][next() as usize % 2],
+                    [1i64, -1][next() as usize % 2],
+                );
+                let slope = 1 + next() as usize % 3;
+                let gap = next() as usize % 60;
+                let gw = 4 + next() as usize % 5;
+                let (mut c, mut r) = (c0 as i64, r0 as i64);
+                for k in 0..80 {
+                    if c <= 0 || r <= 0 || c >= w as i64 - 1 || r >= h as i64 - 1 {
+                        break;
+                    }
+                    if k < gap || k >= gap + gw {
+                        cells[r as usize * w + c as usize] = Cell::Occupied;
+                    }
+                    c += dc;
+                    if k % slope == 0 {
+                        r += dr;
+                    }
+                }
+            }
+            // A slanted corridor about the robot's width (two parallel slanted walls): the
+            // robot's centre fits at single pixels only, some joined diagonally, some not.
+            for _ in 0..2 {
+                let (c0, r0) = (next() as usize % w, next() as usize % h);
+                let apart = 5 + (next() % 5) as i64;
+                let slope = 1 + next() as usize % 3;
+                let dr = [1i64, -1][next() as usize % 2];
+                for side in [0, apart] {
+                    let (mut c, mut r) = (c0 as i64, r0 as i64 + side);
+                    for k in 0..70 {
+                        if c <= 0 || r <= 0 || c >= w as i64 - 1 || r >= h as i64 - 1 {
+                            break;
+                        }
+                        cells[r as usize * w + c as usize] = Cell::Occupied;
+                        c += 1;
+                        if k % slope == 0 {
+                            r += dr;
+                        }
+                    }
+                }
+            }
+            let salt = [0, 1, 3][map % 3];
+            for j in 0..w * h {
+                if next() % 100 < salt {
+                    cells[j] = Cell::Occupied;
+                }
+            }
+            let frame = MapFrame::new(w, h, 0.05);
+            let Ok(grid_map) = GridMap::new(frame, cells) else {
+                continue;
+            };
+            // Start at some free spot the robot fits in.
+            let Ok(world) = World::new(grid_map, Robot::new(0.14), None) else {
+                continue;
+            };
+            // Every C-free pixel, not only the start's part: pairs in rooms no gap joins, and
+            // pairs a squeeze the robot's centre passes only at one pixel may separate.
+            let mut ctx = ctx(&world);
+            ctx.ok = (0..w * h).map(|i| world.cfree().contains(i)).collect();
+            let ok: Vec<usize> = (0..w * h).filter(|&i| ctx.ok[i]).collect();
+            if ok.len() < 50 {
+                continue;
+            }
+            let grid = Coarse::new(&ctx, [4.0, 6.0, 9.0][map % 3]);
+            let mut search = Search::new(w, h);
+            let diag =
+                |i: usize, j: usize| ctx.free(ctx.centre(i % w, i / w), ctx.centre(j % w, j / w));
+            let plain = |j: usize| ctx.ok[j];
+            for q in 0..60 {
+                let a = ok[next() as usize % ok.len()];
+                // Every other pair lies within one block: the pixels beside the other side
+                // of a wall (or of a squeeze) share a block with `a`.
+                let b = if q % 2 == 0 {
+                    ok[next() as usize % ok.len()]
+                } else {
+                    let (bs, w_) = (grid.b, w);
+                    let near: Vec<usize> = ok
+                        .iter()
+                        .copied()
+                        .filter(|&j| j / w_ / bs == a / w_ / bs && j % w_ / bs == a % w_ / bs)
+                        .collect();
+                    near[next() as usize % near.len()]
+                };
+                let by_pixels = search
+                    .path(&plain, (a % w, a / w), (b % w, b / w), &diag)
+                    .is_some();
+                assert_eq!(
+                    joined(&grid, &ctx, a, b),
+                    by_pixels,
+                    "map {map}, {a} -> {b}"
+                );
+                pairs += 1;
+                apart += usize::from(!by_pixels);
+                in_block_apart += usize::from(!by_pixels && q % 2 == 1);
+            }
+        }
+        // Real comparisons, some of them between pixels no transfer joins.
+        assert!(
+            pairs > 800 && apart > 10 && in_block_apart > 5,
+            "{pairs} pairs, {apart} apart, {in_block_apart} of them in one block"
+        );
+    }
 }

@@ -20,6 +20,8 @@ pub(super) struct Ctx<'a> {
     pub(super) keep_px: Option<f64>,
     /// Tool radius in pixels.
     pub(super) rt: f64,
+    /// The coarse grids of the hop costs, made once ([`super::hops::CoarseCache`]).
+    pub(super) coarse: super::hops::CoarseCache,
 }
 
 /// The lattice the cells are decomposed on: points `(c, r)` one pixel apart (`c` to the right,

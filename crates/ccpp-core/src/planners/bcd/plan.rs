@@ -113,6 +113,7 @@ impl Bcd {
             safe,
             keep_px: (opts.margin_px > 0.0).then_some(need),
             rt: robot.tool_radius / res,
+            coarse: hops::CoarseCache::default(),
         };
         // The plan on the pixel lattice and, when the walls run at an angle to the pixel
         // axes, on the lattices turned to them; the cheapest is kept (module docs, step 1).
@@ -632,8 +633,8 @@ impl Bcd {
             paths.push([p.clone(), p.clone()]);
             rots.push(rs);
         }
-        let coarse = hops::Coarse::new(ctx, sp);
-        let far = hops::Coarse::new(ctx, sp * f64::from(hops::FAR_FACTOR));
+        let coarse = ctx.coarse.get(ctx, sp);
+        let far = ctx.coarse.get(ctx, sp * f64::from(hops::FAR_FACTOR));
         let ncells = paths.len();
         // Two ways to sweep the rim (module docs, step 3): its passes as pieces of the tour,
         // or inserted into the finished tour where they cost least; the cheaper plan is kept.

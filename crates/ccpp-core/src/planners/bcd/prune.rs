@@ -735,6 +735,7 @@ mod tests {
             keep_px: None,
             ok,
             rt: world.robot().tool_radius / frame.resolution,
+            coarse: super::super::hops::CoarseCache::default(),
         }
     }
 

@@ -184,7 +184,7 @@ impl Search {
     /// `diag(from, to)` allows it. Settles in `(f, g, pixel index)` order (a
     /// [`MonotoneQueue`] keyed `f << 32 | g`: the octile heuristic is consistent, so keys
     /// never go below the last popped one).
-    fn path<O: Fn(usize) -> bool, D: Fn(usize, usize) -> bool>(
+    pub(super) fn path<O: Fn(usize) -> bool, D: Fn(usize, usize) -> bool>(
         &mut self,
         ok: &O,
         s: (usize, usize),
