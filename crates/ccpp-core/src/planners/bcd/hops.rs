@@ -386,7 +386,8 @@ impl Coarse {
     }
 
     /// Shortest path costs (tenths of a block) from node `s` over the links, up to `cap`:
-    /// `visit(n, g)` is called once for every node reached, in non-decreasing `g`. `g` must
+    /// `visit(n, g)` is called once for every node reached, in non-decreasing `g`, until it
+    /// returns `false`. `g` must
     /// hold `u32::MAX` everywhere and is left so; `touched` and `buckets` are scratch. (Costs
     /// are small integers, so a circular bucket queue gives the exact Dijkstra costs.)
     fn search(
@@ -396,7 +397,7 @@ impl Coarse {
         g: &mut [u32],
         touched: &mut Vec<u32>,
         buckets: &mut [Vec<u32>; BUCKETS],
-        mut visit: impl FnMut(u32, u32),
+        mut visit: impl FnMut(u32, u32) -> bool,
     ) {
         g[s as usize] = 0;
         touched.push(s);
@@ -413,7 +414,9 @@ impl Coarse {
             if g[k as usize] != d {
                 continue;
             }
-            visit(k, d);
+            if !visit(k, d) {
+                break;
+            }
             let (a, z) = (
                 self.adj_start[k as usize] as usize,
                 self.adj_start[k as usize + 1] as usize,
@@ -434,6 +437,8 @@ impl Coarse {
             g[k as usize] = u32::MAX;
         }
         touched.clear();
+        // (left over when `visit` stopped the search)
+        buckets.iter_mut().for_each(Vec::clear);
     }
 }
 
@@ -519,6 +524,7 @@ impl<'a> HopTable<'a> {
                 if row_of[k as usize] != u32::MAX {
                     row.push((k, gk));
                 }
+                true
             });
             row.sort_unstable();
             rows.push(row);
@@ -672,9 +678,15 @@ fn euclid(a: Point, b: Point) -> f64 {
 struct Far<'a> {
     coarse: &'a Coarse,
     row_of: Vec<u32>,
-    /// Square matrix of path costs in tenths of a far block (`u16::MAX`: not joined).
-    dense: Vec<u16>,
-    m: usize,
+    /// Path costs in tenths of a far block (`u16::MAX`: not joined) between the end-point
+    /// nodes of rows `i >= j`, at `i (i + 1) / 2 + j` (costs are the same both ways: links
+    /// join both ways at one cost).
+    tri: Vec<u16>,
+}
+
+/// Index of the pair of rows `i >= j` in [`Far::tri`].
+fn tri(i: usize, j: usize) -> usize {
+    i * (i + 1) / 2 + j
 }
 
 impl<'a> Far<'a> {
@@ -685,12 +697,14 @@ impl<'a> Far<'a> {
             row_of[k as usize] = i as u32;
         }
         let m = nodes.len();
-        let mut dense = vec![u16::MAX; m * m];
+        let mut costs = vec![u16::MAX; tri(m, 0)];
         let mut g = vec![u32::MAX; coarse.nodes()];
         let mut touched: Vec<u32> = Vec::new();
         let mut buckets: [Vec<u32>; BUCKETS] = std::array::from_fn(|_| Vec::new());
         for (i, &s) in nodes.iter().enumerate() {
-            let out = &mut dense[i * m..(i + 1) * m];
+            // The rows up to `i` (itself included); the search stops once it has reached them.
+            let out = &mut costs[tri(i, 0)..tri(i, 0) + i + 1];
+            let mut left = i + 1;
             coarse.search(
                 s,
                 u32::MAX - 14,
@@ -698,17 +712,19 @@ impl<'a> Far<'a> {
                 &mut touched,
                 &mut buckets,
                 |k, gk| {
-                    if row_of[k as usize] != u32::MAX {
-                        out[row_of[k as usize] as usize] = gk.min(u32::from(u16::MAX) - 1) as u16;
+                    let r = row_of[k as usize] as usize;
+                    if r <= i {
+                        out[r] = gk.min(u32::from(u16::MAX) - 1) as u16;
+                        left -= 1;
                     }
+                    left > 0
                 },
             );
         }
         Self {
             coarse,
             row_of,
-            dense,
-            m,
+            tri: costs,
         }
     }
 
@@ -721,7 +737,7 @@ impl<'a> Far<'a> {
         if ra == u32::MAX || rb == u32::MAX {
             return 0.0;
         }
-        let g = self.dense[ra as usize * self.m + rb as usize];
+        let g = self.tri[tri(ra.max(rb) as usize, ra.min(rb) as usize)];
         if g == u16::MAX {
             return 0.0;
         }
@@ -785,6 +801,7 @@ mod tests {
             &mut buckets,
             |k, _| {
                 hit |= k == nb;
+                !hit
             },
         );
         hit
