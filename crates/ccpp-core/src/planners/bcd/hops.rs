@@ -703,7 +703,7 @@ impl<'a> Far<'a> {
         let mut buckets: [Vec<u32>; BUCKETS] = std::array::from_fn(|_| Vec::new());
         for (i, &s) in nodes.iter().enumerate() {
             // The rows up to `i` (itself included); the search stops once it has reached them.
-            let out = &mut costs[tri(i, 0)..tri(i, 0) + i + 1];
+            let out = &mut costs[tri(i, 0)..=tri(i, i)];
             let mut left = i + 1;
             coarse.search(
                 s,
