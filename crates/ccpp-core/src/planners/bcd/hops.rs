@@ -905,7 +905,7 @@ mod tests {
             }
             // Walls at a slant (steps of one pixel and the next), with a gap: the robot's
             // centre squeezes along them at single pixels, diagonally.
-            for _ in 0..(1 + next() % 3) {
+            for _ in 0..=(next() % 3) {
                 let (c0, r0) = (next() as usize % w, next() as usize % h);
                 let (dc, dr) = (
                     [1i64, -1][next() as usize % 2],

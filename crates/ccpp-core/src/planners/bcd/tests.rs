@@ -77,7 +77,7 @@ fn walls_at_an_angle_get_a_turned_lattice() {
             keep_px: None,
             ok,
             rt: 3.0,
-            coarse: Default::default(),
+            coarse: super::hops::CoarseCache::default(),
         };
         let a = dominant_angles(&ctx)[0].to_degrees();
         // The image's rows run down: a room turned by +30 degrees there has walls at
@@ -107,7 +107,7 @@ fn walls_at_an_angle_get_a_turned_lattice() {
         keep_px: None,
         ok,
         rt: 3.0,
-        coarse: Default::default(),
+        coarse: super::hops::CoarseCache::default(),
     };
     let mut search = Search::new(frame.width, frame.height);
     // The lattices' plain plans (`plan_on` makes the plan of the options it is given: with a
@@ -140,7 +140,7 @@ fn smoothing_straightens_wiggles_but_keeps_corners_and_marks() {
         safe: vec![true; n],
         keep_px: None,
         rt: 4.0,
-        coarse: Default::default(),
+        coarse: super::hops::CoarseCache::default(),
     };
     // A wiggle of 0.3 px along a free row, then a corner, then a mark.
     let mut items: Vec<Item> = (0..36)
@@ -182,7 +182,7 @@ fn repair_counts_the_moves_it_cannot_route() {
         safe: vec![true; n],
         keep_px: None,
         rt: 4.0,
-        coarse: Default::default(),
+        coarse: super::hops::CoarseCache::default(),
     };
     let mut search = Search::new(frame.width, frame.height);
     // A move into the middle of the block has no route: it is dropped and counted, and
@@ -613,7 +613,7 @@ fn transfers_keep_the_margin_they_are_given() {
                 .collect(),
             keep_px: (margin > 0.0).then_some(need),
             rt: 4.0,
-            coarse: Default::default(),
+            coarse: super::hops::CoarseCache::default(),
         };
         let (a, b) = (Point::new(30.0, 20.0), Point::new(70.0, 60.0));
         let mut pts = vec![a];
@@ -709,7 +709,7 @@ fn a_ring_is_peeled_into_offset_loops_from_the_outer_wall() {
         keep_px: None,
         ok,
         rt: 3.0,
-        coarse: Default::default(),
+        coarse: super::hops::CoarseCache::default(),
     };
     let lat = Lattice::pixels(&ctx);
     // Row 50 (through the block) from the left border: C-free from column 3 to 16 (the
