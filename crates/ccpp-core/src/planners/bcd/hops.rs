@@ -107,7 +107,7 @@ impl Coarse {
         // A diagonal pixel step from `i` to `j` (both C-free): as the transfers' search.
         let diag = |i: usize, j: usize| {
             let (ci, ri, cj, rj) = (i % w, i / w, j % w, j / w);
-            (ok[ri * w + cj] && ok[rj * w + ci]) || ctx.free(ctx.centre(ci, ri), ctx.centre(cj, rj))
+            (ok[ri * w + cj] && ok[rj * w + ci]) || ctx.pixel_move_free(i, j)
         };
         // Parts of each block: first joined by side steps and by the diagonal steps whose side
         // pixels are both C-free (no map test), then by the other diagonal steps, each tested
@@ -175,10 +175,10 @@ impl Coarse {
                     }
                     x
                 };
+                // By pixel: to find a pixel's part, and to number parts by their smallest pixel.
+                pix.sort_unstable();
                 if parent.len() > 1 {
-                    // The part of each pixel (sorted by pixel), to find the diagonal steps
-                    // between parts.
-                    pix.sort_unstable();
+                    // The diagonal steps between parts.
                     let part_of =
                         |i: usize| pix.binary_search_by_key(&i, |e| e.0).map(|k| pix[k].1);
                     for k in 0..pix.len() {
@@ -204,7 +204,6 @@ impl Coarse {
                 // Compact part numbers, in the order of their smallest pixel.
                 let mut number: Vec<u32> = vec![u32::MAX; parent.len()];
                 let mut parts = 0u32;
-                pix.sort_unstable();
                 for &(i, part) in &pix {
                     let root = find(&mut parent, part) as usize;
                     if number[root] == u32::MAX {
@@ -973,8 +972,7 @@ mod tests {
             }
             let grid = Coarse::new(&ctx, [4.0, 6.0, 9.0][map % 3]);
             let mut search = Search::new(w, h);
-            let diag =
-                |i: usize, j: usize| ctx.free(ctx.centre(i % w, i / w), ctx.centre(j % w, j / w));
+            let diag = |i: usize, j: usize| ctx.pixel_move_free(i, j);
             let plain = |j: usize| ctx.ok[j];
             for q in 0..60 {
                 let a = ok[next() as usize % ok.len()];

@@ -30,6 +30,14 @@ impl Ctx<'_> {
         best.map(|b| b.1)
     }
 
+    /// Is the straight move between the centres of pixels `i` and `j` (row-major indices)
+    /// free on the true map? (the test of a diagonal step of [`Search::path`] whose side
+    /// pixels are not both admitted)
+    pub(super) fn pixel_move_free(&self, i: usize, j: usize) -> bool {
+        let w = self.frame.width;
+        self.free(self.centre(i % w, i / w), self.centre(j % w, j / w))
+    }
+
     /// Moves from `a` to `b` (excluding `a`): straight when free, else an A* pixel path
     /// shortened by line of sight; `None` when no verified path exists.
     pub(super) fn route(&self, search: &mut Search, a: Point, b: Point) -> Option<Vec<Point>> {
@@ -38,10 +46,7 @@ impl Ctx<'_> {
         }
         let pa = self.anchor(a)?;
         let pb = self.anchor(b)?;
-        let diag = |i: usize, j: usize| {
-            let w = self.frame.width;
-            self.free(self.centre(i % w, i / w), self.centre(j % w, j / w))
-        };
+        let diag = |i: usize, j: usize| self.pixel_move_free(i, j);
         // Through the margin where a path keeps it (then shortened without giving it up),
         // else through the plain C-free set.
         let w = self.frame.width;
