@@ -17,8 +17,11 @@
 //! nodes in a sorted row. A pair beyond the radius (or not joined by the coarse grid within
 //! it) is costed on a second grid of blocks [`FAR_FACTOR`] times larger, searched whole from
 //! each of its end-point nodes: the path there less two far-block diagonals (the points can
-//! sit anywhere in their blocks), at least the radius and the straight line. Both grids depend
-//! on the C-free set alone and are made once per plan ([`CoarseCache`]).
+//! sit anywhere in their blocks), at least the radius and the straight line. A table of
+//! every pair grows with the square of the end-point nodes, so beyond [`FAR_EXACT_MAX`] of
+//! them the far grid gives landmark lower bounds instead (searches from [`LANDMARKS`] nodes;
+//! `Far`). Both grids depend on the C-free set alone and are made once per plan
+//! ([`CoarseCache`]).
 
 use std::sync::{Arc, Mutex};
 
@@ -677,24 +680,70 @@ fn euclid(a: Point, b: Point) -> f64 {
 struct Far<'a> {
     coarse: &'a Coarse,
     row_of: Vec<u32>,
-    /// Path costs in tenths of a far block (`u16::MAX`: not joined) between the end-point
-    /// nodes of rows `i >= j`, at `i (i + 1) / 2 + j` (costs are the same both ways: links
-    /// join both ways at one cost).
-    tri: Vec<u16>,
+    costs: FarCosts,
 }
 
-/// Index of the pair of rows `i >= j` in [`Far::tri`].
+/// Most end-point nodes whose far costs are kept exact ([`FarCosts::Exact`]: a triangle of
+/// `m (m + 1) / 2` two-byte costs, 16 MiB here, and one search per node). On the 14 shared
+/// maps (r 0.15 m) `m` is at most 1140 (`stage_willow_full`) and on the bench map
+/// `cluttered_2000` 2430; `office_4096` at `--radius 0.1` has 27 000, whose triangle (730 MB
+/// per table, several tables alive at once) and searches (each over most of the grid) grew
+/// with the map's square.
+const FAR_EXACT_MAX: usize = 4096;
+/// Landmarks of [`FarCosts::Landmarks`]. On `office_4096` at `--radius 0.1` (`ccpp plan
+/// --planner bcd`, single runs): the exact table 412 s, 3.52 GB peak, path 199 918 m; 24
+/// landmarks 103 s, 2.30 GB, 200 894 m; 64 landmarks 111 s, 2.31 GB, 200 495 m.
+const LANDMARKS: usize = 64;
+
+/// The far grid's path costs (tenths of a far block) between end-point nodes.
+enum FarCosts {
+    /// Exact costs between rows `i >= j` at [`tri`]`(i, j)` (`u16::MAX`: not joined; costs
+    /// are the same both ways: links join both ways at one cost).
+    Exact(Vec<u16>),
+    /// Lower bounds from landmarks (ALT: Goldberg and Harrelson, "Computing the shortest path:
+    /// A* search meets graph theory", SODA 2005): the path costs from each of `k` landmarks to
+    /// every row (`d[row * k + l]`, `u32::MAX`: not joined), and the cost between two rows is at
+    /// least `max_l |d(l, a) - d(l, b)|` by the triangle inequality. Memory and time grow with
+    /// the number of rows, not its square.
+    Landmarks { k: usize, d: Vec<u32> },
+}
+
+/// Index of the pair of rows `i >= j` in [`FarCosts::Exact`].
 fn tri(i: usize, j: usize) -> usize {
     i * (i + 1) / 2 + j
 }
 
 impl<'a> Far<'a> {
     fn new(coarse: &'a Coarse, pieces: &[tsp::Piece], start: Point) -> Self {
+        Self::with_limit(coarse, pieces, start, FAR_EXACT_MAX)
+    }
+
+    /// [`Self::new`] with exact costs only up to `exact_max` end-point nodes.
+    fn with_limit(
+        coarse: &'a Coarse,
+        pieces: &[tsp::Piece],
+        start: Point,
+        exact_max: usize,
+    ) -> Self {
         let (mut nodes, mut row_of) = end_nodes(coarse, pieces, start);
         nodes.sort_unstable();
         for (i, &k) in nodes.iter().enumerate() {
             row_of[k as usize] = i as u32;
         }
+        let costs = if nodes.len() <= exact_max {
+            Self::exact(coarse, &nodes, &row_of)
+        } else {
+            Self::landmarks(coarse, &nodes, &row_of)
+        };
+        Self {
+            coarse,
+            row_of,
+            costs,
+        }
+    }
+
+    /// One search per end-point node, each stopping once it has reached the rows up to its own.
+    fn exact(coarse: &Coarse, nodes: &[u32], row_of: &[u32]) -> FarCosts {
         let m = nodes.len();
         let mut costs = vec![u16::MAX; tri(m, 0)];
         let mut g = vec![u32::MAX; coarse.nodes()];
@@ -720,11 +769,49 @@ impl<'a> Far<'a> {
                 },
             );
         }
-        Self {
-            coarse,
-            row_of,
-            tri: costs,
+        FarCosts::Exact(costs)
+    }
+
+    /// [`LANDMARKS`] whole searches from landmarks picked farthest first: the first row's
+    /// node, then each time the row farthest from every landmark so far (a row no landmark
+    /// reaches counts as farthest, so each part of the grid gets one while landmarks last;
+    /// ties: the lower row).
+    fn landmarks(coarse: &Coarse, nodes: &[u32], row_of: &[u32]) -> FarCosts {
+        let m = nodes.len();
+        let k = LANDMARKS.min(m);
+        let mut d = vec![u32::MAX; m * k];
+        // Per row: the least cost from the landmarks so far (u64::MAX: none reaches it).
+        let mut least = vec![u64::MAX; m];
+        let mut g = vec![u32::MAX; coarse.nodes()];
+        let mut touched: Vec<u32> = Vec::new();
+        let mut buckets: [Vec<u32>; BUCKETS] = std::array::from_fn(|_| Vec::new());
+        let mut next = 0usize;
+        for l in 0..k {
+            coarse.search(
+                nodes[next],
+                u32::MAX - 14,
+                &mut g,
+                &mut touched,
+                &mut buckets,
+                |n, gn| {
+                    let r = row_of[n as usize];
+                    if r != u32::MAX {
+                        let r = r as usize;
+                        d[r * k + l] = gn;
+                        least[r] = least[r].min(u64::from(gn));
+                    }
+                    true
+                },
+            );
+            // (`max_by_key` keeps the last of equal keys: compare on the row reversed)
+            next = (0..m)
+                .max_by_key(|&r| (least[r], std::cmp::Reverse(r)))
+                .unwrap_or(0);
+            if least[next] == 0 {
+                break;
+            }
         }
+        FarCosts::Landmarks { k, d }
     }
 
     /// Estimated path cost (pixels) between `a` and `b`; 0 when unknown.
@@ -736,10 +823,31 @@ impl<'a> Far<'a> {
         if ra == u32::MAX || rb == u32::MAX {
             return 0.0;
         }
-        let g = self.tri[tri(ra.max(rb) as usize, ra.min(rb) as usize)];
-        if g == u16::MAX {
-            return 0.0;
-        }
+        let (ra, rb) = (ra as usize, rb as usize);
+        let g = match &self.costs {
+            FarCosts::Exact(tri_costs) => {
+                let g = tri_costs[tri(ra.max(rb), ra.min(rb))];
+                if g == u16::MAX {
+                    return 0.0;
+                }
+                u32::from(g)
+            }
+            FarCosts::Landmarks { k, d } => {
+                let (da, db) = (&d[ra * k..(ra + 1) * k], &d[rb * k..(rb + 1) * k]);
+                let mut lb: Option<u32> = None;
+                for (&x, &y) in da.iter().zip(db) {
+                    match (x == u32::MAX, y == u32::MAX) {
+                        (false, false) => lb = Some(lb.unwrap_or(0).max(x.abs_diff(y))),
+                        // Reached from a landmark that does not reach the other: not joined.
+                        (true, false) | (false, true) => return 0.0,
+                        (true, true) => {}
+                    }
+                }
+                // (no landmark reaches either: unknown)
+                let Some(lb) = lb else { return 0.0 };
+                lb
+            }
+        };
         let bpx = self.coarse.b as f64;
         (f64::from(g) / 10.0 - 2.0 * std::f64::consts::SQRT_2) * bpx
     }
@@ -760,7 +868,7 @@ fn morton(c: usize, r: usize) -> u64 {
 
 #[cfg(test)]
 mod tests {
-    use super::{Coarse, CoarseCache, HopTable, BUCKETS};
+    use super::{Coarse, CoarseCache, Far, HopTable, BUCKETS};
     use crate::geometry::{Point, Pose};
     use crate::grid::{Cell, GridMap, MapFrame};
     use crate::planners::bcd::lattice::Ctx;
@@ -1006,6 +1114,93 @@ mod tests {
         assert!(
             pairs > 800 && apart > 10 && in_block_apart > 5,
             "{pairs} pairs, {apart} apart, {in_block_apart} of them in one block"
+        );
+    }
+
+    /// Beyond [`super::FAR_EXACT_MAX`] end-point nodes the far costs are landmark lower
+    /// bounds: never above the exact costs, exact from the first landmark (the first row),
+    /// "not joined" exactly where the exact table says so (a closed room), and not trivially
+    /// low (a wall with a door at its end costs the way round).
+    ///
+    /// ```text
+    ///   ####################
+    ///   #.....#......#.....#
+    ///   #.....#......#.....#   three rooms joined by doors at the bottom and the top,
+    ///   #.....#......#.....#   and a closed room (right) that no way reaches
+    ///   #.....#......#######
+    ///   #..................#
+    ///   ####################
+    /// ```
+    #[test]
+    fn landmark_far_costs_bound_the_exact_ones_from_below() {
+        let art = "####################\n\
+                   #.....#......#.....#\n\
+                   #.....#......#.....#\n\
+                   #.....#......#.....#\n\
+                   #.............######\n\
+                   #.............#....#\n\
+                   #.............#....#\n\
+                   ####################";
+        let map = GridMap::from_ascii_scaled(art, 8, 0.02).expect("map");
+        let world =
+            World::new(map, Robot::new(0.03), Some(Pose::new(0.2, 0.2, 0.0))).expect("world");
+        let mut ctx = ctx(&world);
+        let (w, h) = (ctx.frame.width, ctx.frame.height);
+        ctx.ok = (0..w * h).map(|i| world.cfree().contains(i)).collect();
+        let far = Coarse::new(&ctx, 4.0);
+        // An end point every 3 pixels: many more end-point nodes than landmarks.
+        let mut pts = Vec::new();
+        for r in (0..h).step_by(3) {
+            for c in (0..w).step_by(3) {
+                if ctx.ok[r * w + c] {
+                    pts.push(ctx.centre(c, r));
+                }
+            }
+        }
+        let pieces: Vec<tsp::Piece> = pts
+            .iter()
+            .map(|&p| tsp::Piece {
+                entry: vec![p],
+                exit: vec![p],
+                inner: vec![0.0],
+            })
+            .collect();
+        let start = pts[0];
+        let exact = Far::with_limit(&far, &pieces, start, usize::MAX);
+        let bound = Far::with_limit(&far, &pieces, start, 0);
+        assert!(matches!(exact.costs, super::FarCosts::Exact(_)));
+        assert!(matches!(bound.costs, super::FarCosts::Landmarks { .. }));
+        let rows = exact.row_of.iter().filter(|&&r| r != u32::MAX).count();
+        assert!(rows > 4 * super::LANDMARKS, "{rows} end-point nodes");
+        // The first landmark: the node of the first row.
+        let first = (0..far.nodes())
+            .find(|&k| exact.row_of[k] == 0)
+            .expect("a first row") as u32;
+        let (mut apart, mut tight, mut pairs, mut from_first) = (0, 0, 0, 0);
+        for (i, &a) in pts.iter().enumerate() {
+            for &b in pts.iter().skip(i + 1).step_by(7) {
+                let (e, l) = (exact.path_px(a, b), bound.path_px(a, b));
+                assert!(l <= e + 1e-9, "{a:?} -> {b:?}: bound {l} above exact {e}");
+                if e == 0.0 {
+                    assert_eq!(l, 0.0, "{a:?} -> {b:?}: joined by landmarks only");
+                    apart += 1;
+                    continue;
+                }
+                pairs += 1;
+                tight += usize::from(l >= 0.8 * e);
+                if far.node(a) == Some(first) {
+                    assert!((l - e).abs() < 1e-9, "from the first landmark: {l} vs {e}");
+                    from_first += 1;
+                }
+            }
+        }
+        assert!(
+            apart > 10 && from_first > 0,
+            "{apart} apart, {from_first} from the first"
+        );
+        assert!(
+            tight * 2 > pairs,
+            "only {tight} of {pairs} bounds within 80 % of the exact cost"
         );
     }
 }
