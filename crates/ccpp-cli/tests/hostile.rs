@@ -1527,3 +1527,65 @@ fn a_map_image_too_large_for_the_memory_limit_is_refused_from_its_header() {
     );
     assert!(!out.exists());
 }
+
+/// `bcd` counted 64 bytes a map pixel and its lane squares, but makes several plans at once,
+/// each with pixel-sized state: `office_4096` at `--radius 0.1` peaked at 2.3 GB against an
+/// estimate of 1.3 GB, so `--max-memory` let through runs of twice the limit. Its estimate now
+/// counts the plans' pixels, once per plan made at the same time (one per thread, up to four),
+/// and names the way down to one.
+#[test]
+fn bcd_counts_its_plans_pixels_once_per_plan_at_a_time() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    // 1000 x 1000 px: 64 MB of map pixels pass a limit of 120 MB, bcd's plans do not.
+    let map = common::pgm(dir, "big.pgm", 1000, 1000, |x, y| {
+        (x % 200 == 100 && y % 300 > 40) || (y == 500 && x % 250 > 30)
+    });
+    let out = dir.join("out");
+    let figure = |threads: &str, needles: &[&str]| -> u64 {
+        let args = [
+            "plan",
+            "--planner",
+            "bcd",
+            "--map",
+            s(&map),
+            "--radius",
+            "0.1",
+            "--max-memory",
+            "120",
+            "--out",
+            s(&out),
+        ];
+        let a = ccpp()
+            .env("RAYON_NUM_THREADS", threads)
+            .args(args)
+            .assert()
+            .failure();
+        let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        for n in needles {
+            assert!(err.contains(n), "{err:?} should contain {n:?}");
+        }
+        assert!(!out.exists());
+        let about = err.split("about ").nth(1).expect("a figure");
+        about.split(' ').next().unwrap().parse().expect("MB")
+    };
+    let common = [
+        "big.pgm",
+        "bcd would need",
+        "map pixels",
+        "limit of 120 MB",
+        "RAYON_NUM_THREADS=1",
+    ];
+    let one = figure("1", &[&common[..], &["1 plan at a time"]].concat());
+    let four = figure("4", &[&common[..], &["4 plans at a time"]].concat());
+    // Up to four plans at a time: eight threads make no more than four.
+    let eight = figure("8", &[&common[..], &["4 plans at a time"]].concat());
+    // 1e6 pixels x (64 + 40 + 32) bytes and the lane squares; 3 x 32 bytes more a pixel.
+    assert!((136..160).contains(&one), "{one} MB");
+    assert!(
+        (91..=92).contains(&(four - one)),
+        "3 x 32 B a pixel: 91.6 MiB, {four} - {one}"
+    );
+    assert_eq!(eight, four);
+}

@@ -31,6 +31,19 @@ pub const PIXEL_BYTES: f64 = 64.0;
 pub const TILE_BYTES: f64 = 600.0;
 /// Bytes per trace record: the record in memory and its `trace.jsonl` / `path.csv` lines.
 pub const RECORD_BYTES: f64 = 200.0;
+/// Bytes per map pixel that `bcd` holds beyond [`PIXEL_BYTES`] whatever its parallelism (the
+/// planning context's masks, the coarse grids' labels, the headland's distance transform).
+pub const BCD_PIXEL_BYTES: f64 = 40.0;
+/// Bytes per map pixel of each `bcd` plan made at the same time (its transfer search, sweep
+/// counts and rim masks), for up to [`BCD_MAX_JOBS`] plans: `bcd` makes its plans in
+/// parallel, one per thread. Fitted to peak resident memory (`/usr/bin/time -v ccpp plan
+/// --planner bcd`, `RAYON_NUM_THREADS` 1, 2, 4, 8): `office_1024` at `--radius 0.1` 137,
+/// 202, 246, 272 MB, `cluttered_2000` 377, 477, 547, 660 MB, `office_4096` at `--radius 0.1`
+/// 1700 MB (1 thread), 2312 MB (2); every figure within this estimate.
+pub const BCD_JOB_PIXEL_BYTES: f64 = 32.0;
+/// Most `bcd` plans counted as made at the same time ([`BCD_JOB_PIXEL_BYTES`]): beyond four
+/// threads the measured peaks grow little (the plans of one round are few).
+pub const BCD_MAX_JOBS: usize = 4;
 
 /// What a planner's checks and estimate may use: what an operator knows before the run.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -774,7 +787,24 @@ impl PlannerSettings for BcdOptions {
         let mut e = ResourceEstimate::units(s.tiles(sp), TILE_BYTES / 2.0, "lane squares")
             .remedy("a larger tool radius or bcd.lane_spacing_m");
         e.detail = format!("{} of {} m", e.detail, fmt_m(sp));
-        e
+        // The plans' own pixel-sized state, part of it once per plan made at the same time.
+        let jobs = rayon::current_num_threads().clamp(1, BCD_MAX_JOBS);
+        let per_px = BCD_PIXEL_BYTES + BCD_JOB_PIXEL_BYTES * jobs as f64;
+        let mut px = ResourceEstimate::units(s.pixels(), per_px, "map pixels").remedy(&format!(
+            "{PIXELS_REMEDY}, or one plan at a time (RAYON_NUM_THREADS=1)"
+        ));
+        px.detail = format!(
+            "{}, {jobs} plan{} at a time",
+            px.detail,
+            if jobs == 1 { "" } else { "s" }
+        );
+        if px.bytes > e.bytes {
+            px.bytes += e.bytes;
+            px
+        } else {
+            e.bytes += px.bytes;
+            e
+        }
     }
 
     fn tile_side(&self, _: &Robot) -> Option<f64> {
