@@ -1590,3 +1590,82 @@ fn bcd_counts_its_plans_pixels_once_per_plan_at_a_time() {
     );
     assert_eq!(eight, four);
 }
+
+/// Under PID execution the trace holds a pose per control step: the estimate counts the steps
+/// of the moves (not the path over the top speed), names them, and `record_every` (which keeps
+/// one record in so many) lowers it.
+#[test]
+fn pid_trace_records_are_counted_by_control_steps() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    // 400 x 300 px at 0.05 m with walls; --radius 0.05 (cells of 0.1 m, 30 000 cell moves).
+    let map = common::pgm(dir, "flat.pgm", 400, 300, |x, y| {
+        x == 0 || y == 0 || x == 399 || y == 299 || (x == 200 && y > 60)
+    });
+    let out = dir.join("out");
+    let refusal = |config: Option<&std::path::Path>| -> String {
+        let mut args = vec![
+            "run",
+            "--planner",
+            "bsa-bfs",
+            "--map",
+            s(&map),
+            "--radius",
+            "0.05",
+            "--max-memory",
+            "60",
+            "--out",
+            s(&out),
+        ];
+        if let Some(c) = config {
+            args.extend(["--config", s(c)]);
+        }
+        let a = ccpp().args(&args).assert().failure();
+        let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        assert!(!out.exists());
+        err
+    };
+    let err = refusal(None);
+    for n in [
+        "flat.pgm",
+        "bsa-bfs would need",
+        "PID trace records",
+        "limit of 60 MB",
+        "bsa_bfs.exec.pid.record_every",
+    ] {
+        assert!(err.contains(n), "{err:?} should contain {n:?}");
+    }
+    // About 30 000 moves of 32 steps and a quarter turn (33 steps) every fourth: ~1.2 million
+    // records, where the path over the top speed gave 120 000.
+    let records: f64 = err
+        .split("about ")
+        .nth(2)
+        .and_then(|t| t.split(' ').next())
+        .and_then(|t| t.parse().ok())
+        .expect("a record count");
+    assert!((1.1e6..1.3e6).contains(&records), "{records}");
+    // One record in 20 kept: the same limit admits the run.
+    let cfg = dir.join("sparse.yaml");
+    std::fs::write(&cfg, "bsa_bfs: { exec: { pid: { record_every: 20 } } }\n").unwrap();
+    let a = ccpp()
+        .args([
+            "run",
+            "--planner",
+            "bsa-bfs",
+            "--map",
+            s(&map),
+            "--radius",
+            "0.05",
+            "--max-memory",
+            "60",
+            "--config",
+            s(&cfg),
+            "--out",
+            s(&out),
+        ])
+        .assert();
+    let o = a.get_output();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.join("metrics.json").exists());
+}

@@ -241,6 +241,49 @@ impl Default for PidOptions {
     }
 }
 
+impl PidOptions {
+    /// Control steps of one noise-free motion from rest: turning in place by `turn_rad`, then
+    /// driving a straight segment of `len_m` metres, each capped at `max_steps_per_motion` as
+    /// the simulator caps them. Memory estimates count PID trace records with it: the creep
+    /// and the arrival shaping make a short move take many more steps than its length over
+    /// the top speed (at the defaults a 0.1 m move takes 25 steps, not 4).
+    pub fn motion_steps(&self, turn_rad: f64, len_m: f64) -> u64 {
+        let opts = PidOptions {
+            noise: None,
+            ..*self
+        };
+        let mut tracker = Tracker::new(&opts);
+        let mut pose = Pose::new(0.0, 0.0, 0.0);
+        let mut steps = 0u64;
+        let mut drive = |goal: Goal, pose: &mut Pose| {
+            tracker.reset();
+            for _ in 0..opts.max_steps_per_motion {
+                let Some((v, w)) = tracker.command(*pose, &goal) else {
+                    break;
+                };
+                *pose = Unicycle::step(*pose, v, w, opts.dt_s);
+                steps += 1;
+            }
+        };
+        if turn_rad.is_finite() && turn_rad != 0.0 {
+            drive(Goal::Heading(wrap_angle(turn_rad)), &mut pose);
+        }
+        if len_m.is_finite() && len_m > 0.0 {
+            let (s, c) = pose.theta.sin_cos();
+            let to = Point::new(len_m * c, len_m * s);
+            drive(
+                Goal::Segment {
+                    from: Point::new(0.0, 0.0),
+                    to,
+                    reverse: false,
+                },
+                &mut pose,
+            );
+        }
+        steps
+    }
+}
+
 /// A `linear` / `angular` section as written in an options file: the fields it gives, the
 /// others taken from that controller's default in [`PidOptions::default`].
 #[derive(Deserialize)]
@@ -452,6 +495,58 @@ mod tests {
             assert!(n < 100_000, "no convergence");
         }
         (p, n, max_dev)
+    }
+
+    #[test]
+    fn motion_steps_counts_the_steps_of_a_driven_motion() {
+        let opts = PidOptions::default();
+        for len in [0.05, 0.1, 0.3, 2.0] {
+            let goal = Goal::Segment {
+                from: Point::new(0.0, 0.0),
+                to: Point::new(len, 0.0),
+                reverse: false,
+            };
+            let (_, n, _) = run(goal, Pose::new(0.0, 0.0, 0.0), &opts);
+            assert_eq!(opts.motion_steps(0.0, len), n as u64, "{len} m");
+            // More than the top speed alone gives: acceleration, arrival, creep.
+            let top = len / (opts.linear.output_limit * opts.dt_s);
+            assert!(n as f64 > top, "{len} m: {n} steps");
+        }
+        let (_, turn, _) = run(
+            Goal::Heading(std::f64::consts::FRAC_PI_2),
+            Pose::new(0.0, 0.0, 0.0),
+            &opts,
+        );
+        assert!(turn > 0);
+        // Turning first, then driving along the new heading.
+        let (p, drive, _) = run(
+            Goal::Segment {
+                from: Point::new(0.0, 0.0),
+                to: Point::new(0.0, 0.1),
+                reverse: false,
+            },
+            Pose::new(0.0, 0.0, std::f64::consts::FRAC_PI_2),
+            &opts,
+        );
+        assert!(p.position().dist(Point::new(0.0, 0.1)) < 1e-6);
+        assert_eq!(
+            opts.motion_steps(std::f64::consts::FRAC_PI_2, 0.1),
+            (turn + drive) as u64
+        );
+        assert_eq!(opts.motion_steps(0.0, 0.0), 0);
+        // Capped per motion as the simulator caps them.
+        let capped = PidOptions {
+            max_steps_per_motion: 3,
+            ..opts
+        };
+        assert_eq!(capped.motion_steps(1.0, 5.0), 6);
+        eprintln!(
+            "0.1 m {} 0.2 m {} 0.3 m {} turn {}",
+            opts.motion_steps(0.0, 0.1),
+            opts.motion_steps(0.0, 0.2),
+            opts.motion_steps(0.0, 0.3),
+            turn
+        );
     }
 
     #[test]

@@ -359,18 +359,33 @@ fn validate_pid(field: &str, p: &PidOptions) -> Result<(), OptionsError> {
     Ok(())
 }
 
-/// Trace records of a PID-executed path of `path_m` metres: one every `record_every` control
-/// steps of at most `output_limit * dt_s` metres each (creeping is slower but bounded by the
-/// per-motion step cap).
-fn pid_records(e: Option<&Execution>, path_m: f64) -> f64 {
+/// Bytes of one PID trace record in memory: a stored pose (56 bytes) in a vector that grows by
+/// doubling (1.5 times that on average, twice at worst; the record count [`pid_records`] gives
+/// is itself above the measured ones). The trace's text is written as it is made, not held.
+pub const PID_RECORD_BYTES: f64 = 84.0;
+
+/// Trace records of a PID-executed path of `moves` straight moves of `move_m` metres each,
+/// with a quarter turn in place before one move in [`PID_TURN_EVERY`]: the control steps of
+/// such motions ([`crate::exec::PidOptions::motion_steps`], creep and arrival included), one
+/// record every `record_every` steps. Measured with `ccpp run --planner bsa-bfs`: 32 steps a
+/// 0.1 m move and 33 a quarter turn at the default gains; 906 424 records on
+/// `apartment_400x300` at `--radius 0.05` (25 841 moves, 1198 turns), where the old count
+/// (length over top speed) gave 120 000 and the estimate 37 MB against a peak of 81 MB.
+fn pid_records(e: Option<&Execution>, moves: f64, move_m: f64) -> f64 {
     match e {
         Some(Execution::Pid(p)) => {
-            let step = (p.linear.output_limit * p.dt_s).max(1e-12);
-            path_m / step / f64::from(p.record_every.max(1))
+            let per_move = p.motion_steps(0.0, move_m) as f64
+                + p.motion_steps(std::f64::consts::FRAC_PI_2, 0.0) as f64 / PID_TURN_EVERY;
+            moves * per_move / f64::from(p.record_every.max(1))
         }
         _ => 0.0,
     }
 }
+
+/// One move in this many is counted with a quarter turn in place before it
+/// ([`pid_records`]): `bsa-bfs` turned before one move in 22 on `apartment_400x300`, one in 6.5
+/// on `office_1024`.
+const PID_TURN_EVERY: f64 = 4.0;
 
 /// The sensor must see a neighbour tile's whole contact disk: the pixels whose centres lie
 /// within `r + half a pixel` of the tile centre ([`crate::collide::contact_radius_px`]), so up
@@ -718,11 +733,19 @@ impl PlannerSettings for BsaBfsOptions {
         let cells = s.tiles(c);
         // Cell state and return stacks; the trace is counted by PID records below.
         let mut e = ResourceEstimate::units(cells, TILE_BYTES / 3.0, "cells")
-            .remedy("a larger robot or cell side");
+            .remedy("a larger robot or cell side, or a larger bsa_bfs.exec.pid.record_every");
         e.detail = format!("{} of {} m", e.detail, fmt_m(c));
-        // The lane-by-lane length of the whole frame.
-        let path = s.frame_area_m2() / c;
-        e.bytes += pid_records(Some(&self.exec), path) * RECORD_BYTES;
+        // The lane-by-lane length of the whole frame, one cell a move.
+        let moves = s.frame_area_m2() / (c * c);
+        let records = pid_records(Some(&self.exec), moves, c);
+        e.bytes += records * PID_RECORD_BYTES;
+        if records > 0.0 {
+            e.detail = format!(
+                "{}, about {} PID trace records",
+                e.detail,
+                fmt_count(records)
+            );
+        }
         e
     }
 
@@ -893,8 +916,16 @@ impl PlannerSettings for RectOptions {
         let n = (w / self.width_m + 2.0) * (h / self.length_m + 2.0);
         let mut e = ResourceEstimate::units(n, RECORD_BYTES, "waypoints")
             .remedy("a larger robot length and width, or a smaller area");
-        let path = n * self.length_m;
-        e.bytes += pid_records(Some(&self.exec), path) * RECORD_BYTES;
+        // A move a waypoint, at most a lane's length each.
+        let records = pid_records(Some(&self.exec), n, self.length_m);
+        e.bytes += records * PID_RECORD_BYTES;
+        if records > 0.0 {
+            e.detail = format!(
+                "{}, about {} PID trace records",
+                e.detail,
+                fmt_count(records)
+            );
+        }
         e
     }
 
@@ -985,5 +1016,50 @@ pub fn fmt_m(v: f64) -> String {
     } else {
         let s = format!("{v:.6}");
         s.trim_end_matches('0').trim_end_matches('.').to_string()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn apartment() -> Setup {
+        // `apartment_400x300` at `--radius 0.05` (cells of 0.1 m).
+        Setup {
+            frame: MapFrame::new(400, 300, 0.05),
+            robot: Robot::new(0.05),
+            sensor_range: 1.0,
+        }
+    }
+
+    #[test]
+    fn bsa_bfs_estimate_counts_the_pid_records_a_run_makes() {
+        let s = apartment();
+        let o = BsaBfsOptions::default();
+        assert!(matches!(o.exec, Execution::Pid(_)));
+        let e = o.estimate(&s);
+        // Measured (`ccpp run --planner bsa-bfs --radius 0.05`): 906 424 trace records, peak
+        // resident memory 81 MB of which 8 MB are the map's pixels ([`PIXEL_BYTES`]).
+        let records = pid_records(Some(&o.exec), s.frame_area_m2() / 0.01, 0.1);
+        assert!(records >= 906_424.0, "{records}");
+        assert!(e.bytes + s.pixels() * PIXEL_BYTES >= 81e6, "{}", e.bytes);
+        assert!(e.detail.contains("PID trace records"), "{}", e.detail);
+        assert!(e.remedy.contains("record_every"), "{}", e.remedy);
+        // Fewer records kept, less memory; none under ideal execution.
+        let sparse = BsaBfsOptions {
+            exec: Execution::Pid(PidOptions {
+                record_every: 10,
+                ..PidOptions::default()
+            }),
+            ..BsaBfsOptions::default()
+        };
+        assert!(sparse.estimate(&s).bytes < e.bytes / 2.0);
+        let ideal = BsaBfsOptions {
+            exec: Execution::Ideal,
+            ..BsaBfsOptions::default()
+        };
+        let i = ideal.estimate(&s);
+        assert!(i.bytes < e.bytes / 10.0);
+        assert!(!i.detail.contains("PID"), "{}", i.detail);
     }
 }
