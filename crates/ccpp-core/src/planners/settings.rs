@@ -360,7 +360,7 @@ fn validate_pid(field: &str, p: &PidOptions) -> Result<(), OptionsError> {
 }
 
 /// Bytes of one PID trace record in memory: a stored pose (56 bytes) in a vector that grows by
-/// doubling (1.5 times that on average, twice at worst; the record count [`pid_records`] gives
+/// doubling (1.5 times that on average, twice at worst; the record count the estimates use
 /// is itself above the measured ones). The trace's text is written as it is made, not held.
 pub const PID_RECORD_BYTES: f64 = 84.0;
 
