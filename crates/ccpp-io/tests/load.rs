@@ -476,8 +476,8 @@ fn bad_resolution_and_thresholds() {
 fn unsupported_mode() {
     let d = TempDir::new().unwrap();
     write(&d, "img.pgm", b"P5 1 1 255\n\x00");
-    for mode in ["scale", "raw"] {
-        let name = format!("{mode}.yaml");
+    for mode in ["likelihood", "tri nary"] {
+        let name = format!("{}.yaml", mode.replace(' ', "_"));
         let y = write(
             &d,
             &name,
@@ -488,8 +488,86 @@ fn unsupported_mode() {
             matches!(&e, MapError::UnsupportedMode { mode: m, .. } if m == mode),
             "{e}"
         );
+        assert!(e.to_string().contains("trinary, scale and raw"), "{e}");
         names(&e, &name);
     }
+}
+
+#[test]
+fn scale_mode_makes_transparent_pixels_unknown() {
+    let d = TempDir::new().unwrap();
+    // Opaque free, occupied, grey-205 unknown; then the same three transparent or half so.
+    let rgba: ImageBuffer<Rgba<u8>, Vec<u8>> = ImageBuffer::from_raw(
+        6,
+        1,
+        vec![
+            254, 254, 254, 255, 0, 0, 0, 255, 205, 205, 205, 255, 254, 254, 254, 0, 0, 0, 0, 128,
+            205, 205, 205, 0,
+        ],
+    )
+    .unwrap();
+    rgba.save(d.path().join("rgba.png")).unwrap();
+    let la: ImageBuffer<image::LumaA<u16>, Vec<u16>> =
+        ImageBuffer::from_raw(2, 1, vec![65535, 65535, 65535, 65534]).unwrap();
+    DynamicImage::ImageLumaA16(la)
+        .save(d.path().join("la16.png"))
+        .unwrap();
+    for (mode, rgba_cells, la_cells) in [
+        ("trinary", [F, O, U, F, O, U], [F, F]),
+        ("scale", [F, O, U, U, U, U], [F, U]),
+        ("Scale", [F, O, U, U, U, U], [F, U]),
+    ] {
+        for (image, want) in [("rgba.png", &rgba_cells[..]), ("la16.png", &la_cells[..])] {
+            let y = write(
+                &d,
+                "m.yaml",
+                format!("image: {image}\nmode: {mode}\n{YAML_TAIL}").as_bytes(),
+            );
+            assert_eq!(cells(&y), want, "{mode} {image}");
+        }
+    }
+}
+
+#[test]
+fn raw_mode_reads_the_occupancy_in_percent() {
+    let d = TempDir::new().unwrap();
+    // Levels 0, 19, 20, 65, 66, 100, 101, 255 under the default thresholds (0.196, 0.65).
+    write(
+        &d,
+        "raw.pgm",
+        b"P5 8 1 255\n\x00\x13\x14\x41\x42\x64\x65\xff",
+    );
+    let y = write(
+        &d,
+        "raw.yaml",
+        format!("image: raw.pgm\nmode: raw\n{YAML_TAIL}").as_bytes(),
+    );
+    assert_eq!(cells(&y), [F, F, U, U, O, O, U, U]);
+    // The same image in trinary mode: dark is occupied.
+    let t = write(
+        &d,
+        "tri.yaml",
+        format!("image: raw.pgm\n{YAML_TAIL}").as_bytes(),
+    );
+    assert_eq!(cells(&t), [O, O, O, O, O, U, U, F]);
+    // Raw with negate means two things (ROS 1 inverts, Nav2 does not): refused.
+    let n = write(
+        &d,
+        "rawneg.yaml",
+        format!("image: raw.pgm\nmode: raw\nnegate: 1\n{YAML_TAIL}").as_bytes(),
+    );
+    let e = load(&n).unwrap_err();
+    assert!(
+        matches!(
+            &e,
+            MapError::BadValue {
+                field: "negate",
+                ..
+            }
+        ),
+        "{e}"
+    );
+    names(&e, "rawneg.yaml");
 }
 
 #[test]

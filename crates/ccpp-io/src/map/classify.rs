@@ -1,4 +1,5 @@
-//! Pixel classification: ROS `map_server` trinary mode ([`Thresholds`], [`classify`]).
+//! Pixel classification: ROS `map_server`'s `trinary`, `scale` and `raw` modes ([`Thresholds`],
+//! [`MapMode`], [`classify`]).
 
 use std::path::Path;
 
@@ -11,7 +12,47 @@ pub const DEFAULT_OCCUPIED_THRESH: f64 = 0.65;
 /// Default `free_thresh` of ROS `map_server` when the YAML has none.
 pub const DEFAULT_FREE_THRESH: f64 = 0.196;
 
-/// Trinary classification thresholds of `map_server`.
+/// How a `map_server` YAML's `mode` reads a pixel (module docs of [`crate::map`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum MapMode {
+    /// `p` from the grey level, three classes by the thresholds (the default).
+    #[default]
+    Trinary,
+    /// As trinary, and a transparent pixel (alpha below its maximum) is unknown. `map_server`
+    /// grades the occupancies between the thresholds (1..99); ccpp has no graded cells and
+    /// keeps them unknown, as trinary does.
+    Scale,
+    /// The grey level is the occupancy in percent: 0..=100 gives `p = v / 100` (rounded to
+    /// a whole level first), classified by the thresholds; 101 and above is unknown.
+    Raw,
+}
+
+impl MapMode {
+    /// The mode named by a YAML `mode` value (`trinary`, `scale`, `raw`; any case, spaces
+    /// around ignored), or `None`.
+    pub fn parse(name: &str) -> Option<Self> {
+        let n = name.trim();
+        [
+            ("trinary", Self::Trinary),
+            ("scale", Self::Scale),
+            ("raw", Self::Raw),
+        ]
+        .into_iter()
+        .find(|(k, _)| n.eq_ignore_ascii_case(k))
+        .map(|(_, m)| m)
+    }
+
+    /// The YAML name of the mode.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Trinary => "trinary",
+            Self::Scale => "scale",
+            Self::Raw => "raw",
+        }
+    }
+}
+
+/// Classification thresholds and mode of `map_server`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Thresholds {
     /// A pixel whose occupancy probability `p` is strictly above this is occupied.
@@ -20,6 +61,8 @@ pub struct Thresholds {
     pub free: f64,
     /// When `true`, `p = v / 255` (light is occupied) instead of `p = (255 - v) / 255`.
     pub negate: bool,
+    /// The YAML's `mode`.
+    pub mode: MapMode,
 }
 
 impl Default for Thresholds {
@@ -29,12 +72,15 @@ impl Default for Thresholds {
             occupied: DEFAULT_OCCUPIED_THRESH,
             free: DEFAULT_FREE_THRESH,
             negate: false,
+            mode: MapMode::Trinary,
         }
     }
 }
 
 impl Thresholds {
-    /// Checks that both thresholds lie in `[0, 1]` and that `free < occupied`.
+    /// Checks that both thresholds lie in `[0, 1]`, that `free < occupied`, and that `negate`
+    /// is not asked of `raw` mode (ROS 1's `map_server` inverts a raw value, Nav2's does not:
+    /// such a map means two different things).
     ///
     /// # Errors
     /// [`MapError::BadValue`] naming `path` and the offending field.
@@ -61,6 +107,14 @@ impl Thresholds {
                 ),
             ));
         }
+        if self.negate && self.mode == MapMode::Raw {
+            return Err(bad(
+                "negate",
+                "negate: 1 with mode: raw is ambiguous (ROS 1 map_server inverts raw values, \
+                 Nav2 does not); invert the image and set negate: 0"
+                    .to_owned(),
+            ));
+        }
         Ok(())
     }
 
@@ -79,9 +133,18 @@ impl Thresholds {
 
     /// Classifies a grey level on the 0..=255 scale, possibly fractional (the mean of R, G, B
     /// or a rescaled 16-bit value). `p = (255 - level) / 255`, or `level / 255` when negated,
-    /// computed in `f64` exactly as `map_server` does.
+    /// computed in `f64` exactly as `map_server` does; in `raw` mode the level rounded is the
+    /// occupancy in percent (above 100: unknown).
     #[inline]
     pub fn classify_level(&self, level: f64) -> Cell {
+        if self.mode == MapMode::Raw {
+            let v = level.round();
+            return if v <= 100.0 {
+                self.classify_probability(v / 100.0)
+            } else {
+                Cell::Unknown
+            };
+        }
         let p = if self.negate {
             level / 255.0
         } else {
@@ -164,6 +227,7 @@ mod tests {
             occupied: 0.2,
             free: 0.1,
             negate: false,
+            mode: MapMode::Trinary,
         };
         assert_eq!(classify(204, &t), Cell::Unknown);
         assert_eq!(classify(203, &t), Cell::Occupied);
@@ -171,6 +235,7 @@ mod tests {
             occupied: 0.9,
             free: 0.2,
             negate: false,
+            mode: MapMode::Trinary,
         };
         assert_eq!(classify(204, &t), Cell::Unknown);
         assert_eq!(classify(205, &t), Cell::Free);
@@ -183,6 +248,7 @@ mod tests {
             occupied: 0.5,
             free: 0.3,
             negate: true,
+            mode: MapMode::Trinary,
         };
         let lut = t.lut();
         for v in 0..=255u8 {
@@ -197,7 +263,8 @@ mod tests {
         assert!(Thresholds {
             occupied: 1.0,
             free: 0.0,
-            negate: false
+            negate: false,
+            mode: MapMode::Trinary,
         }
         .validate(p)
         .is_ok());
@@ -212,11 +279,66 @@ mod tests {
                 occupied: o,
                 free: f,
                 negate: false,
+                mode: MapMode::Trinary,
             };
             assert!(
                 matches!(t.validate(p), Err(MapError::BadValue { .. })),
                 "{o} {f}"
             );
         }
+    }
+
+    #[test]
+    fn modes_by_name_and_raw_levels() {
+        assert_eq!(MapMode::parse(" Scale "), Some(MapMode::Scale));
+        assert_eq!(MapMode::parse("RAW"), Some(MapMode::Raw));
+        assert_eq!(MapMode::parse("trinary"), Some(MapMode::Trinary));
+        assert_eq!(MapMode::parse("tri"), None);
+        for m in [MapMode::Trinary, MapMode::Scale, MapMode::Raw] {
+            assert_eq!(MapMode::parse(m.name()), Some(m));
+        }
+        // Scale reads grey levels as trinary does.
+        let scale = Thresholds {
+            mode: MapMode::Scale,
+            ..Thresholds::default()
+        };
+        for v in 0..=255u8 {
+            assert_eq!(
+                classify(v, &scale),
+                classify(v, &Thresholds::default()),
+                "{v}"
+            );
+        }
+        // Raw: the value is the occupancy in percent.
+        let raw = Thresholds {
+            mode: MapMode::Raw,
+            ..Thresholds::default()
+        };
+        assert_eq!(classify(0, &raw), Cell::Free);
+        assert_eq!(classify(19, &raw), Cell::Free); // p = 0.19 < 0.196
+        assert_eq!(classify(20, &raw), Cell::Unknown);
+        assert_eq!(classify(65, &raw), Cell::Unknown); // not above 0.65
+        assert_eq!(classify(66, &raw), Cell::Occupied);
+        assert_eq!(classify(100, &raw), Cell::Occupied);
+        assert_eq!(classify(101, &raw), Cell::Unknown);
+        assert_eq!(classify(255, &raw), Cell::Unknown);
+        // A colour mean rounds to a whole level first.
+        assert_eq!(raw.classify_level(65.6), Cell::Occupied);
+        assert_eq!(raw.classify_level(100.4), Cell::Occupied);
+        assert_eq!(raw.classify_level(100.5), Cell::Unknown);
+        // Raw and negate: refused.
+        let p = Path::new("r.yaml");
+        assert!(raw.validate(p).is_ok());
+        let e = Thresholds {
+            negate: true,
+            ..raw
+        }
+        .validate(p)
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("negate") && e.contains("raw") && e.contains("r.yaml"),
+            "{e}"
+        );
     }
 }

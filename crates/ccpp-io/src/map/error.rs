@@ -84,9 +84,9 @@ pub enum MapError {
         /// The most pixels allowed.
         max_pixels: u64,
     },
-    /// The YAML asks for a `mode` other than `trinary`.
+    /// The YAML asks for a `mode` other than `trinary`, `scale` or `raw`.
     #[error(
-        "map YAML {}: unsupported mode `{mode}` (only `trinary` is supported)",
+        "map YAML {}: unsupported mode `{mode}` (map_server's modes are trinary, scale and raw)",
         path.display()
     )]
     UnsupportedMode {

@@ -2,22 +2,31 @@
 //!
 //! # Pixel rule
 //!
-//! Each pixel becomes a [`Cell`](ccpp_core::grid::Cell) by `map_server`'s **trinary** mode
-//! (the only supported mode; `scale` and `raw` are refused with [`MapError::UnsupportedMode`]):
+//! Each pixel becomes a [`Cell`](ccpp_core::grid::Cell) by `map_server`'s rule for the YAML's
+//! `mode` ([`MapMode`]; **trinary** when there is none or the map is a bare image):
 //!
 //! 1. Grey level `v` on the 0..=255 scale:
 //!    * grey images (8-bit): the value itself;
 //!    * colour images (RGB, RGBA, palette): the **exact** mean `(R + G + B) / 3` as an `f64`, no
 //!      integer rounding (this is what `map_server` computes too);
-//!    * **alpha is ignored.** The real ROS loaders average alpha in as a fourth channel in
-//!      trinary mode, which turns the grey 205 "unknown" of an opaque RGBA map into free; we
-//!      follow the documented rule instead, so 205 stays unknown whatever the alpha;
+//!    * **alpha is ignored** in trinary and raw modes. The real ROS loaders average alpha in as
+//!      a fourth channel in trinary mode, which turns the grey 205 "unknown" of an opaque RGBA
+//!      map into free; we follow the documented rule instead, so 205 stays unknown whatever
+//!      the alpha. In **scale** mode a transparent pixel (alpha below its maximum) is unknown,
+//!      as documented for `map_server`;
 //!    * 16-bit images: `v = v16 / 257` as an `f64` (65535 -> 255.0, 205 * 257 -> 205.0), not
 //!      truncated to 8 bits first; PGMs whose maxval is not 255 or 65535 are rescaled to the
 //!      full range by the decoder (rounded to the nearest integer).
-//! 2. `p = (255 - v) / 255`, or `p = v / 255` with `negate`.
+//! 2. `p = (255 - v) / 255`, or `p = v / 255` with `negate`. In **raw** mode the level is the
+//!    occupancy in percent: `p = round(v) / 100` for `round(v) <= 100`, unknown above (255 is
+//!    the usual unknown); `negate` with raw is refused (ROS 1 inverts a raw value, Nav2 does
+//!    not).
 //! 3. `p > occupied_thresh` -> occupied, `p < free_thresh` -> free, else unknown, compared in
-//!    `f64` without rounding (grey 205 stays unknown under `free_thresh: 0.196`).
+//!    `f64` without rounding (grey 205 stays unknown under `free_thresh: 0.196`). Scale mode's
+//!    graded occupancies between the thresholds stay unknown: ccpp's cells have no grades, and
+//!    a robot should not count uncertain floor as floor to clean.
+//!
+//! A `mode` other than these three is refused ([`MapError::UnsupportedMode`]).
 //!
 //! # Frame
 //!
@@ -36,7 +45,7 @@ use ccpp_core::geometry::Pose;
 use ccpp_core::grid::{GridMap, MapFrame};
 use image::ImageReader;
 
-pub use classify::{classify, Thresholds, DEFAULT_FREE_THRESH, DEFAULT_OCCUPIED_THRESH};
+pub use classify::{classify, MapMode, Thresholds, DEFAULT_FREE_THRESH, DEFAULT_OCCUPIED_THRESH};
 pub use error::MapError;
 pub use yaml::{heading_problem, validate_placement, MapYaml, MAX_HEADING_RAD};
 
@@ -200,7 +209,7 @@ fn finish<R: std::io::BufRead + std::io::Seek>(
     opts: &LoadOptions,
 ) -> Result<LoadedMap, MapError> {
     if let Some(mode) = yaml.and_then(|y| y.mode.as_deref()) {
-        if !mode.trim().eq_ignore_ascii_case("trinary") {
+        if MapMode::parse(mode).is_none() {
             return Err(MapError::UnsupportedMode {
                 path: source.to_path_buf(),
                 mode: mode.to_owned(),
@@ -217,6 +226,7 @@ fn finish<R: std::io::BufRead + std::io::Seek>(
         occupied: opts.occupied_thresh.unwrap_or(base.occupied),
         free: opts.free_thresh.unwrap_or(base.free),
         negate: opts.negate.unwrap_or(base.negate),
+        mode: base.mode,
     };
     validate_placement(resolution, origin, source)?;
     thresholds.validate(source)?;

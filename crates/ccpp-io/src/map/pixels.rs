@@ -2,7 +2,7 @@
 //!
 //! Grey level rule (documented in [`crate::map`]): grey images use their value; colour images
 //! use the exact mean `(R + G + B) / 3` as an `f64` (no rounding, as `map_server` does); alpha
-//! is ignored; 16-bit samples are mapped to the 0..=255 scale as `v / 257` (exact, not truncated
+//! is ignored except in `scale` mode, where a transparent pixel is unknown; 16-bit samples are mapped to the 0..=255 scale as `v / 257` (exact, not truncated
 //! to 8 bits first); float samples as `v * 255` clamped to `[0, 255]`.
 
 use std::io::{BufRead, Seek, SeekFrom};
@@ -11,7 +11,7 @@ use std::path::Path;
 use ccpp_core::grid::Cell;
 use image::{DynamicImage, ImageReader};
 
-use super::classify::Thresholds;
+use super::classify::{MapMode, Thresholds};
 use super::error::{one_line, MapError};
 
 /// Width, height and row-major cells (row 0 on top) of a decoded and classified image.
@@ -93,6 +93,9 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
 fn classify_image(img: &DynamicImage, t: &Thresholds) -> Vec<Cell> {
     let n = img.width() as usize * img.height() as usize;
     let mut cells = Vec::with_capacity(n);
+    // Scale mode: a pixel whose alpha is below its maximum is unknown.
+    let alpha = t.mode == MapMode::Scale;
+    let seen = |opaque: bool, c: Cell| if opaque || !alpha { c } else { Cell::Unknown };
     match img {
         DynamicImage::ImageLuma8(b) => {
             let lut = t.lut();
@@ -100,7 +103,11 @@ fn classify_image(img: &DynamicImage, t: &Thresholds) -> Vec<Cell> {
         }
         DynamicImage::ImageLumaA8(b) => {
             let lut = t.lut();
-            cells.extend(b.as_raw().chunks_exact(2).map(|p| lut[usize::from(p[0])]));
+            cells.extend(
+                b.as_raw()
+                    .chunks_exact(2)
+                    .map(|p| seen(p[1] == u8::MAX, lut[usize::from(p[0])])),
+            );
         }
         DynamicImage::ImageRgb8(b) => {
             let lut = sum_lut(t);
@@ -108,7 +115,11 @@ fn classify_image(img: &DynamicImage, t: &Thresholds) -> Vec<Cell> {
         }
         DynamicImage::ImageRgba8(b) => {
             let lut = sum_lut(t);
-            cells.extend(b.as_raw().chunks_exact(4).map(|p| lut[rgb_sum(p)]));
+            cells.extend(
+                b.as_raw()
+                    .chunks_exact(4)
+                    .map(|p| seen(p[3] == u8::MAX, lut[rgb_sum(p)])),
+            );
         }
         DynamicImage::ImageLuma16(b) => {
             cells.extend(
@@ -121,7 +132,7 @@ fn classify_image(img: &DynamicImage, t: &Thresholds) -> Vec<Cell> {
             cells.extend(
                 b.as_raw()
                     .chunks_exact(2)
-                    .map(|p| t.classify_level(level16(f64::from(p[0])))),
+                    .map(|p| seen(p[1] == u16::MAX, t.classify_level(level16(f64::from(p[0]))))),
             );
         }
         DynamicImage::ImageRgb16(b) => {
@@ -135,15 +146,18 @@ fn classify_image(img: &DynamicImage, t: &Thresholds) -> Vec<Cell> {
             cells.extend(
                 b.as_raw()
                     .chunks_exact(4)
-                    .map(|p| t.classify_level(rgb16_level(p))),
+                    .map(|p| seen(p[3] == u16::MAX, t.classify_level(rgb16_level(p)))),
             );
         }
         other => {
-            // Float images (and any future variant): go through 32-bit float RGB.
-            let rgb = other.to_rgb32f();
-            cells.extend(rgb.as_raw().chunks_exact(3).map(|p| {
+            // Float images (and any future variant): go through 32-bit float RGBA.
+            let rgba = other.to_rgba32f();
+            cells.extend(rgba.as_raw().chunks_exact(4).map(|p| {
                 let mean = (f64::from(p[0]) + f64::from(p[1]) + f64::from(p[2])) / 3.0;
-                t.classify_level((mean * 255.0).clamp(0.0, 255.0))
+                seen(
+                    p[3] >= 1.0,
+                    t.classify_level((mean * 255.0).clamp(0.0, 255.0)),
+                )
             }));
         }
     }

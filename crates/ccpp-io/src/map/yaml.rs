@@ -8,7 +8,7 @@ use serde::Deserialize;
 
 use ccpp_core::display::Compact;
 
-use super::classify::{Thresholds, DEFAULT_FREE_THRESH, DEFAULT_OCCUPIED_THRESH};
+use super::classify::{MapMode, Thresholds, DEFAULT_FREE_THRESH, DEFAULT_OCCUPIED_THRESH};
 use super::error::{one_line, MapError};
 
 /// A parsed and validated ROS `map_server` YAML.
@@ -20,7 +20,7 @@ use super::error::{one_line, MapError};
 /// negate: 0                 # optional, 0/1 or false/true (default 0)
 /// occupied_thresh: 0.65     # optional (default 0.65)
 /// free_thresh: 0.196        # optional (default 0.196)
-/// mode: trinary             # optional; only trinary is supported by the loader
+/// mode: trinary             # optional: trinary (default), scale or raw
 /// ```
 ///
 /// Unknown keys are ignored, as `map_server` does.
@@ -159,6 +159,11 @@ impl MapYaml {
             occupied: self.occupied_thresh,
             free: self.free_thresh,
             negate: self.negate,
+            mode: self
+                .mode
+                .as_deref()
+                .and_then(MapMode::parse)
+                .unwrap_or_default(),
         }
     }
 }
@@ -282,7 +287,8 @@ mod tests {
             Thresholds {
                 occupied: 0.7,
                 free: 0.25,
-                negate: false
+                negate: false,
+                mode: MapMode::Trinary,
             }
         );
     }
