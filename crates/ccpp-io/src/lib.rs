@@ -3,8 +3,9 @@
 //! File input and output for **ccpp**:
 //!
 //! * [`map`]: loads ROS `map_server` maps (YAML + PGM/PNG) and bare images into a
-//!   [`GridMap`](ccpp_core::grid::GridMap), following `map_server`'s trinary rule exactly (see
-//!   the module docs for the grey-level, alpha and 16-bit conventions);
+//!   [`GridMap`](ccpp_core::grid::GridMap), following `map_server`'s trinary rule exactly (and its
+//!   `scale` and `raw` modes; see the module docs for the grey-level, alpha and 16-bit
+//!   conventions);
 //! * [`write`](mod@write): atomic file writers and a `map_saver`-style map writer;
 //! * [`georef`]: `--georef` point-pair files for the affine pixel <-> world fit (seed 003);
 //! * [`landmarks`]: `--landmarks` files (CSV or JSON) for the simulator's pose correction;
