@@ -12,6 +12,15 @@ use crate::components::{free_components, StartComponent};
 use crate::job::{prepare_map, robot_from};
 use crate::output::num;
 
+/// How the map's pixels were read.
+#[derive(Serialize)]
+struct Pixels {
+    mode: &'static str,
+    occupied_thresh: f64,
+    free_thresh: f64,
+    negate: bool,
+}
+
 /// The report. Robot-dependent fields are `null` when the robot does not fit on the map.
 #[derive(Serialize)]
 struct Info {
@@ -22,6 +31,8 @@ struct Info {
     origin: [f64; 3],
     width_m: f64,
     height_m: f64,
+    /// How the pixels were read: `map_server` mode, thresholds, negate.
+    pixels: Pixels,
     free_px: usize,
     occupied_px: usize,
     unknown_px: usize,
@@ -125,6 +136,12 @@ pub fn run(a: &InfoArgs) -> Result<()> {
         origin: [f.origin.x, f.origin.y, f.origin.theta],
         width_m: f.width_m(),
         height_m: f.height_m(),
+        pixels: Pixels {
+            mode: map.thresholds.mode.name(),
+            occupied_thresh: map.thresholds.occupied,
+            free_thresh: map.thresholds.free,
+            negate: map.thresholds.negate,
+        },
         free_px: free,
         occupied_px: occ,
         unknown_px: unk,
@@ -177,6 +194,17 @@ pub fn run(a: &InfoArgs) -> Result<()> {
         num(f.origin.x),
         num(f.origin.y),
         num(f.origin.theta)
+    ));
+    line(format!(
+        "pixels         {}: occupied above p = {}, free below {}{}",
+        info.pixels.mode,
+        num(info.pixels.occupied_thresh),
+        num(info.pixels.free_thresh),
+        if info.pixels.negate {
+            ", negated (light is occupied)"
+        } else {
+            ""
+        }
     ));
     line(format!(
         "free           {free} px ({:.1} %), {:.1} m2",

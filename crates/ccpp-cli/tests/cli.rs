@@ -131,6 +131,80 @@ fn info_reports_counts() {
         + v["unknown_px"].as_u64().unwrap();
     assert_eq!(total, 120 * 120);
     assert!(v["accessible_m2"].as_f64().unwrap() > 20.0);
+    assert_eq!(v["pixels"]["mode"], "trinary");
+    assert_eq!(v["pixels"]["occupied_thresh"], 0.65);
+    assert_eq!(v["pixels"]["negate"], false);
+}
+
+/// A map YAML's mode reaches the classification (`info` names it): the same grey image read as
+/// trinary, scale (transparent = unknown) and raw (the grey level is the occupancy in percent),
+/// and `--free-thresh` overrides the YAML's.
+#[test]
+fn info_names_the_map_mode_the_pixels_were_read_by() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // 20 x 10 px: a border of 0 (56 px), one pixel of 100 (raw: occupied; trinary: p = 0.61,
+    // unknown), one transparent white pixel, the rest white.
+    let mut img = image::RgbaImage::from_pixel(20, 10, image::Rgba([255, 255, 255, 255]));
+    for (x, y, p) in img.enumerate_pixels_mut() {
+        if x == 0 || y == 0 || x == 19 || y == 9 {
+            *p = image::Rgba([0, 0, 0, 255]);
+        } else if x == 5 && y == 5 {
+            *p = image::Rgba([100, 100, 100, 255]);
+        } else if x == 10 && y == 5 {
+            *p = image::Rgba([255, 255, 255, 0]);
+        }
+    }
+    img.save(d.join("m.png")).unwrap();
+    let info = |mode: &str, extra: &[&str]| -> (serde_json::Value, String) {
+        let y = d.join(format!("{mode}.yaml"));
+        std::fs::write(
+            &y,
+            format!("image: m.png\nresolution: 0.05\norigin: [0, 0, 0]\nmode: {mode}\n"),
+        )
+        .unwrap();
+        let run = |json: bool| {
+            let mut c = ccpp();
+            c.args(["info", "--map"]).arg(&y).args(extra);
+            if json {
+                c.arg("--json");
+            }
+            c.assert().success().get_output().stdout.clone()
+        };
+        (
+            serde_json::from_slice(&run(true)).unwrap(),
+            String::from_utf8(run(false)).unwrap(),
+        )
+    };
+    let count = |v: &serde_json::Value, k: &str| v[k].as_u64().unwrap();
+    let (t, text) = info("trinary", &[]);
+    assert!(
+        text.contains("pixels         trinary: occupied above p = 0.65, free below 0.196"),
+        "{text}"
+    );
+    assert_eq!((count(&t, "occupied_px"), count(&t, "unknown_px")), (56, 1));
+    let (s, text) = info("scale", &[]);
+    assert!(text.contains("pixels         scale:"), "{text}");
+    assert_eq!(s["pixels"]["mode"], "scale");
+    assert_eq!((count(&s, "occupied_px"), count(&s, "unknown_px")), (56, 2));
+    // Raw: 0 is free (p = 0), 100 occupied, 255 unknown.
+    let (r, text) = info("raw", &[]);
+    assert!(text.contains("pixels         raw:"), "{text}");
+    assert_eq!(
+        (
+            count(&r, "free_px"),
+            count(&r, "occupied_px"),
+            count(&r, "unknown_px")
+        ),
+        (56, 1, 143)
+    );
+    // An override of the YAML's threshold is what the pixels were read by.
+    let (o, text) = info("trinary", &["--free-thresh", "0.3"]);
+    assert!(
+        text.contains("occupied above p = 0.65, free below 0.3"),
+        "{text}"
+    );
+    assert_eq!(o["pixels"]["free_thresh"], 0.3);
 }
 
 /// Runs `ccpp run` with `args`, expects failure with a one-line error containing every needle,

@@ -42,7 +42,7 @@ use ccpp_core::Pose;
 use fixedbitset::FixedBitSet;
 use serde::{Deserialize, Serialize};
 
-use crate::map::{load_map, LoadOptions, LoadedMap, MapError};
+use crate::map::{load_map, LoadOptions, LoadedMap, MapError, Thresholds};
 use crate::trace::{FileFormer, FormedFiles};
 use crate::zones::{ZoneData, ZoneSpec};
 use ccpp_core::zones::ZoneMasks;
@@ -219,6 +219,9 @@ pub struct PreparedMap {
     pub source: PathBuf,
     /// How it was made.
     pub recipe: MapRecipe,
+    /// How its pixels were classified (the YAML's or the overridden thresholds, negate and
+    /// mode; the defaults for a grid made in memory).
+    pub thresholds: Thresholds,
 }
 
 impl MapRecipe {
@@ -372,6 +375,7 @@ impl MapRecipe {
             name,
             source: loaded.source,
             recipe: self.clone(),
+            thresholds: loaded.thresholds,
         })
     }
 }
@@ -1063,6 +1067,7 @@ impl Scenario {
             name,
             source,
             recipe,
+            thresholds,
         } = map;
         let world = crate::phase::time("world", || {
             // The checks read the map as prepared; the grid is moved back out afterwards.
@@ -1071,6 +1076,7 @@ impl Scenario {
                 name: String::new(),
                 source,
                 recipe,
+                thresholds,
             };
             let zones = self.world_checks(&prepared)?;
             self.world_on(

@@ -34,6 +34,7 @@ fn room() -> PreparedMap {
         name: "room".to_string(),
         source: "room.yaml".into(),
         recipe: MapRecipe::file("room.yaml"),
+        thresholds: ccpp_io::map::Thresholds::default(),
     }
 }
 
