@@ -371,14 +371,28 @@ pub const PID_RECORD_BYTES: f64 = 84.0;
 /// 0.1 m move and 33 a quarter turn at the default gains; 906 424 records on
 /// `apartment_400x300` at `--radius 0.05` (25 841 moves, 1198 turns), where the old count
 /// (length over top speed) gave 120 000 and the estimate 37 MB against a peak of 81 MB.
-fn pid_records(e: Option<&Execution>, moves: f64, move_m: f64) -> f64 {
+fn pid_records(e: &Execution, moves: f64, move_m: f64) -> f64 {
     match e {
-        Some(Execution::Pid(p)) => {
+        Execution::Pid(p) => {
             let per_move = p.motion_steps(0.0, move_m) as f64
                 + p.motion_steps(std::f64::consts::FRAC_PI_2, 0.0) as f64 / PID_TURN_EVERY;
             moves * per_move / f64::from(p.record_every.max(1))
         }
-        _ => 0.0,
+        Execution::Ideal => 0.0,
+    }
+}
+
+/// Adds the PID trace records of `moves` moves of `move_m` metres ([`pid_records`]) to an
+/// estimate, naming them in its detail (nothing under ideal execution).
+fn add_pid_records(e: &mut ResourceEstimate, exec: &Execution, moves: f64, move_m: f64) {
+    let records = pid_records(exec, moves, move_m);
+    if records > 0.0 {
+        e.bytes += records * PID_RECORD_BYTES;
+        e.detail = format!(
+            "{}, about {} PID trace records",
+            e.detail,
+            fmt_count(records)
+        );
     }
 }
 
@@ -737,15 +751,7 @@ impl PlannerSettings for BsaBfsOptions {
         e.detail = format!("{} of {} m", e.detail, fmt_m(c));
         // The lane-by-lane length of the whole frame, one cell a move.
         let moves = s.frame_area_m2() / (c * c);
-        let records = pid_records(Some(&self.exec), moves, c);
-        e.bytes += records * PID_RECORD_BYTES;
-        if records > 0.0 {
-            e.detail = format!(
-                "{}, about {} PID trace records",
-                e.detail,
-                fmt_count(records)
-            );
-        }
+        add_pid_records(&mut e, &self.exec, moves, c);
         e
     }
 
@@ -917,15 +923,7 @@ impl PlannerSettings for RectOptions {
         let mut e = ResourceEstimate::units(n, RECORD_BYTES, "waypoints")
             .remedy("a larger robot length and width, or a smaller area");
         // A move a waypoint, at most a lane's length each.
-        let records = pid_records(Some(&self.exec), n, self.length_m);
-        e.bytes += records * PID_RECORD_BYTES;
-        if records > 0.0 {
-            e.detail = format!(
-                "{}, about {} PID trace records",
-                e.detail,
-                fmt_count(records)
-            );
-        }
+        add_pid_records(&mut e, &self.exec, n, self.length_m);
         e
     }
 
@@ -1040,7 +1038,7 @@ mod tests {
         let e = o.estimate(&s);
         // Measured (`ccpp run --planner bsa-bfs --radius 0.05`): 906 424 trace records, peak
         // resident memory 81 MB of which 8 MB are the map's pixels ([`PIXEL_BYTES`]).
-        let records = pid_records(Some(&o.exec), s.frame_area_m2() / 0.01, 0.1);
+        let records = pid_records(&o.exec, s.frame_area_m2() / 0.01, 0.1);
         assert!(records >= 906_424.0, "{records}");
         assert!(e.bytes + s.pixels() * PIXEL_BYTES >= 81e6, "{}", e.bytes);
         assert!(e.detail.contains("PID trace records"), "{}", e.detail);
