@@ -350,6 +350,10 @@ fn config_values_go_through_the_same_validation() {
         ("bcd: { angle_tries: 4000000000 }", "bcd", "bcd.angle_tries"),
         // Tour rounds stop when one changes nothing, but a huge bound is still refused.
         ("bcd: { tour_rounds: 101 }", "bcd", "bcd.tour_rounds"),
+        // A pool of no thread plans nothing; thousands of threads bound nothing.
+        ("bcd: { plans_at_a_time: 0 }", "bcd", "bcd.plans_at_a_time"),
+        ("bcd: { plans_at_a_time: 65 }", "bcd", "bcd.plans_at_a_time"),
+        ("bcd: { plans_at_a_time: -1 }", "bcd", "invalid u32"),
         (
             "random_bounce: { budget_m: -5 }",
             "random-bounce",
@@ -457,8 +461,13 @@ fn config_values_go_through_the_same_validation() {
             "ba-star",
             "extension",
         ),
-        // bcd's turned-lattice tries belong to bcd only.
+        // bcd's turned-lattice tries and plans at a time belong to bcd only.
         ("ba_star: { angle_tries: 3 }", "ba-star", "angle_tries"),
+        (
+            "ba_star_extended: { plans_at_a_time: 1 }",
+            "ba-star-extended",
+            "plans_at_a_time",
+        ),
         (
             "rect_boustrophedon: { angle_tries: 3 }",
             "rect-boustrophedon",

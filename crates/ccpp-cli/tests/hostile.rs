@@ -1542,8 +1542,12 @@ fn bcd_counts_its_plans_pixels_once_per_plan_at_a_time() {
         (x % 200 == 100 && y % 300 > 40) || (y == 500 && x % 250 > 30)
     });
     let out = dir.join("out");
-    let figure = |threads: &str, needles: &[&str]| -> u64 {
-        let args = [
+    let one_cfg = dir.join("one.yaml");
+    std::fs::write(&one_cfg, "bcd: { plans_at_a_time: 1 }\n").unwrap();
+    let three_cfg = dir.join("three.yaml");
+    std::fs::write(&three_cfg, "bcd: { plans_at_a_time: 3 }\n").unwrap();
+    let figure = |threads: &str, cfg: Option<&Path>, needles: &[&str]| -> u64 {
+        let mut args = vec![
             "plan",
             "--planner",
             "bcd",
@@ -1556,9 +1560,12 @@ fn bcd_counts_its_plans_pixels_once_per_plan_at_a_time() {
             "--out",
             s(&out),
         ];
+        if let Some(c) = cfg {
+            args.extend(["--config", s(c)]);
+        }
         let a = ccpp()
             .env("RAYON_NUM_THREADS", threads)
-            .args(args)
+            .args(&args)
             .assert()
             .failure();
         let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
@@ -1575,12 +1582,12 @@ fn bcd_counts_its_plans_pixels_once_per_plan_at_a_time() {
         "bcd would need",
         "map pixels",
         "limit of 120 MB",
-        "RAYON_NUM_THREADS=1",
+        "bcd.plans_at_a_time: 1",
     ];
-    let one = figure("1", &[&common[..], &["1 plan at a time"]].concat());
-    let four = figure("4", &[&common[..], &["4 plans at a time"]].concat());
+    let one = figure("1", None, &[&common[..], &["1 plan at a time"]].concat());
+    let four = figure("4", None, &[&common[..], &["4 plans at a time"]].concat());
     // Up to four plans at a time: eight threads make no more than four.
-    let eight = figure("8", &[&common[..], &["4 plans at a time"]].concat());
+    let eight = figure("8", None, &[&common[..], &["4 plans at a time"]].concat());
     // 1e6 pixels x (64 + 64 + 32) bytes (153 MiB) and 64 000 lane squares of 0.2 m (18 MiB);
     // 3 x 32 bytes more a pixel for four plans.
     assert!((165..180).contains(&one), "{one} MB");
@@ -1589,6 +1596,76 @@ fn bcd_counts_its_plans_pixels_once_per_plan_at_a_time() {
         "3 x 32 B a pixel: 91.6 MiB, {four} - {one}"
     );
     assert_eq!(eight, four);
+    // bcd.plans_at_a_time sets the count whatever the threads.
+    let cfg_one = figure(
+        "8",
+        Some(&one_cfg),
+        &[&common[..], &["1 plan at a time"]].concat(),
+    );
+    assert_eq!(cfg_one, one);
+    let cfg_three = figure(
+        "1",
+        Some(&three_cfg),
+        &[&common[..], &["3 plans at a time"]].concat(),
+    );
+    assert!(cfg_three > one && cfg_three < four, "{cfg_three}");
+}
+
+/// `bcd.plans_at_a_time` bounds the plans made at the same time, not the plan: one at a time
+/// and the process's pool write the same path, and a limit the default refuses admits one plan
+/// at a time.
+#[test]
+fn bcd_plans_at_a_time_keeps_the_plan() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = common::pgm(dir, "rooms.pgm", 300, 240, |x, y| {
+        x == 0
+            || y == 0
+            || x == 299
+            || y == 239
+            || (x == 150 && y % 120 > 30)
+            || (y == 120 && x % 100 > 20)
+    });
+    let cfg = dir.join("one.yaml");
+    std::fs::write(&cfg, "bcd: { plans_at_a_time: 1 }\n").unwrap();
+    let plan = |out: &Path, config: bool, limit: &str| {
+        let mut c = ccpp();
+        c.env("RAYON_NUM_THREADS", "4").args([
+            "plan",
+            "--planner",
+            "bcd",
+            "--map",
+            s(&map),
+            "--max-memory",
+            limit,
+            "--out",
+            s(out),
+        ]);
+        if config {
+            c.args(["--config", s(&cfg)]);
+        }
+        c.assert()
+    };
+    let (a, b) = (dir.join("pool"), dir.join("one"));
+    plan(&a, false, "4096").success();
+    plan(&b, true, "4096").success();
+    let files: Vec<_> = std::fs::read_dir(&a)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert!(!files.is_empty());
+    for f in &files {
+        assert_eq!(
+            std::fs::read(a.join(f)).unwrap(),
+            std::fs::read(b.join(f)).unwrap(),
+            "{f:?}"
+        );
+    }
+    // 72 000 px: estimated about 19 MB at four plans, 12 MB at one.
+    let refused = plan(&dir.join("x"), false, "15").failure();
+    let err = String::from_utf8_lossy(&refused.get_output().stderr).into_owned();
+    assert!(err.contains("4 plans at a time"), "{err}");
+    plan(&dir.join("y"), true, "15").success();
 }
 
 /// Under PID execution the trace holds a pose per control step: the estimate counts the steps

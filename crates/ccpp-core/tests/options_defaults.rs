@@ -122,7 +122,8 @@ fn a_partial_extension_section_changes_only_its_fields() {
 
 /// The config fuzzer's seed `fuzz/corpus/config/defaults.json` is the serialized defaults: a
 /// seed with fields that no longer exist is refused as a whole and seeds nothing. Run with
-/// `CCPP_BLESS=1` to rewrite it after an options change.
+/// `CCPP_BLESS=1` to rewrite it after an options change (`cargo test -p ccpp-core --test
+/// integration the_fuzz_corpus`).
 #[test]
 fn the_fuzz_corpus_defaults_are_the_current_defaults() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -136,7 +137,7 @@ fn the_fuzz_corpus_defaults_are_the_current_defaults() {
     let got: Value = serde_json::from_str(&text).unwrap();
     assert!(
         got == want,
-        "{} is stale; rewrite it with CCPP_BLESS=1 cargo test -p ccpp-core --test options_defaults",
+        "{} is stale; rewrite it with CCPP_BLESS=1 cargo test -p ccpp-core --test integration the_fuzz_corpus",
         path.display()
     );
     // And it reads back as the defaults.

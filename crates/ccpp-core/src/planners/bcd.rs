@@ -318,6 +318,13 @@ pub struct BcdOptions {
     /// (offset loops from the outer walls in, module docs step 3), which takes `nobleo_grid`
     /// from 1.102 to 0.973 and `teb_empty_box` from 1.026 to 0.992 (mean 1.1833 to 1.1716).
     pub headland_min_m: Option<f64>,
+    /// Most plans made at the same time: planning runs on a pool of this many threads of its
+    /// own. `None` (`null`): on the process's pool, one plan per thread (`RAYON_NUM_THREADS`,
+    /// else one per core). Every plan holds state the size of the map (the memory estimate
+    /// counts 32 bytes a pixel a plan, for up to 4), so fewer at a time bound the memory at
+    /// the cost of time; the plan kept is the same whatever the count (the plans are
+    /// independent and compared in a fixed order). From 1 to [`MAX_PLANS_AT_A_TIME`].
+    pub plans_at_a_time: Option<u32>,
 }
 
 /// Default of [`BcdOptions::headland_min_m`], metres: walls and obstacles whose C-free
@@ -328,6 +335,10 @@ pub const DEFAULT_HEADLAND_MIN_M: f64 = 6.0;
 /// steps up to 10 degrees either side, where the second wall direction may begin. Each try is
 /// a whole plan, so the bound also bounds the planning time.
 pub const MAX_ANGLE_TRIES: u32 = 40;
+
+/// Most threads [`BcdOptions::plans_at_a_time`] may ask for (a count beyond the plans of a
+/// round only adds idle threads).
+pub const MAX_PLANS_AT_A_TIME: u32 = 64;
 
 /// Most improvement rounds [`BcdOptions::tour_rounds`] may ask for. Each round costs a pass of
 /// 2-opt and Or-opt moves over every cell of the tour; on the shared maps the tour settles
@@ -347,6 +358,7 @@ impl Default for BcdOptions {
             min_coverage: 0.9952,
             angle_tries: 1,
             headland_min_m: Some(DEFAULT_HEADLAND_MIN_M),
+            plans_at_a_time: None,
         }
     }
 }
@@ -401,6 +413,11 @@ impl BcdOptions {
         if self.tour_rounds > MAX_TOUR_ROUNDS {
             return bad("tour_rounds", "at most 100", f64::from(self.tour_rounds));
         }
+        if let Some(n) = self.plans_at_a_time {
+            if !(1..=MAX_PLANS_AT_A_TIME).contains(&n) {
+                return bad("plans_at_a_time", "from 1 to 64", f64::from(n));
+            }
+        }
         if self.angle_tries > MAX_ANGLE_TRIES {
             return bad(
                 "angle_tries",
@@ -416,6 +433,23 @@ impl BcdOptions {
 /// tool's width, with a relative tolerance for values computed as `2 r_tool`).
 fn fits_tool(world: &World, spacing: f64) -> bool {
     spacing <= 2.0 * world.robot().tool_radius * (1.0 + 1e-9)
+}
+
+/// Runs `f` on a rayon pool of `threads` threads of its own when given, else on the caller's.
+fn on_pool<T: Send>(threads: Option<u32>, f: impl FnOnce() -> T + Send) -> T {
+    let Some(n) = threads else {
+        return f();
+    };
+    match rayon::ThreadPoolBuilder::new()
+        .num_threads(n as usize)
+        .thread_name(|i| format!("bcd-plan-{i}"))
+        .build()
+    {
+        Ok(pool) => pool.install(f),
+        // No thread could be started (the system's limit): the same plan on the caller's pool,
+        // which already runs; only the bound on plans at a time is not kept.
+        Err(_) => f(),
+    }
 }
 
 /// The BCD planner: a precomputed list of steps.
@@ -465,14 +499,23 @@ impl Bcd {
                     d.angle_tries
                 },
                 headland_min_m: opts.headland_min_m.filter(|m| m.is_finite() && *m >= 0.0),
+                plans_at_a_time: opts
+                    .plans_at_a_time
+                    .filter(|n| (1..=MAX_PLANS_AT_A_TIME).contains(n)),
                 min_coverage: if (0.0..=1.0).contains(&opts.min_coverage) {
                     opts.min_coverage
                 } else {
                     d.min_coverage
                 },
             };
-            Self::plan(world, &fixed)
+            Self::plan_on_pool(world, &fixed)
         }
+    }
+
+    /// Plans on a pool of [`BcdOptions::plans_at_a_time`] threads when it is given, else on
+    /// the caller's pool.
+    fn plan_on_pool(world: &World, opts: &BcdOptions) -> Self {
+        on_pool(opts.plans_at_a_time, || Self::plan(world, opts))
     }
 
     /// Plans the whole coverage of `world` (offline).
@@ -488,7 +531,7 @@ impl Bcd {
                 value: s,
             });
         }
-        Ok(Self::plan(world, opts))
+        Ok(Self::plan_on_pool(world, opts))
     }
 
     /// Number of cells of the decomposition used.

@@ -37,8 +37,9 @@ pub const RECORD_BYTES: f64 = 200.0;
 pub const BCD_PIXEL_BYTES: f64 = 64.0;
 /// Bytes per map pixel of each `bcd` plan made at the same time (its transfer search, sweep
 /// counts and rim masks), for up to [`BCD_MAX_JOBS`] plans: `bcd` makes its plans in
-/// parallel, one per thread. Fitted to peak resident memory (`/usr/bin/time -v ccpp plan
-/// --planner bcd`, `RAYON_NUM_THREADS` 1, 2, 4, 8): `office_1024` at `--radius 0.1` 137,
+/// parallel, one per thread or [`super::bcd::BcdOptions::plans_at_a_time`]. Fitted to peak
+/// resident memory (`/usr/bin/time -v ccpp plan --planner bcd`, `RAYON_NUM_THREADS` 1, 2,
+/// 4, 8): `office_1024` at `--radius 0.1` 137,
 /// 202, 246, 272 MB, `cluttered_2000` 377, 477, 547, 660 MB, `office_4096` at `--radius 0.1`
 /// 1700 MB (1 thread), 2312 MB (2), 2486 MB (4); `ccpp run --planner bcd` on `office_1024`
 /// 153, 195, 270, 275 MB. Every figure is within this estimate (`office_4096`: 3.5 GB at two
@@ -820,10 +821,13 @@ impl PlannerSettings for BcdOptions {
             .remedy("a larger tool radius or bcd.lane_spacing_m");
         e.detail = format!("{} of {} m", e.detail, fmt_m(sp));
         // The plans' own pixel-sized state, part of it once per plan made at the same time.
-        let jobs = rayon::current_num_threads().clamp(1, BCD_MAX_JOBS);
+        let jobs = self
+            .plans_at_a_time
+            .map_or_else(rayon::current_num_threads, |n| n as usize)
+            .clamp(1, BCD_MAX_JOBS);
         let per_px = BCD_PIXEL_BYTES + BCD_JOB_PIXEL_BYTES * jobs as f64;
         let mut px = ResourceEstimate::units(s.pixels(), per_px, "map pixels").remedy(&format!(
-            "{PIXELS_REMEDY}, or one plan at a time (RAYON_NUM_THREADS=1)"
+            "{PIXELS_REMEDY}, or one plan at a time (bcd.plans_at_a_time: 1)"
         ));
         px.detail = format!(
             "{}, {jobs} plan{} at a time",

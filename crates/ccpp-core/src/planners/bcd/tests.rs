@@ -7,7 +7,7 @@ use super::finish::{moves, repair, smooth};
 use super::lanes::{drop_covered, lanes_of, odd_runs};
 use super::lattice::{Ctx, Lattice};
 use super::transfer::Search;
-use super::{Bcd, BcdOptions};
+use super::{on_pool, Bcd, BcdOptions};
 use crate::geometry::Point;
 use crate::planner::Step;
 use crate::trace::Event;
@@ -396,6 +396,14 @@ fn invalid_options_are_refused() {
             min_coverage: 1.5,
             ..BcdOptions::default()
         },
+        BcdOptions {
+            plans_at_a_time: Some(0),
+            ..BcdOptions::default()
+        },
+        BcdOptions {
+            plans_at_a_time: Some(65),
+            ..BcdOptions::default()
+        },
     ] {
         let e = Bcd::try_new(&world, &bad).err().unwrap();
         assert!(e.to_string().starts_with("bcd option "), "{e}");
@@ -758,4 +766,34 @@ fn a_ring_is_peeled_into_offset_loops_from_the_outer_wall() {
     // (without step 6 the plan costs 62.8 m + 19 turns x 0.3 m = 68.5 m)
     let cost = m.path_length_m + 0.3 * f64::from(m.turns);
     assert!(cost < 60.0, "{m:?}");
+}
+
+/// `plans_at_a_time` runs the planning on a pool of exactly that many threads (what bounds the
+/// plans made at once); `None` stays on the caller's pool.
+#[test]
+fn plans_run_on_a_pool_of_plans_at_a_time_threads() {
+    for n in [1, 3, 5] {
+        assert_eq!(on_pool(Some(n), rayon::current_num_threads), n as usize);
+    }
+    let outer = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
+    assert_eq!(
+        outer.install(|| on_pool(None, rayon::current_num_threads)),
+        2
+    );
+    // The plan is the same whatever the count.
+    let world = block_room();
+    let pool = Bcd::new(&world, &BcdOptions::default());
+    for n in [1, 2, 4] {
+        let b = Bcd::new(
+            &world,
+            &BcdOptions {
+                plans_at_a_time: Some(n),
+                ..BcdOptions::default()
+            },
+        );
+        assert_eq!(b.steps, pool.steps, "{n}");
+    }
 }
