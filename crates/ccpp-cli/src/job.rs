@@ -159,13 +159,8 @@ pub fn read_options(path: &Path) -> Result<PlannerOptions> {
     let is_json = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("json"));
-    let opts: PlannerOptions = if is_json {
-        serde_json::from_str(&text)
-            .map_err(|e| anyhow::anyhow!("planner options {}: {e}", path.display()))?
-    } else {
-        serde_saphyr::from_str(&text)
-            .map_err(|e| anyhow::anyhow!("planner options {}: {e}", path.display()))?
-    };
+    let opts: PlannerOptions = ccpp_io::file::parse_yaml_or_json(&text, is_json)
+        .map_err(|e| anyhow::anyhow!("planner options {}: {e}", path.display()))?;
     opts.validate()
         .map_err(|e| anyhow::anyhow!("planner options {}: {e}", path.display()))?;
     Ok(opts)

@@ -99,3 +99,96 @@ mod tests {
         assert_eq!(e.as_deref(), Some("not a regular file"));
     }
 }
+
+/// Deserializes YAML, or JSON when `json`, and on an error names the field it is in: the text
+/// is parsed as `serde_saphyr::from_str` / `serde_json::from_str` parse it (so what is accepted
+/// does not change), and only a failed parse is read again to find the error's path
+/// (`bcd.turn_cost_m: line 1 column 21: invalid floating point` where the parser alone says
+/// `line 1 column 21: invalid floating point`). An error at the document's root keeps the
+/// parser's message as it is.
+///
+/// # Errors
+/// The parser's message, with the field's path in front when there is one.
+pub fn parse_yaml_or_json<T: serde::de::DeserializeOwned>(
+    text: &str,
+    json: bool,
+) -> Result<T, String> {
+    let first = if json {
+        serde_json::from_str::<T>(text).map_err(|e| e.to_string())
+    } else {
+        serde_saphyr::from_str::<T>(text).map_err(|e| e.to_string())
+    };
+    let message = match first {
+        Ok(v) => return Ok(v),
+        Err(m) => m,
+    };
+    let path = if json {
+        let mut de = serde_json::Deserializer::from_str(text);
+        serde_path_to_error::deserialize::<_, T>(&mut de)
+            .err()
+            .map(|e| e.path().to_string())
+    } else {
+        // Kept from inside: a deserialization that stops at its error leaves events unread,
+        // which the reader then reports instead.
+        let mut found = None;
+        let outcome = serde_saphyr::with_deserializer_from_str(text, |de| {
+            found = serde_path_to_error::deserialize::<_, T>(de)
+                .err()
+                .map(|e| e.path().to_string());
+            Ok(())
+        });
+        // Only the path is wanted; the first parse's message is the one reported.
+        drop(outcome);
+        found
+    };
+    Err(match path {
+        Some(p) if !p.is_empty() && p != "." && !message.starts_with(&format!("{p}:")) => {
+            format!("{p}: {message}")
+        }
+        _ => message,
+    })
+}
+
+#[cfg(test)]
+mod parse_tests {
+    use super::parse_yaml_or_json;
+
+    #[derive(Debug, serde::Deserialize, PartialEq)]
+    #[serde(deny_unknown_fields)]
+    struct Inner {
+        rounds: u32,
+        #[serde(default)]
+        cost: f64,
+    }
+
+    #[derive(Debug, serde::Deserialize, PartialEq)]
+    #[serde(deny_unknown_fields)]
+    struct Outer {
+        bcd: Inner,
+    }
+
+    #[test]
+    fn errors_name_the_field_and_good_text_parses_as_before() {
+        let ok: Outer = parse_yaml_or_json("bcd: { rounds: 3 }", false).unwrap();
+        assert_eq!(ok.bcd.rounds, 3);
+        let ok: Outer = parse_yaml_or_json(r#"{"bcd": {"rounds": 3}}"#, true).unwrap();
+        assert_eq!(ok.bcd.rounds, 3);
+        for (text, json) in [
+            ("bcd: { rounds: -2 }", false),
+            ("bcd:\n  rounds: 1\n  cost: abc\n", false),
+            (r#"{"bcd": {"rounds": -2}}"#, true),
+            (r#"{"bcd": {"rounds": 1, "cost": "x"}}"#, true),
+        ] {
+            let e = parse_yaml_or_json::<Outer>(text, json).unwrap_err();
+            assert!(
+                e.starts_with("bcd.rounds: ") || e.starts_with("bcd.cost: "),
+                "{text}: {e}"
+            );
+        }
+        // Unknown fields and root errors keep the parser's words.
+        let e = parse_yaml_or_json::<Outer>("bcd: { rounds: 1, turns: 2 }", false).unwrap_err();
+        assert!(e.contains("unknown field `turns`"), "{e}");
+        let e = parse_yaml_or_json::<Outer>("[1, 2]", false).unwrap_err();
+        assert!(!e.starts_with('.'), "{e}");
+    }
+}

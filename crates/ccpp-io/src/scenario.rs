@@ -620,11 +620,7 @@ impl Scenario {
         let is_json = path
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("json"));
-        if is_json {
-            serde_json::from_str(&text).map_err(|e| err(e.to_string()))
-        } else {
-            serde_saphyr::from_str(&text).map_err(|e| err(e.to_string()))
-        }
+        crate::file::parse_yaml_or_json(&text, is_json).map_err(err)
     }
 
     /// The scenario as pretty JSON (the `run.json` format).
