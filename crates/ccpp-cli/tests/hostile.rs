@@ -1722,6 +1722,38 @@ fn pid_trace_records_are_counted_by_control_steps() {
         .and_then(|t| t.parse().ok())
         .expect("a record count");
     assert!((1.1e6..1.3e6).contains(&records), "{records}");
+    // Gains that crawl with a cap of billions of steps a motion: refused at once for the
+    // records (the estimate does not simulate the crawl to its end; it hung before).
+    let crawl = dir.join("crawl.yaml");
+    std::fs::write(
+        &crawl,
+        "bsa_bfs: { exec: { pid: { linear: { output_limit: 1.0e-9 }, min_speed_mps: 1.0e-12, \
+         max_steps_per_motion: 4000000000 } } }\n",
+    )
+    .unwrap();
+    let a = ccpp()
+        .timeout(std::time::Duration::from_mins(1))
+        .args([
+            "run",
+            "--planner",
+            "bsa-bfs",
+            "--map",
+            s(&map),
+            "--radius",
+            "0.05",
+            "--config",
+            s(&crawl),
+            "--out",
+            s(&out),
+        ])
+        .assert()
+        .code(1);
+    let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
+    assert!(
+        err.contains("PID trace records") && err.contains("no machine"),
+        "{err}"
+    );
+    assert!(!out.exists());
     // One record in 20 kept: the same limit admits the run.
     let cfg = dir.join("sparse.yaml");
     std::fs::write(&cfg, "bsa_bfs: { exec: { pid: { record_every: 20 } } }\n").unwrap();

@@ -241,12 +241,18 @@ impl Default for PidOptions {
     }
 }
 
+/// Most control steps of one part of a motion that [`PidOptions::motion_steps`] simulates.
+pub const MOTION_STEPS_SIMULATED: u64 = 100_000;
+
 impl PidOptions {
     /// Control steps of one noise-free motion from rest: turning in place by `turn_rad`, then
     /// driving a straight segment of `len_m` metres, each capped at `max_steps_per_motion` as
     /// the simulator caps them. Memory estimates count PID trace records with it: the creep
     /// and the arrival shaping make a short move take many more steps than its length over
-    /// the top speed (at the defaults a 0.1 m move takes 25 steps, not 4).
+    /// the top speed (at the defaults a 0.1 m move takes 32 steps, not 4). At most
+    /// [`MOTION_STEPS_SIMULATED`] steps of each part are simulated: a part still under way
+    /// then counts `max_steps_per_motion` steps (what the simulator would run at most), so
+    /// gains that crawl cost the estimate no time.
     pub fn motion_steps(&self, turn_rad: f64, len_m: f64) -> u64 {
         let opts = PidOptions {
             noise: None,
@@ -255,15 +261,25 @@ impl PidOptions {
         let mut tracker = Tracker::new(&opts);
         let mut pose = Pose::new(0.0, 0.0, 0.0);
         let mut steps = 0u64;
+        let cap = u64::from(opts.max_steps_per_motion);
         let mut drive = |goal: Goal, pose: &mut Pose| {
             tracker.reset();
-            for _ in 0..opts.max_steps_per_motion {
+            let mut n = 0u64;
+            loop {
+                if n == cap {
+                    break;
+                }
+                if n == MOTION_STEPS_SIMULATED {
+                    n = cap;
+                    break;
+                }
                 let Some((v, w)) = tracker.command(*pose, &goal) else {
                     break;
                 };
                 *pose = Unicycle::step(*pose, v, w, opts.dt_s);
-                steps += 1;
+                n += 1;
             }
+            steps += n;
         };
         if turn_rad.is_finite() && turn_rad != 0.0 {
             drive(Goal::Heading(wrap_angle(turn_rad)), &mut pose);
@@ -540,6 +556,31 @@ mod tests {
             ..opts
         };
         assert_eq!(capped.motion_steps(1.0, 5.0), 6);
+        // A crawl is not simulated to its end: past MOTION_STEPS_SIMULATED steps a part counts
+        // the cap (with a cap of billions of steps and gains that crawl, simulating to the end
+        // kept the estimate busy for minutes). This one would end after about 6 million steps
+        // (0.3 m at 1 micrometre a second, 0.05 s a step).
+        let crawl = PidOptions {
+            linear: PidGains {
+                output_limit: 1e-6,
+                ..opts.linear
+            },
+            min_speed_mps: 1e-6,
+            max_steps_per_motion: 4_000_000_000,
+            ..opts
+        };
+        assert_eq!(crawl.motion_steps(0.0, 0.3), 4_000_000_000);
+        // Under the simulated bound, the exact count.
+        let slow = PidOptions {
+            linear: PidGains {
+                output_limit: 0.001,
+                ..opts.linear
+            },
+            min_speed_mps: 0.001,
+            ..opts
+        };
+        let n = slow.motion_steps(0.0, 0.3);
+        assert!((6_000..20_000).contains(&n), "{n}");
         eprintln!(
             "0.1 m {} 0.2 m {} 0.3 m {} turn {}",
             opts.motion_steps(0.0, 0.1),
