@@ -22,8 +22,8 @@ pub enum Command {
     Run(RunArgs),
     /// Run the flagship planner on the bundled demo map (writes ./ccpp-demo/).
     Demo(DemoArgs),
-    /// List the planners.
-    Planners,
+    /// List the planners, or print their default options as a `--config` file.
+    Planners(PlannersArgs),
     /// Describe a map: size, resolution, pixel classes, components, accessible area.
     Info(InfoArgs),
     /// Run every planner on every map in parallel; write results.csv, results.md and plots.
@@ -344,6 +344,15 @@ impl From<&BenchRobotArgs> for RobotArgs {
             start: None,
         }
     }
+}
+
+/// `ccpp planners`.
+#[derive(Args, Debug)]
+pub struct PlannersArgs {
+    /// Print the default options of every planner (or of the planners named) as a `--config`
+    /// file: YAML, one section per planner, every field at its default
+    #[arg(long, value_name = "A,B,...", num_args = 0..=1, value_delimiter = ',', require_equals = false, default_missing_value = "")]
+    pub defaults: Option<Vec<String>>,
 }
 
 /// `ccpp info`.

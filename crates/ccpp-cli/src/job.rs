@@ -152,6 +152,41 @@ pub fn planner_options(config: Option<&Path>, seed: Option<u64>) -> Result<Plann
     Ok(options)
 }
 
+/// The default options of every planner, or of the planners `names` (none or empty names:
+/// all), as a `--config` YAML file: one section per planner, every field at its default.
+///
+/// # Errors
+/// An unknown planner name.
+pub fn default_options_yaml(names: &[String]) -> Result<String> {
+    let all = serde_json::to_value(PlannerOptions::default())?;
+    let serde_json::Value::Object(sections) = all else {
+        anyhow::bail!("the planner options are not a mapping");
+    };
+    let wanted: Vec<&str> = names
+        .iter()
+        .map(String::as_str)
+        .filter(|n| !n.trim().is_empty())
+        .map(str::trim)
+        .collect();
+    let mut keep = serde_json::Map::new();
+    for name in &wanted {
+        let section = parse_planner(name)?.info().section;
+        if let Some(v) = sections.get(section) {
+            keep.insert(section.to_string(), v.clone());
+        }
+    }
+    let doc = if wanted.is_empty() {
+        serde_json::Value::Object(sections)
+    } else {
+        serde_json::Value::Object(keep)
+    };
+    let yaml = serde_saphyr::to_string(&doc)?;
+    Ok(format!(
+        "# ccpp {} planner options at their defaults: edit and pass with --config FILE\n{yaml}",
+        env!("CARGO_PKG_VERSION")
+    ))
+}
+
 /// Reads planner options from a YAML or JSON file and validates every section.
 pub fn read_options(path: &Path) -> Result<PlannerOptions> {
     let text = ccpp_io::file::read_text(path)

@@ -20,6 +20,70 @@ fn planners_lists_random_bounce() {
     assert!(s.lines().any(|l| l.starts_with("random-bounce")), "{s}");
 }
 
+/// `planners --defaults` prints a `--config` file of every option at its default: each
+/// planner run with it writes the same path as without; naming planners keeps their sections
+/// only; an unknown name is refused.
+#[test]
+fn planners_defaults_is_a_config_of_the_defaults() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let all = ccpp()
+        .args(["planners", "--defaults"])
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let text = String::from_utf8(all).unwrap();
+    let cfg = d.join("defaults.yaml");
+    std::fs::write(&cfg, &text).unwrap();
+    let map = crate::common::pillars(d);
+    let planners = ccpp_core::planners::CATALOG;
+    assert_eq!(planners.len(), 8);
+    for p in planners {
+        let section = format!("\n{}:\n", p.name.replace('-', "_"));
+        assert!(text.contains(&section), "{section} in {text}");
+        let plain = crate::common::run_ok(d, &format!("{}-plain", p.name), &map, p.name, &[]);
+        let with = crate::common::run_ok(
+            d,
+            &format!("{}-cfg", p.name),
+            &map,
+            p.name,
+            &["--config", cfg.to_str().unwrap()],
+        );
+        assert_eq!(
+            std::fs::read(plain.join("path.csv")).unwrap(),
+            std::fs::read(with.join("path.csv")).unwrap(),
+            "{}",
+            p.name
+        );
+    }
+    assert!(text.contains("plans_at_a_time: null"), "{text}");
+    let some = ccpp()
+        .args(["planners", "--defaults", "bcd,bsa-bfs"])
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let some = String::from_utf8(some).unwrap();
+    let sections: Vec<&str> = some
+        .lines()
+        .filter(|l| !l.starts_with([' ', '#']))
+        .collect();
+    assert_eq!(sections, ["bcd:", "bsa_bfs:"], "{some}");
+    let bad = ccpp()
+        .args(["planners", "--defaults", "bcd,zigzag"])
+        .assert()
+        .code(1);
+    let err = String::from_utf8_lossy(&bad.get_output().stderr).into_owned();
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(
+        err.starts_with("error: ") && err.contains("zigzag"),
+        "{err}"
+    );
+}
+
 #[test]
 fn demo_writes_all_files() {
     let dir = tempfile::tempdir().unwrap();
