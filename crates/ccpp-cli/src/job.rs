@@ -158,33 +158,31 @@ pub fn planner_options(config: Option<&Path>, seed: Option<u64>) -> Result<Plann
 /// # Errors
 /// An unknown planner name.
 pub fn default_options_yaml(names: &[String]) -> Result<String> {
-    let all = serde_json::to_value(PlannerOptions::default())?;
-    let serde_json::Value::Object(sections) = all else {
-        anyhow::bail!("the planner options are not a mapping");
-    };
-    let wanted: Vec<&str> = names
+    let wanted = names
         .iter()
-        .map(String::as_str)
-        .filter(|n| !n.trim().is_empty())
-        .map(str::trim)
-        .collect();
-    let mut keep = serde_json::Map::new();
-    for name in &wanted {
-        let section = parse_planner(name)?.info().section;
-        if let Some(v) = sections.get(section) {
-            keep.insert(section.to_string(), v.clone());
+        .map(|n| n.trim())
+        .filter(|n| !n.is_empty())
+        .map(|n| parse_planner(n).map(|k| k.info().section))
+        .collect::<Result<Vec<_>>>()?;
+    // The typed options keep their fields in declaration order (documented order); a section
+    // is a top-level key and the lines indented under it.
+    let yaml = serde_saphyr::to_string(&PlannerOptions::default())?;
+    let mut out = format!(
+        "# ccpp {} planner options at their defaults: edit and pass with --config FILE\n",
+        env!("CARGO_PKG_VERSION")
+    );
+    let mut keep = wanted.is_empty();
+    for line in yaml.lines() {
+        if !line.starts_with(' ') {
+            let key = line.split(':').next().unwrap_or_default();
+            keep = wanted.is_empty() || wanted.contains(&key);
+        }
+        if keep {
+            out.push_str(line);
+            out.push('\n');
         }
     }
-    let doc = if wanted.is_empty() {
-        serde_json::Value::Object(sections)
-    } else {
-        serde_json::Value::Object(keep)
-    };
-    let yaml = serde_saphyr::to_string(&doc)?;
-    Ok(format!(
-        "# ccpp {} planner options at their defaults: edit and pass with --config FILE\n{yaml}",
-        env!("CARGO_PKG_VERSION")
-    ))
+    Ok(out)
 }
 
 /// Reads planner options from a YAML or JSON file and validates every section.
