@@ -115,10 +115,10 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
             let result = execute(&mut job)?;
             output::emit(&job, &result, false, true, &[])
         }
-        Command::Planners(a) if a.defaults.is_some() => print_stdout(&job::default_options_yaml(
-            a.defaults.as_deref().unwrap_or(&[]),
-        )?),
-        Command::Planners(_) => {
+        Command::Planners(a) => {
+            if let Some(names) = &a.defaults {
+                return print_stdout(&job::default_options_yaml(names)?);
+            }
             let mut s = String::new();
             for p in ccpp_core::planners::CATALOG {
                 let kind = if p.offline { "offline" } else { "online" };

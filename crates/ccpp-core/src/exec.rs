@@ -581,13 +581,6 @@ mod tests {
         };
         let n = slow.motion_steps(0.0, 0.3);
         assert!((6_000..20_000).contains(&n), "{n}");
-        eprintln!(
-            "0.1 m {} 0.2 m {} 0.3 m {} turn {}",
-            opts.motion_steps(0.0, 0.1),
-            opts.motion_steps(0.0, 0.2),
-            opts.motion_steps(0.0, 0.3),
-            turn
-        );
     }
 
     #[test]

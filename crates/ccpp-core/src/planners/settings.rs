@@ -39,11 +39,10 @@ pub const BCD_PIXEL_BYTES: f64 = 64.0;
 /// counts and rim masks), for up to [`BCD_MAX_JOBS`] plans: `bcd` makes its plans in
 /// parallel, one per thread or [`super::bcd::BcdOptions::plans_at_a_time`]. Fitted to peak
 /// resident memory (`/usr/bin/time -v ccpp plan --planner bcd`, `RAYON_NUM_THREADS` 1, 2,
-/// 4, 8): `office_1024` at `--radius 0.1` 137,
-/// 202, 246, 272 MB, `cluttered_2000` 377, 477, 547, 660 MB, `office_4096` at `--radius 0.1`
-/// 1700 MB (1 thread), 2312 MB (2), 2486 MB (4); `ccpp run --planner bcd` on `office_1024`
-/// 153, 195, 270, 275 MB. Every figure is within this estimate (`office_4096`: 3.5 GB at two
-/// threads, 4.6 GB from four).
+/// 4, 8): `office_1024` at `--radius 0.1` 137, 202, 246, 272 MB, `cluttered_2000` 377, 477,
+/// 547, 660 MB, `office_4096` at `--radius 0.1` 1700 MB (1 thread), 2312 MB (2), 2486 MB
+/// (4); `ccpp run --planner bcd` on `office_1024` 153, 195, 270, 275 MB. Every figure is
+/// within this estimate (`office_4096`: 3.5 GB at two threads, 4.6 GB from four).
 pub const BCD_JOB_PIXEL_BYTES: f64 = 32.0;
 /// Most `bcd` plans counted as made at the same time ([`BCD_JOB_PIXEL_BYTES`]): beyond four
 /// threads the measured peaks grow little (the plans of one round are few).
