@@ -34,7 +34,13 @@ pub fn run(a: &WaypointsArgs) -> Result<()> {
     };
     // The same validation, checks and memory estimate as `ccpp run --planner
     // rect-boustrophedon`.
-    let flag = |e: ScenarioError| crate::job::name_flag(e, &["--length", "--width"]);
+    let flag = |e: ScenarioError| {
+        let e = crate::job::name_flag(e, &["--length", "--width"]);
+        // `--area` here is the lanes' rectangle (`rect_boustrophedon.area`), not a zone.
+        anyhow::anyhow!(e
+            .to_string()
+            .replacen("rect_boustrophedon.area: ", "--area: ", 1))
+    };
     let scenario = Scenario::configure(
         recipe_from(&a.map),
         PlannerConfig::RectBoustrophedon(opts.clone()),

@@ -1778,3 +1778,51 @@ fn pid_trace_records_are_counted_by_control_steps() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(out.join("metrics.json").exists());
 }
+
+/// A rect-boustrophedon area that holds no lane point the robot can stop at (inside a pillar,
+/// in a wall corner) gave an empty plan that "succeeded": `waypoints` printed only its header,
+/// `run` reported a run of path 0 and `plan` wrote a one-point path. Refused now, by every
+/// subcommand, naming the area; an area with floor still plans.
+#[test]
+fn a_rect_area_without_a_lane_point_is_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir); // pillar 1: pixels 40..52 x 20..80, i.e. x 2.0-2.6 m, y 2.0-5.0 m
+    for area in ["2.1,2.5,2.5,4.5", "0,0,0.1,0.1"] {
+        refused(
+            &["waypoints", "--map", s(&map), "--area", area],
+            &["--area: ", "holds no lane point", "pillars.pgm"],
+        );
+        let cfg = dir.join("area.yaml");
+        let a: Vec<&str> = area.split(',').collect();
+        std::fs::write(
+            &cfg,
+            format!("rect_boustrophedon: {{ area: [{}] }}\n", a.join(", ")),
+        )
+        .unwrap();
+        for sub in ["run", "plan"] {
+            let out = dir.join(format!("out-{sub}"));
+            refused(
+                &[
+                    sub,
+                    "--planner",
+                    "rect-boustrophedon",
+                    "--map",
+                    s(&map),
+                    "--config",
+                    s(&cfg),
+                    "--out",
+                    s(&out),
+                ],
+                &["rect_boustrophedon.area", "holds no lane point"],
+            );
+            assert!(!out.exists(), "{sub} left {out:?} behind");
+        }
+    }
+    let ok = ccpp()
+        .args(["waypoints", "--map", s(&map), "--area", "0.5,0.5,1.5,1.5"])
+        .assert()
+        .success();
+    let text = String::from_utf8_lossy(&ok.get_output().stdout).into_owned();
+    assert!(text.lines().count() > 2, "{text}");
+}

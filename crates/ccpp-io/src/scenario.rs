@@ -894,18 +894,10 @@ impl Scenario {
         let planner = self.planner.name();
         // Also checked when the map is prepared; again here for a map the caller built.
         check_extent(&map.grid, &map.source)?;
-        self.planner.settings().check(&setup).map_err(|e| {
-            let e = e.in_section(self.planner.kind().info().section);
-            ScenarioError::Degenerate {
-                path: map.source.clone(),
-                planner,
-                message: if e.field.contains('.') {
-                    e.to_string()
-                } else {
-                    e.message
-                },
-            }
-        })?;
+        self.planner
+            .settings()
+            .check(&setup)
+            .map_err(|e| self.degenerate(&map.source, e))?;
         let mut est = estimate_run(&setup, self.planner.settings());
         let zones = estimate_zones(&setup, self.zone_load());
         if zones.bytes > 0.0 {
@@ -972,6 +964,20 @@ impl Scenario {
 
     /// Builds the world on `grid` (the prepared map's, loaded from `source` and grown by
     /// `inflate` metres).
+    /// A planner's check failure as [`ScenarioError::Degenerate`] on the map `source`.
+    fn degenerate(&self, source: &Path, e: OptionsError) -> ScenarioError {
+        let e = e.in_section(self.planner.kind().info().section);
+        ScenarioError::Degenerate {
+            path: source.to_path_buf(),
+            planner: self.planner.name(),
+            message: if e.field.contains('.') {
+                e.to_string()
+            } else {
+                e.message
+            },
+        }
+    }
+
     fn world_on(
         &self,
         grid: GridMap,
@@ -980,7 +986,7 @@ impl Scenario {
         zones: Option<ZoneMasks>,
     ) -> Result<World, ScenarioError> {
         let start = self.start.map(|s| Pose::new(s[0], s[1], s[2]));
-        World::with_zones(grid, self.robot, start, zones).map_err(|source_err| {
+        let world = World::with_zones(grid, self.robot, start, zones).map_err(|source_err| {
             match self.zone_of(&source_err) {
                 Some((kind, label)) => ScenarioError::Zone {
                     kind,
@@ -1008,7 +1014,12 @@ impl Scenario {
                     },
                 },
             }
-        })
+        })?;
+        self.planner
+            .settings()
+            .check_world(&world)
+            .map_err(|e| self.degenerate(source, e))?;
+        Ok(world)
     }
 
     /// Runs the scenario on a map the caller prepared (bench runs share one map).

@@ -150,58 +150,103 @@ pub fn waypoints(world: &World, opts: &RectOptions) -> Vec<Point> {
     plan(world, opts).waypoints
 }
 
-/// Computes the lane plan for `world` (offline: reads the whole map).
-pub fn plan(world: &World, opts: &RectOptions) -> RectPlan {
+/// The world the lanes are planned in: the map and start of `world` with the clearance disk
+/// (`clearance_radius_m`, by default the circumscribed disk of the robot's rectangle, at least
+/// the robot's radius) as robot, its radius, and why the robot's own radius is used instead
+/// when that disk does not fit at the start.
+fn clearance_world(world: &World, opts: &RectOptions) -> (World, f64, Option<String>) {
     let r_world = world.robot().radius;
     let rad = opts
         .clearance_radius_m
         .unwrap_or(0.5 * opts.length_m.hypot(opts.width_m))
         .max(r_world);
+    match World::new(world.map().clone(), Robot::new(rad), Some(world.start())) {
+        Ok(w) => (w, rad, None),
+        Err(e) => (
+            world.clone(),
+            r_world,
+            Some(format!("clearance disk {rad} m does not fit at the start ({e}); planning for the robot's own radius")),
+        ),
+    }
+}
+
+/// The area the lanes cover in the clearance world `rw`: the user's area clipped to the map
+/// (lanes beyond it cannot be driven, and an area of 1e119 m would otherwise ask for more
+/// lanes than memory holds; found by fuzzing), else the bounding box of the reachable pixel
+/// centres.
+fn lane_area(rw: &World, opts: &RectOptions) -> [f64; 4] {
+    let f = *rw.frame();
+    if let Some(a) = opts.area {
+        let (lo, hi) = f.world_bounds();
+        return [
+            a[0].max(lo.x),
+            a[1].max(lo.y),
+            a[2].min(hi.x),
+            a[3].min(hi.y),
+        ];
+    }
+    let (mut x0, mut y0, mut x1, mut y1) = (
+        f64::INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for i in rw.reachable().ones() {
+        let (c, r) = f.col_row(i);
+        let p = f.pixel_center(c, r);
+        x0 = x0.min(p.x);
+        y0 = y0.min(p.y);
+        x1 = x1.max(p.x);
+        y1 = y1.max(p.y);
+    }
+    [x0, y0, x1, y1]
+}
+
+/// Whether the robot can stop at `p` in the clearance world `rw`: its pixel is reachable
+/// from the start and the disk there touches nothing.
+fn stop_valid(rw: &World, p: Point) -> bool {
+    let f = rw.frame();
+    match f.pixel_of(p) {
+        Some((c, r)) => rw.reachable().contains(f.index(c, r)) && !rw.disk_collides(p),
+        None => false,
+    }
+}
+
+/// Whether a user area (`opts.area`) holds a lane point where the robot can stop: else the
+/// plan would be empty, and the run would "succeed" having done nothing. `Ok` without an
+/// area (the default area is the reachable floor's bounding box, which holds the start).
+///
+/// # Errors
+/// The area, clipped to the map, and the clearance radius, when no lane point is valid.
+pub fn check_area(world: &World, opts: &RectOptions) -> Result<(), String> {
+    if opts.area.is_none() {
+        return Ok(());
+    }
+    let (rw, rad, _) = clearance_world(world, opts);
+    let area = lane_area(&rw, opts);
+    let lanes = lanes(area, opts.length_m, opts.width_m);
+    if lanes.iter().flatten().any(|&p| stop_valid(&rw, p)) {
+        return Ok(());
+    }
+    Err(format!(
+        "{} holds no lane point where the robot (clearance disk {:.3} m) fits and that it can reach from the start",
+        crate::display::join(&area),
+        rad
+    ))
+}
+
+/// Computes the lane plan for `world` (offline: reads the whole map).
+pub fn plan(world: &World, opts: &RectOptions) -> RectPlan {
     let mut steps = vec![Step::Mark(Event::RectLanes {
         length_m: opts.length_m,
         width_m: opts.width_m,
     })];
     // The clearance world: same map and start, the circumscribed disk as robot.
-    let (rw, rad) = match World::new(world.map().clone(), Robot::new(rad), Some(world.start())) {
-        Ok(w) => (w, rad),
-        Err(e) => {
-            steps.push(Step::Mark(Event::Note {
-                text: format!("clearance disk {rad} m does not fit at the start ({e}); planning for the robot's own radius"),
-            }));
-            (world.clone(), r_world)
-        }
-    };
-    let f = *rw.frame();
-    let area = opts.area.unwrap_or_else(|| {
-        let (mut x0, mut y0, mut x1, mut y1) = (
-            f64::INFINITY,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::NEG_INFINITY,
-        );
-        for i in rw.reachable().ones() {
-            let (c, r) = f.col_row(i);
-            let p = f.pixel_center(c, r);
-            x0 = x0.min(p.x);
-            y0 = y0.min(p.y);
-            x1 = x1.max(p.x);
-            y1 = y1.max(p.y);
-        }
-        [x0, y0, x1, y1]
-    });
-    // A user area is clipped to the map: lanes beyond it cannot be driven, and an area of
-    // 1e119 m would otherwise ask for more lanes than memory holds (found by fuzzing).
-    let area = if opts.area.is_some() {
-        let (lo, hi) = f.world_bounds();
-        [
-            area[0].max(lo.x),
-            area[1].max(lo.y),
-            area[2].min(hi.x),
-            area[3].min(hi.y),
-        ]
-    } else {
-        area
-    };
+    let (rw, rad, note) = clearance_world(world, opts);
+    if let Some(text) = note {
+        steps.push(Step::Mark(Event::Note { text }));
+    }
+    let area = lane_area(&rw, opts);
     let mut rm = Roadmap::new(&rw);
     let mut waypoints = Vec::new();
     let mut dropped = 0;
@@ -432,11 +477,7 @@ impl<'a> Roadmap<'a> {
 
     /// Can the clearance disk stand at `p` inside the start's component?
     fn valid(&self, p: Point) -> bool {
-        let f = self.w.frame();
-        match f.pixel_of(p) {
-            Some((c, r)) => self.w.reachable().contains(f.index(c, r)) && !self.w.disk_collides(p),
-            None => false,
-        }
+        stop_valid(self.w, p)
     }
 
     /// A reachable pixel next to `p` joined to it by a free segment.

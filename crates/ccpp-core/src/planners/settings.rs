@@ -216,6 +216,15 @@ pub trait PlannerSettings {
     /// What makes the run degenerate.
     fn check(&self, setup: &Setup) -> Result<(), OptionsError>;
 
+    /// Checks the options against the world itself, once it is built (what [`Self::check`]
+    /// cannot tell from the frame: a user area that holds nothing the planner can reach).
+    ///
+    /// # Errors
+    /// What makes the run degenerate.
+    fn check_world(&self, _world: &World) -> Result<(), OptionsError> {
+        Ok(())
+    }
+
     /// The planner's share of the memory a run needs (tiles, cells, waypoints, trace).
     fn estimate(&self, setup: &Setup) -> ResourceEstimate;
 
@@ -913,6 +922,10 @@ impl PlannerSettings for RectOptions {
             }
         }
         Ok(())
+    }
+
+    fn check_world(&self, world: &World) -> Result<(), OptionsError> {
+        super::rect_boustrophedon::check_area(world, self).map_err(|m| OptionsError::new("area", m))
     }
 
     fn estimate(&self, s: &Setup) -> ResourceEstimate {
