@@ -442,6 +442,9 @@ fn sim_from(a: &RunArgs, config: &mut PlannerConfig) -> Result<SimConfig> {
                 kind.info().section
             );
         }
+        if a.seed.is_some() && v.iter().all(|x| *x == 0.0) {
+            bail!("--seed has no effect: --odometry-noise {n} draws no noise (give a noise > 0, or leave --seed out)");
+        }
         // Exactly the noise asked for: a heading drift left out is 0, not the library's
         // default (`--odometry-noise 0` used to drift 0.2 rad per metre).
         pid.noise = Some(OdometryNoise {

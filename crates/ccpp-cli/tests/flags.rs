@@ -208,6 +208,71 @@ fn execution_flags_reach_the_simulator() {
         &["--odometry-noise", "PID"],
     );
     run_fails(dir, &map, "bsa", &["--exec", "fast"], &["--exec"]);
+    // Zero noise draws nothing: a seed for it would be read and change nothing (a hostile
+    // tester found `--odometry-noise 0 --seed 5` and `--seed 6` giving the same trace). The
+    // same seed in an options file is refused too, naming the field.
+    run_fails(
+        dir,
+        &map,
+        "bsa",
+        &["--odometry-noise", "0,0,0", "--seed", "5"],
+        &["--seed has no effect", "draws no noise"],
+    );
+    let zero_cfg = dir.join("zero-noise.yaml");
+    std::fs::write(
+        &zero_cfg,
+        "bsa_bfs: { exec: { pid: { noise: { seed: 5, linear_rel_std: 0, angular_rel_std: 0, heading_drift_std: 0 } } } }\n",
+    )
+    .unwrap();
+    run_fails(
+        dir,
+        &map,
+        "bsa-bfs",
+        &["--config", zero_cfg.to_str().unwrap()],
+        &["bsa_bfs.exec.pid.noise.seed", "every noise std is 0"],
+    );
+    // PID options that switch each other off: an integral limit with ki = 0 (the default),
+    // and ki with an integral limit of 0; each alone was read and changed nothing.
+    for (body, needles) in [
+        (
+            "linear: { integral_limit: 5 }",
+            ["bsa_bfs.exec.pid.linear.integral_limit", "ki = 0"],
+        ),
+        (
+            "angular: { ki: 5, integral_limit: 0 }",
+            ["bsa_bfs.exec.pid.angular.ki", "integral_limit 0"],
+        ),
+    ] {
+        let cfg = dir.join("pid-off.yaml");
+        std::fs::write(
+            &cfg,
+            format!("bsa_bfs: {{ exec: {{ pid: {{ {body} }} }} }}\n"),
+        )
+        .unwrap();
+        run_fails(
+            dir,
+            &map,
+            "bsa-bfs",
+            &["--config", cfg.to_str().unwrap()],
+            &needles,
+        );
+    }
+    // Both together act: the trace differs from the default's.
+    let ki_cfg = dir.join("ki.yaml");
+    std::fs::write(
+        &ki_cfg,
+        "bsa_bfs: { exec: { pid: { linear: { ki: 5, integral_limit: 2 } } } }\n",
+    )
+    .unwrap();
+    let ki_run = run_ok(
+        dir,
+        "ki",
+        &map,
+        "bsa-bfs",
+        &["--config", ki_cfg.to_str().unwrap()],
+    );
+    let default_run = run_ok(dir, "ki-default", &map, "bsa-bfs", &[]);
+    assert_ne!(trace(&ki_run), trace(&default_run));
     // Noise beyond what odometry measures is refused, naming the flag and the bound.
     run_fails(
         dir,

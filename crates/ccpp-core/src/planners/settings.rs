@@ -298,7 +298,9 @@ fn opt_finite_pos(field: &str, v: Option<f64>) -> Result<(), OptionsError> {
     v.map_or(Ok(()), |v| finite_pos(field, v))
 }
 
-fn gains(field: &str, g: &PidGains) -> Result<(), OptionsError> {
+/// Checks one controller's gains `g`; `default` is that controller's default (for the
+/// options that only act together).
+fn gains(field: &str, g: &PidGains, default: &PidGains) -> Result<(), OptionsError> {
     for (name, v) in [("kp", g.kp), ("ki", g.ki), ("kd", g.kd)] {
         if !v.is_finite() {
             return Err(OptionsError::new(
@@ -308,7 +310,25 @@ fn gains(field: &str, g: &PidGains) -> Result<(), OptionsError> {
         }
     }
     finite_pos(&format!("{field}.output_limit"), g.output_limit)?;
-    finite_nonneg(&format!("{field}.integral_limit"), g.integral_limit)
+    finite_nonneg(&format!("{field}.integral_limit"), g.integral_limit)?;
+    // Options that switch each other off: the one switched off would be read, validated and
+    // then change nothing.
+    if g.ki == 0.0 && g.integral_limit != default.integral_limit {
+        return Err(OptionsError::new(
+            &format!("{field}.integral_limit"),
+            format!(
+                "bounds the integral term, which ki = 0 switches off; give ki too, or leave integral_limit at its default ({})",
+                crate::display::Compact(default.integral_limit)
+            ),
+        ));
+    }
+    if g.ki != 0.0 && g.integral_limit == 0.0 {
+        return Err(OptionsError::new(
+            &format!("{field}.ki"),
+            "has no effect: integral_limit 0 holds the integral at 0; give integral_limit > 0, or leave ki at 0",
+        ));
+    }
+    Ok(())
 }
 
 /// Validates execution settings (PID gains, periods, tolerances, odometry noise).
@@ -319,14 +339,16 @@ pub fn validate_execution(field: &str, e: &Execution) -> Result<(), OptionsError
     let Execution::Pid(p) = e else {
         return Ok(());
     };
-    validate_pid(field, p)
+    // Named as written in an options file: `exec: { pid: { ... } }`.
+    validate_pid(&format!("{field}.pid"), p)
 }
 
 fn validate_pid(field: &str, p: &PidOptions) -> Result<(), OptionsError> {
     let f = |s: &str| format!("{field}.{s}");
     finite_pos(&f("dt_s"), p.dt_s)?;
-    gains(&f("linear"), &p.linear)?;
-    gains(&f("angular"), &p.angular)?;
+    let base = PidOptions::default();
+    gains(&f("linear"), &p.linear, &base.linear)?;
+    gains(&f("angular"), &p.angular, &base.angular)?;
     finite_nonneg(&f("tolerance_m"), p.tolerance_m)?;
     finite_nonneg(&f("heading_tolerance_rad"), p.heading_tolerance_rad)?;
     finite_nonneg(&f("align_rad"), p.align_rad)?;
@@ -364,6 +386,17 @@ fn validate_pid(field: &str, p: &PidOptions) -> Result<(), OptionsError> {
             MAX_DRIFT_STD,
             "rad per metre (about a full turn per metre)",
         )?;
+        if n.seed != 0
+            && n.linear_rel_std == 0.0
+            && n.angular_rel_std == 0.0
+            && n.heading_drift_std == 0.0
+        {
+            // Zero noise draws nothing: the seed would be read and change nothing.
+            return Err(OptionsError::new(
+                &f("noise.seed"),
+                "has no effect: every noise std is 0 (give a noise > 0, or leave the seed out)",
+            ));
+        }
     }
     Ok(())
 }
