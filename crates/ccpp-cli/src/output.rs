@@ -90,7 +90,13 @@ pub fn replay_dir(dir: &Path) -> Result<()> {
     let trace =
         ccpp_io::trace::read_trace(&dir.join("trace.jsonl"), Some((world.frame(), margin)))?;
     // Through `read_text`: a FIFO named metrics.json hung the replay (a regular file only).
-    let metrics = ccpp_io::file::read_text(&dir.join("metrics.json")).unwrap_or_default();
+    let metrics_path = dir.join("metrics.json");
+    let metrics = ccpp_io::file::read_text(&metrics_path).with_context(|| {
+        format!(
+            "{} is not a complete ccpp run folder (no readable metrics.json)",
+            dir.display()
+        )
+    })?;
     check_same_run(dir, &scenario, &map.name, &world, &trace, &metrics)?;
     let title = format!("{} on {}", scenario.planner.name(), map.name);
     let (html, gif) = render_replay(&world, &trace, scenario.tile_side(), &metrics, &title)?;
@@ -103,9 +109,11 @@ pub fn replay_dir(dir: &Path) -> Result<()> {
 }
 
 /// Refuses a run folder whose files come from different runs (a trace or metrics copied in
-/// from another run), which the replay would draw as one: the trace must begin at the start
-/// pose of the run that `run.json` describes, and `metrics.json`, when there, must name its
-/// planner and map.
+/// from another run), which the replay would draw as one, or that is not a whole run: the
+/// trace must hold a pose, end with the simulator's `finished` record and begin at the start
+/// pose of the run that `run.json` describes; `metrics.json` must be a run's metrics, name
+/// its planner and map, and report the path length the trace drives (the metrics are computed
+/// from the same poses, so only another run's trace differs).
 fn check_same_run(
     dir: &Path,
     scenario: &Scenario,
@@ -114,8 +122,24 @@ fn check_same_run(
     trace: &Trace,
     metrics: &str,
 ) -> Result<()> {
-    let start = world.start();
-    if let Some(first) = trace.poses().next() {
+    // Where the robot was placed: the start, or the pose outside the area it drove in from.
+    let start = world.initial_pose();
+    let Some(first) = trace.poses().next() else {
+        bail!(
+            "{}: trace.jsonl holds no pose: not a finished run's trace",
+            dir.display()
+        );
+    };
+    if !matches!(
+        trace.events().last(),
+        Some((_, ccpp_core::trace::Event::Finished { .. }))
+    ) {
+        bail!(
+            "{}: trace.jsonl does not end with the simulator's `finished` record: the trace is cut short",
+            dir.display()
+        );
+    }
+    {
         // The trace records the start exactly; a thousandth of a pixel allows for nothing but
         // another run.
         let tol = world.frame().resolution * 1e-3;
@@ -131,23 +155,53 @@ fn check_same_run(
             );
         }
     }
-    let Ok(serde_json::Value::Object(m)) = serde_json::from_str::<serde_json::Value>(metrics)
-    else {
-        return Ok(());
+    let m = match serde_json::from_str::<serde_json::Value>(metrics) {
+        Ok(serde_json::Value::Object(m)) => m,
+        _ => bail!(
+            "{}: metrics.json is not a run's metrics (not a JSON object)",
+            dir.display()
+        ),
     };
     let planner = scenario.planner.name();
     for (key, want) in [("planner", planner), ("map", map_name)] {
-        if let Some(got) = m.get(key).and_then(serde_json::Value::as_str) {
-            if got != want {
-                bail!(
-                    "{}: metrics.json is of {key} {got} but run.json of {key} {want}: the \
-                     folder mixes files of two runs",
-                    dir.display()
-                );
-            }
+        let got = m.get(key).and_then(serde_json::Value::as_str);
+        if got != Some(want) {
+            bail!(
+                "{}: metrics.json is of {key} {} but run.json of {key} {want}: the \
+                 folder mixes files of two runs",
+                dir.display(),
+                got.unwrap_or("(none)")
+            );
         }
     }
+    let Some(reported) = m.get("path_length_m").and_then(serde_json::Value::as_f64) else {
+        bail!(
+            "{}: metrics.json is not a run's metrics (no path_length_m)",
+            dir.display()
+        );
+    };
+    let driven = path_length(trace);
+    if (driven - reported).abs() > 1e-9 + 1e-9 * reported.abs() {
+        bail!(
+            "{}: trace.jsonl drives {driven:.3} m but metrics.json reports {reported:.3} m: the \
+             folder mixes files of two runs",
+            dir.display()
+        );
+    }
     Ok(())
+}
+
+/// The length of the path the trace's poses drive, summed as the metrics sum it.
+fn path_length(trace: &Trace) -> f64 {
+    let mut total = 0.0;
+    let mut prev: Option<ccpp_core::Pose> = None;
+    for p in trace.poses() {
+        if let Some(a) = prev {
+            total += a.position().dist(p.position());
+        }
+        prev = Some(p);
+    }
+    total
 }
 
 /// Writes the run's files (with the replay when `replay`, and the path in each of `exports`)

@@ -909,6 +909,33 @@ fn replay_refuses_a_folder_that_mixes_two_runs() {
         &["metrics.json is of planner bsa but run.json of planner ba-star"],
         10,
     );
+    // Another planner's trace from the same start, beside this run's run.json and metrics
+    // (a hostile tester replayed a bcd path labelled ba-star): the path lengths differ.
+    let e = run_ok(dir, "e", &map, "ba-star", &["--start", "1.0,1.0"]);
+    let f = run_ok(dir, "f", &map, "bcd", &["--start", "1.0,1.0"]);
+    std::fs::copy(f.join("trace.jsonl"), e.join("trace.jsonl")).unwrap();
+    fails(
+        &["replay"],
+        &[&e],
+        &[
+            "trace.jsonl drives",
+            "metrics.json reports",
+            "mixes files of two runs",
+        ],
+        10,
+    );
+    // Not a whole run: an empty trace, a trace cut after a pose, no metrics.json.
+    let g = run_ok(dir, "g", &map, "ba-star", &[]);
+    let whole = std::fs::read_to_string(g.join("trace.jsonl")).unwrap();
+    std::fs::write(g.join("trace.jsonl"), "").unwrap();
+    fails(&["replay"], &[&g], &["trace.jsonl holds no pose"], 10);
+    let cut: Vec<&str> = whole.lines().take(3).collect();
+    std::fs::write(g.join("trace.jsonl"), cut.join("\n") + "\n").unwrap();
+    fails(&["replay"], &[&g], &["cut short"], 10);
+    std::fs::write(g.join("trace.jsonl"), &whole).unwrap();
+    std::fs::remove_file(g.join("metrics.json")).unwrap();
+    fails(&["replay"], &[&g], &["no readable metrics.json"], 10);
+    assert!(!g.join("replay.html").exists());
     // A folder as its run wrote it replays.
     ccpp().arg("replay").arg(&b).assert().success();
     assert!(b.join("replay.html").exists());

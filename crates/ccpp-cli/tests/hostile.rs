@@ -1360,7 +1360,7 @@ fn huge_text_inputs_are_refused_before_they_are_read() {
 }
 
 /// `ccpp replay DIR` read `DIR/metrics.json` with no regular-file check: a FIFO there blocked
-/// it forever.
+/// it forever. It is refused at once now (the replay needs the run's metrics).
 #[cfg(unix)]
 #[test]
 fn replay_does_not_wait_on_a_fifo_metrics_file() {
@@ -1376,12 +1376,14 @@ fn replay_does_not_wait_on_a_fifo_metrics_file() {
         eprintln!("mkfifo unavailable; skipping");
         return;
     }
-    ccpp()
+    let a = ccpp()
         .args(["replay", s(&done)])
         .timeout(std::time::Duration::from_secs(30))
         .assert()
-        .success();
-    assert!(done.join("replay.html").is_file());
+        .failure();
+    let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
+    assert!(err.contains("no readable metrics.json"), "{err}");
+    assert!(!done.join("replay.html").exists());
 }
 
 /// A PNG whose header declares `w` x `h` 8-bit grey pixels, followed by one stored (raw) row of

@@ -189,6 +189,9 @@ fn a_start_outside_the_area_drives_there_first() {
     // run.json keeps the start given.
     let rj = std::fs::read_to_string(out.join("run.json")).unwrap();
     assert!(rj.contains("4.675"), "{rj}");
+    // The folder replays: its trace starts where the robot was placed, not where coverage
+    // starts (the replay refused it as "mixing two runs").
+    ccpp().arg("replay").arg(&out).assert().success();
 }
 
 #[test]
