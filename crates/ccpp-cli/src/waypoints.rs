@@ -74,8 +74,42 @@ pub fn run(a: &WaypointsArgs) -> Result<()> {
         s
     };
     match &a.out {
-        Some(path) => write_file(path, text.as_bytes())?,
+        Some(path) => {
+            check_target(path)?;
+            write_file(path, text.as_bytes())?;
+        }
         None => crate::print_stdout(&text)?,
+    }
+    Ok(())
+}
+
+/// Refuses to replace a file at `path` that `ccpp waypoints` did not write (a map, its image,
+/// an options file...): `--out room.yaml` replaced the map itself. A waypoints file of either
+/// format (CSV: header `x,y`; JSON: the object it writes, which begins with `"area"`) is replaced.
+fn check_target(path: &std::path::Path) -> Result<()> {
+    use std::io::Read as _;
+    let Ok(meta) = std::fs::metadata(path) else {
+        return Ok(());
+    };
+    if !meta.is_file() {
+        bail!(
+            "--out {}: not a regular file (give the path of the file to write)",
+            path.display()
+        );
+    }
+    let mut head = Vec::new();
+    std::fs::File::open(path)
+        .and_then(|f| f.take(16).read_to_end(&mut head))
+        .map_err(|e| {
+            anyhow::anyhow!("--out {}: cannot read the file there: {e}", path.display())
+        })?;
+    let ours =
+        head.is_empty() || head.starts_with(b"x,y\n") || head.starts_with(b"{\n  \"area\": [");
+    if !ours {
+        bail!(
+            "--out {}: the file exists and was not written by `ccpp waypoints`; remove it or choose another path",
+            path.display()
+        );
     }
     Ok(())
 }

@@ -1828,3 +1828,40 @@ fn a_rect_area_without_a_lane_point_is_refused() {
     let text = String::from_utf8_lossy(&ok.get_output().stdout).into_owned();
     assert!(text.lines().count() > 2, "{text}");
 }
+
+/// `ccpp waypoints --out FILE` replaced whatever was at FILE: `--out room.yaml` replaced the
+/// map it had just read. A file it did not write is refused and left as it was; its own
+/// output (CSV or JSON) is replaced, and so is an empty file.
+#[test]
+fn waypoints_out_does_not_replace_a_foreign_file() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let before = std::fs::read(&map).unwrap();
+    refused(
+        &["waypoints", "--map", s(&map), "--out", s(&map)],
+        &["--out", "pillars.pgm", "not written by `ccpp waypoints`"],
+    );
+    assert_eq!(std::fs::read(&map).unwrap(), before);
+    refused(
+        &["waypoints", "--map", s(&map), "--out", s(dir)],
+        &["--out", "not a regular file"],
+    );
+    let out = dir.join("w.txt");
+    std::fs::write(&out, "").unwrap();
+    for format in ["csv", "json", "json", "csv", "csv"] {
+        ccpp()
+            .args([
+                "waypoints",
+                "--map",
+                s(&map),
+                "--format",
+                format,
+                "--out",
+                s(&out),
+            ])
+            .assert()
+            .success();
+    }
+    assert!(std::fs::read_to_string(&out).unwrap().starts_with("x,y\n"));
+}
