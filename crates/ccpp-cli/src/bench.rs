@@ -38,6 +38,17 @@ pub fn expand_maps(items: &[PathBuf]) -> Result<Vec<PathBuf>> {
                     .and_then(|e| e.to_str())
                     .is_some_and(|e| exts.iter().any(|x| e.eq_ignore_ascii_case(x)))
             };
+            if let Some(bad) = files.iter().find(|p| {
+                p.file_name().is_some_and(|n| n.to_str().is_none())
+                    && has_ext(p, &["yaml", "yml", "png", "pgm", "pnm"])
+            }) {
+                // Paths are recorded as text (run.json): the run would fail late, unnamed.
+                bail!(
+                    "map folder {} holds {}, whose name is not valid UTF-8; rename it",
+                    item.display(),
+                    bad.display()
+                );
+            }
             let yamls: Vec<PathBuf> = files
                 .iter()
                 .filter(|p| has_ext(p, &["yaml", "yml"]))

@@ -22,7 +22,7 @@ use std::io::Write as _;
 use std::process::ExitCode;
 
 use clap::error::ErrorKind;
-use clap::Parser;
+use clap::{CommandFactory, FromArgMatches};
 
 use crate::args::{Cli, Command};
 
@@ -33,7 +33,15 @@ fn main() -> ExitCode {
     {
         return bench::child_main();
     }
-    let cli = match Cli::try_parse() {
+    let matches = match Cli::command().try_get_matches() {
+        Ok(m) => m,
+        Err(e) => return clap_exit(&e),
+    };
+    if let Err(msg) = utf8_values(&Cli::command(), &matches) {
+        eprintln!("error: {msg}");
+        return ExitCode::FAILURE;
+    }
+    let cli = match Cli::from_arg_matches(&matches) {
         Ok(cli) => cli,
         Err(e) => return clap_exit(&e),
     };
@@ -49,6 +57,37 @@ fn main() -> ExitCode {
 
 /// Help and version go to stdout with status 0; argument errors are one line and a hint on
 /// stderr with status 1, like every other user error.
+/// Refuses an argument that is not valid UTF-8 (of `cmd`, whose parse gave `m`, and of its
+/// subcommands), naming the flag and the value. Paths are recorded as text (`run.json`,
+/// `bench-key.txt`, exports), so a non-UTF-8 path failed late with a message naming neither
+/// ("cannot serialize the run: path contains invalid UTF-8 characters"), or with a false one
+/// ("must end in a folder name").
+fn utf8_values(cmd: &clap::Command, m: &clap::ArgMatches) -> Result<(), String> {
+    for arg in cmd.get_arguments() {
+        let id = arg.get_id().as_str();
+        let Ok(Some(values)) = m.try_get_raw(id) else {
+            continue;
+        };
+        for v in values {
+            if v.to_str().is_none() {
+                let name = arg
+                    .get_long()
+                    .map_or_else(|| id.to_uppercase(), |l| format!("--{l}"));
+                return Err(format!(
+                    "{name} {}: not valid UTF-8 (ccpp records paths and values as text, in run.json and the exports); rename it",
+                    v.to_string_lossy()
+                ));
+            }
+        }
+    }
+    if let Some((name, sub)) = m.subcommand() {
+        if let Some(c) = cmd.find_subcommand(name) {
+            return utf8_values(c, sub);
+        }
+    }
+    Ok(())
+}
+
 fn clap_exit(e: &clap::Error) -> ExitCode {
     match e.kind() {
         ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {

@@ -1865,3 +1865,63 @@ fn waypoints_out_does_not_replace_a_foreign_file() {
     }
     assert!(std::fs::read_to_string(&out).unwrap().starts_with("x,y\n"));
 }
+
+/// A path that is not valid UTF-8 failed late with a message naming no file ("cannot
+/// serialize the run: path contains invalid UTF-8 characters"), or with a false one (`--out`:
+/// "must end in a folder name"); a bench folder holding such a map gave an error row with the
+/// same message. Each is refused at once now, naming the flag (or folder) and the path.
+#[cfg(unix)]
+#[test]
+fn non_utf8_paths_are_refused_by_name() {
+    use std::ffi::OsStr;
+    use std::os::unix::ffi::OsStrExt;
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let odd_map = dir.join(OsStr::from_bytes(b"x\xfe.pgm"));
+    std::fs::copy(&map, &odd_map).unwrap();
+    let odd_out = dir.join(OsStr::from_bytes(b"o\xff"));
+    let one_line = |cmd: &mut assert_cmd::Command, needles: &[&str]| {
+        let a = cmd.assert().failure();
+        let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
+        assert_eq!(a.get_output().status.code(), Some(1), "{err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        for n in needles {
+            assert!(err.contains(n), "{err:?} should contain {n:?}");
+        }
+    };
+    one_line(
+        ccpp()
+            .args(["run", "--planner", "bcd", "--map"])
+            .arg(&odd_map)
+            .arg("--out")
+            .arg(dir.join("out")),
+        &["--map", "x\u{fffd}.pgm", "not valid UTF-8"],
+    );
+    one_line(
+        ccpp()
+            .args(["run", "--planner", "bcd", "--map"])
+            .arg(&map)
+            .arg("--out")
+            .arg(&odd_out),
+        &["--out", "o\u{fffd}", "not valid UTF-8"],
+    );
+    one_line(
+        ccpp().arg("replay").arg(&odd_out),
+        &["DIR", "not valid UTF-8"],
+    );
+    assert!(!dir.join("out").exists() && !odd_out.exists());
+    let maps = dir.join("maps");
+    std::fs::create_dir(&maps).unwrap();
+    std::fs::copy(&map, maps.join(OsStr::from_bytes(b"y\xfe.pgm"))).unwrap();
+    one_line(
+        ccpp()
+            .args(["bench", "--quiet", "--planners", "ba-star", "--maps"])
+            .arg(&maps)
+            .arg("--out")
+            .arg(dir.join("bench")),
+        &["map folder", "y\u{fffd}.pgm", "not valid UTF-8"],
+    );
+    // The same map under a plain name runs.
+    run_ok(dir, "plain", &map, "ba-star", &[]);
+}
