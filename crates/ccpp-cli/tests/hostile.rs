@@ -1925,3 +1925,25 @@ fn non_utf8_paths_are_refused_by_name() {
     // The same map under a plain name runs.
     run_ok(dir, "plain", &map, "ba-star", &[]);
 }
+
+/// `--max-memory` reached the pixel check but not the image decoder, whose own 512 MiB cap
+/// refused a 24000 x 24000 grey PNG (0.6 MB on disk, 576 MB decoded) under
+/// `--max-memory 60000` with "Memory limit exceeded". Needs about 4.5 GB and half a minute in
+/// release: run with `cargo test --release -- --ignored large_png`.
+#[test]
+#[ignore = "needs about 4.5 GB of memory; run in release"]
+fn max_memory_reaches_the_image_decoder_for_a_large_png() {
+    use image::ImageEncoder as _;
+    let d = tempfile::tempdir().unwrap();
+    let path = d.path().join("p24.png");
+    let (w, h) = (24_000u32, 24_000u32);
+    let pixels = vec![0xfeu8; w as usize * h as usize];
+    image::codecs::png::PngEncoder::new(std::fs::File::create(&path).unwrap())
+        .write_image(&pixels, w, h, image::ExtendedColorType::L8)
+        .unwrap();
+    drop(pixels);
+    ccpp()
+        .args(["info", "--max-memory", "60000", "--map", s(&path)])
+        .assert()
+        .success();
+}

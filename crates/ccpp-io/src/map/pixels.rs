@@ -21,6 +21,23 @@ pub(crate) struct Classified {
     pub cells: Vec<Cell>,
 }
 
+/// Bytes a decoded pixel takes at most (16-bit RGBA).
+const DECODED_BYTES_MAX: u64 = 8;
+/// Decoder allocations beside the decoded image (row buffers, the compressed stream's window).
+const DECODER_ROOM: u64 = 64 << 20;
+
+/// The decoder's limits for an image of at most `max_pixels` pixels: its allocation cap at
+/// least the decoded buffer of that many pixels at the widest sample plus working room, and
+/// never below the decoder's default.
+fn decoder_limits(max_pixels: u64) -> image::Limits {
+    let mut limits = image::Limits::default();
+    let need = max_pixels
+        .saturating_mul(DECODED_BYTES_MAX)
+        .saturating_add(DECODER_ROOM);
+    limits.max_alloc = Some(limits.max_alloc.unwrap_or(0).max(need));
+    limits
+}
+
 /// Decodes an image (format guessed from its content) and classifies every pixel. The decoded
 /// image buffer is dropped before returning, so at most the image plus the cells are alive.
 /// With `max_pixels`, the image's size is read from its header first and a larger image is
@@ -74,7 +91,13 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
                 });
             }
             inner.seek(SeekFrom::Start(start)).map_err(io_err)?;
-            ImageReader::with_format(inner, format)
+            let mut r = ImageReader::with_format(inner, format);
+            // The decoder's own allocation cap (512 MiB by default) must not refuse an image
+            // the caller's budget admits (`--max-memory 60000` still failed on a 24000 x 24000
+            // PNG with "Memory limit exceeded"): it is raised to the decoded buffer of
+            // `max` pixels at the widest sample (16-bit RGBA, 8 bytes), plus working room.
+            r.limits(decoder_limits(max));
+            r
         }
     };
     let img = reader.decode().map_err(image_err)?;
@@ -188,4 +211,23 @@ fn level16(v: f64) -> f64 {
 #[inline]
 fn rgb16_level(p: &[u16]) -> f64 {
     (f64::from(p[0]) + f64::from(p[1]) + f64::from(p[2])) / (3.0 * 257.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The decoder's default cap (512 MiB) refused a 24000 x 24000 PNG under
+    /// `--max-memory 60000` ("Memory limit exceeded"): the cap follows the pixel budget.
+    #[test]
+    fn the_decoder_cap_follows_the_pixel_budget() {
+        let default = image::Limits::default().max_alloc.unwrap();
+        // A small budget keeps the decoder's default.
+        assert_eq!(decoder_limits(1000).max_alloc, Some(default));
+        // 24000 x 24000 grey pixels (576 MB decoded, over the default) fit.
+        let px = 24_000u64 * 24_000;
+        let cap = decoder_limits(px).max_alloc.unwrap();
+        assert!(cap >= px * DECODED_BYTES_MAX && cap > default, "{cap}");
+        assert_eq!(decoder_limits(u64::MAX).max_alloc, Some(u64::MAX));
+    }
 }
