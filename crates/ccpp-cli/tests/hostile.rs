@@ -812,6 +812,17 @@ fn every_subcommand_refuses_a_map_too_large_or_too_far_out() {
             "1e300,0",
             &["pillars.pgm", "from the world's origin"][..],
         ),
+        // Too fine for the geometry's tolerances: a run at 5e-8 m/px "swept" 0.014 of a room
+        // with a path of 0 m, where the same room at its scale sweeps 0.64.
+        (
+            "--resolution",
+            "5e-8",
+            &[
+                "pillars.pgm",
+                "resolution 5e-8 m/px",
+                "finer than the 1e-5 m/px",
+            ][..],
+        ),
     ] {
         let with = |head: &[&'static str]| {
             let mut v: Vec<&str> = head.to_vec();
