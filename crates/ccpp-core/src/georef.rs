@@ -104,6 +104,20 @@ pub enum GeorefError {
     /// The pixel points are (nearly) collinear: the fit is not determined.
     #[error("the pixel points are collinear: an affine fit needs 3 points not on one line")]
     Collinear,
+    /// The pixel points are spread along a line but for one far from the others, which alone
+    /// holds the fit (0-based index): the fit would rest on that one point.
+    #[error(
+        "point pair {} (pixel {}, {}) lies far from the others, which are collinear: the fit is ill-conditioned; check that pair",
+        .index + 1, crate::display::Compact(*.x), crate::display::Compact(*.y)
+    )]
+    Outlier {
+        /// Index of the pair.
+        index: usize,
+        /// Its pixel x.
+        x: f64,
+        /// Its pixel y.
+        y: f64,
+    },
     /// The fitted linear part is singular (cannot invert).
     #[error("the affine transform is singular and has no inverse")]
     Singular,
@@ -111,6 +125,54 @@ pub enum GeorefError {
     /// coordinate of 1e177 squared is infinite and the fit came out NaN).
     #[error("the point coordinates are too large for a fit (the sums overflow)")]
     Overflow,
+}
+
+/// Whether the pixel points of `pairs` are well spread in both directions: the determinant of
+/// their centred scatter matrix is not negligible against its spread squared.
+fn well_spread(pixels: impl Iterator<Item = Point> + Clone) -> bool {
+    let n = pixels.clone().count() as f64;
+    let c = pixels
+        .clone()
+        .fold(Point::default(), |a, p| a + p)
+        .scale(1.0 / n);
+    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
+    for p in pixels {
+        let d = p - c;
+        sxx += d.x * d.x;
+        sxy += d.x * d.y;
+        syy += d.y * d.y;
+    }
+    let spread = (sxx + syy).max(f64::MIN_POSITIVE);
+    sxx * syy - sxy * sxy > 1e-12 * spread * spread
+}
+
+/// For a fit [`fit_affine`] found ill-conditioned: the one pair whose pixel point lies far
+/// from the others when the others alone are well spread (an outlier swamps the spread, so
+/// the points looked collinear); `None` when no single point explains it.
+fn far_point(pairs: &[(Point, Point)]) -> Option<GeorefError> {
+    if pairs.len() < 4 {
+        return None;
+    }
+    let n = pairs.len() as f64;
+    let c = pairs
+        .iter()
+        .fold(Point::default(), |a, (p, _)| a + *p)
+        .scale(1.0 / n);
+    let (index, _) = pairs
+        .iter()
+        .enumerate()
+        .map(|(i, (p, _))| (i, p.dist(c)))
+        .fold((0, f64::NEG_INFINITY), |b, x| if x.1 > b.1 { x } else { b });
+    let others = pairs
+        .iter()
+        .enumerate()
+        .filter(move |(i, _)| *i != index)
+        .map(|(_, (p, _))| *p);
+    well_spread(others).then(|| GeorefError::Outlier {
+        index,
+        x: pairs[index].0.x,
+        y: pairs[index].0.y,
+    })
 }
 
 /// Fits `world = A pixel + b` to `pairs` of `(pixel, world)` points by least squares.
@@ -158,7 +220,7 @@ pub fn fit_affine(pairs: &[(Point, Point)]) -> Result<AffineFit, GeorefError> {
     }
     let spread = (sxx + syy).max(f64::MIN_POSITIVE);
     if det <= 1e-12 * spread * spread {
-        return Err(GeorefError::Collinear);
+        return Err(far_point(pairs).unwrap_or(GeorefError::Collinear));
     }
     let (i00, i01, i11) = (syy / det, -sxy / det, sxx / det);
     let m = [
@@ -268,6 +330,26 @@ mod tests {
         assert_eq!(
             fit_affine(&[p(0.0, 0.0), p(1.0, f64::NAN), p(2.0, 2.0)]),
             Err(GeorefError::NonFinite(1))
+        );
+        // Three good points and one a billion pixels out: the others are well spread, so the
+        // far one is named (it was reported as "the pixel points are collinear").
+        let far = fit_affine(&[p(0.0, 0.0), p(60.0, 0.0), p(0.0, 40.0), p(1e9, 1e9)]);
+        assert_eq!(
+            far,
+            Err(GeorefError::Outlier {
+                index: 3,
+                x: 1e9,
+                y: 1e9
+            })
+        );
+        assert!(far
+            .unwrap_err()
+            .to_string()
+            .contains("point pair 4 (pixel 1e9, 1e9)"));
+        // Collinear points with a far one on the same line stay collinear.
+        assert_eq!(
+            fit_affine(&[p(0.0, 0.0), p(1.0, 1.0), p(2.0, 2.0), p(1e9, 1e9)]),
+            Err(GeorefError::Collinear)
         );
         let flat = Affine {
             m: [1.0, 2.0, 2.0, 4.0],
