@@ -104,10 +104,10 @@ pub enum GeorefError {
     /// The pixel points are (nearly) collinear: the fit is not determined.
     #[error("the pixel points are collinear: an affine fit needs 3 points not on one line")]
     Collinear,
-    /// The pixel points are spread along a line but for one far from the others, which alone
-    /// holds the fit (0-based index): the fit would rest on that one point.
+    /// One pair's pixel point lies so far from the others (well spread on their own) that the
+    /// spread of all looks like a line (0-based index): the fit would rest on that point.
     #[error(
-        "point pair {} (pixel {}, {}) lies far from the others, which are collinear: the fit is ill-conditioned; check that pair",
+        "point pair {} (pixel {}, {}) lies so far from the others that they look collinear beside it: the fit is ill-conditioned; check that pair",
         .index + 1, crate::display::Compact(*.x), crate::display::Compact(*.y)
     )]
     Outlier {
