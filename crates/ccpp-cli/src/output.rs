@@ -155,12 +155,12 @@ fn check_same_run(
             );
         }
     }
-    let m = match serde_json::from_str::<serde_json::Value>(metrics) {
-        Ok(serde_json::Value::Object(m)) => m,
-        _ => bail!(
+    let Ok(serde_json::Value::Object(m)) = serde_json::from_str::<serde_json::Value>(metrics)
+    else {
+        bail!(
             "{}: metrics.json is not a run's metrics (not a JSON object)",
             dir.display()
-        ),
+        );
     };
     let planner = scenario.planner.name();
     for (key, want) in [("planner", planner), ("map", map_name)] {
