@@ -1286,14 +1286,16 @@ fn tiny_values_print_in_exponent_form() {
             "--map",
             s(&map),
             "--resolution",
-            "1e-300",
+            "1.5e-5",
             "--radius",
             "1e-305",
         ])
         .assert()
         .success();
     let info = String::from_utf8_lossy(&a.get_output().stdout).into_owned();
-    assert!(info.contains("1e-300 m/px"), "{info}");
+    // (A resolution below 1e-5 m/px is refused since: `MIN_RESOLUTION_M`.)
+    assert!(info.contains("1.5e-5 m/px"), "{info}");
+    assert!(info.contains("robot radius   1e-305 m"), "{info}");
     assert!(info.lines().all(|l| l.len() < 120), "{info}");
     let out = dir.join("out");
     let a = ccpp()
