@@ -654,7 +654,14 @@ pub fn results_csv(rows: &[Row]) -> String {
                 f.extend(std::iter::repeat_n(String::new(), 15));
             }
         }
-        f.push(csv_field(&r.dir.display().to_string()));
+        // A failed run leaves no folder: its `dir` is empty rather than a path that does not
+        // exist.
+        let dir = if r.outcome.is_ok() {
+            r.dir.display().to_string()
+        } else {
+            String::new()
+        };
+        f.push(csv_field(&dir));
         s.push_str(&f.join(","));
         s.push('\n');
     }
@@ -691,7 +698,12 @@ pub fn results_md(rows: &[Row]) -> String {
             .iter()
             .filter(|r| r.planner == *p && r.outcome.is_err())
             .count();
-        let n = ok.len().max(1) as f64;
+        if ok.is_empty() {
+            // No run to average: dashes, not means of nothing (`-0.0000` was printed).
+            let _ = writeln!(s, "| {p} | 0 | {fails} | - | - | - | - | - | - | - |");
+            continue;
+        }
+        let n = ok.len() as f64;
         let mean = |f: fn(&Metrics) -> f64| ok.iter().map(|m| f(m)).sum::<f64>() / n;
         let _ = writeln!(
             s,
@@ -741,4 +753,32 @@ pub fn results_md(rows: &[Row]) -> String {
         s.push('\n');
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A planner whose every run failed had "means" of nothing (`-0.0000`) in the summary, and
+    /// its rows named run folders that were never written.
+    #[test]
+    fn a_planner_without_a_run_has_no_means_and_no_folders() {
+        let row = |map: &str| Row {
+            map: map.into(),
+            planner: "bsa".into(),
+            outcome: Err("robot too big".into()),
+            dir: PathBuf::from(format!("out/runs/{map}/bsa")),
+        };
+        let rows = [row("a"), row("b")];
+        let md = results_md(&rows);
+        assert!(
+            md.contains("| bsa | 0 | 2 | - | - | - | - | - | - | - |"),
+            "{md}"
+        );
+        assert!(!md.contains("-0.0"), "{md}");
+        let csv = results_csv(&rows);
+        for l in csv.lines().skip(1) {
+            assert!(l.ends_with(",error,robot too big,,,,,,,,,,,,,,,,"), "{l}");
+        }
+    }
 }

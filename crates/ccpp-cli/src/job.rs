@@ -86,17 +86,23 @@ impl JobResult {
     /// The note telling the user that the start lies outside the area and how far the robot
     /// drives to reach it first (`None` when it starts inside).
     pub fn approach_note(&self) -> Option<String> {
-        if self.world.approach().is_empty() {
-            return None;
-        }
-        let e = self.world.start();
-        Some(format!(
-            "note: the start is outside the area: the robot first drives {:.2} m on the known map to reach it at ({:.3}, {:.3})",
-            self.world.approach_length_m(),
-            e.x,
-            e.y
-        ))
+        approach_note(&self.world)
     }
+}
+
+/// The note telling the user that the start lies outside the area of `world` and how far the
+/// robot drives to reach it first (`None` when it starts inside): `run` and `plan` print it.
+pub fn approach_note(world: &World) -> Option<String> {
+    if world.approach().is_empty() {
+        return None;
+    }
+    let e = world.start();
+    Some(format!(
+        "note: the start is outside the area: the robot first drives {:.2} m on the known map to reach it at ({:.3}, {:.3})",
+        world.approach_length_m(),
+        e.x,
+        e.y
+    ))
 }
 
 /// The recipe of `args`: paths made absolute so that `run.json` works from any folder.

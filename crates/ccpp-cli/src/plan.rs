@@ -79,6 +79,9 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         staging.write(name, bytes)?;
     }
     staging.commit()?;
+    if let Some(note) = crate::job::approach_note(&plan.world) {
+        eprintln!("{note}");
+    }
     // As for `run`: a start whose free area reaches the map's border is probably outside.
     let comp = StartComponent::of(plan.world.map(), plan.world.start().position());
     if let Some(w) = comp.warning() {

@@ -399,3 +399,30 @@ fn info_shows_the_zones_and_waypoints_avoid_keepouts() {
     assert!(!inside(&wp(&["--keepout", "-3,-1.2,3,-0.3"])));
     drop(d);
 }
+
+/// `ccpp plan` added the drive into the area to its path without the note `run` prints.
+#[test]
+fn plan_tells_of_the_drive_into_the_area() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("plan");
+    let o = ccpp()
+        .args(["plan", "--planner", "bcd", "--radius", "0.3"])
+        .args([
+            "--area",
+            "-9.3,-5.8,-2.85,-3.15",
+            "--start",
+            "4.675,-1.975",
+            "--map",
+        ])
+        .arg(house())
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains("note: the start is outside the area: the robot first drives"),
+        "{err}"
+    );
+}

@@ -211,18 +211,26 @@ impl Route {
         Self::from_poses(trace.poses(), tolerance_m)
     }
 
-    /// Length of the polyline through the waypoints, metres.
+    /// Length of the polyline through the waypoints, metres (`0.0`, not `-0.0`, for fewer than
+    /// two waypoints: an empty `f64` sum is `-0.0`, which the exports printed).
     pub fn length_m(&self) -> f64 {
         self.waypoints
             .windows(2)
             .map(|w| w[0].position().dist(w[1].position()))
-            .sum()
+            .fold(0.0, |a, b| a + b)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_route_of_one_waypoint_has_length_plus_zero() {
+        let one = Route::from_poses([Pose::new(1.0, 2.0, 0.0)].into_iter(), 0.01);
+        assert!(one.length_m().is_sign_positive() && one.length_m() == 0.0);
+        assert_eq!(serde_json::to_string(&one.length_m()).unwrap(), "0.0");
+    }
 
     fn xy(r: &Route) -> Vec<(f64, f64)> {
         r.waypoints.iter().map(|p| (p.x, p.y)).collect()

@@ -251,10 +251,18 @@ impl Map {
             .into_pyarray(py)
     }
 
-    /// The world coordinates `(x, y)` of the centre of pixel `(col, row)`.
-    fn pixel_center(&self, col: usize, row: usize) -> (f64, f64) {
-        let p = self.map.grid.frame().pixel_center(col, row);
-        (p.x, p.y)
+    /// The world coordinates `(x, y)` of the centre of pixel `(col, row)` (column from the
+    /// left, row from the top); `IndexError` outside the image.
+    fn pixel_center(&self, col: usize, row: usize) -> PyResult<(f64, f64)> {
+        let f = self.map.grid.frame();
+        if col >= f.width || row >= f.height {
+            return Err(pyo3::exceptions::PyIndexError::new_err(format!(
+                "pixel ({col}, {row}) is outside the map's {} x {} px",
+                f.width, f.height
+            )));
+        }
+        let p = f.pixel_center(col, row);
+        Ok((p.x, p.y))
     }
 
     fn __repr__(&self) -> String {
@@ -1128,6 +1136,9 @@ pub struct Env {
     sim: SimConfig,
     max_steps: Option<u64>,
     episode: Option<Episode>,
+    /// The episode terminated or was truncated: `step` refuses until `reset` (a robot that had
+    /// hit a wall kept moving, and a truncated episode kept adding path).
+    ended: bool,
 }
 
 /// `(observation, reward, terminated, truncated, info)` of [`Env::step`].
@@ -1265,7 +1276,12 @@ fn parse_action(a: &Bound<'_, PyAny>) -> PyResult<Step> {
         return Err(bad());
     };
     let num = |i: usize| -> PyResult<f64> {
-        let v: f64 = items.get(i).ok_or_else(bad)?.extract().map_err(|_| bad())?;
+        let item = items.get(i).ok_or_else(bad)?;
+        if item.is_instance_of::<PyBool>() {
+            // A bool is an int to Python: `("translate", True)` drove 1 m.
+            return Err(bad());
+        }
+        let v: f64 = item.extract().map_err(|_| bad())?;
         if v.is_finite() {
             Ok(v)
         } else {
@@ -1360,6 +1376,7 @@ impl Env {
             sim: s.sim,
             max_steps,
             episode: None,
+            ended: false,
         })
     }
 
@@ -1424,6 +1441,7 @@ impl Env {
             })
             .map_err(|e| err(&e))?;
         self.episode = Some(episode);
+        self.ended = false;
         Ok((self.observation(py)?, self.info(py, false)?))
     }
 
@@ -1431,9 +1449,14 @@ impl Env {
     /// `("move_to", x, y)` — and returns `(observation, reward, terminated, truncated, info)`:
     /// the reward is the newly swept accessible area in m²; the episode terminates on a
     /// collision (the bumper) or when every accessible pixel is swept; it is truncated after
-    /// `max_steps` actions.
+    /// `max_steps` actions. A step after the episode has ended is refused (call `reset`).
     fn step(&mut self, py: Python<'_>, action: &Bound<'_, PyAny>) -> PyResult<StepResult> {
         let step = parse_action(action)?;
+        if self.ended {
+            return Err(msg(
+                "the episode has ended (terminated or truncated): call reset() before step()",
+            ));
+        }
         let ep = self
             .episode
             .as_mut()
@@ -1454,6 +1477,7 @@ impl Env {
             )
         });
         let truncated = self.max_steps.is_some_and(|m| steps >= m);
+        self.ended = collided || done || truncated;
         Ok((
             self.observation(py)?,
             gain,

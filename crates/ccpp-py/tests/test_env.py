@@ -83,9 +83,15 @@ def test_driving_into_a_wall_is_a_collision(room: Path) -> None:
     # It stopped at the wall: the east wall's inner face is at x = 2.95 m.
     assert obs["pose"][0] == pytest.approx(2.95 - 0.15, abs=0.05)
     assert env.metrics()["collisions"] == 1
-    # Turning away and driving on is possible.
+    # The episode has ended: stepping on is refused (the robot kept moving after a
+    # terminating collision), and a reset starts a new one.
+    path = env.metrics()["path_length_m"]
+    with pytest.raises(ccpp.CcppError, match="episode has ended"):
+        env.step(("rotate", math.pi))
+    assert env.metrics()["path_length_m"] == path
+    env.reset()
     _, _, terminated, _, info = env.step(("rotate", math.pi))
-    assert not info["collision"]
+    assert not terminated and not info["collision"]
 
 
 def test_reset_seed_and_actions(room: Path) -> None:
@@ -99,8 +105,15 @@ def test_reset_seed_and_actions(room: Path) -> None:
     assert not truncated
     _, _, _, truncated, _ = env.step(("rotate", 0.5))
     assert truncated
+    # Truncated: a third step is refused (it drove on, past max_steps).
+    with pytest.raises(ccpp.CcppError, match="episode has ended"):
+        env.step(("translate", 0.1))
     with pytest.raises(ccpp.CcppError, match="action must be"):
         env.step(("jump", 1.0))
+    # A bool is no distance (`("translate", True)` drove 1 m).
+    env.reset()
+    with pytest.raises(ccpp.CcppError, match="action must be"):
+        env.step(("translate", True))
     with pytest.raises(ccpp.CcppError, match="finite"):
         env.step(("translate", float("nan")))
     with pytest.raises(ccpp.CcppError, match="reset"):

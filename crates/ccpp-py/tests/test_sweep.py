@@ -73,6 +73,10 @@ def test_sweep_radii_and_errors(room: Path, tmp_path: Path, client) -> None:
     assert err["effective_coverage"].isna().all()
     with pytest.raises(ccpp.CcppError, match="unknown planner"):
         ccpp.sweep([str(room)], ["nope"], client=client)
+    # A radius is a number: True ran at 1.0 m and "0.2" at 0.2 m.
+    for radii in ([True], ["0.2"]):
+        with pytest.raises(ccpp.CcppError, match="radii must be numbers"):
+            ccpp.sweep([str(room)], ["bsa"], radii, client=client)
 
 
 def test_sweep_refuses_what_it_would_ignore(room: Path, tmp_path: Path, client) -> None:

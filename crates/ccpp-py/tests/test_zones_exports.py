@@ -114,6 +114,11 @@ def test_env_knows_its_zones(room: Path) -> None:
     m = env.map
     col, row = 22, 19  # pixel centre (1.125, 1.025): inside the keep-out, 0.525 m ahead
     assert m.pixel_center(col, row) == pytest.approx((1.125, 1.025))
+    # Outside the image: IndexError (a row past the last one panicked with an overflow).
+    h, w = m.occupancy.shape
+    for c, r in [(0, h), (w, 0), (0, 10**6)]:
+        with pytest.raises(IndexError, match="outside the map"):
+            m.pixel_center(c, r)
     assert m.occupancy[row, col] == 0 and obs["known"][row, col] == 1
     assert env.metrics()["keepout_violations"] == 0
     # A virtual wall does not stop the robot: driving into the keep-out is a violation, not a

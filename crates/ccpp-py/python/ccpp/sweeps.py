@@ -13,6 +13,7 @@ installed and the map files at the same paths (a shared file system); so does ``
 
 from __future__ import annotations
 
+import numbers
 import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Iterable, Sequence
@@ -161,7 +162,8 @@ def _run_cell(
         # `ccpp bench`'s results.csv.
         row.update(status=metrics.get("stop_reason") or "ok", error=None)
         row.update({c: metrics[c] for c in _METRIC_COLUMNS})
-    row["dir"] = out_dir or ""
+    # A failed run leaves no folder (as `ccpp bench`'s results.csv).
+    row["dir"] = (out_dir or "") if metrics is not None else ""
     return row
 
 
@@ -212,6 +214,10 @@ def sweep(
         radii = (0.15,)
     elif isinstance(radii, (int, float)):
         radii = (radii,)
+    for r in radii:
+        # `float()` took True as 1.0 m and "0.2" as 0.2: a radius is a number.
+        if isinstance(r, bool) or not isinstance(r, numbers.Real):
+            raise _ccpp.CcppError(f"radii must be numbers (metres), got {r!r}")
     radii = _once(float(r) for r in radii)
     if not radii:
         raise _ccpp.CcppError("radii is empty")
