@@ -426,3 +426,34 @@ fn plan_tells_of_the_drive_into_the_area() {
         "{err}"
     );
 }
+
+/// `run.json` recorded a zone file by the path given (relative to the working folder) but the
+/// map by its absolute path, so `ccpp replay` of a zoned run worked only from the folder the
+/// run started in. Zone files are recorded absolute now.
+#[test]
+fn a_zoned_run_replays_from_another_folder() {
+    let d = tempfile::tempdir().unwrap();
+    let work = d.path().join("work");
+    std::fs::create_dir(&work).unwrap();
+    std::fs::write(
+        work.join("room.yaml"),
+        "- [-9.3, -5.8]\n- [-2.85, -5.8]\n- [-2.85, -3.15]\n- [-9.3, -3.15]\n",
+    )
+    .unwrap();
+    ccpp()
+        .current_dir(&work)
+        .args(["run", "--planner", "bsa", "--radius", "0.3"])
+        .args(["--area", "room.yaml", "--out", "zoned", "--map"])
+        .arg(house())
+        .assert()
+        .success();
+    let rj = std::fs::read_to_string(work.join("zoned/run.json")).unwrap();
+    let abs = std::fs::canonicalize(work.join("room.yaml")).unwrap();
+    assert!(rj.contains(abs.to_str().unwrap()), "{rj}");
+    ccpp()
+        .current_dir(d.path())
+        .arg("replay")
+        .arg("work/zoned")
+        .assert()
+        .success();
+}

@@ -1277,11 +1277,18 @@ impl ScenarioBuilder {
         self
     }
 
-    /// Work area (`None`: the whole map) and keep-out zones, replacing any set before.
+    /// Work area (`None`: the whole map) and keep-out zones, replacing any set before; zone
+    /// files are recorded by their absolute paths.
     #[must_use]
     pub fn zones(mut self, area: Option<ZoneSpec>, keepout: Vec<ZoneSpec>) -> Self {
-        self.0.area = area;
-        self.0.keepout = keepout;
+        // Zone files are recorded absolute, as the map is, so that `run.json` replays from any
+        // folder (a relative `area.geojson` was looked up beside the replay's working folder).
+        let abs = |z: ZoneSpec| match z {
+            ZoneSpec::File(p) => ZoneSpec::File(std::fs::canonicalize(&p).unwrap_or(p)),
+            other => other,
+        };
+        self.0.area = area.map(abs);
+        self.0.keepout = keepout.into_iter().map(abs).collect();
         self
     }
 
