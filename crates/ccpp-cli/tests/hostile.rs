@@ -1960,3 +1960,43 @@ fn max_memory_reaches_the_image_decoder_for_a_large_png() {
         .assert()
         .success();
 }
+
+/// A robot wider than the map got the message of whatever the planner checked first: for
+/// ba-star and bsa-bfs "tile side 10 m is larger than the map", an option the user never set.
+/// Every planner now says the robot fits nowhere.
+#[test]
+fn a_robot_wider_than_the_map_is_named_for_every_planner() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir); // 8 x 6 m
+    let out = dir.join("out");
+    for p in [
+        "ba-star",
+        "ba-star-extended",
+        "bsa",
+        "bsa-extended",
+        "bsa-bfs",
+        "bcd",
+        "random-bounce",
+        "rect-boustrophedon",
+    ] {
+        refused(
+            &[
+                "run",
+                "--planner",
+                p,
+                "--map",
+                s(&map),
+                "--radius",
+                "5",
+                "--out",
+                s(&out),
+            ],
+            &[
+                "pillars.pgm",
+                "a robot of radius 5 m (10 m across) is larger than the map (8 x 6 m)",
+            ],
+        );
+        assert!(!out.exists());
+    }
+}

@@ -910,6 +910,21 @@ impl Scenario {
         let planner = self.planner.name();
         // Also checked when the map is prepared; again here for a map the caller built.
         check_extent(&map.grid, &map.source)?;
+        // A robot wider than the map fits nowhere, whatever the planner: said before the
+        // planner's own checks, which would blame its tile (`ba_star.tile_side_m: tile side
+        // 10 m is larger than the map` for a robot of radius 5 m).
+        let f = map.grid.frame();
+        let (w, h) = (f.width_m(), f.height_m());
+        if 2.0 * self.robot.radius > w.max(h) {
+            return Err(ScenarioError::Invalid(format!(
+                "map {}: a robot of radius {} m ({} m across) is larger than the map ({} x {} m): it fits nowhere",
+                map.source.display(),
+                Compact(self.robot.radius),
+                Compact(2.0 * self.robot.radius),
+                Compact(w),
+                Compact(h)
+            )));
+        }
         self.planner
             .settings()
             .check(&setup)
