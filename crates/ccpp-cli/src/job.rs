@@ -245,11 +245,31 @@ fn clash(
     )
 }
 
-/// `--seed` into random-bounce's options, refused beside a different `random_bounce.seed`
-/// from the options file `file` (`run` and `bench` alike).
+/// Whether the options file `file` gives the option at `path` (`ba_star.smoothing`), whatever
+/// its value: a flag beside it replaces the file's value even where that value is the default
+/// (the file `planners --defaults` prints gives every option). `false` without a file.
+fn file_sets(file: Option<&Path>, path: &str) -> bool {
+    let Some(f) = file else { return false };
+    // The file was read and validated already; an error here means it was not given.
+    let Ok(text) = ccpp_io::file::read_text(f) else {
+        return false;
+    };
+    let json = f
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("json"));
+    let Ok(v) = ccpp_io::file::parse_yaml_or_json::<serde_json::Value>(&text, json) else {
+        return false;
+    };
+    path.split('.').try_fold(&v, |v, k| v.get(k)).is_some()
+}
+
+/// `--seed` into random-bounce's options, refused beside a `random_bounce.seed` of another
+/// value from the options file `file` (`run` and `bench` alike).
 fn set_seed(o: &mut RandomBounceOptions, seed: u64, file: Option<&Path>) -> Result<()> {
     let file_seed = o.seed;
-    if file_seed != RandomBounceOptions::default().seed && file_seed != seed {
+    if (file_seed != RandomBounceOptions::default().seed || file_sets(file, "random_bounce.seed"))
+        && file_seed != seed
+    {
         return Err(clash(file, "--seed", seed, "random_bounce.seed", file_seed));
     }
     o.seed = seed;
@@ -284,7 +304,9 @@ pub(crate) fn apply_rect_flags(
             ),
             _ => return Err(not_applicable(flag, kind, "rect-boustrophedon")),
         };
-        if slot.to_bits() != d.to_bits() && slot.to_bits() != v.to_bits() {
+        if (slot.to_bits() != d.to_bits() || file_sets(file, field))
+            && slot.to_bits() != v.to_bits()
+        {
             return Err(clash(file, flag, v, field, *slot));
         }
         *slot = v;
@@ -314,14 +336,10 @@ fn apply_planner_flags(a: &RunArgs, config: &mut PlannerConfig) -> Result<Vec<&'
                 ))
             }
         };
-        if let Some(w) = slot.filter(|w| w.to_bits() != t.to_bits()) {
-            return Err(clash(
-                a.options.config.as_deref(),
-                "--tile-side",
-                t,
-                field,
-                w,
-            ));
+        let file = a.options.config.as_deref();
+        if slot.is_none_or(|w| w.to_bits() != t.to_bits()) && file_sets(file, field) {
+            let w = slot.map_or_else(|| "null".to_string(), |w| w.to_string());
+            return Err(clash(file, "--tile-side", t, field, w));
         }
         *slot = Some(t);
     }
@@ -340,14 +358,16 @@ fn apply_planner_flags(a: &RunArgs, config: &mut PlannerConfig) -> Result<Vec<&'
                 ))
             }
         };
-        // The default is on: a file that turned it off and the flag that turns it on clash.
-        if !*slot && s {
+        // The default is on: a file that turned it off and the flag that turns it on clash,
+        // and so does a file that gives it at all beside a flag of the other value.
+        let file = a.options.config.as_deref();
+        if *slot != s && (!*slot || file_sets(file, field)) {
             return Err(clash(
-                a.options.config.as_deref(),
+                file,
                 "--smoothing",
-                "on",
+                if s { "on" } else { "off" },
                 field,
-                "false",
+                *slot,
             ));
         }
         *slot = s;
@@ -363,7 +383,9 @@ fn apply_planner_flags(a: &RunArgs, config: &mut PlannerConfig) -> Result<Vec<&'
             PlannerConfig::BsaExtended(o) => (&mut o.side, "bsa_extended.side"),
             _ => return Err(not_applicable("--side", kind, "bsa, bsa-extended")),
         };
-        if *slot != Side::default() && *slot != side {
+        if (*slot != Side::default() || file_sets(a.options.config.as_deref(), field))
+            && *slot != side
+        {
             return Err(clash(
                 a.options.config.as_deref(),
                 "--side",
@@ -419,7 +441,16 @@ fn sim_from(a: &RunArgs, config: &mut PlannerConfig) -> Result<SimConfig> {
     };
     // `--exec ideal` replaces the planner's execution: PID settings given for it in the
     // options file would be read, validated and then dropped, so the two are refused together.
-    if exec == Some(false) && pid != PidOptions::default() {
+    // A file that gives the planner's PID execution at all (its defaults too) clashes; one
+    // that runs it ideally agrees.
+    let file_pid = matches!(
+        config.settings().preferred_execution(),
+        Some(Execution::Pid(_))
+    ) && file_sets(
+        a.options.config.as_deref(),
+        &format!("{}.exec", kind.info().section),
+    );
+    if exec == Some(false) && (pid != PidOptions::default() || file_pid) {
         bail!(
             "--exec ideal drops the PID settings given for {kind} in {} ({}.exec); remove one of them",
             options_file(a.options.config.as_deref()),

@@ -59,6 +59,58 @@ fn planners_defaults_is_a_config_of_the_defaults() {
         );
     }
     assert!(text.contains("plans_at_a_time: null"), "{text}");
+    // The file gives every option, at its default: a flag of another value beside it would
+    // replace the file's value without a word (it did), so the pair is refused; a flag of the
+    // same value agrees.
+    for (planner, flag, clashing, agreeing, field) in [
+        ("random-bounce", "--seed", "5", "0", "random_bounce.seed: 0"),
+        (
+            "ba-star",
+            "--smoothing",
+            "off",
+            "on",
+            "ba_star.smoothing: true",
+        ),
+        ("bsa", "--side", "right", "left", "bsa.side: left"),
+        (
+            "ba-star",
+            "--tile-side",
+            "0.4",
+            "",
+            "ba_star.tile_side_m: null",
+        ),
+        (
+            "rect-boustrophedon",
+            "--length",
+            "0.5",
+            "0.3",
+            "rect_boustrophedon.length_m: 0.3",
+        ),
+        ("bsa-bfs", "--exec", "ideal", "pid", "bsa_bfs.exec"),
+    ] {
+        let out = d.join("clash");
+        let a = ccpp()
+            .args(["run", "--planner", planner, "--map", map.to_str().unwrap()])
+            .args(["--config", cfg.to_str().unwrap(), flag, clashing, "--out"])
+            .arg(&out)
+            .assert()
+            .code(1);
+        let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
+        assert!(
+            err.contains(field) && err.contains("defaults.yaml"),
+            "{planner} {flag}: {err}"
+        );
+        assert!(!out.exists());
+        if !agreeing.is_empty() {
+            crate::common::run_ok(
+                d,
+                &format!("{planner}-agree"),
+                &map,
+                planner,
+                &["--config", cfg.to_str().unwrap(), flag, agreeing],
+            );
+        }
+    }
     let some = ccpp()
         .args(["planners", "--defaults", "bcd,bsa-bfs"])
         .assert()
