@@ -148,7 +148,22 @@ fn py_to_json(o: &Bound<'_, PyAny>) -> PyResult<Value> {
         }
         return Ok(Value::Array(a));
     }
-    // numpy scalars and other numbers.
+    // A path (`pathlib.Path`, any `os.PathLike`) as its text, as map and folder arguments.
+    if o.hasattr("__fspath__")? {
+        let p = o.call_method0("__fspath__")?;
+        if p.is_instance_of::<PyString>() {
+            return Ok(Value::String(p.extract()?));
+        }
+    }
+    // numpy arrays and scalars as the Python lists and numbers they hold (`np.int64(3)` is a
+    // whole number, not 3.0; an array of four numbers is a rectangle).
+    if o.hasattr("tolist")? {
+        let plain = o.call_method0("tolist")?;
+        if !plain.hasattr("tolist")? {
+            return py_to_json(&plain);
+        }
+    }
+    // Other numbers.
     if let Ok(f) = o.extract::<f64>() {
         return serde_json::Number::from_f64(f)
             .map(Value::Number)
@@ -361,9 +376,15 @@ const RUN_KEYS: [&str; 11] = [
     "keepout",
 ];
 
+/// What a zone argument may be, for messages (serde's "data did not match any variant of
+/// untagged enum ZoneSpec" says nothing to a user).
+const ZONE_FORMS: &str =
+    "a file name, [x0, y0, x1, y1] or a list of polygons (each a list of [x, y] points)";
+
 /// A work area: a file name, `[x0, y0, x1, y1]` or a list of polygons (`Scenario::area`).
 fn parse_area(v: &Bound<'_, PyAny>) -> PyResult<ZoneSpec> {
-    serde_json::from_value(py_to_json(v)?).map_err(|e| msg(format!("area: {e}")))
+    serde_json::from_value(py_to_json(v)?)
+        .map_err(|_| msg(format!("area must be {ZONE_FORMS}, got {}", repr(v))))
 }
 
 /// Keep-out zones: one zone (as for an area) or a list of zones (`Scenario::keepout`).
@@ -371,7 +392,12 @@ fn parse_keepout(v: &Bound<'_, PyAny>) -> PyResult<Vec<ZoneSpec>> {
     let j = py_to_json(v)?;
     match serde_json::from_value::<ZoneSpec>(j.clone()) {
         Ok(one) => Ok(vec![one]),
-        Err(_) => serde_json::from_value(j).map_err(|e| msg(format!("keepout: {e}"))),
+        Err(_) => serde_json::from_value(j).map_err(|_| {
+            msg(format!(
+                "keepout must be a zone ({ZONE_FORMS}) or a list of zones, got {}",
+                repr(v)
+            ))
+        }),
     }
 }
 
@@ -620,6 +646,21 @@ fn scenario_from(
     // After the planner's options: `pid` runs the planner's own PID settings (as `--exec pid`
     // beside `--config`); the scenario refuses an execution that would drop them.
     if let Some(e) = exec {
+        let gives_pid = in_options.as_ref().is_some_and(|d| {
+            d.get_item("exec")
+                .is_ok_and(|v| v.is_some_and(|v| !v.is_none()))
+        }) && matches!(
+            s.planner.settings().preferred_execution(),
+            Some(Execution::Pid(_))
+        );
+        if gives_pid && e.eq_ignore_ascii_case("ideal") {
+            // As `--exec ideal` beside `exec` in `--config`: the settings given, even at
+            // their defaults, would be read and dropped (the scenario sees only other values).
+            return Err(msg(format!(
+                "exec ideal drops the PID settings given for {kind} in options[\"exec\"], its {}.exec; remove one of them",
+                kind.info().section
+            )));
+        }
         s.sim.exec = Some(match e.to_ascii_lowercase().as_str() {
             "ideal" => Execution::Ideal,
             "pid" => match s.planner.settings().preferred_execution() {

@@ -203,3 +203,11 @@ def test_the_work_area_and_rect_boustrophedons_lane_area_are_both_honoured(room:
     both = ccpp.run(m, "rect-boustrophedon", area=work, options=lanes)
     assert not _same(both, ccpp.run(m, "rect-boustrophedon", area=work))
     assert not _same(both, ccpp.run(m, "rect-boustrophedon", options=lanes))
+
+
+def test_exec_ideal_beside_pid_settings_at_their_defaults_is_refused(room: Path) -> None:
+    # As `--exec ideal` beside `bsa_bfs.exec` in `--config`: the settings given would be read
+    # and dropped, even at their defaults (they were accepted).
+    with pytest.raises(ccpp.CcppError, match="drops the PID settings"):
+        ccpp.run(room, "bsa-bfs", exec="ideal", options={"exec": {"pid": {}}})
+    ccpp.run(room, "bsa-bfs", exec="ideal")

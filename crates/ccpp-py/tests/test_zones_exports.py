@@ -146,3 +146,22 @@ def test_env_drives_into_the_area_and_refuses_bad_zones(room: Path) -> None:
         ccpp.Env(room, keepout=KEEPOUT, start=(1.2, 1.0, 0.0))
     with pytest.raises(ccpp.CcppError, match="keepout"):
         ccpp.Env(room, keepout=str(room.parent / "missing.geojson"))
+
+
+def test_zone_and_seed_arguments_take_paths_and_numpy(room: Path, tmp_path: Path) -> None:
+    # A pathlib.Path keep-out, a numpy area and a numpy seed were refused ("cannot use
+    # PosixPath as an option value", "cannot use ndarray", "expected u64"), though maps and
+    # starts take them; each gives the same run as its plain form.
+    ko = tmp_path / "ko.yaml"
+    ko.write_text("- [1.0, 0.8]\n- [1.4, 0.8]\n- [1.4, 1.2]\n- [1.0, 1.2]\n")
+    a = ccpp.run(room, "bcd", area=AREA, keepout=str(ko))
+    b = ccpp.run(room, "bcd", area=np.array(AREA), keepout=ko)
+    assert a.metrics["path_length_m"] == b.metrics["path_length_m"]
+    c = ccpp.run(room, "random-bounce", seed=np.int64(3))
+    d = ccpp.run(room, "random-bounce", seed=3)
+    assert c.metrics["path_length_m"] == d.metrics["path_length_m"]
+    # A malformed zone says what a zone may be (not serde's "untagged enum ZoneSpec").
+    with pytest.raises(ccpp.CcppError, match=r"area must be a file name, \[x0, y0, x1, y1\]"):
+        ccpp.run(room, "bcd", area=[0, 0, 1])
+    with pytest.raises(ccpp.CcppError, match="keepout must be a zone"):
+        ccpp.run(room, "bcd", keepout=[0, 0, 1])
