@@ -377,7 +377,7 @@ const RUN_KEYS: [&str; 11] = [
 ];
 
 /// What a zone argument may be, for messages (serde's "data did not match any variant of
-/// untagged enum ZoneSpec" says nothing to a user).
+/// untagged enum `ZoneSpec`" says nothing to a user).
 const ZONE_FORMS: &str =
     "a file name, [x0, y0, x1, y1] or a list of polygons (each a list of [x, y] points)";
 
