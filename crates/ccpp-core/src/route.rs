@@ -227,7 +227,7 @@ mod tests {
 
     #[test]
     fn a_route_of_one_waypoint_has_length_plus_zero() {
-        let one = Route::from_poses([Pose::new(1.0, 2.0, 0.0)].into_iter(), 0.01);
+        let one = Route::from_poses([Pose::new(1.0, 2.0, 0.0)], 0.01);
         assert!(one.length_m().is_sign_positive() && one.length_m() == 0.0);
         assert_eq!(serde_json::to_string(&one.length_m()).unwrap(), "0.0");
     }
