@@ -223,7 +223,7 @@ pub fn emit(
         &r.run.trace,
         &r.metrics,
         exports,
-        &ccpp_io::export::zone_features(r.world.zones()),
+        &ccpp_io::export::zone_features(r.world.zones(), r.world.frame()),
     )?;
     // The start's free area (a flood fill over the map), unless found while the planner
     // worked, is found while the files are written.

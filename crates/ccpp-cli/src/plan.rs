@@ -72,7 +72,7 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         &plan.route,
         &meta,
         formats,
-        &zone_features(plan.world.zones()),
+        &zone_features(plan.world.zones(), plan.world.frame()),
     )?;
     let staging = Staging::new(&a.out)?;
     for (name, bytes) in &files {

@@ -480,4 +480,41 @@ fn plan_takes_zones_and_exports_them() {
     assert!(route.waypoints.len() > 4);
     assert!(route_samples(&route).iter().all(|p| inside(p, area)));
     assert!(route_samples(&free_route).iter().any(|p| !inside(p, area)));
+    // A Nav2 keep-out mask (pixels, no polygon) was left out of the GeoJSON: it is there now
+    // as a rectangle of whole pixels (columns 70..80, rows 10..20 from the top of 80: x 3.5 to
+    // 4.0 m, y 3.0 to 3.5 m), named `mask`.
+    let mut bytes = b"P5\n100 80\n255\n".to_vec();
+    for y in 0..80 {
+        for x in 0..100 {
+            let kept = (70..80).contains(&x) && (10..20).contains(&y);
+            bytes.push(if kept { 0 } else { 254 });
+        }
+    }
+    std::fs::write(d.path().join("mask.pgm"), bytes).unwrap();
+    let mask = d.path().join("mask.yaml");
+    std::fs::write(
+        &mask,
+        "image: mask.pgm\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n",
+    )
+    .unwrap();
+    let m = plan_ok(
+        d.path(),
+        "mask",
+        &map,
+        "bcd",
+        &["--keepout", mask.to_str().unwrap(), "--export", "geojson"],
+    );
+    let g: serde_json::Value = serde_json::from_str(&read(&m.join("path.geojson"))).unwrap();
+    let masks: Vec<&serde_json::Value> = g["features"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|f| f["properties"]["kind"] == "keepout" && f["properties"]["name"] == "mask")
+        .collect();
+    assert_eq!(masks.len(), 1, "{g}");
+    let ring: Vec<[f64; 2]> =
+        serde_json::from_value(masks[0]["geometry"]["coordinates"][0].clone()).unwrap();
+    let near = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).abs() < 1e-9 && (a[1] - b[1]).abs() < 1e-9;
+    let want = [[3.5, 3.0], [4.0, 3.0], [4.0, 3.5], [3.5, 3.5], [3.5, 3.0]];
+    assert!(ring.iter().zip(want).all(|(a, b)| near(*a, b)), "{ring:?}");
 }

@@ -21,6 +21,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
+use ccpp_core::geometry::Point;
 use ccpp_core::metrics::Metrics;
 use ccpp_core::route::Route;
 use ccpp_core::world::Robot;
@@ -123,11 +124,16 @@ pub struct PolygonFeature {
     pub rings: Vec<Vec<[f64; 2]>>,
 }
 
-/// The zones' polygons as `GeoJSON` polygon features: the work area's polygons (`kind`
-/// `area`) and the keep-out polygons (`kind` `keepout`), each closed. Keep-outs given as a
-/// Nav2 mask are pixels, not polygons, and are not listed.
+/// The zones as `GeoJSON` polygon features: the work area's polygons (`kind` `area`), the
+/// keep-out polygons (`kind` `keepout`), each closed, and the keep-out pixels that no polygon
+/// gave (a Nav2 mask) as rectangles of whole pixels on `frame` (`kind` `keepout`, `name`
+/// `mask`): runs of pixels along a row, merged with the same run in the rows below. A mask
+/// keep-out was left out of the exports before.
 #[must_use]
-pub fn zone_features(zones: Option<&ccpp_core::zones::ZoneMasks>) -> Vec<PolygonFeature> {
+pub fn zone_features(
+    zones: Option<&ccpp_core::zones::ZoneMasks>,
+    frame: &ccpp_core::grid::MapFrame,
+) -> Vec<PolygonFeature> {
     let Some(z) = zones else {
         return Vec::new();
     };
@@ -136,10 +142,86 @@ pub fn zone_features(zones: Option<&ccpp_core::zones::ZoneMasks>) -> Vec<Polygon
         name: None,
         rings: vec![p.points.clone()],
     };
-    z.area_polygons
+    let mut out: Vec<PolygonFeature> = z
+        .area_polygons
         .iter()
         .map(|p| feature("area", p))
         .chain(z.keepout_polygons.iter().map(|p| feature("keepout", p)))
+        .collect();
+    let mut mask_only = z.keepout.clone();
+    if mask_only.len() == frame.len() {
+        mask_only.difference_with(&ccpp_core::zones::rasterize(frame, &z.keepout_polygons));
+        out.extend(
+            pixel_rectangles(&mask_only, frame)
+                .into_iter()
+                .map(|ring| PolygonFeature {
+                    kind: "keepout".to_string(),
+                    name: Some("mask".to_string()),
+                    rings: vec![ring],
+                }),
+        );
+    }
+    out
+}
+
+/// The pixels of `bits` (on `frame`) as closed rectangle rings in map coordinates: each run
+/// of set pixels along a row, extended down while the next row has the same run.
+fn pixel_rectangles(
+    bits: &fixedbitset::FixedBitSet,
+    frame: &ccpp_core::grid::MapFrame,
+) -> Vec<Vec<[f64; 2]>> {
+    let (w, h) = (frame.width, frame.height);
+    // Open rectangles: (first column, end column, first row), by first column.
+    let mut open: Vec<(usize, usize, usize)> = Vec::new();
+    let mut done: Vec<(usize, usize, usize, usize)> = Vec::new();
+    for row in 0..=h {
+        let mut runs: Vec<(usize, usize)> = Vec::new();
+        if row < h {
+            let mut c = 0;
+            while c < w {
+                if bits.contains(row * w + c) {
+                    let c0 = c;
+                    while c < w && bits.contains(row * w + c) {
+                        c += 1;
+                    }
+                    runs.push((c0, c));
+                } else {
+                    c += 1;
+                }
+            }
+        }
+        let mut next = Vec::with_capacity(runs.len());
+        for &(c0, c1, r0) in &open {
+            if runs.contains(&(c0, c1)) {
+                next.push((c0, c1, r0));
+            } else {
+                done.push((c0, c1, r0, row));
+            }
+        }
+        for &(c0, c1) in &runs {
+            if !open.iter().any(|&(a, b, _)| (a, b) == (c0, c1)) {
+                next.push((c0, c1, row));
+            }
+        }
+        next.sort_unstable();
+        open = next;
+    }
+    done.sort_unstable_by_key(|&(c0, c1, r0, r1)| (r0, c0, c1, r1));
+    done.into_iter()
+        .map(|(c0, c1, r0, r1)| {
+            // Grid y is up: rows r0..r1 (down) span grid y from h - r1 to h - r0.
+            let corner = |c: usize, r: usize| {
+                let p = frame.grid_to_world(Point::new(c as f64, (h - r) as f64));
+                [p.x, p.y]
+            };
+            vec![
+                corner(c0, r1),
+                corner(c1, r1),
+                corner(c1, r0),
+                corner(c0, r0),
+                corner(c0, r1),
+            ]
+        })
         .collect()
 }
 

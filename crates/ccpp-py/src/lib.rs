@@ -691,7 +691,7 @@ impl RunResult {
             &self.output.trace,
             &self.metrics,
             formats,
-            &zone_features(self.world.zones()),
+            &zone_features(self.world.zones(), self.world.frame()),
         )
         .map_err(|e| err(&e))
     }
@@ -753,6 +753,8 @@ pub struct PlanResult {
     robot: Robot,
     route: Route,
     zones: Option<ZoneMasks>,
+    /// The map's frame (for keep-out masks in the exports).
+    frame: MapFrame,
     finished: bool,
 }
 
@@ -769,7 +771,7 @@ impl PlanResult {
             &self.route,
             &meta,
             formats,
-            &zone_features(self.zones.as_ref()),
+            &zone_features(self.zones.as_ref(), &self.frame),
         )
         .map_err(|e| err(&e))
     }
@@ -849,6 +851,7 @@ fn plan(
         robot: scenario.robot,
         route: p.route,
         zones: p.world.zones().cloned(),
+        frame: *p.world.frame(),
         finished: p.stop == StopReason::Done,
     })
 }
