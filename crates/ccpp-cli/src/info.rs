@@ -127,7 +127,11 @@ pub fn run(a: &InfoArgs) -> Result<()> {
         }
     };
     let s = world.as_ref().map(World::start);
-    let comp = s.map(|s| StartComponent::of(g, s.position()));
+    // On the map the planners see (zones as walls), as `run` reports it: on the plain map a
+    // run inside a small area reported the start area of the whole floor.
+    let comp = world
+        .as_ref()
+        .and_then(|w| s.map(|s| StartComponent::of(w.map(), s.position())));
     let info = Info {
         map: map.name.clone(),
         width_px: f.width,

@@ -457,3 +457,51 @@ fn a_zoned_run_replays_from_another_folder() {
         .assert()
         .success();
 }
+
+/// `info` reported the free area holding the start on the plain map, `run` on the map with the
+/// zones as walls: 89.0 against 11.2 m2 for the same start and zones. Both use the zones now.
+#[test]
+fn info_and_run_agree_on_the_start_area_with_zones() {
+    let d = tempfile::tempdir().unwrap();
+    let zones = ["--area", "-9.3,-5.8,-2.85,-3.15", "--radius", "0.3"];
+    let line = |out: &[u8]| {
+        String::from_utf8_lossy(out)
+            .lines()
+            .find(|l| l.trim_start().starts_with("start area"))
+            .map(|l| {
+                l.trim_start()
+                    .trim_start_matches("start area")
+                    .trim_start_matches(':')
+                    .trim()
+                    .to_string()
+            })
+            .unwrap()
+    };
+    let info = ccpp()
+        .arg("info")
+        .args(zones)
+        .arg("--map")
+        .arg(house())
+        .assert()
+        .success();
+    let run = ccpp()
+        .args(["run", "--planner", "bsa"])
+        .args(zones)
+        .arg("--map")
+        .arg(house())
+        .arg("--out")
+        .arg(d.path().join("run"))
+        .assert()
+        .success();
+    let (i, r) = (
+        line(&info.get_output().stdout),
+        line(&run.get_output().stdout),
+    );
+    assert_eq!(i, r);
+    let whole = ccpp()
+        .args(["info", "--radius", "0.3", "--map"])
+        .arg(house())
+        .assert()
+        .success();
+    assert_ne!(line(&whole.get_output().stdout), i, "the area changes it");
+}
