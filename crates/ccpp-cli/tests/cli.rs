@@ -411,9 +411,14 @@ fn bad_inputs_fail_cleanly() {
         &["tool radius"],
     );
 
-    // Robot larger than every free space.
+    // Robot wider than the map, and robot larger than every free space.
     expect_error(
         &["--radius", "4"],
+        &good,
+        &["teb_empty_box.yaml", "larger than the map", "fits nowhere"],
+    );
+    expect_error(
+        &["--radius", "2.9"],
         &good,
         &["teb_empty_box.yaml", "does not fit"],
     );
