@@ -2000,3 +2000,42 @@ fn a_robot_wider_than_the_map_is_named_for_every_planner() {
         assert!(!out.exists());
     }
 }
+
+/// `--exec pid` on a planner that asks for no execution of its own (ba-star, bcd,
+/// random-bounce, ...) left its PID trace out of the memory estimate: random-bounce on
+/// `apartment_400x300` at r = 0.05 m was admitted under `--max-memory 54` and peaked at
+/// 675 MiB. The records are counted now: a limit that admits the ideal run refuses the PID
+/// one, naming the records.
+#[test]
+fn exec_pid_counts_its_trace_for_every_planner() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    for p in ["ba-star", "bcd", "random-bounce"] {
+        let out = dir.join(format!("ideal-{p}"));
+        ccpp()
+            .args(["run", "--planner", p, "--map", s(&map), "--max-memory", "5"])
+            .arg("--out")
+            .arg(&out)
+            .assert()
+            .success();
+        let out = dir.join(format!("pid-{p}"));
+        refused(
+            &[
+                "run",
+                "--planner",
+                p,
+                "--map",
+                s(&map),
+                "--max-memory",
+                "5",
+                "--exec",
+                "pid",
+                "--out",
+                s(&out),
+            ],
+            &["PID trace records", "more than the memory limit of 5 MB"],
+        );
+        assert!(!out.exists());
+    }
+}

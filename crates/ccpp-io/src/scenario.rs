@@ -33,7 +33,9 @@ use ccpp_core::display::Compact;
 use ccpp_core::exec::{Execution, PidOptions};
 use ccpp_core::grid::{GridError, GridMap};
 use ccpp_core::metrics::{self, Metrics};
-use ccpp_core::planners::settings::{estimate_run, estimate_zones, validate_execution, ZoneLoad};
+use ccpp_core::planners::settings::{
+    add_sim_pid_records, estimate_run, estimate_zones, validate_execution, ZoneLoad,
+};
 use ccpp_core::planners::{OptionsError, PlannerConfig, PlannerKind, ResourceEstimate, Setup};
 use ccpp_core::sim::{simulate, simulate_tapped, RunOutput, SimConfig};
 use ccpp_core::trace::Chunk;
@@ -930,6 +932,7 @@ impl Scenario {
             .check(&setup)
             .map_err(|e| self.degenerate(&map.source, e))?;
         let mut est = estimate_run(&setup, self.planner.settings());
+        add_sim_pid_records(&mut est, &setup, self.planner.settings(), &self.execution());
         let zones = estimate_zones(&setup, self.zone_load());
         if zones.bytes > 0.0 {
             est.bytes += zones.bytes;

@@ -228,6 +228,23 @@ pub trait PlannerSettings {
     /// The planner's share of the memory a run needs (tiles, cells, waypoints, trace).
     fn estimate(&self, setup: &Setup) -> ResourceEstimate;
 
+    /// The path a run drives at most, metres, and the length of its typical straight move:
+    /// what the memory estimate counts the PID trace of when the simulator runs the planner
+    /// under PID execution (`--exec pid`) without the planner asking for it. By default twice
+    /// the frame's area over the tool width (a path ratio of 2 over the whole frame) in moves
+    /// of one tool width.
+    fn path_estimate(&self, setup: &Setup) -> (f64, f64) {
+        let w = 2.0 * setup.robot.tool_radius;
+        (2.0 * setup.frame_area_m2() / w, w)
+    }
+
+    /// Bytes a PID trace record of this planner's runs takes at the peak of the process, for
+    /// [`add_sim_pid_records`]: [`PID_RECORD_BYTES`] by default (ba-star under `--exec pid`
+    /// on `apartment_400x300` at r = 0.05 m: 876 k records, 66 MiB peak).
+    fn sim_pid_record_bytes(&self) -> f64 {
+        PID_RECORD_BYTES
+    }
+
     /// The tile (cell) side the planner works on, if it is tile-based.
     fn tile_side(&self, robot: &Robot) -> Option<f64>;
 
@@ -438,6 +455,35 @@ fn add_pid_records(e: &mut ResourceEstimate, exec: &Execution, moves: f64, move_
     }
 }
 
+/// Adds to `est` the PID trace of a run that the simulator executes with `exec` although its
+/// planner asks for no execution of its own (`--exec pid` for ba-star, bcd, ...): the records
+/// of [`PlannerSettings::path_estimate`]'s path in its moves. A planner that runs PID itself
+/// (bsa-bfs, rect-boustrophedon) counts its records in its own estimate. Under `--exec pid`
+/// random-bounce on `apartment_400x300` at r = 0.05 m was admitted under a 54 MB limit and
+/// peaked at 675 MiB.
+pub fn add_sim_pid_records(
+    est: &mut ResourceEstimate,
+    s: &Setup,
+    planner: &dyn PlannerSettings,
+    exec: &Execution,
+) {
+    if matches!(planner.preferred_execution(), Some(Execution::Pid(_))) {
+        return;
+    }
+    let (path_m, move_m) = planner.path_estimate(s);
+    if path_m.is_finite() && move_m > 0.0 {
+        let records = pid_records(exec, path_m / move_m, move_m);
+        if records > 0.0 {
+            est.bytes += records * planner.sim_pid_record_bytes();
+            est.detail = format!(
+                "{}, about {} PID trace records",
+                est.detail,
+                fmt_count(records)
+            );
+        }
+    }
+}
+
 /// One move in this many is counted with a quarter turn in place before it
 /// ([`pid_records`]): `bsa-bfs` turned before one move in 22 on `apartment_400x300`, one in 6.5
 /// on `office_1024`.
@@ -533,6 +579,21 @@ impl PlannerSettings for RandomBounceOptions {
         } else {
             e.remedy("a larger tool radius or a random_bounce.budget_m (the default budget is 3 x the map frame's area over the tool width)")
         }
+    }
+
+    fn sim_pid_record_bytes(&self) -> f64 {
+        // Measured: 3.84 million records, 657 MiB peak (179 bytes a record; its poses are
+        // not lattice steps) on `apartment_400x300` at r = 0.05 m under `--exec pid`.
+        2.0 * PID_RECORD_BYTES
+    }
+
+    fn path_estimate(&self, s: &Setup) -> (f64, f64) {
+        let budget = self.budget_m.unwrap_or_else(|| default_budget(s));
+        let res = s.frame.resolution;
+        (
+            budget,
+            (s.sensor_range - s.robot.radius - 1.5 * res).max(0.5 * res),
+        )
     }
 
     fn tile_side(&self, _: &Robot) -> Option<f64> {
