@@ -14,7 +14,7 @@ pub struct Point {
 }
 
 /// Length of the polyline `from -> pts[0] -> pts[1] -> ...`, summed in that order (in the
-/// points' units).
+/// points' units); `0.0`, not the `-0.0` of an empty `f64` sum, without points.
 pub fn polyline_length(from: Point, pts: &[Point]) -> f64 {
     let mut at = from;
     pts.iter()
@@ -23,7 +23,7 @@ pub fn polyline_length(from: Point, pts: &[Point]) -> f64 {
             at = p;
             d
         })
-        .sum()
+        .fold(0.0, |a, d| a + d)
 }
 
 /// Length of the polyline through `pts` (0 for fewer than two points).
