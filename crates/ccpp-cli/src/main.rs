@@ -55,8 +55,6 @@ fn main() -> ExitCode {
     }
 }
 
-/// Help and version go to stdout with status 0; argument errors are one line and a hint on
-/// stderr with status 1, like every other user error.
 /// Refuses an argument that is not valid UTF-8 (of `cmd`, whose parse gave `m`, and of its
 /// subcommands), naming the flag and the value. Paths are recorded as text (`run.json`,
 /// `bench-key.txt`, exports), so a non-UTF-8 path failed late with a message naming neither
@@ -88,6 +86,8 @@ fn utf8_values(cmd: &clap::Command, m: &clap::ArgMatches) -> Result<(), String> 
     Ok(())
 }
 
+/// Help and version go to stdout with status 0; argument errors are one line and a hint on
+/// stderr with status 1, like every other user error.
 fn clap_exit(e: &clap::Error) -> ExitCode {
     match e.kind() {
         ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {

@@ -139,21 +139,19 @@ fn check_same_run(
             dir.display()
         );
     }
-    {
-        // The trace records the start exactly; a thousandth of a pixel allows for nothing but
-        // another run.
-        let tol = world.frame().resolution * 1e-3;
-        if (first.x - start.x).abs() > tol || (first.y - start.y).abs() > tol {
-            bail!(
-                "{}: trace.jsonl starts at ({:.3}, {:.3}) but the run of run.json starts at \
-                 ({:.3}, {:.3}): the folder mixes files of two runs",
-                dir.display(),
-                first.x,
-                first.y,
-                start.x,
-                start.y
-            );
-        }
+    // The trace records the start exactly; a thousandth of a pixel allows for nothing but
+    // another run.
+    let tol = world.frame().resolution * 1e-3;
+    if (first.x - start.x).abs() > tol || (first.y - start.y).abs() > tol {
+        bail!(
+            "{}: trace.jsonl starts at ({:.3}, {:.3}) but the run of run.json starts at \
+             ({:.3}, {:.3}): the folder mixes files of two runs",
+            dir.display(),
+            first.x,
+            first.y,
+            start.x,
+            start.y
+        );
     }
     let Ok(serde_json::Value::Object(m)) = serde_json::from_str::<serde_json::Value>(metrics)
     else {
@@ -180,7 +178,9 @@ fn check_same_run(
             dir.display()
         );
     };
-    let driven = path_length(trace);
+    // Summed in the trace's order, as the metrics sum it.
+    let positions: Vec<ccpp_core::geometry::Point> = trace.poses().map(|p| p.position()).collect();
+    let driven = ccpp_core::geometry::path_length(&positions);
     if (driven - reported).abs() > 1e-9 + 1e-9 * reported.abs() {
         bail!(
             "{}: trace.jsonl drives {driven:.3} m but metrics.json reports {reported:.3} m: the \
@@ -189,19 +189,6 @@ fn check_same_run(
         );
     }
     Ok(())
-}
-
-/// The length of the path the trace's poses drive, summed as the metrics sum it.
-fn path_length(trace: &Trace) -> f64 {
-    let mut total = 0.0;
-    let mut prev: Option<ccpp_core::Pose> = None;
-    for p in trace.poses() {
-        if let Some(a) = prev {
-            total += a.position().dist(p.position());
-        }
-        prev = Some(p);
-    }
-    total
 }
 
 /// Writes the run's files (with the replay when `replay`, and the path in each of `exports`)

@@ -142,6 +142,12 @@ fn well_spread(pixels: impl Iterator<Item = Point> + Clone) -> bool {
         sxy += d.x * d.y;
         syy += d.y * d.y;
     }
+    conditioned(sxx, sxy, syy)
+}
+
+/// Whether a centred scatter matrix `[[sxx, sxy], [sxy, syy]]` of pixel points determines an
+/// affine fit: its determinant is not negligible against its spread squared.
+fn conditioned(sxx: f64, sxy: f64, syy: f64) -> bool {
     let spread = (sxx + syy).max(f64::MIN_POSITIVE);
     sxx * syy - sxy * sxy > 1e-12 * spread * spread
 }
@@ -218,8 +224,7 @@ pub fn fit_affine(pairs: &[(Point, Point)]) -> Result<AffineFit, GeorefError> {
     {
         return Err(GeorefError::Overflow);
     }
-    let spread = (sxx + syy).max(f64::MIN_POSITIVE);
-    if det <= 1e-12 * spread * spread {
+    if !conditioned(sxx, sxy, syy) {
         return Err(far_point(pairs).unwrap_or(GeorefError::Collinear));
     }
     let (i00, i01, i11) = (syy / det, -sxy / det, sxx / det);

@@ -996,8 +996,6 @@ impl Scenario {
         self.world_on(map.grid.clone(), &map.source, map.recipe.inflate, zones)
     }
 
-    /// Builds the world on `grid` (the prepared map's, loaded from `source` and grown by
-    /// `inflate` metres).
     /// A planner's check failure as [`ScenarioError::Degenerate`] on the map `source`.
     fn degenerate(&self, source: &Path, e: OptionsError) -> ScenarioError {
         let e = e.in_section(self.planner.kind().info().section);
@@ -1012,6 +1010,8 @@ impl Scenario {
         }
     }
 
+    /// Builds the world on `grid` (the prepared map's, loaded from `source` and grown by
+    /// `inflate` metres) and runs the planner's checks against it.
     fn world_on(
         &self,
         grid: GridMap,

@@ -444,9 +444,20 @@ fn pid_records(e: &Execution, moves: f64, move_m: f64) -> f64 {
 /// Adds the PID trace records of `moves` moves of `move_m` metres ([`pid_records`]) to an
 /// estimate, naming them in its detail (nothing under ideal execution).
 fn add_pid_records(e: &mut ResourceEstimate, exec: &Execution, moves: f64, move_m: f64) {
+    add_pid_records_at(e, exec, moves, move_m, PID_RECORD_BYTES);
+}
+
+/// [`add_pid_records`] at `record_bytes` a record.
+fn add_pid_records_at(
+    e: &mut ResourceEstimate,
+    exec: &Execution,
+    moves: f64,
+    move_m: f64,
+    record_bytes: f64,
+) {
     let records = pid_records(exec, moves, move_m);
     if records > 0.0 {
-        e.bytes += records * PID_RECORD_BYTES;
+        e.bytes += records * record_bytes;
         e.detail = format!(
             "{}, about {} PID trace records",
             e.detail,
@@ -472,15 +483,13 @@ pub fn add_sim_pid_records(
     }
     let (path_m, move_m) = planner.path_estimate(s);
     if path_m.is_finite() && move_m > 0.0 {
-        let records = pid_records(exec, path_m / move_m, move_m);
-        if records > 0.0 {
-            est.bytes += records * planner.sim_pid_record_bytes();
-            est.detail = format!(
-                "{}, about {} PID trace records",
-                est.detail,
-                fmt_count(records)
-            );
-        }
+        add_pid_records_at(
+            est,
+            exec,
+            path_m / move_m,
+            move_m,
+            planner.sim_pid_record_bytes(),
+        );
     }
 }
 
@@ -570,8 +579,7 @@ impl PlannerSettings for RandomBounceOptions {
 
     fn estimate(&self, s: &Setup) -> ResourceEstimate {
         let budget = self.budget_m.unwrap_or_else(|| default_budget(s));
-        let res = s.frame.resolution;
-        let stride = (s.sensor_range - s.robot.radius - 1.5 * res).max(0.5 * res);
+        let stride = bounce_stride(s);
         // A stride and a turn per stride.
         let e = ResourceEstimate::units(budget / stride, 2.0 * RECORD_BYTES, "strides");
         if self.budget_m.is_some() {
@@ -588,11 +596,9 @@ impl PlannerSettings for RandomBounceOptions {
     }
 
     fn path_estimate(&self, s: &Setup) -> (f64, f64) {
-        let budget = self.budget_m.unwrap_or_else(|| default_budget(s));
-        let res = s.frame.resolution;
         (
-            budget,
-            (s.sensor_range - s.robot.radius - 1.5 * res).max(0.5 * res),
+            self.budget_m.unwrap_or_else(|| default_budget(s)),
+            bounce_stride(s),
         )
     }
 
@@ -612,6 +618,13 @@ impl PlannerSettings for RandomBounceOptions {
         }
         Box::new(RandomBounce::new(o))
     }
+}
+
+/// The straight move random-bounce's estimates count: as far as the sensor sees ahead of the
+/// robot's disk, at least half a pixel.
+fn bounce_stride(s: &Setup) -> f64 {
+    let res = s.frame.resolution;
+    (s.sensor_range - s.robot.radius - 1.5 * res).max(0.5 * res)
 }
 
 /// The random-bounce default distance budget: 3x the lane-by-lane length of the map frame's
