@@ -229,6 +229,10 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     let maps = name_maps(expand_maps(&a.maps)?);
     check_bench_target(&a.out)?;
     ccpp_io::write::create_folder(&a.out, &a.out)?;
+    // The summary of an earlier bench in this folder goes before any run starts: an
+    // interrupted bench then leaves complete run folders and no summary, never a summary of
+    // the earlier bench (another radius, other planners) beside run folders of this one.
+    clear_summary(&a.out)?;
     if let Some(j) = a.jobs {
         // A thread beyond one per run would only idle: `--jobs 100000` started 100000
         // threads, which took minutes on two cores before the first run.
@@ -306,7 +310,6 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         .collect();
     bar.finish_and_clear();
 
-    clear_plots(&a.out)?;
     write_file(&a.out.join("results.csv"), results_csv(&rows).as_bytes())?;
     write_file(&a.out.join("results.md"), results_md(&rows).as_bytes())?;
     crate::plots::write_all(&a.out, &rows, &prepared, robot)?;
@@ -389,9 +392,18 @@ fn check_bench_target(out: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Removes the plots of an earlier bench in `out/plots/` (maps it had and this one has not
-/// would stay beside this bench's results otherwise).
-fn clear_plots(out: &Path) -> Result<()> {
+/// Removes the summary of an earlier bench in `out`: `results.csv`, `results.md` and the plots
+/// in `out/plots/` (maps it had and this one has not would stay beside this bench's results
+/// otherwise). The run folders stay: each is complete and keyed, so a bench reuses the ones
+/// that match it.
+fn clear_summary(out: &Path) -> Result<()> {
+    for name in ["results.csv", "results.md"] {
+        let p = out.join(name);
+        if std::fs::symlink_metadata(&p).is_ok_and(|m| m.is_file()) {
+            std::fs::remove_file(&p)
+                .with_context(|| format!("cannot remove the old {}", p.display()))?;
+        }
+    }
     let dir = out.join("plots");
     let Ok(entries) = std::fs::read_dir(&dir) else {
         return Ok(());

@@ -297,6 +297,70 @@ fn an_interrupted_bench_leaves_only_complete_runs() {
     }
 }
 
+#[cfg(unix)]
+#[test]
+fn an_interrupted_bench_never_leaves_the_summary_of_an_earlier_bench() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = big_room(dir.path());
+    let out = dir.path().join("bench");
+    // A finished bench at r = 0.2 m ...
+    bench(
+        &out,
+        &[data("teb_empty_box.yaml")],
+        &["--planners", "ba-star", "--radius", "0.2"],
+    )
+    .assert()
+    .success();
+    assert!(out.join("results.csv").is_file());
+    assert!(out.join("plots").read_dir().unwrap().next().is_some());
+    // ... then one at r = 0.15 m into the same folder, stopped while it runs.
+    let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("ccpp"))
+        .args([
+            "bench",
+            "--quiet",
+            "--jobs",
+            "1",
+            "--planners",
+            "ba-star,bcd",
+        ])
+        .arg("--maps")
+        .arg(data("teb_empty_box.yaml"))
+        .arg(&map)
+        .arg("--out")
+        .arg(&out)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    // Until the new bench has rewritten the first run folder (the old r = 0.2 m run).
+    let key = out.join("runs/teb_empty_box/ba-star/bench-key.txt");
+    let old_key = std::fs::read_to_string(&key).unwrap();
+    let t0 = std::time::Instant::now();
+    while std::fs::read_to_string(&key).is_ok_and(|k| k == old_key)
+        && t0.elapsed() < std::time::Duration::from_secs(60)
+    {
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    let _ = std::process::Command::new("kill")
+        .arg("-TERM")
+        .arg(child.id().to_string())
+        .status();
+    let status = child.wait().unwrap();
+    assert!(status.code() == Some(130) || status.success(), "{status:?}");
+    if status.success() {
+        // Finished before the signal: the summary is the new bench's.
+        assert!(csv_rows(&out).iter().all(|r| r.len() > 3));
+        let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+        assert!(!csv.contains(",0.2,"), "{csv}");
+    } else {
+        // Stopped: complete run folders and no summary at all.
+        assert!(!out.join("results.csv").exists());
+        assert!(!out.join("results.md").exists());
+        let plots: Vec<_> = out.join("plots").read_dir().unwrap().flatten().collect();
+        assert!(plots.is_empty(), "{plots:?}");
+    }
+}
+
 /// A bench over `maps` with `extra` arguments; returns the output.
 fn bench(out: &Path, maps: &[PathBuf], extra: &[&str]) -> Command {
     let mut c = ccpp();
