@@ -517,4 +517,52 @@ fn plan_takes_zones_and_exports_them() {
     let near = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).abs() < 1e-9 && (a[1] - b[1]).abs() < 1e-9;
     let want = [[3.5, 3.0], [4.0, 3.0], [4.0, 3.5], [3.5, 3.5], [3.5, 3.0]];
     assert!(ring.iter().zip(want).all(|(a, b)| near(*a, b)), "{ring:?}");
+    // A GeoJSON zone's `properties.name` is carried into the export (it was `null`), for
+    // `plan` and for `run`; an unnamed polygon stays `null`.
+    let zones = d.path().join("zones.geojson");
+    std::fs::write(
+        &zones,
+        r#"{"type":"FeatureCollection","features":[
+            {"type":"Feature","properties":{"name":"rug"},"geometry":{"type":"Polygon","coordinates":[[[0.5,0.5],[1.5,0.5],[1.5,1.5],[0.5,1.5]]]}},
+            {"type":"Feature","properties":{},"geometry":{"type":"Polygon","coordinates":[[[3.0,2.0],[3.5,2.0],[3.5,2.5],[3.0,2.5]]]}}]}"#,
+    )
+    .unwrap();
+    let named = |g: &serde_json::Value| -> Vec<serde_json::Value> {
+        g["features"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|f| f["properties"]["kind"] == "keepout")
+            .map(|f| f["properties"]["name"].clone())
+            .collect()
+    };
+    let want = [serde_json::json!("rug"), serde_json::Value::Null];
+    let n = plan_ok(
+        d.path(),
+        "named",
+        &map,
+        "bcd",
+        &["--keepout", zones.to_str().unwrap(), "--export", "geojson"],
+    );
+    let g: serde_json::Value = serde_json::from_str(&read(&n.join("path.geojson"))).unwrap();
+    assert_eq!(named(&g), want, "{g}");
+    let run = d.path().join("named_run");
+    ccpp()
+        .args([
+            "run",
+            "--planner",
+            "ba-star",
+            "--export",
+            "geojson",
+            "--map",
+        ])
+        .arg(&map)
+        .arg("--keepout")
+        .arg(&zones)
+        .arg("--out")
+        .arg(&run)
+        .assert()
+        .success();
+    let g: serde_json::Value = serde_json::from_str(&read(&run.join("path.geojson"))).unwrap();
+    assert_eq!(named(&g), want, "{g}");
 }

@@ -26,11 +26,18 @@ use crate::grid::MapFrame;
 
 /// A simple polygon in map coordinates (metres): its vertices in order, either orientation;
 /// closing the ring (repeating the first vertex at the end) is optional.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+///
+/// Serialized as its vertex list alone: the name is what a zone file called it (a `GeoJSON`
+/// feature's `properties.name`), carried to the exports; a run's record names the file, which
+/// gives the names again.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(transparent)]
 pub struct Polygon {
     /// Vertices `[x, y]`.
     pub points: Vec<[f64; 2]>,
+    /// The zone's name in its file, if it has one (not serialized).
+    #[serde(skip)]
+    pub name: Option<String>,
 }
 
 /// Errors of zone polygons and masks.
@@ -112,6 +119,7 @@ impl Polygon {
         let [x0, y0, x1, y1] = r;
         Self {
             points: vec![[x0, y0], [x1, y0], [x1, y1], [x0, y1]],
+            name: None,
         }
     }
 
@@ -473,7 +481,10 @@ mod tests {
     use super::*;
 
     fn poly(p: &[[f64; 2]]) -> Polygon {
-        Polygon { points: p.to_vec() }
+        Polygon {
+            points: p.to_vec(),
+            name: None,
+        }
     }
 
     #[test]

@@ -139,7 +139,7 @@ pub fn zone_features(
     };
     let feature = |kind: &str, p: &ccpp_core::zones::Polygon| PolygonFeature {
         kind: kind.to_string(),
-        name: None,
+        name: p.name.clone(),
         rings: vec![p.points.clone()],
     };
     let mut out: Vec<PolygonFeature> = z

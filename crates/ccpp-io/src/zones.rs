@@ -218,6 +218,7 @@ fn ring(v: &Value) -> Result<Polygon, ZoneFileError> {
     };
     Ok(Polygon {
         points: a.iter().map(point).collect::<Result<_, _>>()?,
+        name: None,
     })
 }
 
@@ -284,7 +285,21 @@ fn geojson_collect(v: &Value, out: &mut Vec<Polygon>, depth: usize) -> Result<()
             _ => Err(bad("GeoJSON MultiPolygon coordinates must be a list")),
         },
         "Feature" => match v.get("geometry") {
-            Some(g) if !g.is_null() => geojson_collect(g, out, depth + 1),
+            Some(g) if !g.is_null() => {
+                let first = out.len();
+                geojson_collect(g, out, depth + 1)?;
+                // The feature's name names every polygon of its geometry.
+                let name = v
+                    .get("properties")
+                    .and_then(|p| p.get("name"))
+                    .and_then(Value::as_str);
+                if let Some(name) = name {
+                    for p in &mut out[first..] {
+                        p.name = Some(name.to_string());
+                    }
+                }
+                Ok(())
+            }
             _ => Ok(()),
         },
         "FeatureCollection" => match v.get("features") {
@@ -315,10 +330,12 @@ mod tests {
         let g: Value = serde_json::from_str(
             r#"{"type":"FeatureCollection","features":[
                 {"type":"Feature","properties":{},"geometry":{"type":"Polygon","coordinates":[[[0,0],[1,0],[1,1],[0,0]]]}},
-                {"type":"Feature","geometry":{"type":"MultiPolygon","coordinates":[[[[2,2],[3,2],[3,3]]],[[[5,5,0],[6,5,0],[6,6,0]]]]}}]}"#,
+                {"type":"Feature","properties":{"name":"desks"},"geometry":{"type":"MultiPolygon","coordinates":[[[[2,2],[3,2],[3,3]]],[[[5,5,0],[6,5,0],[6,6,0]]]]}}]}"#,
         )
         .unwrap();
         let p = geojson_polygons(&g).unwrap();
+        let names: Vec<_> = p.iter().map(|p| p.name.as_deref()).collect();
+        assert_eq!(names, [None, Some("desks"), Some("desks")]);
         assert_eq!(p.len(), 3);
         assert_eq!(p[2].points[1], [6.0, 5.0]);
         let holes: Value = serde_json::from_str(
@@ -350,6 +367,7 @@ mod tests {
             ZoneSpec::File("a.geojson".into()),
             ZoneSpec::Polygons(vec![Polygon {
                 points: vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]],
+                name: None,
             }]),
         ];
         let j = serde_json::to_string(&specs).unwrap();
@@ -359,6 +377,15 @@ mod tests {
         );
         let back: Vec<ZoneSpec> = serde_json::from_str(&j).unwrap();
         assert_eq!(back, specs);
+        // A name from a zone file is not part of the spec: it comes from the file again.
+        let named = Polygon {
+            name: Some("rug".into()),
+            ..Polygon::rect([0.0, 0.0, 1.0, 1.0])
+        };
+        assert_eq!(
+            serde_json::to_string(&named).unwrap(),
+            serde_json::to_string(&Polygon::rect([0.0, 0.0, 1.0, 1.0])).unwrap()
+        );
         let f = MapFrame::new(10, 10, 0.1);
         assert!(ZoneSpec::Rect([1.0, 0.0, 0.0, 1.0]).load(&f, true).is_err());
     }
