@@ -108,6 +108,8 @@ fn js_num(v: f64) -> String {
 const DECIMATE_TOL_PX: f64 = 0.25;
 /// Quantisation of display coordinates: 1/`Q` map pixel.
 const Q: f64 = 8.0;
+/// Largest coordinate the path blob carries, in 1/[`Q`] pixel (2^40: far beyond any map).
+const FAR_Q: i64 = 1 << 40;
 /// Samples of the live coverage curve.
 const COVERAGE_SAMPLES: usize = 2000;
 
@@ -140,6 +142,34 @@ fn decimate(pts: &[[f64; 2]], forced: &[bool]) -> Vec<usize> {
     let mut dir: Option<[f64; 2]> = None; // unit direction from the anchor
     let mut last_proj = 0.0f64;
     for j in 1..n {
+        let p = pts[j];
+        // Does `p` go on along the stretch from the anchor?
+        let on_stretch = match dir {
+            None => true,
+            Some(u) => {
+                let a = pts[anchor];
+                let (vx, vy) = (p[0] - a[0], p[1] - a[1]);
+                let proj = vx * u[0] + vy * u[1];
+                let perp = (vx * u[1] - vy * u[0]).abs();
+                let on = perp <= DECIMATE_TOL_PX && proj + DECIMATE_TOL_PX >= last_proj;
+                if on {
+                    last_proj = last_proj.max(proj);
+                }
+                on
+            }
+        };
+        if !on_stretch {
+            // Keep the previous pose and start a new stretch there. This comes first for a
+            // pose that is kept anyway (an event's, the last): the corner before it was
+            // dropped, and the drawn path cut across it.
+            let prev = j - 1;
+            if prev != anchor {
+                kept.push(prev);
+                anchor = prev;
+            }
+            dir = None;
+            last_proj = 0.0;
+        }
         if forced[j] || j == n - 1 {
             kept.push(j);
             anchor = j;
@@ -147,39 +177,14 @@ fn decimate(pts: &[[f64; 2]], forced: &[bool]) -> Vec<usize> {
             last_proj = 0.0;
             continue;
         }
-        let a = pts[anchor];
-        let p = pts[j];
-        let Some(u) = dir else {
+        if dir.is_none() {
+            let a = pts[anchor];
             let dd = d2(a, p);
             if dd > tol2 {
                 let l = dd.sqrt();
                 dir = Some([(p[0] - a[0]) / l, (p[1] - a[1]) / l]);
                 last_proj = l;
             }
-            continue;
-        };
-        let (vx, vy) = (p[0] - a[0], p[1] - a[1]);
-        let proj = vx * u[0] + vy * u[1];
-        let perp = (vx * u[1] - vy * u[0]).abs();
-        if perp <= DECIMATE_TOL_PX && proj + DECIMATE_TOL_PX >= last_proj {
-            last_proj = last_proj.max(proj);
-            continue;
-        }
-        // Keep the previous pose and start a new stretch there.
-        let prev = j - 1;
-        if prev != anchor {
-            kept.push(prev);
-            anchor = prev;
-        }
-        let a = pts[anchor];
-        let dd = d2(a, p);
-        if dd > tol2 {
-            let l = dd.sqrt();
-            dir = Some([(p[0] - a[0]) / l, (p[1] - a[1]) / l]);
-            last_proj = l;
-        } else {
-            dir = None;
-            last_proj = 0.0;
         }
     }
     kept
@@ -253,7 +258,9 @@ fn replay_data(
     for axis in 0..2 {
         let mut prev = 0i64;
         for &k in &kept {
-            let q = (pts[k][axis] * Q).round() as i64;
+            // A pose far off the map (a corrupted trace) is drawn at a far edge: the deltas
+            // stay exact in JavaScript's numbers and never overflow.
+            let q = ((pts[k][axis] * Q).round() as i64).clamp(-FAR_Q, FAR_Q);
             push_varint(&mut blob, zigzag(q - prev));
             prev = q;
         }
@@ -328,8 +335,8 @@ fn replay_data(
     let (mut pi, mut px, mut py) = (0u64, 0i64, 0i64);
     for &i in &tiles {
         let d = display(i) as u64;
-        let qx = (pts[i][0] * Q).round() as i64;
-        let qy = (pts[i][1] * Q).round() as i64;
+        let qx = ((pts[i][0] * Q).round() as i64).clamp(-FAR_Q, FAR_Q);
+        let qy = ((pts[i][1] * Q).round() as i64).clamp(-FAR_Q, FAR_Q);
         push_varint(&mut tblob, d - pi);
         push_varint(&mut tblob, zigzag(qx - px));
         push_varint(&mut tblob, zigzag(qy - py));
@@ -694,6 +701,74 @@ fn fill_disk(buf: &mut [u8], w: usize, h: usize, x: f64, y: f64, r: f64, v: u8) 
             let dy = yy as f64 + 0.5 - y;
             if dx * dx + dy * dy <= r * r {
                 buf[yy * w + xx] = v;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn seg_dist(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+        let l2 = dx * dx + dy * dy;
+        let t = if l2 > 0.0 {
+            (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (p[0] - a[0] - t * dx).hypot(p[1] - a[1] - t * dy)
+    }
+
+    /// A trace's poses as the replay reads them: each move ends in a pose, and a turn in
+    /// place repeats the position.
+    fn poses(vertices: &[(f64, f64)]) -> Vec<[f64; 2]> {
+        let mut out = Vec::new();
+        for &(x, y) in vertices {
+            out.push([x, y]);
+            out.push([x, y]);
+        }
+        out
+    }
+
+    #[test]
+    fn a_corner_before_an_event_pose_is_kept() {
+        // t=8 turn and move to the corner, t=9 turn and move on, then an event: the corner
+        // was dropped and the page drew (0,0) -> (20,10) straight.
+        let pts = poses(&[(0.0, 0.0), (10.0, 0.0), (20.0, 10.0)]);
+        let mut forced = vec![false; pts.len()];
+        forced[0] = true;
+        // The event follows the move's end pose (the turn after it is its own pose).
+        forced[pts.len() - 2] = true;
+        let kept = decimate(&pts, &forced);
+        assert!(kept.iter().any(|&k| pts[k] == [10.0, 0.0]), "{kept:?}");
+    }
+
+    proptest! {
+        /// Every pose lies within twice the tolerance of the drawn polyline, between the kept
+        /// poses around it (the line through the anchor bounds the dropped poses by the
+        /// tolerance; the drawn segment to the next kept pose by as much again).
+        #[test]
+        fn the_drawn_path_follows_every_pose(
+            vertices in prop::collection::vec((0.0f64..60.0, 0.0f64..60.0), 1..40),
+            events in prop::collection::vec(any::<bool>(), 80),
+        ) {
+            let pts = poses(&vertices);
+            let forced: Vec<bool> = (0..pts.len()).map(|i| events[i % events.len()] && i % 3 == 0).collect();
+            let kept = decimate(&pts, &forced);
+            prop_assert_eq!(kept[0], 0);
+            prop_assert_eq!(*kept.last().unwrap(), pts.len() - 1);
+            for (i, f) in forced.iter().enumerate() {
+                prop_assert!(!f || kept.contains(&i));
+            }
+            for w in kept.windows(2) {
+                prop_assert!(w[0] < w[1]);
+                for p in &pts[w[0]..=w[1]] {
+                    let d = seg_dist(*p, pts[w[0]], pts[w[1]]);
+                    prop_assert!(d <= 2.0 * DECIMATE_TOL_PX + 1e-9, "{:?} is {} px off {:?}", p, d, w);
+                }
             }
         }
     }
