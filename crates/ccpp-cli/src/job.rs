@@ -106,8 +106,11 @@ pub fn approach_note(world: &World) -> Option<String> {
 }
 
 /// The recipe of `args`: paths made absolute so that `run.json` works from any folder.
+/// Symbolic links are kept, not resolved: a map YAML's image is looked up beside the path
+/// given, as `map_server` does (a linked `la/m.yaml -> ../lb/m.yaml` reads `la/`'s image; it
+/// read `lb/`'s).
 pub fn recipe_from(args: &MapArgs) -> MapRecipe {
-    let abs = |p: &PathBuf| std::fs::canonicalize(p).unwrap_or_else(|_| p.clone());
+    let abs = |p: &PathBuf| std::path::absolute(p).unwrap_or_else(|_| p.clone());
     MapRecipe {
         path: Some(abs(&args.map)),
         name: Some(

@@ -290,9 +290,9 @@ impl Map {
 }
 
 /// The recipe of a map file as the command line builds it: absolute paths, the file stem as
-/// the name.
+/// the name. Symbolic links are kept: a map YAML's image is looked up beside the path given.
 fn recipe_for(path: &Path) -> MapRecipe {
-    let abs = |p: &Path| std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf());
+    let abs = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
     MapRecipe {
         path: Some(abs(path)),
         name: Some(
@@ -335,7 +335,7 @@ fn load_map(
     recipe.occupied_thresh = occupied_thresh;
     recipe.free_thresh = free_thresh;
     recipe.inflate = inflate;
-    recipe.georef = georef.map(|g| std::fs::canonicalize(&g).unwrap_or(g));
+    recipe.georef = georef.map(|g| std::path::absolute(&g).unwrap_or(g));
     if name.is_some() {
         recipe.name = name;
     }
