@@ -132,46 +132,6 @@ pub fn name_maps(maps: Vec<PathBuf>) -> Vec<(PathBuf, String)> {
     kept.into_iter().zip(names).collect()
 }
 
-/// 64-bit FNV-1a, a fixed hash for cache keys (stable across runs and Rust versions).
-struct Fnv(u64);
-
-impl Fnv {
-    fn new() -> Self {
-        Self(0xcbf2_9ce4_8422_2325)
-    }
-    fn bytes(&mut self, b: &[u8]) {
-        for &x in b {
-            self.0 ^= u64::from(x);
-            self.0 = self.0.wrapping_mul(0x0100_0000_01b3);
-        }
-        // Length-delimit the fields.
-        self.0 ^= b.len() as u64;
-        self.0 = self.0.wrapping_mul(0x0100_0000_01b3);
-    }
-}
-
-/// A hash of the prepared grid's content: size, placement and every cell.
-pub fn grid_hash(g: &ccpp_core::GridMap) -> u64 {
-    let f = g.frame();
-    let mut h = Fnv::new();
-    h.bytes(&(f.width as u64).to_le_bytes());
-    h.bytes(&(f.height as u64).to_le_bytes());
-    for v in [f.resolution, f.origin.x, f.origin.y, f.origin.theta] {
-        h.bytes(&v.to_bits().to_le_bytes());
-    }
-    let cells: Vec<u8> = g
-        .cells()
-        .iter()
-        .map(|c| match c {
-            ccpp_core::Cell::Free => 0,
-            ccpp_core::Cell::Occupied => 1,
-            ccpp_core::Cell::Unknown => 2,
-        })
-        .collect();
-    h.bytes(&cells);
-    h.0
-}
-
 /// What defines a bench run, as written to its `bench-key.txt`: a finished run is reused only
 /// when this matches exactly. Covers the map's content (after inflation), the planner, its
 /// options (seed included), the robot, the simulator settings and the ccpp version.
@@ -182,14 +142,14 @@ pub fn run_key(
     robot: ccpp_core::world::Robot,
     sim: &SimConfig,
 ) -> Result<String> {
-    let mut h = Fnv::new();
+    let mut h = ccpp_core::hash::Fnv::new();
     h.bytes(&grid_hash.to_le_bytes());
     h.bytes(planner.as_bytes());
     h.bytes(serde_json::to_string(options)?.as_bytes());
     h.bytes(serde_json::to_string(&robot)?.as_bytes());
     h.bytes(serde_json::to_string(sim)?.as_bytes());
     h.bytes(env!("CARGO_PKG_VERSION").as_bytes());
-    Ok(format!("ccpp-bench-key v1 {:016x}\n", h.0))
+    Ok(format!("ccpp-bench-key v1 {:016x}\n", h.finish()))
 }
 
 /// Runs the benchmark.
@@ -263,7 +223,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         .collect();
     let hashes: Vec<Option<u64>> = prepared
         .par_iter()
-        .map(|(_, m)| m.as_ref().ok().map(|m| grid_hash(&m.grid)))
+        .map(|(_, m)| m.as_ref().ok().map(|m| m.grid.content_hash()))
         .collect();
 
     let mut tasks = Vec::new();

@@ -2095,3 +2095,48 @@ fn a_linked_map_yaml_reads_the_image_beside_the_link() {
     assert!(run.contains("la/m.yaml"), "{run}");
     ccpp().args(["replay", s(&out)]).assert().success();
 }
+
+/// `replay` read the map again from its file and drew the run's path over whatever the file
+/// held by then: a map edited after the run (mirrored) replayed with the old metrics and a
+/// path through walls. `run.json` now records the world's digest; a replay on an edited map
+/// or zone file is refused, and an unchanged one still replays.
+#[test]
+fn a_map_edited_after_the_run_is_not_replayed() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = common::pgm(dir, "room.pgm", 80, 60, |x, y| {
+        x == 0 || y == 0 || x == 79 || y == 59 || (x == 20 && y < 40)
+    });
+    let zone = dir.join("rug.yaml");
+    std::fs::write(&zone, "[[2.5, 0.5], [3.0, 0.5], [3.0, 1.0], [2.5, 1.0]]\n").unwrap();
+    let out = dir.join("out");
+    ccpp()
+        .args([
+            "run",
+            "--planner",
+            "ba-star",
+            "--map",
+            s(&map),
+            "--keepout",
+            s(&zone),
+        ])
+        .args(["--out", s(&out)])
+        .assert()
+        .success();
+    let run = std::fs::read_to_string(out.join("run.json")).unwrap();
+    assert!(run.contains("\"map_digest\""), "{run}");
+    ccpp().args(["replay", s(&out)]).assert().success();
+    let page = std::fs::read(out.join("replay.html")).unwrap();
+    // The zone file moved: refused.
+    std::fs::write(&zone, "[[2.5, 1.5], [3.0, 1.5], [3.0, 2.0], [2.5, 2.0]]\n").unwrap();
+    refused(&["replay", s(&out)], &["room.pgm", "map_digest", "edited"]);
+    std::fs::write(&zone, "[[2.5, 0.5], [3.0, 0.5], [3.0, 1.0], [2.5, 1.0]]\n").unwrap();
+    // The map mirrored: refused by replay and by a rerun of run.json.
+    common::pgm(dir, "room.pgm", 80, 60, |x, y| {
+        x == 0 || y == 0 || x == 79 || y == 59 || (x == 59 && y < 40)
+    });
+    refused(&["replay", s(&out)], &["room.pgm", "map_digest"]);
+    // The refused replays left the folder as it was.
+    assert_eq!(std::fs::read(out.join("replay.html")).unwrap(), page);
+    assert_eq!(std::fs::read_to_string(out.join("run.json")).unwrap(), run);
+}

@@ -335,6 +335,24 @@ impl GridMap {
         Self::new(self.frame, self.cells)
     }
 
+    /// A hash of the grid's content: size, placement and every cell ([`crate::hash::Fnv`]).
+    #[must_use]
+    pub fn content_hash(&self) -> u64 {
+        let f = self.frame();
+        let mut h = crate::hash::Fnv::new();
+        h.bytes(&(f.width as u64).to_le_bytes());
+        h.bytes(&(f.height as u64).to_le_bytes());
+        for v in [f.resolution, f.origin.x, f.origin.y, f.origin.theta] {
+            h.bytes(&v.to_bits().to_le_bytes());
+        }
+        h.field(self.cells().iter().map(|c| match c {
+            Cell::Free => 0,
+            Cell::Occupied => 1,
+            Cell::Unknown => 2,
+        }));
+        h.finish()
+    }
+
     /// Row-major cells, row 0 on top.
     #[inline]
     pub fn cells(&self) -> &[Cell] {

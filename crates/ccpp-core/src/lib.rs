@@ -20,6 +20,7 @@ pub mod gen;
 pub mod geometry;
 pub mod georef;
 pub mod grid;
+pub mod hash;
 pub mod inflate;
 pub mod landmarks;
 pub mod metrics;

@@ -627,6 +627,20 @@ impl World {
         &self.map
     }
 
+    /// A digest of the maps the world was made of: the true map and, with zones, the planning
+    /// map with the zones as walls ([`GridMap::content_hash`]). Two worlds with the same
+    /// digest plan and measure on the same pixels; a map or zone file edited since a run gives
+    /// another digest.
+    #[must_use]
+    pub fn digest(&self) -> u64 {
+        let mut h = crate::hash::Fnv::new();
+        h.bytes(&self.map.content_hash().to_le_bytes());
+        if let Some(plan) = &self.plan {
+            h.bytes(&plan.content_hash().to_le_bytes());
+        }
+        h.finish()
+    }
+
     /// The work zones as pixel masks, if any.
     pub fn zones(&self) -> Option<&ZoneMasks> {
         self.zones.as_ref()

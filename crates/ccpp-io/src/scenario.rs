@@ -556,6 +556,12 @@ pub struct Scenario {
     /// `keepout_violations`), not counted as floor to cover.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub keepout: Vec<ZoneSpec>,
+    /// The digest ([`World::digest`], 16 hex digits) the world built from the map and zones
+    /// must have; `None` = any. A run writes its world's digest into `run.json`, so a replay
+    /// (or a rerun of that file) refuses a map or zone file edited since the run instead of
+    /// drawing the run's path over other walls. Remove it to run the scenario on the new map.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub map_digest: Option<String>,
 }
 
 /// A finished run.
@@ -609,6 +615,7 @@ impl Scenario {
             max_memory_mb: DEFAULT_MAX_MEMORY_MB,
             area: None,
             keepout: Vec::new(),
+            map_digest: None,
         }
     }
 
@@ -1049,6 +1056,15 @@ impl Scenario {
                 },
             }
         })?;
+        if let Some(want) = &self.map_digest {
+            let got = format!("{:016x}", world.digest());
+            if *want != got {
+                return Err(ScenarioError::Invalid(format!(
+                    "map {}: its content (with the zones) differs from the one this scenario                      was recorded on (map_digest {want}, now {got}): the map or a zone file                      was edited since; remove map_digest to run on it as it is now",
+                    source.display()
+                )));
+            }
+        }
         self.planner
             .settings()
             .check_world(&world)

@@ -81,6 +81,7 @@ fn run_json(scenario: &Scenario, world: &World) -> Result<String, serde_json::Er
     let mut scenario = scenario.clone();
     let start = world.initial_pose();
     scenario.start = Some([start.x, start.y, start.theta]);
+    scenario.map_digest = Some(format!("{:016x}", world.digest()));
     scenario.to_json()
 }
 
