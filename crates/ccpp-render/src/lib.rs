@@ -1420,12 +1420,21 @@ fn draw_markers(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
             None,
         );
     }
+    // The heading in the picture: through the map's placement (an origin yaw turns the
+    // image against the world), not the world angle drawn on the image's axes.
+    let res = world.frame().resolution;
+    let ahead = Point::new(s.x + res * s.theta.cos(), s.y + res * s.theta.sin());
+    let (ax, ay) = view.to_canvas(world, ahead);
+    let (dx, dy) = (ax - sx, ay - sy);
+    let len = dx.hypot(dy);
+    let (ux, uy) = if len > 0.0 && len.is_finite() {
+        (dx / len, dy / len)
+    } else {
+        (s.theta.cos() as f32, -(s.theta.sin() as f32))
+    };
     let mut pb = PathBuilder::new();
     pb.move_to(sx, sy);
-    pb.line_to(
-        sx + rad.max(4.0) * 1.6 * s.theta.cos() as f32,
-        sy - rad.max(4.0) * 1.6 * s.theta.sin() as f32,
-    );
+    pb.line_to(sx + rad.max(4.0) * 1.6 * ux, sy + rad.max(4.0) * 1.6 * uy);
     if let Some(p) = pb.finish() {
         pm.stroke_path(
             &p,

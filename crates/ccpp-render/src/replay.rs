@@ -193,7 +193,7 @@ fn decimate(pts: &[[f64; 2]], forced: &[bool]) -> Vec<usize> {
 /// The replay data as a JS object literal (deterministic text). The path travels as one
 /// base64 blob of varints: for each displayed pose the x and y deltas (zigzag, 1/8 map pixel,
 /// canvas orientation), the step-counter delta, the travelled-distance delta (mm, of the
-/// rounded running total, so no drift), then one heading byte per pose.
+/// rounded running total, so no drift), then one heading byte per pose (on the image's axes).
 fn replay_data(
     world: &World,
     trace: &Trace,
@@ -277,7 +277,8 @@ fn replay_data(
         prev_mm = prev_mm.max(mm);
     }
     for &k in &kept {
-        let a = theta[k].rem_euclid(std::f64::consts::TAU);
+        // On the image's axes: an origin yaw turns the image against the world.
+        let a = (theta[k] - f.origin.theta).rem_euclid(std::f64::consts::TAU);
         blob.push(((a / std::f64::consts::TAU * 256.0).round() as u32 % 256) as u8);
     }
     let blob = base64::engine::general_purpose::STANDARD.encode(&blob);
@@ -744,6 +745,38 @@ mod tests {
         forced[pts.len() - 2] = true;
         let kept = decimate(&pts, &forced);
         assert!(kept.iter().any(|&k| pts[k] == [10.0, 0.0]), "{kept:?}");
+    }
+
+    /// The page draws the heading on the image's axes: with the map's origin turned by pi/2,
+    /// world east (theta 0) is a quarter turn clockwise there, heading byte 192 (it was 0,
+    /// drawn pointing at world north).
+    #[test]
+    fn the_heading_byte_is_on_the_image_axes() {
+        let byte = |yaw: f64| {
+            let map = ccpp_core::grid::GridMap::from_ascii_scaled("#####\n#...#\n#####", 10, 0.05)
+                .unwrap()
+                .with_placement(0.05, ccpp_core::Pose::new(0.0, 0.0, yaw))
+                .unwrap();
+            let c = map.frame().grid_to_world(Point::new(25.0, 15.0));
+            let start = ccpp_core::Pose::new(c.x, c.y, 0.0);
+            let world = World::new(map, ccpp_core::world::Robot::new(0.1), Some(start)).unwrap();
+            let mut trace = Trace::default();
+            trace.push_pose(0, start);
+            let data = replay_data(&world, &trace, None, "{}", crop_box(&world, &trace));
+            let blob = data
+                .split("\"blob\":\"")
+                .nth(1)
+                .unwrap()
+                .split('"')
+                .next()
+                .unwrap();
+            let bytes = base64::engine::general_purpose::STANDARD
+                .decode(blob)
+                .unwrap();
+            *bytes.last().unwrap()
+        };
+        assert_eq!(byte(0.0), 0);
+        assert_eq!(byte(std::f64::consts::FRAC_PI_2), 192);
     }
 
     proptest! {

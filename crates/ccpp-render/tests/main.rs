@@ -4,6 +4,7 @@
 //! time. `autotests = false` in Cargo.toml: a new `tests/*.rs` file must be declared below
 //! (`every_test_file_is_a_module` fails until it is).
 
+mod heading_tick;
 mod replay_browser;
 mod replay_far_pose;
 
