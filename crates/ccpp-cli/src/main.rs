@@ -55,8 +55,8 @@ fn main() -> ExitCode {
     }
 }
 
-/// Refuses an argument that is not valid UTF-8 (of `cmd`, whose parse gave `m`, and of its
-/// subcommands), naming the flag and the value. Paths are recorded as text (`run.json`,
+/// Refuses an argument that is not valid UTF-8 or holds a control character (of `cmd`, whose
+/// parse gave `m`, and of its subcommands), naming the flag and the value. Paths are recorded as text (`run.json`,
 /// `bench-key.txt`, exports), so a non-UTF-8 path failed late with a message naming neither
 /// ("cannot serialize the run: path contains invalid UTF-8 characters"), or with a false one
 /// ("must end in a folder name").
@@ -67,13 +67,24 @@ fn utf8_values(cmd: &clap::Command, m: &clap::ArgMatches) -> Result<(), String> 
             continue;
         };
         for v in values {
-            if v.to_str().is_none() {
-                let name = arg
-                    .get_long()
-                    .map_or_else(|| id.to_uppercase(), |l| format!("--{l}"));
+            let name = || {
+                arg.get_long()
+                    .map_or_else(|| id.to_uppercase(), |l| format!("--{l}"))
+            };
+            let Some(text) = v.to_str() else {
                 return Err(format!(
-                    "{name} {}: not valid UTF-8 (ccpp records paths and values as text, in run.json and the exports); rename it",
+                    "{} {}: not valid UTF-8 (ccpp records paths and values as text, in run.json and the exports); rename it",
+                    name(),
                     v.to_string_lossy()
+                ));
+            };
+            // Printed raw, a newline cut every message naming the value short and an escape
+            // sequence reached the terminal.
+            if let Some(c) = text.chars().find(|c| c.is_control()) {
+                return Err(format!(
+                    "{} {text:?}: holds a control character (U+{:04X}); rename it",
+                    name(),
+                    u32::from(c)
                 ));
             }
         }

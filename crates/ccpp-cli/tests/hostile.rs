@@ -2140,3 +2140,74 @@ fn a_map_edited_after_the_run_is_not_replayed() {
     assert_eq!(std::fs::read(out.join("replay.html")).unwrap(), page);
     assert_eq!(std::fs::read_to_string(out.join("run.json")).unwrap(), run);
 }
+
+/// Map YAML details `map_server` reads differently or that broke the one-line message: a
+/// quoted `negate: "1"` was refused (yaml-cpp reads it as 1), `negate: 1.0` was refused as
+/// "1 is not 0, 1, ...", a second YAML document got the parser's advice to its programmer
+/// ("use `from_str_multiple`"), and an image name or an argument with a newline cut the message
+/// short (an escape sequence reached the terminal).
+#[test]
+fn map_yaml_details_read_as_map_server_does_or_say_why() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    common::pgm(dir, "m.pgm", 40, 30, |x, y| {
+        x == 0 || y == 0 || x == 39 || y == 29
+    });
+    let yaml = |name: &str, extra: &str| {
+        let p = dir.join(name);
+        std::fs::write(
+            &p,
+            format!("image: m.pgm\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\n{extra}"),
+        )
+        .unwrap();
+        p
+    };
+    let info = |p: &Path| {
+        let a = ccpp()
+            .args(["info", "--json", "--map", s(p)])
+            .assert()
+            .success();
+        serde_json::from_slice::<serde_json::Value>(&a.get_output().stdout).unwrap()
+    };
+    let plain = info(&yaml("plain.yaml", "negate: 1\n"));
+    for (name, v) in [("q1.yaml", "\"1\""), ("qt.yaml", "'true'")] {
+        let j = info(&yaml(name, &format!("negate: {v}\n")));
+        assert_eq!(j["pixels"]["negate"], true, "{v}");
+        assert_eq!(j["free_px"], plain["free_px"], "{v}");
+    }
+    refused(
+        &["info", "--map", s(&yaml("f.yaml", "negate: 1.0\n"))],
+        &["f.yaml", "negate", "1.0 is not 0, 1, false or true"],
+    );
+    refused(
+        &["info", "--map", s(&yaml("two.yaml", "---\nimage: m.pgm\n"))],
+        &["two.yaml", "second YAML document"],
+    );
+    let a = ccpp()
+        .args(["info", "--map", s(&yaml("two.yaml", "---\nimage: m.pgm\n"))])
+        .assert()
+        .failure();
+    assert!(!String::from_utf8_lossy(&a.get_output().stderr).contains("from_str_multiple"));
+    std::fs::write(
+        dir.join("nl.yaml"),
+        "image: \"a\\nb.pgm\"\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\n",
+    )
+    .unwrap();
+    refused(
+        &["info", "--map", s(&dir.join("nl.yaml"))],
+        &[
+            "nl.yaml",
+            "image",
+            "\"a\\nb.pgm\"",
+            "control character (U+000A)",
+        ],
+    );
+    refused(
+        &["info", "--map", "x\u{1b}[31m.pgm"],
+        &[
+            "--map",
+            "\"x\\u{1b}[31m.pgm\"",
+            "control character (U+001B)",
+        ],
+    );
+}

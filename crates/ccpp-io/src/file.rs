@@ -100,6 +100,17 @@ mod tests {
     }
 }
 
+/// A YAML parser message in the user's words: the parser's advice to its programmer (a second
+/// document "detected; use `from_str_multiple` ...") becomes what the file holds.
+pub fn yaml_words(message: &str) -> String {
+    const MULTI: &str =
+        "multiple YAML documents detected; use from_str_multiple or from_str_multiple_with_options";
+    message.replace(
+        MULTI,
+        "holds a second YAML document (after a `---` line); ccpp reads files of one document",
+    )
+}
+
 /// Deserializes YAML, or JSON when `json`, and on an error names the field it is in: the text
 /// is parsed as `serde_saphyr::from_str` / `serde_json::from_str` parse it (so what is accepted
 /// does not change), and only a failed parse is read again to find the error's path
@@ -116,7 +127,7 @@ pub fn parse_yaml_or_json<T: serde::de::DeserializeOwned>(
     let first = if json {
         serde_json::from_str::<T>(text).map_err(|e| e.to_string())
     } else {
-        serde_saphyr::from_str::<T>(text).map_err(|e| e.to_string())
+        serde_saphyr::from_str::<T>(text).map_err(|e| yaml_words(&e.to_string()))
     };
     let message = match first {
         Ok(v) => return Ok(v),

@@ -129,8 +129,8 @@ fn read_file(path: &Path, frame: &MapFrame) -> Result<ZoneData, ZoneFileError> {
         let v: Value = serde_json::from_str(&text).map_err(|e| bad(format!("GeoJSON: {e}")))?;
         return Ok(ZoneData::Polygons(geojson_polygons(&v)?));
     }
-    let v: serde_json::Value =
-        serde_saphyr::from_str(&text).map_err(|e| bad(format!("YAML: {e}")))?;
+    let v: serde_json::Value = serde_saphyr::from_str(&text)
+        .map_err(|e| bad(format!("YAML: {}", crate::file::yaml_words(&e.to_string()))))?;
     if v.get("image").is_some() {
         return read_mask(path, frame).map(ZoneData::Mask);
     }

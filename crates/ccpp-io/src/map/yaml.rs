@@ -79,10 +79,19 @@ impl<'de> Deserialize<'de> for Negate {
                 Ok(i64::try_from(v).map_or_else(|_| Negate::Other(v.to_string()), Negate::Int))
             }
             fn visit_f64<E: de::Error>(self, v: f64) -> Result<Negate, E> {
-                Ok(Negate::Other(v.to_string()))
+                // `1.0`, not `1` (which would read as accepted).
+                Ok(Negate::Other(format!("{v:?}")))
             }
             fn visit_str<E: de::Error>(self, v: &str) -> Result<Negate, E> {
-                Ok(Negate::Other(format!("{v:?}")))
+                // A quoted scalar: `map_server` (yaml-cpp) reads "1" and "true" as it reads
+                // 1 and true.
+                Ok(match v.trim().to_ascii_lowercase().as_str() {
+                    "0" => Negate::Int(0),
+                    "1" => Negate::Int(1),
+                    "false" => Negate::Bool(false),
+                    "true" => Negate::Bool(true),
+                    _ => Negate::Other(format!("{v:?}")),
+                })
             }
         }
         deserializer.deserialize_any(V)
@@ -119,6 +128,17 @@ impl MapYaml {
         let image = raw.image.ok_or_else(|| missing("image"))?;
         if image.trim().is_empty() {
             return Err(bad("image", "the image file name is empty".to_owned()));
+        }
+        // A control character would be printed raw in every message naming the image (a
+        // newline cut the message short; an escape sequence reached the terminal).
+        if let Some(c) = image.chars().find(|c| c.is_control()) {
+            return Err(bad(
+                "image",
+                format!(
+                    "the image file name {image:?} holds a control character (U+{:04X})",
+                    u32::from(c)
+                ),
+            ));
         }
         let resolution = raw.resolution.ok_or_else(|| missing("resolution"))?;
         let origin_v = raw.origin.ok_or_else(|| missing("origin"))?;
@@ -172,7 +192,7 @@ impl MapYaml {
 fn yaml_message(e: &serde_saphyr::Error) -> String {
     let mut opts = serde_saphyr::RenderOptions::default();
     opts.snippets = serde_saphyr::SnippetMode::Off;
-    let text = one_line(&e.render_with_options(opts));
+    let text = crate::file::yaml_words(&one_line(&e.render_with_options(opts)));
     text.strip_prefix("error: ")
         .map(str::to_owned)
         .unwrap_or(text)
@@ -254,11 +274,21 @@ mod tests {
 
     #[test]
     fn negate_forms() {
-        for (text, want) in [("0", false), ("1", true), ("false", false), ("true", true)] {
+        // Quoted forms too: yaml-cpp, which `map_server` reads with, converts a quoted scalar
+        // as it converts a plain one.
+        for (text, want) in [
+            ("0", false),
+            ("1", true),
+            ("false", false),
+            ("true", true),
+            ("\"0\"", false),
+            ("'1'", true),
+            ("\"True\"", true),
+        ] {
             let y = parse(&format!("{BASE}negate: {text}\n")).unwrap();
             assert_eq!(y.negate, want, "negate: {text}");
         }
-        for text in ["2", "-1", "0.5", "\"0\""] {
+        for text in ["2", "-1", "0.5", "1.0", "\"2\"", "\"\""] {
             let e = parse(&format!("{BASE}negate: {text}\n")).unwrap_err();
             assert!(
                 matches!(
