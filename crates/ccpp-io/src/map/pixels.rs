@@ -63,6 +63,24 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
             message: "not a PNG or PNM/PGM image (unrecognised content)".to_owned(),
         });
     };
+    // A PNM sample above its maxval: Netpbm forbids it, and the decoder rescaled it beyond
+    // white, so a malformed file read as free floor.
+    let reader = if format == image::ImageFormat::Pnm {
+        let mut inner = reader.into_inner();
+        let start = inner.stream_position().map_err(io_err)?;
+        if let Some((sample, maxval)) = pnm_sample_over_maxval(&mut inner).map_err(io_err)? {
+            return Err(MapError::Decode {
+                path: path.to_path_buf(),
+                message: format!(
+                    "sample {sample} exceeds the image's maxval {maxval} (a malformed PNM)"
+                ),
+            });
+        }
+        inner.seek(SeekFrom::Start(start)).map_err(io_err)?;
+        ImageReader::with_format(inner, format)
+    } else {
+        reader
+    };
     let image_err = |e: image::ImageError| match e {
         image::ImageError::IoError(io) if io.kind() == std::io::ErrorKind::UnexpectedEof => {
             MapError::Decode {
@@ -110,6 +128,126 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
         height,
         cells,
     })
+}
+
+/// The first sample of a PNM image (`P2`, `P3`, `P5`, `P6`) above the header's maxval, with
+/// the maxval; `None` when there is none, for the other kinds (bitmaps, PAM) and for a header
+/// the decoder will refuse anyway. Reads from the stream's position to the raster's end.
+fn pnm_sample_over_maxval<R: BufRead>(r: &mut R) -> std::io::Result<Option<(u32, u32)>> {
+    let mut magic = [0u8; 2];
+    if r.read_exact(&mut magic).is_err() {
+        return Ok(None);
+    }
+    let (ascii, channels) = match &magic {
+        b"P2" => (true, 1u64),
+        b"P3" => (true, 3),
+        b"P5" => (false, 1),
+        b"P6" => (false, 3),
+        _ => return Ok(None),
+    };
+    // Header: width, height, maxval, with `#` comments, then one whitespace byte.
+    let mut fields = [0u64; 3];
+    for f in &mut fields {
+        match header_number(r)? {
+            Some(v) => *f = v,
+            None => return Ok(None),
+        }
+    }
+    let [w, h, maxval] = fields;
+    if maxval == 0 || maxval > 65535 {
+        return Ok(None);
+    }
+    let samples = w.saturating_mul(h).saturating_mul(channels);
+    let over =
+        |v: u64| (v > maxval).then_some((u32::try_from(v).unwrap_or(u32::MAX), maxval as u32));
+    if ascii {
+        for _ in 0..samples {
+            match header_number(r)? {
+                Some(v) => {
+                    if let Some(o) = over(v) {
+                        return Ok(Some(o));
+                    }
+                }
+                None => return Ok(None),
+            }
+        }
+        return Ok(None);
+    }
+    if maxval == 255 || maxval == 65535 {
+        return Ok(None);
+    }
+    let wide = maxval > 255;
+    let mut left = if wide {
+        samples.saturating_mul(2)
+    } else {
+        samples
+    };
+    let mut pending: Option<u8> = None;
+    while left > 0 {
+        let buf = r.fill_buf()?;
+        if buf.is_empty() {
+            return Ok(None);
+        }
+        let take = buf.len().min(usize::try_from(left).unwrap_or(usize::MAX));
+        for &b in &buf[..take] {
+            let v = if wide {
+                match pending.take() {
+                    None => {
+                        pending = Some(b);
+                        continue;
+                    }
+                    Some(hi) => u64::from(hi) << 8 | u64::from(b),
+                }
+            } else {
+                u64::from(b)
+            };
+            if let Some(o) = over(v) {
+                return Ok(Some(o));
+            }
+        }
+        r.consume(take);
+        left -= take as u64;
+    }
+    Ok(None)
+}
+
+/// The next decimal number of a PNM header (or plain raster), skipping whitespace and `#`
+/// comments, and the one byte that ends it; `None` at the end or at anything else.
+fn header_number<R: BufRead>(r: &mut R) -> std::io::Result<Option<u64>> {
+    let mut byte = [0u8; 1];
+    // Skip to the first digit.
+    loop {
+        if r.read(&mut byte)? == 0 {
+            return Ok(None);
+        }
+        match byte[0] {
+            b'#' => {
+                let mut line = Vec::new();
+                r.read_until(b'\n', &mut line)?;
+            }
+            b if b.is_ascii_whitespace() => {}
+            b if b.is_ascii_digit() => break,
+            _ => return Ok(None),
+        }
+    }
+    let mut v = u64::from(byte[0] - b'0');
+    loop {
+        if r.read(&mut byte)? == 0 {
+            return Ok(Some(v));
+        }
+        if !byte[0].is_ascii_digit() {
+            // The whitespace (or comment start) after the number: the binary raster begins
+            // right after one whitespace byte, so nothing more is read.
+            if byte[0] == b'#' {
+                let mut line = Vec::new();
+                r.read_until(b'\n', &mut line)?;
+            }
+            return Ok(Some(v));
+        }
+        v = v
+            .saturating_mul(10)
+            .saturating_add(u64::from(byte[0] - b'0'));
+    }
 }
 
 /// Classifies every pixel of a decoded image, row-major from the top row.
@@ -216,6 +354,41 @@ fn rgb16_level(p: &[u16]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn load(bytes: &[u8]) -> Result<crate::map::LoadedMap, MapError> {
+        crate::map::load_map_bytes(
+            Path::new("m.pgm"),
+            None,
+            bytes,
+            &crate::map::LoadOptions::default(),
+        )
+    }
+
+    /// A sample above the maxval (Netpbm forbids it) read as free floor: the decoder scaled
+    /// it beyond white. It is refused, naming the sample; samples at the maxval load.
+    #[test]
+    fn pnm_samples_above_their_maxval_are_refused() {
+        let over = |bytes: &[u8]| match load(bytes) {
+            Err(MapError::Decode { message, .. }) => message,
+            other => panic!("{other:?}"),
+        };
+        assert!(over(b"P5 2 1 100\n\x00\xc8").contains("sample 200 exceeds the image's maxval 100"));
+        assert!(over(b"P2\n# c\n2 1\n100\n0 150\n").contains("sample 150"));
+        assert!(
+            over(b"P5 1 1 1000\n\x03\xe9").contains("sample 1001 exceeds the image's maxval 1000")
+        );
+        assert!(over(b"P6 1 1 100\n\x00\x00\x65").contains("sample 101"));
+        // At the maxval, and the full ranges, load.
+        for ok in [
+            &b"P5 2 1 100\n\x00\x64"[..],
+            b"P2 2 1 100 0 100",
+            b"P5 2 1 255\n\x00\xff",
+            b"P5 1 1 1000\n\x03\xe8",
+            b"P5 # width\n2 # height\n1 255\n\x00\xfe",
+        ] {
+            load(ok).unwrap_or_else(|e| panic!("{e}"));
+        }
+    }
 
     /// The decoder's default cap (512 MiB) refused a 24000 x 24000 PNG under
     /// `--max-memory 60000` ("Memory limit exceeded"): the cap follows the pixel budget.
