@@ -184,6 +184,10 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     if a.jobs == Some(0) {
         bail!("--jobs must be at least 1, got 0");
     }
+    // Refused here, before the folder is touched (every run would fail on it).
+    if a.limits.max_memory_mb() == 0 {
+        bail!("--max-memory must be >= 1 MB");
+    }
     let (robot, _) = robot_from(&(&a.robot).into())?;
     let options = planner_options(a.options.config.as_deref(), a.seed)?;
     let maps = name_maps(expand_maps(&a.maps)?);
@@ -270,9 +274,19 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         .collect();
     bar.finish_and_clear();
 
-    write_file(&a.out.join("results.csv"), results_csv(&rows).as_bytes())?;
-    write_file(&a.out.join("results.md"), results_md(&rows).as_bytes())?;
+    // The summary is one whole: a stop while it is written removes what it wrote (the plots
+    // folder only when this bench creates it, so that no file of the user's goes with it),
+    // and `results.csv`, written last, marks it complete.
+    let plots = a.out.join("plots");
+    let mut summary = vec![a.out.join("results.csv"), a.out.join("results.md")];
+    if !plots.exists() {
+        summary.push(plots);
+    }
+    let summary = crate::staging::PendingSet::new(summary);
     crate::plots::write_all(&a.out, &rows, &prepared, robot)?;
+    write_file(&a.out.join("results.md"), results_md(&rows).as_bytes())?;
+    write_file(&a.out.join("results.csv"), results_csv(&rows).as_bytes())?;
+    drop(summary);
     let failed = rows.iter().filter(|r| r.outcome.is_err()).count();
     crate::print_stdout(&format!(
         "{} runs ({} failed) on {} maps x {} planners; wrote {}/results.csv, results.md, plots/\n",
@@ -378,6 +392,9 @@ fn clear_summary(out: &Path) -> Result<()> {
                 .with_context(|| format!("cannot remove the old plot {}", p.display()))?;
         }
     }
+    // The folder goes too unless it holds files of the user's (then removing it fails, and
+    // that is the intent: it stays as it is).
+    let _ = std::fs::remove_dir(&dir);
     Ok(())
 }
 

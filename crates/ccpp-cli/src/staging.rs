@@ -52,6 +52,30 @@ fn register(p: &Path) {
     lock(&PENDING).push(p.to_path_buf());
 }
 
+/// Paths written one by one that make one whole (a bench's summary: `results.csv`,
+/// `results.md`, `plots/`): registered for removal on interrupt from creation until the guard
+/// is dropped, so a stop in the middle leaves none of them instead of some.
+pub struct PendingSet(Vec<PathBuf>);
+
+impl PendingSet {
+    /// Registers `paths` (they need not exist yet).
+    pub fn new(paths: Vec<PathBuf>) -> Self {
+        for p in &paths {
+            register(p);
+        }
+        Self(paths)
+    }
+}
+
+impl Drop for PendingSet {
+    /// The whole is written: its paths are no longer removed on interrupt.
+    fn drop(&mut self) {
+        for p in &self.0 {
+            unregister(p);
+        }
+    }
+}
+
 fn unregister(p: &Path) {
     let mut v = lock(&PENDING);
     if let Some(i) = v.iter().position(|q| q == p) {

@@ -2136,6 +2136,27 @@ fn a_map_edited_after_the_run_is_not_replayed() {
         x == 0 || y == 0 || x == 79 || y == 59 || (x == 59 && y < 40)
     });
     refused(&["replay", s(&out)], &["room.pgm", "map_digest"]);
+    // A start the edit put into a wall: the edit is named, not its consequence.
+    common::pgm(dir, "room.pgm", 80, 60, |_, _| true);
+    refused(
+        &["replay", s(&out)],
+        &["room.pgm", "map_digest", "edited since"],
+    );
+    let a = ccpp().args(["replay", s(&out)]).assert().failure();
+    assert!(!String::from_utf8_lossy(&a.get_output().stderr).contains("  "));
+    // A digest that is not one is named as such.
+    let bad = dir.join("bad");
+    std::fs::create_dir_all(&bad).unwrap();
+    for f in ["trace.jsonl", "metrics.json"] {
+        std::fs::copy(out.join(f), bad.join(f)).unwrap();
+    }
+    let mut j: serde_json::Value = serde_json::from_str(&run).unwrap();
+    j["map_digest"] = serde_json::json!("zz\u{1b}[31m");
+    std::fs::write(bad.join("run.json"), j.to_string()).unwrap();
+    refused(
+        &["replay", s(&bad)],
+        &["map_digest \"zz\\u{1b}", "is not a digest"],
+    );
     // The refused replays left the folder as it was.
     assert_eq!(std::fs::read(out.join("replay.html")).unwrap(), page);
     assert_eq!(std::fs::read_to_string(out.join("run.json")).unwrap(), run);

@@ -277,6 +277,19 @@ fn an_interrupted_bench_leaves_only_complete_runs() {
         assert!(status.code() == Some(130) || status.success(), "{status:?}");
         // Give stopped children a moment to remove their staging folders.
         std::thread::sleep(std::time::Duration::from_millis(300));
+        // The summary is whole or absent: `plots/` never without `results.csv` (a stop while
+        // the plots were written left some of them), `results.csv` never without the rest.
+        let csv = out.join("results.csv").exists();
+        assert_eq!(
+            out.join("plots").exists(),
+            csv,
+            "{signal}: a partial summary"
+        );
+        assert_eq!(
+            out.join("results.md").exists(),
+            csv,
+            "{signal}: a partial summary"
+        );
         let mut dirs = Vec::new();
         walk(&out, &mut dirs);
         for (d, names) in &dirs {
@@ -313,6 +326,16 @@ fn an_interrupted_bench_never_leaves_the_summary_of_an_earlier_bench() {
     .success();
     assert!(out.join("results.csv").is_file());
     assert!(out.join("plots").read_dir().unwrap().next().is_some());
+    // A limit no run can keep is refused before the folder is touched.
+    let csv = std::fs::read(out.join("results.csv")).unwrap();
+    bench(
+        &out,
+        &[data("teb_empty_box.yaml")],
+        &["--planners", "ba-star", "--max-memory", "0"],
+    )
+    .assert()
+    .code(1);
+    assert_eq!(std::fs::read(out.join("results.csv")).unwrap(), csv);
     // ... then one at r = 0.15 m into the same folder, stopped while it runs.
     let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("ccpp"))
         .args([
@@ -356,8 +379,7 @@ fn an_interrupted_bench_never_leaves_the_summary_of_an_earlier_bench() {
         // Stopped: complete run folders and no summary at all.
         assert!(!out.join("results.csv").exists());
         assert!(!out.join("results.md").exists());
-        let plots: Vec<_> = out.join("plots").read_dir().unwrap().flatten().collect();
-        assert!(plots.is_empty(), "{plots:?}");
+        assert!(!out.join("plots").exists(), "an empty plots/ stayed");
     }
 }
 

@@ -338,6 +338,13 @@ impl GridMap {
     /// A hash of the grid's content: size, placement and every cell ([`crate::hash::Fnv`]).
     #[must_use]
     pub fn content_hash(&self) -> u64 {
+        self.content_hash_blocked(|_| false)
+    }
+
+    /// [`Self::content_hash`] of the grid with every free pixel `i` where `blocked(i)` occupied
+    /// (a map with virtual walls), without building that grid.
+    #[must_use]
+    pub fn content_hash_blocked(&self, blocked: impl Fn(usize) -> bool) -> u64 {
         let f = self.frame();
         let mut h = crate::hash::Fnv::new();
         h.bytes(&(f.width as u64).to_le_bytes());
@@ -345,7 +352,8 @@ impl GridMap {
         for v in [f.resolution, f.origin.x, f.origin.y, f.origin.theta] {
             h.bytes(&v.to_bits().to_le_bytes());
         }
-        h.field(self.cells().iter().map(|c| match c {
+        h.field(self.cells().iter().enumerate().map(|(i, c)| match c {
+            Cell::Free if blocked(i) => 1,
             Cell::Free => 0,
             Cell::Occupied => 1,
             Cell::Unknown => 2,

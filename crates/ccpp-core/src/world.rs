@@ -227,6 +227,23 @@ impl std::fmt::Debug for World {
     }
 }
 
+/// [`World::digest`] of the world that `map` and `zones` make, computed before it is built
+/// (so a changed map is named as such before anything else about the world is judged): the
+/// true map's content hash and, with zones, that of the map with the zones as walls.
+#[must_use]
+pub fn map_digest(map: &GridMap, zones: Option<&ZoneMasks>) -> u64 {
+    let mut h = crate::hash::Fnv::new();
+    h.bytes(&map.content_hash().to_le_bytes());
+    let n = map.frame().len();
+    let zones = zones.filter(|z| {
+        !z.is_empty() && z.keepout.len() == n && z.area.as_ref().is_none_or(|a| a.len() == n)
+    });
+    if let Some(z) = zones {
+        h.bytes(&map.content_hash_blocked(|i| z.forbidden(i)).to_le_bytes());
+    }
+    h.finish()
+}
+
 impl World {
     /// Prepares the truth for `robot` on `map`, starting at `start` (or, when `None`, at the
     /// default start: the C-free pixel centre with the largest clearance in the largest C-free
@@ -633,12 +650,7 @@ impl World {
     /// another digest.
     #[must_use]
     pub fn digest(&self) -> u64 {
-        let mut h = crate::hash::Fnv::new();
-        h.bytes(&self.map.content_hash().to_le_bytes());
-        if let Some(plan) = &self.plan {
-            h.bytes(&plan.content_hash().to_le_bytes());
-        }
-        h.finish()
+        map_digest(&self.map, self.zones.as_ref())
     }
 
     /// The work zones as pixel masks, if any.

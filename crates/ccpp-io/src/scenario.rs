@@ -1019,6 +1019,41 @@ impl Scenario {
 
     /// Builds the world on `grid` (the prepared map's, loaded from `source` and grown by
     /// `inflate` metres) and runs the planner's checks against it.
+    /// Refuses a map (with its zones) whose digest is not the scenario's `map_digest`, before
+    /// the world is built: a start now in a wall is the edit's consequence, not the news.
+    fn check_digest(
+        &self,
+        grid: &GridMap,
+        zones: Option<&ZoneMasks>,
+        source: &Path,
+    ) -> Result<(), ScenarioError> {
+        let Some(want) = &self.map_digest else {
+            return Ok(());
+        };
+        let well_formed = want.len() == 16
+            && want
+                .bytes()
+                .all(|b| b.is_ascii_digit() || (b'a'..=b'f').contains(&b));
+        if !well_formed {
+            let shown: String = want.chars().take(24).collect();
+            let more = if want.chars().count() > 24 { "..." } else { "" };
+            return Err(ScenarioError::Invalid(format!(
+                "map_digest {shown:?}{more} is not a digest (16 lowercase hex digits, as a run \
+                 writes it into run.json); remove it to run on the map as it is"
+            )));
+        }
+        let got = format!("{:016x}", ccpp_core::world::map_digest(grid, zones));
+        if *want != got {
+            return Err(ScenarioError::Invalid(format!(
+                "map {}: its content (with the zones) differs from the one this scenario was \
+                 recorded on (map_digest {want}, now {got}): the map or a zone file was edited \
+                 since; remove map_digest to run on it as it is now",
+                source.display()
+            )));
+        }
+        Ok(())
+    }
+
     fn world_on(
         &self,
         grid: GridMap,
@@ -1026,6 +1061,7 @@ impl Scenario {
         inflate: Option<f64>,
         zones: Option<ZoneMasks>,
     ) -> Result<World, ScenarioError> {
+        self.check_digest(&grid, zones.as_ref(), source)?;
         let start = self.start.map(|s| Pose::new(s[0], s[1], s[2]));
         let world = World::with_zones(grid, self.robot, start, zones).map_err(|source_err| {
             match self.zone_of(&source_err) {
@@ -1056,15 +1092,6 @@ impl Scenario {
                 },
             }
         })?;
-        if let Some(want) = &self.map_digest {
-            let got = format!("{:016x}", world.digest());
-            if *want != got {
-                return Err(ScenarioError::Invalid(format!(
-                    "map {}: its content (with the zones) differs from the one this scenario                      was recorded on (map_digest {want}, now {got}): the map or a zone file                      was edited since; remove map_digest to run on it as it is now",
-                    source.display()
-                )));
-            }
-        }
         self.planner
             .settings()
             .check_world(&world)

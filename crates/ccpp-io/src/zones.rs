@@ -289,13 +289,15 @@ fn geojson_collect(v: &Value, out: &mut Vec<Polygon>, depth: usize) -> Result<()
                 let first = out.len();
                 geojson_collect(g, out, depth + 1)?;
                 // The feature's name names every polygon of its geometry.
-                let name = v
-                    .get("properties")
-                    .and_then(|p| p.get("name"))
-                    .and_then(Value::as_str);
+                // A number or a boolean names it as written; a list or an object is no name.
+                let name = match v.get("properties").and_then(|p| p.get("name")) {
+                    Some(Value::String(s)) => Some(s.clone()),
+                    Some(n @ (Value::Number(_) | Value::Bool(_))) => Some(n.to_string()),
+                    _ => None,
+                };
                 if let Some(name) = name {
                     for p in &mut out[first..] {
-                        p.name = Some(name.to_string());
+                        p.name = Some(name.clone());
                     }
                 }
                 Ok(())
@@ -336,6 +338,19 @@ mod tests {
         let p = geojson_polygons(&g).unwrap();
         let names: Vec<_> = p.iter().map(|p| p.name.as_deref()).collect();
         assert_eq!(names, [None, Some("desks"), Some("desks")]);
+        let other: Value = serde_json::from_str(
+            r#"{"type":"FeatureCollection","features":[
+                {"type":"Feature","properties":{"name":42},"geometry":{"type":"Polygon","coordinates":[[[0,0],[1,0],[1,1]]]}},
+                {"type":"Feature","properties":{"name":true},"geometry":{"type":"Polygon","coordinates":[[[0,0],[1,0],[1,1]]]}},
+                {"type":"Feature","properties":{"name":["a"]},"geometry":{"type":"Polygon","coordinates":[[[0,0],[1,0],[1,1]]]}}]}"#,
+        )
+        .unwrap();
+        let names: Vec<_> = geojson_polygons(&other)
+            .unwrap()
+            .into_iter()
+            .map(|p| p.name)
+            .collect();
+        assert_eq!(names, [Some("42".into()), Some("true".into()), None]);
         assert_eq!(p.len(), 3);
         assert_eq!(p[2].points[1], [6.0, 5.0]);
         let holes: Value = serde_json::from_str(

@@ -130,30 +130,54 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
     })
 }
 
-/// The first sample of a PNM image (`P2`, `P3`, `P5`, `P6`) above the header's maxval, with
-/// the maxval; `None` when there is none, for the other kinds (bitmaps, PAM) and for a header
+/// The first sample of a PNM image (`P2`, `P3`, `P5`, `P6`, `P7`) above the header's maxval,
+/// with the maxval; `None` when there is none, for bitmaps (`P1`, `P4`) and for a header
 /// the decoder will refuse anyway. Reads from the stream's position to the raster's end.
 fn pnm_sample_over_maxval<R: BufRead>(r: &mut R) -> std::io::Result<Option<(u32, u32)>> {
     let mut magic = [0u8; 2];
     if r.read_exact(&mut magic).is_err() {
         return Ok(None);
     }
-    let (ascii, channels) = match &magic {
+    let (ascii, mut channels) = match &magic {
         b"P2" => (true, 1u64),
         b"P3" => (true, 3),
-        b"P5" => (false, 1),
+        b"P5" | b"P7" => (false, 1),
         b"P6" => (false, 3),
         _ => return Ok(None),
     };
-    // Header: width, height, maxval, with `#` comments, then one whitespace byte.
-    let mut fields = [0u64; 3];
-    for f in &mut fields {
-        match header_number(r)? {
-            Some(v) => *f = v,
-            None => return Ok(None),
+    let [w, h, maxval] = if &magic == b"P7" {
+        // PAM: `KEY value` lines up to `ENDHDR`.
+        let mut fields = [0u64; 3];
+        loop {
+            let mut line = Vec::new();
+            if r.read_until(b'\n', &mut line)? == 0 {
+                return Ok(None);
+            }
+            let line = String::from_utf8_lossy(&line);
+            let mut words = line.split_whitespace();
+            let key = words.next().unwrap_or("");
+            let value = words.next().and_then(|v| v.parse::<u64>().ok());
+            match (key, value) {
+                ("ENDHDR", _) => break,
+                ("WIDTH", Some(v)) => fields[0] = v,
+                ("HEIGHT", Some(v)) => fields[1] = v,
+                ("MAXVAL", Some(v)) => fields[2] = v,
+                ("DEPTH", Some(v)) => channels = v,
+                _ => {}
+            }
         }
-    }
-    let [w, h, maxval] = fields;
+        fields
+    } else {
+        // Header: width, height, maxval, with `#` comments, then one whitespace byte.
+        let mut fields = [0u64; 3];
+        for f in &mut fields {
+            match header_number(r)? {
+                Some(v) => *f = v,
+                None => return Ok(None),
+            }
+        }
+        fields
+    };
     if maxval == 0 || maxval > 65535 {
         return Ok(None);
     }
@@ -378,6 +402,10 @@ mod tests {
             over(b"P5 1 1 1000\n\x03\xe9").contains("sample 1001 exceeds the image's maxval 1000")
         );
         assert!(over(b"P6 1 1 100\n\x00\x00\x65").contains("sample 101"));
+        assert!(over(
+            b"P7\nWIDTH 2\nHEIGHT 1\nDEPTH 1\nMAXVAL 100\nTUPLTYPE GRAYSCALE\nENDHDR\n\x00\xfa"
+        )
+        .contains("sample 250"));
         // At the maxval, and the full ranges, load.
         for ok in [
             &b"P5 2 1 100\n\x00\x64"[..],
@@ -385,6 +413,7 @@ mod tests {
             b"P5 2 1 255\n\x00\xff",
             b"P5 1 1 1000\n\x03\xe8",
             b"P5 # width\n2 # height\n1 255\n\x00\xfe",
+            b"P7\nWIDTH 2\nHEIGHT 1\nDEPTH 1\nMAXVAL 100\nTUPLTYPE GRAYSCALE\nENDHDR\n\x00\x64",
         ] {
             load(ok).unwrap_or_else(|e| panic!("{e}"));
         }
