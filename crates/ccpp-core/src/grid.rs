@@ -338,13 +338,13 @@ impl GridMap {
     /// A hash of the grid's content: size, placement and every cell ([`crate::hash::Fnv`]).
     #[must_use]
     pub fn content_hash(&self) -> u64 {
-        self.content_hash_blocked(|_| false)
+        self.content_hash_mapped(|_, c| c)
     }
 
-    /// [`Self::content_hash`] of the grid with every free pixel `i` where `blocked(i)` occupied
-    /// (a map with virtual walls), without building that grid.
+    /// [`Self::content_hash`] of the grid whose pixel `i` is `cell(i, c)` where this grid has
+    /// `c` (a map with virtual walls), without building that grid.
     #[must_use]
-    pub fn content_hash_blocked(&self, blocked: impl Fn(usize) -> bool) -> u64 {
+    pub fn content_hash_mapped(&self, cell: impl Fn(usize, Cell) -> Cell) -> u64 {
         let f = self.frame();
         let mut h = crate::hash::Fnv::new();
         h.bytes(&(f.width as u64).to_le_bytes());
@@ -352,12 +352,16 @@ impl GridMap {
         for v in [f.resolution, f.origin.x, f.origin.y, f.origin.theta] {
             h.bytes(&v.to_bits().to_le_bytes());
         }
-        h.field(self.cells().iter().enumerate().map(|(i, c)| match c {
-            Cell::Free if blocked(i) => 1,
-            Cell::Free => 0,
-            Cell::Occupied => 1,
-            Cell::Unknown => 2,
-        }));
+        h.field(
+            self.cells()
+                .iter()
+                .enumerate()
+                .map(|(i, &c)| match cell(i, c) {
+                    Cell::Free => 0,
+                    Cell::Occupied => 1,
+                    Cell::Unknown => 2,
+                }),
+        );
         h.finish()
     }
 

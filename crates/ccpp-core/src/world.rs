@@ -239,7 +239,10 @@ pub fn map_digest(map: &GridMap, zones: Option<&ZoneMasks>) -> u64 {
         !z.is_empty() && z.keepout.len() == n && z.area.as_ref().is_none_or(|a| a.len() == n)
     });
     if let Some(z) = zones {
-        h.bytes(&map.content_hash_blocked(|i| z.forbidden(i)).to_le_bytes());
+        h.bytes(
+            &map.content_hash_mapped(|i, c| z.plan_cell(i, c))
+                .to_le_bytes(),
+        );
     }
     h.finish()
 }
@@ -285,9 +288,7 @@ impl World {
             );
             let mut p = map.clone();
             for (i, c) in p.cells_mut().iter_mut().enumerate() {
-                if c.is_free() && z.forbidden(i) {
-                    *c = Cell::Occupied;
-                }
+                *c = z.plan_cell(i, *c);
             }
             p
         });

@@ -22,7 +22,7 @@ use fixedbitset::FixedBitSet;
 use serde::{Deserialize, Serialize};
 
 use crate::geometry::Point;
-use crate::grid::MapFrame;
+use crate::grid::{Cell, MapFrame};
 
 /// A simple polygon in map coordinates (metres): its vertices in order, either orientation;
 /// closing the ring (repeating the first vertex at the end) is optional.
@@ -389,6 +389,16 @@ impl ZoneMasks {
     /// Is pixel `i` forbidden (outside the area or in a keep-out)?
     pub fn forbidden(&self, i: usize) -> bool {
         self.keepout.contains(i) || self.area.as_ref().is_some_and(|a| !a.contains(i))
+    }
+
+    /// Pixel `i`, `c` on the true map, as the planning map has it: a free pixel the zones
+    /// forbid is a (virtual) wall.
+    pub fn plan_cell(&self, i: usize, c: Cell) -> Cell {
+        if c.is_free() && self.forbidden(i) {
+            Cell::Occupied
+        } else {
+            c
+        }
     }
 
     /// No area restriction and no keep-out pixel.

@@ -113,6 +113,13 @@ const FAR_Q: i64 = 1 << 40;
 /// Samples of the live coverage curve.
 const COVERAGE_SAMPLES: usize = 2000;
 
+/// A crop pixel coordinate in the blobs' units (1/[`Q`] px). A pose far off the map (a
+/// corrupted trace) is drawn at a far edge: the deltas stay exact in JavaScript's numbers and
+/// never overflow.
+fn quantize(v: f64) -> i64 {
+    ((v * Q).round() as i64).clamp(-FAR_Q, FAR_Q)
+}
+
 fn push_varint(out: &mut Vec<u8>, mut v: u64) {
     while v >= 0x80 {
         out.push((v as u8 & 0x7f) | 0x80);
@@ -258,9 +265,7 @@ fn replay_data(
     for axis in 0..2 {
         let mut prev = 0i64;
         for &k in &kept {
-            // A pose far off the map (a corrupted trace) is drawn at a far edge: the deltas
-            // stay exact in JavaScript's numbers and never overflow.
-            let q = ((pts[k][axis] * Q).round() as i64).clamp(-FAR_Q, FAR_Q);
+            let q = quantize(pts[k][axis]);
             push_varint(&mut blob, zigzag(q - prev));
             prev = q;
         }
@@ -336,8 +341,7 @@ fn replay_data(
     let (mut pi, mut px, mut py) = (0u64, 0i64, 0i64);
     for &i in &tiles {
         let d = display(i) as u64;
-        let qx = ((pts[i][0] * Q).round() as i64).clamp(-FAR_Q, FAR_Q);
-        let qy = ((pts[i][1] * Q).round() as i64).clamp(-FAR_Q, FAR_Q);
+        let (qx, qy) = (quantize(pts[i][0]), quantize(pts[i][1]));
         push_varint(&mut tblob, d - pi);
         push_varint(&mut tblob, zigzag(qx - px));
         push_varint(&mut tblob, zigzag(qy - py));

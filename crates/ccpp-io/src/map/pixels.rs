@@ -63,24 +63,6 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
             message: "not a PNG or PNM/PGM image (unrecognised content)".to_owned(),
         });
     };
-    // A PNM sample above its maxval: Netpbm forbids it, and the decoder rescaled it beyond
-    // white, so a malformed file read as free floor.
-    let reader = if format == image::ImageFormat::Pnm {
-        let mut inner = reader.into_inner();
-        let start = inner.stream_position().map_err(io_err)?;
-        if let Some((sample, maxval)) = pnm_sample_over_maxval(&mut inner).map_err(io_err)? {
-            return Err(MapError::Decode {
-                path: path.to_path_buf(),
-                message: format!(
-                    "sample {sample} exceeds the image's maxval {maxval} (a malformed PNM)"
-                ),
-            });
-        }
-        inner.seek(SeekFrom::Start(start)).map_err(io_err)?;
-        ImageReader::with_format(inner, format)
-    } else {
-        reader
-    };
     let image_err = |e: image::ImageError| match e {
         image::ImageError::IoError(io) if io.kind() == std::io::ErrorKind::UnexpectedEof => {
             MapError::Decode {
@@ -90,34 +72,45 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
         }
         other => decode_err(&other),
     };
-    let reader = match max_pixels {
-        None => reader,
-        Some(max) => {
-            // The header alone, by a second reader over the same stream, which then goes back
-            // to where the image starts.
-            let mut inner = reader.into_inner();
-            let start = inner.stream_position().map_err(io_err)?;
-            let (width, height) = ImageReader::with_format(&mut inner, format)
-                .into_dimensions()
-                .map_err(image_err)?;
-            if u64::from(width) * u64::from(height) > max {
-                return Err(MapError::TooLarge {
-                    path: path.to_path_buf(),
-                    width,
-                    height,
-                    max_pixels: max,
-                });
-            }
-            inner.seek(SeekFrom::Start(start)).map_err(io_err)?;
-            let mut r = ImageReader::with_format(inner, format);
-            // The decoder's own allocation cap (512 MiB by default) must not refuse an image
-            // the caller's budget admits (`--max-memory 60000` still failed on a 24000 x 24000
-            // PNG with "Memory limit exceeded"): it is raised to the decoded buffer of
-            // `max` pixels at the widest sample (16-bit RGBA, 8 bytes), plus working room.
-            r.limits(decoder_limits(max));
-            r
+    // The checks below read ahead over the same stream, which then goes back to where the
+    // image starts; the cheap one (the header) first.
+    let mut inner = reader.into_inner();
+    let start = inner.stream_position().map_err(io_err)?;
+    if let Some(max) = max_pixels {
+        let (width, height) = ImageReader::with_format(&mut inner, format)
+            .into_dimensions()
+            .map_err(image_err)?;
+        if u64::from(width) * u64::from(height) > max {
+            return Err(MapError::TooLarge {
+                path: path.to_path_buf(),
+                width,
+                height,
+                max_pixels: max,
+            });
         }
-    };
+        inner.seek(SeekFrom::Start(start)).map_err(io_err)?;
+    }
+    // A PNM sample above its maxval: Netpbm forbids it, and the decoder rescaled it beyond
+    // white, so a malformed file read as free floor.
+    if format == image::ImageFormat::Pnm {
+        if let Some((sample, maxval)) = pnm_sample_over_maxval(&mut inner).map_err(io_err)? {
+            return Err(MapError::Decode {
+                path: path.to_path_buf(),
+                message: format!(
+                    "sample {sample} exceeds the image's maxval {maxval} (a malformed PNM)"
+                ),
+            });
+        }
+        inner.seek(SeekFrom::Start(start)).map_err(io_err)?;
+    }
+    let mut reader = ImageReader::with_format(inner, format);
+    if let Some(max) = max_pixels {
+        // The decoder's own allocation cap (512 MiB by default) must not refuse an image the
+        // caller's budget admits (`--max-memory 60000` still failed on a 24000 x 24000 PNG
+        // with "Memory limit exceeded"): it is raised to the decoded buffer of `max` pixels at
+        // the widest sample (16-bit RGBA, 8 bytes), plus working room.
+        reader.limits(decoder_limits(max));
+    }
     let img = reader.decode().map_err(image_err)?;
     let width = img.width() as usize;
     let height = img.height() as usize;
