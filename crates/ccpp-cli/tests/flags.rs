@@ -680,6 +680,30 @@ fn max_memory_refuses_and_allows() {
         &["memory limit of 4096 MB", "tiles of 0.001 m"],
     );
     run_ok(dir, "small", &big, "ba-star", &["--max-memory", "64"]);
+    // Below the process's own 16 MB no smaller map or larger robot helps: the advice says so
+    // (it used to advise cropping a 14 400-pixel map under a 10 MB limit).
+    run_fails(
+        dir,
+        &map,
+        "ba-star",
+        &["--max-memory", "10"],
+        &[
+            "memory limit of 10 MB",
+            "raise it with --max-memory MB / max_memory_mb: the process alone needs about 16 MB",
+        ],
+    );
+    let o = ccpp()
+        .args(["run", "--planner", "ba-star", "--max-memory", "10", "--map"])
+        .arg(&map)
+        .arg("--out")
+        .arg(dir.join("refused"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !err.contains("smaller map") && !err.contains(" or use "),
+        "{err}"
+    );
     fails(
         &["waypoints", "--max-memory", "1", "--map"],
         &[&big],

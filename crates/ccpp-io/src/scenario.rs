@@ -34,7 +34,7 @@ use ccpp_core::exec::{Execution, PidOptions};
 use ccpp_core::grid::{GridError, GridMap};
 use ccpp_core::metrics::{self, Metrics};
 use ccpp_core::planners::settings::{
-    add_sim_pid_records, estimate_run, estimate_zones, validate_execution, ZoneLoad,
+    add_sim_pid_records, estimate_run, estimate_zones, validate_execution, ZoneLoad, PROCESS_BYTES,
 };
 use ccpp_core::planners::{OptionsError, PlannerConfig, PlannerKind, ResourceEstimate, Setup};
 use ccpp_core::sim::{simulate, simulate_tapped, RunOutput, SimConfig};
@@ -950,7 +950,13 @@ impl Scenario {
             let mb = est.bytes / (1024.0 * 1024.0);
             let needed = about_mb(est.bytes);
             // Beyond a petabyte no limit is the answer: only the cause can be changed.
-            let advice = if mb <= MAX_SENSIBLE_MB {
+            let advice = if limit < PROCESS_BYTES {
+                // Below the process's own share no smaller map or larger robot helps.
+                format!(
+                    "raise it with --max-memory MB / max_memory_mb: the process alone needs {}",
+                    about_mb(PROCESS_BYTES)
+                )
+            } else if mb <= MAX_SENSIBLE_MB {
                 format!(
                     "raise it with --max-memory MB / max_memory_mb, or use {}",
                     est.remedy
