@@ -8,6 +8,7 @@
 
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use ccpp_core::exec::{Execution, PidOptions};
 use ccpp_core::grid::{Cell, MapFrame};
@@ -108,7 +109,22 @@ fn json_to_py(py: Python<'_>, v: &Value) -> PyResult<Py<PyAny>> {
     })
 }
 
+/// Deepest nesting of lists and dicts an option value may have: a zone file's polygons nest
+/// four deep, and a value that refers to itself (`l = []; l.append(l)`) nests forever (the
+/// recursion used to overflow the native stack and kill the interpreter).
+const MAX_OPTION_DEPTH: usize = 64;
+
 fn py_to_json(o: &Bound<'_, PyAny>) -> PyResult<Value> {
+    py_to_json_at(o, 0)
+}
+
+/// [`py_to_json`] of a value nested `depth` deep.
+fn py_to_json_at(o: &Bound<'_, PyAny>, depth: usize) -> PyResult<Value> {
+    if depth > MAX_OPTION_DEPTH {
+        return Err(msg(format!(
+            "option value is nested more than {MAX_OPTION_DEPTH} deep (does it hold itself?)"
+        )));
+    }
     if o.is_none() {
         return Ok(Value::Null);
     }
@@ -137,14 +153,17 @@ fn py_to_json(o: &Bound<'_, PyAny>) -> PyResult<Value> {
     if let Ok(d) = o.cast::<PyDict>() {
         let mut m = serde_json::Map::new();
         for (k, v) in d.iter() {
-            m.insert(k.extract::<String>()?, py_to_json(&v)?);
+            let key = k
+                .extract::<String>()
+                .map_err(|_| msg(format!("option names must be strings, got {}", repr(&k))))?;
+            m.insert(key, py_to_json_at(&v, depth + 1)?);
         }
         return Ok(Value::Object(m));
     }
     if o.is_instance_of::<PyList>() || o.is_instance_of::<PyTuple>() {
         let mut a = Vec::new();
         for x in o.try_iter()? {
-            a.push(py_to_json(&x?)?);
+            a.push(py_to_json_at(&x?, depth + 1)?);
         }
         return Ok(Value::Array(a));
     }
@@ -160,7 +179,7 @@ fn py_to_json(o: &Bound<'_, PyAny>) -> PyResult<Value> {
     if o.hasattr("tolist")? {
         let plain = o.call_method0("tolist")?;
         if !plain.hasattr("tolist")? {
-            return py_to_json(&plain);
+            return py_to_json_at(&plain, depth + 1);
         }
     }
     // Other numbers.
@@ -291,7 +310,7 @@ impl Map {
 
 /// The recipe of a map file as the command line builds it: absolute paths, the file stem as
 /// the name. Symbolic links are kept: a map YAML's image is looked up beside the path given.
-fn recipe_for(path: &Path) -> MapRecipe {
+fn recipe_of(path: &Path) -> MapRecipe {
     let abs = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
     MapRecipe {
         path: Some(abs(path)),
@@ -303,9 +322,35 @@ fn recipe_for(path: &Path) -> MapRecipe {
     }
 }
 
-/// Loads a map: a ROS `map_server` YAML (with its PGM/PNG) or a bare image.
+/// [`recipe_of`] a path given by the user, refused when it is not valid UTF-8.
+fn recipe_for(path: &Path) -> PyResult<MapRecipe> {
+    utf8_path(path, "map")?;
+    Ok(recipe_of(path))
+}
+
+/// Refuses a path that is not valid UTF-8, as the command line does: ccpp records paths as
+/// text (`run.json`, the exports), and such a path used to load and run, then fail at `save`
+/// with a message naming no file.
+fn utf8_path(path: &Path, what: &str) -> PyResult<()> {
+    utf8_problem(path, what).map_or(Ok(()), |m| Err(msg(m)))
+}
+
+/// The message of [`utf8_path`], if `path` is not valid UTF-8.
+fn utf8_problem(path: &Path, what: &str) -> Option<String> {
+    path.to_str().is_none().then(|| {
+        format!(
+            "{what} {}: not valid UTF-8 (ccpp records paths as text, in run.json and the exports); rename it",
+            path.display()
+        )
+    })
+}
+
+/// Loads a map: a ROS `map_server` YAML (with its PGM/PNG) or a bare image. An image whose
+/// pixels alone would need more than `max_memory_mb` (default 4096) in a run is refused from
+/// its header, before it is decoded.
 #[pyfunction]
-#[pyo3(signature = (path, *, resolution=None, origin=None, occupied_thresh=None, free_thresh=None, inflate=None, georef=None, name=None))]
+#[pyo3(signature = (path, *, resolution=None, origin=None, occupied_thresh=None, free_thresh=None, inflate=None, georef=None, name=None, max_memory_mb=None))]
+#[allow(clippy::too_many_arguments)] // keyword arguments of a Python function
 fn load_map(
     py: Python<'_>,
     path: PathBuf,
@@ -316,10 +361,11 @@ fn load_map(
     inflate: Option<Real>,
     georef: Option<PathBuf>,
     name: Option<String>,
+    max_memory_mb: Option<Whole>,
 ) -> PyResult<Map> {
     let (resolution, origin, inflate) = (real(resolution), reals(origin), real(inflate));
     let (occupied_thresh, free_thresh) = (real(occupied_thresh), real(free_thresh));
-    let mut recipe = recipe_for(&path);
+    let mut recipe = recipe_for(&path)?;
     recipe.resolution = resolution;
     recipe.origin = match origin.as_deref() {
         None => None,
@@ -335,11 +381,17 @@ fn load_map(
     recipe.occupied_thresh = occupied_thresh;
     recipe.free_thresh = free_thresh;
     recipe.inflate = inflate;
+    if let Some(g) = &georef {
+        utf8_path(g, "georef")?;
+    }
     recipe.georef = georef.map(|g| std::path::absolute(&g).unwrap_or(g));
     if name.is_some() {
         recipe.name = name;
     }
-    let map = py.detach(|| recipe.load()).map_err(|e| err(&e))?;
+    let limit = max_memory_mb.map_or(ccpp_io::scenario::DEFAULT_MAX_MEMORY_MB, |m| m.0);
+    let map = py
+        .detach(|| recipe.load_within(limit))
+        .map_err(|e| err(&e))?;
     Ok(Map { map })
 }
 
@@ -428,11 +480,22 @@ where
     type Error = PyErr;
 
     fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
-        if obj.is_instance_of::<PyBool>() {
+        if is_bool(&obj) {
             return Err(PyTypeError::new_err("must be a number, not bool"));
         }
         obj.extract().map(NotBool)
     }
+}
+
+/// Is `v` a truth value: Python's `bool` or numpy's (`np.True_` converts to 1.0 silently)?
+fn is_bool(v: &Bound<'_, PyAny>) -> bool {
+    if v.is_instance_of::<PyBool>() {
+        return true;
+    }
+    let t = v.get_type();
+    let module = t.module().map(|m| m.to_string()).unwrap_or_default();
+    let name = t.name().map(|n| n.to_string()).unwrap_or_default();
+    module == "numpy" && (name == "bool_" || name == "bool")
 }
 
 /// The values of optional number arguments.
@@ -459,7 +522,7 @@ fn float_arg(key: &str, v: &Bound<'_, PyAny>) -> PyResult<f64> {
 
 /// A keyword option that must be a whole number >= 0.
 fn uint_arg(key: &str, v: &Bound<'_, PyAny>) -> PyResult<u64> {
-    if v.is_instance_of::<PyBool>() {
+    if is_bool(v) {
         return Err(msg(format!(
             "{key} must be a whole number, got {}",
             repr(v)
@@ -584,7 +647,12 @@ fn scenario_from(
                     .map_err(|_| msg("options must be a dict of planner options"))?;
                 in_options = Some(d.clone());
             }
-            "name" => s.map.name = Some(v.extract()?),
+            "name" => {
+                s.map.name = Some(
+                    v.extract()
+                        .map_err(|_| msg(format!("name must be a string, got {}", repr(&v))))?,
+                );
+            }
             // Zones: a file name, [x0, y0, x1, y1] or a list of polygons (`Scenario::area`);
             // keepout: one zone or a list of zones (`Scenario::keepout`).
             "area" => s.area = Some(parse_area(&v)?),
@@ -597,7 +665,13 @@ fn scenario_from(
     let mut planner_opts = serde_json::Map::new();
     if let Some(o) = &in_options {
         for (k, v) in o.iter() {
-            planner_opts.insert(k.extract::<String>()?, py_to_json(&v)?);
+            let key = k.extract::<String>().map_err(|_| {
+                msg(format!(
+                    "options keys must be option names (strings), got {}",
+                    repr(&k)
+                ))
+            })?;
+            planner_opts.insert(key, py_to_json(&v)?);
         }
     }
     for (k, v) in &direct {
@@ -807,7 +881,14 @@ impl PlanResult {
     /// `export` formats, default `["csv", "nav-path"]`; all or nothing, as `run`'s `save`.
     #[pyo3(signature = (folder, export=None))]
     fn save(&self, folder: PathBuf, export: Option<Vec<String>>) -> PyResult<()> {
+        utf8_path(&folder, "folder")?;
         let names = export.unwrap_or_else(|| vec!["csv".into(), "nav-path".into()]);
+        if names.is_empty() {
+            // A plan's folder holds its exports only: none would write an empty folder.
+            return Err(msg(
+                "export names no format: give at least one of csv, json, nav-path, geojson (or leave it out for csv and nav-path)",
+            ));
+        }
         write_files(&folder, &self.files(&parse_formats(&names)?)?)
     }
 
@@ -827,7 +908,8 @@ impl PlanResult {
 /// simulation metrics. As `ccpp plan` refuses them, so does this: `exec` and the planner's own
 /// execution settings (a plan executes the steps ideally), `sensor_range` (offline planners),
 /// a start heading (`start=(x, y)` only), and `tool_radius` for `rect-boustrophedon` (its lanes
-/// follow `width_m`). The GIL is released while planning.
+/// follow `width_m`). The GIL is released while planning; Ctrl-C raises `KeyboardInterrupt`
+/// at once.
 #[pyfunction]
 #[pyo3(signature = (map, planner=None, radius=None, **options))]
 fn plan(
@@ -838,13 +920,17 @@ fn plan(
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<PlanResult> {
     let radius = real(radius);
-    let mut prepared = as_map(py, map)?;
+    let mut prepared = as_map(py, map, memory_option(options)?)?;
     let (planner, radius) = (planner.unwrap_or("bcd"), radius.unwrap_or(DEFAULT_RADIUS));
     let scenario = scenario_from(&prepared, planner, radius, options, Purpose::Plan)?;
     name_map(&mut prepared, &scenario);
-    let p = py
-        .detach(|| ccpp_io::plan::plan_route(&scenario, &prepared, DEFAULT_TOLERANCE_M))
-        .map_err(|e| err(&e))?;
+    let (scenario, prepared) = (Arc::new(scenario), Arc::new(prepared));
+    let (sc, pm) = (Arc::clone(&scenario), Arc::clone(&prepared));
+    let p = interruptible(py, move || {
+        ccpp_io::plan::plan_route(&sc, &pm, DEFAULT_TOLERANCE_M)
+    })?
+    .map_err(|e| err(&e))?;
+    let scenario = Arc::unwrap_or_clone(scenario);
     Ok(PlanResult {
         planner: scenario.planner.name(),
         map: prepared.name.clone(),
@@ -936,6 +1022,7 @@ impl RunResult {
     /// run or plan in `folder` are replaced whole, a folder holding other files is refused.
     #[pyo3(signature = (folder, export=None))]
     fn save(&self, py: Python<'_>, folder: PathBuf, export: Option<Vec<String>>) -> PyResult<()> {
+        utf8_path(&folder, "folder")?;
         let formats = parse_formats(export.as_deref().unwrap_or_default())?;
         let files = self.export_files(&formats)?;
         py.detach(|| {
@@ -996,7 +1083,9 @@ impl RunResult {
 /// `options` must have one value; `exec="pid"` runs the planner's own PID settings
 /// (`options={"exec": {"pid": {...}}}` of bsa-bfs, rect-boustrophedon) and `exec="ideal"`
 /// beside such settings is refused. A keyword given as `None` is its default, as if left out
-/// (a name that is no option is still refused). The GIL is released during the run.
+/// (a name that is no option is still refused). The GIL is released during the run, and
+/// Ctrl-C raises `KeyboardInterrupt` at once (the run ends on its own thread, its result
+/// dropped).
 #[pyfunction]
 #[pyo3(signature = (map, planner=None, radius=None, **options))]
 fn run(
@@ -1007,16 +1096,17 @@ fn run(
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<RunResult> {
     let radius = real(radius);
-    let mut prepared = as_map(py, map)?;
+    let mut prepared = as_map(py, map, memory_option(options)?)?;
     let (planner, radius) = (
         planner.unwrap_or("ba-star"),
         radius.unwrap_or(DEFAULT_RADIUS),
     );
     let scenario = scenario_from(&prepared, planner, radius, options, Purpose::Run)?;
     name_map(&mut prepared, &scenario);
-    let run = py
-        .detach(|| scenario.run_on(&prepared))
-        .map_err(|e| err(&e))?;
+    let (scenario, prepared) = (Arc::new(scenario), Arc::new(prepared));
+    let (sc, pm) = (Arc::clone(&scenario), Arc::clone(&prepared));
+    let run = interruptible(py, move || sc.run_on(&pm))?.map_err(|e| err(&e))?;
+    let scenario = Arc::unwrap_or_clone(scenario);
     Ok(RunResult {
         scenario,
         world: run.world,
@@ -1033,16 +1123,74 @@ fn name_map(map: &mut PreparedMap, scenario: &Scenario) {
     }
 }
 
-/// A `Map`, or a path loaded as one.
-fn as_map(py: Python<'_>, map: &Bound<'_, PyAny>) -> PyResult<PreparedMap> {
+/// Runs `job` on a thread of its own while this one waits with the GIL released, looking
+/// for signals every 50 ms: Ctrl-C (`KeyboardInterrupt`) ends the wait at once. A long run
+/// used to hold the caller until it finished. The simulator cannot be stopped midway, so an
+/// interrupted job finishes on its thread and its result is dropped (a script that ends on
+/// the interrupt ends it with the process).
+fn interruptible<T: Send + 'static>(
+    py: Python<'_>,
+    job: impl FnOnce() -> T + Send + 'static,
+) -> PyResult<T> {
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::Builder::new()
+        .name("ccpp-run".into())
+        // The stack of a main thread: planners recurse no deeper, but a spawned thread's
+        // default is only 2 MiB.
+        .stack_size(8 << 20)
+        .spawn(move || {
+            // After an interrupt nobody waits for the result: it is dropped.
+            tx.send(job()).ok();
+        })
+        .map_err(|e| msg(format!("cannot start a thread for the run: {e}")))?;
+    let mut rx = rx;
+    loop {
+        // (the receiver moves into the GIL-free closure and back: it is `Send`, not `Sync`)
+        let (got, back) = py.detach(move || {
+            let got = rx.recv_timeout(std::time::Duration::from_millis(50));
+            (got, rx)
+        });
+        rx = back;
+        match got {
+            Ok(v) => return Ok(v),
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => py.check_signals()?,
+            Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
+                return Err(msg(
+                    "the run stopped without a result (its thread panicked)",
+                ))
+            }
+        }
+    }
+}
+
+/// A `Map`, or a path loaded as one within the memory limit `max_memory_mb` (an image whose
+/// pixels alone exceed it is refused from its header, before it is decoded).
+fn as_map(py: Python<'_>, map: &Bound<'_, PyAny>, max_memory_mb: u64) -> PyResult<PreparedMap> {
     if let Ok(m) = map.cast::<Map>() {
         return Ok(m.get().map.clone());
     }
     let p: PathBuf = map.extract().map_err(|_| {
         msg("map must be a ccpp.Map (from ccpp.load_map) or the path of a map file")
     })?;
-    let recipe = recipe_for(&p);
-    py.detach(|| recipe.load()).map_err(|e| err(&e))
+    let recipe = recipe_for(&p)?;
+    py.detach(|| recipe.load_within(max_memory_mb))
+        .map_err(|e| err(&e))
+}
+
+/// The memory limit of `run` and `plan` keyword options (`max_memory_mb`, default
+/// [`DEFAULT_MAX_MEMORY_MB`](ccpp_io::scenario::DEFAULT_MAX_MEMORY_MB)), read before the map
+/// is loaded so that loading honours it too (it used to load within the default 4096 MB
+/// whatever the user asked: a raised limit was refused as 4096 MB, and a lower one came too
+/// late to keep a large image from being decoded).
+fn memory_option(options: Option<&Bound<'_, PyDict>>) -> PyResult<u64> {
+    let v = options
+        .map(|o| o.get_item("max_memory_mb"))
+        .transpose()?
+        .flatten();
+    match v {
+        Some(v) if !v.is_none() => uint_arg("max_memory_mb", &v),
+        _ => Ok(ccpp_io::scenario::DEFAULT_MAX_MEMORY_MB),
+    }
 }
 
 /// One run of `ccpp bench` (default options, start and simulator settings): the metrics, or
@@ -1071,8 +1219,13 @@ fn bench_run(
         radius,
         tool_radius: tool_radius.unwrap_or(radius),
     };
+    // A path that is not UTF-8 is the row's error, as any other map that cannot be run.
+    let bad_path = utf8_problem(&map_path, "map");
     let outcome: Result<Metrics, String> = py.detach(|| {
-        let mut recipe = recipe_for(&map_path);
+        if let Some(m) = bad_path {
+            return Err(m);
+        }
+        let mut recipe = recipe_of(&map_path);
         recipe.inflate = inflate;
         if name.is_some() {
             // The bench's distinct name of the map (two maps sharing a file stem).
@@ -1188,16 +1341,20 @@ pub struct Env {
 /// `(observation, reward, terminated, truncated, info)` of [`Env::step`].
 type StepResult = (Py<PyDict>, f64, bool, bool, Py<PyDict>);
 
-/// The square scan window's half side in pixels.
-fn window_half(range: f64, res: f64) -> usize {
-    (range / res).ceil() as usize + 1
+/// The square scan window's half side in pixels for a sensor of `range` metres on the map of
+/// `frame`: no more than the map's diagonal, which from anywhere on the map reaches all of it
+/// (a range capped at twice the diagonal made a window 16 times the area it can show: 537 MB
+/// a scan on a 4096 px map).
+fn window_half(range: f64, frame: &MapFrame) -> usize {
+    let reach = range.min(frame.width_m().hypot(frame.height_m()));
+    (reach / frame.resolution).ceil() as usize + 1
 }
 
 impl Env {
     fn episode(&self) -> PyResult<&Episode> {
         self.episode
             .as_ref()
-            .ok_or_else(|| msg("call reset() before step()"))
+            .ok_or_else(|| msg("the episode has not begun: call reset() first"))
     }
 
     fn observation(&self, py: Python<'_>) -> PyResult<Py<PyDict>> {
@@ -1210,7 +1367,7 @@ impl Env {
         d.set_item("pose", vec![p.x, p.y, p.theta].into_pyarray(py))?;
         // Local scan: a square window of image pixels around the robot's pixel; pixels out
         // of sensor range (or outside the image) read unknown (2).
-        let k = window_half(live.sim.sensor_range(), f.resolution);
+        let k = window_half(live.sim.sensor_range(), &f);
         let side = 2 * k + 1;
         let mut win = Array2::from_elem((side, side), Cell::Unknown as u8);
         let g = f.world_to_grid(live.sim.true_pose().position());
@@ -1321,7 +1478,7 @@ fn parse_action(a: &Bound<'_, PyAny>) -> PyResult<Step> {
     };
     let num = |i: usize| -> PyResult<f64> {
         let item = items.get(i).ok_or_else(bad)?;
-        if item.is_instance_of::<PyBool>() {
+        if is_bool(item) {
             // A bool is an int to Python: `("translate", True)` drove 1 m.
             return Err(bad());
         }
@@ -1352,7 +1509,7 @@ impl Env {
     /// walls the sensor shows, keep-out entries counted as `keepout_violations`, coverage
     /// measured on the allowed floor; a start outside the area drives there first.
     #[new]
-    #[pyo3(signature = (map, *, radius=None, tool_radius=None, sensor_range=None, start=None, exec=None, max_steps=None, area=None, keepout=None))]
+    #[pyo3(signature = (map, *, radius=None, tool_radius=None, sensor_range=None, start=None, exec=None, max_steps=None, area=None, keepout=None, max_memory_mb=None))]
     #[allow(clippy::too_many_arguments)] // keyword arguments of a Python constructor
     fn new(
         py: Python<'_>,
@@ -1362,14 +1519,27 @@ impl Env {
         sensor_range: Option<Real>,
         start: Option<Vec<Real>>,
         exec: Option<&str>,
-        max_steps: Option<Whole>,
+        max_steps: Option<&Bound<'_, PyAny>>,
         area: Option<&Bound<'_, PyAny>>,
         keepout: Option<&Bound<'_, PyAny>>,
+        max_memory_mb: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let (radius, tool_radius, sensor_range) =
             (real(radius), real(tool_radius), real(sensor_range));
-        let (start, max_steps) = (reals(start), max_steps.map(|m| m.0));
-        let map = as_map(py, map)?;
+        let start = reals(start);
+        let max_steps = max_steps
+            .filter(|v| !v.is_none())
+            .map(|v| uint_arg("max_steps", v))
+            .transpose()?;
+        let limit = max_memory_mb
+            .filter(|v| !v.is_none())
+            .map(|v| uint_arg("max_memory_mb", v))
+            .transpose()?;
+        let map = as_map(
+            py,
+            map,
+            limit.unwrap_or(ccpp_io::scenario::DEFAULT_MAX_MEMORY_MB),
+        )?;
         let radius = radius.unwrap_or(DEFAULT_RADIUS);
         let exec = match exec.unwrap_or("ideal").to_ascii_lowercase().as_str() {
             "ideal" => Execution::Ideal,
@@ -1406,8 +1576,12 @@ impl Env {
                 ..SimConfig::default()
             })
             .zones(area, keepout)
+            .memory_limit(limit)
             .build()
             .map_err(|e| err(&e))?;
+        // What a run of the same robot on the map would hold (the world, the sweep, the known
+        // map), against the limit: an episode holds as much.
+        s.check_map(&map).map_err(|e| err(&e))?;
         let zones = py.detach(|| s.zone_masks(&map)).map_err(|e| err(&e))?;
         // The zones and the start are checked now, not at the first reset.
         py.detach(|| s.world_with_zones(&map, zones.clone()))
@@ -1444,46 +1618,48 @@ impl Env {
         let map = &self.map;
         let zones = &self.zones;
         let sim_cfg = self.sim.clone();
-        let episode = py
-            .detach(|| -> Result<Episode, ScenarioError> {
-                let mut world = scenario.world_with_zones(map, zones.clone())?;
-                if let Some(seed) = seed {
-                    let mut rng = SplitMix64::new(seed);
-                    let n = world.reachable().count_ones(..);
-                    let k = (rng.next_u64() % n.max(1) as u64) as usize;
-                    if let Some(i) = world.reachable().ones().nth(k) {
-                        let f = *world.frame();
-                        let (c, r) = f.col_row(i);
-                        let p = f.pixel_center(c, r);
-                        let theta = rng.range(-PI, PI);
-                        let mut at = scenario.clone();
-                        at.start = Some([p.x, p.y, theta]);
-                        world = at.world_with_zones(map, zones.clone())?;
-                    }
+        // The GIL stays held (as in every method of an Env): calls from several threads then
+        // take turns. Released here, a `step` from another thread met this call's borrow of
+        // the Env and raised a bare `RuntimeError: Already borrowed`.
+        let episode = (|| -> Result<Episode, ScenarioError> {
+            let mut world = scenario.world_with_zones(map, zones.clone())?;
+            if let Some(seed) = seed {
+                let mut rng = SplitMix64::new(seed);
+                let n = world.reachable().count_ones(..);
+                let k = (rng.next_u64() % n.max(1) as u64) as usize;
+                if let Some(i) = world.reachable().ones().nth(k) {
+                    let f = *world.frame();
+                    let (c, r) = f.col_row(i);
+                    let p = f.pixel_center(c, r);
+                    let theta = rng.range(-PI, PI);
+                    let mut at = scenario.clone();
+                    at.start = Some([p.x, p.y, theta]);
+                    world = at.world_with_zones(map, zones.clone())?;
                 }
-                Ok(Episode::new(world, |w| {
-                    let f = *w.frame();
-                    // Where the robot is placed (before an approach to the area).
-                    let start = w.initial_pose().position();
-                    let mut sweeper = Sweeper::new(w);
-                    sweeper.add(start, start);
-                    let mut live = Live {
-                        sim: Simulator::new(w, &sim_cfg),
-                        sweeper,
-                        known: KnownMap::new(&f),
-                        known_codes: vec![Cell::Unknown as u8; f.len()],
-                        records_seen: Cursor::default(),
-                        last: start,
-                        covered: 0,
-                        steps: 0,
-                        collisions: 0,
-                    };
-                    integrate_scan(&mut live, &f);
-                    sweep_new(&mut live, w);
-                    live
-                }))
-            })
-            .map_err(|e| err(&e))?;
+            }
+            Ok(Episode::new(world, |w| {
+                let f = *w.frame();
+                // Where the robot is placed (before an approach to the area).
+                let start = w.initial_pose().position();
+                let mut sweeper = Sweeper::new(w);
+                sweeper.add(start, start);
+                let mut live = Live {
+                    sim: Simulator::new(w, &sim_cfg),
+                    sweeper,
+                    known: KnownMap::new(&f),
+                    known_codes: vec![Cell::Unknown as u8; f.len()],
+                    records_seen: Cursor::default(),
+                    last: start,
+                    covered: 0,
+                    steps: 0,
+                    collisions: 0,
+                };
+                integrate_scan(&mut live, &f);
+                sweep_new(&mut live, w);
+                live
+            }))
+        })()
+        .map_err(|e| err(&e))?;
         self.episode = Some(episode);
         self.ended = false;
         Ok((self.observation(py)?, self.info(py, false)?))
@@ -1504,7 +1680,7 @@ impl Env {
         let ep = self
             .episode
             .as_mut()
-            .ok_or_else(|| msg("call reset() before step()"))?;
+            .ok_or_else(|| msg("the episode has not begun: call reset() first"))?;
         let (gain, collided, done, steps) = ep.with_dependent_mut(|world, live| {
             let before = live.covered;
             live.sim.execute(step);
@@ -1561,7 +1737,7 @@ impl Env {
     /// Side of the square `scan` window of observations, pixels.
     #[getter]
     fn scan_side(&self) -> usize {
-        2 * window_half(self.sensor_range(), self.map.grid.frame().resolution) + 1
+        2 * window_half(self.sensor_range(), self.map.grid.frame()) + 1
     }
 
     /// Swept pixels of the episode so far, `bool` `(height, width)` in image layout.
@@ -1605,7 +1781,8 @@ impl Env {
             planner: "env",
             wall_time_s: 0.0,
         };
-        let m = py.detach(|| metrics::compute(world, &out, &self.map.name));
+        // With the GIL held, as in `reset`.
+        let m = metrics::compute(world, &out, &self.map.name);
         to_py(py, &m)
     }
 }

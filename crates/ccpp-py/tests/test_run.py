@@ -199,7 +199,6 @@ def test_bools_are_not_numbers(room: Path, tmp_path: Path) -> None:
         lambda: ccpp.run(room, "bsa", radius=True),
         lambda: ccpp.plan(room, "bcd", radius=True),
         lambda: ccpp.Env(room, radius=True),
-        lambda: ccpp.Env(room, max_steps=True),
         lambda: ccpp.Env(room, start=(True, 0.5)),
         lambda: ccpp.load_map(room, inflate=True),
         lambda: ccpp.load_map(room, origin=(0.0, False, 0.0)),
@@ -207,7 +206,10 @@ def test_bools_are_not_numbers(room: Path, tmp_path: Path) -> None:
     ):
         with pytest.raises(TypeError, match="not bool"):
             call()
-    # Keyword options read as numbers (tool_radius, sensor_range) refuse bools too.
+    # Keyword options read as numbers (tool_radius, sensor_range, Env's max_steps) refuse
+    # bools too, as CcppErrors naming them.
+    with pytest.raises(ccpp.CcppError, match="max_steps must be a whole number, got True"):
+        ccpp.Env(room, max_steps=True)
     with pytest.raises(ccpp.CcppError, match="tool_radius must be a number, got True"):
         ccpp.run(room, "bsa", tool_radius=True)
     with pytest.raises(ccpp.CcppError, match="sensor_range must be a number, got False"):

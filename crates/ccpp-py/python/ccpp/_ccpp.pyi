@@ -108,8 +108,11 @@ class Env:
         max_steps: int | None = None,
         area: Any = None,
         keepout: Any = None,
+        max_memory_mb: int | None = None,
     ) -> None:
-        """``max_steps`` (>= 1) truncates episodes; values are validated as a run's."""
+        """``max_steps`` (>= 1) truncates episodes; values are validated as a run's.
+        ``max_memory_mb`` (default 4096) bounds the map's load and what an episode holds, as a
+        run's. One Env may be used from several threads: calls take turns."""
     def reset(self, seed: int | None = None) -> tuple[dict[str, Any], dict[str, Any]]:
         """Starts an episode; returns (observation, info)."""
     def step(
@@ -147,8 +150,11 @@ def load_map(
     inflate: float | None = None,
     georef: _Path | None = None,
     name: str | None = None,
+    max_memory_mb: int | None = None,
 ) -> Map:
-    """Loads a ROS map_server YAML (with its image) or a bare PGM/PNG."""
+    """Loads a ROS map_server YAML (with its image) or a bare PGM/PNG; an image whose pixels
+    alone would need more than ``max_memory_mb`` (default 4096) in a run is refused from its
+    header, before it is decoded."""
 
 def run(
     map: Map | _Path, planner: str | None = "ba-star", radius: float | None = 0.15, **options: Any
@@ -158,7 +164,9 @@ def run(
     ``keepout``) or the planner's own options (directly or in ``options={...}``; a key given
     both ways must have one value). Options that do not apply are refused; ``exec="pid"`` runs
     the planner's own PID settings, ``exec="ideal"`` beside them is refused. A keyword given as
-    ``None`` is its default, as if left out."""
+    ``None`` is its default, as if left out. ``max_memory_mb`` bounds the map's load too.
+    Ctrl-C raises ``KeyboardInterrupt`` at once (the run ends on its own thread, its result
+    dropped)."""
 
 def plan(
     map: Map | _Path, planner: str | None = "bcd", radius: float | None = 0.15, **options: Any

@@ -13,6 +13,7 @@ installed and the map files at the same paths (a shared file system); so does ``
 
 from __future__ import annotations
 
+import math
 import numbers
 import os
 from pathlib import Path
@@ -56,6 +57,9 @@ def expand_maps(items: Iterable[str | os.PathLike[str]] | str | os.PathLike[str]
     that is neither is refused, as ``ccpp bench`` refuses it, before any run."""
     if isinstance(items, (str, os.PathLike)):
         items = [items]
+    items = list(items)
+    if not items:
+        raise _ccpp.CcppError("maps is empty: give map files or folders")
     out: list[Path] = []
     for item in items:
         p = Path(item)
@@ -192,7 +196,11 @@ def sweep(
     (``stalled``, ``max_steps``) as its ``status``. The cluster is ``client`` or ``scheduler`` (not both). Failed
     runs are rows with ``status == "error"`` and the message in ``error``. Returns a pandas
     DataFrame with the columns :data:`CSV_COLUMNS` (plus ``radius`` when several radii are
-    given).
+    given). ``max_memory_mb`` and ``inflate`` are checked before the cluster starts, too.
+
+    In a script, call it under ``if __name__ == "__main__":`` when it starts a local cluster
+    (no ``client`` and no ``scheduler``, or a ``LocalCluster``): Dask's worker processes import
+    the script again.
     """
     import pandas as pd
     from distributed import Client
@@ -204,6 +212,9 @@ def sweep(
     if isinstance(planners, str):
         # One planner, not its letters.
         planners = [planners]
+    if planners is not None:
+        # Any iterable (a generator has no len()).
+        planners = list(planners)
     if planners is not None and len(planners) == 0:
         raise _ccpp.CcppError("planners is empty (leave it out, or None, for every planner)")
     names = _once(planners) if planners is not None else known
@@ -212,7 +223,10 @@ def sweep(
             raise _ccpp.CcppError(f'unknown planner "{p}"; run `ccpp planners` for the list')
     if radii is None:
         radii = (0.15,)
-    elif isinstance(radii, (int, float)):
+    elif isinstance(radii, (str, bytes)):
+        # Iterated, "0.2" was its characters ("got '0'").
+        raise _ccpp.CcppError(f"radii must be numbers (metres), got {radii!r}")
+    elif isinstance(radii, numbers.Real):
         radii = (radii,)
     for r in radii:
         # `float()` took True as 1.0 m and "0.2" as 0.2: a radius is a number.
@@ -223,6 +237,21 @@ def sweep(
         raise _ccpp.CcppError("radii is empty")
     for r in radii:
         _ccpp.check_robot(r, tool_radius)
+    # Checked here, before the cluster starts: in the tasks a bad value raised a bare
+    # OverflowError or TypeError from a worker, after other tasks had written their folders.
+    if max_memory_mb is not None and (
+        isinstance(max_memory_mb, bool)
+        or not isinstance(max_memory_mb, numbers.Integral)
+        or max_memory_mb < 1
+    ):
+        raise _ccpp.CcppError(f"max_memory_mb must be a whole number of MB >= 1, got {max_memory_mb!r}")
+    if inflate is not None and (
+        isinstance(inflate, bool)
+        or not isinstance(inflate, numbers.Real)
+        or not math.isfinite(inflate)
+        or inflate < 0
+    ):
+        raise _ccpp.CcppError(f"inflate must be a finite number of metres >= 0, got {inflate!r}")
     maps_named = _map_names(expand_maps(maps))
     if out is not None:
         _check_out(out)

@@ -1,0 +1,223 @@
+"""Defects a hostile pass over the Python API found; each test fails on the code before its fix."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import ccpp
+
+
+def big_header(folder: Path, side: int, body: int = 1000) -> Path:
+    """A PGM whose header claims `side` x `side` pixels, followed by only `body` bytes."""
+    p = folder / "big.pgm"
+    p.write_bytes(f"P5\n{side} {side}\n255\n".encode() + bytes(body))
+    return p
+
+
+def test_self_referencing_or_deep_option_values_are_errors_not_crashes(room: Path) -> None:
+    # Each used to overflow the native stack: the interpreter died (SIGSEGV).
+    loop: list = []
+    loop.append(loop)
+    with pytest.raises(ccpp.CcppError, match="nested more than 64 deep"):
+        ccpp.run(room, "bsa", area=loop)
+    d: dict = {}
+    d["a"] = d
+    with pytest.raises(ccpp.CcppError, match="nested more than 64 deep"):
+        ccpp.run(room, "ba-star", options=d)
+    deep: list = []
+    for _ in range(200_000):
+        deep = [deep]
+    with pytest.raises(ccpp.CcppError, match="nested more than 64 deep"):
+        ccpp.run(room, "bsa", keepout=deep)
+    with pytest.raises(ccpp.CcppError, match="nested more than 64 deep"):
+        ccpp.Env(room, keepout=deep)
+    # Non-text option names are named as such (a bare TypeError before).
+    with pytest.raises(ccpp.CcppError, match="option names|options keys"):
+        ccpp.run(room, "ba-star", options={1: 2})
+    with pytest.raises(ccpp.CcppError, match="name must be a string"):
+        ccpp.run(room, "ba-star", name=3)
+
+
+def test_max_memory_mb_applies_to_loading_the_map(tmp_path: Path) -> None:
+    # 8200 x 8200 px need about 4105 MB in a run: beyond the default 4096 MB.
+    big = big_header(tmp_path, 8200)
+    with pytest.raises(ccpp.CcppError, match="memory limit of 4096 MB"):
+        ccpp.run(big, "bsa")
+    # A raised limit is the limit of the load too: the file is then found short (it used to
+    # be refused as "more than the memory limit of 4096 MB" whatever the user raised it to).
+    for call in (
+        lambda: ccpp.run(big, "bsa", max_memory_mb=5000),
+        lambda: ccpp.plan(big, "bcd", max_memory_mb=5000),
+        lambda: ccpp.load_map(big, max_memory_mb=5000),
+        lambda: ccpp.Env(big, max_memory_mb=5000),
+    ):
+        with pytest.raises(ccpp.CcppError) as e:
+            call()
+        assert "memory limit" not in str(e.value), e.value
+    # A lower limit refuses from the header, before decoding.
+    small = big_header(tmp_path, 2000)
+    for call in (
+        lambda: ccpp.run(small, "bsa", max_memory_mb=10),
+        lambda: ccpp.load_map(small, max_memory_mb=10),
+        lambda: ccpp.Env(small, max_memory_mb=10),
+    ):
+        with pytest.raises(ccpp.CcppError, match=r"its pixels alone .* memory limit of 10 MB"):
+            call()
+
+
+def test_env_checks_its_memory_and_its_whole_numbers(room: Path) -> None:
+    with pytest.raises(ccpp.CcppError, match="memory limit of 1 MB"):
+        ccpp.Env(room, radius=0.05, max_memory_mb=1)
+    # A CcppError naming the argument (an OverflowError / TypeError before).
+    with pytest.raises(ccpp.CcppError, match="max_steps"):
+        ccpp.Env(room, max_steps=-1)
+    with pytest.raises(ccpp.CcppError, match="max_steps"):
+        ccpp.Env(room, max_steps=1.0)
+    env = ccpp.Env(room)
+    with pytest.raises(ccpp.CcppError, match="call reset"):
+        env.metrics()
+
+
+def test_numpy_bools_are_not_numbers(room: Path) -> None:
+    # np.True_ became 1.0 m.
+    with pytest.raises(TypeError, match="radius.*not bool"):
+        ccpp.run(room, "bsa", radius=np.bool_(True))
+    with pytest.raises(ccpp.CcppError, match="start"):
+        ccpp.run(room, "bsa", start=(np.True_, np.True_))
+    with pytest.raises(TypeError, match="not bool"):
+        ccpp.load_map(room, resolution=np.bool_(True))
+    with pytest.raises(TypeError, match="not bool"):
+        ccpp.Env(room, sensor_range=np.bool_(True))
+    with pytest.raises(ccpp.CcppError, match="max_steps"):
+        ccpp.run(room, "bsa", max_steps=np.bool_(True))
+    # numpy numbers themselves still work.
+    r = ccpp.run(room, "bsa", radius=np.float64(0.15))
+    assert r.metrics["robot_radius_m"] == 0.15
+
+
+@pytest.mark.skipif(sys.platform == "darwin", reason="macOS file systems refuse such names")
+def test_paths_that_are_not_utf8_are_refused_up_front(room: Path, tmp_path: Path) -> None:
+    odd = Path(os.fsdecode(b"odd\xff"))
+    folder = tmp_path / odd
+    folder.mkdir()
+    for f in ("room.yaml", "room.pgm"):
+        (folder / f).write_bytes((room.parent / f).read_bytes())
+    # It used to run, then fail at save() with a message naming no file.
+    with pytest.raises(ccpp.CcppError, match="not valid UTF-8"):
+        ccpp.run(folder / "room.yaml", "bsa")
+    with pytest.raises(ccpp.CcppError, match="not valid UTF-8"):
+        ccpp.load_map(folder / "room.yaml")
+    r = ccpp.run(room, "bsa")
+    with pytest.raises(ccpp.CcppError, match="folder .*not valid UTF-8"):
+        r.save(tmp_path / odd / "out")
+    assert not (tmp_path / odd / "out").exists()
+
+
+def test_a_plan_saved_with_no_export_is_refused(room: Path, tmp_path: Path) -> None:
+    p = ccpp.plan(room, "bcd")
+    with pytest.raises(ccpp.CcppError, match="export names no format"):
+        p.save(tmp_path / "plan", export=[])
+    assert not (tmp_path / "plan").exists()
+
+
+def test_sweep_checks_its_keywords_before_any_task(room: Path) -> None:
+    # Each raised from inside the Dask tasks (a bare OverflowError / TypeError), after the
+    # cluster had started; now refused before it starts (no client is needed to see it).
+    for kw, needle in [
+        ({"max_memory_mb": -1}, "max_memory_mb"),
+        ({"max_memory_mb": 0}, "max_memory_mb"),
+        ({"max_memory_mb": True}, "max_memory_mb"),
+        ({"max_memory_mb": 1.5}, "max_memory_mb"),
+        ({"inflate": True}, "inflate"),
+        ({"inflate": -0.1}, "inflate"),
+        ({"inflate": float("nan")}, "inflate"),
+        ({"radii": "0.2"}, "radii must be numbers"),
+    ]:
+        with pytest.raises(ccpp.CcppError, match=needle):
+            ccpp.sweep(room, "bsa", **kw)
+    with pytest.raises(ccpp.CcppError, match="maps is empty"):
+        ccpp.sweep([], "bsa")
+    with pytest.raises(ccpp.CcppError, match="unknown planner"):
+        ccpp.sweep(room, (p for p in ["bsa", "nope"]))
+
+
+def test_the_scan_window_is_no_larger_than_the_map_needs(room: Path) -> None:
+    # The room is 3 x 2 m (60 x 40 px at 0.05 m): a window the map's diagonal wide on each
+    # side sees all of it from anywhere. A huge range made it twice that, 16 times the area.
+    env = ccpp.Env(room, sensor_range=1e300)
+    diag_px = (60**2 + 40**2) ** 0.5
+    assert env.scan_side <= 2 * (int(np.ceil(diag_px)) + 1) + 1
+    obs, _ = env.reset()
+    assert obs["scan"].shape == (env.scan_side, env.scan_side)
+    # Every map pixel is in the window wherever the robot is: nothing is unknown in it.
+    assert (obs["known"] != 2).all()
+
+
+def test_one_env_from_several_threads_takes_turns(room: Path) -> None:
+    # `reset` released the GIL while it held the Env: a `step` from another thread raised a
+    # bare `RuntimeError: Already borrowed`.
+    env = ccpp.Env(room)
+    env.reset()
+    problems: list[BaseException] = []
+
+    def stepper() -> None:
+        for _ in range(200):
+            try:
+                env.step(("rotate", 0.1))
+            except ccpp.CcppError:
+                pass  # an ended episode (the other thread's collision) is a legitimate refusal
+            except BaseException as e:  # noqa: BLE001 - the test collects what escapes
+                problems.append(e)
+
+    def resetter() -> None:
+        for k in range(40):
+            try:
+                env.reset(seed=k)
+            except BaseException as e:  # noqa: BLE001
+                problems.append(e)
+
+    threads = [threading.Thread(target=f) for f in (stepper, stepper, resetter)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert not problems, problems
+
+
+def test_ctrl_c_interrupts_a_long_run(tmp_path: Path, room: Path) -> None:
+    # The run released the GIL and never looked at signals: SIGINT waited until it finished.
+    script = tmp_path / "long.py"
+    script.write_text(
+        "import sys, ccpp\n"
+        "print('start', flush=True)\n"
+        "try:\n"
+        f"    ccpp.run({str(room)!r}, 'random-bounce', budget_m=2e6)\n"
+        "    print('finished', flush=True)\n"
+        "except KeyboardInterrupt:\n"
+        "    print('interrupted', flush=True)\n"
+        "    sys.exit(3)\n"
+    )
+    p = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE, text=True)
+    assert p.stdout is not None
+    assert p.stdout.readline().strip() == "start"
+    time.sleep(1.5)
+    sent = time.monotonic()
+    p.send_signal(signal.SIGINT)
+    try:
+        rc = p.wait(timeout=20)
+    except subprocess.TimeoutExpired:
+        p.kill()
+        pytest.fail("the run did not stop on SIGINT")
+    waited = time.monotonic() - sent
+    out = p.stdout.read()
+    assert rc == 3 and "interrupted" in out, (rc, out)
+    assert waited < 5, waited
