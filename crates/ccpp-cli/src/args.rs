@@ -109,7 +109,8 @@ pub struct OptionsArgs {
 #[derive(Args, Debug, Clone, Default)]
 pub struct LimitArgs {
     /// Refuse work whose estimated memory exceeds this many MB (default 4096; `bench` checks
-    /// each run).
+    /// each run, and its runs in progress and summary pictures share the limit: a run starts
+    /// when its estimate fits beside theirs).
     #[arg(long, value_name = "MB")]
     pub max_memory: Option<u64>,
 }

@@ -2,7 +2,7 @@
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
+use std::sync::{Condvar, Mutex};
 
 use anyhow::{bail, Context, Result};
 use ccpp_core::metrics::Metrics;
@@ -245,6 +245,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let done = Mutex::new(());
+    let budget = MemoryBudget::new(a.limits.max_memory_mb());
     let rows: Vec<Row> = tasks
         .par_iter()
         .map(|(mi, name, planner)| {
@@ -258,6 +259,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
                     planner,
                     robot,
                     &options,
+                    &budget,
                 )
             }))
             .unwrap_or_else(|payload| Err(panic_message(payload.as_ref())));
@@ -283,7 +285,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         summary.push(plots);
     }
     let summary = crate::staging::PendingSet::new(summary);
-    crate::plots::write_all(&a.out, &rows, &prepared, robot)?;
+    crate::plots::write_all(&a.out, &rows, &prepared, robot, &budget)?;
     write_file(&a.out.join("results.md"), results_md(&rows).as_bytes())?;
     write_file(&a.out.join("results.csv"), results_csv(&rows).as_bytes())?;
     drop(summary);
@@ -408,6 +410,64 @@ fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
     format!("the run panicked: {msg}")
 }
 
+/// The memory limit of a bench, shared by the runs it holds at once: a run starts when its
+/// estimate fits beside those of the runs in progress (or when none is in progress, so every
+/// run the limit admits alone gets its turn). Checked per run only, `--max-memory 341` with
+/// `--jobs 4` peaked at 861 MB.
+pub(crate) struct MemoryBudget {
+    limit: f64,
+    used: Mutex<f64>,
+    freed: Condvar,
+}
+
+/// A run's share of the [`MemoryBudget`], given back when dropped.
+pub(crate) struct Grant<'a> {
+    budget: &'a MemoryBudget,
+    bytes: f64,
+}
+
+impl MemoryBudget {
+    fn new(limit_mb: u64) -> Self {
+        Self {
+            limit: limit_mb as f64 * 1024.0 * 1024.0,
+            used: Mutex::new(0.0),
+            freed: Condvar::new(),
+        }
+    }
+
+    /// Waits until `bytes` fit beside the runs in progress (or none is in progress).
+    pub(crate) fn take(&self, bytes: f64) -> Grant<'_> {
+        let mut used = self
+            .used
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        while *used > 0.0 && *used + bytes > self.limit {
+            used = self
+                .freed
+                .wait(used)
+                .unwrap_or_else(std::sync::PoisonError::into_inner);
+        }
+        *used += bytes;
+        Grant {
+            budget: self,
+            bytes,
+        }
+    }
+}
+
+impl Drop for Grant<'_> {
+    fn drop(&mut self) {
+        let mut used = self
+            .budget
+            .used
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        *used = (*used - self.bytes).max(0.0);
+        self.budget.freed.notify_all();
+    }
+}
+
+#[allow(clippy::too_many_arguments)] // the run, its map and the bench's shared state
 fn run_one(
     a: &BenchArgs,
     map: &Result<PreparedMap, String>,
@@ -416,6 +476,7 @@ fn run_one(
     planner: &str,
     robot: ccpp_core::world::Robot,
     options: &PlannerOptions,
+    budget: &MemoryBudget,
 ) -> Result<Metrics, String> {
     let map = map.as_ref().map_err(Clone::clone)?;
     let sim = SimConfig::default();
@@ -448,6 +509,10 @@ fn run_one(
         out: dir.to_path_buf(),
         key,
     };
+    // The run's estimate against what the runs in progress hold (a run its own check refuses
+    // holds nothing: the child says why).
+    let bytes = spec.scenario.check_map(map).map_or(0.0, |e| e.bytes);
+    let _grant = budget.take(bytes);
     run_isolated(&spec)
 }
 
@@ -747,6 +812,38 @@ pub fn results_md(rows: &[Row]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Runs that do not fit beside each other under the limit take turns; one that fits alone
+    /// always gets its turn (no deadlock), and runs that fit together run together.
+    #[test]
+    fn runs_take_turns_under_the_memory_limit() {
+        use std::sync::atomic::{AtomicBool, Ordering};
+        let mb = 1024.0 * 1024.0;
+        let budget = MemoryBudget::new(100);
+        let first = budget.take(60.0 * mb);
+        let second_started = AtomicBool::new(false);
+        std::thread::scope(|scope| {
+            let h = scope.spawn(|| {
+                let _g = budget.take(60.0 * mb);
+                second_started.store(true, Ordering::SeqCst);
+            });
+            std::thread::sleep(std::time::Duration::from_millis(100));
+            assert!(
+                !second_started.load(Ordering::SeqCst),
+                "a run started beside one it does not fit beside"
+            );
+            drop(first);
+            h.join().unwrap();
+        });
+        assert!(second_started.load(Ordering::SeqCst));
+        // Two that fit together are held together; one larger than the limit runs alone.
+        let a = budget.take(40.0 * mb);
+        let b = budget.take(40.0 * mb);
+        drop((a, b));
+        let huge = budget.take(500.0 * mb);
+        drop(huge);
+        assert_eq!(*budget.used.lock().unwrap(), 0.0);
+    }
 
     /// A planner whose every run failed had "means" of nothing (`-0.0000`) in the summary, and
     /// its rows named run folders that were never written.

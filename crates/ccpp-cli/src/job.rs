@@ -475,7 +475,14 @@ fn sim_from(a: &RunArgs, config: &mut PlannerConfig) -> Result<SimConfig> {
         if exec == Some(false) {
             bail!("--odometry-noise needs PID execution, not --exec ideal");
         }
-        if pid.noise.is_some() {
+        // A file that gives the noise at all (`noise: null` too, as `planners --defaults`
+        // prints it) clashes, as every other flag beside its option in the file does.
+        if pid.noise.is_some()
+            || file_sets(
+                a.options.config.as_deref(),
+                &format!("{}.exec.pid.noise", kind.info().section),
+            )
+        {
             bail!(
                 "--odometry-noise replaces the odometry noise given for {kind} in {} ({}.exec.pid.noise); remove one of them",
                 options_file(a.options.config.as_deref()),

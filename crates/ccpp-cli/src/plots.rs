@@ -39,6 +39,7 @@ pub fn write_all(
     rows: &[Row],
     maps: &[(PathBuf, Result<PreparedMap, String>)],
     robot: Robot,
+    budget: &crate::bench::MemoryBudget,
 ) -> Result<()> {
     let dir = out.join("plots");
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
@@ -50,6 +51,20 @@ pub fn write_all(
     }
     maps.par_iter().try_for_each(|(_, m)| -> Result<()> {
         let Ok(m) = m else { return Ok(()) };
+        // A map's pictures hold its world and one run's trace at a time: under the bench's
+        // memory limit with the other maps' (drawn all at once, four PID traces of
+        // `office_1024` peaked at 840 MB under `--max-memory 341`). A parsed trace takes about
+        // twice its file's size.
+        let largest_trace = rows
+            .iter()
+            .filter(|r| r.map == m.name)
+            .filter_map(|r| std::fs::metadata(r.dir.join("trace.jsonl")).ok())
+            .map(|md| md.len())
+            .max()
+            .unwrap_or(0);
+        let pixels = (m.grid.frame().width * m.grid.frame().height) as f64;
+        let _grant = budget
+            .take(2.0 * largest_trace as f64 + pixels * ccpp_core::planners::settings::PIXEL_BYTES);
         let Ok(world) = World::new(m.grid.clone(), robot, None) else {
             return Ok(());
         };

@@ -30,6 +30,9 @@ pub fn run(a: &WaypointsArgs) -> Result<()> {
         length_m: a.length,
         width_m: a.width,
         area: a.area,
+        // Waypoints are planned, never driven: no PID trace to hold (its records were counted
+        // in the memory estimate: `cluttered_2000` at 0.05 m was refused for 1.4e8 of them).
+        exec: ccpp_core::exec::Execution::Ideal,
         ..RectOptions::default()
     };
     // The same validation, checks and memory estimate as `ccpp run --planner

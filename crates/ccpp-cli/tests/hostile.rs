@@ -159,7 +159,11 @@ fn odometry_noise_is_exactly_what_is_asked() {
     );
     // Noise in the options file and the flag: the flag would drop the file's noise.
     let cfg = dir.join("noise.yaml");
-    std::fs::write(&cfg, "bsa_bfs: { exec: { pid: { noise: { seed: 4 } } } }\n").unwrap();
+    std::fs::write(
+        &cfg,
+        "bsa_bfs: { exec: { pid: { noise: { linear_rel_std: 0.05, seed: 4 } } } }\n",
+    )
+    .unwrap();
     refused(
         &[
             "run",

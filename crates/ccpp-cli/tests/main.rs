@@ -6,6 +6,7 @@
 
 mod cli;
 mod common;
+mod dropped;
 mod exports;
 mod flags;
 mod hostile;

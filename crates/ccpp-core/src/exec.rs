@@ -149,8 +149,13 @@ impl Pid {
 /// Per control step, with `n1, n2, n3` independent standard normal samples:
 /// `v_true = v (1 + linear_rel_std n1)` and
 /// `omega_true = omega (1 + angular_rel_std n2) + heading_drift_std |v| n3`.
+///
+/// In an options file, the fields a `noise` section leaves out follow `--odometry-noise
+/// LIN[,ANG[,DRIFT]]`: linear 0, angular = linear, drift 0, seed 0. (They took
+/// [`OdometryNoise::default`]'s 0.05 and 0.2 rad/m before: `noise: {linear_rel_std: 0}`
+/// drifted 0.2 rad per metre, where the flag with the same numbers does not drift.)
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
+#[serde(from = "NoiseSection")]
 pub struct OdometryNoise {
     /// Seed of the noise sequence (same seed, same trace).
     pub seed: u64,
@@ -161,6 +166,31 @@ pub struct OdometryNoise {
     /// Heading drift while driving, rad/s per m/s (i.e. rad per metre), standard deviation per
     /// step; in `[0, 6]`.
     pub heading_drift_std: f64,
+}
+
+/// An options file's `noise` section as written ([`OdometryNoise`]'s rule for left-out
+/// fields).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct NoiseSection {
+    #[serde(default)]
+    seed: u64,
+    #[serde(default)]
+    linear_rel_std: f64,
+    angular_rel_std: Option<f64>,
+    #[serde(default)]
+    heading_drift_std: f64,
+}
+
+impl From<NoiseSection> for OdometryNoise {
+    fn from(n: NoiseSection) -> Self {
+        Self {
+            seed: n.seed,
+            linear_rel_std: n.linear_rel_std,
+            angular_rel_std: n.angular_rel_std.unwrap_or(n.linear_rel_std),
+            heading_drift_std: n.heading_drift_std,
+        }
+    }
 }
 
 impl Default for OdometryNoise {

@@ -36,7 +36,14 @@ pub enum GeorefProblem {
     /// The fit failed.
     #[error("{0}")]
     Fit(GeorefError),
+    /// More point pairs than [`MAX_GEOREF_PAIRS`].
+    #[error("more than {MAX_GEOREF_PAIRS} point pairs: a survey has a few dozen (2 million pairs held 146 MB in a run admitted under 20 MB)")]
+    TooMany,
 }
+
+/// Most `(pixel, world)` pairs a georef file may hold: a least-squares affine fit needs 3 and
+/// a survey gives tens; the bound keeps a file from holding memory no estimate counts.
+pub const MAX_GEOREF_PAIRS: usize = 4096;
 
 /// Errors reading a georef file: the [`GeorefProblem`] and the file.
 #[derive(Debug, thiserror::Error)]
@@ -73,6 +80,9 @@ pub fn parse_georef(text: &str) -> Result<Vec<(Point, Point)>, GeorefProblem> {
         let header = std::mem::replace(&mut first, false);
         match nums {
             Some(v) if v.len() == 4 => {
+                if pairs.len() == MAX_GEOREF_PAIRS {
+                    return Err(GeorefProblem::TooMany);
+                }
                 pairs.push((Point::new(v[0], v[1]), Point::new(v[2], v[3])));
             }
             None if header => {}

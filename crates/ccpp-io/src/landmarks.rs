@@ -48,7 +48,15 @@ pub enum LandmarkFileError {
         /// 0-based index.
         index: usize,
     },
+    /// More landmarks than [`MAX_LANDMARKS`].
+    #[error("more than {MAX_LANDMARKS} landmarks: every control step looks at each of them (2.8 million rows ran for hours); give the landmarks of the site")]
+    TooMany,
 }
+
+/// Most landmarks a file may hold: every PID control step checks each landmark in sensor range
+/// of the robot, so the run's time grows with their number (1 000 rows added 3 s to a run on
+/// a 51 m map, 10 000 rows 20 s); a site has tens to hundreds of tags.
+pub const MAX_LANDMARKS: usize = 4096;
 
 fn parse_csv_line(line: &str) -> Option<Landmark> {
     let f: Vec<&str> = fields(line).collect();
@@ -75,6 +83,10 @@ fn parse_csv_line(line: &str) -> Option<Landmark> {
 pub fn parse_landmarks(text: &str) -> Result<Vec<Landmark>, LandmarkFileError> {
     let trimmed = text.trim_start();
     let list: Vec<Landmark> = if trimmed.starts_with('[') {
+        // Counted before parsing: every landmark is an object.
+        if trimmed.bytes().filter(|&b| b == b'{').count() > MAX_LANDMARKS {
+            return Err(LandmarkFileError::TooMany);
+        }
         serde_json::from_str(trimmed).map_err(|e| LandmarkFileError::Json(e.to_string()))?
     } else {
         let mut out = Vec::new();
@@ -86,6 +98,7 @@ pub fn parse_landmarks(text: &str) -> Result<Vec<Landmark>, LandmarkFileError> {
             }
             let header = std::mem::replace(&mut first, false);
             match parse_csv_line(line) {
+                Some(_) if out.len() == MAX_LANDMARKS => return Err(LandmarkFileError::TooMany),
                 Some(l) => out.push(l),
                 None if header && !line.starts_with(|c: char| c.is_ascii_digit()) => {}
                 None => {

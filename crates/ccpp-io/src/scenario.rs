@@ -727,6 +727,17 @@ impl Scenario {
         {
             return Err(invalid(format!("landmark {i} has a non-finite pose")));
         }
+        if lm.landmarks.len() > crate::landmarks::MAX_LANDMARKS {
+            return Err(invalid(
+                crate::landmarks::LandmarkFileError::TooMany.to_string(),
+            ));
+        }
+        // A heading of 100 "rad" is a typo or degrees, as for a start pose or a map's yaw.
+        for (i, l) in lm.landmarks.iter().enumerate() {
+            if let Some(p) = crate::map::heading_problem(l.theta) {
+                return Err(invalid(format!("landmark {i} (id {}) heading: {p}", l.id)));
+            }
+        }
         if !lm.landmarks.is_empty() && !matches!(self.execution(), Execution::Pid(_)) {
             return Err(invalid(format!(
                 "landmarks correct the pose estimate of PID execution only, and {} runs with ideal execution (use --exec pid)",
@@ -938,6 +949,34 @@ impl Scenario {
             .settings()
             .check(&setup)
             .map_err(|e| self.degenerate(&map.source, e))?;
+        // A landmark farther off the map than the landmark range is never seen from it: it
+        // would be read, checked and then change nothing.
+        let (lo, hi) = f.world_bounds();
+        let reach = self.sim.landmarks.range_m;
+        if let Some((i, l)) = self
+            .sim
+            .landmarks
+            .landmarks
+            .iter()
+            .enumerate()
+            .find(|(_, l)| {
+                !(lo.x - reach..=hi.x + reach).contains(&l.x)
+                    || !(lo.y - reach..=hi.y + reach).contains(&l.y)
+            })
+        {
+            return Err(ScenarioError::Invalid(format!(
+                "landmark {i} (id {}) at ({}, {}) lies more than the landmark range ({} m) outside map {} ({}, {} to {}, {}): no robot on the map sees it",
+                l.id,
+                Compact(l.x),
+                Compact(l.y),
+                Compact(reach),
+                map.source.display(),
+                Compact(lo.x),
+                Compact(lo.y),
+                Compact(hi.x),
+                Compact(hi.y)
+            )));
+        }
         let mut est = estimate_run(&setup, self.planner.settings());
         add_sim_pid_records(&mut est, &setup, self.planner.settings(), &self.execution());
         let zones = estimate_zones(&setup, self.zone_load());

@@ -23,18 +23,23 @@ pub(crate) struct Classified {
 
 /// Bytes a decoded pixel takes at most (16-bit RGBA).
 const DECODED_BYTES_MAX: u64 = 8;
-/// Decoder allocations beside the decoded image (row buffers, the compressed stream's window).
-const DECODER_ROOM: u64 = 64 << 20;
+/// Decoder allocations beside the decoded image: row buffers, the compressed stream's window,
+/// the palette and whatever ancillary chunks it inflates. A PNG's colour profile (`iCCP`) is
+/// inflated whole: a 0.5 MB file whose profile inflates to 500 MiB peaked at 531 MB under
+/// `--max-memory 17` while the decoder's cap was at least its 512 MiB default. Real profiles
+/// are a few kilobytes to a few hundred.
+const DECODER_ROOM: u64 = 16 << 20;
 
-/// The decoder's limits for an image of at most `max_pixels` pixels: its allocation cap at
-/// least the decoded buffer of that many pixels at the widest sample plus working room, and
-/// never below the decoder's default.
-fn decoder_limits(max_pixels: u64) -> image::Limits {
+/// The decoder's limits for an image of `pixels` pixels: its allocation cap is the decoded
+/// buffer of that many pixels at the widest sample plus [`DECODER_ROOM`] (0 pixels: the
+/// header, the chunks before the image data and the room alone).
+fn decoder_limits(pixels: u64) -> image::Limits {
     let mut limits = image::Limits::default();
-    let need = max_pixels
-        .saturating_mul(DECODED_BYTES_MAX)
-        .saturating_add(DECODER_ROOM);
-    limits.max_alloc = Some(limits.max_alloc.unwrap_or(0).max(need));
+    limits.max_alloc = Some(
+        pixels
+            .saturating_mul(DECODED_BYTES_MAX)
+            .saturating_add(DECODER_ROOM),
+    );
     limits
 }
 
@@ -76,11 +81,14 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
     // image starts; the cheap one (the header) first.
     let mut inner = reader.into_inner();
     let start = inner.stream_position().map_err(io_err)?;
+    // The size from the header, read under the room's cap alone (a PNG's header read inflates
+    // the chunks before its image data).
+    let mut header = ImageReader::with_format(&mut inner, format);
+    header.limits(decoder_limits(0));
+    let (width, height) = header.into_dimensions().map_err(image_err)?;
+    let pixels = u64::from(width) * u64::from(height);
     if let Some(max) = max_pixels {
-        let (width, height) = ImageReader::with_format(&mut inner, format)
-            .into_dimensions()
-            .map_err(image_err)?;
-        if u64::from(width) * u64::from(height) > max {
+        if pixels > max {
             return Err(MapError::TooLarge {
                 path: path.to_path_buf(),
                 width,
@@ -88,8 +96,8 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
                 max_pixels: max,
             });
         }
-        inner.seek(SeekFrom::Start(start)).map_err(io_err)?;
     }
+    inner.seek(SeekFrom::Start(start)).map_err(io_err)?;
     // A PNM sample above its maxval: Netpbm forbids it, and the decoder rescaled it beyond
     // white, so a malformed file read as free floor.
     if format == image::ImageFormat::Pnm {
@@ -104,13 +112,10 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
         inner.seek(SeekFrom::Start(start)).map_err(io_err)?;
     }
     let mut reader = ImageReader::with_format(inner, format);
-    if let Some(max) = max_pixels {
-        // The decoder's own allocation cap (512 MiB by default) must not refuse an image the
-        // caller's budget admits (`--max-memory 60000` still failed on a 24000 x 24000 PNG
-        // with "Memory limit exceeded"): it is raised to the decoded buffer of `max` pixels at
-        // the widest sample (16-bit RGBA, 8 bytes), plus working room.
-        reader.limits(decoder_limits(max));
-    }
+    // The decoder's cap follows the image's own size: its default (512 MiB) refused a 24000 x
+    // 24000 PNG the caller's budget admits (`--max-memory 60000`: "Memory limit exceeded"),
+    // and let a small image's colour profile inflate to 512 MiB.
+    reader.limits(decoder_limits(pixels));
     let img = reader.decode().map_err(image_err)?;
     let width = img.width() as usize;
     let height = img.height() as usize;
@@ -413,12 +418,17 @@ mod tests {
     }
 
     /// The decoder's default cap (512 MiB) refused a 24000 x 24000 PNG under
-    /// `--max-memory 60000` ("Memory limit exceeded"): the cap follows the pixel budget.
+    /// `--max-memory 60000` ("Memory limit exceeded"), and let a 100 x 100 PNG's colour
+    /// profile inflate to 500 MiB: the cap follows the image's size.
     #[test]
-    fn the_decoder_cap_follows_the_pixel_budget() {
+    fn the_decoder_cap_follows_the_image() {
         let default = image::Limits::default().max_alloc.unwrap();
-        // A small budget keeps the decoder's default.
-        assert_eq!(decoder_limits(1000).max_alloc, Some(default));
+        // A small image gets the room alone, far below the decoder's default.
+        assert_eq!(
+            decoder_limits(100 * 100).max_alloc,
+            Some(10_000 * 8 + DECODER_ROOM)
+        );
+        assert!(decoder_limits(100 * 100).max_alloc.unwrap() < default / 16);
         // 24000 x 24000 grey pixels (576 MB decoded, over the default) fit.
         let px = 24_000u64 * 24_000;
         let cap = decoder_limits(px).max_alloc.unwrap();

@@ -1,0 +1,348 @@
+//! Values that were read, checked and then dropped, and inputs no memory estimate counted, found
+//! by two hostile passes (flags and options honoured; memory limits): each is now honoured or
+//! refused with one `error:` line.
+#![allow(clippy::unwrap_used)]
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use crate::common::{self, ccpp, pillars, run_ok};
+
+/// Runs `ccpp ARGS`, expects exit 1 with one `error:` line holding every needle.
+fn refused(args: &[&str], needles: &[&str]) {
+    let a = ccpp().args(args).assert().failure();
+    let o = a.get_output();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
+    assert!(err.starts_with("error: "), "{err}");
+    for n in needles {
+        assert!(err.contains(n), "{err:?} should contain {n:?}");
+    }
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// The metrics without the wall time, and the trace: what a run did.
+fn outcome(out: &Path) -> (serde_json::Value, String) {
+    let mut m = common::read_json(&out.join("metrics.json"));
+    m.as_object_mut().unwrap().remove("wall_time_s");
+    (m, std::fs::read_to_string(out.join("trace.jsonl")).unwrap())
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> String {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p.to_str().unwrap().to_string()
+}
+
+/// `rect_boustrophedon.clearance_radius_m` below the robot radius was raised to it in silence
+/// (0.1, 0.01 and 0.15 m gave the same run) while run.json recorded the value given.
+#[test]
+fn a_clearance_below_the_robot_radius_is_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let cfg = write(
+        dir,
+        "c.yaml",
+        "rect_boustrophedon: { clearance_radius_m: 0.1 }\n",
+    );
+    let out = dir.join("out");
+    for cmd in ["run", "plan"] {
+        refused(
+            &[
+                cmd,
+                "--map",
+                s(&map),
+                "--planner",
+                "rect-boustrophedon",
+                "--config",
+                &cfg,
+                "--out",
+                s(&out),
+            ],
+            &[
+                "clearance_radius_m",
+                "0.1 m is below the robot radius 0.15 m",
+            ],
+        );
+        assert!(!out.exists());
+    }
+    // At the radius and above it is taken (and above it changes the plan).
+    let at = write(
+        dir,
+        "at.yaml",
+        "rect_boustrophedon: { clearance_radius_m: 0.15 }\n",
+    );
+    let wide = write(
+        dir,
+        "wide.yaml",
+        "rect_boustrophedon: { clearance_radius_m: 0.4 }\n",
+    );
+    let a = run_ok(dir, "at", &map, "rect-boustrophedon", &["--config", &at]);
+    let b = run_ok(
+        dir,
+        "wide",
+        &map,
+        "rect-boustrophedon",
+        &["--config", &wide],
+    );
+    assert_ne!(outcome(&a), outcome(&b));
+}
+
+/// A `noise` section that left fields out took the library's defaults (angular 0.05, drift
+/// 0.2 rad/m), where `--odometry-noise` with the same numbers takes angular = linear and no
+/// drift: `noise: {linear_rel_std: 0, angular_rel_std: 0}` still drifted 0.2 rad per metre.
+#[test]
+fn a_partial_noise_section_reads_as_the_flag_does() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let part = write(
+        dir,
+        "part.yaml",
+        "bsa_bfs: { exec: { pid: { noise: { linear_rel_std: 0.02, seed: 4 } } } }\n",
+    );
+    let by_file = run_ok(dir, "file", &map, "bsa-bfs", &["--config", &part]);
+    let by_flag = run_ok(
+        dir,
+        "flag",
+        &map,
+        "bsa-bfs",
+        &["--odometry-noise", "0.02", "--seed", "4"],
+    );
+    assert_eq!(outcome(&by_file), outcome(&by_flag));
+    let rj = common::read_json(&by_file.join("run.json"));
+    let noise = &rj["options"]["exec"]["pid"]["noise"];
+    assert_eq!(noise["angular_rel_std"], 0.02, "{rj}");
+    assert_eq!(noise["heading_drift_std"], 0.0, "{rj}");
+    // No noise asked, none drawn: the same run as --odometry-noise 0.
+    let zero = write(
+        dir,
+        "zero.yaml",
+        "bsa_bfs: { exec: { pid: { noise: { linear_rel_std: 0 } } } }\n",
+    );
+    let a = run_ok(dir, "zero", &map, "bsa-bfs", &["--config", &zero]);
+    let b = run_ok(
+        dir,
+        "zero-flag",
+        &map,
+        "bsa-bfs",
+        &["--odometry-noise", "0"],
+    );
+    assert_eq!(outcome(&a), outcome(&b));
+    let m = common::read_json(&a.join("metrics.json"));
+    assert!(
+        m["tracking_error_mean_m"].as_f64().unwrap_or(0.0) < 1e-9,
+        "{m}"
+    );
+}
+
+/// `--odometry-noise` beside a file that gives `noise: null` (as `planners --defaults` prints
+/// it) ran with the flag's noise, where every other flag beside its option is refused.
+#[test]
+fn the_noise_flag_beside_a_null_noise_in_the_file_is_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let cfg = write(
+        dir,
+        "n.yaml",
+        "bsa_bfs: { exec: { pid: { noise: null } } }\n",
+    );
+    refused(
+        &[
+            "run",
+            "--map",
+            s(&map),
+            "--planner",
+            "bsa-bfs",
+            "--config",
+            &cfg,
+            "--odometry-noise",
+            "0.1",
+            "--out",
+            s(&dir.join("out")),
+        ],
+        &["--odometry-noise replaces the odometry noise", "n.yaml"],
+    );
+}
+
+/// With one turn angle (`min_turn_deg = max_turn_deg`) random-bounce draws nothing, so a seed
+/// was read, checked and changed nothing.
+#[test]
+fn a_seed_with_a_single_turn_angle_is_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let one = write(
+        dir,
+        "one.yaml",
+        "random_bounce: { min_turn_deg: 135, max_turn_deg: 135 }\n",
+    );
+    let out = dir.join("out");
+    refused(
+        &[
+            "run",
+            "--map",
+            s(&map),
+            "--planner",
+            "random-bounce",
+            "--config",
+            &one,
+            "--seed",
+            "7",
+            "--out",
+            s(&out),
+        ],
+        &["seed", "every turn is 135 degrees"],
+    );
+    let seeded = write(
+        dir,
+        "seeded.yaml",
+        "random_bounce: { min_turn_deg: 135, max_turn_deg: 135, seed: 5 }\n",
+    );
+    refused(
+        &[
+            "run",
+            "--map",
+            s(&map),
+            "--planner",
+            "random-bounce",
+            "--config",
+            &seeded,
+            "--out",
+            s(&out),
+        ],
+        &["random_bounce.seed", "changes nothing"],
+    );
+    // Without a seed the single angle runs.
+    run_ok(dir, "one", &map, "random-bounce", &["--config", &one]);
+}
+
+/// `extension.leave_fraction: 0` leaves no trip, so `min_yield` and `leave_group` judged
+/// nothing; the reverse (`min_yield: 0` beside the leave options) was already refused.
+#[test]
+fn leave_options_without_a_leave_budget_are_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    for (planner, section) in [
+        ("ba-star-extended", "ba_star_extended"),
+        ("bsa-extended", "bsa_extended"),
+    ] {
+        for (field, v) in [("min_yield", "0.9"), ("leave_group", "1")] {
+            let cfg = write(
+                dir,
+                "l.yaml",
+                &format!("{section}: {{ extension: {{ leave_fraction: 0.0, {field}: {v} }} }}\n"),
+            );
+            refused(
+                &[
+                    "run",
+                    "--map",
+                    s(&map),
+                    "--planner",
+                    planner,
+                    "--config",
+                    &cfg,
+                    "--out",
+                    s(&dir.join("out")),
+                ],
+                &[
+                    &format!("extension.{field}"),
+                    "changes nothing while extension.leave_fraction is 0",
+                ],
+            );
+        }
+        let cfg = write(
+            dir,
+            "l0.yaml",
+            &format!("{section}: {{ extension: {{ leave_fraction: 0.0 }} }}\n"),
+        );
+        run_ok(dir, planner, &map, planner, &["--config", &cfg]);
+    }
+}
+
+/// Landmarks: one far off the map was accepted and never seen; a heading of 100 "rad" was
+/// taken; 2.8 million rows ran for hours at 15 times the memory limit.
+#[test]
+fn landmarks_off_the_map_out_of_turn_or_too_many_are_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir); // 8 x 6 m from (0, 0); landmark range 3 m
+    let out = dir.join("out");
+    let run = |file: &str, needles: &[&str]| {
+        refused(
+            &[
+                "run",
+                "--map",
+                s(&map),
+                "--planner",
+                "bsa-bfs",
+                "--landmarks",
+                file,
+                "--out",
+                s(&out),
+            ],
+            needles,
+        );
+        assert!(!out.exists());
+    };
+    let far = write(dir, "far.csv", "id,x,y\n1,1,1\n2,500,500\n");
+    run(
+        &far,
+        &[
+            "landmark 1 (id 2) at (500, 500)",
+            "outside map",
+            "no robot on the map sees it",
+        ],
+    );
+    let turned = write(dir, "turned.csv", "1,1,1,100\n");
+    run(
+        &turned,
+        &["landmark 0 (id 1) heading", "radians, not degrees"],
+    );
+    let mut many = String::new();
+    for i in 0..=4096u32 {
+        let x = 1.0 + f64::from(i % 60) * 0.1;
+        writeln!(many, "{},{x},2", i % 7).unwrap();
+    }
+    let many = write(dir, "many.csv", &many);
+    run(&many, &["more than 4096 landmarks", "many.csv"]);
+    let json: Vec<String> = (0..=4096)
+        .map(|i| format!("{{\"id\": {}, \"x\": 1, \"y\": 2}}", i % 5))
+        .collect();
+    let many_json = write(dir, "many.json", &format!("[{}]", json.join(",")));
+    run(&many_json, &["more than 4096 landmarks"]);
+    // Just beside the map (within the landmark range) is seen from it, and taken.
+    let near = write(dir, "near.csv", "1,1,1\n2,9.5,3\n");
+    run_ok(dir, "near", &map, "bsa-bfs", &["--landmarks", &near]);
+}
+
+/// A georef file of 2 million pairs held 146 MB in a run admitted under 20 MB.
+#[test]
+fn a_georef_file_with_too_many_pairs_is_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let mut text = String::from("px,py,wx,wy\n");
+    for i in 0..=4096u32 {
+        let (px, py) = (f64::from(i % 150), f64::from(i / 150));
+        writeln!(text, "{px},{py},{},{}", px * 0.05, 6.0 - py * 0.05).unwrap();
+    }
+    let g = write(dir, "g.csv", &text);
+    let out = dir.join("out");
+    for cmd in ["run", "info"] {
+        let mut args = vec![cmd, "--map", s(&map), "--georef", &g];
+        if cmd == "run" {
+            args.extend(["--planner", "ba-star", "--out"]);
+            args.push(s(&out));
+        }
+        refused(&args, &["georef", "g.csv", "more than 4096 point pairs"]);
+    }
+}
