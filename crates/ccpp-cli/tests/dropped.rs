@@ -346,3 +346,46 @@ fn a_georef_file_with_too_many_pairs_is_refused() {
         refused(&args, &["georef", "g.csv", "more than 4096 point pairs"]);
     }
 }
+
+/// A `GeoJSON` keep-out of 625 polygons of 4001 points (58 MB) parsed to 550 MB and took 27 s
+/// to draw, in a run admitted under 140 MB: a zone file holds at most 65 536 points in all.
+#[test]
+fn a_geojson_zone_file_with_too_many_points_is_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let mut polys = Vec::new();
+    for k in 0..17u32 {
+        let (cx, cy) = (1.0 + f64::from(k % 6), 1.0 + f64::from(k / 6) * 1.5);
+        let mut ring: Vec<String> = (0..4000u32)
+            .map(|i| {
+                let a = std::f64::consts::TAU * f64::from(i) / 4000.0;
+                format!("[{},{}]", cx + 0.3 * a.cos(), cy + 0.3 * a.sin())
+            })
+            .collect();
+        ring.push(ring[0].clone());
+        polys.push(format!("[[{}]]", ring.join(",")));
+    }
+    let g = write(
+        dir,
+        "many.geojson",
+        &format!(
+            "{{\"type\":\"MultiPolygon\",\"coordinates\":[{}]}}",
+            polys.join(",")
+        ),
+    );
+    refused(
+        &[
+            "run",
+            "--map",
+            s(&map),
+            "--planner",
+            "ba-star",
+            "--keepout",
+            &g,
+            "--out",
+            s(&dir.join("out")),
+        ],
+        &["many.geojson", "points in all", "65536"],
+    );
+}
