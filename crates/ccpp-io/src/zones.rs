@@ -136,8 +136,7 @@ fn read_file(path: &Path, frame: &MapFrame) -> Result<ZoneData, ZoneFileError> {
         let opens = text.bytes().filter(|&b| b == b'[').count();
         if opens > 2 * MAX_ZONE_POINTS {
             return Err(bad(format!(
-                "GeoJSON: more than {MAX_ZONE_POINTS} points in all (about {} arrays); a site's zones have hundreds",
-                opens
+                "GeoJSON: more than {MAX_ZONE_POINTS} points in all (about {opens} arrays); a site's zones have hundreds"
             )));
         }
         let v: Value = serde_json::from_str(&text).map_err(|e| bad(format!("GeoJSON: {e}")))?;
