@@ -190,6 +190,11 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     }
     let (robot, _) = robot_from(&(&a.robot).into())?;
     let options = planner_options(a.options.config.as_deref(), a.seed)?;
+    let kinds: Vec<planners::PlannerKind> = planners
+        .iter()
+        .filter_map(|p| parse_planner(p).ok())
+        .collect();
+    crate::job::warn_unused_config(a.options.config.as_deref(), &kinds);
     let maps = name_maps(expand_maps(&a.maps)?);
     check_bench_target(&a.out)?;
     ccpp_io::write::create_folder(&a.out, &a.out)?;

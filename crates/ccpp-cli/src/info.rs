@@ -42,6 +42,8 @@ struct Info {
     /// Share of the free pixels in the largest component.
     largest_component_share: f64,
     robot_radius_m: f64,
+    /// The tool radius `accessible_m2` is measured with (`--tool-radius`, default the robot's).
+    tool_radius_m: f64,
     /// Whether the robot fits somewhere on the map (with the start given, there).
     robot_fits: bool,
     /// Why the robot does not fit, when it does not.
@@ -157,6 +159,7 @@ pub fn run(a: &InfoArgs) -> Result<()> {
             largest as f64 / free as f64
         },
         robot_radius_m: robot.radius,
+        tool_radius_m: robot.tool_radius,
         robot_fits: world.is_some(),
         robot_error: robot_error.clone(),
         cfree_px: world.as_ref().map(|w| w.cfree().count_ones(..)),
@@ -238,8 +241,9 @@ pub fn run(a: &InfoArgs) -> Result<()> {
                 w.reachable().count_ones(..)
             ));
             line(format!(
-                "accessible     {:.2} m2 (floor the tool can touch from the start{})",
+                "accessible     {:.2} m2 (floor a tool of radius {} m can touch from the start{})",
                 w.accessible_area_m2(),
+                num(robot.tool_radius),
                 if info.zones.is_some() {
                     ", inside the area, outside the keep-outs"
                 } else {

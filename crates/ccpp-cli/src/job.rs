@@ -201,11 +201,60 @@ pub fn read_options(path: &Path) -> Result<PlannerOptions> {
     let is_json = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("json"));
+    // A file with nothing in it — empty, comments only, `---`, `null` or `~` — gives no
+    // option, as an empty file always did (`null` was refused as "expected mapping start", an
+    // empty JSON file as "EOF while parsing").
+    let blank = text
+        .lines()
+        .map(|l| l.split('#').next().unwrap_or("").trim())
+        .all(|l| l.is_empty() || matches!(l, "---" | "..." | "null" | "~" | "Null" | "NULL"));
+    if blank {
+        return Ok(PlannerOptions::default());
+    }
     let opts: PlannerOptions = ccpp_io::file::parse_yaml_or_json(&text, is_json)
         .map_err(|e| anyhow::anyhow!("planner options {}: {e}", path.display()))?;
     opts.validate()
         .map_err(|e| anyhow::anyhow!("planner options {}: {e}", path.display()))?;
     Ok(opts)
+}
+
+/// Warns (on stderr) when the options file `config` has no section for any of the planners
+/// `kinds`: they run at their defaults, which a section for another planner (`ba_star:` for
+/// `ba-star-extended`, whose BA* options are `ba_star_extended.ba_star`) suggests the user did
+/// not mean. The file's sections for other planners are allowed (one file can serve a bench).
+pub fn warn_unused_config(config: Option<&Path>, kinds: &[PlannerKind]) {
+    let Some(f) = config else { return };
+    if kinds.iter().any(|k| file_sets(config, k.info().section)) {
+        return;
+    }
+    let sections = ccpp_io::file::read_text(f)
+        .ok()
+        .and_then(|text| {
+            let json = f
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("json"));
+            ccpp_io::file::parse_yaml_or_json::<serde_json::Value>(&text, json).ok()
+        })
+        .and_then(|v| v.as_object().map(|o| o.keys().cloned().collect::<Vec<_>>()))
+        .unwrap_or_default();
+    let names: Vec<&str> = kinds.iter().map(|k| k.name()).collect();
+    let wanted: Vec<&str> = kinds.iter().map(|k| k.info().section).collect();
+    eprintln!(
+        "warning: {} has no section for {} ({}{}): {} at the planner defaults",
+        f.display(),
+        names.join(", "),
+        wanted.join(", "),
+        if sections.is_empty() {
+            "; it has none".to_string()
+        } else {
+            format!("; it has {}", sections.join(", "))
+        },
+        if kinds.len() == 1 {
+            "it runs"
+        } else {
+            "they run"
+        }
+    );
 }
 
 /// Parses a planner name.
@@ -575,6 +624,7 @@ impl Job {
         let kind = parse_planner(&a.planner)?;
         let (robot, start) = robot_from(&a.robot)?;
         let mut planner = planner_options(a.options.config.as_deref(), None)?.config(kind);
+        warn_unused_config(a.options.config.as_deref(), &[kind]);
         let mut given = apply_planner_flags(a, &mut planner)?;
         let sim = sim_from(a, &mut planner)?;
         if a.sensor_range.is_some() {

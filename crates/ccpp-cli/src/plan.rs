@@ -37,6 +37,7 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     }
     let (robot, start) = robot_from(&a.robot)?;
     let mut planner = planner_options(a.options.config.as_deref(), None)?.config(kind);
+    crate::job::warn_unused_config(a.options.config.as_deref(), &[kind]);
     let given =
         crate::job::apply_rect_flags(a.length, a.width, &mut planner, a.options.config.as_deref())?;
     let flag = |e: ScenarioError| crate::job::name_flag(e, &given);

@@ -389,3 +389,108 @@ fn a_geojson_zone_file_with_too_many_points_is_refused() {
         &["many.geojson", "points in all", "65536"],
     );
 }
+
+/// An options file without a section for the planner run (`ba_star:` given to
+/// `ba-star-extended`, whose BA* options are `ba_star_extended.ba_star`) ran at the defaults
+/// without a word; it is still run (one file may serve a bench), with a warning naming the
+/// sections the file has.
+#[test]
+fn an_options_file_without_the_planners_section_is_named() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let cfg = write(dir, "bs.yaml", "ba_star: { tile_side_m: 0.4 }\n");
+    let out = dir.join("out");
+    let o = ccpp()
+        .args(["run", "--map", s(&map), "--planner", "ba-star-extended"])
+        .args(["--config", &cfg, "--out", s(&out)])
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("warning: ")
+            && err.contains(
+                "bs.yaml has no section for ba-star-extended (ba_star_extended; it has ba_star)"
+            ),
+        "{err}"
+    );
+    // The planner's own section: no warning.
+    let o = ccpp()
+        .args(["run", "--map", s(&map), "--planner", "ba-star"])
+        .args(["--config", &cfg, "--out", s(&dir.join("own"))])
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    assert!(!String::from_utf8_lossy(&o.stderr).contains("warning"));
+}
+
+/// `info --tool-radius` changed `accessible_m2`, but neither the JSON nor the text said which
+/// tool radius it was measured with.
+#[test]
+fn info_names_the_tool_radius_it_measures_with() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let info = |tool: &str| -> serde_json::Value {
+        let o = ccpp()
+            .args(["info", "--map", s(&map), "--json", "--tool-radius", tool])
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_slice(&o.stdout).unwrap()
+    };
+    let (a, b) = (info("0.05"), info("0.15"));
+    assert_eq!(a["tool_radius_m"], 0.05);
+    assert_eq!(b["tool_radius_m"], 0.15);
+    assert_ne!(a["accessible_m2"], b["accessible_m2"]);
+    let o = ccpp()
+        .args(["info", "--map", s(&map), "--tool-radius", "0.05"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("a tool of radius 0.05 m"), "{text}");
+}
+
+/// An options file holding no option (`null`, `---`, `~`, an empty JSON file) is read as the
+/// empty file always was: no option (it was refused as "expected mapping start" or "EOF while
+/// parsing").
+#[test]
+fn an_options_file_with_nothing_in_it_gives_no_option() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let plain = run_ok(dir, "plain", &map, "bsa", &[]);
+    for (name, text) in [
+        ("null.yaml", "null\n"),
+        ("dashes.yaml", "---\n"),
+        ("tilde.yaml", "# nothing here\n---\n~\n"),
+        ("empty.json", ""),
+    ] {
+        let cfg = write(dir, name, text);
+        let out = run_ok(
+            dir,
+            &format!("out-{name}"),
+            &map,
+            "bsa",
+            &["--config", &cfg],
+        );
+        assert_eq!(outcome(&out), outcome(&plain), "{name}");
+    }
+    // Something that is not options is still refused.
+    let bad = write(dir, "list.yaml", "- 1\n- 2\n");
+    refused(
+        &[
+            "run",
+            "--map",
+            s(&map),
+            "--planner",
+            "bsa",
+            "--config",
+            &bad,
+            "--out",
+            s(&dir.join("out")),
+        ],
+        &["planner options", "list.yaml"],
+    );
+}
