@@ -494,3 +494,22 @@ fn an_options_file_with_nothing_in_it_gives_no_option() {
         &["planner options", "list.yaml"],
     );
 }
+
+/// A PNG claiming 2147483647 px across failed in the decoder's header read ("cannot decode
+/// map image ...: Memory limit exceeded", no size, no hint); its IHDR is read first now, so it
+/// is named too large like any other.
+#[test]
+fn a_png_claiming_an_absurd_width_is_named_too_large() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let mut png = b"\x89PNG\r\n\x1a\n\x00\x00\x00\x0dIHDR".to_vec();
+    png.extend_from_slice(&2_147_483_647u32.to_be_bytes());
+    png.extend_from_slice(&1u32.to_be_bytes());
+    png.extend_from_slice(&[8, 0, 0, 0, 0, 0, 0, 0, 0]);
+    let p = dir.join("wide.png");
+    std::fs::write(&p, png).unwrap();
+    refused(
+        &["info", "--map", s(&p)],
+        &["wide.png is 2147483647 x 1 px", "its pixels alone"],
+    );
+}

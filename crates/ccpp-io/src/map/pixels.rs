@@ -43,6 +43,25 @@ fn decoder_limits(pixels: u64) -> image::Limits {
     limits
 }
 
+/// The width and height in a PNG's IHDR chunk (the signature, then the IHDR chunk first, as
+/// the format requires), read from the stream's position; `None` when the bytes there are not
+/// that. The stream is left wherever the read stopped.
+fn png_ihdr_size<R: std::io::Read>(r: &mut R) -> std::io::Result<Option<(u32, u32)>> {
+    let mut head = [0u8; 24];
+    let mut got = 0;
+    while got < head.len() {
+        match r.read(&mut head[got..])? {
+            0 => return Ok(None),
+            n => got += n,
+        }
+    }
+    if &head[..8] != b"\x89PNG\r\n\x1a\n" || &head[12..16] != b"IHDR" {
+        return Ok(None);
+    }
+    let word = |i: usize| u32::from_be_bytes([head[i], head[i + 1], head[i + 2], head[i + 3]]);
+    Ok(Some((word(16), word(20))))
+}
+
 /// Decodes an image (format guessed from its content) and classifies every pixel. The decoded
 /// image buffer is dropped before returning, so at most the image plus the cells are alive.
 /// With `max_pixels`, the image's size is read from its header first and a larger image is
@@ -82,10 +101,18 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
     let mut inner = reader.into_inner();
     let start = inner.stream_position().map_err(io_err)?;
     // The size from the header, read under the room's cap alone (a PNG's header read inflates
-    // the chunks before its image data).
-    let mut header = ImageReader::with_format(&mut inner, format);
-    header.limits(decoder_limits(0));
-    let (width, height) = header.into_dimensions().map_err(image_err)?;
+    // the chunks before its image data). A PNG's size is read from its IHDR first: the
+    // decoder's header read allocates a row, so a PNG claiming 2147483647 px across failed as
+    // "Memory limit exceeded" instead of being named too large.
+    let (width, height) = match png_ihdr_size(&mut inner).map_err(io_err)? {
+        Some(size) if format == image::ImageFormat::Png => size,
+        _ => {
+            inner.seek(SeekFrom::Start(start)).map_err(io_err)?;
+            let mut header = ImageReader::with_format(&mut inner, format);
+            header.limits(decoder_limits(0));
+            header.into_dimensions().map_err(image_err)?
+        }
+    };
     let pixels = u64::from(width) * u64::from(height);
     if let Some(max) = max_pixels {
         if pixels > max {
