@@ -233,6 +233,11 @@ pub fn emit(
     if let Some(w) = comp.warning() {
         eprintln!("{w}");
     }
+    if let Some(n) = ccpp_core::sim::motions_cut(&r.run.trace) {
+        eprintln!(
+            "warning: {n} PID motion(s) stopped at max_steps_per_motion before reaching their goal (the run went on from where the robot was): raise exec.pid.max_steps_per_motion or dt_s"
+        );
+    }
     if json_only {
         if let Some(why) = &r.metrics.stop_reason {
             eprintln!("warning: {}", stop_warning(why, "coverage"));

@@ -513,3 +513,40 @@ fn a_png_claiming_an_absurd_width_is_named_too_large() {
         &["wide.png is 2147483647 x 1 px", "its pixels alone"],
     );
 }
+
+/// A control period far too short for the per-motion cap (`dt_s: 1e-9`) made every PID motion
+/// stop at `max_steps_per_motion` short of its goal: a run of 0 m that ended "done" without a
+/// word. The simulator notes a cut motion in the trace, and `run` warns.
+#[test]
+fn pid_motions_cut_at_their_cap_are_told() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let cfg = write(
+        dir,
+        "dt.yaml",
+        "bsa_bfs: { exec: { pid: { dt_s: 1.0e-9 } } }\n",
+    );
+    let out = dir.join("cut");
+    let o = ccpp()
+        .args(["run", "--map", s(&map), "--planner", "bsa-bfs"])
+        .args(["--config", &cfg, "--out", s(&out)])
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("PID motion(s) stopped at max_steps_per_motion before reaching their goal"),
+        "{err}"
+    );
+    let trace = std::fs::read_to_string(out.join("trace.jsonl")).unwrap();
+    assert!(trace.contains("PID motion stopped at max_steps_per_motion before its goal (1 so far"));
+    // At the default period no motion is cut, and nothing is said.
+    let o = ccpp()
+        .args(["run", "--map", s(&map), "--planner", "bsa-bfs"])
+        .args(["--out", s(&dir.join("plain"))])
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    assert!(!String::from_utf8_lossy(&o.stderr).contains("max_steps_per_motion"));
+}

@@ -170,6 +170,8 @@ struct PidState {
     landmarks: LandmarkConfig,
     /// Control steps since the last landmark observation.
     since_fix: u64,
+    /// Motions stopped at `max_steps_per_motion` before their goal, so far.
+    cut: u64,
 }
 
 /// Drives a planner over a world.
@@ -269,6 +271,7 @@ impl<'w> Simulator<'w> {
                 anchor: Some(self.pose.position()),
                 landmarks: self.landmarks.clone(),
                 since_fix: 0,
+                cut: 0,
             });
         }
     }
@@ -432,10 +435,13 @@ impl<'w> Simulator<'w> {
         let mut contact = false;
         let mut moved = false;
         let mut since_record = 0u64;
+        // Control steps run; all of them (and no contact): the motion was cut at the cap.
+        let mut ran = 0u32;
         for _ in 0..st.opts.max_steps_per_motion {
             let Some((v, w)) = st.tracker.command(self.est, goal) else {
                 break;
             };
+            ran += 1;
             // The truth moves with the (possibly perturbed) speeds; the estimate integrates the
             // commanded (measured) ones.
             let (vt, wt) = match (st.opts.noise, st.noise_rng.as_mut()) {
@@ -495,6 +501,26 @@ impl<'w> Simulator<'w> {
         }
         if moved {
             self.trace.push_pose(self.t, self.pose);
+        }
+        if !contact
+            && ran == st.opts.max_steps_per_motion
+            && st.tracker.command(self.est, goal).is_some()
+        {
+            // The goal was not reached: the run goes on from where the robot is, which a
+            // control period far too short for the cap (`dt_s: 1e-9`) made a run of 0 m that
+            // ended "done" without a word. The first cut is noted, then every 1000th.
+            st.cut += 1;
+            if st.cut == 1 || st.cut % 1000 == 0 {
+                self.trace.push_event(
+                    self.t,
+                    Event::Note {
+                        text: format!(
+                            "{MOTION_CUT_NOTE} ({} so far; max_steps_per_motion {} at dt_s {} s)",
+                            st.cut, st.opts.max_steps_per_motion, dt
+                        ),
+                    },
+                );
+            }
         }
         self.bumped = contact;
         st.anchor = if contact {
@@ -614,6 +640,35 @@ impl Sensor for Simulator<'_> {
     fn bumped(&self) -> bool {
         self.bumped
     }
+}
+
+/// The start of the [`Event::Note`] the simulator writes when a PID motion is stopped at
+/// `max_steps_per_motion` before reaching its goal (the first time, then every 1000th, with
+/// the count so far); the run goes on from where the robot is.
+pub const MOTION_CUT_NOTE: &str = "PID motion stopped at max_steps_per_motion before its goal";
+
+/// PID motions of a run stopped at `max_steps_per_motion` before their goal, at least (as the
+/// [`MOTION_CUT_NOTE`] notes of `trace` count them: the first and every 1000th); `None` when
+/// no motion was cut.
+pub fn motions_cut(trace: &Trace) -> Option<u64> {
+    let mut last = None;
+    for e in trace.entries() {
+        if let crate::trace::Entry::Event {
+            event: Event::Note { text },
+            ..
+        } = e
+        {
+            if let Some(rest) = text.strip_prefix(MOTION_CUT_NOTE) {
+                let n = rest
+                    .trim_start_matches(" (")
+                    .split(' ')
+                    .next()
+                    .and_then(|n| n.parse::<u64>().ok());
+                last = n.or(last);
+            }
+        }
+    }
+    last
 }
 
 /// Convenience: simulate `planner` on `world` with `config`.
