@@ -431,17 +431,39 @@ const RUN_KEYS: [&str; 11] = [
 /// What a zone argument may be, for messages (serde's "data did not match any variant of
 /// untagged enum `ZoneSpec`" says nothing to a user).
 const ZONE_FORMS: &str =
-    "a file name, [x0, y0, x1, y1] or a list of polygons (each a list of [x, y] points)";
+    "a file name, [x0, y0, x1, y1], \"x0,y0,x1,y1\" or a list of polygons (each a list of [x, y] points)";
 
 /// A work area: a file name, `[x0, y0, x1, y1]` or a list of polygons (`Scenario::area`).
 fn parse_area(v: &Bound<'_, PyAny>) -> PyResult<ZoneSpec> {
+    if let Some(r) = rect_text(v) {
+        return Ok(r);
+    }
     serde_json::from_value(py_to_json(v)?)
         .map_err(|_| msg(format!("area must be {ZONE_FORMS}, got {}", repr(v))))
 }
 
+/// A zone given as the text `"X0,Y0,X1,Y1"` (four numbers): the rectangle, as the command
+/// line's `--area` / `--keepout` read it (it was taken for a file name: "No such file").
+fn rect_text(v: &Bound<'_, PyAny>) -> Option<ZoneSpec> {
+    let s: String = v.extract().ok()?;
+    let parts: Vec<f64> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .ok()?;
+    <[f64; 4]>::try_from(parts).ok().map(ZoneSpec::Rect)
+}
+
 /// Keep-out zones: one zone (as for an area) or a list of zones (`Scenario::keepout`).
 fn parse_keepout(v: &Bound<'_, PyAny>) -> PyResult<Vec<ZoneSpec>> {
+    if let Some(r) = rect_text(v) {
+        return Ok(vec![r]);
+    }
     let j = py_to_json(v)?;
+    // An empty list is no keep-out (as leaving it out), not an empty polygon list.
+    if j.as_array().is_some_and(Vec::is_empty) {
+        return Ok(Vec::new());
+    }
     match serde_json::from_value::<ZoneSpec>(j.clone()) {
         Ok(one) => Ok(vec![one]),
         Err(_) => serde_json::from_value(j).map_err(|_| {

@@ -221,3 +221,17 @@ def test_ctrl_c_interrupts_a_long_run(tmp_path: Path, room: Path) -> None:
     out = p.stdout.read()
     assert rc == 3 and "interrupted" in out, (rc, out)
     assert waited < 5, waited
+
+
+def test_zones_as_text_rectangles_and_no_keepouts(room: Path) -> None:
+    # "x0,y0,x1,y1" is a rectangle, as on the command line (it was taken for a file name).
+    by_text = ccpp.run(room, "bsa", area="0.5,0.5,2.5,1.5")
+    by_list = ccpp.run(room, "bsa", area=[0.5, 0.5, 2.5, 1.5])
+    assert by_text.metrics == {**by_list.metrics, "wall_time_s": by_text.metrics["wall_time_s"]}
+    kept = ccpp.run(room, "bsa", keepout="1,0.5,1.5,1.5")
+    assert kept.metrics["keepout_violations"] == 0
+    assert kept.metrics != ccpp.run(room, "bsa").metrics
+    # An empty list of keep-outs is none (it was refused as "holds no polygon").
+    none = ccpp.run(room, "bsa", keepout=[])
+    plain = ccpp.run(room, "bsa")
+    assert none.metrics == {**plain.metrics, "wall_time_s": none.metrics["wall_time_s"]}

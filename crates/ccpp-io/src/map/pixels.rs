@@ -27,8 +27,10 @@ const DECODED_BYTES_MAX: u64 = 8;
 /// the palette and whatever ancillary chunks it inflates. A PNG's colour profile (`iCCP`) is
 /// inflated whole: a 0.5 MB file whose profile inflates to 500 MiB peaked at 531 MB under
 /// `--max-memory 17` while the decoder's cap was at least its 512 MiB default. Real profiles
-/// are a few kilobytes to a few hundred.
-const DECODER_ROOM: u64 = 16 << 20;
+/// are a few kilobytes to a few hundred; one beyond the room is skipped by the decoder (the
+/// profile means nothing to an occupancy grid). Row buffers take a few rows of the widest
+/// image (24000 px of 16-bit RGBA: 192 KB a row).
+const DECODER_ROOM: u64 = 4 << 20;
 
 /// The decoder's limits for an image of `pixels` pixels: its allocation cap is the decoded
 /// buffer of that many pixels at the widest sample plus [`DECODER_ROOM`] (0 pixels: the

@@ -39,7 +39,7 @@ fn a_colour_profile_bomb_is_not_inflated() {
         ..LoadOptions::default()
     };
     // The profile (96 MiB inflated) is not inflated: the decoder's cap for 10 000 pixels is
-    // its room, 16 MiB, whether the chunk is then skipped or the file refused. Beyond 32 MiB
+    // its room, 4 MiB, whether the chunk is then skipped or the file refused. Beyond 32 MiB
     // more than now an allocation fails (and the test with it).
     ALLOCATOR
         .set_limit(ALLOCATOR.allocated() + (32 << 20))
