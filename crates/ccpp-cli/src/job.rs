@@ -325,6 +325,10 @@ fn set_seed(o: &mut RandomBounceOptions, seed: u64, file: Option<&Path>) -> Resu
         return Err(clash(file, "--seed", seed, "random_bounce.seed", file_seed));
     }
     o.seed = seed;
+    // With the seed in place (one turn angle makes it change nothing): refused before any
+    // run (in a bench it failed every random-bounce run after the others had run).
+    ccpp_core::planners::PlannerSettings::validate(o)
+        .map_err(|e| anyhow::anyhow!("--seed {seed}: random_bounce.{e}"))?;
     Ok(())
 }
 

@@ -120,26 +120,31 @@ fn a_partial_noise_section_reads_as_the_flag_does() {
     let noise = &rj["options"]["exec"]["pid"]["noise"];
     assert_eq!(noise["angular_rel_std"], 0.02, "{rj}");
     assert_eq!(noise["heading_drift_std"], 0.0, "{rj}");
-    // No noise asked, none drawn: the same run as --odometry-noise 0.
-    let zero = write(
-        dir,
-        "zero.yaml",
-        "bsa_bfs: { exec: { pid: { noise: { linear_rel_std: 0 } } } }\n",
-    );
-    let a = run_ok(dir, "zero", &map, "bsa-bfs", &["--config", &zero]);
-    let b = run_ok(
-        dir,
-        "zero-flag",
-        &map,
-        "bsa-bfs",
-        &["--odometry-noise", "0"],
-    );
-    assert_eq!(outcome(&a), outcome(&b));
-    let m = common::read_json(&a.join("metrics.json"));
-    assert!(
-        m["tracking_error_mean_m"].as_f64().unwrap_or(0.0) < 1e-9,
-        "{m}"
-    );
+    // A section that draws nothing (every std 0, as `noise: {}` now reads) runs exactly as
+    // no section: refused, as a seed with zero noise is.
+    for (name, text) in [
+        ("empty.yaml", "bsa_bfs: { exec: { pid: { noise: {} } } }\n"),
+        (
+            "zero.yaml",
+            "bsa_bfs: { exec: { pid: { noise: { linear_rel_std: 0 } } } }\n",
+        ),
+    ] {
+        let cfg = write(dir, name, text);
+        refused(
+            &[
+                "run",
+                "--map",
+                s(&map),
+                "--planner",
+                "bsa-bfs",
+                "--config",
+                &cfg,
+                "--out",
+                s(&dir.join("out")),
+            ],
+            &["bsa_bfs.exec.pid.noise", "draws no noise"],
+        );
+    }
 }
 
 /// `--odometry-noise` beside a file that gives `noise: null` (as `planners --defaults` prints
@@ -222,6 +227,26 @@ fn a_seed_with_a_single_turn_angle_is_refused() {
     );
     // Without a seed the single angle runs.
     run_ok(dir, "one", &map, "random-bounce", &["--config", &one]);
+    // A bench refuses it before any run (it failed every random-bounce row at the end).
+    let bench_out = dir.join("bench");
+    refused(
+        &[
+            "bench",
+            "--maps",
+            s(&map),
+            "--planners",
+            "random-bounce,bsa",
+            "--config",
+            &one,
+            "--seed",
+            "5",
+            "--out",
+            s(&bench_out),
+            "--quiet",
+        ],
+        &["--seed 5", "every turn is 135 degrees"],
+    );
+    assert!(!bench_out.exists());
 }
 
 /// `extension.leave_fraction: 0` leaves no trip, so `min_yield` and `leave_group` judged
@@ -319,6 +344,15 @@ fn landmarks_off_the_map_out_of_turn_or_too_many_are_refused() {
         .collect();
     let many_json = write(dir, "many.json", &format!("[{}]", json.join(",")));
     run(&many_json, &["more than 4096 landmarks"]);
+    // Off a corner: inside the box widened by the range (3 m), but 4.1 m from the map.
+    let corner = write(dir, "corner.csv", "1,1,1\n2,10.9,8.9\n");
+    run(
+        &corner,
+        &[
+            "landmark 1 (id 2) at (10.9, 8.9)",
+            "no robot on the map sees it",
+        ],
+    );
     // Just beside the map (within the landmark range) is seen from it, and taken.
     let near = write(dir, "near.csv", "1,1,1\n2,9.5,3\n");
     run_ok(dir, "near", &map, "bsa-bfs", &["--landmarks", &near]);
@@ -541,6 +575,28 @@ fn pid_motions_cut_at_their_cap_are_told() {
     );
     let trace = std::fs::read_to_string(out.join("trace.jsonl")).unwrap();
     assert!(trace.contains("PID motion stopped at max_steps_per_motion before its goal (1 so far"));
+    // Many cut motions: the warning gives the count in all, not the last note's.
+    let few = write(
+        dir,
+        "few.yaml",
+        "bsa_bfs: { exec: { pid: { max_steps_per_motion: 30 } } }\n",
+    );
+    let o = ccpp()
+        .args(["run", "--map", s(&map), "--planner", "bsa-bfs"])
+        .args(["--config", &few, "--out", s(&dir.join("few"))])
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    let n: u64 = err
+        .split("warning: ")
+        .nth(1)
+        .and_then(|w| w.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{err}"));
+    assert!(n > 1, "{err}");
+    let trace = std::fs::read_to_string(dir.join("few").join("trace.jsonl")).unwrap();
+    assert!(trace.contains(&format!("({n} in all;")), "{n}");
     // At the default period no motion is cut, and nothing is said.
     let o = ccpp()
         .args(["run", "--map", s(&map), "--planner", "bsa-bfs"])

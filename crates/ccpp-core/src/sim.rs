@@ -603,6 +603,17 @@ impl<'w> Simulator<'w> {
                 }
             }
         }
+        // The count of cut motions in all (the notes on the way give the first and every
+        // 1000th: a warning read from the last of them under-reported up to 999).
+        if let Some(st) = &self.pid {
+            if st.cut > 1 && st.cut % 1000 != 0 {
+                let text = format!(
+                    "{MOTION_CUT_NOTE} ({} in all; max_steps_per_motion {} at dt_s {} s)",
+                    st.cut, st.opts.max_steps_per_motion, st.opts.dt_s
+                );
+                self.trace.push_event(self.t, Event::Note { text });
+            }
+        }
         self.trace.push_event(
             self.t,
             Event::Finished {
@@ -647,9 +658,9 @@ impl Sensor for Simulator<'_> {
 /// the count so far); the run goes on from where the robot is.
 pub const MOTION_CUT_NOTE: &str = "PID motion stopped at max_steps_per_motion before its goal";
 
-/// PID motions of a run stopped at `max_steps_per_motion` before their goal, at least (as the
-/// [`MOTION_CUT_NOTE`] notes of `trace` count them: the first and every 1000th); `None` when
-/// no motion was cut.
+/// PID motions of a run stopped at `max_steps_per_motion` before their goal, as the
+/// [`MOTION_CUT_NOTE`] notes of `trace` count them (the first, every 1000th and, at the run's
+/// end, the count in all); `None` when no motion was cut.
 pub fn motions_cut(trace: &Trace) -> Option<u64> {
     let mut last = None;
     for e in trace.entries() {

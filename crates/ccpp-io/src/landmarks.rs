@@ -83,8 +83,12 @@ fn parse_csv_line(line: &str) -> Option<Landmark> {
 pub fn parse_landmarks(text: &str) -> Result<Vec<Landmark>, LandmarkFileError> {
     let trimmed = text.trim_start();
     let list: Vec<Landmark> = if trimmed.starts_with('[') {
-        // Counted before parsing: every landmark is an object.
-        if trimmed.bytes().filter(|&b| b == b'{').count() > MAX_LANDMARKS {
+        // Counted before they are built: the array's items are skipped, whatever their form
+        // (objects, or arrays, which serde also takes for a landmark; braces of extra fields
+        // inside an object are not items). A zero-sized item allocates nothing.
+        let items: Vec<serde::de::IgnoredAny> =
+            serde_json::from_str(trimmed).map_err(|e| LandmarkFileError::Json(e.to_string()))?;
+        if items.len() > MAX_LANDMARKS {
             return Err(LandmarkFileError::TooMany);
         }
         serde_json::from_str(trimmed).map_err(|e| LandmarkFileError::Json(e.to_string()))?

@@ -88,8 +88,13 @@ pub enum ScenarioError {
     Map(#[from] MapError),
     /// The map image is too large for the memory limit (told by its header, before decoding).
     #[error(
-        "map image {} is {width} x {height} px: its pixels alone would need {needed} in a run ({per_pixel} bytes a pixel), more than the memory limit of {limit_mb} MB (raise it with --max-memory MB / max_memory_mb, or use a smaller map: crop the image or downsample it)",
-        path.display()
+        "map image {} is {width} x {height} px: its pixels alone would need {needed} in a run ({per_pixel} bytes a pixel), more than the memory limit of {limit_mb} MB (raise it with --max-memory MB / max_memory_mb{})",
+        path.display(),
+        if *limit_mb as f64 * 1024.0 * 1024.0 <= PROCESS_BYTES {
+            format!(": the process alone needs {}", about_mb(PROCESS_BYTES))
+        } else {
+            ", or use a smaller map: crop the image or downsample it".to_string()
+        }
     )]
     MapTooLarge {
         /// The image file.
@@ -960,8 +965,11 @@ impl Scenario {
             .iter()
             .enumerate()
             .find(|(_, l)| {
-                !(lo.x - reach..=hi.x + reach).contains(&l.x)
-                    || !(lo.y - reach..=hi.y + reach).contains(&l.y)
+                // Distance from the map's bounding box (a box widened by the range let a
+                // landmark off a corner, 4.1 m away with a 3 m range, through).
+                let dx = (lo.x - l.x).max(l.x - hi.x).max(0.0);
+                let dy = (lo.y - l.y).max(l.y - hi.y).max(0.0);
+                dx.hypot(dy) > reach
             })
         {
             return Err(ScenarioError::Invalid(format!(
@@ -989,7 +997,7 @@ impl Scenario {
             let mb = est.bytes / (1024.0 * 1024.0);
             let needed = about_mb(est.bytes);
             // Beyond a petabyte no limit is the answer: only the cause can be changed.
-            let advice = if limit < PROCESS_BYTES {
+            let advice = if limit <= PROCESS_BYTES {
                 // Below the process's own share no smaller map or larger robot helps.
                 format!(
                     "raise it with --max-memory MB / max_memory_mb: the process alone needs {}",

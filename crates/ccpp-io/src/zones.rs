@@ -130,10 +130,10 @@ fn read_file(path: &Path, frame: &MapFrame) -> Result<ZoneData, ZoneFileError> {
         .unwrap_or_default();
     let yaml_ext = ext == "yaml" || ext == "yml";
     if ext == "geojson" || ext == "json" || (!yaml_ext && text.trim_start().starts_with('{')) {
-        // Counted before parsing (every point opens a `[`): a file of 625 polygons of 4001
-        // points (58 MB) parsed to 550 MB and took 27 s to draw, in a run admitted under
-        // 140 MB.
-        let opens = text.bytes().filter(|&b| b == b'[').count();
+        // Counted before parsing (every point opens a `[`, or a `{` when written as
+        // `{"x": .., "y": ..}`): a file of 625 polygons of 4001 points (58 MB) parsed to 550 MB
+        // and took 27 s to draw, in a run admitted under 140 MB.
+        let opens = text.bytes().filter(|&b| b == b'[' || b == b'{').count();
         if opens > 2 * MAX_ZONE_POINTS {
             return Err(bad(format!(
                 "GeoJSON: more than {MAX_ZONE_POINTS} points in all (about {opens} arrays); a site's zones have hundreds"
@@ -209,11 +209,7 @@ fn mask_image_size(yaml: &Path) -> Option<(usize, usize)> {
     let y = MapYaml::parse(&text, yaml).ok()?;
     let image = yaml.parent().unwrap_or(Path::new("")).join(&y.image);
     let file = crate::file::open_regular(&image).ok()?;
-    let (w, h) = image::ImageReader::new(std::io::BufReader::new(file))
-        .with_guessed_format()
-        .ok()?
-        .into_dimensions()
-        .ok()?;
+    let (w, h) = crate::map::pixels::header_size(std::io::BufReader::new(file))?;
     Some((usize::try_from(w).ok()?, usize::try_from(h).ok()?))
 }
 

@@ -148,7 +148,14 @@ fn py_to_json_at(o: &Bound<'_, PyAny>, depth: usize) -> PyResult<Value> {
             .ok_or_else(|| msg(format!("option values must be finite numbers, got {f}")));
     }
     if o.is_instance_of::<PyString>() {
-        return Ok(Value::String(o.extract()?));
+        // A path from `os.fsdecode` of bytes that are not UTF-8 holds surrogates: named as
+        // such (a raw UnicodeEncodeError before), as a map path is.
+        return o.extract().map(Value::String).map_err(|_| {
+            msg(format!(
+                "{}: not valid UTF-8 (ccpp records paths as text, in run.json and the exports); rename it",
+                repr(o)
+            ))
+        });
     }
     if let Ok(d) = o.cast::<PyDict>() {
         let mut m = serde_json::Map::new();
@@ -459,6 +466,19 @@ fn parse_keepout(v: &Bound<'_, PyAny>) -> PyResult<Vec<ZoneSpec>> {
     if let Some(r) = rect_text(v) {
         return Ok(vec![r]);
     }
+    // A list whose every item is a zone given as text ("x0,y0,x1,y1" rectangles and file
+    // names, as repeated `--keepout` flags): each item as one zone (a list of text rectangles
+    // was read as file names).
+    if !v.is_instance_of::<PyString>() {
+        if let Ok(items) = v.extract::<Vec<Bound<'_, PyAny>>>() {
+            if !items.is_empty() && items.iter().all(PyAnyMethods::is_instance_of::<PyString>) {
+                return items
+                    .iter()
+                    .map(|i| rect_text(i).map_or_else(|| parse_area(i), Ok))
+                    .collect();
+            }
+        }
+    }
     let j = py_to_json(v)?;
     // An empty list is no keep-out (as leaving it out), not an empty polygon list.
     if j.as_array().is_some_and(Vec::is_empty) {
@@ -514,10 +534,12 @@ fn is_bool(v: &Bound<'_, PyAny>) -> bool {
     if v.is_instance_of::<PyBool>() {
         return true;
     }
-    let t = v.get_type();
-    let module = t.module().map(|m| m.to_string()).unwrap_or_default();
-    let name = t.name().map(|n| n.to_string()).unwrap_or_default();
-    module == "numpy" && (name == "bool_" || name == "bool")
+    // numpy's bool scalars and bool arrays (a 0-d `np.array(True)` converts to 1.0 too): their
+    // dtype's kind is "b".
+    v.getattr("dtype")
+        .and_then(|d| d.getattr("kind"))
+        .and_then(|k| k.extract::<String>())
+        .is_ok_and(|k| k == "b")
 }
 
 /// The values of optional number arguments.
@@ -1145,15 +1167,31 @@ fn name_map(map: &mut PreparedMap, scenario: &Scenario) {
     }
 }
 
+/// Interrupted runs still finishing on their threads ([`interruptible`]).
+static ORPHANS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
 /// Runs `job` on a thread of its own while this one waits with the GIL released, looking
 /// for signals every 50 ms: Ctrl-C (`KeyboardInterrupt`) ends the wait at once. A long run
 /// used to hold the caller until it finished. The simulator cannot be stopped midway, so an
 /// interrupted job finishes on its thread and its result is dropped (a script that ends on
-/// the interrupt ends it with the process).
+/// the interrupt ends it with the process). A new job first waits (interruptibly) until the
+/// interrupted ones have finished, so they never pile up: three interrupted runs slowed the
+/// next one threefold and held 921 MB beside it, over the 800 MB each was admitted under.
 fn interruptible<T: Send + 'static>(
     py: Python<'_>,
     job: impl FnOnce() -> T + Send + 'static,
 ) -> PyResult<T> {
+    use std::sync::atomic::{AtomicU8, Ordering};
+    const RUNNING: u8 = 0;
+    const FINISHED: u8 = 1;
+    const ABANDONED: u8 = 2;
+    let pause = std::time::Duration::from_millis(50);
+    while ORPHANS.load(Ordering::SeqCst) > 0 {
+        py.detach(|| std::thread::sleep(pause));
+        py.check_signals()?;
+    }
+    let state = Arc::new(AtomicU8::new(RUNNING));
+    let theirs = Arc::clone(&state);
     let (tx, rx) = std::sync::mpsc::channel();
     std::thread::Builder::new()
         .name("ccpp-run".into())
@@ -1161,21 +1199,49 @@ fn interruptible<T: Send + 'static>(
         // default is only 2 MiB.
         .stack_size(8 << 20)
         .spawn(move || {
-            // After an interrupt nobody waits for the result: it is dropped.
-            tx.send(job()).ok();
+            /// Marks the job finished when the thread ends, even by a panic (an orphan that
+            /// was never counted down would hold every later run).
+            struct Finish(Arc<AtomicU8>);
+            impl Drop for Finish {
+                fn drop(&mut self) {
+                    if self.0.swap(FINISHED, Ordering::SeqCst) == ABANDONED {
+                        ORPHANS.fetch_sub(1, Ordering::SeqCst);
+                    }
+                }
+            }
+            let finish = Finish(theirs);
+            let out = job();
+            if finish.0.load(Ordering::SeqCst) != ABANDONED {
+                // The caller may leave meanwhile: the result is then dropped with the channel.
+                tx.send(out).ok();
+            }
+            drop(finish);
         })
         .map_err(|e| msg(format!("cannot start a thread for the run: {e}")))?;
     let mut rx = rx;
     loop {
         // (the receiver moves into the GIL-free closure and back: it is `Send`, not `Sync`)
         let (got, back) = py.detach(move || {
-            let got = rx.recv_timeout(std::time::Duration::from_millis(50));
+            let got = rx.recv_timeout(pause);
             (got, rx)
         });
         rx = back;
         match got {
             Ok(v) => return Ok(v),
-            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => py.check_signals()?,
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {
+                if let Err(e) = py.check_signals() {
+                    // Counted before the job can see it abandoned (it then counts it down);
+                    // a job that finished meanwhile is no orphan.
+                    ORPHANS.fetch_add(1, Ordering::SeqCst);
+                    if state
+                        .compare_exchange(RUNNING, ABANDONED, Ordering::SeqCst, Ordering::SeqCst)
+                        .is_err()
+                    {
+                        ORPHANS.fetch_sub(1, Ordering::SeqCst);
+                    }
+                    return Err(e);
+                }
+            }
             Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
                 return Err(msg(
                     "the run stopped without a result (its thread panicked)",

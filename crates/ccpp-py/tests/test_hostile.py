@@ -235,3 +235,45 @@ def test_zones_as_text_rectangles_and_no_keepouts(room: Path) -> None:
     none = ccpp.run(room, "bsa", keepout=[])
     plain = ccpp.run(room, "bsa")
     assert none.metrics == {**plain.metrics, "wall_time_s": none.metrics["wall_time_s"]}
+
+
+def test_round_two_python_holes(room: Path, tmp_path: Path) -> None:
+    # A 0-d numpy bool array converted to 1.0 as well.
+    with pytest.raises(TypeError, match="not bool"):
+        ccpp.run(room, "bsa", radius=np.array(True))
+    with pytest.raises(TypeError, match="not bool"):
+        ccpp.load_map(room, resolution=np.array(True))
+    # A list of text rectangles is a list of rectangles (it was read as file names).
+    two = ccpp.run(room, "bsa", keepout=["1,0.5,1.5,1.5", "2,0.5,2.5,1.5"])
+    assert two.metrics["keepout_violations"] == 0
+    assert two.metrics != ccpp.run(room, "bsa", keepout="1,0.5,1.5,1.5").metrics
+    # Past u64, refused before the cluster starts (an OverflowError in every task).
+    with pytest.raises(ccpp.CcppError, match="max_memory_mb"):
+        ccpp.sweep(room, "bsa", max_memory_mb=2**64)
+    # A keep-out path that is not UTF-8 is named as such (a raw UnicodeEncodeError).
+    odd = os.fsdecode(b"odd\xff.geojson")
+    with pytest.raises(ccpp.CcppError, match="not valid UTF-8"):
+        ccpp.run(room, "bsa", keepout=str(tmp_path / odd))
+
+
+def test_a_run_after_an_interrupted_one_waits_for_it_and_completes(tmp_path: Path, room: Path) -> None:
+    # Interrupted runs finish on their threads; a new run waits for them instead of piling up
+    # beside them, and then completes.
+    script = tmp_path / "again.py"
+    script.write_text(
+        "import signal, threading, time, ccpp\n"
+        f"room = {str(room)!r}\n"
+        "def interrupt(after):\n"
+        "    threading.Timer(after, lambda: signal.raise_signal(signal.SIGINT)).start()\n"
+        "for _ in range(2):\n"
+        "    interrupt(0.5)\n"
+        "    try:\n"
+        "        ccpp.run(room, 'random-bounce', budget_m=3e5)\n"
+        "    except KeyboardInterrupt:\n"
+        "        print('interrupted', flush=True)\n"
+        "r = ccpp.run(room, 'bsa')\n"
+        "print('done', r.metrics['effective_coverage'] > 0.5, flush=True)\n"
+    )
+    out = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["interrupted", "interrupted", "done", "True"], out.stdout

@@ -418,6 +418,24 @@ fn validate_pid(field: &str, p: &PidOptions) -> Result<(), OptionsError> {
     Ok(())
 }
 
+/// Refuses a planner's own PID `noise` section whose every std is 0: it draws nothing, so it
+/// runs exactly as no section (`noise: {}` was taken as zero noise without a word, where it
+/// meant the library's defaults before the section's fields followed `--odometry-noise`).
+/// (`--odometry-noise 0` is another matter: it switches an ideal run to PID execution.)
+fn noise_that_draws(field: &str, e: &Execution) -> Result<(), OptionsError> {
+    if let Execution::Pid(p) = e {
+        if let Some(n) = p.noise {
+            if n.linear_rel_std == 0.0 && n.angular_rel_std == 0.0 && n.heading_drift_std == 0.0 {
+                return Err(OptionsError::new(
+                    &format!("{field}.pid.noise"),
+                    "draws no noise: every std is 0 (leave the section out, or give linear_rel_std > 0)",
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Bytes of one PID trace record in memory: a stored pose (56 bytes) in a vector that grows by
 /// doubling (1.5 times that on average, twice at worst; the record count the estimates use
 /// is itself above the measured ones). The trace's text is written as it is made, not held.
@@ -878,7 +896,8 @@ impl PlannerSettings for BsaBfsOptions {
     fn validate(&self) -> Result<(), OptionsError> {
         opt_finite_pos("cell_side_m", self.cell_side_m)?;
         finite_nonneg("clearance_margin_m", self.clearance_margin_m)?;
-        validate_execution("exec", &self.exec)
+        validate_execution("exec", &self.exec)?;
+        noise_that_draws("exec", &self.exec)
     }
 
     fn check(&self, s: &Setup) -> Result<(), OptionsError> {
@@ -1012,7 +1031,8 @@ impl PlannerSettings for RectOptions {
                 ));
             }
         }
-        validate_execution("exec", &self.exec)
+        validate_execution("exec", &self.exec)?;
+        noise_that_draws("exec", &self.exec)
     }
 
     fn check(&self, s: &Setup) -> Result<(), OptionsError> {

@@ -35,7 +35,7 @@
 
 mod classify;
 mod error;
-mod pixels;
+pub(crate) mod pixels;
 mod yaml;
 
 use std::io::{BufReader, Cursor};

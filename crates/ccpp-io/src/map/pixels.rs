@@ -32,17 +32,39 @@ const DECODED_BYTES_MAX: u64 = 8;
 /// image (24000 px of 16-bit RGBA: 192 KB a row).
 const DECODER_ROOM: u64 = 4 << 20;
 
-/// The decoder's limits for an image of `pixels` pixels: its allocation cap is the decoded
-/// buffer of that many pixels at the widest sample plus [`DECODER_ROOM`] (0 pixels: the
-/// header, the chunks before the image data and the room alone).
-fn decoder_limits(pixels: u64) -> image::Limits {
+/// The decoder's limits for an image of `pixels` pixels in a file of `file_bytes` bytes: its
+/// allocation cap is the decoded buffer of that many pixels at the widest sample, plus
+/// [`DECODER_ROOM`], plus three times the file's size (a chunk the decoder keeps as it is, such
+/// as text or EXIF metadata, is no larger than the file, and is held while its buffer doubles
+/// and once more as text: a 6 MB `tEXt` in a 200 x 200 map must load; only what the decoder
+/// inflates, a colour profile, can outgrow it). 0 pixels: the header and
+/// the chunks before the image data.
+fn decoder_limits(pixels: u64, file_bytes: u64) -> image::Limits {
     let mut limits = image::Limits::default();
     limits.max_alloc = Some(
         pixels
             .saturating_mul(DECODED_BYTES_MAX)
-            .saturating_add(DECODER_ROOM),
+            .saturating_add(DECODER_ROOM)
+            .saturating_add(file_bytes.saturating_mul(3)),
     );
     limits
+}
+
+/// The width and height an image file's header gives (a PNG's IHDR; other formats through the
+/// decoder's header read under [`decoder_limits`] for no pixels), or `None` when it cannot be
+/// read. For size checks that must not decode: a keep-out mask's header read with the
+/// decoder's default cap inflated a colour-profile bomb to 520 MB.
+pub(crate) fn header_size<R: BufRead + Seek>(mut r: R) -> Option<(u32, u32)> {
+    let start = r.stream_position().ok()?;
+    let file_bytes = r.seek(SeekFrom::End(0)).ok()?.saturating_sub(start);
+    r.seek(SeekFrom::Start(start)).ok()?;
+    if let Some(size) = png_ihdr_size(&mut r).ok()? {
+        return Some(size);
+    }
+    r.seek(SeekFrom::Start(start)).ok()?;
+    let mut reader = ImageReader::new(r).with_guessed_format().ok()?;
+    reader.limits(decoder_limits(0, file_bytes));
+    reader.into_dimensions().ok()
 }
 
 /// The width and height in a PNG's IHDR chunk (the signature, then the IHDR chunk first, as
@@ -102,6 +124,11 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
     // image starts; the cheap one (the header) first.
     let mut inner = reader.into_inner();
     let start = inner.stream_position().map_err(io_err)?;
+    let file_bytes = inner
+        .seek(SeekFrom::End(0))
+        .map_err(io_err)?
+        .saturating_sub(start);
+    inner.seek(SeekFrom::Start(start)).map_err(io_err)?;
     // The size from the header, read under the room's cap alone (a PNG's header read inflates
     // the chunks before its image data). A PNG's size is read from its IHDR first: the
     // decoder's header read allocates a row, so a PNG claiming 2147483647 px across failed as
@@ -111,7 +138,7 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
         _ => {
             inner.seek(SeekFrom::Start(start)).map_err(io_err)?;
             let mut header = ImageReader::with_format(&mut inner, format);
-            header.limits(decoder_limits(0));
+            header.limits(decoder_limits(0, file_bytes));
             header.into_dimensions().map_err(image_err)?
         }
     };
@@ -144,7 +171,7 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
     // The decoder's cap follows the image's own size: its default (512 MiB) refused a 24000 x
     // 24000 PNG the caller's budget admits (`--max-memory 60000`: "Memory limit exceeded"),
     // and let a small image's colour profile inflate to 512 MiB.
-    reader.limits(decoder_limits(pixels));
+    reader.limits(decoder_limits(pixels, file_bytes));
     let img = reader.decode().map_err(image_err)?;
     let width = img.width() as usize;
     let height = img.height() as usize;
@@ -454,14 +481,14 @@ mod tests {
         let default = image::Limits::default().max_alloc.unwrap();
         // A small image gets the room alone, far below the decoder's default.
         assert_eq!(
-            decoder_limits(100 * 100).max_alloc,
+            decoder_limits(100 * 100, 0).max_alloc,
             Some(10_000 * 8 + DECODER_ROOM)
         );
-        assert!(decoder_limits(100 * 100).max_alloc.unwrap() < default / 16);
+        assert!(decoder_limits(100 * 100, 1 << 20).max_alloc.unwrap() < default / 16);
         // 24000 x 24000 grey pixels (576 MB decoded, over the default) fit.
         let px = 24_000u64 * 24_000;
-        let cap = decoder_limits(px).max_alloc.unwrap();
+        let cap = decoder_limits(px, 0).max_alloc.unwrap();
         assert!(cap >= px * DECODED_BYTES_MAX && cap > default, "{cap}");
-        assert_eq!(decoder_limits(u64::MAX).max_alloc, Some(u64::MAX));
+        assert_eq!(decoder_limits(u64::MAX, 0).max_alloc, Some(u64::MAX));
     }
 }

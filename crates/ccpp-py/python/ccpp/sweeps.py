@@ -243,6 +243,7 @@ def sweep(
         isinstance(max_memory_mb, bool)
         or not isinstance(max_memory_mb, numbers.Integral)
         or max_memory_mb < 1
+        or max_memory_mb >= 2**64
     ):
         raise _ccpp.CcppError(f"max_memory_mb must be a whole number of MB >= 1, got {max_memory_mb!r}")
     if inflate is not None and (
