@@ -170,8 +170,16 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
     let mut reader = ImageReader::with_format(inner, format);
     // The decoder's cap follows the image's own size: its default (512 MiB) refused a 24000 x
     // 24000 PNG the caller's budget admits (`--max-memory 60000`: "Memory limit exceeded"),
-    // and let a small image's colour profile inflate to 512 MiB.
-    reader.limits(decoder_limits(pixels, file_bytes));
+    // and let a small image's colour profile inflate to 512 MiB. Without a budget
+    // (`max_pixels: None`) the size the header claims is not checked, so the cap stays at
+    // most the decoder's default: a header claiming 5 x 4294901764 px aborted on a 21 GB
+    // allocation (found by the fuzz smoke).
+    let mut limits = decoder_limits(pixels, file_bytes);
+    if max_pixels.is_none() {
+        let default = image::Limits::default().max_alloc;
+        limits.max_alloc = limits.max_alloc.min(default);
+    }
+    reader.limits(limits);
     let img = reader.decode().map_err(image_err)?;
     let width = img.width() as usize;
     let height = img.height() as usize;
@@ -471,6 +479,29 @@ mod tests {
         ] {
             load(ok).unwrap_or_else(|e| panic!("{e}"));
         }
+    }
+
+    /// Without a budget (`max_pixels: None`, as `load_map_bytes` with default options) the
+    /// cap followed a header claiming 5 x 4294901764 px and the decoder aborted on a 21 GB
+    /// allocation (found by the fuzz smoke): the cap then stays the decoder's default.
+    #[test]
+    fn a_huge_claimed_size_without_a_budget_is_an_error_not_an_abort() {
+        let png = hex(
+            "89504e470d0a1a0a0000000d4948445200000005ffff000408030000009adabe7100000009504c5445\
+             000000ffffffcdcdcd7130916c0000000274ff4e53ff80080fb36a0000000f49444154789c6300\
+             49454e44ae426082",
+        );
+        let t = Thresholds::default();
+        let reader = ImageReader::new(std::io::Cursor::new(png));
+        assert!(decode_and_classify(reader, Path::new("claim.png"), &t, None).is_err());
+    }
+
+    fn hex(s: &str) -> Vec<u8> {
+        let s: String = s.split_whitespace().collect();
+        (0..s.len())
+            .step_by(2)
+            .map(|i| u8::from_str_radix(&s[i..i + 2], 16).unwrap())
+            .collect()
     }
 
     /// The decoder's default cap (512 MiB) refused a 24000 x 24000 PNG under
