@@ -224,17 +224,15 @@ pub fn read_options(path: &Path) -> Result<PlannerOptions> {
 /// not mean. The file's sections for other planners are allowed (one file can serve a bench).
 pub fn warn_unused_config(config: Option<&Path>, kinds: &[PlannerKind]) {
     let Some(f) = config else { return };
-    if kinds.iter().any(|k| file_sets(config, k.info().section)) {
+    // Read and parsed once for every planner.
+    let value = file_value(f);
+    if value
+        .as_ref()
+        .is_some_and(|v| kinds.iter().any(|k| value_sets(v, k.info().section)))
+    {
         return;
     }
-    let sections = ccpp_io::file::read_text(f)
-        .ok()
-        .and_then(|text| {
-            let json = f
-                .extension()
-                .is_some_and(|e| e.eq_ignore_ascii_case("json"));
-            ccpp_io::file::parse_yaml_or_json::<serde_json::Value>(&text, json).ok()
-        })
+    let sections = value
         .and_then(|v| v.as_object().map(|o| o.keys().cloned().collect::<Vec<_>>()))
         .unwrap_or_default();
     let names: Vec<&str> = kinds.iter().map(|k| k.name()).collect();
@@ -301,18 +299,23 @@ fn clash(
 /// its value: a flag beside it replaces the file's value even where that value is the default
 /// (the file `planners --defaults` prints gives every option). `false` without a file.
 fn file_sets(file: Option<&Path>, path: &str) -> bool {
-    let Some(f) = file else { return false };
-    // The file was read and validated already; an error here means it was not given.
-    let Ok(text) = ccpp_io::file::read_text(f) else {
-        return false;
-    };
+    file.and_then(file_value)
+        .is_some_and(|v| value_sets(&v, path))
+}
+
+/// The options file `f` as a JSON value (`None` when it cannot be read or parsed: it was read
+/// and validated already, so that means it was not given).
+fn file_value(f: &Path) -> Option<serde_json::Value> {
+    let text = ccpp_io::file::read_text(f).ok()?;
     let json = f
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("json"));
-    let Ok(v) = ccpp_io::file::parse_yaml_or_json::<serde_json::Value>(&text, json) else {
-        return false;
-    };
-    path.split('.').try_fold(&v, |v, k| v.get(k)).is_some()
+    ccpp_io::file::parse_yaml_or_json::<serde_json::Value>(&text, json).ok()
+}
+
+/// Whether the parsed options file `v` gives the option at `path`, whatever its value.
+fn value_sets(v: &serde_json::Value, path: &str) -> bool {
+    path.split('.').try_fold(v, |v, k| v.get(k)).is_some()
 }
 
 /// `--seed` into random-bounce's options, refused beside a `random_bounce.seed` of another
