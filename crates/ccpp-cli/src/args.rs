@@ -401,17 +401,13 @@ fn parse_quad(s: &str) -> Result<[f64; 4], String> {
     Ok(v)
 }
 
-/// Parses a zone: `X0,Y0,X1,Y1` (four numbers) is a rectangle, anything else a file name.
+/// Parses a zone ([`ZoneSpec`]'s `FromStr`: `X0,Y0,X1,Y1` is a rectangle, anything else a file
+/// name); a rectangle's numbers are checked here already, so clap names the flag.
 fn parse_zone(s: &str) -> Result<ZoneSpec, String> {
-    let parts: Vec<&str> = s.split(',').collect();
-    if parts.len() == 4 && parts.iter().all(|p| p.trim().parse::<f64>().is_ok()) {
-        let r = parse_quad(s)?;
-        return Ok(ZoneSpec::Rect(r));
+    match s.parse::<ZoneSpec>().map_err(|e| e.to_string())? {
+        ZoneSpec::Rect(_) => parse_quad(s).map(ZoneSpec::Rect),
+        other => Ok(other),
     }
-    if s.is_empty() {
-        return Err("expected a file or X0,Y0,X1,Y1, got an empty value".into());
-    }
-    Ok(ZoneSpec::File(PathBuf::from(s)))
 }
 
 /// Parses `A,B` or `A,B,C` into three numbers (C defaults to 0).

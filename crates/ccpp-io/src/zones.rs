@@ -46,12 +46,39 @@ pub enum ZoneData {
 }
 
 /// Error reading a zone file (the message never names the file: the caller adds it).
-#[derive(Debug, thiserror::Error)]
+#[derive(Debug, PartialEq, thiserror::Error)]
 #[error("{0}")]
 pub struct ZoneFileError(pub String);
 
 fn bad(m: impl Into<String>) -> ZoneFileError {
     ZoneFileError(m.into())
+}
+
+/// A zone as the command line and Python take it as text: four comma-separated numbers are the
+/// rectangle `X0,Y0,X1,Y1` (spaces around the numbers allowed), anything else names a file.
+/// The rectangle's values are checked where every zone is ([`ZoneSpec::load`] through the
+/// scenario), so `"nan,0,1,1"` parses here and is refused there.
+///
+/// ```
+/// use ccpp_io::zones::ZoneSpec;
+/// assert_eq!("0, 1, 2.5, 3".parse(), Ok(ZoneSpec::Rect([0.0, 1.0, 2.5, 3.0])));
+/// assert_eq!("rug.geojson".parse(), Ok(ZoneSpec::File("rug.geojson".into())));
+/// assert_eq!("1,2,3".parse(), Ok(ZoneSpec::File("1,2,3".into())));
+/// assert!("".parse::<ZoneSpec>().is_err());
+/// ```
+impl std::str::FromStr for ZoneSpec {
+    type Err = ZoneFileError;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let numbers: Result<Vec<f64>, _> = s.split(',').map(|p| p.trim().parse::<f64>()).collect();
+        if let Ok(Ok(r)) = numbers.map(<[f64; 4]>::try_from) {
+            return Ok(Self::Rect(r));
+        }
+        if s.is_empty() {
+            return Err(bad("expected a file or X0,Y0,X1,Y1, got an empty value"));
+        }
+        Ok(Self::File(PathBuf::from(s)))
+    }
 }
 
 impl ZoneSpec {

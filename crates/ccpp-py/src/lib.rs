@@ -453,12 +453,7 @@ fn parse_area(v: &Bound<'_, PyAny>) -> PyResult<ZoneSpec> {
 /// line's `--area` / `--keepout` read it (it was taken for a file name: "No such file").
 fn rect_text(v: &Bound<'_, PyAny>) -> Option<ZoneSpec> {
     let s: String = v.extract().ok()?;
-    let parts: Vec<f64> = s
-        .split(',')
-        .map(|p| p.trim().parse::<f64>())
-        .collect::<Result<_, _>>()
-        .ok()?;
-    <[f64; 4]>::try_from(parts).ok().map(ZoneSpec::Rect)
+    s.parse().ok().filter(|z| matches!(z, ZoneSpec::Rect(_)))
 }
 
 /// Keep-out zones: one zone (as for an area) or a list of zones (`Scenario::keepout`).
