@@ -23,6 +23,7 @@
 
 use serde::{Deserialize, Serialize};
 use std::ops::{Add, Sub};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::exec::{Execution, Goal, PidOptions, Tracker, Unicycle};
 use crate::geometry::{atan2_exact, dist_exact, wrap_angle, Point, Pose};
@@ -561,11 +562,39 @@ impl<'w> Simulator<'w> {
     /// [sealed](Trace::sealed_count) pieces while the run goes on). The tap only reads: the
     /// run is the same.
     pub fn run_tapped(
-        mut self,
+        self,
         planner: &mut dyn Planner,
         config: &SimConfig,
         tap: &mut dyn FnMut(&Trace),
     ) -> RunOutput {
+        self.run_stoppable(planner, config, tap, None).0
+    }
+
+    /// [`Self::run_tapped`], stopped between two steps once another thread sets `stop`
+    /// (looked at every [`STOP_CHECK_STEPS`] steps): `None` when it was stopped. A caller
+    /// that gives up on a run (Python's Ctrl-C) ends its work instead of leaving it to run
+    /// to the end. The planning an offline planner does before its first step is not stopped.
+    pub fn run_until(
+        self,
+        planner: &mut dyn Planner,
+        config: &SimConfig,
+        tap: &mut dyn FnMut(&Trace),
+        stop: &AtomicBool,
+    ) -> Option<RunOutput> {
+        match self.run_stoppable(planner, config, tap, Some(stop)) {
+            (out, false) => Some(out),
+            (_, true) => None,
+        }
+    }
+
+    /// The run, and whether `stop` ended it.
+    fn run_stoppable(
+        mut self,
+        planner: &mut dyn Planner,
+        config: &SimConfig,
+        tap: &mut dyn FnMut(&Trace),
+        stop_flag: Option<&AtomicBool>,
+    ) -> (RunOutput, bool) {
         let started = std::time::Instant::now();
         if !self.exec_set {
             let e = config
@@ -580,7 +609,12 @@ impl<'w> Simulator<'w> {
         let near = 0.5 * self.world.frame().resolution;
         let mut anchor = self.pose.position();
         let mut still = 0u64;
-        for _ in 0..config.max_steps {
+        let mut stopped = false;
+        for n in 0..config.max_steps {
+            if n % STOP_CHECK_STEPS == 0 && stop_flag.is_some_and(|f| f.load(Ordering::Relaxed)) {
+                stopped = true;
+                break;
+            }
             let step = planner.next(&self);
             if step == Step::Done {
                 stop = StopReason::Done;
@@ -620,15 +654,19 @@ impl<'w> Simulator<'w> {
                 reason: stop.as_str().to_string(),
             },
         );
-        RunOutput {
+        let out = RunOutput {
             trace: self.trace,
             stop,
             tile_side: planner.tile_side(),
             planner: planner.name(),
             wall_time_s: started.elapsed().as_secs_f64(),
-        }
+        };
+        (out, stopped)
     }
 }
+
+/// How often (in steps) [`Simulator::run_until`] looks at its stop flag.
+pub const STOP_CHECK_STEPS: u64 = 64;
 
 // `pose` is the estimate by design: the planner sees odometry/localization, not the truth.
 #[allow(clippy::misnamed_getters)]
@@ -680,6 +718,18 @@ pub fn motions_cut(trace: &Trace) -> Option<u64> {
         }
     }
     last
+}
+
+/// [`simulate_tapped`] that another thread can stop ([`Simulator::run_until`]): `None` when
+/// `stop` ended it.
+pub fn simulate_until(
+    world: &World,
+    planner: &mut dyn Planner,
+    config: &SimConfig,
+    tap: &mut dyn FnMut(&Trace),
+    stop: &AtomicBool,
+) -> Option<RunOutput> {
+    Simulator::new(world, config).run_until(planner, config, tap, stop)
 }
 
 /// Convenience: simulate `planner` on `world` with `config`.
@@ -775,6 +825,36 @@ mod tests {
             })),
             ..SimConfig::default()
         }
+    }
+
+    #[test]
+    fn a_stop_flag_ends_the_run_between_steps() {
+        let world = big_room();
+        let cfg = SimConfig::default();
+        // Not set: the same run as without a flag.
+        let flag = AtomicBool::new(false);
+        let free = simulate_until(&world, &mut Script(square(50)), &cfg, &mut |_| {}, &flag)
+            .expect("a run whose flag is never set finishes");
+        let plain = simulate(&world, &mut Script(square(50)), &cfg);
+        let poses = |o: &RunOutput| o.trace.poses().collect::<Vec<_>>();
+        assert_eq!(poses(&free), poses(&plain));
+        // Set by the tap after the first steps: the run stops within STOP_CHECK_STEPS steps.
+        let flag = AtomicBool::new(false);
+        let mut steps = 0u64;
+        let stopped = simulate_until(
+            &world,
+            &mut Script(square(50)),
+            &cfg,
+            &mut |_| {
+                steps += 1;
+                if steps == 10 {
+                    flag.store(true, Ordering::Relaxed);
+                }
+            },
+            &flag,
+        );
+        assert!(stopped.is_none());
+        assert!(steps <= STOP_CHECK_STEPS, "{steps} steps");
     }
 
     #[test]

@@ -37,12 +37,13 @@ use ccpp_core::planners::settings::{
     add_sim_pid_records, estimate_run, estimate_zones, validate_execution, ZoneLoad, PROCESS_BYTES,
 };
 use ccpp_core::planners::{OptionsError, PlannerConfig, PlannerKind, ResourceEstimate, Setup};
-use ccpp_core::sim::{simulate, simulate_tapped, RunOutput, SimConfig};
+use ccpp_core::sim::{simulate, simulate_tapped, simulate_until, RunOutput, SimConfig};
 use ccpp_core::trace::Chunk;
 use ccpp_core::world::{Robot, World, WorldError};
 use ccpp_core::Pose;
 use fixedbitset::FixedBitSet;
 use serde::{Deserialize, Serialize};
+use std::sync::atomic::AtomicBool;
 
 use crate::map::{load_map, LoadOptions, LoadedMap, MapError, Thresholds};
 use crate::trace::{FileFormer, FormedFiles};
@@ -83,6 +84,9 @@ fn default_max_memory_mb() -> u64 {
 /// degenerate or too big. Every message names the value or the file at fault.
 #[derive(Debug, thiserror::Error)]
 pub enum ScenarioError {
+    /// The run was stopped by its caller ([`Scenario::run_on_until`]).
+    #[error("the run was interrupted")]
+    Interrupted,
     /// The map cannot be loaded.
     #[error(transparent)]
     Map(#[from] MapError),
@@ -1158,7 +1162,22 @@ impl Scenario {
     /// As [`world`](Self::world).
     pub fn run_on(&self, map: &PreparedMap) -> Result<Run, ScenarioError> {
         let world = crate::phase::time("world", || self.world(map))?;
-        Ok(self.run_in(world, &map.name, |_| ()).0)
+        self.run_in(world, &map.name, |_| (), None)
+            .map(|(run, ())| run)
+    }
+
+    /// [`run_on`](Self::run_on) that another thread can stop by setting `stop`: the
+    /// simulation ends within [`STOP_CHECK_STEPS`](ccpp_core::sim::STOP_CHECK_STEPS) steps of
+    /// it and no metrics are computed (Python's Ctrl-C gives up a run this way, instead of
+    /// leaving it to finish unseen). An offline planner's planning before the first step is
+    /// not stopped.
+    ///
+    /// # Errors
+    /// As [`world`](Self::world); [`ScenarioError::Interrupted`] when `stop` ended the run.
+    pub fn run_on_until(&self, map: &PreparedMap, stop: &AtomicBool) -> Result<Run, ScenarioError> {
+        let world = crate::phase::time("world", || self.world(map))?;
+        self.run_in(world, &map.name, |_| (), Some(stop))
+            .map(|(run, ())| run)
     }
 
     /// [`run_on`](Self::run_on) taking the prepared map, whose grid becomes the world's
@@ -1226,20 +1245,22 @@ impl Scenario {
         if form_files {
             Ok(self.run_forming(world, &name, beside))
         } else {
-            let (run, extra) = self.run_in(world, &name, beside);
+            let (run, extra) = self.run_in(world, &name, beside, None)?;
             Ok((run, extra, None))
         }
     }
 
     /// Plans and simulates in `world`, then computes the metrics. What the metrics need of the
     /// world alone ([`metrics::WorldPart`]) and `beside` are computed on a second thread while
-    /// the planner works.
+    /// the planner works. `stop` set by another thread ends the simulation early
+    /// ([`ScenarioError::Interrupted`]).
     fn run_in<T: Send>(
         &self,
         world: World,
         map_name: &str,
         beside: impl FnOnce(&World) -> T + Send,
-    ) -> (Run, T) {
+        stop: Option<&AtomicBool>,
+    ) -> Result<(Run, T), ScenarioError> {
         let side = self.tile_side();
         let (output, part, extra) = crate::phase::time("plan + simulate", || {
             std::thread::scope(|s| {
@@ -1248,12 +1269,21 @@ impl Scenario {
                 // Wall time covers planning (offline planners plan in `build`) and simulation.
                 let started = std::time::Instant::now();
                 let mut planner = self.planner.build(&world);
-                let mut output = simulate(&world, planner.as_mut(), &self.sim);
-                output.wall_time_s = started.elapsed().as_secs_f64();
+                let output = match stop {
+                    None => Some(simulate(&world, planner.as_mut(), &self.sim)),
+                    Some(flag) => {
+                        simulate_until(&world, planner.as_mut(), &self.sim, &mut |_| {}, flag)
+                    }
+                };
+                let wall_time_s = started.elapsed().as_secs_f64();
                 let (part, extra) = join_scoped(other);
-                (output, part, extra)
+                output.map(|mut output| {
+                    output.wall_time_s = wall_time_s;
+                    (output, part, extra)
+                })
             })
-        });
+        })
+        .ok_or(ScenarioError::Interrupted)?;
         let (metrics, swept) = crate::phase::time("metrics", || {
             metrics::compute_prepared(&world, &output, map_name, part)
         });
@@ -1263,7 +1293,7 @@ impl Scenario {
             metrics,
             swept,
         };
-        (run, extra)
+        Ok((run, extra))
     }
 
     /// [`run_in`](Self::run_in), a third thread reading the trace as it grows (copied out in

@@ -8,6 +8,7 @@
 
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
 use ccpp_core::exec::{Execution, PidOptions};
@@ -965,7 +966,7 @@ fn plan(
     name_map(&mut prepared, &scenario);
     let (scenario, prepared) = (Arc::new(scenario), Arc::new(prepared));
     let (sc, pm) = (Arc::clone(&scenario), Arc::clone(&prepared));
-    let p = interruptible(py, move || {
+    let p = interruptible(py, move |_| {
         ccpp_io::plan::plan_route(&sc, &pm, DEFAULT_TOLERANCE_M)
     })?
     .map_err(|e| err(&e))?;
@@ -1144,7 +1145,7 @@ fn run(
     name_map(&mut prepared, &scenario);
     let (scenario, prepared) = (Arc::new(scenario), Arc::new(prepared));
     let (sc, pm) = (Arc::clone(&scenario), Arc::clone(&prepared));
-    let run = interruptible(py, move || sc.run_on(&pm))?.map_err(|e| err(&e))?;
+    let run = interruptible(py, move |stop| sc.run_on_until(&pm, stop))?.map_err(|e| err(&e))?;
     let scenario = Arc::unwrap_or_clone(scenario);
     Ok(RunResult {
         scenario,
@@ -1167,14 +1168,17 @@ static ORPHANS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize:
 
 /// Runs `job` on a thread of its own while this one waits with the GIL released, looking
 /// for signals every 50 ms: Ctrl-C (`KeyboardInterrupt`) ends the wait at once. A long run
-/// used to hold the caller until it finished. The simulator cannot be stopped midway, so an
-/// interrupted job finishes on its thread and its result is dropped (a script that ends on
-/// the interrupt ends it with the process). A new job first waits (interruptibly) until the
-/// interrupted ones have finished, so they never pile up: three interrupted runs slowed the
-/// next one threefold and held 921 MB beside it, over the 800 MB each was admitted under.
+/// used to hold the caller until it finished. On the interrupt the flag given to `job` is
+/// set: a simulation stops within a few steps ([`Scenario::run_on_until`]); what cannot be
+/// stopped (an offline planner's planning) finishes on its thread and its result is dropped
+/// (a script that ends on the interrupt ends it with the process). A new job first waits
+/// (interruptibly) until the interrupted ones have ended, so they never pile up: three
+/// interrupted runs slowed the next one threefold and held 921 MB beside it, over the 800 MB
+/// each was admitted under. An interrupted simulation used to run to its end too, so the next
+/// run waited minutes for it.
 fn interruptible<T: Send + 'static>(
     py: Python<'_>,
-    job: impl FnOnce() -> T + Send + 'static,
+    job: impl FnOnce(&AtomicBool) -> T + Send + 'static,
 ) -> PyResult<T> {
     use std::sync::atomic::{AtomicU8, Ordering};
     const RUNNING: u8 = 0;
@@ -1187,6 +1191,8 @@ fn interruptible<T: Send + 'static>(
     }
     let state = Arc::new(AtomicU8::new(RUNNING));
     let theirs = Arc::clone(&state);
+    let stop = Arc::new(AtomicBool::new(false));
+    let their_stop = Arc::clone(&stop);
     let (tx, rx) = std::sync::mpsc::channel();
     std::thread::Builder::new()
         .name("ccpp-run".into())
@@ -1205,7 +1211,7 @@ fn interruptible<T: Send + 'static>(
                 }
             }
             let finish = Finish(theirs);
-            let out = job();
+            let out = job(&their_stop);
             if finish.0.load(Ordering::SeqCst) != ABANDONED {
                 // The caller may leave meanwhile: the result is then dropped with the channel.
                 tx.send(out).ok();
@@ -1225,6 +1231,7 @@ fn interruptible<T: Send + 'static>(
             Ok(v) => return Ok(v),
             Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {
                 if let Err(e) = py.check_signals() {
+                    stop.store(true, Ordering::SeqCst);
                     // Counted before the job can see it abandoned (it then counts it down);
                     // a job that finished meanwhile is no orphan.
                     ORPHANS.fetch_add(1, Ordering::SeqCst);

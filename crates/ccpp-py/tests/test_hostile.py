@@ -277,3 +277,28 @@ def test_a_run_after_an_interrupted_one_waits_for_it_and_completes(tmp_path: Pat
     out = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr
     assert out.stdout.split() == ["interrupted", "interrupted", "done", "True"], out.stdout
+
+
+def test_an_interrupted_run_stops_instead_of_finishing_unseen(tmp_path: Path, room: Path) -> None:
+    # Ctrl-C returned at once but the simulation ran on to its end on its thread, and the
+    # next run waited for it (minutes for this budget). The simulation now stops within a few
+    # steps of the interrupt, so the next run starts at once.
+    script = tmp_path / "stop.py"
+    script.write_text(
+        "import signal, threading, time, ccpp\n"
+        f"room = {str(room)!r}\n"
+        "threading.Timer(1.0, lambda: signal.raise_signal(signal.SIGINT)).start()\n"
+        "try:\n"
+        "    ccpp.run(room, 'random-bounce', budget_m=2e6)\n"
+        "    print('finished', flush=True)\n"
+        "except KeyboardInterrupt:\n"
+        "    print('interrupted', flush=True)\n"
+        "t = time.monotonic()\n"
+        "r = ccpp.run(room, 'bsa')\n"
+        "print('next', round(time.monotonic() - t, 1), flush=True)\n"
+    )
+    out = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    words = out.stdout.split()
+    assert words[:2] == ["interrupted", "next"], out.stdout
+    assert float(words[2]) < 5.0, out.stdout
