@@ -154,10 +154,12 @@ pub struct RunArgs {
     /// BSA reference lateral side: `left` (default) or `right`.
     #[arg(long, value_name = "left|right")]
     pub side: Option<String>,
-    /// Rectangular robot length in metres (rect-boustrophedon: waypoint spacing).
+    /// Rectangular robot length in metres (rect-boustrophedon: waypoint spacing; default: the
+    /// tool's width 2 x tool radius).
     #[arg(long, value_name = "M")]
     pub length: Option<f64>,
-    /// Rectangular robot width in metres (rect-boustrophedon: lane spacing).
+    /// Rectangular robot width in metres (rect-boustrophedon: lane spacing; default and at
+    /// most: the tool's width 2 x tool radius).
     #[arg(long, value_name = "M")]
     pub width: Option<f64>,
     /// Work area and keep-out zones.
@@ -211,10 +213,12 @@ pub struct PlanArgs {
     /// Planner options.
     #[command(flatten)]
     pub options: OptionsArgs,
-    /// Rectangular robot length in metres (rect-boustrophedon: waypoint spacing).
+    /// Rectangular robot length in metres (rect-boustrophedon: waypoint spacing; default: the
+    /// tool's width 2 x tool radius).
     #[arg(long, value_name = "M")]
     pub length: Option<f64>,
-    /// Rectangular robot width in metres (rect-boustrophedon: lane spacing).
+    /// Rectangular robot width in metres (rect-boustrophedon: lane spacing; default and at
+    /// most: the tool's width 2 x tool radius).
     #[arg(long, value_name = "M")]
     pub width: Option<f64>,
     /// Work area and keep-out zones (the path stays inside the area, outside the keep-outs).
@@ -243,12 +247,12 @@ pub struct WaypointsArgs {
     /// The robot (its radius is the smallest clearance kept).
     #[command(flatten)]
     pub robot: RobotArgs,
-    /// Robot length in metres (waypoint spacing along a lane).
-    #[arg(long, value_name = "M", default_value_t = 0.3)]
-    pub length: f64,
-    /// Robot width in metres (lane spacing).
-    #[arg(long, value_name = "M", default_value_t = 0.3)]
-    pub width: f64,
+    /// Robot length in metres (waypoint spacing along a lane; default: the robot's diameter).
+    #[arg(long, value_name = "M")]
+    pub length: Option<f64>,
+    /// Robot width in metres (lane spacing; default and at most: the robot's diameter).
+    #[arg(long, value_name = "M")]
+    pub width: Option<f64>,
     /// Area to cover `X0,Y0,X1,Y1`: the seed's lane rectangle for the robot's centre
     /// (default: the start's free component).
     #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = parse_quad, allow_hyphen_values = true)]

@@ -11,7 +11,6 @@ use ccpp_core::exec::{Execution, OdometryNoise, PidOptions};
 use ccpp_core::metrics::Metrics;
 use ccpp_core::planners::bsa::Side;
 use ccpp_core::planners::random_bounce::RandomBounceOptions;
-use ccpp_core::planners::rect_boustrophedon::RectOptions;
 use ccpp_core::planners::{PlannerConfig, PlannerKind, PlannerOptions};
 use ccpp_core::sim::{RunOutput, SimConfig};
 use ccpp_core::world::{Robot, World};
@@ -345,30 +344,26 @@ pub(crate) fn apply_rect_flags(
     file: Option<&Path>,
 ) -> Result<Vec<&'static str>> {
     let kind = config.kind();
-    let rect_default = RectOptions::default();
     let mut given = Vec::new();
     for (flag, v) in [("--length", length), ("--width", width)] {
         let Some(v) = v else { continue };
         given.push(flag);
-        let (slot, field, d) = match config {
-            PlannerConfig::RectBoustrophedon(o) if flag == "--length" => (
-                &mut o.length_m,
-                "rect_boustrophedon.length_m",
-                rect_default.length_m,
-            ),
-            PlannerConfig::RectBoustrophedon(o) => (
-                &mut o.width_m,
-                "rect_boustrophedon.width_m",
-                rect_default.width_m,
-            ),
+        let (slot, field) = match config {
+            PlannerConfig::RectBoustrophedon(o) if flag == "--length" => {
+                (&mut o.length_m, "rect_boustrophedon.length_m")
+            }
+            PlannerConfig::RectBoustrophedon(o) => (&mut o.width_m, "rect_boustrophedon.width_m"),
             _ => return Err(not_applicable(flag, kind, "rect-boustrophedon")),
         };
-        if (slot.to_bits() != d.to_bits() || file_sets(file, field))
-            && slot.to_bits() != v.to_bits()
+        // A value from the file (`null` too: the file `planners --defaults` prints gives it)
+        // that the flag would replace.
+        if slot.is_none_or(|w| w.to_bits() != v.to_bits())
+            && (slot.is_some() || file_sets(file, field))
         {
-            return Err(clash(file, flag, v, field, *slot));
+            let w = slot.map_or_else(|| "null".to_string(), |w| w.to_string());
+            return Err(clash(file, flag, v, field, w));
         }
-        *slot = v;
+        *slot = Some(v);
     }
     Ok(given)
 }
@@ -647,6 +642,7 @@ impl Job {
             .map_err(|e| name_flag(e, &given))?;
         let map = load_recipe(&scenario.map, scenario.max_memory_mb)?;
         scenario.check_map(&map).map_err(|e| name_flag(e, &given))?;
+        scenario.check_run().map_err(|e| name_flag(e, &given))?;
         Ok(Self {
             scenario,
             map: Some(map),

@@ -83,8 +83,8 @@ fn planners_defaults_is_a_config_of_the_defaults() {
             "rect-boustrophedon",
             "--length",
             "0.5",
-            "0.3",
-            "rect_boustrophedon.length_m: 0.3",
+            "",
+            "rect_boustrophedon.length_m: null",
         ),
         ("bsa-bfs", "--exec", "ideal", "pid", "bsa_bfs.exec"),
     ] {

@@ -111,7 +111,7 @@ fn planner_flags_apply_where_they_should() {
     );
     flag_applies(dir, m, &["--side", "right"], &["bsa", "bsa-extended"], &[]);
     flag_applies(dir, m, &["--length", "0.5"], &["rect-boustrophedon"], &[]);
-    flag_applies(dir, m, &["--width", "0.5"], &["rect-boustrophedon"], &[]);
+    flag_applies(dir, m, &["--width", "0.2"], &["rect-boustrophedon"], &[]);
     // Zones apply to every planner (virtual walls).
     flag_applies(dir, m, &["--area", "0.5,0.5,4,4"], &ALL, &[]);
     flag_applies(dir, m, &["--keepout", "5.5,1,6.5,5"], &ALL, &[]);
@@ -724,13 +724,15 @@ fn absurd_sizes_end_within_seconds() {
         &["--radius", "1e-9", "--sensor-range", "1"],
         &["memory limit", "tiles"],
     );
-    for p in [
-        "bsa-bfs",
-        "bsa",
-        "bcd",
+    // rect-boustrophedon's lanes follow the tool: at this radius they are finer than a pixel.
+    run_fails(
+        dir,
+        &map,
         "rect-boustrophedon",
-        "bsa-extended",
-    ] {
+        &["--radius", "1e-6"],
+        &["finer than the map resolution", "2 x tool radius"],
+    );
+    for p in ["bsa-bfs", "bsa", "bcd", "bsa-extended"] {
         // A sensor range that sees the neighbours, so that the size is what is refused (the
         // default 4 r cannot see past half a pixel).
         let online = !["bcd", "rect-boustrophedon"].contains(&p);
@@ -993,7 +995,7 @@ fn run_json_is_the_scenario_and_replays_exactly() {
         ),
         (
             "rect-boustrophedon",
-            &["--length", "0.4", "--width", "0.35", "--inflate", "0.05"],
+            &["--length", "0.4", "--width", "0.25", "--inflate", "0.05"],
         ),
     ]
     .into_iter()

@@ -1156,11 +1156,26 @@ impl Scenario {
         Ok(world)
     }
 
+    /// What a simulated run refuses and a plan does not (checked by every run entry point
+    /// before the map is read): `rect-boustrophedon` lanes farther apart than the tool sweeps
+    /// ([`RectOptions::check_tool`](ccpp_core::planners::rect_boustrophedon::RectOptions)).
+    ///
+    /// # Errors
+    /// The option at fault.
+    pub fn check_run(&self) -> Result<(), ScenarioError> {
+        if let PlannerConfig::RectBoustrophedon(o) = &self.planner {
+            o.check_tool(&self.robot)
+                .map_err(|e| ScenarioError::Options(e.in_section("rect_boustrophedon")))?;
+        }
+        Ok(())
+    }
+
     /// Runs the scenario on a map the caller prepared (bench runs share one map).
     ///
     /// # Errors
     /// As [`world`](Self::world).
     pub fn run_on(&self, map: &PreparedMap) -> Result<Run, ScenarioError> {
+        self.check_run()?;
         let world = crate::phase::time("world", || self.world(map))?;
         self.run_in(world, &map.name, |_| (), None)
             .map(|(run, ())| run)
@@ -1175,6 +1190,7 @@ impl Scenario {
     /// # Errors
     /// As [`world`](Self::world); [`ScenarioError::Interrupted`] when `stop` ended the run.
     pub fn run_on_until(&self, map: &PreparedMap, stop: &AtomicBool) -> Result<Run, ScenarioError> {
+        self.check_run()?;
         let world = crate::phase::time("world", || self.world(map))?;
         self.run_in(world, &map.name, |_| (), Some(stop))
             .map(|(run, ())| run)
@@ -1218,6 +1234,7 @@ impl Scenario {
         beside: impl FnOnce(&World) -> T + Send,
         form_files: bool,
     ) -> Result<(Run, T, Option<FormedFiles>), ScenarioError> {
+        self.check_run()?;
         let PreparedMap {
             grid,
             name,

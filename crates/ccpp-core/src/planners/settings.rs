@@ -1015,10 +1015,38 @@ impl PlannerSettings for BcdOptions {
     }
 }
 
+impl RectOptions {
+    /// What a simulated run refuses and a plan does not: lanes farther apart than the tool
+    /// of `robot` sweeps. A run measures coverage with the disk tool, so each lane would
+    /// leave a strip unswept: a 0.6 m wide robot with the default 0.15 m tool swept 54 % of
+    /// the floor while `rect_guarantee` promised all of it. (A plan has no tool: the
+    /// rectangle is the robot, and its radius only the clearance kept.)
+    ///
+    /// # Errors
+    /// `width_m` wider than `2 tool_radius`.
+    pub fn check_tool(&self, robot: &Robot) -> Result<(), OptionsError> {
+        if let Some(b) = self.width_m {
+            let tool = 2.0 * robot.tool_radius;
+            if b > tool * (1.0 + 1e-9) {
+                return Err(OptionsError::new(
+                    "width_m",
+                    format!(
+                        "{} m lanes are farther apart than the tool sweeps in a run ({} m, 2 x tool radius): every lane would leave a strip unswept; give a tool radius of half the width (and a robot radius at least that), or a width of at most {} m",
+                        crate::display::Compact(b),
+                        crate::display::Compact(tool),
+                        crate::display::Compact(tool)
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
 impl PlannerSettings for RectOptions {
     fn validate(&self) -> Result<(), OptionsError> {
-        finite_pos("length_m", self.length_m)?;
-        finite_pos("width_m", self.width_m)?;
+        opt_finite_pos("length_m", self.length_m)?;
+        opt_finite_pos("width_m", self.width_m)?;
         opt_finite_pos("clearance_radius_m", self.clearance_radius_m)?;
         if let Some(a) = self.area {
             if a.iter().any(|v| !v.is_finite()) || a[2] <= a[0] || a[3] <= a[1] {
@@ -1053,12 +1081,21 @@ impl PlannerSettings for RectOptions {
                 ));
             }
         }
-        for (f, v) in [("length_m", self.length_m), ("width_m", self.width_m)] {
+        for (f, given, v) in [
+            ("length_m", self.length_m, self.length_for(&s.robot)),
+            ("width_m", self.width_m, self.width_for(&s.robot)),
+        ] {
+            // A default follows the tool: the message says so (the user gave no such field).
+            let f = if given.is_some() {
+                f.to_string()
+            } else {
+                format!("{f} (not given: the tool's width, 2 x tool radius)")
+            };
             // A robot longer or wider than the map fits nowhere: its lanes would be empty (an
             // empty waypoint list) or its estimate absurd.
             if v > w.max(h) {
                 return Err(OptionsError::new(
-                    f,
+                    &f,
                     format!(
                         "{} m is larger than the map ({} x {} m): the robot fits nowhere",
                         crate::display::Compact(v),
@@ -1069,7 +1106,7 @@ impl PlannerSettings for RectOptions {
             }
             if v < res {
                 return Err(OptionsError::new(
-                    f,
+                    &f,
                     format!(
                         "{} m is finer than the map resolution ({} m/px)",
                         crate::display::Compact(v),
@@ -1106,11 +1143,12 @@ impl PlannerSettings for RectOptions {
             w = w.min(a[2] - a[0]);
             h = h.min(a[3] - a[1]);
         }
-        let n = (w / self.width_m + 2.0) * (h / self.length_m + 2.0);
+        let (length, width) = (self.length_for(&s.robot), self.width_for(&s.robot));
+        let n = (w / width + 2.0) * (h / length + 2.0);
         let mut e = ResourceEstimate::units(n, RECORD_BYTES, "waypoints")
             .remedy("a larger robot length and width, or a smaller area");
         // A move a waypoint, at most a lane's length each.
-        add_pid_records(&mut e, &self.exec, n, self.length_m);
+        add_pid_records(&mut e, &self.exec, n, length);
         e
     }
 
