@@ -9,7 +9,9 @@
 //! under their own names (no `.tmp` and rename each). Each staged file is synced to disk on a
 //! thread of its own as soon as it is written (the disk's latency overlaps the work on the next
 //! file; small files known early, such as `metrics.json`, go first); the swap waits for all of
-//! them, so the folder that appears is on disk whole.
+//! them, so the folder that appears is on disk whole. For a long `<name>` the staging names
+//! keep a cut of it and a hash, to stay within the file system's 255 bytes
+//! ([`ccpp_io::write::staging_name`]).
 //!
 //! What a crash (power loss) can leave: the file contents are durable before the swap, the two
 //! renames of the swap are not synced themselves (that would add a wait for the disk after the
@@ -169,8 +171,8 @@ fn clean_stale(parent: &Path, name: &str) {
     let Ok(entries) = std::fs::read_dir(parent) else {
         return;
     };
-    let new_prefix = format!(".{name}.ccpp-new-");
-    let old_prefix = format!(".{name}.ccpp-old-");
+    let new_prefix = ccpp_io::write::staging_prefix(name, "new");
+    let old_prefix = ccpp_io::write::staging_prefix(name, "old");
     let mut names: Vec<String> = entries
         .filter_map(|e| e.ok()?.file_name().into_string().ok())
         .collect();
@@ -255,7 +257,12 @@ impl Staging {
         }
         clean_stale(&parent, &name);
         let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-        let dir = parent.join(format!(".{name}.ccpp-new-{}-{n}", std::process::id()));
+        let dir = parent.join(ccpp_io::write::staging_name(
+            &name,
+            "new",
+            std::process::id(),
+            n,
+        ));
         {
             // Registered and created under the lock: the signal handler sees both or neither.
             let mut pending = lock(&PENDING);
@@ -332,10 +339,11 @@ impl Staging {
     pub fn commit(mut self) -> Result<()> {
         self.wait_synced()?;
         let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-        let old = self.parent.join(format!(
-            ".{}.ccpp-old-{}-{n}",
-            self.name,
-            std::process::id()
+        let old = self.parent.join(ccpp_io::write::staging_name(
+            &self.name,
+            "old",
+            std::process::id(),
+            n,
         ));
         let swap = lock(&SWAP);
         let had_old = std::fs::symlink_metadata(&self.target).is_ok();

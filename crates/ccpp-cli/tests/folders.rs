@@ -1,0 +1,89 @@
+//! End-to-end tests of what the output folders hold and who writes them.
+#![allow(clippy::unwrap_used)]
+
+use std::path::Path;
+
+use crate::common::{ccpp, data};
+
+/// Entry names of a folder, sorted.
+fn entries(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+fn stderr_of(o: &std::process::Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+const BASE_SET: [&str; 5] = [
+    "coverage.png",
+    "metrics.json",
+    "path.csv",
+    "run.json",
+    "trace.jsonl",
+];
+
+/// `run` and `plan` took any `*.tmp` in `--out` for their own and deleted it with the old
+/// folder. Only the `.tmp` of a file ccpp writes is its own.
+#[test]
+fn run_and_plan_refuse_a_users_tmp_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("u");
+    std::fs::create_dir(&out).unwrap();
+    std::fs::write(out.join("thesis.tmp"), "precious").unwrap();
+    for sub in ["run", "plan"] {
+        let o = ccpp()
+            .args([sub, "--planner", "bcd", "--map"])
+            .arg(data("teb_empty_box.yaml"))
+            .arg("--out")
+            .arg(&out)
+            .assert()
+            .code(1)
+            .get_output()
+            .clone();
+        let err = stderr_of(&o);
+        assert!(
+            err.starts_with("error: ") && err.contains("holds thesis.tmp"),
+            "{sub}: {err}"
+        );
+        assert_eq!(entries(&out), ["thesis.tmp"], "{sub}");
+    }
+    // The `.tmp` of a file ccpp writes (left by an interrupted `ccpp replay`) is its own.
+    std::fs::remove_file(out.join("thesis.tmp")).unwrap();
+    std::fs::write(out.join("replay.html.tmp"), "cut short").unwrap();
+    ccpp()
+        .args(["run", "--planner", "bcd", "--map"])
+        .arg(data("teb_empty_box.yaml"))
+        .arg("--out")
+        .arg(&out)
+        .assert()
+        .success();
+    assert_eq!(entries(&out), BASE_SET);
+}
+
+/// A legal long `--out` name failed with "File name too long": the staging folder's name added
+/// 20-odd bytes to it. Any name the file system takes works now, and is replaced on a rerun.
+#[test]
+fn run_and_plan_take_the_longest_folder_name() {
+    let dir = tempfile::tempdir().unwrap();
+    for (sub, c) in [("run", "a"), ("plan", "\u{e9}")] {
+        let name = c.repeat(255 / c.len());
+        let out = dir.path().join(&name);
+        for _ in 0..2 {
+            ccpp()
+                .args([sub, "--planner", "bcd", "--map"])
+                .arg(data("teb_empty_box.yaml"))
+                .arg("--out")
+                .arg(&out)
+                .assert()
+                .success();
+        }
+        assert!(out.is_dir(), "{sub}");
+        assert!(!entries(&out).is_empty(), "{sub}");
+    }
+    assert_eq!(entries(dir.path()).len(), 2, "stray staging folder");
+}
