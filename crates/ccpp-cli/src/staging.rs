@@ -155,6 +155,71 @@ pub fn install_signal_handler() {
     });
 }
 
+/// Writes `files` (name, bytes) into the existing folder `dir` as one set, both or neither:
+/// each is written and synced as `<name>.tmp` first (a failure there removes them all and
+/// leaves the old files as they were); then, under the swap lock (an interrupt waits for it),
+/// each is renamed over its name in order. When a rename fails, the files renamed before it
+/// are put back as they were (the old content, kept in memory, or no file). Used by
+/// `ccpp replay`, whose page and GIF went one by one: a failure or interrupt between them left
+/// the page without its GIF. Honours the [`FAIL_WRITE_ENV`] test hook.
+///
+/// # Errors
+/// When a file cannot be written (named as in `dir`) or renamed into place.
+pub fn write_files_together(dir: &Path, files: &[(&str, &[u8])]) -> Result<()> {
+    let tmp_of = |name: &str| dir.join(format!("{name}.tmp"));
+    let clear = |upto: usize| {
+        for (name, _) in &files[..upto] {
+            let t = tmp_of(name);
+            // Best effort: it may not exist (already renamed, or never created).
+            let _ = std::fs::remove_file(&t);
+            unregister(&t);
+        }
+    };
+    for (i, (name, bytes)) in files.iter().enumerate() {
+        let tmp = tmp_of(name);
+        register(&tmp);
+        let failing = std::env::var_os(FAIL_WRITE_ENV).is_some_and(|v| v == *name);
+        let written = (|| {
+            if failing {
+                return Err(std::io::Error::from_raw_os_error(28));
+            }
+            let mut f = std::fs::File::create(&tmp)?;
+            std::io::Write::write_all(&mut f, bytes)?;
+            f.sync_all()
+        })();
+        if let Err(e) = written {
+            clear(i + 1);
+            bail!("cannot write {}: {e}", dir.join(name).display());
+        }
+    }
+    let _swap = lock(&SWAP);
+    // The old content of each file before it is replaced, to put back if a later one fails.
+    let mut before: Vec<Option<Vec<u8>>> = Vec::new();
+    for (i, (name, _)) in files.iter().enumerate() {
+        let path = dir.join(name);
+        let old = if i + 1 < files.len() {
+            std::fs::read(&path).ok()
+        } else {
+            None
+        };
+        if let Err(e) = std::fs::rename(tmp_of(name), &path) {
+            for ((done, _), old) in files[..i].iter().zip(&before).rev() {
+                let p = dir.join(done);
+                // Best effort: the error below is what the user learns.
+                let _ = match old {
+                    Some(bytes) => std::fs::write(&p, bytes),
+                    None => std::fs::remove_file(&p),
+                };
+            }
+            clear(files.len());
+            bail!("cannot write {}: {e}", path.display());
+        }
+        unregister(&tmp_of(name));
+        before.push(old);
+    }
+    Ok(())
+}
+
 /// Whether the process `pid` still runs (Linux `/proc`; elsewhere assumed gone).
 fn pid_alive(pid: u32) -> bool {
     pid == std::process::id() || Path::new("/proc").join(pid.to_string()).exists()

@@ -65,6 +65,65 @@ fn run_and_plan_refuse_a_users_tmp_file() {
     assert_eq!(entries(&out), BASE_SET);
 }
 
+/// `ccpp replay` wrote `replay.html` and then `replay.gif`: a failure between them left the page
+/// without its GIF, or a new page beside the GIF of an earlier replay. Both or neither now.
+#[test]
+fn replay_writes_its_page_and_gif_together() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("r");
+    ccpp()
+        .args(["run", "--planner", "bcd", "--map"])
+        .arg(data("teb_empty_box.yaml"))
+        .arg("--out")
+        .arg(&out)
+        .assert()
+        .success();
+    let replay = |fail: &str| {
+        let mut c = ccpp();
+        c.arg("replay").arg(&out);
+        if !fail.is_empty() {
+            c.env("CCPP_TEST_FAIL_WRITE", fail);
+        }
+        c
+    };
+    for fail in ["replay.html", "replay.gif"] {
+        let o = replay(fail).assert().code(1).get_output().clone();
+        let err = stderr_of(&o);
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(err.contains(fail) && err.contains("os error 28"), "{err}");
+        assert_eq!(entries(&out), BASE_SET, "{fail}: no replay at all");
+    }
+    // An earlier replay stays whole when the new one fails.
+    std::fs::write(out.join("replay.html"), "old page").unwrap();
+    std::fs::write(out.join("replay.gif"), "old gif").unwrap();
+    for fail in ["replay.html", "replay.gif"] {
+        replay(fail).assert().code(1);
+        assert_eq!(
+            std::fs::read_to_string(out.join("replay.html")).unwrap(),
+            "old page",
+            "{fail}"
+        );
+        assert_eq!(
+            std::fs::read_to_string(out.join("replay.gif")).unwrap(),
+            "old gif",
+            "{fail}"
+        );
+        assert_eq!(
+            entries(&out).len(),
+            BASE_SET.len() + 2,
+            "{fail}: stray file"
+        );
+    }
+    replay("").assert().success();
+    assert!(std::fs::read(out.join("replay.gif"))
+        .unwrap()
+        .starts_with(b"GIF8"));
+    assert!(std::fs::read_to_string(out.join("replay.html"))
+        .unwrap()
+        .contains("<html"));
+    assert_eq!(entries(&out).len(), BASE_SET.len() + 2);
+}
+
 /// A legal long `--out` name failed with "File name too long": the staging folder's name added
 /// 20-odd bytes to it. Any name the file system takes works now, and is replaced on a rerun.
 #[test]
