@@ -281,9 +281,9 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         .collect();
     bar.finish_and_clear();
 
-    // The summary is one whole: a stop while it is written removes what it wrote (the plots
-    // folder only when this bench creates it, so that no file of the user's goes with it),
-    // and `results.csv`, written last, marks it complete.
+    // The summary is one whole: a stop or an error (a full disk) while it is written removes
+    // what it wrote (the plots folder only when this bench creates it, so that no file of the
+    // user's goes with it), and `results.csv`, written last, marks it complete.
     let plots = a.out.join("plots");
     let mut summary = vec![a.out.join("results.csv"), a.out.join("results.md")];
     if !plots.exists() {
@@ -293,7 +293,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     crate::plots::write_all(&a.out, &rows, &prepared, robot, &budget)?;
     write_file(&a.out.join("results.md"), results_md(&rows).as_bytes())?;
     write_file(&a.out.join("results.csv"), results_csv(&rows).as_bytes())?;
-    drop(summary);
+    summary.done();
     let failed = rows.iter().filter(|r| r.outcome.is_err()).count();
     crate::print_stdout(&format!(
         "{} runs ({} failed) on {} maps x {} planners; wrote {}/results.csv, results.md, plots/\n",

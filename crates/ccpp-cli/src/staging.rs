@@ -55,9 +55,13 @@ fn register(p: &Path) {
 }
 
 /// Paths written one by one that make one whole (a bench's summary: `results.csv`,
-/// `results.md`, `plots/`): registered for removal on interrupt from creation until the guard
-/// is dropped, so a stop in the middle leaves none of them instead of some.
-pub struct PendingSet(Vec<PathBuf>);
+/// `results.md`, `plots/`): registered for removal on interrupt from creation until
+/// [`PendingSet::done`], and removed when the guard is dropped before that (an error on the
+/// way), so a stop or a failure in the middle leaves none of them instead of some.
+pub struct PendingSet {
+    paths: Vec<PathBuf>,
+    done: bool,
+}
 
 impl PendingSet {
     /// Registers `paths` (they need not exist yet).
@@ -65,14 +69,22 @@ impl PendingSet {
         for p in &paths {
             register(p);
         }
-        Self(paths)
+        Self { paths, done: false }
+    }
+
+    /// The whole is written: its paths stay, and are no longer removed on interrupt.
+    pub fn done(mut self) {
+        self.done = true;
     }
 }
 
 impl Drop for PendingSet {
-    /// The whole is written: its paths are no longer removed on interrupt.
+    /// Removes the paths unless the whole was written ([`PendingSet::done`]).
     fn drop(&mut self) {
-        for p in &self.0 {
+        for p in &self.paths {
+            if !self.done {
+                remove_all(p);
+            }
             unregister(p);
         }
     }

@@ -3,6 +3,8 @@
 
 use std::path::Path;
 
+use assert_cmd::Command;
+
 use crate::common::{ccpp, data};
 
 /// Entry names of a folder, sorted.
@@ -26,6 +28,16 @@ const BASE_SET: [&str; 5] = [
     "run.json",
     "trace.jsonl",
 ];
+
+fn bench(out: &Path, planners: &str) -> Command {
+    let mut c = ccpp();
+    c.args(["bench", "--quiet", "--jobs", "1", "--planners", planners])
+        .arg("--maps")
+        .arg(data("teb_empty_box.yaml"))
+        .arg("--out")
+        .arg(out);
+    c
+}
 
 /// `run` and `plan` took any `*.tmp` in `--out` for their own and deleted it with the old
 /// folder. Only the `.tmp` of a file ccpp writes is its own.
@@ -122,6 +134,37 @@ fn replay_writes_its_page_and_gif_together() {
         .unwrap()
         .contains("<html"));
     assert_eq!(entries(&out).len(), BASE_SET.len() + 2);
+}
+
+/// A bench that failed while writing its summary (a full disk) left some of its plots; the
+/// error path now removes what the summary wrote, as the interrupt path does, and keeps the
+/// complete run folders.
+#[test]
+fn a_failed_bench_summary_leaves_no_part_of_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bench");
+    bench(&out, "bsa,bcd").assert().success();
+    for fail in ["summary.png", "results.md", "results.csv"] {
+        let o = bench(&out, "bsa,bcd")
+            .env("CCPP_TEST_FAIL_WRITE", fail)
+            .assert()
+            .code(1)
+            .get_output()
+            .clone();
+        let err = stderr_of(&o);
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(err.contains(fail) && err.contains("os error 28"), "{err}");
+        assert_eq!(entries(&out), ["runs"], "{fail}: a partial summary");
+        for p in ["bsa", "bcd"] {
+            let run = out.join("runs/teb_empty_box").join(p);
+            assert!(run.join("metrics.json").is_file(), "{fail}: run {p} lost");
+        }
+    }
+    bench(&out, "bsa,bcd").assert().success();
+    assert_eq!(
+        entries(&out),
+        ["plots", "results.csv", "results.md", "runs"]
+    );
 }
 
 /// A legal long `--out` name failed with "File name too long": the staging folder's name added
