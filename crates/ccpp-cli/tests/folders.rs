@@ -39,6 +39,46 @@ fn bench(out: &Path, planners: &str) -> Command {
     c
 }
 
+/// `bench` removed every PNG and SVG in `OUT/plots/`, a user's own figure too. Only the plots a
+/// bench writes are its own; anything else there is refused, as at the top of the folder.
+#[test]
+fn bench_keeps_a_users_files_in_plots_and_refuses_the_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bf6");
+    std::fs::create_dir_all(out.join("plots")).unwrap();
+    std::fs::write(out.join("plots/my_figure.png"), "fig").unwrap();
+    let o = bench(&out, "bsa").assert().code(1).get_output().clone();
+    let err = stderr_of(&o);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.starts_with("error: ") && err.contains("plots/my_figure.png"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(out.join("plots/my_figure.png")).unwrap(),
+        "fig"
+    );
+    assert_eq!(
+        entries(&out),
+        ["plots"],
+        "the refused bench wrote something"
+    );
+    // A bench's own old plots (of a map this bench does not have) still go, and a stray
+    // `.tmp` at the top that a bench does not write is refused like any other file.
+    std::fs::remove_file(out.join("plots/my_figure.png")).unwrap();
+    bench(&out, "bsa").assert().success();
+    std::fs::write(out.join("plots/coverage_gone.png"), "old").unwrap();
+    bench(&out, "bsa").assert().success();
+    assert!(!out.join("plots/coverage_gone.png").exists());
+    std::fs::write(out.join("thesis.tmp"), "precious").unwrap();
+    let o = bench(&out, "bsa").assert().code(1).get_output().clone();
+    assert!(stderr_of(&o).contains("thesis.tmp"), "{}", stderr_of(&o));
+    assert_eq!(
+        std::fs::read_to_string(out.join("thesis.tmp")).unwrap(),
+        "precious"
+    );
+}
+
 /// `run` and `plan` took any `*.tmp` in `--out` for their own and deleted it with the old
 /// folder. Only the `.tmp` of a file ccpp writes is its own.
 #[test]
