@@ -198,6 +198,9 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     let maps = name_maps(expand_maps(&a.maps)?);
     check_bench_target(&a.out)?;
     ccpp_io::write::create_folder(&a.out, &a.out)?;
+    // Held until the bench ends: a second bench on the folder is refused instead of writing
+    // its runs and summary among this one's.
+    let _lock = crate::lock::FolderLock::take(&a.out)?;
     // The summary of an earlier bench in this folder goes before any run starts: an
     // interrupted bench then leaves complete run folders and no summary, never a summary of
     // the earlier bench (another radius, other planners) beside run folders of this one.
@@ -352,9 +355,14 @@ fn check_bench_target(out: &Path) -> Result<()> {
         let name = name.to_string_lossy();
         let Ok(t) = e.file_type() else { continue };
         let known = match name.as_ref() {
-            // A write cut short leaves `<file>.tmp` (see `staging::write_file`); any other
-            // `.tmp` is a user's.
-            "results.csv" | "results.md" | "results.csv.tmp" | "results.md.tmp" => t.is_file(),
+            // A write cut short leaves `<file>.tmp` (see `staging::write_file`; any other
+            // `.tmp` is a user's), and a bench its lock file while it runs (a later bench is
+            // then refused, see `crate::lock`) or when it was killed (taken over).
+            "results.csv"
+            | "results.md"
+            | "results.csv.tmp"
+            | "results.md.tmp"
+            | crate::lock::LOCK_FILE => t.is_file(),
             "runs" => t.is_dir(),
             "plots" => {
                 if t.is_dir() {

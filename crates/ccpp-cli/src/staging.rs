@@ -41,6 +41,10 @@ static CHILDREN: Mutex<Vec<u32>> = Mutex::new(Vec::new());
 static STOPPING: AtomicBool = AtomicBool::new(false);
 /// Distinguishes the staging folders of one process.
 static COUNTER: AtomicU64 = AtomicU64::new(0);
+/// Lock files of output folders this process holds (a bench's, see [`crate::lock`]): removed on
+/// interrupt after the child processes have ended, so that no other bench starts on the folder
+/// while they may still write into it.
+static LOCKS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
 /// Test hook: when this environment variable names a file, writing that file fails as on a full
 /// disk (`ENOSPC`). Used by the end-to-end tests to check that a failed run leaves no output.
@@ -162,9 +166,34 @@ pub fn install_signal_handler() {
         while !lock(&CHILDREN).is_empty() && std::time::Instant::now() < deadline {
             std::thread::sleep(std::time::Duration::from_millis(10));
         }
+        // Held until exit: no lock can be taken after this cleanup. The process's own lock on
+        // each file goes with it.
+        let locks = lock(&LOCKS);
+        for p in locks.iter() {
+            // Best effort: a lock file left behind is taken over by the next bench.
+            let _ = std::fs::remove_file(p);
+        }
         eprintln!("error: interrupted");
         std::process::exit(130);
     });
+}
+
+/// Runs `take` (which creates and locks a lock file, returning its path when it took the lock)
+/// under the lock of the interrupt cleanup, and registers the path it returns: an interrupt
+/// removes the file unless it came before `take` started.
+///
+/// # Errors
+/// What `take` returns.
+pub fn register_lock<T>(take: impl FnOnce() -> Result<(PathBuf, T)>) -> Result<T> {
+    let mut locks = lock(&LOCKS);
+    let (path, held) = take()?;
+    locks.push(path);
+    Ok(held)
+}
+
+/// Forgets a lock file (before removing it on a normal exit).
+pub fn unregister_lock(p: &Path) {
+    lock(&LOCKS).retain(|q| q != p);
 }
 
 /// Writes `files` (name, bytes) into the existing folder `dir` as one set, both or neither:

@@ -1,7 +1,11 @@
-//! End-to-end tests of what the output folders hold and who writes them.
+//! End-to-end tests of what the output folders hold and who writes them: one bench at a time
+//! on a folder, a user's files never taken for ccpp's (`plots/`, `*.tmp`), the replay's two
+//! files written together, a failed bench summary removed whole, and `--out` names up to the
+//! file system's 255 bytes.
 #![allow(clippy::unwrap_used)]
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::process::Stdio;
 
 use assert_cmd::Command;
 
@@ -29,6 +33,8 @@ const BASE_SET: [&str; 5] = [
     "trace.jsonl",
 ];
 
+const LOCK_FILE: &str = ".ccpp-bench.lock";
+
 fn bench(out: &Path, planners: &str) -> Command {
     let mut c = ccpp();
     c.args(["bench", "--quiet", "--jobs", "1", "--planners", planners])
@@ -37,6 +43,85 @@ fn bench(out: &Path, planners: &str) -> Command {
         .arg("--out")
         .arg(out);
     c
+}
+
+/// A 600 x 600 px (30 x 30 m) room with pillars: a bench on it takes long enough to be caught
+/// running.
+fn slow_map(dir: &Path) -> PathBuf {
+    let n = 600u32;
+    let mut img = image::GrayImage::from_pixel(n, n, image::Luma([254]));
+    for (x, y, p) in img.enumerate_pixels_mut() {
+        let wall = x < 2 || y < 2 || x >= n - 2 || y >= n - 2;
+        let pillar = (x % 120) < 15 && (y % 120) < 15 && x > 30 && y > 30;
+        if wall || pillar {
+            *p = image::Luma([0]);
+        }
+    }
+    let p = dir.join("slow_room.png");
+    img.save(&p).unwrap();
+    p
+}
+
+/// Two benches on one `--out` at once wrote over each other and left a mixed folder, both
+/// exiting 0. The second is now refused while the first runs, naming the first's process; the
+/// lock goes with the first, on an interrupt too, and one left by a killed bench is taken over.
+#[cfg(unix)]
+#[test]
+fn a_second_bench_on_a_folder_in_use_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = slow_map(dir.path());
+    let out = dir.path().join("bb");
+    let mut first = std::process::Command::new(assert_cmd::cargo::cargo_bin("ccpp"))
+        .args(["bench", "--quiet", "--jobs", "1"])
+        .args(["--planners", "ba-star,bsa,bcd,random-bounce", "--maps"])
+        .arg(&map)
+        .arg("--out")
+        .arg(&out)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let lock = out.join(LOCK_FILE);
+    let t0 = std::time::Instant::now();
+    while !std::fs::read_to_string(&lock).is_ok_and(|t| t.ends_with('\n'))
+        && t0.elapsed() < std::time::Duration::from_secs(30)
+    {
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    assert!(lock.is_file(), "the running bench holds no lock file");
+    let still_running = first.try_wait().unwrap().is_none();
+    let o = bench(&out, "bsa")
+        .arg("--radius")
+        .arg("0.2")
+        .assert()
+        .code(1)
+        .get_output()
+        .clone();
+    assert!(
+        still_running,
+        "the first bench ended before the second started"
+    );
+    assert_eq!(
+        stderr_of(&o),
+        format!(
+            "error: {} is in use by another ccpp bench (pid {})\n",
+            out.display(),
+            first.id()
+        )
+    );
+    // Stopped, the first removes its lock file with its partial summary.
+    let _ = std::process::Command::new("kill")
+        .arg("-TERM")
+        .arg(first.id().to_string())
+        .status();
+    let status = first.wait().unwrap();
+    assert!(status.code() == Some(130) || status.success(), "{status:?}");
+    assert!(!lock.exists(), "lock file left by an interrupted bench");
+    // A lock file left by a killed bench (no process holds it) is taken over.
+    std::fs::write(&lock, "4294967295\n").unwrap();
+    bench(&out, "bsa").assert().success();
+    let names = entries(&out);
+    assert_eq!(names, ["plots", "results.csv", "results.md", "runs"]);
 }
 
 /// `bench` removed every PNG and SVG in `OUT/plots/`, a user's own figure too. Only the plots a
