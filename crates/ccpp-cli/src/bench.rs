@@ -198,6 +198,9 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     let maps = name_maps(expand_maps(&a.maps)?);
     check_bench_target(&a.out)?;
     ccpp_io::write::create_folder(&a.out, &a.out)?;
+    // Held until the bench ends: a second bench on the folder is refused instead of writing
+    // its runs and summary among this one's.
+    let _lock = crate::lock::FolderLock::take(&a.out)?;
     // The summary of an earlier bench in this folder goes before any run starts: an
     // interrupted bench then leaves complete run folders and no summary, never a summary of
     // the earlier bench (another radius, other planners) beside run folders of this one.
@@ -281,9 +284,9 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         .collect();
     bar.finish_and_clear();
 
-    // The summary is one whole: a stop while it is written removes what it wrote (the plots
-    // folder only when this bench creates it, so that no file of the user's goes with it),
-    // and `results.csv`, written last, marks it complete.
+    // The summary is one whole: a stop or an error (a full disk) while it is written removes
+    // what it wrote (the plots folder only when this bench creates it, so that no file of the
+    // user's goes with it), and `results.csv`, written last, marks it complete.
     let plots = a.out.join("plots");
     let mut summary = vec![a.out.join("results.csv"), a.out.join("results.md")];
     if !plots.exists() {
@@ -293,7 +296,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     crate::plots::write_all(&a.out, &rows, &prepared, robot, &budget)?;
     write_file(&a.out.join("results.md"), results_md(&rows).as_bytes())?;
     write_file(&a.out.join("results.csv"), results_csv(&rows).as_bytes())?;
-    drop(summary);
+    summary.done();
     let failed = rows.iter().filter(|r| r.outcome.is_err()).count();
     crate::print_stdout(&format!(
         "{} runs ({} failed) on {} maps x {} planners; wrote {}/results.csv, results.md, plots/\n",
@@ -352,15 +355,22 @@ fn check_bench_target(out: &Path) -> Result<()> {
         let name = name.to_string_lossy();
         let Ok(t) = e.file_type() else { continue };
         let known = match name.as_ref() {
-            "results.csv" | "results.md" => t.is_file(),
-            "plots" | "runs" => t.is_dir(),
-            // A write cut short leaves `<file>.tmp` (see `staging::write_file`).
-            _ => {
-                Path::new(name.as_ref())
-                    .extension()
-                    .is_some_and(|x| x == "tmp")
-                    && t.is_file()
+            // A write cut short leaves `<file>.tmp` (see `staging::write_file`; any other
+            // `.tmp` is a user's), and a bench its lock file while it runs (a later bench is
+            // then refused, see `crate::lock`) or when it was killed (taken over).
+            "results.csv"
+            | "results.md"
+            | "results.csv.tmp"
+            | "results.md.tmp"
+            | crate::lock::LOCK_FILE => t.is_file(),
+            "runs" => t.is_dir(),
+            "plots" => {
+                if t.is_dir() {
+                    check_plots(out, &e.path())?;
+                }
+                t.is_dir()
             }
+            _ => false,
         };
         if !known {
             bail!(
@@ -373,10 +383,52 @@ fn check_bench_target(out: &Path) -> Result<()> {
     Ok(())
 }
 
+/// Checks that the `plots/` folder of the bench folder `out` holds only plots a bench writes
+/// ([`is_bench_plot`]): a bench removes the old ones, and removed a user's own figure there
+/// with them.
+///
+/// # Errors
+/// When it holds anything else (named), or cannot be read.
+fn check_plots(out: &Path, dir: &Path) -> Result<()> {
+    let entries =
+        std::fs::read_dir(dir).with_context(|| format!("cannot read {}", dir.display()))?;
+    for e in entries {
+        let e = e.with_context(|| format!("cannot read {}", dir.display()))?;
+        let name = e.file_name();
+        let name = name.to_string_lossy();
+        if !(is_bench_plot(&name) && e.file_type().is_ok_and(|t| t.is_file())) {
+            bail!(
+                "output folder {} holds plots/{name}, which ccpp bench did not write; a bench \
+                 rewrites its plots there, so choose a new or bench-only folder",
+                out.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Whether `name` is a plot a bench writes in `plots/` ([`crate::plots::write_all`]):
+/// `summary`, `coverage_MAP`, `paths_MAP` or `tradeoff_MAP` (`tradeoff_summary` included) as
+/// `.svg` or `.png`, or the `.tmp` of one that a write cut short left.
+fn is_bench_plot(name: &str) -> bool {
+    let name = name.strip_suffix(".tmp").unwrap_or(name);
+    let Some(stem) = name
+        .strip_suffix(".svg")
+        .or_else(|| name.strip_suffix(".png"))
+    else {
+        return false;
+    };
+    stem == "summary"
+        || ["coverage_", "paths_", "tradeoff_"]
+            .iter()
+            .any(|p| stem.len() > p.len() && stem.starts_with(p))
+}
+
 /// Removes the summary of an earlier bench in `out`: `results.csv`, `results.md` and the plots
 /// in `out/plots/` (maps it had and this one has not would stay beside this bench's results
-/// otherwise). The run folders stay: each is complete and keyed, so a bench reuses the ones
-/// that match it.
+/// otherwise), then the emptied `plots/`. Only names a bench writes ([`is_bench_plot`]; a
+/// user's figure there is refused by [`check_bench_target`] before this). The run folders stay:
+/// each is complete and keyed, so a bench reuses the ones that match it.
 fn clear_summary(out: &Path) -> Result<()> {
     for name in ["results.csv", "results.md"] {
         let p = out.join(name);
@@ -391,17 +443,19 @@ fn clear_summary(out: &Path) -> Result<()> {
     };
     for e in entries.flatten() {
         let p = e.path();
-        let plot = p
-            .extension()
-            .is_some_and(|x| x.eq_ignore_ascii_case("png") || x.eq_ignore_ascii_case("svg"));
+        let plot = is_bench_plot(&e.file_name().to_string_lossy());
         if plot && e.file_type().is_ok_and(|t| t.is_file()) {
             std::fs::remove_file(&p)
                 .with_context(|| format!("cannot remove the old plot {}", p.display()))?;
         }
     }
-    // The folder goes too unless it holds files of the user's (then removing it fails, and
-    // that is the intent: it stays as it is).
-    let _ = std::fs::remove_dir(&dir);
+    // Not removed when something else appeared there since the check: it stays as it is (and
+    // the summary then leaves the folder in place on a stop or an error).
+    if let Err(e) = std::fs::remove_dir(&dir) {
+        if e.kind() != std::io::ErrorKind::DirectoryNotEmpty {
+            return Err(e).with_context(|| format!("cannot remove the old {}", dir.display()));
+        }
+    }
     Ok(())
 }
 
@@ -848,6 +902,29 @@ mod tests {
         let huge = budget.take(500.0 * mb);
         drop(huge);
         assert_eq!(*budget.used.lock().unwrap(), 0.0);
+    }
+
+    #[test]
+    fn bench_plots_are_known_by_name() {
+        for ok in [
+            "summary.png",
+            "summary.svg",
+            "tradeoff_summary.png",
+            "coverage_teb_maze.svg",
+            "paths_a-b.png",
+            "tradeoff_x.svg.tmp",
+        ] {
+            assert!(is_bench_plot(ok), "{ok}");
+        }
+        for foreign in [
+            "my_figure.png",
+            "coverage_.png",
+            "summary.pdf",
+            "notes.txt",
+            "paths_x.png.bak",
+        ] {
+            assert!(!is_bench_plot(foreign), "{foreign}");
+        }
     }
 
     /// A planner whose every run failed had "means" of nothing (`-0.0000`) in the summary, and

@@ -10,6 +10,7 @@ mod components;
 mod errors;
 mod info;
 mod job;
+mod lock;
 mod output;
 mod plan;
 mod plots;

@@ -13,7 +13,7 @@ use ccpp_io::scenario::Scenario;
 
 use crate::components::StartComponent;
 use crate::job::{Job, JobResult};
-use crate::staging::{write_file, Staging};
+use crate::staging::Staging;
 
 /// Writes a run's files (plus `extra` ones) as one set: everything goes into a staging folder
 /// beside `out`, which then replaces `out` whole (see [`crate::staging`]). A failure or an
@@ -100,8 +100,12 @@ pub fn replay_dir(dir: &Path) -> Result<()> {
     check_same_run(dir, &scenario, &map.name, &world, &trace, &metrics)?;
     let title = format!("{} on {}", scenario.planner.name(), map.name);
     let (html, gif) = render_replay(&world, &trace, scenario.tile_side(), &metrics, &title)?;
-    write_file(&dir.join("replay.html"), html.as_bytes())?;
-    write_file(&dir.join("replay.gif"), &gif)?;
+    // Both or neither: one by one, a failure or an interrupt between them left the page
+    // without its GIF (or beside the GIF of an earlier replay).
+    crate::staging::write_files_together(
+        dir,
+        &[("replay.html", html.as_bytes()), ("replay.gif", &gif)],
+    )?;
     crate::print_stdout(&format!(
         "wrote {}/replay.html and replay.gif\n",
         dir.display()

@@ -9,7 +9,6 @@ use ccpp_core::metrics::{coverage_curve, swept_pixels, Metrics};
 use ccpp_core::trace::Trace;
 use ccpp_core::world::{Robot, World};
 use ccpp_core::Pose;
-use ccpp_io::write_atomic;
 use ccpp_render::chart::{
     bar_panels, image_grid_captioned, line_chart, tradeoff_chart, Chart, Panel,
 };
@@ -21,6 +20,7 @@ use rayon::prelude::*;
 
 use crate::job::PreparedMap;
 use crate::row::Row;
+use crate::staging::write_file;
 
 /// Reads a `trace.jsonl` back (the checked codec of `ccpp_io::trace`).
 pub fn read_trace(path: &Path) -> Result<Trace> {
@@ -28,8 +28,10 @@ pub fn read_trace(path: &Path) -> Result<Trace> {
 }
 
 fn write_chart(dir: &Path, stem: &str, chart: &Chart) -> Result<()> {
-    write_atomic(&dir.join(format!("{stem}.svg")), chart.to_svg().as_bytes())?;
-    write_atomic(&dir.join(format!("{stem}.png")), &chart.to_png()?)?;
+    // Through the command line's writer: its `.tmp` goes on interrupt, and the test hook of a
+    // full disk reaches the plots.
+    write_file(&dir.join(format!("{stem}.svg")), chart.to_svg().as_bytes())?;
+    write_file(&dir.join(format!("{stem}.png")), &chart.to_png()?)?;
     Ok(())
 }
 

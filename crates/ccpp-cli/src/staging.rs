@@ -9,7 +9,9 @@
 //! under their own names (no `.tmp` and rename each). Each staged file is synced to disk on a
 //! thread of its own as soon as it is written (the disk's latency overlaps the work on the next
 //! file; small files known early, such as `metrics.json`, go first); the swap waits for all of
-//! them, so the folder that appears is on disk whole.
+//! them, so the folder that appears is on disk whole. For a long `<name>` the staging names
+//! keep a cut of it and a hash, to stay within the file system's 255 bytes
+//! ([`ccpp_io::write::staging_name`]).
 //!
 //! What a crash (power loss) can leave: the file contents are durable before the swap, the two
 //! renames of the swap are not synced themselves (that would add a wait for the disk after the
@@ -39,6 +41,10 @@ static CHILDREN: Mutex<Vec<u32>> = Mutex::new(Vec::new());
 static STOPPING: AtomicBool = AtomicBool::new(false);
 /// Distinguishes the staging folders of one process.
 static COUNTER: AtomicU64 = AtomicU64::new(0);
+/// Lock files of output folders this process holds (a bench's, see [`crate::lock`]): removed on
+/// interrupt after the child processes have ended, so that no other bench starts on the folder
+/// while they may still write into it.
+static LOCKS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
 /// Test hook: when this environment variable names a file, writing that file fails as on a full
 /// disk (`ENOSPC`). Used by the end-to-end tests to check that a failed run leaves no output.
@@ -53,9 +59,13 @@ fn register(p: &Path) {
 }
 
 /// Paths written one by one that make one whole (a bench's summary: `results.csv`,
-/// `results.md`, `plots/`): registered for removal on interrupt from creation until the guard
-/// is dropped, so a stop in the middle leaves none of them instead of some.
-pub struct PendingSet(Vec<PathBuf>);
+/// `results.md`, `plots/`): registered for removal on interrupt from creation until
+/// [`PendingSet::done`], and removed when the guard is dropped before that (an error on the
+/// way), so a stop or a failure in the middle leaves none of them instead of some.
+pub struct PendingSet {
+    paths: Vec<PathBuf>,
+    done: bool,
+}
 
 impl PendingSet {
     /// Registers `paths` (they need not exist yet).
@@ -63,14 +73,22 @@ impl PendingSet {
         for p in &paths {
             register(p);
         }
-        Self(paths)
+        Self { paths, done: false }
+    }
+
+    /// The whole is written: its paths stay, and are no longer removed on interrupt.
+    pub fn done(mut self) {
+        self.done = true;
     }
 }
 
 impl Drop for PendingSet {
-    /// The whole is written: its paths are no longer removed on interrupt.
+    /// Removes the paths unless the whole was written ([`PendingSet::done`]).
     fn drop(&mut self) {
-        for p in &self.0 {
+        for p in &self.paths {
+            if !self.done {
+                remove_all(p);
+            }
             unregister(p);
         }
     }
@@ -148,9 +166,99 @@ pub fn install_signal_handler() {
         while !lock(&CHILDREN).is_empty() && std::time::Instant::now() < deadline {
             std::thread::sleep(std::time::Duration::from_millis(10));
         }
+        // Held until exit: no lock can be taken after this cleanup. The process's own lock on
+        // each file goes with it.
+        let locks = lock(&LOCKS);
+        for p in locks.iter() {
+            // Best effort: a lock file left behind is taken over by the next bench.
+            let _ = std::fs::remove_file(p);
+        }
         eprintln!("error: interrupted");
         std::process::exit(130);
     });
+}
+
+/// Runs `take` (which creates and locks a lock file, returning its path when it took the lock)
+/// under the lock of the interrupt cleanup, and registers the path it returns: an interrupt
+/// removes the file unless it came before `take` started.
+///
+/// # Errors
+/// What `take` returns.
+pub fn register_lock<T>(take: impl FnOnce() -> Result<(PathBuf, T)>) -> Result<T> {
+    let mut locks = lock(&LOCKS);
+    let (path, held) = take()?;
+    locks.push(path);
+    Ok(held)
+}
+
+/// Forgets a lock file (before removing it on a normal exit).
+pub fn unregister_lock(p: &Path) {
+    lock(&LOCKS).retain(|q| q != p);
+}
+
+/// Writes `files` (name, bytes) into the existing folder `dir` as one set, both or neither:
+/// each is written and synced as `<name>.tmp` first (a failure there removes them all and
+/// leaves the old files as they were); then, under the swap lock (an interrupt waits for it),
+/// each is renamed over its name in order. When a rename fails, the files renamed before it
+/// are put back as they were (the old content, kept in memory, or no file). Used by
+/// `ccpp replay`, whose page and GIF went one by one: a failure or interrupt between them left
+/// the page without its GIF. Honours the [`FAIL_WRITE_ENV`] test hook.
+///
+/// # Errors
+/// When a file cannot be written (named as in `dir`) or renamed into place.
+pub fn write_files_together(dir: &Path, files: &[(&str, &[u8])]) -> Result<()> {
+    let tmp_of = |name: &str| dir.join(format!("{name}.tmp"));
+    let clear = |upto: usize| {
+        for (name, _) in &files[..upto] {
+            let t = tmp_of(name);
+            // Best effort: it may not exist (already renamed, or never created).
+            let _ = std::fs::remove_file(&t);
+            unregister(&t);
+        }
+    };
+    for (i, (name, bytes)) in files.iter().enumerate() {
+        let tmp = tmp_of(name);
+        register(&tmp);
+        let failing = std::env::var_os(FAIL_WRITE_ENV).is_some_and(|v| v == *name);
+        let written = (|| {
+            if failing {
+                return Err(std::io::Error::from_raw_os_error(28));
+            }
+            let mut f = std::fs::File::create(&tmp)?;
+            std::io::Write::write_all(&mut f, bytes)?;
+            f.sync_all()
+        })();
+        if let Err(e) = written {
+            clear(i + 1);
+            bail!("cannot write {}: {e}", dir.join(name).display());
+        }
+    }
+    let _swap = lock(&SWAP);
+    // The old content of each file before it is replaced, to put back if a later one fails.
+    let mut before: Vec<Option<Vec<u8>>> = Vec::new();
+    for (i, (name, _)) in files.iter().enumerate() {
+        let path = dir.join(name);
+        let old = if i + 1 < files.len() {
+            std::fs::read(&path).ok()
+        } else {
+            None
+        };
+        if let Err(e) = std::fs::rename(tmp_of(name), &path) {
+            for ((done, _), old) in files[..i].iter().zip(&before).rev() {
+                let p = dir.join(done);
+                // Best effort: the error below is what the user learns.
+                let _ = match old {
+                    Some(bytes) => std::fs::write(&p, bytes),
+                    None => std::fs::remove_file(&p),
+                };
+            }
+            clear(files.len());
+            bail!("cannot write {}: {e}", path.display());
+        }
+        unregister(&tmp_of(name));
+        before.push(old);
+    }
+    Ok(())
 }
 
 /// Whether the process `pid` still runs (Linux `/proc`; elsewhere assumed gone).
@@ -169,8 +277,8 @@ fn clean_stale(parent: &Path, name: &str) {
     let Ok(entries) = std::fs::read_dir(parent) else {
         return;
     };
-    let new_prefix = format!(".{name}.ccpp-new-");
-    let old_prefix = format!(".{name}.ccpp-old-");
+    let new_prefix = ccpp_io::write::staging_prefix(name, "new");
+    let old_prefix = ccpp_io::write::staging_prefix(name, "old");
     let mut names: Vec<String> = entries
         .filter_map(|e| e.ok()?.file_name().into_string().ok())
         .collect();
@@ -255,7 +363,12 @@ impl Staging {
         }
         clean_stale(&parent, &name);
         let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-        let dir = parent.join(format!(".{name}.ccpp-new-{}-{n}", std::process::id()));
+        let dir = parent.join(ccpp_io::write::staging_name(
+            &name,
+            "new",
+            std::process::id(),
+            n,
+        ));
         {
             // Registered and created under the lock: the signal handler sees both or neither.
             let mut pending = lock(&PENDING);
@@ -332,10 +445,11 @@ impl Staging {
     pub fn commit(mut self) -> Result<()> {
         self.wait_synced()?;
         let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-        let old = self.parent.join(format!(
-            ".{}.ccpp-old-{}-{n}",
-            self.name,
-            std::process::id()
+        let old = self.parent.join(ccpp_io::write::staging_name(
+            &self.name,
+            "old",
+            std::process::id(),
+            n,
         ));
         let swap = lock(&SWAP);
         let had_old = std::fs::symlink_metadata(&self.target).is_ok();

@@ -9,6 +9,7 @@ mod common;
 mod dropped;
 mod exports;
 mod flags;
+mod folders;
 mod hostile;
 mod options;
 mod polish;

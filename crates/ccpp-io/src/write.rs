@@ -191,8 +191,52 @@ pub enum FolderError {
     },
 }
 
-/// Checks that `target` is absent, or a folder holding only [`RUN_FILES`] (and stale `.tmp`
-/// files of an interrupted atomic write).
+/// Whether `name` is one ccpp writes in a run folder: one of [`RUN_FILES`], or the `<file>.tmp`
+/// of one of them that an interrupted atomic write left (`ccpp replay` writes its files into
+/// the run folder that way). Any other `.tmp` is a user's file.
+pub fn is_run_file_name(name: &str) -> bool {
+    RUN_FILES.contains(&name)
+        || name
+            .strip_suffix(".tmp")
+            .is_some_and(|f| RUN_FILES.contains(&f))
+}
+
+/// Longest file name the usual file systems take, in bytes.
+const NAME_MAX: usize = 255;
+
+/// The start `.<name>.ccpp-<kind>-` of the names of the staging (`kind` `new`) and set-aside
+/// (`old`) folders of the output folder `name`, which go on with `<pid>-<n>`
+/// ([`staging_name`]). Kept short enough that the whole name stays within 255 bytes with any
+/// process id and counter: a longer `name` is cut at a character boundary and followed by `~`
+/// and a hash of the whole name, so that two long names with the same start keep their
+/// staging folders apart. Without the cut, a legal 250-byte `--out` failed with "File name too
+/// long".
+pub fn staging_prefix(name: &str, kind: &str) -> String {
+    // `.`, name, `.ccpp-`, kind, `-`, a u32 process id, `-`, a u64 counter.
+    let fixed = 1 + ".ccpp-".len() + kind.len() + 1 + 10 + 1 + 20;
+    let room = NAME_MAX.saturating_sub(fixed);
+    if name.len() <= room {
+        return format!(".{name}.ccpp-{kind}-");
+    }
+    let mut h = ccpp_core::hash::Fnv::new();
+    h.bytes(name.as_bytes());
+    let hash = format!("~{:016x}", h.finish());
+    let mut cut = room.saturating_sub(hash.len());
+    while !name.is_char_boundary(cut) {
+        cut -= 1;
+    }
+    format!(".{}{hash}.ccpp-{kind}-", &name[..cut])
+}
+
+/// The name of a staging (`kind` `new`) or set-aside (`old`) folder of the output folder
+/// `name`, made by process `pid` as its `n`-th: `.<name>.ccpp-<kind>-<pid>-<n>`, within 255
+/// bytes (see [`staging_prefix`]).
+pub fn staging_name(name: &str, kind: &str, pid: u32, n: u64) -> String {
+    format!("{}{pid}-{n}", staging_prefix(name, kind))
+}
+
+/// Checks that `target` is absent, or a folder holding only run files ([`is_run_file_name`]:
+/// [`RUN_FILES`] and the `.tmp` of one of them left by an interrupted atomic write).
 ///
 /// # Errors
 /// [`FolderError::NotAFolder`], [`FolderError::Foreign`], or [`FolderError::Io`] when the
@@ -213,8 +257,7 @@ pub fn check_run_folder(target: &Path) -> Result<(), FolderError> {
     for e in std::fs::read_dir(target).map_err(io_err)? {
         let e = e.map_err(io_err)?;
         let name = e.file_name().to_string_lossy().into_owned();
-        let tmp = Path::new(&name).extension().is_some_and(|x| x == "tmp");
-        let known = RUN_FILES.contains(&name.as_str()) || tmp;
+        let known = is_run_file_name(&name);
         if !known || !e.file_type().is_ok_and(|t| t.is_file()) {
             return Err(FolderError::Foreign {
                 path: target.to_path_buf(),
@@ -292,7 +335,7 @@ pub fn write_folder(target: &Path, files: &[(&str, Vec<u8>)]) -> Result<(), Fold
     }
     let tag = |kind: &str| {
         let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-        parent.join(format!(".{name}.ccpp-{kind}-{}-{n}", std::process::id()))
+        parent.join(staging_name(&name, kind, std::process::id(), n))
     };
     let staging = tag("new");
     std::fs::create_dir(&staging).map_err(io_err)?;
@@ -428,6 +471,58 @@ mod tests {
         write_folder(&dotdot, &[("run.json", b"4".to_vec())]).unwrap();
         assert_eq!(std::fs::read(d.path().join("new/run.json")).unwrap(), b"4");
         assert_eq!(names(d.path()), ["new", "out"]);
+    }
+
+    #[test]
+    fn only_ccpp_names_are_run_files() {
+        for ok in [
+            "run.json",
+            "replay.gif",
+            "replay.html.tmp",
+            "metrics.json.tmp",
+        ] {
+            assert!(is_run_file_name(ok), "{ok}");
+        }
+        for foreign in ["thesis.tmp", ".tmp", "tmp", "run.json.tmp.tmp", "notes.txt"] {
+            assert!(!is_run_file_name(foreign), "{foreign}");
+        }
+        let d = tempfile::tempdir().unwrap();
+        let target = d.path().join("u");
+        std::fs::create_dir(&target).unwrap();
+        std::fs::write(target.join("thesis.tmp"), b"precious").unwrap();
+        let e = write_folder(&target, &[("run.json", b"1".to_vec())]).unwrap_err();
+        assert!(e.to_string().contains("holds thesis.tmp"), "{e}");
+        assert_eq!(names(&target), ["thesis.tmp"]);
+    }
+
+    #[test]
+    fn staging_names_stay_within_255_bytes() {
+        let long = |c: &str, n: usize| c.repeat(n);
+        for name in [
+            "out".to_string(),
+            long("a", 213),
+            long("a", 214),
+            long("a", 255),
+            long("\u{e9}", 127),
+            long("\u{1f600}", 63),
+        ] {
+            for kind in ["new", "old"] {
+                let s = staging_name(&name, kind, u32::MAX, u64::MAX);
+                assert!(s.len() <= 255, "{} bytes for {} bytes", s.len(), name.len());
+                assert!(s.starts_with(&staging_prefix(&name, kind)));
+            }
+        }
+        // Short names are kept whole; long ones that share a start stay apart.
+        assert_eq!(staging_name("out", "new", 7, 1), ".out.ccpp-new-7-1");
+        let (a, b) = (long("a", 250), format!("{}b", long("a", 249)));
+        assert_ne!(staging_prefix(&a, "new"), staging_prefix(&b, "new"));
+        // A folder of the longest legal name is written and replaced.
+        let d = tempfile::tempdir().unwrap();
+        let target = d.path().join(long("a", 255));
+        write_folder(&target, &[("run.json", b"1".to_vec())]).unwrap();
+        write_folder(&target, &[("run.json", b"2".to_vec())]).unwrap();
+        assert_eq!(std::fs::read(target.join("run.json")).unwrap(), b"2");
+        assert_eq!(names(d.path()).len(), 1);
     }
 
     #[test]

@@ -1,0 +1,316 @@
+//! End-to-end tests of what the output folders hold and who writes them: one bench at a time
+//! on a folder, a user's files never taken for ccpp's (`plots/`, `*.tmp`), the replay's two
+//! files written together, a failed bench summary removed whole, and `--out` names up to the
+//! file system's 255 bytes.
+#![allow(clippy::unwrap_used)]
+
+use std::path::{Path, PathBuf};
+use std::process::Stdio;
+
+use assert_cmd::Command;
+
+use crate::common::{ccpp, data};
+
+/// Entry names of a folder, sorted.
+fn entries(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+fn stderr_of(o: &std::process::Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+const BASE_SET: [&str; 5] = [
+    "coverage.png",
+    "metrics.json",
+    "path.csv",
+    "run.json",
+    "trace.jsonl",
+];
+
+const LOCK_FILE: &str = ".ccpp-bench.lock";
+
+fn bench(out: &Path, planners: &str) -> Command {
+    let mut c = ccpp();
+    c.args(["bench", "--quiet", "--jobs", "1", "--planners", planners])
+        .arg("--maps")
+        .arg(data("teb_empty_box.yaml"))
+        .arg("--out")
+        .arg(out);
+    c
+}
+
+/// A 600 x 600 px (30 x 30 m) room with pillars: a bench on it takes long enough to be caught
+/// running.
+fn slow_map(dir: &Path) -> PathBuf {
+    let n = 600u32;
+    let mut img = image::GrayImage::from_pixel(n, n, image::Luma([254]));
+    for (x, y, p) in img.enumerate_pixels_mut() {
+        let wall = x < 2 || y < 2 || x >= n - 2 || y >= n - 2;
+        let pillar = (x % 120) < 15 && (y % 120) < 15 && x > 30 && y > 30;
+        if wall || pillar {
+            *p = image::Luma([0]);
+        }
+    }
+    let p = dir.join("slow_room.png");
+    img.save(&p).unwrap();
+    p
+}
+
+/// Two benches on one `--out` at once wrote over each other and left a mixed folder, both
+/// exiting 0. The second is now refused while the first runs, naming the first's process; the
+/// lock goes with the first, on an interrupt too, and one left by a killed bench is taken over.
+#[cfg(unix)]
+#[test]
+fn a_second_bench_on_a_folder_in_use_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = slow_map(dir.path());
+    let out = dir.path().join("bb");
+    let mut first = std::process::Command::new(assert_cmd::cargo::cargo_bin("ccpp"))
+        .args(["bench", "--quiet", "--jobs", "1"])
+        .args(["--planners", "ba-star,bsa,bcd,random-bounce", "--maps"])
+        .arg(&map)
+        .arg("--out")
+        .arg(&out)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let lock = out.join(LOCK_FILE);
+    let t0 = std::time::Instant::now();
+    while !std::fs::read_to_string(&lock).is_ok_and(|t| t.ends_with('\n'))
+        && t0.elapsed() < std::time::Duration::from_secs(30)
+    {
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    assert!(lock.is_file(), "the running bench holds no lock file");
+    let still_running = first.try_wait().unwrap().is_none();
+    let o = bench(&out, "bsa")
+        .arg("--radius")
+        .arg("0.2")
+        .assert()
+        .code(1)
+        .get_output()
+        .clone();
+    assert!(
+        still_running,
+        "the first bench ended before the second started"
+    );
+    assert_eq!(
+        stderr_of(&o),
+        format!(
+            "error: {} is in use by another ccpp bench (pid {})\n",
+            out.display(),
+            first.id()
+        )
+    );
+    // Stopped, the first removes its lock file with its partial summary.
+    let _ = std::process::Command::new("kill")
+        .arg("-TERM")
+        .arg(first.id().to_string())
+        .status();
+    let status = first.wait().unwrap();
+    assert!(status.code() == Some(130) || status.success(), "{status:?}");
+    assert!(!lock.exists(), "lock file left by an interrupted bench");
+    // A lock file left by a killed bench (no process holds it) is taken over.
+    std::fs::write(&lock, "4294967295\n").unwrap();
+    bench(&out, "bsa").assert().success();
+    let names = entries(&out);
+    assert_eq!(names, ["plots", "results.csv", "results.md", "runs"]);
+}
+
+/// `bench` removed every PNG and SVG in `OUT/plots/`, a user's own figure too. Only the plots a
+/// bench writes are its own; anything else there is refused, as at the top of the folder.
+#[test]
+fn bench_keeps_a_users_files_in_plots_and_refuses_the_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bf6");
+    std::fs::create_dir_all(out.join("plots")).unwrap();
+    std::fs::write(out.join("plots/my_figure.png"), "fig").unwrap();
+    let o = bench(&out, "bsa").assert().code(1).get_output().clone();
+    let err = stderr_of(&o);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.starts_with("error: ") && err.contains("plots/my_figure.png"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(out.join("plots/my_figure.png")).unwrap(),
+        "fig"
+    );
+    assert_eq!(
+        entries(&out),
+        ["plots"],
+        "the refused bench wrote something"
+    );
+    // A bench's own old plots (of a map this bench does not have) still go, and a stray
+    // `.tmp` at the top that a bench does not write is refused like any other file.
+    std::fs::remove_file(out.join("plots/my_figure.png")).unwrap();
+    bench(&out, "bsa").assert().success();
+    std::fs::write(out.join("plots/coverage_gone.png"), "old").unwrap();
+    bench(&out, "bsa").assert().success();
+    assert!(!out.join("plots/coverage_gone.png").exists());
+    std::fs::write(out.join("thesis.tmp"), "precious").unwrap();
+    let o = bench(&out, "bsa").assert().code(1).get_output().clone();
+    assert!(stderr_of(&o).contains("thesis.tmp"), "{}", stderr_of(&o));
+    assert_eq!(
+        std::fs::read_to_string(out.join("thesis.tmp")).unwrap(),
+        "precious"
+    );
+}
+
+/// `run` and `plan` took any `*.tmp` in `--out` for their own and deleted it with the old
+/// folder. Only the `.tmp` of a file ccpp writes is its own.
+#[test]
+fn run_and_plan_refuse_a_users_tmp_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("u");
+    std::fs::create_dir(&out).unwrap();
+    std::fs::write(out.join("thesis.tmp"), "precious").unwrap();
+    for sub in ["run", "plan"] {
+        let o = ccpp()
+            .args([sub, "--planner", "bcd", "--map"])
+            .arg(data("teb_empty_box.yaml"))
+            .arg("--out")
+            .arg(&out)
+            .assert()
+            .code(1)
+            .get_output()
+            .clone();
+        let err = stderr_of(&o);
+        assert!(
+            err.starts_with("error: ") && err.contains("holds thesis.tmp"),
+            "{sub}: {err}"
+        );
+        assert_eq!(entries(&out), ["thesis.tmp"], "{sub}");
+    }
+    // The `.tmp` of a file ccpp writes (left by an interrupted `ccpp replay`) is its own.
+    std::fs::remove_file(out.join("thesis.tmp")).unwrap();
+    std::fs::write(out.join("replay.html.tmp"), "cut short").unwrap();
+    ccpp()
+        .args(["run", "--planner", "bcd", "--map"])
+        .arg(data("teb_empty_box.yaml"))
+        .arg("--out")
+        .arg(&out)
+        .assert()
+        .success();
+    assert_eq!(entries(&out), BASE_SET);
+}
+
+/// `ccpp replay` wrote `replay.html` and then `replay.gif`: a failure between them left the page
+/// without its GIF, or a new page beside the GIF of an earlier replay. Both or neither now.
+#[test]
+fn replay_writes_its_page_and_gif_together() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("r");
+    ccpp()
+        .args(["run", "--planner", "bcd", "--map"])
+        .arg(data("teb_empty_box.yaml"))
+        .arg("--out")
+        .arg(&out)
+        .assert()
+        .success();
+    let replay = |fail: &str| {
+        let mut c = ccpp();
+        c.arg("replay").arg(&out);
+        if !fail.is_empty() {
+            c.env("CCPP_TEST_FAIL_WRITE", fail);
+        }
+        c
+    };
+    for fail in ["replay.html", "replay.gif"] {
+        let o = replay(fail).assert().code(1).get_output().clone();
+        let err = stderr_of(&o);
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(err.contains(fail) && err.contains("os error 28"), "{err}");
+        assert_eq!(entries(&out), BASE_SET, "{fail}: no replay at all");
+    }
+    // An earlier replay stays whole when the new one fails.
+    std::fs::write(out.join("replay.html"), "old page").unwrap();
+    std::fs::write(out.join("replay.gif"), "old gif").unwrap();
+    for fail in ["replay.html", "replay.gif"] {
+        replay(fail).assert().code(1);
+        assert_eq!(
+            std::fs::read_to_string(out.join("replay.html")).unwrap(),
+            "old page",
+            "{fail}"
+        );
+        assert_eq!(
+            std::fs::read_to_string(out.join("replay.gif")).unwrap(),
+            "old gif",
+            "{fail}"
+        );
+        assert_eq!(
+            entries(&out).len(),
+            BASE_SET.len() + 2,
+            "{fail}: stray file"
+        );
+    }
+    replay("").assert().success();
+    assert!(std::fs::read(out.join("replay.gif"))
+        .unwrap()
+        .starts_with(b"GIF8"));
+    assert!(std::fs::read_to_string(out.join("replay.html"))
+        .unwrap()
+        .contains("<html"));
+    assert_eq!(entries(&out).len(), BASE_SET.len() + 2);
+}
+
+/// A bench that failed while writing its summary (a full disk) left some of its plots; the
+/// error path now removes what the summary wrote, as the interrupt path does, and keeps the
+/// complete run folders.
+#[test]
+fn a_failed_bench_summary_leaves_no_part_of_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bench");
+    bench(&out, "bsa,bcd").assert().success();
+    for fail in ["summary.png", "results.md", "results.csv"] {
+        let o = bench(&out, "bsa,bcd")
+            .env("CCPP_TEST_FAIL_WRITE", fail)
+            .assert()
+            .code(1)
+            .get_output()
+            .clone();
+        let err = stderr_of(&o);
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(err.contains(fail) && err.contains("os error 28"), "{err}");
+        assert_eq!(entries(&out), ["runs"], "{fail}: a partial summary");
+        for p in ["bsa", "bcd"] {
+            let run = out.join("runs/teb_empty_box").join(p);
+            assert!(run.join("metrics.json").is_file(), "{fail}: run {p} lost");
+        }
+    }
+    bench(&out, "bsa,bcd").assert().success();
+    assert_eq!(
+        entries(&out),
+        ["plots", "results.csv", "results.md", "runs"]
+    );
+}
+
+/// A legal long `--out` name failed with "File name too long": the staging folder's name added
+/// 20-odd bytes to it. Any name the file system takes works now, and is replaced on a rerun.
+#[test]
+fn run_and_plan_take_the_longest_folder_name() {
+    let dir = tempfile::tempdir().unwrap();
+    for (sub, c) in [("run", "a"), ("plan", "\u{e9}")] {
+        let name = c.repeat(255 / c.len());
+        let out = dir.path().join(&name);
+        for _ in 0..2 {
+            ccpp()
+                .args([sub, "--planner", "bcd", "--map"])
+                .arg(data("teb_empty_box.yaml"))
+                .arg("--out")
+                .arg(&out)
+                .assert()
+                .success();
+        }
+        assert!(out.is_dir(), "{sub}");
+        assert!(!entries(&out).is_empty(), "{sub}");
+    }
+    assert_eq!(entries(dir.path()).len(), 2, "stray staging folder");
+}
