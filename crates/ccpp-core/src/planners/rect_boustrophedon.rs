@@ -98,6 +98,18 @@ impl Default for RectOptions {
     }
 }
 
+impl RectOptions {
+    /// The radius of the disk the lanes and detours are planned for, for a robot of radius
+    /// `robot_radius`: `clearance_radius_m`, by default the rectangle's circumscribed disk
+    /// `hypot(l, b) / 2`, never less than `robot_radius` (a plan falls back to the robot's own
+    /// radius, with a note in its trace, when that disk does not fit at the start).
+    pub fn clearance_radius(&self, robot_radius: f64) -> f64 {
+        self.clearance_radius_m
+            .unwrap_or(0.5 * self.length_m.hypot(self.width_m))
+            .max(robot_radius)
+    }
+}
+
 /// The seed's lanes over `area = [x0, y0, x1, y1]`: lane `k` at `y0 + k b` (the last one clamped
 /// to `y1`), waypoints every `l` from `x0` (the last one clamped to `x1`), even lanes going +x
 /// and odd lanes -x. Degenerate input (non-positive sizes, empty area) gives no lane.
@@ -156,10 +168,7 @@ pub fn waypoints(world: &World, opts: &RectOptions) -> Vec<Point> {
 /// when that disk does not fit at the start.
 fn clearance_world(world: &World, opts: &RectOptions) -> (World, f64, Option<String>) {
     let r_world = world.robot().radius;
-    let rad = opts
-        .clearance_radius_m
-        .unwrap_or(0.5 * opts.length_m.hypot(opts.width_m))
-        .max(r_world);
+    let rad = opts.clearance_radius(r_world);
     match World::new(world.map().clone(), Robot::new(rad), Some(world.start())) {
         Ok(w) => (w, rad, None),
         Err(e) => (
