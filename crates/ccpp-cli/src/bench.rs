@@ -299,11 +299,8 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     summary.done();
     let failed = rows.iter().filter(|r| r.outcome.is_err()).count();
     crate::print_stdout(&format!(
-        "{} runs ({} failed) on {} maps x {} planners; wrote {}/results.csv, results.md, plots/\n",
-        rows.len(),
-        failed,
-        prepared.len(),
-        planners.len(),
+        "{}; wrote {}/results.csv, results.md, plots/\n",
+        done_line(rows.len(), failed, prepared.len(), planners.len()),
         a.out.display()
     ))?;
     // Runs the simulator stopped before the planner finished (`stalled`, `max_steps`) are
@@ -779,6 +776,18 @@ pub fn results_csv(rows: &[Row]) -> String {
         s.push('\n');
     }
     s
+}
+
+/// The head of bench's last line: `3 runs (0 failed) on 1 map x 3 planners`, each count with
+/// its noun in the singular or plural it takes.
+fn done_line(runs: usize, failed: usize, maps: usize, planners: usize) -> String {
+    use crate::output::count;
+    format!(
+        "{} ({failed} failed) on {} x {}",
+        count(runs, "run", "runs"),
+        count(maps, "map", "maps"),
+        count(planners, "planner", "planners")
+    )
 }
 
 /// `results.md`: a table per map and a summary across maps.

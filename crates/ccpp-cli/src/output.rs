@@ -276,7 +276,18 @@ pub fn num(v: f64) -> String {
     }
 }
 
-/// A short human table of the metrics.
+/// `n` and its noun: `1 map`, `2 maps`.
+pub fn count(n: usize, one: &str, many: &str) -> String {
+    if n == 1 {
+        format!("{n} {one}")
+    } else {
+        format!("{n} {many}")
+    }
+}
+
+/// A short human table of the metrics: every key of `metrics.json` but the header's (planner,
+/// map, radii), the optional ones (`tracking_error_*`, `rect_guarantee`, `stop_reason`) when
+/// the run has them.
 pub fn summary(m: &Metrics) -> String {
     let mut s = String::new();
     let _ = writeln!(
@@ -311,11 +322,20 @@ pub fn summary(m: &Metrics) -> String {
         ("keepout_violations", m.keepout_violations.to_string()),
         ("wall_time_s", format!("{:.3}", m.wall_time_s)),
     ];
-    for (k, v) in rows {
-        let _ = writeln!(s, "  {k:<20} {v:>12}");
+    // The optional metrics, when present (null keys are left out of metrics.json).
+    let optional = [
+        ("tracking_error_mean_m", m.tracking_error_mean_m, 4),
+        ("tracking_error_max_m", m.tracking_error_max_m, 4),
+        ("rect_guarantee", m.rect_guarantee, 4),
+    ];
+    let optional = optional
+        .into_iter()
+        .filter_map(|(k, v, digits)| v.map(|v| (k, format!("{v:.digits$}"))));
+    for (k, v) in rows.into_iter().chain(optional) {
+        let _ = writeln!(s, "  {k:<21} {v:>12}");
     }
     if let Some(why) = &m.stop_reason {
-        let _ = writeln!(s, "  {:<20} {why:>12}", "stop_reason");
+        let _ = writeln!(s, "  {:<21} {why:>12}", "stop_reason");
         let _ = writeln!(s, "  warning: {}", stop_warning(why, "coverage"));
     }
     s

@@ -4,7 +4,7 @@
 use std::fmt::Write as _;
 
 use anyhow::{bail, Result};
-use ccpp_core::planners::PlannerKind;
+use ccpp_core::planners::{PlannerConfig, PlannerKind};
 use ccpp_core::route::DEFAULT_TOLERANCE_M;
 use ccpp_core::sim::StopReason;
 use ccpp_io::export::{render_exports, zone_features, ExportFormat, ExportMeta};
@@ -91,10 +91,10 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "{} on {} (r = {} m): {} waypoints, {:.2} m, planned in {:.3} s",
+        "{} on {} ({}): {} waypoints, {:.2} m, planned in {:.3} s",
         kind,
         map.name,
-        crate::output::num(robot.radius),
+        robot_used(&scenario),
         plan.route.waypoints.len(),
         plan.route.length_m(),
         plan.wall_time_s
@@ -109,4 +109,26 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     let names: Vec<&str> = files.iter().map(|(n, _)| *n).collect();
     let _ = writeln!(s, "wrote {}/{{{}}}", a.out.display(), names.join(", "));
     crate::print_stdout(&s)
+}
+
+/// The robot a plan was made for, as the summary prints it: `r = 0.15 m, tool r = 0.15 m`,
+/// and for rect-boustrophedon the rectangle (whose width is its lanes' spacing: a plan has no
+/// tool of its own) and the disk it plans for (`rectangle 0.4 x 0.4 m, clearance disk
+/// r = 0.283 m`).
+pub fn robot_used(scenario: &Scenario) -> String {
+    use crate::output::num;
+    let robot = scenario.robot;
+    match &scenario.planner {
+        PlannerConfig::RectBoustrophedon(o) => format!(
+            "rectangle {} x {} m, clearance disk r = {:.3} m",
+            num(o.length_for(&robot)),
+            num(o.width_for(&robot)),
+            o.clearance_radius(&robot),
+        ),
+        _ => format!(
+            "r = {} m, tool r = {} m",
+            num(robot.radius),
+            num(robot.tool_radius)
+        ),
+    }
 }

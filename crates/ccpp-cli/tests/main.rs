@@ -8,6 +8,7 @@ mod cli;
 mod common;
 mod dropped;
 mod exports;
+mod first_use;
 mod flags;
 mod folders;
 mod hostile;

@@ -158,6 +158,39 @@ impl Chart {
                 Swatch::Fill(c) => {
                     self.rect(sx + s * 0.3, sy, s, s, Some(*c), Some([90, 90, 90]));
                 }
+                Swatch::Hatched { fill, hatch } => {
+                    let (a, b) = (sx + s * 0.3, sy);
+                    self.rect(a, b, s, s, Some(*fill), None);
+                    // Diagonals x + y = c (up to the right, as the map's hatching), clipped
+                    // to the square.
+                    for k in 1..6 {
+                        let c = a + b + 2.0 * s * k as f32 / 6.0;
+                        let x0 = a.max(c - (b + s));
+                        let x1 = (a + s).min(c - b);
+                        self.line(
+                            vec![(x0, c - x0), (x1, c - x1)],
+                            *hatch,
+                            (s / 8.0).max(1.5),
+                            false,
+                        );
+                    }
+                    self.rect(a, b, s, s, None, Some([90, 90, 90]));
+                }
+                Swatch::Dotted(c) => {
+                    let w = (s / 6.0).max(2.0);
+                    self.line(
+                        vec![(sx, my), (sx + s * 1.6, my)],
+                        [255, 255, 255],
+                        2.0 * w,
+                        false,
+                    );
+                    let n = 5;
+                    for k in 0..n {
+                        let a = sx + s * 1.6 * (2 * k) as f32 / (2 * n - 1) as f32;
+                        let b = sx + s * 1.6 * (2 * k + 1) as f32 / (2 * n - 1) as f32;
+                        self.line(vec![(a, my), (b, my)], *c, w, false);
+                    }
+                }
                 Swatch::Line { rgb, dashed } => {
                     let pts = vec![(sx, my), (sx + s * 1.6, my)];
                     if *dashed {
@@ -519,6 +552,15 @@ impl Chart {
 pub enum Swatch {
     /// A filled square (an area colour).
     Fill([u8; 3]),
+    /// A filled square with diagonal hatching (the keep-out zones).
+    Hatched {
+        /// Background colour.
+        fill: [u8; 3],
+        /// Hatching colour.
+        hatch: [u8; 3],
+    },
+    /// A dotted line sample over a white casing (the approach to the work area).
+    Dotted([u8; 3]),
     /// A line sample; dashed lines are drawn over a white casing.
     Line {
         /// Colour.

@@ -100,6 +100,36 @@ pub mod colours {
     pub const OUTSIDE_AREA: [u8; 3] = [226, 222, 208];
     /// Work-area border.
     pub const AREA_BORDER: [u8; 3] = [110, 40, 150];
+    /// The approach to the work area from a start outside it (dotted, over a white casing).
+    pub const APPROACH: [u8; 3] = [105, 105, 105];
+    /// The badge of a run the simulator stopped before the planner finished.
+    pub const STOPPED: [u8; 3] = [200, 30, 30];
+}
+
+/// Where the approach to the work area ends (a start outside the area: the simulator drives
+/// [`World::approach`] before the planner starts, all at step 0): the index among the trace's
+/// poses and the pose of the first one at [`World::start`]. `None` without an approach (or a
+/// trace that never reaches its end).
+pub fn approach_end(world: &World, trace: &Trace) -> Option<(usize, ccpp_core::Pose)> {
+    if world.approach().is_empty() {
+        return None;
+    }
+    let target = world.start().position();
+    // The approach is driven exactly: its end is the target up to rounding.
+    let tol = world.frame().resolution * 1e-3;
+    trace
+        .poses()
+        .enumerate()
+        .find(|(_, pose)| pose.position().dist(target) <= tol)
+}
+
+/// Why the simulator stopped a run the planner did not finish (`stalled`, `max_steps`): the
+/// reason of the trace's `finished` event when it is not `done`.
+pub fn stop_reason(trace: &Trace) -> Option<String> {
+    trace.events().find_map(|(_, e)| match e {
+        Event::Finished { reason } if reason != "done" => Some(reason.clone()),
+        _ => None,
+    })
 }
 
 /// Zone class of map pixel `i` for the pictures: 1 = keep-out, 2 = outside the area, 0 = none.
@@ -298,6 +328,8 @@ struct Shown {
     swept: bool,
     missed: bool,
     swept_outside: bool,
+    /// Floor outside the work area that the tool swept (the approach, mostly).
+    swept_outside_area: bool,
     unreachable: bool,
     obstacle: bool,
     unknown: bool,
@@ -314,6 +346,8 @@ struct Shown {
     keepout: bool,
     outside_area: bool,
     area_border: bool,
+    /// The robot drove an approach to the work area.
+    approach: bool,
 }
 
 fn shown(world: &World, trace: &Trace, crop: (usize, usize, usize, usize)) -> Shown {
@@ -343,7 +377,13 @@ fn shown_with(
                     Cell::Occupied => s.obstacle = true,
                     Cell::Unknown => s.unknown = true,
                     Cell::Free if zone_class(world, i) == 1 => s.keepout = true,
-                    Cell::Free if zone_class(world, i) == 2 => s.outside_area = true,
+                    Cell::Free if zone_class(world, i) == 2 => {
+                        if swept.contains(i) {
+                            s.swept_outside_area = true;
+                        } else {
+                            s.outside_area = true;
+                        }
+                    }
                     Cell::Free => s.free_class(acc.contains(i), swept.contains(i)),
                 }
             }
@@ -351,6 +391,8 @@ fn shown_with(
     } else {
         shown_classes(&mut s, &f, cells, acc, swept, crop);
     }
+    s.approach = approach_end(world, trace)
+        .is_some_and(|(_, end)| world.initial_pose().position() != end.position());
     let mut in_bt = false;
     let mut regions = std::collections::BTreeSet::new();
     let mut region = 0u32;
@@ -590,6 +632,7 @@ pub fn legend_entries_union_of(runs: &[LegendShown]) -> Vec<LegendEntry> {
         all.swept |= s.swept;
         all.missed |= s.missed;
         all.swept_outside |= s.swept_outside;
+        all.swept_outside_area |= s.swept_outside_area;
         all.unreachable |= s.unreachable;
         all.obstacle |= s.obstacle;
         all.unknown |= s.unknown;
@@ -603,6 +646,7 @@ pub fn legend_entries_union_of(runs: &[LegendShown]) -> Vec<LegendEntry> {
         all.keepout |= s.keepout;
         all.outside_area |= s.outside_area;
         all.area_border |= s.area_border;
+        all.approach |= s.approach;
     }
     let mut e = entries_of(&all);
     // Counts differ per run: drop them from the shared legend.
@@ -625,9 +669,14 @@ fn entries_of(s: &Shown) -> Vec<LegendEntry> {
     add(s.swept, Swatch::Fill(c::SWEPT), "swept floor".into());
     add(s.missed, Swatch::Fill(c::MISSED), "missed floor".into());
     add(
-        s.swept_outside,
+        s.swept_outside || s.swept_outside_area,
         Swatch::Fill(c::SWEPT_OUTSIDE),
-        "swept, outside reachable floor".into(),
+        match (s.swept_outside, s.swept_outside_area) {
+            (true, false) => "swept, outside reachable floor",
+            (false, true) => "swept, outside the area",
+            _ => "swept, outside the area or reachable floor",
+        }
+        .into(),
     );
     add(
         s.unreachable,
@@ -638,7 +687,10 @@ fn entries_of(s: &Shown) -> Vec<LegendEntry> {
     add(s.unknown, Swatch::Fill(c::UNKNOWN), "unknown".into());
     add(
         s.keepout,
-        Swatch::Fill(c::KEEPOUT_HATCH),
+        Swatch::Hatched {
+            fill: c::KEEPOUT,
+            hatch: c::KEEPOUT_HATCH,
+        },
         "keep-out zone (hatched)".into(),
     );
     add(
@@ -669,6 +721,11 @@ fn entries_of(s: &Shown) -> Vec<LegendEntry> {
         } else {
             "path".into()
         },
+    );
+    add(
+        s.approach,
+        Swatch::Dotted(c::APPROACH),
+        "approach to the area".into(),
     );
     add(
         s.backtrack,
@@ -768,7 +825,8 @@ pub fn coverage_pixmap_swept(
             .events()
             .filter(|(_, e)| matches!(e, Event::Collision { .. }))
             .count();
-        // Badges, right-aligned on the first line.
+        // Badges, right-aligned on the first line; a run the simulator stopped says so first.
+        let stopped = stop_reason(trace).map(|why| (format!("stopped: {why}"), colours::STOPPED));
         let badges = [
             (
                 format!("{:.1}% covered", 100.0 * cov),
@@ -783,6 +841,7 @@ pub fn coverage_pixmap_swept(
                 },
             ),
         ];
+        let badges: Vec<(String, [u8; 3])> = stopped.into_iter().chain(badges).collect();
         let bh = font::line_height(title_px) + 4.0;
         let mut bx = cw as f32 - 6.0;
         for (text, colour) in badges.iter().rev() {
@@ -869,7 +928,14 @@ pub fn coverage_pixmap_swept(
                     colours::KEEPOUT
                 }
             }
-            Cell::Free if zone_class(world, i) == 2 => colours::OUTSIDE_AREA,
+            Cell::Free if zone_class(world, i) == 2 => {
+                // The approach sweeps floor outside the area: shown as swept.
+                if swept.contains(i) {
+                    colours::SWEPT_OUTSIDE
+                } else {
+                    colours::OUTSIDE_AREA
+                }
+            }
             Cell::Free => match (acc.contains(i), swept.contains(i)) {
                 (true, true) => colours::SWEPT,
                 (true, false) => colours::MISSED,
@@ -1008,13 +1074,18 @@ fn draw_zone_borders(pm: &mut Pixmap, world: &World, view: View) {
 }
 
 /// The entries of a trace with each straight run reduced to its first and last pose (what a
-/// drawn polyline needs).
-fn path_entries(trace: &Trace) -> impl Iterator<Item = Entry<'_>> + '_ {
+/// drawn polyline needs), each with the index of its pose among the trace's poses (an event:
+/// the number of poses before it).
+fn path_entries(trace: &Trace) -> impl Iterator<Item = (usize, Entry<'_>)> + '_ {
     let lattice = trace.lattice();
+    let mut poses = 0usize;
     trace.pieces().flat_map(move |piece| {
         let pair = match piece {
-            Piece::Pose { t, pose } => [Some(Entry::Pose { t, pose }), None],
-            Piece::Event { t, event } => [Some(Entry::Event { t, event }), None],
+            Piece::Pose { t, pose } => {
+                poses += 1;
+                [Some((poses - 1, Entry::Pose { t, pose })), None]
+            }
+            Piece::Event { t, event } => [Some((poses, Entry::Event { t, event })), None],
             Piece::Run(run) => {
                 let [x, y] = run.to(lattice);
                 let first = Entry::Pose {
@@ -1025,30 +1096,56 @@ fn path_entries(trace: &Trace) -> impl Iterator<Item = Entry<'_>> + '_ {
                     t: run.t + u64::from(run.n) - 1,
                     pose: ccpp_core::Pose::new(x, y, run.theta),
                 };
-                [Some(first), Some(last)]
+                let n = run.n as usize;
+                poses += n;
+                [Some((poses - n, first)), Some((poses - 1, last))]
             }
         };
         pair.into_iter().flatten()
     })
 }
 
+/// How a stretch of the path is drawn: a region's colour, a backtracking transfer (dashed) or
+/// the approach to the work area (dotted).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum PathStyle {
+    Region(usize),
+    Backtrack,
+    Approach,
+}
+
 fn draw_path(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
     let width = (view.scale * 0.6).clamp(1.0, 3.0);
     let mut region = 0usize;
     let mut in_backtrack = false;
+    // The approach (a start outside the area) ends at this step and pose.
+    let mut approach = approach_end(world, trace);
     let mut last: Option<(f32, f32)> = None;
     // Collect runs of segments with the same style, then stroke each run once.
     let mut run: Vec<(f32, f32)> = Vec::new();
-    let mut run_style = (0usize, false);
+    let mut run_style = PathStyle::Region(0);
     let mut lanes = LaneBlitter::default();
-    let mut flush = |pm: &mut Pixmap, run: &mut Vec<(f32, f32)>, style: (usize, bool)| {
+    let mut flush = |pm: &mut Pixmap, run: &mut Vec<(f32, f32)>, style: PathStyle| {
         if run.len() >= 2 {
             let mut stroke = Stroke {
                 width,
                 ..Stroke::default()
             };
             stroke.line_join = tiny_skia::LineJoin::Round;
-            if style.1 {
+            if let PathStyle::Region(k) = style {
+                // A region's lanes: the axis-aligned segments (nearly all of a coverage path)
+                // are filled with their exact area coverage, the others stroked.
+                let colour = PALETTE[k.saturating_sub(1) % PALETTE.len()];
+                if let Some(path) = lanes.draw(pm, run, width, colour) {
+                    pm.stroke_path(
+                        &path,
+                        &paint(rgb(colour)),
+                        &stroke,
+                        Transform::identity(),
+                        None,
+                    );
+                }
+            } else {
                 let mut pb = PathBuilder::new();
                 pb.move_to(run[0].0, run[0].1);
                 for &(x, y) in &run[1..] {
@@ -1066,15 +1163,12 @@ fn draw_path(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
                         Transform::identity(),
                         None,
                     );
-                    stroke.dash = StrokeDash::new(vec![width * 4.0, width * 3.0], 0.0);
-                    let colour = rgb(colours::BACKTRACK);
-                    pm.stroke_path(&path, &paint(colour), &stroke, Transform::identity(), None);
-                }
-            } else {
-                // A region's lanes: the axis-aligned segments (nearly all of a coverage path)
-                // are filled with their exact area coverage, the others stroked.
-                let colour = PALETTE[style.0.saturating_sub(1) % PALETTE.len()];
-                if let Some(path) = lanes.draw(pm, run, width, colour) {
+                    let (dash, colour) = if style == PathStyle::Approach {
+                        (vec![width * 1.5, width * 1.5], colours::APPROACH)
+                    } else {
+                        (vec![width * 4.0, width * 3.0], colours::BACKTRACK)
+                    };
+                    stroke.dash = StrokeDash::new(dash, 0.0);
                     pm.stroke_path(
                         &path,
                         &paint(rgb(colour)),
@@ -1087,29 +1181,53 @@ fn draw_path(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
         }
         run.clear();
     };
-    for r in path_entries(trace) {
+    let mut add = |pm: &mut Pixmap, p: (f32, f32), style: PathStyle| {
+        if last == Some(p) {
+            return;
+        }
+        if style != run_style {
+            let keep = run.last().copied();
+            flush(pm, &mut run, run_style);
+            if let Some(k) = keep {
+                run.push(k);
+            }
+            run_style = style;
+        }
+        if run.is_empty() {
+            if let Some(l) = last {
+                run.push(l);
+            }
+        }
+        run.push(p);
+        last = Some(p);
+    };
+    for (i, r) in path_entries(trace) {
         match r {
             Entry::Pose { pose, .. } => {
-                let p = view.to_canvas(world, pose.position());
-                if last == Some(p) {
-                    continue;
-                }
-                let style = (region, in_backtrack);
-                if style != run_style {
-                    let keep = run.last().copied();
-                    flush(pm, &mut run, run_style);
-                    if let Some(k) = keep {
-                        run.push(k);
+                if let Some((end_i, end)) = approach {
+                    if i < end_i {
+                        add(
+                            pm,
+                            view.to_canvas(world, pose.position()),
+                            PathStyle::Approach,
+                        );
+                        continue;
                     }
-                    run_style = style;
+                    // The approach's end (inside a straight run that goes on, it is no
+                    // drawn pose of its own).
+                    add(
+                        pm,
+                        view.to_canvas(world, end.position()),
+                        PathStyle::Approach,
+                    );
+                    approach = None;
                 }
-                if run.is_empty() {
-                    if let Some(l) = last {
-                        run.push(l);
-                    }
-                }
-                run.push(p);
-                last = Some(p);
+                let style = if in_backtrack {
+                    PathStyle::Backtrack
+                } else {
+                    PathStyle::Region(region)
+                };
+                add(pm, view.to_canvas(world, pose.position()), style);
             }
             Entry::Event { event, .. } => match event {
                 Event::RegionStart { region: k } => region = *k as usize,
@@ -1626,6 +1744,144 @@ mod tests {
             checked += 1;
         }
         assert_eq!(checked, 60);
+    }
+
+    /// The room of [`run`] with a work area over its left part and a keep-out square in it,
+    /// the start at `(5.0, 1.0)` outside the area: the simulator drives the approach, then a
+    /// few lanes inside the area, and the run ends with `reason`.
+    fn approach_run(reason: &str) -> (World, Trace) {
+        use ccpp_core::zones::{Polygon, ZoneMasks};
+        let (room, _) = run(1);
+        let map = room.true_map().clone();
+        let area = [Polygon::rect([0.1, 0.1, 2.4, 3.9])];
+        let keepout = [Polygon::rect([1.0, 2.5, 1.6, 3.1])];
+        let zones = ZoneMasks::new(map.frame(), Some(&area), &keepout, &[]);
+        let world = World::with_zones(
+            map,
+            Robot::new(0.15),
+            Some(Pose::new(5.0, 1.0, 0.0)),
+            Some(zones),
+        )
+        .unwrap();
+        assert!(
+            !world.approach().is_empty(),
+            "the start is outside the area"
+        );
+        let sim = ccpp_core::sim::Simulator::new(&world, &ccpp_core::sim::SimConfig::default());
+        let mut t = sim.trace().clone();
+        let s = world.start();
+        t.push_event(1, Event::RegionStart { region: 1 });
+        let mut k = 1;
+        for lane in 0..4 {
+            let y = s.y - f64::from(lane) * 0.3;
+            let (a, b) = if lane % 2 == 0 {
+                (s.x, 0.3)
+            } else {
+                (0.3, s.x)
+            };
+            t.push_pose(k, Pose::new(a, y, 0.0));
+            t.push_pose(k + 1, Pose::new(b, y, 0.0));
+            k += 2;
+        }
+        t.push_event(
+            k,
+            Event::Finished {
+                reason: reason.into(),
+            },
+        );
+        (world, t)
+    }
+
+    fn count_colour(pm: &Pixmap, rows: std::ops::Range<u32>, colour: [u8; 3]) -> usize {
+        rows.flat_map(|y| (0..pm.width()).map(move |x| (x, y)))
+            .filter(|&(x, y)| {
+                let p = pm.pixel(x, y).unwrap();
+                [p.red(), p.green(), p.blue()] == colour
+            })
+            .count()
+    }
+
+    /// A start outside the area: the approach is drawn as the approach (dotted, its own
+    /// legend entry, not region 1's colour), the floor it swept shows as swept outside the
+    /// area (it was painted as unswept floor outside the area), and the start marker is where
+    /// the robot was placed.
+    #[test]
+    fn the_approach_to_the_area_is_drawn_and_its_swept_floor_shown() {
+        let (world, trace) = approach_run("done");
+        let labels: Vec<String> = legend_entries(&world, &trace)
+            .into_iter()
+            .map(|e| e.label)
+            .collect();
+        assert!(
+            labels.iter().any(|l| l == "approach to the area"),
+            "{labels:?}"
+        );
+        assert!(
+            labels
+                .iter()
+                .any(|l| l.starts_with("swept, outside the area")),
+            "{labels:?}"
+        );
+        let pm = coverage_pixmap(&world, &trace, &style()).unwrap();
+        let all = 0..pm.height();
+        assert!(count_colour(&pm, all.clone(), colours::SWEPT_OUTSIDE) > 500);
+        assert!(count_colour(&pm, all.clone(), colours::APPROACH) > 20);
+        // The approach's first stretch (from (5.0, 1.0)) is not in region 1's colour.
+        let (end_i, end) = approach_end(&world, &trace).unwrap();
+        assert!(end_i > 0);
+        assert!((end.position().dist(world.start().position())) < 1e-9);
+        assert!(world.initial_pose().position().dist(Point::new(5.0, 1.0)) < 1e-12);
+        // The replay's start marker is the placed pose (it was the area entry point), and the
+        // page knows where the approach ends.
+        let data = replay::tests_support::data(&world, &trace);
+        let f = world.frame();
+        let (c0, r0, _, _) = crop_box(&world, &trace);
+        let g = f.world_to_grid(Point::new(5.0, 1.0));
+        let want = format!(
+            r#""start":[{},{},0]"#,
+            g.x - c0 as f64,
+            f.height as f64 - g.y - r0 as f64
+        );
+        assert!(data.contains(&want), "{want} not in the page data");
+        assert!(!data.contains(r#""approach":null"#));
+    }
+
+    /// A run the simulator stopped says so in the header: one more red badge.
+    #[test]
+    fn a_stopped_run_says_so_in_the_header() {
+        let header_red = |reason: &str| {
+            let (world, trace) = approach_run(reason);
+            let pm = coverage_pixmap(&world, &trace, &style()).unwrap();
+            count_colour(&pm, 0..40, colours::STOPPED)
+        };
+        let (done, stalled) = (header_red("done"), header_red("stalled"));
+        assert!(
+            stalled > done + 200,
+            "{done} vs {stalled} red header pixels"
+        );
+        let (_, trace) = approach_run("stalled");
+        assert_eq!(stop_reason(&trace).as_deref(), Some("stalled"));
+        let (_, trace) = approach_run("done");
+        assert_eq!(stop_reason(&trace), None);
+    }
+
+    /// The keep-out's legend swatch is hatched like the zone (it was a solid square of the
+    /// hatching colour).
+    #[test]
+    fn the_keepout_legend_swatch_is_hatched() {
+        let (world, trace) = approach_run("done");
+        let e = legend_entries(&world, &trace);
+        let ko = e
+            .iter()
+            .find(|e| e.label == "keep-out zone (hatched)")
+            .unwrap();
+        assert_eq!(
+            ko.swatch,
+            Swatch::Hatched {
+                fill: colours::KEEPOUT,
+                hatch: colours::KEEPOUT_HATCH
+            }
+        );
     }
 
     #[test]

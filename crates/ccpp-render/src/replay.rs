@@ -11,7 +11,7 @@ use ccpp_core::Point;
 use tiny_skia::{Color, Pixmap};
 
 use crate::colours::{AREA_BORDER, KEEPOUT, KEEPOUT_HATCH, OUTSIDE_AREA};
-use crate::{crop_box, zone_class, RenderError};
+use crate::{approach_end, crop_box, stop_reason, zone_class, RenderError};
 
 /// Map class colours shared by the replay page and the GIF.
 const C_OCC: [u8; 3] = [30, 30, 30];
@@ -221,7 +221,13 @@ fn replay_data(
     let mut raw_events: Vec<(usize, &Event)> = Vec::new();
     let mut tiles: Vec<usize> = Vec::new();
     let mut seen_tiles = std::collections::BTreeSet::new();
+    // Tiles are on the lattice of the pose coverage starts from; the start marker is where the
+    // robot was placed (before the approach, when the start is outside the area).
     let start = world.start();
+    let placed = world.initial_pose();
+    // The approach's last pose (kept for display, so that the page can tell it apart).
+    let approach = approach_end(world, trace);
+    let mut approach_pose: Option<usize> = None;
     let to_crop = |x: f64, y: f64| -> [f64; 2] {
         let g = f.world_to_grid(Point::new(x, y));
         [g.x - c0 as f64, f.height as f64 - g.y - r0 as f64]
@@ -229,8 +235,12 @@ fn replay_data(
     for r in trace.entries() {
         match r {
             Entry::Pose { pose, .. } => {
+                let ends_approach = approach.is_some_and(|(end, _)| end == pts.len());
                 pts.push(to_crop(pose.x, pose.y));
-                forced.push(false);
+                if ends_approach {
+                    approach_pose = Some(pts.len() - 1);
+                }
+                forced.push(ends_approach);
                 if let Some(t) = tile_side {
                     let fi = (pose.x - start.x) / t;
                     let fj = (pose.y - start.y) / t;
@@ -379,22 +389,28 @@ fn replay_data(
     }
     cov.push(']');
     let (sx, sy) = {
-        let g = f.world_to_grid(start.position());
+        let g = f.world_to_grid(placed.position());
         (g.x - c0 as f64, f.height as f64 - g.y - r0 as f64)
     };
     // Tile side in map pixels (first visits are drawn around the visiting pose).
     let tile = tile_side.map_or_else(|| "null".to_string(), |t| js_num(t / f.resolution));
     let yaw = f.origin.theta;
     let zones = zones_js(world, crop);
+    let approach = approach_pose.map_or_else(|| "null".to_string(), |i| display(i).to_string());
+    let stop = stop_reason(trace).map_or_else(
+        || "null".to_string(),
+        |why| serde_json::Value::String(why).to_string(),
+    );
+    let classes = classes_js(world, crop);
     format!(
-        r#"{{"w":{w},"h":{h},"res":{res},"yaw":{yaw},"r":{r},"rt":{rt},"tile":{tile},"start":[{sx},{sy},{st}],"n":{n},"m":{m},"q":{q},"blob":"{blob}","events":{events},"nt":{nt},"tblob":"{tblob}","cov":{cov},"palette":{palette},"zones":{zones},"metrics":{metrics}}}"#,
+        r#"{{"w":{w},"h":{h},"res":{res},"yaw":{yaw},"r":{r},"rt":{rt},"tile":{tile},"start":[{sx},{sy},{st}],"n":{n},"m":{m},"q":{q},"blob":"{blob}","events":{events},"nt":{nt},"tblob":"{tblob}","cov":{cov},"palette":{palette},"zones":{zones},"approach":{approach},"stop":{stop},"classes":{classes},"metrics":{metrics}}}"#,
         res = js_num(f.resolution),
         yaw = js_num(yaw),
         r = js_num(world.robot().radius / f.resolution),
         rt = js_num(world.robot().tool_radius / f.resolution),
         sx = js_num(sx),
         sy = js_num(sy),
-        st = js_num(start.theta),
+        st = js_num(placed.theta),
         n = pts.len(),
         nt = tiles.len(),
         m = kept.len(),
@@ -405,6 +421,33 @@ fn replay_data(
         } else {
             metrics_json.trim()
         },
+    )
+}
+
+/// Which map classes outside the zones the crop shows (the legend lists only those):
+/// `{"occupied":..,"unknown":..,"out_of_reach":..,"accessible":..}`.
+fn classes_js(world: &World, crop: (usize, usize, usize, usize)) -> String {
+    let f = *world.frame();
+    let (c0, r0, w, h) = crop;
+    let mut seen = [false; 4];
+    'rows: for y in r0..r0 + h {
+        for x in c0..c0 + w {
+            let k = match class_of(world, f.index(x, y)) {
+                Class::Occupied => 0,
+                Class::Unknown => 1,
+                Class::OutOfReach => 2,
+                Class::Accessible => 3,
+                Class::Keepout | Class::OutsideArea => continue,
+            };
+            seen[k] = true;
+            if seen.iter().all(|s| *s) {
+                break 'rows;
+            }
+        }
+    }
+    format!(
+        r#"{{"occupied":{},"unknown":{},"out_of_reach":{},"accessible":{}}}"#,
+        seen[0], seen[1], seen[2], seen[3]
     )
 }
 
@@ -541,7 +584,8 @@ impl Default for GifOptions {
     }
 }
 
-/// Builds an animated GIF of the run (swept area growing, path, robot).
+/// Builds an animated GIF of the run (swept area growing, path, robot), with the work area's
+/// and keep-outs' borders as in the coverage picture.
 ///
 /// # Errors
 /// When encoding fails.
@@ -554,7 +598,8 @@ pub fn replay_gif(world: &World, trace: &Trace, opts: &GifOptions) -> Result<Vec
         ((ch as f64 * k).round() as usize).max(1),
     );
     // Palette: 0 occ, 1 unk, 2 free-out, 3 accessible, 4 swept, 5 path, 6 robot, 7 white,
-    // 8 keep-out, 9 keep-out hatching, 10 outside the area (then padding to 16).
+    // 8 keep-out, 9 keep-out hatching and border, 10 outside the area, 11 area border (then
+    // padding to 16).
     let palette: Vec<u8> = [
         C_OCC,
         C_UNK,
@@ -567,7 +612,7 @@ pub fn replay_gif(world: &World, trace: &Trace, opts: &GifOptions) -> Result<Vec
         KEEPOUT,
         KEEPOUT_HATCH,
         OUTSIDE_AREA,
-        [255, 255, 255],
+        AREA_BORDER,
         [255, 255, 255],
         [255, 255, 255],
         [255, 255, 255],
@@ -603,6 +648,26 @@ pub fn replay_gif(world: &World, trace: &Trace, opts: &GifOptions) -> Result<Vec
             (f.height as f64 - g.y - r0 as f64) * k,
         )
     };
+    // The zones' borders (palette index per GIF pixel, 0 = none), drawn over the swept floor
+    // and under the path.
+    let mut borders = vec![0u8; gw * gh];
+    if let Some(z) = world.zones() {
+        for (polys, v) in [(&z.area_polygons, 11u8), (&z.keepout_polygons, 9u8)] {
+            for poly in polys {
+                let ring = poly.ring();
+                let mut layer = vec![false; gw * gh];
+                for (k, &a) in ring.iter().enumerate() {
+                    let b = ring[(k + 1) % ring.len()];
+                    draw_line(&mut layer, gw, gh, to_gif(a), to_gif(b));
+                }
+                for (d, on) in borders.iter_mut().zip(layer) {
+                    if on {
+                        *d = v;
+                    }
+                }
+            }
+        }
+    }
     let mut out = Vec::new();
     {
         let mut enc = gif::Encoder::new(&mut out, gw as u16, gh as u16, &palette)
@@ -633,9 +698,13 @@ pub fn replay_gif(world: &World, trace: &Trace, opts: &GifOptions) -> Result<Vec
             let swept = sweeper.swept();
             let mut buf = base.clone();
             for (p, v) in buf.iter_mut().enumerate() {
-                // Zones keep their colours, as in the coverage picture.
-                if (2..=3).contains(v) && swept.contains(src(p % gw, p / gw)) {
+                // Keep-outs keep their colours, as in the coverage picture; floor outside the
+                // area that the tool swept (the approach to it) shows as swept.
+                if matches!(*v, 2 | 3 | 10) && swept.contains(src(p % gw, p / gw)) {
                     *v = 4;
+                }
+                if borders[p] != 0 {
+                    *v = borders[p];
                 }
                 if path_layer[p] {
                     *v = 5;
@@ -731,10 +800,79 @@ fn fill_disk(buf: &mut [u8], w: usize, h: usize, x: f64, y: f64, r: f64, v: u8) 
     }
 }
 
+/// Test access to the page data (for the coverage picture's tests, which build the runs).
+#[cfg(test)]
+pub(crate) mod tests_support {
+    use super::{replay_data, Trace, World};
+
+    /// The page data of a run (no tiles, no metrics).
+    pub(crate) fn data(world: &World, trace: &Trace) -> String {
+        replay_data(world, trace, None, "{}", crate::crop_box(world, trace))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    /// A room with a work area and a keep-out, a start inside the area and one lane.
+    fn zoned() -> (World, Trace) {
+        use ccpp_core::zones::{Polygon, ZoneMasks};
+        let map =
+            ccpp_core::grid::GridMap::from_ascii_scaled("######\n#....#\n#....#\n######", 20, 0.05)
+                .unwrap();
+        let area = [Polygon::rect([0.1, 0.1, 2.0, 2.9])];
+        let keepout = [Polygon::rect([1.2, 1.8, 1.7, 2.3])];
+        let zones = ZoneMasks::new(map.frame(), Some(&area), &keepout, &[]);
+        let start = ccpp_core::Pose::new(1.3, 1.3, 0.0);
+        let world = World::with_zones(
+            map,
+            ccpp_core::world::Robot::new(0.15),
+            Some(start),
+            Some(zones),
+        )
+        .unwrap();
+        let mut trace = Trace::default();
+        trace.push_pose(0, start);
+        trace.push_pose(1, ccpp_core::Pose::new(1.8, 1.3, 0.0));
+        (world, trace)
+    }
+
+    /// The GIF draws the area's and keep-outs' borders (README: "`coverage.png` and the replay
+    /// (`replay.html`, `replay.gif`) ... draw the area and keep-out polygon borders").
+    #[test]
+    fn the_gif_draws_the_zone_borders() {
+        let (world, trace) = zoned();
+        let bytes = replay_gif(&world, &trace, &GifOptions::default()).unwrap();
+        let mut opts = gif::DecodeOptions::new();
+        opts.set_color_output(gif::ColorOutput::RGBA);
+        let mut dec = opts.read_info(std::io::Cursor::new(bytes)).unwrap();
+        let frame = dec.read_next_frame().unwrap().unwrap();
+        let count = |c: [u8; 3]| {
+            frame
+                .buffer
+                .chunks_exact(4)
+                .filter(|p| p[..3] == c[..])
+                .count()
+        };
+        assert!(count(AREA_BORDER) > 100, "area border pixels");
+        // The keep-out's border: its hatching colour beyond the hatching inside it.
+        assert!(count(KEEPOUT_HATCH) > 0);
+    }
+
+    /// The page lists only the map classes the map shows (`teb_maze` has no unknown pixel, the
+    /// legend said "unknown") and names the wall time for what it is.
+    #[test]
+    fn the_page_knows_which_classes_the_map_shows() {
+        let (world, trace) = zoned();
+        let data = tests_support::data(&world, &trace);
+        assert!(data.contains(r#""unknown":false"#), "{}", &data[..200]);
+        assert!(data.contains(r#""occupied":true"#));
+        assert!(TEMPLATE.contains("if (C.unknown) add("));
+        assert!(TEMPLATE.contains(r#"["wall_time_s", "planning + simulation time", "s"]"#));
+        assert!(data.contains(r#""stop":null"#));
+    }
 
     fn seg_dist(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
         let (dx, dy) = (b[0] - a[0], b[1] - a[1]);

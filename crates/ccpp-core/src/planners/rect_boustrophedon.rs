@@ -111,6 +111,16 @@ impl RectOptions {
     pub fn width_for(&self, robot: &Robot) -> f64 {
         self.width_m.unwrap_or(2.0 * robot.tool_radius)
     }
+
+    /// The radius of the disk the lanes and detours are planned for `robot`:
+    /// `clearance_radius_m`, by default the rectangle's circumscribed disk `hypot(l, b) / 2`,
+    /// never less than the robot's radius (a plan falls back to the robot's own radius, with
+    /// a note in its trace, when that disk does not fit at the start).
+    pub fn clearance_radius(&self, robot: &Robot) -> f64 {
+        self.clearance_radius_m
+            .unwrap_or(0.5 * self.length_for(robot).hypot(self.width_for(robot)))
+            .max(robot.radius)
+    }
 }
 
 /// The seed's lanes over `area = [x0, y0, x1, y1]`: lane `k` at `y0 + k b` (the last one clamped
@@ -176,10 +186,7 @@ pub fn waypoints(world: &World, opts: &RectOptions) -> Vec<Point> {
 fn clearance_world(world: &World, opts: &RectOptions) -> (World, f64, Option<String>) {
     let robot = world.robot();
     let r_world = robot.radius;
-    let rad = opts
-        .clearance_radius_m
-        .unwrap_or(0.5 * opts.length_for(&robot).hypot(opts.width_for(&robot)))
-        .max(r_world);
+    let rad = opts.clearance_radius(&robot);
     match World::new(world.map().clone(), Robot::new(rad), Some(world.start())) {
         Ok(w) => (w, rad, None),
         Err(e) => (
