@@ -55,7 +55,7 @@ fn the_summary_shows_every_metric_of_metrics_json() {
         dir.path(),
         "rect",
         "rect-boustrophedon",
-        &["--length", "0.4", "--width", "0.4"],
+        &["--length", "0.3", "--width", "0.3"],
     );
     assert!(m["rect_guarantee"].is_number(), "{m}");
     assert_every_metric_shown(&stdout, &m);
