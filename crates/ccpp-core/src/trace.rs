@@ -121,6 +121,11 @@ pub enum Event {
         /// Waypoint tolerance, metres: a waypoint counts as reached within this distance (the
         /// `coverage_rate` metric uses it as the tile-centre visit tolerance).
         tolerance_m: f64,
+        /// Whether odometry noise perturbs the motion (written only when it does): the robot
+        /// reaches its waypoints by its estimate, so `coverage_rate` counts a tile centre
+        /// visited within half a tile of the true path.
+        #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+        noisy: bool,
     },
     /// The straight segment the robot is asked to follow next (PID execution only). The pose
     /// records up to the next such event are measured against it (`tracking_error_*`).
