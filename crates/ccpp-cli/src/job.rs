@@ -641,7 +641,15 @@ impl Job {
             .build()
             .map_err(|e| name_flag(e, &given))?;
         let map = load_recipe(&scenario.map, scenario.max_memory_mb)?;
-        scenario.check_map(&map).map_err(|e| name_flag(e, &given))?;
+        scenario
+            .check_map(&map)
+            .map_err(|e| match (e, &a.landmarks) {
+                // A landmark the map never sees: name the landmark file, not only the map.
+                (ScenarioError::Invalid(m), Some(p)) if m.starts_with("landmark ") => {
+                    anyhow::anyhow!("landmarks {}: {m}", p.display())
+                }
+                (e, _) => name_flag(e, &given),
+            })?;
         scenario.check_run().map_err(|e| name_flag(e, &given))?;
         Ok(Self {
             scenario,

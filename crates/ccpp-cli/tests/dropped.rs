@@ -733,3 +733,66 @@ fn tile_coverage_under_odometry_noise_is_measured_on_the_true_path() {
     assert_eq!(exact, 1.0);
     assert!(!marked);
 }
+
+/// Errors that named the wrong thing or let a value through unused, from a first-use pass:
+/// `info` echoed a start heading nothing depends on; `--occupied-thresh 0.1` was reported as a
+/// bad `free_thresh` of the map; a landmark the map never sees named the map, not the landmark
+/// file; `--area 1,1,2,2,3` was reported as a missing file.
+#[test]
+fn errors_name_what_the_user_gave() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let m = s(&map);
+    refused(
+        &["info", "--map", m, "--start", "1,1,0.5"],
+        &["--start THETA does not apply to `ccpp info`"],
+    );
+    refused(
+        &["info", "--map", m, "--occupied-thresh", "0.1"],
+        &[
+            "bad `occupied_thresh`",
+            "0.1 (given)",
+            "free_thresh 0.196 (the map's)",
+        ],
+    );
+    let lm = write(dir, "far.csv", "1,100,100\n");
+    let out = dir.join("out");
+    refused(
+        &[
+            "run",
+            "--map",
+            m,
+            "--planner",
+            "ba-star",
+            "--exec",
+            "pid",
+            "--landmarks",
+            &lm,
+            "--out",
+            s(&out),
+        ],
+        &[
+            &format!("landmarks {lm}: landmark 0"),
+            "no robot on the map sees it",
+        ],
+    );
+    let a = ccpp()
+        .args([
+            "run",
+            "--map",
+            m,
+            "--planner",
+            "ba-star",
+            "--area",
+            "1,1,2,2,3",
+            "--out",
+        ])
+        .arg(&out)
+        .assert()
+        .code(1);
+    let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
+    assert!(err.contains("got 5 numbers"), "{err}");
+    assert!(!err.contains("No such file"), "{err}");
+    assert!(!out.exists());
+}

@@ -55,7 +55,8 @@ fn bad(m: impl Into<String>) -> ZoneFileError {
 }
 
 /// A zone as the command line and Python take it as text: four comma-separated numbers are the
-/// rectangle `X0,Y0,X1,Y1` (spaces around the numbers allowed), anything else names a file.
+/// rectangle `X0,Y0,X1,Y1` (spaces around the numbers allowed), anything else names a file
+/// (other counts of comma-separated numbers only when such a file exists).
 /// The rectangle's values are checked where every zone is ([`ZoneSpec::load`] through the
 /// scenario), so `"nan,0,1,1"` parses here and is refused there.
 ///
@@ -63,7 +64,8 @@ fn bad(m: impl Into<String>) -> ZoneFileError {
 /// use ccpp_io::zones::ZoneSpec;
 /// assert_eq!("0, 1, 2.5, 3".parse(), Ok(ZoneSpec::Rect([0.0, 1.0, 2.5, 3.0])));
 /// assert_eq!("rug.geojson".parse(), Ok(ZoneSpec::File("rug.geojson".into())));
-/// assert_eq!("1,2,3".parse(), Ok(ZoneSpec::File("1,2,3".into())));
+/// // Numbers, but not four, that name no file: a mistyped rectangle.
+/// assert!("1,2,3".parse::<ZoneSpec>().is_err());
 /// assert!("".parse::<ZoneSpec>().is_err());
 /// ```
 impl std::str::FromStr for ZoneSpec {
@@ -76,6 +78,18 @@ impl std::str::FromStr for ZoneSpec {
         }
         if s.is_empty() {
             return Err(bad("expected a file or X0,Y0,X1,Y1, got an empty value"));
+        }
+        // Numbers, but not four of them, and no such file: a mistyped rectangle (it was
+        // reported as a missing file `/cwd/1,1,2,2,3`).
+        let parts: Vec<&str> = s.split(',').collect();
+        if parts.len() > 1
+            && parts.iter().all(|p| p.trim().parse::<f64>().is_ok())
+            && !Path::new(s).exists()
+        {
+            return Err(bad(format!(
+                "expected a file or X0,Y0,X1,Y1 (four numbers), got {} numbers: {s:?}",
+                parts.len()
+            )));
         }
         Ok(Self::File(PathBuf::from(s)))
     }

@@ -443,24 +443,28 @@ const ZONE_FORMS: &str =
 
 /// A work area: a file name, `[x0, y0, x1, y1]` or a list of polygons (`Scenario::area`).
 fn parse_area(v: &Bound<'_, PyAny>) -> PyResult<ZoneSpec> {
-    if let Some(r) = rect_text(v) {
-        return Ok(r);
+    if let Some(r) = text_zone(v) {
+        return r;
     }
     serde_json::from_value(py_to_json(v)?)
         .map_err(|_| msg(format!("area must be {ZONE_FORMS}, got {}", repr(v))))
 }
 
-/// A zone given as the text `"X0,Y0,X1,Y1"` (four numbers): the rectangle, as the command
-/// line's `--area` / `--keepout` read it (it was taken for a file name: "No such file").
-fn rect_text(v: &Bound<'_, PyAny>) -> Option<ZoneSpec> {
+/// A zone given as text, read as the command line's `--area` / `--keepout` read it
+/// ([`ZoneSpec`]'s `FromStr`): `"X0,Y0,X1,Y1"` is the rectangle (it was taken for a file name:
+/// "No such file"), other text a file; `None` when `v` is not text.
+fn text_zone(v: &Bound<'_, PyAny>) -> Option<PyResult<ZoneSpec>> {
     let s: String = v.extract().ok()?;
-    s.parse().ok().filter(|z| matches!(z, ZoneSpec::Rect(_)))
+    Some(
+        s.parse::<ZoneSpec>()
+            .map_err(|e| msg(format!("area or keepout {s:?}: {e}"))),
+    )
 }
 
 /// Keep-out zones: one zone (as for an area) or a list of zones (`Scenario::keepout`).
 fn parse_keepout(v: &Bound<'_, PyAny>) -> PyResult<Vec<ZoneSpec>> {
-    if let Some(r) = rect_text(v) {
-        return Ok(vec![r]);
+    if let Some(r) = text_zone(v) {
+        return r.map(|z| vec![z]);
     }
     // A list whose every item is a zone given as text ("x0,y0,x1,y1" rectangles and file
     // names, as repeated `--keepout` flags): each item as one zone (a list of text rectangles
@@ -468,10 +472,7 @@ fn parse_keepout(v: &Bound<'_, PyAny>) -> PyResult<Vec<ZoneSpec>> {
     if !v.is_instance_of::<PyString>() {
         if let Ok(items) = v.extract::<Vec<Bound<'_, PyAny>>>() {
             if !items.is_empty() && items.iter().all(PyAnyMethods::is_instance_of::<PyString>) {
-                return items
-                    .iter()
-                    .map(|i| rect_text(i).map_or_else(|| parse_area(i), Ok))
-                    .collect();
+                return items.iter().map(parse_area).collect();
             }
         }
     }

@@ -302,3 +302,11 @@ def test_an_interrupted_run_stops_instead_of_finishing_unseen(tmp_path: Path, ro
     words = out.stdout.split()
     assert words[:2] == ["interrupted", "next"], out.stdout
     assert float(words[2]) < 5.0, out.stdout
+
+
+def test_a_mistyped_text_rectangle_is_named_as_such(room: Path) -> None:
+    # Five numbers were taken for a file name and reported as "No such file".
+    with pytest.raises(ccpp.CcppError, match="got 5 numbers"):
+        ccpp.run(room, "bsa", area="1,1,2,2,3")
+    with pytest.raises(ccpp.CcppError, match="got 3 numbers"):
+        ccpp.run(room, "bsa", keepout=["1,0.5,1.5,1.5", "1,2,3"])

@@ -229,7 +229,43 @@ fn finish<R: std::io::BufRead + std::io::Seek>(
         mode: base.mode,
     };
     validate_placement(resolution, origin, source)?;
-    thresholds.validate(source)?;
+    thresholds.validate(source).map_err(|e| {
+        // Thresholds that cross because of an override: say which value was given and which
+        // is the map's (`--occupied-thresh 0.1` was reported as a bad `free_thresh`).
+        let (t, given) = (
+            &thresholds,
+            |o: Option<f64>| if o.is_some() { "given" } else { "the map's" },
+        );
+        match e {
+            MapError::BadValue {
+                path,
+                field: "free_thresh",
+                ..
+            } if t.free >= t.occupied && opts.occupied_thresh.is_some() => MapError::BadValue {
+                path,
+                field: "occupied_thresh",
+                reason: format!(
+                    "occupied_thresh {} (given) must be above free_thresh {} ({})",
+                    t.occupied,
+                    t.free,
+                    given(opts.free_thresh)
+                ),
+            },
+            MapError::BadValue {
+                path,
+                field: "free_thresh",
+                ..
+            } if t.free >= t.occupied && opts.free_thresh.is_some() => MapError::BadValue {
+                path,
+                field: "free_thresh",
+                reason: format!(
+                    "free_thresh {} (given) must be below occupied_thresh {} (the map's)",
+                    t.free, t.occupied
+                ),
+            },
+            e => e,
+        }
+    })?;
 
     let c = pixels::decode_and_classify(reader, &image_path, &thresholds, opts.max_pixels)?;
     let frame = MapFrame {
