@@ -159,7 +159,7 @@ pub struct RunArgs {
     #[arg(long, value_name = "M")]
     pub length: Option<f64>,
     /// Rectangular robot width in metres (rect-boustrophedon: lane spacing; default and at
-    /// most: the tool's width 2 x tool radius).
+    /// most, in a run: the tool's width 2 x tool radius).
     #[arg(long, value_name = "M")]
     pub width: Option<f64>,
     /// Work area and keep-out zones.
@@ -214,11 +214,11 @@ pub struct PlanArgs {
     #[command(flatten)]
     pub options: OptionsArgs,
     /// Rectangular robot length in metres (rect-boustrophedon: waypoint spacing; default: the
-    /// tool's width 2 x tool radius).
+    /// robot's diameter).
     #[arg(long, value_name = "M")]
     pub length: Option<f64>,
-    /// Rectangular robot width in metres (rect-boustrophedon: lane spacing; default and at
-    /// most: the tool's width 2 x tool radius).
+    /// Rectangular robot width in metres (rect-boustrophedon: lane spacing; default: the
+    /// robot's diameter; any width: a plan has no tool, the rectangle is the robot).
     #[arg(long, value_name = "M")]
     pub width: Option<f64>,
     /// Work area and keep-out zones (the path stays inside the area, outside the keep-outs).
@@ -250,7 +250,7 @@ pub struct WaypointsArgs {
     /// Robot length in metres (waypoint spacing along a lane; default: the robot's diameter).
     #[arg(long, value_name = "M")]
     pub length: Option<f64>,
-    /// Robot width in metres (lane spacing; default and at most: the robot's diameter).
+    /// Robot width in metres (lane spacing; default: the robot's diameter).
     #[arg(long, value_name = "M")]
     pub width: Option<f64>,
     /// Area to cover `X0,Y0,X1,Y1`: the seed's lane rectangle for the robot's centre

@@ -196,7 +196,17 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         .collect();
     crate::job::warn_unused_config(a.options.config.as_deref(), &kinds);
     let maps = name_maps(expand_maps(&a.maps)?);
-    check_bench_target(&a.out)?;
+    // The maps whose plots a bench in this folder writes: this bench's and those of the run
+    // folders an earlier one left (`runs/MAP`).
+    let mut plotted: Vec<String> = maps.iter().map(|(_, n)| n.clone()).collect();
+    if let Ok(entries) = std::fs::read_dir(a.out.join("runs")) {
+        plotted.extend(
+            entries
+                .flatten()
+                .map(|e| e.file_name().to_string_lossy().into_owned()),
+        );
+    }
+    check_bench_target(&a.out, &plotted)?;
     ccpp_io::write::create_folder(&a.out, &a.out)?;
     // Held until the bench ends: a second bench on the folder is refused instead of writing
     // its runs and summary among this one's.
@@ -204,7 +214,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     // The summary of an earlier bench in this folder goes before any run starts: an
     // interrupted bench then leaves complete run folders and no summary, never a summary of
     // the earlier bench (another radius, other planners) beside run folders of this one.
-    clear_summary(&a.out)?;
+    clear_summary(&a.out, &plotted)?;
     if let Some(j) = a.jobs {
         // A thread beyond one per run would only idle: `--jobs 100000` started 100000
         // threads, which took minutes on two cores before the first run.
@@ -329,12 +339,12 @@ pub fn run(a: &BenchArgs) -> Result<()> {
 }
 
 /// Checks that `out` is absent or a folder holding only what a bench writes (`results.csv`,
-/// `results.md`, `plots/`, `runs/`): a bench rewrites those, so another file there (a user's
-/// own `results.csv` in a folder of theirs) would be overwritten.
+/// `results.md`, `plots/` with the plots of `maps`, `runs/`): a bench rewrites those, so
+/// another file there (a user's own `results.csv` in a folder of theirs) would be overwritten.
 ///
 /// # Errors
 /// When `out` is a file, or a folder holding anything else.
-fn check_bench_target(out: &Path) -> Result<()> {
+fn check_bench_target(out: &Path, maps: &[String]) -> Result<()> {
     let Ok(meta) = std::fs::symlink_metadata(out) else {
         return Ok(());
     };
@@ -363,7 +373,7 @@ fn check_bench_target(out: &Path) -> Result<()> {
             "runs" => t.is_dir(),
             "plots" => {
                 if t.is_dir() {
-                    check_plots(out, &e.path())?;
+                    check_plots(out, &e.path(), maps)?;
                 }
                 t.is_dir()
             }
@@ -386,14 +396,14 @@ fn check_bench_target(out: &Path) -> Result<()> {
 ///
 /// # Errors
 /// When it holds anything else (named), or cannot be read.
-fn check_plots(out: &Path, dir: &Path) -> Result<()> {
+fn check_plots(out: &Path, dir: &Path, maps: &[String]) -> Result<()> {
     let entries =
         std::fs::read_dir(dir).with_context(|| format!("cannot read {}", dir.display()))?;
     for e in entries {
         let e = e.with_context(|| format!("cannot read {}", dir.display()))?;
         let name = e.file_name();
         let name = name.to_string_lossy();
-        if !(is_bench_plot(&name) && e.file_type().is_ok_and(|t| t.is_file())) {
+        if !(is_bench_plot(&name, maps) && e.file_type().is_ok_and(|t| t.is_file())) {
             bail!(
                 "output folder {} holds plots/{name}, which ccpp bench did not write; a bench \
                  rewrites its plots there, so choose a new or bench-only folder",
@@ -405,9 +415,10 @@ fn check_plots(out: &Path, dir: &Path) -> Result<()> {
 }
 
 /// Whether `name` is a plot a bench writes in `plots/` ([`crate::plots::write_all`]):
-/// `summary`, `coverage_MAP`, `paths_MAP` or `tradeoff_MAP` (`tradeoff_summary` included) as
-/// `.svg` or `.png`, or the `.tmp` of one that a write cut short left.
-fn is_bench_plot(name: &str) -> bool {
+/// `summary`, `tradeoff_summary`, or `coverage_MAP`, `paths_MAP`, `tradeoff_MAP` of one of
+/// `maps` (a user's `coverage_mydiagram.png` was taken for a bench's and deleted), as `.svg`
+/// or `.png`, or the `.tmp` of one that a write cut short left.
+fn is_bench_plot(name: &str, maps: &[String]) -> bool {
     let name = name.strip_suffix(".tmp").unwrap_or(name);
     let Some(stem) = name
         .strip_suffix(".svg")
@@ -416,9 +427,11 @@ fn is_bench_plot(name: &str) -> bool {
         return false;
     };
     stem == "summary"
+        || stem == "tradeoff_summary"
         || ["coverage_", "paths_", "tradeoff_"]
             .iter()
-            .any(|p| stem.len() > p.len() && stem.starts_with(p))
+            .filter_map(|p| stem.strip_prefix(p))
+            .any(|m| maps.iter().any(|k| k == m))
 }
 
 /// Removes the summary of an earlier bench in `out`: `results.csv`, `results.md` and the plots
@@ -426,7 +439,7 @@ fn is_bench_plot(name: &str) -> bool {
 /// otherwise), then the emptied `plots/`. Only names a bench writes ([`is_bench_plot`]; a
 /// user's figure there is refused by [`check_bench_target`] before this). The run folders stay:
 /// each is complete and keyed, so a bench reuses the ones that match it.
-fn clear_summary(out: &Path) -> Result<()> {
+fn clear_summary(out: &Path, maps: &[String]) -> Result<()> {
     for name in ["results.csv", "results.md"] {
         let p = out.join(name);
         if std::fs::symlink_metadata(&p).is_ok_and(|m| m.is_file()) {
@@ -440,7 +453,7 @@ fn clear_summary(out: &Path) -> Result<()> {
     };
     for e in entries.flatten() {
         let p = e.path();
-        let plot = is_bench_plot(&e.file_name().to_string_lossy());
+        let plot = is_bench_plot(&e.file_name().to_string_lossy(), maps);
         if plot && e.file_type().is_ok_and(|t| t.is_file()) {
             std::fs::remove_file(&p)
                 .with_context(|| format!("cannot remove the old plot {}", p.display()))?;
@@ -915,6 +928,7 @@ mod tests {
 
     #[test]
     fn bench_plots_are_known_by_name() {
+        let maps = ["teb_maze".to_string(), "a-b".to_string(), "x".to_string()];
         for ok in [
             "summary.png",
             "summary.svg",
@@ -923,7 +937,7 @@ mod tests {
             "paths_a-b.png",
             "tradeoff_x.svg.tmp",
         ] {
-            assert!(is_bench_plot(ok), "{ok}");
+            assert!(is_bench_plot(ok, &maps), "{ok}");
         }
         for foreign in [
             "my_figure.png",
@@ -931,8 +945,11 @@ mod tests {
             "summary.pdf",
             "notes.txt",
             "paths_x.png.bak",
+            // Named like a bench's plot, but of no map of this bench or its run folders.
+            "coverage_mydiagram.png",
+            "tradeoff_notes.svg",
         ] {
-            assert!(!is_bench_plot(foreign), "{foreign}");
+            assert!(!is_bench_plot(foreign, &maps), "{foreign}");
         }
     }
 

@@ -81,13 +81,13 @@ struct ZonesInfo {
 
 /// Runs `ccpp info`.
 pub fn run(a: &InfoArgs) -> Result<()> {
+    let (robot, start) = robot_from(&a.robot)?;
     if a.robot.start.is_some_and(|s| s[2] != 0.0) {
         // Nothing `info` reports depends on the heading: it was echoed and otherwise dropped.
         anyhow::bail!(
             "--start THETA does not apply to `ccpp info` (nothing it reports depends on the heading); give X,Y"
         );
     }
-    let (robot, start) = robot_from(&a.robot)?;
     let map = prepare_map(&a.map, a.limits.max_memory_mb())?;
     let g = &map.grid;
     let f = *g.frame();

@@ -1019,17 +1019,21 @@ fn a_heading_beyond_two_turns_is_refused() {
         &["info", "--map", s(&yaml)],
         &["turned.yaml", "origin", "more than two turns"],
     );
-    // Within two turns: accepted and wrapped as before.
+    // Within two turns: accepted and wrapped as before (`info` takes no heading: a run).
     ccpp()
         .args([
-            "info",
+            "run",
+            "--planner",
+            "bsa",
             "--map",
             s(&map),
             "--start",
             "1,1,-12",
             "--origin",
             "0,0,6.2",
+            "--out",
         ])
+        .arg(map.with_file_name("wrapped"))
         .assert()
         .success();
 }

@@ -168,6 +168,14 @@ pub struct OdometryNoise {
     pub heading_drift_std: f64,
 }
 
+impl OdometryNoise {
+    /// Whether it perturbs anything (some standard deviation above 0): `--odometry-noise 0`
+    /// runs as clean as no noise.
+    pub fn draws(&self) -> bool {
+        self.linear_rel_std > 0.0 || self.angular_rel_std > 0.0 || self.heading_drift_std > 0.0
+    }
+}
+
 /// An options file's `noise` section as written ([`OdometryNoise`]'s rule for left-out
 /// fields).
 #[derive(Deserialize)]

@@ -263,7 +263,7 @@ impl<'w> Simulator<'w> {
                     mode: "pid".to_string(),
                     dt_s: opts.dt_s,
                     tolerance_m: opts.tolerance_m,
-                    noisy: opts.noise.is_some(),
+                    noisy: opts.noise.is_some_and(|n| n.draws()),
                 },
             );
             self.pid = Some(PidState {

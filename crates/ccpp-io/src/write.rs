@@ -46,11 +46,24 @@ pub enum WriteError {
     },
 }
 
-/// The temporary path `<name>.tmp` beside `path`.
+/// The temporary path `<name>.tmp` beside `path`; for a name within 4 bytes of the 255-byte
+/// limit, `<start>~<hash>.tmp` with the name cut at a character boundary (a legal 252-byte
+/// `waypoints --out` failed with "File name too long").
 fn tmp_path(path: &Path) -> Result<PathBuf, WriteError> {
     let name = path.file_name().ok_or_else(|| WriteError::NoFileName {
         path: path.to_path_buf(),
     })?;
+    if name.len() + ".tmp".len() > NAME_MAX {
+        let text = name.to_string_lossy();
+        let mut h = ccpp_core::hash::Fnv::new();
+        h.bytes(name.as_encoded_bytes());
+        let hash = format!("~{:016x}.tmp", h.finish());
+        let mut cut = (NAME_MAX - hash.len()).min(text.len());
+        while !text.is_char_boundary(cut) {
+            cut -= 1;
+        }
+        return Ok(path.with_file_name(format!("{}{hash}", &text[..cut])));
+    }
     let mut tmp = OsString::from(name);
     tmp.push(".tmp");
     Ok(path.with_file_name(tmp))

@@ -74,6 +74,12 @@ impl std::str::FromStr for ZoneSpec {
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         let numbers: Result<Vec<f64>, _> = s.split(',').map(|p| p.trim().parse::<f64>()).collect();
         if let Ok(Ok(r)) = numbers.map(<[f64; 4]>::try_from) {
+            // A file of that very name was ignored in silence.
+            if Path::new(s).exists() {
+                return Err(bad(format!(
+                    "{s:?} reads as the rectangle X0,Y0,X1,Y1 and names a file too: give the file as ./{s}, or rename it"
+                )));
+            }
             return Ok(Self::Rect(r));
         }
         if s.is_empty() {

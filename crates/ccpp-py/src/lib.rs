@@ -443,7 +443,7 @@ const ZONE_FORMS: &str =
 
 /// A work area: a file name, `[x0, y0, x1, y1]` or a list of polygons (`Scenario::area`).
 fn parse_area(v: &Bound<'_, PyAny>) -> PyResult<ZoneSpec> {
-    if let Some(r) = text_zone(v) {
+    if let Some(r) = text_zone(v, "area") {
         return r;
     }
     serde_json::from_value(py_to_json(v)?)
@@ -453,17 +453,17 @@ fn parse_area(v: &Bound<'_, PyAny>) -> PyResult<ZoneSpec> {
 /// A zone given as text, read as the command line's `--area` / `--keepout` read it
 /// ([`ZoneSpec`]'s `FromStr`): `"X0,Y0,X1,Y1"` is the rectangle (it was taken for a file name:
 /// "No such file"), other text a file; `None` when `v` is not text.
-fn text_zone(v: &Bound<'_, PyAny>) -> Option<PyResult<ZoneSpec>> {
+fn text_zone(v: &Bound<'_, PyAny>, what: &str) -> Option<PyResult<ZoneSpec>> {
     let s: String = v.extract().ok()?;
     Some(
         s.parse::<ZoneSpec>()
-            .map_err(|e| msg(format!("area or keepout {s:?}: {e}"))),
+            .map_err(|e| msg(format!("{what} {s:?}: {e}"))),
     )
 }
 
 /// Keep-out zones: one zone (as for an area) or a list of zones (`Scenario::keepout`).
 fn parse_keepout(v: &Bound<'_, PyAny>) -> PyResult<Vec<ZoneSpec>> {
-    if let Some(r) = text_zone(v) {
+    if let Some(r) = text_zone(v, "keepout") {
         return r.map(|z| vec![z]);
     }
     // A list whose every item is a zone given as text ("x0,y0,x1,y1" rectangles and file
@@ -472,7 +472,13 @@ fn parse_keepout(v: &Bound<'_, PyAny>) -> PyResult<Vec<ZoneSpec>> {
     if !v.is_instance_of::<PyString>() {
         if let Ok(items) = v.extract::<Vec<Bound<'_, PyAny>>>() {
             if !items.is_empty() && items.iter().all(PyAnyMethods::is_instance_of::<PyString>) {
-                return items.iter().map(parse_area).collect();
+                return items
+                    .iter()
+                    .map(|i| match text_zone(i, "keepout") {
+                        Some(z) => z,
+                        None => parse_area(i),
+                    })
+                    .collect();
             }
         }
     }

@@ -306,7 +306,34 @@ def test_an_interrupted_run_stops_instead_of_finishing_unseen(tmp_path: Path, ro
 
 def test_a_mistyped_text_rectangle_is_named_as_such(room: Path) -> None:
     # Five numbers were taken for a file name and reported as "No such file".
-    with pytest.raises(ccpp.CcppError, match="got 5 numbers"):
+    with pytest.raises(ccpp.CcppError, match="^area .*got 5 numbers"):
         ccpp.run(room, "bsa", area="1,1,2,2,3")
-    with pytest.raises(ccpp.CcppError, match="got 3 numbers"):
+    with pytest.raises(ccpp.CcppError, match="^keepout .*got 3 numbers"):
         ccpp.run(room, "bsa", keepout=["1,0.5,1.5,1.5", "1,2,3"])
+
+
+def test_a_sweep_holds_the_bench_lock(tmp_path: Path, room: Path) -> None:
+    # A sweep ignored the lock `ccpp bench` holds in its folder: a sweep and a bench wrote one
+    # folder at once, both "succeeded", and the folder was mixed. A sweep refused a lock file a
+    # killed bench left ("which a sweep or ccpp bench did not write").
+    import fcntl
+
+    from ccpp import sweeps
+
+    out = tmp_path / "out"
+    out.mkdir()
+    lock = out / ".ccpp-bench.lock"
+    with open(lock, "w", encoding="utf-8") as f:
+        f.write("4242\n")
+        f.flush()
+        fcntl.flock(f.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+        with pytest.raises(ccpp.CcppError, match=r"in use by another ccpp bench or sweep \(pid 4242\)"):
+            with sweeps._folder_lock(out):
+                pass
+    # Released (its holder gone): taken over, and removed when the sweep ends.
+    with sweeps._folder_lock(out):
+        assert lock.read_text().strip() == str(os.getpid())
+    assert not lock.exists()
+    # A lock file left behind does not make the folder foreign.
+    lock.write_text("1\n")
+    sweeps._check_out(out)

@@ -425,7 +425,7 @@ fn validate_pid(field: &str, p: &PidOptions) -> Result<(), OptionsError> {
 fn noise_that_draws(field: &str, e: &Execution) -> Result<(), OptionsError> {
     if let Execution::Pid(p) = e {
         if let Some(n) = p.noise {
-            if n.linear_rel_std == 0.0 && n.angular_rel_std == 0.0 && n.heading_drift_std == 0.0 {
+            if !n.draws() {
                 return Err(OptionsError::new(
                     &format!("{field}.pid.noise"),
                     "draws no noise: every std is 0 (leave the section out, or give linear_rel_std > 0)",

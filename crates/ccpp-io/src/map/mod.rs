@@ -216,6 +216,7 @@ fn finish<R: std::io::BufRead + std::io::Seek>(
             });
         }
     }
+    let bare = yaml.is_none();
     let (res, origin, base) = yaml.map_or(
         (DEFAULT_BARE_RESOLUTION, [0.0; 3], Thresholds::default()),
         |y| (y.resolution, y.origin, y.thresholds()),
@@ -232,9 +233,14 @@ fn finish<R: std::io::BufRead + std::io::Seek>(
     thresholds.validate(source).map_err(|e| {
         // Thresholds that cross because of an override: say which value was given and which
         // is the map's (`--occupied-thresh 0.1` was reported as a bad `free_thresh`).
+        let theirs = if bare {
+            "the default for a bare image"
+        } else {
+            "the map's"
+        };
         let (t, given) = (
             &thresholds,
-            |o: Option<f64>| if o.is_some() { "given" } else { "the map's" },
+            |o: Option<f64>| if o.is_some() { "given" } else { theirs },
         );
         match e {
             MapError::BadValue {
@@ -259,7 +265,7 @@ fn finish<R: std::io::BufRead + std::io::Seek>(
                 path,
                 field: "free_thresh",
                 reason: format!(
-                    "free_thresh {} (given) must be below occupied_thresh {} (the map's)",
+                    "free_thresh {} (given) must be below occupied_thresh {} ({theirs})",
                     t.free, t.occupied
                 ),
             },

@@ -13,11 +13,12 @@ installed and the map files at the same paths (a shared file system); so does ``
 
 from __future__ import annotations
 
+import contextlib
 import math
 import numbers
 import os
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Iterable, Sequence
+from typing import TYPE_CHECKING, Any, Iterable, Iterator, Sequence
 
 from . import _ccpp
 
@@ -116,13 +117,58 @@ def _check_out(out: str | os.PathLike[str]) -> None:
             known = e.is_file() and not e.is_symlink()
         elif e.name in ("plots", "runs"):
             known = e.is_dir() and not e.is_symlink()
+        elif e.name == _LOCK_FILE:
+            # A bench's or sweep's lock: held by a live one (refused when taken), or left by
+            # a killed one (taken over).
+            known = e.is_file() and not e.is_symlink()
         else:
-            known = e.suffix == ".tmp" and e.is_file()
+            known = e.name in ("results.csv.tmp", "results.md.tmp") and e.is_file()
         if not known:
             raise _ccpp.CcppError(
                 f"output folder {p} holds {e.name}, which a sweep or ccpp bench did not write; "
                 "a sweep writes its runs there, so choose a new or bench-only folder"
             )
+
+
+#: The lock file ``ccpp bench`` holds in its output folder; a sweep holds it too.
+_LOCK_FILE = ".ccpp-bench.lock"
+
+
+@contextlib.contextmanager
+def _folder_lock(out: str | os.PathLike[str]) -> Iterator[None]:
+    """Holds ``out``'s bench lock while a sweep writes there, as ``ccpp bench`` does (the same
+    file and the same operating-system lock, ``flock``): a sweep and a bench, or two sweeps,
+    writing one folder at once mixed their runs. A lock left by a killed process is taken
+    over; one held is refused naming its process. Where ``fcntl`` is missing (Windows) no lock
+    is taken."""
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - not on the platforms tested
+        yield
+        return
+    folder = Path(out)
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / _LOCK_FILE
+    with open(path, "a+", encoding="utf-8") as f:
+        try:
+            fcntl.flock(f.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            f.seek(0)
+            holder = f.read().strip()
+            pid = f"pid {holder}" if holder.isdigit() else "pid unknown"
+            raise _ccpp.CcppError(
+                f"{folder} is in use by another ccpp bench or sweep ({pid})"
+            ) from None
+        f.seek(0)
+        f.truncate()
+        f.write(f"{os.getpid()}\n")
+        f.flush()
+        try:
+            yield
+        finally:
+            # Removed while still held, then released as the file closes.
+            with contextlib.suppress(OSError):
+                path.unlink()
 
 
 def _once(items: Iterable[Any]) -> list[Any]:
@@ -203,7 +249,6 @@ def sweep(
     the script again.
     """
     import pandas as pd
-    from distributed import Client
 
     if client is not None and scheduler is not None:
         # One of them would be ignored.
@@ -268,6 +313,18 @@ def sweep(
                     d = str(base / map_name / p)
                 tasks.append((str(m), map_name, p, r, tool_radius, inflate, max_memory_mb, d))
 
+    with _folder_lock(out) if out is not None else contextlib.nullcontext():
+        rows = _gather(tasks, client, scheduler)
+    df = pd.DataFrame(rows, columns=CSV_COLUMNS)
+    if len(radii) > 1:
+        df.insert(2, "radius", [t[3] for t in tasks])
+    return df
+
+
+def _gather(tasks: list[tuple[Any, ...]], client: Any, scheduler: str | None) -> list[Any]:
+    """Runs the sweep's cells on ``client`` (or a cluster of its own) and gathers their rows."""
+    from distributed import Client
+
     own = None
     if client is None:
         address = scheduler or os.environ.get("CCPP_DASK_SCHEDULER")
@@ -275,11 +332,7 @@ def sweep(
         client = own
     try:
         futures = [client.submit(_run_cell, *t, pure=False) for t in tasks]
-        rows = client.gather(futures)
+        return list(client.gather(futures))
     finally:
         if own is not None:
             own.close()
-    df = pd.DataFrame(rows, columns=CSV_COLUMNS)
-    if len(radii) > 1:
-        df.insert(2, "radius", [t[3] for t in tasks])
-    return df
