@@ -148,11 +148,19 @@ fn bench_keeps_a_users_files_in_plots_and_refuses_the_folder() {
         ["plots"],
         "the refused bench wrote something"
     );
-    // A bench's own old plots (of a map this bench does not have) still go, and a stray
-    // `.tmp` at the top that a bench does not write is refused like any other file.
+    // A bench's own old plots (of a map this bench does not have, whose run folders an
+    // earlier bench left in `runs/`) still go; one of no such map is a user's, refused; a
+    // stray `.tmp` at the top that a bench does not write is refused like any other file.
     std::fs::remove_file(out.join("plots/my_figure.png")).unwrap();
     bench(&out, "bsa").assert().success();
     std::fs::write(out.join("plots/coverage_gone.png"), "old").unwrap();
+    let o = bench(&out, "bsa").assert().code(1).get_output().clone();
+    assert!(
+        stderr_of(&o).contains("plots/coverage_gone.png"),
+        "{}",
+        stderr_of(&o)
+    );
+    std::fs::create_dir_all(out.join("runs/gone/bsa")).unwrap();
     bench(&out, "bsa").assert().success();
     assert!(!out.join("plots/coverage_gone.png").exists());
     std::fs::write(out.join("thesis.tmp"), "precious").unwrap();
