@@ -893,3 +893,28 @@ fn this_rounds_fixes_hold_under_noise_and_odd_names() {
     );
     assert!(out.join("plots/coverage_mydiagram.png").exists());
 }
+
+/// A threshold override could not repair a map YAML whose own thresholds cross: the YAML's pair
+/// was refused before the override applied. The merged pair is checked now.
+#[test]
+fn a_threshold_override_repairs_a_crossed_yaml() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let yaml = write(
+        dir,
+        "crossed.yaml",
+        &format!(
+            "image: {}\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.1\nfree_thresh: 0.196\n",
+            map.file_name().unwrap().to_str().unwrap()
+        ),
+    );
+    refused(
+        &["info", "--map", &yaml],
+        &["bad `free_thresh`", "must be below occupied_thresh 0.1"],
+    );
+    ccpp()
+        .args(["info", "--map", &yaml, "--occupied-thresh", "0.3"])
+        .assert()
+        .success();
+}

@@ -123,7 +123,8 @@ pub fn load_map(path: &Path, opts: &LoadOptions) -> Result<LoadedMap, MapError> 
             path: path.to_path_buf(),
             message: format!("not UTF-8 text ({e})"),
         })?;
-        let yaml = MapYaml::parse(text, path)?;
+        // The thresholds are checked with the overrides applied (`finish`).
+        let yaml = MapYaml::parse_fields(text, path)?;
         let image_path = path.parent().unwrap_or(Path::new("")).join(&yaml.image);
         let file = match crate::file::open_regular(&image_path) {
             Ok(f) => f,
@@ -185,7 +186,7 @@ pub fn load_map_bytes(
     let reader = ImageReader::new(Cursor::new(image));
     match yaml {
         Some(text) => {
-            let y = MapYaml::parse(text, name)?;
+            let y = MapYaml::parse_fields(text, name)?;
             let image_path = name.parent().unwrap_or(Path::new("")).join(&y.image);
             finish(Some(&y), name, image_path, reader, opts)
         }

@@ -107,6 +107,15 @@ impl MapYaml {
     /// [`MapError::BadValue`] for out-of-domain values (see [`validate_placement`] and
     /// [`Thresholds::validate`]). The mode is not checked here.
     pub fn parse(text: &str, path: &Path) -> Result<Self, MapError> {
+        let yaml = Self::parse_fields(text, path)?;
+        yaml.thresholds().validate(path)?;
+        Ok(yaml)
+    }
+
+    /// [`Self::parse`] without the check of the thresholds, for a load that checks them after
+    /// its overrides: `--occupied-thresh 0.3` could not repair a YAML of `occupied_thresh 0.1`
+    /// beside `free_thresh 0.196` (the YAML's pair was refused before the override applied).
+    pub(crate) fn parse_fields(text: &str, path: &Path) -> Result<Self, MapError> {
         // Let `.nan` / `.inf` through so they are reported as bad values of their field.
         let mut options = serde_saphyr::Options::default();
         options.non_finite_float_policy = serde_saphyr::NonFiniteFloatPolicy::PassThrough;
@@ -169,7 +178,6 @@ impl MapYaml {
             mode: raw.mode,
         };
         validate_placement(yaml.resolution, yaml.origin, path)?;
-        yaml.thresholds().validate(path)?;
         Ok(yaml)
     }
 
