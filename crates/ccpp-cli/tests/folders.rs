@@ -48,18 +48,7 @@ fn bench(out: &Path, planners: &str) -> Command {
 /// A 600 x 600 px (30 x 30 m) room with pillars: a bench on it takes long enough to be caught
 /// running.
 fn slow_map(dir: &Path) -> PathBuf {
-    let n = 600u32;
-    let mut img = image::GrayImage::from_pixel(n, n, image::Luma([254]));
-    for (x, y, p) in img.enumerate_pixels_mut() {
-        let wall = x < 2 || y < 2 || x >= n - 2 || y >= n - 2;
-        let pillar = (x % 120) < 15 && (y % 120) < 15 && x > 30 && y > 30;
-        if wall || pillar {
-            *p = image::Luma([0]);
-        }
-    }
-    let p = dir.join("slow_room.png");
-    img.save(&p).unwrap();
-    p
+    crate::common::pillared_room(dir, "slow_room.png", 600)
 }
 
 /// Two benches on one `--out` at once wrote over each other and left a mixed folder, both

@@ -56,18 +56,7 @@ fn planner_of(dir: &Path) -> String {
 /// An 800 x 800 px (40 x 40 m) room with pillars: big enough that a run with its replay takes
 /// a noticeable time.
 fn big_room(dir: &Path) -> PathBuf {
-    let n = 800u32;
-    let mut img = image::GrayImage::from_pixel(n, n, image::Luma([254]));
-    for (x, y, p) in img.enumerate_pixels_mut() {
-        let wall = x < 2 || y < 2 || x >= n - 2 || y >= n - 2;
-        let pillar = (x % 160) < 20 && (y % 160) < 20 && x > 40 && y > 40;
-        if wall || pillar {
-            *p = image::Luma([0]);
-        }
-    }
-    let p = dir.join("big_room.png");
-    img.save(&p).unwrap();
-    p
+    crate::common::pillared_room(dir, "big_room.png", 800)
 }
 
 fn run_into(out: &Path, planner: &str, replay: bool) -> Command {

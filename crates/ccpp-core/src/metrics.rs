@@ -132,6 +132,10 @@ pub fn execution_tolerance(trace: &Trace) -> Option<f64> {
     execution_of(trace).map(|(t, _)| t)
 }
 
+/// How near (in tiles) the true path must pass a tile centre for the tile to count visited
+/// under odometry noise ([`noisy_execution`]): half a tile.
+pub const NOISY_TILE_VISIT_TILES: f64 = 0.5;
+
 /// Whether odometry noise perturbed the run (its `execution` event says `noisy`): a tile
 /// centre then counts visited within half a tile of the true path (`coverage_rate`; the
 /// replay's tile outlines follow the same rule).
@@ -532,7 +536,13 @@ pub fn compute_prepared_with(
             // `effective_coverage` 0.89).
             let exec = execution_of(trace);
             run.tile_side.map(|side| {
-                let exec_tol = exec.map(|(t, noisy)| if noisy { t.max(0.5 * side) } else { t });
+                let exec_tol = exec.map(|(t, noisy)| {
+                    if noisy {
+                        t.max(NOISY_TILE_VISIT_TILES * side)
+                    } else {
+                        t
+                    }
+                });
                 let grid = TileGrid::new(start, side);
                 let reach = match part {
                     Some(p) if p.side.to_bits() == side.to_bits() => p.reach,

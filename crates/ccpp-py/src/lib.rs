@@ -474,10 +474,7 @@ fn parse_keepout(v: &Bound<'_, PyAny>) -> PyResult<Vec<ZoneSpec>> {
             if !items.is_empty() && items.iter().all(PyAnyMethods::is_instance_of::<PyString>) {
                 return items
                     .iter()
-                    .map(|i| match text_zone(i, "keepout") {
-                        Some(z) => z,
-                        None => parse_area(i),
-                    })
+                    .map(|i| text_zone(i, "keepout").unwrap_or_else(|| parse_area(i)))
                     .collect();
             }
         }

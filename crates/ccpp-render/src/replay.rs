@@ -249,7 +249,7 @@ fn replay_data(
                     let fj = (pose.y - start.y) / t;
                     let (i2, j2) = (fi.round(), fj.round());
                     let near = if noisy {
-                        (fi - i2).hypot(fj - j2) <= 0.5
+                        (fi - i2).hypot(fj - j2) <= ccpp_core::metrics::NOISY_TILE_VISIT_TILES
                     } else {
                         (fi - i2).abs() < 1e-3 && (fj - j2).abs() < 1e-3
                     };

@@ -125,3 +125,21 @@ pub fn run_ok(dir: &Path, sub: &str, map: &Path, planner: &str, args: &[&str]) -
 pub fn plan_ok(dir: &Path, sub: &str, map: &Path, planner: &str, args: &[&str]) -> PathBuf {
     ccpp_ok("plan", dir, sub, map, planner, args)
 }
+
+/// A square room of `n` x `n` px at 0.05 m/px, a 2 px wall around and square pillars
+/// (`n / 40` px wide, every `n / 5` px, from `n / 20` px in): big enough for a run or bench on
+/// it to take a noticeable time.
+pub fn pillared_room(dir: &Path, name: &str, n: u32) -> PathBuf {
+    let mut img = image::GrayImage::from_pixel(n, n, image::Luma([254]));
+    let (period, side, margin) = (n / 5, n / 40, n / 20);
+    for (x, y, p) in img.enumerate_pixels_mut() {
+        let wall = x < 2 || y < 2 || x >= n - 2 || y >= n - 2;
+        let pillar = (x % period) < side && (y % period) < side && x > margin && y > margin;
+        if wall || pillar {
+            *p = image::Luma([0]);
+        }
+    }
+    let p = dir.join(name);
+    img.save(&p).unwrap();
+    p
+}
