@@ -49,6 +49,52 @@ impl Cell {
             runs,
         })
     }
+
+    /// [`Cell::transposed`], or when that fails only because of the first or last `max`
+    /// positions along the lines (a jagged wall along one side, whose bumps split the lines
+    /// across), the transposed cell without them. The band left out is at most `max` pixels
+    /// deep: the edge lane beside it sweeps most of it and the rim passes the rest.
+    pub(super) fn transposed_trim(&self, max: usize) -> Option<Cell> {
+        if let Some(t) = self.transposed() {
+            return Some(t);
+        }
+        if max == 0 {
+            return None;
+        }
+        let lo = self.runs.iter().map(|r| r.0).min()?;
+        let hi = self.runs.iter().map(|r| r.1).max()?;
+        let n = hi - lo + 1;
+        let mut runs: Vec<Option<(usize, usize)>> = vec![None; n];
+        let mut bad = vec![false; n];
+        for (k, &(a, b)) in self.runs.iter().enumerate() {
+            let u = self.u0 + k;
+            for (r, bad) in runs[a - lo..=b - lo]
+                .iter_mut()
+                .zip(&mut bad[a - lo..=b - lo])
+            {
+                match r {
+                    None => *r = Some((u, u)),
+                    Some((_, last)) if *last + 1 == u => *last = u,
+                    Some(_) => *bad = true,
+                }
+            }
+        }
+        let band = max.min(n);
+        let cut_lo = (0..band).rev().find(|&j| bad[j]).map_or(0, |j| j + 1);
+        let cut_hi = (n - band..n).find(|&j| bad[j]).map_or(0, |j| n - j);
+        if cut_lo + cut_hi >= n || bad[cut_lo..n - cut_hi].iter().any(|&b| b) {
+            return None;
+        }
+        let runs = runs[cut_lo..n - cut_hi]
+            .iter()
+            .copied()
+            .collect::<Option<Vec<_>>>()?;
+        Some(Cell {
+            cols: !self.cols,
+            u0: lo + cut_lo,
+            runs,
+        })
+    }
 }
 
 /// Cells elongated along their lines (more lines than twice their longest run) that are not

@@ -91,6 +91,32 @@ fn best_index(plans: &[(Plan, usize)]) -> Option<usize> {
     })
 }
 
+/// A job of the planning round: its kind (lattice, headland, peeled, other sweep), the index
+/// of its options in the turn-cost variants (step 6), and whether its cells take the
+/// jagged-wall views (step 2).
+type Job = (usize, usize, bool);
+
+/// How a plan is made beyond its lattice and options.
+#[derive(Clone, Copy, Default)]
+struct How {
+    /// Offset loops from the outer walls instead of lanes (module docs, step 3).
+    peel: bool,
+    /// The cells of the sweep (west-to-east or north-to-south, step 1) whose estimate is
+    /// the higher.
+    other: bool,
+    /// A cell's view across its lines may leave out a band along a jagged wall (step 2,
+    /// [`TRIM_LANES`]).
+    trim: bool,
+}
+
+/// Deepest band along a jagged wall that a cell's view across its lines may leave out, in
+/// lane spacings (module docs, step 2).
+const TRIM_LANES: f64 = 2.0;
+
+/// The turn-cost variants (step 6, the first of [`TURN_FACTORS`]) made with the jagged-wall
+/// views (step 2).
+const TRIM_VARIANTS: usize = 2;
+
 /// Improvement rounds of the first tour (which only picks each cell's path for the rim step).
 const FIRST_ROUNDS: u32 = 1;
 
@@ -198,32 +224,40 @@ impl Bcd {
             }
         }
         // A job: its kind and the index of its options in `variants`.
-        let options = |(kind, f): (usize, usize)| {
+        let options = |(kind, f, trim): Job| {
             let (k, head, peel, other) = kinds[kind];
             let (plain, o) = &variants[f];
-            (k, if head { o } else { plain }, peel, other)
+            let how = How { peel, other, trim };
+            (k, if head { o } else { plain }, how)
         };
-        let run = |jobs: &[(usize, usize)], sets: Sets| -> Vec<(Plan, usize)> {
+        let run = |jobs: &[Job], sets: Sets| -> Vec<(Plan, usize)> {
             jobs.par_iter()
                 .map(|&job| {
-                    let (k, o, peel, other) = options(job);
+                    let (k, o, how) = options(job);
                     let mut search = Search::new(w, h);
                     let lat = lattice(&turns_by[k]);
-                    Self::plan_sets(&ctx, &lat, o, cost_turn_px, &mut search, sets, peel, other)
+                    Self::plan_sets(&ctx, &lat, o, cost_turn_px, &mut search, sets, how)
                 })
                 .collect()
         };
         // (job `i` of the first round is kind `i`)
-        let mut jobs: Vec<(usize, usize)> = (0..kinds.len()).map(|i| (i, 0)).collect();
+        let mut jobs: Vec<Job> = (0..kinds.len()).map(|i| (i, 0, false)).collect();
         let mut plans = run(&jobs, Sets::Whole);
         // The lower turn costs (step 6) on the best job's kind only: on the 14 shared maps
         // every plan they improved came from it (made on every kind within 1 % of the best
         // too, they won nowhere else and the bcd bench took about a tenth more time; on
         // every kind, the same plans in about 1.6 times the time).
         let lead = best_index(&plans);
-        let more: Vec<(usize, usize)> = lead
+        // The jagged-wall views (step 2) likewise, on the best job's kind with the user's
+        // turn cost and with half of it (module docs, step 6: where they won on the 14
+        // shared maps; with no turn cost at all they won nowhere).
+        let more: Vec<Job> = lead
             .into_iter()
-            .flat_map(|i| (1..variants.len()).map(move |f| (i, f)))
+            .flat_map(|i| {
+                (1..variants.len())
+                    .map(move |f| (i, f, false))
+                    .chain((0..variants.len().min(TRIM_VARIANTS)).map(move |f| (i, f, true)))
+            })
             .collect();
         plans.extend(run(&more, Sets::Whole));
         jobs.extend(more);
@@ -232,7 +266,7 @@ impl Bcd {
         // cost too (so no plan is dearer than without step 6).
         let mut cut: Vec<usize> = lead.into_iter().chain(best_index(&plans)).collect();
         cut.dedup();
-        let cut_jobs: Vec<(usize, usize)> = cut.into_iter().map(|j| jobs[j]).collect();
+        let cut_jobs: Vec<Job> = cut.into_iter().map(|j| jobs[j]).collect();
         plans.extend(run(&cut_jobs, Sets::Split));
         let best = best_index(&plans).map(|i| plans.swap_remove(i));
         let (items, ncells) = best.map_or((Vec::new(), 0), |(p, n)| (p.items, n));
@@ -301,16 +335,13 @@ impl Bcd {
             cost_turn_px,
             search,
             Sets::Both,
-            false,
-            false,
+            How::default(),
         )
     }
 
     /// Steps 1-5 of the module docs on the lattice `lat`, touring only the cell sets `sets`
     /// (step 4): the best plan and the number of cells. With [`Sets::Split`] and no even cell,
-    /// an empty plan that never beats another (skips `usize::MAX`). `other`: the cells of the
-    /// sweep (west-to-east or north-to-south, step 1) whose estimate is the higher.
-    #[allow(clippy::too_many_arguments)] // the job's choices, passed down unchanged
+    /// an empty plan that never beats another (skips `usize::MAX`).
     fn plan_sets(
         ctx: &Ctx<'_>,
         lat: &Lattice,
@@ -318,9 +349,9 @@ impl Bcd {
         cost_turn_px: f64,
         search: &mut Search,
         sets: Sets,
-        peel: bool,
-        other: bool,
+        how: How,
     ) -> (Plan, usize) {
+        let How { peel, other, .. } = how;
         let world = ctx.world;
         let frame = ctx.frame;
         let robot = world.robot();
@@ -354,6 +385,13 @@ impl Bcd {
         let start = frame.world_to_grid(world.start().position());
 
         // 1-2. Both decompositions, each cell's cheaper lane direction, the cheaper total.
+        // Lines across a cell that a jagged wall's bumps split may be left out of its view
+        // across, up to a band this deep (step 2).
+        let trim_band = if how.trim {
+            (TRIM_LANES * sp).floor() as usize
+        } else {
+            0
+        };
         let ok = &lat.ok;
         let by_cols = decompose(w, h, true, &|c, r| ok[r * w + c]);
         let by_rows = decompose(h, w, false, &|r, c| ok[r * w + c]);
@@ -364,7 +402,7 @@ impl Bcd {
             cells
                 .into_iter()
                 .map(|c| {
-                    let t = c.transposed();
+                    let t = c.transposed_trim(trim_band);
                     let mut v = Vec::with_capacity(2);
                     for c in std::iter::once(c).chain(t) {
                         let lo = side_open(lat, &c, c.u0, -1, &|_| true);
@@ -384,7 +422,8 @@ impl Bcd {
                 estimate(c, &lanes, turn_px) + 2.0 * turn_px + sp
             };
             let along = view(c);
-            c.transposed().map_or(along, |t| along.min(view(&t)))
+            c.transposed_trim(trim_band)
+                .map_or(along, |t| along.min(view(&t)))
         };
         let trim_max = (2.0 * sp).ceil() as usize;
         let jump = (sp / 2.0).ceil() as usize;

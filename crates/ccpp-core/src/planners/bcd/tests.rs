@@ -585,6 +585,64 @@ fn transposed_cell_needs_one_run_per_line() {
     assert!(u.transposed().is_none());
 }
 
+#[test]
+fn a_jagged_wall_band_may_be_left_out_of_the_view_across() {
+    // Rows 0-7 from a jagged wall on the left (columns 0-2, its bumps 1-2 pixels deep) to a
+    // straight wall on the right (column 9):
+    //
+    //   ..........      row 0
+    //   #.........      row 1
+    //   ..........      row 2
+    //   ##........      row 3
+    //   ..........      row 4
+    //   #.........      row 5
+    //   ..........      row 6
+    //   ###.......      row 7 (the deepest bump)
+    //
+    // Columns 0 and 1 meet the cell in several runs, so it is not monotone across.
+    let runs = vec![
+        (0, 9),
+        (1, 9),
+        (0, 9),
+        (2, 9),
+        (0, 9),
+        (1, 9),
+        (0, 9),
+        (3, 9),
+    ];
+    let cell = Cell {
+        cols: false,
+        u0: 0,
+        runs,
+    };
+    assert!(cell.transposed().is_none());
+    // A band of one column is not enough, of two it is: columns 2-9 (column 2 holds rows
+    // 0-6, one run) become the lines of the view across.
+    assert!(cell.transposed_trim(0).is_none());
+    assert!(cell.transposed_trim(1).is_none());
+    let t = cell.transposed_trim(2).unwrap();
+    assert!(t.cols);
+    assert_eq!(t.u0, 2);
+    assert_eq!(t.runs[0], (0, 6));
+    assert_eq!(t.runs[1..], [(0, 7); 7]);
+    // A deeper band takes no more than it needs.
+    assert_eq!(cell.transposed_trim(5).unwrap().u0, 2);
+    // A monotone cell is transposed whole, whatever the band.
+    let whole = Cell {
+        cols: false,
+        u0: 0,
+        runs: vec![(0, 9); 4],
+    };
+    assert_eq!(whole.transposed_trim(3).unwrap().runs, vec![(0, 3); 10]);
+    // Bumps in the middle are no wall band: no view across.
+    let mid = Cell {
+        cols: false,
+        u0: 0,
+        runs: vec![(0, 9), (0, 3), (0, 9)],
+    };
+    assert!(mid.transposed_trim(3).is_none());
+}
+
 /// `margin_px`: a transfer around the block keeps the extra clearance along its whole length
 /// (apart from the stretches next to its ends), where without it the shortened path grazes
 /// the block's corners.
