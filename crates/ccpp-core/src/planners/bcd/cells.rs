@@ -27,44 +27,21 @@ impl Cell {
 
     /// The same pixels with lines the other way, if every such line meets the cell in one run.
     pub(super) fn transposed(&self) -> Option<Cell> {
-        let lo = self.runs.iter().map(|r| r.0).min()?;
-        let hi = self.runs.iter().map(|r| r.1).max()?;
-        // Per position `v`: the first and last line whose run holds it; a line that holds it
-        // after a gap makes it two runs.
-        let mut runs: Vec<Option<(usize, usize)>> = vec![None; hi - lo + 1];
-        for (k, &(a, b)) in self.runs.iter().enumerate() {
-            let u = self.u0 + k;
-            for r in &mut runs[a - lo..=b - lo] {
-                match r {
-                    None => *r = Some((u, u)),
-                    Some((_, last)) if *last + 1 == u => *last = u,
-                    Some(_) => return None,
-                }
-            }
-        }
-        let runs = runs.into_iter().collect::<Option<Vec<_>>>()?;
-        Some(Cell {
-            cols: !self.cols,
-            u0: lo,
-            runs,
-        })
+        self.transposed_trim(0)
     }
 
-    /// [`Cell::transposed`], or when that fails only because of the first or last `max`
-    /// positions along the lines (a jagged wall along one side, whose bumps split the lines
+    /// The same pixels with lines the other way ([`Cell::transposed`]), or when some lines
+    /// would meet the cell in several runs only among the first or last `max` positions along
+    /// the lines (a jagged wall along one side, whose bumps split the lines
     /// across), the transposed cell without them. The band left out is at most `max` pixels
     /// deep: the edge lane beside it sweeps most of it and the rim passes the rest.
     pub(super) fn transposed_trim(&self, max: usize) -> Option<Cell> {
-        if let Some(t) = self.transposed() {
-            return Some(t);
-        }
-        if max == 0 {
-            return None;
-        }
         let lo = self.runs.iter().map(|r| r.0).min()?;
         let hi = self.runs.iter().map(|r| r.1).max()?;
         let n = hi - lo + 1;
         let mut runs: Vec<Option<(usize, usize)>> = vec![None; n];
+        // Per position `v`: the first and last line whose run holds it; a line that holds it
+        // after a gap makes it two runs (`bad`).
         let mut bad = vec![false; n];
         for (k, &(a, b)) in self.runs.iter().enumerate() {
             let u = self.u0 + k;
@@ -75,6 +52,7 @@ impl Cell {
                 match r {
                     None => *r = Some((u, u)),
                     Some((_, last)) if *last + 1 == u => *last = u,
+                    Some(_) if max == 0 => return None,
                     Some(_) => *bad = true,
                 }
             }
