@@ -9,10 +9,12 @@
 //! most of its time. Online planners are refused: their path exists only once a simulated robot
 //! has discovered the map ([`Scenario::run_on`] and the route of its trace).
 
+use std::sync::atomic::AtomicBool;
+
 use ccpp_core::exec::Execution;
 use ccpp_core::planners::PlannerConfig;
 use ccpp_core::route::Route;
-use ccpp_core::sim::{simulate, StopReason};
+use ccpp_core::sim::{simulate, simulate_until, StopReason};
 use ccpp_core::world::World;
 
 use crate::scenario::{PreparedMap, Scenario, ScenarioError};
@@ -85,6 +87,30 @@ pub fn plan_route(
     map: &PreparedMap,
     tolerance_m: f64,
 ) -> Result<Plan, PlanError> {
+    plan_with(scenario, map, tolerance_m, None)
+}
+
+/// [`plan_route`] that another thread can give up by setting `stop`: bcd's planning ends at
+/// its next step ([`PlannerConfig::build_until`]) and the execution within a few steps
+/// (Python's Ctrl-C gives a plan up this way).
+///
+/// # Errors
+/// As [`plan_route`]; [`ScenarioError::Interrupted`] when `stop` ended the plan.
+pub fn plan_route_until(
+    scenario: &Scenario,
+    map: &PreparedMap,
+    tolerance_m: f64,
+    stop: &AtomicBool,
+) -> Result<Plan, PlanError> {
+    plan_with(scenario, map, tolerance_m, Some(stop))
+}
+
+fn plan_with(
+    scenario: &Scenario,
+    map: &PreparedMap,
+    tolerance_m: f64,
+    stop: Option<&AtomicBool>,
+) -> Result<Plan, PlanError> {
     let kind = scenario.planner.kind();
     if !kind.info().offline {
         return Err(PlanError::Online(kind.name(), offline_planners()));
@@ -101,10 +127,19 @@ pub fn plan_route(
     ideal.sim.exec = Some(Execution::Ideal);
     let world = ideal.world(map)?;
     let started = std::time::Instant::now();
-    let mut planner = scenario.planner.build(&world);
     let mut sim = scenario.sim.clone();
     sim.exec = Some(Execution::Ideal);
-    let output = simulate(&world, planner.as_mut(), &sim);
+    let output = match stop {
+        None => {
+            let mut planner = scenario.planner.build(&world);
+            simulate(&world, planner.as_mut(), &sim)
+        }
+        Some(flag) => {
+            let mut planner = scenario.planner.build_until(&world, flag);
+            simulate_until(&world, planner.as_mut(), &sim, &mut |_| {}, flag)
+                .ok_or(ScenarioError::Interrupted)?
+        }
+    };
     let route = Route::from_trace(&output.trace, tolerance_m);
     Ok(Plan {
         world,

@@ -1184,8 +1184,8 @@ impl Scenario {
     /// [`run_on`](Self::run_on) that another thread can stop by setting `stop`: the
     /// simulation ends within [`STOP_CHECK_STEPS`](ccpp_core::sim::STOP_CHECK_STEPS) steps of
     /// it and no metrics are computed (Python's Ctrl-C gives up a run this way, instead of
-    /// leaving it to finish unseen). An offline planner's planning before the first step is
-    /// not stopped.
+    /// leaving it to finish unseen). bcd's planning before the first step stops too
+    /// ([`PlannerConfig::build_until`]).
     ///
     /// # Errors
     /// As [`world`](Self::world); [`ScenarioError::Interrupted`] when `stop` ended the run.
@@ -1285,7 +1285,11 @@ impl Scenario {
                 let other = s.spawn(|| (metrics::WorldPart::of(&world, side), beside(&world)));
                 // Wall time covers planning (offline planners plan in `build`) and simulation.
                 let started = std::time::Instant::now();
-                let mut planner = self.planner.build(&world);
+                // (with `stop`, bcd's planning ends early when it is set)
+                let mut planner = match stop {
+                    None => self.planner.build(&world),
+                    Some(flag) => self.planner.build_until(&world, flag),
+                };
                 let output = match stop {
                     None => Some(simulate(&world, planner.as_mut(), &self.sim)),
                     Some(flag) => {

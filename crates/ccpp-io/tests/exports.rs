@@ -10,8 +10,8 @@ use std::path::PathBuf;
 use ccpp_core::planners::PlannerKind;
 use ccpp_core::route::{Route, DEFAULT_TOLERANCE_M};
 use ccpp_io::export::{nav_path_yaml, parse_waypoints_csv};
-use ccpp_io::plan::{plan_route, PlanError};
-use ccpp_io::scenario::Scenario;
+use ccpp_io::plan::{plan_route, plan_route_until, PlanError};
+use ccpp_io::scenario::{Scenario, ScenarioError};
 use ccpp_io::trace::path_csv;
 
 /// `<repo>/../shared/maps`, valid from any worktree that sits beside `shared/`.
@@ -85,4 +85,23 @@ fn plan_route_of_known_map_planners_and_online_refusal() {
         .err()
         .unwrap();
     assert!(matches!(e, PlanError::Online("ba-star", _)), "{e}");
+    // A plan or a run given up before it starts is interrupted, not an empty path; one not
+    // given up is the same plan and run.
+    let given_up = std::sync::atomic::AtomicBool::new(true);
+    let e = plan_route_until(&scenario, &prepared, DEFAULT_TOLERANCE_M, &given_up)
+        .err()
+        .unwrap();
+    assert!(
+        matches!(e, PlanError::Scenario(ScenarioError::Interrupted)),
+        "{e}"
+    );
+    assert!(matches!(
+        scenario.run_on_until(&prepared, &given_up),
+        Err(ScenarioError::Interrupted)
+    ));
+    let going = std::sync::atomic::AtomicBool::new(false);
+    let kept = plan_route_until(&scenario, &prepared, DEFAULT_TOLERANCE_M, &going).unwrap();
+    assert_eq!(kept.route, plan.route);
+    let kept = scenario.run_on_until(&prepared, &going).unwrap();
+    assert_eq!(kept.output.trace, run.output.trace);
 }

@@ -970,8 +970,8 @@ fn plan(
     name_map(&mut prepared, &scenario);
     let (scenario, prepared) = (Arc::new(scenario), Arc::new(prepared));
     let (sc, pm) = (Arc::clone(&scenario), Arc::clone(&prepared));
-    let p = interruptible(py, move |_| {
-        ccpp_io::plan::plan_route(&sc, &pm, DEFAULT_TOLERANCE_M)
+    let p = interruptible(py, move |stop| {
+        ccpp_io::plan::plan_route_until(&sc, &pm, DEFAULT_TOLERANCE_M, stop)
     })?
     .map_err(|e| err(&e))?;
     let scenario = Arc::unwrap_or_clone(scenario);
@@ -1173,9 +1173,10 @@ static ORPHANS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize:
 /// Runs `job` on a thread of its own while this one waits with the GIL released, looking
 /// for signals every 50 ms: Ctrl-C (`KeyboardInterrupt`) ends the wait at once. A long run
 /// used to hold the caller until it finished. On the interrupt the flag given to `job` is
-/// set: a simulation stops within a few steps ([`Scenario::run_on_until`]); what cannot be
-/// stopped (an offline planner's planning) finishes on its thread and its result is dropped
-/// (a script that ends on the interrupt ends it with the process). A new job first waits
+/// set: a simulation stops within a few steps and bcd's planning at its next step
+/// ([`Scenario::run_on_until`]); what cannot be stopped (the other planners' building, which
+/// is quick) finishes on its thread and its result is dropped (a script that ends on the
+/// interrupt ends it with the process). A new job first waits
 /// (interruptibly) until the interrupted ones have ended, so they never pile up: three
 /// interrupted runs slowed the next one threefold and held 921 MB beside it, over the 800 MB
 /// each was admitted under. An interrupted simulation used to run to its end too, so the next

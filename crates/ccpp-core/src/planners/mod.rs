@@ -274,6 +274,16 @@ impl PlannerConfig {
     pub fn build(&self, world: &World) -> Box<dyn Planner> {
         self.settings().build(world)
     }
+
+    /// [`build`](Self::build) that another thread can give up by setting `stop` (bcd's
+    /// planning ends early; the planner built then must not be driven).
+    pub fn build_until(
+        &self,
+        world: &World,
+        stop: &std::sync::atomic::AtomicBool,
+    ) -> Box<dyn Planner> {
+        self.settings().build_until(world, stop)
+    }
 }
 
 /// Error building a planner.

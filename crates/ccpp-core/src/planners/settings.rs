@@ -7,6 +7,8 @@
 //! (per-pixel arrays, per-tile / per-cell state, trace records and their text): the point is to
 //! refuse runs that would take gigabytes or hours *before* allocating, not to predict the peak.
 
+use std::sync::atomic::AtomicBool;
+
 use crate::exec::{Execution, PidGains, PidOptions};
 use crate::grid::MapFrame;
 use crate::options::{present, OptionsError};
@@ -255,6 +257,13 @@ pub trait PlannerSettings {
 
     /// Builds the planner for `world` (offline planners plan here).
     fn build(&self, world: &World) -> Box<dyn Planner>;
+
+    /// [`build`](Self::build) that another thread can give up by setting `stop`: a planner
+    /// whose building takes long (bcd's planning) then ends it early, with a planner that
+    /// must not be driven (the caller is giving the run up). The others build as usual.
+    fn build_until(&self, world: &World, _stop: &AtomicBool) -> Box<dyn Planner> {
+        self.build(world)
+    }
 }
 
 fn finite_pos(field: &str, v: f64) -> Result<(), OptionsError> {
@@ -1012,6 +1021,10 @@ impl PlannerSettings for BcdOptions {
 
     fn build(&self, world: &World) -> Box<dyn Planner> {
         Box::new(Bcd::new(world, self))
+    }
+
+    fn build_until(&self, world: &World, stop: &AtomicBool) -> Box<dyn Planner> {
+        Box::new(Bcd::new_until(world, self, stop))
     }
 }
 

@@ -888,6 +888,7 @@ mod tests {
             ok,
             rt: world.robot().tool_radius / frame.resolution,
             coarse: CoarseCache::default(),
+            stop: None,
         }
     }
 

@@ -2,6 +2,7 @@
 //! [`Lattice`] the cells are decomposed on (the map's pixels or a turned lattice).
 
 use std::borrow::Cow;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::geometry::Point;
 use crate::grid::MapFrame;
@@ -22,6 +23,8 @@ pub(super) struct Ctx<'a> {
     pub(super) rt: f64,
     /// The coarse grids of the hop costs, made once ([`super::hops::CoarseCache`]).
     pub(super) coarse: super::hops::CoarseCache,
+    /// Set by another thread to give the planning up ([`super::Bcd::new_until`]).
+    pub(super) stop: Option<&'a AtomicBool>,
 }
 
 /// The lattice the cells are decomposed on: points `(c, r)` one pixel apart (`c` to the right,
@@ -122,6 +125,12 @@ impl<'a> Lattice<'a> {
 }
 
 impl Ctx<'_> {
+    /// Has the caller given the planning up? Each step of a plan looks before it starts, and
+    /// a plan given up ends with no plan.
+    pub(super) fn stopped(&self) -> bool {
+        self.stop.is_some_and(|s| s.load(Ordering::Relaxed))
+    }
+
     pub(super) fn ok_at(&self, c: i64, r: i64) -> bool {
         self.frame
             .checked(c, r)

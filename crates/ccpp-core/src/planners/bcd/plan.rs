@@ -3,6 +3,7 @@
 
 use std::collections::VecDeque;
 use std::ops::{Add, Sub};
+use std::sync::atomic::AtomicBool;
 
 use rayon::prelude::*;
 
@@ -121,7 +122,7 @@ const TRIM_VARIANTS: usize = 2;
 const FIRST_ROUNDS: u32 = 1;
 
 impl Bcd {
-    pub(super) fn plan(world: &World, opts: &BcdOptions) -> Self {
+    pub(super) fn plan(world: &World, opts: &BcdOptions, stop: Option<&AtomicBool>) -> Self {
         let frame = *world.frame();
         let (w, h) = (frame.width, frame.height);
         let robot = world.robot();
@@ -140,6 +141,7 @@ impl Bcd {
             keep_px: (opts.margin_px > 0.0).then_some(need),
             rt: robot.tool_radius / res,
             coarse: hops::CoarseCache::default(),
+            stop,
         };
         // The plan on the pixel lattice and, when the walls run at an angle to the pixel
         // axes, on the lattices turned to them; the cheapest is kept (module docs, step 1).
@@ -233,6 +235,9 @@ impl Bcd {
         let run = |jobs: &[Job], sets: Sets| -> Vec<(Plan, usize)> {
             jobs.par_iter()
                 .map(|&job| {
+                    if ctx.stopped() {
+                        return (Plan::empty(usize::MAX), 0);
+                    }
                     let (k, o, how) = options(job);
                     let mut search = Search::new(w, h);
                     let lat = lattice(&turns_by[k]);
@@ -268,6 +273,12 @@ impl Bcd {
         cut.dedup();
         let cut_jobs: Vec<Job> = cut.into_iter().map(|j| jobs[j]).collect();
         plans.extend(run(&cut_jobs, Sets::Split));
+        if ctx.stopped() {
+            return Self {
+                steps: VecDeque::new(),
+                cells: 0,
+            };
+        }
         let best = best_index(&plans).map(|i| plans.swap_remove(i));
         let (items, ncells) = best.map_or((Vec::new(), 0), |(p, n)| (p.items, n));
         let start = frame.world_to_grid(world.start().position());
@@ -682,11 +693,12 @@ impl Bcd {
         let mut best: Option<Plan> = None;
         // The hop table and nearest-neighbour tour of the cells alone serve both plans.
         let cell_table = hops::HopTable::new(&coarse, &far, &cell_pieces, start);
+        let stop: tsp::Stop<'_> = &|| ctx.stopped();
         let cell_nn = cell_table.nearest_tour(&cell_pieces, start);
         // The cells' tour after the first rounds, whether those settled it, and its neighbours.
         let mut cell_tour: Option<(tsp::Tour, bool, Vec<Vec<usize>>)> = None;
         for in_tour in [true, false] {
-            if !opts.rim && !in_tour {
+            if !opts.rim && !in_tour || ctx.stopped() {
                 break;
             }
             // (with a headland, whose passes sweep most of the rim, the rest is only
@@ -702,8 +714,8 @@ impl Bcd {
                 let nb = tsp::neighbours(&pieces, &dist);
                 let mut first = cell_nn.clone();
                 let rounds = opts.tour_rounds.min(FIRST_ROUNDS);
-                let settled =
-                    rounds > 0 && tsp::improve(&pieces, start, rounds, &dist, &nb, &mut first);
+                let settled = rounds > 0
+                    && tsp::improve(&pieces, start, rounds, &dist, &nb, &mut first, stop);
                 cell_tour = Some((first.clone(), settled, nb));
                 let mut keep = vec![0usize; ncells];
                 for &(c, v) in &first {
@@ -753,7 +765,7 @@ impl Bcd {
             let tour = match (&own, cont) {
                 (Some(t), _) => {
                     let nn = t.nearest_tour(&pieces, start);
-                    tsp::solve(&pieces, start, opts.tour_rounds, &dist, Some(nn))
+                    tsp::solve(&pieces, start, opts.tour_rounds, &dist, Some(nn), stop)
                 }
                 // (the rounds left after the first ones; none when they settled the tour)
                 (None, Some((mut tour, settled, nb))) => {
@@ -766,6 +778,7 @@ impl Bcd {
                             &dist,
                             &nb,
                             &mut tour,
+                            stop,
                         );
                     }
                     tour
@@ -776,9 +789,13 @@ impl Bcd {
                     opts.tour_rounds,
                     &dist,
                     Some(cell_nn.clone()),
+                    stop,
                 ),
             };
 
+            if ctx.stopped() {
+                return None;
+            }
             // Hop corrections (module docs, step 4) in the tour of the cells (and headland
             // passes); the tour with the rim passes keeps its estimates (corrected, it wins
             // on cost with fewer turns but longer paths: `rmf_office_scan` 1.52 -> 1.57).
@@ -852,6 +869,9 @@ impl Bcd {
                 here = pts[pts.len() - 1];
             }
 
+            if ctx.stopped() {
+                return None;
+            }
             if opts.rim {
                 rim_pass(
                     ctx,
@@ -860,6 +880,9 @@ impl Bcd {
                     opts.rim_min_yield,
                     opts.rim_coverage,
                 );
+            }
+            if ctx.stopped() {
+                return None;
             }
             let mut items = smooth(ctx, repair(ctx, search, items, &mut skipped));
             if opts.rim && !in_tour {
@@ -872,6 +895,9 @@ impl Bcd {
                     opts.rim_coverage,
                 );
                 items = smooth(ctx, repair(ctx, search, items, &mut skipped));
+            }
+            if ctx.stopped() {
+                return None;
             }
             let (items, short) = prune::prune(ctx, items, opts.min_coverage, turn_px);
             let pts: Vec<Point> = moves(&items).into_iter().map(|m| m.0).collect();
@@ -995,6 +1021,9 @@ fn correct_hops(
     // The best tour by its routed cost (hops as routed, unroutable hops at their estimate).
     let mut best: Option<(f64, tsp::Tour)> = None;
     for r in 0..=CORRECT_ROUNDS {
+        if ctx.stopped() {
+            break;
+        }
         let mut changed = false;
         let mut here = start;
         let mut real = 0.0;
@@ -1038,6 +1067,7 @@ fn correct_hops(
             &d,
             nb,
             &mut tour,
+            &|| ctx.stopped(),
         );
     }
     best.map_or(tour, |b| b.1)

@@ -433,6 +433,10 @@ impl Pruner<'_, '_> {
             }
         }
         while let Some(Reverse((k, u, ver))) = heap.pop() {
+            // (a plan given up is dropped whole: leave the rest)
+            if self.ctx.stopped() {
+                return;
+            }
             if !self.alive[u] || ver != self.version[u] {
                 continue;
             }
@@ -736,6 +740,7 @@ mod tests {
             ok,
             rt: world.robot().tool_radius / frame.resolution,
             coarse: super::super::hops::CoarseCache::default(),
+            stop: None,
         }
     }
 

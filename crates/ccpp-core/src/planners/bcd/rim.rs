@@ -98,6 +98,10 @@ pub(super) fn rim_contours(
     }
     let mut out = Vec::with_capacity(groups.len());
     for members in &groups {
+        // (a plan given up is dropped whole: leave the rest)
+        if ctx.stopped() {
+            break;
+        }
         let mut ws: Vec<usize> = members.iter().map(|&i| witness[i] as usize).collect();
         ws.sort_unstable();
         ws.dedup();
@@ -205,6 +209,9 @@ pub(super) fn rim_pass(
     // (insert after path segment s, at parameter t along it, the detour points)
     let mut inserts: Vec<(usize, f64, Vec<Point>)> = Vec::new();
     for (contour, _) in contours {
+        if ctx.stopped() {
+            return;
+        }
         let clen = path_length(&contour);
         let (cs, ce) = (contour[0], contour[contour.len() - 1]);
         // Cheapest insertion: segments near the contour's start, widening the search.

@@ -78,6 +78,7 @@ fn walls_at_an_angle_get_a_turned_lattice() {
             ok,
             rt: 3.0,
             coarse: super::hops::CoarseCache::default(),
+            stop: None,
         };
         let a = dominant_angles(&ctx)[0].to_degrees();
         // The image's rows run down: a room turned by +30 degrees there has walls at
@@ -108,6 +109,7 @@ fn walls_at_an_angle_get_a_turned_lattice() {
         ok,
         rt: 3.0,
         coarse: super::hops::CoarseCache::default(),
+        stop: None,
     };
     let mut search = Search::new(frame.width, frame.height);
     // The lattices' plain plans (`plan_on` makes the plan of the options it is given: with a
@@ -141,6 +143,7 @@ fn smoothing_straightens_wiggles_but_keeps_corners_and_marks() {
         keep_px: None,
         rt: 4.0,
         coarse: super::hops::CoarseCache::default(),
+        stop: None,
     };
     // A wiggle of 0.3 px along a free row, then a corner, then a mark.
     let mut items: Vec<Item> = (0..36)
@@ -183,6 +186,7 @@ fn repair_counts_the_moves_it_cannot_route() {
         keep_px: None,
         rt: 4.0,
         coarse: super::hops::CoarseCache::default(),
+        stop: None,
     };
     let mut search = Search::new(frame.width, frame.height);
     // A move into the middle of the block has no route: it is dropped and counted, and
@@ -314,6 +318,21 @@ fn rim_coverage_trades_rim_passes_for_floor() {
         "{}",
         part.effective_coverage
     );
+}
+
+#[test]
+fn a_plan_given_up_has_no_steps_and_one_not_given_up_is_the_plan() {
+    use std::sync::atomic::AtomicBool;
+    let world = block_room();
+    let opts = BcdOptions::default();
+    let given_up = Bcd::new_until(&world, &opts, &AtomicBool::new(true));
+    assert!(given_up.steps.is_empty());
+    assert_eq!(given_up.cells(), 0);
+    let kept = Bcd::new_until(&world, &opts, &AtomicBool::new(false));
+    let plain = Bcd::new(&world, &opts);
+    assert!(!kept.steps.is_empty());
+    assert_eq!(kept.steps, plain.steps);
+    assert_eq!(kept.cells(), plain.cells());
 }
 
 #[test]
@@ -680,6 +699,7 @@ fn transfers_keep_the_margin_they_are_given() {
             keep_px: (margin > 0.0).then_some(need),
             rt: 4.0,
             coarse: super::hops::CoarseCache::default(),
+            stop: None,
         };
         let (a, b) = (Point::new(30.0, 20.0), Point::new(70.0, 60.0));
         let mut pts = vec![a];
@@ -776,6 +796,7 @@ fn a_ring_is_peeled_into_offset_loops_from_the_outer_wall() {
         ok,
         rt: 3.0,
         coarse: super::hops::CoarseCache::default(),
+        stop: None,
     };
     let lat = Lattice::pixels(&ctx);
     // Row 50 (through the block) from the left border: C-free from column 3 to 16 (the

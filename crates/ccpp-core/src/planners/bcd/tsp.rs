@@ -41,6 +41,14 @@ pub(crate) type Tour = Vec<(usize, usize)>;
 /// moves skip a move whose straight-line cost already shows that it cannot win).
 pub(crate) type Dist<'a> = &'a dyn Fn(Point, Point) -> f64;
 
+/// Has the caller given the planning up? The improvement then ends within [`STOP_EVERY`]
+/// positions of a pass, leaving a valid tour (`Ctx::stopped`).
+pub(crate) type Stop<'a> = &'a dyn Fn() -> bool;
+
+/// Positions of a pass between two looks at [`Stop`] (a pass over thousands of pieces took
+/// seconds on the bench map `office_4096`).
+const STOP_EVERY: usize = 64;
+
 /// A lower bound of every hop cost from `a` to `b`: the straight-line distance, a little less
 /// (so that it stays below a distance rounded another way, as by `hypot`).
 fn low(a: Point, b: Point) -> f64 {
@@ -67,13 +75,14 @@ pub(crate) fn solve(
     rounds: u32,
     d: Dist<'_>,
     first: Option<Tour>,
+    stop: Stop<'_>,
 ) -> Tour {
     let mut tour = first.unwrap_or_else(|| nearest_neighbour(pieces, start, d));
     if rounds == 0 {
         return tour;
     }
     let nb = neighbour_lists(pieces, d);
-    improve(pieces, start, rounds, d, &nb, &mut tour);
+    improve(pieces, start, rounds, d, &nb, &mut tour, stop);
     tour
 }
 
@@ -92,11 +101,15 @@ pub(crate) fn improve(
     d: Dist<'_>,
     nb: &[Vec<usize>],
     tour: &mut Tour,
+    stop: Stop<'_>,
 ) -> bool {
     for _ in 0..rounds {
+        if stop() {
+            return true;
+        }
         let before = cost(pieces, start, tour, d);
-        two_opt(pieces, start, tour, nb, d);
-        or_opt(pieces, start, tour, nb, d);
+        two_opt(pieces, start, tour, nb, d, stop);
+        or_opt(pieces, start, tour, nb, d, stop);
         choose_variants(pieces, start, tour, d);
         if cost(pieces, start, tour, d) >= before - EPS {
             return true;
@@ -407,7 +420,14 @@ fn rehop(
 /// 2-opt over candidate neighbours: reversing `tour[i..=j]` makes the hops
 /// `prev(i) -> exit(j)` and `entry(i) -> entry(j + 1)`; `j` is taken where either new hop
 /// joins neighbours.
-fn two_opt(pieces: &[Piece], start: Point, tour: &mut Tour, nb: &[Vec<usize>], d: Dist<'_>) {
+fn two_opt(
+    pieces: &[Piece],
+    start: Point,
+    tour: &mut Tour,
+    nb: &[Vec<usize>],
+    d: Dist<'_>,
+    stop: Stop<'_>,
+) {
     let n = tour.len();
     let entry = |t: &Tour, i: usize| pieces[t[i].0].entry[t[i].1];
     let exit = |t: &Tour, i: usize| pieces[t[i].0].exit[t[i].1];
@@ -416,10 +436,13 @@ fn two_opt(pieces: &[Piece], start: Point, tour: &mut Tour, nb: &[Vec<usize>], d
     let mut improved = true;
     let mut passes = 0;
     let mut cand: Vec<usize> = Vec::new();
-    while improved && passes < 50 {
+    while improved && passes < 50 && !stop() {
         improved = false;
         passes += 1;
         for i in 0..n {
+            if i % STOP_EVERY == 0 && stop() {
+                return;
+            }
             cand.clear();
             if i > 0 {
                 cand.extend(nb[tour[i - 1].0].iter().map(|&q| pos[q]));
@@ -484,7 +507,14 @@ enum Alt {
 /// Or-opt over candidate neighbours: stretches of 1 to 3 pieces moved next to a neighbour of
 /// their first or last piece, either way round; a single piece moved may also change its
 /// variant (be started at another corner) where that costs less at its new place.
-fn or_opt(pieces: &[Piece], start: Point, tour: &mut Tour, nb: &[Vec<usize>], d: Dist<'_>) {
+fn or_opt(
+    pieces: &[Piece],
+    start: Point,
+    tour: &mut Tour,
+    nb: &[Vec<usize>],
+    d: Dist<'_>,
+    stop: Stop<'_>,
+) {
     let entry = |t: &Tour, i: usize| pieces[t[i].0].entry[t[i].1];
     let exit = |t: &Tour, i: usize| pieces[t[i].0].exit[t[i].1];
     let mut pos = positions(tour, pieces.len());
@@ -493,7 +523,7 @@ fn or_opt(pieces: &[Piece], start: Point, tour: &mut Tour, nb: &[Vec<usize>], d:
     let mut passes = 0;
     let mut cand: Vec<usize> = Vec::new();
     let mut alts: Vec<(Point, Point, f64, Alt)> = Vec::new();
-    while improved && passes < 50 {
+    while improved && passes < 50 && !stop() {
         improved = false;
         passes += 1;
         let n = tour.len();
@@ -502,6 +532,9 @@ fn or_opt(pieces: &[Piece], start: Point, tour: &mut Tour, nb: &[Vec<usize>], d:
                 break;
             }
             for i in 0..=n - k {
+                if i % STOP_EVERY == 0 && stop() {
+                    return;
+                }
                 let j = i + k - 1;
                 let a = prev_exit(pieces, start, tour, i);
                 let (si, ej) = (entry(tour, i), exit(tour, j));
@@ -784,7 +817,7 @@ mod tests {
     fn points_on_a_line_are_visited_in_order() {
         let xs = [5.0, 1.0, 9.0, 3.0, 7.0, 2.0];
         let pieces: Vec<Piece> = xs.iter().map(|&x| point_piece(x, 0.0)).collect();
-        let tour = solve(&pieces, Point::new(0.0, 0.0), 10, &euclid, None);
+        let tour = solve(&pieces, Point::new(0.0, 0.0), 10, &euclid, None, &|| false);
         let order: Vec<f64> = tour.iter().map(|&(p, _)| xs[p]).collect();
         assert_eq!(order, vec![1.0, 2.0, 3.0, 5.0, 7.0, 9.0]);
         assert!((cost(&pieces, Point::new(0.0, 0.0), &tour, &euclid) - 9.0).abs() < 1e-9);
@@ -799,7 +832,7 @@ mod tests {
             inner: vec![10.0, 10.0],
         };
         let pieces = vec![seg(1.0), seg(0.0)];
-        let tour = solve(&pieces, Point::new(0.0, 0.0), 10, &euclid, None);
+        let tour = solve(&pieces, Point::new(0.0, 0.0), 10, &euclid, None, &|| false);
         assert_eq!(tour, vec![(1, 0), (0, 1)]);
         assert!((cost(&pieces, Point::new(0.0, 0.0), &tour, &euclid) - 21.0).abs() < 1e-9);
     }
@@ -824,7 +857,7 @@ mod tests {
         let mut tour = vec![(0, 0), (1, 0), (2, 0)];
         let before = cost(&pieces, start, &tour, &euclid);
         assert!((before - (3.0 + 101.0f64.sqrt())).abs() < 1e-9);
-        improve(&pieces, start, 5, &euclid, &nb, &mut tour);
+        improve(&pieces, start, 5, &euclid, &nb, &mut tour, &|| false);
         let order: Vec<usize> = tour.iter().map(|e| e.0).collect();
         assert_eq!(order, vec![0, 2, 1]);
         assert!(tour[1].1 >= 2, "{tour:?}");
@@ -845,7 +878,7 @@ mod tests {
         }
         let start = Point::new(0.0, 0.0);
         let nn = nearest_neighbour(&pieces, start, &euclid);
-        let best = solve(&pieces, start, 20, &euclid, None);
+        let best = solve(&pieces, start, 20, &euclid, None, &|| false);
         assert!(cost(&pieces, start, &best, &euclid) <= cost(&pieces, start, &nn, &euclid) + 1e-9);
         let mut seen: Vec<usize> = best.iter().map(|e| e.0).collect();
         seen.sort_unstable();
