@@ -92,10 +92,29 @@ fn best_index(plans: &[(Plan, usize)]) -> Option<usize> {
     })
 }
 
-/// A job of the planning round: its kind (lattice, headland, peeled, other sweep), the index
-/// of its options in the turn-cost variants (step 6), and whether its cells take the
-/// jagged-wall views (step 2).
-type Job = (usize, usize, bool);
+/// A kind of plan of the first round (module docs, steps 1 and 3).
+#[derive(Clone, Copy)]
+struct Kind {
+    /// Its lattice: 0 the pixels, else the turned lattice of that index.
+    lattice: usize,
+    /// With a headland.
+    head: bool,
+    /// Peeled (offset loops instead of lanes; with a headland, on the pixels only).
+    peel: bool,
+    /// On the sweep the estimate did not pick (on the pixels, without a headland).
+    other: bool,
+}
+
+/// A job of the planning round.
+#[derive(Clone, Copy)]
+struct Job {
+    /// Its kind (an index into the round's kinds; job `i` of the first round is kind `i`).
+    kind: usize,
+    /// The index of its options in the turn-cost variants (step 6; 0: the user's).
+    factor: usize,
+    /// Its cells take the jagged-wall views (step 2).
+    trim: bool,
+}
 
 /// How a plan is made beyond its lattice and options.
 #[derive(Clone, Copy, Default)]
@@ -211,26 +230,40 @@ impl Bcd {
         // (offset loops follow the walls on any lattice). Jobs: lattice, options, peeled,
         // other sweep.
         let many = turns_by.len() > 1;
-        // Job kinds: lattice, headland, peeled, other sweep.
-        let mut kinds: Vec<(usize, bool, bool, bool)> = Vec::new();
+        let kind = |lattice, head, peel, other| Kind {
+            lattice,
+            head,
+            peel,
+            other,
+        };
+        let mut kinds: Vec<Kind> = Vec::new();
         for k in 0..turns_by.len() {
-            kinds.push((k, false, false, false));
+            kinds.push(kind(k, false, false, false));
             if !many {
-                kinds.push((k, false, false, true));
+                kinds.push(kind(k, false, false, true));
             }
             if opts.headland_min_m.is_some() {
-                kinds.push((k, true, false, false));
+                kinds.push(kind(k, true, false, false));
                 if k == 0 {
-                    kinds.push((k, true, true, false));
+                    kinds.push(kind(k, true, true, false));
                 }
             }
         }
-        // A job: its kind and the index of its options in `variants`.
-        let options = |(kind, f, trim): Job| {
-            let (k, head, peel, other) = kinds[kind];
-            let (plain, o) = &variants[f];
-            let how = How { peel, other, trim };
-            (k, if head { o } else { plain }, how)
+        // A job's lattice, options and how its plan is made.
+        let options = |job: Job| {
+            let Kind {
+                lattice,
+                head,
+                peel,
+                other,
+            } = kinds[job.kind];
+            let (plain, o) = &variants[job.factor];
+            let how = How {
+                peel,
+                other,
+                trim: job.trim,
+            };
+            (lattice, if head { o } else { plain }, how)
         };
         let run = |jobs: &[Job], sets: Sets| -> Vec<(Plan, usize)> {
             jobs.par_iter()
@@ -245,8 +278,8 @@ impl Bcd {
                 })
                 .collect()
         };
-        // (job `i` of the first round is kind `i`)
-        let mut jobs: Vec<Job> = (0..kinds.len()).map(|i| (i, 0, false)).collect();
+        let job = |kind, factor, trim| Job { kind, factor, trim };
+        let mut jobs: Vec<Job> = (0..kinds.len()).map(|i| job(i, 0, false)).collect();
         let mut plans = run(&jobs, Sets::Whole);
         // The lower turn costs (step 6) on the best job's kind only: on the 14 shared maps
         // every plan they improved came from it (made on every kind within 1 % of the best
@@ -260,8 +293,8 @@ impl Bcd {
             .into_iter()
             .flat_map(|i| {
                 (1..variants.len())
-                    .map(move |f| (i, f, false))
-                    .chain((0..variants.len().min(TRIM_VARIANTS)).map(move |f| (i, f, true)))
+                    .map(move |f| job(i, f, false))
+                    .chain((0..variants.len().min(TRIM_VARIANTS)).map(move |f| job(i, f, true)))
             })
             .collect();
         plans.extend(run(&more, Sets::Whole));
