@@ -14,7 +14,7 @@ use std::sync::atomic::AtomicBool;
 use ccpp_core::exec::Execution;
 use ccpp_core::planners::PlannerConfig;
 use ccpp_core::route::Route;
-use ccpp_core::sim::{simulate, simulate_until, StopReason};
+use ccpp_core::sim::{simulate_until, StopReason};
 use ccpp_core::world::World;
 
 use crate::scenario::{PreparedMap, Scenario, ScenarioError};
@@ -87,7 +87,8 @@ pub fn plan_route(
     map: &PreparedMap,
     tolerance_m: f64,
 ) -> Result<Plan, PlanError> {
-    plan_with(scenario, map, tolerance_m, None)
+    // (a flag nobody sets: the same plan as one that cannot be given up)
+    plan_route_until(scenario, map, tolerance_m, &AtomicBool::new(false))
 }
 
 /// [`plan_route`] that another thread can give up by setting `stop`: bcd's planning ends at
@@ -101,15 +102,6 @@ pub fn plan_route_until(
     map: &PreparedMap,
     tolerance_m: f64,
     stop: &AtomicBool,
-) -> Result<Plan, PlanError> {
-    plan_with(scenario, map, tolerance_m, Some(stop))
-}
-
-fn plan_with(
-    scenario: &Scenario,
-    map: &PreparedMap,
-    tolerance_m: f64,
-    stop: Option<&AtomicBool>,
 ) -> Result<Plan, PlanError> {
     let kind = scenario.planner.kind();
     if !kind.info().offline {
@@ -129,17 +121,9 @@ fn plan_with(
     let started = std::time::Instant::now();
     let mut sim = scenario.sim.clone();
     sim.exec = Some(Execution::Ideal);
-    let output = match stop {
-        None => {
-            let mut planner = scenario.planner.build(&world);
-            simulate(&world, planner.as_mut(), &sim)
-        }
-        Some(flag) => {
-            let mut planner = scenario.planner.build_until(&world, flag);
-            simulate_until(&world, planner.as_mut(), &sim, &mut |_| {}, flag)
-                .ok_or(ScenarioError::Interrupted)?
-        }
-    };
+    let mut planner = scenario.planner.build_until(&world, stop);
+    let output = simulate_until(&world, planner.as_mut(), &sim, &mut |_| {}, stop)
+        .ok_or(ScenarioError::Interrupted)?;
     let route = Route::from_trace(&output.trace, tolerance_m);
     Ok(Plan {
         world,

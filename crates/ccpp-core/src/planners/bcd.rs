@@ -491,7 +491,7 @@ impl Bcd {
     }
 
     fn new_stoppable(world: &World, opts: &BcdOptions, stop: Option<&AtomicBool>) -> Self {
-        if let Ok(()) = Self::check(world, opts) {
+        if Self::check(world, opts).is_ok() {
             Self::plan_on_pool(world, opts, stop)
         } else {
             let d = BcdOptions::default();
