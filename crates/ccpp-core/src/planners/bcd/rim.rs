@@ -263,13 +263,41 @@ pub(super) fn rim_pass(
         det.push(q);
         inserts.push((s, t, det));
     }
-    // Apply: later segments first so indices stay valid; along a segment, by parameter.
-    inserts.sort_by(|x, y| y.0.cmp(&x.0).then(y.1.total_cmp(&x.1)));
-    for (s, _, det) in inserts {
-        let at = path[s + 1].1;
-        let new: Vec<Item> = det.into_iter().map(Item::Move).collect();
-        items.splice(at..at, new);
+    let inserts = inserts
+        .into_iter()
+        .map(|(s, t, det)| (path[s + 1].1, t, det))
+        .collect();
+    insert_detours(items, inserts);
+}
+
+/// Inserts the detours `(at, t, points)` into `items`, each before the item at index `at` (the
+/// move that ends the segment it leaves from): the detours at one index by their parameter `t`
+/// along the segment, those at one parameter in the reverse of their order in `inserts`. One
+/// pass over the plan (a splice per detour moved the rest of the plan each time: about a third
+/// of the planning time of a large map).
+fn insert_detours(items: &mut Vec<Item>, inserts: Vec<(usize, f64, Vec<Point>)>) {
+    let mut order: Vec<(usize, f64, usize)> = inserts
+        .iter()
+        .enumerate()
+        .map(|(k, &(at, t, _))| (at, t, k))
+        .collect();
+    order.sort_by(|x, y| x.0.cmp(&y.0).then(x.1.total_cmp(&y.1)).then(y.2.cmp(&x.2)));
+    let extra: usize = inserts.iter().map(|d| d.2.len()).sum();
+    let mut dets: Vec<Option<Vec<Point>>> = inserts.into_iter().map(|d| Some(d.2)).collect();
+    let old = std::mem::take(items);
+    items.reserve(old.len() + extra);
+    let mut next = order.iter().peekable();
+    for (k, it) in old.into_iter().enumerate() {
+        while let Some(&&(at, _, d)) = next.peek() {
+            if at != k {
+                break;
+            }
+            items.extend(dets[d].take().into_iter().flatten().map(Item::Move));
+            next.next();
+        }
+        items.push(it);
     }
+    debug_assert!(next.peek().is_none(), "a detour before no item");
 }
 
 /// Parameter in `[0, 1]` of the point of segment `a`-`b` nearest to `p`.
@@ -280,5 +308,57 @@ fn proj(a: Point, b: Point, p: Point) -> f64 {
         0.0
     } else {
         (p.sub(a).dot(d) / l2).clamp(0.0, 1.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::trace::Event;
+
+    /// The one-pass insertion puts every detour where a splice per detour put them (later
+    /// segments first, along a segment from its far end): several detours at one index and at
+    /// one parameter, at the first and the last index, beside a mark.
+    #[test]
+    fn detours_go_where_a_splice_each_put_them() {
+        let p = |x: f64| Point::new(x, 0.0);
+        let items: Vec<Item> = (0..8)
+            .map(|i| {
+                if i == 3 {
+                    Item::Mark(Event::BacktrackStart)
+                } else {
+                    Item::Move(p(f64::from(i)))
+                }
+            })
+            .collect();
+        let inserts: Vec<(usize, f64, Vec<Point>)> = vec![
+            (5, 0.5, vec![p(100.0), p(101.0)]),
+            (1, 0.2, vec![p(102.0)]),
+            (5, 0.1, vec![p(103.0)]),
+            (5, 0.5, vec![p(104.0)]),
+            (0, 0.0, vec![p(105.0)]),
+            (7, 1.0, vec![p(106.0), p(107.0)]),
+            (5, 0.5, vec![p(108.0)]),
+            (4, 0.3, vec![p(109.0)]),
+        ];
+        // The splice per detour it replaces.
+        let mut want = items.clone();
+        let mut sorted = inserts.clone();
+        sorted.sort_by(|x, y| y.0.cmp(&x.0).then(y.1.total_cmp(&x.1)));
+        for (at, _, det) in sorted {
+            want.splice(at..at, det.into_iter().map(Item::Move));
+        }
+        let mut got = items;
+        insert_detours(&mut got, inserts);
+        let show = |v: &[Item]| -> Vec<String> {
+            v.iter()
+                .map(|i| match i {
+                    Item::Move(q) => format!("{q:?}"),
+                    Item::Mark(e) => format!("{e:?}"),
+                })
+                .collect()
+        };
+        assert_eq!(show(&got), show(&want));
+        assert_eq!(got.len(), 8 + 10);
     }
 }
