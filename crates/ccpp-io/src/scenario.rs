@@ -37,7 +37,7 @@ use ccpp_core::planners::settings::{
     add_sim_pid_records, estimate_run, estimate_zones, validate_execution, ZoneLoad, PROCESS_BYTES,
 };
 use ccpp_core::planners::{OptionsError, PlannerConfig, PlannerKind, ResourceEstimate, Setup};
-use ccpp_core::sim::{simulate, simulate_tapped, simulate_until, RunOutput, SimConfig};
+use ccpp_core::sim::{simulate_tapped, simulate_until, RunOutput, SimConfig};
 use ccpp_core::trace::Chunk;
 use ccpp_core::world::{Robot, World, WorldError};
 use ccpp_core::Pose;
@@ -1177,7 +1177,8 @@ impl Scenario {
     pub fn run_on(&self, map: &PreparedMap) -> Result<Run, ScenarioError> {
         self.check_run()?;
         let world = crate::phase::time("world", || self.world(map))?;
-        self.run_in(world, &map.name, |_| (), None)
+        // (a flag nobody sets: the same run as one that cannot be stopped)
+        self.run_in(world, &map.name, |_| (), &AtomicBool::new(false))
             .map(|(run, ())| run)
     }
 
@@ -1192,7 +1193,7 @@ impl Scenario {
     pub fn run_on_until(&self, map: &PreparedMap, stop: &AtomicBool) -> Result<Run, ScenarioError> {
         self.check_run()?;
         let world = crate::phase::time("world", || self.world(map))?;
-        self.run_in(world, &map.name, |_| (), Some(stop))
+        self.run_in(world, &map.name, |_| (), stop)
             .map(|(run, ())| run)
     }
 
@@ -1262,7 +1263,7 @@ impl Scenario {
         if form_files {
             Ok(self.run_forming(world, &name, beside))
         } else {
-            let (run, extra) = self.run_in(world, &name, beside, None)?;
+            let (run, extra) = self.run_in(world, &name, beside, &AtomicBool::new(false))?;
             Ok((run, extra, None))
         }
     }
@@ -1276,7 +1277,7 @@ impl Scenario {
         world: World,
         map_name: &str,
         beside: impl FnOnce(&World) -> T + Send,
-        stop: Option<&AtomicBool>,
+        stop: &AtomicBool,
     ) -> Result<(Run, T), ScenarioError> {
         let side = self.tile_side();
         let (output, part, extra) = crate::phase::time("plan + simulate", || {
@@ -1285,17 +1286,9 @@ impl Scenario {
                 let other = s.spawn(|| (metrics::WorldPart::of(&world, side), beside(&world)));
                 // Wall time covers planning (offline planners plan in `build`) and simulation.
                 let started = std::time::Instant::now();
-                // (with `stop`, bcd's planning ends early when it is set)
-                let mut planner = match stop {
-                    None => self.planner.build(&world),
-                    Some(flag) => self.planner.build_until(&world, flag),
-                };
-                let output = match stop {
-                    None => Some(simulate(&world, planner.as_mut(), &self.sim)),
-                    Some(flag) => {
-                        simulate_until(&world, planner.as_mut(), &self.sim, &mut |_| {}, flag)
-                    }
-                };
+                // (bcd's planning ends early too when `stop` is set)
+                let mut planner = self.planner.build_until(&world, stop);
+                let output = simulate_until(&world, planner.as_mut(), &self.sim, &mut |_| {}, stop);
                 let wall_time_s = started.elapsed().as_secs_f64();
                 let (part, extra) = join_scoped(other);
                 output.map(|mut output| {

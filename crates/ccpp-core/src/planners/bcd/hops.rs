@@ -37,6 +37,10 @@ pub(super) const FAR_FACTOR: u32 = 4;
 /// Largest hop matrix kept dense (bytes).
 const DENSE_MAX: usize = 16 << 20;
 
+/// Rows of a [`HopTable`] searched between two looks at the stop flag (a table of a large
+/// map holds tens of thousands of rows and took seconds).
+const STOP_EVERY_ROWS: usize = 16;
+
 /// The coarse grid of the C-free set: blocks of `b` x `b` pixels, each split into the connected
 /// parts of its C-free pixels (the *nodes*), joined where a pixel step crosses from one block's
 /// part into the next block's.
@@ -498,12 +502,15 @@ fn end_nodes(coarse: &Coarse, pieces: &[tsp::Piece], start: Point) -> (Vec<u32>,
 }
 
 impl<'a> HopTable<'a> {
-    /// The table for the entries and exits of `pieces` and the point `start`.
+    /// The table for the entries and exits of `pieces` and the point `start`. Once `stop`
+    /// says the plan is given up, the rows not searched yet stay empty (every hop from them
+    /// is then priced on the far grid): a table for a plan nobody will use, made quickly.
     pub(super) fn new(
         coarse: &'a Coarse,
         far: &'a Coarse,
         pieces: &[tsp::Piece],
         start: Point,
+        stop: tsp::Stop<'_>,
     ) -> Self {
         let (mut nodes, mut row_of) = end_nodes(coarse, pieces, start);
         // Z-order of their blocks, so that the rows and columns of nearby nodes (the hops
@@ -520,8 +527,12 @@ impl<'a> HopTable<'a> {
         let mut touched: Vec<u32> = Vec::new();
         let mut buckets: [Vec<u32>; BUCKETS] = std::array::from_fn(|_| Vec::new());
         let mut rows = Vec::with_capacity(nodes.len());
-        for &s in &nodes {
+        for (i, &s) in nodes.iter().enumerate() {
             let mut row: Vec<(u32, u32)> = Vec::new();
+            if i.is_multiple_of(STOP_EVERY_ROWS) && stop() {
+                rows.resize_with(nodes.len(), Vec::new);
+                break;
+            }
             coarse.search(s, cap, &mut g, &mut touched, &mut buckets, |k, gk| {
                 if row_of[k as usize] != u32::MAX {
                     row.push((k, gk));
@@ -954,7 +965,7 @@ mod tests {
             exit: vec![p],
             inner: vec![0.0],
         };
-        let table = HopTable::new(&grid, &far, &[piece(a), piece(b)], a);
+        let table = HopTable::new(&grid, &far, &[piece(a), piece(b)], a, &|| false);
         let d = table.dist(a, b);
         // The way round: down the wall (about 4 rows of 6 pixels) and up again.
         assert!(d > 3.0 * a.dist(b), "hop {d} px, straight {} px", a.dist(b));
@@ -962,6 +973,47 @@ mod tests {
         let route = ctx.route(&mut search, a, b).expect("a way through the gap");
         let len = crate::geometry::polyline_length(a, &route);
         assert!(d <= 1.2 * len, "hop {d} px against the route's {len} px");
+    }
+
+    /// A table given up before its first row holds an empty row per node and still prices
+    /// every hop (no index out of range): by the straight line or the far grid, never below
+    /// the straight line. Not given up, the same hop is priced by the way round.
+    #[test]
+    fn a_table_given_up_has_empty_rows_and_still_prices_hops() {
+        let art =
+            "##########\n#...#....#\n#...#....#\n#...#....#\n#...#....#\n#........#\n##########";
+        let map = GridMap::from_ascii_scaled(art, 6, 0.02).expect("map");
+        let world =
+            World::new(map, Robot::new(0.03), Some(Pose::new(0.2, 0.2, 0.0))).expect("world");
+        let ctx = ctx(&world);
+        let grid = Coarse::new(&ctx, 20.0);
+        let far = Coarse::new(&ctx, 80.0);
+        let h = world.frame().height as f64;
+        let pts = [
+            Point::new(10.5, h - 8.5),
+            Point::new(22.5, h - 20.5),
+            Point::new(40.5, h - 8.5),
+        ];
+        let pieces: Vec<tsp::Piece> = pts
+            .iter()
+            .map(|&p| tsp::Piece {
+                entry: vec![p],
+                exit: vec![p],
+                inner: vec![0.0],
+            })
+            .collect();
+        let given_up = HopTable::new(&grid, &far, &pieces, pts[0], &|| true);
+        assert_eq!(given_up.rows.len(), given_up.nodes.len());
+        assert!(given_up.rows.iter().all(Vec::is_empty));
+        let full = HopTable::new(&grid, &far, &pieces, pts[0], &|| false);
+        assert!(full.rows.iter().all(|r| !r.is_empty()));
+        for &a in &pts {
+            for &b in &pts {
+                let d = given_up.dist(a, b);
+                assert!(d.is_finite() && d >= a.dist(b) - 1e-9, "{d}");
+            }
+        }
+        assert!(full.dist(pts[0], pts[2]) > 1.5 * pts[0].dist(pts[2]));
     }
 
     /// The grid's nodes are joined exactly when the transfers' pixel search finds a way

@@ -725,8 +725,12 @@ impl Bcd {
         let cell_paths_all = paths;
         let mut best: Option<Plan> = None;
         // The hop table and nearest-neighbour tour of the cells alone serve both plans.
-        let cell_table = hops::HopTable::new(&coarse, &far, &cell_pieces, start);
         let stop: tsp::Stop<'_> = &|| ctx.stopped();
+        let cell_table = hops::HopTable::new(&coarse, &far, &cell_pieces, start, stop);
+        // (a table given up has empty rows: no tour over it)
+        if ctx.stopped() {
+            return None;
+        }
         let cell_nn = cell_table.nearest_tour(&cell_pieces, start);
         // The cells' tour after the first rounds, whether those settled it, and its neighbours.
         let mut cell_tour: Option<(tsp::Tour, bool, Vec<Vec<usize>>)> = None;
@@ -786,8 +790,11 @@ impl Bcd {
             }
             // Only the rim-in-tour plan changes the pieces (one variant per cell, rim passes
             // added); the other plan tours the cells alone.
-            let own =
-                (opts.rim && in_tour).then(|| hops::HopTable::new(&coarse, &far, &pieces, start));
+            let own = (opts.rim && in_tour)
+                .then(|| hops::HopTable::new(&coarse, &far, &pieces, start, stop));
+            if ctx.stopped() {
+                return None;
+            }
             let table = own.as_ref().unwrap_or(&cell_table);
             let dist = |a: Point, b: Point| table.dist(a, b);
             let cont = if own.is_none() {

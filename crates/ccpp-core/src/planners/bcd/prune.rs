@@ -57,6 +57,9 @@ fn sixteenths(d: f64) -> u64 {
 
 /// Most vertices one drop removes.
 const MAX_SPAN: usize = 4;
+
+/// Vertices of a pass over the whole plan between two looks at the stop flag.
+const STOP_EVERY: usize = 256;
 const NONE: usize = usize::MAX;
 
 struct Pruner<'a, 'b> {
@@ -427,7 +430,10 @@ impl Pruner<'_, '_> {
         self.epoch += 1;
         // (key, start vertex, its version)
         let mut heap: BinaryHeap<Reverse<(u64, usize, u32)>> = BinaryHeap::new();
-        for u in starts {
+        for (i, u) in starts.enumerate() {
+            if i.is_multiple_of(STOP_EVERY) && self.ctx.stopped() {
+                return;
+            }
             if let Some(s) = self.best_from(u) {
                 heap.push(Reverse((s.key, u, self.version[u])));
             }
@@ -504,7 +510,12 @@ impl Pruner<'_, '_> {
         let rt2 = self.rt * self.rt;
         let mut merged = Vec::new();
         let mut v1 = 0;
+        let mut looks = 0usize;
         while v1 != NONE {
+            looks += 1;
+            if looks.is_multiple_of(STOP_EVERY) && self.ctx.stopped() {
+                return merged;
+            }
             let (u, v2) = (self.prev[v1], self.next[v1]);
             let w = if v2 == NONE { NONE } else { self.next[v2] };
             if u == NONE || w == NONE {
@@ -627,6 +638,10 @@ pub(super) fn prune(
     let p0 = pr.pts[0];
     pr.add(p0, p0, true, &mut buf);
     for i in 0..n - 1 {
+        // (a plan given up is dropped whole: return it as it came)
+        if i.is_multiple_of(STOP_EVERY) && ctx.stopped() {
+            return (items, false);
+        }
         let seg = pr.segment(i);
         pr.apply(&seg, true);
         pr.seg[i] = seg;
@@ -810,5 +825,32 @@ mod tests {
                 assert!(c.free(*a, *b));
             }
         }
+    }
+
+    /// A plan given up while it is pruned comes back as it went in (the planner drops it
+    /// whole): the stop is looked at before the first pass over its moves.
+    #[test]
+    fn pruning_a_plan_given_up_returns_it_unchanged() {
+        let world = room();
+        let flag = std::sync::atomic::AtomicBool::new(true);
+        let c = Ctx {
+            stop: Some(&flag),
+            ..ctx(&world)
+        };
+        let p = Point::new;
+        let items = vec![
+            Item::Move(p(20.0, 20.0)),
+            Item::Move(p(40.0, 21.0)),
+            Item::Move(p(60.0, 20.0)),
+            Item::Move(p(60.0, 40.0)),
+            Item::Move(p(58.0, 42.0)),
+            Item::Move(p(20.0, 40.0)),
+        ];
+        let (out, short) = prune(&c, items.clone(), 0.5, 6.0);
+        assert_eq!(points(&out), points(&items));
+        assert_eq!(out.len(), items.len());
+        assert!(!short);
+        // The same plan not given up loses turns.
+        assert!(turns(&prune(&ctx(&world), items.clone(), 0.5, 6.0).0) < turns(&items));
     }
 }
