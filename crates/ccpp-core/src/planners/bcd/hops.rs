@@ -528,11 +528,11 @@ impl<'a> HopTable<'a> {
         let mut buckets: [Vec<u32>; BUCKETS] = std::array::from_fn(|_| Vec::new());
         let mut rows = Vec::with_capacity(nodes.len());
         for (i, &s) in nodes.iter().enumerate() {
-            let mut row: Vec<(u32, u32)> = Vec::new();
             if i.is_multiple_of(STOP_EVERY_ROWS) && stop() {
                 rows.resize_with(nodes.len(), Vec::new);
                 break;
             }
+            let mut row: Vec<(u32, u32)> = Vec::new();
             coarse.search(s, cap, &mut g, &mut touched, &mut buckets, |k, gk| {
                 if row_of[k as usize] != u32::MAX {
                     row.push((k, gk));

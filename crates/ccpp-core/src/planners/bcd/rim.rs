@@ -270,30 +270,25 @@ pub(super) fn rim_pass(
     insert_detours(items, inserts);
 }
 
+/// A detour to insert: before the item at this index, at this parameter along the segment
+/// that item ends, these points.
+type Detour = (usize, f64, Vec<Point>);
+
 /// Inserts the detours `(at, t, points)` into `items`, each before the item at index `at` (the
 /// move that ends the segment it leaves from): the detours at one index by their parameter `t`
 /// along the segment, those at one parameter in the reverse of their order in `inserts`. One
 /// pass over the plan (a splice per detour moved the rest of the plan each time: about a third
 /// of the planning time of a large map).
-fn insert_detours(items: &mut Vec<Item>, inserts: Vec<(usize, f64, Vec<Point>)>) {
-    let mut order: Vec<(usize, f64, usize)> = inserts
-        .iter()
-        .enumerate()
-        .map(|(k, &(at, t, _))| (at, t, k))
-        .collect();
-    order.sort_by(|x, y| x.0.cmp(&y.0).then(x.1.total_cmp(&y.1)).then(y.2.cmp(&x.2)));
+fn insert_detours(items: &mut Vec<Item>, inserts: Vec<Detour>) {
     let extra: usize = inserts.iter().map(|d| d.2.len()).sum();
-    let mut dets: Vec<Option<Vec<Point>>> = inserts.into_iter().map(|d| Some(d.2)).collect();
+    let mut order: Vec<(usize, Detour)> = inserts.into_iter().enumerate().collect();
+    order.sort_by(|(kx, x), (ky, y)| x.0.cmp(&y.0).then(x.1.total_cmp(&y.1)).then(ky.cmp(kx)));
     let old = std::mem::take(items);
     items.reserve(old.len() + extra);
-    let mut next = order.iter().peekable();
+    let mut next = order.into_iter().peekable();
     for (k, it) in old.into_iter().enumerate() {
-        while let Some(&&(at, _, d)) = next.peek() {
-            if at != k {
-                break;
-            }
-            items.extend(dets[d].take().into_iter().flatten().map(Item::Move));
-            next.next();
+        while let Some((_, (_, _, det))) = next.next_if(|(_, d)| d.0 == k) {
+            items.extend(det.into_iter().map(Item::Move));
         }
         items.push(it);
     }
