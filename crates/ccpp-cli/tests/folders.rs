@@ -93,7 +93,7 @@ fn a_second_bench_on_a_folder_in_use_is_refused() {
     assert_eq!(
         stderr_of(&o),
         format!(
-            "error: {} is in use by another ccpp bench (pid {})\n",
+            "error: {} is in use by another ccpp bench or sweep (pid {})\n",
             out.display(),
             first.id()
         )

@@ -16,6 +16,7 @@
 //! * [`export`]: path exports a robot stack reads (waypoints CSV/JSON, ROS `nav_msgs/Path`
 //!   YAML, `GeoJSON`) and the waypoint readers;
 //! * [`plan`]: a known-map planner's route without simulation overhead or metrics;
+//! * [`lock`]: the lock a bench or a Python sweep holds on its output folder;
 //! * [`phase`]: optional phase timing (`CCPP_PHASES`);
 //! * [`mod@file`]: opening user files (regular files only: a FIFO is refused, not read forever).
 //!
@@ -26,6 +27,7 @@ pub mod export;
 pub mod file;
 pub mod georef;
 pub mod landmarks;
+pub mod lock;
 pub mod map;
 pub mod phase;
 pub mod plan;

@@ -1883,6 +1883,36 @@ impl Env {
 }
 
 /// The extension module.
+/// The lock a sweep holds on its output folder, the same as `ccpp bench`'s
+/// ([`ccpp_io::lock`]): taken when made (an error naming the holder's process when another
+/// bench or sweep holds it), released, and its file removed, by `release()` or when
+/// collected.
+#[pyclass(module = "ccpp")]
+pub struct FolderLock {
+    held: Option<ccpp_io::lock::FolderLock>,
+}
+
+#[pymethods]
+impl FolderLock {
+    /// Takes the lock of the existing folder `folder`.
+    #[new]
+    fn new(folder: std::path::PathBuf) -> PyResult<Self> {
+        let held = ccpp_io::lock::FolderLock::take(&folder).map_err(|e| err(&e))?;
+        Ok(Self { held: Some(held) })
+    }
+
+    /// Releases the lock and removes its file (again: nothing).
+    fn release(&mut self) {
+        self.held = None;
+    }
+
+    /// Whether the lock is still held.
+    #[getter]
+    fn held(&self) -> bool {
+        self.held.is_some()
+    }
+}
+
 #[pymodule]
 fn _ccpp(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("CcppError", m.py().get_type::<CcppError>())?;
@@ -1891,6 +1921,8 @@ fn _ccpp(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PlanResult>()?;
     m.add_function(wrap_pyfunction!(plan, m)?)?;
     m.add_class::<Env>()?;
+    m.add_class::<FolderLock>()?;
+    m.add("LOCK_FILE", ccpp_io::lock::LOCK_FILE)?;
     m.add_function(wrap_pyfunction!(load_map, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(bench_run, m)?)?;

@@ -369,3 +369,33 @@ def test_a_sweep_holds_the_bench_lock(tmp_path: Path, room: Path) -> None:
     # A lock file left behind does not make the folder foreign.
     lock.write_text("1\n")
     sweeps._check_out(out)
+
+
+def test_the_sweep_lock_is_the_bench_lock(tmp_path: Path, room: Path, ccpp_bin: str) -> None:
+    # One implementation (ccpp_io::lock) for `ccpp bench` and the sweeps: while a sweep holds
+    # its folder, a bench there is refused naming this process, and the other way round a
+    # second taker in this process is refused too; released, the folder is free again.
+    from ccpp import sweeps
+
+    out = tmp_path / "out"
+    with sweeps._folder_lock(out):
+        p = subprocess.run(
+            [ccpp_bin, "bench", "--maps", str(room), "--planners", "bsa", "--out", str(out), "--quiet"],
+            capture_output=True, text=True, timeout=120,
+        )
+        assert p.returncode == 1, p.stderr
+        assert p.stderr == f"error: {out} is in use by another ccpp bench or sweep (pid {os.getpid()})\n"
+        with pytest.raises(ccpp.CcppError, match=rf"in use by another ccpp bench or sweep \(pid {os.getpid()}\)"):
+            ccpp._ccpp.FolderLock(out)
+    assert not (out / ccpp._ccpp.LOCK_FILE).exists()
+    lock = ccpp._ccpp.FolderLock(out)
+    assert lock.held
+    lock.release()
+    lock.release()
+    assert not lock.held
+    assert sorted(e.name for e in out.iterdir()) == []
+    p = subprocess.run(
+        [ccpp_bin, "bench", "--maps", str(room), "--planners", "bsa", "--out", str(out), "--quiet"],
+        capture_output=True, text=True, timeout=120,
+    )
+    assert p.returncode == 0, p.stderr

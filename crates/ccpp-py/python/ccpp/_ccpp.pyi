@@ -93,6 +93,19 @@ class PlanResult:
     def save(self, folder: _Path, export: Sequence[str] | None = None) -> None:
         """Writes the exports (default csv and nav-path), as ``ccpp plan --out folder``."""
 
+LOCK_FILE: str
+"""The lock file a ``ccpp bench`` or a sweep holds in its output folder."""
+
+class FolderLock:
+    """The lock a sweep holds on its output folder, the same as ``ccpp bench``'s: taken when
+    made (``CcppError`` naming the holder's process when another bench or sweep holds it)."""
+
+    def __init__(self, folder: _Path) -> None: ...
+    def release(self) -> None:
+        """Releases the lock and removes its file (again: nothing)."""
+    @property
+    def held(self) -> bool: ...
+
 class Env:
     """Step-by-step coverage environment on the simulator's physics and sensor."""
 

@@ -117,7 +117,7 @@ def _check_out(out: str | os.PathLike[str]) -> None:
             known = e.is_file() and not e.is_symlink()
         elif e.name in ("plots", "runs"):
             known = e.is_dir() and not e.is_symlink()
-        elif e.name == _LOCK_FILE:
+        elif e.name == _ccpp.LOCK_FILE:
             # A bench's or sweep's lock: held by a live one (refused when taken), or left by
             # a killed one (taken over).
             known = e.is_file() and not e.is_symlink()
@@ -130,45 +130,19 @@ def _check_out(out: str | os.PathLike[str]) -> None:
             )
 
 
-#: The lock file ``ccpp bench`` holds in its output folder; a sweep holds it too.
-_LOCK_FILE = ".ccpp-bench.lock"
-
-
 @contextlib.contextmanager
 def _folder_lock(out: str | os.PathLike[str]) -> Iterator[None]:
-    """Holds ``out``'s bench lock while a sweep writes there, as ``ccpp bench`` does (the same
-    file and the same operating-system lock, ``flock``): a sweep and a bench, or two sweeps,
-    writing one folder at once mixed their runs. A lock left by a killed process is taken
-    over; one held is refused naming its process. Where ``fcntl`` is missing (Windows) no lock
-    is taken."""
-    try:
-        import fcntl
-    except ImportError:  # pragma: no cover - not on the platforms tested
-        yield
-        return
+    """Holds ``out``'s bench lock while a sweep writes there: the lock ``ccpp bench`` takes (one
+    implementation, in the native module: the same file and operating-system lock), so a sweep
+    and a bench, or two sweeps, never write one folder at once. A lock left by a killed process
+    is taken over; one held is refused naming its process. The folder is made if missing."""
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)
-    path = folder / _LOCK_FILE
-    with open(path, "a+", encoding="utf-8") as f:
-        try:
-            fcntl.flock(f.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            f.seek(0)
-            holder = f.read().strip()
-            pid = f"pid {holder}" if holder.isdigit() else "pid unknown"
-            raise _ccpp.CcppError(
-                f"{folder} is in use by another ccpp bench or sweep ({pid})"
-            ) from None
-        f.seek(0)
-        f.truncate()
-        f.write(f"{os.getpid()}\n")
-        f.flush()
-        try:
-            yield
-        finally:
-            # Removed while still held, then released as the file closes.
-            with contextlib.suppress(OSError):
-                path.unlink()
+    lock = _ccpp.FolderLock(folder)
+    try:
+        yield
+    finally:
+        lock.release()
 
 
 def _once(items: Iterable[Any]) -> list[Any]:
