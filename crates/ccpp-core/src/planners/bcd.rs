@@ -209,9 +209,9 @@
 //!    saved; on the 14 shared maps this lowers the path ratio of every map against ranking by
 //!    turns alone), while the floor the plan sweeps (estimated with the metric's own
 //!    capsule test, so the estimate is the measured `effective_coverage`) stays at least
-//!    `min_coverage` of the accessible floor (default 0.9952). Then two turns in a row become
-//!    one where the moves before and after them, extended, meet (for at most `turn_cost_m` of
-//!    extra path), and the runs are pruned once more:
+//!    `min_coverage` of the accessible floor (default 0.9952). Then two to four turns in a
+//!    row become one where the moves before and after them, extended, meet (for at most
+//!    `turn_cost_m` of extra path per turn saved), and the runs are pruned once more:
 //!
 //!    ```text
 //!    u ----- v1                u ---------- x
@@ -317,7 +317,7 @@ pub struct BcdOptions {
     /// | 0.97 | 0.9707 | 1.052 | 794 |
     /// | 0.98 | 0.9811 | 1.074 | 881 |
     /// | 0.99 | 0.9909 | 1.104 | 1047 |
-    /// | 0.9952 (default) | 0.9958 | 1.135 | 1162 |
+    /// | 0.9952 (default) | 0.9958 | 1.136 | 1149 |
     pub min_coverage: f64,
     /// Turned lattices tried per off-axis wall angle (step 1 of the module docs): at the
     /// angle, then half a degree above and below it, one degree, ...; the cheapest plan of
