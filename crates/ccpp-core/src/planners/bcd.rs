@@ -210,8 +210,9 @@
 //!    turns alone), while the floor the plan sweeps (estimated with the metric's own
 //!    capsule test, so the estimate is the measured `effective_coverage`) stays at least
 //!    `min_coverage` of the accessible floor (default 0.9952). Then two to four turns in a
-//!    row become one where the moves before and after them, extended, meet (for at most
-//!    `turn_cost_m` of extra path per turn saved), and the runs are pruned once more:
+//!    row become one where the moves before and after them meet, extended beyond the turns
+//!    (for at most `turn_cost_m` of extra path per turn saved) or cut short before them (a
+//!    bump cut off), and the runs are pruned once more:
 //!
 //!    ```text
 //!    u ----- v1                u ---------- x
@@ -314,10 +315,10 @@ pub struct BcdOptions {
     ///
     /// | `min_coverage` | mean effective coverage | mean path ratio | mean turns |
     /// |---|---:|---:|---:|
-    /// | 0.97 | 0.9707 | 1.052 | 794 |
-    /// | 0.98 | 0.9811 | 1.074 | 881 |
-    /// | 0.99 | 0.9909 | 1.104 | 1047 |
-    /// | 0.9952 (default) | 0.9958 | 1.136 | 1149 |
+    /// | 0.97 | 0.9707 | 1.050 | 779 |
+    /// | 0.98 | 0.9811 | 1.072 | 868 |
+    /// | 0.99 | 0.9909 | 1.105 | 1002 |
+    /// | 0.9952 (default) | 0.9958 | 1.134 | 1124 |
     pub min_coverage: f64,
     /// Turned lattices tried per off-axis wall angle (step 1 of the module docs): at the
     /// angle, then half a degree above and below it, one degree, ...; the cheapest plan of
