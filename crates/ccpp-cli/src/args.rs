@@ -142,7 +142,9 @@ pub struct RunArgs {
     /// Planner options.
     #[command(flatten)]
     pub options: OptionsArgs,
-    /// Sensor range in metres (default 4 r).
+    /// Sensor range in metres (default 4 r) of random-bounce, ba-star-extended and
+    /// bsa-extended; ba-star, bsa and bsa-bfs decide from their neighbour tiles alone and sense
+    /// as far as that needs (refused for them and for the offline planners)
     #[arg(long, value_name = "M")]
     pub sensor_range: Option<f64>,
     /// Tile side in metres: ba-star and ba-star-extended tiles, bsa-bfs cells (default 2 r).

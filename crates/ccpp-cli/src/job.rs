@@ -473,12 +473,8 @@ fn sim_from(a: &RunArgs, config: &mut PlannerConfig) -> Result<SimConfig> {
     let kind = config.kind();
     let mut sim = SimConfig::default();
     if let Some(r) = a.sensor_range {
-        if kind.info().offline {
-            return Err(not_applicable(
-                "--sensor-range",
-                kind,
-                "the online planners; offline planners read the whole map",
-            ));
+        if let Some(applies) = kind.sensor_range_refusal() {
+            return Err(not_applicable("--sensor-range", kind, &applies));
         }
         sim.sensor_range = Some(r);
     }

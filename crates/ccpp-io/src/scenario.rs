@@ -31,7 +31,7 @@ use std::path::{Path, PathBuf};
 
 use ccpp_core::display::Compact;
 use ccpp_core::exec::{Execution, PidOptions};
-use ccpp_core::grid::{GridError, GridMap};
+use ccpp_core::grid::{GridError, GridMap, MapFrame};
 use ccpp_core::metrics::{self, Metrics};
 use ccpp_core::planners::settings::{
     add_sim_pid_records, estimate_run, estimate_zones, validate_execution, ZoneLoad, PROCESS_BYTES,
@@ -921,11 +921,37 @@ impl Scenario {
 
     /// What the planner's checks and estimate see for `map`.
     pub fn setup(&self, map: &PreparedMap) -> Setup {
-        Setup {
-            frame: *map.grid.frame(),
+        self.setup_on(map.grid.frame())
+    }
+
+    /// [`Self::setup`] for a map of `frame`: the sensor range in force is the one asked for
+    /// (default 4 r), or for a planner that decides from its neighbour tiles alone, with no
+    /// range asked for, at least what sees them
+    /// ([`sensor_need`](ccpp_core::planners::PlannerSettings::sensor_need): a tiny robot
+    /// or a large tile needs more than 4 r, and more changes nothing).
+    fn setup_on(&self, frame: &MapFrame) -> Setup {
+        let mut setup = Setup {
+            frame: *frame,
             robot: self.robot,
-            sensor_range: self.sim.sensor_range_on(&self.robot, map.grid.frame()),
+            sensor_range: self.sim.sensor_range_on(&self.robot, frame),
+        };
+        if self.sim.sensor_range.is_none() {
+            if let Some(need) = self.planner.settings().sensor_need(&setup) {
+                setup.sensor_range = setup.sensor_range.max(need);
+            }
         }
+        setup
+    }
+
+    /// The simulator settings of a run on a map of `frame`: [`Self::sim`]'s, with the sensor
+    /// range [`Self::setup`] resolves.
+    fn sim_on(&self, frame: &MapFrame) -> SimConfig {
+        let range = self.setup_on(frame).sensor_range;
+        let mut sim = self.sim.clone();
+        if self.sim.sensor_range.is_none() && range > self.sim.sensor_range_on(&self.robot, frame) {
+            sim.sensor_range = Some(range);
+        }
+        sim
     }
 
     /// Checks the run against the loaded map: the map's extent, the planner's checks
@@ -1288,7 +1314,8 @@ impl Scenario {
                 let started = std::time::Instant::now();
                 // (bcd's planning ends early too when `stop` is set)
                 let mut planner = self.planner.build_until(&world, stop);
-                let output = simulate_until(&world, planner.as_mut(), &self.sim, &mut |_| {}, stop);
+                let sim = self.sim_on(world.frame());
+                let output = simulate_until(&world, planner.as_mut(), &sim, &mut |_| {}, stop);
                 let wall_time_s = started.elapsed().as_secs_f64();
                 let (part, extra) = join_scoped(other);
                 output.map(|mut output| {
@@ -1342,16 +1369,16 @@ impl Scenario {
                     // Wall time covers planning (offline planners plan in `build`) and simulation.
                     let started = std::time::Instant::now();
                     let mut planner = self.planner.build(world);
+                    let sim = self.sim_on(world.frame());
                     let mut sent = 0usize;
-                    let mut output =
-                        simulate_tapped(world, planner.as_mut(), &self.sim, &mut |t| {
-                            let n = t.sealed_count();
-                            if n >= sent + FORM_CHUNK {
-                                // A closed channel (the former panicked) shows when it is joined.
-                                let _ = tx.send(t.chunk(sent..n));
-                                sent = n;
-                            }
-                        });
+                    let mut output = simulate_tapped(world, planner.as_mut(), &sim, &mut |t| {
+                        let n = t.sealed_count();
+                        if n >= sent + FORM_CHUNK {
+                            // A closed channel (the former panicked) shows when it is joined.
+                            let _ = tx.send(t.chunk(sent..n));
+                            sent = n;
+                        }
+                    });
                     output.wall_time_s = started.elapsed().as_secs_f64();
                     let _ = tx.send(output.trace.chunk(sent..output.trace.piece_count()));
                     drop(tx);

@@ -656,12 +656,8 @@ fn scenario_from(
                 s.start = Some(p);
             }
             "sensor_range" => {
-                if kind.info().offline {
-                    return Err(not_applicable(
-                        "sensor_range",
-                        kind,
-                        "the online planners; offline planners read the whole map",
-                    ));
+                if let Some(applies) = kind.sensor_range_refusal() {
+                    return Err(not_applicable("sensor_range", kind, &applies));
                 }
                 s.sim.sensor_range = Some(float_arg(&key, &v)?);
             }

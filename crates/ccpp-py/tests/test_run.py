@@ -125,6 +125,12 @@ def test_errors_are_the_cli_messages(ccpp_bin: str, tmp_path: Path, room: Path) 
         ccpp.run(room, planner="ba-star", nonsense=1)
     with pytest.raises(ccpp.CcppError, match="sensor_range does not apply to bcd"):
         ccpp.run(room, planner="bcd", sensor_range=1.0)
+    # ba-star, bsa and bsa-bfs decide from their neighbour tiles alone: a range changed
+    # nothing in their runs, and is refused as the command line refuses it.
+    for p in ("ba-star", "bsa", "bsa-bfs"):
+        with pytest.raises(ccpp.CcppError, match=rf"^sensor_range does not apply to {p} \(it applies to random-bounce, ba-star-extended and bsa-extended; {p} decides from its neighbour tiles alone"):
+            ccpp.run(room, planner=p, sensor_range=3.0)
+    assert ccpp.run(room, planner="ba-star-extended", sensor_range=3.0).metrics["collisions"] == 0
     with pytest.raises(ccpp.CcppError, match="seed does not apply to ba-star"):
         ccpp.run(room, planner="ba-star", seed=3)
     with pytest.raises(ccpp.CcppError, match="side"):
@@ -213,7 +219,7 @@ def test_bools_are_not_numbers(room: Path, tmp_path: Path) -> None:
     with pytest.raises(ccpp.CcppError, match="tool_radius must be a number, got True"):
         ccpp.run(room, "bsa", tool_radius=True)
     with pytest.raises(ccpp.CcppError, match="sensor_range must be a number, got False"):
-        ccpp.run(room, "bsa", sensor_range=False)
+        ccpp.run(room, "random-bounce", sensor_range=False)
     assert ccpp.run(room, "bsa", radius=0.1).metrics["robot_radius_m"] == 0.1
 
 

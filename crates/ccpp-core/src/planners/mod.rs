@@ -40,6 +40,11 @@ pub struct PlannerInfo {
     pub description: &'static str,
     /// `true` when the planner reads the whole map up front.
     pub offline: bool,
+    /// `true` when the sensor range changes the planner's run beyond seeing its neighbour
+    /// tiles (`false` for offline planners, and for those that decide from their neighbour
+    /// tiles or cells alone: their range is set to what sees them, and `--sensor-range` /
+    /// `sensor_range` is refused for them).
+    pub range_matters: bool,
 }
 
 /// Generates the planner registry from one row per planner.
@@ -51,6 +56,7 @@ macro_rules! registry {
             section: $section:ident,
             options: $opts:ty,
             offline: $offline:literal,
+            range_matters: $range:literal,
             description: $desc:literal $(,)?
         }
     )*) => {
@@ -84,6 +90,7 @@ macro_rules! registry {
                 section: stringify!($section),
                 description: $desc,
                 offline: $offline,
+                range_matters: $range,
             },
         )*];
 
@@ -163,6 +170,7 @@ registry! {
         section: random_bounce,
         options: random_bounce::RandomBounceOptions,
         offline: false,
+        range_matters: true,
         description: "Roomba-like baseline: straight until the sensed obstacle, seeded random turn, distance budget",
     }
     /// BA* (Viet et al. 2013).
@@ -171,6 +179,7 @@ registry! {
         section: ba_star,
         options: ba_star::BaStarOptions,
         offline: false,
+        range_matters: false,
         description: "BA* (Viet et al. 2013): boustrophedon regions on 2r tiles, A* + smoothed backtracking to the nearest corner tile",
     }
     /// BA* plus the seed-002 extension.
@@ -179,6 +188,7 @@ registry! {
         section: ba_star_extended,
         options: ba_star_extended::BaStarExtendedOptions,
         offline: false,
+        range_matters: true,
         description: "BA* plus the seed-002 extension: online wall following of the rims its tiles leave, merged into straight known-free segments",
     }
     /// Backtracking Spiral Algorithm.
@@ -187,6 +197,7 @@ registry! {
         section: bsa,
         options: bsa::BsaOptions,
         offline: false,
+        range_matters: false,
         description: "Backtracking Spiral Algorithm: spirals on robot-sized cells, BFS backtracking over visited cells",
     }
     /// BSA hosting the coverage extension (wall following of the rims, gap crossing).
@@ -195,6 +206,7 @@ registry! {
         section: bsa_extended,
         options: bsa_extended::BsaExtendedOptions,
         offline: false,
+        range_matters: true,
         description: "BSA plus the coverage extension (as ba-star-extended): wall passes over the rims its cells leave, straight known-free transfers",
     }
     /// The vacuum-robot BSA of seed 003.
@@ -203,6 +215,7 @@ registry! {
         section: bsa_bfs,
         options: bsa_bfs::BsaBfsOptions,
         offline: false,
+        range_matters: false,
         description: "Vacuum-robot BSA (seed 003): cells +x,+y,-x,-y, return-cell stack, BFS return over visited cells, PID execution",
     }
     /// Boustrophedon cellular decomposition.
@@ -211,6 +224,7 @@ registry! {
         section: bcd,
         options: bcd::BcdOptions,
         offline: true,
+        range_matters: false,
         description: "Boustrophedon cellular decomposition of the known map, lanes 2 r_tool apart (the known-map baseline)",
     }
     /// Lane waypoints for a rectangular robot (seed 001).
@@ -219,6 +233,7 @@ registry! {
         section: rect_boustrophedon,
         options: rect_boustrophedon::RectOptions,
         offline: true,
+        range_matters: false,
         description: "Known-map lane waypoints for a rectangular robot (seed 001): lanes b apart, waypoints every l, blocked edges joined by clearance A*",
     }
 }
@@ -227,6 +242,34 @@ impl PlannerKind {
     /// Command-line name (kebab-case).
     pub fn name(self) -> &'static str {
         self.info().name
+    }
+
+    /// `None` when a sensor range asked for changes this planner's runs; else what the range
+    /// applies to instead, for the refusal (`--sensor-range does not apply to bcd (it applies
+    /// to ...)`): offline planners read the whole map; ba-star, bsa and bsa-bfs decide from
+    /// their neighbour tiles alone, which their sensor is set to see.
+    pub fn sensor_range_refusal(self) -> Option<String> {
+        let info = self.info();
+        if info.range_matters {
+            return None;
+        }
+        let names: Vec<&str> = CATALOG
+            .iter()
+            .filter(|i| i.range_matters)
+            .map(|i| i.name)
+            .collect();
+        let list = match names.split_last() {
+            Some((last, rest)) if !rest.is_empty() => format!("{} and {last}", rest.join(", ")),
+            _ => names.join(""),
+        };
+        Some(if info.offline {
+            format!("{list}; offline planners read the whole map")
+        } else {
+            format!(
+                "{list}; {} decides from its neighbour tiles alone, which its sensor is set to see: a longer range changes nothing",
+                info.name
+            )
+        })
     }
 }
 

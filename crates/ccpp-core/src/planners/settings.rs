@@ -247,6 +247,15 @@ pub trait PlannerSettings {
         PID_RECORD_BYTES
     }
 
+    /// For a planner that decides from its neighbour tiles (cells) alone, the sensor range that
+    /// sees a neighbour's whole contact disk (tile side + r + half a pixel, metres): a longer
+    /// range changes nothing in its run, so a run of it senses at least this far whatever the
+    /// default ([`PlannerInfo::range_matters`](super::PlannerInfo::range_matters) is `false`).
+    /// `None` for the others.
+    fn sensor_need(&self, _setup: &Setup) -> Option<f64> {
+        None
+    }
+
     /// The tile (cell) side the planner works on, if it is tile-based.
     fn tile_side(&self, robot: &Robot) -> Option<f64>;
 
@@ -531,7 +540,7 @@ const PID_TURN_EVERY: f64 = 4.0;
 /// disk unknown, the planner reads every neighbour as blocked and the run ends where it
 /// started.
 fn check_neighbour_sight(setup: &Setup, side: f64, what: &str) -> Result<(), OptionsError> {
-    let need = side + setup.robot.radius + 0.5 * setup.frame.resolution;
+    let need = neighbour_sight(setup, side);
     if setup.sensor_range < need * (1.0 - 1e-9) {
         return Err(OptionsError::new(
             "",
@@ -542,6 +551,11 @@ fn check_neighbour_sight(setup: &Setup, side: f64, what: &str) -> Result<(), Opt
         ));
     }
     Ok(())
+}
+
+/// The range that sees a neighbour tile's (cell's) whole contact disk ([`check_neighbour_sight`]).
+fn neighbour_sight(setup: &Setup, side: f64) -> f64 {
+    side + setup.robot.radius + 0.5 * setup.frame.resolution
 }
 
 /// A tile larger than the map leaves no neighbour tile to move to.
@@ -682,6 +696,13 @@ impl PlannerSettings for BaStarOptions {
         let t = self.tile_side_m.unwrap_or(2.0 * s.robot.radius);
         check_side_fits(s, t, "tile_side_m", "tile")?;
         check_neighbour_sight(s, t, "tile")
+    }
+
+    fn sensor_need(&self, s: &Setup) -> Option<f64> {
+        Some(neighbour_sight(
+            s,
+            self.tile_side_m.unwrap_or(2.0 * s.robot.radius),
+        ))
     }
 
     fn estimate(&self, s: &Setup) -> ResourceEstimate {
@@ -855,6 +876,10 @@ impl PlannerSettings for BsaOptions {
         check_neighbour_sight(s, 2.0 * s.robot.radius, "cell")
     }
 
+    fn sensor_need(&self, s: &Setup) -> Option<f64> {
+        Some(neighbour_sight(s, 2.0 * s.robot.radius))
+    }
+
     fn estimate(&self, s: &Setup) -> ResourceEstimate {
         bsa_cells(s)
     }
@@ -913,6 +938,13 @@ impl PlannerSettings for BsaBfsOptions {
         let c = self.cell_side_m.unwrap_or(2.0 * s.robot.radius);
         check_side_fits(s, c, "cell_side_m", "cell")?;
         check_neighbour_sight(s, c, "cell")
+    }
+
+    fn sensor_need(&self, s: &Setup) -> Option<f64> {
+        Some(neighbour_sight(
+            s,
+            self.cell_side_m.unwrap_or(2.0 * s.robot.radius),
+        ))
     }
 
     fn estimate(&self, s: &Setup) -> ResourceEstimate {
