@@ -9,7 +9,7 @@ use std::io::{BufRead, Seek, SeekFrom};
 use std::path::Path;
 
 use ccpp_core::grid::Cell;
-use image::{DynamicImage, ImageReader};
+use image::{DynamicImage, ImageDecoder as _, ImageReader};
 
 use super::classify::{MapMode, Thresholds};
 use super::error::{one_line, MapError};
@@ -167,7 +167,6 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
         }
         inner.seek(SeekFrom::Start(start)).map_err(io_err)?;
     }
-    let mut reader = ImageReader::with_format(inner, format);
     // The decoder's cap follows the image's own size: its default (512 MiB) refused a 24000 x
     // 24000 PNG the caller's budget admits (`--max-memory 60000`: "Memory limit exceeded"),
     // and let a small image's colour profile inflate to 512 MiB. Without a budget
@@ -179,6 +178,25 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
         let default = image::Limits::default().max_alloc;
         limits.max_alloc = limits.max_alloc.min(default);
     }
+    // The decoded buffer is allocated whole before any pixel is read, and a failed allocation
+    // aborts the process: it is asked for here first, fallibly (a 21-byte PGM claiming
+    // 100000 x 100000 px, with `--max-memory` raised to admit it, aborted under a 3 GB
+    // address-space limit instead of being refused).
+    let mut header = ImageReader::with_format(&mut inner, format);
+    header.limits(limits.clone());
+    let total = header.into_decoder().map_err(image_err)?.total_bytes();
+    inner.seek(SeekFrom::Start(start)).map_err(io_err)?;
+    let mut probe: Vec<u8> = Vec::new();
+    if usize::try_from(total).map_or(true, |n| probe.try_reserve_exact(n).is_err()) {
+        return Err(MapError::Decode {
+            path: path.to_path_buf(),
+            message: format!(
+                "its {width} x {height} pixels take {total} bytes decoded, which cannot be allocated"
+            ),
+        });
+    }
+    drop(probe);
+    let mut reader = ImageReader::with_format(inner, format);
     reader.limits(limits);
     let img = reader.decode().map_err(image_err)?;
     let width = img.width() as usize;

@@ -94,3 +94,29 @@ fn a_colour_profile_bomb_in_a_keepout_mask_is_not_inflated() {
         assert!(!e.to_string().contains("Memory limit"), "{e}");
     }
 }
+
+/// A PGM whose header claims 20000 x 20000 pixels (400 MB decoded) over a few bytes of data,
+/// loaded with a pixel budget that admits it: the decoded buffer that cannot be had is an
+/// error naming the file, not an aborted process (the decoder allocates it whole, infallibly,
+/// before reading a pixel).
+#[test]
+fn a_decoded_buffer_that_cannot_be_had_is_an_error() {
+    let _turn = SERIAL
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    let pgm = b"P5\n20000 20000\n255\n\xfe\xfe".to_vec();
+    let opts = LoadOptions {
+        resolution: Some(0.05),
+        max_pixels: Some(1 << 30),
+        ..LoadOptions::default()
+    };
+    let e = within_32_mib(|| load_map_bytes(Path::new("huge.pgm"), None, &pgm, &opts))
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.contains("huge.pgm"), "{e}");
+    assert!(
+        e.contains("20000 x 20000 pixels take 400000000 bytes decoded, which cannot be allocated"),
+        "{e}"
+    );
+}
