@@ -171,6 +171,560 @@ fn planner_flags_apply_where_they_should() {
 }
 
 #[test]
+fn execution_flags_reach_the_simulator() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let tracking = |out: &Path| {
+        metrics(out)
+            .get("tracking_error_mean_m")
+            .and_then(serde_json::Value::as_f64)
+    };
+
+    // --exec pid on an ideal planner adds tracking; --exec ideal on a PID planner removes it.
+    let bsa = run_ok(dir, "bsa", &map, "bsa", &[]);
+    assert_eq!(tracking(&bsa), None);
+    let bsa_pid = run_ok(dir, "bsa-pid", &map, "bsa", &["--exec", "pid"]);
+    let clean = tracking(&bsa_pid).unwrap();
+    let bfs = run_ok(dir, "bfs", &map, "bsa-bfs", &[]);
+    assert!(tracking(&bfs).is_some());
+    let bfs_ideal = run_ok(dir, "bfs-ideal", &map, "bsa-bfs", &["--exec", "ideal"]);
+    assert_eq!(tracking(&bfs_ideal), None);
+    let run_json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(bfs_ideal.join("run.json")).unwrap())
+            .unwrap();
+    assert_eq!(run_json["sim"]["exec"], "ideal");
+
+    // Odometry noise: a larger tracking error; its seed changes the trace.
+    let noisy = run_ok(
+        dir,
+        "noisy",
+        &map,
+        "bsa",
+        &["--exec", "pid", "--odometry-noise", "0.2,0.2"],
+    );
+    assert!(tracking(&noisy).unwrap() > clean + 1e-3);
+    let noisy7 = run_ok(
+        dir,
+        "noisy7",
+        &map,
+        "bsa",
+        &["--odometry-noise", "0.2,0.2", "--seed", "7"],
+    );
+    assert_ne!(trace(&noisy), trace(&noisy7));
+    run_fails(
+        dir,
+        &map,
+        "bsa",
+        &["--exec", "ideal", "--odometry-noise", "0.2"],
+        &["--odometry-noise", "PID"],
+    );
+    run_fails(dir, &map, "bsa", &["--exec", "fast"], &["--exec"]);
+    // Zero noise draws nothing: a seed for it would be read and change nothing (a hostile
+    // tester found `--odometry-noise 0 --seed 5` and `--seed 6` giving the same trace). The
+    // same seed in an options file is refused too, naming the field.
+    run_fails(
+        dir,
+        &map,
+        "bsa",
+        &["--odometry-noise", "0,0,0", "--seed", "5"],
+        &["--seed has no effect", "draws no noise"],
+    );
+    let zero_cfg = dir.join("zero-noise.yaml");
+    std::fs::write(
+        &zero_cfg,
+        "bsa_bfs: { exec: { pid: { noise: { seed: 5, linear_rel_std: 0, angular_rel_std: 0, heading_drift_std: 0 } } } }\n",
+    )
+    .unwrap();
+    run_fails(
+        dir,
+        &map,
+        "bsa-bfs",
+        &["--config", zero_cfg.to_str().unwrap()],
+        &["bsa_bfs.exec.pid.noise.seed", "every noise std is 0"],
+    );
+    // PID options that switch each other off: an integral limit with ki = 0 (the default),
+    // and ki with an integral limit of 0; each alone was read and changed nothing.
+    for (body, needles) in [
+        (
+            "linear: { integral_limit: 5 }",
+            ["bsa_bfs.exec.pid.linear.integral_limit", "ki = 0"],
+        ),
+        (
+            "angular: { ki: 5, integral_limit: 0 }",
+            ["bsa_bfs.exec.pid.angular.ki", "integral_limit 0"],
+        ),
+    ] {
+        let cfg = dir.join("pid-off.yaml");
+        std::fs::write(
+            &cfg,
+            format!("bsa_bfs: {{ exec: {{ pid: {{ {body} }} }} }}\n"),
+        )
+        .unwrap();
+        run_fails(
+            dir,
+            &map,
+            "bsa-bfs",
+            &["--config", cfg.to_str().unwrap()],
+            &needles,
+        );
+    }
+    // Both together act: the trace differs from the default's.
+    let ki_cfg = dir.join("ki.yaml");
+    std::fs::write(
+        &ki_cfg,
+        "bsa_bfs: { exec: { pid: { linear: { ki: 5, integral_limit: 2 } } } }\n",
+    )
+    .unwrap();
+    let ki_run = run_ok(
+        dir,
+        "ki",
+        &map,
+        "bsa-bfs",
+        &["--config", ki_cfg.to_str().unwrap()],
+    );
+    let default_run = run_ok(dir, "ki-default", &map, "bsa-bfs", &[]);
+    assert_ne!(trace(&ki_run), trace(&default_run));
+    // Noise beyond what odometry measures is refused, naming the flag and the bound.
+    run_fails(
+        dir,
+        &map,
+        "bsa",
+        &["--odometry-noise", "1e300"],
+        &["--odometry-noise", "linear_rel_std", "at most 1", "1e300"],
+    );
+    run_fails(
+        dir,
+        &map,
+        "bsa",
+        &["--odometry-noise", "0.1,1.5"],
+        &["--odometry-noise", "angular_rel_std", "at most 1", "1.5"],
+    );
+    run_fails(
+        dir,
+        &map,
+        "bsa",
+        &["--odometry-noise", "0.1,0.1,7"],
+        &[
+            "--odometry-noise",
+            "heading_drift_std",
+            "at most 6",
+            "got 7",
+        ],
+    );
+    // PID settings from the options file and `--exec ideal` together: the flag would drop
+    // them, so the pair is refused, naming the file and the section.
+    let pid_cfg = dir.join("pid.yaml");
+    std::fs::write(&pid_cfg, "bsa_bfs: { exec: { pid: { dt_s: 0.1 } } }\n").unwrap();
+    run_fails(
+        dir,
+        &map,
+        "bsa-bfs",
+        &["--exec", "ideal", "--config", pid_cfg.to_str().unwrap()],
+        &["--exec ideal", "pid.yaml", "bsa_bfs.exec"],
+    );
+    // A file that runs the planner ideally and `--exec pid` disagree the same way.
+    let ideal_cfg = dir.join("ideal.yaml");
+    std::fs::write(&ideal_cfg, "bsa_bfs: { exec: ideal }\n").unwrap();
+    run_fails(
+        dir,
+        &map,
+        "bsa-bfs",
+        &["--exec", "pid", "--config", ideal_cfg.to_str().unwrap()],
+        &["sim.exec pid", "bsa_bfs.exec", "remove one of them"],
+    );
+    // The same file without the flag is read: its control period changes the run.
+    let pid_run = run_ok(
+        dir,
+        "bfs-pid-cfg",
+        &map,
+        "bsa-bfs",
+        &["--config", pid_cfg.to_str().unwrap()],
+    );
+    assert!(
+        trace(&pid_run) != trace(&bfs),
+        "bsa_bfs.exec.pid.dt_s changed nothing"
+    );
+
+    // Landmarks correct the noisy estimate: the run changes; refused under ideal execution.
+    let lm = dir.join("landmarks.csv");
+    std::fs::write(&lm, "1,1,1\n2,4,3\n3,7,5\n4,2,5\n5,6,1\n").unwrap();
+    let lmo = dir.join("landmarks.csv");
+    let corrected = run_ok(
+        dir,
+        "corrected",
+        &map,
+        "bsa",
+        &[
+            "--exec",
+            "pid",
+            "--odometry-noise",
+            "0.2,0.2",
+            "--landmarks",
+            lmo.to_str().unwrap(),
+        ],
+    );
+    assert_ne!(trace(&noisy), trace(&corrected));
+    run_fails(
+        dir,
+        &map,
+        "ba-star",
+        &["--landmarks", lm.to_str().unwrap()],
+        &["landmarks", "PID"],
+    );
+    // --seed without noise does not apply to a deterministic planner.
+    run_fails(
+        dir,
+        &map,
+        "ba-star",
+        &["--seed", "3"],
+        &["--seed", "does not apply"],
+    );
+}
+
+#[test]
+fn map_and_robot_flags_change_the_run() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let base = run_ok(dir, "base", &map, "ba-star", &[]);
+    for (i, args) in [
+        &["--radius", "0.2"][..],
+        &["--tool-radius", "0.1"],
+        &["--start", "1,1"],
+        &["--resolution", "0.04"],
+        &["--origin", "1,2"],
+        &["--inflate", "0.1"],
+    ]
+    .iter()
+    .enumerate()
+    {
+        let out = run_ok(dir, &format!("m{i}"), &map, "ba-star", args);
+        assert!(
+            metrics(&base) != metrics(&out) || trace(&base) != trace(&out),
+            "{args:?} changes nothing"
+        );
+    }
+}
+
+#[test]
+fn config_values_go_through_the_same_validation() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = box60(dir);
+    for (i, (yaml, planner, needle)) in [
+        (
+            "ba_star: { tile_side_m: 0 }",
+            "ba-star",
+            "ba_star.tile_side_m",
+        ),
+        ("bcd: { lane_spacing_m: .nan }", "bcd", "bcd.lane_spacing_m"),
+        ("bcd: { rim_coverage: 1.5 }", "bcd", "bcd.rim_coverage"),
+        ("bcd: { min_coverage: -0.5 }", "bcd", "bcd.min_coverage"),
+        // Each angle try is a whole plan: a huge count must be refused, not planned.
+        ("bcd: { angle_tries: 41 }", "bcd", "bcd.angle_tries"),
+        ("bcd: { headland_min_m: -1.0 }", "bcd", "bcd.headland_min_m"),
+        ("bcd: { angle_tries: 4000000000 }", "bcd", "bcd.angle_tries"),
+        // Tour rounds stop when one changes nothing, but a huge bound is still refused.
+        ("bcd: { tour_rounds: 101 }", "bcd", "bcd.tour_rounds"),
+        // A pool of no thread plans nothing; thousands of threads bound nothing.
+        ("bcd: { plans_at_a_time: 0 }", "bcd", "bcd.plans_at_a_time"),
+        ("bcd: { plans_at_a_time: 65 }", "bcd", "bcd.plans_at_a_time"),
+        ("bcd: { plans_at_a_time: -1 }", "bcd", "bcd.plans_at_a_time"),
+        (
+            "random_bounce: { budget_m: -5 }",
+            "random-bounce",
+            "random_bounce.budget_m",
+        ),
+        (
+            "random_bounce: { min_turn_deg: 300, max_turn_deg: 100 }",
+            "random-bounce",
+            "min_turn_deg",
+        ),
+        (
+            "bsa_bfs: { cell_side_m: -1 }",
+            "bsa-bfs",
+            "bsa_bfs.cell_side_m",
+        ),
+        (
+            "rect_boustrophedon: { width_m: .inf }",
+            "rect-boustrophedon",
+            "width_m",
+        ),
+        (
+            "bsa_extended: { extension: { reach_r: -1 } }",
+            "bsa-extended",
+            "bsa_extended.extension.reach_r",
+        ),
+        (
+            "ba_star_extended: { extension: { min_yield: -0.1 } }",
+            "ba-star-extended",
+            "ba_star_extended.extension.min_yield",
+        ),
+        (
+            "bsa_extended: { extension: { leave_fraction: 1.5 } }",
+            "bsa-extended",
+            "bsa_extended.extension.leave_fraction",
+        ),
+        (
+            "ba_star_extended: { extension: { simplify_fraction: 1.5 } }",
+            "ba-star-extended",
+            "ba_star_extended.extension.simplify_fraction",
+        ),
+        (
+            "bsa_extended: { extension: { simplify_loss: -1 } }",
+            "bsa-extended",
+            "bsa_extended.extension.simplify_loss",
+        ),
+        (
+            "ba_star_extended: { extension: { corner_slack: -0.5 } }",
+            "ba-star-extended",
+            "ba_star_extended.extension.corner_slack",
+        ),
+        (
+            "ba_star_extended: { extension: { leave_group: 0 } }",
+            "ba-star-extended",
+            "ba_star_extended.extension.leave_group",
+        ),
+        (
+            "bsa_extended: { extension: { leave_group: 0 } }",
+            "bsa-extended",
+            "bsa_extended.extension.leave_group",
+        ),
+        // `shorter_backtrack` belongs to ba-star-extended only (bsa-extended and ba-star
+        // refuse it as an unknown key).
+        (
+            "bsa_extended: { shorter_backtrack: false }",
+            "bsa-extended",
+            "shorter_backtrack",
+        ),
+        (
+            "ba_star: { shorter_backtrack: false }",
+            "ba-star",
+            "shorter_backtrack",
+        ),
+        // `strip_walk` belongs to bsa-extended only (not to its extension section, not to
+        // ba-star-extended or bsa).
+        (
+            "ba_star_extended: { strip_walk: false }",
+            "ba-star-extended",
+            "strip_walk",
+        ),
+        (
+            "bsa_extended: { extension: { strip_walk: false } }",
+            "bsa-extended",
+            "strip_walk",
+        ),
+        ("bsa: { strip_walk: false }", "bsa", "strip_walk"),
+        // `backtrack_sweep` too (ba-star-extended only), and it must be a number >= 0.
+        (
+            "bsa_extended: { backtrack_sweep: 2 }",
+            "bsa-extended",
+            "backtrack_sweep",
+        ),
+        (
+            "ba_star: { backtrack_sweep: 2 }",
+            "ba-star",
+            "backtrack_sweep",
+        ),
+        (
+            "ba_star_extended: { backtrack_sweep: -1 }",
+            "ba-star-extended",
+            "backtrack_sweep",
+        ),
+        // An extension option given to a planner without the extension is an unknown key.
+        (
+            "ba_star: { extension: { leave_group: 2 } }",
+            "ba-star",
+            "extension",
+        ),
+        // bcd's turned-lattice tries and plans at a time belong to bcd only.
+        ("ba_star: { angle_tries: 3 }", "ba-star", "angle_tries"),
+        (
+            "ba_star_extended: { plans_at_a_time: 1 }",
+            "ba-star-extended",
+            "plans_at_a_time",
+        ),
+        (
+            "rect_boustrophedon: { angle_tries: 3 }",
+            "rect-boustrophedon",
+            "angle_tries",
+        ),
+        // Options the rebuilt bsa-extended dropped are unknown keys now, refused by name.
+        ("bsa_extended: { gap_cost: 4 }", "bsa-extended", "gap_cost"),
+        (
+            "bsa_extended: { extension: { lane_ends: true } }",
+            "bsa-extended",
+            "bsa_extended.extension.lane_ends",
+        ),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let cfg = dir.join(format!("cfg{i}.yaml"));
+        std::fs::write(&cfg, yaml).unwrap();
+        let name = format!("cfg{i}.yaml");
+        run_fails(
+            dir,
+            &map,
+            planner,
+            &["--config", cfg.to_str().unwrap()],
+            &[&name, needle],
+        );
+    }
+    // The same values given as flags are refused by the same check, naming the flag.
+    run_fails(
+        dir,
+        &map,
+        "ba-star",
+        &["--tile-side", "0"],
+        &["--tile-side", "ba_star.tile_side_m"],
+    );
+    run_fails(
+        dir,
+        &map,
+        "rect-boustrophedon",
+        &["--width", "NaN"],
+        &["--width", "width_m"],
+    );
+    // A valid config changes the run.
+    let cfg = dir.join("ok.yaml");
+    std::fs::write(&cfg, "random_bounce: { budget_m: 20 }\n").unwrap();
+    let a = run_ok(dir, "a", &map, "random-bounce", &[]);
+    let b = run_ok(
+        dir,
+        "b",
+        &map,
+        "random-bounce",
+        &["--config", cfg.to_str().unwrap()],
+    );
+    let len = |o: &Path| metrics(o)["path_length_m"].as_f64().unwrap();
+    assert!(len(&b) <= 20.0 + 1e-9 && len(&a) > 20.0);
+    // bcd's turn pruning keeps its coverage floor and trades floor for turns.
+    let map = pillars(dir);
+    let mut runs = Vec::new();
+    for (i, floor) in [1.0, 0.95].into_iter().enumerate() {
+        let cfg = dir.join(format!("bcd{i}.yaml"));
+        std::fs::write(&cfg, format!("bcd: {{ min_coverage: {floor} }}\n")).unwrap();
+        let o = run_ok(
+            dir,
+            &format!("bcd{i}"),
+            &map,
+            "bcd",
+            &["--config", cfg.to_str().unwrap()],
+        );
+        let m = metrics(&o);
+        // 1 drops only what loses no floor; below 1 the floor holds as measured.
+        assert!(
+            floor == 1.0 || m["effective_coverage"].as_f64().unwrap() >= floor,
+            "{m}"
+        );
+        assert_eq!(m["collisions"], 0);
+        runs.push(m);
+    }
+    let turns = |m: &serde_json::Value| m["turns"].as_u64().unwrap();
+    assert!(turns(&runs[1]) < turns(&runs[0]), "{} {}", runs[0], runs[1]);
+    // The extension's wall-pass simplification, through the same file: switching it off
+    // (`simplify_fraction: 0`, or `simplify_loss: 0`), or the squared corners
+    // (`corner_slack: 0`), changes the run of each extended planner.
+    let by_cfg = |planner: &str, name: &str, text: &str| {
+        let cfg = dir.join(format!("{name}.yaml"));
+        std::fs::write(&cfg, text).unwrap();
+        let o = run_ok(
+            dir,
+            name,
+            &map,
+            planner,
+            &["--config", cfg.to_str().unwrap()],
+        );
+        (metrics(&o), trace(&o))
+    };
+    for (planner, section) in [
+        ("ba-star-extended", "ba_star_extended"),
+        ("bsa-extended", "bsa_extended"),
+    ] {
+        let base = by_cfg(planner, &format!("{section}_default"), "");
+        for field in ["simplify_fraction", "simplify_loss"] {
+            let off = by_cfg(
+                planner,
+                &format!("{section}_{field}"),
+                &format!("{section}: {{ extension: {{ {field}: 0 }} }}\n"),
+            );
+            assert_ne!(off.1, base.1, "{planner} {field}: 0 changed nothing");
+            assert_eq!(off.0["collisions"], 0);
+        }
+        // Squared corners: none (`0`) against a generous slack (`1`; the default 0.1 finds
+        // nothing to square on this small map).
+        let corners = |v: &str| {
+            by_cfg(
+                planner,
+                &format!("{section}_corner_slack_{v}"),
+                &format!("{section}: {{ extension: {{ corner_slack: {v} }} }}\n"),
+            )
+        };
+        let (off, wide) = (corners("0"), corners("1"));
+        assert_ne!(off.1, wide.1, "{planner} corner_slack changed nothing");
+        let turns = |m: &serde_json::Value| m["turns"].as_u64().unwrap();
+        assert!(turns(&wide.0) <= turns(&off.0), "{} {}", off.0, wide.0);
+        assert_eq!(wide.0["collisions"], 0);
+    }
+}
+
+#[test]
+fn max_memory_refuses_and_allows() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = box60(dir);
+    let big = pillars(dir);
+    run_fails(
+        dir,
+        &big,
+        "ba-star",
+        &["--max-memory", "1"],
+        &["memory limit of 1 MB", "--max-memory"],
+    );
+    // The default limit (4096 MB) refuses 9e6 BA* tiles on a 3 x 3 m map.
+    run_fails(
+        dir,
+        &map,
+        "ba-star",
+        &["--tile-side", "0.001"],
+        &["memory limit of 4096 MB", "tiles of 0.001 m"],
+    );
+    run_ok(dir, "small", &big, "ba-star", &["--max-memory", "64"]);
+    // Below the process's own 16 MB no smaller map or larger robot helps: the advice says so
+    // (it used to advise cropping a 14 400-pixel map under a 10 MB limit).
+    run_fails(
+        dir,
+        &map,
+        "ba-star",
+        &["--max-memory", "10"],
+        &[
+            "memory limit of 10 MB",
+            "raise it with --max-memory MB / max_memory_mb: the process alone needs about 16 MB",
+        ],
+    );
+    let o = ccpp()
+        .args(["run", "--planner", "ba-star", "--max-memory", "10", "--map"])
+        .arg(&map)
+        .arg("--out")
+        .arg(dir.join("refused"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !err.contains("smaller map") && !err.contains(" or use "),
+        "{err}"
+    );
+    fails(
+        &["waypoints", "--max-memory", "1", "--map"],
+        &[&big],
+        &["memory limit of 1 MB"],
+        10,
+    );
+}
+
+#[test]
 fn absurd_sizes_end_within_seconds() {
     let d = tempfile::tempdir().unwrap();
     let dir = d.path();
