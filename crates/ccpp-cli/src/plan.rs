@@ -66,6 +66,7 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         planner: kind.name(),
         map: &map.name,
         robot,
+        footprint: ccpp_io::export::Footprint::of(&scenario.planner, &robot),
         tolerance_m: DEFAULT_TOLERANCE_M,
         metrics: None,
     };

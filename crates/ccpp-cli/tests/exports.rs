@@ -349,6 +349,28 @@ fn plan_writes_only_the_path_of_a_known_map_planner() {
             "{flag}"
         );
     }
+    // The GeoJSON names the robot the route was planned for: the disk planners' disk, and
+    // rect-boustrophedon's rectangle beside it (its robot was the `--radius` default alone).
+    let bcd_robot = &json(&g.join("path.geojson"))["features"][0]["properties"]["robot"];
+    assert!(bcd_robot.get("footprint").is_none(), "{bcd_robot}");
+    let args = ["--length", "0.5", "--width", "0.3", "--export", "geojson"];
+    let planned = plan_ok(d.path(), "rect-geo", &map, "rect-boustrophedon", &args);
+    let ran = run_ok(d.path(), "rect-geo-run", &map, "rect-boustrophedon", &args);
+    for out in [planned, ran] {
+        let robot = &json(&out.join("path.geojson"))["features"][0]["properties"]["robot"];
+        let f = &robot["footprint"];
+        assert_eq!(f["shape"], "rectangle", "{robot}");
+        assert_eq!(
+            (f["length_m"].as_f64(), f["width_m"].as_f64()),
+            (Some(0.5), Some(0.3))
+        );
+        let r = f["clearance_radius_m"].as_f64().unwrap();
+        assert!((r - 0.5f64.hypot(0.3) / 2.0).abs() < 1e-12, "{r}");
+    }
+}
+
+fn json(p: &Path) -> serde_json::Value {
+    serde_json::from_str(&read(p)).unwrap()
 }
 
 #[test]

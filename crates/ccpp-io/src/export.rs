@@ -105,10 +105,42 @@ pub struct ExportMeta<'a> {
     pub map: &'a str,
     /// The robot.
     pub robot: Robot,
+    /// The rectangle a rect-boustrophedon route was planned for ([`Footprint::of`]), written
+    /// beside the robot's disk; `None` for the disk planners.
+    pub footprint: Option<Footprint>,
     /// The merging tolerance the route was built with, metres.
     pub tolerance_m: f64,
     /// The run's metrics (`GeoJSON` properties), when the path was simulated and measured.
     pub metrics: Option<&'a Metrics>,
+}
+
+/// The rectangular robot a route was planned for (seed 001's `l x b` robot, planned as its
+/// clearance disk), as the exports name it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Footprint {
+    /// Length `l` along the direction of travel, metres.
+    pub length_m: f64,
+    /// Width `b` (the lane spacing), metres.
+    pub width_m: f64,
+    /// Radius of the disk the route keeps clear, metres.
+    pub clearance_radius_m: f64,
+}
+
+impl Footprint {
+    /// The rectangle of a rect-boustrophedon `planner` for `robot` (its options' length and
+    /// width, defaults resolved); `None` for the other planners, which plan for the robot's
+    /// disk.
+    #[must_use]
+    pub fn of(planner: &ccpp_core::planners::PlannerConfig, robot: &Robot) -> Option<Self> {
+        match planner {
+            ccpp_core::planners::PlannerConfig::RectBoustrophedon(o) => Some(Self {
+                length_m: o.length_for(robot),
+                width_m: o.width_for(robot),
+                clearance_radius_m: o.clearance_radius(robot),
+            }),
+            _ => None,
+        }
+    }
 }
 
 /// An extra polygon for the `GeoJSON` export (a keep-out zone, a work area...): rings of map
@@ -467,11 +499,34 @@ fn closed_ring(ring: &[[f64; 2]]) -> Vec<[f64; 2]> {
     r
 }
 
+/// The `robot` property of the exports: the disk (`radius_m`, `tool_radius_m`) and, for a
+/// rectangular robot, its `footprint` (`shape: "rectangle"`, `length_m`, `width_m`,
+/// `clearance_radius_m`).
+fn robot_json(meta: &ExportMeta<'_>) -> serde_json::Value {
+    let mut robot = serde_json::json!({
+        "radius_m": meta.robot.radius,
+        "tool_radius_m": meta.robot.tool_radius,
+    });
+    if let (Some(f), serde_json::Value::Object(fields)) = (meta.footprint, &mut robot) {
+        fields.insert(
+            "footprint".into(),
+            serde_json::json!({
+                "shape": "rectangle",
+                "length_m": f.length_m,
+                "width_m": f.width_m,
+                "clearance_radius_m": f.clearance_radius_m,
+            }),
+        );
+    }
+    robot
+}
+
 /// The route (and `polygons`) as a `GeoJSON` `FeatureCollection` in map coordinates
 /// (`[x, y]` order, metres). The first feature is the route: a `LineString` of the waypoints
 /// (a single waypoint is repeated so the line has the two positions `GeoJSON` requires; an empty
 /// route has a `null` geometry) with properties `kind: "path"`, `frame_id`, `planner`, `map`,
-/// `robot` (`radius_m`, `tool_radius_m`), `route` (`waypoints`, `length_m`, `tolerance_m`) and
+/// `robot` (`radius_m`, `tool_radius_m`, and a rectangular robot's `footprint`), `route`
+/// (`waypoints`, `length_m`, `tolerance_m`) and
 /// `metrics` (the run's metrics but `wall_time_s`, which differs between identical runs, or
 /// `null` for a plan that was not measured). Then one
 /// `Polygon` feature per entry of `polygons` with properties `kind` and `name`, rings closed.
@@ -510,10 +565,7 @@ pub fn geojson(
             "frame_id": FRAME_ID,
             "planner": meta.planner,
             "map": meta.map,
-            "robot": {
-                "radius_m": meta.robot.radius,
-                "tool_radius_m": meta.robot.tool_radius,
-            },
+            "robot": robot_json(meta),
             "route": {
                 "waypoints": route.waypoints.len(),
                 "length_m": route.length_m(),
@@ -585,6 +637,7 @@ mod tests {
                 radius: 0.15,
                 tool_radius: 0.15,
             },
+            footprint: None,
             tolerance_m: 0.001,
             metrics: None,
         }

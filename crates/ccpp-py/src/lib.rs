@@ -865,6 +865,8 @@ pub struct PlanResult {
     planner: &'static str,
     map: String,
     robot: Robot,
+    /// The rectangle a rect-boustrophedon route was planned for (the exports name it).
+    footprint: Option<ccpp_io::export::Footprint>,
     route: Route,
     zones: Option<ZoneMasks>,
     /// The map's frame (for keep-out masks in the exports).
@@ -878,6 +880,7 @@ impl PlanResult {
             planner: self.planner,
             map: &self.map,
             robot: self.robot,
+            footprint: self.footprint,
             tolerance_m: DEFAULT_TOLERANCE_M,
             metrics: None,
         };
@@ -975,6 +978,7 @@ fn plan(
         planner: scenario.planner.name(),
         map: prepared.name.clone(),
         robot: scenario.robot,
+        footprint: ccpp_io::export::Footprint::of(&scenario.planner, &scenario.robot),
         route: p.route,
         zones: p.world.zones().cloned(),
         frame: *p.world.frame(),

@@ -87,6 +87,12 @@ def test_plan_refuses_what_a_plan_would_drop(room: Path, ccpp_bin: str, tmp_path
         ccpp.plan(room, "rect-boustrophedon", tool_radius=0.1)
     # bcd's lanes follow the tool: there it applies.
     assert ccpp.plan(room, "bcd", tool_radius=0.1).export("csv") != ccpp.plan(room, "bcd").export("csv")
+    # The GeoJSON names the rectangle a rect-boustrophedon route was planned for (as `ccpp plan`).
+    geo = json.loads(ccpp.plan(room, "rect-boustrophedon", length_m=0.5, width_m=0.3).export("geojson"))
+    assert geo["features"][0]["properties"]["robot"]["footprint"] == {
+        "shape": "rectangle", "length_m": 0.5, "width_m": 0.3, "clearance_radius_m": 0.5 * (0.5**2 + 0.3**2) ** 0.5,
+    }
+    assert "footprint" not in json.loads(ccpp.plan(room, "bcd").export("geojson"))["features"][0]["properties"]["robot"]
     # A start heading changes nothing a plan gives (`ccpp plan --start X,Y,THETA` is refused).
     p = cli(ccpp_bin, "plan", "--map", str(room), "--planner", "bcd", "--start", "1,1,1",
             "--out", str(tmp_path / "o"))

@@ -242,6 +242,7 @@ pub fn render_export_files(
         planner: &metrics.planner,
         map: &metrics.map,
         robot: scenario.robot,
+        footprint: ccpp_io::export::Footprint::of(&scenario.planner, &scenario.robot),
         tolerance_m: DEFAULT_TOLERANCE_M,
         metrics: Some(metrics),
     };
