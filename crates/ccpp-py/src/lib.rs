@@ -1882,7 +1882,6 @@ impl Env {
     }
 }
 
-/// The extension module.
 /// The lock a sweep holds on its output folder, the same as `ccpp bench`'s
 /// ([`ccpp_io::lock`]): taken when made (an error naming the holder's process when another
 /// bench or sweep holds it), released, and its file removed, by `release()` or when
@@ -1913,6 +1912,7 @@ impl FolderLock {
     }
 }
 
+/// The extension module.
 #[pymodule]
 fn _ccpp(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("CcppError", m.py().get_type::<CcppError>())?;

@@ -182,10 +182,12 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
     // aborts the process: it is asked for here first, fallibly (a 21-byte PGM claiming
     // 100000 x 100000 px, with `--max-memory` raised to admit it, aborted under a 3 GB
     // address-space limit instead of being refused).
-    let mut header = ImageReader::with_format(&mut inner, format);
-    header.limits(limits.clone());
-    let total = header.into_decoder().map_err(image_err)?.total_bytes();
-    inner.seek(SeekFrom::Start(start)).map_err(io_err)?;
+    // (the decoder that will decode, so its header is read once; then the checks
+    // `ImageReader::decode` makes)
+    let mut reader = ImageReader::with_format(inner, format);
+    reader.limits(limits.clone());
+    let mut decoder = reader.into_decoder().map_err(image_err)?;
+    let total = decoder.total_bytes();
     let mut probe: Vec<u8> = Vec::new();
     if usize::try_from(total).map_or(true, |n| probe.try_reserve_exact(n).is_err()) {
         return Err(MapError::Decode {
@@ -196,9 +198,9 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
         });
     }
     drop(probe);
-    let mut reader = ImageReader::with_format(inner, format);
-    reader.limits(limits);
-    let img = reader.decode().map_err(image_err)?;
+    limits.reserve(total).map_err(image_err)?;
+    decoder.set_limits(limits).map_err(image_err)?;
+    let img = DynamicImage::from_decoder(decoder).map_err(image_err)?;
     let width = img.width() as usize;
     let height = img.height() as usize;
     let cells = classify_image(&img, t);
