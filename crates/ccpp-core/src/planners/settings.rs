@@ -1314,6 +1314,26 @@ mod tests {
         }
     }
 
+    /// The registry's `range_matters` and the settings' `sensor_need` say the same thing twice
+    /// (the CLI and Python refuse a range by the first, the scenario sizes the sensor by the
+    /// second): an online planner has a sensor need exactly when its range does not matter.
+    #[test]
+    fn range_matters_and_sensor_need_agree() {
+        let s = apartment();
+        let all = super::super::PlannerOptions::default();
+        for &kind in super::super::PlannerKind::ALL {
+            let info = kind.info();
+            let need = all.config(kind).settings().sensor_need(&s);
+            assert_eq!(
+                need.is_some(),
+                !info.offline && !info.range_matters,
+                "{}",
+                info.name
+            );
+            assert_eq!(kind.sensor_range_refusal().is_none(), info.range_matters);
+        }
+    }
+
     #[test]
     fn bsa_bfs_estimate_counts_the_pid_records_a_run_makes() {
         let s = apartment();
