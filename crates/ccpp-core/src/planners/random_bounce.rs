@@ -6,7 +6,9 @@
 //! inefficient reference; ccpp uses it as the baseline every plot compares against.
 //!
 //! Online: it stops *before* contact using its range sensor (a virtual bumper), so a correct run
-//! has no collisions.
+//! has no collisions. When its pose estimate drifts (odometry noise under PID execution) the
+//! sensed obstacle can be nearer than it believes; a bumper contact then bounces it like a
+//! sensed obstacle (a random turn) instead of driving on into the wall.
 //!
 //! ```
 //! use ccpp_core::{GridMap, Pose};
@@ -64,6 +66,8 @@ pub struct RandomBounce {
     travelled: f64,
     started: bool,
     turns_in_a_row: u32,
+    /// The last step was a translation (so a bumper contact now is its doing).
+    last_was_translate: bool,
     finished: bool,
 }
 
@@ -78,6 +82,7 @@ impl RandomBounce {
             travelled: 0.0,
             started: false,
             turns_in_a_row: 0,
+            last_was_translate: false,
             finished: false,
         }
     }
@@ -113,15 +118,63 @@ impl Planner for RandomBounce {
             self.finished = true;
             return Step::Mark(Event::RegionEnd { region: 1 });
         }
-        if stride >= 0.5 * res || (stride > 0.0 && stride >= left - 1e-12) {
+        // A bumper contact bounces like a sensed obstacle: under odometry noise the pose
+        // estimate can put a wall further off than it is, and driving on would push into it.
+        let bounced = sensor.bumped() && self.last_was_translate;
+        if !bounced && (stride >= 0.5 * res || (stride > 0.0 && stride >= left - 1e-12)) {
+            self.last_was_translate = true;
             self.turns_in_a_row = 0;
             self.travelled += stride;
             return Step::Translate(stride);
         }
+        self.last_was_translate = false;
         self.turns_in_a_row += 1;
         let deg = self
             .rng
             .range(self.opts.min_turn_deg, self.opts.max_turn_deg);
         Step::Rotate(crate::geometry::wrap_angle(deg.to_radians()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::exec::{Execution, OdometryNoise, PidOptions};
+    use crate::sim::{simulate, SimConfig, StopReason};
+    use crate::world::{Robot, World};
+    use crate::{GridMap, Pose};
+
+    /// A 4 m x 3 m room, dead-reckoned with drifting odometry: the pose estimate soon puts the
+    /// walls where they are not, and the robot meets them on its bumper.
+    #[test]
+    fn a_bumper_contact_bounces_instead_of_pushing_on() {
+        let art = "##########\n#........#\n#........#\n#........#\n##########";
+        let map = GridMap::from_ascii_scaled(art, 10, 0.05).unwrap();
+        let world = World::new(map, Robot::new(0.15), Some(Pose::new(1.0, 1.0, 0.3))).unwrap();
+        let cfg = SimConfig {
+            exec: Some(Execution::Pid(PidOptions {
+                noise: Some(OdometryNoise {
+                    seed: 3,
+                    linear_rel_std: 0.05,
+                    angular_rel_std: 0.05,
+                    heading_drift_std: 0.3,
+                }),
+                ..PidOptions::default()
+            })),
+            ..SimConfig::default()
+        };
+        let mut p = RandomBounce::new(RandomBounceOptions {
+            budget_m: Some(150.0),
+            ..Default::default()
+        });
+        let out = simulate(&world, &mut p, &cfg);
+        let m = crate::metrics::compute(&world, &out, "room");
+        // It met walls it did not expect (the test is about those contacts)...
+        assert!(m.collisions > 0, "no contact: the noise did not bite");
+        // ...and bounced off each: it spent its budget and finished, instead of pushing into
+        // one wall until the simulator ended the run as stalled after 1000 contacts.
+        assert_eq!(out.stop, StopReason::Done);
+        assert!(m.collisions < 200, "{} contacts", m.collisions);
+        assert!(m.path_length_m > 100.0, "{} m", m.path_length_m);
     }
 }
