@@ -95,6 +95,22 @@ pub enum MapError {
         /// The mode asked for.
         mode: String,
     },
+    /// A key that is not one of `map_server`'s but so near one that it is taken for a misspelling
+    /// (`negat`, `occupied_threshold`, `Resolution`). `map_server` ignores unknown keys, so a
+    /// misspelt optional field silently falls back to its default (an un-negated map, other
+    /// thresholds); other unknown keys are ignored here too.
+    #[error(
+        "map YAML {}: unknown key `{key}`; did you mean `{field}`? (map_server would ignore it and use the default of `{field}`)",
+        path.display()
+    )]
+    MisspeltField {
+        /// The YAML file.
+        path: PathBuf,
+        /// The key as written.
+        key: String,
+        /// The field it is near.
+        field: &'static str,
+    },
     /// The decoded image does not make a valid grid (e.g. it has no pixel).
     #[error("map {}: {source}", path.display())]
     Grid {

@@ -1,5 +1,6 @@
 //! The ROS `map_server` YAML file ([`MapYaml`]).
 
+use std::collections::BTreeMap;
 use std::fmt;
 use std::path::Path;
 
@@ -23,7 +24,8 @@ use super::error::{one_line, MapError};
 /// mode: trinary             # optional: trinary (default), scale or raw
 /// ```
 ///
-/// Unknown keys are ignored, as `map_server` does.
+/// Unknown keys are ignored, as `map_server` does, except one so near a field that it is taken
+/// for a misspelling of it ([`MapError::MisspeltField`]: `negat`, `free_threshold`, `Origin`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct MapYaml {
     /// The image file as written in the YAML (not yet resolved against the YAML's folder).
@@ -52,6 +54,52 @@ struct RawYaml {
     occupied_thresh: Option<f64>,
     free_thresh: Option<f64>,
     mode: Option<String>,
+    /// Every other key (checked for misspellings of the fields above).
+    #[allow(
+        clippy::zero_sized_map_values,
+        reason = "only the keys are wanted; the values are skipped unread"
+    )]
+    #[serde(flatten)]
+    other: BTreeMap<String, de::IgnoredAny>,
+}
+
+/// The fields of a `map_server` YAML.
+const FIELDS: [&str; 7] = [
+    "image",
+    "resolution",
+    "origin",
+    "negate",
+    "occupied_thresh",
+    "free_thresh",
+    "mode",
+];
+
+/// The field `key` is taken to misspell, if any: the same but for case, one beginning with the
+/// other (`negat`, `free_threshold`; at least four letters), or at most two edits apart
+/// (`orgin`, `occupied_tresh`).
+fn misspelt(key: &str) -> Option<&'static str> {
+    let k = key.to_ascii_lowercase();
+    FIELDS.into_iter().find(|f| {
+        k == *f
+            || (k.len() >= 4 && (k.starts_with(f) || f.starts_with(k.as_str())))
+            || edits(&k, f) <= 2
+    })
+}
+
+/// Levenshtein distance of two short ASCII keys.
+fn edits(a: &str, b: &str) -> usize {
+    let (a, b) = (a.as_bytes(), b.as_bytes());
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, &ca) in a.iter().enumerate() {
+        let mut diag = row[0];
+        row[0] = i + 1;
+        for (j, &cb) in b.iter().enumerate() {
+            let up = row[j + 1];
+            row[j + 1] = (diag + usize::from(ca != cb)).min(up + 1).min(row[j] + 1);
+            diag = up;
+        }
+    }
+    row[b.len()]
 }
 
 /// `negate` as written: an integer or a boolean.
@@ -134,6 +182,14 @@ impl MapYaml {
             reason,
         };
 
+        // BTreeMap: the first misspelling in key order, whatever the file's order.
+        if let Some((key, field)) = raw.other.keys().find_map(|k| misspelt(k).map(|f| (k, f))) {
+            return Err(MapError::MisspeltField {
+                path: path.to_path_buf(),
+                key: one_line(key).chars().take(80).collect(),
+                field,
+            });
+        }
         let image = raw.image.ok_or_else(|| missing("image"))?;
         if image.trim().is_empty() {
             return Err(bad("image", "the image file name is empty".to_owned()));
@@ -267,6 +323,33 @@ mod tests {
     }
 
     const BASE: &str = "image: m.pgm\nresolution: 0.05\norigin: [-1, -2.5, 0.0]\n";
+
+    #[test]
+    fn a_misspelt_field_is_refused_and_other_keys_ignored() {
+        for (key, field) in [
+            ("negat: 1", "negate"),
+            ("Negate: 1", "negate"),
+            ("occupied_threshold: 0.5", "occupied_thresh"),
+            ("free_tresh: 0.1", "free_thresh"),
+            ("orgin: [0, 0, 0]", "origin"),
+            ("moed: raw", "mode"),
+        ] {
+            let e = parse(&format!("{BASE}{key}\n")).unwrap_err();
+            assert!(
+                matches!(&e, MapError::MisspeltField { field: f, .. } if *f == field),
+                "{key}: {e}"
+            );
+            let msg = e.to_string();
+            assert!(msg.contains(key.split(':').next().unwrap()), "{msg}");
+            assert!(msg.contains("dir/test.yaml"), "{msg}");
+        }
+        // A key near no field is ignored, as map_server does.
+        let y = parse(&format!("{BASE}name: lab\nsensor: lidar\n")).unwrap();
+        assert_eq!(y, parse(BASE).unwrap());
+        // A misspelt `image` is named as such, not as a missing field.
+        let e = parse("Image: m.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n").unwrap_err();
+        assert!(e.to_string().contains("did you mean `image`"), "{e}");
+    }
 
     #[test]
     fn defaults_and_integer_origin() {
