@@ -291,6 +291,33 @@ fn bad_zones_are_refused_with_one_line_naming_the_file() {
     );
     let two = w("two.yaml", "- [0, 0]\n- [1, 1]\n- [0, 0]\n");
     run(&["--keepout", &two], &["two.yaml", "2 distinct points"]);
+    // A GeoJSON in latitude/longitude (a named crs), and a YAML zone with a foreign key:
+    // both were read as if in map coordinates, the crs and the key ignored.
+    let wgs = w(
+        "wgs84.geojson",
+        r#"{"type":"FeatureCollection","crs":{"type":"name","properties":{"name":"EPSG:4326"}},"features":[{"type":"Feature","properties":{},"geometry":{"type":"Polygon","coordinates":[[[2.35,48.85],[2.36,48.85],[2.36,48.86],[2.35,48.85]]]}}]}"#,
+    );
+    run(
+        &["--keepout", &wgs],
+        &["wgs84.geojson", "crs \"EPSG:4326\"", "map coordinates"],
+    );
+    let framed = w(
+        "framed.yaml",
+        "frame: odom\npolygons:\n  - [[0, 0], [1, 0], [1, 1]]\n",
+    );
+    run(
+        &["--area", &framed],
+        &["framed.yaml", "unknown key `frame`"],
+    );
+    // A misspelt field of a keepout mask's own map_server YAML.
+    let negat = w(
+        "negat.yaml",
+        "image: huge.pgm\nresolution: 0.05\norigin: [-12.5, -12.5, 0]\nnegat: 1\n",
+    );
+    run(
+        &["--keepout", &negat],
+        &["negat.yaml", "did you mean `negate`"],
+    );
     let empty = w(
         "empty.geojson",
         r#"{"type":"FeatureCollection","features":[]}"#,

@@ -21,7 +21,7 @@ use fixedbitset::FixedBitSet;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
-use crate::map::{load_map, LoadOptions, MapYaml};
+use crate::map::{load_map, one_line, LoadOptions, MapYaml};
 
 /// Where a zone comes from (serialized untagged: `[x0, y0, x1, y1]`, a file name, or a list of
 /// polygons, each a list of `[x, y]`).
@@ -295,6 +295,16 @@ fn is_point(v: &Value) -> bool {
 
 /// Polygons of a YAML polygon list (one polygon, a list of them, or `polygons: [...]`).
 fn yaml_polygons(v: &Value) -> Result<Vec<Polygon>, ZoneFileError> {
+    // A misspelt or foreign key beside `polygons` (`frame: odom`, `keepout: false`) would be
+    // ignored with what it meant.
+    if let Value::Object(o) = v {
+        if let Some(k) = o.keys().find(|k| k.as_str() != "polygons") {
+            let k: String = one_line(k).chars().take(80).collect();
+            return Err(bad(format!(
+                "unknown key `{k}`: a YAML zone file is a list of x,y points, a list of such lists, `polygons:` with such lists, or a map_server YAML (keepout mask)"
+            )));
+        }
+    }
     let v = v.get("polygons").unwrap_or(v);
     let Value::Array(a) = v else {
         return Err(bad(
@@ -335,6 +345,19 @@ fn geojson_polygon(rings: &Value, out: &mut Vec<Polygon>) -> Result<(), ZoneFile
 fn geojson_collect(v: &Value, out: &mut Vec<Polygon>, depth: usize) -> Result<(), ZoneFileError> {
     if depth > 8 {
         return Err(bad("GeoJSON nested too deeply"));
+    }
+    // The 2008 GeoJSON's `crs` member: a named CRS (EPSG:4326 latitude/longitude, a UTM zone)
+    // is not the map's frame, and reading its numbers as metres in the map put the zone
+    // anywhere, silently. RFC 7946 dropped the member; ccpp's own exports never write it.
+    if let Some(crs) = v.get("crs") {
+        let name = crs
+            .pointer("/properties/name")
+            .and_then(Value::as_str)
+            .map_or_else(|| one_line(&crs.to_string()), one_line);
+        let name: String = name.chars().take(80).collect();
+        return Err(bad(format!(
+            "GeoJSON crs {name:?}: zones are read in map coordinates (metres in the map YAML's frame, as ccpp's exports write them); convert the file to map coordinates and leave out \"crs\""
+        )));
     }
     let ty = v.get("type").and_then(Value::as_str).unwrap_or("");
     let coords = || {
@@ -427,6 +450,15 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("LineString"));
+        let crs: Value = serde_json::from_str(
+            r#"{"type":"FeatureCollection","crs":{"type":"name","properties":{"name":"urn:ogc:def:crs:EPSG::4326"}},"features":[]}"#,
+        )
+        .unwrap();
+        let e = geojson_polygons(&crs).unwrap_err().to_string();
+        assert!(
+            e.contains("EPSG::4326") && e.contains("map coordinates"),
+            "{e}"
+        );
         let one: Value = serde_saphyr::from_str("- [0, 0]\n- [1, 0]\n- [1, 1]\n").unwrap();
         assert_eq!(yaml_polygons(&one).unwrap().len(), 1);
         let two: Value = serde_saphyr::from_str(
@@ -435,6 +467,15 @@ mod tests {
         .unwrap();
         let p = yaml_polygons(&two).unwrap();
         assert_eq!(p.len(), 2);
+        for extra in ["frame: odom\n", "polygon:\n  - [[0, 0], [1, 0], [1, 1]]\n"] {
+            let v: Value = serde_saphyr::from_str(&format!(
+                "polygons:\n  - [[0, 0], [1, 0], [1, 1]]\n{extra}"
+            ))
+            .unwrap();
+            let e = yaml_polygons(&v).unwrap_err().to_string();
+            let key = extra.split(':').next().unwrap();
+            assert!(e.contains(&format!("unknown key `{key}`")), "{e}");
+        }
         assert_eq!(p[1].points[2], [3.0, 3.0]);
     }
 

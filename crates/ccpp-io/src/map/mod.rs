@@ -46,6 +46,7 @@ use ccpp_core::grid::{GridMap, MapFrame};
 use image::ImageReader;
 
 pub use classify::{classify, MapMode, Thresholds, DEFAULT_FREE_THRESH, DEFAULT_OCCUPIED_THRESH};
+pub(crate) use error::one_line;
 pub use error::MapError;
 pub use yaml::{heading_problem, validate_placement, MapYaml, MAX_HEADING_RAD};
 
