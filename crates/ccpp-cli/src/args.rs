@@ -402,7 +402,7 @@ fn parse_quad(s: &str) -> Result<[f64; 4], String> {
         .try_into()
         .map_err(|_| format!("expected X0,Y0,X1,Y1, got {s:?}"))?;
     if v[2] <= v[0] || v[3] <= v[1] {
-        return Err(format!("area {s:?} must have X1 > X0 and Y1 > Y0"));
+        return Err(format!("rectangle {s:?} must have X1 > X0 and Y1 > Y0"));
     }
     Ok(v)
 }

@@ -803,6 +803,20 @@ fn done_line(runs: usize, failed: usize, maps: usize, planners: usize) -> String
     )
 }
 
+/// A name as Markdown text on one line: control characters escaped (`\n`; a map file named
+/// with a newline split its heading in two), `|` escaped so it does not end a table cell.
+fn md_text(name: &str) -> String {
+    let mut out = String::with_capacity(name.len());
+    for c in name.chars() {
+        match c {
+            '|' => out.push_str("\\|"),
+            c if c.is_control() => out.extend(c.escape_default()),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
 /// `results.md`: a table per map and a summary across maps.
 pub fn results_md(rows: &[Row]) -> String {
     let mut s = String::from("# ccpp bench results\n\n");
@@ -855,7 +869,7 @@ pub fn results_md(rows: &[Row]) -> String {
     }
     s.push('\n');
     for map in &maps {
-        let _ = writeln!(s, "## {map}\n");
+        let _ = writeln!(s, "## {}\n", md_text(map));
         s.push_str(header);
         for r in rows.iter().filter(|r| r.map == *map) {
             match &r.outcome {
@@ -974,5 +988,18 @@ mod tests {
         for l in csv.lines().skip(1) {
             assert!(l.ends_with(",error,robot too big,,,,,,,,,,,,,,,,"), "{l}");
         }
+    }
+
+    /// A map named with a newline (from its file name) split its heading in two.
+    #[test]
+    fn a_map_name_is_one_heading_line() {
+        let rows = [Row {
+            map: "lab\nb|c".into(),
+            planner: "bsa".into(),
+            outcome: Err("robot too big".into()),
+            dir: PathBuf::from("out/runs/x/bsa"),
+        }];
+        let md = results_md(&rows);
+        assert!(md.contains("\n## lab\\nb\\|c\n"), "{md}");
     }
 }

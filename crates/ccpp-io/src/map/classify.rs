@@ -1,6 +1,7 @@
 //! Pixel classification: ROS `map_server`'s `trinary`, `scale` and `raw` modes ([`Thresholds`],
 //! [`MapMode`], [`classify`]).
 
+use ccpp_core::display::Compact;
 use std::path::Path;
 
 use ccpp_core::grid::Cell;
@@ -95,7 +96,7 @@ impl Thresholds {
             ("free_thresh", self.free),
         ] {
             if !(0.0..=1.0).contains(&v) {
-                return Err(bad(field, format!("{v} is not in [0, 1]")));
+                return Err(bad(field, format!("{} is not in [0, 1]", Compact(v))));
             }
         }
         if self.free >= self.occupied {
@@ -103,7 +104,8 @@ impl Thresholds {
                 "free_thresh",
                 format!(
                     "free_thresh {} must be below occupied_thresh {}",
-                    self.free, self.occupied
+                    Compact(self.free),
+                    Compact(self.occupied)
                 ),
             ));
         }

@@ -41,6 +41,7 @@ mod yaml;
 use std::io::{BufReader, Cursor};
 use std::path::{Path, PathBuf};
 
+use ccpp_core::display::Compact;
 use ccpp_core::geometry::Pose;
 use ccpp_core::grid::{GridMap, MapFrame};
 use image::ImageReader;
@@ -254,8 +255,8 @@ fn finish<R: std::io::BufRead + std::io::Seek>(
                 field: "occupied_thresh",
                 reason: format!(
                     "occupied_thresh {} (given) must be above free_thresh {} ({})",
-                    t.occupied,
-                    t.free,
+                    Compact(t.occupied),
+                    Compact(t.free),
                     given(opts.free_thresh)
                 ),
             },
@@ -268,7 +269,8 @@ fn finish<R: std::io::BufRead + std::io::Seek>(
                 field: "free_thresh",
                 reason: format!(
                     "free_thresh {} (given) must be below occupied_thresh {} ({theirs})",
-                    t.free, t.occupied
+                    Compact(t.free),
+                    Compact(t.occupied)
                 ),
             },
             e => e,
