@@ -522,6 +522,11 @@ fn sim_from(a: &RunArgs, config: &mut PlannerConfig) -> Result<SimConfig> {
         if exec == Some(false) {
             bail!("--odometry-noise needs PID execution, not --exec ideal");
         }
+        if v.iter().all(|x| *x == 0.0) {
+            // It would run exactly as `--exec pid` (and change nothing for a planner that
+            // executes by PID already): a value read and dropped.
+            bail!("--odometry-noise {n} draws no noise: give a noise > 0, or use --exec pid for PID execution without noise");
+        }
         // A file that gives the noise at all (`noise: null` too, as `planners --defaults`
         // prints it) clashes, as every other flag beside its option in the file does.
         if pid.noise.is_some()
@@ -535,9 +540,6 @@ fn sim_from(a: &RunArgs, config: &mut PlannerConfig) -> Result<SimConfig> {
                 options_file(a.options.config.as_deref()),
                 kind.info().section
             );
-        }
-        if a.seed.is_some() && v.iter().all(|x| *x == 0.0) {
-            bail!("--seed has no effect: --odometry-noise {n} draws no noise (give a noise > 0, or leave --seed out)");
         }
         // Exactly the noise asked for: a heading drift left out is 0, not the library's
         // default (`--odometry-noise 0` used to drift 0.2 rad per metre).

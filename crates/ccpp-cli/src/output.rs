@@ -237,6 +237,9 @@ pub fn emit(
     if let Some(w) = comp.warning() {
         eprintln!("{w}");
     }
+    if let Some(w) = drift_warning(job, r) {
+        eprintln!("{w}");
+    }
     if let Some(n) = ccpp_core::sim::motions_cut(&r.run.trace) {
         eprintln!(
             "warning: {n} PID motion(s) stopped at max_steps_per_motion before reaching their goal (the run went on from where the robot was): raise exec.pid.max_steps_per_motion or dt_s"
@@ -339,6 +342,29 @@ pub fn summary(m: &Metrics) -> String {
         let _ = writeln!(s, "  warning: {}", stop_warning(why, "coverage"));
     }
     s
+}
+
+/// The warning for a run with odometry noise, no landmarks and bumper contacts: its pose
+/// estimate drifted from the truth, so the planner drove into walls it placed elsewhere, and
+/// an offline planner's remaining moves started from a wrong position. The trace still ends
+/// `done` (the planner finished its plan), so without this the run read as complete.
+fn drift_warning(job: &Job, r: &JobResult) -> Option<String> {
+    if r.metrics.collisions == 0 || !job.scenario.sim.landmarks.landmarks.is_empty() {
+        return None;
+    }
+    // The execution event comes first of all events (a run's first step).
+    let noisy = r
+        .run
+        .trace
+        .events()
+        .take(4)
+        .any(|(_, e)| matches!(e, ccpp_core::trace::Event::Execution { noisy: true, .. }));
+    noisy.then(|| {
+        format!(
+            "warning: {} bumper contact(s): under odometry noise without landmarks the pose estimate drifts from the truth, and the robot drives into walls it believes are elsewhere; give --landmarks to correct the estimate (the coverage is what was swept)",
+            r.metrics.collisions
+        )
+    })
 }
 
 /// What an early stop (`Metrics::stop_reason`) means, for the summary; `what` is the

@@ -221,15 +221,22 @@ fn execution_flags_reach_the_simulator() {
     );
     run_fails(dir, &map, "bsa", &["--exec", "fast"], &["--exec"]);
     // Zero noise draws nothing: a seed for it would be read and change nothing (a hostile
-    // tester found `--odometry-noise 0 --seed 5` and `--seed 6` giving the same trace). The
-    // same seed in an options file is refused too, naming the field.
-    run_fails(
-        dir,
-        &map,
-        "bsa",
-        &["--odometry-noise", "0,0,0", "--seed", "5"],
-        &["--seed has no effect", "draws no noise"],
-    );
+    // tester found `--odometry-noise 0 --seed 5` and `--seed 6` giving the same trace), and
+    // the noise itself ran as `--exec pid` (for bsa-bfs, which executes by PID already, as
+    // nothing at all). The same seed in an options file is refused too, naming the field.
+    for extra in [&["--seed", "5"][..], &[]] {
+        for planner in ["bsa", "bsa-bfs"] {
+            let mut args = vec!["--odometry-noise", "0,0,0"];
+            args.extend_from_slice(extra);
+            run_fails(
+                dir,
+                &map,
+                planner,
+                &args,
+                &["--odometry-noise 0,0,0 draws no noise", "--exec pid"],
+            );
+        }
+    }
     let zero_cfg = dir.join("zero-noise.yaml");
     std::fs::write(
         &zero_cfg,

@@ -169,8 +169,9 @@ pub struct OdometryNoise {
 }
 
 impl OdometryNoise {
-    /// Whether it perturbs anything (some standard deviation above 0): `--odometry-noise 0`
-    /// runs as clean as no noise.
+    /// Whether it perturbs anything (some standard deviation above 0). Noise that draws
+    /// nothing runs as clean as no noise, so `--odometry-noise 0` and an options file's
+    /// all-zero `noise` section are refused.
     pub fn draws(&self) -> bool {
         self.linear_rel_std > 0.0 || self.angular_rel_std > 0.0 || self.heading_drift_std > 0.0
     }

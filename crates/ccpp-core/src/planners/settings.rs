@@ -439,7 +439,7 @@ fn validate_pid(field: &str, p: &PidOptions) -> Result<(), OptionsError> {
 /// Refuses a planner's own PID `noise` section whose every std is 0: it draws nothing, so it
 /// runs exactly as no section (`noise: {}` was taken as zero noise without a word, where it
 /// meant the library's defaults before the section's fields followed `--odometry-noise`).
-/// (`--odometry-noise 0` is another matter: it switches an ideal run to PID execution.)
+/// `--odometry-noise 0` is refused for the same reason (it ran exactly as `--exec pid`).
 fn noise_that_draws(field: &str, e: &Execution) -> Result<(), OptionsError> {
     if let Execution::Pid(p) = e {
         if let Some(n) = p.noise {
