@@ -7,7 +7,7 @@ use std::fmt::Display;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use ccpp_core::exec::{Execution, OdometryNoise, PidOptions};
+use ccpp_core::exec::{Execution, PidOptions};
 use ccpp_core::metrics::Metrics;
 use ccpp_core::planners::bsa::Side;
 use ccpp_core::planners::random_bounce::RandomBounceOptions;
@@ -15,6 +15,7 @@ use ccpp_core::planners::{PlannerConfig, PlannerKind, PlannerOptions};
 use ccpp_core::sim::{RunOutput, SimConfig};
 use ccpp_core::world::{Robot, World};
 use ccpp_core::Pose;
+use ccpp_io::execution::{execution, ExecAsk, Names};
 use ccpp_io::map::{load_map_bytes, LoadOptions};
 use ccpp_io::scenario::{Scenario, ScenarioError};
 
@@ -484,91 +485,43 @@ fn sim_from(a: &RunArgs, config: &mut PlannerConfig) -> Result<SimConfig> {
         Some("pid") => Some(true),
         Some(other) => bail!("--exec must be ideal or pid, got {other:?}"),
     };
-    // PID options: the planner's own (bsa-bfs, rect-boustrophedon) or the defaults.
-    let mut pid = match config.settings().preferred_execution() {
-        Some(Execution::Pid(p)) => p,
-        _ => PidOptions::default(),
-    };
+    let preferred = config.settings().preferred_execution();
+    let section = kind.info().section;
+    let file = options_file(a.options.config.as_deref());
     // `--exec ideal` replaces the planner's execution: PID settings given for it in the
     // options file would be read, validated and then dropped, so the two are refused together.
     // A file that gives the planner's PID execution at all (its defaults too) clashes; one
     // that runs it ideally agrees.
-    let file_pid = matches!(
-        config.settings().preferred_execution(),
-        Some(Execution::Pid(_))
-    ) && file_sets(
-        a.options.config.as_deref(),
-        &format!("{}.exec", kind.info().section),
-    );
-    if exec == Some(false) && (pid != PidOptions::default() || file_pid) {
-        bail!(
-            "--exec ideal drops the PID settings given for {kind} in {} ({}.exec); remove one of them",
-            options_file(a.options.config.as_deref()),
-            kind.info().section
-        );
-    }
-    let mut noise_given = false;
-    if let Some(n) = &a.odometry_noise {
-        let v: Vec<f64> = n
-            .split(',')
-            .map(|x| x.trim().parse::<f64>())
-            .collect::<Result<_, _>>()
-            .map_err(|_| {
-                anyhow::anyhow!("--odometry-noise expects LIN[,ANG[,DRIFT]], got {n:?}")
-            })?;
-        if v.is_empty() || v.len() > 3 || v.iter().any(|x| !x.is_finite() || *x < 0.0) {
-            bail!("--odometry-noise expects one to three finite numbers >= 0, got {n:?}");
-        }
-        if exec == Some(false) {
-            bail!("--odometry-noise needs PID execution, not --exec ideal");
-        }
-        if v.iter().all(|x| *x == 0.0) {
-            // It would run exactly as `--exec pid` (and change nothing for a planner that
-            // executes by PID already): a value read and dropped.
-            bail!("--odometry-noise {n} draws no noise: give a noise > 0, or use --exec pid for PID execution without noise");
-        }
+    let own_pid = matches!(preferred, Some(Execution::Pid(p)) if p != PidOptions::default());
+    let file_pid = matches!(preferred, Some(Execution::Pid(_)))
+        && file_sets(a.options.config.as_deref(), &format!("{section}.exec"));
+    let noise = match &a.odometry_noise {
+        None => None,
+        Some(n) => Some(
+            n.split(',')
+                .map(|x| x.trim().parse::<f64>())
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(|_| {
+                    anyhow::anyhow!("--odometry-noise expects LIN[,ANG[,DRIFT]], got {n:?}")
+                })?,
+        ),
+    };
+    let ask = ExecAsk {
+        pid: exec,
+        noise,
+        seed: a.seed,
         // A file that gives the noise at all (`noise: null` too, as `planners --defaults`
         // prints it) clashes, as every other flag beside its option in the file does.
-        if pid.noise.is_some()
-            || file_sets(
-                a.options.config.as_deref(),
-                &format!("{}.exec.pid.noise", kind.info().section),
-            )
-        {
-            bail!(
-                "--odometry-noise replaces the odometry noise given for {kind} in {} ({}.exec.pid.noise); remove one of them",
-                options_file(a.options.config.as_deref()),
-                kind.info().section
-            );
-        }
-        // Exactly the noise asked for: a heading drift left out is 0, not the library's
-        // default (`--odometry-noise 0` used to drift 0.2 rad per metre).
-        pid.noise = Some(OdometryNoise {
-            seed: a.seed.unwrap_or(0),
-            linear_rel_std: v[0],
-            angular_rel_std: v.get(1).copied().unwrap_or(v[0]),
-            heading_drift_std: v.get(2).copied().unwrap_or(0.0),
-        });
-        noise_given = true;
-    }
-    sim.exec = match exec {
-        Some(false) => Some(Execution::Ideal),
-        Some(true) => Some(Execution::Pid(pid)),
-        None if noise_given => Some(Execution::Pid(pid)),
-        None => None,
+        noise_given_in: file_sets(
+            a.options.config.as_deref(),
+            &format!("{section}.exec.pid.noise"),
+        )
+        .then(|| format!("{file} ({section}.exec.pid.noise)")),
+        pid_given_in: (own_pid || file_pid).then(|| format!("{file} ({section}.exec)")),
     };
-    if let Some(seed) = a.seed {
-        match config {
-            PlannerConfig::RandomBounce(o) => set_seed(o, seed, a.options.config.as_deref())?,
-            _ if noise_given => {}
-            _ => {
-                return Err(not_applicable(
-                    "--seed",
-                    kind,
-                    "random-bounce and --odometry-noise",
-                ))
-            }
-        }
+    sim.exec = execution(kind, preferred, &ask, &Names::FLAGS).map_err(anyhow::Error::msg)?;
+    if let (Some(seed), PlannerConfig::RandomBounce(o)) = (a.seed, &mut *config) {
+        set_seed(o, seed, a.options.config.as_deref())?;
     }
     if let Some(p) = &a.landmarks {
         sim.landmarks.landmarks = ccpp_io::landmarks::load_landmarks(p)

@@ -2242,7 +2242,7 @@ fn map_yaml_details_read_as_map_server_does_or_say_why() {
 }
 
 /// Under odometry noise without landmarks, bcd's replay drove into walls it believed elsewhere
-/// (124 contacts on teb_maze, a quarter of the floor swept) and the run read as complete: the
+/// (124 contacts on `teb_maze`, a quarter of the floor swept) and the run read as complete: the
 /// trace ends `done` and nothing was said. The console now says why the robot hit walls and
 /// what corrects it; with landmarks, or without contacts, it says nothing.
 #[test]
@@ -2282,14 +2282,7 @@ fn contacts_under_drift_are_explained() {
     assert_eq!(hits, 0);
     assert!(!err.contains("bumper"), "{err}");
     let tags = d.path().join("tags.csv");
-    let mut text = String::new();
-    for (k, (x, y)) in [(1.0, 1.0), (9.0, 1.0), (1.0, 9.0), (9.0, 9.0), (5.0, 5.0)]
-        .into_iter()
-        .enumerate()
-    {
-        text.push_str(&format!("{k},{x},{y}\n"));
-    }
-    std::fs::write(&tags, text).unwrap();
+    std::fs::write(&tags, "0,1,1\n1,9,1\n2,1,9\n3,9,9\n4,5,5\n").unwrap();
     let (err, _) = run(
         "tags",
         &[

@@ -8,6 +8,8 @@
 //!   conventions);
 //! * [`write`](mod@write): atomic file writers and a `map_saver`-style map writer;
 //! * [`georef`]: `--georef` point-pair files for the affine pixel <-> world fit (seed 003);
+//! * [`execution`]: ideal or PID execution, odometry noise and its seed as the command line and
+//!   Python ask for them;
 //! * [`landmarks`]: `--landmarks` files (CSV or JSON) for the simulator's pose correction;
 //! * [`scenario`]: the serializable description of a run ([`Scenario`](scenario::Scenario)),
 //!   its one validation (including the memory estimate) and its execution;
@@ -23,6 +25,7 @@
 //! Errors are [`thiserror`] enums that always name the file concerned; nothing here panics on
 //! user data.
 
+pub mod execution;
 pub mod export;
 pub mod file;
 pub mod georef;

@@ -23,6 +23,7 @@ use ccpp_core::trace::{Cursor, Entry, Event, Record, Trace};
 use ccpp_core::world::{Robot, World};
 use ccpp_core::zones::ZoneMasks;
 use ccpp_core::Point;
+use ccpp_io::execution::{execution, ExecAsk, Names};
 use ccpp_io::export::{render_exports, zone_features, ExportFormat, ExportMeta};
 use ccpp_io::scenario::{MapRecipe, PreparedMap, Scenario, ScenarioError};
 use ccpp_io::zones::ZoneSpec;
@@ -422,13 +423,15 @@ fn not_applicable(opt: &str, kind: PlannerKind, applies_to: &str) -> PyErr {
 const DEFAULT_RADIUS: f64 = 0.15;
 
 /// Keyword options of `run` that are not planner options.
-const RUN_KEYS: [&str; 11] = [
+const RUN_KEYS: [&str; 13] = [
     "tool_radius",
     "start",
     "sensor_range",
     "max_memory_mb",
     "max_steps",
     "exec",
+    "odometry_noise",
+    "landmarks",
     "seed",
     "options",
     "name",
@@ -582,6 +585,53 @@ fn uint_arg(key: &str, v: &Bound<'_, PyAny>) -> PyResult<u64> {
     })
 }
 
+/// `odometry_noise=`: a number (LIN) or a sequence of one to three numbers (LIN, ANG, DRIFT),
+/// as `--odometry-noise LIN[,ANG[,DRIFT]]`.
+fn noise_arg(v: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
+    let bad = || {
+        msg(format!(
+            "odometry_noise expects a number or (lin, ang, drift) (one to three numbers), got {}",
+            repr(v)
+        ))
+    };
+    if v.is_instance_of::<PyString>() {
+        return Err(bad());
+    }
+    let values: Vec<Real> = match v.extract::<Real>() {
+        Ok(x) => vec![x],
+        Err(_) => v.extract().map_err(|_| bad())?,
+    };
+    if is_bool(v) {
+        return Err(bad());
+    }
+    Ok(values.into_iter().map(|r| r.0).collect())
+}
+
+/// `landmarks=`: a landmark file (CSV `id,x,y[,theta]` or a JSON array, as `--landmarks`) or
+/// a list of `(id, x, y[, theta])`.
+fn landmarks_arg(v: &Bound<'_, PyAny>) -> PyResult<Vec<ccpp_core::landmarks::Landmark>> {
+    let list = if let Ok(path) = v.extract::<PathBuf>() {
+        ccpp_io::landmarks::load_landmarks(&path)
+            .map_err(|e| msg(format!("landmarks {}: {e}", path.display())))?
+    } else {
+        // A list goes through the file reader's own parsing (a JSON array), so both are
+        // checked alike.
+        if !v.is_instance_of::<PyList>() && !v.is_instance_of::<PyTuple>() {
+            return Err(msg(format!(
+                "landmarks expects a file name or a list of (id, x, y[, theta]), got {}",
+                repr(v)
+            )));
+        }
+        let text = py_to_json(v)?.to_string();
+        ccpp_io::landmarks::parse_landmarks(&text).map_err(|e| msg(format!("landmarks: {e}")))?
+    };
+    if list.is_empty() {
+        // Read and then nothing to correct with: the run would be the run without it.
+        return Err(msg("landmarks: no landmark given"));
+    }
+    Ok(list)
+}
+
 /// A start pose `(x, y)` or `(x, y, theta)`.
 fn start_arg(v: &Bound<'_, PyAny>) -> PyResult<[f64; 3]> {
     let p: Vec<Real> = v.extract().map_err(|_| {
@@ -622,6 +672,8 @@ fn scenario_from(
     let mut direct: Vec<(String, Bound<'_, PyAny>)> = Vec::new();
     let mut in_options: Option<Bound<'_, PyDict>> = None;
     let mut exec: Option<String> = None;
+    let mut noise: Option<Vec<f64>> = None;
+    let mut seed: Option<u64> = None;
     // A planner option given as `None`: its default, as if left out; the name is still
     // checked (a misspelt option is refused, `None` or not).
     let mut unset: Vec<String> = Vec::new();
@@ -673,14 +725,16 @@ fn scenario_from(
                 exec = Some(e);
             }
             "seed" => {
-                // random-bounce's own option `seed`: a planner option like the others (so
-                // `seed=` and `options={"seed": ...}` must agree).
-                if kind != PlannerKind::RandomBounce {
-                    return Err(not_applicable("seed", kind, "random-bounce"));
+                // The seed of the odometry noise and random-bounce's own option `seed`: there,
+                // a planner option like the others (so `seed=` and `options={"seed": ...}` must
+                // agree). Where it seeds nothing, the execution refuses it (below).
+                seed = Some(uint_arg(&key, &v)?);
+                if kind == PlannerKind::RandomBounce {
+                    direct.push((key, v));
                 }
-                uint_arg(&key, &v)?;
-                direct.push((key, v));
             }
+            "odometry_noise" => noise = Some(noise_arg(&v)?),
+            "landmarks" => s.sim.landmarks.landmarks = landmarks_arg(&v)?,
             "options" => {
                 let d = v
                     .cast::<PyDict>()
@@ -758,32 +812,38 @@ fn scenario_from(
         })?;
     }
     // After the planner's options: `pid` runs the planner's own PID settings (as `--exec pid`
-    // beside `--config`); the scenario refuses an execution that would drop them.
-    if let Some(e) = exec {
-        let gives_pid = in_options.as_ref().is_some_and(|d| {
-            d.get_item("exec")
-                .is_ok_and(|v| v.is_some_and(|v| !v.is_none()))
-        }) && matches!(
-            s.planner.settings().preferred_execution(),
-            Some(Execution::Pid(_))
-        );
-        if gives_pid && e.eq_ignore_ascii_case("ideal") {
-            // As `--exec ideal` beside `exec` in `--config`: the settings given, even at
-            // their defaults, would be read and dropped (the scenario sees only other values).
-            return Err(msg(format!(
-                "exec ideal drops the PID settings given for {kind} in options[\"exec\"], its {}.exec; remove one of them",
-                kind.info().section
-            )));
-        }
-        s.sim.exec = Some(match e.to_ascii_lowercase().as_str() {
-            "ideal" => Execution::Ideal,
-            "pid" => match s.planner.settings().preferred_execution() {
-                Some(Execution::Pid(p)) => Execution::Pid(p),
-                _ => Execution::Pid(PidOptions::default()),
-            },
-            other => return Err(msg(format!("exec must be ideal or pid, got {other:?}"))),
-        });
-    }
+    // beside `--config`); an execution that would drop them, and noise beside the planner's
+    // own, are refused (the command line's rules, `ccpp_io::execution`).
+    let pid = match exec.as_deref().map(str::to_ascii_lowercase).as_deref() {
+        None => None,
+        Some("ideal") => Some(false),
+        Some("pid") => Some(true),
+        Some(other) => return Err(msg(format!("exec must be ideal or pid, got {other:?}"))),
+    };
+    let preferred = s.planner.settings().preferred_execution();
+    let section = kind.info().section;
+    let exec_item = in_options
+        .as_ref()
+        .map(|d| d.get_item("exec"))
+        .transpose()?
+        .flatten()
+        .filter(|v| !v.is_none());
+    let gives_pid = exec_item.is_some() && matches!(preferred, Some(Execution::Pid(_)));
+    let own_pid = matches!(preferred, Some(Execution::Pid(p)) if p != PidOptions::default());
+    let gives_noise = exec_item
+        .as_ref()
+        .and_then(|e| e.get_item("pid").ok())
+        .is_some_and(|p| p.get_item("noise").is_ok());
+    let ask = ExecAsk {
+        pid,
+        noise,
+        seed,
+        noise_given_in: gives_noise
+            .then(|| format!("options[\"exec\"], its {section}.exec.pid.noise")),
+        pid_given_in: (gives_pid || own_pid)
+            .then(|| format!("options[\"exec\"], its {section}.exec")),
+    };
+    s.sim.exec = execution(kind, preferred, &ask, &Names::KEYWORDS).map_err(msg)?;
     Ok(s)
 }
 
@@ -1049,14 +1109,11 @@ impl RunResult {
         (s.x, s.y, s.theta)
     }
 
-    /// The scenario that ran, as the `run.json` text (with the start used): `ccpp replay`
-    /// and `Scenario::run` reproduce the run from it.
+    /// The scenario that ran, as the `run.json` text `save` writes (with the start used and the
+    /// map's digest): `ccpp replay` and `Scenario::run` reproduce the run from it.
     #[getter]
     fn scenario_json(&self) -> PyResult<String> {
-        let mut s = self.scenario.clone();
-        let st = self.world.start();
-        s.start = Some([st.x, st.y, st.theta]);
-        s.to_json().map_err(|e| err(&e))
+        ccpp_render::run_files::run_json(&self.scenario, &self.world).map_err(|e| err(&e))
     }
 
     /// Writes `run.json`, `path.csv`, `trace.jsonl`, `coverage.png` and `metrics.json` into
@@ -1120,9 +1177,11 @@ impl RunResult {
 }
 
 /// Runs `planner` on `map` with robot radius `radius`; the other keyword options are scenario
-/// fields (`tool_radius`, `start`, `sensor_range`, `exec`, `seed`, `max_steps`,
-/// `max_memory_mb`, `name`, `area`, `keepout`) or the planner's own options (`options={...}`
-/// or directly, e.g. `smoothing=False`). The command line's rules hold: an option that does
+/// fields (`tool_radius`, `start`, `sensor_range`, `exec`, `odometry_noise` (LIN or
+/// `(LIN, ANG, DRIFT)`, as `--odometry-noise`), `landmarks` (a file or a list of
+/// `(id, x, y[, theta])`, as `--landmarks`), `seed` (of random-bounce and of the noise),
+/// `max_steps`, `max_memory_mb`, `name`, `area`, `keepout`) or the planner's own options
+/// (`options={...}` or directly, e.g. `smoothing=False`). The command line's rules hold: an option that does
 /// not apply to the planner is refused; a planner option given both directly and in
 /// `options` must have one value; `exec="pid"` runs the planner's own PID settings
 /// (`options={"exec": {"pid": {...}}}` of bsa-bfs, rect-boustrophedon) and `exec="ideal"`

@@ -217,3 +217,52 @@ def test_exec_ideal_beside_pid_settings_at_their_defaults_is_refused(room: Path)
     with pytest.raises(ccpp.CcppError, match="drops the PID settings"):
         ccpp.run(room, "bsa-bfs", exec="ideal", options={"exec": {"pid": {}}})
     ccpp.run(room, "bsa-bfs", exec="ideal")
+
+
+def test_odometry_noise_and_landmarks_are_the_cli_runs(shared_maps: Path, ccpp_bin: str, tmp_path: Path) -> None:
+    """Python could not express a run with odometry noise or landmarks (`odometry_noise=` and
+    `landmarks=` were unknown, and `seed=` was refused for every planner but random-bounce),
+    so a CLI run.json had no Python equivalent. They are the flags' keywords now, through the
+    same rules (`ccpp_io::execution`)."""
+    maze = shared_maps / "teb_maze.yaml"
+    tags = tmp_path / "tags.csv"
+    tags.write_text("0,1,1\n1,9,1\n2,1,9\n3,9,9\n4,5,5\n")
+    cases = [
+        (["--odometry-noise", "0.02", "--seed", "1"], {"odometry_noise": 0.02, "seed": 1}),
+        (["--odometry-noise", "0.02,0.01,0.1"], {"odometry_noise": (0.02, 0.01, 0.1)}),
+        (
+            ["--odometry-noise", "0.02", "--seed", "1", "--landmarks", str(tags)],
+            {"odometry_noise": [0.02], "seed": 1, "landmarks": str(tags)},
+        ),
+    ]
+    traces = []
+    for k, (flags, kw) in enumerate(cases):
+        out = tmp_path / f"cli{k}"
+        p = cli(ccpp_bin, "run", "--map", str(maze), "--planner", "bcd", "--out", str(out), *flags)
+        assert p.returncode == 0, p.stderr
+        r = ccpp.run(maze, "bcd", **kw)
+        r.save(tmp_path / f"py{k}")
+        trace = (tmp_path / f"py{k}" / "trace.jsonl").read_text()
+        assert trace == (out / "trace.jsonl").read_text(), flags
+        assert json.loads(r.scenario_json)["sim"] == json.loads((out / "run.json").read_text())["sim"]
+        traces.append(trace)
+    assert len(set(traces)) == 3, "noise, drift or landmarks changed nothing"
+    # Landmarks as a list are the file's.
+    listed = ccpp.run(maze, "bcd", odometry_noise=0.02, seed=1, landmarks=[(0, 1, 1), (1, 9, 1), (2, 1, 9), (3, 9, 9), (4, 5, 5)])
+    assert np.array_equal(listed.path, ccpp.run(maze, "bcd", **cases[2][1]).path)
+    # Refused as the command line refuses them.
+    for kw, needle in [
+        ({"odometry_noise": 0}, "odometry_noise 0 draws no noise"),
+        ({"odometry_noise": (0.1, 0.1, 0.1, 0.1)}, "one to three finite numbers"),
+        ({"odometry_noise": "0.1"}, "odometry_noise expects a number"),
+        ({"odometry_noise": 0.1, "exec": "ideal"}, "needs PID execution, not exec ideal"),
+        ({"seed": 3}, r"seed does not apply to bcd \(it applies to random-bounce and odometry_noise\)"),
+        ({"landmarks": []}, "no landmark"),
+        ({"landmarks": str(tmp_path / "none.csv")}, "none.csv"),
+    ]:
+        with pytest.raises(ccpp.CcppError, match=needle):
+            ccpp.run(maze, "bcd", **kw)
+    with pytest.raises(ccpp.CcppError, match="does not apply to a plan"):
+        ccpp.plan(maze, "bcd", odometry_noise=0.02)
+    with pytest.raises(ccpp.CcppError, match="replaces the odometry noise given for bsa-bfs"):
+        ccpp.run(maze, "bsa-bfs", odometry_noise=0.02, options={"exec": {"pid": {"noise": None}}})

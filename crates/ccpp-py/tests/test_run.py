@@ -231,3 +231,15 @@ def test_save_under_a_file_names_the_file(room: Path, tmp_path: Path) -> None:
         ccpp.run(room, "bsa").save(notes / "run")
     assert str(e.value) == f"cannot create output folder {notes / 'run'}: {notes} is a file, not a folder"
     assert notes.read_text() == "keep me"
+
+
+def test_scenario_json_is_the_saved_run_json(room: Path, tmp_path: Path) -> None:
+    """`scenario_json` lacked the run.json's `map_digest`, and gave the start inside the area
+    (after the approach) where run.json gives the start the run began at."""
+    for kw in ({}, {"start": (0.5, 0.5, 0.0), "area": [1.0, 0.6, 2.5, 1.6]}):
+        r = ccpp.run(room, "bsa", **kw)
+        out = tmp_path / f"s{len(kw)}"
+        r.save(out)
+        assert r.scenario_json == (out / "run.json").read_text()
+        assert len(json.loads(r.scenario_json)["map_digest"]) == 16
+    assert json.loads(r.scenario_json)["start"] == [0.5, 0.5, 0.0]

@@ -76,8 +76,12 @@ pub fn title_lines(m: &Metrics) -> Vec<String> {
     ]
 }
 
-/// `run.json`: `scenario` with the start actually used (the world's).
-fn run_json(scenario: &Scenario, world: &World) -> Result<String, serde_json::Error> {
+/// `run.json`: `scenario` with the start actually used (the world's initial pose, before any
+/// approach into the work area) and the digest of the map and zones it ran on.
+///
+/// # Errors
+/// A scenario that does not serialise (a non-finite number).
+pub fn run_json(scenario: &Scenario, world: &World) -> Result<String, serde_json::Error> {
     let mut scenario = scenario.clone();
     let start = world.initial_pose();
     scenario.start = Some([start.x, start.y, start.theta]);

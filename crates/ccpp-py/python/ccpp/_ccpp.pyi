@@ -173,8 +173,10 @@ def run(
     map: Map | _Path, planner: str | None = "ba-star", radius: float | None = 0.15, **options: Any
 ) -> RunResult:
     """Runs a planner; options are scenario fields (``tool_radius``, ``start``,
-    ``sensor_range``, ``exec``, ``seed``, ``max_steps``, ``max_memory_mb``, ``name``, ``area``,
-    ``keepout``) or the planner's own options (directly or in ``options={...}``; a key given
+    ``sensor_range``, ``exec``, ``odometry_noise`` (LIN or ``(LIN, ANG, DRIFT)``, as
+    ``--odometry-noise``), ``landmarks`` (a file or a list of ``(id, x, y[, theta])``),
+    ``seed`` (of random-bounce and of the noise), ``max_steps``, ``max_memory_mb``, ``name``,
+    ``area``, ``keepout``) or the planner's own options (directly or in ``options={...}``; a key given
     both ways must have one value). Options that do not apply are refused; ``exec="pid"`` runs
     the planner's own PID settings, ``exec="ideal"`` beside them is refused. A keyword given as
     ``None`` is its default, as if left out. ``max_memory_mb`` bounds the map's load too.
