@@ -707,7 +707,10 @@ impl Scenario {
             }
         }
         if self.sim.max_steps == 0 {
-            return Err(invalid("sim.max_steps must be >= 1".into()));
+            // Python's `max_steps=` names it so; a scenario file's field is `sim.max_steps`.
+            return Err(invalid(
+                "max_steps / sim.max_steps must be >= 1, got 0".into(),
+            ));
         }
         if let Some(e) = &self.sim.exec {
             validate_execution("sim.exec", e).map_err(|e| {

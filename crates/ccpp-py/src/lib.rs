@@ -296,15 +296,17 @@ impl Map {
 
     /// The world coordinates `(x, y)` of the centre of pixel `(col, row)` (column from the
     /// left, row from the top); `IndexError` outside the image.
-    fn pixel_center(&self, col: usize, row: usize) -> PyResult<(f64, f64)> {
+    fn pixel_center(&self, col: i64, row: i64) -> PyResult<(f64, f64)> {
         let f = self.map.grid.frame();
-        if col >= f.width || row >= f.height {
+        // A negative index is outside too (as `usize` it raised OverflowError).
+        let inside = |i: i64, n: usize| usize::try_from(i).ok().filter(|&i| i < n);
+        let (Some(c), Some(r)) = (inside(col, f.width), inside(row, f.height)) else {
             return Err(pyo3::exceptions::PyIndexError::new_err(format!(
                 "pixel ({col}, {row}) is outside the map's {} x {} px",
                 f.width, f.height
             )));
-        }
-        let p = f.pixel_center(col, row);
+        };
+        let p = f.pixel_center(c, r);
         Ok((p.x, p.y))
     }
 
@@ -469,12 +471,13 @@ fn parse_keepout(v: &Bound<'_, PyAny>) -> PyResult<Vec<ZoneSpec>> {
     if let Some(r) = text_zone(v, "keepout") {
         return r.map(|z| vec![z]);
     }
-    // A list whose every item is a zone given as text ("x0,y0,x1,y1" rectangles and file
-    // names, as repeated `--keepout` flags): each item as one zone (a list of text rectangles
-    // was read as file names).
+    // A list with a zone given as text ("x0,y0,x1,y1" rectangles and file names, as repeated
+    // `--keepout` flags): each item as one zone (a list of text rectangles was read as file
+    // names, and so was a text rectangle beside a list rectangle). No single zone is a list
+    // holding text (a polygon's points are numbers).
     if !v.is_instance_of::<PyString>() {
         if let Ok(items) = v.extract::<Vec<Bound<'_, PyAny>>>() {
-            if !items.is_empty() && items.iter().all(PyAnyMethods::is_instance_of::<PyString>) {
+            if items.iter().any(PyAnyMethods::is_instance_of::<PyString>) {
                 return items
                     .iter()
                     .map(|i| text_zone(i, "keepout").unwrap_or_else(|| parse_area(i)))
@@ -872,6 +875,26 @@ impl RunResult {
 }
 
 /// Export format names -> formats.
+/// `export=` of `save`: one format name or a list of them (`export="csv"` raised "Can't
+/// extract 'str' to 'Vec'").
+#[derive(FromPyObject)]
+enum Formats {
+    /// One format.
+    One(String),
+    /// Several.
+    Many(Vec<String>),
+}
+
+impl Formats {
+    /// The names given.
+    fn names(self) -> Vec<String> {
+        match self {
+            Formats::One(n) => vec![n],
+            Formats::Many(v) => v,
+        }
+    }
+}
+
 fn parse_formats(names: &[String]) -> PyResult<Vec<ExportFormat>> {
     names
         .iter()
@@ -983,9 +1006,9 @@ impl PlanResult {
     /// Writes the exports into `folder` (created if needed), as `ccpp plan --out folder`:
     /// `export` formats, default `["csv", "nav-path"]`; all or nothing, as `run`'s `save`.
     #[pyo3(signature = (folder, export=None))]
-    fn save(&self, folder: PathBuf, export: Option<Vec<String>>) -> PyResult<()> {
+    fn save(&self, folder: PathBuf, export: Option<Formats>) -> PyResult<()> {
         utf8_path(&folder, "folder")?;
-        let names = export.unwrap_or_else(|| vec!["csv".into(), "nav-path".into()]);
+        let names = export.map_or_else(|| vec!["csv".into(), "nav-path".into()], Formats::names);
         if names.is_empty() {
             // A plan's folder holds its exports only: none would write an empty folder.
             return Err(msg(
@@ -1117,14 +1140,14 @@ impl RunResult {
     }
 
     /// Writes `run.json`, `path.csv`, `trace.jsonl`, `coverage.png` and `metrics.json` into
-    /// `folder` (created if needed), exactly as `ccpp run --out folder`; `export` (a list of
-    /// `"csv"`, `"json"`, `"nav-path"`, `"geojson"`) adds the path exports, as
+    /// `folder` (created if needed), exactly as `ccpp run --out folder`; `export` (one of, or
+    /// a list of, `"csv"`, `"json"`, `"nav-path"`, `"geojson"`) adds the path exports, as
     /// `ccpp run --export FORMAT`. All or nothing, as the command line: the files of an older
     /// run or plan in `folder` are replaced whole, a folder holding other files is refused.
     #[pyo3(signature = (folder, export=None))]
-    fn save(&self, py: Python<'_>, folder: PathBuf, export: Option<Vec<String>>) -> PyResult<()> {
+    fn save(&self, py: Python<'_>, folder: PathBuf, export: Option<Formats>) -> PyResult<()> {
         utf8_path(&folder, "folder")?;
-        let formats = parse_formats(export.as_deref().unwrap_or_default())?;
+        let formats = parse_formats(&export.map(Formats::names).unwrap_or_default())?;
         let files = self.export_files(&formats)?;
         py.detach(|| {
             ccpp_render::run_files::write_run_files(

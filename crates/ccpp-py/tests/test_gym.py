@@ -44,3 +44,16 @@ def test_refuses_what_it_would_ignore(room: Path) -> None:
     env.reset(seed=1, options={})
     with pytest.raises(ValueError, match="no options"):
         env.reset(seed=1, options={"start": (1.0, 1.0)})
+
+
+def test_only_the_actions_of_the_space(room: Path) -> None:
+    """`int(action)` took 1.7 for action 1, and True and "1" too."""
+    import numpy as np
+
+    env = CoverageEnv(str(room), max_steps=10)
+    env.reset(seed=1)
+    for bad in (1.7, True, "1", 3, -1, np.float64(1.0), np.array([1])):
+        with pytest.raises(ValueError, match="action must be 0, 1 or 2"):
+            env.step(bad)
+    for good in (0, 1, 2, np.int64(1), np.array(2)):
+        env.step(good)

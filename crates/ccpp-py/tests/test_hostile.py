@@ -247,6 +247,10 @@ def test_round_two_python_holes(room: Path, tmp_path: Path) -> None:
     two = ccpp.run(room, "bsa", keepout=["1,0.5,1.5,1.5", "2,0.5,2.5,1.5"])
     assert two.metrics["keepout_violations"] == 0
     assert two.metrics != ccpp.run(room, "bsa", keepout="1,0.5,1.5,1.5").metrics
+    # A text rectangle beside a list rectangle, in either order (the text was read as a file).
+    for mixed in (["1,0.5,1.5,1.5", [2, 0.5, 2.5, 1.5]], [[1, 0.5, 1.5, 1.5], "2,0.5,2.5,1.5"]):
+        r = ccpp.run(room, "bsa", keepout=mixed)
+        assert r.metrics == {**two.metrics, "wall_time_s": r.metrics["wall_time_s"]}
     # Past u64, refused before the cluster starts (an OverflowError in every task).
     with pytest.raises(ccpp.CcppError, match="max_memory_mb"):
         ccpp.sweep(room, "bsa", max_memory_mb=2**64)
@@ -399,3 +403,19 @@ def test_the_sweep_lock_is_the_bench_lock(tmp_path: Path, room: Path, ccpp_bin: 
         capture_output=True, text=True, timeout=120,
     )
     assert p.returncode == 0, p.stderr
+
+
+def test_round_three_python_holes(room: Path, tmp_path: Path) -> None:
+    """From a hostile tester: a negative pixel raised OverflowError, `export="csv"` a
+    TypeError, and `max_steps=0` named an internal field only."""
+    m = ccpp.load_map(room)
+    for col, row in ((-1, 0), (0, -1), (60, 0)):
+        with pytest.raises(IndexError, match="outside the map's 60 x 40 px"):
+            m.pixel_center(col, row)
+    r = ccpp.run(m, "bsa")
+    r.save(tmp_path / "one", export="csv")
+    assert (tmp_path / "one" / "waypoints.csv").is_file()
+    ccpp.plan(m, "bcd").save(tmp_path / "plan", export="geojson")
+    assert sorted(p.name for p in (tmp_path / "plan").iterdir()) == ["path.geojson"]
+    with pytest.raises(ccpp.CcppError, match=r"^max_steps / sim.max_steps must be >= 1, got 0"):
+        ccpp.run(m, "bsa", max_steps=0)

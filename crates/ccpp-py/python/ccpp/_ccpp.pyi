@@ -68,7 +68,7 @@ class RunResult:
     @property
     def scenario_json(self) -> str:
         """The run.json text."""
-    def save(self, folder: _Path, export: Sequence[str] | None = None) -> None:
+    def save(self, folder: _Path, export: str | Sequence[str] | None = None) -> None:
         """Writes the files of ``ccpp run --out folder`` (``export``: ``--export`` formats).
 
         All or nothing: an older run's files in ``folder`` are replaced whole; a folder
@@ -90,7 +90,7 @@ class PlanResult:
     def finished(self) -> bool: ...
     def export(self, format: str) -> str:
         """The text of ``ccpp plan --export FORMAT``'s file (csv, json, nav-path, geojson)."""
-    def save(self, folder: _Path, export: Sequence[str] | None = None) -> None:
+    def save(self, folder: _Path, export: str | Sequence[str] | None = None) -> None:
         """Writes the exports (default csv and nav-path), as ``ccpp plan --out folder``."""
 
 LOCK_FILE: str

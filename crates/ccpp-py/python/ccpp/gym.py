@@ -107,6 +107,12 @@ class CoverageEnv(gym.Env):  # type: ignore[misc]
     def step(
         self, action: Any
     ) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
+        # Only the actions of `Discrete(3)`: `int()` took 1.7, True and "1" as actions.
+        integral = isinstance(action, (int, np.integer)) or (
+            isinstance(action, np.ndarray) and action.shape == () and action.dtype.kind in "iu"
+        )
+        if not integral or isinstance(action, (bool, np.bool_)):
+            raise ValueError(f"action must be 0, 1 or 2, got {action!r}")
         a = int(action)
         if a == 0:
             act: tuple[Any, ...] = ("translate", self.step_m)
