@@ -68,8 +68,10 @@ pub struct Metrics {
     pub collisions: u32,
     /// Entries into a keep-out zone: times the robot's disk, clear of every keep-out pixel,
     /// starts to overlap one (pixels as the disks inscribed in their squares, as for
-    /// obstacles; see [`crate::zones::keepout_entries`]); 0 without keep-outs and for a
-    /// correct planner.
+    /// obstacles; see [`crate::zones::keepout_entries`]), plus exits from the work area
+    /// counted alike (its outside is forbidden floor: [`crate::zones::area_exits`]; the
+    /// approach from a start outside the area is none); 0 without zones and for a correct
+    /// planner.
     #[serde(default)]
     pub keepout_violations: u32,
     /// Planning + simulation wall time, seconds (the one non-deterministic figure).
@@ -763,7 +765,19 @@ fn compute_rest(
             .poses()
             .map(|p| frame.world_to_grid(p.position()))
             .collect();
-        crate::zones::keepout_entries(&frame, &z.keepout, &pts, robot.radius / frame.resolution)
+        let r_px = robot.radius / frame.resolution;
+        let entries = crate::zones::keepout_entries(&frame, &z.keepout, &pts, r_px);
+        let exits = z.area.as_ref().map_or(0, |area| {
+            // From the end of the approach to the area (driven from a start outside it, not
+            // by the planner): the first pose at the start the planner began from.
+            let begin = frame.world_to_grid(world.start().position());
+            let from = pts
+                .iter()
+                .position(|p| p.x == begin.x && p.y == begin.y)
+                .unwrap_or(0);
+            crate::zones::area_exits(&frame, area, &pts[from..], r_px)
+        });
+        entries + exits
     });
     let tracking = tracking_error(trace);
     let rect_guarantee = trace.events().find_map(|(_, e)| match e {

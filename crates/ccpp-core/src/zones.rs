@@ -468,20 +468,42 @@ pub fn keepout_entries(
     points: &[Point],
     r_px: f64,
 ) -> u32 {
-    if keepout.is_clear() || points.is_empty() {
+    if keepout.is_clear() {
         return 0;
     }
-    let occ = MaskOccupancy::new(frame, keepout, false);
-    let mut inside = crate::collide::disk_hits(&occ, points[0], r_px);
-    let mut n = u32::from(inside);
+    entries(
+        &MaskOccupancy::new(frame, keepout, false),
+        points,
+        r_px,
+        true,
+    )
+}
+
+/// Exits from the work area `area` along a centre polyline (grid coordinates), counted as
+/// [`keepout_entries`] counts entries into the pixels outside the area (the area's border is
+/// a virtual wall as a keep-out's is): a robot that drives out of the area, as a user of the
+/// step API can, enters forbidden floor. A start outside the area is no exit (the approach
+/// to the area begins there; give the points from the approach's end).
+pub fn area_exits(frame: &MapFrame, area: &FixedBitSet, points: &[Point], r_px: f64) -> u32 {
+    entries(&MaskOccupancy::new(frame, area, true), points, r_px, false)
+}
+
+/// Entries of the disk into `occ`'s blocked pixels along `points` (see [`keepout_entries`]);
+/// a start overlapping one counts when `count_start`.
+fn entries(occ: &MaskOccupancy<'_>, points: &[Point], r_px: f64, count_start: bool) -> u32 {
+    if points.is_empty() {
+        return 0;
+    }
+    let mut inside = crate::collide::disk_hits(occ, points[0], r_px);
+    let mut n = u32::from(inside && count_start);
     for w in points.windows(2) {
         if w[0] == w[1] {
             continue;
         }
-        if !inside && crate::collide::segment_first_contact(&occ, w[0], w[1], r_px).is_some() {
+        if !inside && crate::collide::segment_first_contact(occ, w[0], w[1], r_px).is_some() {
             n += 1;
         }
-        inside = crate::collide::disk_hits(&occ, w[1], r_px);
+        inside = crate::collide::disk_hits(occ, w[1], r_px);
     }
     n
 }
@@ -586,5 +608,23 @@ mod tests {
             keepout_entries(&f, &FixedBitSet::with_capacity(200), &across, r),
             0
         );
+    }
+
+    #[test]
+    fn area_exits_are_entries_into_the_outside() {
+        let f = MapFrame::new(20, 10, 0.1);
+        // The area: x in [0, 1.2), all rows.
+        let a = rasterize(&f, &[Polygon::rect([0.0, 0.0, 1.2, 1.0])]);
+        let g = |x: f64, y: f64| f.world_to_grid(Point::new(x, y));
+        let r = 1.0; // px
+                     // Out and back in, twice: two exits; staying inside: none.
+        let out = [g(0.5, 0.5), g(1.6, 0.5), g(0.5, 0.5), g(1.6, 0.5)];
+        assert_eq!(area_exits(&f, &a, &out, r), 2);
+        let inside = [g(0.2, 0.5), g(1.0, 0.5), g(0.2, 0.3)];
+        assert_eq!(area_exits(&f, &a, &inside, r), 0);
+        // A start outside (the approach) is no exit; leaving again after it is one.
+        let approach = [g(1.8, 0.5), g(0.5, 0.5), g(1.8, 0.5)];
+        assert_eq!(area_exits(&f, &a, &approach, r), 1);
+        assert_eq!(area_exits(&f, &a, &approach[..2], r), 0);
     }
 }

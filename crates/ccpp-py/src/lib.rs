@@ -1683,7 +1683,8 @@ impl Env {
     /// `sensor_range` metres (default 4 r). `exec` is `"ideal"` or `"pid"`; `start` a fixed
     /// start pose (default: the widest free spot, as in runs); `max_steps` truncates episodes.
     /// `area` and `keepout` are zones as in `run` (and `ccpp run --area/--keepout`): virtual
-    /// walls the sensor shows, keep-out entries counted as `keepout_violations`, coverage
+    /// walls the sensor shows (they do not stop the robot), keep-out entries and exits from
+    /// the area counted as `keepout_violations` in `metrics()`, coverage
     /// measured on the allowed floor; a start outside the area drives there first.
     #[new]
     #[pyo3(signature = (map, *, radius=None, tool_radius=None, sensor_range=None, start=None, exec=None, max_steps=None, area=None, keepout=None, max_memory_mb=None))]

@@ -147,3 +147,22 @@ def test_replaying_a_run_sweeps_what_the_run_swept(room: Path) -> None:
             prev = np.array([x, y])
     assert np.array_equal(env.swept, r.swept)
     assert info["coverage"] == pytest.approx(r.metrics["effective_coverage"], abs=1e-12)
+
+
+def test_leaving_the_area_is_a_violation(room: Path) -> None:
+    """A robot driven out of the area (the step API does not stop it: a virtual wall is no
+    obstacle) was counted nowhere; leaving the area is now counted as entering a keep-out."""
+    env = ccpp.Env(ccpp.load_map(room), area=[0.3, 0.3, 1.6, 1.7], sensor_range=1.0)
+    env.reset()
+    env.step(("move_to", 1.0, 1.0))
+    assert env.metrics()["keepout_violations"] == 0
+    env.step(("move_to", 2.5, 1.0))  # out of the area
+    env.step(("move_to", 1.0, 1.0))  # back in
+    assert env.metrics()["keepout_violations"] == 1
+    env.step(("move_to", 1.0, 1.9))  # out again, over the top edge
+    assert env.metrics()["keepout_violations"] == 2
+    # A start outside the area drives in first: that approach is no violation.
+    env = ccpp.Env(ccpp.load_map(room), area=[0.3, 0.3, 1.6, 1.7], start=(2.5, 1.0))
+    env.reset()
+    env.step(("move_to", 1.0, 1.0))
+    assert env.metrics()["keepout_violations"] == 0
