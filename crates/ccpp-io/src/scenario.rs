@@ -964,8 +964,31 @@ impl Scenario {
     /// # Errors
     /// [`ScenarioError::Memory`] or [`ScenarioError::Degenerate`].
     pub fn check_map(&self, map: &PreparedMap) -> Result<ResourceEstimate, ScenarioError> {
+        self.check_map_as(map, true)
+    }
+
+    /// [`Self::check_map`] for a robot its caller drives (Python's step API): the planner's
+    /// checks and its memory are left out (an `Env` holds the world, the sweep and the known
+    /// map, and no planner; a tiny robot was refused for the tiles of a planner it never ran).
+    ///
+    /// # Errors
+    /// As [`Self::check_map`], but for the planner's own.
+    pub fn check_driven_map(&self, map: &PreparedMap) -> Result<ResourceEstimate, ScenarioError> {
+        self.check_map_as(map, false)
+    }
+
+    /// [`Self::check_map`], with the planner's checks and memory (`with_planner`) or without.
+    fn check_map_as(
+        &self,
+        map: &PreparedMap,
+        with_planner: bool,
+    ) -> Result<ResourceEstimate, ScenarioError> {
         let setup = self.setup(map);
-        let planner = self.planner.name();
+        let planner = if with_planner {
+            self.planner.name()
+        } else {
+            "the step API"
+        };
         // Also checked when the map is prepared; again here for a map the caller built.
         check_extent(&map.grid, &map.source)?;
         // A robot wider than the map fits nowhere, whatever the planner: said before the
@@ -983,10 +1006,12 @@ impl Scenario {
                 Compact(h)
             )));
         }
-        self.planner
-            .settings()
-            .check(&setup)
-            .map_err(|e| self.degenerate(&map.source, e))?;
+        if with_planner {
+            self.planner
+                .settings()
+                .check(&setup)
+                .map_err(|e| self.degenerate(&map.source, e))?;
+        }
         // A landmark farther off the map than the landmark range is never seen from it: it
         // would be read, checked and then change nothing.
         let (lo, hi) = f.world_bounds();
@@ -1018,8 +1043,15 @@ impl Scenario {
                 Compact(hi.y)
             )));
         }
-        let mut est = estimate_run(&setup, self.planner.settings());
-        add_sim_pid_records(&mut est, &setup, self.planner.settings(), &self.execution());
+        // The PID trace of the planner's path; a driven robot's trace grows with its
+        // caller's steps, which nothing estimates beforehand.
+        let mut est = if with_planner {
+            let mut est = estimate_run(&setup, self.planner.settings());
+            add_sim_pid_records(&mut est, &setup, self.planner.settings(), &self.execution());
+            est
+        } else {
+            ccpp_core::planners::settings::estimate_driven(&setup)
+        };
         let zones = estimate_zones(&setup, self.zone_load());
         if zones.bytes > 0.0 {
             est.bytes += zones.bytes;

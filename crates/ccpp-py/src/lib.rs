@@ -1759,7 +1759,7 @@ impl Env {
             .map_err(|e| err(&e))?;
         // What a run of the same robot on the map would hold (the world, the sweep, the known
         // map), against the limit: an episode holds as much.
-        s.check_map(&map).map_err(|e| err(&e))?;
+        s.check_driven_map(&map).map_err(|e| err(&e))?;
         let zones = py.detach(|| s.zone_masks(&map)).map_err(|e| err(&e))?;
         // The zones and the start are checked now, not at the first reset.
         py.detach(|| s.world_with_zones(&map, zones.clone()))

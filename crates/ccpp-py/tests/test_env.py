@@ -166,3 +166,14 @@ def test_leaving_the_area_is_a_violation(room: Path) -> None:
     env.reset()
     env.step(("move_to", 1.0, 1.0))
     assert env.metrics()["keepout_violations"] == 0
+
+
+def test_env_memory_is_its_own_not_a_planners(shared_maps: Path) -> None:
+    """An Env of a tiny robot was refused for ba-star's tiles (`ba-star would need about 14633
+    MB`), a planner an Env never runs; the estimate is now what an Env holds."""
+    env = ccpp.Env(shared_maps / "teb_maze.yaml", radius=0.001)
+    env.reset()
+    assert env.step(("translate", 0.1))[4]["collision"] is False
+    # What it does hold is still checked against the limit, naming the step API.
+    with pytest.raises(ccpp.CcppError, match="the step API would need"):
+        ccpp.Env(shared_maps / "teb_maze.yaml", radius=0.001, max_memory_mb=17)

@@ -1213,10 +1213,25 @@ impl PlannerSettings for RectOptions {
 /// The memory a run needs: the per-pixel part, the metrics' tile set and the planner's share;
 /// the detail names the largest part.
 pub fn estimate_run(s: &Setup, planner: &dyn PlannerSettings) -> ResourceEstimate {
-    let own = planner.estimate(s);
     let metrics_side = planner
         .tile_side(&s.robot)
         .unwrap_or(2.0 * s.robot.tool_radius);
+    estimate_with(s, planner.estimate(s), metrics_side)
+}
+
+/// [`estimate_run`] of a robot its caller drives (Python's step API): the world, the sweep
+/// and the metrics' tiles of `2 r_tool`, no planner's own state.
+pub fn estimate_driven(s: &Setup) -> ResourceEstimate {
+    let none = ResourceEstimate {
+        bytes: 0.0,
+        detail: "no planner".into(),
+        remedy: GENERIC_REMEDY.into(),
+    };
+    estimate_with(s, none, 2.0 * s.robot.tool_radius)
+}
+
+/// A run's estimate from its planner's own part `own` and the metrics' tile side.
+fn estimate_with(s: &Setup, own: ResourceEstimate, metrics_side: f64) -> ResourceEstimate {
     let mut metric_tiles = ResourceEstimate::units(s.tiles(metrics_side), 1.0 / 8.0, "tiles")
         .remedy("a larger robot, tool or tile");
     metric_tiles.detail = format!(
