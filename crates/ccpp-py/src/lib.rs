@@ -588,6 +588,28 @@ fn uint_arg(key: &str, v: &Bound<'_, PyAny>) -> PyResult<u64> {
     })
 }
 
+/// The nested section of a planner's options (`defaults`, the options at their defaults) that
+/// alone holds the option `key`, when the planner itself has no option `key`: `ba_star` for
+/// ba-star-extended's `smoothing`. The execution section is left out (`exec=` is a run
+/// keyword).
+fn nested_section<'a>(
+    defaults: Option<&'a serde_json::Map<String, Value>>,
+    key: &str,
+) -> Option<&'a str> {
+    let d = defaults?;
+    if d.contains_key(key) {
+        return None;
+    }
+    let mut holders = d
+        .iter()
+        .filter(|(sec, v)| *sec != "exec" && v.as_object().is_some_and(|o| o.contains_key(key)))
+        .map(|(sec, _)| sec.as_str());
+    match (holders.next(), holders.next()) {
+        (Some(sec), None) => Some(sec),
+        _ => None,
+    }
+}
+
 /// `odometry_noise=`: a number (LIN) or a sequence of one to three numbers (LIN, ANG, DRIFT),
 /// as `--odometry-noise LIN[,ANG[,DRIFT]]`.
 fn noise_arg(v: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
@@ -771,29 +793,57 @@ fn scenario_from(
             planner_opts.insert(key, py_to_json(&v)?);
         }
     }
+    let defaults = serde_json::to_value(&s.planner).map_err(|e| err(&e))?;
+    let defaults = defaults.get("options").and_then(Value::as_object);
     for (k, v) in &direct {
-        if let Some(w) = in_options
-            .as_ref()
-            .map(|o| o.get_item(k))
-            .transpose()?
-            .flatten()
-        {
+        // A keyword that is no option of the planner itself but of exactly one of its nested
+        // sections (ba-star-extended's `ba_star`, `extension`) sets it there, as the command
+        // line's `--smoothing` and `--tile-side` do for ba-star-extended.
+        let section = nested_section(defaults, k);
+        let given = match (&in_options, section) {
+            (None, _) => None,
+            (Some(o), None) => o.get_item(k)?,
+            (Some(o), Some(sec)) => match o.get_item(sec)? {
+                Some(d) => d.get_item(k).ok(),
+                None => None,
+            },
+        };
+        if let Some(w) = given {
             if !v.eq(&w)? {
+                let place =
+                    section.map_or_else(|| format!("[{k:?}]"), |sec| format!("[{sec:?}][{k:?}]"));
                 return Err(msg(format!(
-                    "{k}={} and options[{k:?}]={} set the same option; remove one of them",
+                    "{k}={} and options{place}={} set the same option; remove one of them",
                     repr(v),
                     repr(&w)
                 )));
             }
         }
-        planner_opts.insert(k.clone(), py_to_json(v)?);
+        let value = py_to_json(v)?;
+        match section {
+            None => {
+                planner_opts.insert(k.clone(), value);
+            }
+            Some(sec) => {
+                let entry = planner_opts
+                    .entry(sec.to_string())
+                    .or_insert_with(|| Value::Object(serde_json::Map::new()));
+                match entry {
+                    Value::Object(o) => {
+                        o.insert(k.clone(), value);
+                    }
+                    other => {
+                        return Err(msg(format!(
+                            "options[{sec:?}] must be a dict of {sec} options, got {other}"
+                        )))
+                    }
+                }
+            }
+        }
     }
     for k in &unset {
-        let cfg = serde_json::to_value(&s.planner).map_err(|e| err(&e))?;
-        let known = cfg
-            .get("options")
-            .and_then(Value::as_object)
-            .is_some_and(|o| o.contains_key(k));
+        let known =
+            defaults.is_some_and(|o| o.contains_key(k)) || nested_section(defaults, k).is_some();
         if !known {
             return Err(msg(format!(
                 "{k}=None: {k} is not an option of {kind} nor a run option ({})",

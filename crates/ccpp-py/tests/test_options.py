@@ -266,3 +266,34 @@ def test_odometry_noise_and_landmarks_are_the_cli_runs(shared_maps: Path, ccpp_b
         ccpp.plan(maze, "bcd", odometry_noise=0.02)
     with pytest.raises(ccpp.CcppError, match="replaces the odometry noise given for bsa-bfs"):
         ccpp.run(maze, "bsa-bfs", odometry_noise=0.02, options={"exec": {"pid": {"noise": None}}})
+
+
+def test_nested_options_as_keywords_are_the_cli_flags(shared_maps: Path, ccpp_bin: str, tmp_path: Path) -> None:
+    """`--smoothing off` and `--tile-side 0.4` set ba-star-extended's `ba_star` options, but
+    `smoothing=False` and `tile_side_m=0.4` were "unknown field" for it in Python (only
+    `ba_star={...}` worked). A keyword of exactly one nested section sets it there."""
+    maze = shared_maps / "teb_maze.yaml"
+    for flags, kw in (
+        (["--smoothing", "off"], {"smoothing": False}),
+        (["--tile-side", "0.4"], {"tile_side_m": 0.4}),
+    ):
+        out = tmp_path / flags[0].strip("-")
+        p = cli(ccpp_bin, "run", "--map", str(maze), "--planner", "ba-star-extended", "--out", str(out), *flags)
+        assert p.returncode == 0, p.stderr
+        r = ccpp.run(maze, "ba-star-extended", **kw)
+        assert json.loads(r.scenario_json)["options"] == json.loads((out / "run.json").read_text())["options"]
+        nested = ccpp.run(maze, "ba-star-extended", ba_star=kw)
+        assert np.array_equal(r.path, nested.path)
+    # Beside the same option in options=, one value, as a flag beside --config.
+    with pytest.raises(ccpp.CcppError, match=r"smoothing=False and options\[\"ba_star\"\]\[\"smoothing\"\]=True"):
+        ccpp.run(maze, "ba-star-extended", smoothing=False, options={"ba_star": {"smoothing": True}})
+    # Merged with other options of the same section.
+    both = ccpp.run(maze, "ba-star-extended", smoothing=False, options={"ba_star": {"tile_side_m": 0.4}})
+    assert json.loads(both.scenario_json)["options"]["ba_star"]["smoothing"] is False
+    assert json.loads(both.scenario_json)["options"]["ba_star"]["tile_side_m"] == 0.4
+    # An extension option too, and None as its default.
+    yielded = ccpp.run(maze, "ba-star-extended", min_yield=0.2)
+    assert json.loads(yielded.scenario_json)["options"]["extension"]["min_yield"] == 0.2
+    ccpp.run(maze, "ba-star-extended", smoothing=None)
+    with pytest.raises(ccpp.CcppError, match="unknown field"):
+        ccpp.run(maze, "ba-star-extended", pid={"dt_s": 0.1})  # inside exec: not a keyword
