@@ -67,8 +67,9 @@ pub fn run(a: &WaypointsArgs) -> Result<()> {
         let pts: Vec<[f64; 2]> = p.waypoints.iter().map(|w| [w.x, w.y]).collect();
         let v = serde_json::json!({
             "map": map.name,
-            "length_m": a.length,
-            "width_m": a.width,
+            // The values used (the robot's diameter when not given: `null` hid them).
+            "length_m": opts.length_for(&scenario.robot),
+            "width_m": opts.width_for(&scenario.robot),
             "area": p.area,
             "waypoints": pts,
         });

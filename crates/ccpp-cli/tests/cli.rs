@@ -590,6 +590,24 @@ fn waypoints_follow_the_seed_001_example() {
         assert!((y - (0.5 + 0.1 * k as f64)).abs() < 1e-9, "{ys:?}");
     }
     assert!((ys[5] - 1.0).abs() < 1e-9);
+    assert_eq!(
+        (v["length_m"].as_f64(), v["width_m"].as_f64()),
+        (Some(0.1), Some(0.1))
+    );
+    // Left out, they are the robot's diameter, and the JSON says so (it said `null`).
+    let o = ccpp()
+        .args(["waypoints", "--radius", "0.06", "--format", "json", "--map"])
+        .arg(&map)
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let d: serde_json::Value = serde_json::from_slice(&o).unwrap();
+    assert_eq!(
+        (d["length_m"].as_f64(), d["width_m"].as_f64()),
+        (Some(0.12), Some(0.12))
+    );
     let csv = ccpp()
         .args([
             "waypoints",

@@ -1022,7 +1022,7 @@ pub fn coverage_pixmap_swept(
         col0: col0 as f64,
         row0: row0 as f64,
     };
-    draw_zone_borders(&mut pm, world, view);
+    draw_zone_borders(&mut pm, world, view, (cw, ch_map));
     ccpp_io::phase::time("coverage.png path", || {
         draw_path(&mut pm, world, trace, view);
     });
@@ -1036,10 +1036,22 @@ pub fn coverage_pixmap_swept(
     Ok(pm)
 }
 
-/// Outlines of the area polygons (solid) and keep-out polygons (hatch colour).
-fn draw_zone_borders(pm: &mut Pixmap, world: &World, view: View) {
+/// Outlines of the area polygons (solid) and keep-out polygons (hatch colour), clipped to the
+/// map's `cw` x `ch` canvas below the header: a polygon reaching past the map's picture was
+/// drawn over the title and the legend.
+fn draw_zone_borders(pm: &mut Pixmap, world: &World, view: View, (cw, ch): (u32, u32)) {
     let Some(z) = world.zones() else { return };
     let width = (view.scale * 0.8).clamp(1.5, 4.0);
+    let clip = Rect::from_xywh(0.0, view.top, cw as f32, ch as f32).and_then(|r| {
+        let mut mask = tiny_skia::Mask::new(pm.width(), pm.height())?;
+        mask.fill_path(
+            &PathBuilder::from_rect(r),
+            FillRule::Winding,
+            false,
+            Transform::identity(),
+        );
+        Some(mask)
+    });
     for (polys, colour) in [
         (&z.area_polygons, colours::AREA_BORDER),
         (&z.keepout_polygons, colours::KEEPOUT_HATCH),
@@ -1066,7 +1078,7 @@ fn draw_zone_borders(pm: &mut Pixmap, world: &World, view: View) {
                     &paint(rgb(colour)),
                     &stroke,
                     Transform::identity(),
-                    None,
+                    clip.as_ref(),
                 );
             }
         }
@@ -1844,6 +1856,26 @@ mod tests {
         );
         assert!(data.contains(&want), "{want} not in the page data");
         assert!(!data.contains(r#""approach":null"#));
+    }
+
+    /// An area polygon reaching past the map's picture was drawn over the title (and the
+    /// legend): its border is clipped to the map's canvas.
+    #[test]
+    fn zone_borders_stay_on_the_map() {
+        use ccpp_core::zones::{Polygon, ZoneMasks};
+        let (room, trace) = run(1);
+        let map = room.true_map().clone();
+        // A triangle whose two long edges leave the map's top and go on far above it.
+        let area = [Polygon {
+            points: vec![[0.1, 0.1], [2.4, 0.1], [1.2, 60.0]],
+            name: None,
+        }];
+        let zones = ZoneMasks::new(map.frame(), Some(&area), &[], &[]);
+        let world = World::with_zones(map, Robot::new(0.15), None, Some(zones)).unwrap();
+        let pm = coverage_pixmap(&world, &trace, &style()).unwrap();
+        let header = 0..30;
+        assert_eq!(count_colour(&pm, header, colours::AREA_BORDER), 0);
+        assert!(count_colour(&pm, 0..pm.height(), colours::AREA_BORDER) > 50);
     }
 
     /// A run the simulator stopped says so in the header: one more red badge.
