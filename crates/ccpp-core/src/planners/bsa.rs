@@ -76,7 +76,9 @@ use crate::tiles::{Tile, TileGrid};
 use crate::trace::Event;
 
 /// The reference lateral side (RLS): where BSA keeps obstacles while filling a spiral.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+///
+/// Read without regard to case (`RIGHT`, as `--side RIGHT` is), written in lower case.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Side {
     /// Obstacles on the robot's left (the spiral turns counter-clockwise).
@@ -84,6 +86,17 @@ pub enum Side {
     Left,
     /// Obstacles on the robot's right (the spiral turns clockwise).
     Right,
+}
+
+impl<'de> Deserialize<'de> for Side {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let s = String::deserialize(d)?;
+        match s.to_ascii_lowercase().as_str() {
+            "left" => Ok(Side::Left),
+            "right" => Ok(Side::Right),
+            _ => Err(serde::de::Error::unknown_variant(&s, &["left", "right"])),
+        }
+    }
 }
 
 impl Side {
@@ -726,6 +739,22 @@ mod tests {
         assert_eq!(
             merge_collinear(&path),
             vec![(0, 0), (2, 0), (2, 3), (4, 3), (4, 2)]
+        );
+    }
+
+    #[test]
+    fn sides_read_in_any_case_and_are_written_in_lower_case() {
+        // As the command line's `--side RIGHT` (Python's `side="RIGHT"` was refused).
+        for (text, side) in [("\"RIGHT\"", Side::Right), ("\"Left\"", Side::Left)] {
+            assert_eq!(serde_json::from_str::<Side>(text).unwrap(), side);
+        }
+        assert_eq!(serde_json::to_string(&Side::Right).unwrap(), "\"right\"");
+        let e = serde_json::from_str::<Side>("\"up\"")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("unknown variant `up`, expected `left` or `right`"),
+            "{e}"
         );
     }
 
