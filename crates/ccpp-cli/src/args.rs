@@ -48,7 +48,7 @@ pub struct MapArgs {
     /// Override the resolution (m/px); bare images default to 0.05.
     #[arg(long, value_name = "M")]
     pub resolution: Option<f64>,
-    /// Override the origin `X,Y[,YAW]` (world pose of the lower-left pixel).
+    /// Override the origin `X,Y[,YAW]` (world pose of the lower-left pixel; YAW left out is 0, not the map's yaw).
     #[arg(long, value_name = "X,Y[,YAW]", value_parser = parse_triple, allow_hyphen_values = true)]
     pub origin: Option<[f64; 3]>,
     /// Override `occupied_thresh`.
