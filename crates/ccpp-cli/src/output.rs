@@ -237,13 +237,12 @@ pub fn emit(
     if let Some(w) = comp.warning() {
         eprintln!("{w}");
     }
-    if let Some(w) = drift_warning(job, r) {
-        eprintln!("{w}");
-    }
-    if let Some(n) = ccpp_core::sim::motions_cut(&r.run.trace) {
-        eprintln!(
-            "warning: {n} PID motion(s) stopped at max_steps_per_motion before reaching their goal (the run went on from where the robot was): raise exec.pid.max_steps_per_motion or dt_s"
-        );
+    let drift = ccpp_io::warnings::drift_warning(&job.scenario, &r.run.trace, r.metrics.collisions);
+    for w in drift
+        .into_iter()
+        .chain(ccpp_io::warnings::motions_cut_warning(&r.run.trace))
+    {
+        eprintln!("warning: {w}");
     }
     if json_only {
         if let Some(why) = &r.metrics.stop_reason {
@@ -344,38 +343,5 @@ pub fn summary(m: &Metrics) -> String {
     s
 }
 
-/// The warning for a run with odometry noise, no landmarks and bumper contacts: its pose
-/// estimate drifted from the truth, so the planner drove into walls it placed elsewhere, and
-/// an offline planner's remaining moves started from a wrong position. The trace still ends
-/// `done` (the planner finished its plan), so without this the run read as complete.
-fn drift_warning(job: &Job, r: &JobResult) -> Option<String> {
-    if r.metrics.collisions == 0 || !job.scenario.sim.landmarks.landmarks.is_empty() {
-        return None;
-    }
-    // The execution event comes first of all events (a run's first step).
-    let noisy = r
-        .run
-        .trace
-        .events()
-        .take(4)
-        .any(|(_, e)| matches!(e, ccpp_core::trace::Event::Execution { noisy: true, .. }));
-    noisy.then(|| {
-        format!(
-            "warning: {} bumper contact(s): under odometry noise without landmarks the pose estimate drifts from the truth, and the robot drives into walls it believes are elsewhere; give --landmarks to correct the estimate (the coverage is what was swept)",
-            r.metrics.collisions
-        )
-    })
-}
-
-/// What an early stop (`Metrics::stop_reason`) means, for the summary; `what` is the
-/// incomplete result (`coverage` of a run, `path` of a plan).
-pub fn stop_warning(why: &str, what: &str) -> String {
-    match why {
-        "stalled" => format!(
-            "the run was stopped: the robot made no progress for {} motions in a row (its true position stayed within half a map pixel, as when it keeps driving into a wall its drifted pose estimate does not show); the {what} is incomplete",
-            ccpp_core::sim::STALL_STEPS
-        ),
-        "max_steps" => format!("the planner hit the simulator's step cap; the {what} is incomplete"),
-        other => format!("the run ended early ({other}); the {what} is incomplete"),
-    }
-}
+/// What an early stop means ([`ccpp_io::warnings::stop_warning`]).
+pub use ccpp_io::warnings::stop_warning;

@@ -18,6 +18,8 @@
 //! * [`export`]: path exports a robot stack reads (waypoints CSV/JSON, ROS `nav_msgs/Path`
 //!   YAML, `GeoJSON`) and the waypoint readers;
 //! * [`plan`]: a known-map planner's route without simulation overhead or metrics;
+//! * [`warnings`]: the warnings of a finished run (stderr of `ccpp run`, Python's
+//!   `RunResult.warnings`);
 //! * [`lock`]: the lock a bench or a Python sweep holds on its output folder;
 //! * [`phase`]: optional phase timing (`CCPP_PHASES`);
 //! * [`mod@file`]: opening user files (regular files only: a FIFO is refused, not read forever).
@@ -36,6 +38,7 @@ pub mod phase;
 pub mod plan;
 pub mod scenario;
 pub mod trace;
+pub mod warnings;
 pub mod write;
 pub mod zones;
 

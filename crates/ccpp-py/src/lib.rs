@@ -1175,6 +1175,14 @@ impl RunResult {
         self.output.stop.as_str()
     }
 
+    /// The warnings `ccpp run` prints for this run (without `warning: `): an early stop, PID
+    /// motions cut at `max_steps_per_motion`, bumper contacts under odometry noise without
+    /// landmarks. A run that ends `done` may still have some (`stop` is the planner's word).
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        ccpp_io::warnings::run_warnings(&self.scenario, &self.output.trace, &self.metrics)
+    }
+
     /// The start pose used, `(x, y, theta)`.
     #[getter]
     fn start(&self) -> (f64, f64, f64) {

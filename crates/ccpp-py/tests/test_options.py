@@ -297,3 +297,24 @@ def test_nested_options_as_keywords_are_the_cli_flags(shared_maps: Path, ccpp_bi
     ccpp.run(maze, "ba-star-extended", smoothing=None)
     with pytest.raises(ccpp.CcppError, match="unknown field"):
         ccpp.run(maze, "ba-star-extended", pid={"dt_s": 0.1})  # inside exec: not a keyword
+
+
+def test_warnings_are_the_cli_warnings(shared_maps: Path, ccpp_bin: str, tmp_path: Path) -> None:
+    """A run that ended `done` after its PID motions were cut short, or after drifting into
+    walls, said so only in a trace note (Python) where `ccpp run` warns on stderr."""
+    maze = shared_maps / "teb_maze.yaml"
+    cut = {"exec": {"pid": {"max_steps_per_motion": 1}}}
+    cases = [
+        ({"odometry_noise": 0.02, "seed": 1}, ["--odometry-noise", "0.02", "--seed", "1"], "bcd", None),
+        ({"options": cut}, ["--config", str(tmp_path / "cut.yaml")], "bsa-bfs", "bsa_bfs: { exec: { pid: { max_steps_per_motion: 1 } } }\n"),
+    ]
+    for kw, flags, planner, cfg in cases:
+        if cfg:
+            (tmp_path / "cut.yaml").write_text(cfg)
+        r = ccpp.run(maze, planner, **kw)
+        assert r.stop == "done" and r.warnings, planner
+        p = cli(ccpp_bin, "run", "--map", str(maze), "--planner", planner, "--out", str(tmp_path / planner), *flags)
+        assert p.returncode == 0, p.stderr
+        cli_warnings = [line.removeprefix("warning: ") for line in p.stderr.splitlines() if line.startswith("warning: ")]
+        assert r.warnings == cli_warnings
+    assert ccpp.run(maze, "bcd").warnings == []

@@ -64,6 +64,10 @@ class RunResult:
     def stop(self) -> str:
         """``"done"``, ``"stalled"`` (no progress for 1000 motions in a row) or ``"max_steps"``."""
     @property
+    def warnings(self) -> list[str]:
+        """The warnings ``ccpp run`` prints: an early stop, PID motions cut short, bumper
+        contacts under odometry noise without landmarks."""
+    @property
     def start(self) -> tuple[float, float, float]: ...
     @property
     def scenario_json(self) -> str:

@@ -1,0 +1,61 @@
+//! The warnings of a finished run: what the command line prints on stderr and Python's
+//! `RunResult.warnings` lists, from one place (the texts without the `warning: ` prefix).
+
+use ccpp_core::metrics::Metrics;
+use ccpp_core::trace::{Event, Trace};
+
+use crate::scenario::Scenario;
+
+/// What an early stop (`Metrics::stop_reason`, or a plan's stop) means; `what` is the
+/// incomplete result (`coverage` of a run, `path` of a plan).
+pub fn stop_warning(why: &str, what: &str) -> String {
+    match why {
+        "stalled" => format!(
+            "the run was stopped: the robot made no progress for {} motions in a row (its true position stayed within half a map pixel, as when it keeps driving into a wall its drifted pose estimate does not show); the {what} is incomplete",
+            ccpp_core::sim::STALL_STEPS
+        ),
+        "max_steps" => format!("the planner hit the simulator's step cap; the {what} is incomplete"),
+        other => format!("the run ended early ({other}); the {what} is incomplete"),
+    }
+}
+
+/// PID motions the per-motion cap cut short, said (`None` when none was).
+pub fn motions_cut_warning(trace: &Trace) -> Option<String> {
+    ccpp_core::sim::motions_cut(trace).map(|n| {
+        format!(
+            "{n} PID motion(s) stopped at max_steps_per_motion before reaching their goal (the run went on from where the robot was): raise exec.pid.max_steps_per_motion or dt_s"
+        )
+    })
+}
+
+/// Bumper contacts under odometry noise without landmarks, explained: the pose estimate
+/// drifted from the truth, so the planner drove into walls it placed elsewhere (and an
+/// offline planner's remaining moves started from a wrong position). The trace still ends
+/// `done` (the planner finished its plan), so without this the run read as complete.
+pub fn drift_warning(scenario: &Scenario, trace: &Trace, collisions: u32) -> Option<String> {
+    if collisions == 0 || !scenario.sim.landmarks.landmarks.is_empty() {
+        return None;
+    }
+    // The execution event comes first of all events (a run's first step).
+    let noisy = trace
+        .events()
+        .take(4)
+        .any(|(_, e)| matches!(e, Event::Execution { noisy: true, .. }));
+    noisy.then(|| {
+        format!(
+            "{collisions} bumper contact(s): under odometry noise without landmarks the pose estimate drifts from the truth, and the robot drives into walls it believes are elsewhere; give --landmarks / landmarks= to correct the estimate (the coverage is what was swept)"
+        )
+    })
+}
+
+/// Every warning of a run of `scenario` with this trace and these metrics: an early stop, PID
+/// motions cut short, contacts under drift.
+pub fn run_warnings(scenario: &Scenario, trace: &Trace, metrics: &Metrics) -> Vec<String> {
+    let mut out = Vec::new();
+    out.extend(drift_warning(scenario, trace, metrics.collisions));
+    out.extend(motions_cut_warning(trace));
+    if let Some(why) = &metrics.stop_reason {
+        out.push(stop_warning(why, "coverage"));
+    }
+    out
+}
