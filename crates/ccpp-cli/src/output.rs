@@ -237,17 +237,12 @@ pub fn emit(
     if let Some(w) = comp.warning() {
         eprintln!("{w}");
     }
-    let drift = ccpp_io::warnings::drift_warning(&job.scenario, &r.run.trace, r.metrics.collisions);
-    for w in drift
-        .into_iter()
-        .chain(ccpp_io::warnings::motions_cut_warning(&r.run.trace))
-    {
+    // Every warning on stderr, with or without --json (the early stop's was a line of the
+    // table on stdout without it), as Python's `RunResult.warnings` lists them.
+    for w in ccpp_io::warnings::run_warnings(&job.scenario, &r.run.trace, &r.metrics) {
         eprintln!("warning: {w}");
     }
     if json_only {
-        if let Some(why) = &r.metrics.stop_reason {
-            eprintln!("warning: {}", stop_warning(why, "coverage"));
-        }
         return crate::print_stdout(&metrics);
     }
     let mut s = summary(&r.metrics);
@@ -338,7 +333,6 @@ pub fn summary(m: &Metrics) -> String {
     }
     if let Some(why) = &m.stop_reason {
         let _ = writeln!(s, "  {:<21} {why:>12}", "stop_reason");
-        let _ = writeln!(s, "  warning: {}", stop_warning(why, "coverage"));
     }
     s
 }

@@ -691,7 +691,14 @@ fn a_robot_that_stops_making_progress_is_stopped_and_says_so() {
         stdout.contains("stop_reason") && stdout.contains("stalled"),
         "{stdout}"
     );
-    assert!(stdout.contains("no progress for 1000 motions"), "{stdout}");
+    // The warning on stderr (it was a line of the table on stdout).
+    let stderr = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
+    assert!(
+        stderr
+            .contains("warning: the run was stopped: the robot made no progress for 1000 motions"),
+        "{stderr}"
+    );
+    assert!(!stdout.contains("warning"), "{stdout}");
     let m = read_json(&out.join("metrics.json"));
     assert_eq!(m["stop_reason"], "stalled");
     let collisions = m["collisions"].as_u64().unwrap();

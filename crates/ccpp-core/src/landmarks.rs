@@ -30,8 +30,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::geometry::{wrap_angle, Point, Pose};
 
-/// A landmark (tag) on the map. Ids need not be unique.
+/// A landmark (tag) on the map. Ids need not be unique. An unknown field is refused (a
+/// misspelt `thta` was dropped, the tag then facing east).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Landmark {
     /// Identifier shown by the tag (may be shared by several tags).
     pub id: u32,

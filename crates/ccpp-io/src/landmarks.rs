@@ -165,6 +165,9 @@ mod tests {
             Err(LandmarkFileError::Json(_))
         ));
         assert!(parse_landmarks("").unwrap().is_empty());
+        // A misspelt field is refused (it was dropped: the tag faced east).
+        let e = parse_landmarks(r#"[{"id":1,"x":0,"y":0,"thta":1.0}]"#).unwrap_err();
+        assert!(e.to_string().contains("unknown field `thta`"), "{e}");
     }
 
     #[test]

@@ -28,12 +28,13 @@ pub fn motions_cut_warning(trace: &Trace) -> Option<String> {
     })
 }
 
-/// Bumper contacts under odometry noise without landmarks, explained: the pose estimate
+/// Bumper contacts and keep-out violations under odometry noise without landmarks, explained: the pose estimate
 /// drifted from the truth, so the planner drove into walls it placed elsewhere (and an
 /// offline planner's remaining moves started from a wrong position). The trace still ends
 /// `done` (the planner finished its plan), so without this the run read as complete.
-pub fn drift_warning(scenario: &Scenario, trace: &Trace, collisions: u32) -> Option<String> {
-    if collisions == 0 || !scenario.sim.landmarks.landmarks.is_empty() {
+pub fn drift_warning(scenario: &Scenario, trace: &Trace, metrics: &Metrics) -> Option<String> {
+    let (collisions, zones) = (metrics.collisions, metrics.keepout_violations);
+    if (collisions == 0 && zones == 0) || !scenario.sim.landmarks.landmarks.is_empty() {
         return None;
     }
     // The execution event comes first of all events (a run's first step).
@@ -41,9 +42,14 @@ pub fn drift_warning(scenario: &Scenario, trace: &Trace, collisions: u32) -> Opt
         .events()
         .take(4)
         .any(|(_, e)| matches!(e, Event::Execution { noisy: true, .. }));
+    let what = match (collisions, zones) {
+        (c, 0) => format!("{c} bumper contact(s)"),
+        (0, z) => format!("{z} keep-out violation(s)"),
+        (c, z) => format!("{c} bumper contact(s) and {z} keep-out violation(s)"),
+    };
     noisy.then(|| {
         format!(
-            "{collisions} bumper contact(s): under odometry noise without landmarks the pose estimate drifts from the truth, and the robot drives into walls it believes are elsewhere; give --landmarks / landmarks= to correct the estimate (the coverage is what was swept)"
+            "{what}: under odometry noise without landmarks the pose estimate drifts from the truth, and the robot drives into walls and zones it believes are elsewhere; give --landmarks / landmarks= to correct the estimate (the coverage is what was swept)"
         )
     })
 }
@@ -52,7 +58,7 @@ pub fn drift_warning(scenario: &Scenario, trace: &Trace, collisions: u32) -> Opt
 /// motions cut short, contacts under drift.
 pub fn run_warnings(scenario: &Scenario, trace: &Trace, metrics: &Metrics) -> Vec<String> {
     let mut out = Vec::new();
-    out.extend(drift_warning(scenario, trace, metrics.collisions));
+    out.extend(drift_warning(scenario, trace, metrics));
     out.extend(motions_cut_warning(trace));
     if let Some(why) = &metrics.stop_reason {
         out.push(stop_warning(why, "coverage"));

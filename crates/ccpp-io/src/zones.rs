@@ -299,7 +299,12 @@ fn yaml_polygons(v: &Value) -> Result<Vec<Polygon>, ZoneFileError> {
     // ignored with what it meant.
     if let Value::Object(o) = v {
         if let Some(k) = o.keys().find(|k| k.as_str() != "polygons") {
-            let k: String = one_line(k).chars().take(80).collect();
+            let k = k
+                .chars()
+                .take(80)
+                .collect::<String>()
+                .escape_debug()
+                .to_string();
             return Err(bad(format!(
                 "unknown key `{k}`: a YAML zone file is a list of x,y points, a list of such lists, `polygons:` with such lists, or a map_server YAML (keepout mask)"
             )));
@@ -347,9 +352,9 @@ fn geojson_collect(v: &Value, out: &mut Vec<Polygon>, depth: usize) -> Result<()
         return Err(bad("GeoJSON nested too deeply"));
     }
     // The 2008 GeoJSON's `crs` member: a named CRS (EPSG:4326 latitude/longitude, a UTM zone)
-    // is not the map's frame, and reading its numbers as metres in the map put the zone
+    // is not the map's frame (`"crs": null`, no CRS, is no claim), and reading its numbers as metres in the map put the zone
     // anywhere, silently. RFC 7946 dropped the member; ccpp's own exports never write it.
-    if let Some(crs) = v.get("crs") {
+    if let Some(crs) = v.get("crs").filter(|c| !c.is_null()) {
         let name = crs
             .pointer("/properties/name")
             .and_then(Value::as_str)
@@ -459,6 +464,12 @@ mod tests {
             e.contains("EPSG::4326") && e.contains("map coordinates"),
             "{e}"
         );
+        // `"crs": null` names no CRS: read as usual.
+        let none: Value = serde_json::from_str(
+            r#"{"type":"Polygon","crs":null,"coordinates":[[[0,0],[1,0],[1,1]]]}"#,
+        )
+        .unwrap();
+        assert_eq!(geojson_polygons(&none).unwrap().len(), 1);
         let one: Value = serde_saphyr::from_str("- [0, 0]\n- [1, 0]\n- [1, 1]\n").unwrap();
         assert_eq!(yaml_polygons(&one).unwrap().len(), 1);
         let two: Value = serde_saphyr::from_str(

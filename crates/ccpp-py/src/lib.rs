@@ -588,6 +588,26 @@ fn uint_arg(key: &str, v: &Bound<'_, PyAny>) -> PyResult<u64> {
     })
 }
 
+/// Whether two Python values set an option alike: equal, or text equal but for case (option
+/// names such as `side` are read without regard to case: `"RIGHT"` beside `"right"` is one
+/// value, as `--side RIGHT` beside `side: right` in `--config`).
+fn same_value(a: &Bound<'_, PyAny>, b: &Bound<'_, PyAny>) -> PyResult<bool> {
+    if let (Ok(x), Ok(y)) = (a.extract::<String>(), b.extract::<String>()) {
+        return Ok(x.eq_ignore_ascii_case(&y));
+    }
+    a.eq(b)
+}
+
+/// [`same_value`] on JSON values.
+fn same_json(a: &Value, b: &Value) -> bool {
+    match (a, b) {
+        (Value::String(x), Value::String(y)) => x.eq_ignore_ascii_case(y),
+        // `1` and `1.0` are one value, as in Python.
+        (Value::Number(x), Value::Number(y)) => x.as_f64() == y.as_f64(),
+        _ => a == b,
+    }
+}
+
 /// The nested section of a planner's options (`defaults`, the options at their defaults) that
 /// alone holds the option `key`, when the planner itself has no option `key`: `ba_star` for
 /// ba-star-extended's `smoothing`. The execution section is left out (`exec=` is a run
@@ -739,7 +759,16 @@ fn scenario_from(
                 s.sim.sensor_range = Some(float_arg(&key, &v)?);
             }
             "max_memory_mb" => s.max_memory_mb = uint_arg(&key, &v)?,
-            "max_steps" => s.sim.max_steps = uint_arg(&key, &v)?,
+            "max_steps" => {
+                if purpose == Purpose::Plan {
+                    // `ccpp plan` has no step cap to give: a cap cut the plan short, saying so
+                    // only in `finished`.
+                    return Err(msg(
+                        "max_steps does not apply to plan (a plan runs the planner to its end); leave it out",
+                    ));
+                }
+                s.sim.max_steps = uint_arg(&key, &v)?;
+            }
             "exec" => {
                 let e: String = v.extract().map_err(|_| {
                     msg(format!(
@@ -795,6 +824,11 @@ fn scenario_from(
     }
     let defaults = serde_json::to_value(&s.planner).map_err(|e| err(&e))?;
     let defaults = defaults.get("options").and_then(Value::as_object);
+    // The planner's own options first, then those of its nested sections: a nested keyword
+    // beside its section given as a keyword (`ba_star={"smoothing": True}, smoothing=False`)
+    // is checked against it whatever their order.
+    let mut direct = direct;
+    direct.sort_by_key(|(k, _)| nested_section(defaults, k).is_some());
     for (k, v) in &direct {
         // A keyword that is no option of the planner itself but of exactly one of its nested
         // sections (ba-star-extended's `ba_star`, `extension`) sets it there, as the command
@@ -809,7 +843,7 @@ fn scenario_from(
             },
         };
         if let Some(w) = given {
-            if !v.eq(&w)? {
+            if !same_value(v, &w)? {
                 let place =
                     section.map_or_else(|| format!("[{k:?}]"), |sec| format!("[{sec:?}][{k:?}]"));
                 return Err(msg(format!(
@@ -830,6 +864,15 @@ fn scenario_from(
                     .or_insert_with(|| Value::Object(serde_json::Map::new()));
                 match entry {
                     Value::Object(o) => {
+                        if let Some(w) = o.get(k.as_str()) {
+                            // Set by the section's own keyword (`ba_star={...}`).
+                            if !same_json(w, &value) {
+                                return Err(msg(format!(
+                                    "{k}={} and {sec}={{{k:?}: {w}}} set the same option; remove one of them",
+                                    repr(v)
+                                )));
+                            }
+                        }
                         o.insert(k.clone(), value);
                     }
                     other => {
@@ -927,12 +970,33 @@ impl RunResult {
 /// Export format names -> formats.
 /// `export=` of `save`: one format name or a list of them (`export="csv"` raised "Can't
 /// extract 'str' to 'Vec'").
-#[derive(FromPyObject)]
 enum Formats {
     /// One format.
     One(String),
     /// Several.
     Many(Vec<String>),
+}
+
+impl<'a, 'py> FromPyObject<'a, 'py> for Formats {
+    type Error = PyErr;
+
+    fn extract(ob: pyo3::Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        if let Ok(s) = ob.extract::<String>() {
+            return Ok(Formats::One(s));
+        }
+        let bad = || {
+            PyTypeError::new_err(format!(
+                "must be a format name or a list of them (csv, json, nav-path, geojson), got {}",
+                repr(&ob)
+            ))
+        };
+        if !ob.is_instance_of::<PyList>() && !ob.is_instance_of::<PyTuple>() {
+            return Err(bad());
+        }
+        ob.extract::<Vec<String>>()
+            .map(Formats::Many)
+            .map_err(|_| bad())
+    }
 }
 
 impl Formats {

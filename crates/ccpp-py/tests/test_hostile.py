@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 import signal
 import subprocess
@@ -419,3 +420,38 @@ def test_round_three_python_holes(room: Path, tmp_path: Path) -> None:
     assert sorted(p.name for p in (tmp_path / "plan").iterdir()) == ["path.geojson"]
     with pytest.raises(ccpp.CcppError, match=r"^max_steps / sim.max_steps must be >= 1, got 0"):
         ccpp.run(m, "bsa", max_steps=0)
+
+
+def test_round_four_python_holes(shared_maps: Path, tmp_path: Path) -> None:
+    """From a third hostile tester."""
+    box = shared_maps / "teb_empty_box.yaml"
+    # A nested keyword beside its section's keyword: one value, whatever the order (the later
+    # one silently won).
+    for kw in (
+        {"ba_star": {"smoothing": True}, "smoothing": False},
+        {"smoothing": False, "ba_star": {"smoothing": True}},
+    ):
+        with pytest.raises(ccpp.CcppError, match="set the same option"):
+            ccpp.run(box, "ba-star-extended", **kw)
+    agree = ccpp.run(box, "ba-star-extended", ba_star={"smoothing": False, "tile_side_m": 0.4}, smoothing=False)
+    assert json.loads(agree.scenario_json)["options"]["ba_star"]["tile_side_m"] == 0.4
+    # Text equal but for case is one value, as --side RIGHT beside side: right in --config.
+    right = ccpp.run(box, "bsa", side="RIGHT", options={"side": "right"})
+    assert json.loads(right.scenario_json)["options"]["side"] == "right"
+    # A plan has no step cap to give (it cut the plan short, said only in `finished`).
+    with pytest.raises(ccpp.CcppError, match="max_steps does not apply to plan"):
+        ccpp.plan(box, "bcd", max_steps=5)
+    # export= of another type: one line naming what is wanted (a pyo3 message of internal
+    # types before).
+    r = ccpp.run(box, "bsa")
+    for bad in (5, b"csv", {"csv"}):
+        with pytest.raises(TypeError, match=r"^argument 'export': must be a format name or a list of them") as e:
+            r.save(tmp_path / "x", export=bad)
+        assert "\n" not in str(e.value)
+    # A misspelt landmark field is refused (the tag faced east).
+    with pytest.raises(ccpp.CcppError, match="unknown field `thta`"):
+        ccpp.run(box, "bcd", odometry_noise=0.02, landmarks=[{"id": 1, "x": 0, "y": 0, "thta": 1.0}])
+    # Drift out of the area is explained too (it was only counted).
+    drifted = ccpp.run(box, "bcd", area=[-2, -2, 2, 2], odometry_noise=0.03, seed=1)
+    assert drifted.metrics["keepout_violations"] > 0
+    assert any("keep-out violation" in w for w in drifted.warnings), drifted.warnings

@@ -78,7 +78,12 @@ const FIELDS: [&str; 7] = [
 /// other (`negat`, `free_threshold`; at least four letters), or at most two edits apart
 /// (`orgin`, `occupied_tresh`).
 fn misspelt(key: &str) -> Option<&'static str> {
-    let k = key.to_ascii_lowercase();
+    let k = key.trim().to_ascii_lowercase();
+    if k.chars().count() > 64 {
+        // No field is near a key this long (and its edit distance would cost its length
+        // times the field's).
+        return None;
+    }
     FIELDS.into_iter().find(|f| {
         k == *f
             || (k.len() >= 4 && (k.starts_with(f) || f.starts_with(k.as_str())))
@@ -88,7 +93,9 @@ fn misspelt(key: &str) -> Option<&'static str> {
 
 /// Levenshtein distance of two short ASCII keys.
 fn edits(a: &str, b: &str) -> usize {
-    let (a, b) = (a.as_bytes(), b.as_bytes());
+    // In characters: a zero-width space inside `negate` is one edit, not three bytes.
+    let (a, b): (Vec<char>, Vec<char>) = (a.chars().collect(), b.chars().collect());
+    let (a, b) = (a.as_slice(), b.as_slice());
     let mut row: Vec<usize> = (0..=b.len()).collect();
     for (i, &ca) in a.iter().enumerate() {
         let mut diag = row[0];
@@ -186,7 +193,13 @@ impl MapYaml {
         if let Some((key, field)) = raw.other.keys().find_map(|k| misspelt(k).map(|f| (k, f))) {
             return Err(MapError::MisspeltField {
                 path: path.to_path_buf(),
-                key: one_line(key).chars().take(80).collect(),
+                // Escaped: a tab or an escape sequence in the key was trimmed or printed raw.
+                key: key
+                    .chars()
+                    .take(80)
+                    .collect::<String>()
+                    .escape_debug()
+                    .to_string(),
                 field,
             });
         }
@@ -342,6 +355,12 @@ mod tests {
             let msg = e.to_string();
             assert!(msg.contains(key.split(':').next().unwrap()), "{msg}");
             assert!(msg.contains("dir/test.yaml"), "{msg}");
+        }
+        // A tab and a zero-width space: named escaped, and one edit away.
+        for key in ["\"negate\\t\": 1", "\"nega\\u200bte\": 1"] {
+            let e = parse(&format!("{BASE}{key}\n")).unwrap_err().to_string();
+            assert!(e.contains("did you mean `negate`"), "{e}");
+            assert!(e.contains("\\t") || e.contains("\\u{200b}"), "{e}");
         }
         // A key near no field is ignored, as map_server does.
         let y = parse(&format!("{BASE}name: lab\nsensor: lidar\n")).unwrap();
