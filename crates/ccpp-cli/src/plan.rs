@@ -53,9 +53,16 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     let busy = crate::busy::Busy::start(format!("{kind} on {}: planning", map.name));
     let plan = plan_route(&scenario, &map, DEFAULT_TOLERANCE_M);
     busy.done();
-    let plan = plan.map_err(|e| match e {
-        PlanError::Scenario(s) => flag(s),
-        other @ PlanError::Online(..) => other.into(),
+    let plan = plan.map_err(|e| match (e, a.options.config.as_deref()) {
+        // The planner's execution given in the options file: name the file (`ccpp run` names
+        // it for the same clash).
+        (PlanError::Scenario(ScenarioError::Invalid(m)), Some(cfg))
+            if m.starts_with("the execution given for") =>
+        {
+            anyhow::anyhow!("{}: {m}", cfg.display())
+        }
+        (PlanError::Scenario(s), _) => flag(s),
+        (other @ PlanError::Online(..), _) => other.into(),
     })?;
     let formats: &[ExportFormat] = if a.export.is_empty() {
         &DEFAULT_EXPORTS

@@ -429,7 +429,11 @@ fn plan_refuses_online_planners_and_foreign_flags() {
             o,
         ],
         Some(&map),
-        &["rect_boustrophedon.exec", "does not apply to a plan"],
+        &[
+            cfg.file_name().unwrap().to_str().unwrap(),
+            "rect_boustrophedon.exec",
+            "does not apply to a plan",
+        ],
     );
     assert!(!out.exists());
 }

@@ -62,7 +62,9 @@ fn check_dropped(scenario: &Scenario) -> Result<(), ScenarioError> {
         ))
     };
     if scenario.sim.exec.is_some() {
-        return Err(dropped("sim.exec (exec=)".into()));
+        return Err(dropped(
+            "sim.exec (--exec, --odometry-noise; exec=, odometry_noise=)".into(),
+        ));
     }
     if scenario.planner_sets_execution() {
         let kind = scenario.planner.kind();

@@ -752,7 +752,7 @@ impl Scenario {
         }
         if !lm.landmarks.is_empty() && !matches!(self.execution(), Execution::Pid(_)) {
             return Err(invalid(format!(
-                "landmarks correct the pose estimate of PID execution only, and {} runs with ideal execution (use --exec pid)",
+                "landmarks correct the pose estimate of PID execution only, and {} runs with ideal execution (use --exec pid / exec=\"pid\", or odometry noise, which runs PID)",
                 self.planner.name()
             )));
         }

@@ -101,7 +101,7 @@ def test_plan_refuses_what_a_plan_would_drop(room: Path, ccpp_bin: str, tmp_path
         ccpp.plan(room, "bcd", start=(1.0, 1.0, 1.0))
     assert ccpp.plan(room, "bcd", start=(1.0, 1.0)).finished
     # A plan executes the steps ideally: an execution would be dropped.
-    with pytest.raises(ccpp.CcppError, match=r"sim\.exec \(exec=\) does not apply to a plan"):
+    with pytest.raises(ccpp.CcppError, match=r"sim\.exec \(--exec, --odometry-noise; exec=, odometry_noise=\) does not apply to a plan"):
         ccpp.plan(room, "bcd", exec="pid")
     with pytest.raises(ccpp.CcppError, match=r"rect_boustrophedon\.exec does not apply to a plan"):
         ccpp.plan(room, "rect-boustrophedon", options=PID)
