@@ -91,7 +91,17 @@ pub fn parse_landmarks(text: &str) -> Result<Vec<Landmark>, LandmarkFileError> {
         if items.len() > MAX_LANDMARKS {
             return Err(LandmarkFileError::TooMany);
         }
-        serde_json::from_str(trimmed).map_err(|e| LandmarkFileError::Json(e.to_string()))?
+        serde_json::from_str(trimmed).map_err(|e| {
+            // serde's words for an item of the wrong length name the struct's four fields
+            // (`expected struct Landmark with 4 elements`); the theta is optional.
+            let text = e.to_string();
+            let text = if text.contains("struct Landmark") || text.contains("trailing characters") {
+                format!("each landmark is [id, x, y] or [id, x, y, theta], or an object with those fields ({text})")
+            } else {
+                text
+            };
+            LandmarkFileError::Json(text)
+        })?
     } else {
         let mut out = Vec::new();
         let mut first = true;
@@ -165,6 +175,14 @@ mod tests {
             Err(LandmarkFileError::Json(_))
         ));
         assert!(parse_landmarks("").unwrap().is_empty());
+        // An item of the wrong length says what an item is.
+        for bad in ["[[1, 0]]", "[[1, 0, 0, 0, 0]]"] {
+            let e = parse_landmarks(bad).unwrap_err().to_string();
+            assert!(
+                e.contains("each landmark is [id, x, y] or [id, x, y, theta]"),
+                "{bad}: {e}"
+            );
+        }
         // A misspelt field is refused (it was dropped: the tag faced east).
         let e = parse_landmarks(r#"[{"id":1,"x":0,"y":0,"thta":1.0}]"#).unwrap_err();
         assert!(e.to_string().contains("unknown field `thta`"), "{e}");
