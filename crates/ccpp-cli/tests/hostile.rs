@@ -2302,4 +2302,24 @@ fn contacts_under_drift_are_explained() {
         ],
     );
     assert!(!err.contains("bumper"), "{err}");
+    // A landmark given but never seen corrects nothing: the run is the run without it, and
+    // the warning says so (it was silent).
+    let far = d.path().join("far.csv");
+    std::fs::write(&far, "1,11.5,11.5\n").unwrap();
+    let (err, hits) = run(
+        "far",
+        &[
+            "--odometry-noise",
+            "0.02",
+            "--seed",
+            "1",
+            "--landmarks",
+            s(&far),
+        ],
+    );
+    assert!(hits > 0);
+    assert!(
+        err.contains("the robot saw none of the 1 landmark(s) given"),
+        "{err}"
+    );
 }

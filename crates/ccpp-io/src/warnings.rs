@@ -28,13 +28,14 @@ pub fn motions_cut_warning(trace: &Trace) -> Option<String> {
     })
 }
 
-/// Bumper contacts and keep-out violations under odometry noise without landmarks, explained: the pose estimate
+/// Bumper contacts and keep-out violations under odometry noise with no landmark fix (none
+/// given, or none seen), explained: the pose estimate
 /// drifted from the truth, so the planner drove into walls it placed elsewhere (and an
 /// offline planner's remaining moves started from a wrong position). The trace still ends
 /// `done` (the planner finished its plan), so without this the run read as complete.
 pub fn drift_warning(scenario: &Scenario, trace: &Trace, metrics: &Metrics) -> Option<String> {
     let (collisions, zones) = (metrics.collisions, metrics.keepout_violations);
-    if (collisions == 0 && zones == 0) || !scenario.sim.landmarks.landmarks.is_empty() {
+    if collisions == 0 && zones == 0 {
         return None;
     }
     // The execution event comes first of all events (a run's first step).
@@ -42,16 +43,35 @@ pub fn drift_warning(scenario: &Scenario, trace: &Trace, metrics: &Metrics) -> O
         .events()
         .take(4)
         .any(|(_, e)| matches!(e, Event::Execution { noisy: true, .. }));
+    if !noisy {
+        return None;
+    }
+    // Landmarks correct the estimate only when seen: given but never in range, the run is
+    // the run without them (it got no warning).
+    let given = scenario.sim.landmarks.landmarks.len();
+    if given > 0
+        && trace
+            .events()
+            .any(|(_, e)| matches!(e, Event::LandmarkFix { .. }))
+    {
+        return None;
+    }
     let what = match (collisions, zones) {
         (c, 0) => format!("{c} bumper contact(s)"),
         (0, z) => format!("{z} keep-out violation(s)"),
         (c, z) => format!("{c} bumper contact(s) and {z} keep-out violation(s)"),
     };
-    noisy.then(|| {
+    let remedy = if given == 0 {
+        "give --landmarks / landmarks= to correct the estimate".to_string()
+    } else {
         format!(
-            "{what}: under odometry noise without landmarks the pose estimate drifts from the truth, and the robot drives into walls and zones it believes are elsewhere; give --landmarks / landmarks= to correct the estimate (the coverage is what was swept)"
+            "the robot saw none of the {given} landmark(s) given (within {} m of its path): place them where it drives",
+            ccpp_core::display::Compact(scenario.sim.landmarks.range_m)
         )
-    })
+    };
+    Some(format!(
+        "{what}: under odometry noise without a landmark fix the pose estimate drifts from the truth, and the robot drives into walls and zones it believes are elsewhere; {remedy} (the coverage is what was swept)"
+    ))
 }
 
 /// Every warning of a run of `scenario` with this trace and these metrics: an early stop, PID
