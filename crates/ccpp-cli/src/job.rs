@@ -15,7 +15,7 @@ use ccpp_core::planners::{PlannerConfig, PlannerKind, PlannerOptions};
 use ccpp_core::sim::{RunOutput, SimConfig};
 use ccpp_core::world::{Robot, World};
 use ccpp_core::Pose;
-use ccpp_io::execution::{execution, ExecAsk, Names};
+use ccpp_io::execution::{exec_choice, execution, ExecAsk, Names};
 use ccpp_io::map::{load_map_bytes, LoadOptions};
 use ccpp_io::scenario::{Scenario, ScenarioError};
 
@@ -479,12 +479,7 @@ fn sim_from(a: &RunArgs, config: &mut PlannerConfig) -> Result<SimConfig> {
         }
         sim.sensor_range = Some(r);
     }
-    let exec = match a.exec.as_deref().map(str::to_ascii_lowercase).as_deref() {
-        None => None,
-        Some("ideal") => Some(false),
-        Some("pid") => Some(true),
-        Some(other) => bail!("--exec must be ideal or pid, got {other:?}"),
-    };
+    let exec = exec_choice(a.exec.as_deref(), &Names::FLAGS).map_err(anyhow::Error::msg)?;
     let preferred = config.settings().preferred_execution();
     let section = kind.info().section;
     let file = options_file(a.options.config.as_deref());

@@ -69,6 +69,23 @@ impl Names {
     };
 }
 
+/// The execution choice as typed (`ideal` or `pid`, without regard to case): `Some(true)` for
+/// PID, `Some(false)` for ideal, `None` when none is given ([`ExecAsk::pid`]).
+///
+/// # Errors
+/// Any other text, named by `names.exec`.
+pub fn exec_choice(text: Option<&str>, names: &Names) -> Result<Option<bool>, String> {
+    match text.map(str::to_ascii_lowercase).as_deref() {
+        None => Ok(None),
+        Some("ideal") => Ok(Some(false)),
+        Some("pid") => Ok(Some(true)),
+        Some(other) => Err(format!(
+            "{} must be ideal or pid, got {other:?}",
+            names.exec
+        )),
+    }
+}
+
 /// The execution of a run of `kind` for `ask`, given the planner's own (`preferred`, from its
 /// options): `None` leaves the planner's own. The seed is used for the noise here
 /// (random-bounce also takes it as its option, which the caller sets).

@@ -23,7 +23,7 @@ use ccpp_core::trace::{Cursor, Entry, Event, Record, Trace};
 use ccpp_core::world::{Robot, World};
 use ccpp_core::zones::ZoneMasks;
 use ccpp_core::Point;
-use ccpp_io::execution::{execution, ExecAsk, Names};
+use ccpp_io::execution::{exec_choice, execution, ExecAsk, Names};
 use ccpp_io::export::{render_exports, zone_features, ExportFormat, ExportMeta};
 use ccpp_io::scenario::{MapRecipe, PreparedMap, Scenario, ScenarioError};
 use ccpp_io::zones::ZoneSpec;
@@ -910,12 +910,7 @@ fn scenario_from(
     // After the planner's options: `pid` runs the planner's own PID settings (as `--exec pid`
     // beside `--config`); an execution that would drop them, and noise beside the planner's
     // own, are refused (the command line's rules, `ccpp_io::execution`).
-    let pid = match exec.as_deref().map(str::to_ascii_lowercase).as_deref() {
-        None => None,
-        Some("ideal") => Some(false),
-        Some("pid") => Some(true),
-        Some(other) => return Err(msg(format!("exec must be ideal or pid, got {other:?}"))),
-    };
+    let pid = exec_choice(exec.as_deref(), &Names::KEYWORDS).map_err(msg)?;
     let preferred = s.planner.settings().preferred_execution();
     let section = kind.info().section;
     let exec_item = in_options
@@ -1841,10 +1836,9 @@ impl Env {
             limit.unwrap_or(ccpp_io::scenario::DEFAULT_MAX_MEMORY_MB),
         )?;
         let radius = radius.unwrap_or(DEFAULT_RADIUS);
-        let exec = match exec.unwrap_or("ideal").to_ascii_lowercase().as_str() {
-            "ideal" => Execution::Ideal,
-            "pid" => Execution::Pid(PidOptions::default()),
-            other => return Err(msg(format!("exec must be ideal or pid, got {other:?}"))),
+        let exec = match exec_choice(exec, &Names::KEYWORDS).map_err(msg)? {
+            Some(true) => Execution::Pid(PidOptions::default()),
+            Some(false) | None => Execution::Ideal,
         };
         let start = match start.as_deref() {
             None => None,
