@@ -336,6 +336,3 @@ pub fn summary(m: &Metrics) -> String {
     }
     s
 }
-
-/// What an early stop means ([`ccpp_io::warnings::stop_warning`]).
-pub use ccpp_io::warnings::stop_warning;

@@ -111,7 +111,7 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         let _ = writeln!(
             s,
             "  warning: {}",
-            crate::output::stop_warning(plan.stop.as_str(), "path")
+            ccpp_io::warnings::stop_warning(plan.stop.as_str(), "path")
         );
     }
     let names: Vec<&str> = files.iter().map(|(n, _)| *n).collect();
