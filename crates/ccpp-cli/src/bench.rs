@@ -82,9 +82,21 @@ pub fn expand_maps(items: &[PathBuf]) -> Result<Vec<PathBuf>> {
     Ok(out)
 }
 
+/// A map's name from its file stem. A stem that is not a usable folder name (`..yaml` and
+/// `...yaml` have the stems `.` and `..`, which would put the run folders beside `runs/`)
+/// becomes `map`, and `summary` becomes `summary-map`: the per-map plot `tradeoff_<map>`
+/// would otherwise be the summary's `tradeoff_summary`.
 fn map_name(p: &Path) -> String {
-    p.file_stem()
-        .map_or_else(|| "map".into(), |s| s.to_string_lossy().into_owned())
+    let stem = p
+        .file_stem()
+        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+    if stem.chars().all(|c| c == '.') {
+        "map".into()
+    } else if stem == "summary" {
+        "summary-map".into()
+    } else {
+        stem
+    }
 }
 
 /// Drops repeated maps (the same file named twice) and gives every map a distinct name, used
@@ -907,6 +919,29 @@ pub fn results_md(rows: &[Row]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The stems `.` and `..` (files `..yaml`, `...yaml`) would put run folders beside
+    /// `runs/`, and a map `summary` would share its trade-off plot with the summary's.
+    #[test]
+    fn map_names_are_folder_names_and_not_the_summary() {
+        let dir = tempfile::tempdir().unwrap();
+        let files = ["..yaml", "...yaml", "summary.yaml", "a.yaml"];
+        let paths: Vec<PathBuf> = files.iter().map(|f| dir.path().join(f)).collect();
+        for p in &paths {
+            std::fs::write(p, "").unwrap();
+        }
+        let folder = dir.path().file_name().unwrap().to_string_lossy().into_owned();
+        let names: Vec<String> = name_maps(paths).into_iter().map(|(_, n)| n).collect();
+        assert_eq!(
+            names,
+            [
+                format!("{folder}-map"),
+                format!("{folder}-map-2"),
+                "summary-map".to_string(),
+                "a".to_string()
+            ]
+        );
+    }
 
     /// Runs that do not fit beside each other under the limit take turns; one that fits alone
     /// always gets its turn (no deadlock), and runs that fit together run together.
