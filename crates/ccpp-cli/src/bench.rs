@@ -930,7 +930,12 @@ mod tests {
         for p in &paths {
             std::fs::write(p, "").unwrap();
         }
-        let folder = dir.path().file_name().unwrap().to_string_lossy().into_owned();
+        let folder = dir
+            .path()
+            .file_name()
+            .unwrap()
+            .to_string_lossy()
+            .into_owned();
         let names: Vec<String> = name_maps(paths).into_iter().map(|(_, n)| n).collect();
         assert_eq!(
             names,

@@ -240,7 +240,8 @@ pub struct PidOptions {
     /// Aim point distance ahead of the robot's projection on the segment, metres.
     pub lookahead_m: f64,
     /// Record the true pose in the trace every this many control steps (the end of every motion
-    /// is always recorded). 1 = every step.
+    /// and the poses where the robot starts or stops turning in place are always recorded, so
+    /// the turns counted do not depend on it). 1 = every step.
     pub record_every: u32,
     /// Safety cap on control steps per motion (a motion that has not converged by then ends
     /// where it is).

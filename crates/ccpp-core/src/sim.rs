@@ -15,7 +15,7 @@
 //!   landmark observations when [`SimConfig::landmarks`] has some ([`crate::landmarks`]).
 //!   The trace gets an [`Event::Execution`] at the start, an [`Event::PlannedSegment`] before
 //!   each translation, and true poses every `record_every` control steps plus at the end of
-//!   each motion. `MoveTo` follows the segment from the previous planned goal (when the last
+//!   each motion and where the robot starts or stops turning in place. `MoveTo` follows the segment from the previous planned goal (when the last
 //!   motion ended without contact) to the new one, so the robot steers back onto the plan.
 //!
 //! The sensor scan is always taken around the **true** position and returned in map
@@ -439,11 +439,24 @@ impl<'w> Simulator<'w> {
         let mut since_record = 0u64;
         // Control steps run; all of them (and no contact): the motion was cut at the cap.
         let mut ran = 0u32;
+        // Whether the last command turned in place (no linear speed).
+        let mut was_in_place = None;
         for _ in 0..st.opts.max_steps_per_motion {
             let Some((v, w)) = st.tracker.command(self.est, goal) else {
                 break;
             };
             ran += 1;
+            // The pose where the robot starts or stops turning in place is recorded whatever
+            // `record_every` is: the metrics count in-place rotations between poses at one
+            // position, and a thinned trace that skipped these poses showed none (bsa-bfs on
+            // teb_maze: 182 turns at `record_every: 1`, 0 at 1000).
+            let in_place = v == 0.0;
+            if was_in_place.is_some_and(|was| was != in_place) && moved {
+                since_record = 0;
+                self.trace.push_pose(self.t, self.pose);
+                moved = false;
+            }
+            was_in_place = Some(in_place);
             // The truth moves with the (possibly perturbed) speeds; the estimate integrates the
             // commanded (measured) ones.
             let (vt, wt) = match (st.opts.noise, st.noise_rng.as_mut()) {
@@ -885,6 +898,36 @@ mod tests {
         let out = simulate(&world, &mut Script(square(1)), &coarse);
         let (_, max) = crate::metrics::tracking_error(&out.trace).unwrap();
         assert!(max < 0.03 + 1e-9, "coarse max {max}");
+    }
+
+    /// Thinning the PID trace keeps the in-place turns: the pose where a turn starts or ends
+    /// is recorded whatever `record_every` is (it once gave 0 turns at 1000).
+    #[test]
+    fn thinned_pid_traces_count_the_same_turns() {
+        let world = big_room();
+        let every = |record_every| SimConfig {
+            exec: Some(Execution::Pid(PidOptions {
+                record_every,
+                ..PidOptions::default()
+            })),
+            ..SimConfig::default()
+        };
+        let full = simulate(&world, &mut Script(square(2)), &every(1));
+        let full = crate::metrics::compute(&world, &full, "room");
+        // Two laps of four corners; the first move already faces east.
+        assert_eq!(full.turns, 7);
+        for n in [10, 1000, u32::MAX] {
+            let out = simulate(&world, &mut Script(square(2)), &every(n));
+            let m = crate::metrics::compute(&world, &out, "room");
+            assert_eq!(m.turns, full.turns, "record_every {n}");
+            assert!(
+                (m.rotation_rad - full.rotation_rad).abs() < 1e-6,
+                "record_every {n}: {} against {}",
+                m.rotation_rad,
+                full.rotation_rad
+            );
+            assert!((m.path_length_m - full.path_length_m).abs() < 1e-6);
+        }
     }
 
     #[test]
