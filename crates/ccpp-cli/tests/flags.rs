@@ -897,6 +897,17 @@ fn degenerate_runs_say_what_is_wrong() {
             ],
         );
     }
+    // Finer than a pixel: lanes lie on pixel lines, so 0.02 and 0.05 m ran the same plan on
+    // a 0.05 m map.
+    let cfg = dir.join("lanes-fine.yaml");
+    std::fs::write(&cfg, "bcd: { lane_spacing_m: 0.0001 }\n").unwrap();
+    run_fails(
+        dir,
+        &map,
+        "bcd",
+        &["--config", cfg.to_str().unwrap()],
+        &["bcd.lane_spacing_m", "finer than the map's pixel"],
+    );
     let cfg = dir.join("lanes0.yaml");
     run_ok(
         dir,

@@ -285,8 +285,10 @@ use crate::world::World;
 #[serde(default, deny_unknown_fields)]
 pub struct BcdOptions {
     /// Largest lane spacing in metres (lanes are spread evenly, at most this far apart);
-    /// `None` = `2 r_tool`. Must be > 0 and at most `2 r_tool` (wider lanes leave strips
-    /// unswept; the planner settings' `check` refuses them against the robot).
+    /// `None` = `2 r_tool`. Must be at least the map's resolution and at most `2 r_tool`
+    /// (wider lanes leave strips unswept; the planner settings' `check` refuses them against
+    /// the robot). Below `2 r_tool` the lanes overlap: the plan then counts swept floor with
+    /// half the spacing as the tool's radius, so no lane is dropped as already swept.
     pub lane_spacing_m: Option<f64>,
     /// Extra clearance (pixels, >= 0) that transfer paths keep from obstacles when they can,
     /// apart from the stretches next to their ends (a lane end may sit at plain clearance);
@@ -508,9 +510,11 @@ impl Bcd {
         } else {
             let d = BcdOptions::default();
             let fixed = BcdOptions {
-                lane_spacing_m: opts
-                    .lane_spacing_m
-                    .filter(|&s| s.is_finite() && s > 0.0 && fits_tool(world, s)),
+                lane_spacing_m: opts.lane_spacing_m.filter(|&s| {
+                    s.is_finite()
+                        && s >= world.frame().resolution * (1.0 - 1e-9)
+                        && fits_tool(world, s)
+                }),
                 margin_px: if opts.margin_px.is_finite() && opts.margin_px >= 0.0 {
                     opts.margin_px
                 } else {
@@ -574,6 +578,16 @@ impl Bcd {
             return Err(BcdOptionsError::OutOfRange {
                 name: "lane_spacing_m",
                 what: "at most 2 r_tool (wider lanes leave strips unswept)",
+                value: s,
+            });
+        }
+        if let Some(s) = opts
+            .lane_spacing_m
+            .filter(|&s| s < world.frame().resolution * (1.0 - 1e-9))
+        {
+            return Err(BcdOptionsError::OutOfRange {
+                name: "lane_spacing_m",
+                what: "at least the map's resolution (lanes lie on its pixel lines)",
                 value: s,
             });
         }

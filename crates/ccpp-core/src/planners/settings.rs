@@ -1014,6 +1014,19 @@ impl PlannerSettings for BcdOptions {
                     ),
                 ));
             }
+            // Lanes lie on pixel lines: a finer spacing ran as one pixel (0.05 and 0.02 m on a
+            // 0.05 m map gave the same plan).
+            let res = s.frame.resolution;
+            if sp < res * (1.0 - 1e-9) {
+                return Err(OptionsError::new(
+                    "lane_spacing_m",
+                    format!(
+                        "lane spacing {} m is finer than the map's pixel ({} m): the lanes lie on its pixel lines",
+                        fmt_m(sp),
+                        fmt_m(res)
+                    ),
+                ));
+            }
         }
         Ok(())
     }

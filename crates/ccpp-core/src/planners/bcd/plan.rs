@@ -158,7 +158,14 @@ impl Bcd {
             ok,
             safe,
             keep_px: (opts.margin_px > 0.0).then_some(need),
-            rt: robot.tool_radius / res,
+            // Lanes set closer than the tool's width overlap on purpose (mowing, disinfection):
+            // every choice that counts swept floor (cells left to their neighbours' lanes, rim
+            // passes, turn pruning) counts it with half the spacing, else the pruning drops
+            // the lanes the overlap doubles (`lane_spacing_m: 0.1` gave gaps of 0.2 m).
+            rt: robot
+                .tool_radius
+                .min(opts.lane_spacing_m.map_or(f64::INFINITY, |s| s / 2.0))
+                / res,
             coarse: hops::CoarseCache::default(),
             stop,
         };

@@ -377,6 +377,39 @@ fn min_coverage_trades_floor_for_turns_and_holds_it() {
     assert!(last.effective_coverage < keep.effective_coverage);
 }
 
+/// Lanes closer than the tool's width overlap as asked: the plan sweeps the floor even with a
+/// tool of half the spacing (the pruning once dropped every other lane as already swept, which
+/// left gaps of twice the spacing).
+#[test]
+fn a_spacing_below_the_tool_width_keeps_its_lanes() {
+    let world = block_room();
+    let narrow = |spacing: f64| {
+        let robot = crate::world::Robot {
+            radius: 0.08,
+            tool_radius: spacing / 2.0,
+        };
+        World::new(world.map().clone(), robot, Some(world.start())).unwrap()
+    };
+    let swept = |opts: &BcdOptions, spacing: f64| {
+        let mut p = Bcd::try_new(&world, opts).unwrap();
+        let out = crate::sim::simulate(&world, &mut p, &crate::sim::SimConfig::default());
+        crate::metrics::compute(&narrow(spacing), &out, "block_room").effective_coverage
+    };
+    for spacing in [0.08, 0.04] {
+        let opts = BcdOptions {
+            lane_spacing_m: Some(spacing),
+            ..BcdOptions::default()
+        };
+        let asked = swept(&opts, spacing);
+        let plain = swept(&BcdOptions::default(), spacing);
+        assert!(asked >= 0.99, "spacing {spacing}: {asked}");
+        assert!(
+            plain < 0.9,
+            "spacing {spacing}: the default plan sweeps {plain}"
+        );
+    }
+}
+
 #[test]
 fn invalid_options_are_refused() {
     let world = block_room();
@@ -393,6 +426,11 @@ fn invalid_options_are_refused() {
         },
         BcdOptions {
             lane_spacing_m: Some(8.888_888_888_888_889e24),
+            ..BcdOptions::default()
+        },
+        // Finer than a pixel (0.02 m): lanes lie on pixel lines.
+        BcdOptions {
+            lane_spacing_m: Some(0.01),
             ..BcdOptions::default()
         },
         BcdOptions {
