@@ -74,10 +74,24 @@ pub fn drift_warning(scenario: &Scenario, trace: &Trace, metrics: &Metrics) -> O
     ))
 }
 
+/// A run that drove nothing while floor was left, said (`None` otherwise). Options that are
+/// legal but leave the planner nothing to do (a PID `tolerance_m` of 10 m that counts every
+/// goal reached at once, a bsa-bfs `clearance_margin_m` no free cell meets) ended "done" at
+/// 0 m without a word.
+pub fn no_motion_warning(metrics: &Metrics) -> Option<String> {
+    (metrics.path_length_m == 0.0 && metrics.effective_coverage < 1.0).then(|| {
+        format!(
+            "the robot did not move (0 m driven, {:.1} % of the floor swept from the start): check the options that bound its moves (exec.pid.tolerance_m, clearance margins, the sensor range)",
+            100.0 * metrics.effective_coverage
+        )
+    })
+}
+
 /// Every warning of a run of `scenario` with this trace and these metrics: an early stop, PID
-/// motions cut short, contacts under drift.
+/// motions cut short, contacts under drift, no motion at all.
 pub fn run_warnings(scenario: &Scenario, trace: &Trace, metrics: &Metrics) -> Vec<String> {
     let mut out = Vec::new();
+    out.extend(no_motion_warning(metrics));
     out.extend(drift_warning(scenario, trace, metrics));
     out.extend(motions_cut_warning(trace));
     if let Some(why) = &metrics.stop_reason {
