@@ -150,7 +150,10 @@ pub struct RunArgs {
     /// Tile side in metres: ba-star and ba-star-extended tiles, bsa-bfs cells (default 2 r).
     #[arg(long, value_name = "M")]
     pub tile_side: Option<f64>,
-    /// BA* backtracking path smoothing (A*SPT): `on` (default) or `off` to compare.
+    /// BA* backtracking path smoothing (A*SPT): `on` (default) or `off` to compare. For
+    /// ba-star-extended it changes only the backtracks where BA*'s own path is driven: by
+    /// default (`shorter_backtrack: true`) the extension's known-free way replaces it wherever
+    /// that is shorter, which is almost everywhere.
     #[arg(long, value_name = "on|off", value_parser = parse_on_off)]
     pub smoothing: Option<bool>,
     /// BSA reference lateral side: `left` (default) or `right`.

@@ -548,6 +548,82 @@ fn a_png_claiming_an_absurd_width_is_named_too_large() {
     );
 }
 
+/// A control period far below any robot's with a cap that lets it run (`dt_s: 1e-7`,
+/// `max_steps_per_motion: 4e9`) simulated for over half an hour in a few MB: refused up front
+/// by its estimated control steps, naming dt_s. At `dt_s: 1e-5` the memory estimate once
+/// counted the cap for every motion (4.4 TB) and refused a run of 25 s and 143 MB.
+#[test]
+fn a_control_period_that_would_run_for_hours_is_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let cfg = write(
+        dir,
+        "fine.yaml",
+        "bsa_bfs: { exec: { pid: { dt_s: 1.0e-7, record_every: 4000000000, max_steps_per_motion: 4000000000 } } }\n",
+    );
+    refused(
+        &[
+            "run",
+            "--map",
+            s(&map),
+            "--planner",
+            "bsa-bfs",
+            "--config",
+            &cfg,
+            "--out",
+            s(&dir.join("o")),
+        ],
+        &["control steps", "dt_s 1e-7 s", "raise exec.pid.dt_s"],
+    );
+    assert!(!dir.join("o").exists());
+}
+
+/// Options that are legal but leave the planner nothing to do ended "done" at 0 m without a
+/// word: a PID tolerance wider than every move (each goal reached at once), a clearance
+/// margin no free cell meets. The run now warns.
+#[test]
+fn a_run_that_never_moves_is_told() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    for (i, text) in [
+        "bsa_bfs: { exec: { pid: { tolerance_m: 10 } } }\n",
+        "bsa_bfs: { clearance_margin_m: 5 }\n",
+    ]
+    .iter()
+    .enumerate()
+    {
+        let cfg = write(dir, &format!("still{i}.yaml"), text);
+        let o = ccpp()
+            .args(["run", "--map", s(&map), "--planner", "bsa-bfs"])
+            .args([
+                "--config",
+                &cfg,
+                "--json",
+                "--out",
+                s(&dir.join(format!("o{i}"))),
+            ])
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{text}");
+        let m: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        assert_eq!(m["path_length_m"], 0.0, "{text}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            err.contains("warning: the robot did not move (0 m driven"),
+            "{text}: {err}"
+        );
+    }
+    // A run that moves is not told.
+    let o = ccpp()
+        .args(["run", "--map", s(&map), "--planner", "bsa-bfs", "--out"])
+        .arg(dir.join("moved"))
+        .output()
+        .unwrap();
+    assert!(!String::from_utf8_lossy(&o.stderr).contains("did not move"));
+}
+
 /// A control period far too short for the per-motion cap (`dt_s: 1e-9`) made every PID motion
 /// stop at `max_steps_per_motion` short of its goal: a run of 0 m that ended "done" without a
 /// word. The simulator notes a cut motion in the trace, and `run` warns.

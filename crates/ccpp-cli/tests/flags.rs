@@ -772,6 +772,20 @@ fn absurd_sizes_end_within_seconds() {
         &["--radius", "1e-6"],
         &["sensor range"],
     );
+    // Nor half a pixel beyond it (0.05 m map): these runs turned in place 65 times and ended
+    // "done" at 0 m (r = 0.03 at the default 4 r, and a range of r + 1.6 px).
+    for args in [
+        &["--radius", "0.03"][..],
+        &["--radius", "0.15", "--sensor-range", "0.23"],
+    ] {
+        run_fails(
+            dir,
+            &map,
+            "random-bounce",
+            args,
+            &["sensor range", "r + 2 px"],
+        );
+    }
     run_fails(
         dir,
         &map,

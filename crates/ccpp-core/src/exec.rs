@@ -290,53 +290,72 @@ impl PidOptions {
     /// the simulator caps them. Memory estimates count PID trace records with it: the creep
     /// and the arrival shaping make a short move take many more steps than its length over
     /// the top speed (at the defaults a 0.1 m move takes 32 steps, not 4). At most
-    /// [`MOTION_STEPS_SIMULATED`] steps of each part are simulated: a part still under way
-    /// then counts `max_steps_per_motion` steps (what the simulator would run at most), so
-    /// gains that crawl cost the estimate no time.
+    /// [`MOTION_STEPS_SIMULATED`] steps of each part are simulated: a motion that needs more
+    /// is simulated again with a control period 10, 100, ... times longer and its steps
+    /// counted that many times (the controller follows the same motion in time, so the steps
+    /// scale with `1 / dt_s`: at `dt_s: 1e-5` a 2 m move's count is within a percent of the
+    /// steps run; it once counted `max_steps_per_motion` for it, 4e9 at that run's cap). A
+    /// motion still too long at a million times the period (gains that barely move) counts
+    /// `max_steps_per_motion` a part, what the simulator would run at most.
     pub fn motion_steps(&self, turn_rad: f64, len_m: f64) -> u64 {
-        let opts = PidOptions {
-            noise: None,
-            ..*self
-        };
-        let mut tracker = Tracker::new(&opts);
+        let cap = u64::from(self.max_steps_per_motion);
+        let turn = turn_rad.is_finite() && turn_rad != 0.0;
+        let drive = len_m.is_finite() && len_m > 0.0;
+        let mut scale = 1u64;
+        while scale <= 1_000_000 {
+            let opts = PidOptions {
+                noise: None,
+                dt_s: self.dt_s * scale as f64,
+                ..*self
+            };
+            if let Some(parts) = opts.motion_parts(turn_rad, len_m, cap.div_ceil(scale)) {
+                return parts
+                    .iter()
+                    .map(|&n| n.saturating_mul(scale).min(cap))
+                    .sum();
+            }
+            scale *= 10;
+        }
+        cap * (u64::from(turn) + u64::from(drive))
+    }
+
+    /// The steps of the turn and of the drive of [`Self::motion_steps`]'s motion, each stopped
+    /// at `cap` steps; `None` when a part runs past [`MOTION_STEPS_SIMULATED`] below its cap.
+    fn motion_parts(&self, turn_rad: f64, len_m: f64, cap: u64) -> Option<[u64; 2]> {
+        let mut tracker = Tracker::new(self);
         let mut pose = Pose::new(0.0, 0.0, 0.0);
-        let mut steps = 0u64;
-        let cap = u64::from(opts.max_steps_per_motion);
-        let mut drive = |goal: Goal, pose: &mut Pose| {
+        let mut drive = |goal: Goal, pose: &mut Pose| -> Option<u64> {
             tracker.reset();
             let mut n = 0u64;
-            loop {
-                if n == cap {
-                    break;
-                }
+            while n < cap {
                 if n == MOTION_STEPS_SIMULATED {
-                    n = cap;
-                    break;
+                    return None;
                 }
                 let Some((v, w)) = tracker.command(*pose, &goal) else {
                     break;
                 };
-                *pose = Unicycle::step(*pose, v, w, opts.dt_s);
+                *pose = Unicycle::step(*pose, v, w, self.dt_s);
                 n += 1;
             }
-            steps += n;
+            Some(n)
         };
+        let mut parts = [0u64; 2];
         if turn_rad.is_finite() && turn_rad != 0.0 {
-            drive(Goal::Heading(wrap_angle(turn_rad)), &mut pose);
+            parts[0] = drive(Goal::Heading(wrap_angle(turn_rad)), &mut pose)?;
         }
         if len_m.is_finite() && len_m > 0.0 {
             let (s, c) = pose.theta.sin_cos();
             let to = Point::new(len_m * c, len_m * s);
-            drive(
+            parts[1] = drive(
                 Goal::Segment {
                     from: Point::new(0.0, 0.0),
                     to,
                     reverse: false,
                 },
                 &mut pose,
-            );
+            )?;
         }
-        steps
+        Some(parts)
     }
 }
 
@@ -596,10 +615,11 @@ mod tests {
             ..opts
         };
         assert_eq!(capped.motion_steps(1.0, 5.0), 6);
-        // A crawl is not simulated to its end: past MOTION_STEPS_SIMULATED steps a part counts
-        // the cap (with a cap of billions of steps and gains that crawl, simulating to the end
-        // kept the estimate busy for minutes). This one would end after about 6 million steps
-        // (0.3 m at 1 micrometre a second, 0.05 s a step).
+        // A crawl is not simulated to its end (with a cap of billions of steps and gains that
+        // crawl, simulating to the end kept the estimate busy for minutes): past
+        // MOTION_STEPS_SIMULATED steps a part counts its steps so far over the part of the
+        // motion made. This one ends after about 6 million steps (0.3 m at 1 micrometre a
+        // second, 0.05 s a step); it once counted the cap, 4e9.
         let crawl = PidOptions {
             linear: PidGains {
                 output_limit: 1e-6,
@@ -609,7 +629,43 @@ mod tests {
             max_steps_per_motion: 4_000_000_000,
             ..opts
         };
-        assert_eq!(crawl.motion_steps(0.0, 0.3), 4_000_000_000);
+        let n = crawl.motion_steps(0.0, 0.3);
+        assert!((5_900_000..6_300_000).contains(&n), "{n}");
+        // A control period far below any robot's: the count scaled from the first steps is
+        // within a percent of the steps the motion runs (2 m at dt 1e-5 s).
+        let fine = PidOptions {
+            dt_s: 1e-5,
+            max_steps_per_motion: 4_000_000_000,
+            ..opts
+        };
+        let mut t = Tracker::new(&fine);
+        let goal = Goal::Segment {
+            from: Point::new(0.0, 0.0),
+            to: Point::new(2.0, 0.0),
+            reverse: false,
+        };
+        let (mut p, mut exact) = (Pose::new(0.0, 0.0, 0.0), 0u64);
+        while let Some((v, w)) = t.command(p, &goal) {
+            p = Unicycle::step(p, v, w, fine.dt_s);
+            exact += 1;
+        }
+        assert!(exact > MOTION_STEPS_SIMULATED, "{exact}");
+        let n = fine.motion_steps(0.0, 2.0);
+        assert!(
+            (n as f64 - exact as f64).abs() < 0.01 * exact as f64,
+            "{n} against {exact}"
+        );
+        // Gains that never move count the cap.
+        let still = PidOptions {
+            linear: PidGains {
+                output_limit: 0.0,
+                ..opts.linear
+            },
+            min_speed_mps: 0.0,
+            max_steps_per_motion: 4_000_000_000,
+            ..opts
+        };
+        assert_eq!(still.motion_steps(0.0, 0.3), 4_000_000_000);
         // Under the simulated bound, the exact count.
         let slow = PidOptions {
             linear: PidGains {
