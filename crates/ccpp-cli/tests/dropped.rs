@@ -548,6 +548,39 @@ fn a_png_claiming_an_absurd_width_is_named_too_large() {
     );
 }
 
+/// A tool narrower than half a pixel: coverage is counted per pixel centre, so bcd at
+/// `--radius 0.01` on a 0.05 m map reported 100 % at path ratio 0.40. The run warns; at half a
+/// pixel it does not.
+#[test]
+fn a_tool_narrower_than_the_pixels_is_told() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    for (r, told) in [("0.02", true), ("0.025", false)] {
+        let o = ccpp()
+            .args([
+                "run",
+                "--map",
+                s(&map),
+                "--planner",
+                "bcd",
+                "--radius",
+                r,
+                "--out",
+            ])
+            .arg(dir.join(format!("r{r}")))
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{r}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(
+            err.contains("warning: the tool radius") && err.contains("below half the map's pixel"),
+            told,
+            "{r}: {err}"
+        );
+    }
+}
+
 /// A control period far below any robot's with a cap that lets it run (`dt_s: 1e-7`,
 /// `max_steps_per_motion: 4e9`) simulated for over half an hour in a few MB: refused up front
 /// by its estimated control steps, naming dt_s. At `dt_s: 1e-5` the memory estimate once

@@ -1236,10 +1236,15 @@ impl RunResult {
 
     /// The warnings `ccpp run` prints for this run (without `warning: `): an early stop, PID
     /// motions cut at `max_steps_per_motion`, bumper contacts under odometry noise without
-    /// landmarks. A run that ends `done` may still have some (`stop` is the planner's word).
+    /// landmarks, a run that never moved, a tool narrower than the map's pixels. A run that ends `done` may still have some (`stop` is the planner's word).
     #[getter]
     fn warnings(&self) -> Vec<String> {
-        ccpp_io::warnings::run_warnings(&self.scenario, &self.output.trace, &self.metrics)
+        ccpp_io::warnings::run_warnings(
+            &self.scenario,
+            &self.world,
+            &self.output.trace,
+            &self.metrics,
+        )
     }
 
     /// The start pose used, `(x, y, theta)`.
