@@ -870,8 +870,12 @@ fn georef_errors_name_the_file_once() {
     std::fs::write(&short, "0,0,0,0\n1,2,3\n").unwrap();
     let huge = dir.join("huge.csv");
     std::fs::write(&huge, "0,0,0,0\n100,0,1e300,0\n0,100,0,-1e300\n").unwrap();
+    // Pixel rows counted y up: the fit mirrors the image (it read as "200 % shear").
+    let mirrored = dir.join("mirrored.csv");
+    std::fs::write(&mirrored, "0,0,0,0\n200,0,10,0\n0,200,0,10\n").unwrap();
     let missing = dir.join("missing.csv");
     for (file, needle) in [
+        (&mirrored, "the fit mirrors the image"),
         (&one, "at least 3 point pairs"),
         (&short, "line 2"),
         (&huge, "degenerate transform"),

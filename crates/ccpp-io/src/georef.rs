@@ -2,8 +2,9 @@
 //! ([`ccpp_core::georef::fit_affine`]).
 //!
 //! Format: one pair per line, `px,py,wx,wy` (pixel column, pixel row, world x, world y; commas
-//! or whitespace between the numbers). Blank lines and lines starting with `#` are skipped; a
-//! first line that does not parse as numbers is taken as a header and skipped.
+//! or whitespace between the numbers). Blank lines are skipped and `#` starts a comment to the
+//! end of its line; a first line none of whose fields is a number is taken as a header and
+//! skipped (a data line with one bad field is an error, never a header).
 //!
 //! ```
 //! let text = "px,py,wx,wy\n0,0,0,5\n100,0,5,5\n0,100,0,0\n";
@@ -70,14 +71,18 @@ pub fn parse_georef(text: &str) -> Result<Vec<(Point, Point)>, GeorefProblem> {
     let mut pairs = Vec::new();
     let mut first = true;
     for (n, raw) in text.lines().enumerate() {
-        let line = raw.trim();
-        if line.is_empty() || line.starts_with('#') {
+        // A trailing comment is a comment too: `0,0,0,10 # corner` was taken for a header
+        // and its pair dropped without a word.
+        let line = raw.split('#').next().unwrap_or_default().trim();
+        if line.is_empty() {
             continue;
         }
         let nums: Option<Vec<f64>> = fields(line)
             .map(|f| f.parse::<f64>().ok().filter(|v| v.is_finite()))
             .collect();
-        let header = std::mem::replace(&mut first, false);
+        // A header has no number at all (`px,py,wx,wy`).
+        let header =
+            std::mem::replace(&mut first, false) && fields(line).all(|f| f.parse::<f64>().is_err());
         match nums {
             Some(v) if v.len() == 4 => {
                 if pairs.len() == MAX_GEOREF_PAIRS {
@@ -122,6 +127,17 @@ mod tests {
         let p = parse_georef(t).unwrap();
         assert_eq!(p.len(), 3);
         assert_eq!(p[1], (Point::new(5.0, 6.0), Point::new(7.0, 8.0)));
+    }
+
+    /// A first line with a trailing comment is data, and a first line with a number among
+    /// words is an error, not a header: either once dropped a pair without a word.
+    #[test]
+    fn trailing_comments_and_half_numeric_first_lines() {
+        let p = parse_georef("0,0,0,10 # a\n200,0,10,10\n0,200,0,0 # c\n").unwrap();
+        assert_eq!(p.len(), 3);
+        assert_eq!(p[0], (Point::new(0.0, 0.0), Point::new(0.0, 10.0)));
+        let e = parse_georef("0,0,x,10\n200,0,10,10\n").unwrap_err();
+        assert!(matches!(e, GeorefProblem::BadLine { line: 1, .. }), "{e}");
     }
 
     #[test]

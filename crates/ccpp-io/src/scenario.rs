@@ -490,6 +490,15 @@ pub fn apply_georef(grid: GridMap, path: &Path) -> Result<GridMap, ScenarioError
             Compact(res)
         )));
     }
+    // Pixel rows grow downwards and world y upwards: a map's transform flips orientation.
+    // One that does not mirrors the image, as pixel coordinates given y up do (it read as
+    // "200 % shear or anisotropy").
+    if a * d - b * c > 0.0 {
+        return Err(err(
+            "the fit mirrors the image: pixel coordinates are counted from the top-left corner with py growing downwards, and these look counted y up (use py = image height - py)"
+                .to_string(),
+        ));
+    }
     let yaw = c.atan2(a);
     // Pixel y grows downwards, so the second column is res * (sin yaw, -cos yaw).
     let (sy, cy) = yaw.sin_cos();
