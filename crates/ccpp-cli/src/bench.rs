@@ -315,10 +315,13 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         summary.push(plots);
     }
     let summary = crate::staging::PendingSet::new(summary);
-    crate::plots::write_all(&a.out, &rows, &prepared, robot, &budget)?;
+    let left_out = crate::plots::write_all(&a.out, &rows, &prepared, robot, &budget)?;
     write_file(&a.out.join("results.md"), results_md(&rows).as_bytes())?;
     write_file(&a.out.join("results.csv"), results_csv(&rows).as_bytes())?;
     summary.done();
+    for line in &left_out {
+        eprintln!("{line}");
+    }
     let failed = rows.iter().filter(|r| r.outcome.is_err()).count();
     crate::print_stdout(&format!(
         "{}; wrote {}/results.csv, results.md, plots/\n",
@@ -508,7 +511,7 @@ pub(crate) struct Grant<'a> {
 }
 
 impl MemoryBudget {
-    fn new(limit_mb: u64) -> Self {
+    pub(crate) fn new(limit_mb: u64) -> Self {
         Self {
             limit: limit_mb as f64 * 1024.0 * 1024.0,
             used: Mutex::new(0.0),
@@ -573,7 +576,14 @@ fn run_one(
         if same_key {
             if let Ok(text) = ccpp_io::file::read_text(&metrics_path) {
                 if let Ok(m) = serde_json::from_str::<Metrics>(&text) {
-                    return Ok(m);
+                    // Reused only when its trace reads back whole: a damaged trace was reused
+                    // and then left out of the plots in silence.
+                    match whole_trace(dir, budget) {
+                        Ok(()) => return Ok(m),
+                        Err(why) => {
+                            eprintln!("warning: {}: {why}; running it again", dir.display());
+                        }
+                    }
                 }
             }
         }
@@ -595,6 +605,25 @@ fn run_one(
     let bytes = spec.scenario.check_map(map).map_or(0.0, |e| e.bytes);
     let _grant = budget.take(bytes);
     run_isolated(&spec)
+}
+
+/// Checks that the `trace.jsonl` of the run folder `dir` reads back (as the plots read it) and
+/// ends with the simulator's `finished` record (a trace cut at a line's end reads back). The
+/// parsed trace is held against `budget` while it is checked (streamed, about twice the
+/// file's size).
+fn whole_trace(dir: &Path, budget: &MemoryBudget) -> Result<(), String> {
+    let path = dir.join("trace.jsonl");
+    let len = std::fs::metadata(&path).map_or(0, |m| m.len());
+    let _grant = budget.take(2.0 * len as f64);
+    let trace = crate::plots::read_trace(&path).map_err(|e| crate::errors::one_line(&e))?;
+    if matches!(
+        trace.events().last(),
+        Some((_, ccpp_core::trace::Event::Finished { .. }))
+    ) {
+        Ok(())
+    } else {
+        Err("trace.jsonl does not end with the simulator's `finished` record (cut short)".into())
+    }
 }
 
 /// Hidden first argument that makes `ccpp` run one bench job (a [`JobSpec`] as JSON on stdin)
@@ -930,7 +959,12 @@ mod tests {
         for p in &paths {
             std::fs::write(p, "").unwrap();
         }
-        let folder = dir.path().file_name().unwrap().to_string_lossy().into_owned();
+        let folder = dir
+            .path()
+            .file_name()
+            .unwrap()
+            .to_string_lossy()
+            .into_owned();
         let names: Vec<String> = name_maps(paths).into_iter().map(|(_, n)| n).collect();
         assert_eq!(
             names,
