@@ -481,3 +481,58 @@ fn region_numbers_beyond_sixteen_bits_stay_apart() {
         "{legend:?}"
     );
 }
+
+/// A run that never moves (a 7 x 7 px free square, bcd plans nothing) sweeps its start disk, as
+/// the metrics and `coverage.png` count it. Its replay failed its self-test (`moved=false
+/// swept_px=0`) and showed the floor beside the robot as not swept: the start disk was drawn
+/// as a circle the robot's disc hides, where the metrics sweep whole pixels.
+#[test]
+fn a_run_that_never_moves_shows_its_swept_start_disk() {
+    let (w, h) = (40usize, 40usize);
+    let frame = MapFrame::new(w, h, RES);
+    let mut cells = vec![Cell::Occupied; w * h];
+    for r in 16..23 {
+        for c in 16..23 {
+            cells[r * w + c] = Cell::Free;
+        }
+    }
+    let map = GridMap::new(frame, cells).expect("map");
+    let world = World::new(map, Robot::new(0.15), None).expect("fits");
+    let start = world.start();
+    let mut trace = Trace::default();
+    trace.push_pose(0, start);
+    trace.push_event(
+        0,
+        Event::Finished {
+            reason: "done".into(),
+        },
+    );
+    let swept = ccpp_core::metrics::swept_pixels(&world, &trace).count_ones(..);
+    assert_eq!(swept, 29, "the start disk of radius 3 px");
+    let metrics = r#"{"planner":"bcd","map":"tiny","effective_coverage":1.0,"path_length_m":0.0}"#;
+    let html = replay_html(&world, &trace, None, metrics, "bcd on tiny").expect("page");
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("replay-still");
+    std::fs::create_dir_all(&dir).expect("dir");
+    std::fs::write(dir.join("page.html"), &html).expect("write");
+    let Some(chrome) = require_chromium() else {
+        return;
+    };
+    let _serial = BROWSER
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    for hash in ["selftest", "at=0.5&selftest", "at=1&selftest"] {
+        let url = format!("file://{}#{hash}", dir.join("page.html").display());
+        let v = self_test(&chrome, &url, true);
+        assert_eq!(v["pass"], true, "{hash}: {v}");
+        assert_eq!(
+            (v["moved"].as_bool(), v["still"].as_bool()),
+            (Some(false), Some(true))
+        );
+        assert!(v["swept_px"].as_u64().unwrap_or(0) > 0, "{hash}: {v}");
+        // The swept pixels that stick out of the robot's disc show as swept.
+        assert!(
+            v["visible_swept_px"].as_u64().unwrap_or(0) > 0,
+            "{hash}: {v}"
+        );
+    }
+}
