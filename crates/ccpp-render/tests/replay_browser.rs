@@ -536,3 +536,70 @@ fn a_run_that_never_moves_shows_its_swept_start_disk() {
         );
     }
 }
+
+/// The URL fragment was read at load only: `location.hash = "#at=0.9"` in an open page did
+/// nothing. The page now moves on `hashchange` as at load (`#at=F`, `#frame=last`). Checked by a
+/// script added to the page that changes the hash and writes down the slider and readout.
+#[test]
+fn a_fragment_set_in_the_open_page_moves_the_replay() {
+    let (world, trace) = run(200, 120, 400);
+    let html = replay_html(&world, &trace, None, "{}", "hash").expect("page");
+    let probe = r##"<script>
+window.addEventListener("load", () => {
+  const seen = [];
+  const note = () => seen.push([location.hash, Number(document.getElementById("scrub").value), document.getElementById("readout").textContent]);
+  const steps = ["#at=0.9", "#frame=last", "#at=0.25", "#nothing"];
+  let k = 0;
+  const next = () => {
+    note();
+    if (k < steps.length) { location.hash = steps[k++]; setTimeout(next, 200); return; }
+    const o = document.createElement("pre");
+    o.textContent = "HASH" + "JSON " + JSON.stringify(seen) + " END" + "HASHJSON";
+    document.body.appendChild(o);
+  };
+  setTimeout(next, 100);
+});
+</script></body>"##;
+    assert!(html.contains("</body>"));
+    let page = html.replacen("</body>", probe, 1);
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("replay-hash");
+    std::fs::create_dir_all(&dir).expect("dir");
+    std::fs::write(dir.join("page.html"), &page).expect("write");
+    let Some(chrome) = require_chromium() else {
+        return;
+    };
+    let _serial = BROWSER
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    // What the probe wrote down: (fragment, slider, readout) at load and after each change.
+    let probe = |fragment: &str| -> Vec<(String, f64, String)> {
+        let url = format!("file://{}{fragment}", dir.join("page.html").display());
+        for _ in 0..3 {
+            let (dom, err) = dump_dom(&chrome, &url, true);
+            no_console_errors(&err);
+            if let (Some(a), Some(b)) = (dom.find("HASHJSON "), dom.find(" ENDHASHJSON")) {
+                let text = dom[a + 9..b].replace("&quot;", "\"").replace("&amp;", "&");
+                return serde_json::from_str(&text).expect("json");
+            }
+        }
+        panic!("no probe result from {url}");
+    };
+    let seen = probe("");
+    assert_eq!(seen.len(), 5, "{seen:?}");
+    // At load without a fragment: the start.
+    assert_eq!((seen[0].0.as_str(), seen[0].1), ("", 0.0), "{seen:?}");
+    // Each fragment set in the open page shows what a load at that fragment shows.
+    for (k, fragment) in ["#at=0.9", "#frame=last", "#at=0.25"].iter().enumerate() {
+        let loaded = probe(fragment);
+        assert_eq!(seen[k + 1].0, *fragment, "{seen:?}");
+        assert_eq!(
+            (seen[k + 1].1, &seen[k + 1].2),
+            (loaded[0].1, &loaded[0].2),
+            "{fragment}: set in the page {seen:?}, at load {loaded:?}"
+        );
+    }
+    assert!(seen[1].1 > 8000.0 && seen[2].1 == 10000.0, "{seen:?}");
+    assert!(seen[3].1 > 1000.0 && seen[3].1 < 3000.0, "{seen:?}");
+    // A fragment that names no frame leaves the replay where it is.
+    assert_eq!((seen[4].1, &seen[4].2), (seen[3].1, &seen[3].2), "{seen:?}");
+}
