@@ -172,11 +172,12 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             .map(|p| p.name.to_string())
             .collect()
     } else {
-        a.planners.clone()
+        // Each by its own name: `--planners "bsa, bcd"` names ` bcd` (and its run folder).
+        a.planners
+            .iter()
+            .map(|p| Ok(parse_planner(p)?.name().to_string()))
+            .collect::<Result<_>>()?
     };
-    for p in &planners {
-        parse_planner(p)?;
-    }
     // A planner named twice runs once, as a map named twice does: two runs of it would
     // write the same run folder at the same time.
     let mut planners = planners;
