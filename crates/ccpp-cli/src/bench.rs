@@ -846,12 +846,17 @@ fn done_line(runs: usize, failed: usize, maps: usize, planners: usize) -> String
 }
 
 /// A name as Markdown text on one line: control characters escaped (`\n`; a map file named
-/// with a newline split its heading in two), `|` escaped so it does not end a table cell.
+/// with a newline split its heading in two), `|` escaped so it does not end a table cell, and
+/// `<`, `>`, `&` as HTML entities so that they show as written (a map `<script>.yaml` gave the
+/// heading `## <script>`, which a Markdown renderer drops as HTML).
 fn md_text(name: &str) -> String {
     let mut out = String::with_capacity(name.len());
     for c in name.chars() {
         match c {
             '|' => out.push_str("\\|"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '&' => out.push_str("&amp;"),
             c if c.is_control() => out.extend(c.escape_default()),
             c => out.push(c),
         }
@@ -891,14 +896,19 @@ pub fn results_md(rows: &[Row]) -> String {
             .count();
         if ok.is_empty() {
             // No run to average: dashes, not means of nothing (`-0.0000` was printed).
-            let _ = writeln!(s, "| {p} | 0 | {fails} | - | - | - | - | - | - | - |");
+            let _ = writeln!(
+                s,
+                "| {} | 0 | {fails} | - | - | - | - | - | - | - |",
+                md_text(p)
+            );
             continue;
         }
         let n = ok.len() as f64;
         let mean = |f: fn(&Metrics) -> f64| ok.iter().map(|m| f(m)).sum::<f64>() / n;
         let _ = writeln!(
             s,
-            "| {p} | {} | {fails} | {:.4} | {:.3} | {:.1} | {:.3} | {:.0} | {} | {:.2} |",
+            "| {} | {} | {fails} | {:.4} | {:.3} | {:.1} | {:.3} | {:.0} | {} | {:.2} |",
+            md_text(p),
             ok.len(),
             mean(|m| m.effective_coverage),
             mean(|m| m.path_ratio),
@@ -919,7 +929,7 @@ pub fn results_md(rows: &[Row]) -> String {
                     let _ = writeln!(
                         s,
                         "| {} | {:.4} | {} | {:.3} | {} | {:.3} | {} | {} | {:.3} |",
-                        r.planner,
+                        md_text(&r.planner),
                         m.effective_coverage,
                         m.coverage_rate
                             .map_or_else(|| "–".to_string(), |c| format!("{c:.4}")),
@@ -935,8 +945,8 @@ pub fn results_md(rows: &[Row]) -> String {
                     let _ = writeln!(
                         s,
                         "| {} | error: {} | | | | | | | |",
-                        r.planner,
-                        e.replace('|', "/")
+                        md_text(&r.planner),
+                        md_text(&e.replace('|', "/"))
                     );
                 }
             }

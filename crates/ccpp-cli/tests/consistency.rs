@@ -13,13 +13,7 @@ fn planner_names_with_spaces_around_them_are_read_everywhere() {
     let map = data("teb_empty_box.yaml");
     let out = dir.path().join("bench");
     ccpp()
-        .args([
-            "bench",
-            "--quiet",
-            "--planners",
-            "bsa, bcd , bsa",
-            "--maps",
-        ])
+        .args(["bench", "--quiet", "--planners", "bsa, bcd , bsa", "--maps"])
         .arg(&map)
         .arg("--out")
         .arg(&out)
@@ -69,4 +63,40 @@ fn planner_names_with_spaces_around_them_are_read_everywhere() {
         "{}",
         String::from_utf8_lossy(&o.stderr)
     );
+}
+
+/// A map file named `<script>.yaml` gave the heading `## <script>` in `results.md`, which a
+/// Markdown renderer drops as HTML. Headings and table cells (an error naming the file too)
+/// show `<`, `>` and `&` as written: as HTML entities.
+#[test]
+fn map_names_in_results_md_show_as_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let maps = dir.path().join("maps");
+    std::fs::create_dir(&maps).unwrap();
+    std::fs::copy(data("teb_empty_box.png"), maps.join("teb_empty_box.png")).unwrap();
+    let yaml = std::fs::read_to_string(data("teb_empty_box.yaml")).unwrap();
+    std::fs::write(maps.join("<script>.yaml"), &yaml).unwrap();
+    // A map that fails to load: its error row names the file.
+    std::fs::write(
+        maps.join("a&<b>.yaml"),
+        "image: missing.png\nresolution: 0.05\n",
+    )
+    .unwrap();
+    let out = dir.path().join("bench");
+    ccpp()
+        .args(["bench", "--quiet", "--planners", "bcd", "--maps"])
+        .arg(&maps)
+        .arg("--out")
+        .arg(&out)
+        .assert()
+        .code(1);
+    let md = std::fs::read_to_string(out.join("results.md")).unwrap();
+    assert!(md.contains("\n## &lt;script&gt;\n"), "{md}");
+    assert!(md.contains("\n## a&amp;&lt;b&gt;\n"), "{md}");
+    assert!(
+        md.lines()
+            .any(|l| l.starts_with("| bcd | error: ") && l.contains("a&amp;&lt;b&gt;.yaml")),
+        "{md}"
+    );
+    assert!(!md.contains('<') && !md.contains('>'), "{md}");
 }
