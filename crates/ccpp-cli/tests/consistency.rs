@@ -100,3 +100,49 @@ fn map_names_in_results_md_show_as_written() {
     );
     assert!(!md.contains('<') && !md.contains('>'), "{md}");
 }
+
+/// A trace pose of `1e308` made `ccpp replay` print its x as a 309-digit number, and `--radius
+/// 1e308` printed `(inf m across)`: both messages show their numbers compactly.
+#[test]
+fn huge_numbers_in_trace_and_radius_messages_are_short() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = data("teb_empty_box.yaml");
+    let o = ccpp()
+        .args(["run", "--planner", "bcd", "--radius", "1e308", "--map"])
+        .arg(&map)
+        .arg("--out")
+        .arg(dir.path().join("huge"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("a robot of radius 1e308 m (2e308 m across) is larger than the map"),
+        "{err}"
+    );
+    assert!(!err.contains("inf"), "{err}");
+    let run = dir.path().join("run");
+    ccpp()
+        .args(["run", "--planner", "bcd", "--map"])
+        .arg(&map)
+        .arg("--out")
+        .arg(&run)
+        .assert()
+        .success();
+    let trace = run.join("trace.jsonl");
+    let text = std::fs::read_to_string(&trace).unwrap();
+    let (first, rest) = text.split_once('\n').unwrap();
+    std::fs::write(
+        &trace,
+        format!("{first}\n{{\"t\":0,\"pose\":[1e308,5.0,0.0]}}\n{rest}"),
+    )
+    .unwrap();
+    let o = ccpp().arg("replay").arg(&run).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("line 2: pose (1e308, 5) lies outside the map ("),
+        "{err}"
+    );
+    assert!(err.len() < 400 && !err.contains("00000000"), "{err}");
+}
