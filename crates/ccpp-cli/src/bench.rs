@@ -172,11 +172,12 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             .map(|p| p.name.to_string())
             .collect()
     } else {
-        a.planners.clone()
+        // Each by its own name: `--planners "bsa, bcd"` names ` bcd` (and its run folder).
+        a.planners
+            .iter()
+            .map(|p| Ok(parse_planner(p)?.name().to_string()))
+            .collect::<Result<_>>()?
     };
-    for p in &planners {
-        parse_planner(p)?;
-    }
     // A planner named twice runs once, as a map named twice does: two runs of it would
     // write the same run folder at the same time.
     let mut planners = planners;
@@ -315,10 +316,13 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         summary.push(plots);
     }
     let summary = crate::staging::PendingSet::new(summary);
-    crate::plots::write_all(&a.out, &rows, &prepared, robot, &budget)?;
+    let left_out = crate::plots::write_all(&a.out, &rows, &prepared, robot, &budget)?;
     write_file(&a.out.join("results.md"), results_md(&rows).as_bytes())?;
     write_file(&a.out.join("results.csv"), results_csv(&rows).as_bytes())?;
     summary.done();
+    for line in &left_out {
+        eprintln!("{line}");
+    }
     let failed = rows.iter().filter(|r| r.outcome.is_err()).count();
     crate::print_stdout(&format!(
         "{}; wrote {}/results.csv, results.md, plots/\n",
@@ -508,7 +512,7 @@ pub(crate) struct Grant<'a> {
 }
 
 impl MemoryBudget {
-    fn new(limit_mb: u64) -> Self {
+    pub(crate) fn new(limit_mb: u64) -> Self {
         Self {
             limit: limit_mb as f64 * 1024.0 * 1024.0,
             used: Mutex::new(0.0),
@@ -573,7 +577,14 @@ fn run_one(
         if same_key {
             if let Ok(text) = ccpp_io::file::read_text(&metrics_path) {
                 if let Ok(m) = serde_json::from_str::<Metrics>(&text) {
-                    return Ok(m);
+                    // Reused only when its trace reads back whole: a damaged trace was reused
+                    // and then left out of the plots in silence.
+                    match whole_trace(dir, budget) {
+                        Ok(()) => return Ok(m),
+                        Err(why) => {
+                            eprintln!("warning: {}: {why}; running it again", dir.display());
+                        }
+                    }
                 }
             }
         }
@@ -595,6 +606,25 @@ fn run_one(
     let bytes = spec.scenario.check_map(map).map_or(0.0, |e| e.bytes);
     let _grant = budget.take(bytes);
     run_isolated(&spec)
+}
+
+/// Checks that the `trace.jsonl` of the run folder `dir` reads back (as the plots read it) and
+/// ends with the simulator's `finished` record (a trace cut at a line's end reads back). The
+/// parsed trace is held against `budget` while it is checked (streamed, about twice the
+/// file's size).
+fn whole_trace(dir: &Path, budget: &MemoryBudget) -> Result<(), String> {
+    let path = dir.join("trace.jsonl");
+    let len = std::fs::metadata(&path).map_or(0, |m| m.len());
+    let _grant = budget.take(2.0 * len as f64);
+    let trace = crate::plots::read_trace(&path).map_err(|e| crate::errors::one_line(&e))?;
+    if matches!(
+        trace.events().last(),
+        Some((_, ccpp_core::trace::Event::Finished { .. }))
+    ) {
+        Ok(())
+    } else {
+        Err("trace.jsonl does not end with the simulator's `finished` record (cut short)".into())
+    }
 }
 
 /// Hidden first argument that makes `ccpp` run one bench job (a [`JobSpec`] as JSON on stdin)
@@ -816,12 +846,17 @@ fn done_line(runs: usize, failed: usize, maps: usize, planners: usize) -> String
 }
 
 /// A name as Markdown text on one line: control characters escaped (`\n`; a map file named
-/// with a newline split its heading in two), `|` escaped so it does not end a table cell.
+/// with a newline split its heading in two), `|` escaped so it does not end a table cell, and
+/// `<`, `>`, `&` as HTML entities so that they show as written (a map `<script>.yaml` gave the
+/// heading `## <script>`, which a Markdown renderer drops as HTML).
 fn md_text(name: &str) -> String {
     let mut out = String::with_capacity(name.len());
     for c in name.chars() {
         match c {
             '|' => out.push_str("\\|"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '&' => out.push_str("&amp;"),
             c if c.is_control() => out.extend(c.escape_default()),
             c => out.push(c),
         }
@@ -861,14 +896,19 @@ pub fn results_md(rows: &[Row]) -> String {
             .count();
         if ok.is_empty() {
             // No run to average: dashes, not means of nothing (`-0.0000` was printed).
-            let _ = writeln!(s, "| {p} | 0 | {fails} | - | - | - | - | - | - | - |");
+            let _ = writeln!(
+                s,
+                "| {} | 0 | {fails} | - | - | - | - | - | - | - |",
+                md_text(p)
+            );
             continue;
         }
         let n = ok.len() as f64;
         let mean = |f: fn(&Metrics) -> f64| ok.iter().map(|m| f(m)).sum::<f64>() / n;
         let _ = writeln!(
             s,
-            "| {p} | {} | {fails} | {:.4} | {:.3} | {:.1} | {:.3} | {:.0} | {} | {:.2} |",
+            "| {} | {} | {fails} | {:.4} | {:.3} | {:.1} | {:.3} | {:.0} | {} | {:.2} |",
+            md_text(p),
             ok.len(),
             mean(|m| m.effective_coverage),
             mean(|m| m.path_ratio),
@@ -889,7 +929,7 @@ pub fn results_md(rows: &[Row]) -> String {
                     let _ = writeln!(
                         s,
                         "| {} | {:.4} | {} | {:.3} | {} | {:.3} | {} | {} | {:.3} |",
-                        r.planner,
+                        md_text(&r.planner),
                         m.effective_coverage,
                         m.coverage_rate
                             .map_or_else(|| "–".to_string(), |c| format!("{c:.4}")),
@@ -905,8 +945,8 @@ pub fn results_md(rows: &[Row]) -> String {
                     let _ = writeln!(
                         s,
                         "| {} | error: {} | | | | | | | |",
-                        r.planner,
-                        e.replace('|', "/")
+                        md_text(&r.planner),
+                        md_text(&e.replace('|', "/"))
                     );
                 }
             }

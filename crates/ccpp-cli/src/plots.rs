@@ -35,14 +35,16 @@ fn write_chart(dir: &Path, stem: &str, chart: &Chart) -> Result<()> {
     Ok(())
 }
 
-/// Writes every plot into `out/plots/`.
+/// Writes every plot into `out/plots/`. Returns one `warning:` line per run (or map) left
+/// out of its map's plots, saying why, in the maps' order (the caller prints them: nothing
+/// vanishes from the plots in silence).
 pub fn write_all(
     out: &Path,
     rows: &[Row],
     maps: &[(PathBuf, Result<PreparedMap, String>)],
     robot: Robot,
     budget: &crate::bench::MemoryBudget,
-) -> Result<()> {
+) -> Result<Vec<String>> {
     let dir = out.join("plots");
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let mut planners: Vec<String> = Vec::new();
@@ -51,116 +53,147 @@ pub fn write_all(
             planners.push(r.planner.clone());
         }
     }
-    maps.par_iter().try_for_each(|(_, m)| -> Result<()> {
-        let Ok(m) = m else { return Ok(()) };
-        // A map's pictures hold its world and one run's trace at a time: under the bench's
-        // memory limit with the other maps' (drawn all at once, four PID traces of
-        // `office_1024` peaked at 840 MB under `--max-memory 341`). A parsed trace takes about
-        // twice its file's size.
-        let largest_trace = rows
-            .iter()
-            .filter(|r| r.map == m.name)
-            .filter_map(|r| std::fs::metadata(r.dir.join("trace.jsonl")).ok())
-            .map(|md| md.len())
-            .max()
-            .unwrap_or(0);
-        let pixels = (m.grid.frame().width * m.grid.frame().height) as f64;
-        let _grant = budget
-            .take(2.0 * largest_trace as f64 + pixels * ccpp_core::planners::settings::PIXEL_BYTES);
-        let Ok(world) = World::new(m.grid.clone(), robot, None) else {
-            return Ok(());
-        };
-        let mut series = Vec::new();
-        let mut panels = Vec::new();
-        // What each drawn run's picture shows, for the shared legend (its trace and world are
-        // dropped once drawn: a map holds one trace at a time).
-        let mut shown: Vec<LegendShown> = Vec::new();
-        for r in rows.iter().filter(|r| r.map == m.name) {
-            let Ok(metrics) = &r.outcome else { continue };
-            let Ok(trace) = read_trace(&r.dir.join("trace.jsonl")) else {
-                continue;
+    // What was left out of the plots, and why: printed after them, in the maps' order.
+    let skipped: Vec<Vec<String>> = maps
+        .par_iter()
+        .map(|(_, m)| -> Result<Vec<String>> {
+            let mut skipped = Vec::new();
+            let Ok(m) = m else { return Ok(skipped) };
+            // A map's pictures hold its world and one run's trace at a time: under the bench's
+            // memory limit with the other maps' (drawn all at once, four PID traces of
+            // `office_1024` peaked at 840 MB under `--max-memory 341`). A parsed trace takes about
+            // twice its file's size.
+            let largest_trace = rows
+                .iter()
+                .filter(|r| r.map == m.name)
+                .filter_map(|r| std::fs::metadata(r.dir.join("trace.jsonl")).ok())
+                .map(|md| md.len())
+                .max()
+                .unwrap_or(0);
+            let pixels = (m.grid.frame().width * m.grid.frame().height) as f64;
+            let _grant = budget.take(
+                2.0 * largest_trace as f64 + pixels * ccpp_core::planners::settings::PIXEL_BYTES,
+            );
+            let world = match World::new(m.grid.clone(), robot, None) {
+                Ok(w) => w,
+                Err(e) => {
+                    skipped.push(format!(
+                        "warning: no plots of map {}: its world cannot be built ({e})",
+                        m.name
+                    ));
+                    return Ok(skipped);
+                }
             };
-            series.push((r.planner.clone(), coverage_curve(&world, &trace, 200)));
-            // The panel: the run's picture without header or legend (one shared legend and
-            // legible captions instead), drawn from the run's own start pose.
-            // A run from the default start (as bench runs are) is drawn on the map's world.
-            let start = trace.poses().next().map(|p| Pose::new(p.x, p.y, p.theta));
-            let own = if start == Some(world.start()) {
-                None
-            } else {
-                let Ok(w) = World::new(m.grid.clone(), robot, start) else {
-                    continue;
+            let mut series = Vec::new();
+            let mut panels = Vec::new();
+            // What each drawn run's picture shows, for the shared legend (its trace and world are
+            // dropped once drawn: a map holds one trace at a time).
+            let mut shown: Vec<LegendShown> = Vec::new();
+            for r in rows.iter().filter(|r| r.map == m.name) {
+                let Ok(metrics) = &r.outcome else { continue };
+                let trace = match read_trace(&r.dir.join("trace.jsonl")) {
+                    Ok(t) => t,
+                    Err(e) => {
+                        skipped.push(left_out(r, &crate::errors::one_line(&e)));
+                        continue;
+                    }
                 };
-                Some(w)
-            };
-            let run_world = own.as_ref().unwrap_or(&world);
-            let swept = swept_pixels(run_world, &trace);
-            let style = CoverageStyle {
-                min_width: 500,
-                max_side: 1000,
-                title: Vec::new(),
-                legend: false,
-            };
-            let Ok(png) = coverage_png_swept(run_world, &trace, &style, &swept) else {
-                continue;
-            };
-            panels.push(Panel {
-                label: r.planner.clone(),
-                badge: Some((
-                    format!(
-                        "effective coverage {:.1}%",
-                        100.0 * metrics.effective_coverage
-                    ),
-                    coverage_verdict_colour(metrics.effective_coverage),
-                )),
-                caption: vec![
-                    format!(
-                        "path {:.1} m, ratio {:.2}, revisits {:.2}",
-                        metrics.path_length_m, metrics.path_ratio, metrics.revisit_rate
-                    ),
-                    format!(
-                        "regions {}, turns {}, collisions {}",
-                        metrics.regions, metrics.turns, metrics.collisions
-                    ),
-                ],
-                png,
-            });
-            shown.push(LegendShown::of(run_world, &trace, &swept));
-        }
-        let points = tradeoff_points(rows, &planners, &m.name);
-        if points.iter().any(Option::is_some) {
-            let c = tradeoff_chart(
-                &format!("Coverage against path ratio - {}", m.name),
-                &planners,
-                &points,
-                &[],
-            );
-            write_chart(&dir, &format!("tradeoff_{}", m.name), &c)?;
-        }
-        if !series.is_empty() {
-            let c = line_chart(
-                &format!("Effective coverage over travelled distance - {}", m.name),
-                "travelled distance (m)",
-                "effective coverage",
-                &series,
-                Some(1.0),
-            );
-            write_chart(&dir, &format!("coverage_{}", m.name), &c)?;
-        }
-        if !panels.is_empty() {
-            let legend = legend_entries_union_of(&shown);
-            let c = image_grid_captioned(
-                &format!("Paths - {}", m.name),
-                &panels,
-                &legend,
-                3,
-                520,
-                420,
-            );
-            write_chart(&dir, &format!("paths_{}", m.name), &c)?;
-        }
-        Ok(())
-    })?;
+                series.push((r.planner.clone(), coverage_curve(&world, &trace, 200)));
+                // The panel: the run's picture without header or legend (one shared legend and
+                // legible captions instead), drawn from the run's own start pose.
+                // A run from the default start (as bench runs are) is drawn on the map's world.
+                let start = trace.poses().next().map(|p| Pose::new(p.x, p.y, p.theta));
+                let own = if start == Some(world.start()) {
+                    None
+                } else {
+                    match World::new(m.grid.clone(), robot, start) {
+                        Ok(w) => Some(w),
+                        Err(e) => {
+                            skipped
+                                .push(left_out(r, &format!("its start pose gives no world ({e})")));
+                            continue;
+                        }
+                    }
+                };
+                let run_world = own.as_ref().unwrap_or(&world);
+                let swept = swept_pixels(run_world, &trace);
+                let style = CoverageStyle {
+                    min_width: 500,
+                    max_side: 1000,
+                    title: Vec::new(),
+                    legend: false,
+                };
+                let png = match coverage_png_swept(run_world, &trace, &style, &swept) {
+                    Ok(png) => png,
+                    Err(e) => {
+                        // Its coverage curve is drawn; its panel is not.
+                        skipped.push(format!(
+                            "warning: {}: left out of paths_{}: its picture cannot be drawn ({e})",
+                            r.dir.display(),
+                            m.name
+                        ));
+                        continue;
+                    }
+                };
+                panels.push(Panel {
+                    label: r.planner.clone(),
+                    badge: Some((
+                        format!(
+                            "effective coverage {:.1}%",
+                            100.0 * metrics.effective_coverage
+                        ),
+                        coverage_verdict_colour(metrics.effective_coverage),
+                    )),
+                    caption: vec![
+                        format!(
+                            "path {:.1} m, ratio {:.2}, revisits {:.2}",
+                            metrics.path_length_m, metrics.path_ratio, metrics.revisit_rate
+                        ),
+                        format!(
+                            "regions {}, turns {}, collisions {}",
+                            metrics.regions, metrics.turns, metrics.collisions
+                        ),
+                    ],
+                    png,
+                });
+                shown.push(LegendShown::of(run_world, &trace, &swept));
+            }
+            let points = tradeoff_points(rows, &planners, &m.name);
+            if points.iter().any(Option::is_some) {
+                let c = tradeoff_chart(
+                    &format!("Coverage against path ratio - {}", m.name),
+                    &planners,
+                    &points,
+                    &[],
+                );
+                write_chart(&dir, &format!("tradeoff_{}", m.name), &c)?;
+            }
+            if !series.is_empty() {
+                let c = line_chart(
+                    &format!("Effective coverage over travelled distance - {}", m.name),
+                    "travelled distance (m)",
+                    "effective coverage",
+                    &series,
+                    Some(1.0),
+                );
+                write_chart(&dir, &format!("coverage_{}", m.name), &c)?;
+            }
+            if !panels.is_empty() {
+                let legend = legend_entries_union_of(&shown);
+                let c = image_grid_captioned(
+                    &format!("Paths - {}", m.name),
+                    &panels,
+                    &legend,
+                    3,
+                    520,
+                    420,
+                );
+                write_chart(&dir, &format!("paths_{}", m.name), &c)?;
+            }
+            Ok(skipped)
+        })
+        .collect::<Result<_>>()?;
+
     // Summary bars: means over maps.
     let mean = |p: &str, f: fn(&Metrics) -> f64| {
         let v: Vec<f64> = rows
@@ -245,7 +278,16 @@ pub fn write_all(
         );
         write_chart(&dir, "tradeoff_summary", &c)?;
     }
-    Ok(())
+    Ok(skipped.into_iter().flatten().collect())
+}
+
+/// The warning for a run left out of its map's plots (`why` says why).
+fn left_out(r: &Row, why: &str) -> String {
+    format!(
+        "warning: {}: left out of the plots of map {}: {why}",
+        r.dir.display(),
+        r.map
+    )
 }
 
 /// Each planner's `[path_ratio, effective_coverage]` on `map` (`None`: no successful run).
@@ -259,4 +301,52 @@ fn tradeoff_points(rows: &[Row], planners: &[String], map: &str) -> Vec<Option<[
                 .map(|m| [m.path_ratio, m.effective_coverage])
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    /// A run whose trace does not read back (or whose picture cannot be drawn) is left out of
+    /// its map's plots with a `warning:` line naming its folder and why; it was left out in
+    /// silence.
+    #[test]
+    fn a_run_left_out_of_the_plots_is_named() {
+        let out = tempfile::tempdir().unwrap();
+        let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/teb_empty_box.yaml");
+        let args = crate::args::MapArgs {
+            map: data.clone(),
+            ..crate::args::MapArgs::default()
+        };
+        let mut map = crate::job::prepare_map(&args, 1024).unwrap();
+        map.name = "box".into();
+        let metrics: Metrics = serde_json::from_str(
+            r#"{"planner": "bsa", "map": "box", "robot_radius_m": 0.15, "tool_radius_m": 0.15,
+            "coverage_rate": 1.0, "effective_coverage": 0.8, "path_length_m": 2.0,
+            "path_ratio": 0.9, "redundancy": 0.1, "revisit_rate": 0.1, "regions": 1,
+            "backtracks": 0, "backtrack_length_m": 0.0, "turns": 1, "rotation_rad": 1.0,
+            "collisions": 0, "keepout_violations": 0, "wall_time_s": 0.001}"#,
+        )
+        .unwrap();
+        let dir = out.path().join("runs/box/bsa");
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("trace.jsonl"), "{\"t\":0,\"pose\":[1.0,").unwrap();
+        let rows = [Row {
+            map: "box".into(),
+            planner: "bsa".into(),
+            outcome: Ok(metrics),
+            dir: dir.clone(),
+        }];
+        let maps = [(data, Ok(map))];
+        let budget = crate::bench::MemoryBudget::new(1024);
+        let warnings = write_all(out.path(), &rows, &maps, Robot::new(0.15), &budget).unwrap();
+        assert_eq!(warnings.len(), 1, "{warnings:?}");
+        let w = &warnings[0];
+        assert!(w.starts_with("warning: "), "{w}");
+        assert!(w.contains(&dir.display().to_string()), "{w}");
+        assert!(w.contains("left out of the plots of map box"), "{w}");
+        assert!(w.contains("not a trace record"), "{w}");
+        assert!(!w.contains('\n'), "{w}");
+    }
 }

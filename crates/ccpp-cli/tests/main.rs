@@ -6,6 +6,7 @@
 
 mod cli;
 mod common;
+mod consistency;
 mod dropped;
 mod exports;
 mod first_use;

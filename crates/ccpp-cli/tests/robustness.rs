@@ -445,6 +445,61 @@ fn a_panicking_run_becomes_an_error_row_and_the_bench_exits_1() {
         .success();
 }
 
+/// A run whose `trace.jsonl` was damaged (cut in a line, or at a line's end) was reused by the
+/// next bench and left out of its plots, exit 0 and nothing said. It is now run again, with a
+/// warning naming its folder, and the plots show it.
+#[test]
+fn bench_runs_again_a_run_whose_trace_is_damaged() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bench");
+    let maps = [data("teb_empty_box.yaml")];
+    let run = out.join("runs/teb_empty_box/bsa");
+    let trace = run.join("trace.jsonl");
+    bench(&out, &maps, &["--planners", "bsa,bcd"])
+        .assert()
+        .success();
+    let whole = std::fs::read(&trace).unwrap();
+    assert!(whole.len() > 1000);
+    let in_plots = |out: &Path| {
+        ["coverage", "paths"].map(|p| {
+            std::fs::read_to_string(out.join(format!("plots/{p}_teb_empty_box.svg")))
+                .unwrap()
+                .contains(">bsa<")
+        })
+    };
+    assert_eq!(in_plots(&out), [true, true]);
+    let lines = whole.split_inclusive(|b| *b == b'\n').count();
+    let cut_at_line_end = whole
+        .split_inclusive(|b| *b == b'\n')
+        .take(lines / 2)
+        .flatten()
+        .copied()
+        .collect::<Vec<u8>>();
+    for damaged in [whole[..1000].to_vec(), cut_at_line_end] {
+        std::fs::write(&trace, damaged).unwrap();
+        let o = bench(&out, &maps, &["--planners", "bsa,bcd"])
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{stderr}");
+        assert_eq!(
+            std::fs::read(&trace).unwrap(),
+            whole,
+            "the run was not redone"
+        );
+        assert_eq!(
+            in_plots(&out),
+            [true, true],
+            "the run is left out of the plots"
+        );
+        let warning = stderr.lines().find(|l| l.starts_with("warning: ")).unwrap();
+        assert!(
+            warning.contains(&run.display().to_string()) && warning.contains("running it again"),
+            "{stderr}"
+        );
+    }
+}
+
 #[test]
 fn bench_resume_reruns_when_anything_that_defines_a_run_changed() {
     let dir = tempfile::tempdir().unwrap();

@@ -399,6 +399,25 @@ impl MapRecipe {
     }
 }
 
+/// The width `2 r` of a robot of radius `r`, as [`Compact`] shows it, also where `2 r` is
+/// beyond `f64` (`--radius 1e308` printed `inf m across`): then the mantissa of `r` doubled
+/// (`2e308`).
+fn across(r: f64) -> String {
+    let d = 2.0 * r;
+    if d.is_finite() || !r.is_finite() {
+        return Compact(d).to_string();
+    }
+    let text = format!("{r:e}");
+    let parts = text
+        .split_once('e')
+        .and_then(|(m, e)| Some((m.parse::<f64>().ok()?, e.parse::<i32>().ok()?)));
+    match parts {
+        Some((m, e)) if (2.0 * m).abs() >= 10.0 => format!("{}e{}", 2.0 * m / 10.0, e + 1),
+        Some((m, e)) => format!("{}e{e}", 2.0 * m),
+        None => Compact(d).to_string(),
+    }
+}
+
 /// A memory need of `bytes` as the refusals print it: `about 1234 MB` (rounded up), `about
 /// 1.0e297 MB` from 1e9 MB up, or `unbounded memory` when the estimate overflowed.
 fn about_mb(bytes: f64) -> String {
@@ -1010,7 +1029,7 @@ impl Scenario {
                 "map {}: a robot of radius {} m ({} m across) is larger than the map ({} x {} m): it fits nowhere",
                 map.source.display(),
                 Compact(self.robot.radius),
-                Compact(2.0 * self.robot.radius),
+                across(self.robot.radius),
                 Compact(w),
                 Compact(h)
             )));
@@ -1599,6 +1618,18 @@ impl ScenarioBuilder {
 mod tests {
     use super::*;
     use ccpp_core::planners::ba_star::BaStarOptions;
+
+    /// A robot's width in the "fits nowhere" refusal stays a number where `2 r` overflows
+    /// (`--radius 1e308` printed `inf m across`).
+    #[test]
+    fn the_width_of_a_huge_robot_is_a_number() {
+        assert_eq!(across(5.0), "10");
+        assert_eq!(across(1e300), "2e300");
+        assert_eq!(across(1e308), "2e308");
+        assert_eq!(across(9e307), "1.8e308");
+        assert_eq!(across(f64::MAX), "3.5953862697246315e308");
+        assert_eq!(across(f64::INFINITY), "inf");
+    }
 
     #[test]
     fn json_round_trip_keeps_planner_and_options_flat() {

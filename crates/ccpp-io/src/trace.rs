@@ -32,6 +32,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+use ccpp_core::display::Compact;
 use ccpp_core::grid::MapFrame;
 use ccpp_core::route::{Route, RouteBuilder, DEFAULT_TOLERANCE_M};
 use ccpp_core::trace::{Advance, Chunk, Event, Lattice, Piece, Record, Run, Trace};
@@ -64,7 +65,16 @@ pub enum TraceFileError {
         message: String,
     },
     /// A pose lies far outside the map (or is not finite).
-    #[error("trace {} line {line}: pose ({x}, {y}) lies outside the map ({lo_x}, {lo_y} to {hi_x}, {hi_y})", path.display())]
+    #[error(
+        "trace {} line {line}: pose ({}, {}) lies outside the map ({}, {} to {}, {})",
+        path.display(),
+        Compact(*.x),
+        Compact(*.y),
+        Compact(*.lo_x),
+        Compact(*.lo_y),
+        Compact(*.hi_x),
+        Compact(*.hi_y)
+    )]
     OutsideMap {
         /// The file.
         path: PathBuf,

@@ -408,11 +408,14 @@ fn replay_data(
     );
     let classes = classes_js(world, crop);
     format!(
-        r#"{{"w":{w},"h":{h},"res":{res},"yaw":{yaw},"r":{r},"rt":{rt},"tile":{tile},"start":[{sx},{sy},{st}],"n":{n},"m":{m},"q":{q},"blob":"{blob}","events":{events},"nt":{nt},"tblob":"{tblob}","cov":{cov},"palette":{palette},"zones":{zones},"approach":{approach},"stop":{stop},"classes":{classes},"metrics":{metrics}}}"#,
+        r#"{{"w":{w},"h":{h},"res":{res},"yaw":{yaw},"r":{r},"rt":{rt},"swept_r":{swept_r},"tile":{tile},"start":[{sx},{sy},{st}],"n":{n},"m":{m},"q":{q},"blob":"{blob}","events":{events},"nt":{nt},"tblob":"{tblob}","cov":{cov},"palette":{palette},"zones":{zones},"approach":{approach},"stop":{stop},"classes":{classes},"metrics":{metrics}}}"#,
         res = js_num(f.resolution),
         yaw = js_num(yaw),
         r = js_num(world.robot().radius / f.resolution),
         rt = js_num(world.robot().tool_radius / f.resolution),
+        // Pixel centres within this many map pixels of a pose are swept (as in the metrics).
+        swept_r =
+            js_num(world.robot().tool_radius / f.resolution + ccpp_core::metrics::SWEEP_EPS_PX),
         sx = js_num(sx),
         sy = js_num(sy),
         st = js_num(placed.theta),

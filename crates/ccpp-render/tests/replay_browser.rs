@@ -481,3 +481,125 @@ fn region_numbers_beyond_sixteen_bits_stay_apart() {
         "{legend:?}"
     );
 }
+
+/// A run that never moves (a 7 x 7 px free square, bcd plans nothing) sweeps its start disk, as
+/// the metrics and `coverage.png` count it. Its replay failed its self-test (`moved=false
+/// swept_px=0`) and showed the floor beside the robot as not swept: the start disk was drawn
+/// as a circle the robot's disc hides, where the metrics sweep whole pixels.
+#[test]
+fn a_run_that_never_moves_shows_its_swept_start_disk() {
+    let (w, h) = (40usize, 40usize);
+    let frame = MapFrame::new(w, h, RES);
+    let mut cells = vec![Cell::Occupied; w * h];
+    for r in 16..23 {
+        for c in 16..23 {
+            cells[r * w + c] = Cell::Free;
+        }
+    }
+    let map = GridMap::new(frame, cells).expect("map");
+    let world = World::new(map, Robot::new(0.15), None).expect("fits");
+    let start = world.start();
+    let mut trace = Trace::default();
+    trace.push_pose(0, start);
+    trace.push_event(
+        0,
+        Event::Finished {
+            reason: "done".into(),
+        },
+    );
+    let swept = ccpp_core::metrics::swept_pixels(&world, &trace).count_ones(..);
+    assert_eq!(swept, 29, "the start disk of radius 3 px");
+    let metrics = r#"{"planner":"bcd","map":"tiny","effective_coverage":1.0,"path_length_m":0.0}"#;
+    let html = replay_html(&world, &trace, None, metrics, "bcd on tiny").expect("page");
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("replay-still");
+    std::fs::create_dir_all(&dir).expect("dir");
+    std::fs::write(dir.join("page.html"), &html).expect("write");
+    let Some(chrome) = require_chromium() else {
+        return;
+    };
+    let _serial = BROWSER
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    for hash in ["selftest", "at=0.5&selftest", "at=1&selftest"] {
+        let url = format!("file://{}#{hash}", dir.join("page.html").display());
+        let v = self_test(&chrome, &url, true);
+        assert_eq!(v["pass"], true, "{hash}: {v}");
+        assert_eq!(
+            (v["moved"].as_bool(), v["still"].as_bool()),
+            (Some(false), Some(true))
+        );
+        assert!(v["swept_px"].as_u64().unwrap_or(0) > 0, "{hash}: {v}");
+        // The swept pixels that stick out of the robot's disc show as swept.
+        assert!(
+            v["visible_swept_px"].as_u64().unwrap_or(0) > 0,
+            "{hash}: {v}"
+        );
+    }
+}
+
+/// The URL fragment was read at load only: `location.hash = "#at=0.9"` in an open page did
+/// nothing. The page now moves on `hashchange` as at load (`#at=F`, `#frame=last`). Checked by a
+/// script added to the page that changes the hash and writes down the slider and readout.
+#[test]
+fn a_fragment_set_in_the_open_page_moves_the_replay() {
+    let (world, trace) = run(200, 120, 400);
+    let html = replay_html(&world, &trace, None, "{}", "hash").expect("page");
+    let probe = r##"<script>
+window.addEventListener("load", () => {
+  const seen = [];
+  const note = () => seen.push([location.hash, Number(document.getElementById("scrub").value), document.getElementById("readout").textContent]);
+  const steps = ["#at=0.9", "#frame=last", "#at=0.25", "#nothing"];
+  let k = 0;
+  const next = () => {
+    note();
+    if (k < steps.length) { location.hash = steps[k++]; setTimeout(next, 200); return; }
+    const o = document.createElement("pre");
+    o.textContent = "HASH" + "JSON " + JSON.stringify(seen) + " END" + "HASHJSON";
+    document.body.appendChild(o);
+  };
+  setTimeout(next, 100);
+});
+</script></body>"##;
+    assert!(html.contains("</body>"));
+    let page = html.replacen("</body>", probe, 1);
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("replay-hash");
+    std::fs::create_dir_all(&dir).expect("dir");
+    std::fs::write(dir.join("page.html"), &page).expect("write");
+    let Some(chrome) = require_chromium() else {
+        return;
+    };
+    let _serial = BROWSER
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    // What the probe wrote down: (fragment, slider, readout) at load and after each change.
+    let probe = |fragment: &str| -> Vec<(String, f64, String)> {
+        let url = format!("file://{}{fragment}", dir.join("page.html").display());
+        for _ in 0..3 {
+            let (dom, err) = dump_dom(&chrome, &url, true);
+            no_console_errors(&err);
+            if let (Some(a), Some(b)) = (dom.find("HASHJSON "), dom.find(" ENDHASHJSON")) {
+                let text = dom[a + 9..b].replace("&quot;", "\"").replace("&amp;", "&");
+                return serde_json::from_str(&text).expect("json");
+            }
+        }
+        panic!("no probe result from {url}");
+    };
+    let seen = probe("");
+    assert_eq!(seen.len(), 5, "{seen:?}");
+    // At load without a fragment: the start.
+    assert_eq!((seen[0].0.as_str(), seen[0].1), ("", 0.0), "{seen:?}");
+    // Each fragment set in the open page shows what a load at that fragment shows.
+    for (k, fragment) in ["#at=0.9", "#frame=last", "#at=0.25"].iter().enumerate() {
+        let loaded = probe(fragment);
+        assert_eq!(seen[k + 1].0, *fragment, "{seen:?}");
+        assert_eq!(
+            (seen[k + 1].1, &seen[k + 1].2),
+            (loaded[0].1, &loaded[0].2),
+            "{fragment}: set in the page {seen:?}, at load {loaded:?}"
+        );
+    }
+    assert!(seen[1].1 > 8000.0 && seen[2].1 == 10000.0, "{seen:?}");
+    assert!(seen[3].1 > 1000.0 && seen[3].1 < 3000.0, "{seen:?}");
+    // A fragment that names no frame leaves the replay where it is.
+    assert_eq!((seen[4].1, &seen[4].2), (seen[3].1, &seen[3].2), "{seen:?}");
+}

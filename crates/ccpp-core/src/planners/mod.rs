@@ -282,10 +282,12 @@ impl std::fmt::Display for PlannerKind {
 impl std::str::FromStr for PlannerKind {
     type Err = BuildError;
 
+    /// A planner's name, with any whitespace around it (`"bsa, bcd"` split at the comma).
     fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let name = s.trim();
         CATALOG
             .iter()
-            .find(|p| p.name == s)
+            .find(|p| p.name == name)
             .map(|p| p.kind)
             .ok_or_else(|| BuildError::Unknown(s.to_string()))
     }

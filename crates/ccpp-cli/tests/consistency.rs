@@ -1,0 +1,148 @@
+//! End-to-end checks that the same text is read and written the same way everywhere: planner
+//! names with spaces around them, map names in `results.md`, huge numbers in messages.
+#![allow(clippy::unwrap_used)]
+
+use crate::common::{ccpp, data};
+
+/// `ccpp planners --defaults "bsa, bcd"` took the space, `ccpp bench --planners "bsa, bcd"` and
+/// `ccpp run --planner " bsa"` failed with `unknown planner " bcd"`. Whitespace around a planner
+/// name is dropped wherever a name is read, and the bench's run folders and rows carry the name.
+#[test]
+fn planner_names_with_spaces_around_them_are_read_everywhere() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = data("teb_empty_box.yaml");
+    let out = dir.path().join("bench");
+    ccpp()
+        .args(["bench", "--quiet", "--planners", "bsa, bcd , bsa", "--maps"])
+        .arg(&map)
+        .arg("--out")
+        .arg(&out)
+        .assert()
+        .success();
+    let mut runs: Vec<String> = std::fs::read_dir(out.join("runs/teb_empty_box"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    runs.sort();
+    assert_eq!(runs, ["bcd", "bsa"]);
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    let planners: Vec<&str> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(1).unwrap())
+        .collect();
+    assert_eq!(planners, ["bsa", "bcd"], "{csv}");
+    let run = dir.path().join("run");
+    ccpp()
+        .args(["run", "--planner", " bsa ", "--map"])
+        .arg(&map)
+        .arg("--out")
+        .arg(&run)
+        .assert()
+        .success();
+    let json = crate::common::read_json(&run.join("metrics.json"));
+    assert_eq!(json["planner"], "bsa");
+    ccpp()
+        .args(["plan", "--planner", " bcd", "--map"])
+        .arg(&map)
+        .arg("--out")
+        .arg(dir.path().join("plan"))
+        .assert()
+        .success();
+    // A name that is not a planner's is still refused, as given.
+    let o = ccpp()
+        .args(["run", "--planner", " bs a", "--map"])
+        .arg(&map)
+        .arg("--out")
+        .arg(dir.path().join("bad"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("unknown planner \" bs a\""),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+/// A map file named `<script>.yaml` gave the heading `## <script>` in `results.md`, which a
+/// Markdown renderer drops as HTML. Headings and table cells (an error naming the file too)
+/// show `<`, `>` and `&` as written: as HTML entities.
+#[test]
+fn map_names_in_results_md_show_as_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let maps = dir.path().join("maps");
+    std::fs::create_dir(&maps).unwrap();
+    std::fs::copy(data("teb_empty_box.png"), maps.join("teb_empty_box.png")).unwrap();
+    let yaml = std::fs::read_to_string(data("teb_empty_box.yaml")).unwrap();
+    std::fs::write(maps.join("<script>.yaml"), &yaml).unwrap();
+    // A map that fails to load: its error row names the file.
+    std::fs::write(
+        maps.join("a&<b>.yaml"),
+        "image: missing.png\nresolution: 0.05\n",
+    )
+    .unwrap();
+    let out = dir.path().join("bench");
+    ccpp()
+        .args(["bench", "--quiet", "--planners", "bcd", "--maps"])
+        .arg(&maps)
+        .arg("--out")
+        .arg(&out)
+        .assert()
+        .code(1);
+    let md = std::fs::read_to_string(out.join("results.md")).unwrap();
+    assert!(md.contains("\n## &lt;script&gt;\n"), "{md}");
+    assert!(md.contains("\n## a&amp;&lt;b&gt;\n"), "{md}");
+    assert!(
+        md.lines()
+            .any(|l| l.starts_with("| bcd | error: ") && l.contains("a&amp;&lt;b&gt;.yaml")),
+        "{md}"
+    );
+    assert!(!md.contains('<') && !md.contains('>'), "{md}");
+}
+
+/// A trace pose of `1e308` made `ccpp replay` print its x as a 309-digit number, and `--radius
+/// 1e308` printed `(inf m across)`: both messages show their numbers compactly.
+#[test]
+fn huge_numbers_in_trace_and_radius_messages_are_short() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = data("teb_empty_box.yaml");
+    let o = ccpp()
+        .args(["run", "--planner", "bcd", "--radius", "1e308", "--map"])
+        .arg(&map)
+        .arg("--out")
+        .arg(dir.path().join("huge"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("a robot of radius 1e308 m (2e308 m across) is larger than the map"),
+        "{err}"
+    );
+    assert!(!err.contains("inf"), "{err}");
+    let run = dir.path().join("run");
+    ccpp()
+        .args(["run", "--planner", "bcd", "--map"])
+        .arg(&map)
+        .arg("--out")
+        .arg(&run)
+        .assert()
+        .success();
+    let trace = run.join("trace.jsonl");
+    let text = std::fs::read_to_string(&trace).unwrap();
+    let (first, rest) = text.split_once('\n').unwrap();
+    std::fs::write(
+        &trace,
+        format!("{first}\n{{\"t\":0,\"pose\":[1e308,5.0,0.0]}}\n{rest}"),
+    )
+    .unwrap();
+    let o = ccpp().arg("replay").arg(&run).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("line 2: pose (1e308, 5) lies outside the map ("),
+        "{err}"
+    );
+    assert!(err.len() < 400 && !err.contains("00000000"), "{err}");
+}
