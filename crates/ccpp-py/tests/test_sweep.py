@@ -140,6 +140,9 @@ def test_sweep_takes_one_planner_name_and_none_as_defaults(room: Path, client) -
         out=None, client=client, scheduler=None,
     )
     assert d.drop(columns=VOLATILE).equals(df.drop(columns=VOLATILE))
+    # Spaces around a name are dropped, as ccpp.run and `ccpp bench --planners` drop them.
+    spaced = ccpp.sweep(str(room), [" bsa "], client=client)
+    assert spaced["planner"].tolist() == ["bsa"]
 
 
 def test_sweep_status_of_a_stalled_run_is_stalled(shared_maps: Path, monkeypatch) -> None:

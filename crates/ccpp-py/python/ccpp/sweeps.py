@@ -232,8 +232,9 @@ def sweep(
         # One planner, not its letters.
         planners = [planners]
     if planners is not None:
-        # Any iterable (a generator has no len()).
-        planners = list(planners)
+        # Any iterable (a generator has no len()); spaces around a name are dropped, as
+        # `ccpp.run(planner=" bsa")` and `ccpp bench --planners "bsa, bcd"` drop them.
+        planners = [p.strip() if isinstance(p, str) else p for p in planners]
     if planners is not None and len(planners) == 0:
         raise _ccpp.CcppError("planners is empty (leave it out, or None, for every planner)")
     names = _once(planners) if planners is not None else known
