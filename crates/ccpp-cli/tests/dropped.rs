@@ -1026,4 +1026,10 @@ fn a_threshold_override_repairs_a_crossed_yaml() {
         .args(["info", "--map", &yaml, "--occupied-thresh", "0.3"])
         .assert()
         .success();
+    // A threshold out of [0, 1] is said to be so, not out of order (`--free-thresh 1.1` said
+    // "must be below occupied_thresh").
+    refused(
+        &["info", "--map", &yaml, "--free-thresh", "1.1"],
+        &["bad `free_thresh`", "1.1 is not in [0, 1]"],
+    );
 }

@@ -570,8 +570,9 @@ fn float_arg(key: &str, v: &Bound<'_, PyAny>) -> PyResult<f64> {
         .map_err(|_| msg(format!("{key} must be a number, got {}", repr(v))))
 }
 
-/// A keyword option that must be a whole number >= 0.
-fn uint_arg(key: &str, v: &Bound<'_, PyAny>) -> PyResult<u64> {
+/// A keyword option that must be a whole number, at least `lo` (named in the message of a
+/// value that is no such number: `max_steps=-1` said "from 0", and 0 was then refused).
+fn uint_arg(key: &str, v: &Bound<'_, PyAny>, lo: u64) -> PyResult<u64> {
     if is_bool(v) {
         return Err(msg(format!(
             "{key} must be a whole number, got {}",
@@ -581,7 +582,7 @@ fn uint_arg(key: &str, v: &Bound<'_, PyAny>) -> PyResult<u64> {
     // Past u64 (`max_steps=2**70`) the value is not below 0: say what the range is.
     v.extract().map_err(|_| {
         msg(format!(
-            "{key} must be a whole number from 0 to {}, got {}",
+            "{key} must be a whole number from {lo} to {}, got {}",
             u64::MAX,
             repr(v)
         ))
@@ -758,7 +759,7 @@ fn scenario_from(
                 }
                 s.sim.sensor_range = Some(float_arg(&key, &v)?);
             }
-            "max_memory_mb" => s.max_memory_mb = uint_arg(&key, &v)?,
+            "max_memory_mb" => s.max_memory_mb = uint_arg(&key, &v, 1)?,
             "max_steps" => {
                 if purpose == Purpose::Plan {
                     // `ccpp plan` has no step cap to give: a cap cut the plan short, saying so
@@ -767,7 +768,7 @@ fn scenario_from(
                         "max_steps does not apply to plan (a plan runs the planner to its end); leave it out",
                     ));
                 }
-                s.sim.max_steps = uint_arg(&key, &v)?;
+                s.sim.max_steps = uint_arg(&key, &v, 1)?;
             }
             "exec" => {
                 let e: String = v.extract().map_err(|_| {
@@ -782,7 +783,7 @@ fn scenario_from(
                 // The seed of the odometry noise and random-bounce's own option `seed`: there,
                 // a planner option like the others (so `seed=` and `options={"seed": ...}` must
                 // agree). Where it seeds nothing, the execution refuses it (below).
-                seed = Some(uint_arg(&key, &v)?);
+                seed = Some(uint_arg(&key, &v, 0)?);
                 if kind == PlannerKind::RandomBounce {
                     direct.push((key, v));
                 }
@@ -1487,7 +1488,7 @@ fn memory_option(options: Option<&Bound<'_, PyDict>>) -> PyResult<u64> {
         .transpose()?
         .flatten();
     match v {
-        Some(v) if !v.is_none() => uint_arg("max_memory_mb", &v),
+        Some(v) if !v.is_none() => uint_arg("max_memory_mb", &v, 1),
         _ => Ok(ccpp_io::scenario::DEFAULT_MAX_MEMORY_MB),
     }
 }
@@ -1791,7 +1792,15 @@ fn parse_action(a: &Bound<'_, PyAny>) -> PyResult<Step> {
         }
     };
     match (kind.as_str(), items.len()) {
-        ("rotate", 2) => Ok(Step::Rotate(num(1)?)),
+        ("rotate", 2) => {
+            let a = num(1)?;
+            // More than two turns is a typo or degrees, as for a start heading (the CLI
+            // refuses those); `1e300` was taken.
+            match ccpp_io::map::heading_problem(a) {
+                Some(p) => Err(msg(format!("action rotate: {p}"))),
+                None => Ok(Step::Rotate(a)),
+            }
+        }
         ("translate", 2) => Ok(Step::Translate(num(1)?)),
         ("move_to" | "move-to", 3) => Ok(Step::MoveTo(Point::new(num(1)?, num(2)?))),
         _ => Err(bad()),
@@ -1829,11 +1838,11 @@ impl Env {
         let start = reals(start);
         let max_steps = max_steps
             .filter(|v| !v.is_none())
-            .map(|v| uint_arg("max_steps", v))
+            .map(|v| uint_arg("max_steps", v, 1))
             .transpose()?;
         let limit = max_memory_mb
             .filter(|v| !v.is_none())
-            .map(|v| uint_arg("max_memory_mb", v))
+            .map(|v| uint_arg("max_memory_mb", v, 1))
             .transpose()?;
         let map = as_map(
             py,
@@ -1911,7 +1920,7 @@ impl Env {
         // `OverflowError`).
         let seed = seed
             .filter(|s| !s.is_none())
-            .map(|s| uint_arg("seed", s))
+            .map(|s| uint_arg("seed", s, 0))
             .transpose()?;
         let scenario = &self.scenario;
         let map = &self.map;

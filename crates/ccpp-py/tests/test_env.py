@@ -116,6 +116,11 @@ def test_reset_seed_and_actions(room: Path) -> None:
         env.step(("translate", True))
     with pytest.raises(ccpp.CcppError, match="finite"):
         env.step(("translate", float("nan")))
+    # More than two turns is a typo or degrees, as the CLI says of a start heading.
+    for angle in (1e300, 2**1000, -13.0):
+        with pytest.raises(ccpp.CcppError, match="more than two turns"):
+            env.step(("rotate", angle))
+    env.step(("rotate", 12.0))
     with pytest.raises(ccpp.CcppError, match="reset"):
         ccpp.Env(room).step(("rotate", 1.0))
     with pytest.raises(ccpp.CcppError, match="sensor"):

@@ -189,8 +189,12 @@ def test_errors_name_each_cause_once(room: Path, ccpp_bin: str, tmp_path: Path) 
 def test_whole_number_options_name_their_range(room: Path) -> None:
     """`max_steps=2**70` was refused as not `>= 0`, and `Env.reset(seed=-1)` raised an
     `OverflowError` where `run(seed=-1)` raises `CcppError`."""
-    with pytest.raises(ccpp.CcppError, match=r"max_steps must be a whole number from 0 to 18446744073709551615, got 1180591620717411303424"):
+    with pytest.raises(ccpp.CcppError, match=r"max_steps must be a whole number from 1 to 18446744073709551615, got 1180591620717411303424"):
         ccpp.run(room, "bsa", max_steps=2**70)
+    # The range named is the one taken (it said "from 0", and 0 was then refused).
+    for kw in ("max_steps", "max_memory_mb"):
+        with pytest.raises(ccpp.CcppError, match=f"{kw} must be a whole number from 1 to"):
+            ccpp.run(room, "bsa", **{kw: -1})
     env = ccpp.Env(room)
     for bad in (-1, 2**70):
         with pytest.raises(ccpp.CcppError, match=r"seed must be a whole number from 0 to 18446744073709551615"):

@@ -245,34 +245,41 @@ fn finish<R: std::io::BufRead + std::io::Seek>(
             &thresholds,
             |o: Option<f64>| if o.is_some() { "given" } else { theirs },
         );
+        // Only the order of two thresholds in [0, 1] is reworded (`--free-thresh 1.1` said
+        // "must be below occupied_thresh", not "not in [0, 1]").
+        let in_range = (0.0..=1.0).contains(&t.free) && (0.0..=1.0).contains(&t.occupied);
         match e {
             MapError::BadValue {
                 path,
                 field: "free_thresh",
                 ..
-            } if t.free >= t.occupied && opts.occupied_thresh.is_some() => MapError::BadValue {
-                path,
-                field: "occupied_thresh",
-                reason: format!(
-                    "occupied_thresh {} (given) must be above free_thresh {} ({})",
-                    Compact(t.occupied),
-                    Compact(t.free),
-                    given(opts.free_thresh)
-                ),
-            },
+            } if in_range && t.free >= t.occupied && opts.occupied_thresh.is_some() => {
+                MapError::BadValue {
+                    path,
+                    field: "occupied_thresh",
+                    reason: format!(
+                        "occupied_thresh {} (given) must be above free_thresh {} ({})",
+                        Compact(t.occupied),
+                        Compact(t.free),
+                        given(opts.free_thresh)
+                    ),
+                }
+            }
             MapError::BadValue {
                 path,
                 field: "free_thresh",
                 ..
-            } if t.free >= t.occupied && opts.free_thresh.is_some() => MapError::BadValue {
-                path,
-                field: "free_thresh",
-                reason: format!(
-                    "free_thresh {} (given) must be below occupied_thresh {} ({theirs})",
-                    Compact(t.free),
-                    Compact(t.occupied)
-                ),
-            },
+            } if in_range && t.free >= t.occupied && opts.free_thresh.is_some() => {
+                MapError::BadValue {
+                    path,
+                    field: "free_thresh",
+                    reason: format!(
+                        "free_thresh {} (given) must be below occupied_thresh {} ({theirs})",
+                        Compact(t.free),
+                        Compact(t.occupied)
+                    ),
+                }
+            }
             e => e,
         }
     })?;
