@@ -583,7 +583,7 @@ fn a_tool_narrower_than_the_pixels_is_told() {
 
 /// A control period far below any robot's with a cap that lets it run (`dt_s: 1e-7`,
 /// `max_steps_per_motion: 4e9`) simulated for over half an hour in a few MB: refused up front
-/// by its estimated control steps, naming dt_s. At `dt_s: 1e-5` the memory estimate once
+/// by its estimated control steps, naming `dt_s`. At `dt_s: 1e-5` the memory estimate once
 /// counted the cap for every motion (4.4 TB) and refused a run of 25 s and 143 MB.
 #[test]
 fn a_control_period_that_would_run_for_hours_is_refused() {

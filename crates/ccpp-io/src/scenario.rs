@@ -1039,27 +1039,6 @@ impl Scenario {
                 .settings()
                 .check(&setup)
                 .map_err(|e| self.degenerate(&map.source, e))?;
-            // A bound on time, as the memory estimate below is one on space: a control period
-            // far below any robot's ran for half an hour in a few MB.
-            let exec = self.execution();
-            if let Execution::Pid(p) = &exec {
-                let steps = ccpp_core::planners::settings::pid_control_steps(
-                    &setup,
-                    self.planner.settings(),
-                    &exec,
-                );
-                if steps > ccpp_core::planners::settings::MAX_PID_STEPS {
-                    return Err(ScenarioError::Invalid(format!(
-                        "map {}: {} under PID execution would simulate about {:.1e} control steps (dt_s {} s, max_steps_per_motion {}), more than {:.0e}: raise exec.pid.dt_s (a robot's control loop runs at 10 to 1000 Hz: dt_s 0.001 to 0.1)",
-                        map.source.display(),
-                        self.planner.name(),
-                        steps,
-                        Compact(p.dt_s),
-                        p.max_steps_per_motion,
-                        ccpp_core::planners::settings::MAX_PID_STEPS
-                    )));
-                }
-            }
         }
         // A landmark farther off the map than the landmark range is never seen from it: it
         // would be read, checked and then change nothing.
@@ -1133,6 +1112,30 @@ impl Scenario {
                 limit_mb: self.max_memory_mb,
                 advice,
             });
+        }
+        // A bound on time, as the memory estimate above is one on space (checked after it:
+        // a tiny robot or gains that crawl are refused there with their own advice): a
+        // control period far below any robot's ran for half an hour in a few MB.
+        if with_planner {
+            let exec = self.execution();
+            if let Execution::Pid(p) = &exec {
+                let steps = ccpp_core::planners::settings::pid_control_steps(
+                    &setup,
+                    self.planner.settings(),
+                    &exec,
+                );
+                if steps > ccpp_core::planners::settings::MAX_PID_STEPS {
+                    return Err(ScenarioError::Invalid(format!(
+                        "map {}: {} under PID execution would simulate about {:.1e} control steps (dt_s {} s, max_steps_per_motion {}), more than {:.0e}: raise exec.pid.dt_s (a robot's control loop runs at 10 to 1000 Hz: dt_s 0.001 to 0.1) or the PID speeds",
+                        map.source.display(),
+                        self.planner.name(),
+                        steps,
+                        Compact(p.dt_s),
+                        p.max_steps_per_motion,
+                        ccpp_core::planners::settings::MAX_PID_STEPS
+                    )));
+                }
+            }
         }
         Ok(est)
     }
