@@ -579,7 +579,7 @@ fn run_one(
                 if let Ok(m) = serde_json::from_str::<Metrics>(&text) {
                     // Reused only when its trace reads back whole: a damaged trace was reused
                     // and then left out of the plots in silence.
-                    match whole_trace(dir, budget) {
+                    match whole_trace(dir, map.grid.frame(), robot.radius, budget) {
                         Ok(()) => return Ok(m),
                         Err(why) => {
                             eprintln!("warning: {}: {why}; running it again", dir.display());
@@ -608,15 +608,22 @@ fn run_one(
     run_isolated(&spec)
 }
 
-/// Checks that the `trace.jsonl` of the run folder `dir` reads back (as the plots read it) and
+/// Checks that the `trace.jsonl` of the run folder `dir` reads back (as the plots read it,
+/// every pose on the map of `frame`, within the robot's `radius` and two pixels) and
 /// ends with the simulator's `finished` record (a trace cut at a line's end reads back). The
 /// parsed trace is held against `budget` while it is checked (streamed, about twice the
 /// file's size).
-fn whole_trace(dir: &Path, budget: &MemoryBudget) -> Result<(), String> {
+fn whole_trace(
+    dir: &Path,
+    frame: &ccpp_core::grid::MapFrame,
+    radius: f64,
+    budget: &MemoryBudget,
+) -> Result<(), String> {
     let path = dir.join("trace.jsonl");
     let len = std::fs::metadata(&path).map_or(0, |m| m.len());
     let _grant = budget.take(2.0 * len as f64);
-    let trace = crate::plots::read_trace(&path).map_err(|e| crate::errors::one_line(&e))?;
+    let trace =
+        crate::plots::read_trace(&path, frame, radius).map_err(|e| crate::errors::one_line(&e))?;
     if matches!(
         trace.events().last(),
         Some((_, ccpp_core::trace::Event::Finished { .. }))

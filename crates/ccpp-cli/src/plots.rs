@@ -22,9 +22,13 @@ use crate::job::PreparedMap;
 use crate::row::Row;
 use crate::staging::write_file;
 
-/// Reads a `trace.jsonl` back (the checked codec of `ccpp_io::trace`).
-pub fn read_trace(path: &Path) -> Result<Trace> {
-    Ok(ccpp_io::trace::read_trace(path, None)?)
+/// Reads a `trace.jsonl` back (the checked codec of `ccpp_io::trace`) of a run on a map of
+/// `frame` by a robot of radius `radius`: every pose must lie on the map, as `ccpp replay`
+/// requires (a pose of 1.7e308 m hung the bench's pictures, and one of 100 m on a 6 m map drew
+/// a path off the picture).
+pub fn read_trace(path: &Path, frame: &ccpp_core::grid::MapFrame, radius: f64) -> Result<Trace> {
+    let margin = radius + 2.0 * frame.resolution;
+    Ok(ccpp_io::trace::read_trace(path, Some((frame, margin)))?)
 }
 
 fn write_chart(dir: &Path, stem: &str, chart: &Chart) -> Result<()> {
@@ -91,13 +95,14 @@ pub fn write_all(
             let mut shown: Vec<LegendShown> = Vec::new();
             for r in rows.iter().filter(|r| r.map == m.name) {
                 let Ok(metrics) = &r.outcome else { continue };
-                let trace = match read_trace(&r.dir.join("trace.jsonl")) {
-                    Ok(t) => t,
-                    Err(e) => {
-                        skipped.push(left_out(r, &crate::errors::one_line(&e)));
-                        continue;
-                    }
-                };
+                let trace =
+                    match read_trace(&r.dir.join("trace.jsonl"), m.grid.frame(), robot.radius) {
+                        Ok(t) => t,
+                        Err(e) => {
+                            skipped.push(left_out(r, &crate::errors::one_line(&e)));
+                            continue;
+                        }
+                    };
                 series.push((r.planner.clone(), coverage_curve(&world, &trace, 200)));
                 // The panel: the run's picture without header or legend (one shared legend and
                 // legible captions instead), drawn from the run's own start pose.

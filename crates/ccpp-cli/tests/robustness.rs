@@ -475,7 +475,25 @@ fn bench_runs_again_a_run_whose_trace_is_damaged() {
         .flatten()
         .copied()
         .collect::<Vec<u8>>();
-    for damaged in [whole[..1000].to_vec(), cut_at_line_end] {
+    // A line replaced by a pose off the 6 m map: read back without a word (100 m drew a path
+    // off the picture; 1.7e308 m hung the pictures).
+    let off_map = |x: &str| {
+        let mut v = Vec::new();
+        for (i, l) in whole.split_inclusive(|b| *b == b'\n').enumerate() {
+            if i == lines / 2 {
+                v.extend_from_slice(format!("{{\"t\":5,\"pose\":[{x},5.0,0.0]}}\n").as_bytes());
+            } else {
+                v.extend_from_slice(l);
+            }
+        }
+        v
+    };
+    for damaged in [
+        whole[..1000].to_vec(),
+        cut_at_line_end,
+        off_map("100.0"),
+        off_map("1.7e308"),
+    ] {
         std::fs::write(&trace, damaged).unwrap();
         let o = bench(&out, &maps, &["--planners", "bsa,bcd"])
             .output()
