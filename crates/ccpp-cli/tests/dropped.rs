@@ -613,20 +613,39 @@ fn a_control_period_that_would_run_for_hours_is_refused() {
 }
 
 /// Options that are legal but leave the planner nothing to do ended "done" at 0 m without a
-/// word: a PID tolerance wider than every move (each goal reached at once), a clearance
-/// margin no free cell meets. The run now warns.
+/// word: a clearance margin no free cell meets. The run now warns. A PID tolerance of a robot
+/// radius or more (each goal reached at once: 0 m at 10 m, 2.8 m and 2 % swept at 0.3 m) is
+/// refused.
 #[test]
 fn a_run_that_never_moves_is_told() {
     let d = tempfile::tempdir().unwrap();
     let dir = d.path();
     let map = pillars(dir);
-    for (i, text) in [
-        "bsa_bfs: { exec: { pid: { tolerance_m: 10 } } }\n",
-        "bsa_bfs: { clearance_margin_m: 5 }\n",
-    ]
-    .iter()
-    .enumerate()
-    {
+    for tol in ["10", "0.3", "0.15"] {
+        let cfg = write(
+            dir,
+            &format!("tol{tol}.yaml"),
+            &format!("bsa_bfs: {{ exec: {{ pid: {{ tolerance_m: {tol} }} }} }}\n"),
+        );
+        refused(
+            &[
+                "run",
+                "--map",
+                s(&map),
+                "--planner",
+                "bsa-bfs",
+                "--config",
+                &cfg,
+                "--out",
+                s(&dir.join("t")),
+            ],
+            &[
+                "exec.pid.tolerance_m",
+                "is not below the robot radius 0.15 m",
+            ],
+        );
+    }
+    for (i, text) in ["bsa_bfs: { clearance_margin_m: 5 }\n"].iter().enumerate() {
         let cfg = write(dir, &format!("still{i}.yaml"), text);
         let o = ccpp()
             .args(["run", "--map", s(&map), "--planner", "bsa-bfs"])

@@ -70,6 +70,8 @@ pub(crate) fn fields(line: &str) -> impl Iterator<Item = &str> {
 pub fn parse_georef(text: &str) -> Result<Vec<(Point, Point)>, GeorefProblem> {
     let mut pairs = Vec::new();
     let mut first = true;
+    // A byte-order mark (Excel's "CSV UTF-8") is no part of the first field.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     for (n, raw) in text.lines().enumerate() {
         // A trailing comment is a comment too: `0,0,0,10 # corner` was taken for a header
         // and its pair dropped without a word.
@@ -133,7 +135,7 @@ mod tests {
     /// words is an error, not a header: either once dropped a pair without a word.
     #[test]
     fn trailing_comments_and_half_numeric_first_lines() {
-        let p = parse_georef("0,0,0,10 # a\n200,0,10,10\n0,200,0,0 # c\n").unwrap();
+        let p = parse_georef("\u{feff}0,0,0,10 # a\n200,0,10,10\n0,200,0,0 # c\n").unwrap();
         assert_eq!(p.len(), 3);
         assert_eq!(p[0], (Point::new(0.0, 0.0), Point::new(0.0, 10.0)));
         let e = parse_georef("0,0,x,10\n200,0,10,10\n").unwrap_err();

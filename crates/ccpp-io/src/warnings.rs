@@ -76,13 +76,13 @@ pub fn drift_warning(scenario: &Scenario, trace: &Trace, metrics: &Metrics) -> O
 }
 
 /// A run that drove nothing while floor was left, said (`None` otherwise). Options that are
-/// legal but leave the planner nothing to do (a PID `tolerance_m` of 10 m that counts every
-/// goal reached at once, a bsa-bfs `clearance_margin_m` no free cell meets) ended "done" at
-/// 0 m without a word.
+/// legal but leave the planner nothing to do (a bsa-bfs `clearance_margin_m` no free cell
+/// meets) ended "done" at 0 m without a word, as does a room too small for the planner's cells
+/// at the robot's size.
 pub fn no_motion_warning(metrics: &Metrics) -> Option<String> {
     (metrics.path_length_m == 0.0 && metrics.effective_coverage < 1.0).then(|| {
         format!(
-            "the robot did not move (0 m driven, {:.1} % of the floor swept from the start): check the options that bound its moves (exec.pid.tolerance_m, clearance margins, the sensor range)",
+            "the robot did not move (0 m driven, {:.1} % of the floor swept from the start): the planner found nowhere to go, as when its cells or lanes do not fit this floor at this robot size, or an option bounds its moves (a clearance margin, the sensor range)",
             100.0 * metrics.effective_coverage
         )
     })
