@@ -602,4 +602,12 @@ window.addEventListener("load", () => {
     assert!(seen[3].1 > 1000.0 && seen[3].1 < 3000.0, "{seen:?}");
     // A fragment that names no frame leaves the replay where it is.
     assert_eq!((seen[4].1, &seen[4].2), (seen[3].1, &seen[3].2), "{seen:?}");
+    // The fraction is read whole: `#at=5e-1` is a half (only its "5" was read: the end).
+    let (sci, plain) = (probe("#at=5e-1"), probe("#at=0.5"));
+    assert_eq!(
+        (sci[0].1, &sci[0].2),
+        (plain[0].1, &plain[0].2),
+        "{sci:?} {plain:?}"
+    );
+    assert!(plain[0].1 > 4000.0 && plain[0].1 < 6000.0, "{plain:?}");
 }
