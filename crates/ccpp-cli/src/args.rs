@@ -70,9 +70,11 @@ pub struct MapArgs {
 /// Robot options shared by commands.
 #[derive(Args, Debug, Clone)]
 pub struct RobotArgs {
-    /// Robot (footprint) radius in metres.
-    #[arg(long, value_name = "M", default_value_t = 0.15)]
-    pub radius: f64,
+    /// Robot (footprint) radius in metres [default: 0.15].
+    // An `Option` (its default applied in `job::robot_from`): `plan` and `waypoints` refuse a
+    // radius given beside a rectangle whose disk it cannot change.
+    #[arg(long, value_name = "M")]
+    pub radius: Option<f64>,
     /// Cleaning tool radius in metres (default: the robot radius).
     #[arg(long, value_name = "M")]
     pub tool_radius: Option<f64>,
@@ -349,7 +351,7 @@ pub struct BenchRobotArgs {
 impl From<&BenchRobotArgs> for RobotArgs {
     fn from(b: &BenchRobotArgs) -> Self {
         Self {
-            radius: b.radius,
+            radius: Some(b.radius),
             tool_radius: b.tool_radius,
             start: None,
         }

@@ -40,6 +40,13 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     crate::job::warn_unused_config(a.options.config.as_deref(), &[kind]);
     let given =
         crate::job::apply_rect_flags(a.length, a.width, &mut planner, a.options.config.as_deref())?;
+    // A plan is not simulated: beside a rectangle the radius is only a floor under its disk
+    // (`ccpp run` keeps it: the simulator's collisions use it).
+    if let PlannerConfig::RectBoustrophedon(o) = &planner {
+        if let Some(why) = crate::job::radius_under_the_rectangle(a.robot.radius, o) {
+            bail!("{why}");
+        }
+    }
     let flag = |e: ScenarioError| crate::job::name_flag(e, &given);
     let scenario = Scenario::configure(recipe_from(&a.map), planner)
         .robot(robot)

@@ -562,8 +562,6 @@ fn waypoints_follow_the_seed_001_example() {
     let o = ccpp()
         .args([
             "waypoints",
-            "--radius",
-            "0.02",
             "--length",
             "0.1",
             "--width",
@@ -611,8 +609,6 @@ fn waypoints_follow_the_seed_001_example() {
     let csv = ccpp()
         .args([
             "waypoints",
-            "--radius",
-            "0.02",
             "--length",
             "0.1",
             "--width",

@@ -249,6 +249,33 @@ fn tool_radius_is_refused_where_it_changes_nothing() {
     let b = plan_ok(dir, "b", &map, "bcd", &["--tool-radius", "0.08"]);
     let csv = |p: &Path| std::fs::read_to_string(p.join("waypoints.csv")).unwrap();
     assert_ne!(csv(&a), csv(&b));
+    // `--radius` beside `--length` and `--width` is a floor under the rectangle's disk
+    // (0.2121 m for 0.3 x 0.3): 0.1 and 0.2 wrote the same waypoints as none. Refused there;
+    // above the disk, or without the rectangle, it changes the plan.
+    let rect = ["--length", "0.3", "--width", "0.3"];
+    for r in ["0.1", "0.2"] {
+        let mut args = vec!["plan", "--planner", "rect-boustrophedon", "--map", s(&map)];
+        args.extend(rect);
+        args.extend(["--radius", r, "--out", s(&out)]);
+        refused(&args, &["--radius", "changes nothing", "0.2121 m"]);
+        let mut args = vec!["waypoints", "--map", s(&map)];
+        args.extend(rect);
+        args.extend(["--radius", r]);
+        refused(&args, &["--radius", "changes nothing"]);
+    }
+    assert!(!out.exists());
+    let plain = plan_ok(dir, "plain", &map, "rect-boustrophedon", &rect);
+    let wide = [&rect[..], &["--radius", "0.3"]].concat();
+    let wider = plan_ok(dir, "wider", &map, "rect-boustrophedon", &wide);
+    assert_ne!(csv(&plain), csv(&wider));
+    let small = plan_ok(
+        dir,
+        "small",
+        &map,
+        "rect-boustrophedon",
+        &["--radius", "0.1"],
+    );
+    assert_ne!(csv(&plain), csv(&small));
 }
 
 /// `--georef` with `--resolution` or `--origin`: the fit replaced them without a word.

@@ -399,15 +399,7 @@ fn info_shows_the_zones_and_waypoints_avoid_keepouts() {
     // waypoints: no waypoint in the keep-out strip across the house.
     let wp = |extra: &[&str]| {
         let o = ccpp()
-            .args([
-                "waypoints",
-                "--radius",
-                "0.3",
-                "--length",
-                "0.6",
-                "--width",
-                "0.6",
-            ])
+            .args(["waypoints", "--length", "0.6", "--width", "0.6"])
             .args(extra)
             .arg("--map")
             .arg(house())
