@@ -136,25 +136,6 @@ pub fn prepare_map(args: &MapArgs, max_memory_mb: u64) -> Result<PreparedMap> {
 /// The robot radius when `--radius` is not given, metres.
 pub const DEFAULT_RADIUS_M: f64 = 0.15;
 
-/// Why `--radius` (`given`) changes nothing beside the rectangle of `o` (`None` when it
-/// does): with both `--length` and `--width` the lanes keep clear the rectangle's
-/// circumscribed disk (or `clearance_radius_m`), and the radius is only a floor under it
-/// (`--radius 0.1` beside a 0.3 x 0.3 m rectangle wrote the same waypoints as 0.2 or none).
-pub fn radius_under_the_rectangle(
-    given: Option<f64>,
-    o: &ccpp_core::planners::rect_boustrophedon::RectOptions,
-) -> Option<String> {
-    let r = given?;
-    let (l, b) = (o.length_m?, o.width_m?);
-    let disk = o.clearance_radius_m.unwrap_or(0.5 * l.hypot(b));
-    (r <= disk).then(|| {
-        format!(
-            "--radius {} m changes nothing here: the lanes keep clear the rectangle's disk of radius {disk:.4} m (from --length and --width), which is larger; leave --radius out, or give more than that",
-            ccpp_core::display::Compact(r)
-        )
-    })
-}
-
 /// The robot and start of `args`, validated by the library.
 pub fn robot_from(args: &RobotArgs) -> Result<(Robot, Option<Pose>)> {
     let radius = args.radius.unwrap_or(DEFAULT_RADIUS_M);

@@ -43,7 +43,8 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     // A plan is not simulated: beside a rectangle the radius is only a floor under its disk
     // (`ccpp run` keeps it: the simulator's collisions use it).
     if let PlannerConfig::RectBoustrophedon(o) = &planner {
-        if let Some(why) = crate::job::radius_under_the_rectangle(a.robot.radius, o) {
+        if let Some(why) = ccpp_io::plan::radius_under_the_rectangle("--radius", a.robot.radius, o)
+        {
             bail!("{why}");
         }
     }

@@ -35,7 +35,8 @@ pub fn run(a: &WaypointsArgs) -> Result<()> {
         exec: ccpp_core::exec::Execution::Ideal,
         ..RectOptions::default()
     };
-    if let Some(why) = crate::job::radius_under_the_rectangle(a.robot.radius, &opts) {
+    if let Some(why) = ccpp_io::plan::radius_under_the_rectangle("--radius", a.robot.radius, &opts)
+    {
         bail!("{why}");
     }
     // The same validation, checks and memory estimate as `ccpp run --planner

@@ -42,6 +42,28 @@ pub struct Plan {
     pub wall_time_s: f64,
 }
 
+/// Why a robot radius given beside the rectangle of rect-boustrophedon's `o` changes nothing in
+/// a plan (`None` when it does): with both `length_m` and `width_m` the lanes keep clear the
+/// rectangle's circumscribed disk (or `clearance_radius_m`), and the radius is only a floor
+/// under it (`ccpp plan --radius 0.1` beside a 0.3 x 0.3 m rectangle wrote the same waypoints as
+/// 0.2 or none). `name` is the radius as the caller's user wrote it (`--radius`, `radius=`). A
+/// simulated run keeps the radius: its collisions use it.
+pub fn radius_under_the_rectangle(
+    name: &str,
+    given: Option<f64>,
+    o: &ccpp_core::planners::rect_boustrophedon::RectOptions,
+) -> Option<String> {
+    let r = given?;
+    let (l, b) = (o.length_m?, o.width_m?);
+    let disk = o.clearance_radius_m.unwrap_or(0.5 * l.hypot(b));
+    (r <= disk).then(|| {
+        format!(
+            "{name} {} m changes nothing here: the lanes keep clear the rectangle's disk of radius {disk:.4} m (from its length and width), which is larger; leave the radius out, or give more than that",
+            ccpp_core::display::Compact(r)
+        )
+    })
+}
+
 /// The names of the known-map planners, comma-separated.
 pub fn offline_planners() -> String {
     ccpp_core::planners::CATALOG

@@ -1144,7 +1144,8 @@ impl PlanResult {
 /// simulation metrics. As `ccpp plan` refuses them, so does this: `exec` and the planner's own
 /// execution settings (a plan executes the steps ideally), `sensor_range` (offline planners),
 /// a start heading (`start=(x, y)` only), and `tool_radius` for `rect-boustrophedon` (its lanes
-/// follow `width_m`). The GIL is released while planning; Ctrl-C raises `KeyboardInterrupt`
+/// follow `width_m`), as is a `radius` not above the disk of its `length_m` x `width_m`
+/// rectangle (the lanes keep clear of that disk; the radius is only a floor under it). The GIL is released while planning; Ctrl-C raises `KeyboardInterrupt`
 /// at once.
 #[pyfunction]
 #[pyo3(signature = (map, planner=None, radius=None, **options))]
@@ -1156,9 +1157,16 @@ fn plan(
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<PlanResult> {
     let radius = real(radius);
+    let given = radius;
     let mut prepared = as_map(py, map, memory_option(options)?)?;
     let (planner, radius) = (planner.unwrap_or("bcd"), radius.unwrap_or(DEFAULT_RADIUS));
     let scenario = scenario_from(&prepared, planner, radius, options, Purpose::Plan)?;
+    // Beside a rectangle a plan's radius is only a floor under its disk, as `ccpp plan` says.
+    if let PlannerConfig::RectBoustrophedon(o) = &scenario.planner {
+        if let Some(why) = ccpp_io::plan::radius_under_the_rectangle("radius", given, o) {
+            return Err(msg(why));
+        }
+    }
     name_map(&mut prepared, &scenario);
     let (scenario, prepared) = (Arc::new(scenario), Arc::new(prepared));
     let (sc, pm) = (Arc::clone(&scenario), Arc::clone(&prepared));

@@ -87,6 +87,13 @@ def test_plan_refuses_what_a_plan_would_drop(room: Path, ccpp_bin: str, tmp_path
         ccpp.plan(room, "rect-boustrophedon", tool_radius=0.1)
     # bcd's lanes follow the tool: there it applies.
     assert ccpp.plan(room, "bcd", tool_radius=0.1).export("csv") != ccpp.plan(room, "bcd").export("csv")
+    # A radius under the rectangle's disk (0.2121 m for 0.3 x 0.3) changed nothing: refused, as
+    # `ccpp plan --radius` is; above it, it changes the plan.
+    rect = {"length_m": 0.3, "width_m": 0.3}
+    with pytest.raises(ccpp.CcppError, match=r"radius 0.1 m changes nothing here.*0.2121 m"):
+        ccpp.plan(room, "rect-boustrophedon", radius=0.1, **rect)
+    plain = ccpp.plan(room, "rect-boustrophedon", **rect).export("csv")
+    assert ccpp.plan(room, "rect-boustrophedon", radius=0.3, **rect).export("csv") != plain
     # The GeoJSON names the rectangle a rect-boustrophedon route was planned for (as `ccpp plan`).
     geo = json.loads(ccpp.plan(room, "rect-boustrophedon", length_m=0.5, width_m=0.3).export("geojson"))
     assert geo["features"][0]["properties"]["robot"]["footprint"] == {
