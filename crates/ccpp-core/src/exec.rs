@@ -617,9 +617,9 @@ mod tests {
         assert_eq!(capped.motion_steps(1.0, 5.0), 6);
         // A crawl is not simulated to its end (with a cap of billions of steps and gains that
         // crawl, simulating to the end kept the estimate busy for minutes): past
-        // MOTION_STEPS_SIMULATED steps a part counts its steps so far over the part of the
-        // motion made. This one ends after about 6 million steps (0.3 m at 1 micrometre a
-        // second, 0.05 s a step); it once counted the cap, 4e9.
+        // MOTION_STEPS_SIMULATED steps the motion is simulated again at a 10, 100, ... times
+        // longer control period and its steps scaled. This one ends after about 6 million
+        // steps (0.3 m at 1 micrometre a second, 0.05 s a step); it once counted the cap, 4e9.
         let crawl = PidOptions {
             linear: PidGains {
                 output_limit: 1e-6,

@@ -15,8 +15,9 @@
 //!   landmark observations when [`SimConfig::landmarks`] has some ([`crate::landmarks`]).
 //!   The trace gets an [`Event::Execution`] at the start, an [`Event::PlannedSegment`] before
 //!   each translation, and true poses every `record_every` control steps plus at the end of
-//!   each motion and where the robot starts or stops turning in place. `MoveTo` follows the segment from the previous planned goal (when the last
-//!   motion ended without contact) to the new one, so the robot steers back onto the plan.
+//!   each motion and where the robot starts or stops turning in place. `MoveTo` follows the
+//!   segment from the previous planned goal (when the last motion ended without contact) to
+//!   the new one, so the robot steers back onto the plan.
 //!
 //! The sensor scan is always taken around the **true** position and returned in map
 //! coordinates (a scan registered to the map), whatever the estimate.

@@ -54,8 +54,9 @@ pub fn radius_under_the_rectangle(
     o: &ccpp_core::planners::rect_boustrophedon::RectOptions,
 ) -> Option<String> {
     let r = given?;
-    let (l, b) = (o.length_m?, o.width_m?);
-    let disk = o.clearance_radius_m.unwrap_or(0.5 * l.hypot(b));
+    // Without both sides the rectangle follows the tool, and so the radius.
+    o.length_m.zip(o.width_m)?;
+    let disk = o.rectangle_disk(&ccpp_core::world::Robot::new(r));
     (r <= disk).then(|| {
         format!(
             "{name} {} m changes nothing here: the lanes keep clear the rectangle's disk of radius {disk:.4} m (from its length and width), which is larger; leave the radius out, or give more than that",

@@ -117,9 +117,14 @@ impl RectOptions {
     /// never less than the robot's radius (a plan falls back to the robot's own radius, with
     /// a note in its trace, when that disk does not fit at the start).
     pub fn clearance_radius(&self, robot: &Robot) -> f64 {
+        self.rectangle_disk(robot).max(robot.radius)
+    }
+
+    /// The disk of [`Self::clearance_radius`] before the robot's radius is laid under it:
+    /// `clearance_radius_m`, by default `hypot(l, b) / 2`.
+    pub fn rectangle_disk(&self, robot: &Robot) -> f64 {
         self.clearance_radius_m
             .unwrap_or(0.5 * self.length_for(robot).hypot(self.width_for(robot)))
-            .max(robot.radius)
     }
 }
 

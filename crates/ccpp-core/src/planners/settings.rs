@@ -651,7 +651,8 @@ impl PlannerSettings for RandomBounceOptions {
         // at 0 m (r = 0.03 m at the default range 4 r on a 0.05 m map).
         let res = s.frame.resolution;
         let need = s.robot.radius + 2.0 * res;
-        if s.sensor_range < s.robot.radius + (2.0 + 1e-3) * res {
+        // A thousandth of a pixel above it: the strides stop 1e-4 px short of what is seen.
+        if s.sensor_range < need + 1e-3 * res {
             return Err(OptionsError::new(
                 "",
                 format!(
