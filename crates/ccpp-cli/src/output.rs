@@ -84,11 +84,12 @@ pub fn replay_dir(dir: &Path) -> Result<()> {
         serde_json::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", rec_path.display()))?;
     let map = crate::job::load_recipe(&scenario.map, scenario.max_memory_mb)?;
     let world = scenario.world(&map)?;
-    // Poses must lie on the map (a robot cannot leave it): a damaged trace is refused here
-    // instead of hanging the renderer.
-    let margin = scenario.robot.radius + 2.0 * world.frame().resolution;
-    let trace =
-        ccpp_io::trace::read_trace(&dir.join("trace.jsonl"), Some((world.frame(), margin)))?;
+    // Poses must lie on the map: a damaged trace is refused instead of hanging the renderer.
+    let trace = ccpp_io::trace::read_run_trace(
+        &dir.join("trace.jsonl"),
+        world.frame(),
+        scenario.robot.radius,
+    )?;
     // Through `read_text`: a FIFO named metrics.json hung the replay (a regular file only).
     let metrics_path = dir.join("metrics.json");
     let metrics = ccpp_io::file::read_text(&metrics_path).with_context(|| {

@@ -22,13 +22,10 @@ use crate::job::PreparedMap;
 use crate::row::Row;
 use crate::staging::write_file;
 
-/// Reads a `trace.jsonl` back (the checked codec of `ccpp_io::trace`) of a run on a map of
-/// `frame` by a robot of radius `radius`: every pose must lie on the map, as `ccpp replay`
-/// requires (a pose of 1.7e308 m hung the bench's pictures, and one of 100 m on a 6 m map drew
-/// a path off the picture).
+/// Reads a run's `trace.jsonl` back as `ccpp replay` does ([`ccpp_io::trace::read_run_trace`]:
+/// every pose on the map of `frame`, for a robot of radius `radius`).
 pub fn read_trace(path: &Path, frame: &ccpp_core::grid::MapFrame, radius: f64) -> Result<Trace> {
-    let margin = radius + 2.0 * frame.resolution;
-    Ok(ccpp_io::trace::read_trace(path, Some((frame, margin)))?)
+    Ok(ccpp_io::trace::read_run_trace(path, frame, radius)?)
 }
 
 fn write_chart(dir: &Path, stem: &str, chart: &Chart) -> Result<()> {

@@ -697,6 +697,18 @@ fn parse_trace_lines<'a>(
     Ok(trace)
 }
 
+/// Reads the `trace.jsonl` of a finished run on a map of `frame` by a robot of radius
+/// `radius`: [`read_trace`] with every pose on the map, widened by the radius and two pixels
+/// (a robot cannot leave its map). A damaged trace is refused here instead of hanging a
+/// renderer (a pose of 1.7e308 m hung the bench's pictures; one of 100 m on a 6 m map drew a
+/// path off the picture). `ccpp replay` and `ccpp bench` read traces back through it.
+///
+/// # Errors
+/// See [`read_trace`].
+pub fn read_run_trace(path: &Path, frame: &MapFrame, radius: f64) -> Result<Trace, TraceFileError> {
+    read_trace(path, Some((frame, radius + 2.0 * frame.resolution)))
+}
+
 /// Reads a `trace.jsonl` (a regular file), checked as [`parse_trace`].
 ///
 /// # Errors
