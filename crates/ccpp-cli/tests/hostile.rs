@@ -2354,3 +2354,43 @@ fn contacts_under_drift_are_explained() {
         "{err}"
     );
 }
+
+/// A start where the rectangle's clearance disk does not fit: the plan fell back to the robot's
+/// own radius (a note in a trace `plan` and `waypoints` do not write), and the route drove the
+/// 0.8 x 0.3 m robot's body into walls beside the start (467 of 491 segments on
+/// `aws_small_house`). Refused by `run`, `plan` and `waypoints` alike; a disk that fits plans.
+#[test]
+fn a_start_where_the_rectangle_does_not_fit_is_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir); // a pillar from x = 2.0 m: (1.7, 3.0) is 0.3 m from it
+    let out = dir.join("out");
+    let big = ["--length", "0.8", "--width", "0.3", "--start", "1.7,3"];
+    let needles = [
+        "clearance disk",
+        "0.8 x 0.3 m robot",
+        "radius 0.427 m",
+        "does not fit at the start (1.700, 3.000)",
+        "pillars.pgm",
+    ];
+    for cmd in ["run", "plan"] {
+        let mut args = vec![cmd, "--planner", "rect-boustrophedon", "--map", s(&map)];
+        args.extend(big);
+        args.extend(["--out", s(&out)]);
+        refused(&args, &needles);
+    }
+    let mut args = vec!["waypoints", "--map", s(&map)];
+    args.extend(big);
+    refused(&args, &needles);
+    assert!(!out.exists());
+    // The 0.3 x 0.3 m robot's disk (0.212 m) fits there: planned, every stop clear of the pillar.
+    let p = plan_ok(
+        dir,
+        "fits",
+        &map,
+        "rect-boustrophedon",
+        &["--length", "0.3", "--width", "0.3", "--start", "1.7,3"],
+    );
+    let csv = std::fs::read_to_string(p.join("waypoints.csv")).unwrap();
+    assert!(csv.lines().count() > 50, "{csv}");
+}

@@ -114,8 +114,8 @@ impl RectOptions {
 
     /// The radius of the disk the lanes and detours are planned for `robot`:
     /// `clearance_radius_m`, by default the rectangle's circumscribed disk `hypot(l, b) / 2`,
-    /// never less than the robot's radius (a plan falls back to the robot's own radius, with
-    /// a note in its trace, when that disk does not fit at the start).
+    /// never less than the robot's radius (a start where that disk does not fit is refused by
+    /// [`check_area`]).
     pub fn clearance_radius(&self, robot: &Robot) -> f64 {
         self.rectangle_disk(robot).max(robot.radius)
     }
@@ -186,20 +186,45 @@ pub fn waypoints(world: &World, opts: &RectOptions) -> Vec<Point> {
 
 /// The world the lanes are planned in: the map and start of `world` with the clearance disk
 /// (`clearance_radius_m`, by default the circumscribed disk of the robot's rectangle, at least
-/// the robot's radius) as robot, its radius, and why the robot's own radius is used instead
-/// when that disk does not fit at the start.
-fn clearance_world(world: &World, opts: &RectOptions) -> (World, f64, Option<String>) {
+/// the robot's radius) as robot, and its radius.
+///
+/// # Errors
+/// Why the clearance disk does not fit at the start. The plan does not fall back to the
+/// robot's own radius: a route planned for a smaller disk drives the rectangle into walls and
+/// keep-outs, and `ccpp plan` and `ccpp waypoints` (which write no trace) said nothing of it.
+fn clearance_world(world: &World, opts: &RectOptions) -> Result<(World, f64), String> {
     let robot = world.robot();
-    let r_world = robot.radius;
     let rad = opts.clearance_radius(&robot);
-    match World::new(world.map().clone(), Robot::new(rad), Some(world.start())) {
-        Ok(w) => (w, rad, None),
-        Err(e) => (
-            world.clone(),
-            r_world,
-            Some(format!("clearance disk {rad} m does not fit at the start ({e}); planning for the robot's own radius")),
-        ),
-    }
+    World::new(world.map().clone(), Robot::new(rad), Some(world.start()))
+        .map(|w| (w, rad))
+        .map_err(|e| {
+            use crate::world::WorldError as E;
+            let p = world.start().position();
+            let why = match e {
+                E::StartInObstacle { .. } => "it overlaps occupied or unknown pixels there".into(),
+                E::StartInKeepout { .. } => "it overlaps a keep-out zone there".into(),
+                E::RobotTooBig { max_clearance, .. } => {
+                    format!("it fits nowhere on the map (the widest free spot has clearance {max_clearance:.3} m)")
+                }
+                e => e.to_string(),
+            };
+            let at = if world.approach().is_empty() {
+                format!("at the start ({:.3}, {:.3})", p.x, p.y)
+            } else {
+                // The approach from a start outside the area ends where the robot's own disk
+                // first fits inside it.
+                format!(
+                    "where the approach from the start outside the area enters it ({:.3}, {:.3})",
+                    p.x, p.y
+                )
+            };
+            format!(
+                "the clearance disk of the {} x {} m robot (radius {:.3} m, the circle it turns in) does not fit {at}: {why}; start farther from walls and zones, or give a smaller robot or clearance_radius_m",
+                crate::display::Compact(opts.length_for(&robot)),
+                crate::display::Compact(opts.width_for(&robot)),
+                rad,
+            )
+        })
 }
 
 /// The area the lanes cover in the clearance world `rw`: the user's area clipped to the map
@@ -244,17 +269,28 @@ fn stop_valid(rw: &World, p: Point) -> bool {
     }
 }
 
+/// Whether the robot rectangle's clearance disk ([`RectOptions::clearance_radius`]) fits at
+/// the start of `world`: the lanes, detours and the approach keep that clearance, so a start
+/// where it does not fit has no plan.
+///
+/// # Errors
+/// Why it does not fit, with the disk, the rectangle and the start.
+pub fn check_start(world: &World, opts: &RectOptions) -> Result<(), String> {
+    clearance_world(world, opts).map(|_| ())
+}
+
 /// Whether a user area (`opts.area`) holds a lane point where the robot can stop: else the
 /// plan would be empty, and the run would "succeed" having done nothing. `Ok` without an
 /// area (the default area is the reachable floor's bounding box, which holds the start).
 ///
 /// # Errors
-/// The area, clipped to the map, and the clearance radius, when no lane point is valid.
+/// The area, clipped to the map, and the clearance radius, when no lane point is valid; or
+/// [`check_start`]'s error.
 pub fn check_area(world: &World, opts: &RectOptions) -> Result<(), String> {
+    let (rw, rad) = clearance_world(world, opts)?;
     if opts.area.is_none() {
         return Ok(());
     }
-    let (rw, rad, _) = clearance_world(world, opts);
     let area = lane_area(&rw, opts);
     let robot = world.robot();
     let lanes = lanes(area, opts.length_for(&robot), opts.width_for(&robot));
@@ -277,10 +313,18 @@ pub fn plan(world: &World, opts: &RectOptions) -> RectPlan {
         width_m: width,
     })];
     // The clearance world: same map and start, the circumscribed disk as robot.
-    let (rw, rad, note) = clearance_world(world, opts);
-    if let Some(text) = note {
-        steps.push(Step::Mark(Event::Note { text }));
-    }
+    let (rw, rad) = match clearance_world(world, opts) {
+        Ok(v) => v,
+        Err(text) => {
+            // Unchecked worlds only ([`check_area`] refuses this first): no route, said so.
+            steps.push(Step::Mark(Event::Note { text }));
+            return RectPlan {
+                steps,
+                clearance_radius_m: opts.clearance_radius(&robot),
+                ..RectPlan::default()
+            };
+        }
+    };
     let area = lane_area(&rw, opts);
     let mut rm = Roadmap::new(&rw);
     let mut waypoints = Vec::new();
