@@ -99,7 +99,7 @@ pub enum ZoneError {
         index: usize,
     },
     /// More vertices than the self-intersection check accepts.
-    #[error("polygon {index} has {points} points; at most {max} are accepted")]
+    #[error("polygon {index} has {points} vertices; at most {max} are accepted")]
     TooManyPoints {
         /// Polygon index (0-based).
         index: usize,
@@ -165,10 +165,14 @@ impl Polygon {
         {
             return Err(ZoneError::NonFinite { index, point: k });
         }
-        if self.points.len() > MAX_POLYGON_POINTS {
+        // The closing repeat of a ring (GeoJSON requires it) is not a vertex of its own: a
+        // closed ring of 4096 vertices was refused as 4097 points.
+        let n = self.points.len();
+        let vertices = n - usize::from(n > 1 && self.points.first() == self.points.last());
+        if vertices > MAX_POLYGON_POINTS {
             return Err(ZoneError::TooManyPoints {
                 index,
-                points: self.points.len(),
+                points: vertices,
                 max: MAX_POLYGON_POINTS,
             });
         }
@@ -627,6 +631,29 @@ mod tests {
             points: p.to_vec(),
             name: None,
         }
+    }
+
+    /// The vertex limit counts vertices: a closed ring repeats its first one at the end.
+    #[test]
+    fn the_vertex_limit_does_not_count_the_closing_repeat() {
+        let circle = |n: usize, closed: bool| {
+            let mut p: Vec<[f64; 2]> = (0..n)
+                .map(|k| {
+                    let a = std::f64::consts::TAU * k as f64 / n as f64;
+                    [10.0 * a.cos(), 10.0 * a.sin()]
+                })
+                .collect();
+            if closed {
+                p.push(p[0]);
+            }
+            poly(&p)
+        };
+        assert!(circle(MAX_POLYGON_POINTS, true).validate(0).is_ok());
+        assert!(circle(MAX_POLYGON_POINTS, false).validate(0).is_ok());
+        let e = circle(MAX_POLYGON_POINTS + 1, true)
+            .validate(0)
+            .unwrap_err();
+        assert!(e.to_string().contains("4097 vertices; at most 4096"), "{e}");
     }
 
     #[test]

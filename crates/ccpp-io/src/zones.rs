@@ -260,27 +260,56 @@ fn mask_image_size(yaml: &Path) -> Option<(usize, usize)> {
     Some((usize::try_from(w).ok()?, usize::try_from(h).ok()?))
 }
 
-fn point(v: &Value) -> Result<[f64; 2], ZoneFileError> {
+/// A point of a zone file: `[x, y]` or `{x: .., y: ..}`; in `GeoJSON` (`geo`) a position may
+/// carry a third coordinate (altitude, ignored). Anything more is refused: a YAML row
+/// `[0, -4, 2, -4]` (two points written on one line) was read as its first point, in silence.
+fn point(v: &Value, geo: bool) -> Result<[f64; 2], ZoneFileError> {
     let num = |x: &Value| {
         x.as_f64()
             .ok_or_else(|| bad(format!("coordinate {x} is not a number")))
     };
+    let most = if geo { 3 } else { 2 };
     match v {
-        Value::Array(a) if a.len() >= 2 => Ok([num(&a[0])?, num(&a[1])?]),
+        Value::Array(a) if (2..=most).contains(&a.len()) => Ok([num(&a[0])?, num(&a[1])?]),
+        Value::Array(a) if a.len() > most => Err(bad(format!(
+            "point [{}{}] has {} numbers; a point is {}",
+            a.iter()
+                .take(4)
+                .map(Value::to_string)
+                .collect::<Vec<_>>()
+                .join(", "),
+            if a.len() > 4 { ", ..." } else { "" },
+            a.len(),
+            if geo { "[x, y] or [x, y, z]" } else { "[x, y]" }
+        ))),
         Value::Object(o) => match (o.get("x"), o.get("y")) {
-            (Some(x), Some(y)) => Ok([num(x)?, num(y)?]),
+            (Some(x), Some(y)) if o.len() == 2 => Ok([num(x)?, num(y)?]),
+            (Some(_), Some(_)) => Err(bad(format!(
+                "point has keys other than x and y: {}",
+                o.keys()
+                    .filter(|k| *k != "x" && *k != "y")
+                    .take(3)
+                    .map(|k| k
+                        .chars()
+                        .take(40)
+                        .collect::<String>()
+                        .escape_debug()
+                        .to_string())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ))),
             _ => Err(bad(format!("point {v} needs x and y"))),
         },
         _ => Err(bad(format!("point {v} is not [x, y]"))),
     }
 }
 
-fn ring(v: &Value) -> Result<Polygon, ZoneFileError> {
+fn ring(v: &Value, geo: bool) -> Result<Polygon, ZoneFileError> {
     let Value::Array(a) = v else {
         return Err(bad(format!("a polygon must be a list of points, got {v}")));
     };
     Ok(Polygon {
-        points: a.iter().map(point).collect::<Result<_, _>>()?,
+        points: a.iter().map(|p| point(p, geo)).collect::<Result<_, _>>()?,
         name: None,
     })
 }
@@ -320,9 +349,9 @@ fn yaml_polygons(v: &Value) -> Result<Vec<Polygon>, ZoneFileError> {
         return Ok(Vec::new());
     }
     if is_point(&a[0]) {
-        return Ok(vec![ring(v)?]);
+        return Ok(vec![ring(v, false)?]);
     }
-    a.iter().map(ring).collect()
+    a.iter().map(|r| ring(r, false)).collect()
 }
 
 /// Polygons of a `GeoJSON` object.
@@ -342,7 +371,7 @@ fn geojson_polygon(rings: &Value, out: &mut Vec<Polygon>) -> Result<(), ZoneFile
         ));
     }
     if let Some(outer) = r.first() {
-        out.push(ring(outer)?);
+        out.push(ring(outer, true)?);
     }
     Ok(())
 }
@@ -417,6 +446,56 @@ fn geojson_collect(v: &Value, out: &mut Vec<Polygon>, depth: usize) -> Result<()
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A YAML point is `[x, y]` or `{x, y}` and nothing more; a `GeoJSON` position may add
+    /// an altitude. A row `[0, -4, 2, -4]` (two points on one line) was read as `[0, -4]`.
+    #[test]
+    fn points_with_more_numbers_are_refused() {
+        let yaml = |t: &str| yaml_polygons(&serde_saphyr::from_str::<Value>(t).unwrap());
+        let e = yaml(
+            "- [0, -4, 2, -4]
+- [2, -2, 0, -2]
+- [1, -1, 5, 5]
+",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("[0, -4, 2, -4] has 4 numbers"), "{e}");
+        assert!(yaml(
+            "- [0, 0, 1]
+- [1, 0]
+- [1, 1]
+"
+        )
+        .is_err());
+        let e = yaml(
+            "- {x: 0, y: 0, z: 1}
+- {x: 1, y: 0}
+- {x: 1, y: 1}
+",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("other than x and y: z"), "{e}");
+        assert_eq!(
+            yaml(
+                "- [0, 0]
+- [1, 0]
+- [1, 1]
+"
+            )
+            .unwrap()
+            .len(),
+            1
+        );
+        let geo = |t: &str| geojson_polygons(&serde_json::from_str::<Value>(t).unwrap());
+        let z = geo(r#"{"type":"Polygon","coordinates":[[[0,0,9],[1,0,9],[1,1,9]]]}"#).unwrap();
+        assert_eq!(z[0].points, [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]);
+        let e = geo(r#"{"type":"Polygon","coordinates":[[[0,0,9,9],[1,0],[1,1]]]}"#)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("[x, y] or [x, y, z]"), "{e}");
+    }
 
     #[test]
     fn geojson_and_yaml_shapes_parse() {
