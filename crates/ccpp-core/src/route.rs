@@ -184,8 +184,13 @@ impl RouteBuilder {
 
     /// The route of the poses pushed.
     pub fn finish(mut self) -> Route {
-        if let (Some(end), Some(w)) = (self.last, self.waypoints.last()) {
-            if end != *w {
+        if let (Some(end), Some(w)) = (self.last, self.waypoints.last_mut()) {
+            if dist_exact(end.position(), w.position()) <= SAME_POSITION_M {
+                // The run ends where the last waypoint is (a rotation in place there, its
+                // position a rounding away under odometry noise): one waypoint, with the
+                // heading the robot ends with, as `push` merges rotations in place.
+                w.theta = end.theta;
+            } else {
                 self.waypoints.push(end);
             }
         }
@@ -234,6 +239,40 @@ mod tests {
 
     fn xy(r: &Route) -> Vec<(f64, f64)> {
         r.waypoints.iter().map(|p| (p.x, p.y)).collect()
+    }
+
+    /// A run that ends with a rotation in place at a position a rounding away from the last
+    /// corner (odometry noise) ended with two waypoints at the same place and heading.
+    #[test]
+    fn a_final_rotation_a_rounding_away_is_one_waypoint() {
+        let c = 1.0 + f64::EPSILON;
+        let poses = [
+            Pose::new(0.0, 0.0, 0.0),
+            Pose::new(1.0, 0.0, 0.0),
+            Pose::new(c, 0.0, 0.5),
+        ];
+        let r = Route::from_poses(poses, DEFAULT_TOLERANCE_M);
+        assert_eq!(xy(&r), vec![(0.0, 0.0), (1.0, 0.0)]);
+        assert_eq!(r.waypoints[1].theta, 0.5);
+        // Two turns in place at the end: still one waypoint, with the last heading.
+        let poses = [
+            Pose::new(0.0, 0.0, 0.0),
+            Pose::new(1.0, 0.0, 0.0),
+            Pose::new(c, 0.0, 0.5),
+            Pose::new(1.0, 0.0, 0.7),
+        ];
+        let r = Route::from_poses(poses, DEFAULT_TOLERANCE_M);
+        assert_eq!(r.waypoints.len(), 2);
+        assert_eq!(r.waypoints[1].theta, 0.7);
+        // A route of one pose, and one that ends moving, are as before.
+        assert_eq!(
+            Route::from_poses([Pose::new(1.0, 2.0, 0.3)], 0.01)
+                .waypoints
+                .len(),
+            1
+        );
+        let r = Route::from_poses([Pose::new(0.0, 0.0, 0.0), Pose::new(2.0, 0.0, 0.0)], 0.01);
+        assert_eq!(xy(&r), vec![(0.0, 0.0), (2.0, 0.0)]);
     }
 
     #[test]
