@@ -499,6 +499,20 @@ fn closed_ring(ring: &[[f64; 2]]) -> Vec<[f64; 2]> {
     r
 }
 
+/// A ring closed ([`closed_ring`]) and turned as RFC 7946 (section 3.1.6) asks: an exterior
+/// ring counter-clockwise, a hole clockwise. A zone given clockwise was written clockwise.
+fn oriented_ring(ring: &[[f64; 2]], exterior: bool) -> Vec<[f64; 2]> {
+    let mut r = closed_ring(ring);
+    let twice_area: f64 = r
+        .windows(2)
+        .map(|w| w[0][0] * w[1][1] - w[1][0] * w[0][1])
+        .sum();
+    if (twice_area < 0.0) == exterior {
+        r.reverse();
+    }
+    r
+}
+
 /// The `robot` property of the exports: the disk (`radius_m`, `tool_radius_m`) and, for a
 /// rectangular robot, its `footprint` (`shape: "rectangle"`, `length_m`, `width_m`,
 /// `clearance_radius_m`).
@@ -529,7 +543,8 @@ fn robot_json(meta: &ExportMeta<'_>) -> serde_json::Value {
 /// (`waypoints`, `length_m`, `tolerance_m`) and
 /// `metrics` (the run's metrics but `wall_time_s`, which differs between identical runs, or
 /// `null` for a plan that was not measured). Then one
-/// `Polygon` feature per entry of `polygons` with properties `kind` and `name`, rings closed.
+/// `Polygon` feature per entry of `polygons` with properties `kind` and `name`, rings closed
+/// and turned counter-clockwise (holes clockwise).
 ///
 /// # Errors
 /// Serialization failure (a non-finite number).
@@ -575,7 +590,12 @@ pub fn geojson(
         },
     })];
     for p in polygons {
-        let rings: Vec<Vec<[f64; 2]>> = p.rings.iter().map(|r| closed_ring(r)).collect();
+        let rings: Vec<Vec<[f64; 2]>> = p
+            .rings
+            .iter()
+            .enumerate()
+            .map(|(k, r)| oriented_ring(r, k == 0))
+            .collect();
         features.push(json!({
             "type": "Feature",
             "geometry": { "type": "Polygon", "coordinates": rings },
@@ -702,5 +722,42 @@ mod tests {
         assert_eq!(ring.as_array().map(Vec::len), Some(4));
         assert_eq!(ring[0], ring[3]);
         assert_eq!(v["features"][1]["properties"]["kind"], "keepout");
+    }
+
+    /// RFC 7946 ring orientation: a zone given clockwise is written counter-clockwise, one
+    /// given counter-clockwise as it is; a second ring (a hole) clockwise.
+    #[test]
+    fn geojson_rings_turn_counter_clockwise() {
+        let ccw = vec![[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]];
+        let cw: Vec<[f64; 2]> = ccw.iter().rev().copied().collect();
+        let hole = vec![[0.5, 0.5], [1.0, 0.5], [1.0, 1.0]];
+        let polys: Vec<PolygonFeature> = [vec![cw.clone()], vec![ccw.clone()], vec![cw, hole]]
+            .into_iter()
+            .map(|rings| PolygonFeature {
+                kind: "keepout".into(),
+                name: None,
+                rings,
+            })
+            .collect();
+        let text = geojson(&route(), &meta(), &polys).unwrap_or_default();
+        let v: serde_json::Value = serde_json::from_str(&text).unwrap_or_default();
+        let area2 = |r: &serde_json::Value| -> f64 {
+            let p: Vec<[f64; 2]> = serde_json::from_value(r.clone()).unwrap_or_default();
+            p.windows(2)
+                .map(|w| w[0][0] * w[1][1] - w[1][0] * w[0][1])
+                .sum()
+        };
+        for k in 1..=3 {
+            let ring = &v["features"][k]["geometry"]["coordinates"][0];
+            assert!((area2(ring) - 8.0).abs() < 1e-12, "feature {k}: {ring}");
+            assert_eq!(ring[0], ring[4]);
+        }
+        let hole = &v["features"][3]["geometry"]["coordinates"][1];
+        assert!(area2(hole) < 0.0, "{hole}");
+        // The counter-clockwise ring is written as given.
+        assert_eq!(
+            v["features"][2]["geometry"]["coordinates"][0][1],
+            serde_json::json!([2.0, 0.0])
+        );
     }
 }
