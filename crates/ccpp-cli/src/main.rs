@@ -46,6 +46,14 @@ fn main() -> ExitCode {
         Ok(cli) => cli,
         Err(e) => return clap_exit(&e),
     };
+    // Before any parallel work (a bench loads its maps on the process's pool before its first
+    // scenario is built; the scenario checks this too, for the library and Python).
+    if let Some(why) =
+        ccpp_io::scenario::threads_env_problem(std::env::var("RAYON_NUM_THREADS").ok().as_deref())
+    {
+        eprintln!("error: {why}");
+        return ExitCode::FAILURE;
+    }
     staging::install_signal_handler();
     match dispatch(cli) {
         Ok(()) => ExitCode::SUCCESS,

@@ -2394,3 +2394,55 @@ fn a_start_where_the_rectangle_does_not_fit_is_refused() {
     let csv = std::fs::read_to_string(p.join("waypoints.csv")).unwrap();
     assert!(csv.lines().count() > 50, "{csv}");
 }
+
+/// `RAYON_NUM_THREADS=99999999` started thousands of threads (bcd plans one a thread; a bench
+/// loads its maps on the pool) and a run of a second had not finished after five minutes.
+/// Refused before any work, naming the variable; a count the machine can hold still runs.
+#[test]
+fn an_absurd_thread_count_is_refused_before_any_work() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let out = dir.join("out");
+    let runs = [
+        vec![
+            "run",
+            "--planner",
+            "bcd",
+            "--map",
+            s(&map),
+            "--out",
+            s(&out),
+        ],
+        vec![
+            "bench",
+            "--maps",
+            s(dir),
+            "--planners",
+            "bcd",
+            "--out",
+            s(&out),
+        ],
+    ];
+    for args in &runs {
+        let a = ccpp()
+            .env("RAYON_NUM_THREADS", "99999999")
+            .args(args)
+            .timeout(std::time::Duration::from_secs(60))
+            .assert()
+            .failure();
+        let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
+        assert_eq!(a.get_output().status.code(), Some(1), "{err}");
+        assert!(
+            err.starts_with("error: RAYON_NUM_THREADS=99999999: at most 1024 threads"),
+            "{err}"
+        );
+        assert!(!out.exists());
+    }
+    ccpp()
+        .env("RAYON_NUM_THREADS", "3")
+        .args(&runs[0])
+        .assert()
+        .success();
+    assert!(out.join("metrics.json").exists());
+}

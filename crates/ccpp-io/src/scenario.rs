@@ -714,6 +714,8 @@ impl Scenario {
     /// # Errors
     /// The first invalid value, named.
     pub fn validate(&self) -> Result<(), ScenarioError> {
+        threads_env_problem(std::env::var("RAYON_NUM_THREADS").ok().as_deref())
+            .map_or(Ok(()), |why| Err(invalid(why)))?;
         self.map.validate()?;
         self.robot
             .validate()
@@ -1632,10 +1634,45 @@ impl ScenarioBuilder {
     }
 }
 
+/// Most threads `RAYON_NUM_THREADS` may ask for. A process's pool starts that many threads,
+/// and bcd's plans run one a thread: `RAYON_NUM_THREADS=99999999` started thousands of
+/// threads and had not finished after five minutes (a run of one second); 1000 still runs.
+pub const MAX_THREADS: usize = 1024;
+
+/// Why the `RAYON_NUM_THREADS` value `v` is refused: a count above [`MAX_THREADS`]. Values
+/// rayon itself ignores (not a number, 0: one thread a core) are left to it.
+pub fn threads_env_problem(v: Option<&str>) -> Option<String> {
+    let v = v?.trim();
+    let n: u128 = v.parse().ok()?;
+    (n > MAX_THREADS as u128).then(|| {
+        format!(
+            "RAYON_NUM_THREADS={}: at most {MAX_THREADS} threads (this machine has {}); unset it or give a smaller count",
+            v.chars().take(40).collect::<String>(),
+            std::thread::available_parallelism().map_or_else(|_| "an unknown number of cores".to_string(), |n| format!("{n} cores"))
+        )
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use ccpp_core::planners::ba_star::BaStarOptions;
+
+    #[test]
+    fn an_absurd_thread_count_is_refused() {
+        assert_eq!(threads_env_problem(None), None);
+        for ok in ["1", "2", "1024", " 64 ", "0", "abc", "-1", ""] {
+            assert_eq!(threads_env_problem(Some(ok)), None, "{ok}");
+        }
+        for bad in [
+            "1025",
+            "99999999",
+            "340282366920938463463374607431768211455",
+        ] {
+            let e = threads_env_problem(Some(bad)).unwrap_or_default();
+            assert!(e.contains("at most 1024 threads"), "{bad}: {e}");
+        }
+    }
 
     /// A robot's width in the "fits nowhere" refusal stays a number where `2 r` overflows
     /// (`--radius 1e308` printed `inf m across`).
