@@ -73,6 +73,10 @@ pub fn render_replay(
 
 /// `ccpp replay DIR`: rebuilds the world of a finished run and writes its replay files.
 pub fn replay_dir(dir: &Path) -> Result<()> {
+    // The folder read, to write into that one only: a `ccpp run` into the same folder swaps a
+    // new folder in under the same name, and a replay that read the old run wrote its page and
+    // GIF beside the new run's files (a folder mixing two runs).
+    let identity = folder_identity(dir);
     let rec_path = dir.join("run.json");
     let text = ccpp_io::file::read_text(&rec_path).with_context(|| {
         format!(
@@ -99,18 +103,58 @@ pub fn replay_dir(dir: &Path) -> Result<()> {
         )
     })?;
     check_same_run(dir, &scenario, &map.name, &world, &trace, &metrics)?;
+    if let Some(ms) = std::env::var(crate::staging::REPLAY_PAUSE_ENV)
+        .ok()
+        .and_then(|v| v.parse::<u64>().ok())
+    {
+        std::thread::sleep(std::time::Duration::from_millis(ms.min(60_000)));
+    }
     let title = format!("{} on {}", scenario.planner.name(), map.name);
     let (html, gif) = render_replay(&world, &trace, scenario.tile_side(), &metrics, &title)?;
+    let replaced = || {
+        anyhow::anyhow!(
+            "{} was replaced by another run while its replay was made: nothing written; run ccpp replay again",
+            dir.display()
+        )
+    };
+    if folder_identity(dir) != identity {
+        bail!(replaced());
+    }
+    let files: [(&str, &[u8]); 2] = [("replay.html", html.as_bytes()), ("replay.gif", &gif)];
     // Both or neither: one by one, a failure or an interrupt between them left the page
     // without its GIF (or beside the GIF of an earlier replay).
-    crate::staging::write_files_together(
-        dir,
-        &[("replay.html", html.as_bytes()), ("replay.gif", &gif)],
-    )?;
+    crate::staging::write_files_together(dir, &files)?;
+    if folder_identity(dir) != identity {
+        // Swapped while the files were renamed in (a few milliseconds): take back whatever of
+        // this replay landed in the new run's folder.
+        for (name, bytes) in files {
+            let p = dir.join(name);
+            if std::fs::read(&p).is_ok_and(|b| b == bytes) {
+                // Best effort: the error below tells the user to replay again.
+                let _ = std::fs::remove_file(&p);
+            }
+        }
+        bail!(replaced());
+    }
     crate::print_stdout(&format!(
         "wrote {}/replay.html and replay.gif\n",
         dir.display()
     ))
+}
+
+/// The identity of the folder at `dir` (device and inode): a folder swapped in under the same
+/// name has another. `None` where it cannot be read (or off Unix, where the check is skipped).
+fn folder_identity(dir: &Path) -> Option<(u64, u64)> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        std::fs::metadata(dir).ok().map(|m| (m.dev(), m.ino()))
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = dir;
+        None
+    }
 }
 
 /// Refuses a run folder whose files come from different runs (a trace or metrics copied in

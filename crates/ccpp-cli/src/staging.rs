@@ -50,6 +50,10 @@ static LOCKS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 /// disk (`ENOSPC`). Used by the end-to-end tests to check that a failed run leaves no output.
 pub const FAIL_WRITE_ENV: &str = "CCPP_TEST_FAIL_WRITE";
 
+/// Test hook: `ccpp replay` waits this many milliseconds after reading the run folder, before
+/// it renders (a test swaps the folder meanwhile, as a `ccpp run` into it would).
+pub const REPLAY_PAUSE_ENV: &str = "CCPP_TEST_REPLAY_PAUSE_MS";
+
 fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
     m.lock().unwrap_or_else(PoisonError::into_inner)
 }

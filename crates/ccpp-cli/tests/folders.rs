@@ -311,3 +311,48 @@ fn run_and_plan_take_the_longest_folder_name() {
     }
     assert_eq!(entries(dir.path()).len(), 2, "stray staging folder");
 }
+
+/// A `ccpp run` into a folder while `ccpp replay` of its old run was rendering: the replay wrote
+/// the old run's page and GIF beside the new run's files, a folder mixing two runs. Now it
+/// writes into the folder it read or not at all. (The swap is made here as a run makes it:
+/// the old folder renamed away, the new one renamed in under the same name.)
+#[test]
+fn a_replay_never_writes_into_a_folder_swapped_in_meanwhile() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("r");
+    let new = dir.path().join("new");
+    for (d, planner) in [(&out, "bcd"), (&new, "ba-star")] {
+        ccpp()
+            .args(["run", "--planner", planner, "--map"])
+            .arg(data("teb_empty_box.yaml"))
+            .arg("--out")
+            .arg(d)
+            .assert()
+            .success();
+    }
+    let child = std::process::Command::new(assert_cmd::cargo::cargo_bin("ccpp"))
+        .arg("replay")
+        .arg(&out)
+        .env("CCPP_TEST_REPLAY_PAUSE_MS", "3000")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Reading a run of this size takes milliseconds; the replay then waits three seconds.
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    std::fs::rename(&out, dir.path().join("old")).unwrap();
+    std::fs::rename(&new, &out).unwrap();
+    let o = child.wait_with_output().unwrap();
+    let err = stderr_of(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("was replaced by another run while its replay was made"),
+        "{err}"
+    );
+    assert_eq!(entries(&out), BASE_SET, "the new run's folder is untouched");
+    assert_eq!(entries(&dir.path().join("old")), BASE_SET);
+    // Replayed again, the folder's own run is drawn.
+    ccpp().arg("replay").arg(&out).assert().success();
+    let page = std::fs::read_to_string(out.join("replay.html")).unwrap();
+    assert!(page.contains("ba-star on teb_empty_box"));
+}
