@@ -2428,7 +2428,7 @@ fn an_absurd_thread_count_is_refused_before_any_work() {
         let a = ccpp()
             .env("RAYON_NUM_THREADS", "99999999")
             .args(args)
-            .timeout(std::time::Duration::from_secs(60))
+            .timeout(std::time::Duration::from_mins(1))
             .assert()
             .failure();
         let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
