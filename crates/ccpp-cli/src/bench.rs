@@ -552,6 +552,16 @@ impl Drop for Grant<'_> {
     }
 }
 
+/// The files every finished bench run folder holds (a bench writes no replay or exports).
+const BENCH_RUN_FILES: [&str; 6] = [
+    "run.json",
+    "path.csv",
+    "trace.jsonl",
+    "coverage.png",
+    "metrics.json",
+    "bench-key.txt",
+];
+
 #[allow(clippy::too_many_arguments)] // the run, its map and the bench's shared state
 fn run_one(
     a: &BenchArgs,
@@ -579,7 +589,16 @@ fn run_one(
                 if let Ok(m) = serde_json::from_str::<Metrics>(&text) {
                     // Reused only when its trace reads back whole: a damaged trace was reused
                     // and then left out of the plots in silence.
-                    match whole_trace(dir, map.grid.frame(), robot.radius, budget) {
+                    // And only when the folder holds every file of a run: one missing
+                    // (removed by hand, or a copy cut short) was reused, "0 failed".
+                    let missing = BENCH_RUN_FILES
+                        .iter()
+                        .find(|f| ccpp_io::file::open_regular(&dir.join(f)).is_err());
+                    let whole = match missing {
+                        Some(f) => Err(format!("{f} is missing")),
+                        None => whole_trace(dir, map.grid.frame(), robot.radius, budget),
+                    };
+                    match whole {
                         Ok(()) => return Ok(m),
                         Err(why) => {
                             eprintln!("warning: {}: {why}; running it again", dir.display());

@@ -518,6 +518,34 @@ fn bench_runs_again_a_run_whose_trace_is_damaged() {
     }
 }
 
+/// A run folder missing one of its files (removed by hand) was reused: "0 failed", and its
+/// replay then failed ("no readable run.json"). It is run again, with a warning naming the file.
+#[test]
+fn bench_runs_again_a_run_missing_a_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bench");
+    let maps = [data("teb_empty_box.yaml")];
+    let run = out.join("runs/teb_empty_box/bcd");
+    bench(&out, &maps, &["--planners", "bcd"])
+        .assert()
+        .success();
+    for f in ["coverage.png", "path.csv", "run.json"] {
+        let whole = std::fs::read(run.join(f)).unwrap();
+        std::fs::remove_file(run.join(f)).unwrap();
+        let o = bench(&out, &maps, &["--planners", "bcd"]).output().unwrap();
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{stderr}");
+        assert!(
+            stderr.contains(&format!("{f} is missing; running it again")),
+            "{f}: {stderr}"
+        );
+        assert_eq!(std::fs::read(run.join(f)).unwrap(), whole, "{f}");
+    }
+    // Whole again: reused without a word.
+    let o = bench(&out, &maps, &["--planners", "bcd"]).output().unwrap();
+    assert!(!String::from_utf8_lossy(&o.stderr).contains("warning"));
+}
+
 #[test]
 fn bench_resume_reruns_when_anything_that_defines_a_run_changed() {
     let dir = tempfile::tempdir().unwrap();
