@@ -1126,6 +1126,9 @@ enum PathStyle {
     Approach,
 }
 
+/// Most segments stroked as one path by [`draw_path`] (see there).
+const STROKE_PIECE: usize = 2048;
+
 fn draw_path(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
     let width = (view.scale * 0.6).clamp(1.0, 3.0);
     let mut region = 0usize;
@@ -1137,7 +1140,7 @@ fn draw_path(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
     let mut run: Vec<(f32, f32)> = Vec::new();
     let mut run_style = PathStyle::Region(0);
     let mut lanes = LaneBlitter::default();
-    let mut flush = |pm: &mut Pixmap, run: &mut Vec<(f32, f32)>, style: PathStyle| {
+    let mut stroke_run = |pm: &mut Pixmap, run: &[(f32, f32)], style: PathStyle| {
         if run.len() >= 2 {
             let mut stroke = Stroke {
                 width,
@@ -1190,6 +1193,17 @@ fn draw_path(pm: &mut Pixmap, world: &World, trace: &Trace, view: View) {
                     );
                 }
             }
+        }
+    };
+    // A run is stroked in pieces of at most `STROKE_PIECE` points (each piece starting where
+    // the last ended): one path's fill costs about the square of its segments where they
+    // cross each other (a random-bounce run of 1e6 m drew for 200 s, 2e5 m for 11 s).
+    let mut flush = |pm: &mut Pixmap, run: &mut Vec<(f32, f32)>, style: PathStyle| {
+        let mut i = 0;
+        while i + 1 < run.len() {
+            let j = (i + STROKE_PIECE).min(run.len() - 1);
+            stroke_run(pm, &run[i..=j], style);
+            i = j;
         }
         run.clear();
     };
