@@ -122,6 +122,9 @@ pub fn run(a: &PlanArgs) -> Result<()> {
             ccpp_io::warnings::stop_warning(plan.stop.as_str(), "path")
         );
     }
+    // As `run` prints it: an area of two rooms the start's room does not join was planned in
+    // the start's room only, and nothing said so.
+    let _ = writeln!(s, "  start area: {}", comp.line());
     let names: Vec<&str> = files.iter().map(|(n, _)| *n).collect();
     let _ = writeln!(s, "wrote {}/{{{}}}", a.out.display(), names.join(", "));
     crate::print_stdout(&s)

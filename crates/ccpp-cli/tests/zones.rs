@@ -524,3 +524,33 @@ fn info_and_run_agree_on_the_start_area_with_zones() {
         .success();
     assert_ne!(line(&whole.get_output().stdout), i, "the area changes it");
 }
+
+/// An area of two parts the start's part does not join: `plan` covered the start's part only
+/// and said nothing (`run` prints the start area). It prints the same line now.
+#[test]
+fn plan_says_how_much_of_the_area_it_can_reach() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = crate::common::pillars(dir); // 8 x 6 m, open around its pillars
+    let area = dir.join("two.yaml");
+    std::fs::write(
+        &area,
+        "- [[0.5, 0.5], [1.5, 0.5], [1.5, 1.5], [0.5, 1.5]]\n- [[6, 0.5], [7, 0.5], [7, 1.5], [6, 1.5]]\n",
+    )
+    .unwrap();
+    let out = dir.join("p");
+    let a = ccpp()
+        .args(["plan", "--planner", "bcd", "--map"])
+        .arg(&map)
+        .arg("--area")
+        .arg(&area)
+        .args(["--start", "1,1", "--out"])
+        .arg(&out)
+        .assert()
+        .success();
+    let stdout = String::from_utf8_lossy(&a.get_output().stdout).to_string();
+    assert!(
+        stdout.contains("start area: 1.0 m2 of 2.0 m2 free (50 %)"),
+        "{stdout}"
+    );
+}
