@@ -1275,23 +1275,28 @@ impl RunResult {
     /// a list of, `"csv"`, `"json"`, `"nav-path"`, `"geojson"`) adds the path exports, as
     /// `ccpp run --export FORMAT`. All or nothing, as the command line: the files of an older
     /// run or plan in `folder` are replaced whole, a folder holding other files is refused.
+    /// Ctrl-C while the files are drawn raises `KeyboardInterrupt` once they are drawn (the
+    /// picture of a long run takes seconds) and leaves `folder` as it was.
     #[pyo3(signature = (folder, export=None))]
     fn save(&self, py: Python<'_>, folder: PathBuf, export: Option<Formats>) -> PyResult<()> {
         utf8_path(&folder, "folder")?;
         let formats = parse_formats(&export.map(Formats::names).unwrap_or_default())?;
-        let files = self.export_files(&formats)?;
-        py.detach(|| {
-            ccpp_render::run_files::write_run_files(
-                &folder,
-                &self.scenario,
-                &self.world,
-                &self.output.trace,
-                &self.metrics,
-                &files,
-            )
-        })
-        .map_err(|e| err(&e))?;
-        Ok(())
+        let extra = self.export_files(&formats)?;
+        let mut files = py
+            .detach(|| {
+                ccpp_render::run_files::render_run_files(
+                    &self.scenario,
+                    &self.world,
+                    &self.output.trace,
+                    &self.metrics,
+                )
+            })
+            .map_err(|e| err(&e))?;
+        // A Ctrl-C while the files were drawn raises here, before the folder is touched: it
+        // was raised after the write, with the folder already replaced.
+        py.check_signals()?;
+        files.extend(extra);
+        py.detach(|| write_files(&folder, &files))
     }
 
     /// The executed path's waypoints, `float64` `(N, 3)`: x, y, theta at the ends of its
