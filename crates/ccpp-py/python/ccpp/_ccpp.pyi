@@ -76,7 +76,9 @@ class RunResult:
         """Writes the files of ``ccpp run --out folder`` (``export``: ``--export`` formats).
 
         All or nothing: an older run's files in ``folder`` are replaced whole; a folder
-        holding files ccpp did not write is refused (``CcppError``)."""
+        holding files ccpp did not write is refused (``CcppError``). Ctrl-C while the files
+        are drawn raises ``KeyboardInterrupt`` once they are drawn, before ``folder`` is
+        touched."""
     def waypoints(self, tolerance_m: float = 0.001) -> npt.NDArray[np.float64]:
         """Waypoints of the executed path, (N, 3): x, y, theta at segment ends."""
     def export(self, format: str) -> str:
