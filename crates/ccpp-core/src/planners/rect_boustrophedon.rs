@@ -62,6 +62,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::exec::{Execution, PidOptions};
 use crate::geometry::Point;
+use crate::options::OptionsError;
 use crate::planner::{Planner, Sensor, Step};
 use crate::search::{DeeperFirst, SearchSpace};
 use crate::trace::Event;
@@ -115,7 +116,7 @@ impl RectOptions {
     /// The radius of the disk the lanes and detours are planned for `robot`:
     /// `clearance_radius_m`, by default the rectangle's circumscribed disk `hypot(l, b) / 2`,
     /// never less than the robot's radius (a start where that disk does not fit is refused by
-    /// [`check_area`]).
+    /// [`check`]).
     pub fn clearance_radius(&self, robot: &Robot) -> f64 {
         self.rectangle_disk(robot).max(robot.radius)
     }
@@ -269,25 +270,20 @@ fn stop_valid(rw: &World, p: Point) -> bool {
     }
 }
 
-/// Whether the robot rectangle's clearance disk ([`RectOptions::clearance_radius`]) fits at
-/// the start of `world`: the lanes, detours and the approach keep that clearance, so a start
-/// where it does not fit has no plan.
+/// Checks that `world` has a plan for `opts`, building the clearance world once: the robot
+/// rectangle's clearance disk ([`RectOptions::clearance_radius`]) fits at the start (the
+/// lanes, detours and the approach keep that clearance), and a user area (`opts.area`) holds
+/// a lane point where the robot can stop (else the plan would be empty, and the run would
+/// "succeed" having done nothing). Without an area the lanes cover the reachable floor's
+/// bounding box, which holds the start.
 ///
 /// # Errors
-/// Why it does not fit, with the disk, the rectangle and the start.
-pub fn check_start(world: &World, opts: &RectOptions) -> Result<(), String> {
-    clearance_world(world, opts).map(|_| ())
-}
-
-/// Whether a user area (`opts.area`) holds a lane point where the robot can stop: else the
-/// plan would be empty, and the run would "succeed" having done nothing. `Ok` without an
-/// area (the default area is the reachable floor's bounding box, which holds the start).
-///
-/// # Errors
-/// The area, clipped to the map, and the clearance radius, when no lane point is valid; or
-/// [`check_start`]'s error.
-pub fn check_area(world: &World, opts: &RectOptions) -> Result<(), String> {
-    let (rw, rad) = clearance_world(world, opts)?;
+/// `clearance_radius_m`: why the disk does not fit, with the disk, the rectangle and the
+/// start. `area`: the area, clipped to the map, and the clearance radius, when no lane point
+/// is valid.
+pub fn check(world: &World, opts: &RectOptions) -> Result<(), OptionsError> {
+    let (rw, rad) =
+        clearance_world(world, opts).map_err(|m| OptionsError::new("clearance_radius_m", m))?;
     if opts.area.is_none() {
         return Ok(());
     }
@@ -297,10 +293,13 @@ pub fn check_area(world: &World, opts: &RectOptions) -> Result<(), String> {
     if lanes.iter().flatten().any(|&p| stop_valid(&rw, p)) {
         return Ok(());
     }
-    Err(format!(
-        "{} holds no lane point where the robot (clearance disk {:.3} m) fits and that it can reach from the start",
-        crate::display::join(&area),
-        rad
+    Err(OptionsError::new(
+        "area",
+        format!(
+            "{} holds no lane point where the robot (clearance disk {:.3} m) fits and that it can reach from the start",
+            crate::display::join(&area),
+            rad
+        ),
     ))
 }
 
@@ -316,7 +315,7 @@ pub fn plan(world: &World, opts: &RectOptions) -> RectPlan {
     let (rw, rad) = match clearance_world(world, opts) {
         Ok(v) => v,
         Err(text) => {
-            // Unchecked worlds only ([`check_area`] refuses this first): no route, said so.
+            // Unchecked worlds only ([`check`] refuses this first): no route, said so.
             steps.push(Step::Mark(Event::Note { text }));
             return RectPlan {
                 steps,

@@ -1225,9 +1225,7 @@ impl PlannerSettings for RectOptions {
     }
 
     fn check_world(&self, world: &World) -> Result<(), OptionsError> {
-        super::rect_boustrophedon::check_start(world, self)
-            .map_err(|m| OptionsError::new("clearance_radius_m", m))?;
-        super::rect_boustrophedon::check_area(world, self).map_err(|m| OptionsError::new("area", m))
+        super::rect_boustrophedon::check(world, self)
     }
 
     fn estimate(&self, s: &Setup) -> ResourceEstimate {
