@@ -502,12 +502,13 @@ fn closed_ring(ring: &[[f64; 2]]) -> Vec<[f64; 2]> {
 /// A ring closed ([`closed_ring`]) and turned as RFC 7946 (section 3.1.6) asks: an exterior
 /// ring counter-clockwise, a hole clockwise. A zone given clockwise was written clockwise.
 fn oriented_ring(ring: &[[f64; 2]], exterior: bool) -> Vec<[f64; 2]> {
-    let mut r = closed_ring(ring);
-    let twice_area: f64 = r
-        .windows(2)
-        .map(|w| w[0][0] * w[1][1] - w[1][0] * w[0][1])
-        .sum();
-    if (twice_area < 0.0) == exterior {
+    let p = ccpp_core::zones::Polygon {
+        points: closed_ring(ring),
+        name: None,
+    };
+    let clockwise = p.signed_area() < 0.0;
+    let mut r = p.points;
+    if clockwise == exterior {
         r.reverse();
     }
     r

@@ -260,6 +260,15 @@ fn mask_image_size(yaml: &Path) -> Option<(usize, usize)> {
     Some((usize::try_from(w).ok()?, usize::try_from(h).ok()?))
 }
 
+/// A key of a zone file as a message shows it: its first `max` characters, escaped.
+fn key_text(k: &str, max: usize) -> String {
+    k.chars()
+        .take(max)
+        .collect::<String>()
+        .escape_debug()
+        .to_string()
+}
+
 /// A point of a zone file: `[x, y]` or `{x: .., y: ..}`; in `GeoJSON` (`geo`) a position may
 /// carry a third coordinate (altitude, ignored). Anything more is refused: a YAML row
 /// `[0, -4, 2, -4]` (two points written on one line) was read as its first point, in silence.
@@ -289,12 +298,7 @@ fn point(v: &Value, geo: bool) -> Result<[f64; 2], ZoneFileError> {
                 o.keys()
                     .filter(|k| *k != "x" && *k != "y")
                     .take(3)
-                    .map(|k| k
-                        .chars()
-                        .take(40)
-                        .collect::<String>()
-                        .escape_debug()
-                        .to_string())
+                    .map(|k| key_text(k, 40))
                     .collect::<Vec<_>>()
                     .join(", ")
             ))),
@@ -328,12 +332,7 @@ fn yaml_polygons(v: &Value) -> Result<Vec<Polygon>, ZoneFileError> {
     // ignored with what it meant.
     if let Value::Object(o) = v {
         if let Some(k) = o.keys().find(|k| k.as_str() != "polygons") {
-            let k = k
-                .chars()
-                .take(80)
-                .collect::<String>()
-                .escape_debug()
-                .to_string();
+            let k = key_text(k, 80);
             return Err(bad(format!(
                 "unknown key `{k}`: a YAML zone file is a list of x,y points, a list of such lists, `polygons:` with such lists, or a map_server YAML (keepout mask)"
             )));
