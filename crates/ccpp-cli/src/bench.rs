@@ -317,7 +317,11 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     }
     let summary = crate::staging::PendingSet::new(summary);
     let left_out = crate::plots::write_all(&a.out, &rows, &prepared, robot, &budget)?;
-    write_file(&a.out.join("results.md"), results_md(&rows).as_bytes())?;
+    let outside = starts_maybe_outside(&maps, &rows, &prepared);
+    write_file(
+        &a.out.join("results.md"),
+        results_md(&rows, &outside).as_bytes(),
+    )?;
     write_file(&a.out.join("results.csv"), results_csv(&rows).as_bytes())?;
     summary.done();
     for line in &left_out {
@@ -343,6 +347,9 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             "warning: stopped before the planner finished, with incomplete coverage (status in results.csv): {}\n",
             stopped.join(", ")
         ))?;
+    }
+    if !outside.is_empty() {
+        eprintln!("{}", outside_warning(&outside));
     }
     if failed > 0 {
         bail!(
@@ -890,8 +897,55 @@ fn md_text(name: &str) -> String {
     out
 }
 
-/// `results.md`: a table per map and a summary across maps.
-pub fn results_md(rows: &[Row]) -> String {
+/// The maps (names, in bench order) whose runs started in a free area that reaches the map's
+/// border, so probably outside the building, as `ccpp run` and `ccpp info` warn: the start
+/// each run used is in its `run.json` (the first run of the map that has one; every planner
+/// of a bench starts at the same place).
+fn starts_maybe_outside(
+    maps: &[(PathBuf, String)],
+    rows: &[Row],
+    prepared: &[(PathBuf, Result<PreparedMap, String>)],
+) -> Vec<String> {
+    maps.iter()
+        .zip(prepared)
+        .filter_map(|((_, name), (_, map))| {
+            let map = map.as_ref().ok()?;
+            let start = rows
+                .iter()
+                .filter(|r| r.map == *name && r.outcome.is_ok())
+                .find_map(|r| run_start(&r.dir))?;
+            crate::components::StartComponent::of(&map.grid, start)
+                .touches_border
+                .then(|| name.clone())
+        })
+        .collect()
+}
+
+/// The start position a run used (`run.json`'s `start`), when its folder says.
+fn run_start(dir: &Path) -> Option<ccpp_core::geometry::Point> {
+    let text = ccpp_io::file::read_text(&dir.join("run.json")).ok()?;
+    let v: serde_json::Value = serde_json::from_str(&text).ok()?;
+    let s = v.get("start")?.as_array()?;
+    Some(ccpp_core::geometry::Point::new(
+        s.first()?.as_f64()?,
+        s.get(1)?.as_f64()?,
+    ))
+}
+
+/// The warning a bench prints for [`starts_maybe_outside`]'s maps.
+fn outside_warning(maps: &[String]) -> String {
+    format!(
+        "warning: on {} the free area holding the start reaches the map's border, so the start \
+         may be outside the building (only that area is covered; `ccpp info` shows it); a \
+         start inside needs `ccpp run --start X,Y`",
+        maps.join(", ")
+    )
+}
+
+/// `results.md`: a table per map and a summary across maps; `outside` names the maps whose
+/// start may lie outside the building ([`starts_maybe_outside`]), said under their tables and
+/// under the summary.
+pub fn results_md(rows: &[Row], outside: &[String]) -> String {
     let mut s = String::from("# ccpp bench results\n\n");
     let mut maps: Vec<&str> = Vec::new();
     let mut planners: Vec<&str> = Vec::new();
@@ -945,9 +999,24 @@ pub fn results_md(rows: &[Row]) -> String {
             ok.iter().map(|m| m.wall_time_s).sum::<f64>(),
         );
     }
+    if !outside.is_empty() {
+        let names: Vec<String> = outside.iter().map(|m| md_text(m)).collect();
+        let _ = writeln!(
+            s,
+            "\nOn {} the free area holding the start reaches the map's border: the start may be \
+             outside the building, and only that area is covered and measured.",
+            names.join(", ")
+        );
+    }
     s.push('\n');
     for map in &maps {
         let _ = writeln!(s, "## {}\n", md_text(map));
+        if outside.iter().any(|m| m == map) {
+            s.push_str(
+                "The free area holding the start reaches the map's border: the start may be \
+                 outside the building.\n\n",
+            );
+        }
         s.push_str(header);
         for r in rows.iter().filter(|r| r.map == *map) {
             match &r.outcome {
@@ -1084,7 +1153,7 @@ mod tests {
             dir: PathBuf::from(format!("out/runs/{map}/bsa")),
         };
         let rows = [row("a"), row("b")];
-        let md = results_md(&rows);
+        let md = results_md(&rows, &[]);
         assert!(
             md.contains("| bsa | 0 | 2 | - | - | - | - | - | - | - |"),
             "{md}"
@@ -1105,7 +1174,7 @@ mod tests {
             outcome: Err("robot too big".into()),
             dir: PathBuf::from("out/runs/x/bsa"),
         }];
-        let md = results_md(&rows);
+        let md = results_md(&rows, &[]);
         assert!(md.contains("\n## lab\\nb\\|c\n"), "{md}");
     }
 }

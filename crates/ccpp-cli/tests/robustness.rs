@@ -828,6 +828,52 @@ fn drawn_plan(dir: &Path) -> PathBuf {
     p
 }
 
+/// A bench says which maps' starts may lie outside the building, as `run` and `info` do: on
+/// stderr and in `results.md`, for those maps only (the hostile tester's `tuw_freihaus_eg`
+/// runs swept the car park around the building, and the bench said nothing).
+#[test]
+fn bench_warns_of_a_start_outside_the_building() {
+    let dir = tempfile::tempdir().unwrap();
+    let plan = drawn_plan(dir.path());
+    // A walled room filling its image: the start is inside.
+    let mut img = image::GrayImage::from_pixel(60, 40, image::Luma([254]));
+    for (x, y, p) in img.enumerate_pixels_mut() {
+        if x == 0 || y == 0 || x == 59 || y == 39 {
+            *p = image::Luma([0]);
+        }
+    }
+    let room = dir.path().join("room.png");
+    img.save(&room).unwrap();
+    let out = dir.path().join("bench");
+    let o = bench(&out, &[plan, room], &["--planners", "bcd"])
+        .assert()
+        .success()
+        .get_output()
+        .clone();
+    let err = stderr_of(&o);
+    let line = err
+        .lines()
+        .find(|l| l.contains("border"))
+        .unwrap_or_else(|| panic!("no warning: {err}"));
+    assert!(line.starts_with("warning: on plan the free area"), "{line}");
+    assert!(!line.contains("room"), "{line}");
+    let md = std::fs::read_to_string(out.join("results.md")).unwrap();
+    let section = |name: &str| {
+        let at = md.find(&format!("## {name}\n")).unwrap();
+        let rest = &md[at + 3..];
+        rest[..rest.find("\n## ").unwrap_or(rest.len())].to_string()
+    };
+    assert!(
+        section("plan").contains("may be outside the building"),
+        "{md}"
+    );
+    assert!(!section("room").contains("outside the building"), "{md}");
+    assert!(
+        md.contains("On plan the free area holding the start reaches"),
+        "{md}"
+    );
+}
+
 #[test]
 fn a_start_outside_the_building_is_warned_about() {
     let dir = tempfile::tempdir().unwrap();
