@@ -246,7 +246,8 @@ pub struct PlanArgs {
 
 /// `ccpp waypoints`.
 #[derive(Args, Debug)]
-#[command(allow_negative_numbers = true)]
+// `--tool-radius` is refused here (the lanes follow `--width`), so the help does not list it.
+#[command(allow_negative_numbers = true, mut_arg("tool_radius", |a| a.hide(true)))]
 pub struct WaypointsArgs {
     /// The map.
     #[command(flatten)]

@@ -244,6 +244,13 @@ fn tool_radius_is_refused_where_it_changes_nothing() {
         &["--tool-radius", "waypoints"],
     );
     assert!(!out.exists());
+    // Refused always, so `waypoints --help` does not offer it (`plan --help` does: bcd).
+    let help = |cmd: &str| {
+        let o = ccpp().args([cmd, "--help"]).assert().success();
+        String::from_utf8_lossy(&o.get_output().stdout).into_owned()
+    };
+    assert!(!help("waypoints").contains("--tool-radius"));
+    assert!(help("plan").contains("--tool-radius"));
     // bcd's lanes follow the tool: there it changes the plan.
     let a = plan_ok(dir, "a", &map, "bcd", &[]);
     let b = plan_ok(dir, "b", &map, "bcd", &["--tool-radius", "0.08"]);
