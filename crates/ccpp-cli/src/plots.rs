@@ -141,8 +141,8 @@ pub fn write_all(
                     label: r.planner.clone(),
                     badge: Some((
                         format!(
-                            "effective coverage {:.1}%",
-                            100.0 * metrics.effective_coverage
+                            "effective coverage {}",
+                            ccpp_render::percent(metrics.effective_coverage)
                         ),
                         coverage_verdict_colour(metrics.effective_coverage),
                     )),

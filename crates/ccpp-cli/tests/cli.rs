@@ -842,6 +842,29 @@ fn replay_page_works_in_headless_chromium() {
             "console error: {l}"
         );
     }
+    // `#at=F` shows the robot at that fraction of the distance, under way inside a move (it
+    // snapped back to the last pose before: 0.0 m at `#at=0.01` of a run whose first move was
+    // longer than that).
+    for f in [0.013, 0.37] {
+        let mut c = std::process::Command::new(&chrome);
+        base(&mut c);
+        let o = c
+            .arg("--dump-dom")
+            .arg(format!("{url}#at={f}"))
+            .output()
+            .unwrap();
+        let dom = String::from_utf8_lossy(&o.stdout);
+        let key = "id=\"now-dist\">";
+        let at = dom.find(key).expect("the distance readout") + key.len();
+        let text = &dom[at..at + dom[at..].find('<').unwrap()];
+        let (shown, total) = text.trim_end_matches(" m").split_once(" / ").unwrap();
+        let num = |t: &str| t.replace(',', "").parse::<f64>().unwrap();
+        let (shown, total) = (num(shown), num(total));
+        assert!(
+            (shown - f * total).abs() <= 0.051 + 0.0005 * total,
+            "#at={f}: shows {text}"
+        );
+    }
     // Screenshot of the last frame, kept as a test artefact.
     let shot = Path::new(env!("CARGO_TARGET_TMPDIR")).join("replay-last-frame.png");
     let mut c = std::process::Command::new(&chrome);

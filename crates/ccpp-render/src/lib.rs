@@ -346,6 +346,8 @@ struct Shown {
     keepout: bool,
     outside_area: bool,
     area_border: bool,
+    /// Keep-out polygons are outlined ([`draw_zone_borders`]; a mask keep-out is not).
+    keepout_border: bool,
     /// The robot drove an approach to the work area.
     approach: bool,
 }
@@ -366,6 +368,9 @@ fn shown_with(
     let cells = world.true_map().cells();
     let mut s = Shown {
         area_border: world.zones().is_some_and(|z| !z.area_polygons.is_empty()),
+        keepout_border: world
+            .zones()
+            .is_some_and(|z| !z.keepout_polygons.is_empty()),
         ..Shown::default()
     };
     let (c0, r0, w, h) = crop;
@@ -646,6 +651,7 @@ pub fn legend_entries_union_of(runs: &[LegendShown]) -> Vec<LegendEntry> {
         all.keepout |= s.keepout;
         all.outside_area |= s.outside_area;
         all.area_border |= s.area_border;
+        all.keepout_border |= s.keepout_border;
         all.approach |= s.approach;
     }
     let mut e = entries_of(&all);
@@ -707,6 +713,14 @@ fn entries_of(s: &Shown) -> Vec<LegendEntry> {
         "area border".into(),
     );
     add(
+        s.keepout_border,
+        Swatch::Line {
+            rgb: c::KEEPOUT_HATCH,
+            dashed: false,
+        },
+        "keep-out border".into(),
+    );
+    add(
         s.regions > 0,
         Swatch::Regions(PALETTE[..s.regions.clamp(1, 5)].to_vec()),
         if s.regions_started > s.regions && s.regions_started > 1 {
@@ -760,6 +774,19 @@ fn effective_coverage(world: &World, swept: &fixedbitset::FixedBitSet) -> f64 {
     let acc = world.accessible();
     let hit = acc.intersection(swept).count();
     hit as f64 / world.accessible_count().max(1) as f64
+}
+
+/// A share (`0..=1`) as a percentage with one decimal, rounded *down*: a run that misses any
+/// floor never reads "100.0%", and one just under a verdict threshold of
+/// [`coverage_verdict_colour`] (0.79993 is red) never reads as the threshold ("80.0%").
+pub fn percent(share: f64) -> String {
+    if !share.is_finite() {
+        return "-".to_string();
+    }
+    // The epsilon keeps shares that are exact in decimal (0.995) from flooring a step lower
+    // through binary rounding (994.9999...).
+    let tenths = (share * 1000.0 + 1e-6).floor().clamp(0.0, 1000.0);
+    format!("{:.1}%", tenths / 10.0)
 }
 
 /// Badge colour of an effective coverage: green from 95 %, amber from 80 %, red below.
@@ -829,7 +856,7 @@ pub fn coverage_pixmap_swept(
         let stopped = stop_reason(trace).map(|why| (format!("stopped: {why}"), colours::STOPPED));
         let badges = [
             (
-                format!("{:.1}% covered", 100.0 * cov),
+                format!("{} covered", percent(cov)),
                 coverage_verdict_colour(cov),
             ),
             (
@@ -1930,6 +1957,26 @@ mod tests {
         );
     }
 
+    /// A keep-out polygon's outline is drawn, so the legend names it (the replay's did, the
+    /// picture's did not); a run without zones has none.
+    #[test]
+    fn the_keepout_border_is_in_the_legend() {
+        let (world, trace) = approach_run("done");
+        let e = legend_entries(&world, &trace);
+        let border = e.iter().find(|e| e.label == "keep-out border").unwrap();
+        assert_eq!(
+            border.swatch,
+            Swatch::Line {
+                rgb: colours::KEEPOUT_HATCH,
+                dashed: false
+            }
+        );
+        let (world, trace) = run(3);
+        assert!(!legend_entries(&world, &trace)
+            .iter()
+            .any(|e| e.label.contains("keep-out")));
+    }
+
     #[test]
     fn coverage_png_is_deterministic_and_matches_its_snapshot() {
         let (world, trace) = run(12);
@@ -1982,6 +2029,17 @@ mod tests {
         assert_eq!(coverage_verdict_colour(0.97), [20, 130, 60]);
         assert_eq!(coverage_verdict_colour(0.85), [200, 120, 0]);
         assert_eq!(coverage_verdict_colour(0.5), [200, 30, 30]);
+    }
+
+    #[test]
+    fn percentages_round_down() {
+        // The hostile tester's cases: red 0.79993 read "80.0%", 0.99992 read "100.0%".
+        assert_eq!(percent(0.79993), "79.9%");
+        assert_eq!(percent(0.99992), "99.9%");
+        assert_eq!(percent(1.0), "100.0%");
+        assert_eq!(percent(0.995), "99.5%");
+        assert_eq!(percent(0.0), "0.0%");
+        assert_eq!(percent(f64::NAN), "-");
         let (world, trace) = run(2);
         let labels: Vec<String> = legend_entries(&world, &trace)
             .into_iter()

@@ -21,7 +21,8 @@ const C_ACC: [u8; 3] = [250, 205, 190];
 /// Swept floor (also the colour the browser test looks for).
 pub const C_SWEPT: [u8; 3] = [120, 190, 245];
 const C_PATH: [u8; 3] = [0, 70, 160];
-const C_ROBOT: [u8; 3] = [0, 160, 60];
+/// The robot: the replay page's yellow disc (green means the start in every picture).
+const C_ROBOT: [u8; 3] = [255, 212, 0];
 
 /// Period of the keep-out hatching, in map pixels (the replay's background has one pixel per
 /// map pixel; the coverage picture hatches in canvas pixels).
@@ -867,6 +868,11 @@ mod tests {
         assert!(count(AREA_BORDER) > 100, "area border pixels");
         // The keep-out's border: its hatching colour beyond the hatching inside it.
         assert!(count(KEEPOUT_HATCH) > 0);
+        // The robot is the page's yellow disc, not the start's green (the tester read the
+        // green dot at the end of an approach as the start).
+        assert!(count(C_ROBOT) > 10, "robot pixels");
+        assert_eq!(C_ROBOT, [255, 212, 0]);
+        assert!(TEMPLATE.contains("rgba(255,212,0,"));
     }
 
     /// The page lists only the map classes the map shows (`teb_maze` has no unknown pixel, the

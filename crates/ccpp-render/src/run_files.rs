@@ -56,15 +56,15 @@ pub fn metrics_json(m: &Metrics) -> Result<String, serde_json::Error> {
 pub fn title_lines(m: &Metrics) -> Vec<String> {
     let cov = m
         .coverage_rate
-        .map_or_else(|| "-".to_string(), |c| format!("{:.1}%", 100.0 * c));
+        .map_or_else(|| "-".to_string(), crate::percent);
     vec![
         format!(
             "{} on {}  r={} m  tool={} m",
             m.planner, m.map, m.robot_radius_m, m.tool_radius_m
         ),
         format!(
-            "effective coverage {:.1}%  tiles {}  path {:.1} m  ratio {:.2}",
-            100.0 * m.effective_coverage,
+            "effective coverage {}  tiles {}  path {:.1} m  ratio {:.2}",
+            crate::percent(m.effective_coverage),
             cov,
             m.path_length_m,
             m.path_ratio,
