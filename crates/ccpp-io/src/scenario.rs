@@ -801,6 +801,15 @@ impl Scenario {
                 self.planner.name()
             )));
         }
+        if let Execution::Pid(p) = self.execution() {
+            // Without odometry noise the estimate is the true pose: a fix corrects nothing
+            // (the run differed from one without landmarks in the 12th digit only).
+            if !lm.landmarks.is_empty() && p.noise.is_none() {
+                return Err(invalid(
+                    "landmarks correct odometry drift, and this run has none: without odometry noise the pose estimate is the true pose (add --odometry-noise / odometry_noise=, or leave the landmarks out)".to_string(),
+                ));
+            }
+        }
         check_memory_limit(self.max_memory_mb)?;
         self.planner.validate()?;
         self.validate_zones()?;
@@ -1807,6 +1816,22 @@ mod tests {
             .map(|e| e.to_string())
             .unwrap_or_default();
         assert!(e.contains("PID"), "{e}");
+        // PID without odometry noise: the estimate is the truth, nothing to correct.
+        s.sim.exec = Some(Execution::Pid(PidOptions::default()));
+        let e = s
+            .validate()
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(e.contains("landmarks correct odometry drift"), "{e}");
+        s.sim.exec = Some(Execution::Pid(PidOptions {
+            noise: Some(ccpp_core::exec::OdometryNoise {
+                linear_rel_std: 0.05,
+                ..Default::default()
+            }),
+            ..PidOptions::default()
+        }));
+        assert!(s.validate().is_ok(), "{:?}", s.validate());
     }
 
     #[test]
