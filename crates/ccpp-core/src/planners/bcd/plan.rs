@@ -32,9 +32,10 @@ enum Sets {
     Both,
 }
 
-/// A candidate plan and how it ranks: fewer moves the repair had to skip first, then the lower
-/// cost (length plus `turn_cost_m` per turn, pixels). Every choice between candidates (cell
-/// sets, rim variants, lattices) uses [`Plan::beats`]; of equal candidates the first is kept.
+/// A candidate plan and how it ranks: one that sweeps `min_coverage` of the floor first, then
+/// fewer moves the repair had to skip, then the lower cost (length plus `turn_cost_m` per turn,
+/// pixels). Every choice between candidates (cell sets, rim variants, lattices) uses
+/// [`Plan::beats`]; of equal candidates the first is kept.
 pub(super) struct Plan {
     /// Moves the repair could not make known-free and dropped.
     pub(super) skipped: usize,
@@ -59,11 +60,17 @@ impl Plan {
         }
     }
 
-    /// Does this plan rank before `best` (always, when there is none yet)? Fewer skipped moves
-    /// first, then a plan that sweeps `min_coverage` of the floor before one that does not (a
-    /// cheaper plan that sweeps less is not better), then the lower cost.
+    /// Does this plan rank before `best` (always, when there is none yet)? A plan that sweeps
+    /// `min_coverage` of the floor before one that does not (a cheaper plan that sweeps less
+    /// is not better), then fewer skipped moves, then the lower cost.
+    ///
+    /// Skipped moves ranked first before: a property test's map (0.01 m/px, r = 5.9 px, two
+    /// thin walls and three blobs) got the peeled plan, which skipped none and swept 97.6 % of
+    /// the floor, over lane plans that dropped 3 moves and swept 99.52 % (a skipped move is
+    /// left out of the path, whose floor is then counted without it). On the 14 shared maps
+    /// no plan chosen was short, so every plan there is the same.
     fn beats(&self, best: Option<&Plan>) -> bool {
-        best.is_none_or(|b| (self.skipped, self.short, self.cost) < (b.skipped, b.short, b.cost))
+        best.is_none_or(|b| (self.short, self.skipped, self.cost) < (b.short, b.skipped, b.cost))
     }
 }
 
