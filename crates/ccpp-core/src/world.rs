@@ -1300,7 +1300,7 @@ mod proptests {
         ) {
             let f = *map.frame();
             let robot = Robot { radius: r, tool_radius: r * tool };
-            let Ok(world) = World::new(map.clone(), robot, None) else { return Ok(()) };
+            let Ok(world) = World::new(map.clone(), robot, None) else { return Err(TestCaseError::reject("the robot fits nowhere")) };
             let plain = squared_edt(f.width, f.height, |i| !map.cells()[i].is_free(), true);
             for (i, &d2) in plain.iter().enumerate() {
                 prop_assert_eq!(world.obstacle_dt2.get(i), d2);
@@ -1335,9 +1335,9 @@ mod proptests {
             let pb = Point::new(b.0 * f.width_m(), b.1 * f.height_m());
             let robot = Robot::new(r);
             // Any valid start will do; skip maps where the robot fits nowhere.
-            let Ok(world) = World::new(map, robot, None) else { return Ok(()) };
+            let Ok(world) = World::new(map, robot, None) else { return Err(TestCaseError::reject("the robot fits nowhere")) };
             if world.disk_collides(pa) {
-                return Ok(());
+                return Err(TestCaseError::reject("the segment starts in contact"));
             }
             let n = 400;
             let first_hit = (0..=n).map(|k| f64::from(k) / f64::from(n)).find(|&t| {

@@ -539,7 +539,7 @@ mod tests {
         ) {
             let art = random_map(seed, w, h, density);
             let map = GridMap::from_ascii_scaled(&art, 5, 0.05).unwrap();
-            let Ok(world) = World::new(map, Robot::new(0.15), None) else { return Ok(()) };
+            let Ok(world) = World::new(map, Robot::new(0.15), None) else { return Err(TestCaseError::reject("the robot fits nowhere")) };
             let mut p = BsaBfs::new(BsaBfsOptions::default());
             let out = simulate(&world, &mut p, &SimConfig::default());
             let m = compute(&world, &out, "random");
