@@ -726,11 +726,12 @@ pub fn line_chart(
     let (l, r, t, b) = (80.0f32, 200.0f32, 62.0f32, 60.0f32);
     let pw = w as f32 - l - r;
     let ph = h as f32 - t - b;
-    let xmax = series
+    let longest = series
         .iter()
         .flat_map(|s| s.1.iter().map(|p| p[0]))
         .fold(0.0f64, f64::max)
         .max(1e-9);
+    let xmax = x_extent(series, longest);
     let ymax = y_max.unwrap_or_else(|| {
         series
             .iter()
@@ -765,16 +766,40 @@ pub fn line_chart(
     c.text(8.0, t - 24.0, 14, y_label, [40, 40, 40], Anchor::Start);
     for (k, (name, pts)) in series.iter().enumerate() {
         let col = SERIES[k % SERIES.len()];
-        let poly: Vec<(f32, f32)> = pts
-            .iter()
-            .map(|p| {
-                (
-                    l + (p[0] / xmax) as f32 * pw,
-                    t + ph - (p[1].min(ymax) / ymax) as f32 * ph,
-                )
-            })
-            .collect();
+        let to_canvas = |p: [f64; 2]| {
+            (
+                l + (p[0] / xmax) as f32 * pw,
+                t + ph - (p[1].min(ymax) / ymax) as f32 * ph,
+            )
+        };
+        // A series running past the axis is cut at its end, the cut interpolated.
+        let mut poly: Vec<(f32, f32)> = Vec::with_capacity(pts.len());
+        let mut cut = None;
+        for (j, &p) in pts.iter().enumerate() {
+            if p[0] <= xmax + 1e-9 {
+                poly.push(to_canvas(p));
+                continue;
+            }
+            if let Some(&q) = j.checked_sub(1).and_then(|i| pts.get(i)) {
+                let f = ((xmax - q[0]) / (p[0] - q[0])).clamp(0.0, 1.0);
+                poly.push(to_canvas([xmax, q[1] + f * (p[1] - q[1])]));
+            }
+            cut = pts.last().copied();
+            break;
+        }
+        // Where a cut series ends, off the axis: said at the cut.
+        if let (Some(e), Some(&(cx, cy))) = (cut, poly.last()) {
+            c.text(
+                cx - 4.0,
+                cy - 18.0,
+                12,
+                format!("-> {} m", fmt_tick(e[0], nice_step(e[0], 6))),
+                col,
+                Anchor::End,
+            );
+        }
         c.line(poly, col, 2.0, false);
+        let name = name.clone();
         let ly = t + 10.0 + k as f32 * 24.0;
         c.line(
             vec![(l + pw + 14.0, ly + 9.0), (l + pw + 40.0, ly + 9.0)],
@@ -782,17 +807,34 @@ pub fn line_chart(
             3.0,
             false,
         );
-        c.text(
-            l + pw + 46.0,
-            ly,
-            14,
-            name.clone(),
-            [30, 30, 30],
-            Anchor::Start,
-        );
+        c.text(l + pw + 46.0, ly, 14, name, [30, 30, 30], Anchor::Start);
     }
     c
 }
+
+/// The x axis of [`line_chart`]: to the longest series, unless it runs more than
+/// [`X_OUTLIER`] times as far as the median series' end (random-bounce's budget of 6250 m
+/// beside planners ending near 600 m squeezed them into the first tenth of the axis); then
+/// to that bound, and the longer series are cut there.
+fn x_extent(series: &[(String, Vec<[f64; 2]>)], longest: f64) -> f64 {
+    let mut ends: Vec<f64> = series
+        .iter()
+        .filter_map(|s| s.1.last().map(|p| p[0]))
+        .collect();
+    if ends.len() < 3 {
+        return longest;
+    }
+    ends.sort_by(f64::total_cmp);
+    let median = ends[ends.len() / 2];
+    if median > 0.0 && longest > X_OUTLIER * median {
+        X_OUTLIER * median
+    } else {
+        longest
+    }
+}
+
+/// How many times the median series' length the x axis of [`line_chart`] reaches at most.
+const X_OUTLIER: f64 = 3.0;
 
 /// Bar panels: for each metric a small bar chart with one bar per planner.
 pub fn bar_panels(title: &str, planners: &[String], metrics: &[(String, Vec<f64>)]) -> Chart {
@@ -1410,6 +1452,32 @@ pub fn image_grid_captioned(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A series far longer than the others (random-bounce's budget) no longer squeezes them
+    /// into the first tenth of the axis: the axis ends at three times the median length, and
+    /// the long series is cut there with its end written at the cut.
+    #[test]
+    fn an_outlier_series_is_cut_at_three_times_the_median_length() {
+        let line = |end: f64| vec![[0.0, 0.0], [end, 1.0]];
+        let series: Vec<(String, Vec<[f64; 2]>)> = [600.0, 650.0, 700.0, 6250.0]
+            .iter()
+            .enumerate()
+            .map(|(k, &e)| (format!("p{k}"), line(e)))
+            .collect();
+        assert!((x_extent(&series, 6250.0) - 2100.0).abs() < 1e-9);
+        let svg = line_chart("T", "distance (m)", "coverage", &series, Some(1.0)).to_svg();
+        assert!(
+            svg.contains("-&gt; 6250 m") || svg.contains("-> 6250 m"),
+            "{svg}"
+        );
+        // Comparable lengths keep the whole axis.
+        assert!((x_extent(&series[..3], 700.0) - 700.0).abs() < 1e-9);
+        let near: Vec<(String, Vec<[f64; 2]>)> = [600.0, 650.0, 1500.0]
+            .iter()
+            .map(|&e| ("p".to_string(), line(e)))
+            .collect();
+        assert!((x_extent(&near, 1500.0) - 1500.0).abs() < 1e-9);
+    }
 
     #[test]
     fn svg_and_png_agree_on_size_and_are_deterministic() {
