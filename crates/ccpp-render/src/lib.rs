@@ -789,6 +789,10 @@ pub fn percent(share: f64) -> String {
     format!("{:.1}%", tenths / 10.0)
 }
 
+/// Least width (pixels) the title's first line keeps beside the header's badges; on a
+/// narrower canvas the badges stand one per line above the title.
+const MIN_TITLE_BESIDE_BADGES: f32 = 160.0;
+
 /// Badge colour of an effective coverage: green from 95 %, amber from 80 %, red below.
 pub fn coverage_verdict_colour(coverage: f64) -> [u8; 3] {
     if coverage >= 0.95 {
@@ -871,19 +875,42 @@ pub fn coverage_pixmap_swept(
         let badges: Vec<(String, [u8; 3])> = stopped.into_iter().chain(badges).collect();
         let bh = font::line_height(title_px) + 4.0;
         let mut bx = cw as f32 - 6.0;
-        for (text, colour) in badges.iter().rev() {
-            let tw = font::text_width(text, title_px) + 16.0;
-            bx -= tw;
-            head.rect(bx, y - 2.0, tw, bh, Some(*colour), None);
-            head.text(
-                bx + 8.0,
-                y + 1.0,
-                title_px as u32,
-                text.clone(),
-                [255, 255, 255],
-                chart::Anchor::Start,
-            );
-            bx -= 8.0;
+        let widths: Vec<f32> = badges
+            .iter()
+            .map(|(text, _)| font::text_width(text, title_px) + 16.0)
+            .collect();
+        let in_a_row = widths.iter().sum::<f32>() + 8.0 * (widths.len() as f32 - 1.0);
+        if in_a_row <= cw as f32 - 12.0 - MIN_TITLE_BESIDE_BADGES {
+            for ((text, colour), tw) in badges.iter().zip(&widths).rev() {
+                bx -= tw;
+                head.rect(bx, y - 2.0, *tw, bh, Some(*colour), None);
+                head.text(
+                    bx + 8.0,
+                    y + 1.0,
+                    title_px as u32,
+                    text.clone(),
+                    [255, 255, 255],
+                    chart::Anchor::Start,
+                );
+                bx -= 8.0;
+            }
+        } else {
+            // A canvas too narrow for the badges beside the title (a map a few pixels wide):
+            // one badge per line, the title under them (they were drawn over each other and
+            // over the title).
+            for ((text, colour), tw) in badges.iter().zip(&widths) {
+                let x = (cw as f32 - 6.0 - tw).max(2.0);
+                head.rect(x, y - 2.0, *tw, bh, Some(*colour), None);
+                head.text(
+                    x + 8.0,
+                    y + 1.0,
+                    title_px as u32,
+                    text.clone(),
+                    [255, 255, 255],
+                    chart::Anchor::Start,
+                );
+                y += bh + 4.0;
+            }
         }
         // The first title line wraps at spaces so that no word runs under the badges; its
         // continuation lines take the whole width.
@@ -907,15 +934,11 @@ pub fn coverage_pixmap_swept(
                 font::line_height(title_px)
             };
         }
-        for line in style.title.iter().skip(1) {
-            head.text(
-                8.0,
-                y,
-                px as u32,
-                line.clone(),
-                [20, 20, 20],
-                chart::Anchor::Start,
-            );
+        // The other lines wrap at spaces too (on a canvas a few map pixels wide they ran off
+        // its edge).
+        let width = cw as f32 - 16.0;
+        for line in wrap_words(&style.title[1.min(style.title.len())..], width, width, px) {
+            head.text(8.0, y, px as u32, line, [20, 20, 20], chart::Anchor::Start);
             y += font::line_height(px);
         }
         header = (y + 6.0).ceil() as u32;
@@ -1955,6 +1978,36 @@ mod tests {
                 hatch: colours::KEEPOUT_HATCH
             }
         );
+    }
+
+    /// On a canvas a few map pixels wide the header's badges stand one per line (they were
+    /// drawn over each other and over the title, the hostile case a 9 x 77 px map).
+    #[test]
+    fn badges_of_a_narrow_map_do_not_overlap() {
+        let map = GridMap::from_ascii_scaled("###\n#.#\n#.#\n#.#\n#.#\n###", 3, 0.01).unwrap();
+        let world = World::new(map, Robot::new(0.01), Some(Pose::new(0.045, 0.045, 0.0))).unwrap();
+        let mut trace = Trace::default();
+        trace.push_pose(0, Pose::new(0.045, 0.045, 0.0));
+        trace.push_pose(1, Pose::new(0.045, 0.06, 0.0));
+        let png = coverage_png(&world, &trace, &style()).unwrap();
+        let pm = Pixmap::decode_png(&png).unwrap();
+        let rows_of = |c: [u8; 3]| -> Vec<u32> {
+            (0..pm.height())
+                .filter(|&y| {
+                    (0..pm.width()).any(|x| {
+                        let p = pm.pixel(x, y).unwrap();
+                        [p.red(), p.green(), p.blue()] == c
+                    })
+                })
+                .collect()
+        };
+        let cov = rows_of(coverage_verdict_colour(effective_coverage(
+            &world,
+            &swept_pixels(&world, &trace),
+        )));
+        let ok = rows_of([20, 130, 60]);
+        assert!(!cov.is_empty() && !ok.is_empty());
+        assert!(cov.iter().all(|y| !ok.contains(y)), "badges share rows");
     }
 
     /// A keep-out polygon's outline is drawn, so the legend names it (the replay's did, the
