@@ -266,6 +266,8 @@ def test_odometry_noise_and_landmarks_are_the_cli_runs(shared_maps: Path, ccpp_b
         ({"seed": 3}, r"seed does not apply to bcd \(it applies to random-bounce and odometry_noise\)"),
         ({"landmarks": []}, "no landmark"),
         ({"landmarks": str(tmp_path / "none.csv")}, "none.csv"),
+        # Without odometry noise the estimate is the true pose: nothing to correct.
+        ({"exec": "pid", "landmarks": [(0, 1, 1)]}, "landmarks correct odometry drift"),
     ]:
         with pytest.raises(ccpp.CcppError, match=needle):
             ccpp.run(maze, "bcd", **kw)
