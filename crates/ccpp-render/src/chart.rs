@@ -1177,28 +1177,70 @@ pub fn tradeoff_chart(
         [40, 40, 40],
         Anchor::Start,
     );
-    // Faint points first, then the planners' discs, then their labels.
+    // Faint points first, then the planners' discs, then their labels. A faint point beyond
+    // the axes is a chevron on the frame's edge, pointing its way (they were only counted, so
+    // a summary never showed its worst maps).
     let mut outside = 0usize;
     for (k, pts) in faint.iter().enumerate() {
         let col = faded(SERIES[k % SERIES.len()], 0.55);
+        let edge = faded(SERIES[k % SERIES.len()], 0.3);
         for p in pts.iter().filter(|p| ok(p)) {
             let (x, y) = px(p);
             if x < l || x > l + pw || y < t || y > t + ph {
                 outside += 1;
+                let (cx, cy) = (
+                    x.clamp(l + 4.0, l + pw - 4.0),
+                    y.clamp(t + 4.0, t + ph - 4.0),
+                );
+                // Unit vector out of the frame (either axis, or a corner's diagonal).
+                let dx = if x < l {
+                    -1.0
+                } else if x > l + pw {
+                    1.0
+                } else {
+                    0.0
+                };
+                let dy = if y < t {
+                    -1.0
+                } else if y > t + ph {
+                    1.0
+                } else {
+                    0.0
+                };
+                let (nx, ny) = (-dy, dx);
+                c.line(
+                    vec![
+                        (cx - 4.0 * dx + 4.0 * nx, cy - 4.0 * dy + 4.0 * ny),
+                        (cx, cy),
+                        (cx - 4.0 * dx - 4.0 * nx, cy - 4.0 * dy - 4.0 * ny),
+                    ],
+                    edge,
+                    2.0,
+                    false,
+                );
                 continue;
             }
             c.circle(x, y, 3.5, Some(col), None, 1.0);
         }
     }
     if outside > 0 {
-        c.text(
-            8.0,
-            h as f32 - 22.0,
-            12,
-            format!("{outside} per-map points outside the axes"),
-            [110, 110, 110],
-            Anchor::Start,
-        );
+        // In the legend's column: under the plot it ran into the axis label.
+        for (j, line) in [
+            format!("{outside} per-map points beyond"),
+            "the axes: chevrons on the edge".to_string(),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            c.text(
+                l + pw + 14.0,
+                t + ph - 30.0 + j as f32 * 16.0,
+                12,
+                line,
+                [110, 110, 110],
+                Anchor::Start,
+            );
+        }
     }
     let rad = 7.0f32;
     let mut anchors = Vec::new();
@@ -1612,10 +1654,18 @@ mod tests {
         )
         .to_svg();
         assert!(
-            svg.contains(">1 per-map points outside the axes</text>"),
+            svg.contains(">1 per-map points beyond</text>")
+                && svg.contains(">the axes: chevrons on the edge</text>"),
             "{svg}"
         );
         assert!(svg.contains(">mean over maps</text>") && svg.contains(">one map</text>"));
+        // The point beyond the axes is a chevron in its planner's colour on the edge.
+        let edge = hex(faded(SERIES[0], 0.3));
+        assert_eq!(
+            svg.matches(&format!("stroke=\"{edge}\"")).count(),
+            1,
+            "{svg}"
+        );
         // Narrow range: a linear axis.
         assert!(!svg.contains("log scale"));
     }
