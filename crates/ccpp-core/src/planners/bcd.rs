@@ -36,10 +36,11 @@
 //!    turned by that angle (a point is free where its pixel is reachable C-free and the
 //!    robot's disk there touches nothing) and by angles half a degree, one degree, ... beside
 //!    it (`angle_tries` lattices per angle: a plan's cost reacts strongly to where the lattice
-//!    lines fall), and the plan that skips fewer moves, then sweeps `min_coverage` of the
-//!    floor (estimated; a plan below it loses to one that reaches it, whatever their costs:
-//!    this is the rule for every choice between plans below), then costs less (length plus
-//!    `turn_cost_m` per turn), is kept. Maps drawn along the axes get the
+//!    lines fall), and the plan that sweeps `min_coverage` of the floor (estimated; a plan
+//!    below it loses to one that reaches it, whatever their costs; of two plans below it, the
+//!    one that misses less by steps of `1 - rim_coverage` of the floor wins: this is the rule
+//!    for every choice between plans below), then skips fewer moves, then costs less (length
+//!    plus `turn_cost_m` per turn), is kept. Maps drawn along the axes get the
 //!    pixel lattice's plan unchanged.
 //! 2. **Lanes fitted to each cell** (the paper's boustrophedon motions). Per cell, lanes run
 //!    along the sweep line or, when the cell is monotone the other way too, across it — the

@@ -622,13 +622,14 @@ impl Pruner<'_, '_> {
 
 /// Drops turn vertices of the plan's moves while its estimated effective coverage stays at
 /// least `floor` (module docs); corners are completed where that saves a turn for at most
-/// `max_extra` (pixels) of path.
+/// `max_extra` (pixels) of path. Returns the moves, whether the plan came short of `floor`
+/// already before pruning, and the accessible pixels the pruned plan sweeps.
 pub(super) fn prune(
     ctx: &Ctx<'_>,
     items: Vec<Item>,
     floor: f64,
     max_extra: f64,
-) -> (Vec<Item>, bool) {
+) -> (Vec<Item>, bool, usize) {
     // The distinct consecutive points of the plan with their item indices.
     let mut pts: Vec<Point> = Vec::new();
     let mut at: Vec<usize> = Vec::new();
@@ -656,7 +657,7 @@ pub(super) fn prune(
             crate::raster::stamp_capsule(&mut swept, &ctx.frame, a, b, rt, &mut |_| {});
         }
         let covered = swept.intersection(acc).count();
-        return (items, n == 0 || covered < need);
+        return (items, n == 0 || covered < need, covered);
     }
     let frame = ctx.frame;
     let mut pr = Pruner {
@@ -689,7 +690,7 @@ pub(super) fn prune(
     for i in 0..n - 1 {
         // (a plan given up is dropped whole: return it as it came)
         if i.is_multiple_of(STOP_EVERY) && ctx.stopped() {
-            return (items, false);
+            return (items, false, 0);
         }
         let seg = pr.segment(i);
         pr.apply(&seg, true);
@@ -739,7 +740,7 @@ pub(super) fn prune(
             Item::Mark(_) => Some(it),
         })
         .collect();
-    (items, short)
+    (items, short, pr.covered)
 }
 
 #[cfg(test)]
@@ -958,7 +959,7 @@ mod tests {
             Item::Move(p(58.0, 42.0)),
             Item::Move(p(20.0, 40.0)),
         ];
-        let (out, short) = prune(&c, items.clone(), 0.5, 6.0);
+        let (out, short, _) = prune(&c, items.clone(), 0.5, 6.0);
         assert_eq!(points(&out), points(&items));
         assert_eq!(out.len(), items.len());
         assert!(!short);
