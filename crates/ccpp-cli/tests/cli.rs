@@ -865,6 +865,26 @@ fn replay_page_works_in_headless_chromium() {
             "#at={f}: shows {text}"
         );
     }
+    // At the last frame "Now" reads the run's own coverage, as "Whole run" does (it read
+    // 99.9 % beside 100.0 %: the curve's samples and distances are rounded apart).
+    let mut c = std::process::Command::new(&chrome);
+    base(&mut c);
+    let o = c
+        .arg("--dump-dom")
+        .arg(format!("{url}#frame=last"))
+        .output()
+        .unwrap();
+    let dom = String::from_utf8_lossy(&o.stdout);
+    let text_after = |key: &str| {
+        let at = dom.find(key).unwrap_or_else(|| panic!("{key}")) + key.len();
+        let rest = &dom[at..];
+        let open = rest.find('>').unwrap() + 1;
+        rest[open..open + rest[open..].find('<').unwrap()].to_string()
+    };
+    assert_eq!(
+        text_after("id=\"now-cov\""),
+        text_after("id=\"m-effective_coverage\"")
+    );
     // Screenshot of the last frame, kept as a test artefact.
     let shot = Path::new(env!("CARGO_TARGET_TMPDIR")).join("replay-last-frame.png");
     let mut c = std::process::Command::new(&chrome);

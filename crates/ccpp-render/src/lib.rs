@@ -898,13 +898,23 @@ pub fn coverage_pixmap_swept(
             // A canvas too narrow for the badges beside the title (a map a few pixels wide):
             // one badge per line, the title under them (they were drawn over each other and
             // over the title).
+            // A badge wider than the canvas is set in a smaller type that fits (a 5 px wide
+            // map's read "99.1% co...").
             for ((text, colour), tw) in badges.iter().zip(&widths) {
-                let x = (cw as f32 - 6.0 - tw).max(2.0);
-                head.rect(x, y - 2.0, *tw, bh, Some(*colour), None);
+                let room = cw as f32 - 4.0;
+                let (fpx, tw) = if *tw > room {
+                    let f = (title_px * (room - 16.0) / (tw - 16.0)).floor().max(6.0);
+                    (f, font::text_width(text, f) + 16.0)
+                } else {
+                    (title_px, *tw)
+                };
+                let bh = font::line_height(fpx) + 4.0;
+                let x = (cw as f32 - 2.0 - tw).max(2.0);
+                head.rect(x, y - 2.0, tw, bh, Some(*colour), None);
                 head.text(
                     x + 8.0,
                     y + 1.0,
-                    title_px as u32,
+                    fpx as u32,
                     text.clone(),
                     [255, 255, 255],
                     chart::Anchor::Start,

@@ -875,6 +875,20 @@ mod tests {
         assert!(TEMPLATE.contains("rgba(255,212,0,"));
     }
 
+    /// The approach's dotted style is tested before backtracking's (both negative): the other
+    /// way round a finished approach was drawn dashed, as backtracking, while the move under
+    /// way was dotted.
+    #[test]
+    fn a_finished_approach_keeps_its_style() {
+        let approach = TEMPLATE
+            .find("if (style === -2) {")
+            .expect("approach style");
+        let backtrack = TEMPLATE
+            .find("} else if (style < 0) {")
+            .expect("backtrack style");
+        assert!(approach < backtrack);
+    }
+
     /// The page lists only the map classes the map shows (`teb_maze` has no unknown pixel, the
     /// legend said "unknown") and names the wall time for what it is.
     #[test]
