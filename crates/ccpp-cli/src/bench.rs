@@ -923,13 +923,8 @@ fn starts_maybe_outside(
 
 /// The start position a run used (`run.json`'s `start`), when its folder says.
 fn run_start(dir: &Path) -> Option<ccpp_core::geometry::Point> {
-    let text = ccpp_io::file::read_text(&dir.join("run.json")).ok()?;
-    let v: serde_json::Value = serde_json::from_str(&text).ok()?;
-    let s = v.get("start")?.as_array()?;
-    Some(ccpp_core::geometry::Point::new(
-        s.first()?.as_f64()?,
-        s.get(1)?.as_f64()?,
-    ))
+    let [x, y, _] = Scenario::from_file(&dir.join("run.json")).ok()?.start?;
+    Some(ccpp_core::geometry::Point::new(x, y))
 }
 
 /// The warning a bench prints for [`starts_maybe_outside`]'s maps.
