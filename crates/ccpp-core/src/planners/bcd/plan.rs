@@ -75,7 +75,6 @@ impl Plan {
     /// left out of the path, whose floor is then counted without it). On the 14 shared maps
     /// no plan chosen was short, so every plan there is the same.
     ///
-    ///
     /// Of two short plans, the one that falls short by fewer steps of the floor ranks first,
     /// a step being the share `1 - rim_coverage` the user lets the rim passes leave (0.1 % by
     /// default): a salted map at r = 1.7 px had every plan short, and the peeled plan (no
@@ -967,12 +966,11 @@ impl Bcd {
             if ctx.stopped() {
                 return None;
             }
-            let (items, short, covered) = prune::prune(ctx, items, opts.min_coverage, turn_px);
+            let (items, short, missing) = prune::prune(ctx, items, opts.min_coverage, turn_px);
             let shortfall = if short {
-                let acc = ctx.world.accessible().count_ones(..);
-                let need = (opts.min_coverage * acc as f64).ceil() as usize;
+                let acc = ctx.world.accessible_count();
                 let step = ((1.0 - opts.rim_coverage) * acc as f64).floor() as usize;
-                need.saturating_sub(covered).div_ceil(step.max(1))
+                missing.div_ceil(step.max(1))
             } else {
                 0
             };

@@ -623,7 +623,8 @@ impl Pruner<'_, '_> {
 /// Drops turn vertices of the plan's moves while its estimated effective coverage stays at
 /// least `floor` (module docs); corners are completed where that saves a turn for at most
 /// `max_extra` (pixels) of path. Returns the moves, whether the plan came short of `floor`
-/// already before pruning, and the accessible pixels the pruned plan sweeps.
+/// already before pruning, and how many accessible pixels the pruned plan sweeps fewer than
+/// `floor` of them (0 when it reaches it).
 pub(super) fn prune(
     ctx: &Ctx<'_>,
     items: Vec<Item>,
@@ -643,12 +644,12 @@ pub(super) fn prune(
     }
     let n = pts.len();
     let acc = ctx.world.accessible();
+    let need = (floor * ctx.world.accessible_count() as f64).ceil() as usize;
     if n < 3 {
         // Nothing to prune, but whether the plan is short still counts: a plan of one or no
         // move was reported as sweeping the floor, and on a property test's map (0.087 m/px,
         // r = 2.9 px, salt) such a plan of a turned lattice beat every plan with moves; the
         // run swept 38 % of the floor.
-        let need = (floor * acc.count_ones(..) as f64).ceil() as usize;
         let mut swept = FixedBitSet::with_capacity(ctx.frame.len());
         let rt = ctx.rt + crate::raster::SWEEP_EPS_PX;
         for k in 0..n {
@@ -657,7 +658,11 @@ pub(super) fn prune(
             crate::raster::stamp_capsule(&mut swept, &ctx.frame, a, b, rt, &mut |_| {});
         }
         let covered = swept.intersection(acc).count();
-        return (items, n == 0 || covered < need, covered);
+        return (
+            items,
+            n == 0 || covered < need,
+            need.saturating_sub(covered),
+        );
     }
     let frame = ctx.frame;
     let mut pr = Pruner {
@@ -696,7 +701,6 @@ pub(super) fn prune(
         pr.apply(&seg, true);
         pr.seg[i] = seg;
     }
-    let need = (floor * acc.count_ones(..) as f64).ceil() as usize;
     // Pruning never takes the plan below the floor, but a plan may come to it below already.
     let short = pr.covered < need;
     pr.drop_spans(need, 0..n);
@@ -740,7 +744,7 @@ pub(super) fn prune(
             Item::Mark(_) => Some(it),
         })
         .collect();
-    (items, short, pr.covered)
+    (items, short, need.saturating_sub(pr.covered))
 }
 
 #[cfg(test)]
