@@ -873,55 +873,52 @@ pub fn coverage_pixmap_swept(
             ),
         ];
         let badges: Vec<(String, [u8; 3])> = stopped.into_iter().chain(badges).collect();
-        let bh = font::line_height(title_px) + 4.0;
         let mut bx = cw as f32 - 6.0;
         let widths: Vec<f32> = badges
             .iter()
             .map(|(text, _)| font::text_width(text, title_px) + 16.0)
             .collect();
         let in_a_row = widths.iter().sum::<f32>() + 8.0 * (widths.len() as f32 - 1.0);
+        // Each badge's left edge, top line, width and type size.
+        let mut placed: Vec<(f32, f32, f32, f32)> = Vec::with_capacity(badges.len());
         if in_a_row <= cw as f32 - 12.0 - MIN_TITLE_BESIDE_BADGES {
-            for ((text, colour), tw) in badges.iter().zip(&widths).rev() {
+            // In a row, right-aligned beside the title.
+            for tw in widths.iter().rev() {
                 bx -= tw;
-                head.rect(bx, y - 2.0, *tw, bh, Some(*colour), None);
-                head.text(
-                    bx + 8.0,
-                    y + 1.0,
-                    title_px as u32,
-                    text.clone(),
-                    [255, 255, 255],
-                    chart::Anchor::Start,
-                );
+                placed.push((bx, y, *tw, title_px));
                 bx -= 8.0;
             }
+            placed.reverse();
         } else {
             // A canvas too narrow for the badges beside the title (a map a few pixels wide):
             // one badge per line, the title under them (they were drawn over each other and
-            // over the title).
-            // A badge wider than the canvas is set in a smaller type that fits (a 5 px wide
-            // map's read "99.1% co...").
-            for ((text, colour), tw) in badges.iter().zip(&widths) {
-                let room = cw as f32 - 4.0;
+            // over the title). A badge wider than the canvas is set in a smaller type that
+            // fits (a 5 px wide map's read "99.1% co...").
+            let room = cw as f32 - 4.0;
+            for ((text, _), tw) in badges.iter().zip(&widths) {
                 let (fpx, tw) = if *tw > room {
                     let f = (title_px * (room - 16.0) / (tw - 16.0)).floor().max(6.0);
                     (f, font::text_width(text, f) + 16.0)
                 } else {
                     (title_px, *tw)
                 };
-                let bh = font::line_height(fpx) + 4.0;
-                let x = (cw as f32 - 2.0 - tw).max(2.0);
-                head.rect(x, y - 2.0, tw, bh, Some(*colour), None);
-                head.text(
-                    x + 8.0,
-                    y + 1.0,
-                    fpx as u32,
-                    text.clone(),
-                    [255, 255, 255],
-                    chart::Anchor::Start,
-                );
-                y += bh + 4.0;
+                placed.push(((cw as f32 - 2.0 - tw).max(2.0), y, tw, fpx));
+                y += font::line_height(fpx) + 8.0;
             }
         }
+        for ((text, colour), &(x, top, tw, fpx)) in badges.iter().zip(&placed) {
+            let bh = font::line_height(fpx) + 4.0;
+            head.rect(x, top - 2.0, tw, bh, Some(*colour), None);
+            head.text(
+                x + 8.0,
+                top + 1.0,
+                fpx as u32,
+                text.clone(),
+                [255, 255, 255],
+                chart::Anchor::Start,
+            );
+        }
+        let bh = font::line_height(title_px) + 4.0;
         // The first title line wraps at spaces so that no word runs under the badges; its
         // continuation lines take the whole width.
         let first = style
