@@ -103,6 +103,7 @@ pub fn replay_dir(dir: &Path) -> Result<()> {
         )
     })?;
     check_same_run(dir, &scenario, &map.name, &world, &trace, &metrics)?;
+    let trace = check_metrics_of_run(dir, &scenario, &map.name, &world, trace, &metrics)?;
     if let Some(ms) = std::env::var(crate::staging::REPLAY_PAUSE_ENV)
         .ok()
         .and_then(|v| v.parse::<u64>().ok())
@@ -155,6 +156,83 @@ fn folder_identity(dir: &Path) -> Option<(u64, u64)> {
         let _ = dir;
         None
     }
+}
+
+/// The figures of `metrics.json` that [`check_metrics_of_run`] computes again from the trace
+/// (all but the planner's wall time, which no trace records, and the stop reason and
+/// rectangle guarantee, which the run states rather than measures).
+const RECOMPUTED: [&str; 17] = [
+    "robot_radius_m",
+    "tool_radius_m",
+    "coverage_rate",
+    "effective_coverage",
+    "path_length_m",
+    "path_ratio",
+    "redundancy",
+    "revisit_rate",
+    "regions",
+    "backtracks",
+    "backtrack_length_m",
+    "turns",
+    "rotation_rad",
+    "collisions",
+    "keepout_violations",
+    "tracking_error_mean_m",
+    "tracking_error_max_m",
+];
+
+/// Refuses a run folder whose `metrics.json` is not what the run of `run.json` (its robot,
+/// map, zones and planner options such as the tile side) makes of `trace.jsonl`: the metrics are
+/// computed again from the trace and compared figure by figure ([`RECOMPUTED`]). A `run.json`
+/// copied in from another run on the same path (another tool radius, another tile side) passed
+/// [`check_same_run`], and the page drew that run's swept floor beside this run's metrics (a
+/// coverage curve ending at 0.771 beside an effective coverage of 0.907). Returns the trace.
+fn check_metrics_of_run(
+    dir: &Path,
+    scenario: &Scenario,
+    map_name: &str,
+    world: &World,
+    trace: Trace,
+    metrics: &str,
+) -> Result<Trace> {
+    let out = ccpp_core::sim::RunOutput {
+        trace,
+        // Not among the figures compared.
+        stop: ccpp_core::sim::StopReason::Done,
+        tile_side: scenario.tile_side(),
+        planner: scenario.planner.name(),
+        wall_time_s: 0.0,
+    };
+    let again = serde_json::to_value(ccpp_core::metrics::compute(world, &out, map_name))
+        .context("metrics computed again from trace.jsonl")?;
+    let reported: serde_json::Value = serde_json::from_str(metrics)
+        .with_context(|| format!("{}: metrics.json", dir.display()))?;
+    for key in RECOMPUTED {
+        let (want, got) = (again.get(key), reported.get(key));
+        let same = match (
+            want.and_then(serde_json::Value::as_f64),
+            got.and_then(serde_json::Value::as_f64),
+        ) {
+            // Computed the same way from the same poses; the tolerance only allows for the
+            // decimal round trip of the JSON numbers.
+            (Some(a), Some(b)) => (a - b).abs() <= 1e-9 * (1.0 + a.abs()),
+            (None, None) => {
+                want.is_none_or(serde_json::Value::is_null)
+                    && got.is_none_or(serde_json::Value::is_null)
+            }
+            _ => false,
+        };
+        if !same {
+            bail!(
+                "{}: metrics.json reports {key} {} but the run of run.json makes {} of \
+                 trace.jsonl: the folder mixes files of two runs (or a file was edited)",
+                dir.display(),
+                got.map_or_else(|| "(none)".to_string(), ToString::to_string),
+                want.map_or_else(|| "(none)".to_string(), ToString::to_string),
+            );
+        }
+    }
+    Ok(out.trace)
 }
 
 /// Refuses a run folder whose files come from different runs (a trace or metrics copied in

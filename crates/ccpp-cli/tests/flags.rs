@@ -1008,6 +1008,24 @@ fn replay_refuses_a_folder_that_mixes_two_runs() {
     std::fs::remove_file(g.join("metrics.json")).unwrap();
     fails(&["replay"], &[&g], &["no readable metrics.json"], 10);
     assert!(!g.join("replay.html").exists());
+    // The run.json of a run with another tool radius (or tile side) on the same path: the
+    // page drew that tool's swept floor (a coverage curve ending at 0.771) beside this run's
+    // metrics (0.907); the metrics computed again from the trace tell them apart.
+    let h = run_ok(dir, "h", &map, "ba-star", &[]);
+    for (name, args, figure) in [
+        ("i", &["--tool-radius", "0.1"][..], "tool_radius_m 0.15"),
+        ("j", &["--tile-side", "0.4"][..], "metrics.json reports"),
+    ] {
+        let other = run_ok(dir, name, &map, "ba-star", args);
+        let k = dir.join(format!("{name}-mixed"));
+        std::fs::create_dir(&k).unwrap();
+        for f in ["trace.jsonl", "metrics.json", "path.csv", "coverage.png"] {
+            std::fs::copy(h.join(f), k.join(f)).unwrap();
+        }
+        std::fs::copy(other.join("run.json"), k.join("run.json")).unwrap();
+        fails(&["replay"], &[&k], &[figure, "mixes files of two runs"], 10);
+        assert!(!k.join("replay.html").exists());
+    }
     // A folder as its run wrote it replays.
     ccpp().arg("replay").arg(&b).assert().success();
     assert!(b.join("replay.html").exists());
