@@ -198,9 +198,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         bail!("--jobs must be at least 1, got 0");
     }
     // Refused here, before the folder is touched (every run would fail on it).
-    if a.limits.max_memory_mb() == 0 {
-        bail!("--max-memory must be >= 1 MB");
-    }
+    ccpp_io::scenario::check_memory_limit(a.limits.max_memory_mb())?;
     let (robot, _) = robot_from(&(&a.robot).into())?;
     let options = planner_options(a.options.config.as_deref(), a.seed)?;
     let kinds: Vec<planners::PlannerKind> = planners

@@ -1554,7 +1554,27 @@ fn a_map_image_too_large_for_the_memory_limit_is_refused_from_its_header() {
     );
     refused(
         &["info", "--map", s(&pillars), "--max-memory", "0"],
-        &["--max-memory", "must be >= 1 MB"],
+        &[
+            "--max-memory",
+            "must be from 1 to 1099511627776 MB",
+            "got 0",
+        ],
+    );
+    // A limit beyond 2^40 MB overflowed the byte count: the widest map was refused as needing
+    // less than the limit the message named.
+    refused(
+        &[
+            "info",
+            "--map",
+            s(&widest),
+            "--max-memory",
+            "18446744073709551615",
+        ],
+        &[
+            "--max-memory",
+            "must be from 1 to",
+            "got 18446744073709551615",
+        ],
     );
     ccpp()
         .args(["info", "--map", s(&pillars), "--max-memory", "2"])

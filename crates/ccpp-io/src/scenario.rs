@@ -54,6 +54,12 @@ use ccpp_core::zones::ZoneMasks;
 /// (`cluttered_2000` at r = 0.025 m, `office_4096` at r = 0.1 m) with a wide margin.
 pub const DEFAULT_MAX_MEMORY_MB: u64 = 4096;
 
+/// The largest memory limit a scenario takes, MB (2^40 MB, an exbibyte). Limits are compared in
+/// bytes, and a larger one (up to `u64::MAX` MB) overflowed them: the byte count was capped at
+/// 2^64 while messages named the limit given, so a map was refused as needing "1.1e15 MB, more
+/// than the memory limit of 18446744073709551615 MB".
+pub const MAX_MEMORY_LIMIT_MB: u64 = 1 << 40;
+
 /// Largest map side ccpp accepts, metres (1000 km): larger frames come from a wrong
 /// resolution, and their tile and distance arithmetic would lose all precision.
 pub const MAX_MAP_SIDE_M: f64 = 1e6;
@@ -627,11 +633,15 @@ fn join_scoped<T>(h: std::thread::ScopedJoinHandle<'_, T>) -> T {
 }
 
 /// Refuses a memory limit of 0 MB (a scenario's, or the one a map is loaded within).
-fn check_memory_limit(mb: u64) -> Result<(), ScenarioError> {
-    if mb == 0 {
-        return Err(invalid(
-            "--max-memory / max_memory_mb must be >= 1 MB".into(),
-        ));
+/// Checks a memory limit, MB: from 1 to [`MAX_MEMORY_LIMIT_MB`].
+///
+/// # Errors
+/// [`ScenarioError::Invalid`] naming the option and the range.
+pub fn check_memory_limit(mb: u64) -> Result<(), ScenarioError> {
+    if !(1..=MAX_MEMORY_LIMIT_MB).contains(&mb) {
+        return Err(invalid(format!(
+            "--max-memory / max_memory_mb must be from 1 to {MAX_MEMORY_LIMIT_MB} MB (1 EiB), got {mb}"
+        )));
     }
     Ok(())
 }
