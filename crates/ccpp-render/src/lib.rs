@@ -45,7 +45,8 @@ pub enum RenderError {
 #[derive(Clone, Debug)]
 pub struct CoverageStyle {
     /// Target width in pixels for small maps (maps are scaled up by an integer factor to reach
-    /// it; large maps are drawn 1:1 or scaled down to `max_side`).
+    /// it; large maps are drawn 1:1 or scaled down to `max_side`). The canvas is at least
+    /// this wide up to 480 px: a map drawn narrower stands in its middle.
     pub min_width: u32,
     /// Largest canvas side.
     pub max_side: u32,
@@ -171,6 +172,8 @@ fn paint(c: Color) -> Paint<'static> {
 struct View {
     scale: f32,
     height: f64,
+    /// Canvas columns left of the map (a narrow map stands in the middle of the canvas).
+    left: f32,
     top: f32,
     col0: f64,
     row0: f64,
@@ -180,7 +183,7 @@ impl View {
     fn to_canvas(self, world: &World, p: Point) -> (f32, f32) {
         let g = world.frame().world_to_grid(p);
         (
-            ((g.x - self.col0) as f32) * self.scale,
+            ((g.x - self.col0) as f32) * self.scale + self.left,
             ((self.height - g.y - self.row0) as f32) * self.scale + self.top,
         )
     }
@@ -789,6 +792,11 @@ pub fn percent(share: f64) -> String {
     format!("{:.1}%", tenths / 10.0)
 }
 
+/// Least width (pixels) of a coverage picture (or [`CoverageStyle::min_width`] when smaller):
+/// a map narrower than that on the canvas stands in its middle, with white either side, so
+/// that the title and the legend keep a readable width.
+const MIN_CANVAS_WIDTH: u32 = 480;
+
 /// Least width (pixels) the title's first line keeps beside the header's badges; on a
 /// narrower canvas the badges stand one per line above the title.
 const MIN_TITLE_BESIDE_BADGES: f32 = 160.0;
@@ -842,7 +850,12 @@ pub fn coverage_pixmap_swept(
         1.0
     };
     let scale = scale.min(style.max_side as f32 / w.max(h) as f32).max(0.05);
-    let cw = ((w as f32 * scale).round() as u32).max(1);
+    // The map's width on the canvas, and the canvas's: a map much taller than wide (a
+    // corridor 9 px wide and 4000 long was drawn 7 px wide, its title and legend squeezed into
+    // that) stands in the middle of a canvas at least [`MIN_CANVAS_WIDTH`] wide.
+    let mw = ((w as f32 * scale).round() as u32).max(1);
+    let cw = mw.max(MIN_CANVAS_WIDTH.min(style.min_width));
+    let left = (cw - mw) / 2;
     let ch_map = ((h as f32 * scale).round() as u32).max(1);
     // Text sizes follow the canvas width (about 60 characters per line).
     let px = (cw as f32 / 62.0).clamp(13.0, 30.0).round();
@@ -1003,9 +1016,11 @@ pub fn coverage_pixmap_swept(
     };
     ccpp_io::phase::time("coverage.png background", || {
         // The map column of each canvas column, computed once (same formula per pixel).
-        let cols: Vec<usize> = (0..cw)
+        let cols: Vec<usize> = (0..mw)
             .map(|x| (col0 + ((x as f32 + 0.5) / scale) as usize).min(frame.width - 1))
             .collect();
+        // The map's bytes in a canvas row; white either side of a map narrower than the canvas.
+        let (m0, m1) = (left as usize * 4, (left + mw) as usize * 4);
         let stride = cw as usize * 4;
         // Paints the canvas map rows `y0..` into `rows` (those rows, `stride` bytes each).
         let paint = |y0: u32, rows: &mut [u8]| {
@@ -1022,11 +1037,14 @@ pub fn coverage_pixmap_swept(
                 }
                 let mut hatched = false;
                 let out = &mut rows[o..o + stride];
+                out[..m0].fill(u8::MAX);
+                out[m1..].fill(u8::MAX);
+                let out = &mut out[m0..m1];
                 // The last map pixel classified and its colour, when it is not hatched (its
                 // colour then depends on the pixel alone): the canvas pixels showing the same
                 // map pixel next to it take that colour.
                 let mut last: Option<(usize, [u8; 4])> = None;
-                for ((x, &col), d) in (0..cw).zip(&cols).zip(out.chunks_exact_mut(4)) {
+                for ((x, &col), d) in (left..).zip(&cols).zip(out.chunks_exact_mut(4)) {
                     let i = frame.index(col, row);
                     if let Some((j, c)) = last {
                         if j == i {
@@ -1075,11 +1093,12 @@ pub fn coverage_pixmap_swept(
     let view = View {
         scale,
         height: frame.height as f64,
+        left: left as f32,
         top: header as f32,
         col0: col0 as f64,
         row0: row0 as f64,
     };
-    draw_zone_borders(&mut pm, world, view, (cw, ch_map));
+    draw_zone_borders(&mut pm, world, view, (mw, ch_map));
     ccpp_io::phase::time("coverage.png path", || {
         draw_path(&mut pm, world, trace, view);
     });
@@ -1094,12 +1113,12 @@ pub fn coverage_pixmap_swept(
 }
 
 /// Outlines of the area polygons (solid) and keep-out polygons (hatch colour), clipped to the
-/// map's `cw` x `ch` canvas below the header: a polygon reaching past the map's picture was
+/// map's `mw` x `ch` picture below the header: a polygon reaching past the map's picture was
 /// drawn over the title and the legend.
-fn draw_zone_borders(pm: &mut Pixmap, world: &World, view: View, (cw, ch): (u32, u32)) {
+fn draw_zone_borders(pm: &mut Pixmap, world: &World, view: View, (mw, ch): (u32, u32)) {
     let Some(z) = world.zones() else { return };
     let width = (view.scale * 0.8).clamp(1.5, 4.0);
-    let clip = Rect::from_xywh(0.0, view.top, cw as f32, ch as f32).and_then(|r| {
+    let clip = Rect::from_xywh(view.left, view.top, mw as f32, ch as f32).and_then(|r| {
         let mut mask = tiny_skia::Mask::new(pm.width(), pm.height())?;
         mask.fill_path(
             &PathBuilder::from_rect(r),
@@ -1996,7 +2015,13 @@ mod tests {
         let mut trace = Trace::default();
         trace.push_pose(0, Pose::new(0.045, 0.045, 0.0));
         trace.push_pose(1, Pose::new(0.045, 0.06, 0.0));
-        let png = coverage_png(&world, &trace, &style()).unwrap();
+        // A canvas this narrow takes a style asking for it (the default keeps 480 px).
+        let narrow = CoverageStyle {
+            min_width: 40,
+            ..style()
+        };
+        let png = coverage_png(&world, &trace, &narrow).unwrap();
+        assert!(Pixmap::decode_png(&png).unwrap().width() < 100);
         let pm = Pixmap::decode_png(&png).unwrap();
         let rows_of = |c: [u8; 3]| -> Vec<u32> {
             (0..pm.height())
@@ -2015,6 +2040,51 @@ mod tests {
         let ok = rows_of([20, 130, 60]);
         assert!(!cov.is_empty() && !ok.is_empty());
         assert!(cov.iter().all(|y| !ok.contains(y)), "badges share rows");
+    }
+
+    /// A map much taller than wide (a corridor 9 px by 4000 was drawn 7 px wide, its title and
+    /// legend squeezed into that) stands in the middle of a canvas 480 px wide, white either
+    /// side, with the path drawn where its floor is.
+    #[test]
+    fn a_narrow_map_stands_in_the_middle_of_a_readable_canvas() {
+        let mut art = String::from("#####\n");
+        for _ in 0..400 {
+            art.push_str("#...#\n");
+        }
+        art.push_str("#####");
+        let map = GridMap::from_ascii_scaled(&art, 1, 0.05).unwrap();
+        let world = World::new(map, Robot::new(0.05), Some(Pose::new(0.125, 0.125, 0.0))).unwrap();
+        let mut trace = Trace::default();
+        trace.push_pose(0, Pose::new(0.125, 0.125, 0.0));
+        trace.push_pose(1, Pose::new(0.125, 19.9, 0.0));
+        let png = coverage_png(&world, &trace, &style()).unwrap();
+        let pm = Pixmap::decode_png(&png).unwrap();
+        assert_eq!(pm.width(), 480);
+        // A map row halfway down: white, then the map (its walls and swept floor), then white,
+        // symmetric about the middle.
+        let y = pm.height() / 2;
+        let rgb = |x: u32| {
+            let p = pm.pixel(x, y).unwrap();
+            [p.red(), p.green(), p.blue()]
+        };
+        let drawn: Vec<u32> = (0..pm.width())
+            .filter(|&x| rgb(x) != [255, 255, 255])
+            .collect();
+        let (first, last) = (drawn[0], drawn[drawn.len() - 1]);
+        assert!(first > 200 && last < 280, "map at columns {first}..={last}");
+        // (an odd margin puts its extra column on the right)
+        assert!(
+            (first + last).abs_diff(pm.width() - 1) <= 1,
+            "not centred: {first}..={last}"
+        );
+        assert!(
+            (first..=last).any(|x| rgb(x) == colours::SWEPT),
+            "no swept floor in the map"
+        );
+        assert!(
+            (first..=last).all(|x| rgb(x) != [255, 255, 255]),
+            "a white gap in the map"
+        );
     }
 
     /// A keep-out polygon's outline is drawn, so the legend names it (the replay's did, the
