@@ -465,7 +465,18 @@ impl Staging {
         }
         if let Err(e) = std::fs::rename(&self.dir, &self.target) {
             if had_old {
-                let _ = std::fs::rename(&old, &self.target);
+                if let Err(back) = std::fs::rename(&old, &self.target) {
+                    unregister(&old);
+                    // The previous output stays under its hidden name (the next `ccpp run`
+                    // into this folder puts it back): say where.
+                    return Err(e).with_context(|| {
+                        format!(
+                            "cannot move the new output into {}, nor put the previous one back ({back}): it is at {}",
+                            self.shown.display(),
+                            old.display()
+                        )
+                    });
+                }
                 unregister(&old);
             }
             return Err(e).with_context(|| {

@@ -344,6 +344,7 @@ pub fn write_folder(target: &Path, files: &[(&str, Vec<u8>)]) -> Result<(), Fold
     let target_in = parent.join(&name);
     if !existed {
         // `create_dir_all("a/..")` created `a`, the target itself (empty): not a run folder.
+        // Best effort: an empty folder left behind is harmless (the swap below replaces it).
         let _ = std::fs::remove_dir(&target_in);
     }
     let tag = |kind: &str| {
@@ -358,6 +359,8 @@ pub fn write_folder(target: &Path, files: &[(&str, Vec<u8>)]) -> Result<(), Fold
         f.sync_all()
     });
     if let Err(e) = written {
+        // Best effort: the write's error is the one to report; a staging folder left behind
+        // carries the staging name, never the target's.
         let _ = std::fs::remove_dir_all(&staging);
         return Err(io_err(e));
     }
@@ -365,18 +368,32 @@ pub fn write_folder(target: &Path, files: &[(&str, Vec<u8>)]) -> Result<(), Fold
     let had_old = std::fs::symlink_metadata(&target_in).is_ok();
     if had_old {
         if let Err(e) = std::fs::rename(&target_in, &old) {
+            // Best effort, as above: the target is untouched.
             let _ = std::fs::remove_dir_all(&staging);
             return Err(io_err(e));
         }
     }
     if let Err(e) = std::fs::rename(&staging, &target_in) {
-        if had_old {
-            let _ = std::fs::rename(&old, &target_in);
-        }
+        // Best effort: the new files are not in place, whatever happens to their staging copy.
         let _ = std::fs::remove_dir_all(&staging);
+        if had_old {
+            if let Err(back) = std::fs::rename(&old, &target_in) {
+                // The previous folder stays under its hidden name: say where, or the user's
+                // earlier run looks lost.
+                return Err(io_err(std::io::Error::new(
+                    e.kind(),
+                    format!(
+                        "{e}; the previous folder could not be put back ({back}) and is at {}",
+                        old.display()
+                    ),
+                )));
+            }
+        }
         return Err(io_err(e));
     }
     if had_old {
+        // Best effort: the new folder is in place; an old copy left behind carries the
+        // staging name (`ccpp run` clears such leftovers of dead processes).
         let _ = std::fs::remove_dir_all(&old);
     }
     Ok(())
