@@ -115,21 +115,7 @@ pub(super) fn rim_contours(
                     .then(b.cmp(&a))
             })
             .unwrap_or(0);
-        let mut used = vec![false; pts.len()];
-        let mut chain = vec![pts[far]];
-        used[far] = true;
-        for _ in 1..pts.len() {
-            let last = chain[chain.len() - 1];
-            let mut best: Option<(f64, usize)> = None;
-            for (j, p) in pts.iter().enumerate() {
-                if !used[j] && best.is_none_or(|b| p.dist2(last) < b.0) {
-                    best = Some((p.dist2(last), j));
-                }
-            }
-            let Some((_, j)) = best else { break };
-            used[j] = true;
-            chain.push(pts[j]);
-        }
+        let chain = nearest_neighbour_chain(&pts, far);
         let Some(tail) = ctx.follow(search, &chain) else {
             continue;
         };
@@ -169,6 +155,108 @@ pub(super) fn rim_contours(
         });
     }
     out
+}
+
+/// Calls `f(x, y)` for the cells of a `w` x `h` grid on the square ring `ring` cells around
+/// cell `(cx, cy)` (Chebyshev distance `ring`), row by row from the top, each row left to right.
+/// Rows and ends outside the grid are skipped without a look, so the rings around a cell of a
+/// grid a few cells wide cost a few cells each, not the ring's whole perimeter (a ring search
+/// over a corridor 10 000 px long went over millions of cells outside it).
+fn for_ring_cells(
+    (cx, cy): (usize, usize),
+    ring: usize,
+    (w, h): (usize, usize),
+    mut f: impl FnMut(usize, usize),
+) {
+    let (cx, cy, r) = (cx as i64, cy as i64, ring as i64);
+    let (w, h) = (w as i64, h as i64);
+    let (x0, x1) = ((cx - r).max(0), (cx + r).min(w - 1));
+    let mut row = |y: i64, whole: bool| {
+        if y < 0 || y >= h {
+            return;
+        }
+        if whole {
+            for x in x0..=x1 {
+                f(x as usize, y as usize);
+            }
+        } else {
+            for x in [cx - r, cx + r] {
+                if x >= 0 && x < w {
+                    f(x as usize, y as usize);
+                }
+            }
+        }
+    };
+    if r == 0 {
+        row(cy, true);
+        return;
+    }
+    row(cy - r, true);
+    // The ring's sides: only when one of them lies in the grid.
+    if cx - r >= 0 || cx + r < w {
+        for y in (cy - r + 1).max(0)..=(cy + r - 1).min(h - 1) {
+            row(y, false);
+        }
+    }
+    row(cy + r, true);
+}
+
+/// Side of [`nearest_neighbour_chain`]'s grid cells, pixels.
+const CHAIN_CELL: f64 = 8.0;
+
+/// The points `pts` chained from `pts[first]`, each next one the nearest of those not chained
+/// yet (ties: the lowest index). Unchained points are found on a grid of [`CHAIN_CELL`] px
+/// cells, ring by ring around the last point, until no farther ring can hold a nearer one: a
+/// scan of every point per step took seconds on the rim of a corridor 10 000 px long.
+fn nearest_neighbour_chain(pts: &[Point], first: usize) -> Vec<Point> {
+    let (mut x0, mut y0, mut x1, mut y1) = (f64::MAX, f64::MAX, f64::MIN, f64::MIN);
+    for p in pts {
+        (x0, y0, x1, y1) = (x0.min(p.x), y0.min(p.y), x1.max(p.x), y1.max(p.y));
+    }
+    let cell_of = |v: f64, v0: f64| ((v - v0) / CHAIN_CELL).floor().max(0.0) as usize;
+    let (gw, gh) = (cell_of(x1, x0) + 1, cell_of(y1, y0) + 1);
+    let mut cells: Vec<Vec<u32>> = vec![Vec::new(); gw * gh];
+    let at = |p: Point| (cell_of(p.x, x0), cell_of(p.y, y0));
+    for (j, &p) in pts.iter().enumerate() {
+        let (cx, cy) = at(p);
+        cells[cy * gw + cx].push(j as u32);
+    }
+    let take = |cells: &mut Vec<Vec<u32>>, j: usize| {
+        let (cx, cy) = at(pts[j]);
+        let c = &mut cells[cy * gw + cx];
+        if let Some(k) = c.iter().position(|&x| x as usize == j) {
+            c.swap_remove(k);
+        }
+    };
+    let mut chain = Vec::with_capacity(pts.len());
+    chain.push(pts[first]);
+    take(&mut cells, first);
+    for _ in 1..pts.len() {
+        let last = chain[chain.len() - 1];
+        let (lx, ly) = at(last);
+        let mut best: Option<(f64, usize)> = None;
+        for ring in 0..gw.max(gh) {
+            for_ring_cells((lx, ly), ring, (gw, gh), |x, y| {
+                for &j in &cells[y * gw + x] {
+                    let (j, d) = (j as usize, pts[j as usize].dist2(last));
+                    if best.is_none_or(|b| d < b.0 || (d == b.0 && j < b.1)) {
+                        best = Some((d, j));
+                    }
+                }
+            });
+            // Beyond this ring every point lies more than `ring` cells away on an axis.
+            if let Some((d, _)) = best {
+                let reach = ring as f64 * CHAIN_CELL;
+                if reach * reach > d {
+                    break;
+                }
+            }
+        }
+        let Some((_, j)) = best else { break };
+        take(&mut cells, j);
+        chain.push(pts[j]);
+    }
+    chain
 }
 
 /// Final mop-up of step 3: sweeps what the assembled plan still misses with contour detours
@@ -218,30 +306,21 @@ pub(super) fn rim_pass(
         let mut best: Option<(f64, usize, f64, bool)> = None;
         let (bx, by) = bucket(cs);
         for ring in 0..bw.max(bh) {
-            let ring_i = ring as i64;
-            for y in by as i64 - ring_i..=by as i64 + ring_i {
-                for x in bx as i64 - ring_i..=bx as i64 + ring_i {
-                    if (y - by as i64).abs() != ring_i && (x - bx as i64).abs() != ring_i {
-                        continue;
-                    }
-                    if x < 0 || y < 0 || x >= bw as i64 || y >= bh as i64 {
-                        continue;
-                    }
-                    for &s in &buckets[y as usize * bw + x as usize] {
-                        let s = s as usize;
-                        let (a, b) = (path[s].0, path[s + 1].0);
-                        for rev in [false, true] {
-                            let (i0, i1) = if rev { (ce, cs) } else { (cs, ce) };
-                            let t = proj(a, b, i0);
-                            let q = a.add(b.sub(a).scale(t));
-                            let c = q.dist(i0) + clen + i1.dist(q);
-                            if best.is_none_or(|bb| c < bb.0) {
-                                best = Some((c, s, t, rev));
-                            }
+            for_ring_cells((bx, by), ring, (bw, bh), |x, y| {
+                for &s in &buckets[y * bw + x] {
+                    let s = s as usize;
+                    let (a, b) = (path[s].0, path[s + 1].0);
+                    for rev in [false, true] {
+                        let (i0, i1) = if rev { (ce, cs) } else { (cs, ce) };
+                        let t = proj(a, b, i0);
+                        let q = a.add(b.sub(a).scale(t));
+                        let c = q.dist(i0) + clen + i1.dist(q);
+                        if best.is_none_or(|bb| c < bb.0) {
+                            best = Some((c, s, t, rev));
                         }
                     }
                 }
-            }
+            });
             // Stop once the ring is farther than the best detour's approach.
             if let Some(bb) = best {
                 if (ring as f64 - 1.0) * B > bb.0 - clen {
@@ -310,6 +389,74 @@ fn proj(a: Point, b: Point, p: Point) -> f64 {
 mod tests {
     use super::*;
     use crate::trace::Event;
+    use proptest::prelude::*;
+
+    /// The chain by a scan of every point per step (the rim step's before the grid).
+    fn chain_by_scan(pts: &[Point], first: usize) -> Vec<Point> {
+        let mut used = vec![false; pts.len()];
+        let mut chain = vec![pts[first]];
+        used[first] = true;
+        for _ in 1..pts.len() {
+            let last = chain[chain.len() - 1];
+            let mut best: Option<(f64, usize)> = None;
+            for (j, p) in pts.iter().enumerate() {
+                if !used[j] && best.is_none_or(|b| p.dist2(last) < b.0) {
+                    best = Some((p.dist2(last), j));
+                }
+            }
+            let Some((_, j)) = best else { break };
+            used[j] = true;
+            chain.push(pts[j]);
+        }
+        chain
+    }
+
+    proptest! {
+        /// The grid's chain is the scan's, ties included: pixel centres (many equal
+        /// distances) in clusters and strips, wide apart and close together.
+        #[test]
+        fn the_grid_chain_is_the_scans(
+            cells in prop::collection::btree_set((0u32..90, 0u32..30), 1..160),
+            stretch in 1u32..40,
+            first in any::<prop::sample::Index>(),
+        ) {
+            let pts: Vec<Point> = cells
+                .iter()
+                .map(|&(x, y)| Point::new(f64::from(x * stretch) + 0.5, f64::from(y) + 0.5))
+                .collect();
+            let first = first.index(pts.len());
+            prop_assert_eq!(nearest_neighbour_chain(&pts, first), chain_by_scan(&pts, first));
+        }
+    }
+
+    /// The ring of a grid cell, as the scan of the whole square that skipped its inside visited
+    /// it: the same cells in the same order, in grids wide, tall and of one cell.
+    #[test]
+    fn ring_cells_are_the_squares_border_in_order() {
+        for (w, h) in [(1, 1), (3, 40), (40, 3), (7, 9)] {
+            for cy in 0..h {
+                for cx in 0..w {
+                    for ring in 0..w.max(h) + 2 {
+                        let mut got = Vec::new();
+                        for_ring_cells((cx, cy), ring, (w, h), |x, y| got.push((x, y)));
+                        let (c, r) = (cx as i64, cy as i64);
+                        let k = ring as i64;
+                        let mut want = Vec::new();
+                        for y in r - k..=r + k {
+                            for x in c - k..=c + k {
+                                let on_ring = (y - r).abs() == k || (x - c).abs() == k;
+                                let inside = x >= 0 && y >= 0 && x < w as i64 && y < h as i64;
+                                if on_ring && inside {
+                                    want.push((x as usize, y as usize));
+                                }
+                            }
+                        }
+                        assert_eq!(got, want, "{w} x {h}, cell ({cx}, {cy}), ring {ring}");
+                    }
+                }
+            }
+        }
+    }
 
     /// The one-pass insertion puts every detour where a splice per detour put them (later
     /// segments first, along a segment from its far end): several detours at one index and at

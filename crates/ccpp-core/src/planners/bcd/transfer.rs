@@ -129,11 +129,20 @@ impl Ctx<'_> {
         let mut out = Vec::new();
         let mut i = 0;
         let tol2 = CONTOUR_TOL_PX * CONTOUR_TOL_PX;
+        let mut hull = Hull::default();
         while i + 1 < pts.len() {
-            // Farthest j whose chord keeps every point in between within the tolerance.
+            // Farthest j whose chord keeps every point in between within the tolerance. The
+            // points in between are judged by their convex hull where that decides (a
+            // straight chain of n points cost n^2 / 2 distances: a 10 000 px corridor's rim
+            // took seconds), else one by one.
             let mut jmax = i + 1;
+            hull.clear();
             for j in i + 2..pts.len() {
-                if (i + 1..j).all(|m| point_segment_dist2(pts[m], pts[i], pts[j]) <= tol2) {
+                hull.add(pts[j - 1]);
+                let within = hull.chord_within(pts[i], pts[j], tol2).unwrap_or_else(|| {
+                    (i + 1..j).all(|m| point_segment_dist2(pts[m], pts[i], pts[j]) <= tol2)
+                });
+                if within {
                     jmax = j;
                 } else {
                     break;
@@ -151,6 +160,96 @@ impl Ctx<'_> {
             i = j;
         }
         Some(out)
+    }
+}
+
+/// The convex hull of a growing set of points (counter-clockwise, collinear points left
+/// out), for [`Ctx::follow`]'s chord test: a linear function of the points (the distance
+/// across a chord, the position along it) is largest and smallest at hull vertices. The
+/// points of a chain within a pixel of a chord have few hull vertices.
+#[derive(Default)]
+struct Hull {
+    pts: Vec<Point>,
+    scratch: Vec<Point>,
+}
+
+/// Margin (squared pixels, and chord fractions) within which [`Hull::chord_within`] leaves the
+/// decision to the exact test: far above the rounding of its products, far below any distance
+/// that matters.
+const HULL_MARGIN: f64 = 1e-7;
+
+/// `(a - o) x (b - o)`.
+fn cross(o: Point, a: Point, b: Point) -> f64 {
+    (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x)
+}
+
+/// Pushes `q` onto a monotone chain's half hull, first popping the points that would not
+/// turn left while the chain holds at least `min_len` of them.
+fn push_turning(hull: &mut Vec<Point>, q: Point, min_len: usize) {
+    while hull.len() >= min_len && cross(hull[hull.len() - 2], hull[hull.len() - 1], q) <= 0.0 {
+        hull.pop();
+    }
+    hull.push(q);
+}
+
+impl Hull {
+    fn clear(&mut self) {
+        self.pts.clear();
+    }
+
+    /// Adds `p` (nothing changes when it lies inside).
+    fn add(&mut self, p: Point) {
+        let n = self.pts.len();
+        if n >= 3 && (0..n).all(|k| cross(self.pts[k], self.pts[(k + 1) % n], p) >= 0.0) {
+            return;
+        }
+        // Andrew's monotone chain over the old vertices and `p`.
+        let mut v = std::mem::take(&mut self.scratch);
+        v.clear();
+        v.extend_from_slice(&self.pts);
+        v.push(p);
+        v.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+        v.dedup();
+        self.pts.clear();
+        if v.len() < 3 {
+            self.pts.extend_from_slice(&v);
+        } else {
+            // Lower hull left to right, then upper right to left; the last point of each
+            // half is the first of the other.
+            for &q in &v {
+                push_turning(&mut self.pts, q, 2);
+            }
+            let upper = self.pts.len() + 1;
+            for &q in v.iter().rev().skip(1) {
+                push_turning(&mut self.pts, q, upper);
+            }
+            self.pts.pop();
+        }
+        self.scratch = v;
+    }
+
+    /// Whether every point added lies within `sqrt(tol2)` of the segment `a b`, when the hull
+    /// decides it clearly: `Some(true)` when every vertex lies within it across the chord and
+    /// strictly between its ends along it (so the distance to the segment is the distance
+    /// to its line), `Some(false)` when a vertex lies farther than that across it (no nearer
+    /// to the segment than to its line); `None` otherwise, and near either bound.
+    fn chord_within(&self, a: Point, b: Point, tol2: f64) -> Option<bool> {
+        let d = b - a;
+        let l2 = d.dot(d);
+        if l2 == 0.0 || self.pts.is_empty() {
+            return None;
+        }
+        let mut inside = true;
+        for &v in &self.pts {
+            let c = cross(a, b, v);
+            let across2 = c * c / l2;
+            if across2 > tol2 + HULL_MARGIN {
+                return Some(false);
+            }
+            let t = (v - a).dot(d) / l2;
+            inside &= across2 < tol2 - HULL_MARGIN && t > HULL_MARGIN && t < 1.0 - HULL_MARGIN;
+        }
+        inside.then_some(true)
     }
 }
 
@@ -302,7 +401,59 @@ mod tests {
     use std::cmp::Reverse;
     use std::collections::BinaryHeap;
 
-    use super::Search;
+    use proptest::prelude::*;
+
+    use super::{Hull, Search, CONTOUR_TOL_PX};
+    use crate::geometry::{point_segment_dist2, Point};
+
+    proptest! {
+        /// Where the hull decides the chord test it decides as the test of every point does:
+        /// chains of pixel centres along a line (distances of exactly the tolerance are
+        /// common there), wiggling, doubling back, and at sub-pixel offsets.
+        #[test]
+        fn the_hull_decides_the_chord_test_as_every_point_does(
+            steps in prop::collection::vec((-1i32..=2, -1i32..=1), 2..60),
+            off in (0u32..4, 0u32..4),
+            slope in 0u32..4,
+        ) {
+            let tol2 = CONTOUR_TOL_PX * CONTOUR_TOL_PX;
+            let (mut x, mut y) = (
+                0.5 + f64::from(off.0) * 0.25,
+                0.5 + f64::from(off.1) * 0.25,
+            );
+            let mut pts = vec![Point::new(x, y)];
+            for (k, &(dx, dy)) in steps.iter().enumerate() {
+                x += f64::from(dx);
+                y += f64::from(dy) + if slope > 0 && (k as u32).is_multiple_of(slope + 1) { 1.0 } else { 0.0 };
+                pts.push(Point::new(x, y));
+            }
+            let mut hull = Hull::default();
+            for j in 2..pts.len() {
+                hull.add(pts[j - 1]);
+                let every = (1..j).all(|m| point_segment_dist2(pts[m], pts[0], pts[j]) <= tol2);
+                if let Some(decided) = hull.chord_within(pts[0], pts[j], tol2) {
+                    prop_assert_eq!(decided, every, "chord 0..{} of {:?}", j, &pts[..=j]);
+                }
+            }
+        }
+    }
+
+    /// On a straight chain the hull decides every chord (so the test is not the scan of every
+    /// point, which made a long straight rim cost its length squared).
+    #[test]
+    fn the_hull_decides_a_straight_chain() {
+        let pts: Vec<Point> = (0..500)
+            .map(|k| Point::new(f64::from(k) + 0.5, f64::from(k / 7) + 0.5))
+            .collect();
+        let mut hull = Hull::default();
+        let mut decided = 0;
+        for j in 2..pts.len() {
+            hull.add(pts[j - 1]);
+            decided += usize::from(hull.chord_within(pts[0], pts[j], 1.0).is_some());
+        }
+        assert!(hull.pts.len() < 40, "{} hull vertices", hull.pts.len());
+        assert!(decided > 490, "{decided} of 498 chords decided by the hull");
+    }
 
     /// The A* of [`Search::path`] with a binary heap of `(f, g, index)` triples: the order the
     /// planner's transfers were planned in before the monotone queue.
