@@ -159,9 +159,9 @@ fn folder_identity(dir: &Path) -> Option<(u64, u64)> {
 }
 
 /// The figures of `metrics.json` that [`check_metrics_of_run`] computes again from the trace
-/// (all but the planner's wall time, which no trace records, and the stop reason and
-/// rectangle guarantee, which the run states rather than measures).
-const RECOMPUTED: [&str; 17] = [
+/// (all but the planner's wall time, which no trace records; the stop reason is the one the
+/// trace's `finished` record gives).
+const RECOMPUTED: [&str; 19] = [
     "robot_radius_m",
     "tool_radius_m",
     "coverage_rate",
@@ -179,6 +179,8 @@ const RECOMPUTED: [&str; 17] = [
     "keepout_violations",
     "tracking_error_mean_m",
     "tracking_error_max_m",
+    "rect_guarantee",
+    "stop_reason",
 ];
 
 /// Refuses a run folder whose `metrics.json` is not what the run of `run.json` (its robot,
@@ -195,10 +197,28 @@ fn check_metrics_of_run(
     trace: Trace,
     metrics: &str,
 ) -> Result<Trace> {
+    use ccpp_core::sim::StopReason;
+    // The reason the trace's `finished` record gives (`check_same_run` made sure there is one).
+    let stop = trace
+        .events()
+        .last()
+        .and_then(|(_, e)| match e {
+            ccpp_core::trace::Event::Finished { reason } => {
+                [StopReason::Done, StopReason::MaxSteps, StopReason::Stalled]
+                    .into_iter()
+                    .find(|s| s.as_str() == reason)
+            }
+            _ => None,
+        })
+        .with_context(|| {
+            format!(
+                "{}: trace.jsonl's `finished` record gives no stop reason the simulator writes",
+                dir.display()
+            )
+        })?;
     let out = ccpp_core::sim::RunOutput {
         trace,
-        // Not among the figures compared.
-        stop: ccpp_core::sim::StopReason::Done,
+        stop,
         tile_side: scenario.tile_side(),
         planner: scenario.planner.name(),
         wall_time_s: 0.0,
@@ -213,6 +233,12 @@ fn check_metrics_of_run(
             want.and_then(serde_json::Value::as_f64),
             got.and_then(serde_json::Value::as_f64),
         ) {
+            // A word (the stop reason): the same word.
+            _ if want.is_some_and(serde_json::Value::is_string)
+                || got.is_some_and(serde_json::Value::is_string) =>
+            {
+                want == got
+            }
             // Computed the same way from the same poses; the tolerance only allows for the
             // decimal round trip of the JSON numbers.
             (Some(a), Some(b)) => (a - b).abs() <= 1e-9 * (1.0 + a.abs()),

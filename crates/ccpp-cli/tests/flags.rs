@@ -1026,6 +1026,18 @@ fn replay_refuses_a_folder_that_mixes_two_runs() {
         fails(&["replay"], &[&k], &[figure, "mixes files of two runs"], 10);
         assert!(!k.join("replay.html").exists());
     }
+    // A stop reason the trace's `finished` record does not give (a hostile check: the page
+    // carried "stalled" for a run that was done).
+    let m = run_ok(dir, "m", &map, "ba-star", &[]);
+    let text = std::fs::read_to_string(m.join("metrics.json")).unwrap();
+    let edited = text.replacen('{', "{\n  \"stop_reason\": \"stalled\",", 1);
+    std::fs::write(m.join("metrics.json"), edited).unwrap();
+    fails(
+        &["replay"],
+        &[&m],
+        &["metrics.json reports stop_reason \"stalled\"", "(none)"],
+        10,
+    );
     // A folder as its run wrote it replays.
     ccpp().arg("replay").arg(&b).assert().success();
     assert!(b.join("replay.html").exists());
