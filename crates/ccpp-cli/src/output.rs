@@ -102,8 +102,8 @@ pub fn replay_dir(dir: &Path) -> Result<()> {
             dir.display()
         )
     })?;
-    check_same_run(dir, &scenario, &map.name, &world, &trace, &metrics)?;
-    let trace = check_metrics_of_run(dir, &scenario, &map.name, &world, trace, &metrics)?;
+    let reported = check_same_run(dir, &scenario, &map.name, &world, &trace, &metrics)?;
+    let trace = check_metrics_of_run(dir, &scenario, &map.name, &world, trace, &reported)?;
     if let Some(ms) = std::env::var(crate::staging::REPLAY_PAUSE_ENV)
         .ok()
         .and_then(|v| v.parse::<u64>().ok())
@@ -188,25 +188,23 @@ const RECOMPUTED: [&str; 19] = [
 /// computed again from the trace and compared figure by figure ([`RECOMPUTED`]). A `run.json`
 /// copied in from another run on the same path (another tool radius, another tile side) passed
 /// [`check_same_run`], and the page drew that run's swept floor beside this run's metrics (a
-/// coverage curve ending at 0.771 beside an effective coverage of 0.907). Returns the trace.
+/// coverage curve ending at 0.771 beside an effective coverage of 0.907). `reported`: the
+/// parsed `metrics.json` ([`check_same_run`]'s). Returns the trace.
 fn check_metrics_of_run(
     dir: &Path,
     scenario: &Scenario,
     map_name: &str,
     world: &World,
     trace: Trace,
-    metrics: &str,
+    reported: &serde_json::Map<String, serde_json::Value>,
 ) -> Result<Trace> {
-    use ccpp_core::sim::StopReason;
     // The reason the trace's `finished` record gives (`check_same_run` made sure there is one).
     let stop = trace
         .events()
         .last()
         .and_then(|(_, e)| match e {
             ccpp_core::trace::Event::Finished { reason } => {
-                [StopReason::Done, StopReason::MaxSteps, StopReason::Stalled]
-                    .into_iter()
-                    .find(|s| s.as_str() == reason)
+                ccpp_core::sim::StopReason::from_name(reason)
             }
             _ => None,
         })
@@ -225,8 +223,6 @@ fn check_metrics_of_run(
     };
     let again = serde_json::to_value(ccpp_core::metrics::compute(world, &out, map_name))
         .context("metrics computed again from trace.jsonl")?;
-    let reported: serde_json::Value = serde_json::from_str(metrics)
-        .with_context(|| format!("{}: metrics.json", dir.display()))?;
     for key in RECOMPUTED {
         let (want, got) = (again.get(key), reported.get(key));
         let same = match (
@@ -266,7 +262,7 @@ fn check_metrics_of_run(
 /// trace must hold a pose, end with the simulator's `finished` record and begin at the start
 /// pose of the run that `run.json` describes; `metrics.json` must be a run's metrics, name
 /// its planner and map, and report the path length the trace drives (the metrics are computed
-/// from the same poses, so only another run's trace differs).
+/// from the same poses, so only another run's trace differs). Returns `metrics.json` parsed.
 fn check_same_run(
     dir: &Path,
     scenario: &Scenario,
@@ -274,7 +270,7 @@ fn check_same_run(
     world: &World,
     trace: &Trace,
     metrics: &str,
-) -> Result<()> {
+) -> Result<serde_json::Map<String, serde_json::Value>> {
     // Where the robot was placed: the start, or the pose outside the area it drove in from.
     let start = world.initial_pose();
     let Some(first) = trace.poses().next() else {
@@ -341,7 +337,7 @@ fn check_same_run(
             dir.display()
         );
     }
-    Ok(())
+    Ok(m)
 }
 
 /// Writes the run's files (with the replay when `replay`, and the path in each of `exports`)

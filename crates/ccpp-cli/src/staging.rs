@@ -465,8 +465,9 @@ impl Staging {
         }
         if let Err(e) = std::fs::rename(&self.dir, &self.target) {
             if had_old {
-                if let Err(back) = std::fs::rename(&old, &self.target) {
-                    unregister(&old);
+                let back = std::fs::rename(&old, &self.target);
+                unregister(&old);
+                if let Err(back) = back {
                     // The previous output stays under its hidden name (the next `ccpp run`
                     // into this folder puts it back): say where.
                     return Err(e).with_context(|| {
@@ -477,7 +478,6 @@ impl Staging {
                         )
                     });
                 }
-                unregister(&old);
             }
             return Err(e).with_context(|| {
                 format!("cannot move the new output into {}", self.shown.display())

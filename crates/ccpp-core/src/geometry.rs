@@ -167,6 +167,12 @@ pub fn wrap_angle(a: f64) -> f64 {
     w
 }
 
+/// `(a - o) x (b - o)`: positive when `o`, `a`, `b` turn left (counter-clockwise).
+#[inline]
+pub fn cross(o: Point, a: Point, b: Point) -> f64 {
+    (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x)
+}
+
 /// Distance from point `p` to segment `a`-`b`.
 #[inline]
 pub fn point_segment_dist2(p: Point, a: Point, b: Point) -> f64 {

@@ -119,6 +119,13 @@ impl StopReason {
             Self::Stalled => "stalled",
         }
     }
+
+    /// The reason named `name` ([`Self::as_str`]'s inverse), if any.
+    pub fn from_name(name: &str) -> Option<Self> {
+        [Self::Done, Self::MaxSteps, Self::Stalled]
+            .into_iter()
+            .find(|s| s.as_str() == name)
+    }
 }
 
 /// The outcome of a simulated run.

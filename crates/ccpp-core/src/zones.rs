@@ -21,7 +21,7 @@ use crate::display::Compact;
 use fixedbitset::FixedBitSet;
 use serde::{Deserialize, Serialize};
 
-use crate::geometry::Point;
+use crate::geometry::{cross, Point};
 use crate::grid::{Cell, MapFrame};
 
 /// A simple polygon in map coordinates (metres): its vertices in order, either orientation;
@@ -236,10 +236,6 @@ fn bbox_scale(r: &[Point]) -> f64 {
         hi = Point::new(hi.x.max(p.x), hi.y.max(p.y));
     }
     (hi.x - lo.x) * (hi.y - lo.y)
-}
-
-fn cross(o: Point, a: Point, b: Point) -> f64 {
-    (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x)
 }
 
 fn on_segment(p: Point, a: Point, b: Point) -> bool {

@@ -632,8 +632,8 @@ fn join_scoped<T>(h: std::thread::ScopedJoinHandle<'_, T>) -> T {
     }
 }
 
-/// Refuses a memory limit of 0 MB (a scenario's, or the one a map is loaded within).
-/// Checks a memory limit, MB: from 1 to [`MAX_MEMORY_LIMIT_MB`].
+/// Checks a memory limit, MB (a scenario's, or the one a map is loaded within): from 1 to
+/// [`MAX_MEMORY_LIMIT_MB`].
 ///
 /// # Errors
 /// [`ScenarioError::Invalid`] naming the option and the range.

@@ -2021,8 +2021,8 @@ mod tests {
             ..style()
         };
         let png = coverage_png(&world, &trace, &narrow).unwrap();
-        assert!(Pixmap::decode_png(&png).unwrap().width() < 100);
         let pm = Pixmap::decode_png(&png).unwrap();
+        assert!(pm.width() < 100);
         let rows_of = |c: [u8; 3]| -> Vec<u32> {
             (0..pm.height())
                 .filter(|&y| {

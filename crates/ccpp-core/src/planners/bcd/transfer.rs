@@ -2,7 +2,7 @@
 //! ([`Search`]), shortened by line-of-sight checks on the true map.
 
 use super::lattice::Ctx;
-use crate::geometry::{point_segment_dist2, Point};
+use crate::geometry::{cross, point_segment_dist2, Point};
 use crate::search::MonotoneQueue;
 
 /// How far a merged boundary segment may stray from the boundary points it replaces (pixels).
@@ -177,11 +177,6 @@ struct Hull {
 /// decision to the exact test: far above the rounding of its products, far below any distance
 /// that matters.
 const HULL_MARGIN: f64 = 1e-7;
-
-/// `(a - o) x (b - o)`.
-fn cross(o: Point, a: Point, b: Point) -> f64 {
-    (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x)
-}
 
 /// Pushes `q` onto a monotone chain's half hull, first popping the points that would not
 /// turn left while the chain holds at least `min_len` of them.
