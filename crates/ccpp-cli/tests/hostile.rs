@@ -1576,6 +1576,29 @@ fn a_map_image_too_large_for_the_memory_limit_is_refused_from_its_header() {
             "got 18446744073709551615",
         ],
     );
+    // The same bounds hold for every command that takes the limit, checked before any work.
+    let out = dir.join("bounds-out");
+    for (cmd, extra) in [
+        ("run", &["--planner", "ba-star", "--out", s(&out)][..]),
+        ("plan", &["--planner", "bcd", "--out", s(&out)][..]),
+        ("waypoints", &["--length", "0.3", "--width", "0.3"][..]),
+        ("bench", &["--out", s(&out)][..]),
+    ] {
+        let map_flag = if cmd == "bench" { "--maps" } else { "--map" };
+        for limit in ["0", "1099511627777", "18446744073709551615"] {
+            let mut args = vec![cmd, map_flag, s(&pillars), "--max-memory", limit];
+            args.extend_from_slice(extra);
+            refused(
+                &args,
+                &["--max-memory", "must be from 1 to 1099511627776 MB"],
+            );
+        }
+        assert!(
+            !out.exists(),
+            "{cmd} wrote {} before refusing its limit",
+            out.display()
+        );
+    }
     ccpp()
         .args(["info", "--map", s(&pillars), "--max-memory", "2"])
         .assert()
