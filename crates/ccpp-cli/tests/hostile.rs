@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::common::{self, ccpp, pillars, plan_ok, read_json, run_ok};
+use crate::common::{self, ccpp, pgm, pillars, plan_ok, read_json, run_ok};
 
 /// Runs `ccpp ARGS`, expects exit 1 with one `error:` line holding every needle.
 fn refused(args: &[&str], needles: &[&str]) {
@@ -2495,4 +2495,42 @@ fn an_absurd_thread_count_is_refused_before_any_work() {
         .assert()
         .success();
     assert!(out.join("metrics.json").exists());
+}
+
+/// A start beside a pillar was refused as "in an obstacle" once `--inflate` had grown the
+/// pillar, without a word of the inflation (the same start runs without it); a map 3 px wide
+/// was said to be `0.15000000000000002 m` wide.
+#[test]
+fn a_start_in_an_inflated_obstacle_names_the_inflation_and_map_sizes_are_rounded() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    // 0.4 m right of the first pillar's face (x = 2.6 m): free at r = 0.15 m, not after 0.5 m.
+    let start = ["--start", "3.0,3.5"];
+    run_ok(dir, "plain", &map, "ba-star", &start);
+    let mut args = vec![
+        "run",
+        "--planner",
+        "ba-star",
+        "--map",
+        s(&map),
+        "--inflate",
+        "0.5",
+    ];
+    args.extend(start);
+    let out = dir.join("inflated");
+    args.extend(["--out", s(&out)]);
+    refused(
+        &args,
+        &[
+            "pillars.pgm",
+            "start (3.000, 3.500) is in an obstacle",
+            "once --inflate / map.inflate 0.5 m has grown the obstacles",
+        ],
+    );
+    let tiny = pgm(dir, "tiny.pgm", 3, 3, |_, _| false);
+    refused(
+        &["run", "--planner", "ba-star", "--map", s(&tiny)],
+        &["tiny.pgm", "is larger than the map (0.15 x 0.15 m)"],
+    );
 }

@@ -34,7 +34,8 @@ use ccpp_core::exec::{Execution, PidOptions};
 use ccpp_core::grid::{GridError, GridMap, MapFrame};
 use ccpp_core::metrics::{self, Metrics};
 use ccpp_core::planners::settings::{
-    add_sim_pid_records, estimate_run, estimate_zones, validate_execution, ZoneLoad, PROCESS_BYTES,
+    add_sim_pid_records, estimate_run, estimate_zones, fmt_m, validate_execution, ZoneLoad,
+    PROCESS_BYTES,
 };
 use ccpp_core::planners::{OptionsError, PlannerConfig, PlannerKind, ResourceEstimate, Setup};
 use ccpp_core::sim::{simulate_tapped, simulate_until, RunOutput, SimConfig};
@@ -1066,8 +1067,8 @@ impl Scenario {
                 map.source.display(),
                 Compact(self.robot.radius),
                 across(self.robot.radius),
-                Compact(w),
-                Compact(h)
+                fmt_m(w),
+                fmt_m(h)
             )));
         }
         if with_planner {
@@ -1291,6 +1292,15 @@ impl Scenario {
                             max_clearance
                         ),
                     )),
+                    // A start in an obstacle that --inflate grew: the start may be valid on
+                    // the map as drawn, so the message says which obstacles it means.
+                    e @ WorldError::StartInObstacle { .. } if inflate.is_some_and(|m| m > 0.0) => {
+                        ScenarioError::Invalid(format!(
+                            "map {}: {e} once --inflate / map.inflate {} m has grown the obstacles",
+                            source.display(),
+                            Compact(inflate.unwrap_or_default()),
+                        ))
+                    }
                     source_err => ScenarioError::World {
                         path: source.to_path_buf(),
                         source: source_err,
