@@ -3,7 +3,7 @@
 //!
 //! Two formats, chosen by content: a JSON array of `{"id": 1, "x": 2.0, "y": 3.0}` objects
 //! (optional `"theta"`, radians), or CSV lines `id,x,y[,theta]` (commas, semicolons or
-//! whitespace; blank and `#` lines skipped; a non-numeric first line is a header).
+//! whitespace; blank and `#` lines skipped; a first line without any number is a header).
 //!
 //! ```
 //! let l = ccpp_io::landmarks::parse_landmarks("id,x,y\n1,0.5,2\n1,4.5,2,1.57\n").unwrap();
@@ -110,11 +110,14 @@ pub fn parse_landmarks(text: &str) -> Result<Vec<Landmark>, LandmarkFileError> {
             if line.is_empty() || line.starts_with('#') {
                 continue;
             }
-            let header = std::mem::replace(&mut first, false);
+            // A header has no number at all (`id,x,y`), as in a georef file: a first line
+            // `-1,1.5,1.5` (a bad id) was taken for a header and dropped without a word.
+            let header = std::mem::replace(&mut first, false)
+                && fields(line).all(|f| f.parse::<f64>().is_err());
             match parse_csv_line(line) {
                 Some(_) if out.len() == MAX_LANDMARKS => return Err(LandmarkFileError::TooMany),
                 Some(l) => out.push(l),
-                None if header && !line.starts_with(|c: char| c.is_ascii_digit()) => {}
+                None if header => {}
                 None => {
                     return Err(LandmarkFileError::BadLine {
                         line: n + 1,
@@ -170,6 +173,13 @@ mod tests {
             matches!(e, LandmarkFileError::BadLine { line: 2, .. }),
             "{e}"
         );
+        // The same bad line first is an error too, not a header; a header has no number.
+        let e = parse_landmarks("-1,1.5,1.5\n2,-1.5,-1.5\n").unwrap_err();
+        assert!(
+            matches!(e, LandmarkFileError::BadLine { line: 1, .. }),
+            "{e}"
+        );
+        assert_eq!(parse_landmarks("id x y\n2 0 0\n").unwrap().len(), 1);
         assert!(matches!(
             parse_landmarks("[{\"id\":1}]"),
             Err(LandmarkFileError::Json(_))
