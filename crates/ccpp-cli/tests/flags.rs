@@ -250,6 +250,59 @@ fn execution_flags_reach_the_simulator() {
         &["--config", zero_cfg.to_str().unwrap()],
         &["bsa_bfs.exec.pid.noise.seed", "every noise std is 0"],
     );
+    // Noise too small to change a pose's float (1e-17 gave noiseless PID execution's trace for
+    // every seed) is refused as zero is, from the flag and from a file.
+    for (noise, needle) in [
+        ("1e-17", "1e-17"),
+        ("0.05,5e-324", "5e-324"),
+        ("0.05,0.05,1e-10", "1e-10"),
+    ] {
+        run_fails(
+            dir,
+            &map,
+            "bsa",
+            &["--odometry-noise", noise, "--seed", "1"],
+            &[
+                &format!("--odometry-noise {noise}: {needle} is too small to change the motion"),
+                "at least 1e-9",
+            ],
+        );
+    }
+    let tiny_cfg = dir.join("tiny-noise.yaml");
+    std::fs::write(
+        &tiny_cfg,
+        "bsa_bfs: { exec: { pid: { noise: { seed: 5, linear_rel_std: 0.05, angular_rel_std: 1e-12 } } } }\n",
+    )
+    .unwrap();
+    run_fails(
+        dir,
+        &map,
+        "bsa-bfs",
+        &["--config", tiny_cfg.to_str().unwrap()],
+        &[
+            "bsa_bfs.exec.pid.noise.angular_rel_std",
+            "1e-12 is too small",
+        ],
+    );
+    // 1e-9 is the smallest accepted, and draws: another seed, another run.
+    let a = run_ok(
+        dir,
+        "n9a",
+        &map,
+        "bsa",
+        &["--odometry-noise", "1e-9", "--seed", "1"],
+    );
+    let b = run_ok(
+        dir,
+        "n9b",
+        &map,
+        "bsa",
+        &["--odometry-noise", "1e-9", "--seed", "2"],
+    );
+    assert_ne!(
+        std::fs::read(a.join("trace.jsonl")).unwrap(),
+        std::fs::read(b.join("trace.jsonl")).unwrap()
+    );
     // PID options that switch each other off: an integral limit with ki = 0 (the default),
     // and ki with an integral limit of 0; each alone was read and changed nothing.
     for (body, needles) in [

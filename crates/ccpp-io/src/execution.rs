@@ -22,6 +22,7 @@
 
 use ccpp_core::display::join;
 use ccpp_core::exec::{Execution, OdometryNoise, PidOptions};
+use ccpp_core::planners::settings::noise_too_small;
 use ccpp_core::planners::PlannerKind;
 
 /// What the caller asks of the execution.
@@ -130,6 +131,9 @@ pub fn execution(
             return Err(format!(
                 "{noise} {shown} draws no noise: give a noise > 0, or use {exec} pid for PID execution without noise"
             ));
+        }
+        if let Some(why) = v.iter().find_map(|x| noise_too_small(*x)) {
+            return Err(format!("{noise} {shown}: {why}"));
         }
         if pid.noise.is_some() || ask.noise_given_in.is_some() {
             let place = ask.noise_given_in.as_deref().unwrap_or("its options");

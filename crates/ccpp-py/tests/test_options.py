@@ -260,6 +260,7 @@ def test_odometry_noise_and_landmarks_are_the_cli_runs(shared_maps: Path, ccpp_b
     # Refused as the command line refuses them.
     for kw, needle in [
         ({"odometry_noise": 0}, "odometry_noise 0 draws no noise"),
+        ({"odometry_noise": 1e-17}, "1e-17 is too small to change the motion"),
         ({"odometry_noise": (0.1, 0.1, 0.1, 0.1)}, "one to three finite numbers"),
         ({"odometry_noise": "0.1"}, "odometry_noise expects a number"),
         ({"odometry_noise": 0.1, "exec": "ideal"}, "needs PID execution, not exec ideal"),
