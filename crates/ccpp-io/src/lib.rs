@@ -34,6 +34,7 @@ pub mod georef;
 pub mod landmarks;
 pub mod lock;
 pub mod map;
+pub mod names;
 pub mod phase;
 pub mod plan;
 pub mod scenario;

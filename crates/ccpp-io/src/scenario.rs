@@ -1601,14 +1601,8 @@ impl ScenarioBuilder {
     pub fn zones(mut self, area: Option<ZoneSpec>, keepout: Vec<ZoneSpec>) -> Self {
         // Zone files are recorded absolute, as the map is, so that `run.json` replays from any
         // folder (a relative `area.geojson` was looked up beside the replay's working folder).
-        // Symbolic links are kept, not resolved: a mask YAML's image is looked up beside the
-        // path given, as `map_server` does.
-        let abs = |z: ZoneSpec| match z {
-            ZoneSpec::File(p) => ZoneSpec::File(std::path::absolute(&p).unwrap_or(p)),
-            other => other,
-        };
-        self.0.area = area.map(abs);
-        self.0.keepout = keepout.into_iter().map(abs).collect();
+        self.0.area = area.map(ZoneSpec::absolute);
+        self.0.keepout = keepout.into_iter().map(ZoneSpec::absolute).collect();
         self
     }
 

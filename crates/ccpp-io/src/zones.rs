@@ -102,6 +102,18 @@ impl std::str::FromStr for ZoneSpec {
 }
 
 impl ZoneSpec {
+    /// The same zone with a file named by its absolute path (made from the working folder),
+    /// as `run.json` records zone files so that a run replays from any folder. Symbolic links
+    /// are kept, not resolved: a mask YAML's image is looked up beside the path given, as
+    /// `map_server` does.
+    #[must_use]
+    pub fn absolute(self) -> Self {
+        match self {
+            ZoneSpec::File(p) => ZoneSpec::File(std::path::absolute(&p).unwrap_or(p)),
+            other => other,
+        }
+    }
+
     /// The file this spec names, if any.
     pub fn path(&self) -> Option<&Path> {
         match self {

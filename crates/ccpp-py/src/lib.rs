@@ -372,7 +372,7 @@ fn load_map(
     inflate: Option<Real>,
     georef: Option<PathBuf>,
     name: Option<String>,
-    max_memory_mb: Option<Whole>,
+    max_memory_mb: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Map> {
     let (resolution, origin, inflate) = (real(resolution), reals(origin), real(inflate));
     let (occupied_thresh, free_thresh) = (real(occupied_thresh), real(free_thresh));
@@ -399,7 +399,12 @@ fn load_map(
     if name.is_some() {
         recipe.name = name;
     }
-    let limit = max_memory_mb.map_or(ccpp_io::scenario::DEFAULT_MAX_MEMORY_MB, |m| m.0);
+    // As `Env` and `run` read it (a -1 or 2**64 was a bare `OverflowError` here).
+    let limit = max_memory_mb
+        .filter(|v| !v.is_none())
+        .map(|v| uint_arg("max_memory_mb", v, 1))
+        .transpose()?
+        .unwrap_or(ccpp_io::scenario::DEFAULT_MAX_MEMORY_MB);
     let map = py
         .detach(|| recipe.load_within(limit))
         .map_err(|e| err(&e))?;
@@ -804,8 +809,15 @@ fn scenario_from(
             }
             // Zones: a file name, [x0, y0, x1, y1] or a list of polygons (`Scenario::area`);
             // keepout: one zone or a list of zones (`Scenario::keepout`).
-            "area" => s.area = Some(parse_area(&v)?),
-            "keepout" => s.keepout = parse_keepout(&v)?,
+            // Zone files recorded absolute, as the command line and `Env` record them (a
+            // relative `area.yaml` in run.json did not replay from another folder).
+            "area" => s.area = Some(parse_area(&v)?.absolute()),
+            "keepout" => {
+                s.keepout = parse_keepout(&v)?
+                    .into_iter()
+                    .map(ZoneSpec::absolute)
+                    .collect();
+            }
             _ => direct.push((key, v)),
         }
     }
@@ -1506,6 +1518,21 @@ fn memory_option(options: Option<&Bound<'_, PyDict>>) -> PyResult<u64> {
     }
 }
 
+/// The maps a sweep runs and their names, as `ccpp bench` names them
+/// ([`ccpp_io::names::name_maps`]): `(index in paths, name)` for every map kept (a file named
+/// twice is run once), in order.
+#[pyfunction]
+fn name_maps(paths: Vec<PathBuf>) -> Vec<(usize, String)> {
+    let keyed: Vec<PathBuf> = paths.clone();
+    ccpp_io::names::name_maps(paths)
+        .into_iter()
+        .map(|(p, n)| {
+            let i = keyed.iter().position(|k| *k == p).unwrap_or_default();
+            (i, n)
+        })
+        .collect()
+}
+
 /// One run of `ccpp bench` (default options, start and simulator settings): the metrics, or
 /// the error message the bench's `results.csv` records. With `out`, the run's files are
 /// written there.
@@ -2152,6 +2179,7 @@ fn _ccpp(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(load_map, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(bench_run, m)?)?;
+    m.add_function(wrap_pyfunction!(name_maps, m)?)?;
     m.add_function(wrap_pyfunction!(check_robot, m)?)?;
     m.add_function(wrap_pyfunction!(planners, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import pytest
@@ -37,9 +38,23 @@ def test_episode(room: Path) -> None:
 
 
 def test_refuses_what_it_would_ignore(room: Path) -> None:
-    for kw in ({"step_m": 0.0}, {"step_m": -0.1}, {"turn_rad": float("nan")}, {"turn_rad": 0}):
+    # More than two turns was accepted, and then every turn action failed.
+    for kw in (
+        {"step_m": 0.0},
+        {"step_m": -0.1},
+        {"turn_rad": float("nan")},
+        {"turn_rad": 0},
+        {"turn_rad": 4 * math.pi + 0.1},
+    ):
         with pytest.raises(ValueError, match=next(iter(kw))):
             CoverageEnv(str(room), **kw)
+    # Two turns is the most, and a turn of it is taken.
+    env = CoverageEnv(str(room), turn_rad=4 * math.pi, max_steps=5)
+    env.reset(seed=1)
+    env.step(1)
+    # `radius=None` is the default robot, as for `ccpp.Env` (it was a bare TypeError).
+    env = CoverageEnv(str(room), radius=None)
+    assert env.step_m == 0.15
     env = CoverageEnv(str(room), max_steps=5)
     env.reset(seed=1, options={})
     with pytest.raises(ValueError, match="no options"):

@@ -455,3 +455,51 @@ def test_round_four_python_holes(shared_maps: Path, tmp_path: Path) -> None:
     drifted = ccpp.run(box, "bcd", area=[-2, -2, 2, 2], odometry_noise=0.03, seed=1)
     assert drifted.metrics["keepout_violations"] > 0
     assert any("keep-out violation" in w for w in drifted.warnings), drifted.warnings
+
+
+def test_relative_zone_files_are_recorded_absolute_and_replay_from_elsewhere(
+    room: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, ccpp_bin: str
+) -> None:
+    # `area="area.yaml"` was written to run.json as given: `ccpp replay` of the folder from any
+    # other working folder failed with "area area.yaml: No such file or directory".
+    (tmp_path / "area.yaml").write_text("- [[0.2, 0.2], [2.5, 0.2], [2.5, 1.8], [0.2, 1.8]]\n")
+    (tmp_path / "ko.yaml").write_text("- [[1.0, 0.8], [1.4, 0.8], [1.4, 1.2]]\n")
+    monkeypatch.chdir(tmp_path)
+    r = ccpp.run(room, "bcd", area="area.yaml", keepout=["ko.yaml"])
+    r.save(tmp_path / "py")
+    scenario = json.loads((tmp_path / "py" / "run.json").read_text())
+    assert scenario["area"] == str(tmp_path / "area.yaml"), scenario["area"]
+    assert scenario["keepout"] == [str(tmp_path / "ko.yaml")], scenario["keepout"]
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    p = subprocess.run(
+        [ccpp_bin, "replay", str(tmp_path / "py")], cwd=elsewhere, capture_output=True, text=True
+    )
+    assert p.returncode == 0, p.stderr
+
+
+def test_sweep_names_maps_as_the_bench_does(tmp_path: Path) -> None:
+    # Stems of dots were names of their own (`..`: the run folder `out/runs/../bcd` lay outside
+    # `runs/`), and `summary` was not `summary-map` as in `ccpp bench`.
+    from ccpp.sweeps import _map_names
+
+    names = ["....yaml", "...yaml", "summary.yaml", "a.yaml"]
+    paths = [tmp_path / n for n in names]
+    for p in paths:
+        p.write_text("")
+    got = _map_names(paths + [paths[3]])
+    folder = tmp_path.name
+    assert got == [
+        (paths[0], f"{folder}-map"),
+        (paths[1], f"{folder}-map-2"),
+        (paths[2], "summary-map"),
+        (paths[3], "a"),
+    ]
+
+
+def test_load_map_reads_max_memory_mb_as_run_and_env_do(room: Path) -> None:
+    # -1 and 2**64 were bare OverflowErrors from load_map, CcppErrors from run and Env.
+    for bad in (-1, 0, 2**64, True, 1.5):
+        with pytest.raises(ccpp.CcppError, match="max_memory_mb"):
+            ccpp.load_map(room, max_memory_mb=bad)
+    assert ccpp.load_map(room, max_memory_mb=None).size == ccpp.load_map(room).size

@@ -209,6 +209,10 @@ def bench_run(
     """One ``ccpp bench`` run: (metrics, None) or (None, error message); ``name`` is the
     map's name in the results (default its file stem)."""
 
+def name_maps(paths: list[_Path]) -> list[tuple[int, str]]:
+    """The maps a sweep runs and their names, as ``ccpp bench`` names them: ``(index in
+    paths, name)`` for every map kept (a file named twice is run once), in order."""
+
 def check_robot(radius: float, tool_radius: float | None = None) -> None:
     """Raises CcppError for a robot a run would refuse."""
 

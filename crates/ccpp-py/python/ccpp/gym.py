@@ -37,7 +37,7 @@ class CoverageEnv(gym.Env):  # type: ignore[misc]
     def __init__(
         self,
         map: Any,
-        radius: float = 0.15,
+        radius: float | None = 0.15,
         tool_radius: float | None = None,
         sensor_range: float | None = None,
         step_m: float | None = None,
@@ -54,12 +54,16 @@ class CoverageEnv(gym.Env):  # type: ignore[misc]
             sensor_range=sensor_range,
             max_steps=max_steps,
         )
-        self.step_m = float(step_m if step_m is not None else radius)
+        # `radius=None` is the default robot, as for `ccpp.Env`.
+        self.step_m = float(step_m if step_m is not None else self._env.radius)
         self.turn_rad = float(turn_rad)
         for name, v in (("step_m", self.step_m), ("turn_rad", self.turn_rad)):
             # 0 would make the action a no-op, a negative value reverse it, NaN fail each step.
             if not (math.isfinite(v) and v > 0):
                 raise ValueError(f"{name} must be a finite number > 0, got {v}")
+        # The simulator refuses a rotation of more than two turns: each turn action would fail.
+        if self.turn_rad > 4 * math.pi:
+            raise ValueError(f"turn_rad must be at most two turns (4 pi rad), got {self.turn_rad}")
         self.random_start = random_start
         self.include_known = include_known
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:

@@ -78,29 +78,12 @@ def expand_maps(items: Iterable[str | os.PathLike[str]] | str | os.PathLike[str]
 
 
 def _map_names(paths: list[Path]) -> list[tuple[Path, str]]:
-    """As ``ccpp bench`` names its maps: a file named twice is run once, and every map gets a
-    distinct name for its rows and run folders -- the file stem, or ``<folder>-<stem>`` when
-    maps in different folders share a stem (then ``-2``, ``-3``, ... if that still repeats)."""
-    seen: set[Path] = set()
-    kept: list[Path] = []
-    for p in paths:
-        c = p.resolve()
-        if c not in seen:
-            seen.add(c)
-            kept.append(p)
-    stems = [p.stem or "map" for p in kept]
-    names = []
-    for p, stem in zip(kept, stems):
-        folder = p.resolve().parent.name
-        names.append(f"{folder}-{stem}" if stems.count(stem) > 1 and folder else stem)
-    for i, n in enumerate(names):
-        earlier = names[:i].count(n)
-        if earlier:
-            k = earlier + 1
-            while f"{n}-{k}" in names:
-                k += 1
-            names[i] = f"{n}-{k}"
-    return list(zip(kept, names))
+    """As ``ccpp bench`` names its maps (the same Rust function names them): a file named twice
+    is run once, and every map gets a distinct name for its rows and run folders -- the file
+    stem, or ``<folder>-<stem>`` when maps in different folders share a stem (then ``-2``,
+    ``-3``, ... if that still repeats); a stem of dots is ``map``, ``summary`` is
+    ``summary-map``."""
+    return [(paths[i], name) for i, name in _ccpp.name_maps(paths)]
 
 
 def _check_out(out: str | os.PathLike[str]) -> None:
