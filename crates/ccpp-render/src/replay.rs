@@ -601,11 +601,9 @@ impl Default for GifOptions {
 pub fn replay_gif(world: &World, trace: &Trace, opts: &GifOptions) -> Result<Vec<u8>, RenderError> {
     let f = *world.frame();
     let (c0, r0, cw, ch) = crop_box(world, trace);
-    let k = (f64::from(opts.max_side) / cw.max(ch) as f64).min(4.0);
-    let (gw, gh) = (
-        ((cw as f64 * k).round() as usize).max(1),
-        ((ch as f64 * k).round() as usize).max(1),
-    );
+    let (k, (mw, mh), (gw, gh)) = gif_layout(cw, ch, opts.max_side);
+    // The map's offset on the canvas (white margins around a map thinner than the canvas).
+    let (ox, oy) = ((gw - mw) / 2, (gh - mh) / 2);
     // Palette: 0 occ, 1 unk, 2 free-out, 3 accessible, 4 swept, 5 path, 6 robot, 7 white,
     // 8 keep-out, 9 keep-out hatching and border, 10 outside the area, 11 area border (then
     // padding to 16).
@@ -630,14 +628,21 @@ pub fn replay_gif(world: &World, trace: &Trace, opts: &GifOptions) -> Result<Vec
     .iter()
     .flat_map(|c| c.iter().copied())
     .collect();
-    let src = |gx: usize, gy: usize| -> usize {
-        let c = (c0 + ((gx as f64 + 0.5) / k) as usize).min(f.width - 1);
-        let r = (r0 + ((gy as f64 + 0.5) / k) as usize).min(f.height - 1);
-        f.index(c, r)
+    // The map pixel under canvas pixel (gx, gy), `None` in the margins.
+    let src = |gx: usize, gy: usize| -> Option<usize> {
+        let (mx, my) = (gx.checked_sub(ox)?, gy.checked_sub(oy)?);
+        if mx >= mw || my >= mh {
+            return None;
+        }
+        let c = (c0 + ((mx as f64 + 0.5) / k) as usize).min(f.width - 1);
+        let r = (r0 + ((my as f64 + 0.5) / k) as usize).min(f.height - 1);
+        Some(f.index(c, r))
     };
     let base: Vec<u8> = (0..gw * gh)
         .map(|p| {
-            let i = src(p % gw, p / gw);
+            let Some(i) = src(p % gw, p / gw) else {
+                return 7;
+            };
             match class_of(world, i) {
                 Class::Occupied => 0,
                 Class::Unknown => 1,
@@ -653,8 +658,8 @@ pub fn replay_gif(world: &World, trace: &Trace, opts: &GifOptions) -> Result<Vec
     let to_gif = |p: Point| {
         let g = f.world_to_grid(p);
         (
-            (g.x - c0 as f64) * k,
-            (f.height as f64 - g.y - r0 as f64) * k,
+            (g.x - c0 as f64) * k + ox as f64,
+            (f.height as f64 - g.y - r0 as f64) * k + oy as f64,
         )
     };
     // The zones' borders (palette index per GIF pixel, 0 = none), drawn over the swept floor
@@ -709,7 +714,9 @@ pub fn replay_gif(world: &World, trace: &Trace, opts: &GifOptions) -> Result<Vec
             for (p, v) in buf.iter_mut().enumerate() {
                 // Keep-outs keep their colours, as in the coverage picture; floor outside the
                 // area that the tool swept (the approach to it) shows as swept.
-                if matches!(*v, 2 | 3 | 10) && swept.contains(src(p % gw, p / gw)) {
+                if matches!(*v, 2 | 3 | 10)
+                    && src(p % gw, p / gw).is_some_and(|i| swept.contains(i))
+                {
                     *v = 4;
                 }
                 if borders[p] != 0 {
@@ -731,6 +738,35 @@ pub fn replay_gif(world: &World, trace: &Trace, opts: &GifOptions) -> Result<Vec
         }
     }
     Ok(out)
+}
+
+/// Thinnest the map's strip is drawn in the GIF, pixels, where the canvas may grow longer for
+/// it (up to four times `max_side`): a 4000 x 9 px corridor was a GIF of 400 x 1 px, in which
+/// nothing of the run could be made out.
+const MIN_GIF_STRIP: f64 = 16.0;
+
+/// Shortest side of the GIF's canvas, pixels: a thinner map stands in the middle of white
+/// margins, as in the coverage picture.
+const MIN_GIF_SIDE: usize = 48;
+
+/// The GIF's scale (GIF pixels per map pixel), the map's size on the canvas and the canvas's
+/// size, for a crop of `cw` x `ch` map pixels: the long side `max_side` at most 4 GIF pixels a
+/// map pixel; a map so elongated that its short side would be thinner than [`MIN_GIF_STRIP`]
+/// scaled up to reach it, the long side then up to `4 max_side`; the canvas at least
+/// [`MIN_GIF_SIDE`] each way.
+fn gif_layout(cw: usize, ch: usize, max_side: u32) -> (f64, (usize, usize), (usize, usize)) {
+    let (long, short) = (cw.max(ch).max(1) as f64, cw.min(ch).max(1) as f64);
+    let max_side = f64::from(max_side);
+    let mut k = (max_side / long).min(4.0);
+    if short * k < MIN_GIF_STRIP {
+        let longest = (4.0 * max_side).min(f64::from(u16::MAX));
+        k = (MIN_GIF_STRIP / short).min(longest / long).min(4.0).max(k);
+    }
+    let (mw, mh) = (
+        ((cw as f64 * k).round() as usize).max(1),
+        ((ch as f64 * k).round() as usize).max(1),
+    );
+    (k, (mw, mh), (mw.max(MIN_GIF_SIDE), mh.max(MIN_GIF_SIDE)))
 }
 
 fn draw_line(layer: &mut [bool], w: usize, h: usize, a: (f64, f64), b: (f64, f64)) {
@@ -873,6 +909,67 @@ mod tests {
         assert!(count(C_ROBOT) > 10, "robot pixels");
         assert_eq!(C_ROBOT, [255, 212, 0]);
         assert!(TEMPLATE.contains("rgba(255,212,0,"));
+    }
+
+    /// A corridor of 4000 x 9 px was a GIF of 400 x 1 px: the strip is now at least 16 px
+    /// thick where a longer GIF (up to 1600 px) allows it, or as thick as that length allows,
+    /// on a canvas of at least 48 px each way; ordinary maps keep their size.
+    #[test]
+    fn an_elongated_map_makes_a_gif_one_can_see() {
+        // (crop w, crop h) -> (map on the canvas, canvas)
+        for ((cw, ch), map, canvas) in [
+            ((600, 400), (400, 267), (400, 267)),
+            ((4000, 40), (1600, 16), (1600, 48)),
+            ((400, 4000), (40, 400), (48, 400)),
+            ((4000, 9), (1600, 4), (1600, 48)),
+            ((9, 4000), (4, 1600), (48, 1600)),
+            ((3, 3), (12, 12), (48, 48)),
+            ((1000, 100), (400, 40), (400, 48)),
+        ] {
+            let (_, m, c) = gif_layout(cw, ch, 400);
+            assert_eq!((m, c), (map, canvas), "{cw} x {ch}");
+        }
+        // The canvas fits a GIF's 16-bit sides whatever `max_side` asks.
+        let (_, _, c) = gif_layout(1_000_000, 1, 60_000);
+        assert!(u16::try_from(c.0).is_ok(), "{c:?}");
+    }
+
+    /// The margins of a thin map's GIF are white, and the run is drawn in the map's strip.
+    #[test]
+    fn a_thin_map_stands_in_white_margins() {
+        let map = ccpp_core::grid::GridMap::from_ascii_scaled(
+            &format!(
+                "{}\n#{}#\n{}",
+                "#".repeat(60),
+                ".".repeat(58),
+                "#".repeat(60)
+            ),
+            6,
+            0.05,
+        )
+        .unwrap();
+        let start = ccpp_core::Pose::new(0.5, 0.45, 0.0);
+        let world = World::new(map, ccpp_core::world::Robot::new(0.1), Some(start)).unwrap();
+        let mut trace = Trace::default();
+        trace.push_pose(0, start);
+        trace.push_pose(1, ccpp_core::Pose::new(17.5, 0.45, 0.0));
+        let bytes = replay_gif(&world, &trace, &GifOptions::default()).unwrap();
+        let mut opts = gif::DecodeOptions::new();
+        opts.set_color_output(gif::ColorOutput::RGBA);
+        let mut dec = opts.read_info(std::io::Cursor::new(bytes)).unwrap();
+        let (w, h) = (usize::from(dec.width()), usize::from(dec.height()));
+        assert_eq!((w, h), (400, 48));
+        let frame = dec.read_next_frame().unwrap().unwrap();
+        let px = |x: usize, y: usize| &frame.buffer[(y * w + x) * 4..][..3];
+        // 360 x 18 map pixels at 400/360 GIF px each: 20 px tall, rows 14 to 33.
+        for x in [0, w / 2, w - 1] {
+            assert_eq!(px(x, 0), [255, 255, 255]);
+            assert_eq!(px(x, h - 1), [255, 255, 255]);
+        }
+        assert!(
+            (0..w).any(|x| px(x, h / 2) == C_PATH),
+            "the path in the strip"
+        );
     }
 
     /// The approach's dotted style is tested before backtracking's (both negative): the other
