@@ -62,7 +62,10 @@ pub struct MapArgs {
     /// metres). Overrides resolution and origin.
     #[arg(long, value_name = "FILE")]
     pub georef: Option<PathBuf>,
-    /// Grow obstacles by this many metres (exact distance transform) before planning.
+    /// Grow obstacles by this many metres (exact distance transform) before planning. The grown
+    /// map is the run's world: the planner, its sensor, collisions and the coverage figures all
+    /// use it (the floor within M of an obstacle is no floor to cover, and touching it counts as
+    /// a collision), as with a costmap's inflation.
     #[arg(long, value_name = "M")]
     pub inflate: Option<f64>,
 }
@@ -312,7 +315,8 @@ pub struct BenchArgs {
     /// Robot radius and tool radius (the start is each map's default start).
     #[command(flatten)]
     pub robot: BenchRobotArgs,
-    /// Grow obstacles by this many metres before planning.
+    /// Grow obstacles by this many metres before planning (the grown map is each run's world,
+    /// its figures included: see `ccpp run --help`).
     #[arg(long, value_name = "M")]
     pub inflate: Option<f64>,
     /// Seed of random-bounce's turns.

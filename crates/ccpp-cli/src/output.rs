@@ -392,6 +392,12 @@ pub fn emit(
     }
     let mut s = summary(&r.metrics);
     let _ = writeln!(s, "  start area: {}", comp.line());
+    if let Some(m) = job.scenario.map.inflate.filter(|m| *m > 0.0) {
+        // The figures above are on the grown map, not the map as drawn: said where they are
+        // read (with 0.3 m, teb_empty_box's coverage rose from 0.907 to 0.973 while the floor
+        // swept of the drawn map fell by a tenth).
+        let _ = writeln!(s, "{}", inflated_line(m));
+    }
     let mut extra = String::new();
     if replay {
         extra.push_str(", replay.html, replay.gif");
@@ -406,6 +412,15 @@ pub fn emit(
         job.out.display()
     );
     crate::print_stdout(&s)
+}
+
+/// The summary's line of a run on a map grown by `--inflate` `m` metres.
+pub fn inflated_line(m: f64) -> String {
+    format!(
+        "  inflated: obstacles grown by {} m (--inflate); every figure is on the grown map (the floor within {} m of an obstacle is not counted, and touching it is a collision)",
+        num(m),
+        num(m)
+    )
 }
 
 /// A user-given number as `{}` prints it (`0.15`, `50000000`), but in exponent form (`1e-300`)

@@ -465,6 +465,27 @@ fn map_and_robot_flags_change_the_run() {
             "{args:?} changes nothing"
         );
     }
+    // The summary says that an inflated run's figures are on the grown map (its coverage rose
+    // while less of the drawn floor was swept, without a word), and says nothing without it.
+    let said = |args: &[&str]| {
+        let out = dir.join("said");
+        let mut all = vec![
+            "run",
+            "--planner",
+            "ba-star",
+            "--map",
+            map.to_str().unwrap(),
+        ];
+        all.extend_from_slice(args);
+        all.extend(["--out", out.to_str().unwrap()]);
+        let o = ccpp().args(&all).output().unwrap();
+        assert!(o.status.success());
+        std::fs::remove_dir_all(&out).unwrap();
+        String::from_utf8(o.stdout).unwrap()
+    };
+    let line = "inflated: obstacles grown by 0.1 m (--inflate); every figure is on the grown map";
+    assert!(said(&["--inflate", "0.1"]).contains(line));
+    assert!(!said(&[]).contains("inflated"));
 }
 
 #[test]
