@@ -407,9 +407,16 @@ fn replay_data(
         || "null".to_string(),
         |why| serde_json::Value::String(why).to_string(),
     );
+    // The step the run ended at (its `finished` record): a run the simulator stopped for a
+    // stall holds a thousand steps after its last move, and the page's step count ended at
+    // that move (64 / 64 for a run stopped at step 1063).
+    let last = trace
+        .events()
+        .find_map(|(t, e)| matches!(e, Event::Finished { .. }).then_some(t))
+        .map_or_else(|| "null".to_string(), |t| t.to_string());
     let classes = classes_js(world, crop);
     format!(
-        r#"{{"w":{w},"h":{h},"res":{res},"yaw":{yaw},"r":{r},"rt":{rt},"swept_r":{swept_r},"tile":{tile},"start":[{sx},{sy},{st}],"n":{n},"m":{m},"q":{q},"blob":"{blob}","events":{events},"nt":{nt},"tblob":"{tblob}","cov":{cov},"palette":{palette},"zones":{zones},"approach":{approach},"stop":{stop},"classes":{classes},"metrics":{metrics}}}"#,
+        r#"{{"w":{w},"h":{h},"res":{res},"yaw":{yaw},"r":{r},"rt":{rt},"swept_r":{swept_r},"tile":{tile},"start":[{sx},{sy},{st}],"n":{n},"m":{m},"q":{q},"blob":"{blob}","events":{events},"nt":{nt},"tblob":"{tblob}","cov":{cov},"palette":{palette},"zones":{zones},"approach":{approach},"stop":{stop},"last":{last},"classes":{classes},"metrics":{metrics}}}"#,
         res = js_num(f.resolution),
         yaw = js_num(yaw),
         r = js_num(world.robot().radius / f.resolution),

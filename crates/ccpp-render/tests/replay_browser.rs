@@ -611,3 +611,45 @@ window.addEventListener("load", () => {
     );
     assert!(plain[0].1 > 4000.0 && plain[0].1 < 6000.0, "{plain:?}");
 }
+
+/// The step count at the scrubber. A run the simulator stopped for a stall (its robot stuck
+/// for a thousand steps after its last move) ended the count at that move: "64 / 64" for a
+/// run stopped at step 1063. And over a straight move (one move of the decimated path) the
+/// count stood still: "step 0" at 60 % of a 666-step lane. The last step is now the run's
+/// end, and the count runs along a move by distance.
+#[test]
+fn the_step_count_runs_along_a_lane_and_ends_at_the_runs_end() {
+    let map = room(200, 120);
+    let start = Pose::new(0.3, 0.3, 0.0);
+    let world = World::new(map, Robot::new(0.15), Some(start)).expect("fits");
+    let mut trace = Trace::default();
+    for k in 0..=100u64 {
+        trace.push_pose(k, Pose::new(0.3 + 0.09 * k as f64, 0.3, 0.0));
+    }
+    trace.push_event(
+        1100,
+        Event::Finished {
+            reason: "stalled".into(),
+        },
+    );
+    let html = replay_html(&world, &trace, None, "{}", "stalled lane").expect("page");
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("replay-steps");
+    std::fs::create_dir_all(&dir).expect("dir");
+    std::fs::write(dir.join("page.html"), &html).expect("write");
+    let Some(chrome) = require_chromium() else {
+        return;
+    };
+    let _serial = BROWSER
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    let step_cell = |fragment: &str| -> String {
+        let url = format!("file://{}#{fragment}", dir.join("page.html").display());
+        let (dom, err) = dump_dom(&chrome, &url, true);
+        no_console_errors(&err);
+        let at = dom.find(r#"id="now-step">"#).expect("step cell") + 14;
+        dom[at..at + dom[at..].find('<').expect("cell end")].to_string()
+    };
+    assert_eq!(step_cell("at=0"), "0 / 1,100");
+    assert_eq!(step_cell("at=0.6"), "60 / 1,100");
+    assert_eq!(step_cell("frame=last"), "1,100 / 1,100");
+}
