@@ -701,6 +701,16 @@ fn start_arg(v: &Bound<'_, PyAny>) -> PyResult<[f64; 3]> {
     }
 }
 
+/// The text of an `exec=` keyword ("ideal" or "pid", checked by `exec_choice`).
+fn exec_arg(v: &Bound<'_, PyAny>) -> PyResult<String> {
+    v.extract().map_err(|_| {
+        msg(format!(
+            "exec must be \"ideal\" or \"pid\", got {} (the planner's own execution settings go in options={{\"exec\": ...}})",
+            repr(v)
+        ))
+    })
+}
+
 /// Builds the scenario of `ccpp.run` / `ccpp.plan`: keyword options -> scenario fields
 /// (validated later, once, by the scenario). The rules are the command line's:
 /// * an option that does not apply to the planner (or to a plan) is refused, not ignored;
@@ -775,15 +785,7 @@ fn scenario_from(
                 }
                 s.sim.max_steps = uint_arg(&key, &v, 1)?;
             }
-            "exec" => {
-                let e: String = v.extract().map_err(|_| {
-                    msg(format!(
-                        "exec must be \"ideal\" or \"pid\", got {} (the planner's own execution settings go in options={{\"exec\": ...}})",
-                        repr(&v)
-                    ))
-                })?;
-                exec = Some(e);
-            }
+            "exec" => exec = Some(exec_arg(&v)?),
             "seed" => {
                 // The seed of the odometry noise and random-bounce's own option `seed`: there,
                 // a planner option like the others (so `seed=` and `options={"seed": ...}` must
@@ -1866,8 +1868,8 @@ impl Env {
         radius: Option<Real>,
         tool_radius: Option<Real>,
         sensor_range: Option<Real>,
-        start: Option<Vec<Real>>,
-        exec: Option<&str>,
+        start: Option<&Bound<'_, PyAny>>,
+        exec: Option<&Bound<'_, PyAny>>,
         max_steps: Option<&Bound<'_, PyAny>>,
         area: Option<&Bound<'_, PyAny>>,
         keepout: Option<&Bound<'_, PyAny>>,
@@ -1875,7 +1877,6 @@ impl Env {
     ) -> PyResult<Self> {
         let (radius, tool_radius, sensor_range) =
             (real(radius), real(tool_radius), real(sensor_range));
-        let start = reals(start);
         let max_steps = max_steps
             .filter(|v| !v.is_none())
             .map(|v| uint_arg("max_steps", v, 1))
@@ -1890,21 +1891,14 @@ impl Env {
             limit.unwrap_or(ccpp_io::scenario::DEFAULT_MAX_MEMORY_MB),
         )?;
         let radius = radius.unwrap_or(DEFAULT_RADIUS);
-        let exec = match exec_choice(exec, &Names::KEYWORDS).map_err(msg)? {
+        // `start` and `exec` are read as `ccpp.run` reads them (a text start or a number for
+        // `exec` was a bare TypeError here, a CcppError there).
+        let exec = exec.filter(|v| !v.is_none()).map(exec_arg).transpose()?;
+        let exec = match exec_choice(exec.as_deref(), &Names::KEYWORDS).map_err(msg)? {
             Some(true) => Execution::Pid(PidOptions::default()),
             Some(false) | None => Execution::Ideal,
         };
-        let start = match start.as_deref() {
-            None => None,
-            Some([x, y]) => Some([*x, *y, 0.0]),
-            Some([x, y, t]) => Some([*x, *y, *t]),
-            Some(p) => {
-                return Err(msg(format!(
-                    "start expects (x, y) or (x, y, theta), got {} values",
-                    p.len()
-                )))
-            }
-        };
+        let start = start.filter(|v| !v.is_none()).map(start_arg).transpose()?;
         let area = area.map(parse_area).transpose()?;
         let keepout = keepout.map(parse_keepout).transpose()?.unwrap_or_default();
         // The scenario validates the robot, the sensor range, the execution, the episode cap

@@ -503,3 +503,21 @@ def test_load_map_reads_max_memory_mb_as_run_and_env_do(room: Path) -> None:
         with pytest.raises(ccpp.CcppError, match="max_memory_mb"):
             ccpp.load_map(room, max_memory_mb=bad)
     assert ccpp.load_map(room, max_memory_mb=None).size == ccpp.load_map(room).size
+
+
+def test_env_reads_start_and_exec_as_run_does(room: Path) -> None:
+    # A text start or a number for exec was a bare TypeError from Env, a CcppError from run.
+    for kw, needle in [
+        ({"start": "1,2"}, "start expects"),
+        ({"start": (1.0,)}, "start expects"),
+        ({"exec": 1}, "exec must be"),
+        ({"exec": "fast"}, "must be ideal or pid"),
+    ]:
+        with pytest.raises(ccpp.CcppError, match=needle):
+            ccpp.run(room, "ba-star", **kw)
+        with pytest.raises(ccpp.CcppError, match=needle):
+            ccpp.Env(room, **kw)
+    env = ccpp.Env(room, start=(1.0, 1.0, 0.5), exec="PID")
+    obs, _ = env.reset()
+    assert list(obs["pose"]) == [1.0, 1.0, 0.5]
+    assert ccpp.Env(room, start=None, exec=None).radius == 0.15

@@ -209,7 +209,6 @@ def test_bools_are_not_numbers(room: Path, tmp_path: Path) -> None:
         lambda: ccpp.run(room, "bsa", radius=True),
         lambda: ccpp.plan(room, "bcd", radius=True),
         lambda: ccpp.Env(room, radius=True),
-        lambda: ccpp.Env(room, start=(True, 0.5)),
         lambda: ccpp.load_map(room, inflate=True),
         lambda: ccpp.load_map(room, origin=(0.0, False, 0.0)),
         lambda: ccpp.run(room, "bsa").waypoints(tolerance_m=True),
@@ -220,6 +219,10 @@ def test_bools_are_not_numbers(room: Path, tmp_path: Path) -> None:
     # bools too, as CcppErrors naming them.
     with pytest.raises(ccpp.CcppError, match="max_steps must be a whole number, got True"):
         ccpp.Env(room, max_steps=True)
+    # A start holding a bool, as `run` says it.
+    for call in (ccpp.Env, lambda *a, **k: ccpp.run(*a, "bsa", **k)):
+        with pytest.raises(ccpp.CcppError, match=r"start expects \(x, y\) or \(x, y, theta\), got \(True, 0.5\)"):
+            call(room, start=(True, 0.5))
     with pytest.raises(ccpp.CcppError, match="tool_radius must be a number, got True"):
         ccpp.run(room, "bsa", tool_radius=True)
     with pytest.raises(ccpp.CcppError, match="sensor_range must be a number, got False"):
