@@ -62,10 +62,10 @@ pub struct MapArgs {
     /// metres). Overrides resolution and origin.
     #[arg(long, value_name = "FILE")]
     pub georef: Option<PathBuf>,
-    /// Grow obstacles by this many metres (exact distance transform) before planning. The grown
-    /// map is the run's world: the planner, its sensor, collisions and the coverage figures all
-    /// use it (the floor within M of an obstacle is no floor to cover, and touching it counts as
-    /// a collision), as with a costmap's inflation.
+    /// Grow obstacles by this many metres (exact distance transform) before anything else, as a
+    /// costmap's inflation: the grown map is what the command works on (a run's planner, sensor,
+    /// collisions and coverage figures, a plan's path, `info`'s figures), so the floor within M
+    /// of an obstacle is no floor to cover and touching it is a collision.
     #[arg(long, value_name = "M")]
     pub inflate: Option<f64>,
 }

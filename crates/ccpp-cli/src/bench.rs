@@ -8,7 +8,7 @@ use anyhow::{bail, Context, Result};
 use ccpp_core::metrics::Metrics;
 use ccpp_core::planners::{self, PlannerOptions};
 use ccpp_core::sim::SimConfig;
-use ccpp_io::names::name_maps;
+use ccpp_io::names::{expand_maps, name_maps};
 use ccpp_io::scenario::Scenario;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
@@ -22,66 +22,6 @@ use crate::staging::write_file;
 /// Test hook: a planner named by this environment variable panics in a `ccpp bench` run, to
 /// check that one failing run becomes an error row and the others finish.
 pub const PANIC_ENV: &str = "CCPP_TEST_PANIC_PLANNER";
-
-/// Expands `--maps` arguments: a folder gives its `*.yaml` maps (or, when it has none, its
-/// PNG/PGM images), sorted; a file is taken as it is.
-pub fn expand_maps(items: &[PathBuf]) -> Result<Vec<PathBuf>> {
-    let mut out = Vec::new();
-    for item in items {
-        if item.is_dir() {
-            let mut files: Vec<PathBuf> = std::fs::read_dir(item)
-                .with_context(|| format!("cannot read map folder {}", item.display()))?
-                .filter_map(|e| e.ok().map(|e| e.path()))
-                .collect();
-            files.sort();
-            let has_ext = |p: &Path, exts: &[&str]| {
-                p.extension()
-                    .and_then(|e| e.to_str())
-                    .is_some_and(|e| exts.iter().any(|x| e.eq_ignore_ascii_case(x)))
-            };
-            if let Some(bad) = files.iter().find(|p| {
-                p.file_name().is_some_and(|n| n.to_str().is_none())
-                    && has_ext(p, &["yaml", "yml", "png", "pgm", "pnm"])
-            }) {
-                // Paths are recorded as text (run.json): the run would fail late, unnamed.
-                bail!(
-                    "map folder {} holds {}, whose name is not valid UTF-8; rename it",
-                    item.display(),
-                    bad.display()
-                );
-            }
-            let yamls: Vec<PathBuf> = files
-                .iter()
-                .filter(|p| has_ext(p, &["yaml", "yml"]))
-                .cloned()
-                .collect();
-            if yamls.is_empty() {
-                out.extend(
-                    files
-                        .into_iter()
-                        .filter(|p| has_ext(p, &["png", "pgm", "pnm"])),
-                );
-            } else {
-                out.extend(yamls);
-            }
-        } else if item.is_file() {
-            out.push(item.clone());
-        } else {
-            bail!("--maps {}: no such file or folder", item.display());
-        }
-    }
-    if out.is_empty() {
-        bail!(
-            "no map found in {}",
-            items
-                .iter()
-                .map(|p| p.display().to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
-        );
-    }
-    Ok(out)
-}
 
 /// What defines a bench run, as written to its `bench-key.txt`: a finished run is reused only
 /// when this matches exactly. Covers the map's content (after inflation), the planner, its

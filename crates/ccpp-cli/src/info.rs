@@ -33,6 +33,9 @@ struct Info {
     height_m: f64,
     /// How the pixels were read: `map_server` mode, thresholds, negate.
     pixels: Pixels,
+    /// How far `--inflate` grew the obstacles (m): every figure after it is on the grown map.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    inflate_m: Option<f64>,
     free_px: usize,
     occupied_px: usize,
     unknown_px: usize,
@@ -115,23 +118,23 @@ pub fn run(a: &InfoArgs) -> Result<()> {
     });
     let (world, robot_error) = match World::with_zones(g.clone(), robot, start, zones) {
         Ok(w) => (Some(w), None),
-        // An inflation that grew the obstacles over every free spot is the likely cause: the
-        // report names it, as `run` does.
-        Err(WorldError::RobotTooBig {
-            radius,
-            max_clearance,
-        }) if map.recipe.inflate.is_some_and(|m| m > 0.0) => (
+        // A robot that fits nowhere is reported, not refused; with an inflation (the likely
+        // cause) the report and a refused start name it, as `run` does.
+        Err(e @ WorldError::RobotTooBig { .. }) => (
             None,
-            Some(ccpp_io::scenario::inflation_leaves_no_room(
-                radius,
-                map.recipe.inflate.unwrap_or_default(),
-                max_clearance,
-            )),
+            Some(
+                ccpp_io::scenario::inflated_world_error(&e, map.recipe.inflate)
+                    .unwrap_or_else(|| e.to_string()),
+            ),
         ),
-        Err(e @ WorldError::RobotTooBig { .. }) => (None, Some(e.to_string())),
         // A start the user gave that does not work is a user error.
         Err(e) => {
-            return Err(anyhow::Error::new(e).context(format!("map {}", map.source.display())))
+            return Err(
+                match ccpp_io::scenario::inflated_world_error(&e, map.recipe.inflate) {
+                    Some(m) => anyhow::anyhow!("map {}: {m}", map.source.display()),
+                    None => anyhow::Error::new(e).context(format!("map {}", map.source.display())),
+                },
+            )
         }
     };
     let s = world.as_ref().map(World::start);
@@ -154,6 +157,7 @@ pub fn run(a: &InfoArgs) -> Result<()> {
             free_thresh: map.thresholds.free,
             negate: map.thresholds.negate,
         },
+        inflate_m: map.recipe.inflate.filter(|m| *m > 0.0),
         free_px: free,
         occupied_px: occ,
         unknown_px: unk,
@@ -219,6 +223,12 @@ pub fn run(a: &InfoArgs) -> Result<()> {
             ""
         }
     ));
+    if let Some(m) = info.inflate_m {
+        line(format!(
+            "inflated       obstacles grown by {} m (--inflate): every figure below is on the grown map",
+            num(m)
+        ));
+    }
     line(format!(
         "free           {free} px ({:.1} %), {:.1} m2",
         free as f64 / n,

@@ -2528,6 +2528,30 @@ fn a_start_in_an_inflated_obstacle_names_the_inflation_and_map_sizes_are_rounded
             "once --inflate / map.inflate 0.5 m has grown the obstacles",
         ],
     );
+    // `info` names it too (it had its own copy of the inflated-map errors, without this one),
+    // and says that its figures are on the grown map.
+    refused(
+        &[
+            "info",
+            "--map",
+            s(&map),
+            "--inflate",
+            "0.5",
+            "--start",
+            "3.0,3.5",
+        ],
+        &[
+            "start (3.000, 3.500) is in an obstacle",
+            "once --inflate / map.inflate 0.5 m",
+        ],
+    );
+    let o = ccpp()
+        .args(["info", "--map", s(&map), "--inflate", "0.1"])
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    assert!(String::from_utf8_lossy(&o.stdout)
+        .contains("inflated       obstacles grown by 0.1 m (--inflate): every figure below is on the grown map"));
     let tiny = pgm(dir, "tiny.pgm", 3, 3, |_, _| false);
     refused(
         &["run", "--planner", "ba-star", "--map", s(&tiny)],

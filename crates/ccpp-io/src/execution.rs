@@ -20,9 +20,9 @@
 //! assert!(e.contains("draws no noise"), "{e}");
 //! ```
 
-use ccpp_core::display::join;
+use ccpp_core::display::{join, Compact};
 use ccpp_core::exec::{Execution, OdometryNoise, PidOptions};
-use ccpp_core::planners::settings::noise_too_small;
+use ccpp_core::planners::settings::{noise_too_small, MIN_NOISE_STD};
 use ccpp_core::planners::PlannerKind;
 
 /// What the caller asks of the execution.
@@ -129,7 +129,8 @@ pub fn execution(
             // It would run exactly as PID execution without noise (and change nothing for a
             // planner that executes by PID already): a value read and dropped.
             return Err(format!(
-                "{noise} {shown} draws no noise: give a noise > 0, or use {exec} pid for PID execution without noise"
+                "{noise} {shown} draws no noise: give a noise of at least {}, or use {exec} pid for PID execution without noise",
+                Compact(MIN_NOISE_STD)
             ));
         }
         if let Some(why) = v.iter().find_map(|x| noise_too_small(*x)) {

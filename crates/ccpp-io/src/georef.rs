@@ -62,6 +62,19 @@ pub(crate) fn fields(line: &str) -> impl Iterator<Item = &str> {
         .filter(|s| !s.is_empty())
 }
 
+/// The content lines of a small CSV-like file (georef pairs, landmarks), numbered from 0, each
+/// without its comment (from `#` to the end of the line) and surrounding white space; lines
+/// left empty are skipped. A byte-order mark (Excel's "CSV UTF-8") is no part of the first
+/// field. A trailing comment is a comment too: `0,0,0,10 # corner` was taken for a header and
+/// its pair dropped without a word.
+pub(crate) fn content_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    text.lines()
+        .enumerate()
+        .map(|(n, raw)| (n, raw.split('#').next().unwrap_or_default().trim()))
+        .filter(|(_, line)| !line.is_empty())
+}
+
 /// Parses `(pixel, world)` pairs from the text of a georef file.
 ///
 /// # Errors
@@ -70,15 +83,7 @@ pub(crate) fn fields(line: &str) -> impl Iterator<Item = &str> {
 pub fn parse_georef(text: &str) -> Result<Vec<(Point, Point)>, GeorefProblem> {
     let mut pairs = Vec::new();
     let mut first = true;
-    // A byte-order mark (Excel's "CSV UTF-8") is no part of the first field.
-    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    for (n, raw) in text.lines().enumerate() {
-        // A trailing comment is a comment too: `0,0,0,10 # corner` was taken for a header
-        // and its pair dropped without a word.
-        let line = raw.split('#').next().unwrap_or_default().trim();
-        if line.is_empty() {
-            continue;
-        }
+    for (n, line) in content_lines(text) {
         let nums: Option<Vec<f64>> = fields(line)
             .map(|f| f.parse::<f64>().ok().filter(|v| v.is_finite()))
             .collect();

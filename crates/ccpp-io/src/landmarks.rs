@@ -3,7 +3,7 @@
 //!
 //! Two formats, chosen by content: a JSON array of `{"id": 1, "x": 2.0, "y": 3.0}` objects
 //! (optional `"theta"`, radians), or CSV lines `id,x,y[,theta]` (commas, semicolons or
-//! whitespace; blank and `#` lines skipped; a first line without any number is a header).
+//! whitespace; blank lines and `#` comments skipped; a first line without any number is a header).
 //!
 //! ```
 //! let l = ccpp_io::landmarks::parse_landmarks("id,x,y\n1,0.5,2\n1,4.5,2,1.57\n").unwrap();
@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 
 use ccpp_core::landmarks::Landmark;
 
-use crate::georef::fields;
+use crate::georef::{content_lines, fields};
 
 /// Errors reading a landmark file.
 #[derive(Debug, thiserror::Error)]
@@ -81,6 +81,8 @@ fn parse_csv_line(line: &str) -> Option<Landmark> {
 /// # Errors
 /// Invalid JSON, a bad CSV line, or a non-finite coordinate.
 pub fn parse_landmarks(text: &str) -> Result<Vec<Landmark>, LandmarkFileError> {
+    // A byte-order mark is no part of the content, JSON or CSV.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let trimmed = text.trim_start();
     let list: Vec<Landmark> = if trimmed.starts_with('[') {
         // Counted before they are built: the array's items are skipped, whatever their form
@@ -105,11 +107,9 @@ pub fn parse_landmarks(text: &str) -> Result<Vec<Landmark>, LandmarkFileError> {
     } else {
         let mut out = Vec::new();
         let mut first = true;
-        for (n, raw) in text.lines().enumerate() {
-            let line = raw.trim();
-            if line.is_empty() || line.starts_with('#') {
-                continue;
-            }
+        // Lines as in a georef file: a byte-order mark, trailing comments and blank lines
+        // (a file saved as Excel's "CSV UTF-8" lost its first landmark as a "header").
+        for (n, line) in content_lines(text) {
             // A header has no number at all (`id,x,y`), as in a georef file: a first line
             // `-1,1.5,1.5` (a bad id) was taken for a header and dropped without a word.
             let header = std::mem::replace(&mut first, false)
@@ -180,6 +180,15 @@ mod tests {
             "{e}"
         );
         assert_eq!(parse_landmarks("id x y\n2 0 0\n").unwrap().len(), 1);
+        // Excel's "CSV UTF-8" starts with a byte-order mark (the first landmark was taken for
+        // a header, then refused as a bad line); a comment may end a line, as in georef files.
+        let l = parse_landmarks("\u{feff}1,1.0,1.0\n2,4.0,4.0 # dock\n").unwrap();
+        assert_eq!(
+            l,
+            vec![Landmark::new(1, 1.0, 1.0), Landmark::new(2, 4.0, 4.0)]
+        );
+        let l = parse_landmarks("\u{feff}[{\"id\":1,\"x\":0,\"y\":0}]").unwrap();
+        assert_eq!(l, vec![Landmark::new(1, 0.0, 0.0)]);
         assert!(matches!(
             parse_landmarks("[{\"id\":1}]"),
             Err(LandmarkFileError::Json(_))

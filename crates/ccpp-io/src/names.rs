@@ -1,6 +1,7 @@
-//! The names of the maps of a sweep (`ccpp bench`, Python's `ccpp.sweep`): one name a map, for
-//! its run folders (`runs/MAP/PLANNER`), its rows and its plots. The command line and Python
-//! name maps here, so that their rows and folders agree.
+//! The maps of a sweep (`ccpp bench --maps`, Python's `ccpp.sweep`) and their names: the map
+//! files that folders and files given stand for ([`expand_maps`]), and one name a map for its
+//! run folders (`runs/MAP/PLANNER`), rows and plots ([`name_maps`]). The command line and Python
+//! both use these, so that they take the same maps and their rows and folders agree.
 //!
 //! ```
 //! let dir = tempfile::tempdir().unwrap();
@@ -15,6 +16,111 @@
 //! ```
 
 use std::path::{Path, PathBuf};
+
+/// Why the maps given to a sweep are not a list of map files.
+#[derive(Debug, thiserror::Error)]
+pub enum MapListError {
+    /// Nothing given.
+    #[error("maps is empty: give map files or folders")]
+    Empty,
+    /// A folder that cannot be listed.
+    #[error("cannot read map folder {}: {source}", folder.display())]
+    Unreadable {
+        /// The folder.
+        folder: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// A map in a folder whose name is not UTF-8: paths are recorded as text (`run.json`), so
+    /// its runs would fail late, unnamed.
+    #[error("map folder {} holds {}, whose name is not valid UTF-8; rename it", folder.display(), file.display())]
+    NotUtf8 {
+        /// The folder.
+        folder: PathBuf,
+        /// The map file.
+        file: PathBuf,
+    },
+    /// An item that is neither a file nor a folder.
+    #[error("maps: {}: no such file or folder", item.display())]
+    Missing {
+        /// The item as given.
+        item: PathBuf,
+    },
+    /// Folders without a map in them.
+    #[error("no map found in {items}")]
+    NoMap {
+        /// The items given, comma-separated.
+        items: String,
+    },
+}
+
+/// The map files of `items`: a folder gives its `*.yaml`/`*.yml` maps (or, when it has none,
+/// its PNG/PGM images), sorted; a file is taken as it is.
+///
+/// # Errors
+/// An empty list, an item that is neither file nor folder, a folder that cannot be read or
+/// holds a map whose name is not UTF-8, or no map at all.
+pub fn expand_maps(items: &[PathBuf]) -> Result<Vec<PathBuf>, MapListError> {
+    if items.is_empty() {
+        return Err(MapListError::Empty);
+    }
+    let has_ext = |p: &Path, exts: &[&str]| {
+        p.extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| exts.iter().any(|x| e.eq_ignore_ascii_case(x)))
+    };
+    let mut out = Vec::new();
+    for item in items {
+        if item.is_dir() {
+            let unreadable = |source| MapListError::Unreadable {
+                folder: item.clone(),
+                source,
+            };
+            let mut files = Vec::new();
+            for e in std::fs::read_dir(item).map_err(unreadable)? {
+                files.push(e.map_err(unreadable)?.path());
+            }
+            files.sort();
+            if let Some(bad) = files.iter().find(|p| {
+                p.file_name().is_some_and(|n| n.to_str().is_none())
+                    && has_ext(p, &["yaml", "yml", "png", "pgm", "pnm"])
+            }) {
+                return Err(MapListError::NotUtf8 {
+                    folder: item.clone(),
+                    file: bad.clone(),
+                });
+            }
+            let yamls: Vec<PathBuf> = files
+                .iter()
+                .filter(|p| has_ext(p, &["yaml", "yml"]))
+                .cloned()
+                .collect();
+            if yamls.is_empty() {
+                out.extend(
+                    files
+                        .into_iter()
+                        .filter(|p| has_ext(p, &["png", "pgm", "pnm"])),
+                );
+            } else {
+                out.extend(yamls);
+            }
+        } else if item.is_file() {
+            out.push(item.clone());
+        } else {
+            return Err(MapListError::Missing { item: item.clone() });
+        }
+    }
+    if out.is_empty() {
+        return Err(MapListError::NoMap {
+            items: items
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .join(", "),
+        });
+    }
+    Ok(out)
+}
 
 /// A map's name from its file stem. A stem that is not a usable folder name (`..yaml` and
 /// `...yaml` have the stems `.` and `..`, which would put the run folders beside `runs/`)
@@ -81,6 +187,53 @@ pub fn name_maps(maps: Vec<PathBuf>) -> Vec<(PathBuf, String)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A folder gives its YAML maps, or its images when it has none, sorted; what is neither
+    /// file nor folder, a folder without maps and a map whose name is not UTF-8 are refused.
+    #[test]
+    fn folders_expand_to_their_maps() {
+        let dir = tempfile::tempdir().unwrap();
+        let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+        for (folder, files) in [
+            (&a, &["z.yaml", "m.YML", "x.png"][..]),
+            (&b, &["q.pgm", "n.txt"]),
+        ] {
+            std::fs::create_dir(folder).unwrap();
+            for f in files {
+                std::fs::write(folder.join(f), "").unwrap();
+            }
+        }
+        let got = expand_maps(&[a.clone(), b.clone(), a.join("x.png")]).unwrap();
+        assert_eq!(
+            got,
+            [
+                a.join("m.YML"),
+                a.join("z.yaml"),
+                b.join("q.pgm"),
+                a.join("x.png")
+            ]
+        );
+        let missing = dir.path().join("none");
+        let e = expand_maps(&[missing]).unwrap_err().to_string();
+        assert!(e.ends_with("none: no such file or folder"), "{e}");
+        let empty = dir.path().join("empty");
+        std::fs::create_dir(&empty).unwrap();
+        let e = expand_maps(&[empty]).unwrap_err().to_string();
+        assert!(e.starts_with("no map found in "), "{e}");
+        assert!(matches!(expand_maps(&[]), Err(MapListError::Empty)));
+        #[cfg(unix)]
+        {
+            use std::os::unix::ffi::OsStrExt;
+            let odd = dir.path().join("odd");
+            std::fs::create_dir(&odd).unwrap();
+            std::fs::write(odd.join(std::ffi::OsStr::from_bytes(b"\xff.yaml")), "").unwrap();
+            let e = expand_maps(&[odd]).unwrap_err().to_string();
+            assert!(
+                e.contains("whose name is not valid UTF-8; rename it"),
+                "{e}"
+            );
+        }
+    }
 
     /// The stems `.` and `..` (files `..yaml`, `...yaml`) would put run folders beside
     /// `runs/`, and a map `summary` would share its trade-off plot with the summary's.

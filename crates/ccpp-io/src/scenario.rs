@@ -438,17 +438,30 @@ fn about_mb(bytes: f64) -> String {
     }
 }
 
-/// Why a robot of `radius` m fits nowhere on a map whose obstacles `--inflate` grew by
-/// `inflate` m (`max_clearance`: the widest free spot left, m). `run`'s refusal and `info`'s
-/// report both say it this way.
-pub fn inflation_leaves_no_room(radius: f64, inflate: f64, max_clearance: f64) -> String {
-    format!(
-        "robot of radius {} m does not fit anywhere once --inflate / map.inflate {} m has grown \
-         the obstacles (the widest free spot then has clearance {max_clearance:.3} m); lower the \
-         inflation",
-        Compact(radius),
-        Compact(inflate),
-    )
+/// What a world error on a map whose obstacles `--inflate` grew by `inflate` m says, naming
+/// the inflation (the likely cause), or `None` for an error the inflation has no part in (or
+/// no inflation). A robot that fits nowhere: the widest free spot left; a start in an
+/// obstacle: the start may be free on the map as drawn. `run`'s refusal and `info`'s report
+/// both say it this way.
+pub fn inflated_world_error(e: &WorldError, inflate: Option<f64>) -> Option<String> {
+    let m = inflate.filter(|m| *m > 0.0)?;
+    match e {
+        WorldError::RobotTooBig {
+            radius,
+            max_clearance,
+        } => Some(format!(
+            "robot of radius {} m does not fit anywhere once --inflate / map.inflate {} m has \
+             grown the obstacles (the widest free spot then has clearance {max_clearance:.3} m); \
+             lower the inflation",
+            Compact(*radius),
+            Compact(m),
+        )),
+        WorldError::StartInObstacle { .. } => Some(format!(
+            "{e} once --inflate / map.inflate {} m has grown the obstacles",
+            Compact(m)
+        )),
+        _ => None,
+    }
 }
 
 /// Refuses a map frame finer than [`MIN_RESOLUTION_M`], wider or taller than
@@ -1277,31 +1290,10 @@ impl Scenario {
                     label,
                     message: format!("{source_err} (map {})", source.display()),
                 },
-                // A robot that fits nowhere on an inflated map: the inflation is the likely
-                // cause, so the message names it.
-                None => match source_err {
-                    WorldError::RobotTooBig {
-                        radius,
-                        max_clearance,
-                    } if inflate.is_some_and(|m| m > 0.0) => ScenarioError::Invalid(format!(
-                        "map {}: {}",
-                        source.display(),
-                        inflation_leaves_no_room(
-                            radius,
-                            inflate.unwrap_or_default(),
-                            max_clearance
-                        ),
-                    )),
-                    // A start in an obstacle that --inflate grew: the start may be valid on
-                    // the map as drawn, so the message says which obstacles it means.
-                    e @ WorldError::StartInObstacle { .. } if inflate.is_some_and(|m| m > 0.0) => {
-                        ScenarioError::Invalid(format!(
-                            "map {}: {e} once --inflate / map.inflate {} m has grown the obstacles",
-                            source.display(),
-                            Compact(inflate.unwrap_or_default()),
-                        ))
-                    }
-                    source_err => ScenarioError::World {
+                // An error the inflation likely caused names it.
+                None => match inflated_world_error(&source_err, inflate) {
+                    Some(m) => ScenarioError::Invalid(format!("map {}: {m}", source.display())),
+                    None => ScenarioError::World {
                         path: source.to_path_buf(),
                         source: source_err,
                     },

@@ -584,11 +584,16 @@ fn uint_arg(key: &str, v: &Bound<'_, PyAny>, lo: u64) -> PyResult<u64> {
             repr(v)
         )));
     }
-    // Past u64 (`max_steps=2**70`) the value is not below 0: say what the range is.
+    // Past u64 (`max_steps=2**70`) the value is not below 0: say what the range is (the
+    // memory limit's is the scenario's, which refuses what lies beyond it).
+    let hi = if key == "max_memory_mb" {
+        ccpp_io::scenario::MAX_MEMORY_LIMIT_MB
+    } else {
+        u64::MAX
+    };
     v.extract().map_err(|_| {
         msg(format!(
-            "{key} must be a whole number from {lo} to {}, got {}",
-            u64::MAX,
+            "{key} must be a whole number from {lo} to {hi}, got {}",
             repr(v)
         ))
     })
@@ -1520,6 +1525,13 @@ fn memory_option(options: Option<&Bound<'_, PyDict>>) -> PyResult<u64> {
     }
 }
 
+/// The map files that `items` (files and folders) stand for, as `ccpp bench --maps` takes them
+/// ([`ccpp_io::names::expand_maps`]).
+#[pyfunction]
+fn expand_maps(items: Vec<PathBuf>) -> PyResult<Vec<PathBuf>> {
+    ccpp_io::names::expand_maps(&items).map_err(|e| err(&e))
+}
+
 /// The maps a sweep runs and their names, as `ccpp bench` names them
 /// ([`ccpp_io::names::name_maps`]): `(index in paths, name)` for every map kept (a file named
 /// twice is run once), in order.
@@ -2174,6 +2186,7 @@ fn _ccpp(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(bench_run, m)?)?;
     m.add_function(wrap_pyfunction!(name_maps, m)?)?;
+    m.add_function(wrap_pyfunction!(expand_maps, m)?)?;
     m.add_function(wrap_pyfunction!(check_robot, m)?)?;
     m.add_function(wrap_pyfunction!(planners, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

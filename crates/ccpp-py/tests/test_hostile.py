@@ -499,9 +499,12 @@ def test_sweep_names_maps_as_the_bench_does(tmp_path: Path) -> None:
 
 def test_load_map_reads_max_memory_mb_as_run_and_env_do(room: Path) -> None:
     # -1 and 2**64 were bare OverflowErrors from load_map, CcppErrors from run and Env.
-    for bad in (-1, 0, 2**64, True, 1.5):
+    for bad in (-1, 0, 2**64, 2**64 - 1, True, 1.5):
         with pytest.raises(ccpp.CcppError, match="max_memory_mb"):
             ccpp.load_map(room, max_memory_mb=bad)
+    # The range said is the one checked (it said "from 1 to 18446744073709551615").
+    with pytest.raises(ccpp.CcppError, match="from 1 to 1099511627776"):
+        ccpp.load_map(room, max_memory_mb=-1)
     assert ccpp.load_map(room, max_memory_mb=None).size == ccpp.load_map(room).size
 
 
@@ -521,3 +524,19 @@ def test_env_reads_start_and_exec_as_run_does(room: Path) -> None:
     obs, _ = env.reset()
     assert list(obs["pose"]) == [1.0, 1.0, 0.5]
     assert ccpp.Env(room, start=None, exec=None).radius == 0.15
+
+
+def test_sweep_takes_the_maps_bench_takes(tmp_path: Path) -> None:
+    # A map whose name is not UTF-8 was taken by `ccpp.sweep` (and named '\ufffd'), refused by
+    # `ccpp bench`: both now expand folders with the same function.
+    folder = tmp_path / "maps"
+    folder.mkdir()
+    (folder / "a.yaml").write_text("")
+    assert ccpp.expand_maps(folder) == [folder / "a.yaml"]
+    odd = os.fsencode(folder) + b"/\xff.yaml"
+    with open(odd, "w"):
+        pass
+    with pytest.raises(ccpp.CcppError, match="not valid UTF-8; rename it"):
+        ccpp.expand_maps([folder])
+    with pytest.raises(ccpp.CcppError, match="no such file or folder"):
+        ccpp.expand_maps([tmp_path / "none"])

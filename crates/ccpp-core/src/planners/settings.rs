@@ -457,7 +457,10 @@ fn validate_pid(field: &str, p: &PidOptions) -> Result<(), OptionsError> {
             // Zero noise draws nothing: the seed would be read and change nothing.
             return Err(OptionsError::new(
                 &f("noise.seed"),
-                "has no effect: every noise std is 0 (give a noise > 0, or leave the seed out)",
+                format!(
+                    "has no effect: every noise std is 0 (give a noise of at least {}, or leave the seed out)",
+                    crate::display::Compact(MIN_NOISE_STD)
+                ),
             ));
         }
     }
@@ -474,7 +477,10 @@ fn noise_that_draws(field: &str, e: &Execution) -> Result<(), OptionsError> {
             if !n.draws() {
                 return Err(OptionsError::new(
                     &format!("{field}.pid.noise"),
-                    "draws no noise: every std is 0 (leave the section out, or give linear_rel_std > 0)",
+                    format!(
+                        "draws no noise: every std is 0 (leave the section out, or give linear_rel_std of at least {})",
+                        crate::display::Compact(MIN_NOISE_STD)
+                    ),
                 ));
             }
         }

@@ -209,6 +209,9 @@ def bench_run(
     """One ``ccpp bench`` run: (metrics, None) or (None, error message); ``name`` is the
     map's name in the results (default its file stem)."""
 
+def expand_maps(items: list[_Path]) -> list[Any]:
+    """The map files that files and folders stand for, as ``ccpp bench --maps`` takes them."""
+
 def name_maps(paths: list[_Path]) -> list[tuple[int, str]]:
     """The maps a sweep runs and their names, as ``ccpp bench`` names them: ``(index in
     paths, name)`` for every map kept (a file named twice is run once), in order."""

@@ -53,28 +53,13 @@ _METRIC_COLUMNS = CSV_COLUMNS[4:19]
 
 
 def expand_maps(items: Iterable[str | os.PathLike[str]] | str | os.PathLike[str]) -> list[Path]:
-    """Map files as ``ccpp bench --maps`` takes them: a folder gives its ``*.yaml``/``*.yml``
-    maps (or, when it has none, its PNG/PGM images), sorted; a file is taken as it is. A name
-    that is neither is refused, as ``ccpp bench`` refuses it, before any run."""
+    """Map files as ``ccpp bench --maps`` takes them (the same Rust function expands them): a
+    folder gives its ``*.yaml``/``*.yml`` maps (or, when it has none, its PNG/PGM images),
+    sorted; a file is taken as it is. A name that is neither, a folder without maps, or a map
+    whose name is not UTF-8 is refused, as ``ccpp bench`` refuses it, before any run."""
     if isinstance(items, (str, os.PathLike)):
         items = [items]
-    items = list(items)
-    if not items:
-        raise _ccpp.CcppError("maps is empty: give map files or folders")
-    out: list[Path] = []
-    for item in items:
-        p = Path(item)
-        if not p.exists():
-            raise _ccpp.CcppError(f"maps: {p}: no such file or folder")
-        if p.is_dir():
-            files = sorted(p.iterdir())
-            yamls = [f for f in files if f.suffix.lower() in (".yaml", ".yml")]
-            out.extend(yamls or [f for f in files if f.suffix.lower() in (".png", ".pgm", ".pnm")])
-        else:
-            out.append(p)
-    if not out:
-        raise _ccpp.CcppError("no map found in " + ", ".join(str(i) for i in items))
-    return out
+    return [Path(p) for p in _ccpp.expand_maps(list(items))]
 
 
 def _map_names(paths: list[Path]) -> list[tuple[Path, str]]:
