@@ -47,7 +47,7 @@ impl<'a> Scan<'a> {
     /// A scan of `map` around world point `center` with radius `range` metres. Only the simulator
     /// should build these.
     pub fn new(map: &'a GridMap, center: Point, range: f64) -> Self {
-        let g = map.frame().world_to_grid(center);
+        let g = map.frame().world_to_grid_snapped(center);
         Self {
             map,
             center: g,
