@@ -2566,7 +2566,10 @@ fn a_start_in_an_inflated_obstacle_names_the_inflation_and_map_sizes_are_rounded
 ///   `rmf_office_scan` with the origin at (1e6, 2e6) m: 1188 turns against 1165);
 /// - a sensor range that reaches a pixel centre exactly saw it or not with the rounding of the
 ///   robot's position, which depends on the origin: ba-star-extended on this room made 802
-///   turns at (0, 0), 743 at (1000, 2000) and 796 at (1e6, 2e6), bsa-extended 602, 613, 587.
+///   turns at (0, 0), 743 at (1000, 2000) and 796 at (1e6, 2e6), bsa-extended 602, 613, 587;
+/// - bcd read its start's grid position with that rounding (below).
+///
+/// What still depends on the origin is listed in the README ("Where the map lies").
 #[test]
 fn moving_the_map_origin_changes_only_coordinates() {
     let d = tempfile::tempdir().unwrap();
@@ -2608,4 +2611,32 @@ fn moving_the_map_origin_changes_only_coordinates() {
             );
         }
     }
+    // bcd read its start's grid position with the rounding of the origin too: on nav2_depot
+    // 570 turns at the map's own origin and at (0, 0), 596 at (1000, 2000).
+    let Some(shared) = common::shared_maps() else {
+        return;
+    };
+    let depot = shared.join("nav2_depot.yaml");
+    let mut seen = Vec::new();
+    for origin in ["0,0", "1000,2000"] {
+        let out = run_ok(
+            dir,
+            &format!("depot{origin}"),
+            &depot,
+            "bcd",
+            &["--origin", origin],
+        );
+        let m = read_json(&out.join("metrics.json"));
+        seen.push((
+            m["turns"].clone(),
+            m["regions"].clone(),
+            m["path_length_m"].as_f64().unwrap(),
+        ));
+    }
+    assert_eq!(
+        (&seen[0].0, &seen[0].1),
+        (&seen[1].0, &seen[1].1),
+        "{seen:?}"
+    );
+    assert!((seen[0].2 - seen[1].2).abs() < 1e-6, "{seen:?}");
 }

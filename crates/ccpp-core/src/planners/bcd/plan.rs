@@ -341,7 +341,7 @@ impl Bcd {
         }
         let best = best_index(&plans).map(|i| plans.swap_remove(i));
         let (items, ncells) = best.map_or((Vec::new(), 0), |(p, n)| (p.items, n));
-        let start = frame.world_to_grid(world.start().position());
+        let start = frame.world_to_grid_snapped(world.start().position());
 
         // A region whose moves the smoothing and pruning merged into the moves around it (or
         // a cell whose lane is a single point) has nothing left between its start and end: it
@@ -453,7 +453,7 @@ impl Bcd {
         let (w, h) = (lat.w, lat.h);
         let sp = (spacing / res).max(1.0);
         let turn_px = opts.turn_cost_m / res;
-        let start = frame.world_to_grid(world.start().position());
+        let start = frame.world_to_grid_snapped(world.start().position());
 
         // 1-2. Both decompositions, each cell's cheaper lane direction, the cheaper total.
         // Lines across a cell that a jagged wall's bumps split may be left out of its view
