@@ -66,13 +66,20 @@ pub(crate) fn fields(line: &str) -> impl Iterator<Item = &str> {
 /// without its comment (from `#` to the end of the line) and surrounding white space; lines
 /// left empty are skipped. A byte-order mark (Excel's "CSV UTF-8") is no part of the first
 /// field. A trailing comment is a comment too: `0,0,0,10 # corner` was taken for a header and
-/// its pair dropped without a word.
-pub(crate) fn content_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
+/// its pair dropped without a word. The flag says whether the line is a header: the first
+/// content line, with no number at all (`px,py,wx,wy`; a first line `-1,1.5,1.5` with a bad
+/// field is a data line, to be refused, not a header to skip).
+pub(crate) fn content_lines(text: &str) -> impl Iterator<Item = (usize, &str, bool)> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     text.lines()
         .enumerate()
         .map(|(n, raw)| (n, raw.split('#').next().unwrap_or_default().trim()))
         .filter(|(_, line)| !line.is_empty())
+        .enumerate()
+        .map(|(k, (n, line))| {
+            let header = k == 0 && fields(line).all(|f| f.parse::<f64>().is_err());
+            (n, line, header)
+        })
 }
 
 /// Parses `(pixel, world)` pairs from the text of a georef file.
@@ -82,14 +89,10 @@ pub(crate) fn content_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
 /// header on the first content line).
 pub fn parse_georef(text: &str) -> Result<Vec<(Point, Point)>, GeorefProblem> {
     let mut pairs = Vec::new();
-    let mut first = true;
-    for (n, line) in content_lines(text) {
+    for (n, line, header) in content_lines(text) {
         let nums: Option<Vec<f64>> = fields(line)
             .map(|f| f.parse::<f64>().ok().filter(|v| v.is_finite()))
             .collect();
-        // A header has no number at all (`px,py,wx,wy`).
-        let header =
-            std::mem::replace(&mut first, false) && fields(line).all(|f| f.parse::<f64>().is_err());
         match nums {
             Some(v) if v.len() == 4 => {
                 if pairs.len() == MAX_GEOREF_PAIRS {

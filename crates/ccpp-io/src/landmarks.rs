@@ -106,14 +106,11 @@ pub fn parse_landmarks(text: &str) -> Result<Vec<Landmark>, LandmarkFileError> {
         })?
     } else {
         let mut out = Vec::new();
-        let mut first = true;
-        // Lines as in a georef file: a byte-order mark, trailing comments and blank lines
-        // (a file saved as Excel's "CSV UTF-8" lost its first landmark as a "header").
-        for (n, line) in content_lines(text) {
-            // A header has no number at all (`id,x,y`), as in a georef file: a first line
-            // `-1,1.5,1.5` (a bad id) was taken for a header and dropped without a word.
-            let header = std::mem::replace(&mut first, false)
-                && fields(line).all(|f| f.parse::<f64>().is_err());
+        // Lines and headers as in a georef file: a byte-order mark, trailing comments and
+        // blank lines (a file saved as Excel's "CSV UTF-8" lost its first landmark as a
+        // "header"); a header has no number at all (`id,x,y`: a first line `-1,1.5,1.5`, a bad
+        // id, was taken for a header and dropped without a word).
+        for (n, line, header) in content_lines(text) {
             match parse_csv_line(line) {
                 Some(_) if out.len() == MAX_LANDMARKS => return Err(LandmarkFileError::TooMany),
                 Some(l) => out.push(l),
