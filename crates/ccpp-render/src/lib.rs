@@ -127,8 +127,13 @@ pub fn approach_end(world: &World, trace: &Trace) -> Option<(usize, ccpp_core::P
 /// Why the simulator stopped a run the planner did not finish (`stalled`, `max_steps`): the
 /// reason of the trace's `finished` event when it is not `done`.
 pub fn stop_reason(trace: &Trace) -> Option<String> {
-    trace.events().find_map(|(_, e)| match e {
-        Event::Finished { reason } if reason != "done" => Some(reason.clone()),
+    finished_record(trace).and_then(|(_, reason)| (reason != "done").then(|| reason.to_string()))
+}
+
+/// The step and reason of the trace's `finished` event, when it has one.
+pub(crate) fn finished_record(trace: &Trace) -> Option<(u64, &str)> {
+    trace.events().find_map(|(t, e)| match e {
+        Event::Finished { reason } => Some((t, reason.as_str())),
         _ => None,
     })
 }

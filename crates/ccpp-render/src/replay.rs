@@ -11,7 +11,7 @@ use ccpp_core::Point;
 use tiny_skia::{Color, Pixmap};
 
 use crate::colours::{AREA_BORDER, KEEPOUT, KEEPOUT_HATCH, OUTSIDE_AREA};
-use crate::{approach_end, crop_box, stop_reason, zone_class, RenderError};
+use crate::{approach_end, crop_box, finished_record, zone_class, RenderError};
 
 /// Map class colours shared by the replay page and the GIF.
 const C_OCC: [u8; 3] = [30, 30, 30];
@@ -403,17 +403,16 @@ fn replay_data(
     let yaw = f.origin.theta;
     let zones = zones_js(world, crop);
     let approach = approach_pose.map_or_else(|| "null".to_string(), |i| display(i).to_string());
-    let stop = stop_reason(trace).map_or_else(
+    // The stop reason (a run the planner did not finish) and the step the run ended at, both
+    // from the `finished` record: a run the simulator stopped for a stall holds a thousand
+    // steps after its last move, and the page's step count ended at that move (64 / 64 for a
+    // run stopped at step 1063).
+    let finished = finished_record(trace);
+    let stop = finished.filter(|(_, why)| *why != "done").map_or_else(
         || "null".to_string(),
-        |why| serde_json::Value::String(why).to_string(),
+        |(_, why)| serde_json::Value::String(why.to_string()).to_string(),
     );
-    // The step the run ended at (its `finished` record): a run the simulator stopped for a
-    // stall holds a thousand steps after its last move, and the page's step count ended at
-    // that move (64 / 64 for a run stopped at step 1063).
-    let last = trace
-        .events()
-        .find_map(|(t, e)| matches!(e, Event::Finished { .. }).then_some(t))
-        .map_or_else(|| "null".to_string(), |t| t.to_string());
+    let last = finished.map_or_else(|| "null".to_string(), |(t, _)| t.to_string());
     let classes = classes_js(world, crop);
     format!(
         r#"{{"w":{w},"h":{h},"res":{res},"yaw":{yaw},"r":{r},"rt":{rt},"swept_r":{swept_r},"tile":{tile},"start":[{sx},{sy},{st}],"n":{n},"m":{m},"q":{q},"blob":"{blob}","events":{events},"nt":{nt},"tblob":"{tblob}","cov":{cov},"palette":{palette},"zones":{zones},"approach":{approach},"stop":{stop},"last":{last},"classes":{classes},"metrics":{metrics}}}"#,
