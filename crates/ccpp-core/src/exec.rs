@@ -245,7 +245,10 @@ pub struct PidOptions {
     pub lookahead_m: f64,
     /// Record the true pose in the trace every this many control steps (the end of every motion
     /// and the poses where the robot starts or stops turning in place are always recorded, so
-    /// the turns counted do not depend on it). 1 = every step.
+    /// the turns counted do not depend on it; the tracking error is measured on every step,
+    /// [`crate::trace::Event::Tracking`]). 1 = every step but those inside a straight
+    /// glide along a map axis, which lie exactly on the segment between the poses recorded
+    /// (see [`crate::sim`]).
     pub record_every: u32,
     /// Safety cap on control steps per motion (a motion that has not converged by then ends
     /// where it is).

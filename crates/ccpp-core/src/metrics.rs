@@ -76,8 +76,9 @@ pub struct Metrics {
     pub keepout_violations: u32,
     /// Planning + simulation wall time, seconds (the one non-deterministic figure).
     pub wall_time_s: f64,
-    /// PID execution only: mean distance of the recorded true poses from the segment they were
-    /// following ([`Event::PlannedSegment`]), metres. Absent for ideal execution.
+    /// PID execution only: mean distance of the true pose from the segment it was following
+    /// ([`Event::PlannedSegment`]) over every control step ([`Event::Tracking`]), metres.
+    /// Absent for ideal execution.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tracking_error_mean_m: Option<f64>,
     /// PID execution only: largest such distance, metres.
@@ -95,10 +96,19 @@ pub struct Metrics {
     pub stop_reason: Option<String>,
 }
 
-/// Tracking error of a PID run: `(mean, max)` distance of the pose records from the planned
-/// segment in force (the last [`Event::PlannedSegment`] before them); `None` when the trace has
-/// no planned segment (ideal execution).
+/// Tracking error of a PID run: `(mean, max)` distance of the true pose from the planned
+/// segment in force (the last [`Event::PlannedSegment`]) over every control step, as the
+/// simulator's [`Event::Tracking`] gives it; for a trace without one (written before it
+/// existed, or cut short), over the pose records; `None` when the trace has no planned
+/// segment (ideal execution).
 pub fn tracking_error(trace: &Trace) -> Option<(f64, f64)> {
+    let given = trace.events().fold(None, |last, (_, e)| match e {
+        Event::Tracking { mean_m, max_m, .. } => Some((*mean_m, *max_m)),
+        _ => last,
+    });
+    if given.is_some() {
+        return given;
+    }
     // Without a planned segment no pose counts (the events alone tell, without the poses).
     if !trace
         .events()

@@ -15,7 +15,9 @@
 //!   landmark observations when [`SimConfig::landmarks`] has some ([`crate::landmarks`]).
 //!   The trace gets an [`Event::Execution`] at the start, an [`Event::PlannedSegment`] before
 //!   each translation, and true poses every `record_every` control steps plus at the end of
-//!   each motion and where the robot starts or stops turning in place. `MoveTo` follows the
+//!   each motion and where the robot starts or stops turning in place, except the poses inside
+//!   a straight glide along a map axis (see `Glide`: they lie exactly on the segment between
+//!   the poses kept, so the recorded path is the same). `MoveTo` follows the
 //!   segment from the previous planned goal (when the last motion ended without contact) to
 //!   the new one, so the robot steers back onto the plan.
 //!
@@ -181,6 +183,82 @@ impl TrigMemo {
     }
 }
 
+/// The pose records of one PID motion, without the control steps of a straight glide.
+///
+/// A robot driving straight along a map axis (bsa-bfs from cell to cell) keeps its heading
+/// and one coordinate bit for bit while the other one runs on: such a pose lies exactly on
+/// the segment between the poses before and after it, so it adds nothing to the recorded path
+/// (its length, its swept floor, the tile centres it passes, its turns). It is held back and
+/// dropped once the next pose carries the glide on; the glide's last pose is recorded. Every
+/// other pose is recorded as it comes (under odometry noise, or on a diagonal, nothing is
+/// dropped). Without this, `bsa-bfs` on `tuw_freihaus_eg` recorded 4 070 276 poses, 98.5 % of
+/// them inside such glides, and wrote a 305 MB `trace.jsonl`.
+struct Glide {
+    /// The last pose recorded in the trace.
+    last: Pose,
+    /// A pose not recorded yet, on the glide from `last`.
+    held: Option<Pose>,
+}
+
+impl Glide {
+    /// A motion from `last`, the trace's last pose.
+    fn at(last: Pose) -> Self {
+        Self { last, held: None }
+    }
+
+    /// Records `p` (at step `t`) unless it may lie inside a straight glide.
+    fn offer(&mut self, trace: &mut Trace, t: u64, p: Pose) {
+        if let Some(h) = self.held {
+            if glides_on(self.last, h, p) {
+                self.held = Some(p);
+                return;
+            }
+            trace.push_pose(t, h);
+            self.last = h;
+            self.held = None;
+        }
+        if glide_step(self.last, p).is_some() {
+            self.held = Some(p);
+        } else {
+            trace.push_pose(t, p);
+            self.last = p;
+        }
+    }
+
+    /// Records the held pose, if any (before an event, and at the end of the motion).
+    fn flush(&mut self, trace: &mut Trace, t: u64) {
+        if let Some(h) = self.held.take() {
+            trace.push_pose(t, h);
+            self.last = h;
+        }
+    }
+}
+
+/// Whether `b` moves on from `a` along a map axis without turning (heading and one coordinate
+/// the same bit for bit, the other one different): `Some(true)` along x, `Some(false)` along y.
+fn glide_step(a: Pose, b: Pose) -> Option<bool> {
+    let same = |u: f64, v: f64| u.to_bits() == v.to_bits();
+    if !same(a.theta, b.theta) {
+        return None;
+    }
+    match (same(a.x, b.x), same(a.y, b.y)) {
+        (false, true) => Some(true),
+        (true, false) => Some(false),
+        _ => None,
+    }
+}
+
+/// Whether `a -> h -> p` is one straight glide along an axis with `h` strictly between `a`
+/// and `p` (so dropping `h` leaves the path exactly as it was).
+fn glides_on(a: Pose, h: Pose, p: Pose) -> bool {
+    let between = |a: f64, h: f64, p: f64| (a < h && h < p) || (a > h && h > p);
+    match (glide_step(a, h), glide_step(h, p)) {
+        (Some(true), Some(true)) => between(a.x, h.x, p.x),
+        (Some(false), Some(false)) => between(a.y, h.y, p.y),
+        _ => false,
+    }
+}
+
 /// PID execution state.
 struct PidState {
     opts: PidOptions,
@@ -193,6 +271,30 @@ struct PidState {
     since_fix: u64,
     /// Motions stopped at `max_steps_per_motion` before their goal, so far.
     cut: u64,
+    /// The planned segment in force (the last [`Event::PlannedSegment`]).
+    seg: Option<(Point, Point)>,
+    /// The tracking error so far ([`Event::Tracking`]).
+    tracking: TrackingTally,
+}
+
+/// Distances of the true pose from the planned segment, summed over the control steps.
+#[derive(Clone, Copy, Debug, Default)]
+struct TrackingTally {
+    sum: f64,
+    max: f64,
+    n: u64,
+}
+
+impl TrackingTally {
+    /// Measures pose `p` against `seg` (nothing before the first segment).
+    fn add(&mut self, seg: Option<(Point, Point)>, p: Pose) {
+        if let Some((a, b)) = seg {
+            let d = crate::geometry::point_segment_dist2(p.position(), a, b).sqrt();
+            self.sum += d;
+            self.max = self.max.max(d);
+            self.n += 1;
+        }
+    }
 }
 
 /// Drives a planner over a world.
@@ -294,6 +396,8 @@ impl<'w> Simulator<'w> {
                 landmarks: self.landmarks.clone(),
                 since_fix: 0,
                 cut: 0,
+                seg: None,
+                tracking: TrackingTally::default(),
             });
         }
     }
@@ -311,6 +415,20 @@ impl<'w> Simulator<'w> {
     /// The trace so far.
     pub fn trace(&self) -> &Trace {
         &self.trace
+    }
+
+    /// The [`Event::Tracking`] of the run so far: PID execution after a planned segment only
+    /// (a run ends its trace with it; a caller stepping through [`Self::execute`] appends it
+    /// to a copy of the trace for the tracking metrics).
+    pub fn tracking(&self) -> Option<Event> {
+        let st = self.pid.as_ref()?;
+        st.seg?;
+        let t = st.tracking;
+        Some(Event::Tracking {
+            mean_m: if t.n == 0 { 0.0 } else { t.sum / t.n as f64 },
+            max_m: t.max,
+            steps: t.n,
+        })
     }
 
     /// Executes one step (anything but `Done`).
@@ -431,6 +549,9 @@ impl<'w> Simulator<'w> {
     }
 
     fn push_segment(&mut self, from: Point, to: Point) {
+        if let Some(st) = self.pid.as_mut() {
+            st.seg = Some((from, to));
+        }
         self.trace.push_event(
             self.t,
             Event::PlannedSegment {
@@ -458,6 +579,8 @@ impl<'w> Simulator<'w> {
         let mut contact = false;
         let mut moved = false;
         let mut since_record = 0u64;
+        // The motion starts where the trace's last pose is.
+        let mut glide = Glide::at(self.pose);
         // Control steps run; all of them (and no contact): the motion was cut at the cap.
         let mut ran = 0u32;
         // Whether the last command turned in place (no linear speed).
@@ -474,7 +597,7 @@ impl<'w> Simulator<'w> {
             let in_place = v == 0.0;
             if was_in_place.is_some_and(|was| was != in_place) && moved {
                 since_record = 0;
-                self.trace.push_pose(self.t, self.pose);
+                glide.offer(&mut self.trace, self.t, self.pose);
                 moved = false;
             }
             was_in_place = Some(in_place);
@@ -513,8 +636,10 @@ impl<'w> Simulator<'w> {
                     self.est.theta + t * wrap_angle(new_est.theta - self.est.theta),
                 );
                 if t > 0.0 {
-                    self.trace.push_pose(self.t, self.pose);
+                    st.tracking.add(st.seg, self.pose);
+                    glide.offer(&mut self.trace, self.t, self.pose);
                 }
+                glide.flush(&mut self.trace, self.t);
                 self.trace
                     .push_event(self.t, Event::Collision { x: p.x, y: p.y });
                 contact = true;
@@ -522,22 +647,27 @@ impl<'w> Simulator<'w> {
             }
             self.pose = new_true;
             self.est = new_est;
+            st.tracking.add(st.seg, self.pose);
             moved = true;
             since_record += 1;
             if since_record >= every {
                 since_record = 0;
-                self.trace.push_pose(self.t, self.pose);
+                glide.offer(&mut self.trace, self.t, self.pose);
                 moved = false;
             }
             st.since_fix += 1;
             if st.since_fix >= fix_every {
                 st.since_fix = 0;
-                self.landmark_fix(&st.landmarks);
+                if let Some(fix) = self.landmark_fix(&st.landmarks) {
+                    glide.flush(&mut self.trace, self.t);
+                    self.trace.push_event(self.t, fix);
+                }
             }
         }
         if moved {
-            self.trace.push_pose(self.t, self.pose);
+            glide.offer(&mut self.trace, self.t, self.pose);
         }
+        glide.flush(&mut self.trace, self.t);
         if !contact
             && ran == st.opts.max_steps_per_motion
             && st.tracker.command(self.est, goal).is_some()
@@ -568,24 +698,18 @@ impl<'w> Simulator<'w> {
     }
 
     /// Observes the nearest landmark in range (from the truth) and resets the estimate to the
-    /// candidate closest to it.
-    fn landmark_fix(&mut self, cfg: &LandmarkConfig) {
-        let Some(l) = nearest_in_range(self.pose.position(), &cfg.landmarks, cfg.range_m) else {
-            return;
-        };
+    /// candidate closest to it; returns the [`Event::LandmarkFix`] to record, if it did.
+    fn landmark_fix(&mut self, cfg: &LandmarkConfig) -> Option<Event> {
+        let l = nearest_in_range(self.pose.position(), &cfg.landmarks, cfg.range_m)?;
         let obs = observe(self.pose, l);
-        if let Some(p) = choose_pose(self.est, &obs, &cfg.landmarks) {
-            self.est = p;
-            self.trace.push_event(
-                self.t,
-                Event::LandmarkFix {
-                    id: obs.id,
-                    x: p.x,
-                    y: p.y,
-                    theta: p.theta,
-                },
-            );
-        }
+        let p = choose_pose(self.est, &obs, &cfg.landmarks)?;
+        self.est = p;
+        Some(Event::LandmarkFix {
+            id: obs.id,
+            x: p.x,
+            y: p.y,
+            theta: p.theta,
+        })
     }
 
     /// Runs `planner` to completion (or the step cap).
@@ -682,6 +806,9 @@ impl<'w> Simulator<'w> {
                 );
                 self.trace.push_event(self.t, Event::Note { text });
             }
+        }
+        if let Some(e) = self.tracking() {
+            self.trace.push_event(self.t, e);
         }
         self.trace.push_event(
             self.t,
@@ -934,6 +1061,109 @@ mod tests {
         assert!(max < 0.03 + 1e-9, "coarse max {max}");
     }
 
+    /// A PID motion's poses recorded through [`Glide`] make the same path as all of them:
+    /// the same metrics (length within rounding, the same swept floor, tiles, turns), with
+    /// only the poses inside straight axis glides left out.
+    #[test]
+    fn glides_record_the_same_path_with_fewer_poses() {
+        let world = big_room();
+        // Control steps as a PID motion makes them: decelerating along x, a reversal, a spin,
+        // a glide along y, a diagonal, steps that repeat a pose, a glide that ends sideways.
+        let mut steps: Vec<Pose> = Vec::new();
+        let mut x = 4.0;
+        for k in 0..40 {
+            x += 0.025 * 0.9f64.powi(k);
+            steps.push(Pose::new(x, 4.0, 0.0));
+        }
+        for k in 0..5 {
+            steps.push(Pose::new(x - 0.01 * f64::from(k + 1), 4.0, 0.0));
+        }
+        let x = steps.last().unwrap().x;
+        for k in 0..10 {
+            steps.push(Pose::new(x, 4.0, 0.15 * f64::from(k + 1)));
+        }
+        let th = steps.last().unwrap().theta;
+        let mut y = 4.0;
+        for k in 0..30 {
+            y += 0.02 + 0.001 * f64::from(k % 3);
+            steps.push(Pose::new(x, y, th));
+        }
+        steps.push(Pose::new(x, y, th));
+        steps.push(Pose::new(x, y, th));
+        for k in 0..10 {
+            let d = 0.01 * f64::from(k + 1);
+            steps.push(Pose::new(x + d, y + d, th));
+        }
+        let (x, y) = (steps.last().unwrap().x, steps.last().unwrap().y);
+        for k in 0..8 {
+            steps.push(Pose::new(x + 0.03 * f64::from(k + 1), y, th));
+        }
+        steps.push(Pose::new(x + 0.24, y + 0.05, th));
+        let start = Pose::new(4.0, 4.0, 0.0);
+        let mut all = Trace::default();
+        all.push_pose(0, start);
+        let mut thin = all.clone();
+        for &p in &steps {
+            all.push_pose(1, p);
+        }
+        let mut glide = Glide::at(start);
+        for &p in &steps {
+            glide.offer(&mut thin, 1, p);
+        }
+        glide.flush(&mut thin, 1);
+        let (n_all, n_thin) = (all.poses().count(), thin.poses().count());
+        assert!(n_thin * 3 < n_all, "{n_thin} of {n_all} poses recorded");
+        // Every pose recorded is one of the motion's, in order, and the last one is there.
+        let kept: Vec<Pose> = thin.poses().skip(1).collect();
+        let mut it = steps.iter();
+        assert!(kept.iter().all(|k| it.any(|p| p == k)));
+        assert_eq!(kept.last(), steps.last());
+        let metrics = |trace: Trace| {
+            let out = RunOutput {
+                trace,
+                stop: StopReason::Done,
+                tile_side: Some(0.3),
+                planner: "script",
+                wall_time_s: 0.0,
+            };
+            crate::metrics::compute(&world, &out, "room")
+        };
+        let (a, b) = (metrics(all), metrics(thin));
+        assert!((a.path_length_m - b.path_length_m).abs() < 1e-12);
+        assert_eq!(a.effective_coverage, b.effective_coverage);
+        assert_eq!(a.coverage_rate, b.coverage_rate);
+        assert_eq!(a.revisit_rate, b.revisit_rate);
+        assert_eq!(a.turns, b.turns);
+        assert!((a.rotation_rad - b.rotation_rad).abs() < 1e-12);
+        assert!(a.effective_coverage > 0.0 && a.turns > 0);
+    }
+
+    /// A PID run along the axes records the ends of its glides, not its control steps.
+    #[test]
+    fn a_pid_square_records_its_corners_not_its_control_steps() {
+        let world = big_room();
+        let out = simulate(&world, &mut Script(square(2)), &pid(None));
+        let poses: Vec<Pose> = out.trace.poses().collect();
+        // Two laps of four sides: each side's glide is one pose; each corner's turn in place
+        // is recorded step by step (its start and end are what `turns` counts).
+        let at_corners = poses
+            .iter()
+            .filter(|p| {
+                [(4.0, 4.0), (5.0, 4.0), (5.0, 5.0), (4.0, 5.0)]
+                    .iter()
+                    .any(|&(x, y)| Point::new(x, y).dist(p.position()) < 1e-6)
+            })
+            .count();
+        assert!(
+            poses.len() - at_corners <= 8,
+            "{} poses, {at_corners} at corners",
+            poses.len()
+        );
+        let m = crate::metrics::compute(&world, &out, "room");
+        assert!((m.path_length_m - 8.0).abs() < 1e-9, "{}", m.path_length_m);
+        assert_eq!(m.turns, 7);
+    }
+
     /// Thinning the PID trace keeps the in-place turns: the pose where a turn starts or ends
     /// is recorded whatever `record_every` is (it once gave 0 turns at 1000).
     #[test]
@@ -961,6 +1191,58 @@ mod tests {
                 full.rotation_rad
             );
             assert!((m.path_length_m - full.path_length_m).abs() < 1e-6);
+        }
+    }
+
+    /// The tracking error is measured over every control step, so thinning the records does
+    /// not change it (over the recorded poses, a noisy run's mean moved with `record_every`).
+    #[test]
+    fn the_tracking_error_does_not_depend_on_the_records_kept() {
+        let world = big_room();
+        let cfg = |record_every| SimConfig {
+            exec: Some(Execution::Pid(PidOptions {
+                record_every,
+                noise: Some(OdometryNoise {
+                    seed: 7,
+                    ..OdometryNoise::default()
+                }),
+                ..PidOptions::default()
+            })),
+            ..SimConfig::default()
+        };
+        let full = simulate(&world, &mut Script(square(2)), &cfg(1));
+        let (mean, max) = crate::metrics::tracking_error(&full.trace).unwrap();
+        assert!(mean > 1e-4 && max > mean, "{mean} {max}");
+        // The figure from the records alone, for comparison: the trace without its event.
+        let records_only = |trace: &Trace| {
+            let mut out = Trace::default();
+            for e in trace.entries() {
+                match e {
+                    crate::trace::Entry::Pose { t, pose } => out.push_pose(t, pose),
+                    crate::trace::Entry::Event {
+                        event: Event::Tracking { .. },
+                        ..
+                    } => {}
+                    crate::trace::Entry::Event { t, event } => out.push_event(t, event.clone()),
+                }
+            }
+            out
+        };
+        let records = records_only(&full.trace);
+        for n in [3, 10] {
+            let thin = simulate(&world, &mut Script(square(2)), &cfg(n));
+            assert!(thin.trace.pose_count() < full.trace.pose_count());
+            assert_eq!(
+                crate::metrics::tracking_error(&thin.trace),
+                Some((mean, max)),
+                "record_every {n}"
+            );
+            let rec = records_only(&thin.trace);
+            assert_ne!(
+                crate::metrics::tracking_error(&rec).map(|m| m.0),
+                crate::metrics::tracking_error(&records).map(|m| m.0),
+                "record_every {n}: the records alone give another mean"
+            );
         }
     }
 

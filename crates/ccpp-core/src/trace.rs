@@ -135,6 +135,19 @@ pub enum Event {
         /// Goal, world.
         to: [f64; 2],
     },
+    /// PID execution only: how far the true pose was from the planned segment in force (the
+    /// last [`Event::PlannedSegment`]), over every control step after the first segment (and
+    /// the pose of each contact), written once before [`Event::Finished`]: the
+    /// `tracking_error_*` metrics. The trace's poses are a sample of those steps (one in
+    /// `record_every`, and none inside a straight glide), so the figures come from here.
+    Tracking {
+        /// Mean distance, metres.
+        mean_m: f64,
+        /// Largest distance, metres.
+        max_m: f64,
+        /// Poses measured (control steps and contacts).
+        steps: u64,
+    },
     /// Rectangular-robot lane sweep (seed 001): lane spacing and robot length, for the
     /// `rect_guarantee` metric.
     RectLanes {

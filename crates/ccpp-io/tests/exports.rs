@@ -28,9 +28,10 @@ fn shared(name: &str) -> Option<PathBuf> {
 }
 
 #[test]
-fn bsa_bfs_path_csv_on_tuw_freihaus_eg_is_small() {
-    // bsa-bfs runs under PID execution: about 4 million control-step poses on this map, which
-    // path.csv used to list one a line (194 MB).
+fn bsa_bfs_files_on_tuw_freihaus_eg_are_small() {
+    // bsa-bfs runs under PID execution: about 4 million control steps on this map, which
+    // path.csv used to list one a line (194 MB) and trace.jsonl one a line too (305 MB): the
+    // trace now keeps the ends of the straight glides along the axes (98.5 % of the steps).
     let Some(map) = shared("tuw_freihaus_eg.yaml") else {
         return;
     };
@@ -44,9 +45,15 @@ fn bsa_bfs_path_csv_on_tuw_freihaus_eg_is_small() {
     let poses = trace.poses().count();
     let csv = path_csv(trace);
     let rows = csv.lines().count() - 1;
-    assert!(poses > 1_000_000, "{poses} poses");
+    assert!((40_000..400_000).contains(&poses), "{poses} poses");
+    let jsonl = ccpp_io::trace::trace_jsonl(trace).unwrap();
+    assert!(
+        jsonl.len() < 40_000_000,
+        "trace.jsonl is {} bytes",
+        jsonl.len()
+    );
     assert!(csv.len() < 3_000_000, "path.csv is {} bytes", csv.len());
-    assert!(rows * 100 < poses, "{rows} rows for {poses} poses");
+    assert!(rows * 20 < poses, "{rows} rows for {poses} poses");
     // The metrics are those of the full trace (the decimated path is not what is measured).
     let all: Vec<_> = trace.poses().collect();
     let full: f64 = all

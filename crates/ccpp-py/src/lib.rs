@@ -2126,7 +2126,12 @@ impl Env {
     fn metrics(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
         let ep = self.episode()?;
         let world = ep.borrow_owner();
-        let trace: Trace = ep.borrow_dependent().sim.trace().clone();
+        let sim = &ep.borrow_dependent().sim;
+        let mut trace: Trace = sim.trace().clone();
+        // The tracking error over every control step so far (a run's trace ends with it).
+        if let Some(e) = sim.tracking() {
+            trace.push_event(0, e);
+        }
         let out = RunOutput {
             trace,
             // The episode so far: no early-stop reason in its metrics.
