@@ -123,14 +123,14 @@ pub fn run(a: &InfoArgs) -> Result<()> {
         Err(e @ WorldError::RobotTooBig { .. }) => (
             None,
             Some(
-                ccpp_io::scenario::inflated_world_error(&e, map.recipe.inflate)
+                ccpp_io::scenario::inflated_world_error(&e, map.recipe.inflation())
                     .unwrap_or_else(|| e.to_string()),
             ),
         ),
         // A start the user gave that does not work is a user error.
         Err(e) => {
             return Err(
-                match ccpp_io::scenario::inflated_world_error(&e, map.recipe.inflate) {
+                match ccpp_io::scenario::inflated_world_error(&e, map.recipe.inflation()) {
                     Some(m) => anyhow::anyhow!("map {}: {m}", map.source.display()),
                     None => anyhow::Error::new(e).context(format!("map {}", map.source.display())),
                 },
@@ -157,7 +157,7 @@ pub fn run(a: &InfoArgs) -> Result<()> {
             free_thresh: map.thresholds.free,
             negate: map.thresholds.negate,
         },
-        inflate_m: map.recipe.inflate.filter(|m| *m > 0.0),
+        inflate_m: map.recipe.inflation(),
         free_px: free,
         occupied_px: occ,
         unknown_px: unk,

@@ -392,7 +392,7 @@ pub fn emit(
     }
     let mut s = summary(&r.metrics);
     let _ = writeln!(s, "  start area: {}", comp.line());
-    if let Some(m) = job.scenario.map.inflate.filter(|m| *m > 0.0) {
+    if let Some(m) = job.scenario.map.inflation() {
         // The figures above are on the grown map, not the map as drawn: said where they are
         // read (with 0.3 m, teb_empty_box's coverage rose from 0.907 to 0.973 while the floor
         // swept of the drawn map fell by a tenth).

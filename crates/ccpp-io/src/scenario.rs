@@ -251,6 +251,12 @@ pub struct PreparedMap {
 }
 
 impl MapRecipe {
+    /// The inflation in metres when it grows the obstacles (`inflate` above 0), else `None`:
+    /// every figure of a run, plan or `info` is then on the grown map, which their reports say.
+    pub fn inflation(&self) -> Option<f64> {
+        self.inflate.filter(|m| *m > 0.0)
+    }
+
     /// A recipe for the map file `path`, no overrides.
     pub fn file(path: impl Into<PathBuf>) -> Self {
         Self {
@@ -438,13 +444,13 @@ fn about_mb(bytes: f64) -> String {
     }
 }
 
-/// What a world error on a map whose obstacles `--inflate` grew by `inflate` m says, naming
-/// the inflation (the likely cause), or `None` for an error the inflation has no part in (or
-/// no inflation). A robot that fits nowhere: the widest free spot left; a start in an
-/// obstacle: the start may be free on the map as drawn. `run`'s refusal and `info`'s report
-/// both say it this way.
-pub fn inflated_world_error(e: &WorldError, inflate: Option<f64>) -> Option<String> {
-    let m = inflate.filter(|m| *m > 0.0)?;
+/// What a world error on a map whose obstacles `--inflate` grew by `inflation` m
+/// ([`MapRecipe::inflation`]) says, naming the inflation (the likely cause), or `None` for an
+/// error the inflation has no part in (or no inflation). A robot that fits nowhere: the widest
+/// free spot left; a start in an obstacle: the start may be free on the map as drawn. `run`'s
+/// refusal and `info`'s report both say it this way.
+pub fn inflated_world_error(e: &WorldError, inflation: Option<f64>) -> Option<String> {
+    let m = inflation?;
     match e {
         WorldError::RobotTooBig {
             radius,
@@ -1197,7 +1203,7 @@ impl Scenario {
     /// wall or a robot that fits nowhere.
     pub fn world(&self, map: &PreparedMap) -> Result<World, ScenarioError> {
         let zones = self.world_checks(map)?;
-        self.world_on(map.grid.clone(), &map.source, map.recipe.inflate, zones)
+        self.world_on(map.grid.clone(), &map.source, map.recipe.inflation(), zones)
     }
 
     /// The checks before a world is built; returns the zone masks.
@@ -1220,7 +1226,7 @@ impl Scenario {
         map: &PreparedMap,
         zones: Option<ZoneMasks>,
     ) -> Result<World, ScenarioError> {
-        self.world_on(map.grid.clone(), &map.source, map.recipe.inflate, zones)
+        self.world_on(map.grid.clone(), &map.source, map.recipe.inflation(), zones)
     }
 
     /// A planner's check failure as [`ScenarioError::Degenerate`] on the map `source`.
@@ -1237,8 +1243,6 @@ impl Scenario {
         }
     }
 
-    /// Builds the world on `grid` (the prepared map's, loaded from `source` and grown by
-    /// `inflate` metres) and runs the planner's checks against it.
     /// Refuses a map (with its zones) whose digest is not the scenario's `map_digest`, before
     /// the world is built: a start now in a wall is the edit's consequence, not the news.
     fn check_digest(
@@ -1274,11 +1278,15 @@ impl Scenario {
         Ok(())
     }
 
+    /// Builds the world on `grid` (the prepared map's, loaded from `source` and grown by
+    /// `inflation` metres when that is `Some`) after [`Self::check_digest`], and runs the
+    /// planner's checks against it; a world error the inflation likely caused names it
+    /// ([`inflated_world_error`]).
     fn world_on(
         &self,
         grid: GridMap,
         source: &Path,
-        inflate: Option<f64>,
+        inflation: Option<f64>,
         zones: Option<ZoneMasks>,
     ) -> Result<World, ScenarioError> {
         self.check_digest(&grid, zones.as_ref(), source)?;
@@ -1291,7 +1299,7 @@ impl Scenario {
                     message: format!("{source_err} (map {})", source.display()),
                 },
                 // An error the inflation likely caused names it.
-                None => match inflated_world_error(&source_err, inflate) {
+                None => match inflated_world_error(&source_err, inflation) {
                     Some(m) => ScenarioError::Invalid(format!("map {}: {m}", source.display())),
                     None => ScenarioError::World {
                         path: source.to_path_buf(),
@@ -1407,7 +1415,7 @@ impl Scenario {
             self.world_on(
                 prepared.grid,
                 &prepared.source,
-                prepared.recipe.inflate,
+                prepared.recipe.inflation(),
                 zones,
             )
         })?;
