@@ -143,24 +143,50 @@ fn map_name(p: &Path) -> String {
 /// for its run folders, rows and plots: the file stem, or, when two maps in different folders
 /// share a stem, `<folder>-<stem>` (then `-2`, `-3`, ... if that still repeats).
 pub fn name_maps(maps: Vec<PathBuf>) -> Vec<(PathBuf, String)> {
-    let mut seen = Vec::new();
-    let mut kept = Vec::new();
-    for m in maps {
-        let canon = std::fs::canonicalize(&m).unwrap_or_else(|_| m.clone());
-        if !seen.contains(&canon) {
-            seen.push(canon);
-            kept.push(m);
+    let named = name_maps_indexed(&maps);
+    let mut maps: Vec<Option<PathBuf>> = maps.into_iter().map(Some).collect();
+    named
+        .into_iter()
+        .filter_map(|(i, name)| Some((maps[i].take()?, name)))
+        .collect()
+}
+
+/// [`name_maps`] by position: `(index in maps, name)` for every map kept, in order. In
+/// `O(n log n)` for `n` maps (ordered sets and counts; a sweep may name thousands).
+pub fn name_maps_indexed(maps: &[PathBuf]) -> Vec<(usize, String)> {
+    use std::collections::{BTreeMap, BTreeSet};
+    fn add(counts: &mut BTreeMap<String, usize>, name: &str) {
+        *counts.entry(name.to_string()).or_default() += 1;
+    }
+    fn remove(counts: &mut BTreeMap<String, usize>, name: &str) {
+        if let Some(c) = counts.get_mut(name) {
+            *c -= 1;
+            if *c == 0 {
+                counts.remove(name);
+            }
         }
     }
-    let stems: Vec<String> = kept.iter().map(|p| map_name(p)).collect();
+    let mut seen = BTreeSet::new();
+    // (index, canonical path) of the maps kept.
+    let mut kept: Vec<(usize, PathBuf)> = Vec::new();
+    for (i, m) in maps.iter().enumerate() {
+        let canon = std::fs::canonicalize(m).unwrap_or_else(|_| m.clone());
+        if seen.insert(canon.clone()) {
+            kept.push((i, canon));
+        }
+    }
+    let stems: Vec<String> = kept.iter().map(|&(i, _)| map_name(&maps[i])).collect();
+    let mut stem_count: BTreeMap<String, usize> = BTreeMap::new();
+    for stem in &stems {
+        add(&mut stem_count, stem);
+    }
     let mut names: Vec<String> = kept
         .iter()
         .zip(&stems)
-        .map(|(p, stem)| {
-            if stems.iter().filter(|s| *s == stem).count() == 1 {
+        .map(|((_, canon), stem)| {
+            if stem_count[stem] == 1 {
                 return stem.clone();
             }
-            let canon = std::fs::canonicalize(p).unwrap_or_else(|_| p.clone());
             match canon
                 .parent()
                 .and_then(Path::file_name)
@@ -171,17 +197,28 @@ pub fn name_maps(maps: Vec<PathBuf>) -> Vec<(PathBuf, String)> {
             }
         })
         .collect();
-    for i in 0..names.len() {
-        let earlier = names[..i].iter().filter(|n| **n == names[i]).count();
+    // A name that repeats an earlier one gets the first free `-k` (k from the number of
+    // earlier holders + 1), free among all the names as they stand.
+    let mut current: BTreeMap<String, usize> = BTreeMap::new();
+    for n in &names {
+        add(&mut current, n);
+    }
+    let mut before: BTreeMap<String, usize> = BTreeMap::new();
+    for name in &mut names {
+        let earlier = before.get(name.as_str()).copied().unwrap_or(0);
         if earlier > 0 {
             let mut k = earlier + 1;
-            while names.contains(&format!("{}-{k}", names[i])) {
+            while current.contains_key(&format!("{name}-{k}")) {
                 k += 1;
             }
-            names[i] = format!("{}-{k}", names[i]);
+            let renamed = format!("{name}-{k}");
+            remove(&mut current, name);
+            add(&mut current, &renamed);
+            *name = renamed;
         }
+        add(&mut before, name);
     }
-    kept.into_iter().zip(names).collect()
+    kept.into_iter().map(|(i, _)| i).zip(names).collect()
 }
 
 #[cfg(test)]
@@ -233,6 +270,90 @@ mod tests {
                 "{e}"
             );
         }
+    }
+
+    /// The names of the first, quadratic form of [`name_maps`] (kept here as the reference).
+    fn reference_names(maps: Vec<PathBuf>) -> Vec<(PathBuf, String)> {
+        let mut seen = Vec::new();
+        let mut kept = Vec::new();
+        for m in maps {
+            let canon = std::fs::canonicalize(&m).unwrap_or_else(|_| m.clone());
+            if !seen.contains(&canon) {
+                seen.push(canon);
+                kept.push(m);
+            }
+        }
+        let stems: Vec<String> = kept.iter().map(|p| map_name(p)).collect();
+        let mut names: Vec<String> = kept
+            .iter()
+            .zip(&stems)
+            .map(|(p, stem)| {
+                if stems.iter().filter(|s| *s == stem).count() == 1 {
+                    return stem.clone();
+                }
+                let canon = std::fs::canonicalize(p).unwrap_or_else(|_| p.clone());
+                match canon.parent().and_then(Path::file_name) {
+                    Some(folder) => format!("{}-{stem}", folder.to_string_lossy()),
+                    None => stem.clone(),
+                }
+            })
+            .collect();
+        for i in 0..names.len() {
+            let earlier = names[..i].iter().filter(|n| **n == names[i]).count();
+            if earlier > 0 {
+                let mut k = earlier + 1;
+                while names.contains(&format!("{}-{k}", names[i])) {
+                    k += 1;
+                }
+                names[i] = format!("{}-{k}", names[i]);
+            }
+        }
+        kept.into_iter().zip(names).collect()
+    }
+
+    /// Repeated files, shared stems in several folders, names that collide with a folder-stem
+    /// name or with a `-k` suffix: the same names as the reference, and by index for Python.
+    #[test]
+    fn colliding_names_are_told_apart_as_before() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut paths = Vec::new();
+        for (folder, file) in [
+            ("a", "x.yaml"),
+            ("b", "x.yaml"),
+            ("c", "a-x.yaml"),
+            ("d", "a-x-2.yaml"),
+            ("a", "x.pgm"),
+            ("e", "x-2.yaml"),
+            ("e", "x.png"),
+            ("f", "y.yaml"),
+            ("a", "summary.yaml"),
+        ] {
+            let f = dir.path().join(folder);
+            std::fs::create_dir_all(&f).unwrap();
+            std::fs::write(f.join(file), "").unwrap();
+            paths.push(f.join(file));
+        }
+        // The same file twice (once through `..`), and a missing one.
+        paths.push(dir.path().join("b/../a/x.yaml"));
+        paths.push(dir.path().join("g/x.yaml"));
+        paths.push(paths[1].clone());
+        // Many maps of one stem: a sweep's folders of generated maps.
+        for k in 0..300 {
+            let f = dir.path().join(format!("m{k}"));
+            std::fs::create_dir_all(&f).unwrap();
+            std::fs::write(f.join("map.yaml"), "").unwrap();
+            paths.push(f.join("map.yaml"));
+        }
+        let want = reference_names(paths.clone());
+        assert_eq!(name_maps(paths.clone()), want);
+        let by_index: Vec<(PathBuf, String)> = name_maps_indexed(&paths)
+            .into_iter()
+            .map(|(i, n)| (paths[i].clone(), n))
+            .collect();
+        assert_eq!(by_index, want);
+        let distinct: std::collections::BTreeSet<&String> = want.iter().map(|(_, n)| n).collect();
+        assert_eq!(distinct.len(), want.len());
+        assert_eq!(want.len(), paths.len() - 2);
     }
 
     /// The stems `.` and `..` (files `..yaml`, `...yaml`) would put run folders beside

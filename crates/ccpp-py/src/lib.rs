@@ -1537,14 +1537,7 @@ fn expand_maps(items: Vec<PathBuf>) -> PyResult<Vec<PathBuf>> {
 /// twice is run once), in order.
 #[pyfunction]
 fn name_maps(paths: Vec<PathBuf>) -> Vec<(usize, String)> {
-    let keyed: Vec<PathBuf> = paths.clone();
-    ccpp_io::names::name_maps(paths)
-        .into_iter()
-        .map(|(p, n)| {
-            let i = keyed.iter().position(|k| *k == p).unwrap_or_default();
-            (i, n)
-        })
-        .collect()
+    ccpp_io::names::name_maps_indexed(&paths)
 }
 
 /// One run of `ccpp bench` (default options, start and simulator settings): the metrics, or
