@@ -660,7 +660,7 @@ pub fn replay_gif(world: &World, trace: &Trace, opts: &GifOptions) -> Result<Vec
             }
         })
         .collect();
-    let poses: Vec<Point> = trace.poses().map(|p| p.position()).collect();
+    let (poses, progress) = motion_progress(trace, world.robot().radius);
     let to_gif = |p: Point| {
         let g = f.world_to_grid(p);
         (
@@ -698,22 +698,43 @@ pub fn replay_gif(world: &World, trace: &Trace, opts: &GifOptions) -> Result<Vec
         let mut path_layer = vec![false; gw * gh];
         let n = poses.len();
         let frames = opts.frames.max(1);
+        let total = progress.last().copied().unwrap_or(0.0);
         let mut done = 0usize;
         if let Some(&p0) = poses.first() {
             sweeper.add(p0, p0);
         }
         for fr in 1..=frames {
-            let upto = if n == 0 {
-                0
+            // Frames are evenly spaced in motion (see `motion_progress`), not in poses: a PID
+            // run records each step of a turn in place but only the ends of a straight glide,
+            // and an ideal run one pose per move, however long.
+            let target = if fr == frames {
+                f64::INFINITY
             } else {
-                ((n - 1) * fr).div_ceil(frames)
+                total * fr as f64 / frames as f64
             };
-            while done < upto {
+            while done + 1 < n && progress[done + 1] <= target {
                 let (a, b) = (poses[done], poses[done + 1]);
                 sweeper.add(a, b);
                 let (pa, pb) = (to_gif(a), to_gif(b));
                 draw_line(&mut path_layer, gw, gh, pa, pb);
                 done += 1;
+            }
+            // The move under way, as far as the frame's share of the motion reaches.
+            let mut robot = poses.get(done).copied();
+            if done + 1 < n {
+                let (m0, m1) = (progress[done], progress[done + 1]);
+                let t = if m1 > m0 {
+                    ((target - m0) / (m1 - m0)).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                let (a, b) = (poses[done], poses[done + 1]);
+                let q = Point::new(a.x + (b.x - a.x) * t, a.y + (b.y - a.y) * t);
+                if t > 0.0 && q != a {
+                    sweeper.add(a, q);
+                    draw_line(&mut path_layer, gw, gh, to_gif(a), to_gif(q));
+                }
+                robot = Some(q);
             }
             let swept = sweeper.swept();
             let mut buf = base.clone();
@@ -732,7 +753,7 @@ pub fn replay_gif(world: &World, trace: &Trace, opts: &GifOptions) -> Result<Vec
                     *v = 5;
                 }
             }
-            if let Some(&p) = poses.get(done) {
+            if let Some(p) = robot {
                 let (x, y) = to_gif(p);
                 let rr = (world.robot().radius / f.resolution * k).max(2.0);
                 fill_disk(&mut buf, gw, gh, x, y, rr, 6);
@@ -744,6 +765,26 @@ pub fn replay_gif(world: &World, trace: &Trace, opts: &GifOptions) -> Result<Vec
         }
     }
     Ok(out)
+}
+
+/// The trace's positions and the motion up to each, metres: the distance driven plus, for
+/// each turn, the arc the robot's rim sweeps (`radius` times the angle), so that a turn in
+/// place takes GIF time too.
+fn motion_progress(trace: &Trace, radius: f64) -> (Vec<Point>, Vec<f64>) {
+    let n = trace.pose_count();
+    let (mut points, mut progress) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    let mut m = 0.0f64;
+    let mut last: Option<ccpp_core::Pose> = None;
+    for p in trace.poses() {
+        if let Some(a) = last {
+            m += a.position().dist(p.position())
+                + radius * ccpp_core::geometry::wrap_angle(p.theta - a.theta).abs();
+        }
+        points.push(p.position());
+        progress.push(m);
+        last = Some(p);
+    }
+    (points, progress)
 }
 
 /// Thinnest the map's strip is drawn in the GIF, pixels, where the canvas may grow longer for
@@ -915,6 +956,56 @@ mod tests {
         assert!(count(C_ROBOT) > 10, "robot pixels");
         assert_eq!(C_ROBOT, [255, 212, 0]);
         assert!(TEMPLATE.contains("rgba(255,212,0,"));
+    }
+
+    /// The GIF's frames are spaced in motion, not in poses: one long move then a hundred
+    /// short ones (a PID run records a glide by its ends and a turn step by step) put the
+    /// robot halfway along the long move at the middle frame, not at its end.
+    #[test]
+    fn the_gif_paces_its_frames_by_motion() {
+        let map = ccpp_core::grid::GridMap::from_ascii_scaled(
+            "############\n#..........#\n#..........#\n############",
+            10,
+            0.05,
+        )
+        .unwrap();
+        let start = ccpp_core::Pose::new(0.8, 1.0, 0.0);
+        let world = World::new(map, ccpp_core::world::Robot::new(0.15), Some(start)).unwrap();
+        let mut trace = Trace::default();
+        trace.push_pose(0, start);
+        trace.push_pose(1, ccpp_core::Pose::new(4.8, 1.0, 0.0));
+        for k in 0..100 {
+            let th = if k % 2 == 0 { 0.01 } else { 0.0 };
+            trace.push_pose(2 + k, ccpp_core::Pose::new(4.8, 1.0, th));
+        }
+        let opts = GifOptions {
+            frames: 10,
+            ..GifOptions::default()
+        };
+        let bytes = replay_gif(&world, &trace, &opts).unwrap();
+        let mut dec = gif::DecodeOptions::new();
+        dec.set_color_output(gif::ColorOutput::RGBA);
+        let mut dec = dec.read_info(std::io::Cursor::new(bytes)).unwrap();
+        let w = usize::from(dec.width());
+        // The robot's mean column in each frame, as a share of the canvas width.
+        let mut xs = Vec::new();
+        while let Some(frame) = dec.read_next_frame().unwrap() {
+            let (mut sum, mut n) = (0usize, 0usize);
+            for (i, p) in frame.buffer.chunks_exact(4).enumerate() {
+                if p[..3] == C_ROBOT[..] {
+                    sum += i % w;
+                    n += 1;
+                }
+            }
+            assert!(n > 0);
+            xs.push(sum as f64 / n as f64 / w as f64);
+        }
+        assert_eq!(xs.len(), 10);
+        // The motion is 4 m of driving and 50 turns of 0.01 rad (0.075 m of the rim's arc):
+        // the fifth frame shows the robot near x = 0.8 + 0.5 * 4.075 m of a 6 m wide map.
+        let want = (0.8 + 0.5 * 4.075) / 6.0;
+        assert!((xs[4] - want).abs() < 0.03, "{xs:?}");
+        assert!(xs.windows(2).all(|p| p[1] >= p[0] - 1e-9), "{xs:?}");
     }
 
     /// A corridor of 4000 x 9 px was a GIF of 400 x 1 px: the strip is now at least 16 px
