@@ -1,5 +1,6 @@
-//! The trace: every executed pose and every event of a run, in order. Metrics, pictures and the
-//! replay are pure functions of (world, trace).
+//! The trace: every executed pose and every event of a run, in order (under PID execution, the
+//! poses the simulator records: see [`crate::sim`]). Metrics, pictures and the replay are pure
+//! functions of (world, trace).
 //!
 //! # In memory
 //!
