@@ -288,6 +288,14 @@ fn check_same_run(
             dir.display()
         );
     }
+    // The tracking error is read from the trace's record: it must be one the simulator can
+    // have written (a doctored record passed with a matching metrics.json).
+    if let Some(problem) = ccpp_core::metrics::tracking_record_problem(trace) {
+        bail!(
+            "{}: trace.jsonl's tracking record is not a run's: {problem}",
+            dir.display()
+        );
+    }
     // The trace records the start exactly; a thousandth of a pixel allows for nothing but
     // another run.
     let tol = world.frame().resolution * 1e-3;

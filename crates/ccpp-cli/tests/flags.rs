@@ -1117,6 +1117,135 @@ fn replay_refuses_a_folder_that_mixes_two_runs() {
     assert!(b.join("replay.html").exists());
 }
 
+/// The tracking error of a PID run is read from the trace's `tracking` record (the simulator
+/// measures every control step; the trace keeps some of the poses). A record no run can have
+/// written, with a metrics.json edited to match, was replayed and its figures drawn (a
+/// hostile tester's negative errors, a mean above the largest, two records, a record in an
+/// ideal run, a record moved before the motion): refused, naming what is wrong.
+#[test]
+fn replay_refuses_a_tracking_record_no_run_writes() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = box60(dir);
+    let noisy = ["--exec", "pid", "--odometry-noise", "0.05", "--seed", "3"];
+    let base = run_ok(dir, "base", &map, "bsa", &noisy);
+    let ideal = run_ok(dir, "ideal", &map, "bsa", &[]);
+    ccpp().arg("replay").arg(&base).assert().success();
+    let trace = std::fs::read_to_string(base.join("trace.jsonl")).unwrap();
+    let lines: Vec<&str> = trace.lines().collect();
+    let at = lines
+        .iter()
+        .position(|l| l.contains("\"event\":\"tracking\""))
+        .expect("a PID run's trace holds its tracking record");
+    assert!(lines[at + 1].contains("\"finished\"") && at + 2 == lines.len());
+    let m = metrics(&base);
+    let (mean, max) = (
+        m["tracking_error_mean_m"].as_f64().unwrap(),
+        m["tracking_error_max_m"].as_f64().unwrap(),
+    );
+    assert!(mean > 0.0 && max > mean, "{mean} {max}");
+    let record = |mean: f64, max: f64, steps: u64| {
+        format!("{{\"t\":0,\"event\":\"tracking\",\"mean_m\":{mean},\"max_m\":{max},\"steps\":{steps}}}")
+    };
+    // A folder whose trace gets `lines` and whose metrics.json reports `mean` / `max`.
+    let doctor = |name: &str, from: &Path, lines: Vec<String>, mean: f64, max: f64| {
+        let k = dir.join(format!("doctored-{name}"));
+        std::fs::create_dir(&k).unwrap();
+        for f in ["run.json", "path.csv", "coverage.png"] {
+            std::fs::copy(from.join(f), k.join(f)).unwrap();
+        }
+        std::fs::write(k.join("trace.jsonl"), lines.join("\n") + "\n").unwrap();
+        let mut m = metrics(from);
+        m["tracking_error_mean_m"] = serde_json::json!(mean);
+        m["tracking_error_max_m"] = serde_json::json!(max);
+        std::fs::write(k.join("metrics.json"), m.to_string()).unwrap();
+        k
+    };
+    let with = |k: usize, rec: String| {
+        let mut v: Vec<String> = lines.iter().map(ToString::to_string).collect();
+        v[k] = rec;
+        v
+    };
+    let steps: u64 = {
+        let l = lines[at];
+        let i = l.find("\"steps\":").unwrap() + 8;
+        l[i..].trim_end_matches('}').parse().unwrap()
+    };
+    let mut moved: Vec<String> = lines.iter().map(ToString::to_string).collect();
+    let rec = moved.remove(at);
+    moved.insert(1, rec);
+    let mut twice: Vec<String> = lines.iter().map(ToString::to_string).collect();
+    twice.insert(at, record(mean, max, steps));
+    let ideal_lines: Vec<String> = {
+        let t = std::fs::read_to_string(ideal.join("trace.jsonl")).unwrap();
+        let mut v: Vec<String> = t.lines().map(ToString::to_string).collect();
+        let n = v.len();
+        v.insert(n - 1, record(0.1, 0.2, 10));
+        v
+    };
+    for (name, from, lines, (mean, max), needle) in [
+        (
+            "neg",
+            &base,
+            with(at, record(-1.0, -2.0, steps)),
+            (-1.0, -2.0),
+            "are not distances",
+        ),
+        (
+            "above",
+            &base,
+            with(at, record(5.0, 1.0, steps)),
+            (5.0, 1.0),
+            "above the largest",
+        ),
+        (
+            "none",
+            &base,
+            with(at, record(0.3, 0.4, 0)),
+            (0.3, 0.4),
+            "over 0 steps",
+        ),
+        (
+            "few",
+            &base,
+            with(at, record(mean, max, 2)),
+            (mean, max),
+            "a tracking record of 2 steps",
+        ),
+        (
+            "low",
+            &base,
+            with(at, record(mean / 4.0, max / 2.0, steps)),
+            (mean / 4.0, max / 2.0),
+            "largest distance is",
+        ),
+        ("two", &base, twice, (mean, max), "2 tracking records"),
+        (
+            "moved",
+            &base,
+            moved,
+            (mean, max),
+            "not the last before `finished`",
+        ),
+        (
+            "ideal",
+            &ideal,
+            ideal_lines,
+            (0.1, 0.2),
+            "without PID execution",
+        ),
+    ] {
+        let k = doctor(name, from, lines, mean, max);
+        fails(
+            &["replay"],
+            &[&k],
+            &["tracking record is not a run's", needle],
+            10,
+        );
+        assert!(!k.join("replay.html").exists(), "{name}");
+    }
+}
+
 #[test]
 fn run_json_is_the_scenario_and_replays_exactly() {
     let d = tempfile::tempdir().unwrap();

@@ -109,6 +109,12 @@ pub fn tracking_error(trace: &Trace) -> Option<(f64, f64)> {
     if given.is_some() {
         return given;
     }
+    pose_tracking(trace).map(|(mean, max, _)| (mean, max))
+}
+
+/// The tracking error measured on the trace's poses: `(mean, max, poses measured)`, each pose
+/// against the last [`Event::PlannedSegment`] before it; `None` without a planned segment.
+fn pose_tracking(trace: &Trace) -> Option<(f64, f64, u64)> {
     // Without a planned segment no pose counts (the events alone tell, without the poses).
     if !trace
         .events()
@@ -117,7 +123,7 @@ pub fn tracking_error(trace: &Trace) -> Option<(f64, f64)> {
         return None;
     }
     let mut seg: Option<(Point, Point)> = None;
-    let (mut sum, mut max, mut n) = (0.0, 0.0f64, 0usize);
+    let (mut sum, mut max, mut n) = (0.0, 0.0f64, 0u64);
     for r in trace.entries() {
         match r {
             Entry::Event {
@@ -136,7 +142,72 @@ pub fn tracking_error(trace: &Trace) -> Option<(f64, f64)> {
         }
     }
     seg?;
-    Some((if n == 0 { 0.0 } else { sum / n as f64 }, max))
+    Some((if n == 0 { 0.0 } else { sum / n as f64 }, max, n))
+}
+
+/// What is wrong with the trace's [`Event::Tracking`] record, if anything: a reader that takes
+/// the tracking error from it (`ccpp replay`'s check of a run folder) first makes sure that it
+/// can be the simulator's. At most one, right before the `finished` record, in a run under
+/// PID execution with a planned segment; finite, non-negative figures with the mean at most
+/// the largest (both 0 over 0 steps); at least as many steps as poses recorded from the first
+/// planned segment on, and a largest distance no smaller than any of theirs (the recorded
+/// poses are some of the steps it measured). `None` for a trace without the record.
+pub fn tracking_record_problem(trace: &Trace) -> Option<String> {
+    let events: Vec<&Event> = trace.events().map(|(_, e)| e).collect();
+    let at: Vec<usize> = (0..events.len())
+        .filter(|&k| matches!(events[k], Event::Tracking { .. }))
+        .collect();
+    let &k = at.first()?;
+    if at.len() > 1 {
+        return Some(format!("{} tracking records (a run writes one)", at.len()));
+    }
+    if k + 2 != events.len() || !matches!(events[k + 1], Event::Finished { .. }) {
+        return Some("the tracking record is not the last before `finished`".into());
+    }
+    let Event::Tracking {
+        mean_m,
+        max_m,
+        steps,
+    } = *events[k]
+    else {
+        return None;
+    };
+    if !events
+        .iter()
+        .any(|e| matches!(e, Event::Execution { mode, .. } if mode == "pid"))
+    {
+        return Some("a tracking record in a run without PID execution".into());
+    }
+    if !(mean_m.is_finite() && max_m.is_finite() && mean_m >= 0.0 && max_m >= 0.0) {
+        return Some(format!(
+            "tracking figures {mean_m} / {max_m} m are not distances"
+        ));
+    }
+    // A mean of distances is at most the largest (the division may round it a few ulps up).
+    if mean_m > max_m * (1.0 + 1e-12) {
+        return Some(format!(
+            "a mean tracking error of {mean_m} m above the largest, {max_m} m"
+        ));
+    }
+    if steps == 0 && (mean_m != 0.0 || max_m != 0.0) {
+        return Some(format!("tracking errors {mean_m} / {max_m} m over 0 steps"));
+    }
+    // The recorded poses: the record's figures must hold for them.
+    let Some((_, rec_max, rec_n)) = pose_tracking(trace) else {
+        return Some("a tracking record in a run without a planned segment".into());
+    };
+    if rec_n > steps {
+        return Some(format!(
+            "{rec_n} poses measured against planned segments but a tracking record of {steps} steps"
+        ));
+    }
+    if rec_max > max_m * (1.0 + 1e-9) + 1e-12 {
+        return Some(format!(
+            "a recorded pose lies {rec_max} m from its planned segment but the tracking record's \
+             largest distance is {max_m} m"
+        ));
+    }
+    None
 }
 
 /// The PID waypoint tolerance recorded in the trace ([`Event::Execution`]), if any.
