@@ -1214,7 +1214,9 @@ impl RunResult {
         to_py(py, &self.metrics)
     }
 
-    /// The executed poses, `float64` `(N, 3)`: x, y (metres), theta (radians).
+    /// The executed poses, `float64` `(N, 3)`: x, y (metres), theta (radians); under PID
+    /// execution the recorded ones (every control step but the inside of straight glides along
+    /// the map's axes, which lie on the segments between them).
     #[getter]
     fn path<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         let v: Vec<f64> = self

@@ -50,7 +50,8 @@ class RunResult:
         """The keys of metrics.json."""
     @property
     def path(self) -> npt.NDArray[np.float64]:
-        """Executed poses, (N, 3): x, y, theta."""
+        """Executed poses, (N, 3): x, y, theta (under PID execution the recorded ones: no
+        pose inside a straight glide along the map's axes)."""
     @property
     def swept(self) -> npt.NDArray[np.bool_]:
         """Swept pixels, (height, width), image layout."""
