@@ -229,6 +229,79 @@ pub fn segment_first_contact(occ: &impl Occupancy, a: Point, b: Point, r_px: f64
     best.or_else(|| (!band.contains(b)).then(|| band.exit_param(a, b)))
 }
 
+/// The times a disk of radius `r_px` (pixels) moving from `a` to `b` (grid coordinates)
+/// overlaps the blocked pixels whose centres lie within reach of the part `part` of that motion
+/// (two points of it, in order): for each such pixel, the open interval of `t` in `[0, 1]`
+/// during which the disk overlaps it (clipped to `[0, 1]`; a pixel the disk only touches adds
+/// none), appended to `out`. The pixels [`Occupancy::blocked`] says are blocked, in the image
+/// and in the band around it (as [`disk_hits`] asks; [`segment_first_contact`] counts every
+/// pixel outside the image); calls over consecutive parts
+/// cover the whole motion (a pixel near two parts is given twice). Exact per pixel, so the
+/// union of the intervals does not depend on how the motion is cut into parts.
+pub fn contact_intervals(
+    occ: &impl Occupancy,
+    a: Point,
+    b: Point,
+    part: (Point, Point),
+    r_px: f64,
+    out: &mut Vec<(f64, f64)>,
+) {
+    let rc = contact_radius_px(r_px);
+    let rc2 = rc * rc;
+    let frame = *occ.frame();
+    let (w, h) = (frame.width as i64, frame.height as i64);
+    let band = Band::new(&frame, rc);
+    let (p, q) = part;
+    let lo = Point::new(p.x.min(q.x), p.y.min(q.y));
+    let hi = Point::new(p.x.max(q.x), p.y.max(q.y));
+    let (c0, c1, r0, r1) = band.clip(&frame, pixel_window(&frame, lo, hi, rc));
+    let d = b - a;
+    let aa = d.dot(d);
+    if aa.is_nan() || aa <= 0.0 {
+        return;
+    }
+    let mut add = |col: i64, row: i64| {
+        let c = center(&frame, col, row);
+        let f = a - c;
+        let bb = 2.0 * f.dot(d);
+        let cc = f.dot(f) - rc2;
+        let disc = bb * bb - 4.0 * aa * cc;
+        if disc.is_nan() || disc <= 0.0 {
+            return;
+        }
+        let sq = disc.sqrt();
+        let t0 = ((-bb - sq) / (2.0 * aa)).max(0.0);
+        let t1 = ((-bb + sq) / (2.0 * aa)).min(1.0);
+        if t0 < t1 {
+            out.push((t0, t1));
+        }
+    };
+    // Outside the image as `occ` says (as `disk_hits` asks it, so that an overlap the
+    // intervals begin at 0 is one `disk_hits` sees at the start).
+    for row in r0..=r1 {
+        if row < 0 || row >= h {
+            for col in c0..=c1 {
+                if occ.blocked(col, row) {
+                    add(col, row);
+                }
+            }
+            continue;
+        }
+        for col in (c0..=c1.min(-1)).chain(c0.max(w)..=c1) {
+            if occ.blocked(col, row) {
+                add(col, row);
+            }
+        }
+        let (l, u) = (c0.max(0), c1.min(w - 1));
+        if l <= u {
+            occ.for_each_blocked_in_row(row as usize, l as usize, u as usize, &mut |col| {
+                add(col as i64, row);
+                true
+            });
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

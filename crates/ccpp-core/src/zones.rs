@@ -458,11 +458,11 @@ impl crate::collide::Occupancy for MaskOccupancy<'_> {
 /// Keep-out entries along a centre polyline (grid coordinates): a robot of radius `r_px`
 /// pixels enters a keep-out when its disk, not overlapping any keep-out pixel (the obstacle
 /// model of [`crate::collide`]: a pixel is the disk inscribed in its square), starts to overlap
-/// one. Counted once per entry, along each segment in stretches of at most a pixel: a
-/// stretch that starts clear and touches a keep-out anywhere adds one; the disk is then clear
-/// again once a stretch ends clear of every keep-out pixel (so a path counts the same entries
-/// driven in one long move or in many short ones, but for features under a pixel). A start
-/// inside a keep-out counts as one entry.
+/// one. Counted exactly along each segment (the times the disk overlaps each pixel,
+/// [`crate::collide::contact_intervals`], joined: each stretch of overlap that begins after
+/// the disk was clear is one entry), so a path counts the same entries driven in one long move
+/// or in many short ones, whatever the size of the keep-outs and the gaps between them. A
+/// start inside a keep-out counts as one entry.
 pub fn keepout_entries(
     frame: &MapFrame,
     keepout: &FixedBitSet,
@@ -504,6 +504,7 @@ fn entries(occ: &MaskOccupancy<'_>, points: &[Point], r_px: f64, count_start: bo
     let summary = BlockSummary::of(occ);
     let mut inside = crate::collide::disk_hits(occ, points[0], r_px);
     let mut n = u32::from(inside && count_start);
+    let mut spans: Vec<(f64, f64)> = Vec::new();
     for w in points.windows(2) {
         if w[0] == w[1] {
             continue;
@@ -511,14 +512,16 @@ fn entries(occ: &MaskOccupancy<'_>, points: &[Point], r_px: f64, count_start: bo
         if !inside && summary.clear(occ.frame, w[0], w[1], r_px) {
             continue;
         }
-        // In stretches of at most a pixel: a long move that leaves a zone and enters it (or
-        // another) again counts each entry, as the same path driven in short steps does.
+        // The pixels near the move are found in stretches of at most a pixel (each search's
+        // window stays small on a long diagonal move); each one's overlap is timed on the
+        // whole move, so the stretches do not change what is counted.
         let len = w[0].dist(w[1]);
         let pieces = if len.is_finite() {
             (len.ceil() as usize).clamp(1, MAX_PIECES)
         } else {
             1
         };
+        spans.clear();
         let mut from = w[0];
         for k in 1..=pieces {
             let to = if k == pieces {
@@ -530,13 +533,32 @@ fn entries(occ: &MaskOccupancy<'_>, points: &[Point], r_px: f64, count_start: bo
                     w[0].y + (w[1].y - w[0].y) * t,
                 )
             };
-            if inside || !summary.clear(occ.frame, from, to, r_px) {
-                if !inside && crate::collide::segment_first_contact(occ, from, to, r_px).is_some() {
-                    n += 1;
-                }
-                inside = crate::collide::disk_hits(occ, to, r_px);
+            if !summary.clear(occ.frame, from, to, r_px) {
+                crate::collide::contact_intervals(occ, w[0], w[1], (from, to), r_px, &mut spans);
             }
             from = to;
+        }
+        n += overlap_starts(&mut spans, inside);
+        inside = crate::collide::disk_hits(occ, w[1], r_px);
+    }
+    n
+}
+
+/// The stretches of overlap that the intervals `spans` (of one move, in `[0, 1]`) join into
+/// and that begin while the disk is clear: all of them but one that begins at 0 when the move
+/// starts `inside` (intervals that meet or overlap are one stretch; sorts `spans`).
+fn overlap_starts(spans: &mut [(f64, f64)], inside: bool) -> u32 {
+    spans.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.total_cmp(&y.1)));
+    let mut n = 0u32;
+    let mut end: Option<f64> = None;
+    for &(s, e) in spans.iter() {
+        if end.is_none_or(|end| s > end) {
+            if !(s <= 0.0 && inside) {
+                n += 1;
+            }
+            end = Some(e);
+        } else {
+            end = end.map(|end| end.max(e));
         }
     }
     n
@@ -747,15 +769,18 @@ mod tests {
     /// equal the plain segment-by-segment ones on random masks and paths.
     #[test]
     fn the_block_summary_changes_no_count() {
-        // Every move in stretches of at most a pixel, each tested exactly.
+        // Every move's pixels timed exactly, searched in stretches of at most a pixel, with no
+        // block summary.
         let plain = |occ: &MaskOccupancy<'_>, points: &[Point], r_px: f64| {
             let mut inside = crate::collide::disk_hits(occ, points[0], r_px);
             let mut n = u32::from(inside);
+            let mut spans = Vec::new();
             for w in points.windows(2) {
                 if w[0] == w[1] {
                     continue;
                 }
                 let pieces = (w[0].dist(w[1]).ceil() as usize).max(1);
+                spans.clear();
                 let mut from = w[0];
                 for k in 1..=pieces {
                     let to = if k == pieces {
@@ -767,14 +792,18 @@ mod tests {
                             w[0].y + (w[1].y - w[0].y) * t,
                         )
                     };
-                    if !inside
-                        && crate::collide::segment_first_contact(occ, from, to, r_px).is_some()
-                    {
-                        n += 1;
-                    }
-                    inside = crate::collide::disk_hits(occ, to, r_px);
+                    crate::collide::contact_intervals(
+                        occ,
+                        w[0],
+                        w[1],
+                        (from, to),
+                        r_px,
+                        &mut spans,
+                    );
                     from = to;
                 }
+                n += overlap_starts(&mut spans, inside);
+                inside = crate::collide::disk_hits(occ, w[1], r_px);
             }
             n
         };
@@ -826,6 +855,68 @@ mod tests {
                         "case {case}, invert {invert}"
                     );
                 }
+            }
+        }
+    }
+
+    /// A straight move past keep-outs whose gaps are under a pixel counts each one it enters,
+    /// as the same move in small steps does (a long move's stretches of a pixel missed an
+    /// exit and entry inside one stretch: a PID glide recorded by its ends counted 1 where
+    /// its control steps counted 6); and on random specks, one long move counts what the same
+    /// moves cut into steps of a tenth of a pixel count.
+    #[test]
+    fn entries_do_not_depend_on_how_a_move_is_cut() {
+        let f = MapFrame::new(60, 40, 0.05);
+        let mut specks = FixedBitSet::with_capacity(f.len());
+        // Six one-pixel keep-outs in a row, 3 px apart. The robot's centre passes 3 px beside
+        // them: its disk (2.7 px, plus the pixel's inscribed disk, 0.5 px) overlaps each one
+        // for 2.2 px of the way, with 0.8 px clear between two.
+        for k in 0..6 {
+            specks.insert(f.index(10 + 3 * k, 5));
+        }
+        let r = 2.7;
+        let line = |x0: f64, x1: f64, n: usize| -> Vec<Point> {
+            (0..=n)
+                .map(|i| Point::new(x0 + (x1 - x0) * i as f64 / n as f64, 40.0 - 5.5 + 3.0))
+                .collect()
+        };
+        let one = keepout_entries(&f, &specks, &line(2.0, 40.0, 1), r);
+        let fine = keepout_entries(&f, &specks, &line(2.0, 40.0, 3800), r);
+        assert_eq!(fine, 6, "small steps");
+        assert_eq!(one, fine, "one move");
+        let mut rng = crate::rng::SplitMix64::new(11);
+        for case in 0..40 {
+            let f = MapFrame::new(50, 40, 0.05);
+            let mut bits = FixedBitSet::with_capacity(f.len());
+            for _ in 0..(3 + rng.next_u64() % 30) {
+                let (c, r) = (
+                    (rng.next_u64() % f.width as u64) as usize,
+                    (rng.next_u64() % f.height as u64) as usize,
+                );
+                bits.insert(f.index(c, r));
+            }
+            let r_px = 0.3 + (rng.next_u64() % 40) as f64 / 10.0;
+            let points: Vec<Point> = (0..12)
+                .map(|_| Point::new(rng.range(2.0, 48.0), rng.range(2.0, 38.0)))
+                .collect();
+            let mut cut = vec![points[0]];
+            for w in points.windows(2) {
+                let n = (w[0].dist(w[1]) * 10.0).ceil() as usize;
+                for i in 1..=n {
+                    let t = i as f64 / n as f64;
+                    cut.push(Point::new(
+                        w[0].x + (w[1].x - w[0].x) * t,
+                        w[0].y + (w[1].y - w[0].y) * t,
+                    ));
+                }
+            }
+            for invert in [false, true] {
+                let occ = MaskOccupancy::new(&f, &bits, invert);
+                assert_eq!(
+                    entries(&occ, &points, r_px, true),
+                    entries(&occ, &cut, r_px, true),
+                    "case {case}, invert {invert}"
+                );
             }
         }
     }
