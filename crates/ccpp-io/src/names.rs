@@ -204,13 +204,19 @@ pub fn name_maps_indexed(maps: &[PathBuf]) -> Vec<(usize, String)> {
         add(&mut current, n);
     }
     let mut before: BTreeMap<String, usize> = BTreeMap::new();
+    // Per repeated name, the `k` after the last one it was given. A name taken is never freed
+    // (its first holder keeps it), and a name's count of earlier holders never falls, so the
+    // next search for it may start there: each `-k` is tried once, not once per repeat (many
+    // `maps/map.yaml` in different sweep folders are all `maps-map`).
+    let mut next_k: BTreeMap<String, usize> = BTreeMap::new();
     for name in &mut names {
         let earlier = before.get(name.as_str()).copied().unwrap_or(0);
         if earlier > 0 {
-            let mut k = earlier + 1;
+            let mut k = (earlier + 1).max(next_k.get(name.as_str()).copied().unwrap_or(0));
             while current.contains_key(&format!("{name}-{k}")) {
                 k += 1;
             }
+            next_k.insert(name.clone(), k + 1);
             let renamed = format!("{name}-{k}");
             remove(&mut current, name);
             add(&mut current, &renamed);
@@ -337,13 +343,21 @@ mod tests {
         paths.push(dir.path().join("b/../a/x.yaml"));
         paths.push(dir.path().join("g/x.yaml"));
         paths.push(paths[1].clone());
-        // Many maps of one stem: a sweep's folders of generated maps.
+        // Many maps of one stem: a sweep's folders of generated maps, in folders of their own
+        // and in folders of one name (all `maps-map`, then numbered).
         for k in 0..300 {
             let f = dir.path().join(format!("m{k}"));
             std::fs::create_dir_all(&f).unwrap();
             std::fs::write(f.join("map.yaml"), "").unwrap();
             paths.push(f.join("map.yaml"));
+            let g = dir.path().join(format!("run{k}")).join("maps");
+            std::fs::create_dir_all(&g).unwrap();
+            std::fs::write(g.join("map.yaml"), "").unwrap();
+            paths.push(g.join("map.yaml"));
         }
+        std::fs::create_dir_all(dir.path().join("x")).unwrap();
+        std::fs::write(dir.path().join("x/maps-map-7.yaml"), "").unwrap();
+        paths.insert(5, dir.path().join("x/maps-map-7.yaml"));
         let want = reference_names(paths.clone());
         assert_eq!(name_maps(paths.clone()), want);
         let by_index: Vec<(PathBuf, String)> = name_maps_indexed(&paths)
