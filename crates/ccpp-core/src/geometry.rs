@@ -173,7 +173,15 @@ pub fn cross(o: Point, a: Point, b: Point) -> f64 {
     (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x)
 }
 
-/// Distance from point `p` to segment `a`-`b`.
+/// Distance from point `p` to segment `a`-`b` (the tracking error of a pose against its
+/// planned segment: the simulator's per-step figure and the metrics' reading of recorded
+/// poses must be the same number).
+#[inline]
+pub fn point_segment_dist(p: Point, a: Point, b: Point) -> f64 {
+    point_segment_dist2(p, a, b).sqrt()
+}
+
+/// Squared distance from point `p` to segment `a`-`b`.
 #[inline]
 pub fn point_segment_dist2(p: Point, a: Point, b: Point) -> f64 {
     let d = b.sub(a);

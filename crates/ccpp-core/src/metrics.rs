@@ -132,7 +132,7 @@ fn pose_tracking(trace: &Trace) -> Option<(f64, f64, u64)> {
             } => seg = Some((Point::new(from[0], from[1]), Point::new(to[0], to[1]))),
             Entry::Pose { pose, .. } => {
                 if let Some((a, b)) = seg {
-                    let d = point_segment_dist2(pose.position(), a, b).sqrt();
+                    let d = crate::geometry::point_segment_dist(pose.position(), a, b);
                     sum += d;
                     max = max.max(d);
                     n += 1;

@@ -289,7 +289,7 @@ impl TrackingTally {
     /// Measures pose `p` against `seg` (nothing before the first segment).
     fn add(&mut self, seg: Option<(Point, Point)>, p: Pose) {
         if let Some((a, b)) = seg {
-            let d = crate::geometry::point_segment_dist2(p.position(), a, b).sqrt();
+            let d = crate::geometry::point_segment_dist(p.position(), a, b);
             self.sum += d;
             self.max = self.max.max(d);
             self.n += 1;

@@ -444,9 +444,10 @@ fn about_mb(bytes: f64) -> String {
     }
 }
 
-/// What a world error on a map whose obstacles `--inflate` grew by `inflation` m
-/// ([`MapRecipe::inflation`]) says, naming the inflation (the likely cause), or `None` for an
-/// error the inflation has no part in (or no inflation). A robot that fits nowhere: the widest
+/// What a world error on a map whose obstacles `--inflate` grew by `inflation` m says, naming
+/// the inflation (the likely cause), or `None` for an error the inflation has no part in (or
+/// no inflation). `inflation` is [`MapRecipe::inflation`]: `Some` only for an inflation that
+/// grew the obstacles (a `Some(0.0)` would be named as one). A robot that fits nowhere: the widest
 /// free spot left; a start in an obstacle: the start may be free on the map as drawn. `run`'s
 /// refusal and `info`'s report both say it this way.
 pub fn inflated_world_error(e: &WorldError, inflation: Option<f64>) -> Option<String> {
