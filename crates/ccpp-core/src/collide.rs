@@ -170,18 +170,17 @@ pub fn segment_first_contact(occ: &impl Occupancy, a: Point, b: Point, r_px: f64
     let rc = contact_radius_px(r_px);
     let rc2 = rc * rc;
     let frame = *occ.frame();
-    let (w, h) = (frame.width as i64, frame.height as i64);
     let band = Band::new(&frame, rc);
     if !band.contains(a) {
         return Some(0.0);
     }
     let lo = Point::new(a.x.min(b.x), a.y.min(b.y));
     let hi = Point::new(a.x.max(b.x), a.y.max(b.y));
-    let (c0, c1, r0, r1) = band.clip(&frame, pixel_window(&frame, lo, hi, rc));
+    let window = band.clip(&frame, pixel_window(&frame, lo, hi, rc));
     let mut best: Option<f64> = None;
     // Earliest contact with the blocked pixel `(col, row)`; `false` once contact is at t = 0
     // (nothing can come earlier).
-    let mut consider = |col: i64, row: i64| -> bool {
+    let consider = |col: i64, row: i64| -> bool {
         let q = center(&frame, col, row);
         // Quick reject by distance to the segment.
         if crate::geometry::point_segment_dist2(q, a, b) >= rc2 {
@@ -197,32 +196,9 @@ pub fn segment_first_contact(occ: &impl Occupancy, a: Point, b: Point, r_px: f64
         }
         true
     };
-    for row in r0..=r1 {
-        if row < 0 || row >= h {
-            // Outside the image every pixel blocks.
-            for col in c0..=c1 {
-                if !consider(col, row) {
-                    return best;
-                }
-            }
-            continue;
-        }
-        for col in (c0..=c1.min(-1)).chain(c0.max(w)..=c1) {
-            if !consider(col, row) {
-                return best;
-            }
-        }
-        let (lo, hi) = (c0.max(0), c1.min(w - 1));
-        if lo <= hi {
-            let mut go = true;
-            occ.for_each_blocked_in_row(row as usize, lo as usize, hi as usize, &mut |col| {
-                go = consider(col as i64, row);
-                go
-            });
-            if !go {
-                return best;
-            }
-        }
+    // Outside the image every pixel blocks.
+    if !for_each_blocked(occ, window, true, consider) {
+        return best;
     }
     // Leaving the band without contact (only possible for disks thinner than a pixel's
     // diagonal): contact where the motion leaves the box.
@@ -249,12 +225,11 @@ pub fn contact_intervals(
     let rc = contact_radius_px(r_px);
     let rc2 = rc * rc;
     let frame = *occ.frame();
-    let (w, h) = (frame.width as i64, frame.height as i64);
     let band = Band::new(&frame, rc);
     let (p, q) = part;
     let lo = Point::new(p.x.min(q.x), p.y.min(q.y));
     let hi = Point::new(p.x.max(q.x), p.y.max(q.y));
-    let (c0, c1, r0, r1) = band.clip(&frame, pixel_window(&frame, lo, hi, rc));
+    let window = band.clip(&frame, pixel_window(&frame, lo, hi, rc));
     let d = b - a;
     let aa = d.dot(d);
     if aa.is_nan() || aa <= 0.0 {
@@ -278,28 +253,56 @@ pub fn contact_intervals(
     };
     // Outside the image as `occ` says (as `disk_hits` asks it, so that an overlap the
     // intervals begin at 0 is one `disk_hits` sees at the start).
+    for_each_blocked(occ, window, false, |col, row| {
+        add(col, row);
+        true
+    });
+}
+
+/// Calls `f` on the blocked pixels `(col, row)` of the signed pixel window `(c0, c1, r0, r1)`
+/// (inclusive, already cut to the band around the image), row by row: those of the image as
+/// [`Occupancy::for_each_blocked_in_row`] gives them, and outside the image every pixel when
+/// `outside_blocks`, else those [`Occupancy::blocked`] says. Stops as soon as `f` returns
+/// `false`; returns whether it went through the whole window.
+#[inline]
+fn for_each_blocked(
+    occ: &impl Occupancy,
+    window: (i64, i64, i64, i64),
+    outside_blocks: bool,
+    mut f: impl FnMut(i64, i64) -> bool,
+) -> bool {
+    let (c0, c1, r0, r1) = window;
+    let frame = occ.frame();
+    let (w, h) = (frame.width as i64, frame.height as i64);
     for row in r0..=r1 {
-        if row < 0 || row >= h {
-            for col in c0..=c1 {
-                if occ.blocked(col, row) {
-                    add(col, row);
-                }
+        let in_image = (0..h).contains(&row);
+        // The window's pixels outside the image: the whole row, or its ends.
+        let (left, right) = if in_image {
+            (c0..=c1.min(-1), c0.max(w)..=c1)
+        } else {
+            (c0..=c1, c1 + 1..=c1)
+        };
+        for col in left.chain(right) {
+            if (outside_blocks || occ.blocked(col, row)) && !f(col, row) {
+                return false;
             }
+        }
+        if !in_image {
             continue;
         }
-        for col in (c0..=c1.min(-1)).chain(c0.max(w)..=c1) {
-            if occ.blocked(col, row) {
-                add(col, row);
+        let (lo, hi) = (c0.max(0), c1.min(w - 1));
+        if lo <= hi {
+            let mut go = true;
+            occ.for_each_blocked_in_row(row as usize, lo as usize, hi as usize, &mut |col| {
+                go = f(col as i64, row);
+                go
+            });
+            if !go {
+                return false;
             }
         }
-        let (l, u) = (c0.max(0), c1.min(w - 1));
-        if l <= u {
-            occ.for_each_blocked_in_row(row as usize, l as usize, u as usize, &mut |col| {
-                add(col as i64, row);
-                true
-            });
-        }
     }
+    true
 }
 
 #[cfg(test)]
