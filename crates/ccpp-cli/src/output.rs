@@ -259,8 +259,10 @@ fn check_metrics_of_run(
 
 /// Refuses a run folder whose files come from different runs (a trace or metrics copied in
 /// from another run), which the replay would draw as one, or that is not a whole run: the
-/// trace must hold a pose, end with the simulator's `finished` record and begin at the start
-/// pose of the run that `run.json` describes; `metrics.json` must be a run's metrics, name
+/// trace must hold a pose, end with the simulator's `finished` record, hold a `tracking`
+/// record only where a run writes one ([`ccpp_core::metrics::tracking_record_problem`]: the
+/// tracking error is read from it) and begin at the start pose of the run that `run.json`
+/// describes; `metrics.json` must be a run's metrics, name
 /// its planner and map, and report the path length the trace drives (the metrics are computed
 /// from the same poses, so only another run's trace differs). Returns `metrics.json` parsed.
 fn check_same_run(
