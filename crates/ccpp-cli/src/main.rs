@@ -5,6 +5,7 @@
 
 mod args;
 mod bench;
+mod budget;
 mod busy;
 mod components;
 mod errors;

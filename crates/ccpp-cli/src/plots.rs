@@ -44,7 +44,7 @@ pub fn write_all(
     rows: &[Row],
     maps: &[(PathBuf, Result<PreparedMap, String>)],
     robot: Robot,
-    budget: &crate::bench::MemoryBudget,
+    budget: &crate::budget::MemoryBudget,
 ) -> Result<Vec<String>> {
     let dir = out.join("plots");
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
@@ -341,7 +341,7 @@ mod tests {
             dir: dir.clone(),
         }];
         let maps = [(data, Ok(map))];
-        let budget = crate::bench::MemoryBudget::new(1024);
+        let budget = crate::budget::MemoryBudget::new(1024);
         let warnings = write_all(out.path(), &rows, &maps, Robot::new(0.15), &budget).unwrap();
         assert_eq!(warnings.len(), 1, "{warnings:?}");
         let w = &warnings[0];
