@@ -25,7 +25,6 @@
 
 use std::sync::{Arc, Mutex};
 
-use super::lattice::Ctx;
 use super::tsp;
 use crate::geometry::Point;
 
@@ -75,8 +74,9 @@ pub(super) struct Coarse {
 pub(super) struct CoarseCache(Mutex<Vec<(usize, Arc<Coarse>)>>);
 
 impl CoarseCache {
-    /// The grid of `ctx`'s C-free set in blocks of about `sp` pixels ([`Coarse::new`]).
-    pub(super) fn get(&self, ctx: &Ctx<'_>, sp: f64) -> Arc<Coarse> {
+    /// The grid in blocks of about `sp` pixels ([`Coarse::side`]), made by `make` when no
+    /// grid of that block side is cached.
+    pub(super) fn get(&self, sp: f64, make: impl FnOnce() -> Coarse) -> Arc<Coarse> {
         let b = Coarse::side(sp);
         // (a job that panicked while holding the lock left no half-made grid in it)
         let mut grids = self
@@ -86,7 +86,7 @@ impl CoarseCache {
         if let Some((_, g)) = grids.iter().find(|g| g.0 == b) {
             return Arc::clone(g);
         }
-        let g = Arc::new(Coarse::new(ctx, sp));
+        let g = Arc::new(make());
         grids.push((b, Arc::clone(&g)));
         g
     }
@@ -105,16 +105,23 @@ const MAX_PARTS: u8 = NOT_FREE - 1;
 const BUCKETS: usize = 16;
 
 impl Coarse {
-    /// The grid of `ctx`'s C-free set in blocks of about `sp` pixels (at least 4).
-    pub(super) fn new(ctx: &Ctx<'_>, sp: f64) -> Self {
-        let (w, h) = (ctx.frame.width, ctx.frame.height);
+    /// The grid of the C-free set `ok` (row-major, `w` x `h` pixels) in blocks of about `sp`
+    /// pixels (at least 4); `move_free(i, j)` tells whether the straight move between the
+    /// centres of pixels `i` and `j` is free on the map (asked of a diagonal step whose side
+    /// pixels are not both C-free).
+    pub(super) fn new(
+        w: usize,
+        h: usize,
+        ok: &[bool],
+        move_free: impl Fn(usize, usize) -> bool,
+        sp: f64,
+    ) -> Self {
         let b = Self::side(sp);
         let (bw, bh) = (w.div_ceil(b), h.div_ceil(b));
-        let ok = &ctx.ok;
         // A diagonal pixel step from `i` to `j` (both C-free): as the transfers' search.
         let diag = |i: usize, j: usize| {
             let (ci, ri, cj, rj) = (i % w, i / w, j % w, j / w);
-            (ok[ri * w + cj] && ok[rj * w + ci]) || ctx.pixel_move_free(i, j)
+            (ok[ri * w + cj] && ok[rj * w + ci]) || move_free(i, j)
         };
         // Parts of each block: first joined by side steps and by the diagonal steps whose side
         // pixels are both C-free (no map test), then by the other diagonal steps, each tested
@@ -950,7 +957,7 @@ mod tests {
         // (6 pixels a character, robot radius 1.5 pixels: the wall covers columns 24-29 and
         // the robot's centre keeps clear of columns 23-30.) Blocks of 20 pixels: columns
         // 20-39 are one block, holding C-free pixels of both sides.
-        let grid = Coarse::new(&ctx, 20.0);
+        let grid = ctx.coarse_grid(20.0);
         let h = world.frame().height as f64;
         let a = Point::new(22.5, h - 8.5);
         let b = Point::new(33.5, h - 8.5);
@@ -959,7 +966,7 @@ mod tests {
             grid.block_of(grid.node(b).unwrap())
         );
         assert_ne!(grid.node(a), grid.node(b), "two parts of one block");
-        let far = Coarse::new(&ctx, 80.0);
+        let far = ctx.coarse_grid(80.0);
         let piece = |p: Point| tsp::Piece {
             entry: vec![p],
             exit: vec![p],
@@ -986,8 +993,8 @@ mod tests {
         let world =
             World::new(map, Robot::new(0.03), Some(Pose::new(0.2, 0.2, 0.0))).expect("world");
         let ctx = ctx(&world);
-        let grid = Coarse::new(&ctx, 20.0);
-        let far = Coarse::new(&ctx, 80.0);
+        let grid = ctx.coarse_grid(20.0);
+        let far = ctx.coarse_grid(80.0);
         let h = world.frame().height as f64;
         let pts = [
             Point::new(10.5, h - 8.5),
@@ -1131,7 +1138,7 @@ mod tests {
             if ok.len() < 50 {
                 continue;
             }
-            let grid = Coarse::new(&ctx, [4.0, 6.0, 9.0][map % 3]);
+            let grid = ctx.coarse_grid([4.0, 6.0, 9.0][map % 3]);
             let mut search = Search::new(w, h);
             let diag = |i: usize, j: usize| ctx.pixel_move_free(i, j);
             let plain = |j: usize| ctx.ok[j];
@@ -1200,7 +1207,7 @@ mod tests {
         let mut ctx = ctx(&world);
         let (w, h) = (ctx.frame.width, ctx.frame.height);
         ctx.ok = (0..w * h).map(|i| world.cfree().contains(i)).collect();
-        let far = Coarse::new(&ctx, 4.0);
+        let far = ctx.coarse_grid(4.0);
         // An end point every 3 pixels: many more end-point nodes than landmarks.
         let mut pts = Vec::new();
         for r in (0..h).step_by(3) {

@@ -125,6 +125,18 @@ impl<'a> Lattice<'a> {
 }
 
 impl Ctx<'_> {
+    /// The coarse grid of the hop costs over this C-free set, in blocks of about `sp` pixels
+    /// ([`super::hops::Coarse::new`]; cached per plan in [`Ctx::coarse`]).
+    pub(super) fn coarse_grid(&self, sp: f64) -> super::hops::Coarse {
+        super::hops::Coarse::new(
+            self.frame.width,
+            self.frame.height,
+            &self.ok,
+            |i, j| self.pixel_move_free(i, j),
+            sp,
+        )
+    }
+
     /// Has the caller given the planning up? Each step of a plan looks before it starts, and
     /// a plan given up ends with no plan.
     pub(super) fn stopped(&self) -> bool {

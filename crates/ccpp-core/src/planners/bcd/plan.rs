@@ -743,8 +743,9 @@ impl Bcd {
             paths.push([p.clone(), p.clone()]);
             rots.push(rs);
         }
-        let coarse = ctx.coarse.get(ctx, sp);
-        let far = ctx.coarse.get(ctx, sp * f64::from(hops::FAR_FACTOR));
+        let coarse = ctx.coarse.get(sp, || ctx.coarse_grid(sp));
+        let far_sp = sp * f64::from(hops::FAR_FACTOR);
+        let far = ctx.coarse.get(far_sp, || ctx.coarse_grid(far_sp));
         let ncells = paths.len();
         // Two ways to sweep the rim (module docs, step 3): its passes as pieces of the tour,
         // or inserted into the finished tour where they cost least; the cheaper plan is kept.
