@@ -892,7 +892,7 @@ fn every_subcommand_refuses_a_map_too_large_or_too_far_out() {
 }
 
 /// `--georef` errors named the file twice (`georef F: georef file F: ...`, `georef F: cannot
-/// read georef file F: ...`).
+/// read georef file F: ...`), and a fitted placement out of bounds named the map instead.
 #[test]
 fn georef_errors_name_the_file_once() {
     let d = tempfile::tempdir().unwrap();
@@ -907,8 +907,19 @@ fn georef_errors_name_the_file_once() {
     // Pixel rows counted y up: the fit mirrors the image (it read as "200 % shear").
     let mirrored = dir.join("mirrored.csv");
     std::fs::write(&mirrored, "0,0,0,0\n200,0,10,0\n0,200,0,10\n").unwrap();
+    // Fits whose placement the map's bounds refuse: they blamed the map file and its origin or
+    // resolution, which the user never gave.
+    let far = dir.join("far.csv");
+    std::fs::write(&far, "0,0,1e9,0\n100,0,1000000010,0\n0,100,1e9,-10\n").unwrap();
+    let fine = dir.join("fine.csv");
+    std::fs::write(&fine, "0,0,0,0\n100,0,1e-10,0\n0,100,0,-1e-10\n").unwrap();
     let missing = dir.join("missing.csv");
     for (file, needle) in [
+        (
+            &far,
+            "the fitted placement: the map lies 1.00e9 m from the world's origin",
+        ),
+        (&fine, "the fitted placement: the resolution 9.99"),
         (&mirrored, "the fit mirrors the image"),
         (&one, "at least 3 point pairs"),
         (&short, "line 2"),
@@ -922,6 +933,7 @@ fn georef_errors_name_the_file_once() {
             .failure();
         let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
         assert_eq!(err.matches(s(file)).count(), 1, "{err}");
+        assert!(!err.contains(s(&map)), "{err}");
         assert!(
             err.starts_with("error: georef ") && err.contains(needle),
             "{err}"

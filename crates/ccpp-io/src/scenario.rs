@@ -378,6 +378,16 @@ impl MapRecipe {
         let mut grid = loaded.grid;
         if let Some(g) = &self.georef {
             grid = apply_georef(grid, g)?;
+            // A placement out of bounds is the fit's: the georef file is named, not the map
+            // (whose origin and resolution the fit replaced).
+            if let Some((problem, _)) = extent_problem(&grid) {
+                return Err(ScenarioError::Georef {
+                    path: g.clone(),
+                    message: format!(
+                        "the fitted placement: {problem}; check the world coordinates"
+                    ),
+                });
+            }
         }
         check_extent(&grid, &loaded.source)?;
         if let Some(m) = self.inflate {
@@ -480,13 +490,27 @@ pub fn inflated_world_error(e: &WorldError, inflation: Option<f64>) -> Option<St
 /// # Errors
 /// [`ScenarioError::Invalid`] naming the file.
 pub fn check_extent(grid: &GridMap, source: &Path) -> Result<(), ScenarioError> {
+    match extent_problem(grid) {
+        None => Ok(()),
+        Some((problem, what)) => Err(ScenarioError::Invalid(format!(
+            "map {}: {problem}; check the {what}",
+            source.display()
+        ))),
+    }
+}
+
+/// What [`check_extent`] refuses in `grid`'s frame, and which of the map's settings to check
+/// (`resolution` or `origin`); `None` when the frame is within bounds.
+fn extent_problem(grid: &GridMap) -> Option<(String, &'static str)> {
     let f = grid.frame();
     if f.resolution < MIN_RESOLUTION_M {
-        return Err(ScenarioError::Invalid(format!(
-            "map {}: the resolution {:e} m/px is finer than the {MIN_RESOLUTION_M:e} m/px ccpp computes precisely; check the resolution",
-            source.display(),
-            f.resolution
-        )));
+        return Some((
+            format!(
+                "the resolution {:e} m/px is finer than the {MIN_RESOLUTION_M:e} m/px ccpp computes precisely",
+                f.resolution
+            ),
+            "resolution",
+        ));
     }
     let fits = |v: f64| v.is_finite() && v <= MAX_MAP_SIDE_M;
     if fits(f.width_m()) && fits(f.height_m()) {
@@ -495,24 +519,28 @@ pub fn check_extent(grid: &GridMap, source: &Path) -> Result<(), ScenarioError> 
             .into_iter()
             .fold(0.0f64, |m, v| m.max(v.abs()));
         if far <= MAX_COORD_M {
-            return Ok(());
+            return None;
         }
-        return Err(ScenarioError::Invalid(format!(
-            "map {}: the map lies {far:.2e} m from the world's origin (origin {}, {}), farther than the {MAX_COORD_M:e} m ccpp handles precisely; check the origin",
-            source.display(),
-            Compact(f.origin.x),
-            Compact(f.origin.y)
-        )));
+        return Some((
+            format!(
+                "the map lies {far:.2e} m from the world's origin (origin {}, {}), farther than the {MAX_COORD_M:e} m ccpp handles precisely",
+                Compact(f.origin.x),
+                Compact(f.origin.y)
+            ),
+            "origin",
+        ));
     }
-    Err(ScenarioError::Invalid(format!(
-        "map {}: the map is {:e} x {:e} m ({} x {} px at {:e} m/px), larger than the {MAX_MAP_SIDE_M:e} m side ccpp handles; check the resolution",
-        source.display(),
-        f.width_m(),
-        f.height_m(),
-        f.width,
-        f.height,
-        f.resolution
-    )))
+    Some((
+        format!(
+            "the map is {:e} x {:e} m ({} x {} px at {:e} m/px), larger than the {MAX_MAP_SIDE_M:e} m side ccpp handles",
+            f.width_m(),
+            f.height_m(),
+            f.width,
+            f.height,
+            f.resolution
+        ),
+        "resolution",
+    ))
 }
 
 /// Places `grid` by the affine fit of the point pairs in `path` (pixel coordinates from the
