@@ -138,6 +138,14 @@ impl Polygon {
         out
     }
 
+    /// How many vertices the polygon is given with: its points, less a closing repeat of the
+    /// first (`GeoJSON` requires one; it is not a vertex of its own). What
+    /// [`MAX_POLYGON_POINTS`] bounds, and what a zone file's total counts.
+    pub fn vertex_count(&self) -> usize {
+        let n = self.points.len();
+        n - usize::from(n > 1 && self.points.first() == self.points.last())
+    }
+
     /// Signed area (positive counter-clockwise), square metres.
     pub fn signed_area(&self) -> f64 {
         let r = self.ring();
@@ -167,8 +175,7 @@ impl Polygon {
         }
         // The closing repeat of a ring (GeoJSON requires it) is not a vertex of its own: a
         // closed ring of 4096 vertices was refused as 4097 points.
-        let n = self.points.len();
-        let vertices = n - usize::from(n > 1 && self.points.first() == self.points.last());
+        let vertices = self.vertex_count();
         if vertices > MAX_POLYGON_POINTS {
             return Err(ZoneError::TooManyPoints {
                 index,

@@ -200,7 +200,9 @@ fn read_file(path: &Path, frame: &MapFrame) -> Result<ZoneData, ZoneFileError> {
         }
         let v: Value = serde_json::from_str(&text).map_err(|e| bad(format!("GeoJSON: {e}")))?;
         let polygons = geojson_polygons(&v)?;
-        let points: usize = polygons.iter().map(|p| p.points.len()).sum();
+        // Vertices, as each polygon's own limit counts them: 16 closed rings of the most
+        // vertices a polygon may have were refused for their closing repeats.
+        let points: usize = polygons.iter().map(Polygon::vertex_count).sum();
         if points > MAX_ZONE_POINTS {
             return Err(bad(format!(
                 "GeoJSON: {points} points in all; at most {MAX_ZONE_POINTS} are accepted"
@@ -457,6 +459,42 @@ fn geojson_collect(v: &Value, out: &mut Vec<Polygon>, depth: usize) -> Result<()
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A `GeoJSON` file's total counts vertices as each polygon's limit does: 16 closed rings
+    /// of the most vertices a polygon may have were refused (65 552 "points") for their
+    /// closing repeats; 17 such rings are still too many.
+    #[test]
+    fn the_total_limit_does_not_count_closing_repeats() {
+        let n = ccpp_core::zones::MAX_POLYGON_POINTS;
+        let file = |rings: usize| {
+            let ring = |k: usize| {
+                let mut pts: Vec<String> = (0..n)
+                    .map(|i| {
+                        let a = std::f64::consts::TAU * i as f64 / n as f64;
+                        format!("[{},{}]", 10.0 * k as f64 + a.cos(), a.sin())
+                    })
+                    .collect();
+                pts.push(pts[0].clone());
+                format!("[[{}]]", pts.join(","))
+            };
+            let polys: Vec<String> = (0..rings).map(ring).collect();
+            format!(
+                "{{\"type\":\"MultiPolygon\",\"coordinates\":[{}]}}",
+                polys.join(",")
+            )
+        };
+        let d = tempfile::tempdir().unwrap();
+        let frame = MapFrame::new(10, 10, 1.0);
+        let path = d.path().join("z.geojson");
+        std::fs::write(&path, file(16)).unwrap();
+        match read_file(&path, &frame) {
+            Ok(ZoneData::Polygons(p)) => assert_eq!(p.len(), 16),
+            other => panic!("{other:?}"),
+        }
+        std::fs::write(&path, file(17)).unwrap();
+        let e = read_file(&path, &frame).unwrap_err().to_string();
+        assert!(e.contains("69632 points in all"), "{e}");
+    }
 
     /// A YAML point is `[x, y]` or `{x, y}` and nothing more; a `GeoJSON` position may add
     /// an altitude. A row `[0, -4, 2, -4]` (two points on one line) was read as `[0, -4]`.
