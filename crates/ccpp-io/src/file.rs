@@ -57,17 +57,23 @@ pub fn read_bytes(path: &Path) -> io::Result<Vec<u8>> {
     Ok(v)
 }
 
-/// Reads a regular file as UTF-8 text, at most [`MAX_TEXT_BYTES`].
+/// Reads a regular file as UTF-8 text, at most [`MAX_TEXT_BYTES`], without a leading byte
+/// order mark (editors on Windows write one; a `GeoJSON` zone, a JSON options file or a CSV
+/// of landmarks saved so was refused at "line 1 column 1", while YAML parsers skip it).
 ///
 /// # Errors
 /// As [`read_bytes`], plus invalid UTF-8.
 pub fn read_text(path: &Path) -> io::Result<String> {
-    String::from_utf8(read_bytes(path)?).map_err(|_| {
+    let mut text = String::from_utf8(read_bytes(path)?).map_err(|_| {
         io::Error::new(
             io::ErrorKind::InvalidData,
             "stream did not contain valid UTF-8",
         )
-    })
+    })?;
+    if text.starts_with('\u{feff}') {
+        text.drain(..'\u{feff}'.len_utf8());
+    }
+    Ok(text)
 }
 
 #[cfg(test)]
@@ -90,6 +96,16 @@ mod tests {
             read_bytes(&p).map(|b| b.len() as u64).ok(),
             Some(MAX_TEXT_BYTES)
         );
+    }
+
+    /// A leading byte order mark is no part of the text (JSON and CSV readers refused it);
+    /// one elsewhere is kept.
+    #[test]
+    fn a_leading_byte_order_mark_is_skipped() {
+        let d = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+        let p = d.path().join("t.json");
+        std::fs::write(&p, "\u{feff}{\"a\": \"\u{feff}\"}").unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(read_text(&p).ok().as_deref(), Some("{\"a\": \"\u{feff}\"}"));
     }
 
     #[test]

@@ -293,7 +293,14 @@ fn point(v: &Value, geo: bool) -> Result<[f64; 2], ZoneFileError> {
     };
     let most = if geo { 3 } else { 2 };
     match v {
-        Value::Array(a) if (2..=most).contains(&a.len()) => Ok([num(&a[0])?, num(&a[1])?]),
+        Value::Array(a) if (2..=most).contains(&a.len()) => {
+            // An altitude is a number too (RFC 7946, 3.1.1): `[x, y, null]` or `[x, y, "a"]`
+            // was taken in silence.
+            if let Some(z) = a.get(2) {
+                num(z)?;
+            }
+            Ok([num(&a[0])?, num(&a[1])?])
+        }
         Value::Array(a) if a.len() > most => Err(bad(format!(
             "point [{}{}] has {} numbers; a point is {}",
             a.iter()
@@ -459,6 +466,34 @@ fn geojson_collect(v: &Value, out: &mut Vec<Polygon>, depth: usize) -> Result<()
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A `GeoJSON` position's third member is an altitude, a number: `null`, text, objects
+    /// and lists there were taken in silence. A file saved with a byte order mark is read
+    /// (it was refused at "line 1 column 1"; named `.txt`, read as YAML).
+    #[test]
+    fn geojson_altitudes_are_numbers_and_a_byte_order_mark_is_skipped() {
+        let d = tempfile::tempdir().unwrap();
+        let frame = MapFrame::new(10, 10, 1.0);
+        let poly = |z: &str| {
+            format!("{{\"type\":\"Polygon\",\"coordinates\":[[[1,1{z}],[3,1],[3,3],[1,1]]]}}")
+        };
+        let path = d.path().join("z.geojson");
+        for z in [",null", ",\"a\"", ",{}", ",[1]"] {
+            std::fs::write(&path, poly(z)).unwrap();
+            let e = read_file(&path, &frame).unwrap_err().to_string();
+            assert!(e.contains("is not a number"), "{z}: {e}");
+        }
+        std::fs::write(&path, poly(",2.5")).unwrap();
+        assert!(read_file(&path, &frame).is_ok());
+        for name in ["bom.geojson", "bom.txt"] {
+            let path = d.path().join(name);
+            std::fs::write(&path, format!("\u{feff}{}", poly(""))).unwrap();
+            match read_file(&path, &frame) {
+                Ok(ZoneData::Polygons(p)) => assert_eq!(p.len(), 1, "{name}"),
+                other => panic!("{name}: {other:?}"),
+            }
+        }
+    }
 
     /// A `GeoJSON` file's total counts vertices as each polygon's limit does: 16 closed rings
     /// of the most vertices a polygon may have were refused (65 552 "points") for their
