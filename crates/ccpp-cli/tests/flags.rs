@@ -501,6 +501,10 @@ fn config_values_go_through_the_same_validation() {
         ),
         ("bcd: { lane_spacing_m: .nan }", "bcd", "bcd.lane_spacing_m"),
         ("bcd: { rim_coverage: 1.5 }", "bcd", "bcd.rim_coverage"),
+        // A quoted number or boolean is text, as JSON reads it ("3" was read as 3, "no" as
+        // false, in silence).
+        ("bcd: { tour_rounds: \"3\" }", "bcd", "bcd.tour_rounds"),
+        ("bcd: { rim: \"no\" }", "bcd", "bcd.rim"),
         ("bcd: { min_coverage: -0.5 }", "bcd", "bcd.min_coverage"),
         // Each angle try is a whole plan: a huge count must be refused, not planned.
         ("bcd: { angle_tries: 41 }", "bcd", "bcd.angle_tries"),

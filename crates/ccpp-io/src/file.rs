@@ -146,7 +146,10 @@ pub fn parse_yaml_or_json<T: serde::de::DeserializeOwned>(
         serde_saphyr::from_str::<T>(text).map_err(|e| yaml_words(&e.to_string()))
     };
     let message = match first {
-        Ok(v) => return Ok(v),
+        Ok(v) => match (!json).then(|| quoted_scalar_problem::<T>(text)).flatten() {
+            None => return Ok(v),
+            Some(problem) => return Err(problem),
+        },
         Err(m) => m,
     };
     let path = if json {
@@ -173,6 +176,23 @@ pub fn parse_yaml_or_json<T: serde::de::DeserializeOwned>(
             format!("{p}: {message}")
         }
         _ => message,
+    })
+}
+
+/// A quoted YAML scalar that the typed reading took as a number or a boolean (`"3"` as
+/// `3`, `"no"` as `false`), which JSON refuses and a quoted value does not mean: the text
+/// read untyped (a quoted scalar stays text there) and then as `T` says where.
+fn quoted_scalar_problem<T: serde::de::DeserializeOwned>(text: &str) -> Option<String> {
+    let untyped: serde_json::Value = serde_saphyr::from_str(text).ok()?;
+    let e = serde_path_to_error::deserialize::<_, T>(untyped).err()?;
+    let inner = e.inner().to_string();
+    // Only text where the type wants something else: the untyped reading differs from the
+    // typed one in other ways too (`.inf` is null there), which the typed reading settled.
+    inner.starts_with("invalid type: string").then(|| {
+        format!(
+            "{}: {inner}; a quoted value is text in YAML: write numbers and booleans without quotes",
+            e.path()
+        )
     })
 }
 
@@ -212,6 +232,32 @@ mod parse_tests {
                 "{text}: {e}"
             );
         }
+        // A quoted number or boolean is text, as in JSON ("3" was read as 3, "no" as false).
+        #[derive(Debug, serde::Deserialize)]
+        struct Flags {
+            #[serde(default)]
+            on: bool,
+            #[serde(default)]
+            name: String,
+            #[serde(default)]
+            limit: Option<f64>,
+        }
+        for (text, path) in [
+            ("bcd: { rounds: \"3\" }", "bcd.rounds"),
+            ("bcd: { rounds: 3, cost: '0.5' }", "bcd.cost"),
+        ] {
+            let e = parse_yaml_or_json::<Outer>(text, false).unwrap_err();
+            assert!(
+                e.starts_with(&format!("{path}: invalid type: string")) && e.contains("quoted"),
+                "{text}: {e}"
+            );
+        }
+        for text in ["on: \"no\"", "limit: \"2\""] {
+            assert!(parse_yaml_or_json::<Flags>(text, false).is_err(), "{text}");
+        }
+        // Plain scalars read as before: YAML 1.1 booleans, a number as a name, `.inf`.
+        let f: Flags = parse_yaml_or_json("on: yes\nname: 123\nlimit: .inf", false).unwrap();
+        assert!(f.on && f.name == "123" && f.limit == Some(f64::INFINITY));
         // Unknown fields and root errors keep the parser's words.
         let e = parse_yaml_or_json::<Outer>("bcd: { rounds: 1, turns: 2 }", false).unwrap_err();
         assert!(e.contains("unknown field `turns`"), "{e}");
