@@ -1050,6 +1050,7 @@ impl Scenario {
             frame: *frame,
             robot: self.robot,
             sensor_range: self.sim.sensor_range_on(&self.robot, frame),
+            max_steps: self.sim.max_steps,
         };
         if self.sim.sensor_range.is_none() {
             if let Some(need) = self.planner.settings().sensor_need(&setup) {

@@ -540,3 +540,15 @@ def test_sweep_takes_the_maps_bench_takes(tmp_path: Path) -> None:
         ccpp.expand_maps([folder])
     with pytest.raises(ccpp.CcppError, match="no such file or folder"):
         ccpp.expand_maps([tmp_path / "none"])
+
+
+def test_a_step_cap_bounds_random_bounce_estimate(room: Path) -> None:
+    # A budget far beyond the step cap was refused as needing 1e9 MB, though the run stops at
+    # the cap: its strides are steps.
+    r = ccpp.run(room, "random-bounce", budget_m=1e12, max_steps=1000)
+    assert r.metrics["stop_reason"] == "max_steps"
+    capped = ccpp.run(room, "random-bounce", budget_m=1e6, max_steps=1000)
+    assert r.metrics["path_length_m"] == capped.metrics["path_length_m"]
+    # Without a cap of its own the default one (5e7 steps) still needs gigabytes.
+    with pytest.raises(ccpp.CcppError, match="5.0e7 strides"):
+        ccpp.run(room, "random-bounce", budget_m=1e12)

@@ -59,6 +59,9 @@ pub struct Setup {
     pub robot: Robot,
     /// The sensor range in force, metres.
     pub sensor_range: f64,
+    /// The run's step cap ([`crate::sim::SimConfig::max_steps`]): no run takes more steps, so
+    /// no estimate counts more (random-bounce's budget may be far beyond it).
+    pub max_steps: u64,
 }
 
 impl Setup {
@@ -699,10 +702,9 @@ impl PlannerSettings for RandomBounceOptions {
     }
 
     fn estimate(&self, s: &Setup) -> ResourceEstimate {
-        let budget = self.budget_m.unwrap_or_else(|| default_budget(s));
-        let stride = bounce_stride(s);
+        let (path, stride) = self.path_estimate(s);
         // A stride and a turn per stride.
-        let e = ResourceEstimate::units(budget / stride, 2.0 * RECORD_BYTES, "strides");
+        let e = ResourceEstimate::units(path / stride, 2.0 * RECORD_BYTES, "strides");
         if self.budget_m.is_some() {
             e.remedy("a smaller random_bounce.budget_m")
         } else {
@@ -717,10 +719,11 @@ impl PlannerSettings for RandomBounceOptions {
     }
 
     fn path_estimate(&self, s: &Setup) -> (f64, f64) {
-        (
-            self.budget_m.unwrap_or_else(|| default_budget(s)),
-            bounce_stride(s),
-        )
+        let stride = bounce_stride(s);
+        // A stride is a step: the run's step cap ends it before a budget beyond it (a
+        // `budget_m` of 1e12 m with `max_steps` 1000 was refused as 1e9 MB).
+        let budget = self.budget_m.unwrap_or_else(|| default_budget(s));
+        (budget.min(s.max_steps as f64 * stride), stride)
     }
 
     fn tile_side(&self, _: &Robot) -> Option<f64> {
@@ -734,6 +737,7 @@ impl PlannerSettings for RandomBounceOptions {
                 frame: *world.frame(),
                 robot: world.robot(),
                 sensor_range: 0.0,
+                max_steps: u64::MAX,
             };
             o.budget_m = Some(default_budget(&s));
         }
@@ -1407,6 +1411,7 @@ mod tests {
             frame: MapFrame::new(400, 300, 0.05),
             robot: Robot::new(0.05),
             sensor_range: 1.0,
+            max_steps: crate::sim::SimConfig::default().max_steps,
         }
     }
 
@@ -1428,6 +1433,36 @@ mod tests {
             );
             assert_eq!(kind.sensor_range_refusal().is_none(), info.range_matters);
         }
+    }
+
+    /// Random-bounce's strides are steps: a budget beyond the run's step cap is estimated at
+    /// the cap (1e12 m with a cap of 1000 steps was refused as 1e9 MB).
+    #[test]
+    fn random_bounce_estimate_stops_at_the_step_cap() {
+        let opts = RandomBounceOptions {
+            budget_m: Some(1e12),
+            ..RandomBounceOptions::default()
+        };
+        let wide = apartment();
+        let capped = Setup {
+            max_steps: 1000,
+            ..apartment()
+        };
+        let stride = bounce_stride(&capped);
+        assert_eq!(opts.path_estimate(&capped), (1000.0 * stride, stride));
+        assert!(
+            opts.estimate(&capped).bytes < 1e6,
+            "{}",
+            opts.estimate(&capped).bytes
+        );
+        // At the default cap (5e7 steps) still gigabytes: refused under the default limit.
+        assert!(opts.estimate(&wide).bytes > 4096.0 * 1024.0 * 1024.0);
+        // Below the cap the budget is what counts.
+        let small = RandomBounceOptions {
+            budget_m: Some(10.0),
+            ..RandomBounceOptions::default()
+        };
+        assert_eq!(small.path_estimate(&capped).0, 10.0);
     }
 
     #[test]
