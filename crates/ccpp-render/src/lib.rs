@@ -127,7 +127,12 @@ pub fn approach_end(world: &World, trace: &Trace) -> Option<(usize, ccpp_core::P
 /// Why the simulator stopped a run the planner did not finish (`stalled`, `max_steps`): the
 /// reason of the trace's `finished` event when it is not `done`.
 pub fn stop_reason(trace: &Trace) -> Option<String> {
-    finished_record(trace).and_then(|(_, reason)| (reason != "done").then(|| reason.to_string()))
+    unfinished(finished_record(trace)).map(str::to_string)
+}
+
+/// The reason of a `finished` record ([`finished_record`]) when it is not `done`.
+pub(crate) fn unfinished<'a>(finished: Option<(u64, &'a str)>) -> Option<&'a str> {
+    finished.map(|(_, reason)| reason).filter(|r| *r != "done")
 }
 
 /// The step and reason of the trace's `finished` event, when it has one.

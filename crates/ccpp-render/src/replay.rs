@@ -11,7 +11,7 @@ use ccpp_core::Point;
 use tiny_skia::{Color, Pixmap};
 
 use crate::colours::{AREA_BORDER, KEEPOUT, KEEPOUT_HATCH, OUTSIDE_AREA};
-use crate::{approach_end, crop_box, finished_record, zone_class, RenderError};
+use crate::{approach_end, crop_box, finished_record, unfinished, zone_class, RenderError};
 
 /// Map class colours shared by the replay page and the GIF.
 const C_OCC: [u8; 3] = [30, 30, 30];
@@ -408,9 +408,9 @@ fn replay_data(
     // steps after its last move, and the page's step count ended at that move (64 / 64 for a
     // run stopped at step 1063).
     let finished = finished_record(trace);
-    let stop = finished.filter(|(_, why)| *why != "done").map_or_else(
+    let stop = unfinished(finished).map_or_else(
         || "null".to_string(),
-        |(_, why)| serde_json::Value::String(why.to_string()).to_string(),
+        |why| serde_json::Value::String(why.to_string()).to_string(),
     );
     let last = finished.map_or_else(|| "null".to_string(), |(t, _)| t.to_string());
     let classes = classes_js(world, crop);
