@@ -591,7 +591,7 @@ pub fn compute_prepared(
 
 /// [`compute_prepared`] with the swept pixels when the caller has them (they must be
 /// [`swept_pixels`] of the run's trace, as a [`TraceSweep`] fed the whole trace finds them)
-/// and a [`MotionTally`] fed the whole trace (used when made for the run's tile side).
+/// and a [`MotionTally`] fed the whole trace.
 pub fn compute_prepared_with(
     world: &World,
     run: &RunOutput,
@@ -676,12 +676,12 @@ fn join<T>(h: std::thread::ScopedJoinHandle<'_, T>) -> T {
 
 /// The figures of the metrics that follow the poses and events one by one: path length,
 /// turns, rotation; regions, backtracks, collisions, backtrack length (poses between start and
-/// end marks); tile entries for the revisit rate (on the planner's tiling, else one of side
-/// `2 r_tool`). Fed the trace's pieces in order, in one go or chunk by chunk while the run goes
-/// on (the same figures).
+/// end marks); tile entries for the revisit rate, on the conventions' tiles (side `2 r`, the
+/// robot's radius, anchored at the start) whatever the planner's own tiling, so that every
+/// planner's figure is on one grid (bcd's was on tiles of `2 r_tool`, ba-star's on its own). Fed
+/// the trace's pieces in order, in one go or chunk by chunk while the run goes on (the same
+/// figures).
 pub struct MotionTally {
-    /// The tile side the tiles are counted on.
-    side: f64,
     grid: TileGrid,
     distinct: TileSet,
     entries: usize,
@@ -699,13 +699,12 @@ pub struct MotionTally {
 }
 
 impl MotionTally {
-    /// Nothing counted yet, in `world`, for a run of a planner with tile side `tile_side`.
-    pub fn new(world: &World, tile_side: Option<f64>) -> Self {
-        let side = tile_side.unwrap_or(2.0 * world.robot().tool_radius);
+    /// Nothing counted yet, in `world`.
+    pub fn new(world: &World) -> Self {
+        let side = 2.0 * world.robot().radius;
         let grid = TileGrid::new(world.start().position(), side);
         let (i0, i1, j0, j1) = grid.bounds_for(world);
         Self {
-            side,
             grid,
             distinct: TileSet::new(i0, i1, j0, j1),
             entries: 0,
@@ -802,7 +801,7 @@ impl MotionTally {
 
 /// The metrics that follow the poses and events one by one (all but the swept area and the
 /// tile coverage, left at 0 / `None`); `tally`, when given, must be a [`MotionTally`] fed the
-/// whole trace (it is used when made for the run's tile side).
+/// whole trace.
 fn compute_rest(
     world: &World,
     run: &RunOutput,
@@ -811,15 +810,11 @@ fn compute_rest(
 ) -> Metrics {
     let robot = world.robot();
     let trace = &run.trace;
-    let side = run.tile_side.unwrap_or(2.0 * robot.tool_radius);
-    let tally = match tally {
-        Some(t) if t.side.to_bits() == side.to_bits() => t,
-        _ => {
-            let mut t = MotionTally::new(world, run.tile_side);
-            t.pieces(trace.pieces(), trace.lattice());
-            t
-        }
-    };
+    let tally = tally.unwrap_or_else(|| {
+        let mut t = MotionTally::new(world);
+        t.pieces(trace.pieces(), trace.lattice());
+        t
+    });
     let MotionTally {
         distinct,
         entries,

@@ -1502,8 +1502,7 @@ impl Scenario {
 
     /// [`run_in`](Self::run_in), a third thread reading the trace as it grows (copied out in
     /// chunks of [`FORM_CHUNK`] sealed pieces) to sweep the tool's pixels, tally the motion
-    /// metrics ([`metrics::MotionTally`], on the scenario's tile side: the metrics recount when
-    /// the planner reports another) and form `path.csv` and `trace.jsonl`.
+    /// metrics ([`metrics::MotionTally`]) and form `path.csv` and `trace.jsonl`.
     fn run_forming<T: Send>(
         &self,
         world: World,
@@ -1520,7 +1519,7 @@ impl Scenario {
                     let (tx, rx) = std::sync::mpsc::channel::<Chunk>();
                     let former = s.spawn(move || {
                         let mut sweep = metrics::TraceSweep::new(world);
-                        let mut tally = metrics::MotionTally::new(world, side);
+                        let mut tally = metrics::MotionTally::new(world);
                         let mut files = FileFormer::default();
                         for chunk in rx {
                             sweep.chunk(&chunk);
