@@ -157,6 +157,36 @@ const TRIM_LANES: f64 = 2.0;
 /// views (step 2).
 const TRIM_VARIANTS: usize = 2;
 
+/// The steps without the transfers that have no move between their marks: a hop the smoothing
+/// and pruning merged into the moves around it, or one between cells that meet where the one
+/// ends and the next starts, is no transfer between regions (`teb_maze` counted 18 backtracks
+/// between 16 cells, 5 of them without a move). The marks of a transfer with moves are kept.
+fn drop_empty_transfers(steps: VecDeque<Step>) -> VecDeque<Step> {
+    let mut out = VecDeque::with_capacity(steps.len());
+    // Where the open transfer's start mark is in `out`, while no move has followed it.
+    let mut open: Option<usize> = None;
+    for step in steps {
+        match step {
+            Step::Mark(Event::BacktrackStart) => {
+                open = Some(out.len());
+                out.push_back(step);
+            }
+            Step::Mark(Event::BacktrackEnd) => match open.take() {
+                Some(i) => {
+                    out.remove(i);
+                }
+                None => out.push_back(step),
+            },
+            Step::MoveTo(_) | Step::Rotate(_) | Step::Translate(_) => {
+                open = None;
+                out.push_back(step);
+            }
+            Step::Mark(_) | Step::Done => out.push_back(step),
+        }
+    }
+    out
+}
+
 /// Improvement rounds of the first tour (which only picks each cell's path for the rim step).
 const FIRST_ROUNDS: u32 = 1;
 
@@ -384,7 +414,7 @@ impl Bcd {
             steps.extend(marks.into_iter().map(Step::Mark));
         }
         Self {
-            steps,
+            steps: drop_empty_transfers(steps),
             cells: ncells,
         }
     }
