@@ -331,22 +331,31 @@ pub fn plan(world: &World, opts: &RectOptions) -> RectPlan {
     let mut unreached = 0;
     let mut cur = world.start().position();
     let lane_list = lanes(area, length, width);
-    for (k, lane) in lane_list.iter().enumerate() {
-        let region = k as u32 + 1;
-        let mut started = false;
+    // A region is a lane, or the part of one after a detour: the way round an obstacle on the
+    // lane (or to a lane that is not straight ahead) is a transfer between regions, as the
+    // metrics define backtracks, not a backtrack inside one. A region starts with its first
+    // straight move (the shift from the lane before is its first move).
+    let mut region = 0u32;
+    for lane in &lane_list {
+        let mut open = false;
         for &p in lane {
             if !rm.valid(p) {
                 dropped += 1;
                 continue;
             }
-            if !started {
-                steps.push(Step::Mark(Event::RegionStart { region }));
-                started = true;
-            }
             if rw.segment_free(cur, p) {
+                if !open {
+                    region += 1;
+                    steps.push(Step::Mark(Event::RegionStart { region }));
+                    open = true;
+                }
                 steps.push(Step::MoveTo(p));
                 waypoints.push(p);
             } else if let Some(path) = rm.path(cur, p) {
+                if open {
+                    steps.push(Step::Mark(Event::RegionEnd { region }));
+                    open = false;
+                }
                 steps.push(Step::Mark(Event::BacktrackStart));
                 steps.push(Step::Mark(Event::PathSmoothed {
                     points: path.iter().map(|q| [q.x, q.y]).collect(),
@@ -363,7 +372,7 @@ pub fn plan(world: &World, opts: &RectOptions) -> RectPlan {
             }
             cur = p;
         }
-        if started {
+        if open {
             steps.push(Step::Mark(Event::RegionEnd { region }));
         }
     }
