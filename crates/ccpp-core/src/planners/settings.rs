@@ -703,8 +703,14 @@ impl PlannerSettings for RandomBounceOptions {
 
     fn estimate(&self, s: &Setup) -> ResourceEstimate {
         let (path, stride) = self.path_estimate(s);
-        // A stride and a turn per stride.
-        let e = ResourceEstimate::units(path / stride, 2.0 * RECORD_BYTES, "strides");
+        let budget = self.budget_m.unwrap_or_else(|| default_budget(s));
+        // A stride and a turn per stride; the step cap named when it is what bounds them.
+        let what = if path < budget {
+            "strides, the run's step cap"
+        } else {
+            "strides"
+        };
+        let e = ResourceEstimate::units(path / stride, 2.0 * RECORD_BYTES, what);
         if self.budget_m.is_some() {
             e.remedy("a smaller random_bounce.budget_m")
         } else {
