@@ -25,8 +25,9 @@ use crate::staging::write_file;
 pub const PANIC_ENV: &str = "CCPP_TEST_PANIC_PLANNER";
 
 /// What defines a bench run, as written to its `bench-key.txt`: a finished run is reused only
-/// when this matches exactly. Covers the map's content (after inflation), the planner, its
-/// options (seed included), the robot, the simulator settings and the ccpp version.
+/// when this matches exactly. Covers the map's content (after inflation), the planner, its own
+/// options (random-bounce's seed included; another planner's options or a `--seed` for
+/// random-bounce redid every run), the robot, the simulator settings and the ccpp version.
 pub fn run_key(
     grid_hash: u64,
     planner: &str,
@@ -34,14 +35,15 @@ pub fn run_key(
     robot: ccpp_core::world::Robot,
     sim: &SimConfig,
 ) -> Result<String> {
+    let kind: ccpp_core::planners::PlannerKind = planner.parse()?;
     let mut h = ccpp_core::hash::Fnv::new();
     h.bytes(&grid_hash.to_le_bytes());
     h.bytes(planner.as_bytes());
-    h.bytes(serde_json::to_string(options)?.as_bytes());
+    h.bytes(serde_json::to_string(&options.config(kind))?.as_bytes());
     h.bytes(serde_json::to_string(&robot)?.as_bytes());
     h.bytes(serde_json::to_string(sim)?.as_bytes());
     h.bytes(env!("CARGO_PKG_VERSION").as_bytes());
-    Ok(format!("ccpp-bench-key v1 {:016x}\n", h.finish()))
+    Ok(format!("ccpp-bench-key v2 {:016x}\n", h.finish()))
 }
 
 /// Runs the benchmark.

@@ -591,8 +591,9 @@ fn bench_resume_reruns_when_anything_that_defines_a_run_changed() {
             "{key}"
         );
     }
-    // A different seed (taken by random-bounce; part of every run's key) or a changed map
-    // content reruns.
+    // A run's key holds its own planner's options only: a seed (random-bounce's) or another
+    // planner's options leave bcd's run as it is (both redid it); bcd's own options redo it.
+    let rb_trace = out.join("runs/teb_empty_box/random-bounce/trace.jsonl");
     bench(
         &out,
         &maps,
@@ -607,10 +608,40 @@ fn bench_resume_reruns_when_anything_that_defines_a_run_changed() {
     )
     .assert()
     .success();
-    assert_ne!(
-        std::fs::metadata(&trace).unwrap().modified().unwrap(),
-        before
-    );
+    let mtime = |p: &Path| std::fs::metadata(p).unwrap().modified().unwrap();
+    assert_eq!(mtime(&trace), before);
+    let rb_before = mtime(&rb_trace);
+    std::thread::sleep(std::time::Duration::from_millis(20));
+    let cfg = dir.path().join("cfg.yaml");
+    std::fs::write(&cfg, "ba_star: { smoothing: false }\n").unwrap();
+    let with_cfg = |seed: &str| {
+        let c = cfg.to_str().unwrap().to_string();
+        let mut b = bench(
+            &out,
+            &maps,
+            &[
+                "--planners",
+                "bcd,random-bounce",
+                "--radius",
+                "0.3",
+                "--config",
+                &c,
+                "--seed",
+                seed,
+            ],
+        );
+        b.assert().success();
+    };
+    with_cfg("9");
+    assert_eq!(mtime(&trace), before);
+    assert_eq!(mtime(&rb_trace), rb_before);
+    with_cfg("10");
+    assert_eq!(mtime(&trace), before);
+    assert_ne!(mtime(&rb_trace), rb_before);
+    std::fs::write(&cfg, "bcd: { tour_rounds: 2 }\n").unwrap();
+    with_cfg("10");
+    assert_ne!(mtime(&trace), before);
+    // A changed map content reruns.
     let copy = dir.path().join("m");
     std::fs::create_dir(&copy).unwrap();
     std::fs::copy(data("teb_empty_box.png"), copy.join("teb_empty_box.png")).unwrap();
