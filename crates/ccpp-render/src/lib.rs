@@ -131,7 +131,7 @@ pub fn stop_reason(trace: &Trace) -> Option<String> {
 }
 
 /// The reason of a `finished` record ([`finished_record`]) when it is not `done`.
-pub(crate) fn unfinished<'a>(finished: Option<(u64, &'a str)>) -> Option<&'a str> {
+pub(crate) fn unfinished(finished: Option<(u64, &str)>) -> Option<&str> {
     finished.map(|(_, reason)| reason).filter(|r| *r != "done")
 }
 
