@@ -214,6 +214,16 @@ mod parse_tests {
         bcd: Inner,
     }
 
+    #[derive(Debug, serde::Deserialize)]
+    struct Flags {
+        #[serde(default)]
+        on: bool,
+        #[serde(default)]
+        name: String,
+        #[serde(default)]
+        limit: Option<f64>,
+    }
+
     #[test]
     fn errors_name_the_field_and_good_text_parses_as_before() {
         let ok: Outer = parse_yaml_or_json("bcd: { rounds: 3 }", false).unwrap();
@@ -233,15 +243,6 @@ mod parse_tests {
             );
         }
         // A quoted number or boolean is text, as in JSON ("3" was read as 3, "no" as false).
-        #[derive(Debug, serde::Deserialize)]
-        struct Flags {
-            #[serde(default)]
-            on: bool,
-            #[serde(default)]
-            name: String,
-            #[serde(default)]
-            limit: Option<f64>,
-        }
         for (text, path) in [
             ("bcd: { rounds: \"3\" }", "bcd.rounds"),
             ("bcd: { rounds: 3, cost: '0.5' }", "bcd.cost"),
