@@ -30,6 +30,10 @@
 //!   between pixels whose clearance (distance transform) proves them free are not re-checked. This is complete on the pixel grid and
 //!   keeps the clearance of the circumscribed disk; it replaces the seed's Voronoi roadmap.
 //!
+//! **Regions and backtracks**: a region is a lane, or the part of a lane after a detour; the
+//! detours (round an obstacle on the lane, or to a lane not straight ahead of the last) are the
+//! backtracks, transfers between regions as the metrics define them.
+//!
 //! [`waypoints`] returns the plain waypoint list (lane points and detour points in order);
 //! the planner replays it as `MoveTo` steps, under PID execution by default (seed 001 drives to
 //! each waypoint until within a tolerance).
