@@ -247,7 +247,8 @@ fn check_metrics_of_run(
         if !same {
             bail!(
                 "{}: metrics.json reports {key} {} but the run of run.json makes {} of \
-                 trace.jsonl: the folder mixes files of two runs (or a file was edited)",
+                 trace.jsonl: the folder mixes files of two runs, a file was edited, or an \
+                 older ccpp measured it otherwise (run it again)",
                 dir.display(),
                 got.map_or_else(|| "(none)".to_string(), ToString::to_string),
                 want.map_or_else(|| "(none)".to_string(), ToString::to_string),
