@@ -29,6 +29,7 @@ fuzz_target!(|data: &[u8]| {
             frame: *world.frame(),
             robot: world.robot(),
             sensor_range: sim.sensor_range_for(&world.robot()),
+            max_steps: sim.max_steps,
         };
         for &kind in PlannerKind::ALL {
             let config = opts.config(kind);
