@@ -8,6 +8,7 @@ mod bcd_maps;
 mod exports;
 mod load;
 mod maps;
+mod marks;
 mod readme_examples;
 mod regressions;
 mod streamed_run;
