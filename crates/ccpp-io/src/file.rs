@@ -128,15 +128,16 @@ pub fn yaml_words(message: &str) -> String {
 }
 
 /// Deserializes YAML, or JSON when `json`, and on an error names the field it is in: the text
-/// is parsed as `serde_saphyr::from_str` / `serde_json::from_str` parse it (so what is accepted
-/// does not change), and only a failed parse is read again to find the error's path
-/// (`bcd.turn_cost_m: line 1 column 21: invalid floating point` where the parser alone says
-/// `line 1 column 21: invalid floating point`). An error at the document's root keeps the
-/// parser's message as it is.
+/// is parsed as `serde_saphyr::from_str` / `serde_json::from_str` parse it, and only a failed
+/// parse is read again to find the error's path (`bcd.turn_cost_m: line 1 column 21: invalid
+/// floating point` where the parser alone says `line 1 column 21: invalid floating point`).
+/// An error at the document's root keeps the parser's message as it is. YAML is typed as JSON
+/// is: a quoted scalar that the typed reading took as a number or a boolean is refused
+/// ([`quoted_scalar_problem`]).
 ///
 /// # Errors
 /// The parser's message, with the field's path in front when there is one.
-pub fn parse_yaml_or_json<T: serde::de::DeserializeOwned>(
+pub fn parse_yaml_or_json<T: serde::de::DeserializeOwned + serde::Serialize>(
     text: &str,
     json: bool,
 ) -> Result<T, String> {
@@ -146,7 +147,7 @@ pub fn parse_yaml_or_json<T: serde::de::DeserializeOwned>(
         serde_saphyr::from_str::<T>(text).map_err(|e| yaml_words(&e.to_string()))
     };
     let message = match first {
-        Ok(v) => match (!json).then(|| quoted_scalar_problem::<T>(text)).flatten() {
+        Ok(v) => match (!json).then(|| quoted_scalar_problem(text, &v)).flatten() {
             None => return Ok(v),
             Some(problem) => return Err(problem),
         },
@@ -179,28 +180,56 @@ pub fn parse_yaml_or_json<T: serde::de::DeserializeOwned>(
     })
 }
 
-/// A quoted YAML scalar that the typed reading took as a number or a boolean (`"3"` as
-/// `3`, `"no"` as `false`), which JSON refuses and a quoted value does not mean: the text
-/// read untyped (a quoted scalar stays text there) and then as `T` says where.
-fn quoted_scalar_problem<T: serde::de::DeserializeOwned>(text: &str) -> Option<String> {
-    let untyped: serde_json::Value = serde_saphyr::from_str(text).ok()?;
-    let e = serde_path_to_error::deserialize::<_, T>(untyped).err()?;
-    let inner = e.inner().to_string();
-    // Only text where the type wants something else: the untyped reading differs from the
-    // typed one in other ways too (`.inf` is null there), which the typed reading settled.
-    inner.starts_with("invalid type: string").then(|| {
-        format!(
-            "{}: {inner}; a quoted value is text in YAML: write numbers and booleans without quotes",
-            e.path()
-        )
-    })
+/// A quoted YAML scalar that the typed reading `typed` took as a number or a boolean (`"3"` as
+/// `3`, `"no"` as `false`), which JSON refuses and a quoted value does not mean. The text read
+/// untyped (a quoted scalar stays text there; `.inf` passes) is walked beside `typed` written
+/// out as JSON: the first text, in key order, that the typed value holds as a number or a
+/// boolean is named with its path. Other differences (a bare number read into a text field,
+/// defaults filled in, keys the types name otherwise) are not looked at.
+fn quoted_scalar_problem<T: serde::Serialize>(text: &str, typed: &T) -> Option<String> {
+    let mut options = serde_saphyr::Options::default();
+    options.non_finite_float_policy = serde_saphyr::NonFiniteFloatPolicy::PassThrough;
+    let untyped: serde_json::Value = serde_saphyr::from_str_with_options(text, options).ok()?;
+    let typed = serde_json::to_value(typed).ok()?;
+    quoted_in(&untyped, &typed, "")
+}
+
+/// [`quoted_scalar_problem`]'s walk at `path`.
+fn quoted_in(untyped: &serde_json::Value, typed: &serde_json::Value, path: &str) -> Option<String> {
+    use serde_json::Value;
+    match (untyped, typed) {
+        (Value::String(s), Value::Number(_) | Value::Bool(_)) => {
+            let wanted = if typed.is_boolean() {
+                "a boolean"
+            } else {
+                "a number"
+            };
+            Some(format!(
+                "{path}: invalid type: string {s:?}, expected {wanted}; a quoted value is text in YAML: write numbers and booleans without quotes"
+            ))
+        }
+        (Value::Object(u), Value::Object(t)) => u.iter().find_map(|(k, v)| {
+            let inner = if path.is_empty() {
+                k.clone()
+            } else {
+                format!("{path}.{k}")
+            };
+            quoted_in(v, t.get(k)?, &inner)
+        }),
+        (Value::Array(u), Value::Array(t)) => u
+            .iter()
+            .zip(t)
+            .enumerate()
+            .find_map(|(i, (v, w))| quoted_in(v, w, &format!("{path}[{i}]"))),
+        _ => None,
+    }
 }
 
 #[cfg(test)]
 mod parse_tests {
     use super::parse_yaml_or_json;
 
-    #[derive(Debug, serde::Deserialize, PartialEq)]
+    #[derive(Debug, serde::Deserialize, serde::Serialize, PartialEq)]
     #[serde(deny_unknown_fields)]
     struct Inner {
         rounds: u32,
@@ -208,13 +237,13 @@ mod parse_tests {
         cost: f64,
     }
 
-    #[derive(Debug, serde::Deserialize, PartialEq)]
+    #[derive(Debug, serde::Deserialize, serde::Serialize, PartialEq)]
     #[serde(deny_unknown_fields)]
     struct Outer {
         bcd: Inner,
     }
 
-    #[derive(Debug, serde::Deserialize)]
+    #[derive(Debug, serde::Deserialize, serde::Serialize)]
     struct Flags {
         #[serde(default)]
         on: bool,
@@ -253,8 +282,16 @@ mod parse_tests {
                 "{text}: {e}"
             );
         }
-        for text in ["on: \"no\"", "limit: \"2\""] {
-            assert!(parse_yaml_or_json::<Flags>(text, false).is_err(), "{text}");
+        // Also beside `.inf` (which an untyped reading refused by default) and after a bare
+        // number read into a text field (where reading the untyped text as the type stopped).
+        for text in [
+            "on: \"no\"",
+            "limit: \"2\"",
+            "limit: .inf\non: \"no\"",
+            "name: 123\non: \"no\"",
+        ] {
+            let e = parse_yaml_or_json::<Flags>(text, false).unwrap_err();
+            assert!(e.contains("a quoted value is text"), "{text}: {e}");
         }
         // Plain scalars read as before: YAML 1.1 booleans, a number as a name, `.inf`.
         let f: Flags = parse_yaml_or_json("on: yes\nname: 123\nlimit: .inf", false).unwrap();
