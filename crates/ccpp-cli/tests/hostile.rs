@@ -748,9 +748,9 @@ fn a_robot_that_stops_making_progress_is_stopped_and_says_so() {
 }
 
 /// A memory refusal printed `inf MB` (`inf strides`) for an overflowing estimate and always
-/// advised a larger `--max-memory`, robot, tile or spacing: for a random-bounce budget of
-/// 1e300 m no limit helps, and only a smaller `budget_m` does; for a map whose pixels dominate
-/// a robot changes nothing.
+/// advised a larger `--max-memory`, robot, tile or spacing: a random-bounce budget of 1e300 m
+/// is bounded by the run's step cap (19 GB), below which only a budget lower than the cap's
+/// way or a lower cap helps; for a map whose pixels dominate a robot changes nothing.
 #[test]
 fn memory_refusals_give_finite_numbers_and_the_right_advice() {
     let d = tempfile::tempdir().unwrap();
@@ -787,7 +787,8 @@ fn memory_refusals_give_finite_numbers_and_the_right_advice() {
             &[
                 "pillars.pgm",
                 "about 19091 MB (5.0e7 strides, the run's step cap;",
-                "random_bounce.budget_m",
+                "a random_bounce.budget_m below ",
+                "or a lower step cap",
             ],
             &["inf", "larger robot", "no machine has that much"],
         );

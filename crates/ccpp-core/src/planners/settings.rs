@@ -711,7 +711,14 @@ impl PlannerSettings for RandomBounceOptions {
             "strides"
         };
         let e = ResourceEstimate::units(path / stride, 2.0 * RECORD_BYTES, what);
-        if self.budget_m.is_some() {
+        if path < budget {
+            // Beyond the cap a smaller budget changes nothing until it falls below it.
+            e.remedy(&format!(
+                "a random_bounce.budget_m below {} m (beyond it the run's step cap of {} steps bounds the run) or a lower step cap (Python's max_steps, a scenario's sim.max_steps)",
+                fmt_count(path),
+                fmt_count(s.max_steps as f64)
+            ))
+        } else if self.budget_m.is_some() {
             e.remedy("a smaller random_bounce.budget_m")
         } else {
             e.remedy("a larger tool radius or a random_bounce.budget_m (the default budget is 3 x the map frame's area over the tool width)")
@@ -1301,35 +1308,38 @@ impl PlannerSettings for RectOptions {
     }
 }
 
-/// The memory a run needs: the per-pixel part, the metrics' tile set and the planner's share;
+/// The memory a run needs: the per-pixel part, the metrics' tile sets and the planner's share;
 /// the detail names the largest part.
 pub fn estimate_run(s: &Setup, planner: &dyn PlannerSettings) -> ResourceEstimate {
-    let metrics_side = planner
-        .tile_side(&s.robot)
-        .unwrap_or(2.0 * s.robot.tool_radius);
-    estimate_with(s, planner.estimate(s), metrics_side)
+    estimate_with(s, planner.estimate(s), planner.tile_side(&s.robot))
 }
 
 /// [`estimate_run`] of a robot its caller drives (Python's step API): the world, the sweep
-/// and the metrics' tiles of `2 r_tool`, no planner's own state.
+/// and the metrics' tiles, no planner's own state.
 pub fn estimate_driven(s: &Setup) -> ResourceEstimate {
     let none = ResourceEstimate {
         bytes: 0.0,
         detail: "no planner".into(),
         remedy: GENERIC_REMEDY.into(),
     };
-    estimate_with(s, none, 2.0 * s.robot.tool_radius)
+    estimate_with(s, none, None)
 }
 
-/// A run's estimate from its planner's own part `own` and the metrics' tile side.
-fn estimate_with(s: &Setup, own: ResourceEstimate, metrics_side: f64) -> ResourceEstimate {
-    let mut metric_tiles = ResourceEstimate::units(s.tiles(metrics_side), 1.0 / 8.0, "tiles")
-        .remedy("a larger robot, tool or tile");
-    metric_tiles.detail = format!(
-        "{} of {} m for the metrics",
-        metric_tiles.detail,
-        fmt_m(metrics_side)
-    );
+/// A run's estimate from its planner's own part `own` and its tile side, if it has tiles: the
+/// metrics hold the revisit tiles (side `2 r`) and, for a tile planner, its tiles for the tile
+/// coverage.
+fn estimate_with(s: &Setup, own: ResourceEstimate, tile_side: Option<f64>) -> ResourceEstimate {
+    let revisit_side = 2.0 * s.robot.radius;
+    let count = s.tiles(revisit_side) + tile_side.map_or(0.0, |side| s.tiles(side));
+    let sides = match tile_side {
+        Some(side) if side != revisit_side => {
+            format!("{} and {}", fmt_m(revisit_side), fmt_m(side))
+        }
+        _ => fmt_m(revisit_side),
+    };
+    let mut metric_tiles =
+        ResourceEstimate::units(count, 1.0 / 8.0, "tiles").remedy("a larger robot, tool or tile");
+    metric_tiles.detail = format!("{} of {sides} m for the metrics", metric_tiles.detail);
     let pixels =
         ResourceEstimate::units(s.pixels(), PIXEL_BYTES, "map pixels").remedy(PIXELS_REMEDY);
     let bytes = own.bytes + metric_tiles.bytes + pixels.bytes + PROCESS_BYTES;
