@@ -376,20 +376,11 @@ impl MapRecipe {
     pub fn prepare(&self, loaded: LoadedMap) -> Result<PreparedMap, ScenarioError> {
         self.validate()?;
         let mut grid = loaded.grid;
-        if let Some(g) = &self.georef {
-            grid = apply_georef(grid, g)?;
-            // A placement out of bounds is the fit's: the georef file is named, not the map
-            // (whose origin and resolution the fit replaced).
-            if let Some((problem, _)) = extent_problem(&grid) {
-                return Err(ScenarioError::Georef {
-                    path: g.clone(),
-                    message: format!(
-                        "the fitted placement: {problem}; check the world coordinates"
-                    ),
-                });
-            }
+        match &self.georef {
+            // (its placement checked there, against the georef file)
+            Some(g) => grid = apply_georef(grid, g)?,
+            None => check_extent(&grid, &loaded.source)?,
         }
-        check_extent(&grid, &loaded.source)?;
         if let Some(m) = self.inflate {
             if m > 0.0 {
                 // Inflation turns pixels whose centre is within `m` of an obstacle's centre:
@@ -548,7 +539,8 @@ fn extent_problem(grid: &GridMap) -> Option<(String, &'static str)> {
 /// so a fit with more than 1 % shear or anisotropy is refused.
 ///
 /// # Errors
-/// An unreadable or degenerate georef file, or a fit that is not a similarity.
+/// An unreadable or degenerate georef file, a fit that is not a similarity, or a placement
+/// out of the bounds of [`check_extent`].
 pub fn apply_georef(grid: GridMap, path: &Path) -> Result<GridMap, ScenarioError> {
     let err = |message: String| ScenarioError::Georef {
         path: path.to_path_buf(),
@@ -590,9 +582,18 @@ pub fn apply_georef(grid: GridMap, path: &Path) -> Result<GridMap, ScenarioError
     }
     let h = grid.frame().height as f64;
     let o = fit.affine.apply(ccpp_core::Point::new(0.0, h));
-    // A placement the grid refuses is the georef file's fault: named as such (not `map FILE`).
-    grid.with_placement(res, Pose::new(o.x, o.y, yaw))
-        .map_err(|e| err(e.to_string()))
+    // A placement the grid refuses, or one out of the bounds every map is held to
+    // ([`check_extent`]), is the georef file's fault: named as such (not `map FILE`, whose
+    // origin and resolution the fit replaced).
+    let placed = grid
+        .with_placement(res, Pose::new(o.x, o.y, yaw))
+        .map_err(|e| err(e.to_string()))?;
+    if let Some((problem, _)) = extent_problem(&placed) {
+        return Err(err(format!(
+            "the fitted placement: {problem}; check the world coordinates"
+        )));
+    }
+    Ok(placed)
 }
 
 /// One coverage run, fully described. `run.json` is this, serialized.
