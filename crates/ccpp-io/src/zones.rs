@@ -176,8 +176,8 @@ pub fn check_rect(r: [f64; 4]) -> Result<(), ZoneFileError> {
     Ok(())
 }
 
-/// Most points a `GeoJSON` zone file may hold in all (16 polygons of the most points one
-/// polygon may have, [`ccpp_core::zones::MAX_POLYGON_POINTS`]).
+/// Most points a zone file (`GeoJSON` or YAML) may hold in all (16 polygons of the most points
+/// one polygon may have, [`ccpp_core::zones::MAX_POLYGON_POINTS`]).
 pub const MAX_ZONE_POINTS: usize = 16 * ccpp_core::zones::MAX_POLYGON_POINTS;
 
 /// Reads a zone file: `GeoJSON`, YAML polygons or a Nav2 mask (checked against `frame`).
@@ -199,23 +199,27 @@ fn read_file(path: &Path, frame: &MapFrame) -> Result<ZoneData, ZoneFileError> {
             )));
         }
         let v: Value = serde_json::from_str(&text).map_err(|e| bad(format!("GeoJSON: {e}")))?;
-        let polygons = geojson_polygons(&v)?;
-        // Vertices, as each polygon's own limit counts them: 16 closed rings of the most
-        // vertices a polygon may have were refused for their closing repeats.
-        let points: usize = polygons.iter().map(Polygon::vertex_count).sum();
-        if points > MAX_ZONE_POINTS {
-            return Err(bad(format!(
-                "GeoJSON: {points} points in all; at most {MAX_ZONE_POINTS} are accepted"
-            )));
-        }
-        return Ok(ZoneData::Polygons(polygons));
+        return within_total(geojson_polygons(&v)?, "GeoJSON");
     }
     let v: serde_json::Value = serde_saphyr::from_str(&text)
         .map_err(|e| bad(format!("YAML: {}", crate::file::yaml_words(&e.to_string()))))?;
     if v.get("image").is_some() {
         return read_mask(path, frame).map(ZoneData::Mask);
     }
-    Ok(ZoneData::Polygons(yaml_polygons(&v)?))
+    within_total(yaml_polygons(&v)?, "YAML")
+}
+
+/// The polygons of a zone file, if they hold at most [`MAX_ZONE_POINTS`] vertices in all,
+/// counted as each polygon's own limit counts them (16 closed rings of the most vertices a
+/// polygon may have were refused for their closing repeats); `format` names the file's kind.
+fn within_total(polygons: Vec<Polygon>, format: &str) -> Result<ZoneData, ZoneFileError> {
+    let points: usize = polygons.iter().map(Polygon::vertex_count).sum();
+    if points > MAX_ZONE_POINTS {
+        return Err(bad(format!(
+            "{format}: {points} points in all; at most {MAX_ZONE_POINTS} are accepted"
+        )));
+    }
+    Ok(ZoneData::Polygons(polygons))
 }
 
 fn read_mask(path: &Path, frame: &MapFrame) -> Result<FixedBitSet, ZoneFileError> {
@@ -495,9 +499,9 @@ mod tests {
         }
     }
 
-    /// A `GeoJSON` file's total counts vertices as each polygon's limit does: 16 closed rings
-    /// of the most vertices a polygon may have were refused (65 552 "points") for their
-    /// closing repeats; 17 such rings are still too many.
+    /// A zone file's total counts vertices as each polygon's limit does: 16 closed `GeoJSON`
+    /// rings of the most vertices a polygon may have were refused (65 552 "points") for their
+    /// closing repeats; 17 such rings are still too many, in `GeoJSON` and in YAML.
     #[test]
     fn the_total_limit_does_not_count_closing_repeats() {
         let n = ccpp_core::zones::MAX_POLYGON_POINTS;
@@ -529,6 +533,25 @@ mod tests {
         std::fs::write(&path, file(17)).unwrap();
         let e = read_file(&path, &frame).unwrap_err().to_string();
         assert!(e.contains("69632 points in all"), "{e}");
+        // A YAML zone file is held to the same total (only its parser's node budget bounded it).
+        let yaml = |rings: usize| {
+            let ring = (0..n)
+                .map(|i| {
+                    let a = std::f64::consts::TAU * i as f64 / n as f64;
+                    format!("[{},{}]", a.cos(), a.sin())
+                })
+                .collect::<Vec<_>>()
+                .join(",");
+            (0..rings)
+                .map(|_| format!("- [{ring}]\n"))
+                .collect::<String>()
+        };
+        let path = d.path().join("z.yaml");
+        std::fs::write(&path, yaml(16)).unwrap();
+        assert!(read_file(&path, &frame).is_ok());
+        std::fs::write(&path, yaml(17)).unwrap();
+        let e = read_file(&path, &frame).unwrap_err().to_string();
+        assert!(e.contains("YAML: 69632 points in all"), "{e}");
     }
 
     /// A YAML point is `[x, y]` or `{x, y}` and nothing more; a `GeoJSON` position may add
