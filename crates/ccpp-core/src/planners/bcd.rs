@@ -240,7 +240,8 @@
 //! ([`World::first_contact_grid`], [`World::segment_free_grid`]) and ranking keys are integers,
 //! so a map moved far from the world's origin (where world coordinates carry rounding) gets
 //! the same plan. Regions = cells (`RegionStart`
-//! per cell); transfers between cells are marked as backtracks.
+//! per cell); transfers between cells (and to and between rim passes) that move the robot are
+//! marked as backtracks.
 //!
 //! ```
 //! use ccpp_core::{GridMap, Pose};

@@ -74,9 +74,9 @@ pub(super) struct Coarse {
 pub(super) struct CoarseCache(Mutex<Vec<(usize, Arc<Coarse>)>>);
 
 impl CoarseCache {
-    /// The grid in blocks of about `sp` pixels ([`Coarse::side`]), made by `make` when no
+    /// The grid in blocks of about `sp` pixels ([`Coarse::side`]), made by `make(sp)` when no
     /// grid of that block side is cached.
-    pub(super) fn get(&self, sp: f64, make: impl FnOnce() -> Coarse) -> Arc<Coarse> {
+    pub(super) fn get(&self, sp: f64, make: impl FnOnce(f64) -> Coarse) -> Arc<Coarse> {
         let b = Coarse::side(sp);
         // (a job that panicked while holding the lock left no half-made grid in it)
         let mut grids = self
@@ -86,7 +86,7 @@ impl CoarseCache {
         if let Some((_, g)) = grids.iter().find(|g| g.0 == b) {
             return Arc::clone(g);
         }
-        let g = Arc::new(make());
+        let g = Arc::new(make(sp));
         grids.push((b, Arc::clone(&g)));
         g
     }

@@ -163,27 +163,30 @@ const TRIM_VARIANTS: usize = 2;
 /// between 16 cells, 5 of them without a move). The marks of a transfer with moves are kept.
 fn drop_empty_transfers(steps: VecDeque<Step>) -> VecDeque<Step> {
     let mut out = VecDeque::with_capacity(steps.len());
-    // Where the open transfer's start mark is in `out`, while no move has followed it.
-    let mut open: Option<usize> = None;
+    // An open transfer's start mark and the marks after it, held while no move has followed.
+    let mut held: Option<Vec<Step>> = None;
     for step in steps {
         match step {
             Step::Mark(Event::BacktrackStart) => {
-                open = Some(out.len());
-                out.push_back(step);
+                out.extend(held.take().into_iter().flatten());
+                held = Some(vec![step]);
             }
-            Step::Mark(Event::BacktrackEnd) => match open.take() {
-                Some(i) => {
-                    out.remove(i);
-                }
+            Step::Mark(Event::BacktrackEnd) => match held.take() {
+                // No move: the start mark goes, the marks after it stay.
+                Some(marks) => out.extend(marks.into_iter().skip(1)),
                 None => out.push_back(step),
             },
             Step::MoveTo(_) | Step::Rotate(_) | Step::Translate(_) => {
-                open = None;
+                out.extend(held.take().into_iter().flatten());
                 out.push_back(step);
             }
-            Step::Mark(_) | Step::Done => out.push_back(step),
+            Step::Mark(_) | Step::Done => match held.as_mut() {
+                Some(marks) => marks.push(step),
+                None => out.push_back(step),
+            },
         }
     }
+    out.extend(held.into_iter().flatten());
     out
 }
 
@@ -773,9 +776,10 @@ impl Bcd {
             paths.push([p.clone(), p.clone()]);
             rots.push(rs);
         }
-        let coarse = ctx.coarse.get(sp, || ctx.coarse_grid(sp));
-        let far_sp = sp * f64::from(hops::FAR_FACTOR);
-        let far = ctx.coarse.get(far_sp, || ctx.coarse_grid(far_sp));
+        let coarse = ctx.coarse.get(sp, |s| ctx.coarse_grid(s));
+        let far = ctx
+            .coarse
+            .get(sp * f64::from(hops::FAR_FACTOR), |s| ctx.coarse_grid(s));
         let ncells = paths.len();
         // Two ways to sweep the rim (module docs, step 3): its passes as pieces of the tour,
         // or inserted into the finished tour where they cost least; the cheaper plan is kept.
@@ -1177,4 +1181,48 @@ fn correct_hops(
         );
     }
     best.map_or(tour, |b| b.1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Transfer marks with no move between them go (marks between them stay); a transfer with
+    /// a move, a turn or a drive keeps both; an unclosed start is kept as it is.
+    #[test]
+    fn empty_transfers_are_dropped() {
+        let p = Point::new(1.0, 2.0);
+        let note = || Event::Note { text: "n".into() };
+        let bt = |e: Event| Step::Mark(e);
+        let steps: VecDeque<Step> = vec![
+            Step::MoveTo(p),
+            bt(Event::BacktrackStart),
+            bt(note()),
+            bt(Event::BacktrackEnd),
+            bt(Event::BacktrackStart),
+            Step::MoveTo(p),
+            bt(Event::BacktrackEnd),
+            bt(Event::BacktrackStart),
+            Step::Rotate(0.5),
+            bt(Event::BacktrackEnd),
+            bt(Event::BacktrackStart),
+            bt(Event::BacktrackEnd),
+            bt(Event::BacktrackStart),
+            bt(note()),
+        ]
+        .into();
+        let want: Vec<Step> = vec![
+            Step::MoveTo(p),
+            bt(note()),
+            bt(Event::BacktrackStart),
+            Step::MoveTo(p),
+            bt(Event::BacktrackEnd),
+            bt(Event::BacktrackStart),
+            Step::Rotate(0.5),
+            bt(Event::BacktrackEnd),
+            bt(Event::BacktrackStart),
+            bt(note()),
+        ];
+        assert_eq!(Vec::from(drop_empty_transfers(steps)), want);
+    }
 }
