@@ -1183,6 +1183,32 @@ mod tests {
         );
     }
 
+    /// `revisit_rate` is counted on the conventions' tiles (side `2 r`, anchored at the start)
+    /// whatever the planner's tiling and the tool radius: the same path gives the same figure
+    /// (it was on the planner's tiles, else `2 r_tool`, so one bench compared figures on
+    /// different grids).
+    #[test]
+    fn revisits_are_counted_on_the_robots_tiles() {
+        let start = Some(Pose::new(1.0, 1.0, 0.0));
+        let world = World::new(open_room(), Robot::new(0.2), start).unwrap();
+        let config = crate::planners::PlannerConfig::new(crate::planners::PlannerKind::BaStar);
+        let out = simulate(&world, config.build(&world).as_mut(), &SimConfig::default());
+        let want = compute(&world, &out, "room").revisit_rate;
+        assert!(want > 0.0);
+        let mut other_tiles = out.clone();
+        other_tiles.tile_side = Some(0.7);
+        assert_eq!(compute(&world, &other_tiles, "room").revisit_rate, want);
+        let mut no_tiles = out.clone();
+        no_tiles.tile_side = None;
+        assert_eq!(compute(&world, &no_tiles, "room").revisit_rate, want);
+        let narrow = Robot {
+            radius: 0.2,
+            tool_radius: 0.1,
+        };
+        let narrow_tool = World::new(open_room(), narrow, start).unwrap();
+        assert_eq!(compute(&narrow_tool, &out, "room").revisit_rate, want);
+    }
+
     #[test]
     fn straight_pass_length_and_swept_area() {
         let world =
