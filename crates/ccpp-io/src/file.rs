@@ -132,8 +132,8 @@ pub fn yaml_words(message: &str) -> String {
 /// parse is read again to find the error's path (`bcd.turn_cost_m: line 1 column 21: invalid
 /// floating point` where the parser alone says `line 1 column 21: invalid floating point`).
 /// An error at the document's root keeps the parser's message as it is. YAML is typed as JSON
-/// is: a quoted scalar that the typed reading took as a number or a boolean is refused
-/// ([`quoted_scalar_problem`]).
+/// is: a quoted scalar that the typed reading took as a number or a boolean is refused,
+/// naming its path (found by walking the untyped reading beside the typed value).
 ///
 /// # Errors
 /// The parser's message, with the field's path in front when there is one.

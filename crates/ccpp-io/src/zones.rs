@@ -542,9 +542,7 @@ mod tests {
                 })
                 .collect::<Vec<_>>()
                 .join(",");
-            (0..rings)
-                .map(|_| format!("- [{ring}]\n"))
-                .collect::<String>()
+            format!("- [{ring}]\n").repeat(rings)
         };
         let path = d.path().join("z.yaml");
         std::fs::write(&path, yaml(16)).unwrap();

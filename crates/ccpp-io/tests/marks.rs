@@ -37,10 +37,8 @@ pub fn mark_problem(trace: &Trace) -> Option<String> {
                     return Some(format!("step {t}: a backtrack starts inside a region"));
                 }
                 Event::BacktrackStart => open = Some((at, false)),
-                Event::BacktrackEnd => {
-                    if open.take().is_some_and(|(_, moved)| !moved) {
-                        return Some(format!("step {t}: a backtrack without a move ends"));
-                    }
+                Event::BacktrackEnd if open.take().is_some_and(|(_, moved)| !moved) => {
+                    return Some(format!("step {t}: a backtrack without a move ends"));
                 }
                 _ => {}
             },
