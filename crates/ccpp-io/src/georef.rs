@@ -64,13 +64,12 @@ pub(crate) fn fields(line: &str) -> impl Iterator<Item = &str> {
 
 /// The content lines of a small CSV-like file (georef pairs, landmarks), numbered from 0, each
 /// without its comment (from `#` to the end of the line) and surrounding white space; lines
-/// left empty are skipped. A byte-order mark (Excel's "CSV UTF-8") is no part of the first
-/// field. A trailing comment is a comment too: `0,0,0,10 # corner` was taken for a header and
+/// left empty are skipped (a file's byte-order mark, Excel's "CSV UTF-8", is skipped where
+/// the file is read, `read_text`). A trailing comment is a comment too: `0,0,0,10 # corner` was taken for a header and
 /// its pair dropped without a word. The flag says whether the line is a header: the first
 /// content line, with no number at all (`px,py,wx,wy`; a first line `-1,1.5,1.5` with a bad
 /// field is a data line, to be refused, not a header to skip).
 pub(crate) fn content_lines(text: &str) -> impl Iterator<Item = (usize, &str, bool)> {
-    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     text.lines()
         .enumerate()
         .map(|(n, raw)| (n, raw.split('#').next().unwrap_or_default().trim()))
@@ -143,8 +142,15 @@ mod tests {
     /// words is an error, not a header: either once dropped a pair without a word.
     #[test]
     fn trailing_comments_and_half_numeric_first_lines() {
-        let p = parse_georef("\u{feff}0,0,0,10 # a\n200,0,10,10\n0,200,0,0 # c\n").unwrap();
+        let p = parse_georef("0,0,0,10 # a\n200,0,10,10\n0,200,0,0 # c\n").unwrap();
         assert_eq!(p.len(), 3);
+        // A file's byte-order mark is skipped once, where it is read; a second one is content.
+        let d = tempfile::tempdir().unwrap();
+        let g = d.path().join("g.csv");
+        std::fs::write(&g, "\u{feff}0,0,0,10\n200,0,10,10\n0,200,0,0\n").unwrap();
+        assert!(load_georef(&g).is_ok());
+        std::fs::write(&g, "\u{feff}\u{feff}0,0,0,10\n200,0,10,10\n0,200,0,0\n").unwrap();
+        assert!(load_georef(&g).is_err());
         assert_eq!(p[0], (Point::new(0.0, 0.0), Point::new(0.0, 10.0)));
         let e = parse_georef("0,0,x,10\n200,0,10,10\n").unwrap_err();
         assert!(matches!(e, GeorefProblem::BadLine { line: 1, .. }), "{e}");

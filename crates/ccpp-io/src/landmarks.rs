@@ -81,8 +81,8 @@ fn parse_csv_line(line: &str) -> Option<Landmark> {
 /// # Errors
 /// Invalid JSON, a bad CSV line, or a non-finite coordinate.
 pub fn parse_landmarks(text: &str) -> Result<Vec<Landmark>, LandmarkFileError> {
-    // A byte-order mark is no part of the content, JSON or CSV.
-    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    // (A file's byte-order mark is skipped where it is read, `read_text`: here a second one,
+    // or one in text given directly, is content, refused as such.)
     let trimmed = text.trim_start();
     let list: Vec<Landmark> = if trimmed.starts_with('[') {
         // Counted before they are built: the array's items are skipped, whatever their form
@@ -178,14 +178,25 @@ mod tests {
         );
         assert_eq!(parse_landmarks("id x y\n2 0 0\n").unwrap().len(), 1);
         // Excel's "CSV UTF-8" starts with a byte-order mark (the first landmark was taken for
-        // a header, then refused as a bad line); a comment may end a line, as in georef files.
-        let l = parse_landmarks("\u{feff}1,1.0,1.0\n2,4.0,4.0 # dock\n").unwrap();
+        // a header, then refused as a bad line): the file reader skips it, once (a second one
+        // is content, as in every text input); a comment may end a line, as in georef files.
+        let d = tempfile::tempdir().unwrap();
+        let file = |name: &str, text: &str| {
+            let p = d.path().join(name);
+            std::fs::write(&p, text).unwrap();
+            load_landmarks(&p)
+        };
+        let l = file("l.csv", "\u{feff}1,1.0,1.0\n2,4.0,4.0 # dock\n").unwrap();
         assert_eq!(
             l,
             vec![Landmark::new(1, 1.0, 1.0), Landmark::new(2, 4.0, 4.0)]
         );
-        let l = parse_landmarks("\u{feff}[{\"id\":1,\"x\":0,\"y\":0}]").unwrap();
+        let l = file("l.json", "\u{feff}[{\"id\":1,\"x\":0,\"y\":0}]").unwrap();
         assert_eq!(l, vec![Landmark::new(1, 0.0, 0.0)]);
+        assert!(file("l2.csv", "\u{feff}\u{feff}1,1.0,1.0\n").is_err());
+        // (text that does not start with `[` is CSV: this is one header line, no landmark)
+        let l2 = file("l2.json", "\u{feff}\u{feff}[{\"id\":1,\"x\":0,\"y\":0}]");
+        assert!(l2.is_ok_and(|l| l.is_empty()));
         assert!(matches!(
             parse_landmarks("[{\"id\":1}]"),
             Err(LandmarkFileError::Json(_))
