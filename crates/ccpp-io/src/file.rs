@@ -208,6 +208,17 @@ fn quoted_in(untyped: &serde_json::Value, typed: &serde_json::Value, path: &str)
                 "{path}: invalid type: string {s:?}, expected {wanted}; a quoted value is text in YAML: write numbers and booleans without quotes"
             ))
         }
+        // A quoted `.inf` or `.nan` the typed reading took as a float (JSON writes it null).
+        (Value::String(s), Value::Null)
+            if matches!(
+                s.trim_start_matches(['+', '-']).to_ascii_lowercase().as_str(),
+                ".inf" | ".nan"
+            ) =>
+        {
+            Some(format!(
+                "{path}: invalid type: string {s:?}, expected a number; a quoted value is text in YAML: write numbers and booleans without quotes"
+            ))
+        }
         (Value::Object(u), Value::Object(t)) => u.iter().find_map(|(k, v)| {
             let inner = if path.is_empty() {
                 k.clone()
@@ -289,6 +300,8 @@ mod parse_tests {
             "limit: \"2\"",
             "limit: .inf\non: \"no\"",
             "name: 123\non: \"no\"",
+            "limit: \".inf\"",
+            "limit: \"-.NaN\"",
         ] {
             let e = parse_yaml_or_json::<Flags>(text, false).unwrap_err();
             assert!(e.contains("a quoted value is text"), "{text}: {e}");
