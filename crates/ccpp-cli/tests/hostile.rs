@@ -787,8 +787,8 @@ fn memory_refusals_give_finite_numbers_and_the_right_advice() {
             &[
                 "pillars.pgm",
                 "about 19091 MB (5.0e7 strides, the run's step cap;",
-                "a random_bounce.budget_m below ",
-                "or a lower step cap",
+                "a random_bounce.budget_m well below 1.9e7 m, the way the run's step cap of 5.0e7 steps allows",
+                "in Python a lower max_steps",
             ],
             &["inf", "larger robot", "no machine has that much"],
         );

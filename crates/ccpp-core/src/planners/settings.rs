@@ -714,7 +714,7 @@ impl PlannerSettings for RandomBounceOptions {
         if path < budget {
             // Beyond the cap a smaller budget changes nothing until it falls below it.
             e.remedy(&format!(
-                "a random_bounce.budget_m below {} m (beyond it the run's step cap of {} steps bounds the run) or a lower step cap (Python's max_steps, a scenario's sim.max_steps)",
+                "a random_bounce.budget_m well below {} m, the way the run's step cap of {} steps allows (a larger budget changes nothing), or in Python a lower max_steps",
                 fmt_count(path),
                 fmt_count(s.max_steps as f64)
             ))
