@@ -198,25 +198,26 @@ fn quoted_scalar_problem<T: serde::Serialize>(text: &str, typed: &T) -> Option<S
 fn quoted_in(untyped: &serde_json::Value, typed: &serde_json::Value, path: &str) -> Option<String> {
     use serde_json::Value;
     match (untyped, typed) {
-        (Value::String(s), Value::Number(_) | Value::Bool(_)) => {
-            let wanted = if typed.is_boolean() {
-                "a boolean"
-            } else {
-                "a number"
+        (Value::String(s), _) => {
+            let wanted = match typed {
+                Value::Bool(_) => "a boolean",
+                Value::Number(_) => "a number",
+                // A quoted `.inf` or `.nan` the typed reading took as a float (JSON writes
+                // it null).
+                Value::Null
+                    if matches!(
+                        s.trim_start_matches(['+', '-'])
+                            .to_ascii_lowercase()
+                            .as_str(),
+                        ".inf" | ".nan"
+                    ) =>
+                {
+                    "a number"
+                }
+                _ => return None,
             };
             Some(format!(
                 "{path}: invalid type: string {s:?}, expected {wanted}; a quoted value is text in YAML: write numbers and booleans without quotes"
-            ))
-        }
-        // A quoted `.inf` or `.nan` the typed reading took as a float (JSON writes it null).
-        (Value::String(s), Value::Null)
-            if matches!(
-                s.trim_start_matches(['+', '-']).to_ascii_lowercase().as_str(),
-                ".inf" | ".nan"
-            ) =>
-        {
-            Some(format!(
-                "{path}: invalid type: string {s:?}, expected a number; a quoted value is text in YAML: write numbers and booleans without quotes"
             ))
         }
         (Value::Object(u), Value::Object(t)) => u.iter().find_map(|(k, v)| {
