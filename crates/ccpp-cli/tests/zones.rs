@@ -446,6 +446,71 @@ fn plan_tells_of_the_drive_into_the_area() {
     );
 }
 
+/// rect-boustrophedon plans its lanes for the rectangle's clearance disk (0.212 m for the
+/// default 0.3 x 0.3 m robot), larger than the robot's own: the approach from a start outside
+/// the area ended where the robot's disk first fitted, one disk inside the border, where the
+/// clearance disk did not, so every such start was refused ("the clearance disk ... does not
+/// fit where the approach from the start outside the area enters it"). The approach now ends
+/// where the planner's disk fits.
+#[test]
+fn rect_boustrophedon_reaches_an_area_from_a_start_outside_it() {
+    let d = tempfile::tempdir().unwrap();
+    for cmd in ["plan", "run"] {
+        let out = d.path().join(cmd);
+        let o = ccpp()
+            .args([cmd, "--planner", "rect-boustrophedon"])
+            .args(["--area", "0,-2,2,2", "--start", "-1.5,0", "--map"])
+            .arg(
+                Path::new(env!("CARGO_MANIFEST_DIR"))
+                    .join("../../../shared/maps/teb_empty_box.yaml"),
+            )
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{cmd}: {err}");
+        assert!(
+            err.contains("note: the start is outside the area: the robot first drives"),
+            "{cmd}: {err}"
+        );
+        let csv = if cmd == "plan" {
+            "waypoints.csv"
+        } else {
+            "path.csv"
+        };
+        let text = std::fs::read_to_string(out.join(csv)).unwrap();
+        let pts: Vec<(f64, f64)> = text
+            .lines()
+            .skip(1)
+            .map(|l| {
+                let f: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+                (f[0], f[1])
+            })
+            .collect();
+        // From the start given into the area, and inside it from there on, the clearance
+        // disk clear of the area's border.
+        assert!(
+            (pts[0].0 + 1.5).abs() < 1e-9 && pts[0].1.abs() < 1e-9,
+            "{cmd}: {:?}",
+            pts[0]
+        );
+        let inside = |p: &(f64, f64)| (0.2..=1.8).contains(&p.0) && (-1.8..=1.8).contains(&p.1);
+        let first = pts.iter().position(inside).unwrap();
+        assert!(first > 0, "{cmd}");
+        assert!(
+            pts[first..].iter().all(inside),
+            "{cmd}: {:?}",
+            &pts[first..]
+        );
+        if cmd == "run" {
+            let m = std::fs::read_to_string(out.join("metrics.json")).unwrap();
+            assert!(m.contains("\"collisions\": 0"), "{m}");
+            assert!(m.contains("\"keepout_violations\": 0"), "{m}");
+        }
+    }
+}
+
 /// `run.json` recorded a zone file by the path given (relative to the working folder) but the
 /// map by its absolute path, so `ccpp replay` of a zoned run worked only from the folder the
 /// run started in. Zone files are recorded absolute now.

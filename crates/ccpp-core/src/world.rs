@@ -277,6 +277,27 @@ impl World {
         start: Option<Pose>,
         zones: Option<ZoneMasks>,
     ) -> Result<Self, WorldError> {
+        Self::with_zones_fitting(map, robot, start, zones, robot.radius)
+    }
+
+    /// [`World::with_zones`] for a planner that needs room for a disk of radius `fit` (a value
+    /// below the robot's radius counts as the robot's) where its coverage starts: a start outside the area gets an approach that ends at the
+    /// nearest pixel centre where that disk fits inside the area, not only the robot's own
+    /// disk (rect-boustrophedon plans its lanes for the rectangle's clearance disk, which did
+    /// not fit where the robot's disk first did, so every start outside an area was refused).
+    ///
+    /// # Errors
+    /// As [`World::with_zones`].
+    ///
+    /// # Panics
+    /// As [`World::with_zones`].
+    pub fn with_zones_fitting(
+        map: GridMap,
+        robot: Robot,
+        start: Option<Pose>,
+        zones: Option<ZoneMasks>,
+        fit: f64,
+    ) -> Result<Self, WorldError> {
         robot.validate()?;
         let frame = *map.frame();
         let zones = zones.filter(|z| !z.is_empty());
@@ -364,7 +385,7 @@ impl World {
             accessible: std::sync::OnceLock::new(),
         };
         match world.check_start() {
-            Err(WorldError::StartOutsideArea { .. }) => world.plan_approach()?,
+            Err(WorldError::StartOutsideArea { .. }) => world.plan_approach(fit)?,
             r => r?,
         }
         Ok(world)
@@ -422,8 +443,10 @@ impl World {
     /// centres where the robot stands clear of obstacles and keep-outs (the area's border does
     /// not count) from the start to the nearest centre that is C-free under every virtual wall,
     /// shortened to straight segments that are free of obstacles and keep-outs (exact swept-disk
-    /// test). Sets `start` to its end (heading along its last segment).
-    fn plan_approach(&mut self) -> Result<(), WorldError> {
+    /// test). With `fit` above the robot's radius the end is the nearest centre where a disk
+    /// of that radius fits under every virtual wall. Sets `start` to its end (heading along its
+    /// last segment).
+    fn plan_approach(&mut self, fit: f64) -> Result<(), WorldError> {
         let s = self.start;
         let unreachable = || WorldError::AreaUnreachable {
             x: s.x,
@@ -446,6 +469,13 @@ impl World {
         let free_seg =
             |a: Point, b: Point| collide::segment_first_contact(&occ, a, b, r_px).is_none();
         let ok = |i: usize| f64::from(dt[i]) >= rc * rc;
+        // Where coverage may start: C-free, and room for the planner's disk when larger.
+        let fit_rc = contact_radius_px(fit / frame.resolution);
+        let fits = |i: usize| {
+            self.cfree.contains(i)
+                && (fit <= self.robot.radius
+                    || f64::from(self.obstacle_dt2.get(i)) >= fit_rc * fit_rc)
+        };
         // Dijkstra with integer octile costs (70 straight, 99 diagonal).
         let mut dist = vec![u32::MAX; frame.len()];
         let mut parent = vec![u32::MAX; frame.len()];
@@ -477,7 +507,7 @@ impl World {
             if d > dist[i] {
                 continue;
             }
-            if self.cfree.contains(i) {
+            if fits(i) {
                 goal = Some(i);
                 break;
             }

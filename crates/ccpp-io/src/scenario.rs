@@ -1322,23 +1322,26 @@ impl Scenario {
     ) -> Result<World, ScenarioError> {
         self.check_digest(&grid, zones.as_ref(), source)?;
         let start = self.start.map(|s| Pose::new(s[0], s[1], s[2]));
-        let world = World::with_zones(grid, self.robot, start, zones).map_err(|source_err| {
-            match self.zone_of(&source_err) {
-                Some((kind, label)) => ScenarioError::Zone {
-                    kind,
-                    label,
-                    message: format!("{source_err} (map {})", source.display()),
-                },
-                // An error the inflation likely caused names it.
-                None => match inflated_world_error(&source_err, inflation) {
-                    Some(m) => ScenarioError::Invalid(format!("map {}: {m}", source.display())),
-                    None => ScenarioError::World {
-                        path: source.to_path_buf(),
-                        source: source_err,
+        let fit = self.planner.settings().start_radius(&self.robot);
+        let world = World::with_zones_fitting(grid, self.robot, start, zones, fit).map_err(
+            |source_err| {
+                match self.zone_of(&source_err) {
+                    Some((kind, label)) => ScenarioError::Zone {
+                        kind,
+                        label,
+                        message: format!("{source_err} (map {})", source.display()),
                     },
-                },
-            }
-        })?;
+                    // An error the inflation likely caused names it.
+                    None => match inflated_world_error(&source_err, inflation) {
+                        Some(m) => ScenarioError::Invalid(format!("map {}: {m}", source.display())),
+                        None => ScenarioError::World {
+                            path: source.to_path_buf(),
+                            source: source_err,
+                        },
+                    },
+                }
+            },
+        )?;
         self.planner
             .settings()
             .check_world(&world)

@@ -267,6 +267,14 @@ pub trait PlannerSettings {
         None
     }
 
+    /// The radius of the disk the planner needs room for where its coverage starts: the
+    /// robot's radius, or more for a planner that plans a larger body (rect-boustrophedon's
+    /// clearance disk). A start outside the work area gets an approach that ends where this
+    /// disk fits inside the area ([`World::with_zones_fitting`]).
+    fn start_radius(&self, robot: &Robot) -> f64 {
+        robot.radius
+    }
+
     /// Builds the planner for `world` (offline planners plan here).
     fn build(&self, world: &World) -> Box<dyn Planner>;
 
@@ -1297,6 +1305,10 @@ impl PlannerSettings for RectOptions {
 
     fn tile_side(&self, _: &Robot) -> Option<f64> {
         None
+    }
+
+    fn start_radius(&self, robot: &Robot) -> f64 {
+        self.clearance_radius(robot)
     }
 
     fn preferred_execution(&self) -> Option<Execution> {
