@@ -487,6 +487,10 @@ fn whole_trace(
 /// and print its metrics JSON.
 pub const CHILD_ARG: &str = "__bench-job";
 
+/// The bench's process id, given to each job: a job whose bench has gone stops as if
+/// interrupted ([`crate::staging::stop_with_parent`]).
+const PARENT_ENV: &str = "CCPP_BENCH_PARENT";
+
 /// Test hook: a planner named by this environment variable aborts the process running it.
 pub const ABORT_ENV: &str = "CCPP_TEST_ABORT_PLANNER";
 
@@ -513,6 +517,7 @@ fn run_isolated(spec: &JobSpec) -> Result<Metrics, String> {
     let mut child = crate::staging::spawn_child(
         Command::new(exe)
             .arg(CHILD_ARG)
+            .env(PARENT_ENV, std::process::id().to_string())
             .stdin(Stdio::piped())
             .stdout(Stdio::piped())
             .stderr(Stdio::piped()),
@@ -568,6 +573,8 @@ fn child_failure(status: std::process::ExitStatus, stderr: &str) -> String {
 /// its metrics JSON. Errors are one `error:` line on stderr and exit status 1.
 pub fn child_main() -> std::process::ExitCode {
     crate::staging::install_signal_handler();
+    let parent = std::env::var(PARENT_ENV).ok().and_then(|p| p.parse().ok());
+    crate::staging::stop_with_parent(parent);
     match child_job() {
         Ok(metrics) => match crate::print_stdout(&metrics) {
             Ok(()) => std::process::ExitCode::SUCCESS,

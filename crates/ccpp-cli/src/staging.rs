@@ -145,40 +145,60 @@ pub fn unregister_child(pid: u32) {
 /// Installs the SIGINT/SIGTERM handler (once, at start-up).
 pub fn install_signal_handler() {
     // Failure to install (a handler already set) only loses the cleanup.
-    let _ = ctrlc::set_handler(|| {
-        // Hold both locks until exit: no swap can be half done and no new staging folder can
-        // appear after the cleanup.
-        let _swap = lock(&SWAP);
-        let pending = lock(&PENDING);
-        for p in pending.iter() {
-            remove_all(p);
+    let _ = ctrlc::set_handler(|| interrupted());
+}
+
+/// The interrupt cleanup (module docs), then exit with status 130.
+fn interrupted() -> ! {
+    use std::io::Write as _;
+    // Hold both locks until exit: no swap can be half done and no new staging folder can
+    // appear after the cleanup.
+    let _swap = lock(&SWAP);
+    let pending = lock(&PENDING);
+    for p in pending.iter() {
+        remove_all(p);
+    }
+    // Running children clean up their own staging folders when told to stop; no new one
+    // starts once STOPPING is set. Wait (a few seconds at most) until they have ended.
+    {
+        let children = lock(&CHILDREN);
+        STOPPING.store(true, Ordering::SeqCst);
+        for pid in children.iter() {
+            let _ = std::process::Command::new("kill")
+                .arg("-TERM")
+                .arg(pid.to_string())
+                .stderr(std::process::Stdio::null())
+                .status();
         }
-        // Running children clean up their own staging folders when told to stop; no new one
-        // starts once STOPPING is set. Wait (a few seconds at most) until they have ended.
-        {
-            let children = lock(&CHILDREN);
-            STOPPING.store(true, Ordering::SeqCst);
-            for pid in children.iter() {
-                let _ = std::process::Command::new("kill")
-                    .arg("-TERM")
-                    .arg(pid.to_string())
-                    .stderr(std::process::Stdio::null())
-                    .status();
-            }
+    }
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(5);
+    while !lock(&CHILDREN).is_empty() && std::time::Instant::now() < deadline {
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    // Held until exit: no lock can be taken after this cleanup. The process's own lock on
+    // each file goes with it.
+    let locks = lock(&LOCKS);
+    for p in locks.iter() {
+        // Best effort: a lock file left behind is taken over by the next bench.
+        let _ = std::fs::remove_file(p);
+    }
+    // Stderr may be a pipe whose reader is gone (a bench job whose bench died): no panic.
+    let _ = writeln!(std::io::stderr(), "error: interrupted");
+    std::process::exit(130);
+}
+
+/// Ends this process as an interrupt does ([`install_signal_handler`]) once its parent has
+/// gone: a bench's job would otherwise run on as an orphan after the bench was killed
+/// (SIGKILL, which no handler sees), outside the bench's lock and memory budget, and still
+/// write its run folder. `parent`: the process id the parent gave (it may have died before
+/// this process looked), else this process's parent now. Looks at once, then every 50 ms.
+pub fn stop_with_parent(parent: Option<u32>) {
+    let parent = parent.unwrap_or_else(std::os::unix::process::parent_id);
+    std::thread::spawn(move || loop {
+        if std::os::unix::process::parent_id() != parent {
+            interrupted();
         }
-        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(5);
-        while !lock(&CHILDREN).is_empty() && std::time::Instant::now() < deadline {
-            std::thread::sleep(std::time::Duration::from_millis(10));
-        }
-        // Held until exit: no lock can be taken after this cleanup. The process's own lock on
-        // each file goes with it.
-        let locks = lock(&LOCKS);
-        for p in locks.iter() {
-            // Best effort: a lock file left behind is taken over by the next bench.
-            let _ = std::fs::remove_file(p);
-        }
-        eprintln!("error: interrupted");
-        std::process::exit(130);
+        std::thread::sleep(std::time::Duration::from_millis(50));
     });
 }
 

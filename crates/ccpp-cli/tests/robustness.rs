@@ -239,6 +239,101 @@ fn walk(dir: &Path, out: &mut Vec<(PathBuf, Vec<String>)>) {
     out.push((dir.to_path_buf(), names));
 }
 
+/// The bench jobs that are children of process `bench` (found by their command line and
+/// parent in `/proc`).
+#[cfg(target_os = "linux")]
+fn jobs_of(bench: u32) -> Vec<u32> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir("/proc").unwrap().flatten() {
+        let Some(pid) = e.file_name().to_str().and_then(|n| n.parse::<u32>().ok()) else {
+            continue;
+        };
+        // A process that ended meanwhile is not read.
+        let (Ok(cmd), Ok(stat)) = (
+            std::fs::read(e.path().join("cmdline")),
+            std::fs::read_to_string(e.path().join("stat")),
+        ) else {
+            continue;
+        };
+        // `pid (comm) state ppid ...`: the fields after the last ')'.
+        let ppid = stat
+            .rsplit_once(')')
+            .and_then(|(_, rest)| rest.split_whitespace().nth(1))
+            .and_then(|p| p.parse::<u32>().ok());
+        if ppid == Some(bench) && cmd.split(|&b| b == 0).any(|a| a == b"__bench-job") {
+            out.push(pid);
+        }
+    }
+    out
+}
+
+/// Is process `pid` still a bench job?
+#[cfg(target_os = "linux")]
+fn is_job(pid: u32) -> bool {
+    std::fs::read(format!("/proc/{pid}/cmdline"))
+        .is_ok_and(|c| c.split(|&b| b == 0).any(|a| a == b"__bench-job"))
+}
+
+/// A bench killed outright (SIGKILL, which no handler sees) left its jobs running as
+/// orphans: they planned on and wrote their run folders after the bench was gone, outside its
+/// lock and its memory budget. A job now stops as if interrupted once its bench has gone.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_killed_bench_leaves_no_job_running() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = big_room(dir.path());
+    let out = dir.path().join("bench");
+    let bin = assert_cmd::cargo::cargo_bin("ccpp");
+    let mut bench = std::process::Command::new(&bin)
+        .args([
+            "bench",
+            "--quiet",
+            "--jobs",
+            "1",
+            "--planners",
+            "bcd",
+            "--maps",
+        ])
+        .arg(&map)
+        .arg("--out")
+        .arg(&out)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(20);
+    let jobs = loop {
+        let j = jobs_of(bench.id());
+        if !j.is_empty() {
+            break j;
+        }
+        assert!(std::time::Instant::now() < deadline, "no bench job started");
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    };
+    bench.kill().unwrap();
+    bench.wait().unwrap();
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(10);
+    while jobs.iter().any(|&j| is_job(j)) {
+        assert!(
+            std::time::Instant::now() < deadline,
+            "bench jobs run on after their bench was killed: {jobs:?}"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    // The job stopped before its run folder was written, and left no staging folder.
+    let mut dirs = Vec::new();
+    walk(&out, &mut dirs);
+    for (d, names) in &dirs {
+        assert!(
+            !names
+                .iter()
+                .any(|n| n == "metrics.json" || n.contains("ccpp-new")),
+            "{}: {names:?}",
+            d.display()
+        );
+    }
+}
+
 #[cfg(unix)]
 #[test]
 fn an_interrupted_bench_leaves_only_complete_runs() {
