@@ -350,14 +350,20 @@ fn plan_writes_only_the_path_of_a_known_map_planner() {
         );
     }
     // The GeoJSON names the robot the route was planned for: the disk planners' disk, and
-    // rect-boustrophedon's rectangle beside it (its robot was the `--radius` default alone).
+    // rect-boustrophedon's rectangle, alone in a plan (a disk beside it named a `--radius`
+    // default that `plan` calls "changes nothing here" and a tool radius it refuses), beside
+    // the simulated disk in a run.
     let bcd_robot = &json(&g.join("path.geojson"))["features"][0]["properties"]["robot"];
     assert!(bcd_robot.get("footprint").is_none(), "{bcd_robot}");
+    assert!(bcd_robot["radius_m"].as_f64().is_some(), "{bcd_robot}");
     let args = ["--length", "0.5", "--width", "0.3", "--export", "geojson"];
     let planned = plan_ok(d.path(), "rect-geo", &map, "rect-boustrophedon", &args);
     let ran = run_ok(d.path(), "rect-geo-run", &map, "rect-boustrophedon", &args);
-    for out in [planned, ran] {
+    for (out, simulated) in [(planned, false), (ran, true)] {
         let robot = &json(&out.join("path.geojson"))["features"][0]["properties"]["robot"];
+        for key in ["radius_m", "tool_radius_m"] {
+            assert_eq!(robot.get(key).is_some(), simulated, "{key}: {robot}");
+        }
         let f = &robot["footprint"];
         assert_eq!(f["shape"], "rectangle", "{robot}");
         assert_eq!(

@@ -516,12 +516,19 @@ fn oriented_ring(ring: &[[f64; 2]], exterior: bool) -> Vec<[f64; 2]> {
 
 /// The `robot` property of the exports: the disk (`radius_m`, `tool_radius_m`) and, for a
 /// rectangular robot, its `footprint` (`shape: "rectangle"`, `length_m`, `width_m`,
-/// `clearance_radius_m`).
+/// `clearance_radius_m`). A rectangle's plan that was not simulated has the footprint only:
+/// its route depends on the rectangle alone (`ccpp plan` refuses `--tool-radius` there, and a
+/// `--radius` below the clearance disk changes nothing), so a disk beside it named values the
+/// route was not planned for.
 fn robot_json(meta: &ExportMeta<'_>) -> serde_json::Value {
-    let mut robot = serde_json::json!({
-        "radius_m": meta.robot.radius,
-        "tool_radius_m": meta.robot.tool_radius,
-    });
+    let mut robot = if meta.footprint.is_some() && meta.metrics.is_none() {
+        serde_json::json!({})
+    } else {
+        serde_json::json!({
+            "radius_m": meta.robot.radius,
+            "tool_radius_m": meta.robot.tool_radius,
+        })
+    };
     if let (Some(f), serde_json::Value::Object(fields)) = (meta.footprint, &mut robot) {
         fields.insert(
             "footprint".into(),
@@ -540,7 +547,8 @@ fn robot_json(meta: &ExportMeta<'_>) -> serde_json::Value {
 /// (`[x, y]` order, metres). The first feature is the route: a `LineString` of the waypoints
 /// (a single waypoint is repeated so the line has the two positions `GeoJSON` requires; an empty
 /// route has a `null` geometry) with properties `kind: "path"`, `frame_id`, `planner`, `map`,
-/// `robot` (`radius_m`, `tool_radius_m`, and a rectangular robot's `footprint`), `route`
+/// `robot` (`radius_m`, `tool_radius_m`, and a rectangular robot's `footprint`; a rectangle's
+/// plan that was not simulated has only the footprint), `route`
 /// (`waypoints`, `length_m`, `tolerance_m`) and
 /// `metrics` (the run's metrics but `wall_time_s`, which differs between identical runs, or
 /// `null` for a plan that was not measured). Then one
