@@ -915,7 +915,7 @@ fn georef_errors_name_the_file_once() {
     for (file, needle) in [
         (
             &far,
-            "the fitted placement: the map lies 1.00e9 m from the world's origin",
+            "the fitted placement: the map reaches 1.00e9 m from the world's origin along an axis",
         ),
         (&fine, "the fitted placement: the resolution 9.99"),
         (&mirrored, "the fit mirrors the image"),

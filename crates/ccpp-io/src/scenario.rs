@@ -474,7 +474,7 @@ pub fn inflated_world_error(e: &WorldError, inflation: Option<f64>) -> Option<St
 
 /// Refuses a map frame finer than [`MIN_RESOLUTION_M`], wider or taller than
 /// [`MAX_MAP_SIDE_M`], or placed with a corner farther
-/// than [`MAX_COORD_M`] from the world's origin (every subcommand prepares its
+/// than [`MAX_COORD_M`] from the world's origin along either axis (every subcommand prepares its
 /// map through [`MapRecipe::prepare`], so `info`, `waypoints` and `plan` refuse what `run`
 /// refuses).
 ///
@@ -514,7 +514,7 @@ fn extent_problem(grid: &GridMap) -> Option<(String, &'static str)> {
         }
         return Some((
             format!(
-                "the map lies {far:.2e} m from the world's origin (origin {}, {}), farther than the {MAX_COORD_M:e} m ccpp handles precisely",
+                "the map reaches {far:.2e} m from the world's origin along an axis (origin {}, {}), farther than the {MAX_COORD_M:e} m ccpp handles precisely",
                 Compact(f.origin.x),
                 Compact(f.origin.y)
             ),

@@ -339,13 +339,14 @@ pub struct BcdOptions {
     /// lanes only in the interior at least `2 r_tool` inside those passes, and keeps that
     /// plan where it is cheaper (length plus `turn_cost_m` per turn). `None` (`null` in an
     /// options file): no headland. Must be finite and >= 0. Default
-    /// `Some(`[`DEFAULT_HEADLAND_MIN_M`]`)`: on the 14 shared maps (r = 0.15 m) it takes the
-    /// mean path ratio from 1.1985 (`None`) to 1.1833 (`tuw_single_corridors` 1.294 to 1.107,
-    /// `teb_empty_box` 1.050 to 1.026; the other maps keep the plain plan) for about 1.25
-    /// times the planning time of the 14-map bench (the headland plan is made beside the
-    /// plain one; up to twice as long on the largest maps). It also enables the peeled plan
-    /// (offset loops from the outer walls in, module docs step 3), which takes `nobleo_grid`
-    /// from 1.102 to 0.973 and `teb_empty_box` from 1.026 to 0.992 (mean 1.1833 to 1.1716).
+    /// `Some(`[`DEFAULT_HEADLAND_MIN_M`]`)`: on the 14 shared maps (r = 0.15 m, measured on
+    /// the current code) the mean path ratio is 1.1344 with it and 1.1766 with `None`
+    /// (`tuw_single_corridors` 0.960 instead of 1.300, `teb_empty_box` 0.990 instead of
+    /// 1.046), for about 1.25 times the planning time of the 14-map bench (the headland plan
+    /// is made beside the plain one; up to twice as long on the largest maps). It also enables
+    /// the peeled plan (offset loops from the outer walls in, module docs step 3), which takes
+    /// `nobleo_grid` from 1.102 to 0.973. (When the headland came, against the code of its
+    /// day, it took the mean from 1.1985 to 1.1833 and the peeled plan on to 1.1716.)
     pub headland_min_m: Option<f64>,
     /// Most plans made at the same time: planning runs on a pool of this many threads of its
     /// own. `None` (`null`): on the process's pool, one plan per thread (`RAYON_NUM_THREADS`,

@@ -112,13 +112,15 @@ pub struct BsaExtendedOptions {
     /// 1 and 0.0015): on the shared maps 5 % fewer turns for 0.16 % of the floor. Its final
     /// clean-up may leave 0.4 % of the floor in trips that do not pay (`leave_fraction`
     /// 0.004; the component's is 0.002): moving 0.1 % of the floor from the simplification
-    /// budget to this one (0.006 / 0.003 before) made the mean path ratio on the 14 shared
-    /// maps 1.3155 instead of 1.3247 and the mean turns 1874 instead of 1876, every map still
-    /// above 0.99 effective coverage (the lowest 0.9906). Its wall passes square a rounded corner where the way
-    /// grows by at most 0.8 robot radii per turn saved (`corner_slack` 0.8; the component's is
-    /// 0.1): with [`Self::strip_walk`] the mean turns on the 14 shared maps went from 2006 to
-    /// 1876 for a mean path ratio 0.007 higher (1.318 -> 1.325), the mean effective coverage
-    /// 0.9952 either way.
+    /// budget to this one (0.006 / 0.003 before) makes the mean path ratio on the 14 shared
+    /// maps 1.3165 instead of 1.3263 and the mean turns 1876 instead of 1877, every map still
+    /// above 0.99 effective coverage (the lowest 0.9906). Its wall passes square a rounded
+    /// corner where the way grows by at most 0.8 robot radii per turn saved (`corner_slack`
+    /// 0.8; the component's is 0.1). With [`Self::strip_walk`] the mean turns on the 14 shared
+    /// maps are 1876 instead of 1914 and the mean path ratio 1.3165 instead of 1.3221. (All
+    /// measured again on the current code with `ccpp bench --planners bsa-extended` and a
+    /// `--config` holding the other values; when each change was made, against the code of
+    /// its day, strip_walk took the turns from 2006 to 1876 for a path ratio 0.007 higher.)
     #[serde(deserialize_with = "super::settings::bsa_extended_extension")]
     pub extension: ExtensionOptions,
     /// Let the final clean-up's wall pass follow a strip of rim away from the walls: a step
