@@ -12,6 +12,17 @@ fn house() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/maps/aws_small_house.yaml")
 }
 
+/// The `x, y` of each row of a path or waypoints CSV (header skipped).
+fn path_points(csv: &str) -> Vec<(f64, f64)> {
+    csv.lines()
+        .skip(1)
+        .map(|l| {
+            let f: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+            (f[0], f[1])
+        })
+        .collect()
+}
+
 /// `aws_small_house`'s frame: 500 x 500 px at 0.05 m/px, origin (-12.5, -12.5).
 const W: usize = 500;
 const RES: f64 = 0.05;
@@ -125,10 +136,9 @@ fn keepouts_hold(radius: &str) {
     let (v, out) = run(d.path(), "free", "bcd", &["--radius", radius]);
     assert_eq!(v["keepout_violations"], 0);
     let csv = std::fs::read_to_string(out.join("path.csv")).unwrap();
-    assert!(csv.lines().skip(1).any(|l| {
-        let f: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
-        (5.5..=9.0).contains(&f[0]) && (0.3..=3.0).contains(&f[1])
-    }));
+    assert!(path_points(&csv)
+        .iter()
+        .any(|&(x, y)| (5.5..=9.0).contains(&x) && (0.3..=3.0).contains(&y)));
 }
 
 #[test]
@@ -168,15 +178,7 @@ fn a_start_outside_the_area_drives_there_first() {
         "{err}"
     );
     // The path starts at the start given, and once inside the room it stays there.
-    let csv = std::fs::read_to_string(out.join("path.csv")).unwrap();
-    let pts: Vec<(f64, f64)> = csv
-        .lines()
-        .skip(1)
-        .map(|l| {
-            let f: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
-            (f[0], f[1])
-        })
-        .collect();
+    let pts = path_points(&std::fs::read_to_string(out.join("path.csv")).unwrap());
     assert!((pts[0].0 - 4.675).abs() < 1e-9 && (pts[0].1 + 1.975).abs() < 1e-9);
     let inside = |p: &(f64, f64)| {
         (-9.3 + 0.25..=-2.85 - 0.25).contains(&p.0) && (-5.8 + 0.25..=-3.15 - 0.25).contains(&p.1)
@@ -211,9 +213,7 @@ fn an_area_around_one_room_keeps_the_path_inside() {
         let cov = v["effective_coverage"].as_f64().unwrap();
         assert!(cov > if p == "ba-star" { 0.6 } else { 0.9 }, "{p}: {v}");
         let csv = std::fs::read_to_string(out.join("path.csv")).unwrap();
-        for l in csv.lines().skip(1) {
-            let f: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
-            let (x, y) = (f[0], f[1]);
+        for (x, y) in path_points(&csv) {
             // The robot's centre stays at least r (minus the pixel tolerance) inside.
             assert!(
                 (-9.3 + 0.14..=-2.85 - 0.14).contains(&x)
@@ -409,10 +409,9 @@ fn info_shows_the_zones_and_waypoints_avoid_keepouts() {
         String::from_utf8(o.stdout).unwrap()
     };
     let inside = |csv: &str| {
-        csv.lines().skip(1).any(|l| {
-            let f: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
-            (-3.0..=3.0).contains(&f[0]) && (-1.2..=-0.3).contains(&f[1])
-        })
+        path_points(csv)
+            .iter()
+            .any(|&(x, y)| (-3.0..=3.0).contains(&x) && (-1.2..=-0.3).contains(&y))
     };
     assert!(inside(&wp(&[])));
     assert!(!inside(&wp(&["--keepout", "-3,-1.2,3,-0.3"])));
@@ -479,15 +478,7 @@ fn rect_boustrophedon_reaches_an_area_from_a_start_outside_it() {
         } else {
             "path.csv"
         };
-        let text = std::fs::read_to_string(out.join(csv)).unwrap();
-        let pts: Vec<(f64, f64)> = text
-            .lines()
-            .skip(1)
-            .map(|l| {
-                let f: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
-                (f[0], f[1])
-            })
-            .collect();
+        let pts = path_points(&std::fs::read_to_string(out.join(csv)).unwrap());
         // From the start given into the area, and inside it from there on, the clearance
         // disk clear of the area's border.
         assert!(
