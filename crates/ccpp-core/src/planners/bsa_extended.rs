@@ -120,7 +120,7 @@ pub struct BsaExtendedOptions {
     /// maps are 1876 instead of 1914 and the mean path ratio 1.3165 instead of 1.3221. (All
     /// measured again on the current code with `ccpp bench --planners bsa-extended` and a
     /// `--config` holding the other values; when each change was made, against the code of
-    /// its day, strip_walk took the turns from 2006 to 1876 for a path ratio 0.007 higher.)
+    /// its day, `strip_walk` took the turns from 2006 to 1876 for a path ratio 0.007 higher.)
     #[serde(deserialize_with = "super::settings::bsa_extended_extension")]
     pub extension: ExtensionOptions,
     /// Let the final clean-up's wall pass follow a strip of rim away from the walls: a step
