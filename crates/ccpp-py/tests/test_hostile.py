@@ -341,6 +341,37 @@ def test_an_interrupted_bcd_plan_stops_instead_of_holding_the_next_run(
     assert all(float(w) < 5.0 for w in words[2::3]), out.stdout
 
 
+def test_an_interrupted_rect_plan_stops_instead_of_holding_the_next_run(
+    tmp_path: Path, room: Path, shared_maps: Path
+) -> None:
+    # rect-boustrophedon plans before its first step too (about 20 s on this map), and its
+    # planning could not be stopped: after Ctrl-C the next call waited 30-100 s for it. It now
+    # gives up within a lane point or a search.
+    big = shared_maps.parent / "bench" / "cluttered_2000.yaml"
+    if not big.is_file():
+        pytest.skip(f"{big} absent")
+    script = tmp_path / "stop_rect.py"
+    script.write_text(
+        "import signal, threading, time, ccpp\n"
+        "for call in (ccpp.run, ccpp.plan):\n"
+        "    threading.Timer(1.5, lambda: signal.raise_signal(signal.SIGINT)).start()\n"
+        "    try:\n"
+        f"        call({str(big)!r}, 'rect-boustrophedon')\n"
+        "        print('finished', flush=True)\n"
+        "    except KeyboardInterrupt:\n"
+        "        print('interrupted', flush=True)\n"
+        "    t = time.monotonic()\n"
+        f"    r = ccpp.run({str(room)!r}, 'bsa')\n"
+        "    print('next', round(time.monotonic() - t, 1), flush=True)\n"
+    )
+    out = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    words = out.stdout.split()
+    assert words[0::3] == ["interrupted", "interrupted"], out.stdout
+    assert words[1::3] == ["next", "next"], out.stdout
+    assert all(float(w) < 5.0 for w in words[2::3]), out.stdout
+
+
 def test_a_mistyped_text_rectangle_is_named_as_such(room: Path) -> None:
     # Five numbers were taken for a file name and reported as "No such file".
     with pytest.raises(ccpp.CcppError, match="^area .*got 5 numbers"):

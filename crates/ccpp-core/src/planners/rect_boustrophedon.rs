@@ -61,6 +61,7 @@
 //! ```
 
 use std::collections::VecDeque;
+use std::sync::atomic::AtomicBool;
 
 use serde::{Deserialize, Serialize};
 
@@ -309,6 +310,14 @@ pub fn check(world: &World, opts: &RectOptions) -> Result<(), OptionsError> {
 
 /// Computes the lane plan for `world` (offline: reads the whole map).
 pub fn plan(world: &World, opts: &RectOptions) -> RectPlan {
+    plan_until(world, opts, None)
+}
+
+/// [`plan`] that another thread can give up by setting `stop`: the planning then ends within
+/// one lane point, one landmark search or 65 536 settled pixels, with what it has
+/// (the caller is giving the run up; Python's Ctrl-C left a large map's planning running on,
+/// and the next call waited for it).
+pub fn plan_until(world: &World, opts: &RectOptions, stop: Option<&AtomicBool>) -> RectPlan {
     let robot = world.robot();
     let (length, width) = (opts.length_for(&robot), opts.width_for(&robot));
     let mut steps = vec![Step::Mark(Event::RectLanes {
@@ -329,7 +338,7 @@ pub fn plan(world: &World, opts: &RectOptions) -> RectPlan {
         }
     };
     let area = lane_area(&rw, opts);
-    let mut rm = Roadmap::new(&rw);
+    let mut rm = Roadmap::new(&rw, stop);
     let mut waypoints = Vec::new();
     let mut dropped = 0;
     let mut unreached = 0;
@@ -340,9 +349,12 @@ pub fn plan(world: &World, opts: &RectOptions) -> RectPlan {
     // metrics define backtracks, not a backtrack inside one. A region starts with its first
     // straight move (the shift from the lane before is its first move).
     let mut region = 0u32;
-    for lane in &lane_list {
+    'lanes: for lane in &lane_list {
         let mut open = false;
         for &p in lane {
+            if rm.stopped() {
+                break 'lanes;
+            }
             if !rm.valid(p) {
                 dropped += 1;
                 continue;
@@ -438,10 +450,15 @@ struct Roadmap<'a> {
     /// ALT landmarks: exact search-graph distances from each landmark, by compact index
     /// (`u32::MAX` = not connected); computed at the first detour.
     landmarks: Option<Vec<Vec<u32>>>,
+    /// Set by another thread when the planning is given up ([`plan_until`]).
+    stop: Option<&'a AtomicBool>,
 }
 
+/// Pixels a search settles between two looks at the stop flag ([`plan_until`]).
+const STOP_EVERY: usize = 1 << 16;
+
 impl<'a> Roadmap<'a> {
-    fn new(w: &'a World) -> Self {
+    fn new(w: &'a World, stop: Option<&'a AtomicBool>) -> Self {
         let f = *w.frame();
         let n = f.len();
         let need = w.robot().radius + 0.45 * f.resolution;
@@ -459,7 +476,14 @@ impl<'a> Roadmap<'a> {
             space: SearchSpace::new(n),
             compact: Vec::new(),
             landmarks: None,
+            stop,
         }
+    }
+
+    /// Has the planning been given up?
+    fn stopped(&self) -> bool {
+        self.stop
+            .is_some_and(|s| s.load(std::sync::atomic::Ordering::Relaxed))
     }
 
     /// The search-graph successor of pixel `i` along N8 direction `k`, with its step cost: a
@@ -505,10 +529,16 @@ impl<'a> Roadmap<'a> {
         buckets[0].push(src as u32);
         let mut pending = 1usize;
         let mut cost = 0u32;
+        let mut settled = 0usize;
         while pending > 0 {
             let slot = cost as usize % nb;
             while let Some(i) = buckets[slot].pop() {
                 pending -= 1;
+                settled += 1;
+                if settled.is_multiple_of(STOP_EVERY) && self.stopped() {
+                    // Given up: the tables are not used.
+                    return d;
+                }
                 let i = i as usize;
                 if d[self.compact[i] as usize] != cost {
                     continue;
@@ -547,6 +577,9 @@ impl<'a> Roadmap<'a> {
         // min over the landmarks so far of the distance (the seed's table to start with).
         let mut nearest = first;
         for _ in 0..LANDMARKS {
+            if self.stopped() {
+                break;
+            }
             let far = nearest
                 .iter()
                 .enumerate()
@@ -669,11 +702,16 @@ impl<'a> Roadmap<'a> {
         let hs = h(self, s);
         self.space.push_source(s as u32, 0, hs);
         let mut found = false;
+        let mut settled = 0usize;
         while let Some(x) = self.space.pop() {
             let i = x.node as usize;
             if i == t {
                 found = true;
                 break;
+            }
+            settled += 1;
+            if settled.is_multiple_of(STOP_EVERY) && self.stopped() {
+                return None;
             }
             for k in 0..8 {
                 let Some((j, step)) = self.succ(i, k) else {
@@ -743,7 +781,13 @@ pub struct RectBoustrophedon {
 impl RectBoustrophedon {
     /// Plans on `world` (offline).
     pub fn new(world: &World, opts: &RectOptions) -> Self {
-        let plan = plan(world, opts);
+        Self::new_until(world, opts, None)
+    }
+
+    /// [`Self::new`] that another thread can give up by setting `stop` ([`plan_until`]); a
+    /// planner built after `stop` was set must not be driven.
+    pub fn new_until(world: &World, opts: &RectOptions, stop: Option<&AtomicBool>) -> Self {
+        let plan = plan_until(world, opts, stop);
         Self {
             steps: plan.steps.clone().into(),
             exec: opts.exec,

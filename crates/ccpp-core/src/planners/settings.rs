@@ -279,7 +279,7 @@ pub trait PlannerSettings {
     fn build(&self, world: &World) -> Box<dyn Planner>;
 
     /// [`build`](Self::build) that another thread can give up by setting `stop`: a planner
-    /// whose building takes long (bcd's planning) then ends it early, with a planner that
+    /// whose building takes long (bcd's and rect-boustrophedon's planning) then ends it early, with a planner that
     /// must not be driven (the caller is giving the run up). The others build as usual.
     fn build_until(&self, world: &World, _stop: &AtomicBool) -> Box<dyn Planner> {
         self.build(world)
@@ -697,12 +697,19 @@ impl PlannerSettings for RandomBounceOptions {
         let res = s.frame.resolution;
         let need = s.robot.radius + 2.0 * res;
         // A thousandth of a pixel above it: the strides stop 1e-4 px short of what is seen.
-        if s.sensor_range < need + 1e-3 * res {
+        let min = need + 1e-3 * res;
+        if s.sensor_range < min {
+            // The least range named, rounded up to a micrometre so that the value printed
+            // passes (the message named r + 2 px itself, which was refused).
+            let mut shown = (min * 1e6).ceil() / 1e6;
+            if shown < min {
+                shown += 1e-6;
+            }
             return Err(OptionsError::new(
                 "",
                 format!(
-                    "the sensor range {} m sees too little beyond the robot's footprint: random-bounce moves in strides of at least half a pixel beyond the r + 1.5 px its disk can touch, so it needs r + 2 px = {} m or more (raise --sensor-range or the robot radius)",
-                    fmt_m(s.sensor_range), fmt_m(need)
+                    "the sensor range {} m sees too little beyond the robot's footprint: random-bounce moves in strides of at least half a pixel beyond the r + 1.5 px its disk can touch, so it needs a little over r + 2 px, {} m or more (raise --sensor-range or the robot radius)",
+                    fmt_m(s.sensor_range), fmt_m(shown)
                 ),
             ));
         }
@@ -1317,6 +1324,10 @@ impl PlannerSettings for RectOptions {
 
     fn build(&self, world: &World) -> Box<dyn Planner> {
         Box::new(RectBoustrophedon::new(world, self))
+    }
+
+    fn build_until(&self, world: &World, stop: &AtomicBool) -> Box<dyn Planner> {
+        Box::new(RectBoustrophedon::new_until(world, self, Some(stop)))
     }
 }
 
