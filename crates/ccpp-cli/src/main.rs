@@ -7,7 +7,7 @@ mod args;
 mod bench;
 mod budget;
 mod busy;
-mod components;
+use ccpp_io::components;
 mod errors;
 mod info;
 mod job;

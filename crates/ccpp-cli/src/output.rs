@@ -391,7 +391,7 @@ pub fn emit(
     busy.done();
     let metrics = metrics?;
     if let Some(w) = comp.warning() {
-        eprintln!("{w}");
+        eprintln!("warning: {w}");
     }
     // Every warning on stderr, with or without --json (the early stop's was a line of the
     // table on stdout without it), as Python's `RunResult.warnings` lists them.

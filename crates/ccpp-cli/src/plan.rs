@@ -102,7 +102,7 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     // As for `run`: a start whose free area reaches the map's border is probably outside.
     let comp = StartComponent::of(plan.world.map(), plan.world.start().position());
     if let Some(w) = comp.warning() {
-        eprintln!("{w}");
+        eprintln!("warning: {w}");
     }
     let mut s = String::new();
     let _ = writeln!(

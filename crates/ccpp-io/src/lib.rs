@@ -27,6 +27,7 @@
 //! Errors are [`thiserror`] enums that always name the file concerned; nothing here panics on
 //! user data.
 
+pub mod components;
 pub mod execution;
 pub mod export;
 pub mod file;

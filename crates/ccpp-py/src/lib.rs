@@ -1264,17 +1264,27 @@ impl RunResult {
         self.output.stop.as_str()
     }
 
-    /// The warnings `ccpp run` prints for this run (without `warning: `): an early stop, PID
+    /// The warnings `ccpp run` prints for this run (without `warning: `): a start whose free
+    /// area reaches the map's border (it may be outside the building), an early stop, PID
     /// motions cut at `max_steps_per_motion`, bumper contacts under odometry noise without
-    /// landmarks, a run that never moved, a tool narrower than the map's pixels. A run that ends `done` may still have some (`stop` is the planner's word).
+    /// landmarks, a run that never moved, a tool narrower than the map's pixels. A run that
+    /// ends `done` may still have some (`stop` is the planner's word).
     #[getter]
     fn warnings(&self) -> Vec<String> {
-        ccpp_io::warnings::run_warnings(
-            &self.scenario,
-            &self.world,
-            &self.output.trace,
-            &self.metrics,
-        )
+        let start = ccpp_io::components::StartComponent::of(
+            self.world.map(),
+            self.world.start().position(),
+        );
+        start
+            .warning()
+            .into_iter()
+            .chain(ccpp_io::warnings::run_warnings(
+                &self.scenario,
+                &self.world,
+                &self.output.trace,
+                &self.metrics,
+            ))
+            .collect()
     }
 
     /// The start pose used, `(x, y, theta)`.
@@ -1412,9 +1422,11 @@ static ORPHANS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize:
 /// Runs `job` on a thread of its own while this one waits with the GIL released, looking
 /// for signals every 50 ms: Ctrl-C (`KeyboardInterrupt`) ends the wait at once. A long run
 /// used to hold the caller until it finished. On the interrupt the flag given to `job` is
-/// set: a simulation stops within a few steps and bcd's planning at its next step
-/// ([`Scenario::run_on_until`]); what cannot be stopped (the other planners' building, which
-/// is quick) finishes on its thread and its result is dropped (a script that ends on the
+/// set: a simulation stops within a few steps, bcd's planning at its next step and
+/// rect-boustrophedon's within a lane point or a search ([`Scenario::run_on_until`]; its
+/// planning on a large cluttered map ran on for minutes, and the next call waited); what
+/// cannot be stopped (the online planners' building, which is quick) finishes on its thread
+/// and its result is dropped (a script that ends on the
 /// interrupt ends it with the process). A new job first waits
 /// (interruptibly) until the interrupted ones have ended, so they never pile up: three
 /// interrupted runs slowed the next one threefold and held 921 MB beside it, over the 800 MB

@@ -332,3 +332,11 @@ def test_warnings_are_the_cli_warnings(shared_maps: Path, ccpp_bin: str, tmp_pat
         cli_warnings = [line.removeprefix("warning: ") for line in p.stderr.splitlines() if line.startswith("warning: ")]
         assert r.warnings == cli_warnings
     assert ccpp.run(maze, "bcd").warnings == []
+    # A start whose free area reaches the map's border (the robot may be outside the
+    # building): `ccpp run` warned, Python's list left it out.
+    depot = shared_maps / "nav2_depot.yaml"
+    r = ccpp.run(depot, "bsa")
+    assert any("reaches the map's border" in w for w in r.warnings), r.warnings
+    p = cli(ccpp_bin, "run", "--map", str(depot), "--planner", "bsa", "--out", str(tmp_path / "depot"))
+    assert p.returncode == 0, p.stderr
+    assert r.warnings == [line.removeprefix("warning: ") for line in p.stderr.splitlines() if line.startswith("warning: ")]

@@ -1,6 +1,7 @@
 //! The free area holding the start: its size, the map's free area, and whether it reaches the
-//! image border (then the start may lie outside the building). `info`, `run` and `plan` report
-//! it; the fill runs over horizontal runs ([`ccpp_core::search::fill_runs`]).
+//! image border (then the start may lie outside the building). `info`, `run`, `plan`, `bench`
+//! and Python's `RunResult.warnings` report it; the fill runs over horizontal runs
+//! ([`ccpp_core::search::fill_runs`]).
 
 use ccpp_core::grid::{Cell, GridMap};
 use ccpp_core::search::{fill_runs, Connectivity};
@@ -9,11 +10,7 @@ use ccpp_core::Point;
 /// Fills the 4-connected free component holding `seed` by horizontal runs
 /// ([`ccpp_core::search::fill_runs`]), marking `seen`; returns the component's pixel count and
 /// whether it touches the image border.
-pub(crate) fn flood_runs(
-    g: &GridMap,
-    seed: usize,
-    seen: &mut fixedbitset::FixedBitSet,
-) -> (usize, bool) {
+pub fn flood_runs(g: &GridMap, seed: usize, seen: &mut fixedbitset::FixedBitSet) -> (usize, bool) {
     let f = *g.frame();
     let (w, h) = (f.width, f.height);
     let cells = g.cells();
@@ -34,7 +31,7 @@ pub(crate) fn flood_runs(
 }
 
 /// Counts 4-connected components of free pixels and the size of the largest.
-pub(crate) fn free_components(g: &GridMap) -> (usize, usize) {
+pub fn free_components(g: &GridMap) -> (usize, usize) {
     let cells = g.cells();
     let mut seen = fixedbitset::FixedBitSet::with_capacity(cells.len());
     let (mut n, mut largest) = (0usize, 0usize);
@@ -103,12 +100,12 @@ impl StartComponent {
         )
     }
 
-    /// The warning to print when the start's free area reaches the image border.
+    /// The warning (without `warning: `) when the start's free area reaches the image border.
     pub fn warning(&self) -> Option<String> {
         self.touches_border.then(|| {
-            "warning: the free area holding the start reaches the map's border, so the start \
-             may be outside the building (only that area is covered); pass --start X,Y to \
-             start inside"
+            "the free area holding the start reaches the map's border, so the start may be \
+             outside the building (only that area is covered); pass --start X,Y (Python: \
+             start=(x, y)) to start inside"
                 .to_string()
         })
     }
