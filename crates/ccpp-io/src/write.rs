@@ -305,13 +305,20 @@ pub fn create_folder(folder: &Path, target: &Path) -> Result<(), FolderError> {
     })
 }
 
+/// Held by [`write_folder`] while it renames the old folder away and the new one in: two
+/// threads saving into one folder (Python's `save()` from a thread pool) interleaved their
+/// renames, failed with "Directory not empty" or "No such file" and left `.NAME.ccpp-old-*`
+/// copies behind. The last swap wins.
+static FOLDER_SWAP: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 /// Writes `files` as the whole content of the folder `target`, all or nothing, as the command
 /// line writes a run folder: `target` must be absent or hold only [`RUN_FILES`]
 /// ([`check_run_folder`]); the files are written and synced into a staging folder
 /// `.NAME.ccpp-new-PID-N` beside it, the old folder (if any) is renamed away, the staging
-/// folder renamed to `target` and the old one removed. A failure leaves the old folder as it
-/// was and no staging folder; a reader sees the old complete set or the new one, never a mix.
-/// Parent folders are created as needed.
+/// folder renamed to `target` and the old one removed (one such swap at a time in a process,
+/// so threads writing one folder leave the last set whole). A failure leaves the old folder as
+/// it was and no staging folder; a reader sees the old complete set or the new one, never a
+/// mix. Parent folders are created as needed.
 ///
 /// # Errors
 /// As [`check_run_folder`] and [`create_folder`], [`FolderError::NoName`], or
@@ -364,6 +371,10 @@ pub fn write_folder(target: &Path, files: &[(&str, Vec<u8>)]) -> Result<(), Fold
         let _ = std::fs::remove_dir_all(&staging);
         return Err(io_err(e));
     }
+    // One swap at a time in this process (see `FOLDER_SWAP`).
+    let _swap = FOLDER_SWAP
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
     let old = tag("old");
     let had_old = std::fs::symlink_metadata(&target_in).is_ok();
     if had_old {
@@ -553,6 +564,37 @@ mod tests {
         write_folder(&target, &[("run.json", b"2".to_vec())]).unwrap();
         assert_eq!(std::fs::read(target.join("run.json")).unwrap(), b"2");
         assert_eq!(names(d.path()).len(), 1);
+    }
+
+    /// Threads saving into one folder (Python's `save()` from a thread pool) interleaved their
+    /// renames: "Directory not empty", "No such file", and hidden `.out.ccpp-old-*` copies
+    /// left beside the folder. The swaps now take turns: every save succeeds and the folder
+    /// holds one whole set.
+    #[test]
+    fn threads_writing_one_folder_take_turns() {
+        let d = tempfile::tempdir().unwrap();
+        let target = d.path().join("out");
+        for round in 0..10 {
+            std::thread::scope(|s| {
+                for t in 0..4 {
+                    let target = &target;
+                    s.spawn(move || {
+                        let tag = format!("{round}-{t}");
+                        write_folder(
+                            target,
+                            &[
+                                ("metrics.json", tag.clone().into_bytes()),
+                                ("path.csv", tag.into_bytes()),
+                            ],
+                        )
+                        .unwrap();
+                    });
+                }
+            });
+            assert_eq!(names(d.path()), ["out"], "round {round}");
+            let a = std::fs::read(target.join("metrics.json")).unwrap();
+            assert_eq!(a, std::fs::read(target.join("path.csv")).unwrap());
+        }
     }
 
     #[test]
