@@ -59,6 +59,24 @@ def test_refuses_what_it_would_ignore(room: Path) -> None:
     env.reset(seed=1, options={})
     with pytest.raises(ValueError, match="no options"):
         env.reset(seed=1, options={"start": (1.0, 1.0)})
+    # Numbers and flags are typed as `ccpp.Env` types them: "0.3" and True were steps (True a
+    # 1 m step), and "no" kept random starts and the known map on.
+    for kw in (
+        {"step_m": "0.3"},
+        {"step_m": True},
+        {"turn_rad": "1.5"},
+        {"turn_rad": True},
+        {"random_start": "no"},
+        {"include_known": "no"},
+        {"include_known": 0},
+    ):
+        with pytest.raises(TypeError, match=next(iter(kw))):
+            CoverageEnv(str(room), **kw)
+    import numpy as np
+
+    env = CoverageEnv(str(room), step_m=np.float32(0.25), turn_rad=1, include_known=np.bool_(False))
+    assert env.step_m == pytest.approx(0.25) and env.turn_rad == 1.0
+    assert "known" not in env.observation_space.spaces
 
 
 def test_only_the_actions_of_the_space(room: Path) -> None:

@@ -54,6 +54,16 @@ class CoverageEnv(gym.Env):  # type: ignore[misc]
             sensor_range=sensor_range,
             max_steps=max_steps,
         )
+        # Numbers are numbers, flags are flags, as `ccpp.Env` holds them: `float()` took
+        # "0.3" and True (a 1 m step), and "no" was a true flag.
+        for name, v in (("step_m", step_m), ("turn_rad", turn_rad)):
+            if v is not None and (
+                isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, float, np.integer, np.floating))
+            ):
+                raise TypeError(f"{name} must be a number, not {type(v).__name__}")
+        for name, v in (("random_start", random_start), ("include_known", include_known)):
+            if not isinstance(v, (bool, np.bool_)):
+                raise TypeError(f"{name} must be a bool, not {type(v).__name__}")
         # `radius=None` is the default robot, as for `ccpp.Env`.
         self.step_m = float(step_m if step_m is not None else self._env.radius)
         self.turn_rad = float(turn_rad)
@@ -64,8 +74,8 @@ class CoverageEnv(gym.Env):  # type: ignore[misc]
         # The simulator refuses a rotation of more than two turns: each turn action would fail.
         if self.turn_rad > 4 * math.pi:
             raise ValueError(f"turn_rad must be at most two turns (4 pi rad), got {self.turn_rad}")
-        self.random_start = random_start
-        self.include_known = include_known
+        self.random_start = bool(random_start)
+        self.include_known = bool(include_known)
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
         self.render_mode = render_mode
