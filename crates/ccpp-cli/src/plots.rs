@@ -85,6 +85,24 @@ pub fn write_all(
                     return Ok(skipped);
                 }
             };
+            // Planners whose run on this map failed: named in the map's titles (their panel,
+            // curve and point are missing, and the pictures said nothing of it).
+            let failed: Vec<&str> = rows
+                .iter()
+                .filter(|r| r.map == m.name && r.outcome.is_err())
+                .map(|r| r.planner.as_str())
+                .collect();
+            let title = |what: &str| {
+                if failed.is_empty() {
+                    format!("{what} - {}", m.name)
+                } else {
+                    format!(
+                        "{what} - {} (failed: {}; see results.md)",
+                        m.name,
+                        failed.join(", ")
+                    )
+                }
+            };
             let mut series = Vec::new();
             let mut panels = Vec::new();
             // What each drawn run's picture shows, for the shared legend (its trace and world are
@@ -163,7 +181,7 @@ pub fn write_all(
             let points = tradeoff_points(rows, &planners, &m.name);
             if points.iter().any(Option::is_some) {
                 let c = tradeoff_chart(
-                    &format!("Coverage against path ratio - {}", m.name),
+                    &title("Coverage against path ratio"),
                     &planners,
                     &points,
                     &[],
@@ -172,7 +190,7 @@ pub fn write_all(
             }
             if !series.is_empty() {
                 let c = line_chart(
-                    &format!("Effective coverage over travelled distance - {}", m.name),
+                    &title("Effective coverage over travelled distance"),
                     "travelled distance (m)",
                     "effective coverage",
                     &series,
@@ -182,14 +200,7 @@ pub fn write_all(
             }
             if !panels.is_empty() {
                 let legend = legend_entries_union_of(&shown);
-                let c = image_grid_captioned(
-                    &format!("Paths - {}", m.name),
-                    &panels,
-                    &legend,
-                    3,
-                    520,
-                    420,
-                );
+                let c = image_grid_captioned(&title("Paths"), &panels, &legend, 3, 520, 420);
                 write_chart(&dir, &format!("paths_{}", m.name), &c)?;
             }
             Ok(skipped)
@@ -251,7 +262,31 @@ pub fn write_all(
                 .collect(),
         ),
     ];
-    let c = bar_panels("Summary (mean over maps)", &planners, &metrics);
+    // A planner whose runs failed on maps where others ran is averaged over fewer maps than
+    // they are: its label says over how many (its bar and point stood beside means over more
+    // maps, unmarked). A map no planner ran on counts for none.
+    let mut ran_maps: Vec<&str> = rows
+        .iter()
+        .filter(|r| r.outcome.is_ok())
+        .map(|r| r.map.as_str())
+        .collect();
+    ran_maps.sort_unstable();
+    ran_maps.dedup();
+    let labels: Vec<String> = planners
+        .iter()
+        .map(|p| {
+            let ok = rows
+                .iter()
+                .filter(|r| &r.planner == p && r.outcome.is_ok())
+                .count();
+            if ok < ran_maps.len() {
+                format!("{p} ({ok} of {} maps)", ran_maps.len())
+            } else {
+                p.clone()
+            }
+        })
+        .collect();
+    let c = bar_panels("Summary (mean over maps)", &labels, &metrics);
     write_chart(&dir, "summary", &c)?;
     // Trade-off summary: each planner at its means, its per-map points faint behind.
     let means: Vec<Option<[f64; 2]>> = planners
@@ -274,7 +309,7 @@ pub fn write_all(
     if means.iter().any(Option::is_some) {
         let c = tradeoff_chart(
             "Coverage against path ratio (mean over maps)",
-            &planners,
+            &labels,
             &means,
             &per_map,
         );

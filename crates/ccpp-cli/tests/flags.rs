@@ -864,6 +864,32 @@ fn absurd_sizes_end_within_seconds() {
             &["sensor range", "r + 2 px"],
         );
     }
+    // The least range the message names passes (it named r + 2 px, 0.25 m here, which was
+    // refused: the check wants a thousandth of a pixel more).
+    let o = ccpp()
+        .args(["run", "--planner", "random-bounce", "--radius", "0.15"])
+        .args(["--sensor-range", "0.25", "--map"])
+        .arg(&map)
+        .arg("--out")
+        .arg(dir.join("rb-range"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    let named = err
+        .split(" m or more")
+        .next()
+        .and_then(|head| head.rsplit(' ').next())
+        .unwrap()
+        .to_string();
+    assert!(named.parse::<f64>().unwrap() > 0.25, "{err}");
+    run_ok(
+        dir,
+        "rb-named",
+        &map,
+        "random-bounce",
+        &["--radius", "0.15", "--sensor-range", &named],
+    );
     run_fails(
         dir,
         &map,
@@ -1328,6 +1354,57 @@ fn bench_max_memory_turns_runs_into_error_rows() {
     let free = bench("free", &[], true);
     assert!(!free.contains("memory limit"), "{free}");
     assert_eq!(free.matches(",ok,").count(), 2, "{free}");
+}
+
+/// A planner whose run failed on some maps (here bcd on `aws_bookstore`, over the memory
+/// limit) was drawn in the summary pictures at its mean over the other maps, beside means over
+/// every map, unmarked, and the failed map's pictures left it out in silence. Its summary label
+/// now says over how many maps, and the map's titles name the failed planner.
+#[test]
+fn bench_pictures_say_which_runs_failed() {
+    let Some(maps) = common::shared_maps() else {
+        eprintln!("note: ../shared/maps absent; skipped");
+        return;
+    };
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("b");
+    // bcd's estimate counts its plans at a time, one per thread: fixed at two here.
+    ccpp()
+        .env("RAYON_NUM_THREADS", "2")
+        .args([
+            "bench",
+            "--quiet",
+            "--planners",
+            "ba-star,bcd",
+            "--max-memory",
+            "40",
+        ])
+        .arg("--maps")
+        .arg(maps.join("teb_maze.yaml"))
+        .arg(maps.join("aws_bookstore.yaml"))
+        .arg("--out")
+        .arg(&out)
+        .assert()
+        .failure()
+        .code(1);
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    let failed: Vec<&str> = csv.lines().filter(|l| l.contains(",error,\"")).collect();
+    assert_eq!(failed.len(), 1, "{csv}");
+    assert!(failed[0].starts_with("aws_bookstore,bcd,error"), "{csv}");
+    let plot = |f: &str| std::fs::read_to_string(out.join("plots").join(f)).unwrap();
+    for f in ["summary.svg", "tradeoff_summary.svg"] {
+        let svg = plot(f);
+        assert!(svg.contains(">bcd (1 of 2 maps)</text>"), "{f}");
+        assert!(svg.contains(">ba-star</text>"), "{f}");
+    }
+    for f in [
+        "paths_aws_bookstore.svg",
+        "coverage_aws_bookstore.svg",
+        "tradeoff_aws_bookstore.svg",
+    ] {
+        assert!(plot(f).contains("(failed: bcd; see results.md)"), "{f}");
+    }
+    assert!(!plot("paths_teb_maze.svg").contains("failed"));
 }
 
 /// `leave_group` (the final clean-up judges a cluster of specks as one) changes the run end to
