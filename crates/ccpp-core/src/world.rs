@@ -155,8 +155,9 @@ pub enum WorldError {
     },
     /// No path leads from a start outside the area into it.
     #[error(
-        "the area cannot be reached from the start ({:.3}, {:.3}): no path for a robot of \
-         radius {} m leads into it without touching an obstacle or a keep-out zone",
+        "the area cannot be reached from the start ({:.3}, {:.3}): no path for a disk of \
+         radius {} m (the robot, or the clearance disk a rectangular robot turns in) leads into \
+         it without touching an obstacle or a keep-out zone",
         Compact(*.x), Compact(*.y), Compact(*.radius)
     )]
     AreaUnreachable {
@@ -164,7 +165,7 @@ pub enum WorldError {
         x: f64,
         /// Start y.
         y: f64,
-        /// Robot radius.
+        /// Radius of the disk the approach was planned for.
         radius: f64,
     },
     /// The zones leave no spot where the robot fits.
@@ -443,15 +444,17 @@ impl World {
     /// centres where the robot stands clear of obstacles and keep-outs (the area's border does
     /// not count) from the start to the nearest centre that is C-free under every virtual wall,
     /// shortened to straight segments that are free of obstacles and keep-outs (exact swept-disk
-    /// test). With `fit` above the robot's radius the end is the nearest centre where a disk
-    /// of that radius fits under every virtual wall. Sets `start` to its end (heading along its
-    /// last segment).
+    /// test). With `fit` above the robot's radius the whole approach is planned for a disk of
+    /// that radius (a rectangular robot turns at every corner of it in its clearance disk), and
+    /// it ends where that disk fits under every virtual wall. Sets `start` to its end (heading
+    /// along its last segment).
     fn plan_approach(&mut self, fit: f64) -> Result<(), WorldError> {
         let s = self.start;
+        let fit = fit.max(self.robot.radius);
         let unreachable = || WorldError::AreaUnreachable {
             x: s.x,
             y: s.y,
-            radius: self.robot.radius,
+            radius: fit,
         };
         let Some(z) = self.zones.as_ref() else {
             return Err(unreachable());
@@ -460,7 +463,7 @@ impl World {
         let (w, h) = (frame.width, frame.height);
         let cells = self.map.cells();
         let dt = squared_edt(w, h, |i| !cells[i].is_free() || z.keepout.contains(i), true);
-        let r_px = self.r_px();
+        let r_px = fit / frame.resolution;
         let rc = contact_radius_px(r_px);
         let occ = Approach {
             map: &self.map,
@@ -470,11 +473,9 @@ impl World {
             |a: Point, b: Point| collide::segment_first_contact(&occ, a, b, r_px).is_none();
         let ok = |i: usize| f64::from(dt[i]) >= rc * rc;
         // Where coverage may start: C-free, and room for the planner's disk when larger.
-        let fit_rc = contact_radius_px(fit / frame.resolution);
         let fits = |i: usize| {
             self.cfree.contains(i)
-                && (fit <= self.robot.radius
-                    || f64::from(self.obstacle_dt2.get(i)) >= fit_rc * fit_rc)
+                && (fit <= self.robot.radius || f64::from(self.obstacle_dt2.get(i)) >= rc * rc)
         };
         // Dijkstra with integer octile costs (70 straight, 99 diagonal).
         let mut dist = vec![u32::MAX; frame.len()];

@@ -106,6 +106,53 @@ fn online_and_offline_planners_respect_the_zones() {
     }
 }
 
+/// The approach of a planner that needs room for a larger disk than the robot's own
+/// (rect-boustrophedon's clearance disk) is planned for that disk all the way: it ended where
+/// that disk fitted but drove corners where only the robot's did (a rectangle turning there
+/// hits the wall), and through doors too narrow for it.
+#[test]
+fn an_approach_for_a_larger_disk_keeps_that_disk_clear() {
+    let map = room();
+    // Keep-outs leave a door 0.4 m wide (y 0.8 to 1.2) between the start and the area.
+    let z = || {
+        zones(
+            &map,
+            Some([0.0, 0.0, 1.5, 2.0]),
+            &[[1.8, 0.0, 2.2, 0.8], [1.8, 1.2, 2.2, 2.0]],
+        )
+    };
+    let start = Some(Pose::new(3.0, 0.3, 0.0));
+    let robot = Robot::new(0.1);
+    assert!(World::with_zones(map.clone(), robot, start, Some(z())).is_ok());
+    // A disk 0.5 m across does not pass the door.
+    let e = World::with_zones_fitting(map.clone(), robot, start, Some(z()), 0.25);
+    assert!(
+        matches!(e, Err(WorldError::AreaUnreachable { radius, .. }) if radius == 0.25),
+        "{e:?}"
+    );
+    // A disk 0.3 m across does, and keeps clear of the door's posts at every corner and along
+    // every segment (sampled), not only where it ends.
+    let w = World::with_zones_fitting(map.clone(), robot, start, Some(z()), 0.15).unwrap();
+    let posts = [[1.8, 0.0, 2.2, 0.8], [1.8, 1.2, 2.2, 2.0]];
+    let clear = |x: f64, y: f64| {
+        posts.iter().all(|r| {
+            let dx = (r[0] - x).max(x - r[2]).max(0.0);
+            let dy = (r[1] - y).max(y - r[3]).max(0.0);
+            dx.hypot(dy) >= 0.15 - 0.025
+        })
+    };
+    let mut prev = w.initial_pose().position();
+    for p in w.approach() {
+        for k in 0..=50 {
+            let t = f64::from(k) / 50.0;
+            let (x, y) = (prev.x + t * (p.x - prev.x), prev.y + t * (p.y - prev.y));
+            assert!(clear(x, y), "({x}, {y}) on the approach {:?}", w.approach());
+        }
+        prev = *p;
+    }
+    assert!(w.start().x <= 1.5 - 0.15 + 0.025 + 1e-9, "{:?}", w.start());
+}
+
 #[test]
 fn zone_errors_are_specific() {
     let map = room();
