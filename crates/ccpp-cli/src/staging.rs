@@ -26,21 +26,18 @@
 //! the same target removes them, or puts an old folder back when the target is missing.
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Mutex, MutexGuard, PoisonError};
 
 use anyhow::{bail, Context, Result};
+use ccpp_io::write::SwapError;
 
 /// Paths to remove if the process is interrupted.
 static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
-/// Held while an old folder is renamed away and the new one renamed in.
-static SWAP: Mutex<()> = Mutex::new(());
 /// Child processes (bench runs) to stop if this process is interrupted.
 static CHILDREN: Mutex<Vec<u32>> = Mutex::new(Vec::new());
 /// Set by the signal handler: no child process may start any more.
 static STOPPING: AtomicBool = AtomicBool::new(false);
-/// Distinguishes the staging folders of one process.
-static COUNTER: AtomicU64 = AtomicU64::new(0);
 /// Lock files of output folders this process holds (a bench's, see [`crate::lock`]): removed on
 /// interrupt after the child processes have ended, so that no other bench starts on the folder
 /// while they may still write into it.
@@ -153,7 +150,7 @@ fn interrupted() -> ! {
     use std::io::Write as _;
     // Hold both locks until exit: no swap can be half done and no new staging folder can
     // appear after the cleanup.
-    let _swap = lock(&SWAP);
+    let _swap = ccpp_io::write::swap_lock();
     let pending = lock(&PENDING);
     for p in pending.iter() {
         remove_all(p);
@@ -257,7 +254,7 @@ pub fn write_files_together(dir: &Path, files: &[(&str, &[u8])]) -> Result<()> {
             bail!("cannot write {}: {e}", dir.join(name).display());
         }
     }
-    let _swap = lock(&SWAP);
+    let _swap = ccpp_io::write::swap_lock();
     // The old content of each file before it is replaced, to put back if a later one fails.
     let mut before: Vec<Option<Vec<u8>>> = Vec::new();
     for (i, (name, _)) in files.iter().enumerate() {
@@ -386,13 +383,7 @@ impl Staging {
             let _ = std::fs::remove_dir(&resolved);
         }
         clean_stale(&parent, &name);
-        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-        let dir = parent.join(ccpp_io::write::staging_name(
-            &name,
-            "new",
-            std::process::id(),
-            n,
-        ));
+        let dir = ccpp_io::write::staging_path(&parent, &name, "new");
         {
             // Registered and created under the lock: the signal handler sees both or neither.
             let mut pending = lock(&PENDING);
@@ -468,41 +459,33 @@ impl Staging {
     /// When a rename fails; the old folder is then put back where possible.
     pub fn commit(mut self) -> Result<()> {
         self.wait_synced()?;
-        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-        let old = self.parent.join(ccpp_io::write::staging_name(
-            &self.name,
-            "old",
-            std::process::id(),
-            n,
-        ));
-        let swap = lock(&SWAP);
-        let had_old = std::fs::symlink_metadata(&self.target).is_ok();
-        if had_old {
+        let old = ccpp_io::write::staging_path(&self.parent, &self.name, "old");
+        let swap = ccpp_io::write::swap_lock();
+        let had_old = match ccpp_io::write::swap_folder(&self.dir, &self.target, &old, || {
             register(&old);
-            std::fs::rename(&self.target, &old).with_context(|| {
-                format!("cannot replace output folder {}", self.shown.display())
-            })?;
-        }
-        if let Err(e) = std::fs::rename(&self.dir, &self.target) {
-            if had_old {
-                let back = std::fs::rename(&old, &self.target);
+        }) {
+            Ok(had_old) => had_old,
+            Err(e) => {
                 unregister(&old);
-                if let Err(back) = back {
+                return Err(match e {
+                    SwapError::MoveOld(e) => anyhow::Error::new(e).context(format!(
+                        "cannot replace output folder {}",
+                        self.shown.display()
+                    )),
+                    SwapError::MoveNew(e) => anyhow::Error::new(e).context(format!(
+                        "cannot move the new output into {}",
+                        self.shown.display()
+                    )),
                     // The previous output stays under its hidden name (the next `ccpp run`
                     // into this folder puts it back): say where.
-                    return Err(e).with_context(|| {
-                        format!(
-                            "cannot move the new output into {}, nor put the previous one back ({back}): it is at {}",
-                            self.shown.display(),
-                            old.display()
-                        )
-                    });
-                }
+                    SwapError::Lost { error, back } => anyhow::Error::new(error).context(format!(
+                        "cannot move the new output into {}, nor put the previous one back ({back}): it is at {}",
+                        self.shown.display(),
+                        old.display()
+                    )),
+                });
             }
-            return Err(e).with_context(|| {
-                format!("cannot move the new output into {}", self.shown.display())
-            });
-        }
+        };
         unregister(&self.dir);
         self.done = true;
         drop(swap);

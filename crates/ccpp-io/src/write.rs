@@ -248,6 +248,17 @@ pub fn staging_name(name: &str, kind: &str, pid: u32, n: u64) -> String {
     format!("{}{pid}-{n}", staging_prefix(name, kind))
 }
 
+/// A staging (`kind` `new`) or set-aside (`old`) folder for the output folder `name` in
+/// `parent`: [`staging_name`] with this process's id and the next number of one counter that
+/// every writer of the process shares (the command line's staging and [`write_folder`] kept a
+/// counter each, and could name two folders alike).
+pub fn staging_path(parent: &Path, name: &str, kind: &str) -> PathBuf {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+    parent.join(staging_name(name, kind, std::process::id(), n))
+}
+
 /// Checks that `target` is absent, or a folder holding only run files ([`is_run_file_name`]:
 /// [`RUN_FILES`] and the `.tmp` of one of them left by an interrupted atomic write).
 ///
@@ -267,7 +278,13 @@ pub fn check_run_folder(target: &Path) -> Result<(), FolderError> {
         path: target.to_path_buf(),
         source,
     };
-    for e in std::fs::read_dir(target).map_err(io_err)? {
+    let entries = match std::fs::read_dir(target) {
+        Ok(entries) => entries,
+        // Renamed away since it was looked at (another thread's swap): absent.
+        Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(()),
+        Err(e) => return Err(io_err(e)),
+    };
+    for e in entries {
         let e = e.map_err(io_err)?;
         let name = e.file_name().to_string_lossy().into_owned();
         let known = is_run_file_name(&name);
@@ -305,11 +322,66 @@ pub fn create_folder(folder: &Path, target: &Path) -> Result<(), FolderError> {
     })
 }
 
-/// Held by [`write_folder`] while it renames the old folder away and the new one in: two
-/// threads saving into one folder (Python's `save()` from a thread pool) interleaved their
-/// renames, failed with "Directory not empty" or "No such file" and left `.NAME.ccpp-old-*`
-/// copies behind. The last swap wins.
+/// Held while a folder of this process is renamed away and its new content renamed in
+/// ([`swap_lock`]): two threads saving into one folder (Python's `save()` from a thread pool)
+/// interleaved their renames, failed with "Directory not empty" or "No such file" and left
+/// `.NAME.ccpp-old-*` copies behind. The last swap wins.
 static FOLDER_SWAP: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+/// The lock of every folder swap in this process ([`swap_folder`]; the command line's
+/// interrupt cleanup holds it too, so that no swap is half done when it exits).
+pub fn swap_lock() -> std::sync::MutexGuard<'static, ()> {
+    FOLDER_SWAP
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+/// Why [`swap_folder`] failed; each leaves the target as it was, but [`SwapError::Lost`].
+#[derive(Debug)]
+pub enum SwapError {
+    /// The old folder could not be renamed away (nothing moved).
+    MoveOld(io::Error),
+    /// The new folder could not be renamed in (the old one is back in place).
+    MoveNew(io::Error),
+    /// The new folder could not be renamed in, nor the old one put back: it is at `old`.
+    Lost {
+        /// Why the new folder did not move in.
+        error: io::Error,
+        /// Why the old one did not move back.
+        back: io::Error,
+    },
+}
+
+/// Replaces the folder `target` by `staging`: `target` (when present) is renamed to `old`,
+/// `staging` to `target`, and on failure the old folder is put back. The caller holds
+/// [`swap_lock`] and removes `old` afterwards (after letting the lock go: removing a large old
+/// run need not hold up the other swaps). `before_old` runs before the old folder moves (the
+/// command line registers `old` for its interrupt cleanup there). Returns whether there was an
+/// old folder.
+///
+/// # Errors
+/// [`SwapError`].
+pub fn swap_folder(
+    staging: &Path,
+    target: &Path,
+    old: &Path,
+    before_old: impl FnOnce(),
+) -> Result<bool, SwapError> {
+    let had_old = std::fs::symlink_metadata(target).is_ok();
+    if had_old {
+        before_old();
+        std::fs::rename(target, old).map_err(SwapError::MoveOld)?;
+    }
+    if let Err(error) = std::fs::rename(staging, target) {
+        if had_old {
+            if let Err(back) = std::fs::rename(old, target) {
+                return Err(SwapError::Lost { error, back });
+            }
+        }
+        return Err(SwapError::MoveNew(error));
+    }
+    Ok(had_old)
+}
 
 /// Writes `files` as the whole content of the folder `target`, all or nothing, as the command
 /// line writes a run folder: `target` must be absent or hold only [`RUN_FILES`]
@@ -324,8 +396,6 @@ static FOLDER_SWAP: std::sync::Mutex<()> = std::sync::Mutex::new(());
 /// As [`check_run_folder`] and [`create_folder`], [`FolderError::NoName`], or
 /// [`FolderError::Io`] naming `target`.
 pub fn write_folder(target: &Path, files: &[(&str, Vec<u8>)]) -> Result<(), FolderError> {
-    use std::sync::atomic::{AtomicU64, Ordering};
-    static COUNTER: AtomicU64 = AtomicU64::new(0);
     let name = match target.file_name().and_then(|n| n.to_str()) {
         Some(n) if n != "." && n != ".." => n.to_string(),
         _ => {
@@ -354,10 +424,7 @@ pub fn write_folder(target: &Path, files: &[(&str, Vec<u8>)]) -> Result<(), Fold
         // Best effort: an empty folder left behind is harmless (the swap below replaces it).
         let _ = std::fs::remove_dir(&target_in);
     }
-    let tag = |kind: &str| {
-        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-        parent.join(staging_name(&name, kind, std::process::id(), n))
-    };
+    let tag = |kind: &str| staging_path(&parent, &name, kind);
     let staging = tag("new");
     std::fs::create_dir(&staging).map_err(io_err)?;
     let written = files.iter().try_for_each(|(file, bytes)| {
@@ -371,37 +438,34 @@ pub fn write_folder(target: &Path, files: &[(&str, Vec<u8>)]) -> Result<(), Fold
         let _ = std::fs::remove_dir_all(&staging);
         return Err(io_err(e));
     }
-    // One swap at a time in this process (see `FOLDER_SWAP`).
-    let _swap = FOLDER_SWAP
-        .lock()
-        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    // One swap at a time in this process ([`swap_lock`]); the folder is checked again under
+    // it (another thread may have swapped it meanwhile).
     let old = tag("old");
-    let had_old = std::fs::symlink_metadata(&target_in).is_ok();
-    if had_old {
-        if let Err(e) = std::fs::rename(&target_in, &old) {
-            // Best effort, as above: the target is untouched.
+    let swap = swap_lock();
+    let swapped = check_run_folder(target).and_then(|()| {
+        swap_folder(&staging, &target_in, &old, || {}).map_err(|e| match e {
+            SwapError::MoveOld(e) | SwapError::MoveNew(e) => io_err(e),
+            // The previous folder stays under its hidden name: say where, or the user's
+            // earlier run looks lost.
+            SwapError::Lost { error, back } => io_err(std::io::Error::new(
+                error.kind(),
+                format!(
+                    "{error}; the previous folder could not be put back ({back}) and is at {}",
+                    old.display()
+                ),
+            )),
+        })
+    });
+    drop(swap);
+    let had_old = match swapped {
+        Ok(had_old) => had_old,
+        Err(e) => {
+            // Best effort: the new files are not in place, whatever happens to their staging
+            // copy.
             let _ = std::fs::remove_dir_all(&staging);
-            return Err(io_err(e));
+            return Err(e);
         }
-    }
-    if let Err(e) = std::fs::rename(&staging, &target_in) {
-        // Best effort: the new files are not in place, whatever happens to their staging copy.
-        let _ = std::fs::remove_dir_all(&staging);
-        if had_old {
-            if let Err(back) = std::fs::rename(&old, &target_in) {
-                // The previous folder stays under its hidden name: say where, or the user's
-                // earlier run looks lost.
-                return Err(io_err(std::io::Error::new(
-                    e.kind(),
-                    format!(
-                        "{e}; the previous folder could not be put back ({back}) and is at {}",
-                        old.display()
-                    ),
-                )));
-            }
-        }
-        return Err(io_err(e));
-    }
+    };
     if had_old {
         // Best effort: the new folder is in place; an old copy left behind carries the
         // staging name (`ccpp run` clears such leftovers of dead processes).
