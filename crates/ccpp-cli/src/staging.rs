@@ -189,6 +189,8 @@ fn interrupted() -> ! {
 /// (SIGKILL, which no handler sees), outside the bench's lock and memory budget, and still
 /// write its run folder. `parent`: the process id the parent gave (it may have died before
 /// this process looked), else this process's parent now. Looks at once, then every 50 ms.
+/// Elsewhere than on Unix it does nothing (no portable way to read the parent's id).
+#[cfg(unix)]
 pub fn stop_with_parent(parent: Option<u32>) {
     let parent = parent.unwrap_or_else(std::os::unix::process::parent_id);
     std::thread::spawn(move || loop {
@@ -198,6 +200,10 @@ pub fn stop_with_parent(parent: Option<u32>) {
         std::thread::sleep(std::time::Duration::from_millis(50));
     });
 }
+
+/// See the Unix version: nothing to watch here.
+#[cfg(not(unix))]
+pub fn stop_with_parent(_parent: Option<u32>) {}
 
 /// Runs `take` (which creates and locks a lock file, returning its path when it took the lock)
 /// under the lock of the interrupt cleanup, and registers the path it returns: an interrupt
