@@ -966,6 +966,8 @@ pub struct RunResult {
     world: World,
     output: RunOutput,
     metrics: Metrics,
+    /// The start-area warning (`ccpp run`'s), found once on the run's thread.
+    start_warning: Option<String>,
 }
 
 impl RunResult {
@@ -1271,13 +1273,9 @@ impl RunResult {
     /// ends `done` may still have some (`stop` is the planner's word).
     #[getter]
     fn warnings(&self) -> Vec<String> {
-        let start = ccpp_io::components::StartComponent::of(
-            self.world.map(),
-            self.world.start().position(),
-        );
-        start
-            .warning()
-            .into_iter()
+        self.start_warning
+            .iter()
+            .cloned()
             .chain(ccpp_io::warnings::run_warnings(
                 &self.scenario,
                 &self.world,
@@ -1398,13 +1396,25 @@ fn run(
     name_map(&mut prepared, &scenario);
     let (scenario, prepared) = (Arc::new(scenario), Arc::new(prepared));
     let (sc, pm) = (Arc::clone(&scenario), Arc::clone(&prepared));
-    let run = interruptible(py, move |stop| sc.run_on_until(&pm, stop))?.map_err(|e| err(&e))?;
+    let (run, start_warning) = interruptible(py, move |stop| {
+        sc.run_on_until(&pm, stop).map(|run| {
+            // The flood fill of the start's free area, here and not on each `warnings` read.
+            let w = ccpp_io::components::StartComponent::of(
+                run.world.map(),
+                run.world.start().position(),
+            )
+            .warning();
+            (run, w)
+        })
+    })?
+    .map_err(|e| err(&e))?;
     let scenario = Arc::unwrap_or_clone(scenario);
     Ok(RunResult {
         scenario,
         world: run.world,
         output: run.output,
         metrics: run.metrics,
+        start_warning,
     })
 }
 
