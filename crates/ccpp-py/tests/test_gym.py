@@ -61,6 +61,8 @@ def test_refuses_what_it_would_ignore(room: Path) -> None:
         env.reset(seed=1, options={"start": (1.0, 1.0)})
     # Numbers and flags are typed as `ccpp.Env` types them: "0.3" and True were steps (True a
     # 1 m step), and "no" kept random starts and the known map on.
+    import numpy as np
+
     for kw in (
         {"step_m": "0.3"},
         {"step_m": True},
@@ -69,14 +71,18 @@ def test_refuses_what_it_would_ignore(room: Path) -> None:
         {"random_start": "no"},
         {"include_known": "no"},
         {"include_known": 0},
+        {"turn_rad": None},
+        {"step_m": np.array(True)},
     ):
         with pytest.raises(TypeError, match=next(iter(kw))):
             CoverageEnv(str(room), **kw)
-    import numpy as np
+    from fractions import Fraction
 
     env = CoverageEnv(str(room), step_m=np.float32(0.25), turn_rad=1, include_known=np.bool_(False))
     assert env.step_m == pytest.approx(0.25) and env.turn_rad == 1.0
     assert "known" not in env.observation_space.spaces
+    env = CoverageEnv(str(room), step_m=np.array(0.25), turn_rad=Fraction(3, 2), random_start=np.array(False))
+    assert env.step_m == 0.25 and env.turn_rad == 1.5 and env.random_start is False
 
 
 def test_only_the_actions_of_the_space(room: Path) -> None:

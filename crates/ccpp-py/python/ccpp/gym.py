@@ -29,6 +29,22 @@ from . import _ccpp
 __all__ = ["CoverageEnv"]
 
 
+def _is_bool(v: Any) -> bool:
+    return isinstance(v, (bool, np.bool_)) or (isinstance(v, np.ndarray) and v.shape == () and v.dtype.kind == "b")
+
+
+def _number(name: str, v: Any) -> None:
+    """A number as the package takes one: anything with ``__float__`` (numpy scalars, 0-d
+    arrays, ``Fraction``) but a bool, and not text."""
+    if _is_bool(v) or isinstance(v, (str, bytes)) or not hasattr(v, "__float__"):
+        raise TypeError(f"{name} must be a number, not {type(v).__name__}")
+
+
+def _flag(name: str, v: Any) -> None:
+    if not _is_bool(v):
+        raise TypeError(f"{name} must be a bool, not {type(v).__name__}")
+
+
 class CoverageEnv(gym.Env):  # type: ignore[misc]
     """Coverage of one map by a round robot, one discrete action at a time."""
 
@@ -47,6 +63,13 @@ class CoverageEnv(gym.Env):  # type: ignore[misc]
         include_known: bool = True,
         render_mode: str | None = None,
     ) -> None:
+        # Numbers are numbers and flags are flags, checked before the map is read: `float()`
+        # took "0.3" and True (a 1 m step), and "no" was a true flag.
+        if step_m is not None:
+            _number("step_m", step_m)
+        _number("turn_rad", turn_rad)
+        _flag("random_start", random_start)
+        _flag("include_known", include_known)
         self._env = _ccpp.Env(
             map,
             radius=radius,
@@ -54,16 +77,6 @@ class CoverageEnv(gym.Env):  # type: ignore[misc]
             sensor_range=sensor_range,
             max_steps=max_steps,
         )
-        # Numbers are numbers, flags are flags, as `ccpp.Env` holds them: `float()` took
-        # "0.3" and True (a 1 m step), and "no" was a true flag.
-        for name, v in (("step_m", step_m), ("turn_rad", turn_rad)):
-            if v is not None and (
-                isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, float, np.integer, np.floating))
-            ):
-                raise TypeError(f"{name} must be a number, not {type(v).__name__}")
-        for name, v in (("random_start", random_start), ("include_known", include_known)):
-            if not isinstance(v, (bool, np.bool_)):
-                raise TypeError(f"{name} must be a bool, not {type(v).__name__}")
         # `radius=None` is the default robot, as for `ccpp.Env`.
         self.step_m = float(step_m if step_m is not None else self._env.radius)
         self.turn_rad = float(turn_rad)
