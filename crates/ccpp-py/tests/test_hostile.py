@@ -309,54 +309,25 @@ def test_an_interrupted_run_stops_instead_of_finishing_unseen(tmp_path: Path, ro
     assert float(words[2]) < 5.0, out.stdout
 
 
-def test_an_interrupted_bcd_plan_stops_instead_of_holding_the_next_run(
-    tmp_path: Path, room: Path, shared_maps: Path
+@pytest.mark.parametrize("planner", ["bcd", "rect-boustrophedon"])
+def test_an_interrupted_offline_plan_stops_instead_of_holding_the_next_run(
+    planner: str, tmp_path: Path, room: Path, shared_maps: Path
 ) -> None:
-    # bcd plans before its first step, and the planning could not be stopped: Ctrl-C returned
-    # at once, but the next run waited until the abandoned plan was finished (about 11 s more
-    # on this map; up to minutes on office_4096), for `run` and `plan` alike. The planning now
-    # gives up at its next step.
+    # The offline planners plan before their first step, and the planning could not be
+    # stopped: Ctrl-C returned at once, but the next run waited until the abandoned plan was
+    # finished (bcd: about 11 s more on this map, up to minutes on office_4096;
+    # rect-boustrophedon: 30-100 s), for `run` and `plan` alike. The planning now gives up at
+    # its next step (bcd) or within a lane point or a search (rect-boustrophedon).
     big = shared_maps.parent / "bench" / "cluttered_2000.yaml"
     if not big.is_file():
         pytest.skip(f"{big} absent")
-    script = tmp_path / "stop_bcd.py"
+    script = tmp_path / "stop_plan.py"
     script.write_text(
         "import signal, threading, time, ccpp\n"
         "for call in (ccpp.run, ccpp.plan):\n"
         "    threading.Timer(1.5, lambda: signal.raise_signal(signal.SIGINT)).start()\n"
         "    try:\n"
-        f"        call({str(big)!r}, 'bcd')\n"
-        "        print('finished', flush=True)\n"
-        "    except KeyboardInterrupt:\n"
-        "        print('interrupted', flush=True)\n"
-        "    t = time.monotonic()\n"
-        f"    r = ccpp.run({str(room)!r}, 'bsa')\n"
-        "    print('next', round(time.monotonic() - t, 1), flush=True)\n"
-    )
-    out = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=300)
-    assert out.returncode == 0, out.stderr
-    words = out.stdout.split()
-    assert words[0::3] == ["interrupted", "interrupted"], out.stdout
-    assert words[1::3] == ["next", "next"], out.stdout
-    assert all(float(w) < 5.0 for w in words[2::3]), out.stdout
-
-
-def test_an_interrupted_rect_plan_stops_instead_of_holding_the_next_run(
-    tmp_path: Path, room: Path, shared_maps: Path
-) -> None:
-    # rect-boustrophedon plans before its first step too (about 20 s on this map), and its
-    # planning could not be stopped: after Ctrl-C the next call waited 30-100 s for it. It now
-    # gives up within a lane point or a search.
-    big = shared_maps.parent / "bench" / "cluttered_2000.yaml"
-    if not big.is_file():
-        pytest.skip(f"{big} absent")
-    script = tmp_path / "stop_rect.py"
-    script.write_text(
-        "import signal, threading, time, ccpp\n"
-        "for call in (ccpp.run, ccpp.plan):\n"
-        "    threading.Timer(1.5, lambda: signal.raise_signal(signal.SIGINT)).start()\n"
-        "    try:\n"
-        f"        call({str(big)!r}, 'rect-boustrophedon')\n"
+        f"        call({str(big)!r}, {planner!r})\n"
         "        print('finished', flush=True)\n"
         "    except KeyboardInterrupt:\n"
         "        print('interrupted', flush=True)\n"
