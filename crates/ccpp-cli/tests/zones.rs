@@ -480,13 +480,17 @@ fn rect_boustrophedon_reaches_an_area_from_a_start_outside_it() {
         };
         let pts = path_points(&std::fs::read_to_string(out.join(csv)).unwrap());
         // From the start given into the area, and inside it from there on, the clearance
-        // disk clear of the area's border.
+        // disk (0.212 m) clear of the area's border: a disk whose centre keeps r + half a
+        // pixel from the centres of the pixels beyond the border keeps r from the border.
         assert!(
             (pts[0].0 + 1.5).abs() < 1e-9 && pts[0].1.abs() < 1e-9,
             "{cmd}: {:?}",
             pts[0]
         );
-        let inside = |p: &(f64, f64)| (0.2..=1.8).contains(&p.0) && (-1.8..=1.8).contains(&p.1);
+        let inside = |p: &(f64, f64)| {
+            let r = 0.3f64.hypot(0.3) / 2.0 - 1e-6;
+            (r..=2.0 - r).contains(&p.0) && (-2.0 + r..=2.0 - r).contains(&p.1)
+        };
         let first = pts.iter().position(inside).unwrap();
         assert!(first > 0, "{cmd}");
         assert!(
