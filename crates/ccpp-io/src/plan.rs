@@ -117,7 +117,8 @@ pub fn plan_route(
 }
 
 /// [`plan_route`] that another thread can give up by setting `stop`: bcd's planning ends at
-/// its next step ([`PlannerConfig::build_until`]) and the execution within a few steps
+/// its next step, rect-boustrophedon's within a lane point or a search
+/// ([`PlannerConfig::build_until`]), and the execution within a few steps
 /// (Python's Ctrl-C gives a plan up this way).
 ///
 /// # Errors

@@ -1479,7 +1479,7 @@ impl Scenario {
                 let other = s.spawn(|| (metrics::WorldPart::of(&world, side), beside(&world)));
                 // Wall time covers planning (offline planners plan in `build`) and simulation.
                 let started = std::time::Instant::now();
-                // (bcd's planning ends early too when `stop` is set)
+                // (bcd's and rect-boustrophedon's planning end early too when `stop` is set)
                 let mut planner = self.planner.build_until(&world, stop);
                 let sim = self.sim_on(world.frame());
                 let output = simulate_until(&world, planner.as_mut(), &sim, &mut |_| {}, stop);

@@ -320,8 +320,8 @@ impl PlannerConfig {
         self.settings().build(world)
     }
 
-    /// [`build`](Self::build) that another thread can give up by setting `stop` (bcd's
-    /// planning ends early; the planner built then must not be driven).
+    /// [`build`](Self::build) that another thread can give up by setting `stop` (bcd's and
+    /// rect-boustrophedon's planning end early; the planner built then must not be driven).
     pub fn build_until(
         &self,
         world: &World,

@@ -66,8 +66,10 @@ class RunResult:
         """``"done"``, ``"stalled"`` (no progress for 1000 motions in a row) or ``"max_steps"``."""
     @property
     def warnings(self) -> list[str]:
-        """The warnings ``ccpp run`` prints: an early stop, PID motions cut short, bumper
-        contacts under odometry noise without landmarks."""
+        """The warnings ``ccpp run`` prints (without ``warning: ``): a start whose free area
+        reaches the map's border, an early stop, PID motions cut short, bumper contacts under
+        odometry noise without landmarks, a run that never moved, a tool narrower than the
+        map's pixels."""
     @property
     def start(self) -> tuple[float, float, float]: ...
     @property
