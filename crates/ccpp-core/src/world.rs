@@ -158,7 +158,7 @@ pub enum WorldError {
         "the area cannot be reached from the start ({:.3}, {:.3}): no path for a disk of \
          radius {} m (the robot, or the clearance disk a rectangular robot turns in) leads into \
          it without touching an obstacle or a keep-out zone",
-        Compact(*.x), Compact(*.y), Compact(*.radius)
+        Compact(*.x), Compact(*.y), Compact((*.radius * 1e6).round() / 1e6)
     )]
     AreaUnreachable {
         /// Start x.
@@ -172,7 +172,7 @@ pub enum WorldError {
     #[error(
         "the area minus the keep-out zones holds no floor where a robot of radius {} m \
          fits ({free_px} free pixels inside the area)",
-        Compact(*.radius)
+        Compact((*.radius * 1e6).round() / 1e6)
     )]
     NoRoomInZones {
         /// Robot radius.
@@ -534,7 +534,18 @@ impl World {
                 }
             }
         }
-        let goal = goal.ok_or_else(unreachable)?;
+        let Some(goal) = goal else {
+            // No way in; or, for a disk larger than the robot, no spot inside to stand at all
+            // (an area narrower than the disk): say which.
+            if fit > self.robot.radius && !(0..frame.len()).any(fits) {
+                let cells = self.plan.as_ref().unwrap_or(&self.map).cells();
+                return Err(WorldError::NoRoomInZones {
+                    radius: fit,
+                    free_px: cells.iter().filter(|c| c.is_free()).count(),
+                });
+            }
+            return Err(unreachable());
+        };
         let mut chain = vec![goal];
         let mut k = goal;
         while parent[k] != u32::MAX {

@@ -151,6 +151,16 @@ fn an_approach_for_a_larger_disk_keeps_that_disk_clear() {
         prev = *p;
     }
     assert!(w.start().x <= 1.5 - 0.15 + 0.025 + 1e-9, "{:?}", w.start());
+    // An area narrower than the larger disk has no spot for it at all: said so, not "no path
+    // leads into it" (the robot's own disk gets in).
+    let narrow = || zones(&map, Some([0.0, 0.0, 0.4, 2.0]), &[]);
+    let start = Some(Pose::new(3.0, 1.0, 0.0));
+    assert!(World::with_zones(map.clone(), robot, start, Some(narrow())).is_ok());
+    let e = World::with_zones_fitting(map.clone(), robot, start, Some(narrow()), 0.25);
+    assert!(
+        matches!(e, Err(WorldError::NoRoomInZones { radius, .. }) if radius == 0.25),
+        "{e:?}"
+    );
 }
 
 #[test]
