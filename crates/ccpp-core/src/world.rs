@@ -282,10 +282,11 @@ impl World {
     }
 
     /// [`World::with_zones`] for a planner that needs room for a disk of radius `fit` (a value
-    /// below the robot's radius counts as the robot's) where its coverage starts: a start outside the area gets an approach that ends at the
-    /// nearest pixel centre where that disk fits inside the area, not only the robot's own
-    /// disk (rect-boustrophedon plans its lanes for the rectangle's clearance disk, which did
-    /// not fit where the robot's disk first did, so every start outside an area was refused).
+    /// below the robot's radius counts as the robot's): a start outside the area gets an
+    /// approach planned for that disk, ending at the nearest pixel centre where it fits inside
+    /// the area (rect-boustrophedon plans its lanes for the rectangle's clearance disk, which
+    /// did not fit where the robot's disk first did, so every start outside an area was
+    /// refused).
     ///
     /// # Errors
     /// As [`World::with_zones`].
@@ -472,11 +473,9 @@ impl World {
         let free_seg =
             |a: Point, b: Point| collide::segment_first_contact(&occ, a, b, r_px).is_none();
         let ok = |i: usize| f64::from(dt[i]) >= rc * rc;
-        // Where coverage may start: C-free, and room for the planner's disk when larger.
-        let fits = |i: usize| {
-            self.cfree.contains(i)
-                && (fit <= self.robot.radius || f64::from(self.obstacle_dt2.get(i)) >= rc * rc)
-        };
+        // Where coverage may start: room for the planner's disk under every virtual wall (for
+        // the robot's own radius, C-free itself: the same test on the same distances).
+        let fits = |i: usize| f64::from(self.obstacle_dt2.get(i)) >= rc * rc;
         // Dijkstra with integer octile costs (70 straight, 99 diagonal).
         let mut dist = vec![u32::MAX; frame.len()];
         let mut parent = vec![u32::MAX; frame.len()];
