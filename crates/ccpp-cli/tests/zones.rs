@@ -506,6 +506,40 @@ fn rect_boustrophedon_reaches_an_area_from_a_start_outside_it() {
     }
 }
 
+/// An area narrower than rect-boustrophedon's clearance disk (0.4 m against 0.424 m) holds no
+/// spot for it: a one-line error that says so, where bcd, planning for the robot's own disk,
+/// reaches the same area from the same start.
+#[test]
+fn an_area_narrower_than_the_clearance_disk_is_refused_as_such() {
+    let d = tempfile::tempdir().unwrap();
+    let map = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/maps/teb_empty_box.yaml");
+    let plan = |planner: &str| {
+        ccpp()
+            .args(["plan", "--planner", planner])
+            .args(["--area", "0,-2,0.4,2", "--start", "-1.5,0", "--map"])
+            .arg(&map)
+            .arg("--out")
+            .arg(d.path().join(planner))
+            .output()
+            .unwrap()
+    };
+    let o = plan("rect-boustrophedon");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert_eq!(
+        err.lines().filter(|l| l.starts_with("error:")).count(),
+        1,
+        "{err}"
+    );
+    assert!(
+        err.contains("holds no floor where a robot of radius 0.212132 m fits"),
+        "{err}"
+    );
+    assert!(!d.path().join("rect-boustrophedon").exists());
+    let o = plan("bcd");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
 /// `run.json` recorded a zone file by the path given (relative to the working folder) but the
 /// map by its absolute path, so `ccpp replay` of a zoned run worked only from the folder the
 /// run started in. Zone files are recorded absolute now.
