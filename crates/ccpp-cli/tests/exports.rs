@@ -8,7 +8,7 @@
 use std::path::{Path, PathBuf};
 
 use ccpp_core::route::Route;
-use ccpp_io::export::{parse_waypoints_csv, read_waypoints};
+use ccpp_io::export::{parse_waypoints_csv, read_waypoints, round_m, tidy_heading};
 use serde::Deserialize;
 
 use crate::common::{ccpp, pgm, plan_ok, run_ok};
@@ -219,11 +219,15 @@ fn run_export_writes_each_format_beside_the_other_files() {
     // The route starts at the start pose and ends at the last pose of the trace.
     let trace = ccpp_io::trace::read_trace(&ex.join("trace.jsonl"), None).unwrap();
     let poses: Vec<_> = trace.poses().collect();
+    // (positions to a nanometre, headings in (-pi, pi]: `export::tidy`)
+    let tidy = |p: &ccpp_core::Pose| {
+        ccpp_core::Pose::new(round_m(p.x), round_m(p.y), tidy_heading(p.theta))
+    };
     assert_eq!(
         csv.waypoints.first().map(|p| (p.x, p.y)),
-        poses.first().map(|p| (p.x, p.y))
+        poses.first().map(|p| (round_m(p.x), round_m(p.y)))
     );
-    assert_eq!(csv.waypoints.last(), poses.last());
+    assert_eq!(csv.waypoints.last().copied(), poses.last().map(tidy));
     check_nav_path(&read(&ex.join("nav_path.yaml")), &csv);
     let metrics: serde_json::Value = serde_json::from_str(&read(&ex.join("metrics.json"))).unwrap();
     check_geojson(&read(&ex.join("path.geojson")), &csv, Some(&metrics));

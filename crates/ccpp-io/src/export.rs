@@ -12,7 +12,13 @@
 //! All coordinates are in the map frame (metres; `x` east, `y` north): the `GeoJSON` is not
 //! WGS 84, so GIS tools should read it in a local/unknown coordinate system. `theta` is the
 //! heading the robot leaves the waypoint with (radians, 0 = +x, counter-clockwise); the
-//! `nav_msgs/Path` carries it as the quaternion `(0, 0, sin(theta/2), cos(theta/2))`. Every
+//! `nav_msgs/Path` carries it as the quaternion `(0, 0, sin(theta/2), cos(theta/2))`.
+//!
+//! The exported route is [`tidy`]: positions rounded to a nanometre and headings in
+//! `(-pi, pi]`, a heading within a nanoradian of a multiple of 45 degrees set to it exactly,
+//! so the pixel-to-map arithmetic's last bits do not reach the files (`0.675`, not
+//! `0.6750000000000005`; `0` and `3.141592653589793`, not `4.4e-15` and
+//! `-3.141592653589793`); quaternion components below 1e-15 are written as 0. Every
 //! number is written so that it reads back to the same `f64` (shortest round-trip form); YAML
 //! floats always have a decimal point and no exponent, so YAML 1.1 parsers read them as floats
 //! too. Output is a pure function of the inputs (byte-identical for the same route).
@@ -30,6 +36,60 @@ use serde::{Deserialize, Serialize};
 
 /// The frame every export is expressed in (`header.frame_id` of the `nav_msgs/Path`).
 pub const FRAME_ID: &str = "map";
+
+/// `v` metres rounded to a nanometre (no `-0`): far below what a robot resolves and below
+/// the metrics' tolerance (1e-6 pixel), far above the noise of the pixel-to-map arithmetic.
+#[must_use]
+pub fn round_m(v: f64) -> f64 {
+    if !v.is_finite() {
+        return v;
+    }
+    // (dividing by 1e9, not multiplying by the inexact 1e-9, gives the shortest decimal)
+    let r = (v * 1e9).round() / 1e9;
+    if r == 0.0 {
+        0.0
+    } else {
+        r
+    }
+}
+
+/// `theta` wrapped into `(-pi, pi]`, and set to the multiple of 45 degrees it lies within a
+/// nanoradian of (no `-0`, and `pi` rather than `-pi`).
+#[must_use]
+pub fn tidy_heading(theta: f64) -> f64 {
+    use std::f64::consts::{FRAC_PI_4, PI, TAU};
+    if !theta.is_finite() {
+        return theta;
+    }
+    let mut t = theta % TAU;
+    if t <= -PI {
+        t += TAU;
+    } else if t > PI {
+        t -= TAU;
+    }
+    let k = (t / FRAC_PI_4).round();
+    if (t - k * FRAC_PI_4).abs() <= 1e-9 {
+        t = if k == 0.0 { 0.0 } else { k * FRAC_PI_4 };
+    }
+    if t <= -PI {
+        PI
+    } else {
+        t
+    }
+}
+
+/// The route as the exports write it: positions [`round_m`], headings [`tidy_heading`].
+/// Applying it twice changes nothing.
+#[must_use]
+pub fn tidy(route: &Route) -> Route {
+    Route {
+        waypoints: route
+            .waypoints
+            .iter()
+            .map(|p| Pose::new(round_m(p.x), round_m(p.y), tidy_heading(p.theta)))
+            .collect(),
+    }
+}
 
 /// An export format.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -244,7 +304,7 @@ fn pixel_rectangles(
             // Grid y is up: rows r0..r1 (down) span grid y from h - r1 to h - r0.
             let corner = |c: usize, r: usize| {
                 let p = frame.grid_to_world(Point::new(c as f64, (h - r) as f64));
-                [p.x, p.y]
+                [round_m(p.x), round_m(p.y)]
             };
             vec![
                 corner(c0, r1),
@@ -282,6 +342,7 @@ pub enum WaypointFileError {
 
 /// The route as CSV: header `x,y,theta`, one waypoint a line.
 pub fn waypoints_csv(route: &Route) -> String {
+    let route = &tidy(route);
     let mut s = String::with_capacity(16 + route.waypoints.len() * 48);
     s.push_str("x,y,theta\n");
     for p in &route.waypoints {
@@ -358,12 +419,13 @@ struct WaypointsJson {
 /// # Errors
 /// Serialization failure (a non-finite number).
 pub fn waypoints_json(route: &Route, meta: &ExportMeta<'_>) -> Result<String, serde_json::Error> {
+    let route = &tidy(route);
     let doc = WaypointsJson {
         frame_id: FRAME_ID.to_string(),
         planner: meta.planner.to_string(),
         map: meta.map.to_string(),
         tolerance_m: meta.tolerance_m,
-        length_m: route.length_m(),
+        length_m: round_m(route.length_m()),
         waypoints: route
             .waypoints
             .iter()
@@ -439,7 +501,9 @@ fn yaml_float(v: f64) -> String {
 /// The quaternion `[x, y, z, w]` of a rotation by `theta` about the z axis.
 pub fn heading_quaternion(theta: f64) -> [f64; 4] {
     let h = 0.5 * theta;
-    [0.0, 0.0, h.sin(), h.cos()]
+    // (cos(pi / 2) is 6e-17 in floating point; a component that small is written as 0)
+    let clean = |v: f64| if v.abs() < 1e-15 { 0.0 } else { v };
+    [0.0, 0.0, clean(h.sin()), clean(h.cos())]
 }
 
 /// The route as a ROS 2 `nav_msgs/Path` in the YAML shape `ros2 topic echo` prints:
@@ -448,6 +512,7 @@ pub fn heading_quaternion(theta: f64) -> [f64; 4] {
 /// [`heading_quaternion`]). The trailing `---` document separator is left out so that the file
 /// is one YAML document.
 pub fn nav_path_yaml(route: &Route) -> String {
+    let route = &tidy(route);
     let mut s = String::with_capacity(128 + route.waypoints.len() * 280);
     let header = |s: &mut String, indent: &str| {
         let _ = write!(
@@ -563,6 +628,7 @@ pub fn geojson(
     polygons: &[PolygonFeature],
 ) -> Result<String, serde_json::Error> {
     use serde_json::{json, Value};
+    let route = &tidy(route);
     let mut coords: Vec<[f64; 2]> = route.waypoints.iter().map(|p| [p.x, p.y]).collect();
     if coords.len() == 1 {
         coords.push(coords[0]);
@@ -592,7 +658,7 @@ pub fn geojson(
             "robot": robot_json(meta),
             "route": {
                 "waypoints": route.waypoints.len(),
-                "length_m": route.length_m(),
+                "length_m": round_m(route.length_m()),
                 "tolerance_m": meta.tolerance_m,
             },
             "metrics": metrics,
@@ -714,6 +780,36 @@ mod tests {
         let e = parse_waypoints_csv("x,y,theta\n1,NaN,0\n", Path::new("w.csv"));
         assert!(e.is_err());
         assert!(parse_waypoints_json("{}", Path::new("w.json")).is_err());
+    }
+
+    #[test]
+    fn exports_leave_the_float_noise_out() {
+        use std::f64::consts::{FRAC_PI_2, PI};
+        let r = Route {
+            waypoints: vec![
+                Pose::new(0.675_000_000_000_000_5, -1e-17, 4.4e-15),
+                Pose::new(30.650_000_000_000_002, 2.0, -PI),
+                Pose::new(1.234_567_890_4, 2.0, -1.570_796_326_794_825_5),
+                Pose::new(3.0, 2.0, 2.5 + 2.0 * PI),
+            ],
+        };
+        let csv = waypoints_csv(&r);
+        assert_eq!(
+            csv,
+            format!("x,y,theta\n0.675,0,0\n30.65,2,{PI}\n1.23456789,2,-{FRAC_PI_2}\n3,2,2.5\n")
+        );
+        assert_eq!(tidy(&tidy(&r)), tidy(&r));
+        let yaml = nav_path_yaml(&r);
+        assert!(yaml.contains("x: 30.65\n"), "{yaml}");
+        // heading pi: the quaternion (0, 0, 1, 0), not (0, 0, -1, 6e-17)
+        assert!(yaml.contains("z: 1.0\n      w: 0.0\n"), "{yaml}");
+        assert!(!yaml.contains("0000000"), "{yaml}");
+        let json = waypoints_json(&r, &meta()).unwrap_or_default();
+        assert!(json.contains("\"x\": 0.675,"), "{json}");
+        // A heading a micro-radian off an axis is a real heading: kept.
+        assert_eq!(tidy_heading(1e-6), 1e-6);
+        assert_eq!(round_m(-1e-10), 0.0);
+        assert!(round_m(-1e-10).is_sign_positive());
     }
 
     #[test]

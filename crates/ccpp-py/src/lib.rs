@@ -1045,8 +1045,9 @@ fn check_tolerance(t: f64) -> PyResult<()> {
 }
 
 /// A route's waypoints as an `(N, 3)` array.
+/// The route's waypoints as the exports write them ([`ccpp_io::export::tidy`]).
 fn route_array<'py>(py: Python<'py>, route: &Route) -> Bound<'py, PyArray2<f64>> {
-    let v: Vec<f64> = route
+    let v: Vec<f64> = ccpp_io::export::tidy(route)
         .waypoints
         .iter()
         .flat_map(|p| [p.x, p.y, p.theta])
@@ -1119,7 +1120,7 @@ impl PlanResult {
     /// Path length, metres.
     #[getter]
     fn length_m(&self) -> f64 {
-        self.route.length_m()
+        ccpp_io::export::round_m(ccpp_io::export::tidy(&self.route).length_m())
     }
 
     /// Whether the planner finished (not cut by the step cap).
