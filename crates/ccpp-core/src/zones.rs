@@ -320,6 +320,13 @@ pub fn rasterize_into(mask: &mut FixedBitSet, frame: &MapFrame, polys: &[Polygon
             for i in 0..n {
                 let (a, b) = (ring[i], ring[(i + 1) % n]);
                 if (a.y <= gy) != (b.y <= gy) {
+                    // The crossing from the lower end, whichever way the ring runs: an edge two
+                    // polygons share (run one way by one, the other way by the other) then
+                    // crosses at the same float for both, so a centre on it falls inside
+                    // exactly one of them (each rounded it its own way: on a 45-degree edge
+                    // through pixel centres, neither took them, a one-pixel wall across an
+                    // area given as two polygons).
+                    let (a, b) = if a.y < b.y { (a, b) } else { (b, a) };
                     xs.push(a.x + (gy - a.y) * (b.x - a.x) / (b.y - a.y));
                 }
             }
@@ -716,6 +723,37 @@ mod tests {
         poly(&[[0.0, 0.0], [0.0, 1.0], [1.0, 1.0], [1.0, 0.0]])
             .validate(0)
             .unwrap();
+    }
+
+    /// An area given as two polygons that share a slanted edge is their union, whichever way
+    /// each runs along the edge: a centre on it belongs to exactly one of them. (Each computed
+    /// the crossing from its own first vertex: on the 45-degree edge (-1.8, -2.1)-(0.2, -0.1)
+    /// of a `teb_empty_box` area neither took the centres on it, a wall across the area.)
+    #[test]
+    fn polygons_sharing_a_slanted_edge_tile_their_union() {
+        let mut f = MapFrame::new(120, 120, 0.05);
+        f.origin = crate::Pose::new(-3.0, -3.0, 0.0);
+        let whole = rasterize(&f, &[Polygon::rect([-2.8, -2.1, 2.8, -0.1])]);
+        let mut tried = 0;
+        // Splits of the rectangle by the segment from (x0, -2.1) to (x1, -0.1), on the map's
+        // 0.05 m grid (lines through pixel centres: 45 degrees and many others).
+        for i0 in 0..40 {
+            for i1 in (0..60).step_by(3) {
+                let x0 = -1.8 + 0.05 * f64::from(i0);
+                let x1 = -1.0 + 0.05 * f64::from(i1);
+                let left = poly(&[[-2.8, -2.1], [x0, -2.1], [x1, -0.1], [-2.8, -0.1]]);
+                // The right part runs the other way along the shared edge.
+                let right = poly(&[[x0, -2.1], [2.8, -2.1], [2.8, -0.1], [x1, -0.1]]);
+                let (a, b) = (
+                    rasterize(&f, &[left.clone()]),
+                    rasterize(&f, &[right.clone()]),
+                );
+                assert!(a.is_disjoint(&b), "split {x0} {x1}");
+                assert_eq!(rasterize(&f, &[left, right]), whole, "split {x0} {x1}");
+                tried += 1;
+            }
+        }
+        assert_eq!(tried, 800);
     }
 
     #[test]
