@@ -745,8 +745,8 @@ mod tests {
                 // The right part runs the other way along the shared edge.
                 let right = poly(&[[x0, -2.1], [2.8, -2.1], [2.8, -0.1], [x1, -0.1]]);
                 let (a, b) = (
-                    rasterize(&f, &[left.clone()]),
-                    rasterize(&f, &[right.clone()]),
+                    rasterize(&f, std::slice::from_ref(&left)),
+                    rasterize(&f, std::slice::from_ref(&right)),
                 );
                 assert!(a.is_disjoint(&b), "split {x0} {x1}");
                 assert_eq!(rasterize(&f, &[left, right]), whole, "split {x0} {x1}");
