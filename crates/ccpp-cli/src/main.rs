@@ -166,6 +166,11 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Run(a) => {
             let mut job = job::Job::from_run_args(&a)?;
             staging::check_target(&job.out)?;
+            staging::check_inputs(
+                &job.out,
+                &job.scenario,
+                &[a.options.config.as_ref(), a.landmarks.as_ref()],
+            )?;
             let result = execute(&mut job)?;
             output::emit(&job, &result, a.json, a.replay, &a.export)
         }

@@ -57,6 +57,7 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         .build()
         .map_err(flag)?;
     check_target(&a.out)?;
+    crate::staging::check_inputs(&a.out, &scenario, &[a.options.config.as_ref()])?;
     let map = load_recipe(&scenario.map, scenario.max_memory_mb)?;
     let busy = crate::busy::Busy::start(format!("{kind} on {}: planning", map.name));
     let plan = plan_route(&scenario, &map, DEFAULT_TOLERANCE_M);

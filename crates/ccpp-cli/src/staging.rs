@@ -340,6 +340,22 @@ pub fn check_target(target: &Path) -> Result<()> {
     Ok(ccpp_io::write::check_run_folder(target)?)
 }
 
+/// Checks that the output folder `target` holds none of the files the run reads: the
+/// scenario's ([`ccpp_io::scenario::Scenario::input_files`]) and `extra` (the options and
+/// landmark files).
+///
+/// # Errors
+/// An input inside `target` ([`ccpp_io::write::FolderError::HoldsInput`]).
+pub fn check_inputs(
+    target: &Path,
+    scenario: &ccpp_io::scenario::Scenario,
+    extra: &[Option<&std::path::PathBuf>],
+) -> Result<()> {
+    let mut inputs = scenario.input_files();
+    inputs.extend(extra.iter().flatten().map(|p| (*p).clone()));
+    Ok(ccpp_io::write::check_inputs_outside(target, &inputs)?)
+}
+
 /// A staging folder that becomes `target` on [`Staging::commit`] and is removed otherwise.
 pub struct Staging {
     /// The target as the user named it (for messages).

@@ -356,3 +356,86 @@ fn a_replay_never_writes_into_a_folder_swapped_in_meanwhile() {
     let page = std::fs::read_to_string(out.join("replay.html")).unwrap();
     assert!(page.contains("ba-star on teb_empty_box"));
 }
+
+/// A bare-image map named as one of ccpp's outputs (`coverage.png`) inside the output folder:
+/// `run` replaced it with the coverage picture (and `replay` then refused the run), `plan`
+/// deleted it, both exiting 0. Both now refuse the folder in one line naming the map, which
+/// stays as it was; so do a map YAML's image and an options file there, and so does Python
+/// (`test_save_refuses_a_folder_holding_an_input`).
+#[test]
+fn an_output_folder_holding_the_runs_own_input_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = std::fs::read(data("teb_empty_box.png")).unwrap();
+    let out = dir.path().join("m");
+    std::fs::create_dir(&out).unwrap();
+    let map = out.join("coverage.png");
+    std::fs::write(&map, &png).unwrap();
+    for (sub, planner) in [("run", "bsa"), ("plan", "bcd")] {
+        let o = ccpp()
+            .args([sub, "--planner", planner, "--map"])
+            .arg(&map)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(1), "{sub}");
+        let e = stderr_of(&o);
+        assert!(e.starts_with("error: output folder "), "{sub}: {e}");
+        assert!(
+            e.contains("coverage.png, an input of this run"),
+            "{sub}: {e}"
+        );
+        assert_eq!(e.lines().count(), 1, "{e}");
+        assert_eq!(std::fs::read(&map).unwrap(), png, "{sub}");
+        assert_eq!(entries(&out), ["coverage.png"]);
+    }
+    // The image a map YAML (outside) names, inside the folder.
+    let yaml = dir.path().join("box.yaml");
+    std::fs::write(
+        &yaml,
+        "image: m/coverage.png\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n",
+    )
+    .unwrap();
+    let o = ccpp()
+        .args(["run", "--planner", "bsa", "--map"])
+        .arg(&yaml)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr_of(&o).contains("an input of this run"),
+        "{}",
+        stderr_of(&o)
+    );
+    assert_eq!(std::fs::read(&map).unwrap(), png);
+    // An options file named `metrics.json` in the folder of an earlier run.
+    let run = dir.path().join("r");
+    let o = ccpp()
+        .args(["run", "--planner", "bsa", "--map"])
+        .arg(data("teb_empty_box.yaml"))
+        .arg("--out")
+        .arg(&run)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr_of(&o));
+    let config = run.join("metrics.json");
+    std::fs::write(&config, "{\"bsa\": {}}").unwrap();
+    let o = ccpp()
+        .args(["run", "--planner", "bsa", "--map"])
+        .arg(data("teb_empty_box.yaml"))
+        .arg("--config")
+        .arg(&config)
+        .arg("--out")
+        .arg(&run)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr_of(&o).contains("metrics.json, an input of this run"),
+        "{}",
+        stderr_of(&o)
+    );
+    assert_eq!(std::fs::read_to_string(&config).unwrap(), "{\"bsa\": {}}");
+}

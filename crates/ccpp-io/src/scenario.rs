@@ -716,6 +716,31 @@ impl Scenario {
         }
     }
 
+    /// The files the scenario reads: the map (and the image its YAML names), the georeference
+    /// file and the zone files (a Nav2 mask's image too). For
+    /// [`crate::write::check_inputs_outside`]: an output folder must not hold them.
+    pub fn input_files(&self) -> Vec<PathBuf> {
+        let mut out = Vec::new();
+        let mut add = |p: &Path| {
+            out.push(p.to_path_buf());
+            if let Some(image) = crate::map::yaml_image_path(p) {
+                out.push(image);
+            }
+        };
+        if let Some(p) = &self.map.path {
+            add(p);
+        }
+        if let Some(p) = &self.map.georef {
+            add(p);
+        }
+        for z in self.area.iter().chain(&self.keepout) {
+            if let ZoneSpec::File(p) = z {
+                add(p);
+            }
+        }
+        out
+    }
+
     /// A builder for the map file `map` and `planner`.
     pub fn builder(map: impl Into<PathBuf>, planner: PlannerKind) -> ScenarioBuilder {
         ScenarioBuilder(Self::new(MapRecipe::file(map), planner))

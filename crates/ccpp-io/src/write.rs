@@ -193,6 +193,19 @@ pub enum FolderError {
         /// The entry ccpp did not write.
         name: String,
     },
+    /// The folder holds one of the run's own input files (a map named `coverage.png`): the
+    /// run would replace or delete it.
+    #[error(
+        "output folder {} holds {}, an input of this run, which writing the folder would \
+         replace or delete; choose another folder",
+        path.display(), input.display()
+    )]
+    HoldsInput {
+        /// The output folder.
+        path: PathBuf,
+        /// The input file inside it.
+        input: PathBuf,
+    },
     /// Reading, creating, writing or renaming failed.
     #[error("cannot write output folder {}: {source}", path.display())]
     Io {
@@ -292,6 +305,32 @@ pub fn check_run_folder(target: &Path) -> Result<(), FolderError> {
             return Err(FolderError::Foreign {
                 path: target.to_path_buf(),
                 name,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Checks that none of `inputs` (the files a run reads) lies in the output folder `target`.
+/// A folder that [`check_run_folder`] accepts holds only files named as ccpp's outputs, so an
+/// input there has such a name (a bare-image map `coverage.png`) and writing the folder would
+/// replace or delete it. Paths that do not exist, and an absent `target`, pass.
+///
+/// # Errors
+/// [`FolderError::HoldsInput`] naming the first such input.
+pub fn check_inputs_outside(target: &Path, inputs: &[PathBuf]) -> Result<(), FolderError> {
+    let Ok(folder) = std::fs::canonicalize(target) else {
+        return Ok(());
+    };
+    for input in inputs {
+        let inside = std::fs::canonicalize(input)
+            .ok()
+            .and_then(|p| p.parent().map(|d| d == folder))
+            .unwrap_or(false);
+        if inside {
+            return Err(FolderError::HoldsInput {
+                path: target.to_path_buf(),
+                input: input.clone(),
             });
         }
     }

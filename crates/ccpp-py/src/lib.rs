@@ -1069,8 +1069,13 @@ fn export_text(files: Vec<(&'static str, Vec<u8>)>) -> PyResult<String> {
 
 /// Writes `files` as the whole content of `folder`, all or nothing, as `ccpp plan --out`
 /// ([`ccpp_io::write::write_folder`]: an older set there is replaced whole, a folder holding
-/// other files refused).
-fn write_files(folder: &Path, files: &[(&'static str, Vec<u8>)]) -> PyResult<()> {
+/// other files refused, and so is a folder holding one of the run's `inputs`).
+fn write_files(
+    folder: &Path,
+    files: &[(&'static str, Vec<u8>)],
+    inputs: &[PathBuf],
+) -> PyResult<()> {
+    ccpp_io::write::check_inputs_outside(folder, inputs).map_err(|e| err(&e))?;
     ccpp_io::write::write_folder(folder, files).map_err(|e| err(&e))
 }
 
@@ -1087,6 +1092,8 @@ pub struct PlanResult {
     /// The map's frame (for keep-out masks in the exports).
     frame: MapFrame,
     finished: bool,
+    /// The files the plan read (`save` refuses a folder holding one).
+    inputs: Vec<PathBuf>,
 }
 
 impl PlanResult {
@@ -1147,7 +1154,7 @@ impl PlanResult {
                 "export names no format: give at least one of csv, json, nav-path, geojson (or leave it out for csv and nav-path)",
             ));
         }
-        write_files(&folder, &self.files(&parse_formats(&names)?)?)
+        write_files(&folder, &self.files(&parse_formats(&names)?)?, &self.inputs)
     }
 
     fn __repr__(&self) -> String {
@@ -1206,6 +1213,7 @@ fn plan(
         zones: p.world.zones().cloned(),
         frame: *p.world.frame(),
         finished: p.stop == StopReason::Done,
+        inputs: scenario.input_files(),
     })
 }
 
@@ -1326,7 +1334,8 @@ impl RunResult {
         // was raised after the write, with the folder already replaced.
         py.check_signals()?;
         files.extend(extra);
-        py.detach(|| write_files(&folder, &files))
+        let inputs = self.scenario.input_files();
+        py.detach(|| write_files(&folder, &files, &inputs))
     }
 
     /// The executed path's waypoints, `float64` `(N, 3)`: x, y, theta at the ends of its

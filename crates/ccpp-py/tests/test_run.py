@@ -240,6 +240,21 @@ def test_save_under_a_file_names_the_file(room: Path, tmp_path: Path) -> None:
     assert notes.read_text() == "keep me"
 
 
+def test_save_refuses_a_folder_holding_an_input(room: Path, tmp_path: Path) -> None:
+    """A map named `coverage.png` in the folder was replaced by the run's picture (a plan's
+    save deleted it); the save is refused and the map kept, as `ccpp run` and `ccpp plan` do."""
+    folder = tmp_path / "out"
+    folder.mkdir()
+    map_png = folder / "coverage.png"
+    map_png.write_bytes((room.parent / "room.pgm").read_bytes())  # sniffed by content
+    before = map_png.read_bytes()
+    for result in (ccpp.run(map_png, "bsa"), ccpp.plan(map_png, "bcd")):
+        with pytest.raises(ccpp.CcppError, match="coverage.png, an input of this run"):
+            result.save(folder)
+        assert map_png.read_bytes() == before
+        assert sorted(p.name for p in folder.iterdir()) == ["coverage.png"]
+
+
 def test_scenario_json_is_the_saved_run_json(room: Path, tmp_path: Path) -> None:
     """`scenario_json` lacked the run.json's `map_digest`, and gave the start inside the area
     (after the approach) where run.json gives the start the run began at."""

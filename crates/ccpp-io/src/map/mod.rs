@@ -302,3 +302,15 @@ fn finish<R: std::io::BufRead + std::io::Seek>(
         thresholds,
     })
 }
+
+/// The image a map YAML names, resolved beside it (`None`: not a YAML path, or a file that
+/// does not read as a map YAML). For the output-folder check of the files a run reads.
+pub fn yaml_image_path(path: &Path) -> Option<PathBuf> {
+    if !is_yaml_path(path) {
+        return None;
+    }
+    let bytes = crate::file::read_bytes(path).ok()?;
+    let text = std::str::from_utf8(&bytes).ok()?;
+    let yaml = MapYaml::parse_fields(text, path).ok()?;
+    Some(path.parent().unwrap_or(Path::new("")).join(&yaml.image))
+}
