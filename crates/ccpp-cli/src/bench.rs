@@ -81,6 +81,13 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     }
     // Refused here, before the folder is touched (every run would fail on it).
     ccpp_io::scenario::check_memory_limit(a.limits.max_memory_mb())?;
+    // (`--inflate -1` was found map by map inside the bench: every run failed and the
+    // summary of the last good bench in the folder was replaced by error rows)
+    ccpp_io::scenario::MapRecipe {
+        inflate: a.inflate,
+        ..ccpp_io::scenario::MapRecipe::default()
+    }
+    .validate()?;
     let (robot, _) = robot_from(&(&a.robot).into())?;
     let options = planner_options(a.options.config.as_deref(), a.seed)?;
     let kinds: Vec<planners::PlannerKind> = planners

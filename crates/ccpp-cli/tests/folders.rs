@@ -439,3 +439,32 @@ fn an_output_folder_holding_the_runs_own_input_is_refused() {
     );
     assert_eq!(std::fs::read_to_string(&config).unwrap(), "{\"bsa\": {}}");
 }
+
+/// `bench --inflate -1` was checked map by map inside the bench: every run failed and the
+/// summary of the earlier bench in the folder was replaced by error rows. It is refused
+/// before the folder is touched, as `--radius nan` is.
+#[test]
+fn a_bench_with_a_bad_inflation_leaves_the_folder_as_it_was() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("b");
+    bench(&out, "ba-star").assert().success();
+    let before = std::fs::read(out.join("results.csv")).unwrap();
+    for v in ["-1", "nan", "inf"] {
+        let o = bench(&out, "ba-star")
+            .arg(format!("--inflate={v}"))
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(1), "{v}");
+        let e = stderr_of(&o);
+        assert!(
+            e.starts_with("error: --inflate / map.inflate must be a finite number >= 0 m"),
+            "{v}: {e}"
+        );
+        assert_eq!(e.lines().count(), 1, "{e}");
+        assert_eq!(
+            std::fs::read(out.join("results.csv")).unwrap(),
+            before,
+            "{v}"
+        );
+    }
+}
