@@ -526,6 +526,23 @@ fn config_values_go_through_the_same_validation() {
             "random-bounce",
             "min_turn_deg",
         ),
+        // Its width overflowed to infinity: no turn was ever drawn (a 6 m run, "done").
+        (
+            "random_bounce: { min_turn_deg: -9.0e307, max_turn_deg: 9.0e307 }",
+            "random-bounce",
+            "random_bounce.min_turn_deg: must be within [-720, 720] degrees",
+        ),
+        // A heading error is at most pi: larger bounds were taken and changed nothing.
+        (
+            "bsa_bfs: { exec: { pid: { heading_tolerance_rad: 3.2 } } }",
+            "bsa-bfs",
+            "bsa_bfs.exec.pid.heading_tolerance_rad: must be below pi",
+        ),
+        (
+            "bsa_bfs: { exec: { pid: { align_rad: 1.0e308 } } }",
+            "bsa-bfs",
+            "bsa_bfs.exec.pid.align_rad: must be at most pi",
+        ),
         (
             "bsa_bfs: { cell_side_m: -1 }",
             "bsa-bfs",

@@ -417,6 +417,27 @@ fn validate_pid(field: &str, p: &PidOptions) -> Result<(), OptionsError> {
     finite_nonneg(&f("tolerance_m"), p.tolerance_m)?;
     finite_nonneg(&f("heading_tolerance_rad"), p.heading_tolerance_rad)?;
     finite_nonneg(&f("align_rad"), p.align_rad)?;
+    // A heading error is at most pi: a tolerance of pi reaches every heading goal at once (no
+    // turn in place at all), and an alignment bound above pi is never exceeded, so larger
+    // values were taken and changed nothing.
+    if p.heading_tolerance_rad >= std::f64::consts::PI {
+        return Err(OptionsError::new(
+            &f("heading_tolerance_rad"),
+            format!(
+                "must be below pi (a heading error is at most pi: every heading goal would be reached at once), got {}",
+                crate::display::Compact(p.heading_tolerance_rad)
+            ),
+        ));
+    }
+    if p.align_rad > std::f64::consts::PI {
+        return Err(OptionsError::new(
+            &f("align_rad"),
+            format!(
+                "must be at most pi (a heading error is at most pi; pi already never turns in place again), got {}",
+                crate::display::Compact(p.align_rad)
+            ),
+        ));
+    }
     finite_pos(&f("min_speed_mps"), p.min_speed_mps)?;
     finite_pos(&f("min_turn_rate"), p.min_turn_rate)?;
     finite_nonneg(&f("lookahead_m"), p.lookahead_m)?;
@@ -649,6 +670,10 @@ fn check_side_fits(setup: &Setup, side: f64, field: &str, what: &str) -> Result<
     Ok(())
 }
 
+/// The largest turn random-bounce takes, either way (degrees): two whole turns, so that a
+/// range across 360 degrees (`300` to `420`) can be written.
+pub const MAX_TURN_DEG: f64 = 720.0;
+
 impl PlannerSettings for RandomBounceOptions {
     fn validate(&self) -> Result<(), OptionsError> {
         opt_finite_pos("budget_m", self.budget_m)?;
@@ -658,6 +683,18 @@ impl PlannerSettings for RandomBounceOptions {
         ] {
             if !v.is_finite() {
                 return Err(OptionsError::new(f, format!("must be finite, got {v}")));
+            }
+            // (-9e307 to 9e307 was taken: its width overflowed to infinity and no turn was
+            // ever drawn, a run of 6 m ending "done"; wider than two turns either way only
+            // repeats angles)
+            if v.abs() > MAX_TURN_DEG {
+                return Err(OptionsError::new(
+                    f,
+                    format!(
+                        "must be within [-{MAX_TURN_DEG}, {MAX_TURN_DEG}] degrees, got {}",
+                        crate::display::Compact(v)
+                    ),
+                ));
             }
         }
         if self.min_turn_deg > self.max_turn_deg {
