@@ -229,13 +229,14 @@ pub struct PidOptions {
     pub angular: PidGains,
     /// A translation goal is reached when the estimate is within this distance of it, metres.
     pub tolerance_m: f64,
-    /// A heading goal is reached when the heading error is below this, radians.
+    /// A heading goal is reached when the heading error is below this, radians (below pi).
     pub heading_tolerance_rad: f64,
     /// Above this heading error the robot turns in place before driving, radians. Every
     /// motion starts aligned (to `heading_tolerance_rad`) and the estimate follows the line
     /// it tracks, so at the default tolerances the error grows past it only when a landmark
     /// fix moves the estimate; a `tolerance_m` of centimetres (a motion may start that far off
     /// its line) or a value below `heading_tolerance_rad` makes it act without landmarks too.
+    /// At most pi (a heading error is never larger).
     pub align_rad: f64,
     /// Creep speed: the linear command is at least this (m/s) while the goal is not reached.
     pub min_speed_mps: f64,

@@ -41,9 +41,11 @@ pub struct RandomBounceOptions {
     /// [`default_budget`](super::settings::default_budget)): what an operator knows, not the
     /// map's contents.
     pub budget_m: Option<f64>,
-    /// Smallest turn after a bump, degrees.
+    /// Smallest turn after a bump, degrees (within
+    /// `[-`[`MAX_TURN_DEG`](super::settings::MAX_TURN_DEG)`, MAX_TURN_DEG]`).
     pub min_turn_deg: f64,
-    /// Largest turn after a bump, degrees.
+    /// Largest turn after a bump, degrees (at least `min_turn_deg`, at most
+    /// [`MAX_TURN_DEG`](super::settings::MAX_TURN_DEG)).
     pub max_turn_deg: f64,
 }
 
