@@ -393,6 +393,22 @@ fn execution_flags_reach_the_simulator() {
         &["--exec", "pid", "--config", ideal_cfg.to_str().unwrap()],
         &["sim.exec pid", "bsa_bfs.exec", "remove one of them"],
     );
+    // Odometry noise runs PID too; the refusal names the flag given, not `--exec`.
+    run_fails(
+        dir,
+        &map,
+        "bsa-bfs",
+        &[
+            "--odometry-noise",
+            "0.02",
+            "--config",
+            ideal_cfg.to_str().unwrap(),
+        ],
+        &[
+            "error: odometry noise (--odometry-noise / odometry_noise=), which runs PID, would drop",
+            "bsa_bfs.exec",
+        ],
+    );
     // The same file without the flag is read: its control period changes the run.
     let pid_run = run_ok(
         dir,

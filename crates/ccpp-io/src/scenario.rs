@@ -934,10 +934,25 @@ impl Scenario {
             (Execution::Pid(_), Execution::Ideal) => "pid",
             (Execution::Pid(_), Execution::Pid(_)) => "pid with other PID settings",
         };
-        Err(invalid(format!(
-            "sim.exec {what} (--exec / exec=) would drop the execution given for {kind} in {}.exec; remove one of them",
-            kind.info().section
-        )))
+        // Odometry noise is what made the run's execution PID when it carries noise: the user
+        // gave `--odometry-noise`, not `--exec` (the message named a flag they never typed).
+        let by = match sim {
+            Execution::Pid(s) if s.noise.is_some() => {
+                "odometry noise (--odometry-noise / odometry_noise=), which runs PID,"
+            }
+            _ => "",
+        };
+        Err(invalid(if by.is_empty() {
+            format!(
+                "sim.exec {what} (--exec / exec=) would drop the execution given for {kind} in {}.exec; remove one of them",
+                kind.info().section
+            )
+        } else {
+            format!(
+                "{by} would drop the execution given for {kind} in {}.exec; remove one of them",
+                kind.info().section
+            )
+        }))
     }
 
     /// The zone values that can be checked without the map (rectangles, inline polygons).
