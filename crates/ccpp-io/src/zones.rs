@@ -373,6 +373,17 @@ fn yaml_polygons(v: &Value) -> Result<Vec<Polygon>, ZoneFileError> {
         return Ok(Vec::new());
     }
     if is_point(&a[0]) {
+        // One polygon: an item that is itself a list of points mixes the two forms (it was
+        // read as "point [[2, 2], [3, 2]] has 2 numbers").
+        if let Some(k) = a
+            .iter()
+            .position(|p| matches!(p, Value::Array(q) if q.first().is_some_and(is_point)))
+        {
+            return Err(bad(format!(
+                "item {} is a list of points while item 1 is a point: give one polygon as a list of x,y points, or several as a list of such lists",
+                k + 1
+            )));
+        }
         return Ok(vec![ring(v, false)?]);
     }
     a.iter().map(|r| ring(r, false)).collect()
@@ -425,7 +436,17 @@ fn geojson_collect(v: &Value, out: &mut Vec<Polygon>, depth: usize) -> Result<()
     match ty {
         "Polygon" => geojson_polygon(coords()?, out),
         "MultiPolygon" => match coords()? {
-            Value::Array(ps) => ps.iter().try_for_each(|p| geojson_polygon(p, out)),
+            // A member without rings is no polygon (RFC 7946 3.1.7): it was skipped in
+            // silence, and the zone was the other members alone.
+            Value::Array(ps) => ps.iter().enumerate().try_for_each(|(k, p)| {
+                if matches!(p, Value::Array(r) if r.is_empty()) {
+                    return Err(bad(format!(
+                        "GeoJSON MultiPolygon member {} has no ring; each member is a polygon's list of rings",
+                        k + 1
+                    )));
+                }
+                geojson_polygon(p, out)
+            }),
             _ => Err(bad("GeoJSON MultiPolygon coordinates must be a list")),
         },
         "Feature" => match v.get("geometry") {
@@ -600,6 +621,20 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("[x, y] or [x, y, z]"), "{e}");
+        // One polygon's points and a list of points mixed: named as such (it was "point
+        // [[2, 2], [3, 2], [3, 3]] has 3 numbers").
+        let e = yaml("- [-1, 2]\n- [[2, 2], [3, 2], [3, 3]]\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("item 2 is a list of points while item 1 is a point"),
+            "{e}"
+        );
+        // A MultiPolygon member without rings was skipped in silence.
+        let e = geo(r#"{"type":"MultiPolygon","coordinates":[[],[[[0,0],[1,0],[1,1]]]]}"#)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("MultiPolygon member 1 has no ring"), "{e}");
     }
 
     #[test]
