@@ -443,7 +443,9 @@ impl World {
 
     /// The approach of a start outside the area: the shortest 8-connected chain of pixel
     /// centres where the robot stands clear of obstacles and keep-outs (the area's border does
-    /// not count) from the start to the nearest centre that is C-free under every virtual wall,
+    /// not count) from the start to the nearest centre that is C-free under every virtual wall
+    /// in the largest part of the area it can reach (8-connected C-free centres; of equal parts
+    /// the nearest),
     /// shortened to straight segments that are free of obstacles and keep-outs (exact swept-disk
     /// test). With `fit` above the robot's radius the whole approach is planned for a disk of
     /// that radius (a rectangular robot turns at every corner of it in its clearance disk), and
@@ -476,6 +478,12 @@ impl World {
         // Where coverage may start: room for the planner's disk under every virtual wall (for
         // the robot's own radius, C-free itself: the same test on the same distances).
         let fits = |i: usize| f64::from(self.obstacle_dt2.get(i)) >= rc * rc;
+        // The parts of the area (8-connected pixels where the disk fits) and their sizes: the
+        // approach goes to the largest part it reaches, not to the nearest (an area drawn
+        // loosely around a room took in a strip of the corridor below it, and a start in the
+        // corridor swept the 0.8 m2 strip, "effective coverage 1.0", not the 6.1 m2 room).
+        let (part, part_size) = parts_of(w, h, &fits);
+        let largest = part_size.iter().copied().max().unwrap_or(0);
         // Dijkstra with integer octile costs (70 straight, 99 diagonal).
         let mut dist = vec![u32::MAX; frame.len()];
         let mut parent = vec![u32::MAX; frame.len()];
@@ -502,14 +510,21 @@ impl World {
                 }
             }
         }
-        let mut goal = None;
+        // (the first pixel settled of a part is its nearest; of equal parts the nearer wins)
+        let mut goal: Option<usize> = None;
         while let Some(std::cmp::Reverse((d, i))) = heap.pop() {
             if d > dist[i] {
                 continue;
             }
             if fits(i) {
-                goal = Some(i);
-                break;
+                let size = |j: usize| part_size[part[j] as usize];
+                if goal.is_none_or(|g| size(i) > size(g)) {
+                    goal = Some(i);
+                }
+                // No part is larger: the search can stop.
+                if size(i) == largest {
+                    break;
+                }
             }
             let (c, r) = ((i % w) as i64, (i / w) as i64);
             for (dc, dr, cost) in [
@@ -1094,6 +1109,42 @@ fn accessible_pixels(map: &GridMap, reachable: &FixedBitSet, rt: f64) -> FixedBi
         }
     }
     acc
+}
+
+/// 8-connected parts of the pixels of a `w` x `h` grid where `inside` holds: each pixel's part
+/// (`u32::MAX` outside) and each part's pixel count, parts numbered in scan order.
+fn parts_of(w: usize, h: usize, inside: &dyn Fn(usize) -> bool) -> (Vec<u32>, Vec<usize>) {
+    let mut part = vec![u32::MAX; w * h];
+    let mut sizes = Vec::new();
+    let mut stack = Vec::new();
+    for i0 in 0..w * h {
+        if part[i0] != u32::MAX || !inside(i0) {
+            continue;
+        }
+        let k = sizes.len() as u32;
+        part[i0] = k;
+        stack.push(i0);
+        let mut n = 0;
+        while let Some(i) = stack.pop() {
+            n += 1;
+            let (c, r) = (i % w, i / w);
+            for dr in -1i64..=1 {
+                for dc in -1i64..=1 {
+                    let (nc, nr) = (c as i64 + dc, r as i64 + dr);
+                    if nc < 0 || nr < 0 || nc >= w as i64 || nr >= h as i64 {
+                        continue;
+                    }
+                    let j = nr as usize * w + nc as usize;
+                    if part[j] == u32::MAX && inside(j) {
+                        part[j] = k;
+                        stack.push(j);
+                    }
+                }
+            }
+        }
+        sizes.push(n);
+    }
+    (part, sizes)
 }
 
 #[cfg(test)]

@@ -213,3 +213,40 @@ fn zone_errors_are_specific() {
     let e = World::with_zones(map, Robot::new(0.1), None, Some(z));
     assert!(matches!(e, Err(WorldError::NoRoomInZones { .. })), "{e:?}");
 }
+
+/// A start outside an area of two parts drives to the larger part, not to the nearer one (an
+/// area drawn loosely around a room took in a strip of the corridor beside it, and the robot
+/// swept the strip alone, "effective coverage 1.0").
+#[test]
+fn an_approach_goes_to_the_largest_part_of_the_area() {
+    let map = room();
+    // A strip 0.4 m wide (x 1.6 to 2.0) next to the start, and a part 1.4 m wide beyond it.
+    let parts = [
+        Polygon::rect([0.0, 0.0, 1.4, 2.0]),
+        Polygon::rect([1.6, 0.0, 2.0, 2.0]),
+    ];
+    let z = ZoneMasks::new(map.frame(), Some(&parts), &[], &[]);
+    let w = World::with_zones(
+        map.clone(),
+        Robot::new(0.1),
+        Some(Pose::new(3.0, 1.0, 0.0)),
+        Some(z),
+    )
+    .unwrap();
+    assert!(w.start().x < 1.4 - 0.1 + 1e-9, "{:?}", w.start());
+    assert!(!w.approach().is_empty());
+    // The strip alone: the approach ends in it, as before.
+    let z = ZoneMasks::new(map.frame(), Some(&parts[1..]), &[], &[]);
+    let w = World::with_zones(
+        map,
+        Robot::new(0.1),
+        Some(Pose::new(3.0, 1.0, 0.0)),
+        Some(z),
+    )
+    .unwrap();
+    assert!(
+        (1.7 - 1e-9..=1.9 + 1e-9).contains(&w.start().x),
+        "{:?}",
+        w.start()
+    );
+}
