@@ -406,12 +406,42 @@ pub fn swap_folder(
     old: &Path,
     before_old: impl FnOnce(),
 ) -> Result<bool, SwapError> {
-    let had_old = std::fs::symlink_metadata(target).is_ok();
-    if had_old {
-        before_old();
-        std::fs::rename(target, old).map_err(SwapError::MoveOld)?;
-    }
-    if let Err(error) = std::fs::rename(staging, target) {
+    let mut before_old = Some(before_old);
+    let mut attempt = 0;
+    loop {
+        attempt += 1;
+        // Another process swapping the same folder (two `ccpp run --out o` at once; the lock
+        // is per process) can take the old folder away between a look and the rename, or put
+        // its new one in: that is a race, not a failure, and the swap goes round again, the
+        // last writer winning. It said "cannot replace output folder o: No such file or
+        // directory" about once in a hundred such pairs.
+        let again = attempt < SWAP_ATTEMPTS;
+        let had_old = std::fs::symlink_metadata(target).is_ok();
+        if had_old {
+            if let Some(f) = before_old.take() {
+                f();
+            }
+            match std::fs::rename(target, old) {
+                Ok(()) => {}
+                Err(e) if again && e.kind() == io::ErrorKind::NotFound => continue,
+                Err(e) => return Err(SwapError::MoveOld(e)),
+            }
+        }
+        let error = match std::fs::rename(staging, target) {
+            Ok(()) => return Ok(had_old),
+            Err(error) => error,
+        };
+        let taken = matches!(
+            error.kind(),
+            io::ErrorKind::AlreadyExists | io::ErrorKind::DirectoryNotEmpty
+        );
+        if again && taken {
+            // Another writer's complete set is in place: the one moved away is older still.
+            if had_old {
+                remove_all_quietly(old);
+            }
+            continue;
+        }
         if had_old {
             if let Err(back) = std::fs::rename(old, target) {
                 return Err(SwapError::Lost { error, back });
@@ -419,7 +449,16 @@ pub fn swap_folder(
         }
         return Err(SwapError::MoveNew(error));
     }
-    Ok(had_old)
+}
+
+/// Rounds of [`swap_folder`] against other processes swapping the same folder.
+const SWAP_ATTEMPTS: u32 = 16;
+
+/// Removes a folder moved aside, best effort: what is left is a stale `.NAME.ccpp-old-*`
+/// folder, which the next write beside it clears.
+fn remove_all_quietly(path: &Path) {
+    // (best effort by design: see the doc)
+    let _ = std::fs::remove_dir_all(path);
 }
 
 /// Writes `files` as the whole content of the folder `target`, all or nothing, as the command
@@ -673,6 +712,33 @@ mod tests {
     /// renames: "Directory not empty", "No such file", and hidden `.out.ccpp-old-*` copies
     /// left beside the folder. The swaps now take turns: every save succeeds and the folder
     /// holds one whole set.
+    /// Another process's swap can take the old folder away between the look and the rename
+    /// (two `ccpp run --out o` at once): the swap goes round again instead of failing with
+    /// "No such file or directory".
+    #[test]
+    fn a_folder_taken_away_mid_swap_is_swapped_again() {
+        let d = tempfile::tempdir().unwrap();
+        let target = d.path().join("o");
+        let staging = d.path().join(".o.new");
+        let old = d.path().join(".o.old");
+        std::fs::create_dir(&target).unwrap();
+        std::fs::write(target.join("metrics.json"), "old").unwrap();
+        std::fs::create_dir(&staging).unwrap();
+        std::fs::write(staging.join("metrics.json"), "new").unwrap();
+        // The other process: it moves the folder away just before this one's rename.
+        let elsewhere = d.path().join("elsewhere");
+        let had_old = swap_folder(&staging, &target, &old, || {
+            std::fs::rename(&target, &elsewhere).unwrap();
+        })
+        .unwrap();
+        assert!(!had_old);
+        assert_eq!(
+            std::fs::read_to_string(target.join("metrics.json")).unwrap(),
+            "new"
+        );
+        assert!(!staging.exists() && !old.exists());
+    }
+
     #[test]
     fn threads_writing_one_folder_take_turns() {
         let d = tempfile::tempdir().unwrap();
