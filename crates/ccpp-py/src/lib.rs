@@ -1982,7 +1982,8 @@ impl Env {
     /// Starts an episode and returns `(observation, info)`. Without `seed` the robot starts
     /// at the configured start (or the widest free spot); with `seed` at a pose drawn from the
     /// free, reachable positions (deterministic for a seed; with zones, inside the area and
-    /// outside the keep-outs).
+    /// outside the keep-outs). A seed is refused for an Env given `start=`: the drawn pose
+    /// would replace the start in silence.
     #[pyo3(signature = (seed=None))]
     fn reset(
         &mut self,
@@ -1995,6 +1996,14 @@ impl Env {
             .filter(|s| !s.is_none())
             .map(|s| uint_arg("seed", s, 0))
             .transpose()?;
+        if let (Some(_), Some([x, y, theta])) = (seed, self.scenario.start) {
+            return Err(msg(format!(
+                "reset(seed=) draws a random start, and this Env was given start=({}, {}, {}): leave the seed out to start there, or leave start= out to draw starts",
+                ccpp_core::display::Compact(x),
+                ccpp_core::display::Compact(y),
+                ccpp_core::display::Compact(theta)
+            )));
+        }
         let scenario = &self.scenario;
         let map = &self.map;
         let zones = &self.zones;

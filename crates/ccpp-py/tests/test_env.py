@@ -127,6 +127,11 @@ def test_reset_seed_and_actions(room: Path) -> None:
         ccpp.Env(room, sensor_range=-1.0)
     with pytest.raises(ccpp.CcppError, match="exec"):
         ccpp.Env(room, exec="teleport")
+    # A seed draws the start: with start= given it replaced that start in silence.
+    placed = ccpp.Env(room, start=(1.0, 1.0, 0.5))
+    with pytest.raises(ccpp.CcppError, match=r"reset\(seed=\) draws a random start, and this Env was given start=\(1, 1, 0.5\)"):
+        placed.reset(seed=1)
+    assert list(placed.reset()[0]["pose"]) == [1.0, 1.0, 0.5]
 
 
 def test_pid_execution_is_available(room: Path) -> None:

@@ -127,7 +127,9 @@ def test_env_knows_its_zones(room: Path) -> None:
     assert not info["collision"]
     metrics = env.metrics()
     assert metrics["keepout_violations"] == 1 and metrics["collisions"] == 0
-    # Seeded starts are inside the area and outside the keep-out.
+    # Seeded starts are inside the area and outside the keep-out (an Env without start=: with
+    # one, a seed is refused).
+    env = ccpp.Env(room, radius=0.15, sensor_range=0.6, area=AREA, keepout=KEEPOUT)
     for seed in range(5):
         obs, _ = env.reset(seed=seed)
         x, y, _ = obs["pose"]

@@ -136,7 +136,8 @@ class Env:
         ``max_memory_mb`` (default 4096) bounds the map's load and what an episode holds, as a
         run's. One Env may be used from several threads: calls take turns."""
     def reset(self, seed: int | None = None) -> tuple[dict[str, Any], dict[str, Any]]:
-        """Starts an episode; returns (observation, info)."""
+        """Starts an episode; returns (observation, info). A seed draws a random free start
+        (refused for an Env given ``start=``)."""
     def step(
         self, action: Sequence[Any]
     ) -> tuple[dict[str, Any], float, bool, bool, dict[str, Any]]:
