@@ -14,7 +14,7 @@
 //! heading the robot leaves the waypoint with (radians, 0 = +x, counter-clockwise); the
 //! `nav_msgs/Path` carries it as the quaternion `(0, 0, sin(theta/2), cos(theta/2))`.
 //!
-//! The exported route is [`tidy`]: positions rounded to a nanometre and headings in
+//! The exported route is [`tidy`]: positions rounded to a nanometre ([`round_m`]) and headings in
 //! `(-pi, pi]`, a heading within a nanoradian of a multiple of 45 degrees set to it exactly,
 //! so the pixel-to-map arithmetic's last bits do not reach the files (`0.675`, not
 //! `0.6750000000000005`; `0` and `3.141592653589793`, not `4.4e-15` and
@@ -39,13 +39,25 @@ pub const FRAME_ID: &str = "map";
 
 /// `v` metres rounded to a nanometre (no `-0`): far below what a robot resolves and below
 /// the metrics' tolerance (1e-6 pixel), far above the noise of the pixel-to-map arithmetic.
+/// Far from the origin, where a nanometre is within a few steps of an `f64` (above about
+/// 5e5 m), to the decimal place at least eight steps wide (1e-8 m up to about 5e6 m, a
+/// micrometre at the 1e8 m placement limit), so that the result is the `f64` nearest to a
+/// short decimal and rounding it again changes nothing.
 #[must_use]
 pub fn round_m(v: f64) -> f64 {
     if !v.is_finite() {
         return v;
     }
-    // (dividing by 1e9, not multiplying by the inexact 1e-9, gives the shortest decimal)
-    let r = (v * 1e9).round() / 1e9;
+    // The decimal places: 9, fewer where eight steps of an f64 (2.2e-16 relative each)
+    // exceed a unit of the last place.
+    let mut places = 9usize;
+    while places > 0 && v.abs() * 1.8e-15 > 10f64.powi(-(places as i32)) {
+        places -= 1;
+    }
+    // Rounded in decimal (the exact value, half to even), then read back: the nearest f64 to
+    // that decimal. (Scaling by 1e9 and `round` pushed clean values a step off above 2e6 m
+    // and left the noise above 4.5e6 m.)
+    let r: f64 = format!("{v:.places$}").parse().unwrap_or(v);
     if r == 0.0 {
         0.0
     } else {
@@ -810,6 +822,21 @@ mod tests {
         assert_eq!(tidy_heading(1e-6), 1e-6);
         assert_eq!(round_m(-1e-10), 0.0);
         assert!(round_m(-1e-10).is_sign_positive());
+        // Far from the origin (UTM-like coordinates): clean values stay clean, noise goes, and
+        // rounding twice changes nothing, up to the 1e8 m placement limit.
+        assert_eq!(round_m(4_242_856.065), 4_242_856.065);
+        assert_eq!(round_m(5_340_003.347_999_999), 5_340_003.348);
+        assert_eq!(round_m(1e8 - 1e-8), 1e8);
+        let mut v = 0.123_456_789_012_345;
+        for _ in 0..2000 {
+            let r = round_m(v);
+            assert_eq!(round_m(r), r, "{v}");
+            assert!((r - v).abs() <= 5e-9_f64.max(v.abs() * 1e-14), "{v} -> {r}");
+            v = v * 1.013 + 0.37;
+            if v > 1e8 {
+                v = -v / 3e7;
+            }
+        }
     }
 
     #[test]
