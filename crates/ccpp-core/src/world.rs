@@ -445,7 +445,8 @@ impl World {
     /// centres where the robot stands clear of obstacles and keep-outs (the area's border does
     /// not count) from the start to the nearest centre that is C-free under every virtual wall
     /// in the largest part of the area it can reach (8-connected C-free centres; of equal parts
-    /// the nearest),
+    /// the nearest; a start whose own pixel is in the area, its disk across the border, takes
+    /// the nearest part),
     /// shortened to straight segments that are free of obstacles and keep-outs (exact swept-disk
     /// test). With `fit` above the robot's radius the whole approach is planned for a disk of
     /// that radius (a rectangular robot turns at every corner of it in its clearance disk), and
@@ -482,7 +483,19 @@ impl World {
         // approach goes to the largest part it reaches, not to the nearest (an area drawn
         // loosely around a room took in a strip of the corridor below it, and a start in the
         // corridor swept the 0.8 m2 strip, "effective coverage 1.0", not the 6.1 m2 room).
-        let (part, part_size) = parts_of(w, h, &fits);
+        // A start whose own pixel is inside the area (its disk across the border) moves
+        // into the part it stands in, the nearest, as before: the largest-part rule is for a
+        // start out of the area, and a few centimetres across a border must not send the
+        // robot to another part.
+        let inside = frame.pixel_of(s.position()).is_some_and(|(c, r)| {
+            z.area
+                .as_ref()
+                .is_some_and(|a| a.contains(frame.index(c, r)))
+        });
+        let (part, mut part_size) = parts_of(w, h, &fits);
+        if inside {
+            part_size.fill(1);
+        }
         let largest = part_size.iter().copied().max().unwrap_or(0);
         // Dijkstra with integer octile costs (70 straight, 99 diagonal).
         let mut dist = vec![u32::MAX; frame.len()];

@@ -235,6 +235,21 @@ fn an_approach_goes_to_the_largest_part_of_the_area() {
     .unwrap();
     assert!(w.start().x < 1.4 - 0.1 + 1e-9, "{:?}", w.start());
     assert!(!w.approach().is_empty());
+    // A start in the strip whose disk crosses its border moves into the strip (a few
+    // centimetres), not to the larger part.
+    let z = ZoneMasks::new(map.frame(), Some(&parts), &[], &[]);
+    let w = World::with_zones(
+        map.clone(),
+        Robot::new(0.1),
+        Some(Pose::new(1.65, 1.0, 0.0)),
+        Some(z),
+    )
+    .unwrap();
+    assert!(
+        (1.7 - 1e-9..=1.9 + 1e-9).contains(&w.start().x),
+        "{:?}",
+        w.start()
+    );
     // The strip alone: the approach ends in it, as before.
     let z = ZoneMasks::new(map.frame(), Some(&parts[1..]), &[], &[]);
     let w = World::with_zones(
