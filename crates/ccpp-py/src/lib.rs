@@ -968,6 +968,8 @@ pub struct RunResult {
     metrics: Metrics,
     /// The start-area warning (`ccpp run`'s), found once on the run's thread.
     start_warning: Option<String>,
+    /// The files the run read (`save` refuses a folder holding one).
+    inputs: Vec<PathBuf>,
 }
 
 impl RunResult {
@@ -1334,8 +1336,7 @@ impl RunResult {
         // was raised after the write, with the folder already replaced.
         py.check_signals()?;
         files.extend(extra);
-        let inputs = self.scenario.input_files();
-        py.detach(|| write_files(&folder, &files, &inputs))
+        py.detach(|| write_files(&folder, &files, &self.inputs))
     }
 
     /// The executed path's waypoints, `float64` `(N, 3)`: x, y, theta at the ends of its
@@ -1403,6 +1404,15 @@ fn run(
         radius.unwrap_or(DEFAULT_RADIUS),
     );
     let scenario = scenario_from(&prepared, planner, radius, options, Purpose::Run)?;
+    // The files the run reads (`save` refuses a folder holding one): the scenario's, and a
+    // landmarks file, which the scenario holds as read.
+    let mut inputs = scenario.input_files();
+    if let Some(Ok(path)) = options
+        .and_then(|o| o.get_item("landmarks").ok().flatten())
+        .map(|v| v.extract::<PathBuf>())
+    {
+        inputs.push(path);
+    }
     name_map(&mut prepared, &scenario);
     let (scenario, prepared) = (Arc::new(scenario), Arc::new(prepared));
     let (sc, pm) = (Arc::clone(&scenario), Arc::clone(&prepared));
@@ -1425,6 +1435,7 @@ fn run(
         output: run.output,
         metrics: run.metrics,
         start_warning,
+        inputs,
     })
 }
 

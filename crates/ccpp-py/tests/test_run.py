@@ -253,6 +253,15 @@ def test_save_refuses_a_folder_holding_an_input(room: Path, tmp_path: Path) -> N
             result.save(folder)
         assert map_png.read_bytes() == before
         assert sorted(p.name for p in folder.iterdir()) == ["coverage.png"]
+    # A landmarks file named as a run file (`path.csv`) in the folder: refused too.
+    other = tmp_path / "other"
+    other.mkdir()
+    marks = other / "path.csv"
+    marks.write_text("1,0.5,0.5\n2,2.5,1.5\n")
+    noisy = ccpp.run(room, "bsa", odometry_noise=0.01, seed=1, landmarks=marks)
+    with pytest.raises(ccpp.CcppError, match="path.csv, an input of this run"):
+        noisy.save(other)
+    assert marks.read_text() == "1,0.5,0.5\n2,2.5,1.5\n"
 
 
 def test_scenario_json_is_the_saved_run_json(room: Path, tmp_path: Path) -> None:
