@@ -386,6 +386,13 @@ fn yaml_polygons(v: &Value) -> Result<Vec<Polygon>, ZoneFileError> {
         }
         return Ok(vec![ring(v, false)?]);
     }
+    // Several polygons: a point among them mixes the two forms the other way.
+    if let Some(k) = a.iter().position(is_point) {
+        return Err(bad(format!(
+            "item {} is a point while item 1 is a list of points: give one polygon as a list of x,y points, or several as a list of such lists",
+            k + 1
+        )));
+    }
     a.iter().map(|r| ring(r, false)).collect()
 }
 
@@ -628,6 +635,13 @@ mod tests {
             .to_string();
         assert!(
             e.starts_with("item 2 is a list of points while item 1 is a point"),
+            "{e}"
+        );
+        let e = yaml("- [[2, 2], [3, 2], [3, 3]]\n- [2, 2]\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("item 2 is a point while item 1 is a list of points"),
             "{e}"
         );
         // A MultiPolygon member without rings was skipped in silence.
