@@ -405,7 +405,7 @@ fn execution_flags_reach_the_simulator() {
             ideal_cfg.to_str().unwrap(),
         ],
         &[
-            "error: odometry noise (--odometry-noise / odometry_noise=), which runs PID, would drop",
+            "error: PID execution (--exec pid / exec=, or odometry noise: --odometry-noise / odometry_noise=, which runs PID) would drop",
             "bsa_bfs.exec",
         ],
     );

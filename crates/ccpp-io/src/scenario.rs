@@ -938,7 +938,7 @@ impl Scenario {
         // gave `--odometry-noise`, not `--exec` (the message named a flag they never typed).
         let by = match sim {
             Execution::Pid(s) if s.noise.is_some() => {
-                "odometry noise (--odometry-noise / odometry_noise=), which runs PID,"
+                "PID execution (--exec pid / exec=, or odometry noise: --odometry-noise / odometry_noise=, which runs PID)"
             }
             _ => "",
         };
