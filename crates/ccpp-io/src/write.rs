@@ -203,7 +203,7 @@ pub enum FolderError {
     HoldsInput {
         /// The output folder.
         path: PathBuf,
-        /// The input file inside it.
+        /// The input file inside it (links resolved).
         input: PathBuf,
     },
     /// Reading, creating, writing or renaming failed.
@@ -323,14 +323,14 @@ pub fn check_inputs_outside(target: &Path, inputs: &[PathBuf]) -> Result<(), Fol
         return Ok(());
     };
     for input in inputs {
-        let inside = std::fs::canonicalize(input)
-            .ok()
-            .and_then(|p| p.parent().map(|d| d == folder))
-            .unwrap_or(false);
-        if inside {
+        // (the file itself: a link outside the folder to a file in it names that file)
+        let Ok(file) = std::fs::canonicalize(input) else {
+            continue;
+        };
+        if file.parent() == Some(folder.as_path()) {
             return Err(FolderError::HoldsInput {
                 path: target.to_path_buf(),
-                input: input.clone(),
+                input: file,
             });
         }
     }
@@ -435,8 +435,9 @@ pub fn swap_folder(
             error.kind(),
             io::ErrorKind::AlreadyExists | io::ErrorKind::DirectoryNotEmpty
         );
-        if again && taken {
-            // Another writer's complete set is in place: the one moved away is older still.
+        // Another writer's complete set is in place (the one moved away is older still), if
+        // what is there now is a run folder: anything else is not ccpp's to replace.
+        if again && taken && check_run_folder(target).is_ok() {
             if had_old {
                 remove_all_quietly(old);
             }
