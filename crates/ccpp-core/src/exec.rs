@@ -530,8 +530,9 @@ impl Tracker {
                 };
                 // A goal just passed is reached: a landmark fix that puts the estimate a few
                 // micrometres beyond it turned the robot about, drove it back and turned it
-                // again for the next motion (ba-star on teb_empty_box with landmarks: 176
-                // turns instead of about 40, 26 back-and-forth moves under a millimetre).
+                // again for the next motion (ba-star on teb_empty_box with noise and five
+                // landmarks: 176 turns and 26 back-and-forth moves under a millimetre; now 94
+                // and 0, where the run without noise makes 40).
                 if len > 1e-12 && along <= 0.0 && dist < PASSED_GOAL_M {
                     return None;
                 }
