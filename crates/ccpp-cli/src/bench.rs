@@ -238,6 +238,9 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     if !outside.is_empty() {
         eprintln!("{}", outside_warning(&outside));
     }
+    if let Some(note) = earlier_runs_note(&a.out, &rows) {
+        eprintln!("{note}");
+    }
     if failed > 0 {
         bail!(
             "{failed} of {} runs failed; see the error column of {}",
@@ -772,6 +775,44 @@ fn outside_warning(maps: &[String]) -> String {
          start inside needs `ccpp run --start X,Y`",
         maps.join(", ")
     )
+}
+
+/// The run folders under `out/runs/MAP/PLANNER` that `rows` (this bench's runs) leave out:
+/// an earlier bench's, with other maps, planners or settings, which the summary does not
+/// describe. Named on stderr so that a folder holding two benches is not taken for one.
+fn earlier_runs_note(out: &Path, rows: &[Row]) -> Option<String> {
+    let mut left: Vec<String> = Vec::new();
+    let runs = out.join("runs");
+    let mut maps: Vec<_> = std::fs::read_dir(&runs).ok()?.flatten().collect();
+    maps.sort_by_key(std::fs::DirEntry::file_name);
+    for m in maps {
+        let map = m.file_name().to_string_lossy().into_owned();
+        let Ok(planners) = std::fs::read_dir(m.path()) else {
+            continue;
+        };
+        let mut planners: Vec<_> = planners.flatten().collect();
+        planners.sort_by_key(std::fs::DirEntry::file_name);
+        for p in planners {
+            let planner = p.file_name().to_string_lossy().into_owned();
+            let ours = rows.iter().any(|r| r.map == map && r.planner == planner);
+            if !ours && p.path().join("metrics.json").is_file() {
+                left.push(format!("{map}/{planner}"));
+            }
+        }
+    }
+    if left.is_empty() {
+        return None;
+    }
+    let n = left.len();
+    let shown: Vec<&str> = left.iter().take(8).map(String::as_str).collect();
+    let more = if n > shown.len() { ", ..." } else { "" };
+    Some(format!(
+        "note: {} also holds {n} run folder{} of an earlier bench that this summary leaves out ({}{more}); remove {} or bench into a new folder to keep one bench per folder",
+        runs.display(),
+        if n == 1 { "" } else { "s" },
+        shown.join(", "),
+        if n == 1 { "it" } else { "them" }
+    ))
 }
 
 /// `results.md`: a table per map and a summary across maps; `outside` names the maps whose

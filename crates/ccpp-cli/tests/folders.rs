@@ -468,3 +468,32 @@ fn a_bench_with_a_bad_inflation_leaves_the_folder_as_it_was() {
         );
     }
 }
+
+/// A bench into the folder of an earlier one with more planners left that one's run folders
+/// under `runs/` beside a summary that does not list them, in silence: the folder looked like
+/// one bench. The run folders are kept (benches may add planners one at a time) and named.
+#[test]
+fn a_bench_names_the_earlier_runs_its_summary_leaves_out() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("b");
+    let first = bench(&out, "ba-star,bsa").output().unwrap();
+    assert!(first.status.success());
+    assert!(
+        !stderr_of(&first).contains("note:"),
+        "{}",
+        stderr_of(&first)
+    );
+    let o = bench(&out, "ba-star").output().unwrap();
+    assert!(o.status.success(), "{}", stderr_of(&o));
+    let e = stderr_of(&o);
+    assert!(
+        e.contains("also holds 1 run folder of an earlier bench that this summary leaves out (teb_empty_box/bsa); remove it"),
+        "{e}"
+    );
+    assert!(out.join("runs/teb_empty_box/bsa/metrics.json").is_file());
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    assert!(!csv.contains(",bsa,"), "{csv}");
+    // The same bench again lists both: nothing left out, no note.
+    let o = bench(&out, "ba-star,bsa").output().unwrap();
+    assert!(!stderr_of(&o).contains("note:"), "{}", stderr_of(&o));
+}
