@@ -492,11 +492,16 @@ impl World {
                 .as_ref()
                 .is_some_and(|a| a.contains(frame.index(c, r)))
         });
-        let (part, mut part_size) = parts_of(w, h, &fits);
-        if inside {
-            part_size.fill(1);
-        }
-        let largest = part_size.iter().copied().max().unwrap_or(0);
+        // (not labelled for a start inside: every part then counts alike, the nearest wins)
+        let parts = (!inside).then(|| parts_of(w, h, &fits));
+        let size = |j: usize| {
+            parts
+                .as_ref()
+                .map_or(1, |(part, sizes)| sizes[part[j] as usize])
+        };
+        let largest = parts
+            .as_ref()
+            .map_or(1, |(_, sizes)| sizes.iter().copied().max().unwrap_or(0));
         // Dijkstra with integer octile costs (70 straight, 99 diagonal).
         let mut dist = vec![u32::MAX; frame.len()];
         let mut parent = vec![u32::MAX; frame.len()];
@@ -532,7 +537,6 @@ impl World {
                 continue;
             }
             if fits(i) {
-                let size = |j: usize| part_size[part[j] as usize];
                 if goal.is_none_or(|g| size(i) > size(g)) {
                     goal = Some(i);
                 }
@@ -1127,36 +1131,31 @@ fn accessible_pixels(map: &GridMap, reachable: &FixedBitSet, rt: f64) -> FixedBi
 }
 
 /// 8-connected parts of the pixels of a `w` x `h` grid where `inside` holds: each pixel's part
-/// (`u32::MAX` outside) and each part's pixel count, parts numbered in scan order.
+/// (`u32::MAX` outside) and each part's pixel count, parts numbered in scan order (each filled
+/// by [`crate::search::fill_runs`]).
 fn parts_of(w: usize, h: usize, inside: &dyn Fn(usize) -> bool) -> (Vec<u32>, Vec<usize>) {
+    use crate::search::{fill_runs, Connectivity};
     let mut part = vec![u32::MAX; w * h];
     let mut sizes = Vec::new();
-    let mut stack = Vec::new();
+    let mut seen = FixedBitSet::with_capacity(w * h);
     for i0 in 0..w * h {
-        if part[i0] != u32::MAX || !inside(i0) {
+        if seen.contains(i0) || !inside(i0) {
             continue;
         }
         let k = sizes.len() as u32;
-        part[i0] = k;
-        stack.push(i0);
         let mut n = 0;
-        while let Some(i) = stack.pop() {
-            n += 1;
-            let (c, r) = (i % w, i / w);
-            for dr in -1i64..=1 {
-                for dc in -1i64..=1 {
-                    let (nc, nr) = (c as i64 + dc, r as i64 + dr);
-                    if nc < 0 || nr < 0 || nc >= w as i64 || nr >= h as i64 {
-                        continue;
-                    }
-                    let j = nr as usize * w + nc as usize;
-                    if part[j] == u32::MAX && inside(j) {
-                        part[j] = k;
-                        stack.push(j);
-                    }
-                }
-            }
-        }
+        fill_runs(
+            w,
+            h,
+            inside,
+            i0,
+            Connectivity::Eight,
+            &mut seen,
+            |row, lo, hi| {
+                part[row * w + lo..=row * w + hi].fill(k);
+                n += hi - lo + 1;
+            },
+        );
         sizes.push(n);
     }
     (part, sizes)
