@@ -354,7 +354,11 @@ pub enum WaypointFileError {
 
 /// The route as CSV: header `x,y,theta`, one waypoint a line.
 pub fn waypoints_csv(route: &Route) -> String {
-    let route = &tidy(route);
+    csv_of(&tidy(route))
+}
+
+/// [`waypoints_csv`] of a route already [`tidy`].
+fn csv_of(route: &Route) -> String {
     let mut s = String::with_capacity(16 + route.waypoints.len() * 48);
     s.push_str("x,y,theta\n");
     for p in &route.waypoints {
@@ -431,7 +435,11 @@ struct WaypointsJson {
 /// # Errors
 /// Serialization failure (a non-finite number).
 pub fn waypoints_json(route: &Route, meta: &ExportMeta<'_>) -> Result<String, serde_json::Error> {
-    let route = &tidy(route);
+    json_of(&tidy(route), meta)
+}
+
+/// [`waypoints_json`] of a route already [`tidy`].
+fn json_of(route: &Route, meta: &ExportMeta<'_>) -> Result<String, serde_json::Error> {
     let doc = WaypointsJson {
         frame_id: FRAME_ID.to_string(),
         planner: meta.planner.to_string(),
@@ -524,7 +532,11 @@ pub fn heading_quaternion(theta: f64) -> [f64; 4] {
 /// [`heading_quaternion`]). The trailing `---` document separator is left out so that the file
 /// is one YAML document.
 pub fn nav_path_yaml(route: &Route) -> String {
-    let route = &tidy(route);
+    nav_path_of(&tidy(route))
+}
+
+/// [`nav_path_yaml`] of a route already [`tidy`].
+fn nav_path_of(route: &Route) -> String {
     let mut s = String::with_capacity(128 + route.waypoints.len() * 280);
     let header = |s: &mut String, indent: &str| {
         let _ = write!(
@@ -639,8 +651,16 @@ pub fn geojson(
     meta: &ExportMeta<'_>,
     polygons: &[PolygonFeature],
 ) -> Result<String, serde_json::Error> {
+    geojson_of(&tidy(route), meta, polygons)
+}
+
+/// [`geojson`] of a route already [`tidy`].
+fn geojson_of(
+    route: &Route,
+    meta: &ExportMeta<'_>,
+    polygons: &[PolygonFeature],
+) -> Result<String, serde_json::Error> {
     use serde_json::{json, Value};
-    let route = &tidy(route);
     let mut coords: Vec<[f64; 2]> = route.waypoints.iter().map(|p| [p.x, p.y]).collect();
     if coords.len() == 1 {
         coords.push(coords[0]);
@@ -723,16 +743,18 @@ pub fn render_exports(
     formats: &[ExportFormat],
     polygons: &[PolygonFeature],
 ) -> Result<Vec<(&'static str, Vec<u8>)>, serde_json::Error> {
+    // Tidied once for every format (each public writer tidies its own).
+    let route = &tidy(route);
     let mut out = Vec::new();
     for f in ExportFormat::ALL {
         if !formats.contains(&f) {
             continue;
         }
         let text = match f {
-            ExportFormat::Csv => waypoints_csv(route),
-            ExportFormat::Json => waypoints_json(route, meta)?,
-            ExportFormat::NavPath => nav_path_yaml(route),
-            ExportFormat::GeoJson => geojson(route, meta, polygons)?,
+            ExportFormat::Csv => csv_of(route),
+            ExportFormat::Json => json_of(route, meta)?,
+            ExportFormat::NavPath => nav_path_of(route),
+            ExportFormat::GeoJson => geojson_of(route, meta, polygons)?,
         };
         out.push((f.file_name(), text.into_bytes()));
     }
