@@ -937,22 +937,13 @@ impl Scenario {
         // Odometry noise is what made the run's execution PID when it carries noise: the user
         // gave `--odometry-noise`, not `--exec` (the message named a flag they never typed).
         let by = match sim {
-            Execution::Pid(s) if s.noise.is_some() => {
-                "PID execution (--exec pid / exec=, or odometry noise: --odometry-noise / odometry_noise=, which runs PID)"
-            }
-            _ => "",
+            Execution::Pid(s) if s.noise.is_some() => "PID execution (--exec pid / exec=, or odometry noise: --odometry-noise / odometry_noise=, which runs PID)".to_string(),
+            _ => format!("sim.exec {what} (--exec / exec=)"),
         };
-        Err(invalid(if by.is_empty() {
-            format!(
-                "sim.exec {what} (--exec / exec=) would drop the execution given for {kind} in {}.exec; remove one of them",
-                kind.info().section
-            )
-        } else {
-            format!(
-                "{by} would drop the execution given for {kind} in {}.exec; remove one of them",
-                kind.info().section
-            )
-        }))
+        Err(invalid(format!(
+            "{by} would drop the execution given for {kind} in {}.exec; remove one of them",
+            kind.info().section
+        )))
     }
 
     /// The zone values that can be checked without the map (rectangles, inline polygons).
