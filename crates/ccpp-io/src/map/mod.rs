@@ -127,7 +127,7 @@ pub fn load_map(path: &Path, opts: &LoadOptions) -> Result<LoadedMap, MapError> 
         })?;
         // The thresholds are checked with the overrides applied (`finish`).
         let yaml = MapYaml::parse_fields(text, path)?;
-        let image_path = path.parent().unwrap_or(Path::new("")).join(&yaml.image);
+        let image_path = image_beside(path, &yaml.image);
         let file = match crate::file::open_regular(&image_path) {
             Ok(f) => f,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
@@ -189,7 +189,7 @@ pub fn load_map_bytes(
     match yaml {
         Some(text) => {
             let y = MapYaml::parse_fields(text, name)?;
-            let image_path = name.parent().unwrap_or(Path::new("")).join(&y.image);
+            let image_path = image_beside(name, &y.image);
             finish(Some(&y), name, image_path, reader, opts)
         }
         None => finish(None, name, name.to_path_buf(), reader, opts),
@@ -312,5 +312,10 @@ pub fn yaml_image_path(path: &Path) -> Option<PathBuf> {
     let bytes = crate::file::read_bytes(path).ok()?;
     let text = std::str::from_utf8(&bytes).ok()?;
     let yaml = MapYaml::parse_fields(text, path).ok()?;
-    Some(path.parent().unwrap_or(Path::new("")).join(&yaml.image))
+    Some(image_beside(path, &yaml.image))
+}
+
+/// The image a map YAML at `yaml` names, `image` resolved beside it (as `map_server` does).
+fn image_beside(yaml: &Path, image: &str) -> PathBuf {
+    yaml.parent().unwrap_or(Path::new("")).join(image)
 }
