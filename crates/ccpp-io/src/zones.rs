@@ -351,6 +351,10 @@ fn is_point(v: &Value) -> bool {
     }
 }
 
+/// What a YAML zone file that mixes a polygon's points and lists of points should be.
+const MIXED_FORMS: &str =
+    "give one polygon as a list of x,y points, or several as a list of such lists";
+
 /// Polygons of a YAML polygon list (one polygon, a list of them, or `polygons: [...]`).
 fn yaml_polygons(v: &Value) -> Result<Vec<Polygon>, ZoneFileError> {
     // A misspelt or foreign key beside `polygons` (`frame: odom`, `keepout: false`) would be
@@ -380,7 +384,7 @@ fn yaml_polygons(v: &Value) -> Result<Vec<Polygon>, ZoneFileError> {
             .position(|p| matches!(p, Value::Array(q) if q.first().is_some_and(is_point)))
         {
             return Err(bad(format!(
-                "item {} is a list of points while item 1 is a point: give one polygon as a list of x,y points, or several as a list of such lists",
+                "item {} is a list of points while item 1 is a point: {MIXED_FORMS}",
                 k + 1
             )));
         }
@@ -389,7 +393,7 @@ fn yaml_polygons(v: &Value) -> Result<Vec<Polygon>, ZoneFileError> {
     // Several polygons: a point among them mixes the two forms the other way.
     if let Some(k) = a.iter().position(is_point) {
         return Err(bad(format!(
-            "item {} is a point while item 1 is a list of points: give one polygon as a list of x,y points, or several as a list of such lists",
+            "item {} is a point while item 1 is a list of points: {MIXED_FORMS}",
             k + 1
         )));
     }
