@@ -709,10 +709,6 @@ mod tests {
         assert_eq!(names(d.path()).len(), 1);
     }
 
-    /// Threads saving into one folder (Python's `save()` from a thread pool) interleaved their
-    /// renames: "Directory not empty", "No such file", and hidden `.out.ccpp-old-*` copies
-    /// left beside the folder. The swaps now take turns: every save succeeds and the folder
-    /// holds one whole set.
     /// Another process's swap can take the old folder away between the look and the rename
     /// (two `ccpp run --out o` at once): the swap goes round again instead of failing with
     /// "No such file or directory".
@@ -740,6 +736,10 @@ mod tests {
         assert!(!staging.exists() && !old.exists());
     }
 
+    /// Threads saving into one folder (Python's `save()` from a thread pool) interleaved their
+    /// renames: "Directory not empty", "No such file", and hidden `.out.ccpp-old-*` copies
+    /// left beside the folder. The swaps now take turns: every save succeeds and the folder
+    /// holds one whole set.
     #[test]
     fn threads_writing_one_folder_take_turns() {
         let d = tempfile::tempdir().unwrap();

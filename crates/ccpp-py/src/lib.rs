@@ -1046,8 +1046,8 @@ fn check_tolerance(t: f64) -> PyResult<()> {
     }
 }
 
-/// A route's waypoints as an `(N, 3)` array.
-/// The route's waypoints as the exports write them ([`ccpp_io::export::tidy`]).
+/// A route's waypoints as an `(N, 3)` array, as the exports write them
+/// ([`ccpp_io::export::tidy`]).
 fn route_array<'py>(py: Python<'py>, route: &Route) -> Bound<'py, PyArray2<f64>> {
     let v: Vec<f64> = ccpp_io::export::tidy(route)
         .waypoints
