@@ -497,3 +497,53 @@ fn a_bench_names_the_earlier_runs_its_summary_leaves_out() {
     let o = bench(&out, "ba-star,bsa").output().unwrap();
     assert!(!stderr_of(&o).contains("note:"), "{}", stderr_of(&o));
 }
+
+/// An output folder that is the working directory, or holds it, under any name but `.`
+/// (refused by its name) was taken: `ccpp run --out ../out` from inside `out` swapped the
+/// folder away, the shell was left in a deleted folder, and every relative path failed there.
+#[test]
+fn the_working_directory_is_no_output_folder_by_any_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = data("teb_empty_box.png");
+    let out = dir.path().join("up").join("out");
+    let first = ccpp()
+        .args(["run", "--planner", "bsa", "--map"])
+        .arg(&map)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(first.status.success(), "{}", stderr_of(&first));
+    let before: Vec<(String, Vec<u8>)> = entries(&out)
+        .into_iter()
+        .map(|n| (n.clone(), std::fs::read(out.join(&n)).unwrap()))
+        .collect();
+    let up = dir.path().join("up");
+    for (sub, planner) in [("run", "bsa"), ("plan", "bcd")] {
+        for target in [PathBuf::from("../out"), out.clone(), up.clone()] {
+            let o = ccpp()
+                .current_dir(&out)
+                .args([sub, "--planner", planner, "--map"])
+                .arg(&map)
+                .arg("--out")
+                .arg(&target)
+                .output()
+                .unwrap();
+            assert_eq!(o.status.code(), Some(1), "{sub} {}", target.display());
+            let e = stderr_of(&o);
+            assert_eq!(
+                e,
+                format!(
+                    "error: output folder {} is the working directory or holds it, which \
+                     writing the folder would remove; choose another folder\n",
+                    target.display()
+                )
+            );
+        }
+    }
+    let after: Vec<(String, Vec<u8>)> = entries(&out)
+        .into_iter()
+        .map(|n| (n.clone(), std::fs::read(out.join(&n)).unwrap()))
+        .collect();
+    assert_eq!(after, before);
+}

@@ -206,6 +206,18 @@ pub enum FolderError {
         /// The input file inside it (links resolved).
         input: PathBuf,
     },
+    /// The folder is the working directory or holds it (`--out ../here` run from `here`): the
+    /// swap would remove the folder the process and its shell or notebook are in, and every
+    /// relative path used there afterwards fails.
+    #[error(
+        "output folder {} is the working directory or holds it, which writing the folder would \
+         remove; choose another folder",
+        path.display()
+    )]
+    HoldsWorkingDirectory {
+        /// The output folder.
+        path: PathBuf,
+    },
     /// Reading, creating, writing or renaming failed.
     #[error("cannot write output folder {}: {source}", path.display())]
     Io {
@@ -273,11 +285,13 @@ pub fn staging_path(parent: &Path, name: &str, kind: &str) -> PathBuf {
 }
 
 /// Checks that `target` is absent, or a folder holding only run files ([`is_run_file_name`]:
-/// [`RUN_FILES`] and the `.tmp` of one of them left by an interrupted atomic write).
+/// [`RUN_FILES`] and the `.tmp` of one of them left by an interrupted atomic write) that is
+/// not the working directory nor above it (`.` is refused by its name; `../here` from `here`
+/// was taken, and the swap removed the folder the process was in).
 ///
 /// # Errors
-/// [`FolderError::NotAFolder`], [`FolderError::Foreign`], or [`FolderError::Io`] when the
-/// folder cannot be read.
+/// [`FolderError::NotAFolder`], [`FolderError::HoldsWorkingDirectory`],
+/// [`FolderError::Foreign`], or [`FolderError::Io`] when the folder cannot be read.
 pub fn check_run_folder(target: &Path) -> Result<(), FolderError> {
     let Ok(meta) = std::fs::symlink_metadata(target) else {
         return Ok(());
@@ -286,6 +300,15 @@ pub fn check_run_folder(target: &Path) -> Result<(), FolderError> {
         return Err(FolderError::NotAFolder {
             path: target.to_path_buf(),
         });
+    }
+    // (the working directory as the system resolves it, against the folder resolved likewise;
+    // either unknown, e.g. a working directory removed meanwhile: nothing to keep)
+    if let (Ok(cwd), Ok(folder)) = (std::env::current_dir(), std::fs::canonicalize(target)) {
+        if cwd.starts_with(&folder) {
+            return Err(FolderError::HoldsWorkingDirectory {
+                path: target.to_path_buf(),
+            });
+        }
     }
     let io_err = |source| FolderError::Io {
         path: target.to_path_buf(),
