@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import subprocess
 from pathlib import Path
 
@@ -59,6 +60,18 @@ def test_sweep_equals_bench(shared_maps: Path, ccpp_bin: str, tmp_path: Path, cl
         assert (Path(row.dir) / "metrics.json").is_file()
         rel = Path(row.dir).relative_to(sweep_out)
         assert (bench_out / rel / "trace.jsonl").read_bytes() == (Path(row.dir) / "trace.jsonl").read_bytes()
+    # A sweep into the bench's folder is refused before any run: it writes no summary, and its
+    # runs (another radius) replaced run folders that the bench's results.csv went on telling.
+    summary = (bench_out / "results.csv").read_bytes()
+    run = bench_out / "runs" / COMPARE_MAPS[0] / planners[0] / "metrics.json"
+    before = run.read_bytes()
+    with pytest.raises(ccpp.CcppError, match=r"holds plots, the summary of an earlier ccpp bench"):
+        ccpp.sweep(maps[:1], planners[:1], [0.2], client=client, out=bench_out)
+    assert (bench_out / "results.csv").read_bytes() == summary
+    assert run.read_bytes() == before
+    # Its own folder is taken again (the run folders replaced whole).
+    again = ccpp.sweep(maps[:1], planners[:1], [0.2], client=client, out=sweep_out)
+    assert json.loads((Path(again.dir[0]) / "metrics.json").read_text())["robot_radius_m"] == 0.2
 
 
 def test_sweep_radii_and_errors(room: Path, tmp_path: Path, client) -> None:
@@ -83,8 +96,6 @@ def test_sweep_radii_and_errors(room: Path, tmp_path: Path, client) -> None:
 
 
 def test_sweep_refuses_what_it_would_ignore(room: Path, tmp_path: Path, client) -> None:
-    import json
-
     from conftest import write_room
 
     # A scheduler beside a client would be ignored.

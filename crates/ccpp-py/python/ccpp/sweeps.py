@@ -72,29 +72,35 @@ def _map_names(paths: list[Path]) -> list[tuple[Path, str]]:
 
 
 def _check_out(out: str | os.PathLike[str]) -> None:
-    """As ``ccpp bench --out``: ``out`` is absent or a folder holding only what a bench writes
-    (``results.csv``, ``results.md``, ``plots/``, ``runs/``, a cut-short ``*.tmp``), so that the
-    runs are never mixed with a user's own files."""
+    """``out`` is absent or a folder holding only a sweep's runs (``runs/``, the folder lock),
+    so that the runs are never mixed with a user's own files. A folder with a bench's summary
+    (``results.csv``, ``results.md``, ``plots/``) is refused too: a sweep writes no summary, and
+    its runs would replace run folders that summary describes (``ccpp bench`` removes an
+    earlier summary before its runs; a sweep left it, telling another radius's figures)."""
     p = Path(out)
     if not p.exists() and not p.is_symlink():
         return
     if p.is_symlink() or not p.is_dir():
         raise _ccpp.CcppError(f"output folder {p} exists and is not a plain folder")
     for e in sorted(p.iterdir()):
-        if e.name in ("results.csv", "results.md"):
-            known = e.is_file() and not e.is_symlink()
-        elif e.name in ("plots", "runs"):
+        if e.name in ("results.csv", "results.md", "plots", "results.csv.tmp", "results.md.tmp"):
+            raise _ccpp.CcppError(
+                f"output folder {p} holds {e.name}, the summary of an earlier ccpp bench, which a "
+                "sweep does not rewrite and its runs would contradict; choose a new folder or "
+                "remove results.csv, results.md and plots/ first"
+            )
+        if e.name == "runs":
             known = e.is_dir() and not e.is_symlink()
         elif e.name == _ccpp.LOCK_FILE:
             # A bench's or sweep's lock: held by a live one (refused when taken), or left by
             # a killed one (taken over).
             known = e.is_file() and not e.is_symlink()
         else:
-            known = e.name in ("results.csv.tmp", "results.md.tmp") and e.is_file()
+            known = False
         if not known:
             raise _ccpp.CcppError(
                 f"output folder {p} holds {e.name}, which a sweep or ccpp bench did not write; "
-                "a sweep writes its runs there, so choose a new or bench-only folder"
+                "a sweep writes its runs there, so choose a new folder or one a sweep wrote"
             )
 
 
@@ -179,7 +185,8 @@ def sweep(
     is that planner); ``radii`` (one number, or several) are checked (with ``tool_radius``)
     before any task starts, and a radius given twice runs once. With ``out``, each run's files
     are written to ``out/runs/MAP/PLANNER`` (with several radii, ``out/runs/r<RADIUS>/MAP/PLANNER``),
-    as ``ccpp bench --out`` does, and ``out`` must be absent or hold only a bench's files.
+    as ``ccpp bench --out`` does, and ``out`` must be absent or hold only a sweep's runs (a
+    folder with a bench's summary is refused: a sweep writes none).
     ``None`` for any keyword is its default. A run the simulator stopped early has that reason
     (``stalled``, ``max_steps``) as its ``status``. The cluster is ``client`` or ``scheduler`` (not both). Failed
     runs are rows with ``status == "error"`` and the message in ``error``. Returns a pandas
@@ -257,6 +264,9 @@ def sweep(
                 tasks.append((str(m), map_name, p, r, tool_radius, inflate, max_memory_mb, d))
 
     with _folder_lock(out) if out is not None else contextlib.nullcontext():
+        if out is not None:
+            # Again under the lock: a bench may have finished there since the first check.
+            _check_out(out)
         rows = _gather(tasks, client, scheduler)
     df = pd.DataFrame(rows, columns=CSV_COLUMNS)
     if len(radii) > 1:
