@@ -589,17 +589,12 @@ impl Job {
             .memory_limit(a.limits.max_memory)
             .zones(a.zones.area.clone(), a.zones.keepout.clone())
             .build()
-            .map_err(|e| name_flag(e, &given))?;
+            .map_err(|e| name_flag(e.naming_landmarks(a.landmarks.as_deref()), &given))?;
         let map = load_recipe(&scenario.map, scenario.max_memory_mb)?;
         scenario
             .check_map(&map)
-            .map_err(|e| match (e, &a.landmarks) {
-                // A landmark the map never sees: name the landmark file, not only the map.
-                (ScenarioError::Invalid(m), Some(p)) if m.starts_with("landmark ") => {
-                    anyhow::anyhow!("landmarks {}: {m}", p.display())
-                }
-                (e, _) => name_flag(e, &given),
-            })?;
+            // A landmark the map never sees: name the landmark file, not only the map.
+            .map_err(|e| name_flag(e.naming_landmarks(a.landmarks.as_deref()), &given))?;
         scenario.check_run().map_err(|e| name_flag(e, &given))?;
         Ok(Self {
             scenario,

@@ -21,6 +21,7 @@
 //! * [`warnings`]: the warnings of a finished run (stderr of `ccpp run`, Python's
 //!   `RunResult.warnings`);
 //! * [`lock`]: the lock a bench or a Python sweep holds on its output folder;
+//! * [`message`]: errors as the one-line messages the command line prints and Python raises;
 //! * [`phase`]: optional phase timing (`CCPP_PHASES`);
 //! * [`mod@file`]: opening user files (regular files only: a FIFO is refused, not read forever).
 //!
@@ -35,6 +36,7 @@ pub mod georef;
 pub mod landmarks;
 pub mod lock;
 pub mod map;
+pub mod message;
 pub mod names;
 pub mod phase;
 pub mod plan;

@@ -205,6 +205,22 @@ pub enum ScenarioError {
     NoMapPath,
 }
 
+impl ScenarioError {
+    /// This error with the landmarks file named when it is about a landmark (one the map never
+    /// sees, a bad heading): the scenario holds its landmarks as read, so its own message
+    /// names the landmark only, and the command line and Python name the file `file` they read
+    /// them from (Python named none where the command line did).
+    #[must_use]
+    pub fn naming_landmarks(self, file: Option<&Path>) -> Self {
+        match (self, file) {
+            (Self::Invalid(m), Some(p)) if m.starts_with("landmark ") => {
+                Self::Invalid(format!("landmarks {}: {m}", p.display()))
+            }
+            (e, _) => e,
+        }
+    }
+}
+
 impl From<OptionsError> for ScenarioError {
     fn from(e: OptionsError) -> Self {
         Self::Options(e)

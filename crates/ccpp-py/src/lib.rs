@@ -44,28 +44,10 @@ create_exception!(
      The message is the one-line message of the command line."
 );
 
-/// The error and its causes as one line, each cause once (as the command line prints them):
-/// a cause whose text the line already holds is skipped (`cannot read /tmp: not a regular
-/// file` was followed by `: not a regular file`), one that repeats the line and adds to it
-/// replaces it.
-fn chain(e: &(dyn std::error::Error + 'static)) -> String {
-    let mut s = e.to_string();
-    let mut cur = e.source();
-    while let Some(c) = cur {
-        let text = c.to_string();
-        if text.starts_with(&s) {
-            s = text;
-        } else if !text.is_empty() && !s.contains(&text) {
-            s.push_str(": ");
-            s.push_str(&text);
-        }
-        cur = c.source();
-    }
-    s
-}
-
+/// The error and its causes as the command line's one-line message
+/// ([`ccpp_io::message::one_line`]: each cause once, no YAML snippet or library advice).
 fn err(e: &(dyn std::error::Error + 'static)) -> PyErr {
-    CcppError::new_err(chain(e))
+    CcppError::new_err(ccpp_io::message::one_line(e))
 }
 
 fn msg(m: impl Into<String>) -> PyErr {
@@ -1258,7 +1240,8 @@ impl RunResult {
     }
 
     /// The trace's events, in order: dicts with the step counter `t`, the `event` kind and its
-    /// fields (as in `trace.jsonl`).
+    /// fields (as in `trace.jsonl`, except that a `backtrack_list` event holds its whole list
+    /// as `points`, where the file stores most as a `delta` against the list before).
     #[getter]
     fn events(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
         let ev: Vec<Record> = self
@@ -1407,12 +1390,8 @@ fn run(
     // The files the run reads (`save` refuses a folder holding one): the scenario's, and a
     // landmarks file, which the scenario holds as read.
     let mut inputs = scenario.input_files();
-    if let Some(Ok(path)) = options
-        .and_then(|o| o.get_item("landmarks").ok().flatten())
-        .map(|v| v.extract::<PathBuf>())
-    {
-        inputs.push(path);
-    }
+    let landmarks_file = landmarks_file(options);
+    inputs.extend(landmarks_file.clone());
     name_map(&mut prepared, &scenario);
     let (scenario, prepared) = (Arc::new(scenario), Arc::new(prepared));
     let (sc, pm) = (Arc::clone(&scenario), Arc::clone(&prepared));
@@ -1427,7 +1406,7 @@ fn run(
             (run, w)
         })
     })?
-    .map_err(|e| err(&e))?;
+    .map_err(|e| err(&e.naming_landmarks(landmarks_file.as_deref())))?;
     let scenario = Arc::unwrap_or_clone(scenario);
     Ok(RunResult {
         scenario,
@@ -1437,6 +1416,14 @@ fn run(
         start_warning,
         inputs,
     })
+}
+
+/// The landmarks file of `options` (`landmarks=` given as a file name), if any: the scenario
+/// holds the landmarks as read, and `save` and error messages name their file.
+fn landmarks_file(options: Option<&Bound<'_, PyDict>>) -> Option<PathBuf> {
+    options
+        .and_then(|o| o.get_item("landmarks").ok().flatten())
+        .and_then(|v| v.extract::<PathBuf>().ok())
 }
 
 /// Gives the prepared map the scenario's map name (`name=`), which the metrics, the exports
@@ -1625,13 +1612,15 @@ fn bench_run(
         }
         let map = recipe
             .load_within(max_memory_mb.unwrap_or(ccpp_io::scenario::DEFAULT_MAX_MEMORY_MB))
-            .map_err(|e| chain(&e))?;
+            .map_err(|e| ccpp_io::message::one_line(&e))?;
         let scenario = Scenario::configure(map.recipe.clone(), PlannerConfig::new(kind))
             .robot(robot)
             .memory_limit(max_memory_mb)
             .build()
-            .map_err(|e| chain(&e))?;
-        let run = scenario.run_on(&map).map_err(|e| chain(&e))?;
+            .map_err(|e| ccpp_io::message::one_line(&e))?;
+        let run = scenario
+            .run_on(&map)
+            .map_err(|e| ccpp_io::message::one_line(&e))?;
         if let Some(dir) = &out {
             ccpp_render::run_files::write_run_files(
                 dir,
@@ -1641,7 +1630,7 @@ fn bench_run(
                 &run.metrics,
                 &[],
             )
-            .map_err(|e| chain(&e))?;
+            .map_err(|e| ccpp_io::message::one_line(&e))?;
         }
         Ok(run.metrics)
     });

@@ -554,3 +554,86 @@ def test_a_step_cap_bounds_random_bounce_estimate(room: Path) -> None:
     # Without a cap of its own the default one (5e7 steps) still needs gigabytes.
     with pytest.raises(ccpp.CcppError, match="5.0e7 strides"):
         ccpp.run(room, "random-bounce", budget_m=1e12)
+
+
+def test_errors_are_the_command_lines_one_line_messages(room: Path, tmp_path: Path, ccpp_bin: str) -> None:
+    # Python joined the causes as they came: a YAML syntax error in a zone file was an
+    # eight-line message with the source snippet and a nested `error:`, a map YAML with a
+    # duplicate key carried the YAML library's advice to programmers, and an alias bomb the
+    # library's raw budget text. Now the command line's one line, word for word.
+    ko = tmp_path / "ko.yaml"
+    ko.write_text("- [3, 3]\n- [4, 3\n- [4, 4]\n")
+    dup = tmp_path / "dup.yaml"
+    dup.write_text("image: room.pgm\nimage: y.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n")
+    bomb = tmp_path / "bomb.yaml"
+    lines = ['a0: &a0 ["x","x","x","x","x","x","x","x","x","x"]']
+    lines += [f"a{i}: &a{i} [" + ",".join([f"*a{i - 1}"] * 10) + "]" for i in range(1, 9)]
+    bomb.write_text("\n".join(lines + ["image: room.pgm", "resolution: 0.05", "origin: [0, 0, 0]"]) + "\n")
+    out = tmp_path / "out"
+    for call, cli in [
+        (lambda: ccpp.run(room, "bsa", keepout=str(ko)),
+         ["run", "--map", str(room), "--planner", "bsa", "--keepout", str(ko), "--out", str(out)]),
+        (lambda: ccpp.load_map(dup), ["info", "--map", str(dup)]),
+        (lambda: ccpp.load_map(bomb), ["info", "--map", str(bomb)]),
+    ]:
+        with pytest.raises(ccpp.CcppError) as e:
+            call()
+        py = str(e.value)
+        p = subprocess.run([ccpp_bin, *cli], capture_output=True, text=True, timeout=60)
+        assert p.returncode == 1
+        assert p.stderr == f"error: {py}\n"
+        assert "\n" not in py and "DuplicateKeyPolicy" not in py and "budget breached" not in py
+        assert "error:" not in py
+
+
+def test_a_landmark_off_the_map_names_its_file(tmp_path: Path, ccpp_bin: str, shared_maps: Path) -> None:
+    # The command line named the landmarks file; Python named only the landmark and the map.
+    m = shared_maps / "teb_maze.yaml"
+    lm = tmp_path / "far.csv"
+    lm.write_text("id,x,y\n1,100,100\n")
+    with pytest.raises(ccpp.CcppError) as e:
+        ccpp.run(m, "ba-star", odometry_noise=0.02, landmarks=str(lm))
+    assert str(e.value).startswith(f"landmarks {lm}: landmark 0 (id 1) at (100, 100) lies more than")
+    p = subprocess.run(
+        [ccpp_bin, "run", "--map", str(m), "--planner", "ba-star", "--odometry-noise", "0.02",
+         "--landmarks", str(lm), "--out", str(tmp_path / "out")],
+        capture_output=True, text=True, timeout=60,
+    )
+    assert p.stderr == f"error: {e.value}\n"
+
+
+def test_save_refuses_the_working_directory_by_any_name(room: Path, tmp_path: Path) -> None:
+    # `.` was refused by its name, but `../out` or the absolute path of the working directory
+    # was taken: the swap removed the folder the interpreter was in, and every relative path
+    # failed afterwards.
+    r = ccpp.run(room, "bsa")
+    out = tmp_path / "up" / "out"
+    r.save(out)
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    here = os.getcwd()
+    os.chdir(out)
+    try:
+        for target in ("../out", str(out)):
+            with pytest.raises(ccpp.CcppError, match="is the working directory or holds it"):
+                r.save(target)
+        with pytest.raises(ccpp.CcppError, match="is the working directory or holds it"):
+            r.save(str(tmp_path / "up"))
+        assert os.getcwd() == str(out.resolve())
+    finally:
+        os.chdir(here)
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before
+
+
+def test_events_are_the_trace_files_but_for_whole_backtrack_lists(room: Path, tmp_path: Path) -> None:
+    # As documented: every event equals its line in trace.jsonl, except that a backtrack list
+    # is whole (`points`) where the file may store a `delta`.
+    r = ccpp.run(room, "ba-star")
+    r.save(tmp_path / "out")
+    lines = [json.loads(x) for x in (tmp_path / "out" / "trace.jsonl").read_text().splitlines()]
+    events = [x for x in lines if "event" in x]
+    assert len(events) == len(r.events)
+    for a, b in zip(r.events, events):
+        if a["event"] == "backtrack_list":
+            assert b["event"] == "backtrack_list" and a["t"] == b["t"] and "points" in a
+        else:
+            assert a == b

@@ -60,7 +60,9 @@ class RunResult:
         """Pixels the tool can reach from the start, (height, width), image layout."""
     @property
     def events(self) -> list[dict[str, Any]]:
-        """Trace events as in trace.jsonl (with the step counter ``t``)."""
+        """Trace events as in trace.jsonl (with the step counter ``t``), except that every
+        ``backtrack_list`` event holds its whole list as ``points`` (the file stores most of them
+        as a ``delta`` against the list before)."""
     @property
     def stop(self) -> str:
         """``"done"``, ``"stalled"`` (no progress for 1000 motions in a row) or ``"max_steps"``."""
