@@ -546,8 +546,11 @@ pub fn replay_html(
 ) -> Result<String, RenderError> {
     let crop = crop_box(world, trace);
     let bg = base64::engine::general_purpose::STANDARD.encode(background_png(world, crop)?);
-    // `</` inside the script (a map or planner name) must not end it early.
-    let data = replay_data(world, trace, tile_side, metrics_json, crop).replace("</", "<\\/");
+    // No `<` in the script's data at all: `</script>` in a map or planner name would end the
+    // script early, and `<!--<script>` (escaping `</` alone let it through) puts the HTML
+    // parser in a state where the real `</script>` no longer ends it: a blank, dead page. In
+    // JSON a `<` can only stand in a string, where `\u003c` is the same character.
+    let data = replay_data(world, trace, tile_side, metrics_json, crop).replace('<', "\\u003c");
     let title = title
         .replace('&', "&amp;")
         .replace('<', "&lt;")

@@ -653,3 +653,36 @@ fn the_step_count_runs_along_a_lane_and_ends_at_the_runs_end() {
     assert_eq!(step_cell("at=0.6"), "60 / 1,100");
     assert_eq!(step_cell("frame=last"), "1,100 / 1,100");
 }
+
+/// A map named `room<!--<script>` (a legal file name) gave a blank page whose script never
+/// ran: the page escaped `</` in its data but not `<!--`, and `<!--<script>` inside a script
+/// keeps the HTML parser from ending it at `</script>`. The data now holds no `<` at all.
+#[test]
+fn a_map_name_with_html_comment_and_script_tags_still_replays() {
+    let (world, trace) = run(30, 20, 3);
+    let name = "room<!--<script></script>";
+    let metrics = format!(
+        r#"{{"planner":"ba-star","map":{},"effective_coverage":0.5,"path_length_m":1.0}}"#,
+        serde_json::to_string(name).expect("json")
+    );
+    let html = replay_html(&world, &trace, None, &metrics, &format!("ba-star on {name}"))
+        .expect("page");
+    let script = html
+        .split("const D = ")
+        .nth(1)
+        .and_then(|s| s.split(";\n").next())
+        .expect("the data");
+    assert!(!script.contains('<'), "{script}");
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("replay-odd-name");
+    std::fs::create_dir_all(&dir).expect("dir");
+    std::fs::write(dir.join("page.html"), &html).expect("write");
+    let Some(chrome) = require_chromium() else {
+        return;
+    };
+    let _serial = BROWSER
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    let url = format!("file://{}#selftest", dir.join("page.html").display());
+    let v = self_test(&chrome, &url, true);
+    assert_eq!(v["pass"], true, "{v}");
+}
