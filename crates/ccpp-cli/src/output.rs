@@ -159,8 +159,8 @@ fn folder_identity(dir: &Path) -> Option<(u64, u64)> {
 }
 
 /// The figures of `metrics.json` that [`check_metrics_of_run`] computes again from the trace
-/// (all but the planner's wall time, which no trace records; the stop reason is the one the
-/// trace's `finished` record gives).
+/// (all but the planner's wall time, which no trace records and which must only be a time; the
+/// stop reason is the one the trace's `finished` record gives).
 const RECOMPUTED: [&str; 19] = [
     "robot_radius_m",
     "tool_radius_m",
@@ -254,6 +254,20 @@ fn check_metrics_of_run(
                 want.map_or_else(|| "(none)".to_string(), ToString::to_string),
             );
         }
+    }
+    // The one figure no trace records: at least a time a run can have taken (a string there
+    // was shown in the page's panel and pushed every other value out of view).
+    let wall = reported.get("wall_time_s");
+    if !wall
+        .and_then(serde_json::Value::as_f64)
+        .is_some_and(|t| t.is_finite() && t >= 0.0)
+    {
+        bail!(
+            "{}: metrics.json reports wall_time_s {}, not a run's time (seconds, a finite \
+             number >= 0): a file was edited",
+            dir.display(),
+            wall.map_or_else(|| "(none)".to_string(), ToString::to_string),
+        );
     }
     Ok(out.trace)
 }

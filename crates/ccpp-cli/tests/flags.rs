@@ -1175,6 +1175,26 @@ fn replay_refuses_a_folder_that_mixes_two_runs() {
         &["metrics.json reports stop_reason \"stalled\"", "(none)"],
         10,
     );
+    // The wall time, which no trace records, must still be a time: a string there was drawn
+    // in the panel and pushed every other value out of view.
+    let w = run_ok(dir, "w", &map, "ba-star", &[]);
+    let text = std::fs::read_to_string(w.join("metrics.json")).unwrap();
+    let at = text.find("\"wall_time_s\": ").unwrap() + "\"wall_time_s\": ".len();
+    let end = at + text[at..].find(['\n', ',', '}']).unwrap();
+    for bad in ["\"a very long text\"", "-5", "null"] {
+        std::fs::write(
+            w.join("metrics.json"),
+            format!("{}{bad}{}", &text[..at], &text[end..]),
+        )
+        .unwrap();
+        fails(
+            &["replay"],
+            &[&w],
+            &[&format!("metrics.json reports wall_time_s {bad}, not a run's time")],
+            10,
+        );
+        assert!(!w.join("replay.html").exists());
+    }
     // A folder as its run wrote it replays.
     ccpp().arg("replay").arg(&b).assert().success();
     assert!(b.join("replay.html").exists());
