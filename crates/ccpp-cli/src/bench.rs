@@ -25,11 +25,13 @@ use crate::staging::write_file;
 pub const PANIC_ENV: &str = "CCPP_TEST_PANIC_PLANNER";
 
 /// What defines a bench run, as written to its `bench-key.txt`: a finished run is reused only
-/// when this matches exactly. Covers the map's content (after inflation), the planner, its own
+/// when this matches exactly. Covers the map's content (after inflation) and its recipe as
+/// `run.json` records it (path, bench name, inflation), the planner, its own
 /// options (random-bounce's seed included; another planner's options or a `--seed` for
 /// random-bounce redid every run), the robot, the simulator settings and the ccpp version.
 pub fn run_key(
     grid_hash: u64,
+    recipe: &ccpp_io::scenario::MapRecipe,
     planner: &str,
     options: &PlannerOptions,
     robot: ccpp_core::world::Robot,
@@ -38,12 +40,16 @@ pub fn run_key(
     let kind: ccpp_core::planners::PlannerKind = planner.parse()?;
     let mut h = ccpp_core::hash::Fnv::new();
     h.bytes(&grid_hash.to_le_bytes());
+    // The map's recipe (path, name, inflation) as run.json records it: a run of the same map
+    // read from another place was reused with its run.json naming the old path, which
+    // `ccpp replay` then could not find.
+    h.bytes(serde_json::to_string(recipe)?.as_bytes());
     h.bytes(planner.as_bytes());
     h.bytes(serde_json::to_string(&options.config(kind))?.as_bytes());
     h.bytes(serde_json::to_string(&robot)?.as_bytes());
     h.bytes(serde_json::to_string(sim)?.as_bytes());
     h.bytes(env!("CARGO_PKG_VERSION").as_bytes());
-    Ok(format!("ccpp-bench-key v2 {:016x}\n", h.finish()))
+    Ok(format!("ccpp-bench-key v3 {:016x}\n", h.finish()))
 }
 
 /// Runs the benchmark.
@@ -129,6 +135,11 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     let prepared: Vec<(PathBuf, Result<PreparedMap, String>)> = maps
         .par_iter()
         .map(|(m, name)| {
+            // A file of a maps folder named with a newline: the row's error said `map maps/new`
+            // (the message cut at the newline), where `ccpp run` names the character.
+            if let Some(problem) = ccpp_io::names::path_text_problem(m, "map") {
+                return (m.clone(), Err(problem));
+            }
             let args = MapArgs {
                 map: m.clone(),
                 inflate: a.inflate,
@@ -136,7 +147,13 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             };
             let map = prepare_map(&args, a.limits.max_memory_mb())
                 .map(|mut p| {
-                    p.name.clone_from(name);
+                    // The bench's name when it is not the map's own (`FOLDER-NAME` for two
+                    // maps of one file name): in the recipe too, so that run.json names the
+                    // map as metrics.json does (`ccpp replay` refused such runs as mixed).
+                    if p.name != *name {
+                        p.name.clone_from(name);
+                        p.recipe.name = Some(name.clone());
+                    }
                     p
                 })
                 .map_err(|e| crate::errors::one_line(&e));
@@ -416,7 +433,7 @@ fn run_one(
     let map = map.as_ref().map_err(Clone::clone)?;
     let sim = SimConfig::default();
     let key = grid_hash
-        .map(|h| run_key(h, planner, options, robot, &sim))
+        .map(|h| run_key(h, &map.recipe, planner, options, robot, &sim))
         .transpose()
         .map_err(|e| crate::errors::one_line(&e))?
         .unwrap_or_default();
@@ -794,7 +811,11 @@ fn earlier_runs_note(out: &Path, rows: &[Row]) -> Option<String> {
         planners.sort_by_key(std::fs::DirEntry::file_name);
         for p in planners {
             let planner = p.file_name().to_string_lossy().into_owned();
-            let ours = rows.iter().any(|r| r.map == map && r.planner == planner);
+            // (a run of this bench that failed leaves the earlier bench's folder, which its
+            // error row does not describe, in place)
+            let ours = rows
+                .iter()
+                .any(|r| r.map == map && r.planner == planner && r.outcome.is_ok());
             if !ours && p.path().join("metrics.json").is_file() {
                 left.push(format!("{map}/{planner}"));
             }

@@ -547,3 +547,92 @@ fn the_working_directory_is_no_output_folder_by_any_name() {
         .collect();
     assert_eq!(after, before);
 }
+
+/// Copies the test map `teb_empty_box` (YAML and image) into `folder`, made if missing, under
+/// the file stem `stem`; returns the YAML.
+fn map_copy(folder: &Path, stem: &str) -> PathBuf {
+    std::fs::create_dir_all(folder).unwrap();
+    std::fs::copy(data("teb_empty_box.png"), folder.join(format!("{stem}.png"))).unwrap();
+    let yaml = std::fs::read_to_string(data("teb_empty_box.yaml"))
+        .unwrap()
+        .replace("teb_empty_box.png", &format!("{stem}.png"));
+    let p = folder.join(format!("{stem}.yaml"));
+    std::fs::write(&p, yaml).unwrap();
+    p
+}
+
+fn bench_maps(out: &Path, maps: &[&Path]) -> std::process::Output {
+    let mut c = ccpp();
+    c.args(["bench", "--quiet", "--jobs", "1", "--planners", "ba-star", "--maps"]);
+    for m in maps {
+        c.arg(m);
+    }
+    c.arg("--out").arg(out).output().unwrap()
+}
+
+/// Three ways a bench's run folders could not be replayed or misled (a hostile pass): maps of
+/// one file name in two folders (`site1-box`) were named so in metrics.json but not in run.json,
+/// and `ccpp replay` refused them as mixed; a run reused after the maps folder moved kept a
+/// run.json naming the old path, which replay could not find; and a run that failed on its
+/// second bench left the first bench's folder in place beside an error row, unnamed.
+#[test]
+fn bench_run_folders_replay_and_a_failed_rerun_names_the_old_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (
+        map_copy(&dir.path().join("site1"), "box"),
+        map_copy(&dir.path().join("site2"), "box"),
+    );
+    let out = dir.path().join("b");
+    let o = bench_maps(&out, &[&a, &b]);
+    assert!(o.status.success(), "{}", stderr_of(&o));
+    for site in ["site1-box", "site2-box"] {
+        let run = out.join("runs").join(site).join("ba-star");
+        let o = ccpp().arg("replay").arg(&run).output().unwrap();
+        assert!(o.status.success(), "{site}: {}", stderr_of(&o));
+    }
+    // The maps folder moved: the run is made again, its run.json naming the new path.
+    let out3 = dir.path().join("b3");
+    assert!(bench_maps(&out3, &[&b]).status.success());
+    let moved = dir.path().join("site2-moved");
+    std::fs::rename(dir.path().join("site2"), &moved).unwrap();
+    let o = bench_maps(&out3, &[&moved.join("box.yaml")]);
+    assert!(o.status.success(), "{}", stderr_of(&o));
+    let run = out3.join("runs/box/ba-star");
+    let json = std::fs::read_to_string(run.join("run.json")).unwrap();
+    assert!(json.contains("site2-moved"), "{json}");
+    let o = ccpp().arg("replay").arg(&run).output().unwrap();
+    assert!(o.status.success(), "{}", stderr_of(&o));
+    // A rerun that fails (the map's scale changed: beyond the memory limit) names the earlier
+    // folder it leaves.
+    let c = a;
+    let yaml = std::fs::read_to_string(&c).unwrap();
+    let o = bench_maps(&dir.path().join("b4"), &[&c]);
+    assert!(o.status.success(), "{}", stderr_of(&o));
+    assert!(yaml.contains("resolution: 0.050000"), "{yaml}");
+    std::fs::write(&c, yaml.replace("resolution: 0.050000", "resolution: 0.0001")).unwrap();
+    let o = bench_maps(&dir.path().join("b4"), &[&c]);
+    assert_eq!(o.status.code(), Some(1));
+    let e = stderr_of(&o);
+    assert!(
+        e.contains("also holds 1 run folder of an earlier bench that this summary leaves out (box/ba-star)"),
+        "{e}"
+    );
+}
+
+/// A map file named with a newline in a maps folder: its error row said `map maps/new` (the
+/// message cut at the newline) where `ccpp run` names the character.
+#[test]
+fn a_bench_row_names_a_map_file_with_a_control_character() {
+    let dir = tempfile::tempdir().unwrap();
+    let maps = dir.path().join("maps");
+    map_copy(&maps, "new\nline");
+    map_copy(&maps, "plain");
+    let out = dir.path().join("b");
+    let o = bench_maps(&out, &[&maps]);
+    assert_eq!(o.status.code(), Some(1));
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    assert!(
+        csv.contains("new\\nline.yaml\"\": holds a control character (U+000A); rename it"),
+        "{csv}"
+    );
+}

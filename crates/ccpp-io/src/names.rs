@@ -17,6 +17,24 @@
 
 use std::path::{Path, PathBuf};
 
+/// Why the path `path` (of a `what`: `map`, `georef`, ...) cannot be recorded as ccpp records
+/// paths, as text (`run.json`, `bench-key.txt`, the exports), or printed in a one-line
+/// message: not valid UTF-8, or holding a control character (a newline cut the message naming
+/// it, and a bench's error cell, short: `map maps/new`). `None` when it can.
+pub fn path_text_problem(path: &Path, what: &str) -> Option<String> {
+    let Some(text) = path.to_str() else {
+        return Some(format!(
+            "{what} {}: not valid UTF-8 (ccpp records paths as text, in run.json and the exports); rename it",
+            path.display()
+        ));
+    };
+    let c = text.chars().find(|c| c.is_control())?;
+    Some(format!(
+        "{what} {text:?}: holds a control character (U+{:04X}); rename it",
+        u32::from(c)
+    ))
+}
+
 /// Why the maps given to a sweep are not a list of map files.
 #[derive(Debug, thiserror::Error)]
 pub enum MapListError {

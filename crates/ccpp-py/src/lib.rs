@@ -321,21 +321,12 @@ fn recipe_for(path: &Path) -> PyResult<MapRecipe> {
     Ok(recipe_of(path))
 }
 
-/// Refuses a path that is not valid UTF-8, as the command line does: ccpp records paths as
-/// text (`run.json`, the exports), and such a path used to load and run, then fail at `save`
-/// with a message naming no file.
+/// Refuses a path that is not valid UTF-8 or holds a control character, as the command line
+/// does ([`ccpp_io::names::path_text_problem`]): ccpp records paths as text (`run.json`, the
+/// exports), and such a path used to load and run, then fail at `save` with a message naming
+/// no file.
 fn utf8_path(path: &Path, what: &str) -> PyResult<()> {
-    utf8_problem(path, what).map_or(Ok(()), |m| Err(msg(m)))
-}
-
-/// The message of [`utf8_path`], if `path` is not valid UTF-8.
-fn utf8_problem(path: &Path, what: &str) -> Option<String> {
-    path.to_str().is_none().then(|| {
-        format!(
-            "{what} {}: not valid UTF-8 (ccpp records paths as text, in run.json and the exports); rename it",
-            path.display()
-        )
-    })
+    ccpp_io::names::path_text_problem(path, what).map_or(Ok(()), |m| Err(msg(m)))
 }
 
 /// Loads a map: a ROS `map_server` YAML (with its PGM/PNG) or a bare image. An image whose
@@ -1598,8 +1589,9 @@ fn bench_run(
         radius,
         tool_radius: tool_radius.unwrap_or(radius),
     };
-    // A path that is not UTF-8 is the row's error, as any other map that cannot be run.
-    let bad_path = utf8_problem(&map_path, "map");
+    // A path that is not UTF-8 or holds a control character is the row's error, as any other
+    // map that cannot be run.
+    let bad_path = ccpp_io::names::path_text_problem(&map_path, "map");
     let outcome: Result<Metrics, String> = py.detach(|| {
         if let Some(m) = bad_path {
             return Err(m);
