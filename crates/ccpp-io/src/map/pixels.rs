@@ -32,6 +32,14 @@ const DECODED_BYTES_MAX: u64 = 8;
 /// image (24000 px of 16-bit RGBA: 192 KB a row).
 const DECODER_ROOM: u64 = 4 << 20;
 
+/// Most bytes an image file takes per pixel: a plain (`P3`) PNM of 16-bit RGB samples writes
+/// up to 18 characters a pixel, with room for extra whitespace; binary formats take at most 8.
+const FILE_BYTES_PER_PIXEL: u64 = 24;
+
+/// Room an image file may have beyond its pixels' bytes ([`FILE_BYTES_PER_PIXEL`]) for
+/// metadata and comments (a 6 MB `tEXt` chunk in a 200 x 200 px map loads).
+const METADATA_ROOM: u64 = 16 << 20;
+
 /// The decoder's limits for an image of `pixels` pixels in a file of `file_bytes` bytes: its
 /// allocation cap is the decoded buffer of that many pixels at the widest sample, plus
 /// [`DECODER_ROOM`], plus three times the file's size (a chunk the decoder keeps as it is, such
@@ -152,6 +160,23 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
                 max_pixels: max,
             });
         }
+    }
+    // A file far larger than its pixels can take holds that much metadata (a PNG chunk, a PNM
+    // comment), which the decoder keeps in memory: a 40 x 30 px PNG with a 500 MiB `eXIf`
+    // chunk took 1 GB under `--max-memory 20`.
+    let most = pixels
+        .saturating_mul(FILE_BYTES_PER_PIXEL)
+        .saturating_add(METADATA_ROOM);
+    if file_bytes > most {
+        return Err(MapError::Decode {
+            path: path.to_path_buf(),
+            message: format!(
+                "the file is {file_bytes} bytes for {width} x {height} px, more than such an \
+                 image takes with {} MiB of metadata ({most} bytes); metadata or comments that \
+                 large are refused",
+                METADATA_ROOM >> 20
+            ),
+        });
     }
     inner.seek(SeekFrom::Start(start)).map_err(io_err)?;
     // A PNM sample above its maxval: Netpbm forbids it, and the decoder rescaled it beyond
@@ -327,10 +352,7 @@ fn header_number<R: BufRead>(r: &mut R) -> std::io::Result<Option<u64>> {
             return Ok(None);
         }
         match byte[0] {
-            b'#' => {
-                let mut line = Vec::new();
-                r.read_until(b'\n', &mut line)?;
-            }
+            b'#' => skip_line(r)?,
             b if b.is_ascii_whitespace() => {}
             b if b.is_ascii_digit() => break,
             _ => return Ok(None),
@@ -345,14 +367,30 @@ fn header_number<R: BufRead>(r: &mut R) -> std::io::Result<Option<u64>> {
             // The whitespace (or comment start) after the number: the binary raster begins
             // right after one whitespace byte, so nothing more is read.
             if byte[0] == b'#' {
-                let mut line = Vec::new();
-                r.read_until(b'\n', &mut line)?;
+                skip_line(r)?;
             }
             return Ok(Some(v));
         }
         v = v
             .saturating_mul(10)
             .saturating_add(u64::from(byte[0] - b'0'));
+    }
+}
+
+/// Reads past the next `\n` (or to the end) without keeping what it reads: a PNM header
+/// comment of 500 MiB was read into memory whole.
+fn skip_line<R: BufRead>(r: &mut R) -> std::io::Result<()> {
+    loop {
+        let buf = r.fill_buf()?;
+        if buf.is_empty() {
+            return Ok(());
+        }
+        if let Some(i) = buf.iter().position(|&b| b == b'\n') {
+            r.consume(i + 1);
+            return Ok(());
+        }
+        let n = buf.len();
+        r.consume(n);
     }
 }
 

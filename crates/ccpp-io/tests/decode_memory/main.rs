@@ -120,3 +120,73 @@ fn a_decoded_buffer_that_cannot_be_had_is_an_error() {
         "{e}"
     );
 }
+
+/// A 40 x 30 px grey PNG of free pixels carrying a `tEXt` chunk of `text_mib` MiB.
+fn text_png(text_mib: usize) -> Vec<u8> {
+    let (w, h) = (40u32, 30u32);
+    let mut info = png::Info::with_size(w, h);
+    info.color_type = png::ColorType::Grayscale;
+    info.bit_depth = png::BitDepth::Eight;
+    info.uncompressed_latin1_text.push(png::text_metadata::TEXtChunk::new(
+        "Comment",
+        "A".repeat(text_mib << 20),
+    ));
+    let mut out = Vec::new();
+    let mut e = png::Encoder::with_info(&mut out, info)
+        .unwrap()
+        .write_header()
+        .unwrap();
+    e.write_image_data(&vec![254u8; (w * h) as usize]).unwrap();
+    drop(e);
+    out
+}
+
+/// A file far larger than its pixels can take is refused before the decoder reads its
+/// metadata: a 40 x 30 px PNG with a 500 MiB `eXIf` chunk took 1 GB under `--max-memory 20`
+/// (the decoder's cap admitted three times the file's size). Within 16 MiB of metadata the
+/// file loads (a 6 MB `tEXt` chunk in a small map must).
+#[test]
+fn metadata_far_beyond_the_pixels_is_refused_unread() {
+    let _turn = SERIAL
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    let opts = LoadOptions {
+        resolution: Some(0.05),
+        max_pixels: Some(1 << 24),
+        ..LoadOptions::default()
+    };
+    let big = text_png(40);
+    let e = within_32_mib(|| load_map_bytes(Path::new("text.png"), None, &big, &opts))
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        e.contains("text.png") && e.contains("for 40 x 30 px, more than such an image takes"),
+        "{e}"
+    );
+    drop(big);
+    let small = text_png(6);
+    let m = within_32_mib(|| load_map_bytes(Path::new("text.png"), None, &small, &opts)).unwrap();
+    assert_eq!(m.grid.frame().width, 40);
+}
+
+/// A PNM header comment is skipped, not read into memory: a 500 MiB comment took 518 MB. Here
+/// a 1000 x 1000 px PGM (room for 40 MiB of file) with a 30 MiB comment loads within 32 MiB.
+#[test]
+fn a_long_pnm_comment_is_skipped_unread() {
+    let _turn = SERIAL
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    let (w, h) = (1000usize, 1000usize);
+    let mut pgm = b"P5\n# ".to_vec();
+    pgm.resize(pgm.len() + (30 << 20), b'x');
+    pgm.extend_from_slice(format!("\n{w} {h}\n255\n").as_bytes());
+    pgm.resize(pgm.len() + w * h, 254);
+    let opts = LoadOptions {
+        resolution: Some(0.05),
+        max_pixels: Some(1 << 24),
+        ..LoadOptions::default()
+    };
+    let m = within_32_mib(|| load_map_bytes(Path::new("comment.pgm"), None, &pgm, &opts)).unwrap();
+    assert_eq!(m.grid.frame().width, 1000);
+}
