@@ -1190,7 +1190,9 @@ fn replay_refuses_a_folder_that_mixes_two_runs() {
         fails(
             &["replay"],
             &[&w],
-            &[&format!("metrics.json reports wall_time_s {bad}, not a run's time")],
+            &[&format!(
+                "metrics.json reports wall_time_s {bad}, not a run's time"
+            )],
             10,
         );
         assert!(!w.join("replay.html").exists());

@@ -552,7 +552,11 @@ fn the_working_directory_is_no_output_folder_by_any_name() {
 /// the file stem `stem`; returns the YAML.
 fn map_copy(folder: &Path, stem: &str) -> PathBuf {
     std::fs::create_dir_all(folder).unwrap();
-    std::fs::copy(data("teb_empty_box.png"), folder.join(format!("{stem}.png"))).unwrap();
+    std::fs::copy(
+        data("teb_empty_box.png"),
+        folder.join(format!("{stem}.png")),
+    )
+    .unwrap();
     let yaml = std::fs::read_to_string(data("teb_empty_box.yaml"))
         .unwrap()
         .replace("teb_empty_box.png", &format!("{stem}.png"));
@@ -563,7 +567,15 @@ fn map_copy(folder: &Path, stem: &str) -> PathBuf {
 
 fn bench_maps(out: &Path, maps: &[&Path]) -> std::process::Output {
     let mut c = ccpp();
-    c.args(["bench", "--quiet", "--jobs", "1", "--planners", "ba-star", "--maps"]);
+    c.args([
+        "bench",
+        "--quiet",
+        "--jobs",
+        "1",
+        "--planners",
+        "ba-star",
+        "--maps",
+    ]);
     for m in maps {
         c.arg(m);
     }
@@ -609,7 +621,11 @@ fn bench_run_folders_replay_and_a_failed_rerun_names_the_old_folder() {
     let o = bench_maps(&dir.path().join("b4"), &[&c]);
     assert!(o.status.success(), "{}", stderr_of(&o));
     assert!(yaml.contains("resolution: 0.050000"), "{yaml}");
-    std::fs::write(&c, yaml.replace("resolution: 0.050000", "resolution: 0.0001")).unwrap();
+    std::fs::write(
+        &c,
+        yaml.replace("resolution: 0.050000", "resolution: 0.0001"),
+    )
+    .unwrap();
     let o = bench_maps(&dir.path().join("b4"), &[&c]);
     assert_eq!(o.status.code(), Some(1));
     let e = stderr_of(&o);

@@ -648,3 +648,39 @@ fn plan_says_how_much_of_the_area_it_can_reach() {
         "{stdout}"
     );
 }
+
+/// A mask's image given instead of its YAML was refused as "stream did not contain valid
+/// UTF-8" (a binary PGM or PNG); a mask YAML named `mask.txt` was taken for a mask and then
+/// decoded as an image ("not a PNG or PNM/PGM image"). Each now says what the file is.
+#[test]
+fn a_mask_image_or_a_mask_yaml_misnamed_is_told_apart() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let yaml = mask(dir, "ko", ORIGIN, |x, y| x > 5.0 && y > 0.0);
+    let txt = dir.join("ko.txt");
+    std::fs::copy(&yaml, &txt).unwrap();
+    let binary = dir.join("noise.bin");
+    std::fs::write(&binary, [0xffu8, 0xfe, 0x00, 0x9c, 0x80]).unwrap();
+    let png = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/teb_empty_box.png");
+    let map = house();
+    let pgm = dir.join("ko.pgm");
+    for (zone, needle) in [
+        (pgm.as_path(), "is an image; zones are GeoJSON or YAML polygons, and a keepout mask is given by its map_server YAML"),
+        (png.as_path(), "is an image; zones are GeoJSON or YAML polygons"),
+        (txt.as_path(), "holds a Nav2 mask's map_server YAML (an `image` key) but its name does not end in .yaml or .yml"),
+        (binary.as_path(), "is not a text file; a zone file is GeoJSON, a YAML list of polygons or a Nav2 mask's map_server YAML"),
+    ] {
+        let z = zone.to_str().unwrap();
+        fails(
+            &["info", "--map", map.to_str().unwrap(), "--keepout", z],
+            &[&format!("error: keepout {z}: {needle}")],
+        );
+    }
+    // The mask as its YAML is taken.
+    let o = ccpp()
+        .args(["info", "--map", map.to_str().unwrap(), "--keepout"])
+        .arg(&yaml)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}

@@ -182,11 +182,26 @@ pub const MAX_ZONE_POINTS: usize = 16 * ccpp_core::zones::MAX_POLYGON_POINTS;
 
 /// Reads a zone file: `GeoJSON`, YAML polygons or a Nav2 mask (checked against `frame`).
 fn read_file(path: &Path, frame: &MapFrame) -> Result<ZoneData, ZoneFileError> {
-    let text = crate::file::read_text(path).map_err(|e| bad(e.to_string()))?;
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
+    // A mask's image given instead of its YAML was refused as "stream did not contain valid
+    // UTF-8" (a binary file) or as a YAML error (a plain PGM).
+    if ["png", "pgm", "pnm", "ppm", "pbm", "pam"].contains(&ext.as_str()) || is_png(path) {
+        return Err(bad(
+            "is an image; zones are GeoJSON or YAML polygons, and a keepout mask is given by \
+             its map_server YAML (image, resolution, origin in the map's frame), not by the \
+             bare image",
+        ));
+    }
+    let text = crate::file::read_text(path).map_err(|e| match e.kind() {
+        std::io::ErrorKind::InvalidData => bad(
+            "is not a text file; a zone file is GeoJSON, a YAML list of polygons or a Nav2 \
+             mask's map_server YAML",
+        ),
+        _ => bad(e.to_string()),
+    })?;
     let yaml_ext = ext == "yaml" || ext == "yml";
     if ext == "geojson" || ext == "json" || (!yaml_ext && text.trim_start().starts_with('{')) {
         // Counted before parsing (every point opens a `[`, or a `{` when written as
@@ -204,9 +219,27 @@ fn read_file(path: &Path, frame: &MapFrame) -> Result<ZoneData, ZoneFileError> {
     let v: serde_json::Value = serde_saphyr::from_str(&text)
         .map_err(|e| bad(format!("YAML: {}", crate::file::yaml_words(&e.to_string()))))?;
     if v.get("image").is_some() {
+        // Loaded as a map, which is read as a YAML by its name only: a mask YAML named
+        // `mask.txt` was decoded as an image ("not a PNG or PNM/PGM image").
+        if !yaml_ext {
+            return Err(bad(
+                "holds a Nav2 mask's map_server YAML (an `image` key) but its name does not \
+                 end in .yaml or .yml, which a map_server YAML's must; rename it",
+            ));
+        }
         return read_mask(path, frame).map(ZoneData::Mask);
     }
     within_total(yaml_polygons(&v)?, "YAML")
+}
+
+/// Whether the file at `path` begins with the PNG signature.
+fn is_png(path: &Path) -> bool {
+    use std::io::Read as _;
+    let Ok(f) = crate::file::open_regular(path) else {
+        return false;
+    };
+    let mut head = [0u8; 8];
+    f.take(8).read_exact(&mut head).is_ok() && head == *b"\x89PNG\r\n\x1a\n"
 }
 
 /// The polygons of a zone file, if they hold at most [`MAX_ZONE_POINTS`] vertices in all,

@@ -665,8 +665,14 @@ fn a_map_name_with_html_comment_and_script_tags_still_replays() {
         r#"{{"planner":"ba-star","map":{},"effective_coverage":0.5,"path_length_m":1.0}}"#,
         serde_json::to_string(name).expect("json")
     );
-    let html = replay_html(&world, &trace, None, &metrics, &format!("ba-star on {name}"))
-        .expect("page");
+    let html = replay_html(
+        &world,
+        &trace,
+        None,
+        &metrics,
+        &format!("ba-star on {name}"),
+    )
+    .expect("page");
     let script = html
         .split("const D = ")
         .nth(1)

@@ -127,10 +127,11 @@ fn text_png(text_mib: usize) -> Vec<u8> {
     let mut info = png::Info::with_size(w, h);
     info.color_type = png::ColorType::Grayscale;
     info.bit_depth = png::BitDepth::Eight;
-    info.uncompressed_latin1_text.push(png::text_metadata::TEXtChunk::new(
-        "Comment",
-        "A".repeat(text_mib << 20),
-    ));
+    info.uncompressed_latin1_text
+        .push(png::text_metadata::TEXtChunk::new(
+            "Comment",
+            "A".repeat(text_mib << 20),
+        ));
     let mut out = Vec::new();
     let mut e = png::Encoder::with_info(&mut out, info)
         .unwrap()
