@@ -664,17 +664,51 @@ fn a_mask_image_or_a_mask_yaml_misnamed_is_told_apart() {
     let png = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/teb_empty_box.png");
     let map = house();
     let pgm = dir.join("ko.pgm");
-    for (zone, needle) in [
-        (pgm.as_path(), "is an image; zones are GeoJSON or YAML polygons, and a keepout mask is given by its map_server YAML"),
-        (png.as_path(), "is an image; zones are GeoJSON or YAML polygons"),
-        (txt.as_path(), "holds a Nav2 mask's map_server YAML (an `image` key) but its name does not end in .yaml or .yml"),
-        (binary.as_path(), "is not a text file; a zone file is GeoJSON, a YAML list of polygons or a Nav2 mask's map_server YAML"),
+    // Images by their content too: a PGM and a PNG under another name.
+    let (pgm_dat, png_dat) = (dir.join("ko-pgm.dat"), dir.join("box.dat"));
+    std::fs::copy(&pgm, &pgm_dat).unwrap();
+    std::fs::copy(&png, &png_dat).unwrap();
+    // Not there, and too large for a text input: said as such, not as an image or binary.
+    let missing = dir.join("nothere.png");
+    let big = dir.join("big.geojson");
+    std::fs::File::create(&big)
+        .unwrap()
+        .set_len(70 << 20)
+        .unwrap();
+    let keepout = "is an image; zones are GeoJSON or YAML polygons, and a keepout mask is given by its map_server YAML";
+    let area = "is an image; an area must be polygons (GeoJSON or a YAML list of x,y points) or a rectangle";
+    let not_mask = "is a keepout mask; an area must be polygons";
+    let misnamed = "holds a Nav2 mask's map_server YAML (an `image` key) but its name does not end in .yaml or .yml";
+    for (zone, as_keepout, as_area) in [
+        (pgm.as_path(), keepout, area),
+        (png.as_path(), keepout, area),
+        (pgm_dat.as_path(), keepout, area),
+        (png_dat.as_path(), keepout, area),
+        (txt.as_path(), misnamed, not_mask),
+        (yaml.as_path(), "", not_mask),
+        (
+            binary.as_path(),
+            "is not a text file; a zone file is GeoJSON, a YAML list of polygons or a Nav2 mask's map_server YAML",
+            "is not a text file; an area file is GeoJSON or a YAML list of polygons",
+        ),
+        (missing.as_path(), "No such file or directory", "No such file or directory"),
+        (
+            big.as_path(),
+            "the file is 70.0 MiB, more than the 64 MiB a text input may be",
+            "the file is 70.0 MiB, more than the 64 MiB a text input may be",
+        ),
     ] {
         let z = zone.to_str().unwrap();
-        fails(
-            &["info", "--map", map.to_str().unwrap(), "--keepout", z],
-            &[&format!("error: keepout {z}: {needle}")],
-        );
+        for (flag, needle) in [("--keepout", as_keepout), ("--area", as_area)] {
+            if needle.is_empty() {
+                continue;
+            }
+            let kind = flag.trim_start_matches('-');
+            fails(
+                &["info", "--map", map.to_str().unwrap(), flag, z],
+                &[&format!("error: {kind} {z}: {needle}")],
+            );
+        }
     }
     // The mask as its YAML is taken.
     let o = ccpp()

@@ -64,16 +64,23 @@ pub fn read_bytes(path: &Path) -> io::Result<Vec<u8>> {
 /// # Errors
 /// As [`read_bytes`], plus invalid UTF-8.
 pub fn read_text(path: &Path) -> io::Result<String> {
-    let mut text = String::from_utf8(read_bytes(path)?).map_err(|_| {
+    text_of(read_bytes(path)?).ok_or_else(|| {
         io::Error::new(
             io::ErrorKind::InvalidData,
             "stream did not contain valid UTF-8",
         )
-    })?;
+    })
+}
+
+/// `bytes` as text without a leading byte order mark, as [`read_text`] reads a file; `None`
+/// when they are not valid UTF-8 (a caller that tells a binary file apart from a file too
+/// large, both `InvalidData` from [`read_text`], reads the bytes and asks this).
+pub fn text_of(bytes: Vec<u8>) -> Option<String> {
+    let mut text = String::from_utf8(bytes).ok()?;
     if text.starts_with('\u{feff}') {
         text.drain(..'\u{feff}'.len_utf8());
     }
-    Ok(text)
+    Some(text)
 }
 
 #[cfg(test)]

@@ -138,26 +138,26 @@ impl ZoneSpec {
     /// An unreadable or malformed file, an invalid polygon, a mask in another frame, or a mask
     /// where it is not allowed.
     pub fn load(&self, frame: &MapFrame, mask_ok: bool) -> Result<ZoneData, ZoneFileError> {
-        let polys =
-            match self {
-                Self::Rect(r) => {
-                    check_rect(*r)?;
-                    vec![Polygon::rect(*r)]
-                }
-                Self::Polygons(p) => p.clone(),
-                Self::File(path) => match read_file(path, frame)? {
-                    ZoneData::Mask(m) if mask_ok => return Ok(ZoneData::Mask(m)),
-                    ZoneData::Mask(_) => return Err(bad(
-                        "is a keepout mask; an area must be polygons (GeoJSON or a YAML list of \
-                         x,y points) or a rectangle X0,Y0,X1,Y1",
-                    )),
-                    ZoneData::Polygons(p) => p,
-                },
-            };
+        let polys = match self {
+            Self::Rect(r) => {
+                check_rect(*r)?;
+                vec![Polygon::rect(*r)]
+            }
+            Self::Polygons(p) => p.clone(),
+            Self::File(path) => match read_file(path, frame, mask_ok)? {
+                ZoneData::Mask(m) if mask_ok => return Ok(ZoneData::Mask(m)),
+                ZoneData::Mask(_) => return Err(bad(AREA_NOT_MASK)),
+                ZoneData::Polygons(p) => p,
+            },
+        };
         ccpp_core::zones::validate_polygons(&polys).map_err(|e| bad(e.to_string()))?;
         Ok(ZoneData::Polygons(polys))
     }
 }
+
+/// Why a mask is no area.
+const AREA_NOT_MASK: &str = "is a keepout mask; an area must be polygons (GeoJSON or a YAML list \
+                             of x,y points) or a rectangle X0,Y0,X1,Y1";
 
 /// Checks a rectangle `[x0, y0, x1, y1]`: finite with `x1 > x0` and `y1 > y0`.
 ///
@@ -180,27 +180,33 @@ pub fn check_rect(r: [f64; 4]) -> Result<(), ZoneFileError> {
 /// one polygon may have, [`ccpp_core::zones::MAX_POLYGON_POINTS`]).
 pub const MAX_ZONE_POINTS: usize = 16 * ccpp_core::zones::MAX_POLYGON_POINTS;
 
-/// Reads a zone file: `GeoJSON`, YAML polygons or a Nav2 mask (checked against `frame`).
-fn read_file(path: &Path, frame: &MapFrame) -> Result<ZoneData, ZoneFileError> {
+/// Reads a zone file: `GeoJSON`, YAML polygons or a Nav2 mask (checked against `frame`);
+/// `mask_ok`: a mask may be given (a keep-out), which the messages for an image tell.
+fn read_file(path: &Path, frame: &MapFrame, mask_ok: bool) -> Result<ZoneData, ZoneFileError> {
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
+    let bytes = crate::file::read_bytes(path).map_err(|e| bad(e.to_string()))?;
     // A mask's image given instead of its YAML was refused as "stream did not contain valid
     // UTF-8" (a binary file) or as a YAML error (a plain PGM).
-    if ["png", "pgm", "pnm", "ppm", "pbm", "pam"].contains(&ext.as_str()) || is_png(path) {
-        return Err(bad(
+    if ["png", "pgm", "pnm", "ppm", "pbm", "pam"].contains(&ext.as_str()) || is_image(&bytes) {
+        return Err(bad(if mask_ok {
             "is an image; zones are GeoJSON or YAML polygons, and a keepout mask is given by \
              its map_server YAML (image, resolution, origin in the map's frame), not by the \
-             bare image",
-        ));
+             bare image"
+        } else {
+            "is an image; an area must be polygons (GeoJSON or a YAML list of x,y points) or a \
+             rectangle X0,Y0,X1,Y1"
+        }));
     }
-    let text = crate::file::read_text(path).map_err(|e| match e.kind() {
-        std::io::ErrorKind::InvalidData => bad(
+    let text = crate::file::text_of(bytes).ok_or_else(|| {
+        bad(if mask_ok {
             "is not a text file; a zone file is GeoJSON, a YAML list of polygons or a Nav2 \
-             mask's map_server YAML",
-        ),
-        _ => bad(e.to_string()),
+             mask's map_server YAML"
+        } else {
+            "is not a text file; an area file is GeoJSON or a YAML list of polygons"
+        })
     })?;
     let yaml_ext = ext == "yaml" || ext == "yml";
     if ext == "geojson" || ext == "json" || (!yaml_ext && text.trim_start().starts_with('{')) {
@@ -219,9 +225,12 @@ fn read_file(path: &Path, frame: &MapFrame) -> Result<ZoneData, ZoneFileError> {
     let v: serde_json::Value = serde_saphyr::from_str(&text)
         .map_err(|e| bad(format!("YAML: {}", crate::file::yaml_words(&e.to_string()))))?;
     if v.get("image").is_some() {
+        if !mask_ok {
+            return Err(bad(AREA_NOT_MASK));
+        }
         // Loaded as a map, which is read as a YAML by its name only: a mask YAML named
         // `mask.txt` was decoded as an image ("not a PNG or PNM/PGM image").
-        if !yaml_ext {
+        if !yaml_ext && mask_ok {
             return Err(bad(
                 "holds a Nav2 mask's map_server YAML (an `image` key) but its name does not \
                  end in .yaml or .yml, which a map_server YAML's must; rename it",
@@ -232,14 +241,11 @@ fn read_file(path: &Path, frame: &MapFrame) -> Result<ZoneData, ZoneFileError> {
     within_total(yaml_polygons(&v)?, "YAML")
 }
 
-/// Whether the file at `path` begins with the PNG signature.
-fn is_png(path: &Path) -> bool {
-    use std::io::Read as _;
-    let Ok(f) = crate::file::open_regular(path) else {
-        return false;
-    };
-    let mut head = [0u8; 8];
-    f.take(8).read_exact(&mut head).is_ok() && head == *b"\x89PNG\r\n\x1a\n"
+/// Whether `bytes` begin as an image file does: the PNG signature, or a PNM's `P1`..`P7`
+/// followed by whitespace.
+fn is_image(bytes: &[u8]) -> bool {
+    bytes.starts_with(b"\x89PNG\r\n\x1a\n")
+        || matches!(bytes, [b'P', b'1'..=b'7', w, ..] if w.is_ascii_whitespace())
 }
 
 /// The polygons of a zone file, if they hold at most [`MAX_ZONE_POINTS`] vertices in all,
@@ -549,15 +555,15 @@ mod tests {
         let path = d.path().join("z.geojson");
         for z in [",null", ",\"a\"", ",{}", ",[1]"] {
             std::fs::write(&path, poly(z)).unwrap();
-            let e = read_file(&path, &frame).unwrap_err().to_string();
+            let e = read_file(&path, &frame, true).unwrap_err().to_string();
             assert!(e.contains("is not a number"), "{z}: {e}");
         }
         std::fs::write(&path, poly(",2.5")).unwrap();
-        assert!(read_file(&path, &frame).is_ok());
+        assert!(read_file(&path, &frame, true).is_ok());
         for name in ["bom.geojson", "bom.txt"] {
             let path = d.path().join(name);
             std::fs::write(&path, format!("\u{feff}{}", poly(""))).unwrap();
-            match read_file(&path, &frame) {
+            match read_file(&path, &frame, true) {
                 Ok(ZoneData::Polygons(p)) => assert_eq!(p.len(), 1, "{name}"),
                 other => panic!("{name}: {other:?}"),
             }
@@ -591,12 +597,12 @@ mod tests {
         let frame = MapFrame::new(10, 10, 1.0);
         let path = d.path().join("z.geojson");
         std::fs::write(&path, file(16)).unwrap();
-        match read_file(&path, &frame) {
+        match read_file(&path, &frame, true) {
             Ok(ZoneData::Polygons(p)) => assert_eq!(p.len(), 16),
             other => panic!("{other:?}"),
         }
         std::fs::write(&path, file(17)).unwrap();
-        let e = read_file(&path, &frame).unwrap_err().to_string();
+        let e = read_file(&path, &frame, true).unwrap_err().to_string();
         assert!(e.contains("69632 points in all"), "{e}");
         // A YAML zone file is held to the same total (only its parser's node budget bounded it).
         let yaml = |rings: usize| {
@@ -611,9 +617,9 @@ mod tests {
         };
         let path = d.path().join("z.yaml");
         std::fs::write(&path, yaml(16)).unwrap();
-        assert!(read_file(&path, &frame).is_ok());
+        assert!(read_file(&path, &frame, true).is_ok());
         std::fs::write(&path, yaml(17)).unwrap();
-        let e = read_file(&path, &frame).unwrap_err().to_string();
+        let e = read_file(&path, &frame, true).unwrap_err().to_string();
         assert!(e.contains("YAML: 69632 points in all"), "{e}");
     }
 
