@@ -1110,39 +1110,3 @@ fn info_describes_a_map_the_robot_does_not_fit() {
         .assert()
         .code(1);
 }
-
-/// With `--max-memory` raised beyond the address space the process has (`ulimit -v`), a map
-/// that decoded was followed by an abort ("memory allocation of 1600000000 bytes failed", a
-/// backtrace, signal 6) on the next map-sized buffer. What a run holds for the pixels is now
-/// asked for fallibly after decoding: a one-line error, exit 1.
-#[cfg(unix)]
-#[test]
-fn a_map_beyond_the_address_space_is_an_error_not_an_abort() {
-    let dir = tempfile::tempdir().unwrap();
-    let png = dir.path().join("wide.png");
-    let side = 5000u32;
-    image::GrayImage::from_pixel(side, side, image::Luma([254u8]))
-        .save(&png)
-        .unwrap();
-    let bin = assert_cmd::cargo::cargo_bin("ccpp");
-    // 1.2 GB of address space: the image (25 MB) decodes, a run's 64 bytes a pixel (1.6 GB)
-    // cannot be had.
-    let o = std::process::Command::new("sh")
-        .arg("-c")
-        .arg("ulimit -v 1200000 && exec \"$0\" info --map \"$1\" --max-memory 5000")
-        .arg(&bin)
-        .arg(&png)
-        .output()
-        .unwrap();
-    let e = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(1), "{e}");
-    assert_eq!(
-        e,
-        format!(
-            "error: map image {} is 5000 x 5000 px: a run holds about 1526 MB for its pixels, \
-             which this process cannot allocate (its address space is limited, e.g. by `ulimit \
-             -v`); lower --max-memory / max_memory_mb or use a smaller map\n",
-            png.display()
-        )
-    );
-}

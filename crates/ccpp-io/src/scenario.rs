@@ -121,24 +121,6 @@ pub enum ScenarioError {
         /// The limit, MB.
         limit_mb: u64,
     },
-    /// The memory a run holds for the map's pixels cannot be allocated in this process (its
-    /// address space is limited below the memory limit given).
-    #[error(
-        "map image {} is {width} x {height} px: a run holds {needed} for its pixels, which this \
-         process cannot allocate (its address space is limited, e.g. by `ulimit -v`); lower \
-         --max-memory / max_memory_mb or use a smaller map",
-        path.display()
-    )]
-    Unallocatable {
-        /// The image file.
-        path: PathBuf,
-        /// Its width, px.
-        width: usize,
-        /// Its height, px.
-        height: usize,
-        /// What a run holds for its pixels: `about 1234 MB`.
-        needed: String,
-    },
     /// The georeference file cannot be used.
     #[error("georef {}: {message}", path.display())]
     Georef {
@@ -400,25 +382,6 @@ impl MapRecipe {
                 },
                 e => ScenarioError::Map(e),
             })?;
-        // What a run holds for these pixels, asked for fallibly first: a failed allocation
-        // aborts the process, and with `--max-memory` raised beyond the address space the
-        // process has (`ulimit -v`), `ccpp info` on a 20000 x 20000 px map decoded it and then
-        // aborted on its next map-sized buffer (1.6 GB). Nothing is touched: with the system's
-        // overcommit the probe costs nothing.
-        let (w, h) = (loaded.grid.frame().width, loaded.grid.frame().height);
-        let needed = (w as u64)
-            .saturating_mul(h as u64)
-            .saturating_mul(per_pixel);
-        let mut probe: Vec<u8> = Vec::new();
-        if usize::try_from(needed).map_or(true, |n| probe.try_reserve_exact(n).is_err()) {
-            return Err(ScenarioError::Unallocatable {
-                path: loaded.image_path,
-                width: w,
-                height: h,
-                needed: about_mb(needed as f64),
-            });
-        }
-        drop(probe);
         crate::phase::time("prepare map", || self.prepare(loaded))
     }
 
