@@ -551,10 +551,14 @@ pub fn replay_html(
     // parser in a state where the real `</script>` no longer ends it: a blank, dead page. In
     // JSON a `<` can only stand in a string, where `\u003c` is the same character.
     let data = replay_data(world, trace, tile_side, metrics_json, crop).replace('<', "\\u003c");
+    // Braces as character references too: the page's later placeholders are replaced over
+    // the whole page, so a map named `x{{DATA}}` put the whole data into the title.
     let title = title
         .replace('&', "&amp;")
         .replace('<', "&lt;")
-        .replace('>', "&gt;");
+        .replace('>', "&gt;")
+        .replace('{', "&#123;")
+        .replace('}', "&#125;");
     let mut html = String::with_capacity(data.len() + bg.len() + 16000);
     html.push_str(
         &TEMPLATE

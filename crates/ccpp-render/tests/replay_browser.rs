@@ -656,11 +656,12 @@ fn the_step_count_runs_along_a_lane_and_ends_at_the_runs_end() {
 
 /// A map named `room<!--<script>` (a legal file name) gave a blank page whose script never
 /// ran: the page escaped `</` in its data but not `<!--`, and `<!--<script>` inside a script
-/// keeps the HTML parser from ending it at `</script>`. The data now holds no `<` at all.
+/// keeps the HTML parser from ending it at `</script>`. The data now holds no `<` at all, and
+/// the title no placeholder of the page (`{{DATA}}` in a name was replaced by the data).
 #[test]
 fn a_map_name_with_html_comment_and_script_tags_still_replays() {
     let (world, trace) = run(30, 20, 3);
-    let name = "room<!--<script></script>";
+    let name = "room<!--<script></script>{{DATA}}{{BG}}";
     let metrics = format!(
         r#"{{"planner":"ba-star","map":{},"effective_coverage":0.5,"path_length_m":1.0}}"#,
         serde_json::to_string(name).expect("json")
@@ -679,6 +680,17 @@ fn a_map_name_with_html_comment_and_script_tags_still_replays() {
         .and_then(|s| s.split(";\n").next())
         .expect("the data");
     assert!(!script.contains('<'), "{script}");
+    // The title holds the name, not the data the page's placeholders stand for (a map named
+    // `x{{DATA}}` put the whole data into the title).
+    let title = html
+        .split("<title>")
+        .nth(1)
+        .and_then(|s| s.split("</title>").next())
+        .expect("a title");
+    assert_eq!(
+        title,
+        "ba-star on room&lt;!--&lt;script&gt;&lt;/script&gt;&#123;&#123;DATA&#125;&#125;&#123;&#123;BG&#125;&#125;"
+    );
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("replay-odd-name");
     std::fs::create_dir_all(&dir).expect("dir");
     std::fs::write(dir.join("page.html"), &html).expect("write");
