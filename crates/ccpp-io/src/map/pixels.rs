@@ -141,6 +141,20 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
     // the chunks before its image data). A PNG's size is read from its IHDR first: the
     // decoder's header read allocates a row, so a PNG claiming 2147483647 px across failed as
     // "Memory limit exceeded" instead of being named too large.
+    // A PAM's header lines are read whole, by the decoder and by the maxval check below: a
+    // comment line of 100 MiB in a 4 x 4 px PAM took 108 MB before the file was refused.
+    if format == image::ImageFormat::Pnm {
+        if let Some(n) = long_pam_header_line(&mut inner).map_err(io_err)? {
+            return Err(MapError::Decode {
+                path: path.to_path_buf(),
+                message: format!(
+                    "a PAM header line is longer than {n} bytes; header lines and comments that \
+                     long are refused"
+                ),
+            });
+        }
+        inner.seek(SeekFrom::Start(start)).map_err(io_err)?;
+    }
     let (width, height) = match png_ihdr_size(&mut inner).map_err(io_err)? {
         Some(size) if format == image::ImageFormat::Png => size,
         _ => {
@@ -374,6 +388,48 @@ fn header_number<R: BufRead>(r: &mut R) -> std::io::Result<Option<u64>> {
         v = v
             .saturating_mul(10)
             .saturating_add(u64::from(byte[0] - b'0'));
+    }
+}
+
+/// Longest header line of a PAM (`P7`) file ccpp reads, in bytes.
+const PAM_LINE_MAX: u64 = 64 << 10;
+
+/// For a PAM (`P7`) file at the stream's position, `Some(PAM_LINE_MAX)` when a header line
+/// before `ENDHDR` is longer than [`PAM_LINE_MAX`]; `None` otherwise, and for other files. Reads
+/// without keeping more than a line's start; the stream is left wherever the read stopped.
+fn long_pam_header_line<R: BufRead>(r: &mut R) -> std::io::Result<Option<u64>> {
+    let mut magic = [0u8; 3];
+    if r.read_exact(&mut magic).is_err() || &magic[..2] != b"P7" {
+        return Ok(None);
+    }
+    let mut line: Vec<u8> = Vec::new();
+    loop {
+        // One line, keeping at most its first 16 bytes (enough to see `ENDHDR`).
+        line.clear();
+        let mut len = 0u64;
+        loop {
+            let buf = r.fill_buf()?;
+            if buf.is_empty() {
+                return Ok(None);
+            }
+            let (n, end) = match buf.iter().position(|&b| b == b'\n') {
+                Some(i) => (i + 1, true),
+                None => (buf.len(), false),
+            };
+            let keep = n.min(16usize.saturating_sub(line.len()));
+            line.extend_from_slice(&buf[..keep]);
+            len += n as u64;
+            r.consume(n);
+            if len > PAM_LINE_MAX {
+                return Ok(Some(PAM_LINE_MAX));
+            }
+            if end {
+                break;
+            }
+        }
+        if line.trim_ascii().starts_with(b"ENDHDR") {
+            return Ok(None);
+        }
     }
 }
 

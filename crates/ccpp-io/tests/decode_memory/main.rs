@@ -191,3 +191,41 @@ fn a_long_pnm_comment_is_skipped_unread() {
     let m = within_32_mib(|| load_map_bytes(Path::new("comment.pgm"), None, &pgm, &opts)).unwrap();
     assert_eq!(m.grid.frame().width, 1000);
 }
+
+/// A PAM's header lines are read whole by the decoder: a 100 MiB comment line in a 4 x 4 px
+/// PAM took 108 MB before the file was refused. A header line beyond 64 KiB is now refused
+/// before any reader keeps it.
+#[test]
+fn a_long_pam_header_line_is_refused_unread() {
+    let _turn = SERIAL
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    let mut pam = b"P7\n# ".to_vec();
+    pam.resize(pam.len() + (40 << 20), b'x');
+    pam.extend_from_slice(
+        b"\nWIDTH 4\nHEIGHT 4\nDEPTH 1\nMAXVAL 255\nTUPLTYPE GRAYSCALE\nENDHDR\n",
+    );
+    pam.resize(pam.len() + 16, 254);
+    let opts = LoadOptions {
+        resolution: Some(0.05),
+        max_pixels: Some(1 << 24),
+        ..LoadOptions::default()
+    };
+    let e = within_32_mib(|| load_map_bytes(Path::new("long.pam"), None, &pam, &opts))
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        e.contains("long.pam") && e.contains("a PAM header line is longer than 65536 bytes"),
+        "{e}"
+    );
+    // A PAM with a short comment loads.
+    let ok =
+        b"P7\n# made by hand\nWIDTH 4\nHEIGHT 4\nDEPTH 1\nMAXVAL 255\nTUPLTYPE GRAYSCALE\nENDHDR\n"
+            .iter()
+            .copied()
+            .chain(std::iter::repeat_n(254u8, 16))
+            .collect::<Vec<u8>>();
+    let m = load_map_bytes(Path::new("ok.pam"), None, &ok, &opts).unwrap();
+    assert_eq!(m.grid.frame().width, 4);
+}
