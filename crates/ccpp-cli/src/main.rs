@@ -81,21 +81,13 @@ fn utf8_values(cmd: &clap::Command, m: &clap::ArgMatches) -> Result<(), String> 
                 arg.get_long()
                     .map_or_else(|| id.to_uppercase(), |l| format!("--{l}"))
             };
-            let Some(text) = v.to_str() else {
-                return Err(format!(
-                    "{} {}: not valid UTF-8 (ccpp records paths and values as text, in run.json and the exports); rename it",
-                    name(),
-                    v.to_string_lossy()
-                ));
-            };
             // Printed raw, a newline cut every message naming the value short and an escape
-            // sequence reached the terminal.
-            if let Some(c) = text.chars().find(|c| c.is_control()) {
-                return Err(format!(
-                    "{} {text:?}: holds a control character (U+{:04X}); rename it",
-                    name(),
-                    u32::from(c)
-                ));
+            // sequence reached the terminal (the check the bench makes of the map files a
+            // folder holds, and Python of its paths).
+            if let Some(problem) =
+                ccpp_io::names::path_text_problem(std::path::Path::new(v), &name())
+            {
+                return Err(problem);
             }
         }
     }

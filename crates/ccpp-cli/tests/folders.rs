@@ -498,9 +498,9 @@ fn a_bench_names_the_earlier_runs_its_summary_leaves_out() {
     assert!(!stderr_of(&o).contains("note:"), "{}", stderr_of(&o));
 }
 
-/// An output folder that is the working directory, or holds it, under any name but `.`
-/// (refused by its name) was taken: `ccpp run --out ../out` from inside `out` swapped the
-/// folder away, the shell was left in a deleted folder, and every relative path failed there.
+/// An output folder that is the working directory, or holds it, was taken under any name but
+/// `.`: `ccpp run --out ../out` from inside `out` swapped the folder away, the shell was left
+/// in a deleted folder, and every relative path failed there.
 #[test]
 fn the_working_directory_is_no_output_folder_by_any_name() {
     let dir = tempfile::tempdir().unwrap();
@@ -614,8 +614,8 @@ fn bench_run_folders_replay_and_a_failed_rerun_names_the_old_folder() {
     assert!(json.contains("site2-moved"), "{json}");
     let o = ccpp().arg("replay").arg(&run).output().unwrap();
     assert!(o.status.success(), "{}", stderr_of(&o));
-    // A rerun that fails (the map's scale changed: beyond the memory limit) names the earlier
-    // folder it leaves.
+    // A rerun that fails (the map's scale changed: the robot no longer fits on it) names the
+    // earlier folder it leaves.
     let c = a;
     let yaml = std::fs::read_to_string(&c).unwrap();
     let o = bench_maps(&dir.path().join("b4"), &[&c]);

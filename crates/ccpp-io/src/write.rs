@@ -286,8 +286,8 @@ pub fn staging_path(parent: &Path, name: &str, kind: &str) -> PathBuf {
 
 /// Checks that `target` is absent, or a folder holding only run files ([`is_run_file_name`]:
 /// [`RUN_FILES`] and the `.tmp` of one of them left by an interrupted atomic write) that is
-/// not the working directory nor above it (`.` is refused by its name; `../here` from `here`
-/// was taken, and the swap removed the folder the process was in).
+/// not the working directory nor above it (`../here` from `here` was taken, and the swap
+/// removed the folder the process was in).
 ///
 /// # Errors
 /// [`FolderError::NotAFolder`], [`FolderError::HoldsWorkingDirectory`],

@@ -87,7 +87,8 @@ def _check_out(out: str | os.PathLike[str]) -> None:
             raise _ccpp.CcppError(
                 f"output folder {p} holds {e.name}, the summary of an earlier ccpp bench, which a "
                 "sweep does not rewrite and its runs would contradict; choose a new folder or "
-                "remove results.csv, results.md and plots/ first"
+                "remove results.csv, results.md and plots/ (and a results.csv.tmp or "
+                "results.md.tmp left by a stopped bench) first"
             )
         if e.name == "runs":
             known = e.is_dir() and not e.is_symlink()
