@@ -637,3 +637,14 @@ def test_events_are_the_trace_files_but_for_whole_backtrack_lists(room: Path, tm
             assert b["event"] == "backtrack_list" and a["t"] == b["t"] and "points" in a
         else:
             assert a == b
+
+
+def test_a_path_with_a_control_character_is_refused_as_the_command_line_refuses_it(tmp_path: Path) -> None:
+    # Python took such a path and recorded it in run.json; the command line refused it by name.
+    from conftest import write_room
+
+    room = write_room(tmp_path)
+    odd = tmp_path / "new\nline.yaml"
+    odd.write_text(room.read_text())
+    with pytest.raises(ccpp.CcppError, match=r"holds a control character \(U\+000A\); rename it"):
+        ccpp.load_map(odd)
