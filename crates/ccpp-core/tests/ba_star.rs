@@ -1044,3 +1044,28 @@ fn tile_searches_answer_as_an_independent_search() {
     }
     assert!(found > 300 && paths > 300, "{found} {paths}");
 }
+
+/// BA*'s sensor is set to see a neighbour tile's contact disk (side + r + half a pixel), but
+/// its own check at the start asked side + r + a whole pixel: every run at the default range
+/// wrote a note that "some moves may stay undecided" into its trace, which its coverage denied.
+#[test]
+fn the_default_sensor_range_writes_no_note_of_undecided_moves() {
+    let w = world(&room(6, 4), 0, 0, 0.0);
+    // The range the command line gives BA* (its settings' sensor range).
+    let sim = SimConfig {
+        sensor_range: Some(SIDE + R + 0.5 * 0.01),
+        ..SimConfig::default()
+    };
+    let out = simulate(&w, &mut BaStar::new(BaStarOptions::default()), &sim);
+    let m = compute(&w, &out, "test");
+    assert_eq!(m.coverage_rate, Some(1.0));
+    let notes: Vec<String> = out
+        .trace
+        .events()
+        .filter_map(|(_, e)| match e {
+            Event::Note { text } => Some(text.clone()),
+            _ => None,
+        })
+        .collect();
+    assert!(notes.is_empty(), "{notes:?}");
+}

@@ -650,7 +650,15 @@ fn check_neighbour_sight(setup: &Setup, side: f64, what: &str) -> Result<(), Opt
 
 /// The range that sees a neighbour tile's (cell's) whole contact disk ([`check_neighbour_sight`]).
 fn neighbour_sight(setup: &Setup, side: f64) -> f64 {
-    side + setup.robot.radius + 0.5 * setup.frame.resolution
+    neighbour_sight_m(side, setup.robot.radius, setup.frame.resolution)
+}
+
+/// The sensor range that sees a neighbour tile's contact disk: tile side `side` + robot radius
+/// `radius` + half a pixel of `resolution` (metres). BA*'s own check of its sensor at the start
+/// uses this too (it asked a whole pixel, and noted in every trace at the default range that
+/// "some moves may stay undecided").
+pub(crate) fn neighbour_sight_m(side: f64, radius: f64, resolution: f64) -> f64 {
+    side + radius + 0.5 * resolution
 }
 
 /// A tile larger than the map leaves no neighbour tile to move to.

@@ -60,12 +60,12 @@ impl BaStar {
             .collect();
         let (i0, _, j0, _) = tiles.bounds();
         let range = sensor.sensor_range();
-        if range < side + r + frame.resolution {
+        let sight = crate::planners::settings::neighbour_sight_m(side, r, frame.resolution);
+        if range < sight {
             self.pending.push_back(Step::Mark(Event::Note {
                 text: format!(
-                    "ba-star: sensor range {range} m < tile side + r + res = {} m; some moves may \
-                     stay undecided",
-                    side + r + frame.resolution
+                    "ba-star: sensor range {range} m < tile side + r + res / 2 = {sight} m; some \
+                     moves may stay undecided"
                 ),
             }));
         }
