@@ -692,6 +692,55 @@ fn a_control_period_that_would_run_for_hours_is_refused() {
         &["control steps", "dt_s 1e-7 s", "raise exec.pid.dt_s"],
     );
     assert!(!dir.join("o").exists());
+    // At the default `max_steps_per_motion` (20000) the same period, or 1e-4 s, stopped every
+    // or most moves at the cap: "done" in 0.08 s at 1 mm driven (1e-7), 4.6 % swept with 67
+    // moves cut short (1e-4), and only a warning. Such a run is refused; 1e-3 s runs.
+    for dt in ["1.0e-7", "1.0e-4"] {
+        let cfg = write(
+            dir,
+            "short.yaml",
+            &format!("bsa_bfs: {{ exec: {{ pid: {{ dt_s: {dt} }} }} }}\n"),
+        );
+        refused(
+            &[
+                "run",
+                "--map",
+                s(&map),
+                "--planner",
+                "bsa-bfs",
+                "--config",
+                &cfg,
+                "--out",
+                s(&dir.join("o")),
+            ],
+            &[
+                "a move of 0.3 m takes max_steps_per_motion (20000) control steps or more",
+                "every move would stop short of its goal",
+            ],
+        );
+        assert!(!dir.join("o").exists());
+    }
+    let cfg = write(
+        dir,
+        "ms.yaml",
+        "bsa_bfs: { exec: { pid: { dt_s: 1.0e-3 } } }\n",
+    );
+    let o = ccpp()
+        .args([
+            "run",
+            "--map",
+            s(&map),
+            "--planner",
+            "bsa-bfs",
+            "--config",
+            &cfg,
+            "--out",
+        ])
+        .arg(dir.join("ms"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(!String::from_utf8_lossy(&o.stderr).contains("stopped at max_steps_per_motion"));
 }
 
 /// Options that are legal but leave the planner nothing to do ended "done" at 0 m without a
