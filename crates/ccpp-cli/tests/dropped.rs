@@ -714,7 +714,7 @@ fn a_control_period_that_would_run_for_hours_is_refused() {
                 s(&dir.join("o")),
             ],
             &[
-                "a move of 0.3 m takes max_steps_per_motion (20000) control steps or more",
+                "a quarter turn and a move of 0.3 m take max_steps_per_motion (20000) control steps or more",
                 "every move would stop short of its goal",
             ],
         );
@@ -809,7 +809,8 @@ fn a_run_that_never_moves_is_told() {
 
 /// A control period far too short for the per-motion cap (`dt_s: 1e-9`) made every PID motion
 /// stop at `max_steps_per_motion` short of its goal: a run of 0 m that ended "done" without a
-/// word. The simulator notes a cut motion in the trace, and `run` warns.
+/// word. Such a run is now refused (`a_control_period_that_would_run_for_hours_is_refused`);
+/// a cap that cuts some motions is noted in the trace, and `run` warns.
 #[test]
 fn pid_motions_cut_at_their_cap_are_told() {
     let d = tempfile::tempdir().unwrap();
@@ -818,7 +819,7 @@ fn pid_motions_cut_at_their_cap_are_told() {
     let cfg = write(
         dir,
         "dt.yaml",
-        "bsa_bfs: { exec: { pid: { dt_s: 1.0e-9 } } }\n",
+        "bsa_bfs: { exec: { pid: { max_steps_per_motion: 100 } } }\n",
     );
     let out = dir.join("cut");
     let o = ccpp()
@@ -838,7 +839,7 @@ fn pid_motions_cut_at_their_cap_are_told() {
     let few = write(
         dir,
         "few.yaml",
-        "bsa_bfs: { exec: { pid: { max_steps_per_motion: 30 } } }\n",
+        "bsa_bfs: { exec: { pid: { max_steps_per_motion: 100 } } }\n",
     );
     let o = ccpp()
         .args(["run", "--map", s(&map), "--planner", "bsa-bfs"])

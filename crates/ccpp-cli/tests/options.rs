@@ -381,7 +381,7 @@ fn bsa_bfs_and_pid_options_change_the_run() {
         (pid("min_turn_rate: 0.5"), Differs),
         (pid("lookahead_m: 0.3"), Differs),
         (pid("record_every: 5"), FewerRecords),
-        (pid("max_steps_per_motion: 20"), Less("path_length_m")),
+        (pid("max_steps_per_motion: 100"), Differs),
         (
             pid("noise: { linear_rel_std: 0.05, angular_rel_std: 0.05 }"),
             More("tracking_error_mean_m"),

@@ -138,6 +138,23 @@ pub enum WorldError {
         /// Robot radius.
         radius: f64,
     },
+    /// The robot fits at the start, but no pixel centre at or next to it is C-free (a start
+    /// in a gap as wide as the robot, which it fits only between pixel centres): the reachable
+    /// floor, flooded from C-free pixel centres, would be empty and every run measured 0.
+    #[error(
+        "start ({:.3}, {:.3}) fits a robot of radius {} m only between pixel centres: no pixel \
+         centre at or next to it is clear for the robot, and the floor it can reach is measured \
+         from those; move the start out of the gap",
+        Compact(*.x), Compact(*.y), Compact(*.radius)
+    )]
+    StartBetweenCentres {
+        /// Start x.
+        x: f64,
+        /// Start y.
+        y: f64,
+        /// Robot radius.
+        radius: f64,
+    },
     /// The robot's disk at the start reaches outside the work area (internal: such a start
     /// gets an approach, [`World::approach`], and this is never returned).
     #[error(
@@ -438,7 +455,38 @@ impl World {
                 }
             }
         }
+        if self.start_seed().is_none() {
+            return Err(WorldError::StartBetweenCentres {
+                x: s.x,
+                y: s.y,
+                radius: self.robot.radius,
+            });
+        }
         Ok(())
+    }
+
+    /// The pixel the reachable C-free set is flooded from: the start's own pixel when its
+    /// centre is C-free, else the first C-free one of its 8 neighbours; `None` when none is
+    /// (a start in a gap that the robot fits only between pixel centres).
+    fn start_seed(&self) -> Option<usize> {
+        let frame = *self.map.frame();
+        let g = frame.world_to_grid(self.start.position());
+        let (sc, sr) = frame.grid_to_pixel_signed(g);
+        [
+            (0, 0),
+            (1, 0),
+            (-1, 0),
+            (0, 1),
+            (0, -1),
+            (1, 1),
+            (-1, 1),
+            (1, -1),
+            (-1, -1),
+        ]
+        .into_iter()
+        .filter_map(|(dc, dr)| frame.checked(sc + dc, sr + dr))
+        .map(|(c, r)| frame.index(c, r))
+        .find(|&i| self.cfree.contains(i))
     }
 
     /// The approach of a start outside the area: the shortest 8-connected chain of pixel
@@ -658,31 +706,7 @@ impl World {
     fn flood_reachable(&self) -> FixedBitSet {
         let frame = *self.map.frame();
         let mut seen = FixedBitSet::with_capacity(frame.len());
-        let g = frame.world_to_grid(self.start.position());
-        let (sc, sr) = frame.grid_to_pixel_signed(g);
-        let mut seeds = Vec::new();
-        for (dc, dr) in [
-            (0, 0),
-            (1, 0),
-            (-1, 0),
-            (0, 1),
-            (0, -1),
-            (1, 1),
-            (-1, 1),
-            (1, -1),
-            (-1, -1),
-        ] {
-            if let Some((c, r)) = frame.checked(sc + dc, sr + dr) {
-                let i = frame.index(c, r);
-                if self.cfree.contains(i) {
-                    seeds.push(i);
-                    if (dc, dr) == (0, 0) {
-                        break;
-                    }
-                }
-            }
-        }
-        if let Some(&s) = seeds.first() {
+        if let Some(s) = self.start_seed() {
             fill_runs(
                 frame.width,
                 frame.height,
@@ -1263,6 +1287,37 @@ mod tests {
             None,
         );
         assert!(matches!(e, Err(WorldError::BadToolRadius { .. })));
+    }
+
+    /// Two rooms joined by a door exactly one robot diameter wide (6 px at 0.05 m/px, r = 0.15
+    /// m): the robot fits in the doorway only between pixel centres. A start there was taken,
+    /// its reachable floor was empty and every run measured 0 % after sweeping both rooms; it
+    /// is refused. A start in a room beside the door is taken.
+    #[test]
+    fn a_start_that_fits_only_between_pixel_centres_is_refused() {
+        let (w, h) = (120usize, 70usize);
+        let mut art = String::new();
+        for r in 0..h {
+            for c in 0..w {
+                let wall = c == 0 || c == w - 1 || r == 0 || r == h - 1;
+                let door = c == 60 && !(30..36).contains(&r);
+                art.push(if wall || door { '#' } else { '.' });
+            }
+            art.push('\n');
+        }
+        let map = GridMap::from_ascii_scaled(&art, 1, 0.05).unwrap();
+        let e = World::new(
+            map.clone(),
+            Robot::new(0.15),
+            Some(Pose::new(3.025, 1.85, 0.0)),
+        );
+        assert!(
+            matches!(e, Err(WorldError::StartBetweenCentres { .. })),
+            "{:?}",
+            e.map(|w| w.accessible_count())
+        );
+        let w = World::new(map, Robot::new(0.15), Some(Pose::new(1.525, 2.15, 0.0))).unwrap();
+        assert!(w.accessible_count() > 0);
     }
 
     #[test]

@@ -1275,15 +1275,11 @@ impl Scenario {
                     self.planner.settings(),
                     &exec,
                 ) {
-                    let what = if move_m > 0.0 {
-                        format!("a move of {} m", Compact(move_m))
-                    } else {
-                        "a quarter turn".to_string()
-                    };
                     return Err(ScenarioError::Invalid(format!(
-                        "map {}: {} under PID execution: {what} takes max_steps_per_motion ({cap}) control steps or more at dt_s {} s, so every move would stop short of its goal: raise exec.pid.dt_s (a robot's control loop runs at 10 to 1000 Hz: dt_s 0.001 to 0.1) or max_steps_per_motion, or the speed limits and gains that set how many steps a move takes (linear/angular output_limit and kp, min_speed_mps, min_turn_rate)",
+                        "map {}: {} under PID execution: a quarter turn and a move of {} m take max_steps_per_motion ({cap}) control steps or more at dt_s {} s, so every move would stop short of its goal: raise exec.pid.dt_s (a robot's control loop runs at 10 to 1000 Hz: dt_s 0.001 to 0.1) or max_steps_per_motion, or the speed limits and gains that set how many steps a move takes (linear/angular output_limit and kp, min_speed_mps, min_turn_rate)",
                         map.source.display(),
                         self.planner.name(),
+                        Compact(move_m),
                         Compact(p.dt_s),
                     )));
                 }

@@ -313,11 +313,11 @@ def test_warnings_are_the_cli_warnings(shared_maps: Path, ccpp_bin: str, tmp_pat
     """A run that ended `done` after its PID motions were cut short, or after drifting into
     walls, said so only in a trace note (Python) where `ccpp run` warns on stderr."""
     maze = shared_maps / "teb_maze.yaml"
-    cut = {"exec": {"pid": {"max_steps_per_motion": 1}}}
+    cut = {"exec": {"pid": {"max_steps_per_motion": 100}}}
     still = {"clearance_margin_m": 5}
     cases = [
         ({"odometry_noise": 0.02, "seed": 1}, ["--odometry-noise", "0.02", "--seed", "1"], "bcd", None),
-        ({"options": cut}, ["--config", str(tmp_path / "cut.yaml")], "bsa-bfs", "bsa_bfs: { exec: { pid: { max_steps_per_motion: 1 } } }\n"),
+        ({"options": cut}, ["--config", str(tmp_path / "cut.yaml")], "bsa-bfs", "bsa_bfs: { exec: { pid: { max_steps_per_motion: 100 } } }\n"),
         # A run that never moves, and a tool narrower than half a pixel (0.05 m map).
         ({"options": still}, ["--config", str(tmp_path / "cut.yaml")], "bsa-bfs", "bsa_bfs: { clearance_margin_m: 5 }\n"),
         ({"radius": 0.02}, ["--radius", "0.02"], "bsa", None),
