@@ -574,8 +574,9 @@ pub fn pid_control_steps(s: &Setup, planner: &dyn PlannerSettings, exec: &Execut
 
 /// A PID-executed run (`exec`) of `planner` on `s` whose every move would stop short: a quarter
 /// turn and a move of the planner's typical length ([`PlannerSettings::path_estimate`]) take
-/// `max_steps_per_motion` control steps or more. Returns the move's length and the cap. `dt_s: 1e-7` at the default cap ran "done" in 0.08 s having driven 1 mm (0.08 %
-/// swept), with only a warning of motions stopped at the cap; `None` under ideal execution.
+/// `max_steps_per_motion` control steps or more. Returns the move's length and the cap; `None`
+/// under ideal execution. `dt_s: 1e-7` at the default cap ran "done" in 0.08 s having driven
+/// 1 mm (0.08 % swept), with only a warning of motions stopped at the cap.
 pub fn pid_moves_cut_short(
     s: &Setup,
     planner: &dyn PlannerSettings,
