@@ -24,6 +24,12 @@ def big_header(folder: Path, side: int, body: int = 1000) -> Path:
     return p
 
 
+#: First lines of a child script that is sent SIGINT: Python leaves SIGINT ignored when it
+#: starts ignored (a `.ci/run` started with `nohup ... &` passes that on), and the child then
+#: ran to its end instead of raising KeyboardInterrupt.
+CTRL_C = "import signal\nsignal.signal(signal.SIGINT, signal.default_int_handler)\n"
+
+
 def test_self_referencing_or_deep_option_values_are_errors_not_crashes(room: Path) -> None:
     # Each used to overflow the native stack: the interpreter died (SIGSEGV).
     loop: list = []
@@ -198,6 +204,7 @@ def test_ctrl_c_interrupts_a_long_run(tmp_path: Path, room: Path) -> None:
     # The run released the GIL and never looked at signals: SIGINT waited until it finished.
     script = tmp_path / "long.py"
     script.write_text(
+        CTRL_C +
         "import sys, ccpp\n"
         "print('start', flush=True)\n"
         "try:\n"
@@ -266,6 +273,7 @@ def test_a_run_after_an_interrupted_one_waits_for_it_and_completes(tmp_path: Pat
     # beside them, and then completes.
     script = tmp_path / "again.py"
     script.write_text(
+        CTRL_C +
         "import signal, threading, time, ccpp\n"
         f"room = {str(room)!r}\n"
         "def interrupt(after):\n"
@@ -290,6 +298,7 @@ def test_an_interrupted_run_stops_instead_of_finishing_unseen(tmp_path: Path, ro
     # steps of the interrupt, so the next run starts at once.
     script = tmp_path / "stop.py"
     script.write_text(
+        CTRL_C +
         "import signal, threading, time, ccpp\n"
         f"room = {str(room)!r}\n"
         "threading.Timer(1.0, lambda: signal.raise_signal(signal.SIGINT)).start()\n"
@@ -323,6 +332,7 @@ def test_an_interrupted_offline_plan_stops_instead_of_holding_the_next_run(
         pytest.skip(f"{big} absent")
     script = tmp_path / "stop_plan.py"
     script.write_text(
+        CTRL_C +
         "import signal, threading, time, ccpp\n"
         "for call in (ccpp.run, ccpp.plan):\n"
         "    threading.Timer(1.5, lambda: signal.raise_signal(signal.SIGINT)).start()\n"
