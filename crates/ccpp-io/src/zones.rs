@@ -144,9 +144,9 @@ impl ZoneSpec {
                 vec![Polygon::rect(*r)]
             }
             Self::Polygons(p) => p.clone(),
+            // (`read_file` gives a mask only where `mask_ok` allows one)
             Self::File(path) => match read_file(path, frame, mask_ok)? {
-                ZoneData::Mask(m) if mask_ok => return Ok(ZoneData::Mask(m)),
-                ZoneData::Mask(_) => return Err(bad(AREA_NOT_MASK)),
+                ZoneData::Mask(m) => return Ok(ZoneData::Mask(m)),
                 ZoneData::Polygons(p) => p,
             },
         };
@@ -230,7 +230,7 @@ fn read_file(path: &Path, frame: &MapFrame, mask_ok: bool) -> Result<ZoneData, Z
         }
         // Loaded as a map, which is read as a YAML by its name only: a mask YAML named
         // `mask.txt` was decoded as an image ("not a PNG or PNM/PGM image").
-        if !yaml_ext && mask_ok {
+        if !yaml_ext {
             return Err(bad(
                 "holds a Nav2 mask's map_server YAML (an `image` key) but its name does not \
                  end in .yaml or .yml, which a map_server YAML's must; rename it",
