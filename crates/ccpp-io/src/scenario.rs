@@ -244,7 +244,10 @@ pub struct MapRecipe {
     pub occupied_thresh: Option<f64>,
     /// `free_thresh` override.
     pub free_thresh: Option<f64>,
-    /// Grow obstacles by this many metres (exact distance transform).
+    /// Grow obstacles by this many metres (exact distance transform). 0 grows nothing and is
+    /// written as no inflation (`null`), so a run's `run.json` says what was done (it said
+    /// `0.0` beside the same work as a run without `--inflate`).
+    #[serde(serialize_with = "inflate_as_done")]
     pub inflate: Option<f64>,
     /// Georeference point-pair file (`px,py,wx,wy` lines); overrides resolution and origin.
     pub georef: Option<PathBuf>,
@@ -264,6 +267,15 @@ pub struct PreparedMap {
     /// How its pixels were classified (the YAML's or the overridden thresholds, negate and
     /// mode; the defaults for a grid made in memory).
     pub thresholds: Thresholds,
+}
+
+/// Serializes [`MapRecipe::inflate`]: 0 (or -0) as `null`.
+#[allow(clippy::ref_option)] // serde's `serialize_with` passes the field by reference
+fn inflate_as_done<S: serde::Serializer>(v: &Option<f64>, s: S) -> Result<S::Ok, S::Error> {
+    match v {
+        Some(m) if *m != 0.0 => s.serialize_some(m),
+        _ => s.serialize_none(),
+    }
 }
 
 impl MapRecipe {

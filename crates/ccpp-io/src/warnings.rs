@@ -105,9 +105,60 @@ pub fn narrow_tool_warning(world: &World) -> Option<String> {
     })
 }
 
+/// Tiles wider than the tool sweeps, said (`None` otherwise): the planner's lanes lie a tile
+/// apart, so they leave strips between them unswept, while `coverage_rate` counts the
+/// planner's own tiles. ba-star at `--tile-side 0.9` with a 0.3 m tool reported
+/// `coverage_rate` 1.0 beside an effective coverage of 0.34 without a word (bcd's lane
+/// spacing and rect-boustrophedon's lane width are refused beyond the tool; the tile side is
+/// the papers' parameter, and the default, the robot's diameter, is wider than a tool of a
+/// smaller `--tool-radius`).
+pub fn wide_tiles_warning(scenario: &Scenario) -> Option<String> {
+    let side = scenario.tile_side()?;
+    let sweep = 2.0 * scenario.robot.tool_radius;
+    (side > sweep * (1.0 + 1e-9)).then(|| {
+        format!(
+            "the tile side {} m is wider than the tool sweeps (2 x tool radius = {} m): lanes a tile apart leave strips unswept between them, and coverage_rate counts the planner's own tiles; effective_coverage is the share of the floor swept",
+            ccpp_core::display::Compact(side),
+            ccpp_core::display::Compact(sweep)
+        )
+    })
+}
+
+/// A tile planner that visited its tiles but swept less than half the floor the robot can
+/// reach, said (`None` otherwise; not with [`wide_tiles_warning`], which explains it then):
+/// its tile lattice, anchored at the start, does not lead out of where the robot started (a
+/// start in a closet behind a doorway narrower than the lattice's fit). ba-star, bsa and
+/// bsa-bfs swept 6.2 % and reported `coverage_rate` 1.0.
+pub fn stranded_tiles_warning(scenario: &Scenario, metrics: &Metrics) -> Option<String> {
+    let rate = metrics.coverage_rate?;
+    if wide_tiles_warning(scenario).is_some() || metrics.path_length_m == 0.0 {
+        return None;
+    }
+    (rate >= 0.99 && metrics.effective_coverage < 0.5).then(|| {
+        format!(
+            "the planner visited every tile it could reach from the start but swept only {:.1} % of the floor the robot can reach: its tiles (anchored at the start) do not lead out of there, as through a doorway too narrow for them; try another --start or a smaller --tile-side",
+            100.0 * metrics.effective_coverage
+        )
+    })
+}
+
+/// A random-bounce run that ended boxed in, with budget left, said (its trace's
+/// [`BOXED_IN_NOTE`](ccpp_core::planners::random_bounce::BOXED_IN_NOTE), `None` otherwise).
+pub fn boxed_in_warning(trace: &Trace) -> Option<String> {
+    trace.events().find_map(|(_, e)| match e {
+        Event::Note { text }
+            if text.starts_with(ccpp_core::planners::random_bounce::BOXED_IN_NOTE) =>
+        {
+            Some(text.clone())
+        }
+        _ => None,
+    })
+}
+
 /// Every warning of a run of `scenario` in `world` with this trace and these metrics: an early
 /// stop, PID motions cut short, contacts under drift, no motion at all, a tool narrower than
-/// the pixels.
+/// the pixels, tiles wider than the tool or stranded at the start, a random bounce boxed
+/// in.
 pub fn run_warnings(
     scenario: &Scenario,
     world: &World,
@@ -117,6 +168,9 @@ pub fn run_warnings(
     let mut out = Vec::new();
     out.extend(narrow_tool_warning(world));
     out.extend(no_motion_warning(metrics));
+    out.extend(wide_tiles_warning(scenario));
+    out.extend(stranded_tiles_warning(scenario, metrics));
+    out.extend(boxed_in_warning(trace));
     out.extend(drift_warning(scenario, trace, metrics));
     out.extend(motions_cut_warning(trace));
     if let Some(why) = &metrics.stop_reason {
