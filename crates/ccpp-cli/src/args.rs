@@ -82,8 +82,29 @@ pub struct RobotArgs {
     #[arg(long, value_name = "M")]
     pub tool_radius: Option<f64>,
     /// Start pose `X,Y[,THETA]` in metres/radians (default: the widest free spot, heading east).
-    #[arg(long, value_name = "X,Y[,THETA]", value_parser = parse_triple, allow_hyphen_values = true)]
-    pub start: Option<[f64; 3]>,
+    #[arg(long, value_name = "X,Y[,THETA]", value_parser = parse_start, allow_hyphen_values = true)]
+    pub start: Option<StartArg>,
+}
+
+/// A `--start` value: the pose (THETA left out is 0) and whether THETA was given, so that a
+/// command that uses no heading refuses any, 0 included (`--start 2,2,0` was taken by `plan`
+/// and dropped while `--start 2,2,1` was refused).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StartArg {
+    /// `[x, y, theta]`.
+    pub pose: [f64; 3],
+    /// Whether THETA was given.
+    pub heading_given: bool,
+}
+
+/// Parses `X,Y[,THETA]` into a [`StartArg`].
+fn parse_start(s: &str) -> Result<StartArg, String> {
+    let parts = parse_finite_list(s)?;
+    let pose = parse_triple(s)?;
+    Ok(StartArg {
+        pose,
+        heading_given: parts.len() == 3,
+    })
 }
 
 /// Work area and keep-out zones, shared by `run`, `plan` and `info` (every planner honours them).

@@ -85,7 +85,7 @@ struct ZonesInfo {
 /// Runs `ccpp info`.
 pub fn run(a: &InfoArgs) -> Result<()> {
     let (robot, start) = robot_from(&a.robot)?;
-    if a.robot.start.is_some_and(|s| s[2] != 0.0) {
+    if a.robot.start.is_some_and(|s| s.heading_given) {
         // Nothing `info` reports depends on the heading: it was echoed and otherwise dropped.
         anyhow::bail!(
             "--start THETA does not apply to `ccpp info` (nothing it reports depends on the heading); give X,Y"

@@ -145,10 +145,15 @@ pub fn robot_from(args: &RobotArgs) -> Result<(Robot, Option<Pose>)> {
     };
     robot.validate()?;
     // Before `Pose::new` wraps it: a heading beyond two turns is a typo or degrees.
-    if let Some(why) = args.start.and_then(|s| ccpp_io::map::heading_problem(s[2])) {
+    if let Some(why) = args
+        .start
+        .and_then(|s| ccpp_io::map::heading_problem(s.pose[2]))
+    {
         anyhow::bail!("--start THETA {why}");
     }
-    let start = args.start.map(|s| Pose::new(s[0], s[1], s[2]));
+    let start = args
+        .start
+        .map(|s| Pose::new(s.pose[0], s.pose[1], s.pose[2]));
     Ok((robot, start))
 }
 

@@ -31,7 +31,7 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         // validated and then change nothing.
         bail!("--tool-radius does not apply to {kind} in `ccpp plan` (its lanes follow --width)");
     }
-    if a.robot.start.is_some_and(|s| s[2] != 0.0) {
+    if a.robot.start.is_some_and(|s| s.heading_given) {
         // Nothing a plan writes depends on the start heading: it would be dropped.
         bail!("--start THETA does not apply to `ccpp plan` (the path heads from the start to its first waypoint); give X,Y");
     }

@@ -5,6 +5,7 @@ use std::fmt::Write as _;
 use anyhow::{bail, Result};
 use ccpp_core::planners::rect_boustrophedon::{plan, RectOptions};
 use ccpp_core::planners::PlannerConfig;
+use ccpp_io::export::round_m;
 use ccpp_io::scenario::{Scenario, ScenarioError};
 
 use crate::args::WaypointsArgs;
@@ -21,7 +22,7 @@ pub fn run(a: &WaypointsArgs) -> Result<()> {
         // The lanes follow --width: the value would be validated and then change nothing.
         bail!("--tool-radius does not apply to `ccpp waypoints` (its lanes follow --width)");
     }
-    if a.robot.start.is_some_and(|s| s[2] != 0.0) {
+    if a.robot.start.is_some_and(|s| s.heading_given) {
         // Nothing a plan writes depends on the start heading: it would be dropped.
         bail!("--start THETA does not apply to `ccpp waypoints` (waypoints have no heading); give X,Y");
     }
@@ -61,20 +62,26 @@ pub fn run(a: &WaypointsArgs) -> Result<()> {
     let map = recipe_from(&a.map).load_within(scenario.max_memory_mb)?;
     let world = scenario.world(&map).map_err(flag)?;
     let p = plan(&world, &opts);
+    // Rounded as the exports round (`0.425`, not the `0.42500000000000004` of the
+    // pixel-to-map arithmetic).
+    let pts: Vec<[f64; 2]> = p
+        .waypoints
+        .iter()
+        .map(|w| [round_m(w.x), round_m(w.y)])
+        .collect();
     let text = if format == "csv" {
         let mut s = String::from("x,y\n");
-        for w in &p.waypoints {
-            let _ = writeln!(s, "{},{}", w.x, w.y);
+        for [x, y] in &pts {
+            let _ = writeln!(s, "{x},{y}");
         }
         s
     } else {
-        let pts: Vec<[f64; 2]> = p.waypoints.iter().map(|w| [w.x, w.y]).collect();
         let v = serde_json::json!({
             "map": map.name,
             // The values used (the robot's diameter when not given: `null` hid them).
             "length_m": opts.length_for(&scenario.robot),
             "width_m": opts.width_for(&scenario.robot),
-            "area": p.area,
+            "area": p.area.map(round_m),
             "waypoints": pts,
         });
         let mut s = serde_json::to_string_pretty(&v)?;

@@ -662,7 +662,8 @@ fn landmarks_arg(v: &Bound<'_, PyAny>) -> PyResult<Vec<ccpp_core::landmarks::Lan
 }
 
 /// A start pose `(x, y)` or `(x, y, theta)`.
-fn start_arg(v: &Bound<'_, PyAny>) -> PyResult<[f64; 3]> {
+/// The start `(x, y[, theta])` (theta left out is 0) and whether theta was given.
+fn start_arg(v: &Bound<'_, PyAny>) -> PyResult<([f64; 3], bool)> {
     let p: Vec<Real> = v.extract().map_err(|_| {
         msg(format!(
             "start expects (x, y) or (x, y, theta), got {}",
@@ -670,8 +671,8 @@ fn start_arg(v: &Bound<'_, PyAny>) -> PyResult<[f64; 3]> {
         ))
     })?;
     match p.as_slice() {
-        [NotBool(x), NotBool(y)] => Ok([*x, *y, 0.0]),
-        [NotBool(x), NotBool(y), NotBool(t)] => Ok([*x, *y, *t]),
+        [NotBool(x), NotBool(y)] => Ok(([*x, *y, 0.0], false)),
+        [NotBool(x), NotBool(y), NotBool(t)] => Ok(([*x, *y, *t], true)),
         _ => Err(msg(format!(
             "start expects (x, y) or (x, y, theta), got {} values",
             p.len()
@@ -737,9 +738,10 @@ fn scenario_from(
                 s.robot.tool_radius = float_arg(&key, &v)?;
             }
             "start" => {
-                let p = start_arg(&v)?;
-                if purpose == Purpose::Plan && p[2] != 0.0 {
-                    // As `ccpp plan --start X,Y,THETA`: nothing a plan gives depends on it.
+                let (p, heading_given) = start_arg(&v)?;
+                if purpose == Purpose::Plan && heading_given {
+                    // As `ccpp plan --start X,Y,THETA`: nothing a plan gives depends on it
+                    // (0 included: it was taken, where any other theta was refused).
                     return Err(msg(
                         "start theta does not apply to plan (the path heads from the start to its first waypoint); give (x, y)",
                     ));
@@ -1929,7 +1931,10 @@ impl Env {
             Some(true) => Execution::Pid(PidOptions::default()),
             Some(false) | None => Execution::Ideal,
         };
-        let start = start.filter(|v| !v.is_none()).map(start_arg).transpose()?;
+        let start = start
+            .filter(|v| !v.is_none())
+            .map(|v| start_arg(v).map(|(p, _)| p))
+            .transpose()?;
         let area = area.map(parse_area).transpose()?;
         let keepout = keepout.map(parse_keepout).transpose()?.unwrap_or_default();
         // The scenario validates the robot, the sensor range, the execution, the episode cap
