@@ -547,6 +547,34 @@ fn bsa_bfs_and_rect_boustrophedon_on_every_shared_map() {
     }
 }
 
+/// `ccpp waypoints` writes positions as the exports do, to the nanometre: `0.425`, not the
+/// `0.42500000000000004` of the pixel-to-map arithmetic.
+#[test]
+fn waypoints_carry_no_rounding_noise() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = crate::common::pillars(dir.path());
+    for format in ["csv", "json"] {
+        let o = ccpp()
+            .args(["waypoints", "--radius", "0.21", "--format", format, "--map"])
+            .arg(&map)
+            .assert()
+            .success()
+            .get_output()
+            .stdout
+            .clone();
+        let text = String::from_utf8(o).unwrap();
+        let numbers: Vec<&str> = text
+            .split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-' || c == 'e'))
+            .filter(|t| t.contains('.'))
+            .collect();
+        assert!(numbers.len() > 20, "{text}");
+        for n in numbers {
+            let decimals = n.split('.').nth(1).unwrap_or("");
+            assert!(decimals.len() <= 9, "{format}: {n}");
+        }
+    }
+}
+
 #[test]
 fn waypoints_follow_the_seed_001_example() {
     // A 3 x 2 m free room; the seed's area (0,0)-(1.1,0.5) with B = 0.1 inside it.

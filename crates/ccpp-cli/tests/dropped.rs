@@ -515,7 +515,7 @@ fn an_options_file_without_the_planners_section_is_named() {
     let d = tempfile::tempdir().unwrap();
     let dir = d.path();
     let map = pillars(dir);
-    let cfg = write(dir, "bs.yaml", "ba_star: { tile_side_m: 0.4 }\n");
+    let cfg = write(dir, "bs.yaml", "ba_star: { tile_side_m: 0.28 }\n");
     let out = dir.join("out");
     let o = ccpp()
         .args(["run", "--map", s(&map), "--planner", "ba-star-extended"])

@@ -215,6 +215,17 @@ fn inflation_below_one_pixel_is_refused() {
     assert_ne!(trace(&base), trace(&one));
     let zero = run_ok(dir, "zero", &map, "bcd", &["--inflate", "0"]);
     assert_eq!(trace(&base), trace(&zero));
+    // ... and its run.json says so, as a run without it does (it said `"inflate": 0.0`).
+    for out in [&base, &zero] {
+        assert_eq!(
+            read_json(&out.join("run.json"))["map"]["inflate"],
+            serde_json::Value::Null
+        );
+    }
+    assert_eq!(
+        std::fs::read_to_string(base.join("run.json")).unwrap(),
+        std::fs::read_to_string(zero.join("run.json")).unwrap()
+    );
 }
 
 /// `--tool-radius` with `ccpp plan --planner rect-boustrophedon` and with `ccpp waypoints`
@@ -561,28 +572,38 @@ fn a_start_heading_is_refused_where_nothing_uses_it() {
     let dir = d.path();
     let map = pillars(dir);
     let out = dir.join("out");
-    for planner in ["bcd", "rect-boustrophedon"] {
+    // Any heading, 0 included (`1,1,0` was taken and dropped where `1,1,2` was refused).
+    for theta in ["2", "0", "0.0", "-0"] {
+        let start = format!("1,1,{theta}");
+        for planner in ["bcd", "rect-boustrophedon"] {
+            refused(
+                &[
+                    "plan",
+                    "--planner",
+                    planner,
+                    "--map",
+                    s(&map),
+                    "--start",
+                    &start,
+                    "--out",
+                    s(&out),
+                ],
+                &["--start THETA", "plan"],
+            );
+            assert!(!out.exists());
+        }
         refused(
-            &[
-                "plan",
-                "--planner",
-                planner,
-                "--map",
-                s(&map),
-                "--start",
-                "1,1,2",
-                "--out",
-                s(&out),
-            ],
-            &["--start THETA", "plan"],
+            &["waypoints", "--map", s(&map), "--start", &start],
+            &["--start THETA", "waypoints"],
         );
-        assert!(!out.exists());
+        refused(
+            &["info", "--map", s(&map), "--start", &start],
+            &["--start THETA", "info"],
+        );
+    }
+    for planner in ["bcd", "rect-boustrophedon"] {
         plan_ok(dir, planner, &map, planner, &["--start", "1,1"]);
     }
-    refused(
-        &["waypoints", "--map", s(&map), "--start", "1,1,2"],
-        &["--start THETA", "waypoints"],
-    );
     // `run` uses it: the robot first turns from that heading.
     let a = run_ok(dir, "a", &map, "bcd", &["--start", "1,1"]);
     let b = run_ok(dir, "b", &map, "bcd", &["--start", "1,1,2"]);
@@ -2649,4 +2670,168 @@ fn moving_the_map_origin_changes_only_coordinates() {
         "{seen:?}"
     );
     assert!((seen[0].2 - seen[1].2).abs() < 1e-6, "{seen:?}");
+}
+
+/// Runs `ccpp run ... --json` in `dir/sub` and returns the metrics and stderr.
+fn run_with_stderr(
+    dir: &Path,
+    sub: &str,
+    map: &Path,
+    args: &[&str],
+) -> (serde_json::Value, String) {
+    let a = ccpp()
+        .arg("run")
+        .arg("--map")
+        .arg(map)
+        .args(args)
+        .arg("--json")
+        .arg("--out")
+        .arg(dir.join(sub))
+        .assert()
+        .success();
+    let o = a.get_output();
+    (
+        serde_json::from_slice(&o.stdout).unwrap(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+/// An 8 x 6 m hall of 0.1 m pillars every 0.75 m; the work area's virtual wall runs one
+/// contact diameter from a pillar, a gap the robot wedges itself into where only the way back
+/// leads out. random-bounce (seed 1) drove 9 m of its 480 m budget there, swept 7 % and
+/// ended "done" without a word after 64 random turns that all faced an obstacle; it now turns
+/// to a free heading and drives its budget.
+#[test]
+fn random_bounce_wedged_in_a_gap_finds_the_way_out() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = pgm(dir.path(), "hall.pgm", 160, 120, |x, y| {
+        let pillar = |v: usize, lo: usize, hi: usize| v >= lo && v < hi && (v - lo) % 15 < 2;
+        pillar(y, 10, 115) && pillar(x, 10, 155)
+    });
+    let (m, err) = run_with_stderr(
+        dir.path(),
+        "rb",
+        &map,
+        &[
+            "--planner",
+            "random-bounce",
+            "--seed",
+            "1",
+            "--area",
+            "0.3,0.2,7.5,5.8",
+        ],
+    );
+    let driven = m["path_length_m"].as_f64().unwrap();
+    assert!((driven - 480.0).abs() < 1e-3, "{driven} m of 480");
+    assert!(m["effective_coverage"].as_f64().unwrap() > 0.7, "{m}");
+    assert!(!err.contains("warning"), "{err}");
+}
+
+/// Tiles wider than the tool sweeps leave strips between the lanes: said, since
+/// `coverage_rate` (on the planner's own tiles) reads 1.0 beside an effective coverage of a
+/// third. The default tile (2 r, the tool's width here) says nothing.
+#[test]
+fn tiles_wider_than_the_tool_are_said() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = pillars(dir.path());
+    for (planner, side) in [("ba-star", "0.9"), ("bsa-bfs", "0.6")] {
+        let (m, err) = run_with_stderr(
+            dir.path(),
+            &format!("{planner}-wide"),
+            &map,
+            &["--planner", planner, "--tile-side", side],
+        );
+        assert!(m["coverage_rate"].as_f64().unwrap() > 0.99, "{m}");
+        assert!(m["effective_coverage"].as_f64().unwrap() < 0.7, "{m}");
+        assert!(
+            err.contains(&format!("warning: the tile side {side} m is wider than the tool sweeps (2 x tool radius = 0.3 m)")),
+            "{planner}: {err}"
+        );
+        let (_, err) = run_with_stderr(
+            dir.path(),
+            &format!("{planner}-own"),
+            &map,
+            &["--planner", planner],
+        );
+        assert!(!err.contains("warning"), "{planner}: {err}");
+    }
+    // A tool narrower than the robot: the default tiles (the robot's diameter) are wider too.
+    let (_, err) = run_with_stderr(
+        dir.path(),
+        "narrow-tool",
+        &map,
+        &["--planner", "ba-star", "--tool-radius", "0.1"],
+    );
+    assert!(
+        err.contains("the tile side 0.3 m is wider than the tool sweeps (2 x tool radius = 0.2 m)"),
+        "{err}"
+    );
+}
+
+/// A start in a closet behind a 0.4 m door: the tile planners' lattice (anchored at the start)
+/// does not pass the door, so they visited every tile they could reach (`coverage_rate` 1.0)
+/// and swept 6 % of the floor, without a word. From the default start nothing is said.
+#[test]
+fn tiles_stranded_at_the_start_are_said() {
+    let dir = tempfile::tempdir().unwrap();
+    // 120 x 100 px: a closet in the top-right corner (columns 81-118, rows 1-29) behind the
+    // wall at column 80, with a door in rows 18-25.
+    let map = pgm(dir.path(), "closet.pgm", 120, 100, |x, y| {
+        (x == 80 && (10..=30).contains(&y) && !(18..26).contains(&y)) || (y == 30 && x >= 80)
+    });
+    for planner in ["ba-star", "bsa", "bsa-bfs"] {
+        let (m, err) = run_with_stderr(
+            dir.path(),
+            &format!("{planner}-closet"),
+            &map,
+            &["--planner", planner, "--start", "5.0,4.0"],
+        );
+        assert!(
+            m["effective_coverage"].as_f64().unwrap() < 0.1,
+            "{planner}: {m}"
+        );
+        assert!(
+            err.contains("warning: the planner visited every tile it could reach from the start but swept only"),
+            "{planner}: {err}"
+        );
+        let (m, err) = run_with_stderr(
+            dir.path(),
+            &format!("{planner}-hall"),
+            &map,
+            &["--planner", planner],
+        );
+        assert!(
+            m["effective_coverage"].as_f64().unwrap() > 0.5,
+            "{planner}: {m}"
+        );
+        assert!(!err.contains("warning"), "{planner}: {err}");
+    }
+}
+
+/// Under PID execution a motion starts aligned to `heading_tolerance_rad`: at its old default
+/// of 1e-9 rad, the rounding of the heading between two collinear waypoints far from the
+/// map's origin (about 1e-8 rad at 1e5 m) was a turn in place, 119 turns instead of 93 for
+/// rect-boustrophedon on this room of one-pixel diagonal walls placed at (12345.6, -98765.4).
+#[test]
+fn pid_turns_do_not_depend_on_where_the_map_lies() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = pgm(dir.path(), "diag.pgm", 120, 100, |x, y| {
+        ((15..85).contains(&y) && x == y + 5) || ((60..120).contains(&x) && y == 90 - (x - 60) / 2)
+    });
+    let turns = |sub: &str, origin: &str| {
+        let (m, _) = run_with_stderr(
+            dir.path(),
+            sub,
+            &map,
+            &[
+                "--planner",
+                "rect-boustrophedon",
+                &format!("--origin={origin}"),
+            ],
+        );
+        m["turns"].as_u64().unwrap()
+    };
+    let home = turns("home", "0,0");
+    assert_eq!(turns("far", "12345.6,-98765.4"), home);
+    assert_eq!(turns("farther", "512345.6,5098765.4"), home);
 }

@@ -104,8 +104,13 @@ def test_plan_refuses_what_a_plan_would_drop(room: Path, ccpp_bin: str, tmp_path
     p = cli(ccpp_bin, "plan", "--map", str(room), "--planner", "bcd", "--start", "1,1,1",
             "--out", str(tmp_path / "o"))
     assert p.returncode != 0 and "THETA" in p.stderr
-    with pytest.raises(ccpp.CcppError, match="start theta does not apply to plan"):
-        ccpp.plan(room, "bcd", start=(1.0, 1.0, 1.0))
+    # Any heading, 0 included (it was taken and dropped where 1.0 was refused).
+    for theta in (1.0, 0.0, 0, -0.0):
+        with pytest.raises(ccpp.CcppError, match="start theta does not apply to plan"):
+            ccpp.plan(room, "bcd", start=(1.0, 1.0, theta))
+    p = cli(ccpp_bin, "plan", "--map", str(room), "--planner", "bcd", "--start", "1,1,0",
+            "--out", str(tmp_path / "o"))
+    assert p.returncode != 0 and "THETA" in p.stderr
     assert ccpp.plan(room, "bcd", start=(1.0, 1.0)).finished
     # A plan executes the steps ideally: an execution would be dropped.
     with pytest.raises(ccpp.CcppError, match=r"sim\.exec \(--exec, --odometry-noise; exec=, odometry_noise=\) does not apply to a plan"):
