@@ -1326,13 +1326,8 @@ mod tests {
     /// capsule test sees a pixel just beyond reach), across the map and out of it.
     #[test]
     fn capsule_test_agrees_with_the_exact_contact_test() {
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::rng::SplitMix64::new(0x2545_f491_4f6c_dd1d);
+        let mut next = move || rng.range(0.0, 1.0);
         let (w, h) = (300usize, 40usize);
         let mut art = String::new();
         for r in 0..h {
