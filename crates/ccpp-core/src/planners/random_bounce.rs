@@ -145,13 +145,12 @@ impl Planner for RandomBounce {
         let look = (sensor.sensor_range() - r - 1.5 * res).max(0.0).min(left);
         let free = known.free_distance(pose.position(), pose.theta, look, r);
         let stride_of = |free: f64| (free - 1e-4 * res).max(0.0);
-        // Whether a move of `stride` is worth driving: half a pixel, or what is left.
-        let drivable =
-            |stride: f64| stride >= 0.5 * res || (stride > 0.0 && stride >= left - 1e-12);
+        // The shortest move it drives: half a pixel.
+        let drivable = |stride: f64| stride >= 0.5 * res;
         let stride = stride_of(free);
-        // Spent: also when what is left is within the stride's safety gap (no move of it
-        // would be positive; the robot turned at random until it gave up).
-        if left <= 1e-9 || stride_of(left) == 0.0 {
+        // Spent: also when what is left is less than the shortest move (the robot turned on
+        // the spot until it gave up, and then, looking for a way out, said it was boxed in).
+        if left <= 1e-9 || !drivable(stride_of(left)) {
             self.end = End::Done;
             return Step::Mark(Event::RegionEnd { region: 1 });
         }
