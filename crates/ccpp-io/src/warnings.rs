@@ -105,14 +105,25 @@ pub fn narrow_tool_warning(world: &World) -> Option<String> {
     })
 }
 
+/// The planners whose lanes lie a tile apart and leave the floor between them to no one:
+/// the tile planners without the coverage extension (which sweeps what the lanes leave).
+fn tiles_only(scenario: &Scenario) -> bool {
+    use ccpp_core::planners::PlannerKind as K;
+    matches!(scenario.planner.kind(), K::BaStar | K::Bsa | K::BsaBfs)
+}
+
 /// Tiles wider than the tool sweeps, said (`None` otherwise): the planner's lanes lie a tile
 /// apart, so they leave strips between them unswept, while `coverage_rate` counts the
 /// planner's own tiles. ba-star at `--tile-side 0.9` with a 0.3 m tool reported
 /// `coverage_rate` 1.0 beside an effective coverage of 0.34 without a word (bcd's lane
 /// spacing and rect-boustrophedon's lane width are refused beyond the tool; the tile side is
 /// the papers' parameter, and the default, the robot's diameter, is wider than a tool of a
-/// smaller `--tool-radius`).
+/// smaller `--tool-radius`). Not for ba-star-extended and bsa-extended, whose extension
+/// sweeps the strips.
 pub fn wide_tiles_warning(scenario: &Scenario) -> Option<String> {
+    if !tiles_only(scenario) {
+        return None;
+    }
     let side = scenario.tile_side()?;
     let sweep = 2.0 * scenario.robot.tool_radius;
     (side > sweep * (1.0 + 1e-9)).then(|| {
@@ -124,19 +135,30 @@ pub fn wide_tiles_warning(scenario: &Scenario) -> Option<String> {
     })
 }
 
-/// A tile planner that visited its tiles but swept less than half the floor the robot can
-/// reach, said (`None` otherwise; not with [`wide_tiles_warning`], which explains it then):
-/// its tile lattice, anchored at the start, does not lead out of where the robot started (a
-/// start in a closet behind a doorway narrower than the lattice's fit). ba-star, bsa and
-/// bsa-bfs swept 6.2 % and reported `coverage_rate` 1.0.
+/// A tile planner that visited (nearly) all its tiles reachable from the start but swept less
+/// than half the floor the robot can reach, said (`None` otherwise): its tile lattice,
+/// anchored at the start, does not lead out of where the robot started (a start in a closet
+/// behind a doorway narrower than the lattice's fit). ba-star, bsa and bsa-bfs swept 6.2 %
+/// and reported `coverage_rate` 1.0. Not said beside [`wide_tiles_warning`]: wide tiles leave
+/// most of the floor unswept wherever the robot starts, and that warning names the cause.
 pub fn stranded_tiles_warning(scenario: &Scenario, metrics: &Metrics) -> Option<String> {
     let rate = metrics.coverage_rate?;
-    if wide_tiles_warning(scenario).is_some() || metrics.path_length_m == 0.0 {
+    if !tiles_only(scenario)
+        || wide_tiles_warning(scenario).is_some()
+        || metrics.path_length_m == 0.0
+    {
         return None;
     }
+    // bsa's tiles are always the robot's diameter: only another start helps.
+    let remedy = if scenario.planner.kind() == ccpp_core::planners::PlannerKind::Bsa {
+        "try another --start"
+    } else {
+        "try another --start or a smaller --tile-side"
+    };
     (rate >= 0.99 && metrics.effective_coverage < 0.5).then(|| {
         format!(
-            "the planner visited every tile it could reach from the start but swept only {:.1} % of the floor the robot can reach: its tiles (anchored at the start) do not lead out of there, as through a doorway too narrow for them; try another --start or a smaller --tile-side",
+            "the planner visited the tiles it could reach from the start ({:.0} %) but swept only {:.1} % of the floor the robot can reach: its tiles (anchored at the start) do not lead out of there, as through a doorway too narrow for them; {remedy}",
+            100.0 * rate,
             100.0 * metrics.effective_coverage
         )
     })

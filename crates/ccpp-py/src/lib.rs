@@ -661,8 +661,8 @@ fn landmarks_arg(v: &Bound<'_, PyAny>) -> PyResult<Vec<ccpp_core::landmarks::Lan
     Ok(list)
 }
 
-/// A start pose `(x, y)` or `(x, y, theta)`.
-/// The start `(x, y[, theta])` (theta left out is 0) and whether theta was given.
+/// A start pose `(x, y)` or `(x, y, theta)` (theta left out is 0), and whether theta was
+/// given.
 fn start_arg(v: &Bound<'_, PyAny>) -> PyResult<([f64; 3], bool)> {
     let p: Vec<Real> = v.extract().map_err(|_| {
         msg(format!(
@@ -1256,8 +1256,9 @@ impl RunResult {
     /// The warnings `ccpp run` prints for this run (without `warning: `): a start whose free
     /// area reaches the map's border (it may be outside the building), an early stop, PID
     /// motions cut at `max_steps_per_motion`, bumper contacts under odometry noise without
-    /// landmarks, a run that never moved, a tool narrower than the map's pixels. A run that
-    /// ends `done` may still have some (`stop` is the planner's word).
+    /// landmarks, a run that never moved, a tool narrower than the map's pixels, tiles wider
+    /// than the tool or stranded at the start (ba-star, bsa, bsa-bfs), a random bounce boxed
+    /// in. A run that ends `done` may still have some (`stop` is the planner's word).
     #[getter]
     fn warnings(&self) -> Vec<String> {
         self.start_warning
