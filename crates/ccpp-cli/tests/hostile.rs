@@ -2861,3 +2861,36 @@ fn pid_turns_do_not_depend_on_where_the_map_lies() {
     assert_eq!(turns("far", "12345.6,-98765.4"), home);
     assert_eq!(turns("farther", "512345.6,5098765.4"), home);
 }
+
+/// A floor bounded by unknown pixels (as in many scanned maps, `teb_empty_box`) got no margin
+/// from `--inflate`: only occupied pixels grew, so the run was the run without it while its
+/// summary said it had been inflated. Unknown pixels grow too now.
+#[test]
+fn inflation_grows_from_unknown_walls_too() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let (w, h) = (100usize, 80usize);
+    let mut bytes = format!("P5\n{w} {h}\n255\n").into_bytes();
+    for y in 0..h {
+        for x in 0..w {
+            let border = x < 3 || y < 3 || x >= w - 3 || y >= h - 3;
+            bytes.push(if border { 128 } else { 254 });
+        }
+    }
+    let map = dir.join("grey.pgm");
+    std::fs::write(&map, bytes).unwrap();
+    let base = run_ok(dir, "base", &map, "bcd", &[]);
+    let grown = run_ok(dir, "grown", &map, "bcd", &["--inflate", "0.05"]);
+    assert_ne!(trace(&base), trace(&grown));
+    let path = |out: &Path| {
+        read_json(&out.join("metrics.json"))["path_length_m"]
+            .as_f64()
+            .unwrap()
+    };
+    assert!(
+        path(&grown) < path(&base),
+        "{} vs {}",
+        path(&grown),
+        path(&base)
+    );
+}
