@@ -969,6 +969,28 @@ impl World {
     }
 }
 
+/// The pixels `[col0, col1, row0, row1]` (inclusive) whose centres lie within `r` of the box
+/// of the segment from grid point `a` to `b` (so every pixel within `r` of the segment), taken
+/// with a margin far below the contact tolerance and far above the rounding of grid
+/// coordinates; `None` when that box is empty, reaches beyond the image or a value is not
+/// finite (the exact tests then decide: they count every pixel beyond the image as blocked).
+#[inline]
+fn reach_box(frame: &MapFrame, a: Point, b: Point, r: f64) -> Option<[i64; 4]> {
+    let eps = 1e-7;
+    let h = frame.height as f64;
+    if !(a.x.is_finite() && a.y.is_finite() && b.x.is_finite() && b.y.is_finite() && r.is_finite())
+    {
+        return None;
+    }
+    let cmin = ceil_i64(a.x.min(b.x) - r - 0.5 - eps);
+    let cmax = floor_i64(a.x.max(b.x) + r - 0.5 + eps);
+    let rmin = ceil_i64(h - a.y.max(b.y) - r - 0.5 - eps);
+    let rmax = floor_i64(h - a.y.min(b.y) + r - 0.5 + eps);
+    let (w, hh) = (frame.width as i64, frame.height as i64);
+    (0 <= cmin && cmin <= cmax && cmax < w && 0 <= rmin && rmin <= rmax && rmax < hh)
+        .then_some([cmin, cmax, rmin, rmax])
+}
+
 /// Is every pixel that can touch the disk of contact radius `rc` pixels moving from grid point
 /// `a` to `b` inside the image and not in `blocked`? A pixel touches only when its centre lies
 /// within `rc` of the segment ([`collide::segment_first_contact`], [`collide::disk_hits`]),
@@ -978,20 +1000,10 @@ impl World {
 /// "ask them" (also for boxes of more than [`BOX_CLEAR_MAX_PX`] pixels and non-finite points).
 #[inline]
 fn box_clear(frame: &MapFrame, a: Point, b: Point, rc: f64, blocked: &FixedBitSet) -> bool {
-    let eps = 1e-7;
-    let h = frame.height as f64;
-    if !(a.x.is_finite() && a.y.is_finite() && b.x.is_finite() && b.y.is_finite() && rc.is_finite())
-    {
+    let Some([cmin, cmax, rmin, rmax]) = reach_box(frame, a, b, rc) else {
         return false;
-    }
-    let cmin = ceil_i64(a.x.min(b.x) - rc - 0.5 - eps);
-    let cmax = floor_i64(a.x.max(b.x) + rc - 0.5 + eps);
-    let rmin = ceil_i64(h - a.y.max(b.y) - rc - 0.5 - eps);
-    let rmax = floor_i64(h - a.y.min(b.y) + rc - 0.5 + eps);
-    let (w, hh) = (frame.width as i64, frame.height as i64);
-    if !(0 <= cmin && cmin <= cmax && cmax < w && 0 <= rmin && rmin <= rmax && rmax < hh)
-        || (cmax - cmin + 1) * (rmax - rmin + 1) > BOX_CLEAR_MAX_PX
-    {
+    };
+    if (cmax - cmin + 1) * (rmax - rmin + 1) > BOX_CLEAR_MAX_PX {
         return false;
     }
     let words = blocked.as_slice();
@@ -1016,19 +1028,7 @@ fn box_clear(frame: &MapFrame, a: Point, b: Point, rc: f64, blocked: &FixedBitSe
 /// lane of a 2.5 km corridor (`bcd`, 0.05 m/px) took 50 000 exact steps per check.
 fn capsule_clear(frame: &MapFrame, a: Point, b: Point, rc: f64, blocked: &FixedBitSet) -> bool {
     let r = rc + CLEAR_EPS_PX;
-    let h = frame.height as f64;
-    if !(a.x.is_finite() && a.y.is_finite() && b.x.is_finite() && b.y.is_finite() && r.is_finite())
-    {
-        return false;
-    }
-    // Every pixel within `r` of the segment lies in the image (else the exact tests count
-    // the pixels beyond its border as blocked).
-    let eps = 1e-7;
-    let cmin = floor_i64(a.x.min(b.x) - r - 0.5 - eps);
-    let cmax = ceil_i64(a.x.max(b.x) + r - 0.5 + eps);
-    let rmin = floor_i64(h - a.y.max(b.y) - r - 0.5 - eps);
-    let rmax = ceil_i64(h - a.y.min(b.y) + r - 0.5 + eps);
-    if !(0 <= cmin && cmax < frame.width as i64 && 0 <= rmin && rmax < frame.height as i64) {
+    if reach_box(frame, a, b, r).is_none() {
         return false;
     }
     let words = blocked.as_slice();
