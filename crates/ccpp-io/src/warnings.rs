@@ -112,6 +112,17 @@ fn tiles_only(scenario: &Scenario) -> bool {
     matches!(scenario.planner.kind(), K::BaStar | K::Bsa | K::BsaBfs)
 }
 
+/// The tile side and the tool's sweep (`2 r_tool`) of a tile-only planner whose tiles are
+/// wider than that sweep, else `None`.
+fn wide_tiles(scenario: &Scenario) -> Option<(f64, f64)> {
+    if !tiles_only(scenario) {
+        return None;
+    }
+    let side = scenario.tile_side()?;
+    let sweep = 2.0 * scenario.robot.tool_radius;
+    (side > sweep * (1.0 + 1e-9)).then_some((side, sweep))
+}
+
 /// Tiles wider than the tool sweeps, said (`None` otherwise): the planner's lanes lie a tile
 /// apart, so they leave strips between them unswept, while `coverage_rate` counts the
 /// planner's own tiles. ba-star at `--tile-side 0.9` with a 0.3 m tool reported
@@ -121,12 +132,7 @@ fn tiles_only(scenario: &Scenario) -> bool {
 /// smaller `--tool-radius`). Not for ba-star-extended and bsa-extended, whose extension
 /// sweeps the strips.
 pub fn wide_tiles_warning(scenario: &Scenario) -> Option<String> {
-    if !tiles_only(scenario) {
-        return None;
-    }
-    let side = scenario.tile_side()?;
-    let sweep = 2.0 * scenario.robot.tool_radius;
-    (side > sweep * (1.0 + 1e-9)).then(|| {
+    wide_tiles(scenario).map(|(side, sweep)| {
         format!(
             "the tile side {} m is wider than the tool sweeps (2 x tool radius = {} m): lanes a tile apart leave strips unswept between them, and coverage_rate counts the planner's own tiles; effective_coverage is the share of the floor swept",
             ccpp_core::display::Compact(side),
@@ -143,10 +149,7 @@ pub fn wide_tiles_warning(scenario: &Scenario) -> Option<String> {
 /// most of the floor unswept wherever the robot starts, and that warning names the cause.
 pub fn stranded_tiles_warning(scenario: &Scenario, metrics: &Metrics) -> Option<String> {
     let rate = metrics.coverage_rate?;
-    if !tiles_only(scenario)
-        || wide_tiles_warning(scenario).is_some()
-        || metrics.path_length_m == 0.0
-    {
+    if !tiles_only(scenario) || wide_tiles(scenario).is_some() || metrics.path_length_m == 0.0 {
         return None;
     }
     // bsa's tiles are always the robot's diameter: only another start helps.
