@@ -894,7 +894,7 @@ fn absurd_sizes_end_within_seconds() {
             &map,
             "random-bounce",
             args,
-            &["sensor range", "r + 2 px"],
+            &["sensor range", "r + 2 px", "raise --sensor-range;"],
         );
     }
     // The least range the message names passes (it named r + 2 px, 0.25 m here, which was

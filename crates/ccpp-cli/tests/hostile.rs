@@ -2894,3 +2894,64 @@ fn inflation_grows_from_unknown_walls_too() {
         path(&base)
     );
 }
+
+/// random-bounce's default budget is 3x the lane-by-lane length of the floor the operator
+/// names: the map frame's, or the `--area`'s. It ignored the area (a one-pixel area drove
+/// 360 m of jiggles, path ratio 1489). A `budget_m` below its shortest move (half a pixel)
+/// ended at 0 m with the "did not move" warning, which blames the floor: refused.
+#[test]
+fn random_bounce_budget_follows_the_area_and_refuses_less_than_a_move() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir); // 8 x 6 m from (0, 0), 0.05 m/px
+    let whole = read_json(&run_ok(dir, "whole", &map, "random-bounce", &[]).join("metrics.json"));
+    // 3 x 48 m2 / 0.3 m = 480 m in the frame.
+    let driven = whole["path_length_m"].as_f64().unwrap();
+    assert!(driven > 400.0 && driven <= 480.0 + 1e-6, "{driven}");
+    // A 1 x 1 m area (20 x 20 px): 3 x 1 m2 / 0.3 m = 10 m.
+    let out = run_ok(dir, "area", &map, "random-bounce", &["--area", "1,1,2,2"]);
+    let m = read_json(&out.join("metrics.json"));
+    let driven = m["path_length_m"].as_f64().unwrap();
+    assert!(driven > 9.0 && driven <= 10.0 + 1e-6, "{driven}");
+    // An explicit budget is the user's, area or not.
+    std::fs::write(dir.join("b.yaml"), "random_bounce: { budget_m: 20 }\n").unwrap();
+    let cfg = dir.join("b.yaml");
+    let out = run_ok(
+        dir,
+        "area-budget",
+        &map,
+        "random-bounce",
+        &["--area", "1,1,2,2", "--config", s(&cfg)],
+    );
+    let driven = read_json(&out.join("metrics.json"))["path_length_m"]
+        .as_f64()
+        .unwrap();
+    assert!(driven > 19.0 && driven <= 20.0 + 1e-6, "{driven}");
+    // Below half a pixel (0.025 m): refused, naming the option and the shortest move.
+    std::fs::write(dir.join("tiny.yaml"), "random_bounce: { budget_m: 0.02 }\n").unwrap();
+    let tiny = dir.join("tiny.yaml");
+    let refused_out = dir.join("tiny-out");
+    refused(
+        &[
+            "run",
+            "--planner",
+            "random-bounce",
+            "--map",
+            s(&map),
+            "--config",
+            s(&tiny),
+            "--out",
+            s(&refused_out),
+        ],
+        &["budget_m", "0.02 m", "half a pixel", "0.025 m", "pillars"],
+    );
+    assert!(!refused_out.exists());
+    // Half a pixel itself is a move.
+    std::fs::write(
+        dir.join("half.yaml"),
+        "random_bounce: { budget_m: 0.025 }\n",
+    )
+    .unwrap();
+    let half = dir.join("half.yaml");
+    run_ok(dir, "half", &map, "random-bounce", &["--config", s(&half)]);
+}

@@ -36,10 +36,11 @@ use crate::trace::Event;
 pub struct RandomBounceOptions {
     /// Seed of the turn angles.
     pub seed: u64,
-    /// Distance budget in metres; `None` = 3x the lane-by-lane length of the map frame's area
-    /// (`3 * width_m * height_m / (2 r_tool)`, see
-    /// [`default_budget`](super::settings::default_budget)): what an operator knows, not the
-    /// map's contents.
+    /// Distance budget in metres, at least half a pixel (its shortest move); `None` = 3x the
+    /// lane-by-lane length of the map frame's area (`3 * width_m * height_m / (2 r_tool)`, see
+    /// [`default_budget`](super::settings::default_budget)), or of the work area's when the
+    /// run has one ([`default_budget_in`](super::settings::default_budget_in)): what an
+    /// operator knows, not the map's contents.
     pub budget_m: Option<f64>,
     /// Smallest turn after a bump, degrees (within
     /// `[-`[`MAX_TURN_DEG`](super::settings::MAX_TURN_DEG)`, MAX_TURN_DEG]`).
