@@ -31,7 +31,8 @@ pub const PANIC_ENV: &str = "CCPP_TEST_PANIC_PLANNER";
 /// random-bounce redid every run), the robot, the simulator settings and the ccpp version.
 /// The key's own version goes up when a planner's runs change under the same options (v4:
 /// random-bounce finds its way out of a gap; a resumed bench reused its old runs, which
-/// stopped at 13.4 of 31.7 km on `stage_willow_full`).
+/// stopped at 13.4 of 31.7 km on `stage_willow_full`; v5: a run folder holds its
+/// `warnings.txt`, so runs of v4, which have none, run again rather than report none).
 pub fn run_key(
     grid_hash: u64,
     recipe: &ccpp_io::scenario::MapRecipe,
@@ -52,7 +53,7 @@ pub fn run_key(
     h.bytes(serde_json::to_string(&robot)?.as_bytes());
     h.bytes(serde_json::to_string(sim)?.as_bytes());
     h.bytes(env!("CARGO_PKG_VERSION").as_bytes());
-    Ok(format!("ccpp-bench-key v4 {:016x}\n", h.finish()))
+    Ok(format!("ccpp-bench-key v5 {:016x}\n", h.finish()))
 }
 
 /// Runs the benchmark.
@@ -188,7 +189,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         .par_iter()
         .map(|(mi, name, planner)| {
             let dir = a.out.join("runs").join(name).join(planner);
-            let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
                 run_one(
                     a,
                     &prepared[*mi].1,
@@ -201,6 +202,10 @@ pub fn run(a: &BenchArgs) -> Result<()> {
                 )
             }))
             .unwrap_or_else(|payload| Err(panic_message(payload.as_ref())));
+            let (outcome, warnings) = match result {
+                Ok((m, w)) => (Ok(m), w),
+                Err(e) => (Err(e), Vec::new()),
+            };
             let _guard = done.lock();
             bar.inc(1);
             bar.set_message(format!("{name} / {planner}"));
@@ -208,6 +213,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
                 map: name.clone(),
                 planner: planner.clone(),
                 outcome,
+                warnings,
                 dir,
             }
         })
@@ -253,6 +259,21 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         crate::print_stdout(&format!(
             "warning: stopped before the planner finished, with incomplete coverage (status in results.csv): {}\n",
             stopped.join(", ")
+        ))?;
+    }
+    // The warnings `ccpp run` prints for a run (wide tiles, stranded tiles, boxed in, ...),
+    // named here and written out in results.md and results.csv: a row of tile coverage 1.0
+    // beside an effective coverage of 0.69 was shown without a word.
+    let warned: Vec<String> = rows
+        .iter()
+        .filter(|r| !r.warnings.is_empty())
+        .map(|r| format!("{} / {}", r.map, r.planner))
+        .collect();
+    if !warned.is_empty() {
+        crate::print_stdout(&format!(
+            "warning: {} with warnings (in results.md and the warnings column of results.csv): {}\n",
+            crate::output::count(warned.len(), "run", "runs"),
+            warned.join(", ")
         ))?;
     }
     if !outside.is_empty() {
@@ -413,14 +434,26 @@ fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
 }
 
 /// The files every finished bench run folder holds (a bench writes no replay or exports).
-const BENCH_RUN_FILES: [&str; 6] = [
+const BENCH_RUN_FILES: [&str; 7] = [
     "run.json",
     "path.csv",
     "trace.jsonl",
     "coverage.png",
     "metrics.json",
     "bench-key.txt",
+    WARNINGS_FILE,
 ];
+
+/// The warnings of a bench run, one per line (empty when none), beside its other files: a
+/// resumed bench reports a reused run's warnings from it.
+const WARNINGS_FILE: &str = "warnings.txt";
+
+/// The warnings in a bench run folder's [`WARNINGS_FILE`].
+fn read_warnings(dir: &Path) -> Result<Vec<String>, String> {
+    let text = ccpp_io::file::read_text(&dir.join(WARNINGS_FILE))
+        .map_err(|e| crate::errors::one_line(&e.into()))?;
+    Ok(text.lines().map(str::to_string).collect())
+}
 
 #[allow(clippy::too_many_arguments)] // the run, its map and the bench's shared state
 fn run_one(
@@ -432,7 +465,7 @@ fn run_one(
     robot: ccpp_core::world::Robot,
     options: &PlannerOptions,
     budget: &MemoryBudget,
-) -> Result<Metrics, String> {
+) -> Result<(Metrics, Vec<String>), String> {
     let map = map.as_ref().map_err(Clone::clone)?;
     let sim = SimConfig::default();
     let key = grid_hash
@@ -456,10 +489,11 @@ fn run_one(
                         .find(|f| ccpp_io::file::open_regular(&dir.join(f)).is_err());
                     let whole = match missing {
                         Some(f) => Err(format!("{f} is missing")),
-                        None => whole_trace(dir, map.grid.frame(), robot.radius, budget),
+                        None => whole_trace(dir, map.grid.frame(), robot.radius, budget)
+                            .and_then(|()| read_warnings(dir)),
                     };
                     match whole {
-                        Ok(()) => return Ok(m),
+                        Ok(w) => return Ok((m, w)),
                         Err(why) => {
                             eprintln!("warning: {}: {why}; running it again", dir.display());
                         }
@@ -484,7 +518,8 @@ fn run_one(
     // holds nothing: the child says why).
     let bytes = spec.scenario.check_map(map).map_or(0.0, |e| e.bytes);
     let _grant = budget.take(bytes);
-    run_isolated(&spec)
+    let m = run_isolated(&spec)?;
+    Ok((m, read_warnings(dir)?))
 }
 
 /// Checks that the `trace.jsonl` of the run folder `dir` reads back (as the plots read it,
@@ -642,7 +677,19 @@ fn child_job() -> Result<String> {
     if let Some(note) = result.approach_note() {
         eprintln!("{note}");
     }
-    let extra = [("bench-key.txt", spec.key.into_bytes())];
+    let warnings: String = ccpp_io::warnings::run_warnings(
+        &job.scenario,
+        &result.world,
+        &result.run.trace,
+        &result.metrics,
+    )
+    .iter()
+    .map(|w| format!("{}\n", w.replace('\n', " ")))
+    .collect();
+    let extra = [
+        ("bench-key.txt", spec.key.into_bytes()),
+        (WARNINGS_FILE, warnings.into_bytes()),
+    ];
     write_run_files(&job.out, &job, &result, false, &extra)
 }
 
@@ -656,7 +703,7 @@ fn csv_field(s: &str) -> String {
 }
 
 /// Column names of `results.csv`.
-pub const CSV_COLUMNS: [&str; 20] = [
+pub const CSV_COLUMNS: [&str; 21] = [
     "map",
     "planner",
     "status",
@@ -677,7 +724,11 @@ pub const CSV_COLUMNS: [&str; 20] = [
     "collisions",
     "wall_time_s",
     "dir",
+    "warnings",
 ];
+
+/// Joins a run's warnings in one `results.csv` field.
+pub const WARNINGS_SEPARATOR: &str = " | ";
 
 /// `results.csv`: one row per run, failures included.
 pub fn results_csv(rows: &[Row]) -> String {
@@ -720,6 +771,7 @@ pub fn results_csv(rows: &[Row]) -> String {
             String::new()
         };
         f.push(csv_field(&dir));
+        f.push(csv_field(&r.warnings.join(WARNINGS_SEPARATOR)));
         s.push_str(&f.join(","));
         s.push('\n');
     }
@@ -943,6 +995,18 @@ pub fn results_md(rows: &[Row], outside: &[String]) -> String {
                 }
             }
         }
+        let warned: Vec<&Row> = rows
+            .iter()
+            .filter(|r| r.map == *map && !r.warnings.is_empty())
+            .collect();
+        if !warned.is_empty() {
+            s.push_str("\nWarnings:\n\n");
+            for r in warned {
+                for w in &r.warnings {
+                    let _ = writeln!(s, "- {}: {}", md_text(&r.planner), md_text(w));
+                }
+            }
+        }
         s.push('\n');
     }
     s
@@ -987,6 +1051,7 @@ mod tests {
             map: map.into(),
             planner: "bsa".into(),
             outcome: Err("robot too big".into()),
+            warnings: Vec::new(),
             dir: PathBuf::from(format!("out/runs/{map}/bsa")),
         };
         let rows = [row("a"), row("b")];
@@ -1009,6 +1074,7 @@ mod tests {
             map: "lab\nb|c".into(),
             planner: "bsa".into(),
             outcome: Err("robot too big".into()),
+            warnings: Vec::new(),
             dir: PathBuf::from("out/runs/x/bsa"),
         }];
         let md = results_md(&rows, &[]);

@@ -373,6 +373,7 @@ mod tests {
             map: "box".into(),
             planner: "bsa".into(),
             outcome: Ok(metrics),
+            warnings: Vec::new(),
             dir: dir.clone(),
         }];
         let maps = [(data, Ok(map))];

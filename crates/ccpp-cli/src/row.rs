@@ -13,6 +13,9 @@ pub struct Row {
     pub planner: String,
     /// The metrics, or the error.
     pub outcome: Result<Metrics, String>,
+    /// The run's warnings (as `ccpp run` prints them, without `warning: `); none for a
+    /// failed run.
+    pub warnings: Vec<String>,
     /// Where the run's files are.
     pub dir: PathBuf,
 }

@@ -2986,3 +2986,81 @@ fn random_bounce_budget_follows_the_area_and_refuses_less_than_a_move() {
     let half = dir.join("half.yaml");
     run_ok(dir, "half", &map, "random-bounce", &["--config", s(&half)]);
 }
+
+/// `ccpp bench` carries the warnings `ccpp run` prints: its results.md showed ba-star at
+/// `--tool-radius 0.1` with tile coverage 1.0 beside an effective coverage of 0.69 and no
+/// word. They are named on stdout, listed under the map in results.md, in the `warnings`
+/// column of results.csv and in the run folder's `warnings.txt`, from which a resumed bench
+/// reports a reused run's warnings.
+#[test]
+fn bench_reports_the_warnings_of_its_runs() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let out = dir.join("bench");
+    let bench = || {
+        let a = ccpp()
+            .args(["bench", "--planners", "ba-star,bcd", "--quiet"])
+            .args(["--tool-radius", "0.1", "--maps", s(&map), "--out", s(&out)])
+            .timeout(std::time::Duration::from_mins(2))
+            .assert()
+            .success();
+        let o = a.get_output();
+        (
+            String::from_utf8_lossy(&o.stdout).into_owned(),
+            String::from_utf8_lossy(&o.stderr).into_owned(),
+        )
+    };
+    let wide = "the tile side 0.3 m is wider than the tool sweeps (2 x tool radius = 0.2 m)";
+    let check = |stdout: &str| {
+        assert!(
+            stdout.contains("warning: 1 run with warnings (in results.md and the warnings column of results.csv): pillars / ba-star\n"),
+            "{stdout}"
+        );
+        let md = std::fs::read_to_string(out.join("results.md")).unwrap();
+        assert!(
+            md.contains(&format!("Warnings:\n\n- ba-star: {wide}")),
+            "{md}"
+        );
+        assert!(!md.contains("- bcd:"), "{md}");
+        let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+        assert!(
+            csv.lines().next().unwrap().ends_with(",dir,warnings"),
+            "{csv}"
+        );
+        let row = |p: &str| {
+            csv.lines()
+                .find(|l| l.starts_with(&format!("pillars,{p},")))
+                .unwrap()
+                .to_string()
+        };
+        assert!(row("ba-star").contains(wide), "{csv}");
+        assert!(row("bcd").ends_with("bcd,"), "{csv}");
+    };
+    let (stdout, _) = bench();
+    check(&stdout);
+    let warnings = out.join("runs/pillars/ba-star/warnings.txt");
+    // One warning, one line, as `ccpp run` prints it without `warning: `.
+    let text = std::fs::read_to_string(&warnings).unwrap();
+    assert!(
+        text.starts_with(wide) && text.ends_with("the share of the floor swept\n"),
+        "{text}"
+    );
+    assert_eq!(text.lines().count(), 1, "{text}");
+    assert_eq!(
+        std::fs::read_to_string(out.join("runs/pillars/bcd/warnings.txt")).unwrap(),
+        ""
+    );
+    // Resumed: the runs are reused, their warnings read back.
+    let (stdout, stderr) = bench();
+    assert!(!stderr.contains("running it again"), "{stderr}");
+    check(&stdout);
+    // A run folder without its warnings is run again, not reported as without warnings.
+    std::fs::remove_file(&warnings).unwrap();
+    let (stdout, stderr) = bench();
+    assert!(
+        stderr.contains("warnings.txt is missing; running it again"),
+        "{stderr}"
+    );
+    check(&stdout);
+}

@@ -387,6 +387,7 @@ fn an_interrupted_bench_leaves_only_complete_runs() {
             if names.iter().any(|n| n == "metrics.json") {
                 let mut want: Vec<&str> = BASE_SET.to_vec();
                 want.push("bench-key.txt");
+                want.push("warnings.txt");
                 want.sort_unstable();
                 assert_eq!(names, &want, "{signal}: incomplete run {}", d.display());
             }

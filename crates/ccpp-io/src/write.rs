@@ -138,7 +138,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), WriteError> {
 /// The files a run or plan folder may hold (`ccpp run`, `ccpp plan`, a bench's run folders,
 /// the Python package's `save`). Such a folder is replaced whole by the next run into it, so a
 /// folder holding anything else is refused rather than replaced.
-pub const RUN_FILES: [&str; 12] = [
+pub const RUN_FILES: [&str; 13] = [
     "run.json",
     "path.csv",
     "trace.jsonl",
@@ -147,6 +147,7 @@ pub const RUN_FILES: [&str; 12] = [
     "replay.html",
     "replay.gif",
     "bench-key.txt",
+    "warnings.txt",
     // The path exports (`crate::export::ExportFormat::file_name`), also `ccpp plan`'s.
     "waypoints.csv",
     "waypoints.json",

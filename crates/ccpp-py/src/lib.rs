@@ -1567,8 +1567,9 @@ fn name_maps(paths: Vec<PathBuf>) -> Vec<(usize, String)> {
 }
 
 /// One run of `ccpp bench` (default options, start and simulator settings): the metrics, or
-/// the error message the bench's `results.csv` records. With `out`, the run's files are
-/// written there.
+/// the error message the bench's `results.csv` records, and the run's warnings (as
+/// `ccpp run` prints them; none for a failed run). With `out`, the run's files are written
+/// there.
 #[pyfunction]
 #[pyo3(signature = (map_path, planner, radius=None, tool_radius=None, inflate=None, max_memory_mb=None, out=None, name=None))]
 #[allow(clippy::too_many_arguments)] // keyword arguments of a Python function
@@ -1582,7 +1583,7 @@ fn bench_run(
     max_memory_mb: Option<Whole>,
     out: Option<PathBuf>,
     name: Option<String>,
-) -> PyResult<(Option<Py<PyAny>>, Option<String>)> {
+) -> PyResult<(Option<Py<PyAny>>, Option<String>, Vec<String>)> {
     let (radius, tool_radius, inflate) = (real(radius), real(tool_radius), real(inflate));
     let max_memory_mb = max_memory_mb.map(|m| m.0);
     let kind = parse_kind(planner)?;
@@ -1595,7 +1596,7 @@ fn bench_run(
     // A path that is not UTF-8 or holds a control character is the row's error, as any other
     // map that cannot be run.
     let bad_path = ccpp_io::names::path_text_problem(&map_path, "map");
-    let outcome: Result<Metrics, String> = py.detach(|| {
+    let outcome: Result<(Metrics, Vec<String>), String> = py.detach(|| {
         if let Some(m) = bad_path {
             return Err(m);
         }
@@ -1627,11 +1628,13 @@ fn bench_run(
             )
             .map_err(|e| ccpp_io::message::one_line(&e))?;
         }
-        Ok(run.metrics)
+        let warnings =
+            ccpp_io::warnings::run_warnings(&scenario, &run.world, &run.output.trace, &run.metrics);
+        Ok((run.metrics, warnings))
     });
     Ok(match outcome {
-        Ok(m) => (Some(to_py(py, &m)?), None),
-        Err(e) => (None, Some(e)),
+        Ok((m, w)) => (Some(to_py(py, &m)?), None, w),
+        Err(e) => (None, Some(e), Vec::new()),
     })
 }
 

@@ -172,9 +172,27 @@ def test_sweep_status_of_a_stalled_run_is_stalled(shared_maps: Path, monkeypatch
     assert r.metrics["stop_reason"] == "stalled"
     from ccpp import _ccpp, sweeps
 
-    monkeypatch.setattr(_ccpp, "bench_run", lambda *a, **k: (r.metrics, None))
+    monkeypatch.setattr(_ccpp, "bench_run", lambda *a, **k: (r.metrics, None, []))
     row = sweeps._run_cell("m.yaml", "m", "rect-boustrophedon", 0.15, None, None, None, None)
     assert row["status"] == "stalled" and row["error"] is None
     done = ccpp.run(str(shared_maps / "teb_maze.yaml"), "bcd")
-    monkeypatch.setattr(_ccpp, "bench_run", lambda *a, **k: (done.metrics, None))
+    monkeypatch.setattr(_ccpp, "bench_run", lambda *a, **k: (done.metrics, None, []))
     assert sweeps._run_cell("m.yaml", "m", "bcd", 0.15, None, None, None, None)["status"] == "ok"
+
+
+def test_sweep_reports_warnings_as_bench_does(room: Path, ccpp_bin: str, tmp_path: Path, client) -> None:
+    # ba-star's tiles (the robot's diameter, 0.3 m) are wider than a 0.2 m tool: `ccpp run`
+    # warns, and so do the bench's and the sweep's `warnings` column (it was not carried).
+    bench_out = tmp_path / "bench"
+    p = subprocess.run(
+        [ccpp_bin, "bench", "--maps", str(room), "--planners", "ba-star,bcd", "--tool-radius",
+         "0.1", "--out", str(bench_out), "--quiet"],
+        capture_output=True, text=True, check=False,
+    )
+    assert p.returncode == 0, p.stderr
+    expected = pd.read_csv(bench_out / "results.csv", keep_default_na=False, na_values=[""])
+    got = ccpp.sweep(room, ["ba-star", "bcd"], tool_radius=0.1, client=client)
+    assert list(got["warnings"].isna()) == list(expected["warnings"].isna()) == [False, True]
+    assert got["warnings"][0] == expected["warnings"][0]
+    assert got["warnings"][0].startswith("the tile side 0.3 m is wider than the tool sweeps")
+    assert got["warnings"][0] in ccpp.run(room, "ba-star", tool_radius=0.1).warnings

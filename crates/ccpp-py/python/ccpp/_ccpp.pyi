@@ -211,9 +211,10 @@ def bench_run(
     max_memory_mb: int | None = None,
     out: _Path | None = None,
     name: str | None = None,
-) -> tuple[dict[str, Any] | None, str | None]:
-    """One ``ccpp bench`` run: (metrics, None) or (None, error message); ``name`` is the
-    map's name in the results (default its file stem)."""
+) -> tuple[dict[str, Any] | None, str | None, list[str]]:
+    """One ``ccpp bench`` run: (metrics, None, warnings) or (None, error message, []); the
+    warnings are those ``ccpp run`` prints (without ``warning: ``); ``name`` is the map's name
+    in the results (default its file stem)."""
 
 def expand_maps(items: list[_Path]) -> list[Any]:
     """The map files that files and folders stand for, as ``ccpp bench --maps`` takes them."""

@@ -47,7 +47,11 @@ CSV_COLUMNS: list[str] = [
     "collisions",
     "wall_time_s",
     "dir",
+    "warnings",
 ]
+
+#: Joins a run's warnings in its ``warnings`` field, as in ``results.csv``.
+WARNINGS_SEPARATOR = " | "
 
 _METRIC_COLUMNS = CSV_COLUMNS[4:19]
 
@@ -142,7 +146,7 @@ def _run_cell(
     """One run on a worker: a row of the results."""
     from ccpp import _ccpp as native  # imported on the worker
 
-    metrics, error = native.bench_run(
+    metrics, error, warnings = native.bench_run(
         map_path,
         planner,
         radius=radius,
@@ -163,6 +167,9 @@ def _run_cell(
         row.update({c: metrics[c] for c in _METRIC_COLUMNS})
     # A failed run leaves no folder (as `ccpp bench`'s results.csv).
     row["dir"] = (out_dir or "") if metrics is not None else ""
+    # The warnings `ccpp run` prints (wide or stranded tiles, a boxed-in random bounce, ...),
+    # None when there are none (an empty field of results.csv).
+    row["warnings"] = WARNINGS_SEPARATOR.join(warnings) if warnings else None
     return row
 
 
