@@ -2708,6 +2708,9 @@ fn random_bounce_wedged_in_a_gap_finds_the_way_out() {
         let pillar = |v: usize, lo: usize, hi: usize| v >= lo && v < hi && (v - lo) % 15 < 2;
         pillar(y, 10, 115) && pillar(x, 10, 155)
     });
+    // The map frame's default budget (the area's default is 3 x 40.3 m2 / 0.3 m, 403 m).
+    let cfg = dir.path().join("budget.yaml");
+    std::fs::write(&cfg, "random_bounce: { budget_m: 480 }\n").unwrap();
     let (m, err) = run_with_stderr(
         dir.path(),
         "rb",
@@ -2719,6 +2722,8 @@ fn random_bounce_wedged_in_a_gap_finds_the_way_out() {
             "1",
             "--area",
             "0.3,0.2,7.5,5.8",
+            "--config",
+            cfg.to_str().unwrap(),
         ],
     );
     // Its budget, to within its shortest move (half a pixel).
