@@ -446,7 +446,7 @@ const BENCH_RUN_FILES: [&str; 7] = [
 
 /// The warnings of a bench run, one per line (empty when none), beside its other files: a
 /// resumed bench reports a reused run's warnings from it.
-const WARNINGS_FILE: &str = "warnings.txt";
+const WARNINGS_FILE: &str = ccpp_io::write::BENCH_WARNINGS_FILE;
 
 /// The warnings in a bench run folder's [`WARNINGS_FILE`].
 fn read_warnings(dir: &Path) -> Result<Vec<String>, String> {
@@ -693,9 +693,10 @@ fn child_job() -> Result<String> {
     write_run_files(&job.out, &job, &result, false, &extra)
 }
 
-/// Quotes a CSV field when needed.
+/// Quotes a CSV field when needed (a carriage return too: a map file named with one split
+/// its row in two for Python's `csv` and pandas).
 fn csv_field(s: &str) -> String {
-    if s.contains([',', '"', '\n']) {
+    if s.contains([',', '"', '\n', '\r']) {
         format!("\"{}\"", s.replace('"', "\"\""))
     } else {
         s.to_string()
@@ -1003,7 +1004,12 @@ pub fn results_md(rows: &[Row], outside: &[String]) -> String {
             s.push_str("\nWarnings:\n\n");
             for r in warned {
                 for w in &r.warnings {
-                    let _ = writeln!(s, "- {}: {}", md_text(&r.planner), md_text(w));
+                    // (random-bounce's boxed-in warning names the planner itself)
+                    if w.starts_with(&format!("{}:", r.planner)) {
+                        let _ = writeln!(s, "- {}", md_text(w));
+                    } else {
+                        let _ = writeln!(s, "- {}: {}", md_text(&r.planner), md_text(w));
+                    }
                 }
             }
         }
@@ -1066,6 +1072,49 @@ mod tests {
             // 15 metric columns, the folder and the warnings: empty.
             assert!(l.ends_with(",error,robot too big,,,,,,,,,,,,,,,,,"), "{l}");
         }
+    }
+
+    /// A map file named with a carriage return split its `results.csv` row in two (Python's
+    /// `csv` read three rows, pandas two): the field is quoted.
+    #[test]
+    fn a_carriage_return_in_a_name_is_quoted() {
+        let rows = [Row {
+            map: "a\rb".into(),
+            planner: "bsa".into(),
+            outcome: Err("robot too big".into()),
+            warnings: Vec::new(),
+            dir: PathBuf::from("out/runs/x/bsa"),
+        }];
+        let csv = results_csv(&rows);
+        let row = csv.split('\n').nth(1).unwrap();
+        assert!(row.starts_with("\"a\rb\",bsa,error,"), "{row:?}");
+    }
+
+    /// Warnings are listed under their map, each after its planner's name, once (the
+    /// boxed-in warning names random-bounce itself: it read `random-bounce: random-bounce:`).
+    #[test]
+    fn warnings_are_listed_under_their_map() {
+        let row = |planner: &str, w: &str| Row {
+            map: "hall".into(),
+            planner: planner.into(),
+            outcome: Err("x".into()),
+            warnings: vec![w.into()],
+            dir: PathBuf::from("out/runs/hall/x"),
+        };
+        let rows = [
+            row("random-bounce", "random-bounce: boxed in: no heading"),
+            row("ba-star", "the tile side 0.3 m is wider"),
+        ];
+        let md = results_md(&rows, &[]);
+        assert!(
+            md.contains("Warnings:\n\n- random-bounce: boxed in: no heading\n- ba-star: the tile side 0.3 m is wider\n"),
+            "{md}"
+        );
+        let csv = results_csv(&rows);
+        assert!(
+            csv.contains(",random-bounce: boxed in: no heading\n"),
+            "{csv}"
+        );
     }
 
     /// A map named with a newline (from its file name) split its heading in two.

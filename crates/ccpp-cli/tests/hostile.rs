@@ -3069,3 +3069,31 @@ fn bench_reports_the_warnings_of_its_runs() {
     );
     check(&stdout);
 }
+
+/// A folder holding a user's `warnings.txt` is not a run folder: `ccpp run --out` deleted the
+/// file with the folder once bench runs wrote one (only beside `bench-key.txt` is it ccpp's).
+#[test]
+fn a_users_warnings_file_is_not_replaced() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let notes = dir.join("notes");
+    std::fs::create_dir(&notes).unwrap();
+    std::fs::write(notes.join("warnings.txt"), "my notes").unwrap();
+    refused(
+        &[
+            "run",
+            "--planner",
+            "bsa",
+            "--map",
+            s(&map),
+            "--out",
+            s(&notes),
+        ],
+        &["notes", "warnings.txt"],
+    );
+    assert_eq!(
+        std::fs::read_to_string(notes.join("warnings.txt")).unwrap(),
+        "my notes"
+    );
+}

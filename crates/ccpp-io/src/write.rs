@@ -321,6 +321,11 @@ pub fn check_run_folder(target: &Path) -> Result<(), FolderError> {
         Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(()),
         Err(e) => return Err(io_err(e)),
     };
+    // A bench run's `warnings.txt` is ccpp's only beside its `bench-key.txt` (`ccpp run`
+    // writes none): a user's notes of that name in a folder given to `ccpp run --out` were
+    // deleted with the folder.
+    let mut bench_only = None;
+    let mut bench_key = false;
     for e in entries {
         let e = e.map_err(io_err)?;
         let name = e.file_name().to_string_lossy().into_owned();
@@ -331,9 +336,24 @@ pub fn check_run_folder(target: &Path) -> Result<(), FolderError> {
                 name,
             });
         }
+        if name == "bench-key.txt" {
+            bench_key = true;
+        } else if name.trim_end_matches(".tmp") == BENCH_WARNINGS_FILE {
+            bench_only = Some(name);
+        }
     }
-    Ok(())
+    match bench_only {
+        Some(name) if !bench_key => Err(FolderError::Foreign {
+            path: target.to_path_buf(),
+            name,
+        }),
+        _ => Ok(()),
+    }
 }
+
+/// The warnings file of a bench run folder, one of [`RUN_FILES`] only beside its
+/// `bench-key.txt` ([`check_run_folder`]).
+pub const BENCH_WARNINGS_FILE: &str = "warnings.txt";
 
 /// Checks that none of `inputs` (the files a run reads) lies in the output folder `target`.
 /// A folder that [`check_run_folder`] accepts holds only files named as ccpp's outputs, so an
@@ -650,6 +670,24 @@ pub fn save_map(grid: &GridMap, yaml_path: &Path) -> Result<PathBuf, WriteError>
 mod tests {
     #![allow(clippy::unwrap_used)]
     use super::*;
+
+    /// `warnings.txt` is a bench run's only beside its `bench-key.txt`: a user's notes of
+    /// that name were deleted with a folder given to `ccpp run --out`.
+    #[test]
+    fn a_warnings_file_is_ccpps_only_in_a_bench_run_folder() {
+        let d = tempfile::tempdir().unwrap();
+        let notes = d.path().join("notes");
+        std::fs::create_dir(&notes).unwrap();
+        std::fs::write(notes.join("warnings.txt"), "my notes").unwrap();
+        assert!(matches!(
+            check_run_folder(&notes),
+            Err(FolderError::Foreign { ref name, .. }) if name == "warnings.txt"
+        ));
+        std::fs::write(notes.join("metrics.json"), "{}").unwrap();
+        assert!(check_run_folder(&notes).is_err());
+        std::fs::write(notes.join("bench-key.txt"), "ccpp-bench-key v5 0\n").unwrap();
+        check_run_folder(&notes).unwrap();
+    }
 
     fn names(dir: &Path) -> Vec<String> {
         let mut v: Vec<String> = std::fs::read_dir(dir)
