@@ -2982,14 +2982,45 @@ fn random_bounce_budget_follows_the_area_and_refuses_less_than_a_move() {
         &["budget_m", "0.02 m", "half a pixel", "0.025 m", "pillars"],
     );
     assert!(!refused_out.exists());
-    // Half a pixel itself is a move.
+    // Half a pixel itself drove nothing (a move stops 1e-4 px short of what is left): refused
+    // too, naming the least budget, which drives.
     std::fs::write(
         dir.join("half.yaml"),
         "random_bounce: { budget_m: 0.025 }\n",
     )
     .unwrap();
     let half = dir.join("half.yaml");
-    run_ok(dir, "half", &map, "random-bounce", &["--config", s(&half)]);
+    refused(
+        &[
+            "run",
+            "--planner",
+            "random-bounce",
+            "--map",
+            s(&map),
+            "--config",
+            s(&half),
+            "--out",
+            s(&refused_out),
+        ],
+        &["budget_m", "0.02501 m or more"],
+    );
+    std::fs::write(
+        dir.join("least.yaml"),
+        "random_bounce: { budget_m: 0.02501 }\n",
+    )
+    .unwrap();
+    let least = dir.join("least.yaml");
+    let out = run_ok(
+        dir,
+        "least",
+        &map,
+        "random-bounce",
+        &["--config", s(&least)],
+    );
+    let driven = read_json(&out.join("metrics.json"))["path_length_m"]
+        .as_f64()
+        .unwrap();
+    assert!(driven > 0.025, "{driven}");
 }
 
 /// `ccpp bench` carries the warnings `ccpp run` prints: its results.md showed ba-star at

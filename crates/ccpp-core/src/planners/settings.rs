@@ -760,16 +760,25 @@ impl PlannerSettings for RandomBounceOptions {
 
     fn check(&self, s: &Setup) -> Result<(), OptionsError> {
         let res = s.frame.resolution;
-        // Its shortest move is half a pixel: a smaller budget ended the run at 0 m with the
-        // "did not move" warning, which blames the floor.
+        // Its shortest move is half a pixel, and a move stops 1e-4 px short of what is left
+        // (2e-4 px asked, for the rounding of the free distance): a smaller budget ended the
+        // run at 0 m with the "did not move" warning, which blames the floor (budgets from
+        // half a pixel to 1e-4 px more passed and did so too).
         if let Some(b) = self.budget_m {
-            if b < 0.5 * res {
+            let min = (0.5 + 2e-4) * res;
+            if b < min {
+                // The least budget named, rounded up to a micrometre so that it passes.
+                let mut shown = (min * 1e6).ceil() / 1e6;
+                if shown < min {
+                    shown += 1e-6;
+                }
                 return Err(OptionsError::new(
                     "budget_m",
                     format!(
-                        "{} m is shorter than random-bounce's shortest move, half a pixel ({} m on this map)",
+                        "{} m is shorter than random-bounce's shortest move, half a pixel ({} m on this map): {} m or more",
                         fmt_m(b),
-                        fmt_m(0.5 * res)
+                        fmt_m(0.5 * res),
+                        fmt_m(shown)
                     ),
                 ));
             }
