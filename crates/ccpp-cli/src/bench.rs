@@ -677,15 +677,17 @@ fn child_job() -> Result<String> {
     if let Some(note) = result.approach_note() {
         eprintln!("{note}");
     }
-    let warnings: String = ccpp_io::warnings::run_warnings(
+    // One a line (a line break inside one, as from a map's name, made a space).
+    let mut warnings = String::new();
+    for w in ccpp_io::warnings::run_warnings(
         &job.scenario,
         &result.world,
         &result.run.trace,
         &result.metrics,
-    )
-    .iter()
-    .map(|w| format!("{}\n", w.replace('\n', " ")))
-    .collect();
+    ) {
+        warnings.push_str(&w.replace(['\n', '\r'], " "));
+        warnings.push('\n');
+    }
     let extra = [
         ("bench-key.txt", spec.key.into_bytes()),
         (WARNINGS_FILE, warnings.into_bytes()),

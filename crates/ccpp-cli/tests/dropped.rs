@@ -1184,3 +1184,39 @@ fn a_threshold_override_repairs_a_crossed_yaml() {
         &["bad `free_thresh`", "1.1 is not in [0, 1]"],
     );
 }
+
+/// Moves after a cut PID motion start where the robot stopped, off the plan: bsa-bfs on
+/// `teb_maze` at `max_steps_per_motion: 120` (no noise) then drove into a wall 48 times and
+/// swept 23 %, while the warning read as if the run had recovered. It names the contacts.
+#[test]
+fn a_cut_motion_warning_names_the_contacts_after_it() {
+    let Some(maps) = common::shared_maps() else {
+        eprintln!("skipped: no shared maps");
+        return;
+    };
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let cfg = write(
+        dir,
+        "cut.yaml",
+        "bsa_bfs: { exec: { pid: { max_steps_per_motion: 120 } } }\n",
+    );
+    let out = dir.join("cut");
+    let o = ccpp()
+        .args(["run", "--planner", "bsa-bfs", "--map"])
+        .arg(maps.join("teb_maze.yaml"))
+        .args(["--config", &cfg, "--json", "--out", s(&out)])
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    let m: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let n = m["collisions"].as_u64().unwrap();
+    assert!(n > 0, "{m}");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains(&format!(
+            "the moves after it started off the plan and may cross what it went round; the run has {n} bumper contact(s)"
+        )),
+        "{err}"
+    );
+}

@@ -1566,6 +1566,9 @@ fn name_maps(paths: Vec<PathBuf>) -> Vec<(usize, String)> {
     ccpp_io::names::name_maps_indexed(&paths)
 }
 
+/// What [`bench_run`] returns: the metrics (a dict) or the error message, and the warnings.
+type BenchRow = (Option<Py<PyAny>>, Option<String>, Vec<String>);
+
 /// One run of `ccpp bench` (default options, start and simulator settings): the metrics, or
 /// the error message the bench's `results.csv` records, and the run's warnings (as
 /// `ccpp run` prints them; none for a failed run). With `out`, the run's files are written
@@ -1583,7 +1586,7 @@ fn bench_run(
     max_memory_mb: Option<Whole>,
     out: Option<PathBuf>,
     name: Option<String>,
-) -> PyResult<(Option<Py<PyAny>>, Option<String>, Vec<String>)> {
+) -> PyResult<BenchRow> {
     let (radius, tool_radius, inflate) = (real(radius), real(tool_radius), real(inflate));
     let max_memory_mb = max_memory_mb.map(|m| m.0);
     let kind = parse_kind(planner)?;
