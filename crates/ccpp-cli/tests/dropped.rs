@@ -1220,3 +1220,35 @@ fn a_cut_motion_warning_names_the_contacts_after_it() {
         "{err}"
     );
 }
+
+/// Under heavy odometry noise the true pose can stray far from the plan without touching
+/// anything: bsa-bfs on `teb_maze` (seed 4) strayed 1.69 m on average, swept 4.4 % and ended
+/// "done" without a word (the drift warning wanted a contact). It is said.
+#[test]
+fn a_drift_without_contact_is_said() {
+    let Some(maps) = common::shared_maps() else {
+        eprintln!("skipped: no shared maps");
+        return;
+    };
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("drift");
+    let o = ccpp()
+        .args(["run", "--planner", "bsa-bfs", "--map"])
+        .arg(maps.join("teb_maze.yaml"))
+        .args(["--odometry-noise", "0.3,0.3,3", "--seed", "4", "--json"])
+        .args(["--out", s(&out)])
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    let m: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(m["collisions"], 0, "{m}");
+    let mean = m["tracking_error_mean_m"].as_f64().unwrap();
+    assert!(mean > 0.15, "{m}");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains(&format!(
+            "warning: the true pose strayed from the planned path by {mean:.2} m on average"
+        )) && err.contains("with no contact: under odometry noise"),
+        "{err}"
+    );
+}
