@@ -80,8 +80,7 @@ pub fn drift_warning(scenario: &Scenario, trace: &Trace, metrics: &Metrics) -> O
         (0, 0) => {
             let (mean, max) = strayed.unwrap_or_default();
             format!(
-                "the true pose strayed from the planned path by {:.2} m on average (up to {:.2} m), with no contact",
-                mean, max
+                "the true pose strayed from the planned path by {mean:.2} m on average (up to {max:.2} m), with no contact"
             )
         }
         (c, 0) => format!("{c} bumper contact(s)"),
