@@ -701,6 +701,16 @@ fn check_side_fits(setup: &Setup, side: f64, field: &str, what: &str) -> Result<
     Ok(())
 }
 
+/// The least value at or above `min` that a refusal names: `min` rounded up to a micrometre,
+/// so that the value printed passes the check it names.
+fn least_shown(min: f64) -> f64 {
+    let mut shown = (min * 1e6).ceil() / 1e6;
+    if shown < min {
+        shown += 1e-6;
+    }
+    shown
+}
+
 /// The largest turn random-bounce takes, either way (degrees): two whole turns, so that a
 /// range across 360 degrees (`300` to `420`) can be written.
 pub const MAX_TURN_DEG: f64 = 720.0;
@@ -767,18 +777,13 @@ impl PlannerSettings for RandomBounceOptions {
         if let Some(b) = self.budget_m {
             let min = (0.5 + 2e-4) * res;
             if b < min {
-                // The least budget named, rounded up to a micrometre so that it passes.
-                let mut shown = (min * 1e6).ceil() / 1e6;
-                if shown < min {
-                    shown += 1e-6;
-                }
                 return Err(OptionsError::new(
                     "budget_m",
                     format!(
                         "{} m is shorter than random-bounce's shortest move, half a pixel ({} m on this map): {} m or more",
                         fmt_m(b),
                         fmt_m(0.5 * res),
-                        fmt_m(shown)
+                        fmt_m(least_shown(min))
                     ),
                 ));
             }
@@ -790,17 +795,12 @@ impl PlannerSettings for RandomBounceOptions {
         // A thousandth of a pixel above it: the strides stop 1e-4 px short of what is seen.
         let min = need + 1e-3 * res;
         if s.sensor_range < min {
-            // The least range named, rounded up to a micrometre so that the value printed
-            // passes (the message named r + 2 px itself, which was refused).
-            let mut shown = (min * 1e6).ceil() / 1e6;
-            if shown < min {
-                shown += 1e-6;
-            }
+            // (the message named r + 2 px itself, which was refused)
             return Err(OptionsError::new(
                 "",
                 format!(
                     "the sensor range {} m sees too little beyond the robot's footprint: random-bounce moves in strides of at least half a pixel beyond the r + 1.5 px its disk can touch, so it needs a little over r + 2 px, {} m or more (raise --sensor-range; a larger robot needs a larger range)",
-                    fmt_m(s.sensor_range), fmt_m(shown)
+                    fmt_m(s.sensor_range), fmt_m(least_shown(min))
                 ),
             ));
         }
