@@ -730,9 +730,6 @@ pub const CSV_COLUMNS: [&str; 21] = [
     "warnings",
 ];
 
-/// Joins a run's warnings in one `results.csv` field.
-pub const WARNINGS_SEPARATOR: &str = " | ";
-
 /// `results.csv`: one row per run, failures included.
 pub fn results_csv(rows: &[Row]) -> String {
     let mut s = CSV_COLUMNS.join(",");
@@ -774,7 +771,7 @@ pub fn results_csv(rows: &[Row]) -> String {
             String::new()
         };
         f.push(csv_field(&dir));
-        f.push(csv_field(&r.warnings.join(WARNINGS_SEPARATOR)));
+        f.push(csv_field(&r.warnings.join(ccpp_io::warnings::SEPARATOR)));
         s.push_str(&f.join(","));
         s.push('\n');
     }

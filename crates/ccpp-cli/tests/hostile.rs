@@ -2854,7 +2854,7 @@ fn tiles_stranded_at_the_start_are_said() {
     assert!(m["effective_coverage"].as_f64().unwrap() < 0.2, "{m}");
     assert!(
         err.contains("warning: the rectangle's clearance disk (radius 0.212 m, the circle the 0.3 x 0.3 m robot turns in) reaches only")
-            && err.contains("run with --radius 0.212133"),
+            && err.contains("run with --radius 0.212133 --tool-radius 0.15 to count"),
         "{err}"
     );
     let (m, err) = run_with_stderr(
@@ -3124,6 +3124,11 @@ fn bench_reports_the_warnings_of_its_runs() {
         stderr.contains("warnings.txt is missing; running it again"),
         "{stderr}"
     );
+    check(&stdout);
+    // Nor without its key (removed to force a rerun): run again, not refused for holding a
+    // warnings.txt.
+    std::fs::remove_file(out.join("runs/pillars/ba-star/bench-key.txt")).unwrap();
+    let (stdout, _) = bench();
     check(&stdout);
 }
 

@@ -29,7 +29,7 @@ pub fn motions_cut_warning(trace: &Trace, metrics: &Metrics) -> Option<String> {
     ccpp_core::sim::motions_cut(trace).map(|n| {
         let after = if metrics.collisions > 0 {
             format!(
-                ", so the moves after it started off the plan and may cross what it went round; the run has {} bumper contact(s)",
+                ", so the moves after a cut started off the plan and may cross what it went round; the run has {} bumper contact(s)",
                 metrics.collisions
             )
         } else {
@@ -77,12 +77,6 @@ pub fn drift_warning(scenario: &Scenario, trace: &Trace, metrics: &Metrics) -> O
         return None;
     }
     let what = match (collisions, zones) {
-        (0, 0) => {
-            let (mean, max) = strayed.unwrap_or_default();
-            format!(
-                "the true pose strayed from the planned path by {mean:.2} m on average (up to {max:.2} m), with no contact"
-            )
-        }
         (c, 0) => format!("{c} bumper contact(s)"),
         (0, z) => format!("{z} keep-out violation(s)"),
         (c, z) => format!("{c} bumper contact(s) and {z} keep-out violation(s)"),
@@ -95,6 +89,12 @@ pub fn drift_warning(scenario: &Scenario, trace: &Trace, metrics: &Metrics) -> O
             ccpp_core::display::Compact(scenario.sim.landmarks.range_m)
         )
     };
+    if collisions == 0 && zones == 0 {
+        let (mean, max) = strayed.unwrap_or_default();
+        return Some(format!(
+            "the true pose strayed from the planned path by {mean:.2} m on average (up to {max:.2} m): under odometry noise without a landmark fix the pose estimate drifts from the truth, and the planner sweeps floor it believes is elsewhere; {remedy} (the coverage is what was swept)"
+        ));
+    }
     Some(format!(
         "{what}: under odometry noise without a landmark fix the pose estimate drifts from the truth, and the robot drives into walls and zones it believes are elsewhere; {remedy} (the coverage is what was swept)"
     ))
@@ -223,14 +223,22 @@ pub fn rect_reach_warning(scenario: &Scenario, world: &World, metrics: &Metrics)
     // The floor a tool of the same radius touches from each disk's reachable centres.
     let (reach, all) = (rect.accessible_count(), world.accessible_count());
     (all > 0 && (reach as f64) < 0.5 * all as f64).then(|| {
+        let share = 100.0 * reach as f64 / all as f64;
+        let share = if share > 0.0 && share < 0.05 {
+            "less than 0.1 %".to_string()
+        } else {
+            format!("{share:.1} %")
+        };
+        // The tool radius kept: the rectangle's sides default to twice it, and --tool-radius
+        // defaults to --radius, so `--radius` alone would plan another rectangle.
         format!(
-            "the rectangle's clearance disk (radius {:.3} m, the circle the {} x {} m robot turns in) reaches only {:.1} % of the floor a robot of radius {} m reaches from the start, as through a doorway narrower than it: its lanes cover that part, and the metrics count the robot's floor; run with --radius {} to count the rectangle's own, or start elsewhere",
+            "the rectangle's clearance disk (radius {:.3} m, the circle the {} x {} m robot turns in) reaches only {share} of the floor a robot of radius {} m reaches from the start, as through a doorway narrower than it: its lanes cover that part, and the metrics count the robot's floor; run with --radius {} --tool-radius {} to count the rectangle's own, or start elsewhere",
             rad,
             ccpp_core::display::Compact(o.length_for(&robot)),
             ccpp_core::display::Compact(o.width_for(&robot)),
-            100.0 * reach as f64 / all as f64,
             ccpp_core::display::Compact(robot.radius),
             ccpp_core::display::Compact((rad * 1e6).ceil() / 1e6),
+            ccpp_core::display::Compact(robot.tool_radius),
         )
     })
 }
@@ -248,10 +256,15 @@ pub fn boxed_in_warning(trace: &Trace) -> Option<String> {
     })
 }
 
+/// Joins a run's warnings in one field (`ccpp bench`'s `results.csv`, `ccpp.sweep`'s
+/// `warnings` column).
+pub const SEPARATOR: &str = " | ";
+
 /// Every warning of a run of `scenario` in `world` with this trace and these metrics: an early
-/// stop, PID motions cut short, contacts under drift, no motion at all, a tool narrower than
-/// the pixels, tiles wider than the tool or stranded at the start, a random bounce boxed
-/// in.
+/// stop, PID motions cut short, contacts or a true pose far off the plan under drift, no
+/// motion at all, a tool narrower than the pixels, tiles wider than the tool or stranded at
+/// the start, a rectangle whose clearance disk reaches little of the floor, a random bounce
+/// boxed in.
 pub fn run_warnings(
     scenario: &Scenario,
     world: &World,

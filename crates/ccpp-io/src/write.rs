@@ -147,7 +147,7 @@ pub const RUN_FILES: [&str; 13] = [
     "replay.html",
     "replay.gif",
     "bench-key.txt",
-    "warnings.txt",
+    BENCH_WARNINGS_FILE,
     // The path exports (`crate::export::ExportFormat::file_name`), also `ccpp plan`'s.
     "waypoints.csv",
     "waypoints.json",
@@ -321,9 +321,11 @@ pub fn check_run_folder(target: &Path) -> Result<(), FolderError> {
         Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(()),
         Err(e) => return Err(io_err(e)),
     };
-    // A bench run's `warnings.txt` is ccpp's only beside its `bench-key.txt` (`ccpp run`
-    // writes none): a user's notes of that name in a folder given to `ccpp run --out` were
-    // deleted with the folder.
+    // A bench run's `warnings.txt` is ccpp's only beside another file of a run, its
+    // `bench-key.txt` or `metrics.json` (`ccpp run` writes none): a user's notes of that name
+    // in a folder given to `ccpp run --out` were deleted with the folder. (Beside
+    // `bench-key.txt` alone, a bench run folder whose key was removed to force a rerun was
+    // refused as holding a file ccpp did not write.)
     let mut bench_only = None;
     let mut bench_key = false;
     for e in entries {
@@ -336,7 +338,7 @@ pub fn check_run_folder(target: &Path) -> Result<(), FolderError> {
                 name,
             });
         }
-        if name == "bench-key.txt" {
+        if name == "bench-key.txt" || name == "metrics.json" {
             bench_key = true;
         } else if name.trim_end_matches(".tmp") == BENCH_WARNINGS_FILE {
             bench_only = Some(name);
@@ -352,7 +354,7 @@ pub fn check_run_folder(target: &Path) -> Result<(), FolderError> {
 }
 
 /// The warnings file of a bench run folder, one of [`RUN_FILES`] only beside its
-/// `bench-key.txt` ([`check_run_folder`]).
+/// `bench-key.txt` or `metrics.json` ([`check_run_folder`]).
 pub const BENCH_WARNINGS_FILE: &str = "warnings.txt";
 
 /// Checks that none of `inputs` (the files a run reads) lies in the output folder `target`.
@@ -671,8 +673,9 @@ mod tests {
     #![allow(clippy::unwrap_used)]
     use super::*;
 
-    /// `warnings.txt` is a bench run's only beside its `bench-key.txt`: a user's notes of
-    /// that name were deleted with a folder given to `ccpp run --out`.
+    /// `warnings.txt` is a bench run's only beside its `bench-key.txt` or `metrics.json`: a
+    /// user's notes of that name were deleted with a folder given to `ccpp run --out`, and a
+    /// bench run folder whose key was removed was refused.
     #[test]
     fn a_warnings_file_is_ccpps_only_in_a_bench_run_folder() {
         let d = tempfile::tempdir().unwrap();
@@ -683,10 +686,13 @@ mod tests {
             check_run_folder(&notes),
             Err(FolderError::Foreign { ref name, .. }) if name == "warnings.txt"
         ));
-        std::fs::write(notes.join("metrics.json"), "{}").unwrap();
+        std::fs::write(notes.join("path.csv"), "x,y,theta\n").unwrap();
         assert!(check_run_folder(&notes).is_err());
-        std::fs::write(notes.join("bench-key.txt"), "ccpp-bench-key v5 0\n").unwrap();
-        check_run_folder(&notes).unwrap();
+        for beside in ["metrics.json", "bench-key.txt"] {
+            std::fs::write(notes.join(beside), "{}").unwrap();
+            check_run_folder(&notes).unwrap();
+            std::fs::remove_file(notes.join(beside)).unwrap();
+        }
     }
 
     fn names(dir: &Path) -> Vec<String> {

@@ -941,8 +941,8 @@ pub struct RunResult {
     world: World,
     output: RunOutput,
     metrics: Metrics,
-    /// The start-area warning (`ccpp run`'s), found once on the run's thread.
-    start_warning: Option<String>,
+    /// The warnings `ccpp run` prints, found once on the run's thread.
+    warnings: Vec<String>,
     /// The files the run read (`save` refuses a folder holding one).
     inputs: Vec<PathBuf>,
 }
@@ -1255,22 +1255,15 @@ impl RunResult {
 
     /// The warnings `ccpp run` prints for this run (without `warning: `): a start whose free
     /// area reaches the map's border (it may be outside the building), an early stop, PID
-    /// motions cut at `max_steps_per_motion`, bumper contacts under odometry noise without
-    /// landmarks, a run that never moved, a tool narrower than the map's pixels, tiles wider
-    /// than the tool or stranded at the start (ba-star, bsa, bsa-bfs), a random bounce boxed
-    /// in. A run that ends `done` may still have some (`stop` is the planner's word).
+    /// motions cut at `max_steps_per_motion`, bumper contacts or a true pose far off the plan
+    /// under odometry noise without landmarks, a run that never moved, a tool narrower than
+    /// the map's pixels, tiles wider than the tool or stranded at the start (ba-star, bsa,
+    /// bsa-bfs), a rectangle whose clearance disk reaches little of the floor
+    /// (rect-boustrophedon), a random bounce boxed in. A run that ends `done` may still have
+    /// some (`stop` is the planner's word).
     #[getter]
     fn warnings(&self) -> Vec<String> {
-        self.start_warning
-            .iter()
-            .cloned()
-            .chain(ccpp_io::warnings::run_warnings(
-                &self.scenario,
-                &self.world,
-                &self.output.trace,
-                &self.metrics,
-            ))
-            .collect()
+        self.warnings.clone()
     }
 
     /// The start pose used, `(x, y, theta)`.
@@ -1389,14 +1382,24 @@ fn run(
     name_map(&mut prepared, &scenario);
     let (scenario, prepared) = (Arc::new(scenario), Arc::new(prepared));
     let (sc, pm) = (Arc::clone(&scenario), Arc::clone(&prepared));
-    let (run, start_warning) = interruptible(py, move |stop| {
+    let (run, warnings) = interruptible(py, move |stop| {
         sc.run_on_until(&pm, stop).map(|run| {
-            // The flood fill of the start's free area, here and not on each `warnings` read.
+            // The warnings (the flood fill of the start's free area, rect-boustrophedon's
+            // reach) here, once, and not on each `warnings` read: a read held the GIL for a
+            // second on a 16-million-pixel map.
             let w = ccpp_io::components::StartComponent::of(
                 run.world.map(),
                 run.world.start().position(),
             )
-            .warning();
+            .warning()
+            .into_iter()
+            .chain(ccpp_io::warnings::run_warnings(
+                &sc,
+                &run.world,
+                &run.output.trace,
+                &run.metrics,
+            ))
+            .collect::<Vec<String>>();
             (run, w)
         })
     })?
@@ -1407,7 +1410,7 @@ fn run(
         world: run.world,
         output: run.output,
         metrics: run.metrics,
-        start_warning,
+        warnings,
         inputs,
     })
 }
@@ -2227,6 +2230,7 @@ fn _ccpp(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Env>()?;
     m.add_class::<FolderLock>()?;
     m.add("LOCK_FILE", ccpp_io::lock::LOCK_FILE)?;
+    m.add("WARNINGS_SEPARATOR", ccpp_io::warnings::SEPARATOR)?;
     m.add_function(wrap_pyfunction!(load_map, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(bench_run, m)?)?;

@@ -701,6 +701,13 @@ fn check_side_fits(setup: &Setup, side: f64, field: &str, what: &str) -> Result<
     Ok(())
 }
 
+/// The least random-bounce budget that makes a move on a map of `res` metres a pixel: half a
+/// pixel (its shortest move), and 2e-4 px for the 1e-4 px a move stops short of what is left
+/// and the rounding of the free distance.
+pub fn least_budget(res: f64) -> f64 {
+    (0.5 + 2e-4) * res
+}
+
 /// The least value at or above `min` that a refusal names: `min` rounded up to a micrometre,
 /// so that the value printed passes the check it names.
 fn least_shown(min: f64) -> f64 {
@@ -775,7 +782,7 @@ impl PlannerSettings for RandomBounceOptions {
         // run at 0 m with the "did not move" warning, which blames the floor (budgets from
         // half a pixel to 1e-4 px more passed and did so too).
         if let Some(b) = self.budget_m {
-            let min = (0.5 + 2e-4) * res;
+            let min = least_budget(res);
             if b < min {
                 return Err(OptionsError::new(
                     "budget_m",
@@ -874,7 +881,7 @@ pub fn default_budget(s: &Setup) -> f64 {
 
 /// [`default_budget`] for a run in `world`: with a work area, 3x the lane-by-lane length of
 /// the area (its pixels' extent; the operator drew it, so the run stays online-honest), at
-/// least half a pixel (random-bounce's shortest move). The map frame's budget ignored the
+/// least [`least_budget`] (one move). The map frame's budget ignored the
 /// area: a one-pixel area drove 360 m of jiggles, path ratio 1489. Never more than the
 /// frame's, which the memory estimate counts before the area is read.
 pub fn default_budget_in(world: &World) -> f64 {
@@ -891,7 +898,7 @@ pub fn default_budget_in(world: &World) -> f64 {
             let res = frame.resolution;
             let m2 = area.count_ones(..) as f64 * res * res;
             (3.0 * m2 / (2.0 * robot.tool_radius))
-                .max(0.5 * res)
+                .max(least_budget(res))
                 .min(whole)
         }
         None => whole,

@@ -107,6 +107,9 @@ class PlanResult:
 LOCK_FILE: str
 """The lock file a ``ccpp bench`` or a sweep holds in its output folder."""
 
+WARNINGS_SEPARATOR: str
+"""Joins a run's warnings in one field of ``results.csv`` and of a sweep's ``warnings`` column."""
+
 class FolderLock:
     """The lock a sweep holds on its output folder, the same as ``ccpp bench``'s: taken when
     made (``CcppError`` naming the holder's process when another bench or sweep holds it)."""

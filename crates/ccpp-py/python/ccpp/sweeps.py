@@ -50,8 +50,8 @@ CSV_COLUMNS: list[str] = [
     "warnings",
 ]
 
-#: Joins a run's warnings in its ``warnings`` field, as in ``results.csv``.
-WARNINGS_SEPARATOR = " | "
+#: Joins a run's warnings in its ``warnings`` field, as in ``results.csv`` (the same constant).
+WARNINGS_SEPARATOR: str = _ccpp.WARNINGS_SEPARATOR
 
 _METRIC_COLUMNS = CSV_COLUMNS[4:19]
 
@@ -193,7 +193,8 @@ def sweep(
     is that planner); ``radii`` (one number, or several) are checked (with ``tool_radius``)
     before any task starts, and a radius given twice runs once. With ``out``, each run's files
     are written to ``out/runs/MAP/PLANNER`` (with several radii, ``out/runs/r<RADIUS>/MAP/PLANNER``),
-    as ``ccpp bench --out`` does, and ``out`` must be absent or hold only a sweep's runs (a
+    as ``ccpp bench --out`` does (the same files but the bench's own ``bench-key.txt`` and
+    ``warnings.txt``: a sweep's warnings are its ``warnings`` column), and ``out`` must be absent or hold only a sweep's runs (a
     folder with a bench's summary is refused: a sweep writes none).
     ``None`` for any keyword is its default. A run the simulator stopped early has that reason
     (``stalled``, ``max_steps``) as its ``status``. The cluster is ``client`` or ``scheduler`` (not both). Failed
