@@ -718,3 +718,42 @@ fn a_mask_image_or_a_mask_yaml_misnamed_is_told_apart() {
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
+
+/// A Nav2 mask in the map's frame to a thousandth of a pixel is that frame: a mask whose
+/// origin was written in single precision (-12.4999999 for -12.5) or printed to six decimals
+/// was refused for 2e-5 px. One a twentieth of a pixel off is still refused.
+#[test]
+fn a_mask_origin_off_by_rounding_is_the_maps_frame() {
+    if !house().exists() {
+        eprintln!("skipped: no shared maps");
+        return;
+    }
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let info = |m: &Path| {
+        ccpp()
+            .args(["info", "--map"])
+            .arg(house())
+            .arg("--keepout")
+            .arg(m)
+            .output()
+            .unwrap()
+    };
+    for (name, origin) in [("f32", -12.499_999_9), ("um", -12.500_001)] {
+        let m = mask(dir, name, origin, |x, y| x.abs() < 1.0 && y.abs() < 1.0);
+        let o = info(&m);
+        assert!(
+            o.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
+    let m = mask(dir, "off", -12.5 + 0.0025, |_, _| false);
+    let o = info(&m);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("off.yaml") && err.contains("map's frame"),
+        "{err}"
+    );
+}

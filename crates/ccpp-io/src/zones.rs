@@ -278,11 +278,22 @@ fn read_mask(path: &Path, frame: &MapFrame) -> Result<FixedBitSet, ZoneFileError
     }
     let m = load_map(path, &LoadOptions::default()).map_err(|e| bad(e.to_string()))?;
     let f = *m.grid.frame();
-    let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs()).max(1.0);
     if f.width != frame.width || f.height != frame.height {
         return Err(size_err(f.width, f.height));
     }
-    if !close(f.resolution, frame.resolution) {
+    // The same frame to a thousandth of a pixel anywhere on the map: a mask written with its
+    // origin in single precision (-3.0999999 for -3.1) or printed to six decimals was refused
+    // for 2e-5 px (the test was relative, 1e-9).
+    let res = frame.resolution;
+    let extent = frame.width.max(frame.height).max(1) as f64;
+    let tol_px = 1e-3;
+    let same_res = (f.resolution - res).abs() * extent <= tol_px * res;
+    let close = |a: f64, b: f64| (a - b).abs() <= tol_px * res;
+    let same_yaw = {
+        let d = (f.origin.theta - frame.origin.theta).rem_euclid(std::f64::consts::TAU);
+        d.min(std::f64::consts::TAU - d) * extent <= tol_px
+    };
+    if !same_res {
         return Err(bad(format!(
             "keepout mask resolution {} m/px differs from the map's {} m/px; a mask must be in the map's frame",
             Compact(f.resolution),
@@ -290,7 +301,7 @@ fn read_mask(path: &Path, frame: &MapFrame) -> Result<FixedBitSet, ZoneFileError
         )));
     }
     let (o, p) = (f.origin, frame.origin);
-    if !(close(o.x, p.x) && close(o.y, p.y) && close(o.theta, p.theta)) {
+    if !(close(o.x, p.x) && close(o.y, p.y) && same_yaw) {
         return Err(bad(format!(
             "keepout mask origin [{}] differs from the map's [{}]; a mask must be in the map's frame",
             join(&[o.x, o.y, o.theta]),
