@@ -105,6 +105,9 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     if let Some(w) = comp.warning() {
         eprintln!("warning: {w}");
     }
+    if let Some(w) = ccpp_io::warnings::rect_lane_area_warning(&scenario) {
+        eprintln!("warning: {w}");
+    }
     let mut s = String::new();
     let _ = writeln!(
         s,

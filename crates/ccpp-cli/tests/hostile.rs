@@ -3159,3 +3159,35 @@ fn a_users_warnings_file_is_not_replaced() {
         "my notes"
     );
 }
+
+/// rect-boustrophedon's own lane rectangle (`rect_boustrophedon.area`) and `--area` both
+/// bound its lanes: given together they lane their overlap only (a quarter of the area,
+/// effective coverage 0.16, exit 0, no word). Both are honoured, as asked, and said, by `run`
+/// and by `plan`; either alone is not.
+#[test]
+fn rect_lane_area_inside_a_zone_area_is_said() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir); // 8 x 6 m from (0, 0)
+    let cfg = dir.join("area.yaml");
+    std::fs::write(&cfg, "rect_boustrophedon:\n  area: [1, 1, 3, 3]\n").unwrap();
+    let said = "rect_boustrophedon.area [1, 1, 3, 3] and the work area (--area / area) both bound the lanes: only their overlap is laned";
+    for sub in ["run", "plan"] {
+        for (name, args) in [
+            ("both", &["--config", s(&cfg), "--area", "2,2,4,4"][..]),
+            ("lanes", &["--config", s(&cfg)][..]),
+            ("zone", &["--area", "2,2,4,4"][..]),
+        ] {
+            let o = ccpp()
+                .args([sub, "--planner", "rect-boustrophedon", "--map", s(&map)])
+                .args(args)
+                .arg("--out")
+                .arg(dir.join(format!("{sub}-{name}")))
+                .output()
+                .unwrap();
+            let err = String::from_utf8_lossy(&o.stderr);
+            assert!(o.status.success(), "{sub} {name}: {err}");
+            assert_eq!(err.contains(said), name == "both", "{sub} {name}: {err}");
+        }
+    }
+}
