@@ -757,3 +757,72 @@ fn a_mask_origin_off_by_rounding_is_the_maps_frame() {
         "{err}"
     );
 }
+
+/// ccpp's own `path.geojson` holds the path and both kinds of zones, each feature marked by
+/// its `kind`: given back as `--area` and `--keepout` it gives the same run (it was refused for
+/// its path, and without the path its keep-outs were read as area, in silence). A file of
+/// keep-outs only, given as an area, is refused naming the kinds.
+#[test]
+fn an_exported_geojson_gives_its_zones_back() {
+    let Some(maps) = crate::common::shared_maps() else {
+        eprintln!("skipped: no shared maps");
+        return;
+    };
+    let map = maps.join("teb_empty_box.yaml");
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let run = |sub: &str, args: &[&str]| {
+        let out = dir.join(sub);
+        ccpp()
+            .args(["run", "--planner", "bcd", "--map"])
+            .arg(&map)
+            .args(args)
+            .arg("--out")
+            .arg(&out)
+            .assert()
+            .success();
+        out
+    };
+    let first = run(
+        "first",
+        &[
+            "--area",
+            "-2,-2,1,1",
+            "--keepout",
+            "-1,-1,0,0",
+            "--keepout",
+            "-0.5,-0.5,0.5,0.5",
+            "--export",
+            "geojson",
+        ],
+    );
+    let geo = first.join("path.geojson");
+    let geo = geo.to_str().unwrap();
+    let again = run("again", &["--area", geo, "--keepout", geo]);
+    assert_eq!(
+        std::fs::read(first.join("path.csv")).unwrap(),
+        std::fs::read(again.join("path.csv")).unwrap()
+    );
+    // Keep-outs only, as an area.
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(geo).unwrap()).unwrap();
+    let fs = v["features"].as_array_mut().unwrap();
+    fs.retain(|f| f["properties"]["kind"] == "keepout");
+    let ko = dir.join("ko.geojson");
+    std::fs::write(&ko, v.to_string()).unwrap();
+    let o = ccpp()
+        .args(["info", "--map"])
+        .arg(&map)
+        .arg("--area")
+        .arg(&ko)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("ko.geojson")
+            && err.contains("no feature of kind \"area\", only 2 of kind \"keepout\"")
+            && err.contains("give it as --keepout"),
+        "{err}"
+    );
+}

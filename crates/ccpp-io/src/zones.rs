@@ -220,7 +220,8 @@ fn read_file(path: &Path, frame: &MapFrame, mask_ok: bool) -> Result<ZoneData, Z
             )));
         }
         let v: Value = serde_json::from_str(&text).map_err(|e| bad(format!("GeoJSON: {e}")))?;
-        return within_total(geojson_polygons(&v)?, "GeoJSON");
+        let role = if mask_ok { "keepout" } else { "area" };
+        return within_total(geojson_polygons_as(&v, role)?, "GeoJSON");
     }
     let v: serde_json::Value = serde_saphyr::from_str(&text)
         .map_err(|e| bad(format!("YAML: {}", crate::file::yaml_words(&e.to_string()))))?;
@@ -451,9 +452,41 @@ fn yaml_polygons(v: &Value) -> Result<Vec<Polygon>, ZoneFileError> {
 }
 
 /// Polygons of a `GeoJSON` object.
+#[cfg(test)]
 fn geojson_polygons(v: &Value) -> Result<Vec<Polygon>, ZoneFileError> {
     let mut out = Vec::new();
-    geojson_collect(v, &mut out, 0)?;
+    geojson_collect(v, &mut out, 0, &mut Kinds::default())?;
+    Ok(out)
+}
+
+/// What a `GeoJSON` zone file's features say they are (their `kind` property, as ccpp's
+/// exports write it: `area`, `keepout`, `path`), and which ones are taken.
+#[derive(Default)]
+struct Kinds<'a> {
+    /// The role the file is read in (`area` or `keepout`); `None` takes every polygon.
+    role: Option<&'a str>,
+    /// Features left out for another zone kind.
+    other: usize,
+}
+
+/// Polygons of a `GeoJSON` object read as zones of `role` (`area` or `keepout`): features
+/// whose `kind` property names the other role, or `path`, are left out. ccpp's own
+/// `path.geojson` (the path and both kinds of zones) was refused for its path, and without
+/// the path its keep-outs were read as area (or the area as a keep-out), in silence.
+fn geojson_polygons_as(v: &Value, role: &str) -> Result<Vec<Polygon>, ZoneFileError> {
+    let mut out = Vec::new();
+    let mut kinds = Kinds {
+        role: Some(role),
+        other: 0,
+    };
+    geojson_collect(v, &mut out, 0, &mut kinds)?;
+    if out.is_empty() && kinds.other > 0 {
+        let other = if role == "area" { "keepout" } else { "area" };
+        return Err(bad(format!(
+            "GeoJSON: no feature of kind \"{role}\", only {} of kind \"{other}\" (the kind property of ccpp's exports); give it as --{other}",
+            kinds.other
+        )));
+    }
     Ok(out)
 }
 
@@ -472,7 +505,12 @@ fn geojson_polygon(rings: &Value, out: &mut Vec<Polygon>) -> Result<(), ZoneFile
     Ok(())
 }
 
-fn geojson_collect(v: &Value, out: &mut Vec<Polygon>, depth: usize) -> Result<(), ZoneFileError> {
+fn geojson_collect(
+    v: &Value,
+    out: &mut Vec<Polygon>,
+    depth: usize,
+    kinds: &mut Kinds<'_>,
+) -> Result<(), ZoneFileError> {
     if depth > 8 {
         return Err(bad("GeoJSON nested too deeply"));
     }
@@ -512,8 +550,18 @@ fn geojson_collect(v: &Value, out: &mut Vec<Polygon>, depth: usize) -> Result<()
         },
         "Feature" => match v.get("geometry") {
             Some(g) if !g.is_null() => {
+                let kind = v.pointer("/properties/kind").and_then(Value::as_str);
+                if let (Some(role), Some(kind)) = (kinds.role, kind) {
+                    if kind == "path" {
+                        return Ok(());
+                    }
+                    if ["area", "keepout"].contains(&kind) && kind != role {
+                        kinds.other += 1;
+                        return Ok(());
+                    }
+                }
                 let first = out.len();
-                geojson_collect(g, out, depth + 1)?;
+                geojson_collect(g, out, depth + 1, kinds)?;
                 // The feature's name names every polygon of its geometry.
                 // A number or a boolean names it as written; a list or an object is no name.
                 let name = match v.get("properties").and_then(|p| p.get("name")) {
@@ -533,13 +581,13 @@ fn geojson_collect(v: &Value, out: &mut Vec<Polygon>, depth: usize) -> Result<()
         "FeatureCollection" => match v.get("features") {
             Some(Value::Array(fs)) => fs
                 .iter()
-                .try_for_each(|f| geojson_collect(f, out, depth + 1)),
+                .try_for_each(|f| geojson_collect(f, out, depth + 1, kinds)),
             _ => Err(bad("GeoJSON FeatureCollection without a features list")),
         },
         "GeometryCollection" => match v.get("geometries") {
             Some(Value::Array(gs)) => gs
                 .iter()
-                .try_for_each(|g| geojson_collect(g, out, depth + 1)),
+                .try_for_each(|g| geojson_collect(g, out, depth + 1, kinds)),
             _ => Err(bad("GeoJSON GeometryCollection without a geometries list")),
         },
         "" => Err(bad("not GeoJSON: no \"type\"")),
