@@ -3191,3 +3191,35 @@ fn rect_lane_area_inside_a_zone_area_is_said() {
         }
     }
 }
+
+/// A map far from the origin with a yaw: the rounding of headings between collinear moves
+/// (about 1e-8 rad at (512345.6, 5098765.4)) was executed and counted as turns in place, so
+/// bcd's waypoints there were 35 against 33 at the origin. Rotations below 1e-6 rad are
+/// neither (`MIN_ROTATION`).
+#[test]
+fn a_far_turned_map_gives_the_same_waypoints_and_turns() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pgm(dir, "room.pgm", 80, 60, |x, y| {
+        (30..38).contains(&x) && (20..34).contains(&y)
+    });
+    let at = |sub: &str, origin: &str| {
+        let out = dir.join(sub);
+        ccpp()
+            .args(["run", "--planner", "bcd", "--map", s(&map), "--json"])
+            .arg(format!("--origin={origin}"))
+            .args(["--export", "csv", "--out", s(&out)])
+            .assert()
+            .success();
+        let m = read_json(&out.join("metrics.json"));
+        let rows = std::fs::read_to_string(out.join("waypoints.csv"))
+            .unwrap()
+            .lines()
+            .count();
+        (m["turns"].as_u64().unwrap(), rows)
+    };
+    let home = at("home", "0,0,0.3");
+    for origin in ["512345.6,5098765.4,0.3", "-12345.6,98765.4,1.2"] {
+        assert_eq!(at("far", origin), home, "{origin}");
+    }
+}
