@@ -198,6 +198,11 @@ impl Polygon {
                 distinct: distinct.len(),
             });
         }
+        // All on one line: that is the problem to name (its edges fold back onto each other,
+        // which the test below called "intersects itself").
+        if self.signed_area().abs() <= f64::EPSILON * bbox_scale(&r) && on_one_line(&r) {
+            return Err(ZoneError::ZeroArea { index });
+        }
         let n = r.len();
         for i in 0..n {
             let (a, b) = (r[i], r[(i + 1) % n]);
@@ -231,6 +236,18 @@ impl Polygon {
         }
         Ok(())
     }
+}
+
+/// Whether every point of `r` lies on the line through its first point and the first point
+/// distinct from it (to rounding: the cross products within a few ulps of the ring's scale).
+fn on_one_line(r: &[Point]) -> bool {
+    let Some(&a) = r.first() else { return true };
+    let Some(&b) = r.iter().find(|p| p.x != a.x || p.y != a.y) else {
+        return true;
+    };
+    let tol = 8.0 * f64::EPSILON * bbox_scale(r);
+    r.iter()
+        .all(|p| ((b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x)).abs() <= tol)
 }
 
 fn bbox_scale(r: &[Point]) -> f64 {
@@ -669,6 +686,29 @@ mod tests {
             points: p.to_vec(),
             name: None,
         }
+    }
+
+    /// Points all on one line are named as that (zero area), not as edges that intersect
+    /// (they fold back onto each other); a bow tie, whose signed area is zero too, still
+    /// intersects itself.
+    #[test]
+    fn a_polygon_on_one_line_has_zero_area() {
+        for line in [
+            &[[0.0, 0.0], [1.0, 1.0], [2.0, 2.0]][..],
+            &[[0.0, 0.0], [2.0, 0.0], [1.0, 0.0], [3.0, 0.0]],
+            &[[-1.0, -1.0], [0.0, -1.0], [1.0, -1.0]],
+        ] {
+            assert!(
+                matches!(poly(line).validate(0), Err(ZoneError::ZeroArea { .. })),
+                "{line:?}: {:?}",
+                poly(line).validate(0)
+            );
+        }
+        let bow = poly(&[[0.0, 0.0], [1.0, 1.0], [1.0, 0.0], [0.0, 1.0]]);
+        assert!(matches!(
+            bow.validate(0),
+            Err(ZoneError::SelfIntersecting { .. })
+        ));
     }
 
     /// The vertex limit counts vertices: a closed ring repeats its first one at the end.
