@@ -327,7 +327,7 @@ pub fn check_run_folder(target: &Path) -> Result<(), FolderError> {
     // `bench-key.txt` alone, a bench run folder whose key was removed to force a rerun was
     // refused as holding a file ccpp did not write.)
     let mut bench_only = None;
-    let mut bench_key = false;
+    let mut beside_run_file = false;
     for e in entries {
         let e = e.map_err(io_err)?;
         let name = e.file_name().to_string_lossy().into_owned();
@@ -339,13 +339,13 @@ pub fn check_run_folder(target: &Path) -> Result<(), FolderError> {
             });
         }
         if name == "bench-key.txt" || name == "metrics.json" {
-            bench_key = true;
+            beside_run_file = true;
         } else if name.trim_end_matches(".tmp") == BENCH_WARNINGS_FILE {
             bench_only = Some(name);
         }
     }
     match bench_only {
-        Some(name) if !bench_key => Err(FolderError::Foreign {
+        Some(name) if !beside_run_file => Err(FolderError::Foreign {
             path: target.to_path_buf(),
             name,
         }),
