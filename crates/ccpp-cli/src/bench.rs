@@ -244,7 +244,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     crate::print_stdout(&format!(
         "{}; wrote {}/results.csv, results.md, plots/\n",
         done_line(rows.len(), failed, prepared.len(), planners.len()),
-        a.out.display()
+        crate::output::folder_shown(&a.out)
     ))?;
     // Runs the simulator stopped before the planner finished (`stalled`, `max_steps`) are
     // results, not failures, but incomplete ones: named here as well as in `results.csv`.

@@ -139,7 +139,7 @@ pub fn replay_dir(dir: &Path) -> Result<()> {
     }
     crate::print_stdout(&format!(
         "wrote {}/replay.html and replay.gif\n",
-        dir.display()
+        folder_shown(dir)
     ))
 }
 
@@ -434,9 +434,17 @@ pub fn emit(
     let _ = writeln!(
         s,
         "wrote {}/{{metrics.json, path.csv, trace.jsonl, coverage.png, run.json{extra}}}",
-        job.out.display()
+        folder_shown(&job.out)
     );
     crate::print_stdout(&s)
+}
+
+/// A folder as the `wrote DIR/{...}` lines print it: without the separators it was given
+/// with at its end (`--out runs/` printed `wrote runs//{...}`; the root folder prints as
+/// nothing before the `/`).
+pub fn folder_shown(dir: &Path) -> String {
+    let s = dir.display().to_string();
+    s.trim_end_matches(std::path::MAIN_SEPARATOR).to_string()
 }
 
 /// The summary's line of a run on a map grown by `--inflate` `m` metres.

@@ -130,7 +130,12 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     // the start's room only, and nothing said so.
     let _ = writeln!(s, "  start area: {}", comp.line());
     let names: Vec<&str> = files.iter().map(|(n, _)| *n).collect();
-    let _ = writeln!(s, "wrote {}/{{{}}}", a.out.display(), names.join(", "));
+    let _ = writeln!(
+        s,
+        "wrote {}/{{{}}}",
+        crate::output::folder_shown(&a.out),
+        names.join(", ")
+    );
     crate::print_stdout(&s)
 }
 

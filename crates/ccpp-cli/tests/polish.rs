@@ -330,3 +330,52 @@ fn a_spinner_shows_a_long_step_on_a_terminal_only() {
         "{screen}"
     );
 }
+
+/// `--out DIR/` (as a shell completes a folder) printed `wrote DIR//{...}`: every command that
+/// names its output folder prints it once, with one separator.
+#[test]
+fn an_output_folder_given_with_a_slash_is_printed_with_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = pillars(dir.path());
+    let out = |name: &str| format!("{}/", dir.path().join(name).display());
+    let stdout = |args: &[&str]| {
+        let o = ccpp().args(args).output().unwrap();
+        assert!(o.status.success(), "{args:?}: {o:?}");
+        String::from_utf8(o.stdout).unwrap()
+    };
+    let m = map.to_str().unwrap();
+    let run = out("run");
+    let plan = out("plan");
+    let bench = out("bench");
+    let cases = [
+        (
+            stdout(&["run", "--map", m, "--planner", "ba-star", "--out", &run]),
+            format!("wrote {run}{{metrics.json"),
+        ),
+        (
+            stdout(&["replay", &run]),
+            format!("wrote {run}replay.html and replay.gif"),
+        ),
+        (
+            stdout(&["plan", "--map", m, "--planner", "bcd", "--out", &plan]),
+            format!("wrote {plan}{{"),
+        ),
+        (
+            stdout(&[
+                "bench",
+                "--maps",
+                m,
+                "--planners",
+                "ba-star",
+                "--quiet",
+                "--out",
+                &bench,
+            ]),
+            format!("wrote {bench}results.csv"),
+        ),
+    ];
+    for (text, want) in cases {
+        assert!(text.contains(&want), "want {want:?} in:\n{text}");
+        assert!(!text.contains("//"), "{text}");
+    }
+}
