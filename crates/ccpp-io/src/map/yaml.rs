@@ -174,6 +174,10 @@ impl MapYaml {
         // Let `.nan` / `.inf` through so they are reported as bad values of their field.
         let mut options = serde_saphyr::Options::default();
         options.non_finite_float_policy = serde_saphyr::NonFiniteFloatPolicy::PassThrough;
+        // YAML 1.2 booleans only: `negate: y` (or `yes`, `on`) read as true negated the whole
+        // map without a word, where `map_server` refuses it (it reads `negate` as an integer);
+        // now it is a bad `negate` like the quoted "y".
+        options.strict_booleans = true;
         let raw: RawYaml =
             serde_saphyr::from_str_with_options(text, options).map_err(|e| MapError::Yaml {
                 path: path.to_path_buf(),
@@ -398,7 +402,10 @@ mod tests {
             let y = parse(&format!("{BASE}negate: {text}\n")).unwrap();
             assert_eq!(y.negate, want, "negate: {text}");
         }
-        for text in ["2", "-1", "0.5", "1.0", "\"2\"", "\"\""] {
+        // (YAML 1.1's words for true and false are no `negate`: `negate: y` negated the map)
+        for text in [
+            "2", "-1", "0.5", "1.0", "\"2\"", "\"\"", "y", "Y", "yes", "on", "ON", "n", "no", "off",
+        ] {
             let e = parse(&format!("{BASE}negate: {text}\n")).unwrap_err();
             assert!(
                 matches!(
