@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 from pathlib import Path
 
@@ -12,7 +13,7 @@ pd = pytest.importorskip("pandas")
 distributed = pytest.importorskip("distributed")
 
 import ccpp  # noqa: E402
-from conftest import COMPARE_MAPS  # noqa: E402
+from conftest import COMPARE_MAPS, write_room  # noqa: E402
 
 # Columns that differ between any two runs (timing) or by design (output folder).
 VOLATILE = ["wall_time_s", "dir"]
@@ -173,11 +174,11 @@ def test_sweep_status_of_a_stalled_run_is_stalled(shared_maps: Path, monkeypatch
     from ccpp import _ccpp, sweeps
 
     monkeypatch.setattr(_ccpp, "bench_run", lambda *a, **k: (r.metrics, None, []))
-    row = sweeps._run_cell("m.yaml", "m", "rect-boustrophedon", 0.15, None, None, None, None)
+    row = sweeps._run_cell("m.yaml", "m", "rect-boustrophedon", 0.15, None, None, None, None, None)
     assert row["status"] == "stalled" and row["error"] is None
     done = ccpp.run(str(shared_maps / "teb_maze.yaml"), "bcd")
     monkeypatch.setattr(_ccpp, "bench_run", lambda *a, **k: (done.metrics, None, []))
-    assert sweeps._run_cell("m.yaml", "m", "bcd", 0.15, None, None, None, None)["status"] == "ok"
+    assert sweeps._run_cell("m.yaml", "m", "bcd", 0.15, None, None, None, None, None)["status"] == "ok"
 
 
 def test_sweep_reports_warnings_as_bench_does(room: Path, ccpp_bin: str, tmp_path: Path, client) -> None:
@@ -196,3 +197,41 @@ def test_sweep_reports_warnings_as_bench_does(room: Path, ccpp_bin: str, tmp_pat
     assert got["warnings"][0] == expected["warnings"][0]
     assert got["warnings"][0].startswith("the tile side 0.3 m is wider than the tool sweeps")
     assert got["warnings"][0] in ccpp.run(room, "ba-star", tool_radius=0.1).warnings
+
+
+class _ElsewhereClient:
+    """A Dask client stand-in whose worker runs each task in another folder, as a worker of
+    a real cluster started elsewhere does (a local cluster's workers share the caller's)."""
+
+    def __init__(self, cwd: Path) -> None:
+        self.cwd = cwd
+
+    def submit(self, fn, *args, pure=True):  # noqa: ANN001, ANN201, ARG002
+        here = os.getcwd()
+        os.chdir(self.cwd)
+        try:
+            return fn(*args)
+        finally:
+            os.chdir(here)
+
+    def gather(self, futures):  # noqa: ANN001, ANN201
+        return futures
+
+
+def test_relative_paths_mean_the_callers_folder_on_every_worker(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # Before: the worker read `maps/room.yaml` in its own folder (an error row), and with an
+    # absolute map wrote `sw/runs/...` there while the row said ok and the caller's `sw`,
+    # checked and locked, stayed empty.
+    (tmp_path / "maps").mkdir()
+    write_room(tmp_path / "maps")
+    elsewhere = tmp_path / "elsewhere"
+    (elsewhere / "maps").mkdir(parents=True)
+    monkeypatch.chdir(tmp_path)
+    client = _ElsewhereClient(elsewhere)
+    df = ccpp.sweep("maps/room.yaml", ["bsa"], 0.15, client=client, out="sw")
+    assert list(df["status"]) == ["ok"], df.to_dict("records")
+    assert list(df["dir"]) == [str(Path("sw") / "runs" / "room" / "bsa")]
+    assert (tmp_path / "sw" / "runs" / "room" / "bsa" / "metrics.json").is_file()
+    assert not (elsewhere / "sw").exists()

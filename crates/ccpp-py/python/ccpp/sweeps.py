@@ -142,8 +142,10 @@ def _run_cell(
     inflate: float | None,
     max_memory_mb: int | None,
     out_dir: str | None,
+    shown_dir: str | None,
 ) -> dict[str, Any]:
-    """One run on a worker: a row of the results."""
+    """One run on a worker: a row of the results (``out_dir`` absolute, ``shown_dir`` as the
+    row names it)."""
     from ccpp import _ccpp as native  # imported on the worker
 
     metrics, error, warnings = native.bench_run(
@@ -166,7 +168,7 @@ def _run_cell(
         row.update(status=metrics.get("stop_reason") or "ok", error=None)
         row.update({c: metrics[c] for c in _METRIC_COLUMNS})
     # A failed run leaves no folder (as `ccpp bench`'s results.csv).
-    row["dir"] = (out_dir or "") if metrics is not None else ""
+    row["dir"] = (shown_dir or "") if metrics is not None else ""
     # The warnings `ccpp run` prints (wide or stranded tiles, a boxed-in random bounce, ...),
     # None when there are none (an empty field of results.csv).
     row["warnings"] = WARNINGS_SEPARATOR.join(warnings) if warnings else None
@@ -261,6 +263,9 @@ def sweep(
     if out is not None:
         _check_out(out)
     tasks = []
+    # The workers get absolute paths, made here: a worker of a cluster started in another
+    # folder read relative map paths, and wrote relative `out` folders, in its own folder
+    # (the caller's `out`, checked and locked, stayed empty while every row said ok).
     for r in radii:
         for m, map_name in maps_named:
             for p in names:
@@ -270,7 +275,19 @@ def sweep(
                     if len(radii) > 1:
                         base = base / f"r{r}"
                     d = str(base / map_name / p)
-                tasks.append((str(m), map_name, p, r, tool_radius, inflate, max_memory_mb, d))
+                tasks.append(
+                    (
+                        os.path.abspath(m),
+                        map_name,
+                        p,
+                        r,
+                        tool_radius,
+                        inflate,
+                        max_memory_mb,
+                        None if d is None else os.path.abspath(d),
+                        d,
+                    )
+                )
 
     with _folder_lock(out) if out is not None else contextlib.nullcontext():
         if out is not None:
