@@ -278,14 +278,24 @@ impl Map {
 
     /// The world coordinates `(x, y)` of the centre of pixel `(col, row)` (column from the
     /// left, row from the top); `IndexError` outside the image.
-    fn pixel_center(&self, col: i64, row: i64) -> PyResult<(f64, f64)> {
+    fn pixel_center(&self, col: &Bound<'_, PyAny>, row: &Bound<'_, PyAny>) -> PyResult<(f64, f64)> {
         let f = self.map.grid.frame();
-        // A negative index is outside too (as `usize` it raised OverflowError).
-        let inside = |i: i64, n: usize| usize::try_from(i).ok().filter(|&i| i < n);
-        let (Some(c), Some(r)) = (inside(col, f.width), inside(row, f.height)) else {
+        // A negative index is outside too (as `usize` it raised OverflowError), and so is an
+        // int beyond 64 bits (as `i64` it raised OverflowError); not an int: TypeError.
+        let inside = |v: &Bound<'_, PyAny>, n: usize| -> PyResult<Option<usize>> {
+            match v.extract::<i64>() {
+                Ok(i) => Ok(usize::try_from(i).ok().filter(|&i| i < n)),
+                Err(_) if v.is_instance_of::<PyInt>() => Ok(None),
+                Err(e) => Err(e),
+            }
+        };
+        let (Some(c), Some(r)) = (inside(col, f.width)?, inside(row, f.height)?) else {
             return Err(pyo3::exceptions::PyIndexError::new_err(format!(
-                "pixel ({col}, {row}) is outside the map's {} x {} px",
-                f.width, f.height
+                "pixel ({}, {}) is outside the map's {} x {} px",
+                repr(col),
+                repr(row),
+                f.width,
+                f.height
             )));
         };
         let p = f.pixel_center(c, r);
@@ -640,8 +650,16 @@ fn noise_arg(v: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
 /// a list of `(id, x, y[, theta])`.
 fn landmarks_arg(v: &Bound<'_, PyAny>) -> PyResult<Vec<ccpp_core::landmarks::Landmark>> {
     let list = if let Ok(path) = v.extract::<PathBuf>() {
-        ccpp_io::landmarks::load_landmarks(&path)
-            .map_err(|e| msg(format!("landmarks {}: {e}", path.display())))?
+        let list = ccpp_io::landmarks::load_landmarks(&path)
+            .map_err(|e| msg(format!("landmarks {}: {e}", path.display())))?;
+        if list.is_empty() {
+            // (the CLI's words: a file, not a list, was given)
+            return Err(msg(format!(
+                "landmarks {}: the file holds no landmark",
+                path.display()
+            )));
+        }
+        list
     } else {
         // A list goes through the file reader's own parsing (a JSON array), so both are
         // checked alike.

@@ -422,9 +422,12 @@ def test_round_three_python_holes(room: Path, tmp_path: Path) -> None:
     """From a hostile tester: a negative pixel raised OverflowError, `export="csv"` a
     TypeError, and `max_steps=0` named an internal field only."""
     m = ccpp.load_map(room)
-    for col, row in ((-1, 0), (0, -1), (60, 0)):
+    # (and so did one beyond 64 bits; a float is no index)
+    for col, row in ((-1, 0), (0, -1), (60, 0), (2**63, 0), (0, -(2**70))):
         with pytest.raises(IndexError, match="outside the map's 60 x 40 px"):
             m.pixel_center(col, row)
+    with pytest.raises(TypeError):
+        m.pixel_center(1.5, 0)
     r = ccpp.run(m, "bsa")
     r.save(tmp_path / "one", export="csv")
     assert (tmp_path / "one" / "waypoints.csv").is_file()
@@ -658,3 +661,15 @@ def test_a_path_with_a_control_character_is_refused_as_the_command_line_refuses_
     odd.write_text(room.read_text())
     with pytest.raises(ccpp.CcppError, match=r"holds a control character \(U\+000A\); rename it"):
         ccpp.load_map(odd)
+
+
+def test_an_empty_landmarks_file_is_refused_in_the_clis_words(room: Path, tmp_path: Path) -> None:
+    """From a hostile tester: Python said "landmarks: no landmark given" for a file holding
+    none, where the CLI names the file; a list holding none keeps its own words."""
+    for name, text in (("empty.csv", ""), ("comment.csv", "# id,x,y\n")):
+        f = tmp_path / name
+        f.write_text(text)
+        with pytest.raises(ccpp.CcppError, match=f"^landmarks {f}: the file holds no landmark$"):
+            ccpp.run(room, "bcd", landmarks=f, odometry_noise=0.01, seed=1)
+    with pytest.raises(ccpp.CcppError, match="^landmarks: no landmark given$"):
+        ccpp.run(room, "bcd", landmarks=[], odometry_noise=0.01, seed=1)
