@@ -47,9 +47,11 @@ struct Info {
     robot_radius_m: f64,
     /// The tool radius `accessible_m2` is measured with (`--tool-radius`, default the robot's).
     tool_radius_m: f64,
-    /// Whether the robot fits somewhere on the map (with the start given, there).
+    /// Whether the robot fits somewhere on the map (with the start given, there; with zones,
+    /// inside the area and outside the keep-outs).
     robot_fits: bool,
-    /// Why the robot does not fit, when it does not.
+    /// Why the robot does not fit, when it does not (naming the zones when they leave it no
+    /// room).
     robot_error: Option<String>,
     /// C-free pixel centres (the robot fits) on the whole map.
     cfree_px: Option<usize>,
@@ -127,7 +129,23 @@ pub fn run(a: &InfoArgs) -> Result<()> {
                     .unwrap_or_else(|| e.to_string()),
             ),
         ),
-        // A start the user gave that does not work is a user error.
+        // Zones that leave no floor are reported too, naming the zone (as `run` refuses them):
+        // `info` is where a user looks for why, and it printed nothing but an error that named
+        // the map.
+        Err(e @ WorldError::NoRoomInZones { .. }) => (
+            None,
+            Some(
+                zs.zone_error(&e, &map.source)
+                    .map_or_else(|| e.to_string(), |z| z.to_string()),
+            ),
+        ),
+        // A start the user gave that does not work is a user error (naming the zone it is
+        // about, as `run` does).
+        Err(e) if zs.zone_error(&e, &map.source).is_some() => {
+            return Err(zs
+                .zone_error(&e, &map.source)
+                .map_or_else(|| anyhow::Error::new(e), anyhow::Error::new))
+        }
         Err(e) => {
             return Err(
                 match ccpp_io::scenario::inflated_world_error(&e, map.recipe.inflation()) {

@@ -826,3 +826,57 @@ fn an_exported_geojson_gives_its_zones_back() {
         "{err}"
     );
 }
+
+/// `ccpp info` with zones that leave the robot no floor printed no map facts and an error
+/// naming the map (`run` names the zone); now it reports the map with the zone's reason, as
+/// it reports a robot too big for the map. A start in a keep-out is still refused, naming the
+/// keep-out as `run` does.
+#[test]
+fn info_reports_zones_that_leave_no_floor_naming_the_zone() {
+    let d = tempfile::tempdir().unwrap();
+    let map = crate::common::pillars(d.path());
+    let m = map.to_str().unwrap();
+    let o = ccpp()
+        .args(["info", "--map", m, "--keepout", "-1,-1,50,50"])
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.contains("free "), "{out}");
+    let robot = out.lines().find(|l| l.starts_with("robot ")).unwrap();
+    assert!(
+        robot.contains(
+            "keepout rectangle -1,-1,50,50: the area minus the keep-out zones holds no floor"
+        ),
+        "{out}"
+    );
+    let o = ccpp()
+        .args(["info", "--json", "--map", m, "--area", "-1,-1,50,50"])
+        .args(["--keepout", "-1,-1,50,50"])
+        .output()
+        .unwrap();
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(j["robot_fits"], false, "{j}");
+    let why = j["robot_error"].as_str().unwrap();
+    assert!(why.starts_with("area rectangle -1,-1,50,50: "), "{why}");
+    let o = ccpp()
+        .args([
+            "info",
+            "--map",
+            m,
+            "--keepout",
+            "0,0,1,1",
+            "--start",
+            "0.5,0.5",
+        ])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.starts_with(
+            "error: keepout rectangle 0,0,1,1: start (0.500, 0.500) is in a keep-out zone"
+        ),
+        "{err}"
+    );
+}

@@ -1082,6 +1082,17 @@ impl Scenario {
         }
     }
 
+    /// `e` as the error of the zone it is about (`keepout FILE: ...`, as [`ScenarioError::Zone`]
+    /// words it), when it is about one (see `zone_of`); for `ccpp info`, which builds its
+    /// world itself.
+    pub fn zone_error(&self, e: &WorldError, map: &Path) -> Option<ScenarioError> {
+        self.zone_of(e).map(|(kind, label)| ScenarioError::Zone {
+            kind,
+            label,
+            message: format!("{e} (map {})", map.display()),
+        })
+    }
+
     /// What the zones will hold, for the memory estimate (before any zone file is read).
     pub fn zone_load(&self) -> ZoneLoad {
         ZoneLoad {
