@@ -152,15 +152,17 @@ pub(crate) fn zone_class(world: &World, i: usize) -> u8 {
     }
 }
 
-/// Region colours (colour-blind-friendly-ish, distinct on light blue).
+/// Region colours (colour-blind-friendly-ish, distinct on light blue). No red: red marks
+/// collisions, keep-outs and a stopped run (the second region's path was the keep-out
+/// hatching's red).
 const PALETTE: [[u8; 3]; 10] = [
     [0, 90, 181],
-    [220, 50, 32],
+    [180, 140, 0],
     [0, 140, 70],
     [150, 60, 170],
     [230, 130, 0],
     [0, 150, 160],
-    [170, 110, 40],
+    [100, 70, 30],
     [210, 60, 140],
     [90, 90, 20],
     [40, 40, 140],
@@ -2124,6 +2126,22 @@ mod tests {
         let b = coverage_png(&world, &trace, &style()).unwrap();
         assert_eq!(a, b, "same inputs, same bytes");
         insta::assert_snapshot!("coverage_png_dump", dump(&a, 72));
+    }
+
+    #[test]
+    fn no_region_colour_reads_as_a_red_marker() {
+        // (the second region's path was [220, 50, 32], 23 from the keep-out hatching)
+        let far = |a: [u8; 3], b: [u8; 3]| {
+            let d: f64 = (0..3)
+                .map(|k| (f64::from(a[k]) - f64::from(b[k])).powi(2))
+                .sum();
+            d.sqrt()
+        };
+        for p in PALETTE {
+            for red in [colours::COLLISION, colours::KEEPOUT_HATCH, colours::STOPPED] {
+                assert!(far(p, red) > 90.0, "{p:?} is close to {red:?}");
+            }
+        }
     }
 
     #[test]
