@@ -396,7 +396,9 @@ fn ring(v: &Value, geo: bool) -> Result<Polygon, ZoneFileError> {
 
 fn is_point(v: &Value) -> bool {
     match v {
-        Value::Array(a) => a.first().is_some_and(Value::is_number),
+        // (a scalar first: a point, even when it is not a number, so that a quoted `"0"` is
+        // reported as a coordinate that is not a number, not as a mix of the two forms)
+        Value::Array(a) => a.first().is_some_and(|c| !c.is_array() && !c.is_object()),
         Value::Object(o) => o.contains_key("x"),
         _ => false,
     }
@@ -739,6 +741,12 @@ mod tests {
             e.starts_with("item 2 is a list of points while item 1 is a point"),
             "{e}"
         );
+        // A quoted number first is a coordinate that is not a number (it was "item 2 is a
+        // point while item 1 is a list of points").
+        let e = yaml("- [\"0\", 0]\n- [1, 0]\n- [1, 1]\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("coordinate \"0\" is not a number"), "{e}");
         let e = yaml("- [[2, 2], [3, 2], [3, 3]]\n- [2, 2]\n")
             .unwrap_err()
             .to_string();
