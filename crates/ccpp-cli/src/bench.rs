@@ -684,6 +684,7 @@ fn child_job() -> Result<String> {
         &result.world,
         &result.run.trace,
         &result.metrics,
+        &result.swept,
     ) {
         warnings.push_str(&w.replace(['\n', '\r'], " "));
         warnings.push('\n');

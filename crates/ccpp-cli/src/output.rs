@@ -409,7 +409,9 @@ pub fn emit(
     }
     // Every warning on stderr, with or without --json (the early stop's was a line of the
     // table on stdout without it), as Python's `RunResult.warnings` lists them.
-    for w in ccpp_io::warnings::run_warnings(&job.scenario, &r.world, &r.run.trace, &r.metrics) {
+    for w in
+        ccpp_io::warnings::run_warnings(&job.scenario, &r.world, &r.run.trace, &r.metrics, &r.swept)
+    {
         eprintln!("warning: {w}");
     }
     if json_only {

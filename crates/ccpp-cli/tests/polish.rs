@@ -379,3 +379,62 @@ fn an_output_folder_given_with_a_slash_is_printed_with_one() {
         assert!(!text.contains("//"), "{text}");
     }
 }
+
+/// A start in a room holding a little more than half the floor, the other room behind a
+/// 0.4 m doorway off the tile lattice: ba-star, bsa and bsa-bfs visited every tile they could
+/// reach (`coverage_rate` 1.0) and swept 54 % without a word, because the stranded-tiles
+/// warning waited for less than half; rect-boustrophedon, whose clearance disk does not fit
+/// through, and random-bounce, whose budget ran out, were silent too (hostile pass). Each now
+/// says how much floor it never came near; the planners that go through say nothing.
+#[test]
+fn a_room_never_entered_is_said_by_every_planner_that_leaves_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = pgm(dir.path(), "two_rooms.pgm", 160, 120, |x, y| {
+        (100..102).contains(&x) && !(100..108).contains(&y)
+    });
+    let run = |planner: &str| {
+        let o = ccpp()
+            .args(["run", "--planner", planner, "--start", "0.4,0.4", "--map"])
+            .arg(&map)
+            .arg("--out")
+            .arg(dir.path().join(planner))
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{planner}: {o:?}");
+        let m = crate::common::read_json(&dir.path().join(planner).join("metrics.json"));
+        let cov = m["effective_coverage"].as_f64().unwrap();
+        (String::from_utf8(o.stderr).unwrap(), cov)
+    };
+    for planner in ["ba-star", "bsa", "bsa-bfs"] {
+        let (err, cov) = run(planner);
+        assert!(cov > 0.5 && cov < 0.6, "{planner}: {cov}");
+        assert!(
+            err.contains(
+                "visited the tiles it could reach from the start (100 %) but swept only 5"
+            ) && err.contains("m2, lies more than 1 m from anything the tool swept"),
+            "{planner}: {err}"
+        );
+    }
+    for (planner, why) in [
+        ("rect-boustrophedon", "the path never went there"),
+        (
+            "random-bounce",
+            "random-bounce spent its distance budget before it came there",
+        ),
+    ] {
+        let (err, cov) = run(planner);
+        assert!(cov > 0.5 && cov < 0.7, "{planner}: {cov}");
+        let lines: Vec<&str> = err.lines().filter(|l| l.starts_with("warning:")).collect();
+        assert_eq!(lines.len(), 1, "{planner}: {err}");
+        assert!(
+            lines[0].contains("lies more than 1 m from anything the tool swept")
+                && lines[0].contains(why),
+            "{planner}: {err}"
+        );
+    }
+    for planner in ["bcd", "ba-star-extended", "bsa-extended"] {
+        let (err, cov) = run(planner);
+        assert!(cov > 0.99, "{planner}: {cov}");
+        assert!(!err.contains("warning:"), "{planner}: {err}");
+    }
+}

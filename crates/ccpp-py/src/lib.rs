@@ -1416,6 +1416,7 @@ fn run(
                 &run.world,
                 &run.output.trace,
                 &run.metrics,
+                &run.swept,
             ))
             .collect::<Vec<String>>();
             (run, w)
@@ -1652,8 +1653,13 @@ fn bench_run(
             )
             .map_err(|e| ccpp_io::message::one_line(&e))?;
         }
-        let warnings =
-            ccpp_io::warnings::run_warnings(&scenario, &run.world, &run.output.trace, &run.metrics);
+        let warnings = ccpp_io::warnings::run_warnings(
+            &scenario,
+            &run.world,
+            &run.output.trace,
+            &run.metrics,
+            &run.swept,
+        );
         Ok((run.metrics, warnings))
     });
     Ok(match outcome {
