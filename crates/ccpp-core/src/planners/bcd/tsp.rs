@@ -270,15 +270,27 @@ struct BoxGrid<'a> {
     squares: Vec<Vec<u32>>,
 }
 
+/// The most squares a [`BoxGrid`] side is cut into, less one (a side `w` long in squares of
+/// `w / MAX_SQUARES` takes `MAX_SQUARES + 1` of them, at most 4096).
+const MAX_SQUARES: f64 = 4095.0;
+
 impl<'a> BoxGrid<'a> {
     fn new(boxes: &'a [[f64; 4]]) -> Self {
         let low = |k: usize| boxes.iter().map(|b| b[k]).fold(f64::INFINITY, f64::min);
         let high = |k: usize| boxes.iter().map(|b| b[k]).fold(f64::NEG_INFINITY, f64::max);
         let (x0, x1, y0, y1) = (low(0), high(1), low(2), high(3));
         let (wx, wy) = ((x1 - x0).max(0.0), (y1 - y0).max(0.0));
-        // About one piece per square; at least a unit side (grid points are pixels).
+        // About one piece per square; at least a unit side (grid points are pixels), and at
+        // most 4096 squares a side: the side grows to span the pieces in that many (it was
+        // kept while the count was capped, so on a long thin map, a corridor 30 000 px long,
+        // the last square held two thirds of the 7321 pieces and the search went quadratic:
+        // bcd on one 100 000 px long took 13 s to plan).
         let n = boxes.len().max(1) as f64;
-        let side = ((wx * wy) / n).sqrt().max(1.0);
+        let side = ((wx * wy) / n)
+            .sqrt()
+            .max(1.0)
+            .max(wx / MAX_SQUARES)
+            .max(wy / MAX_SQUARES);
         let count = |w: f64| ((w / side).floor() as usize + 1).min(4096);
         let (nx, ny) = if boxes.is_empty() {
             (0, 0)
@@ -811,6 +823,24 @@ mod tests {
                 "lattice {k} x {m}"
             );
         }
+    }
+
+    /// On a long thin spread of pieces the grid's squares grow to span them all: with the
+    /// side kept while the count of squares was capped at 4096, the last square held most of
+    /// the pieces (a corridor 30 000 px long: 2/3 of 7321) and the search went quadratic.
+    #[test]
+    fn a_long_thin_spread_of_pieces_fills_the_squares_evenly() {
+        let pieces: Vec<Piece> = (0..20_000)
+            .map(|i| point_piece(f64::from(i) * 5.0, f64::from(i % 3)))
+            .collect();
+        let ends: Vec<[f64; 4]> = pieces
+            .iter()
+            .map(|p| [p.entry[0].x, p.entry[0].x, p.entry[0].y, p.entry[0].y])
+            .collect();
+        let grid = BoxGrid::new(&ends);
+        let fullest = grid.squares.iter().map(Vec::len).max().unwrap();
+        assert!(grid.nx <= 4096 && grid.ny <= 4096);
+        assert!(fullest <= 8, "{fullest} pieces in one square");
     }
 
     #[test]
