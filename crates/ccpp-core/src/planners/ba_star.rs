@@ -130,8 +130,10 @@ pub struct BaStarOptions {
     pub tile_side_m: Option<f64>,
     /// A*SPT smoothing of the backtracking paths (`false` follows the raw A* path, to compare).
     pub smoothing: bool,
-    /// Record the backtracking list `L` at every critical point (`backtrack_list` events). Large
-    /// maps produce big traces; switch off when only the metrics matter.
+    /// Record the backtracking list `L` at every critical point (`backtrack_list` events), while
+    /// the recorded lists hold at most [`LIST_POINTS_PER_TILE`] points a tile (then a `note`
+    /// event says recording stopped). Large maps produce big traces; switch off when only the
+    /// metrics matter.
     pub record_backtrack_list: bool,
     /// Extend `mu` by [`lane_end_score`] and the move-judged lane ends of [`SIDE_END_PAIRS`]
     /// (default `true`). `false` is the paper's `mu` exactly, which can leave reachable tiles
@@ -158,6 +160,12 @@ enum Phase {
     Finished,
 }
 
+/// The backtracking-list points a run's trace holds at most, per tile of the map: lists are
+/// recorded whole at each critical point while they fit, and a `note` event says where the
+/// recording stopped (the run's memory estimate counts them: 16 bytes a point). Real maps stay
+/// well inside (`office_4096` at r = 0.15 m: about 14 per tile).
+pub const LIST_POINTS_PER_TILE: usize = 32;
+
 /// The BA* planner (see the module docs).
 #[derive(Clone, Debug)]
 pub struct BaStar {
@@ -167,6 +175,8 @@ pub struct BaStar {
     phase: Phase,
     pending: VecDeque<Step>,
     region: u32,
+    /// [`LIST_POINTS_PER_TILE`] (smaller in tests).
+    list_points_per_tile: usize,
 }
 
 impl BaStar {
@@ -179,7 +189,15 @@ impl BaStar {
             phase: Phase::Start,
             pending: VecDeque::new(),
             region: 0,
+            list_points_per_tile: LIST_POINTS_PER_TILE,
         }
+    }
+
+    /// The planner with another bound on the recorded backtracking lists (tests).
+    #[cfg(test)]
+    pub(crate) fn with_list_points_per_tile(mut self, k: usize) -> Self {
+        self.list_points_per_tile = k;
+        self
     }
 
     /// The tiling (after the first step).

@@ -927,7 +927,13 @@ impl PlannerSettings for BaStarOptions {
         let t = self.tile_side_m.unwrap_or(2.0 * s.robot.radius);
         // Cached disk spans: 2 bytes per row of the contact disk.
         let rows = 2.0 * (s.robot.radius / s.frame.resolution + 1.0) + 4.0;
-        let mut e = ResourceEstimate::units(s.tiles(t), TILE_BYTES + 2.0 * rows, "tiles")
+        // The trace's backtracking lists, at most `LIST_POINTS_PER_TILE` points a tile.
+        let lists = if self.record_backtrack_list {
+            16.0 * crate::planners::ba_star::LIST_POINTS_PER_TILE as f64
+        } else {
+            0.0
+        };
+        let mut e = ResourceEstimate::units(s.tiles(t), TILE_BYTES + 2.0 * rows + lists, "tiles")
             .remedy("a larger robot or tile side");
         e.detail = format!("{} of {} m", e.detail, fmt_m(t));
         e

@@ -25,6 +25,11 @@ const TIGHT_BOX_MARGIN_PX: f64 = 1e-7;
 /// Everything the planner knows once it has seen its first scan.
 #[derive(Clone)]
 pub(super) struct Mind {
+    /// Backtracking-list points the trace may still hold ([`LIST_POINTS_PER_TILE`] per tile
+    /// of the model; `None` once a list did not fit and that was said).
+    ///
+    /// [`LIST_POINTS_PER_TILE`]: super::LIST_POINTS_PER_TILE
+    pub(super) list_room: Option<usize>,
     pub(super) known: KnownMap,
     pub(super) tiles: TileModel,
     pub(super) search: TileSearch,
