@@ -138,14 +138,26 @@ impl<'de> Deserialize<'de> for Negate {
                 Ok(Negate::Other(format!("{v:?}")))
             }
             fn visit_str<E: de::Error>(self, v: &str) -> Result<Negate, E> {
-                // A quoted scalar: `map_server` (yaml-cpp) reads "1" and "true" as it reads
-                // 1 and true.
-                Ok(match v.trim().to_ascii_lowercase().as_str() {
-                    "0" => Negate::Int(0),
-                    "1" => Negate::Int(1),
-                    "false" => Negate::Bool(false),
-                    "true" => Negate::Bool(true),
-                    _ => Negate::Other(format!("{v:?}")),
+                // A quoted scalar, or a word the YAML 1.2 reader leaves as text: Nav2's
+                // `map_server` reads `negate` as an integer, else as a yaml-cpp boolean, whose
+                // words are y, yes, true and on (n, no, false, off), each in lower case, upper
+                // case or capitalised; yaml-cpp reads a quoted scalar as a plain one.
+                let t = v.trim();
+                let word = |w: &str| {
+                    let mut cap = w[..1].to_ascii_uppercase();
+                    cap.push_str(&w[1..]);
+                    t == w || t == w.to_ascii_uppercase() || t == cap
+                };
+                Ok(if t == "0" {
+                    Negate::Int(0)
+                } else if t == "1" {
+                    Negate::Int(1)
+                } else if ["y", "yes", "true", "on"].into_iter().any(word) {
+                    Negate::Bool(true)
+                } else if ["n", "no", "false", "off"].into_iter().any(word) {
+                    Negate::Bool(false)
+                } else {
+                    Negate::Other(format!("{v:?}"))
                 })
             }
         }
@@ -174,9 +186,9 @@ impl MapYaml {
         // Let `.nan` / `.inf` through so they are reported as bad values of their field.
         let mut options = serde_saphyr::Options::default();
         options.non_finite_float_policy = serde_saphyr::NonFiniteFloatPolicy::PassThrough;
-        // YAML 1.2 booleans only: `negate: y` (or `yes`, `on`) read as true negated the whole
-        // map without a word, where `map_server` refuses it (it reads `negate` as an integer);
-        // now it is a bad `negate` like the quoted "y".
+        // YAML 1.2 booleans only, so that `negate` sees the other words as text and reads
+        // them as Nav2's `map_server` does (yaml-cpp's words in its three cases, quoted or
+        // not; see `Negate`): YAML 1.1 took `yEs` as true too, and refused a quoted "yes".
         options.strict_booleans = true;
         let raw: RawYaml =
             serde_saphyr::from_str_with_options(text, options).map_err(|e| MapError::Yaml {
@@ -398,13 +410,22 @@ mod tests {
             ("\"0\"", false),
             ("'1'", true),
             ("\"True\"", true),
+            // (yaml-cpp's boolean words, which Nav2's map_server falls back to)
+            ("y", true),
+            ("Yes", true),
+            ("ON", true),
+            ("\"yes\"", true),
+            ("n", false),
+            ("No", false),
+            ("off", false),
+            ("OFF", false),
         ] {
             let y = parse(&format!("{BASE}negate: {text}\n")).unwrap();
             assert_eq!(y.negate, want, "negate: {text}");
         }
-        // (YAML 1.1's words for true and false are no `negate`: `negate: y` negated the map)
+        // (mixed case is no yaml-cpp boolean)
         for text in [
-            "2", "-1", "0.5", "1.0", "\"2\"", "\"\"", "y", "Y", "yes", "on", "ON", "n", "no", "off",
+            "2", "-1", "0.5", "1.0", "\"2\"", "\"\"", "yEs", "oN", "tRUE", "nO", "\"oFf\"",
         ] {
             let e = parse(&format!("{BASE}negate: {text}\n")).unwrap_err();
             assert!(
