@@ -438,3 +438,27 @@ fn a_room_never_entered_is_said_by_every_planner_that_leaves_it() {
         assert!(!err.contains("warning:"), "{planner}: {err}");
     }
 }
+
+/// Tiles much wider than the tool in an open room leave strips between lanes farther than
+/// 1 m from anything swept: that is the wide tiles' doing, said by their own warning, and not
+/// a doorway the tiles did not take (review: `--tile-side 4` was told to try another start).
+#[test]
+fn wide_tiles_in_an_open_room_are_not_taken_for_a_stranded_start() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = pgm(dir.path(), "open.pgm", 400, 400, |_, _| false);
+    let o = ccpp()
+        .args(["run", "--planner", "ba-star", "--tile-side", "4", "--map"])
+        .arg(&map)
+        .arg("--out")
+        .arg(dir.path().join("run"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{o:?}");
+    let err = String::from_utf8(o.stderr).unwrap();
+    let lines: Vec<&str> = err.lines().filter(|l| l.starts_with("warning:")).collect();
+    assert_eq!(lines.len(), 1, "{err}");
+    assert!(
+        lines[0].contains("the tile side 4 m is wider than the tool sweeps"),
+        "{err}"
+    );
+}

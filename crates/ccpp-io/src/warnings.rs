@@ -180,12 +180,12 @@ pub fn wide_tiles_warning(scenario: &Scenario) -> Option<String> {
 /// It also fires when the run's tiles were all visited while a part of the floor the robot can
 /// reach was never approached ([`untouched_floor`]): a start in a room holding a little more
 /// than half the floor left the other room, behind a doorway off the tile lattice, wholly
-/// unswept beside `coverage_rate` 1.0, without a word (hostile pass: 50.7 % swept).
+/// unswept beside `coverage_rate` 1.0, without a word (hostile pass: 50.7 % swept on its
+/// map, 55.8 % on the test's). `untouched` is the run's [`untouched_floor`].
 pub fn stranded_tiles_warning(
     scenario: &Scenario,
-    world: &World,
-    swept: &FixedBitSet,
     metrics: &Metrics,
+    untouched: Option<&Untouched>,
 ) -> Option<String> {
     let rate = metrics.coverage_rate?;
     if !tiles_only(scenario) || metrics.path_length_m == 0.0 || rate < 0.99 {
@@ -199,11 +199,7 @@ pub fn stranded_tiles_warning(
         "try another --start or a smaller --tile-side"
     };
     let low = metrics.effective_coverage < 0.5 * strips;
-    let far = if low {
-        None
-    } else {
-        untouched_floor(world, swept, metrics).filter(Untouched::is_large)
-    };
+    let far = untouched.filter(|u| !low && u.is_large());
     (low || far.is_some()).then(|| {
         let far = far.map_or_else(String::new, |u| format!(" ({})", u.said()));
         format!(
@@ -218,9 +214,7 @@ pub fn stranded_tiles_warning(
 /// from every swept pixel (see [`untouched_floor`]).
 #[derive(Clone, Copy, Debug)]
 pub struct Untouched {
-    /// The distance, in metres: the larger of [`UNTOUCHED_M`] and three tool sweeps
-    /// (`6 r_tool`), so that the rims a planner leaves along walls and between lanes never
-    /// count.
+    /// The distance, in metres ([`untouched_distance_m`]).
     pub distance_m: f64,
     /// Accessible pixels farther than that from every swept pixel.
     pub pixels: usize,
@@ -267,7 +261,18 @@ impl Untouched {
     }
 }
 
-/// The floor a run never approached ([`Untouched`]); `None` for a run that swept at least
+/// How far from swept floor floor counts as never approached, in metres: the larger of
+/// [`UNTOUCHED_M`], three tool sweeps (`6 r_tool`) and, for tiles wider than the tool sweeps,
+/// the unswept strip between two lanes (`side - 2 r_tool`), so that the rims a planner leaves
+/// along walls and between lanes never count (ba-star at `--tile-side 4` in an open room was
+/// told its tiles did not lead out through a doorway).
+pub fn untouched_distance_m(scenario: &Scenario, world: &World) -> f64 {
+    let strip = wide_tiles(scenario).map_or(0.0, |(side, sweep)| side - sweep);
+    UNTOUCHED_M.max(6.0 * world.robot().tool_radius).max(strip)
+}
+
+/// The floor a run never approached ([`Untouched`]) at `distance_m` from its swept floor
+/// ([`untouched_distance_m`]); `None` for a run that swept at least
 /// `1 - UNTOUCHED_SHARE` of its floor or never moved (no need to look). `swept` are the run's
 /// swept pixels ([`ccpp_core::metrics::swept_pixels`], found with its metrics).
 ///
@@ -276,13 +281,18 @@ impl Untouched {
 /// block holding a swept pixel, so each of its unswept accessible pixels is surely farther
 /// than the distance from every swept pixel (the share is a lower bound). Per pixel, the
 /// distance transform of the whole map cost ba-star on the 16-million-pixel bench map
-/// `office_4096` 0.8 s and 60 MB more than the run (2.1 s); on blocks, a few milliseconds.
-pub fn untouched_floor(world: &World, swept: &FixedBitSet, metrics: &Metrics) -> Option<Untouched> {
+/// `office_4096` 0.8 s and 60 MB more than the run (2.1 s); on blocks, about 0.07 s and no
+/// memory to speak of.
+pub fn untouched_floor(
+    world: &World,
+    swept: &FixedBitSet,
+    metrics: &Metrics,
+    distance_m: f64,
+) -> Option<Untouched> {
     if metrics.effective_coverage >= 1.0 - UNTOUCHED_SHARE || metrics.path_length_m == 0.0 {
         return None;
     }
     let frame = *world.frame();
-    let distance_m = UNTOUCHED_M.max(6.0 * world.robot().tool_radius);
     let d_px = distance_m / frame.resolution;
     // (at least one pixel; `d_px / 4` pixels is a whole number below 2^52 here)
     let b = ((d_px / 4.0).floor() as usize).max(1);
@@ -334,11 +344,10 @@ pub fn untouched_floor(world: &World, swept: &FixedBitSet, metrics: &Metrics) ->
 /// it found two rooms (56.5 %), both without a word (hostile pass).
 pub fn untouched_floor_warning(
     scenario: &Scenario,
-    world: &World,
-    swept: &FixedBitSet,
     metrics: &Metrics,
+    untouched: Option<&Untouched>,
 ) -> Option<String> {
-    let u = untouched_floor(world, swept, metrics).filter(Untouched::is_large)?;
+    let u = untouched.filter(|u| u.is_large())?;
     let why = if scenario.planner.kind() == ccpp_core::planners::PlannerKind::RandomBounce {
         // (a random bounce ends when its distance budget is spent)
         "random-bounce spent its distance budget before it came there; a larger random_bounce.budget_m reaches more"
@@ -453,7 +462,9 @@ pub fn run_warnings(
     out.extend(narrow_tool_warning(world));
     out.extend(no_motion_warning(metrics));
     out.extend(wide_tiles_warning(scenario));
-    let stranded = stranded_tiles_warning(scenario, world, swept, metrics);
+    // (measured once, for the two warnings that read it)
+    let untouched = untouched_floor(world, swept, metrics, untouched_distance_m(scenario, world));
+    let stranded = stranded_tiles_warning(scenario, metrics, untouched.as_ref());
     let rect = rect_reach_warning(scenario, world, metrics);
     let boxed = boxed_in_warning(trace);
     // (floor never approached is said once, by the warning that knows why when one does)
@@ -467,7 +478,11 @@ pub fn run_warnings(
     out.extend(rect_lane_area_warning(scenario));
     out.extend(boxed);
     if !explained {
-        out.extend(untouched_floor_warning(scenario, world, swept, metrics));
+        out.extend(untouched_floor_warning(
+            scenario,
+            metrics,
+            untouched.as_ref(),
+        ));
     }
     out.extend(drift_warning(scenario, trace, metrics));
     out.extend(motions_cut_warning(trace, metrics));
