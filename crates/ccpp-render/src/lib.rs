@@ -152,17 +152,17 @@ pub(crate) fn zone_class(world: &World, i: usize) -> u8 {
     }
 }
 
-/// Region colours (colour-blind-friendly-ish, distinct on light blue). No red: red marks
-/// collisions, keep-outs and a stopped run (the second region's path was the keep-out
-/// hatching's red).
+/// Region colours (colour-blind-friendly-ish, distinct on light blue, at least 60 apart in
+/// RGB). No red: red marks collisions, keep-outs and a stopped run (the second region's path
+/// was the keep-out hatching's red, and the first replacement's brown 24.5 from the olive).
 const PALETTE: [[u8; 3]; 10] = [
     [0, 90, 181],
-    [180, 140, 0],
+    [230, 0, 250],
     [0, 140, 70],
     [150, 60, 170],
     [230, 130, 0],
     [0, 150, 160],
-    [100, 70, 30],
+    [130, 190, 0],
     [210, 60, 140],
     [90, 90, 20],
     [40, 40, 140],
@@ -2140,6 +2140,9 @@ mod tests {
         for p in PALETTE {
             for red in [colours::COLLISION, colours::KEEPOUT_HATCH, colours::STOPPED] {
                 assert!(far(p, red) > 90.0, "{p:?} is close to {red:?}");
+            }
+            for q in PALETTE.iter().filter(|&&q| q != p) {
+                assert!(far(p, *q) > 60.0, "{p:?} is close to {q:?}");
             }
         }
     }
