@@ -285,7 +285,8 @@ impl Map {
         let inside = |v: &Bound<'_, PyAny>, n: usize| -> PyResult<Option<usize>> {
             match v.extract::<i64>() {
                 Ok(i) => Ok(usize::try_from(i).ok().filter(|&i| i < n)),
-                Err(_) if v.is_instance_of::<PyInt>() => Ok(None),
+                // (an int of any kind, a numpy uint64 too, beyond 64 signed bits)
+                Err(e) if e.is_instance_of::<pyo3::exceptions::PyOverflowError>(v.py()) => Ok(None),
                 Err(e) => Err(e),
             }
         };

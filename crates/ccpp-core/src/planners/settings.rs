@@ -934,7 +934,11 @@ impl PlannerSettings for BaStarOptions {
             0.0
         };
         let mut e = ResourceEstimate::units(s.tiles(t), TILE_BYTES + 2.0 * rows + lists, "tiles")
-            .remedy("a larger robot or tile side");
+            .remedy(if self.record_backtrack_list {
+                "a larger robot or tile side, or ba_star.record_backtrack_list: false (512 bytes a tile)"
+            } else {
+                "a larger robot or tile side"
+            });
         e.detail = format!("{} of {} m", e.detail, fmt_m(t));
         e
     }

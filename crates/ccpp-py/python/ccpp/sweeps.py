@@ -277,14 +277,14 @@ def sweep(
                     d = str(base / map_name / p)
                 tasks.append(
                     (
-                        os.path.abspath(m),
+                        _from_here(m),
                         map_name,
                         p,
                         r,
                         tool_radius,
                         inflate,
                         max_memory_mb,
-                        None if d is None else os.path.abspath(d),
+                        None if d is None else _from_here(d),
                         d,
                     )
                 )
@@ -298,6 +298,13 @@ def sweep(
     if len(radii) > 1:
         df.insert(2, "radius", [t[3] for t in tasks])
     return df
+
+
+def _from_here(p: Any) -> str:
+    """``p`` from the caller's folder: joined to it when relative, not normalised (``link/..``
+    through a symbolic link is not the folder ``..`` of ``link``'s name)."""
+    p = os.fspath(p)
+    return p if os.path.isabs(p) else os.path.join(os.getcwd(), p)
 
 
 def _gather(tasks: list[tuple[Any, ...]], client: Any, scheduler: str | None) -> list[Any]:
