@@ -153,6 +153,14 @@ pub fn execution(
         noise_given = true;
     }
     if ask.seed.is_some() && !noise_given && kind != PlannerKind::RandomBounce {
+        // A noise from the planner's options has its own seed there (the refusal said the
+        // seed did not apply to a run that was noisy and seeded; hostile pass).
+        if pid.noise.is_some() {
+            let place = ask.noise_given_in.as_deref().unwrap_or("its options");
+            return Err(format!(
+                "{seed} seeds {noise}; the odometry noise of {kind} given in {place} has its own seed there (noise.seed): set it there"
+            ));
+        }
         return Err(format!(
             "{seed} does not apply to {kind} (it applies to random-bounce and {noise})"
         ));

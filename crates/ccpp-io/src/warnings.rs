@@ -42,8 +42,8 @@ pub fn motions_cut_warning(trace: &Trace, metrics: &Metrics) -> Option<String> {
     })
 }
 
-/// Bumper contacts and keep-out violations under odometry noise with no landmark fix (none
-/// given, or none seen), explained: the pose estimate
+/// Bumper contacts and keep-out violations under odometry noise, explained (with the
+/// landmark fixes, when there were some, that did not prevent them): the pose estimate
 /// drifted from the truth, so the planner drove into walls it placed elsewhere (and an
 /// offline planner's remaining moves started from a wrong position). The trace still ends
 /// `done` (the planner finished its plan), so without this the run read as complete. Also
@@ -68,26 +68,41 @@ pub fn drift_warning(scenario: &Scenario, trace: &Trace, metrics: &Metrics) -> O
         return None;
     }
     // Landmarks correct the estimate only when seen: given but never in range, the run is
-    // the run without them (it got no warning).
+    // the run without them (it got no warning). Seen somewhere, they still leave the estimate
+    // to drift between fixes: one landmark by the start of `teb_corridor` gave 824 fixes
+    // there, and the run beyond it made 22 contacts, strayed 0.54 m on average and swept 42 %
+    // without a word (hostile pass).
     let given = scenario.sim.landmarks.landmarks.len();
-    if given > 0
-        && trace
-            .events()
-            .any(|(_, e)| matches!(e, Event::LandmarkFix { .. }))
-    {
-        return None;
-    }
+    let fixes = trace
+        .events()
+        .filter(|(_, e)| matches!(e, Event::LandmarkFix { .. }))
+        .count();
     let what = match (collisions, zones) {
         (c, 0) => format!("{c} bumper contact(s)"),
         (0, z) => format!("{z} keep-out violation(s)"),
         (c, z) => format!("{c} bumper contact(s) and {z} keep-out violation(s)"),
     };
+    let range = ccpp_core::display::Compact(scenario.sim.landmarks.range_m);
+    if fixes > 0 {
+        let strayed = strayed.map_or_else(String::new, |(mean, max)| {
+            format!(
+                ", the true pose {mean:.2} m from the planned path on average (up to {max:.2} m)"
+            )
+        });
+        let what = if collisions == 0 && zones == 0 {
+            "under odometry noise".to_string()
+        } else {
+            format!("{what} under odometry noise")
+        };
+        return Some(format!(
+            "{what}{strayed} although the robot saw landmarks ({fixes} fix(es)): between fixes the pose estimate drifts from the truth; place landmarks along the whole path, within {range} m of where it drives (the coverage is what was swept)"
+        ));
+    }
     let remedy = if given == 0 {
         "give --landmarks / landmarks= to correct the estimate".to_string()
     } else {
         format!(
-            "the robot saw none of the {given} landmark(s) given (within {} m of its path): place them where it drives",
-            ccpp_core::display::Compact(scenario.sim.landmarks.range_m)
+            "the robot saw none of the {given} landmark(s) given (within {range} m of its path): place them where it drives"
         )
     };
     if collisions == 0 && zones == 0 {

@@ -367,10 +367,12 @@ fn opt_finite_pos(field: &str, v: Option<f64>) -> Result<(), OptionsError> {
 /// options that only act together).
 fn gains(field: &str, g: &PidGains, default: &PidGains) -> Result<(), OptionsError> {
     for (name, v) in [("kp", g.kp), ("ki", g.ki), ("kd", g.kd)] {
-        if !v.is_finite() {
+        // (a negative gain was taken and its sign dropped: the controller drives towards the
+        // goal whatever the output's sign, so kp -2 ran byte-identical to kp 2; hostile pass)
+        if !(v.is_finite() && v >= 0.0) {
             return Err(OptionsError::new(
                 &format!("{field}.{name}"),
-                format!("must be finite, got {v}"),
+                format!("must be a finite number >= 0, got {v}"),
             ));
         }
     }
