@@ -530,10 +530,6 @@ fn sim_from(a: &RunArgs, config: &mut PlannerConfig) -> Result<SimConfig> {
     if let Some(p) = &a.landmarks {
         sim.landmarks.landmarks = ccpp_io::landmarks::load_landmarks(p)
             .map_err(|e| anyhow::anyhow!("landmarks {}: {e}", p.display()))?;
-        if sim.landmarks.landmarks.is_empty() {
-            // Read and then nothing to correct with: the run would be the run without it.
-            bail!("landmarks {}: the file holds no landmark", p.display());
-        }
     }
     Ok(sim)
 }

@@ -51,6 +51,10 @@ pub enum LandmarkFileError {
     /// More landmarks than [`MAX_LANDMARKS`].
     #[error("more than {MAX_LANDMARKS} landmarks: every control step looks at each of them (2.8 million rows ran for hours); give the landmarks of the site")]
     TooMany,
+    /// A file that holds no landmark (blank, or comments only): read and then nothing to
+    /// correct with, the run would be the run without it.
+    #[error("the file holds no landmark")]
+    Empty,
 }
 
 /// Most landmarks a file may hold: every PID control step checks each landmark in sensor range
@@ -137,13 +141,18 @@ pub fn parse_landmarks(text: &str) -> Result<Vec<Landmark>, LandmarkFileError> {
 /// Reads and parses a landmark file.
 ///
 /// # Errors
-/// As [`parse_landmarks`], plus an unreadable file.
+/// As [`parse_landmarks`], plus an unreadable file and one that holds no landmark
+/// ([`LandmarkFileError::Empty`]: the CLI and Python both refuse it).
 pub fn load_landmarks(path: &Path) -> Result<Vec<Landmark>, LandmarkFileError> {
     let text = crate::file::read_text(path).map_err(|source| LandmarkFileError::Io {
         path: path.to_path_buf(),
         source,
     })?;
-    parse_landmarks(&text)
+    let list = parse_landmarks(&text)?;
+    if list.is_empty() {
+        return Err(LandmarkFileError::Empty);
+    }
+    Ok(list)
 }
 
 #[cfg(test)]
@@ -194,9 +203,14 @@ mod tests {
         let l = file("l.json", "\u{feff}[{\"id\":1,\"x\":0,\"y\":0}]").unwrap();
         assert_eq!(l, vec![Landmark::new(1, 0.0, 0.0)]);
         assert!(file("l2.csv", "\u{feff}\u{feff}1,1.0,1.0\n").is_err());
-        // (text that does not start with `[` is CSV: this is one header line, no landmark)
+        // (text that does not start with `[` is CSV: this is one header line, no landmark,
+        // which the loader refuses as a file holding none)
         let l2 = file("l2.json", "\u{feff}\u{feff}[{\"id\":1,\"x\":0,\"y\":0}]");
-        assert!(l2.is_ok_and(|l| l.is_empty()));
+        assert!(matches!(l2, Err(LandmarkFileError::Empty)), "{l2:?}");
+        assert!(matches!(
+            file("c.csv", "# id,x,y\n"),
+            Err(LandmarkFileError::Empty)
+        ));
         assert!(matches!(
             parse_landmarks("[{\"id\":1}]"),
             Err(LandmarkFileError::Json(_))

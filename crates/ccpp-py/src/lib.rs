@@ -651,16 +651,9 @@ fn noise_arg(v: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
 /// a list of `(id, x, y[, theta])`.
 fn landmarks_arg(v: &Bound<'_, PyAny>) -> PyResult<Vec<ccpp_core::landmarks::Landmark>> {
     let list = if let Ok(path) = v.extract::<PathBuf>() {
-        let list = ccpp_io::landmarks::load_landmarks(&path)
-            .map_err(|e| msg(format!("landmarks {}: {e}", path.display())))?;
-        if list.is_empty() {
-            // (the CLI's words: a file, not a list, was given)
-            return Err(msg(format!(
-                "landmarks {}: the file holds no landmark",
-                path.display()
-            )));
-        }
-        list
+        // (an empty file is refused by the loader, in the CLI's words)
+        ccpp_io::landmarks::load_landmarks(&path)
+            .map_err(|e| msg(format!("landmarks {}: {e}", path.display())))?
     } else {
         // A list goes through the file reader's own parsing (a JSON array), so both are
         // checked alike.
