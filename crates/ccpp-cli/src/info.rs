@@ -141,18 +141,16 @@ pub fn run(a: &InfoArgs) -> Result<()> {
         ),
         // A start the user gave that does not work is a user error (naming the zone it is
         // about, as `run` does).
-        Err(e) if zs.zone_error(&e, &map.source).is_some() => {
-            return Err(zs
-                .zone_error(&e, &map.source)
-                .map_or_else(|| anyhow::Error::new(e), anyhow::Error::new))
-        }
         Err(e) => {
+            if let Some(zone) = zs.zone_error(&e, &map.source) {
+                return Err(zone.into());
+            }
             return Err(
                 match ccpp_io::scenario::inflated_world_error(&e, map.recipe.inflation()) {
                     Some(m) => anyhow::anyhow!("map {}: {m}", map.source.display()),
                     None => anyhow::Error::new(e).context(format!("map {}", map.source.display())),
                 },
-            )
+            );
         }
     };
     let s = world.as_ref().map(World::start);

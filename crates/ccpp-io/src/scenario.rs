@@ -1409,12 +1409,8 @@ impl Scenario {
         let fit = self.planner.settings().start_radius(&self.robot);
         let world = World::with_zones_fitting(grid, self.robot, start, zones, fit).map_err(
             |source_err| {
-                match self.zone_of(&source_err) {
-                    Some((kind, label)) => ScenarioError::Zone {
-                        kind,
-                        label,
-                        message: format!("{source_err} (map {})", source.display()),
-                    },
+                match self.zone_error(&source_err, source) {
+                    Some(zone) => zone,
                     // An error the inflation likely caused names it.
                     None => match inflated_world_error(&source_err, inflation) {
                         Some(m) => ScenarioError::Invalid(format!("map {}: {m}", source.display())),

@@ -475,7 +475,9 @@ pub fn run_warnings(
 ) -> Vec<String> {
     let mut out = Vec::new();
     out.extend(narrow_tool_warning(world));
-    out.extend(no_motion_warning(metrics));
+    let no_motion = no_motion_warning(metrics);
+    let moved = no_motion.is_none();
+    out.extend(no_motion);
     out.extend(wide_tiles_warning(scenario));
     // (measured once, for the two warnings that read it)
     let untouched = untouched_floor(world, swept, metrics, untouched_distance_m(scenario, world));
@@ -487,7 +489,7 @@ pub fn run_warnings(
         || rect.is_some()
         || boxed.is_some()
         || metrics.stop_reason.is_some()
-        || no_motion_warning(metrics).is_some();
+        || !moved;
     out.extend(stranded);
     out.extend(rect);
     out.extend(rect_lane_area_warning(scenario));

@@ -936,10 +936,10 @@ impl PlannerSettings for BaStarOptions {
             0.0
         };
         let mut e = ResourceEstimate::units(s.tiles(t), TILE_BYTES + 2.0 * rows + lists, "tiles")
-            .remedy(if self.record_backtrack_list {
-                "a larger robot or tile side, or ba_star.record_backtrack_list: false (512 bytes a tile)"
+            .remedy(&if self.record_backtrack_list {
+                format!("a larger robot or tile side, or ba_star.record_backtrack_list: false ({lists} bytes a tile)")
             } else {
-                "a larger robot or tile side"
+                "a larger robot or tile side".to_string()
             });
         e.detail = format!("{} of {} m", e.detail, fmt_m(t));
         e
