@@ -604,11 +604,15 @@ impl<'w> Simulator<'w> {
             // The truth moves with the (possibly perturbed) speeds; the estimate integrates the
             // commanded (measured) ones.
             let (vt, wt) = match (st.opts.noise, st.noise_rng.as_mut()) {
-                (Some(n), Some(rng)) => (
-                    v * (1.0 + n.linear_rel_std * rng.gaussian()),
-                    w * (1.0 + n.angular_rel_std * rng.gaussian())
-                        + n.heading_drift_std * v.abs() * rng.gaussian(),
-                ),
+                (Some(n), Some(rng)) => {
+                    // Deviations given per step of the reference period (`OdometryNoise`).
+                    let k = (crate::exec::NOISE_REF_DT_S / dt).sqrt();
+                    (
+                        v * (1.0 + k * n.linear_rel_std * rng.gaussian()),
+                        w * (1.0 + k * n.angular_rel_std * rng.gaussian())
+                            + k * n.heading_drift_std * v.abs() * rng.gaussian(),
+                    )
+                }
                 _ => (v, w),
             };
             let new_est = Unicycle::step(self.est, v, w, dt);
@@ -1284,6 +1288,45 @@ mod tests {
             worst = worst.max(d);
         }
         worst
+    }
+
+    /// The noise's deviations are per step of the reference period and scaled to the one
+    /// run: the truth strays as far at a tenth of the period (it strayed about half as far
+    /// when each step drew the full deviation).
+    #[test]
+    fn the_drift_does_not_depend_on_the_control_period() {
+        let world = big_room();
+        let mean_stray = |dt_s: f64| {
+            let mut sum = 0.0;
+            for seed in 1..=16 {
+                let cfg = SimConfig {
+                    exec: Some(Execution::Pid(PidOptions {
+                        dt_s,
+                        noise: Some(OdometryNoise {
+                            seed,
+                            linear_rel_std: 0.0,
+                            angular_rel_std: 0.0,
+                            heading_drift_std: 0.5,
+                        }),
+                        ..PidOptions::default()
+                    })),
+                    ..SimConfig::default()
+                };
+                let mut sim = Simulator::new(&world, &cfg);
+                for step in square(2) {
+                    sim.execute(step);
+                }
+                sum += sim.true_pose().position().dist(sim.estimate().position());
+            }
+            sum / 16.0
+        };
+        let (coarse, fine) = (mean_stray(0.05), mean_stray(0.005));
+        assert!(coarse > 0.02, "the noise should move the truth: {coarse}");
+        let ratio = fine / coarse;
+        assert!(
+            (0.75..1.33).contains(&ratio),
+            "{coarse} at 0.05 s, {fine} at 0.005 s"
+        );
     }
 
     #[test]
