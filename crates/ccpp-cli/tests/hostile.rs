@@ -3223,3 +3223,43 @@ fn a_far_turned_map_gives_the_same_waypoints_and_turns() {
         assert_eq!(at("far", origin), home, "{origin}");
     }
 }
+
+/// bsa-bfs moves from cell to cell along the map's axes, and without odometry noise the
+/// simulator keeps only the end of each straight glide: its estimate counts the PID records of
+/// the turns then, and every step only under noise (the run's own `--odometry-noise` too). An
+/// open 20 x 15 m room at r = 0.05 m was estimated at 126 MB and written in 65 092 records
+/// (25 MiB peak) as `apartment_400x300`; a 4096 x 4096 px office at r = 0.1 m, 5211 MB
+/// estimated and 630 MiB peak, was refused by the default limit.
+#[test]
+fn bsa_bfs_estimate_counts_glides_only_without_noise() {
+    let d = tempfile::tempdir().unwrap();
+    let map = pgm(d.path(), "open.pgm", 400, 300, |_, _| false);
+    let out = d.path().join("plain");
+    ccpp()
+        .args(["run", "--planner", "bsa-bfs", "--radius", "0.05", "--map"])
+        .arg(&map)
+        .args(["--max-memory", "90", "--out"])
+        .arg(&out)
+        .assert()
+        .success();
+    let noisy = d.path().join("noisy");
+    refused(
+        &[
+            "run",
+            "--planner",
+            "bsa-bfs",
+            "--radius",
+            "0.05",
+            "--map",
+            s(&map),
+            "--max-memory",
+            "90",
+            "--odometry-noise",
+            "0.01",
+            "--out",
+            s(&noisy),
+        ],
+        &["PID trace records", "more than the memory limit of 90 MB"],
+    );
+    assert!(!noisy.exists());
+}

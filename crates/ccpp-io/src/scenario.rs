@@ -1122,6 +1122,7 @@ impl Scenario {
             robot: self.robot,
             sensor_range: self.sim.sensor_range_on(&self.robot, frame),
             max_steps: self.sim.max_steps,
+            noisy: matches!(self.execution(), Execution::Pid(p) if p.noise.is_some()),
         };
         if self.sim.sensor_range.is_none() {
             if let Some(need) = self.planner.settings().sensor_need(&setup) {

@@ -131,8 +131,8 @@ pub struct BaStarOptions {
     /// A*SPT smoothing of the backtracking paths (`false` follows the raw A* path, to compare).
     pub smoothing: bool,
     /// Record the backtracking list `L` at every critical point (`backtrack_list` events), while
-    /// the recorded lists hold at most [`LIST_POINTS_PER_TILE`] points a tile (then a `note`
-    /// event says recording stopped). Large maps produce big traces; switch off when only the
+    /// the recorded lists hold at most [`LIST_POINTS_PER_TILE`] points a tile and
+    /// [`LIST_POINTS_MAX`] in all (then a `note` event says recording stopped). Large maps produce big traces; switch off when only the
     /// metrics matter.
     pub record_backtrack_list: bool,
     /// Extend `mu` by [`lane_end_score`] and the move-judged lane ends of [`SIDE_END_PAIRS`]
@@ -160,11 +160,18 @@ enum Phase {
     Finished,
 }
 
-/// The backtracking-list points a run's trace holds at most, per tile of the map: lists are
-/// recorded whole at each critical point while they fit, and a `note` event says where the
-/// recording stopped (the run's memory estimate counts them: 16 bytes a point). Real maps stay
-/// well inside (`office_4096` at r = 0.15 m: about 14 per tile).
+/// The backtracking-list points a run's trace holds at most, per tile of the map (and never
+/// more than [`LIST_POINTS_MAX`]): lists are recorded whole at each critical point while they
+/// fit, and a `note` event says where the recording stopped (the run's memory estimate counts
+/// them: 16 bytes a point). Real maps stay well inside (`office_4096` at r = 0.15 m: about 14
+/// per tile).
 pub const LIST_POINTS_PER_TILE: usize = 32;
+
+/// The backtracking-list points a run's trace holds at most whatever the map (128 MB at 16
+/// bytes a point): with tiles of a pixel or two the per-tile bound alone made the estimate of
+/// `cluttered_2000` at r = 0.025 m 4570 MB (refused by the default limit) for a run that
+/// peaks at 83 MiB. `office_4096` at r = 0.15 m records about 6.5 million.
+pub const LIST_POINTS_MAX: usize = 8_000_000;
 
 /// The BA* planner (see the module docs).
 #[derive(Clone, Debug)]

@@ -70,7 +70,11 @@ impl BaStar {
             }));
         }
         self.mind = Some(Box::new(Mind {
-            list_room: Some(n_tiles.saturating_mul(self.list_points_per_tile)),
+            list_room: Some(
+                n_tiles
+                    .saturating_mul(self.list_points_per_tile)
+                    .min(super::LIST_POINTS_MAX),
+            ),
             known,
             tiles,
             search,
@@ -144,8 +148,9 @@ impl BaStar {
                     m.list_room = None;
                     self.pending.push_back(Step::Mark(Event::Note {
                         text: format!(
-                            "ba-star: backtracking lists are not recorded from here on: those recorded hold {} points per tile of the map, the trace's bound (record_backtrack_list)",
-                            self.list_points_per_tile
+                            "ba-star: backtracking lists are not recorded from here on: those recorded reached the trace's bound of {} points per tile of the map, at most {} (record_backtrack_list)",
+                            self.list_points_per_tile,
+                            super::LIST_POINTS_MAX
                         ),
                     }));
                 }
