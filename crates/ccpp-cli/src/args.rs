@@ -202,7 +202,7 @@ pub struct RunArgs {
     pub exec: Option<String>,
     /// Odometry noise under PID execution: relative std of linear and angular speed and the
     /// heading drift while driving (rad/s per m/s), standard deviations per control step of
-    /// 0.05 s (the default `dt_s`; another period scales them by sqrt(0.05 / dt_s), so the
+    /// 0.05 s (the default `dt_s`; another period scales them by `sqrt(0.05 / dt_s)`, so the
     /// drift over a run does not depend on it), `LIN[,ANG[,DRIFT]]` (ANG defaults to LIN,
     /// DRIFT to 0; LIN and ANG at most 1, DRIFT at most 6; each 0 or at least 1e-9; seeded by --seed). Without --exec it switches the run to PID execution;
     /// refused with --exec ideal.
