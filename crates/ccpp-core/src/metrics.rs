@@ -442,8 +442,25 @@ pub fn coverage_curve(world: &World, trace: &Trace, samples: usize) -> Vec<[f64;
     out
 }
 
+/// Tile boundaries of the revisit walk lie this far (in tiles) below the half-way lines:
+/// tile `k` spans `[k - 0.5 - BOUNDARY_SHIFT, k + 0.5 - BOUNDARY_SHIFT)` along each axis. A
+/// path along a boundary (a lane half a tile from the start's lattice) then lies inside one
+/// tile whatever the rounding of its coordinates, which moved a point exactly on the line to
+/// one side or the other when the map was moved: `revisit_rate` of bcd on `aws_small_house`
+/// went from 0.340 to 0.405 with the map's origin moved by (+500 km, +5400 km), the same path.
+const BOUNDARY_SHIFT: f64 = 1e-6;
+
+/// The tile of `p` on the revisit walk's boundaries ([`BOUNDARY_SHIFT`]).
+fn walk_tile(grid: &TileGrid, p: Point) -> Tile {
+    let at = |v: f64, o: f64| {
+        let k = ((v - o) / grid.side + 0.5 + BOUNDARY_SHIFT).floor();
+        k.clamp(f64::from(i32::MIN), f64::from(i32::MAX)) as i32
+    };
+    (at(p.x, grid.anchor.x), at(p.y, grid.anchor.y))
+}
+
 /// Tile entries along a polyline (Amanatides-Woo traversal), fed one point at a time; a
-/// corner crossing is one entry.
+/// corner crossing is one entry. Boundaries as [`walk_tile`] draws them.
 struct TileWalk {
     /// The tile of the last point and the last point (`None` before the first).
     at: Option<(Tile, Point)>,
@@ -453,7 +470,7 @@ impl TileWalk {
     /// Visits the tiles entered on the way to `b` (the first point's own tile for the first).
     fn to(&mut self, grid: &TileGrid, b: Point, mut visit: impl FnMut(Tile)) {
         let Some((mut cur, a)) = self.at else {
-            let t = grid.tile_of(b);
+            let t = walk_tile(grid, b);
             visit(t);
             self.at = Some((t, b));
             return;
@@ -461,7 +478,7 @@ impl TileWalk {
         if a == b {
             return;
         }
-        let target = grid.tile_of(b);
+        let target = walk_tile(grid, b);
         // Fast paths, the same visits as the traversal below: staying in the tile visits
         // nothing, and an axis-parallel move (one coordinate equal bit for bit, so the other
         // component of the direction is exactly 0) into the next tile along that axis crosses
@@ -489,7 +506,8 @@ impl TileWalk {
         let d = ub.sub(ua);
         let step_i = if d.x > 0.0 { 1 } else { -1 };
         let step_j = if d.y > 0.0 { 1 } else { -1 };
-        let next_boundary = |u: f64, i: i32, s: i32| f64::from(i) + 0.5 * f64::from(s) - u;
+        let next_boundary =
+            |u: f64, i: i32, s: i32| f64::from(i) + 0.5 * f64::from(s) - BOUNDARY_SHIFT - u;
         let mut t_max_x = if d.x == 0.0 {
             f64::INFINITY
         } else {
@@ -513,7 +531,9 @@ impl TileWalk {
         let mut guard = 0usize;
         while cur != target && guard < 10_000_000 {
             guard += 1;
-            let tie = (t_max_x - t_max_y).abs() < 1e-9;
+            // A corner crossing within a tenth of the boundaries' shift (in tiles) of the
+            // corner: rounding of far-out coordinates (1e-9 m at 5e6 m) stays below it.
+            let tie = (t_max_x - t_max_y).abs() * d.x.abs().max(d.y.abs()) < 0.1 * BOUNDARY_SHIFT;
             if tie {
                 if t_max_x > 1.0 + 1e-9 {
                     break;
