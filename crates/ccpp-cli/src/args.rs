@@ -422,7 +422,9 @@ fn parse_finite_list(s: &str) -> Result<Vec<f64>, String> {
     s.split(',')
         .map(str::trim)
         .map(|p| match p.parse::<f64>() {
-            Ok(x) if x.is_finite() => Ok(x),
+            // `-0` is 0: the sign of a zero reached run.json, the map digest and, as a start
+            // heading, the trace (bsa-bfs recorded a turn of no angle first).
+            Ok(x) if x.is_finite() => Ok(x + 0.0),
             Ok(_) => Err(format!("{p:?} is not a finite number")),
             Err(_) => Err(format!("{p:?} is not a number")),
         })

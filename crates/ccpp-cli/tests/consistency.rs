@@ -182,3 +182,29 @@ fn moving_the_map_far_out_changes_no_metric_of_the_same_path() {
         }
     }
 }
+
+/// `-0` is 0 in a number list: `--start X,Y,-0` wrote `-0.0` into `run.json` and bsa-bfs's
+/// trace gained a turn of no angle at the start.
+#[test]
+fn a_negative_zero_start_heading_is_zero() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = data("teb_empty_box.yaml");
+    let run = |sub: &str, start: &str| {
+        let out = dir.path().join(sub);
+        ccpp()
+            .args(["run", "--planner", "bsa-bfs", "--start", start, "--map"])
+            .arg(&map)
+            .arg("--out")
+            .arg(&out)
+            .assert()
+            .success();
+        out
+    };
+    let (a, b) = (run("zero", "0.5,0.5,0"), run("minus", "0.5,0.5,-0"));
+    for f in ["run.json", "trace.jsonl", "path.csv"] {
+        assert!(
+            std::fs::read(a.join(f)).unwrap() == std::fs::read(b.join(f)).unwrap(),
+            "{f} differs"
+        );
+    }
+}

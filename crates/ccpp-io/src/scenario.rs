@@ -1691,7 +1691,7 @@ impl ScenarioBuilder {
     /// Start pose.
     #[must_use]
     pub fn start(mut self, x: f64, y: f64, theta: f64) -> Self {
-        self.0.start = Some([x, y, theta]);
+        self.0.start = Some([x + 0.0, y + 0.0, theta + 0.0]);
         self
     }
 
@@ -1702,10 +1702,10 @@ impl ScenarioBuilder {
         self
     }
 
-    /// Start pose `[x, y, theta]`, or `None` for the default start.
+    /// Start pose `[x, y, theta]`, or `None` for the default start. A zero given as `-0` is stored as 0 (its sign reached `run.json` and the trace).
     #[must_use]
     pub fn start_pose(mut self, start: Option<[f64; 3]>) -> Self {
-        self.0.start = start;
+        self.0.start = start.map(|s| s.map(|v| v + 0.0));
         self
     }
 
