@@ -81,7 +81,9 @@ pub struct RobotArgs {
     /// Cleaning tool radius in metres (default: the robot radius).
     #[arg(long, value_name = "M")]
     pub tool_radius: Option<f64>,
-    /// Start pose `X,Y[,THETA]` in metres/radians (default: the widest free spot, heading east).
+    /// Start pose `X,Y[,THETA]` in metres/radians (default: the widest free spot, heading
+    /// east). THETA is for `run`: `info`, `plan` and `waypoints` use no heading and refuse
+    /// one.
     #[arg(long, value_name = "X,Y[,THETA]", value_parser = parse_start, allow_hyphen_values = true)]
     pub start: Option<StartArg>,
 }
@@ -176,7 +178,8 @@ pub struct RunArgs {
     /// Tile side in metres: ba-star and ba-star-extended tiles, bsa-bfs cells (default 2 r).
     #[arg(long, value_name = "M")]
     pub tile_side: Option<f64>,
-    /// BA* backtracking path smoothing (A*SPT): `on` (default) or `off` to compare. For
+    /// BA* backtracking path smoothing (A*SPT): `on` (default) or `off` to compare (also
+    /// `true`/`false`, `yes`/`no`, `1`/`0`). For
     /// ba-star-extended it changes only the backtracks where BA*'s own path is driven: by
     /// default (`shorter_backtrack: true`) the extension's known-free way replaces it wherever
     /// that is shorter, which is almost everywhere.
@@ -472,6 +475,8 @@ fn parse_on_off(s: &str) -> Result<bool, String> {
     match s.to_ascii_lowercase().as_str() {
         "on" | "true" | "1" | "yes" => Ok(true),
         "off" | "false" | "0" | "no" => Ok(false),
-        _ => Err(format!("expected on or off, got {s:?}")),
+        _ => Err(format!(
+            "expected on or off (or true/false, yes/no, 1/0), got {s:?}"
+        )),
     }
 }

@@ -571,6 +571,28 @@ pub(crate) fn name_flag(e: ScenarioError, given: &[&str]) -> anyhow::Error {
     }
 }
 
+/// Names the options file `config` in an error about a planner option it sets (section
+/// `section`): a value fine on its own but wrong on this map (a budget shorter than a move, a
+/// lane spacing finer than the pixels, a control period that stops every move) was reported
+/// against the map alone, and the user had to guess which file held it.
+pub(crate) fn naming_config(
+    e: anyhow::Error,
+    config: Option<&Path>,
+    section: &str,
+) -> anyhow::Error {
+    let Some(f) = config else { return e };
+    let msg = e.to_string();
+    let shown = f.display().to_string();
+    let Some(v) = file_value(f) else { return e };
+    let about = (msg.contains(&format!("{section}.")) && value_sets(&v, section))
+        || (msg.contains("exec.pid") && value_sets(&v, &format!("{section}.exec")));
+    if about && !msg.contains(&shown) {
+        anyhow::anyhow!("{msg} (set in planner options {shown})")
+    } else {
+        e
+    }
+}
+
 impl Job {
     /// A job from `ccpp run` arguments.
     pub fn from_run_args(a: &RunArgs) -> Result<Self> {
@@ -592,11 +614,16 @@ impl Job {
             .build()
             .map_err(|e| name_flag(e.naming_landmarks(a.landmarks.as_deref()), &given))?;
         let map = load_recipe(&scenario.map, scenario.max_memory_mb)?;
+        let config = a.options.config.as_deref();
+        let section = kind.info().section;
         scenario
             .check_map(&map)
             // A landmark the map never sees: name the landmark file, not only the map.
-            .map_err(|e| name_flag(e.naming_landmarks(a.landmarks.as_deref()), &given))?;
-        scenario.check_run().map_err(|e| name_flag(e, &given))?;
+            .map_err(|e| name_flag(e.naming_landmarks(a.landmarks.as_deref()), &given))
+            .map_err(|e| naming_config(e, config, section))?;
+        scenario
+            .check_run()
+            .map_err(|e| naming_config(name_flag(e, &given), config, section))?;
         Ok(Self {
             scenario,
             map: Some(map),

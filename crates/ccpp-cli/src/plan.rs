@@ -70,7 +70,9 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         {
             anyhow::anyhow!("{}: {m}", cfg.display())
         }
-        (PlanError::Scenario(s), _) => flag(s),
+        (PlanError::Scenario(s), cfg) => {
+            crate::job::naming_config(flag(s), cfg, kind.info().section)
+        }
         (other @ PlanError::Online(..), _) => other.into(),
     })?;
     let formats: &[ExportFormat] = if a.export.is_empty() {

@@ -176,7 +176,7 @@ fn moving_the_map_far_out_changes_no_metric_of_the_same_path() {
         }
         match (v.as_f64(), far[k].as_f64()) {
             (Some(a), Some(b)) => {
-                assert!((a - b).abs() <= 1e-6 * a.abs().max(1.0), "{k}: {a} vs {b}")
+                assert!((a - b).abs() <= 1e-6 * a.abs().max(1.0), "{k}: {a} vs {b}");
             }
             _ => assert_eq!(v, &far[k], "{k}"),
         }

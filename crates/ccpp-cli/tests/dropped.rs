@@ -1252,3 +1252,60 @@ fn a_drift_without_contact_is_said() {
         "{err}"
     );
 }
+
+/// A planner option fine on its own but wrong on the map names the options file that set it
+/// (the error named the map alone), for `run` and `plan`; a flag is named as the flag.
+#[test]
+fn an_option_wrong_for_the_map_names_its_options_file() {
+    let d = tempfile::tempdir().unwrap();
+    let map = crate::common::data("teb_empty_box.yaml");
+    let cases = [
+        (
+            "run",
+            "random-bounce",
+            "random_bounce: { budget_m: 0.001 }\n",
+        ),
+        ("run", "bcd", "bcd: { lane_spacing_m: 0.001 }\n"),
+        ("plan", "bcd", "bcd: { lane_spacing_m: 0.001 }\n"),
+        (
+            "run",
+            "bsa-bfs",
+            "bsa_bfs: { exec: { pid: { dt_s: 1.0e-4 } } }\n",
+        ),
+        ("run", "ba-star", "ba_star: { tile_side_m: 50 }\n"),
+    ];
+    for (k, (cmd, planner, text)) in cases.iter().enumerate() {
+        let cfg = d.path().join(format!("opts{k}.yaml"));
+        std::fs::write(&cfg, text).unwrap();
+        let out = d.path().join(format!("out{k}"));
+        let a = ccpp()
+            .args([cmd, "--planner", planner, "--map"])
+            .arg(&map)
+            .arg("--config")
+            .arg(&cfg)
+            .arg("--out")
+            .arg(&out)
+            .assert()
+            .code(1);
+        let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        assert!(
+            err.contains(&format!("(set in planner options {})", cfg.display())),
+            "{cmd} {planner}: {err}"
+        );
+        assert!(!out.exists());
+    }
+    // The same wrong value from a flag names the flag, not a file.
+    let a = ccpp()
+        .args(["run", "--planner", "ba-star", "--tile-side", "50", "--map"])
+        .arg(&map)
+        .arg("--out")
+        .arg(d.path().join("flag"))
+        .assert()
+        .code(1);
+    let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
+    assert!(
+        err.contains("--tile-side: ") && !err.contains("planner options"),
+        "{err}"
+    );
+}

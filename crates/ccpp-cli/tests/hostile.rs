@@ -1823,7 +1823,7 @@ fn pid_trace_records_are_counted_by_control_steps() {
         x == 0 || y == 0 || x == 399 || y == 299 || (x == 200 && y > 60)
     });
     let out = dir.join("out");
-    let refusal = |config: Option<&std::path::Path>| -> String {
+    let refusal = |config: Option<&std::path::Path>, extra: &[&str]| -> String {
         let mut args = vec![
             "run",
             "--planner",
@@ -1833,38 +1833,44 @@ fn pid_trace_records_are_counted_by_control_steps() {
             "--radius",
             "0.05",
             "--max-memory",
-            "60",
+            "45",
             "--out",
             s(&out),
         ];
         if let Some(c) = config {
             args.extend(["--config", s(c)]);
         }
+        args.extend(extra);
         let a = ccpp().args(&args).assert().failure();
         let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
         assert_eq!(err.trim_end().lines().count(), 1, "{err}");
         assert!(!out.exists());
         err
     };
-    let err = refusal(None);
+    let err = refusal(None, &[]);
     for n in [
         "flat.pgm",
         "bsa-bfs would need",
         "PID trace records",
-        "limit of 60 MB",
+        "limit of 45 MB",
         "bsa_bfs.exec.pid.record_every",
     ] {
         assert!(err.contains(n), "{err:?} should contain {n:?}");
     }
     // About 30 000 moves of 32 steps and a quarter turn (33 steps) every fourth: ~1.2 million
-    // records, where the path over the top speed gave 120 000.
-    let records: f64 = err
-        .split("about ")
-        .nth(2)
-        .and_then(|t| t.split(' ').next())
-        .and_then(|t| t.parse().ok())
-        .expect("a record count");
-    assert!((1.1e6..1.3e6).contains(&records), "{records}");
+    // steps, where the path over the top speed gave 120 000; without odometry noise the drives
+    // along the axes are straight glides the trace drops, and the turns' steps are counted
+    // (~315 000 records), under noise every step.
+    let records = |err: &str| -> f64 {
+        err.split("about ")
+            .nth(2)
+            .and_then(|t| t.split(' ').next())
+            .and_then(|t| t.parse().ok())
+            .expect("a record count")
+    };
+    assert!((2.5e5..4e5).contains(&records(&err)), "{err}");
+    let noisy = refusal(None, &["--odometry-noise", "0.01"]);
+    assert!((1.1e6..1.3e6).contains(&records(&noisy)), "{noisy}");
     // Gains that crawl with a cap of billions of steps a motion: refused at once for the
     // records (the estimate does not simulate the crawl to its end; it hung before).
     let crawl = dir.join("crawl.yaml");
@@ -1892,6 +1898,35 @@ fn pid_trace_records_are_counted_by_control_steps() {
         .assert()
         .code(1);
     let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
+    // Refused for its control steps (its drives are glides the trace drops, so its records
+    // fit: they were refused as records "no machine" holds before).
+    assert!(
+        err.contains("would simulate about 1.2e14 control steps") && err.contains("crawl.yaml"),
+        "{err}"
+    );
+    // Under odometry noise every step is a record: refused for them, as no machine holds.
+    let a = ccpp()
+        .timeout(std::time::Duration::from_mins(1))
+        .args([
+            "run",
+            "--planner",
+            "bsa-bfs",
+            "--map",
+            s(&map),
+            "--radius",
+            "0.05",
+        ])
+        .args([
+            "--odometry-noise",
+            "0.01",
+            "--config",
+            s(&crawl),
+            "--out",
+            s(&out),
+        ])
+        .assert()
+        .code(1);
+    let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
     assert!(
         err.contains("PID trace records") && err.contains("no machine"),
         "{err}"
@@ -1910,7 +1945,7 @@ fn pid_trace_records_are_counted_by_control_steps() {
             "--radius",
             "0.05",
             "--max-memory",
-            "60",
+            "45",
             "--config",
             s(&cfg),
             "--out",
@@ -2325,7 +2360,7 @@ fn map_yaml_details_read_as_map_server_does_or_say_why() {
     }
     refused(
         &["info", "--map", s(&yaml("f.yaml", "negate: 1.0\n"))],
-        &["f.yaml", "negate", "1.0 is not 0, 1, false or true"],
+        &["f.yaml", "negate", "1.0 is not 0, 1 or a YAML boolean"],
     );
     refused(
         &["info", "--map", s(&yaml("two.yaml", "---\nimage: m.pgm\n"))],

@@ -188,7 +188,7 @@ pub enum WorldError {
     /// The zones leave no spot where the robot fits.
     #[error(
         "the area minus the keep-out zones holds no floor where a robot of radius {} m \
-         fits ({free_px} free pixels inside the area)",
+         fits ({free_px} free pixels inside the area and outside the keep-outs)",
         Compact((*.radius * 1e6).round() / 1e6)
     )]
     NoRoomInZones {

@@ -434,7 +434,7 @@ pub fn rect_lane_area_warning(scenario: &Scenario) -> Option<String> {
     let lanes = o.area?;
     scenario.area.as_ref()?;
     Some(format!(
-        "rect_boustrophedon.area [{}] and the work area (--area / area) both bound the lanes: only their overlap is laned, while the metrics measure the whole work area; leave out rect_boustrophedon.area to lane the whole area",
+        "rect_boustrophedon.area [{}] and the work area (--area / area) both bound the lanes: only their overlap is laned, while the work area is what is to be covered (a run's metrics measure all of it); leave out rect_boustrophedon.area to lane the whole area",
         lanes
             .iter()
             .map(|v| ccpp_core::display::Compact(*v).to_string())

@@ -1157,7 +1157,8 @@ impl PlanResult {
     }
 }
 
-/// Plans a path with a known-map planner (`bcd`, `rect-boustrophedon`) on `map`, as
+/// Plans a path with a known-map planner (`bcd`, the default, or `rect-boustrophedon`) on
+/// `map` with robot radius `radius` (default 0.15 m), as
 /// `ccpp plan`: the keyword options of `run` (zones included) that apply to a plan, no
 /// simulation metrics. As `ccpp plan` refuses them, so does this: `exec` and the planner's own
 /// execution settings (a plan executes the steps ideally), `sensor_range` (offline planners),
@@ -1267,12 +1268,13 @@ impl RunResult {
 
     /// The warnings `ccpp run` prints for this run (without `warning: `): a start whose free
     /// area reaches the map's border (it may be outside the building), an early stop, PID
-    /// motions cut at `max_steps_per_motion`, bumper contacts or a true pose far off the plan
-    /// under odometry noise without landmarks, a run that never moved, a tool narrower than
-    /// the map's pixels, tiles wider than the tool or stranded at the start (ba-star, bsa,
-    /// bsa-bfs), a rectangle whose clearance disk reaches little of the floor
-    /// (rect-boustrophedon), a random bounce boxed in. A run that ends `done` may still have
-    /// some (`stop` is the planner's word).
+    /// motions cut at `max_steps_per_motion`, bumper contacts, keep-out entries or a true pose
+    /// far off the plan under odometry noise (with or without landmarks: the estimate drifts
+    /// between fixes), a run that never moved, a tool narrower than the map's pixels, tiles
+    /// wider than the tool or stranded at the start (ba-star, bsa, bsa-bfs), a rectangle whose
+    /// clearance disk reaches little of the floor (rect-boustrophedon), a random bounce boxed
+    /// in, floor the run never came near (5 % or more of it farther than 1 m from anything
+    /// swept). A run that ends `done` may still have some (`stop` is the planner's word).
     #[getter]
     fn warnings(&self) -> Vec<String> {
         self.warnings.clone()
@@ -1322,15 +1324,15 @@ impl RunResult {
     }
 
     /// The executed path's waypoints, `float64` `(N, 3)`: x, y, theta at the ends of its
-    /// straight segments (poses merged within `tolerance_m`, as in `path.csv` and the
-    /// exports).
-    #[pyo3(signature = (tolerance_m=NotBool(DEFAULT_TOLERANCE_M)))]
+    /// straight segments (poses merged within `tolerance_m`, default 0.001 m, as in
+    /// `path.csv` and the exports; `None` is the default).
+    #[pyo3(signature = (tolerance_m=None), text_signature = "(self, tolerance_m=0.001)")]
     fn waypoints<'py>(
         &self,
         py: Python<'py>,
-        tolerance_m: Real,
+        tolerance_m: Option<Real>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let tolerance_m = tolerance_m.0;
+        let tolerance_m = real(tolerance_m).unwrap_or(DEFAULT_TOLERANCE_M);
         check_tolerance(tolerance_m)?;
         Ok(route_array(
             py,
@@ -1357,7 +1359,8 @@ impl RunResult {
     }
 }
 
-/// Runs `planner` on `map` with robot radius `radius`; the other keyword options are scenario
+/// Runs `planner` (default `"ba-star"`) on `map` with robot radius `radius` (default 0.15 m);
+/// the other keyword options are scenario
 /// fields (`tool_radius`, `start`, `sensor_range`, `exec`, `odometry_noise` (LIN or
 /// `(LIN, ANG, DRIFT)`, as `--odometry-noise`), `landmarks` (a file or a list of
 /// `(id, x, y[, theta])`, as `--landmarks`), `seed` (of random-bounce and of the noise),

@@ -64,6 +64,10 @@ def test_run_with_zones_and_exports_equals_the_cli(room: Path, ccpp_bin: str, tm
     w = r.waypoints()
     assert w.shape[1] == 3 and np.array_equal(w, csv_rows(r.export("csv")))
     assert len(r.waypoints(tolerance_m=0.05)) <= len(w)
+    # None is the default, as for the other keywords (it raised TypeError), and help() shows
+    # the default's value (it showed Ellipsis).
+    assert np.array_equal(r.waypoints(None), w)
+    assert "tolerance_m=0.001" in (type(r).waypoints.__text_signature__ or "")
     # Without `export`, save writes no export file (as `ccpp run` without --export).
     bare = tmp_path / "bare"
     r.save(bare)

@@ -250,7 +250,10 @@ impl MapYaml {
             Some(Negate::Int(1) | Negate::Bool(true)) => true,
             Some(Negate::Int(v)) => return Err(bad("negate", format!("{v} is not 0 or 1"))),
             Some(Negate::Other(v)) => {
-                return Err(bad("negate", format!("{v} is not 0, 1, false or true")))
+                return Err(bad(
+                    "negate",
+                    format!("{v} is not 0, 1 or a YAML boolean (true/false, yes/no, on/off, y/n)"),
+                ))
             }
         };
         let yaml = Self {

@@ -84,8 +84,9 @@ class RunResult:
         holding files ccpp did not write is refused (``CcppError``). Ctrl-C while the files
         are drawn raises ``KeyboardInterrupt`` once they are drawn, before ``folder`` is
         touched."""
-    def waypoints(self, tolerance_m: float = 0.001) -> npt.NDArray[np.float64]:
-        """Waypoints of the executed path, (N, 3): x, y, theta at segment ends."""
+    def waypoints(self, tolerance_m: float | None = 0.001) -> npt.NDArray[np.float64]:
+        """Waypoints of the executed path, (N, 3): x, y, theta at segment ends (poses merged
+        within ``tolerance_m``; ``None`` is the default)."""
     def export(self, format: str) -> str:
         """The text of ``ccpp run --export FORMAT``'s file (csv, json, nav-path, geojson)."""
 
