@@ -47,6 +47,36 @@ impl TileGrid {
         )
     }
 
+    /// [`Self::tile_of`] for a point that may lie on a tile boundary up to the rounding of
+    /// its world coordinates (a pixel centre: with tiles of `2 r` an odd number of pixels
+    /// wide, half a tile from a centre is a pixel centre): within [`Self::BOUNDARY_TOL`] tile
+    /// of a boundary it counts as on it (half away from the anchor, as `tile_of` rounds an
+    /// exact half). `tile_of` decided such pixels by the last bits of their coordinates, so
+    /// ba-star-extended asking which pixels BA* will sweep took another path when the map was
+    /// moved (`mit_building_31` at +1000 m: 2 % longer).
+    pub fn tile_of_near_boundary(&self, p: Point) -> Tile {
+        let at = |u: f64| -> i32 {
+            let a = u.abs();
+            let f = a.floor();
+            let k = if a - f >= 0.5 - Self::BOUNDARY_TOL {
+                f + 1.0
+            } else {
+                f
+            };
+            k.copysign(u)
+                .clamp(f64::from(i32::MIN), f64::from(i32::MAX)) as i32
+        };
+        (
+            at((p.x - self.anchor.x) / self.side),
+            at((p.y - self.anchor.y) / self.side),
+        )
+    }
+
+    /// Distance from a tile boundary, in tiles, within which
+    /// [`Self::tile_of_near_boundary`] takes a point as on it: far above the rounding of world
+    /// coordinates (about 1e-9 tile at 1e6 m) and far below a pixel of any real map.
+    pub const BOUNDARY_TOL: f64 = 1e-6;
+
     /// The tile containing world point `p` (nearest centre; boundaries round half away).
     #[inline]
     pub fn tile_of(&self, p: Point) -> Tile {

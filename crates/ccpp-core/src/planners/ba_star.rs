@@ -394,7 +394,7 @@ impl BaStar {
     /// that tile is not covered and not judged an obstacle.
     pub fn will_cover(&self, p: Point) -> bool {
         self.mind.as_ref().is_some_and(|m| {
-            let t = m.tiles.grid.tile_of(p);
+            let t = m.tiles.grid.tile_of_near_boundary(p);
             !m.tiles.covered(t) && m.tiles.stand(t) != Judgement::Blocked
         })
     }

@@ -446,7 +446,7 @@ impl Bsa {
     /// out only at the end).
     pub fn will_cover(&self, p: Point) -> bool {
         self.core.as_ref().is_some_and(|c| {
-            let t = c.grid.tile_of(p);
+            let t = c.grid.tile_of_near_boundary(p);
             if c.cells.idx(t).is_none() || c.cells.has(t, VISITED) {
                 return false;
             }

@@ -182,7 +182,7 @@ impl Extension {
         for chunk in group {
             let way: Vec<Point> = std::iter::once(pos)
                 .chain(chunk.transfer.iter().copied())
-                .map(|p| f.world_to_grid(p))
+                .map(|p| f.world_to_grid_snapped(p))
                 .collect();
             for s in way.windows(2) {
                 let key = seg_key(s[0], s[1]);

@@ -558,7 +558,10 @@ impl Extension {
     /// A transfer from world point `from` to world point `to` over positions (A*), merged into
     /// known-free straight segments; `None` when no known-free way exists.
     pub(crate) fn route(&mut self, known: &KnownMap, from: Point, to: Point) -> Option<Vec<Point>> {
-        let (gf, gt) = (self.frame.world_to_grid(from), self.frame.world_to_grid(to));
+        let (gf, gt) = (
+            self.frame.world_to_grid_snapped(from),
+            self.frame.world_to_grid_snapped(to),
+        );
         if self.seg_free(known, gf, gt) {
             return Some(vec![to]);
         }

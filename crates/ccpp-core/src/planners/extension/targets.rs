@@ -29,8 +29,8 @@ impl Extension {
         crate::raster::stamp_capsule(
             &mut self.swept,
             &f,
-            f.world_to_grid(a),
-            f.world_to_grid(b),
+            f.world_to_grid_snapped(a),
+            f.world_to_grid_snapped(b),
             self.rt,
             &mut |_| {},
         );
@@ -78,7 +78,7 @@ impl Extension {
         let grid = |pts: &[Point]| -> Vec<Point> {
             std::iter::once(from)
                 .chain(pts.iter().copied())
-                .map(|p| f.world_to_grid(p))
+                .map(|p| f.world_to_grid_snapped(p))
                 .collect()
         };
         let gains = self.polyline_gains(known, &grid(host));

@@ -28,7 +28,7 @@ impl Extension {
         wanted: Wanted,
         resume: bool,
     ) -> Chunk {
-        let from = self.frame.world_to_grid(pos);
+        let from = self.frame.world_to_grid_snapped(pos);
         let limit = bounded.then(|| {
             (self.opts.reach_r * self.r / self.frame.resolution * COST_ORTHO as f64) as u64
         });
@@ -220,7 +220,9 @@ impl Extension {
         if w.dist(c) < 0.5 * res {
             return None;
         }
-        let gw = self.frame.grid_to_pixel_signed(self.frame.world_to_grid(w));
+        let gw = self
+            .frame
+            .grid_to_pixel_signed(self.frame.world_to_grid_snapped(w));
         if self.gain(known, gw, Some(wanted), 2) < 2 {
             return None;
         }
