@@ -202,6 +202,11 @@ fn decimate(pts: &[[f64; 2]], forced: &[bool]) -> Vec<usize> {
 /// base64 blob of varints: for each displayed pose the x and y deltas (zigzag, 1/8 map pixel,
 /// canvas orientation), the step-counter delta, the travelled-distance delta (mm, of the
 /// rounded running total, so no drift), then one heading byte per pose (on the image's axes).
+/// Longest side of the page's canvas in device pixels (`4096` in the template's `layout`).
+const CANVAS_MAX_PX: f64 = 4096.0;
+/// Smallest tile the page outlines, device pixels (`tilesShown` in the template).
+const TILE_MIN_DRAWN_PX: f64 = 6.0;
+
 fn replay_data(
     world: &World,
     trace: &Trace,
@@ -231,6 +236,12 @@ fn replay_data(
     // Under odometry noise a tile counts within half a tile of the true path, as in
     // `coverage_rate` (the page drew 4 tiles beside a tile coverage of 47.5 %).
     let noisy = ccpp_core::metrics::noisy_execution(trace);
+    // Tile outlines only when the page can ever draw them: it draws them from
+    // `TILE_MIN_DRAWN_PX` device pixels a tile, on a canvas of at most `CANVAS_MAX_PX` on its
+    // longer side (ba-star on `cluttered_2000` at r = 0.025 m embedded 11.5 MB of 1-pixel
+    // tiles, 84 % of a 13.6 MB page, that no screen showed).
+    let tile_side = tile_side
+        .filter(|t| t / f.resolution * CANVAS_MAX_PX / w.max(h).max(1) as f64 >= TILE_MIN_DRAWN_PX);
     let mut approach_pose: Option<usize> = None;
     let to_crop = |x: f64, y: f64| -> [f64; 2] {
         let g = f.world_to_grid(Point::new(x, y));
@@ -1089,6 +1100,32 @@ mod tests {
             .find("} else if (style < 0) {")
             .expect("backtrack style");
         assert!(approach < backtrack);
+    }
+
+    /// Tile outlines are embedded only when the page can draw them (from `TILE_MIN_DRAWN_PX`
+    /// device pixels a tile on a canvas of at most `CANVAS_MAX_PX`, the template's own
+    /// numbers): 1-pixel tiles on a 2000-pixel map were 84 % of a 13.6 MB page. The outlines
+    /// turn with the map's yaw the way headings do (they turned the other way: on a map of yaw
+    /// 0.5 the squares were the lanes' mirror image).
+    #[test]
+    fn tiles_are_embedded_when_the_page_can_draw_them() {
+        let (world, trace) = zoned();
+        let crop = crate::crop_box(&world, &trace);
+        let shown = replay_data(&world, &trace, Some(0.3), "{}", crop);
+        assert!(
+            shown.contains(r#""tile":6,"#) && !shown.contains(r#""nt":0,"#),
+            "{shown:.300}"
+        );
+        // 0.1 px tiles on a 120 px map: at most 3.4 device pixels a tile.
+        let hidden = replay_data(&world, &trace, Some(0.005), "{}", crop);
+        assert!(hidden.contains(r#""tile":null,"#) && hidden.contains(r#""nt":0,"#));
+        assert!(TEMPLATE.contains("const k = Math.min(dpr, 4096 / Math.max(cssW, cssH));"));
+        assert!(TEMPLATE.contains("D.tile * S >= 6;"));
+        assert_eq!((CANVAS_MAX_PX, TILE_MIN_DRAWN_PX), (4096.0, 6.0));
+        assert!(TEMPLATE.contains("paC.rotate(D.yaw); paC.strokeRect"));
+        // Headings on the canvas: (cos h, -sin h) for an angle h on the image's axes, the
+        // same turn as `rotate(+yaw)` on a y-down canvas.
+        assert!(TEMPLATE.contains("cy - rr * Math.sin(h)"));
     }
 
     /// The page lists only the map classes the map shows (`teb_maze` has no unknown pixel, the
