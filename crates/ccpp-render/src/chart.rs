@@ -637,14 +637,19 @@ fn nice_step(range: f64, ticks: usize) -> f64 {
     k * mag
 }
 
+/// A tick label with as many decimals as the step needs (a step of 0.005 needs three: at two
+/// the coverage axis of a trade-off plot read 0.97, 0.98, 0.98, 0.99, 0.99, 1.00, and a point
+/// at 0.9953 sat on a line labelled 0.99).
 fn fmt_tick(v: f64, step: f64) -> String {
-    if step >= 1.0 {
-        format!("{v:.0}")
-    } else if step >= 0.1 {
-        format!("{v:.1}")
-    } else {
-        format!("{v:.2}")
+    let mut d = 0usize;
+    while d < 9 {
+        let scaled = step * 10f64.powi(d as i32);
+        if (scaled - scaled.round()).abs() <= 1e-6 * scaled.max(1.0) {
+            break;
+        }
+        d += 1;
     }
+    format!("{v:.d$}")
 }
 
 /// The plotting box of a chart, in pixels from the top-left corner.
@@ -1493,6 +1498,24 @@ pub fn image_grid_captioned(
 
 #[cfg(test)]
 mod tests {
+
+    /// Tick labels carry the decimals their step needs, so neighbouring ticks never read the
+    /// same (a coverage axis in steps of 0.005 read 0.98 twice).
+    #[test]
+    fn tick_labels_are_distinct_at_any_step() {
+        assert_eq!(fmt_tick(0.975, 0.005), "0.975");
+        assert_eq!(fmt_tick(1.0, 0.005), "1.000");
+        assert_eq!(fmt_tick(0.4, 0.2), "0.4");
+        assert_eq!(fmt_tick(25.0, 5.0), "25");
+        for step in [0.0005, 0.002, 0.005, 0.02, 0.05, 0.25, 0.5, 2.0, 50.0] {
+            let labels: Vec<String> = (0..12)
+                .map(|k| fmt_tick(0.9 + f64::from(k) * step, step))
+                .collect();
+            let mut unique = labels.clone();
+            unique.dedup();
+            assert_eq!(unique.len(), labels.len(), "{step}: {labels:?}");
+        }
+    }
     use super::*;
 
     /// A series far longer than the others (random-bounce's budget) no longer squeezes them
