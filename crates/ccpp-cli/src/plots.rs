@@ -255,7 +255,7 @@ pub fn write_all(
                 .collect(),
         ),
         (
-            "wall time (s)".into(),
+            "wall time (s, mean a map)".into(),
             planners
                 .iter()
                 .map(|p| mean(p, |m| m.wall_time_s))

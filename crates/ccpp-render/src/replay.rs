@@ -1126,6 +1126,9 @@ mod tests {
         // Headings on the canvas: (cos h, -sin h) for an angle h on the image's axes, the
         // same turn as `rotate(+yaw)` on a y-down canvas.
         assert!(TEMPLATE.contains("cy - rr * Math.sin(h)"));
+        // The legend's region count says how many of the run's regions are drawn (a region
+        // with no move has no colour: it said 24 beside the metrics' 28).
+        assert!(TEMPLATE.contains(r#"" drawn of " + D.metrics.regions"#));
     }
 
     /// The page lists only the map classes the map shows (`teb_maze` has no unknown pixel, the
