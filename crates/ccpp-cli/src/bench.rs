@@ -682,14 +682,15 @@ fn child_job() -> Result<String> {
         eprintln!("{note}");
     }
     // One a line (a line break inside one, as from a map's name, made a space).
-    let mut warnings = String::new();
-    for w in ccpp_io::warnings::run_warnings(
+    let list = ccpp_io::warnings::run_warnings(
         &job.scenario,
         &result.world,
         &result.run.trace,
         &result.metrics,
         &result.swept,
-    ) {
+    );
+    let mut warnings = String::new();
+    for w in &list {
         warnings.push_str(&w.replace(['\n', '\r'], " "));
         warnings.push('\n');
     }
@@ -697,7 +698,7 @@ fn child_job() -> Result<String> {
         ("bench-key.txt", spec.key.into_bytes()),
         (WARNINGS_FILE, warnings.into_bytes()),
     ];
-    write_run_files(&job.out, &job, &result, false, &extra)
+    write_run_files(&job.out, &job, &result, false, &extra, &list)
 }
 
 /// Quotes a CSV field when needed (a carriage return too: a map file named with one split

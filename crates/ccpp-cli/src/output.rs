@@ -29,6 +29,7 @@ pub fn write_run_files(
     r: &JobResult,
     replay: bool,
     extra: &[(&'static str, Vec<u8>)],
+    warnings: &[String],
 ) -> Result<String> {
     let metrics = ccpp_render::run_files::metrics_json(&r.metrics)?;
     let staging = Staging::new(out)?;
@@ -43,8 +44,11 @@ pub fn write_run_files(
         &r.world,
         &r.run.trace,
         &r.metrics,
-        Some(&r.swept),
-        r.formed.as_ref(),
+        &ccpp_render::run_files::KnownParts {
+            swept: Some(&r.swept),
+            formed: r.formed.as_ref(),
+            warnings,
+        },
         &mut |name, fill| staging.write_with(name, fill),
     )?;
     if replay {
@@ -386,32 +390,28 @@ pub fn emit(
         exports,
         &ccpp_io::export::zone_features(r.world.zones(), r.world.frame()),
     )?;
-    // The start's free area (a flood fill over the map), unless found while the planner
-    // worked, is found while the files are written.
-    let (metrics, comp) = std::thread::scope(|s| {
-        let found = r.start_area;
-        let comp = found
-            .is_none()
-            .then(|| s.spawn(|| StartComponent::of(r.world.map(), r.world.start().position())));
-        let metrics = write_run_files(&job.out, job, r, replay, &export_files);
-        let comp = match comp.map(std::thread::ScopedJoinHandle::join) {
-            None => found
-                .unwrap_or_else(|| StartComponent::of(r.world.map(), r.world.start().position())),
-            Some(Ok(c)) => c,
-            Some(Err(panic)) => std::panic::resume_unwind(panic),
-        };
-        (metrics, comp)
-    });
+    // The start's free area (a flood fill over the map; `run` finds it while the planner
+    // works) and the run's warnings, before the files: `coverage.png` shows them.
+    let comp = r
+        .start_area
+        .unwrap_or_else(|| StartComponent::of(r.world.map(), r.world.start().position()));
+    let warnings: Vec<String> = comp
+        .warning()
+        .into_iter()
+        .chain(ccpp_io::warnings::run_warnings(
+            &job.scenario,
+            &r.world,
+            &r.run.trace,
+            &r.metrics,
+            &r.swept,
+        ))
+        .collect();
+    let metrics = write_run_files(&job.out, job, r, replay, &export_files, &warnings);
     busy.done();
     let metrics = metrics?;
-    if let Some(w) = comp.warning() {
-        eprintln!("warning: {w}");
-    }
     // Every warning on stderr, with or without --json (the early stop's was a line of the
     // table on stdout without it), as Python's `RunResult.warnings` lists them.
-    for w in
-        ccpp_io::warnings::run_warnings(&job.scenario, &r.world, &r.run.trace, &r.metrics, &r.swept)
-    {
+    for w in &warnings {
         eprintln!("warning: {w}");
     }
     if json_only {

@@ -142,6 +142,7 @@ pub fn write_all(
                     max_side: 1000,
                     title: Vec::new(),
                     legend: false,
+                    warnings: Vec::new(),
                 };
                 let png = match coverage_png_swept(run_world, &trace, &style, &swept) {
                     Ok(png) => png,

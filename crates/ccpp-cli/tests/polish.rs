@@ -552,3 +552,46 @@ fn contacts_under_noise_are_said_even_when_a_landmark_was_seen() {
         "{err}"
     );
 }
+
+/// The run's warnings show in `coverage.png`: an amber badge and the first warning under the
+/// title (a start outside the building showed a green "99.5% covered" and nothing else there;
+/// the warning was on stderr only).
+#[test]
+fn coverage_png_shows_the_runs_warnings() {
+    let d = tempfile::tempdir().unwrap();
+    // Free to the image's border: the start's free area reaches it.
+    let mut bytes = b"P5\n60 40\n255\n".to_vec();
+    bytes.extend(std::iter::repeat_n(254u8, 60 * 40));
+    let open = d.path().join("open.pgm");
+    std::fs::write(&open, bytes).unwrap();
+    let amber = |png: &std::path::Path| {
+        let img = image::open(png).unwrap().to_rgb8();
+        img.pixels().filter(|p| p.0 == [176, 96, 0]).count()
+    };
+    let out = d.path().join("open");
+    let a = crate::common::ccpp()
+        .args(["run", "--planner", "ba-star", "--map"])
+        .arg(&open)
+        .arg("--out")
+        .arg(&out)
+        .assert()
+        .success();
+    let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
+    assert!(
+        err.contains("warning: the free area holding the start reaches the map's border"),
+        "{err}"
+    );
+    assert!(amber(&out.join("coverage.png")) > 500);
+    // A walled room: no warning, no amber.
+    let room = crate::common::pgm(d.path(), "room.pgm", 60, 40, |_, _| false);
+    let out = d.path().join("room");
+    let a = crate::common::ccpp()
+        .args(["run", "--planner", "ba-star", "--map"])
+        .arg(&room)
+        .arg("--out")
+        .arg(&out)
+        .assert()
+        .success();
+    assert!(!String::from_utf8_lossy(&a.get_output().stderr).contains("warning"));
+    assert_eq!(amber(&out.join("coverage.png")), 0);
+}

@@ -1313,6 +1313,7 @@ impl RunResult {
                     &self.world,
                     &self.output.trace,
                     &self.metrics,
+                    &self.warnings,
                 )
             })
             .map_err(|e| err(&e))?;
@@ -1639,17 +1640,6 @@ fn bench_run(
         let run = scenario
             .run_on(&map)
             .map_err(|e| ccpp_io::message::one_line(&e))?;
-        if let Some(dir) = &out {
-            ccpp_render::run_files::write_run_files(
-                dir,
-                &scenario,
-                &run.world,
-                &run.output.trace,
-                &run.metrics,
-                &[],
-            )
-            .map_err(|e| ccpp_io::message::one_line(&e))?;
-        }
         let warnings = ccpp_io::warnings::run_warnings(
             &scenario,
             &run.world,
@@ -1657,6 +1647,18 @@ fn bench_run(
             &run.metrics,
             &run.swept,
         );
+        if let Some(dir) = &out {
+            ccpp_render::run_files::write_run_files(
+                dir,
+                &scenario,
+                &run.world,
+                &run.output.trace,
+                &run.metrics,
+                &warnings,
+                &[],
+            )
+            .map_err(|e| ccpp_io::message::one_line(&e))?;
+        }
         Ok((run.metrics, warnings))
     });
     Ok(match outcome {

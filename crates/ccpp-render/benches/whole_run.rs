@@ -22,13 +22,22 @@ fn bench_dir() -> PathBuf {
 fn whole_run(scenario: &Scenario) -> usize {
     let map = scenario.map.load().expect("map");
     let run = scenario.run_owned(map).expect("run");
-    // As `ccpp run`: the picture reuses the swept pixels of the metrics.
+    // As `ccpp run`: the warnings first (the picture shows them), and the picture reuses the
+    // swept pixels of the metrics.
+    let warnings = ccpp_io::warnings::run_warnings(
+        scenario,
+        &run.world,
+        &run.output.trace,
+        &run.metrics,
+        &run.swept,
+    );
     let files = ccpp_render::run_files::render_run_files_swept(
         scenario,
         &run.world,
         &run.output.trace,
         &run.metrics,
         Some(&run.swept),
+        &warnings,
     )
     .expect("files");
     files.iter().map(|(_, b)| b.len()).sum()

@@ -54,6 +54,11 @@ pub struct CoverageStyle {
     pub title: Vec<String>,
     /// Draw the legend under the map (off for small panels that share one legend).
     pub legend: bool,
+    /// The run's warnings (as `ccpp run` prints them without `warning: `): with any, an
+    /// amber badge counts them beside the coverage badge and the first is written under the
+    /// title (a run that swept the yard around a building, its start outside, showed a green
+    /// "99.5% covered" and nothing else).
+    pub warnings: Vec<String>,
 }
 
 impl Default for CoverageStyle {
@@ -63,6 +68,7 @@ impl Default for CoverageStyle {
             max_side: 3000,
             title: Vec::new(),
             legend: true,
+            warnings: Vec::new(),
         }
     }
 }
@@ -105,6 +111,8 @@ pub mod colours {
     pub const APPROACH: [u8; 3] = [105, 105, 105];
     /// The badge of a run the simulator stopped before the planner finished.
     pub const STOPPED: [u8; 3] = [200, 30, 30];
+    /// The warnings badge and line: amber (dark enough for white text on it).
+    pub const WARNING: [u8; 3] = [176, 96, 0];
 }
 
 /// Where the approach to the work area ends (a start outside the area: the simulator drives
@@ -897,7 +905,14 @@ pub fn coverage_pixmap_swept(
                 },
             ),
         ];
-        let badges: Vec<(String, [u8; 3])> = stopped.into_iter().chain(badges).collect();
+        let warned = (!style.warnings.is_empty()).then(|| {
+            (
+                plural(style.warnings.len(), "warning", "warnings"),
+                colours::WARNING,
+            )
+        });
+        let badges: Vec<(String, [u8; 3])> =
+            stopped.into_iter().chain(badges).chain(warned).collect();
         let mut bx = cw as f32 - 6.0;
         let widths: Vec<f32> = badges
             .iter()
@@ -972,6 +987,26 @@ pub fn coverage_pixmap_swept(
         for line in wrap_words(&style.title[1.min(style.title.len())..], width, width, px) {
             head.text(8.0, y, px as u32, line, [20, 20, 20], chart::Anchor::Start);
             y += font::line_height(px);
+        }
+        // The first warning, in amber, whole (wrapped); the others are counted.
+        if let Some(first) = style.warnings.first() {
+            let more = style.warnings.len() - 1;
+            let text = if more == 0 {
+                format!("warning: {first}")
+            } else {
+                format!("warning: {first} (and {more} more: see the run's output)")
+            };
+            for line in wrap_words(&[text], width, width, px) {
+                head.text(
+                    8.0,
+                    y,
+                    px as u32,
+                    line,
+                    colours::WARNING,
+                    chart::Anchor::Start,
+                );
+                y += font::line_height(px);
+            }
         }
         header = (y + 6.0).ceil() as u32;
     }
@@ -1997,6 +2032,30 @@ mod tests {
         assert_eq!(stop_reason(&trace).as_deref(), Some("stalled"));
         let (_, trace) = approach_run("done");
         assert_eq!(stop_reason(&trace), None);
+    }
+
+    /// A run with warnings says so in the header: an amber badge counting them and the first
+    /// one written out under the title, which grows by its lines (a run outside the building
+    /// showed a green "99.5% covered" and nothing else).
+    #[test]
+    fn warnings_show_in_the_header() {
+        let (world, trace) = approach_run("done");
+        let plain = coverage_pixmap(&world, &trace, &style()).unwrap();
+        let warned_style = CoverageStyle {
+            warnings: vec![
+                "the free area holding the start reaches the map's border".to_string(),
+                "a second one".to_string(),
+            ],
+            ..style()
+        };
+        let warned = coverage_pixmap(&world, &trace, &warned_style).unwrap();
+        assert_eq!(count_colour(&plain, 0..plain.height(), colours::WARNING), 0);
+        let badge = count_colour(&warned, 0..40, colours::WARNING);
+        assert!(badge > 200, "{badge} amber header pixels");
+        assert!(
+            warned.height() > plain.height(),
+            "the warning line takes room"
+        );
     }
 
     /// The keep-out's legend swatch is hatched like the zone (it was a solid square of the

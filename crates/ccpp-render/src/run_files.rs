@@ -90,15 +90,17 @@ pub fn run_json(scenario: &Scenario, world: &World) -> Result<String, serde_json
 }
 
 /// The style of a run's `coverage.png`.
-fn coverage_style(metrics: &Metrics) -> CoverageStyle {
+fn coverage_style(metrics: &Metrics, warnings: &[String]) -> CoverageStyle {
     CoverageStyle {
         title: title_lines(metrics),
+        warnings: warnings.to_vec(),
         ..CoverageStyle::default()
     }
 }
 
 /// Renders a run's standard files in memory, in writing order: `run.json`, `path.csv`,
 /// `trace.jsonl`, `coverage.png`, `metrics.json` (last: its presence marks a complete run).
+/// `warnings` are the run's warnings (as `ccpp run` prints them), shown in `coverage.png`.
 /// `run.json` is `scenario` with the start actually used (the world's), so that
 /// [`Scenario::run`] on it reproduces the run. The command line adds its replay files before
 /// `metrics.json` and writes the set through its own staging folder; [`write_run_files`]
@@ -111,8 +113,9 @@ pub fn render_run_files(
     world: &World,
     trace: &Trace,
     metrics: &Metrics,
+    warnings: &[String],
 ) -> Result<Vec<(&'static str, Vec<u8>)>, RunFilesError> {
-    render_run_files_swept(scenario, world, trace, metrics, None)
+    render_run_files_swept(scenario, world, trace, metrics, None, warnings)
 }
 
 /// [`render_run_files`] reusing the swept pixels when given (they must be
@@ -127,10 +130,11 @@ pub fn render_run_files_swept(
     trace: &Trace,
     metrics: &Metrics,
     swept: Option<&fixedbitset::FixedBitSet>,
+    warnings: &[String],
 ) -> Result<Vec<(&'static str, Vec<u8>)>, RunFilesError> {
     let metrics_text = metrics_json(metrics)?;
     let run_json = run_json(scenario, world)?;
-    let style = coverage_style(metrics);
+    let style = coverage_style(metrics, warnings);
     // The picture and the text files are independent pure functions of (world, trace): draw
     // the picture on a second thread while this one writes the text (same bytes either way).
     let (png, text) = std::thread::scope(|s| {
@@ -169,6 +173,17 @@ fn coverage_picture(
     })
 }
 
+/// What the caller of [`stream_run_files`] already has of a run's files.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct KnownParts<'a> {
+    /// The swept pixels ([`ccpp_core::metrics::swept_pixels`] of the run), when computed.
+    pub swept: Option<&'a fixedbitset::FixedBitSet>,
+    /// The `path.csv` formed while the run went on, when formed.
+    pub formed: Option<&'a FormedFiles>,
+    /// The run's warnings, shown in `coverage.png`.
+    pub warnings: &'a [String],
+}
+
 /// What [`stream_run_files`] writes each file with: `put(name, fill)` creates the file `name`
 /// and calls `fill` with a writer into it (the command line puts the files in its staging
 /// folder).
@@ -179,8 +194,8 @@ pub type PutFile<'a, E> = dyn FnMut(&'static str, &mut dyn FnMut(&mut dyn Write)
 /// `trace.jsonl`, `coverage.png`, in that order — handed to `put` one by one, with
 /// `trace.jsonl` streamed as it is formed instead of built whole in memory (the largest file;
 /// `coverage.png` is drawn on a second thread meanwhile). Same bytes as
-/// [`render_run_files`]. `swept`, when given, must be
-/// [`ccpp_core::metrics::swept_pixels`]`(world, trace)`; `formed`, when given, the `path.csv` of
+/// [`render_run_files`]. `known.swept`, when given, must be
+/// [`ccpp_core::metrics::swept_pixels`]`(world, trace)`; `known.formed`, when given, the `path.csv` of
 /// the trace formed while it ran ([`ccpp_io::scenario::Scenario::run_owned_with`]), written as
 /// it is.
 ///
@@ -191,12 +206,16 @@ pub fn stream_run_files<E: From<RunFilesError>>(
     world: &World,
     trace: &Trace,
     metrics: &Metrics,
-    swept: Option<&fixedbitset::FixedBitSet>,
-    formed: Option<&FormedFiles>,
+    known: &KnownParts<'_>,
     put: &mut PutFile<'_, E>,
 ) -> Result<(), E> {
+    let KnownParts {
+        swept,
+        formed,
+        warnings,
+    } = *known;
     let run_json = run_json(scenario, world).map_err(RunFilesError::from)?;
-    let style = coverage_style(metrics);
+    let style = coverage_style(metrics, warnings);
     std::thread::scope(|s| {
         let png = s.spawn(|| coverage_picture(world, trace, &style, swept));
         let text = (|| -> Result<(), E> {
@@ -266,9 +285,10 @@ pub fn write_run_files(
     world: &World,
     trace: &Trace,
     metrics: &Metrics,
+    warnings: &[String],
     extra: &[(&'static str, Vec<u8>)],
 ) -> Result<String, RunFilesError> {
-    let mut files = render_run_files(scenario, world, trace, metrics)?;
+    let mut files = render_run_files(scenario, world, trace, metrics, warnings)?;
     files.extend(extra.iter().cloned());
     let metrics_text = files
         .iter()

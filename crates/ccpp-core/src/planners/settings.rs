@@ -64,7 +64,7 @@ pub struct Setup {
     pub max_steps: u64,
     /// The run's execution carries odometry noise (from the planner's options or the run's
     /// own, e.g. `--odometry-noise`): the true pose then leaves the map axes, so no PID step
-    /// is dropped from the trace as part of a straight glide ([`pid_records`]).
+    /// is dropped from the trace as part of a straight glide (see [`crate::sim`]).
     pub noisy: bool,
 }
 
