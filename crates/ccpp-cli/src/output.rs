@@ -53,7 +53,14 @@ pub fn write_run_files(
     )?;
     if replay {
         let title = format!("{} on {}", r.metrics.planner, r.metrics.map);
-        let (html, gif) = render_replay(&r.world, &r.run.trace, r.run.tile_side, &metrics, &title)?;
+        let (html, gif) = render_replay(
+            &r.world,
+            &r.run.trace,
+            r.run.tile_side,
+            &metrics,
+            &title,
+            warnings,
+        )?;
         staging.write("replay.html", html.as_bytes())?;
         staging.write("replay.gif", &gif)?;
     }
@@ -68,8 +75,9 @@ pub fn render_replay(
     tile_side: Option<f64>,
     metrics: &str,
     title: &str,
+    warnings: &[String],
 ) -> Result<(String, Vec<u8>)> {
-    let html = ccpp_render::replay::replay_html(world, trace, tile_side, metrics, title)?;
+    let html = ccpp_render::replay::replay_html(world, trace, tile_side, metrics, title, warnings)?;
     let gif =
         ccpp_render::replay::replay_gif(world, trace, &ccpp_render::replay::GifOptions::default())?;
     Ok((html, gif))
@@ -115,7 +123,30 @@ pub fn replay_dir(dir: &Path) -> Result<()> {
         std::thread::sleep(std::time::Duration::from_millis(ms.min(60_000)));
     }
     let title = format!("{} on {}", scenario.planner.name(), map.name);
-    let (html, gif) = render_replay(&world, &trace, scenario.tile_side(), &metrics, &title)?;
+    // The run's warnings, found again as `ccpp run` found them (the folder holds none).
+    let warnings: Vec<String> = match serde_json::from_str::<ccpp_core::metrics::Metrics>(&metrics)
+    {
+        Ok(m) => {
+            let swept = ccpp_core::metrics::swept_pixels(&world, &trace);
+            StartComponent::of(world.map(), world.start().position())
+                .warning()
+                .into_iter()
+                .chain(ccpp_io::warnings::run_warnings(
+                    &scenario, &world, &trace, &m, &swept,
+                ))
+                .collect()
+        }
+        // Metrics of another shape (checked above for the figures the replay reads).
+        Err(_) => Vec::new(),
+    };
+    let (html, gif) = render_replay(
+        &world,
+        &trace,
+        scenario.tile_side(),
+        &metrics,
+        &title,
+        &warnings,
+    )?;
     let replaced = || {
         anyhow::anyhow!(
             "{} was replaced by another run while its replay was made: nothing written; run ccpp replay again",

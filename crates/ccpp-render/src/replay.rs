@@ -213,6 +213,7 @@ fn replay_data(
     tile_side: Option<f64>,
     metrics_json: &str,
     crop: (usize, usize, usize, usize),
+    warnings: &[String],
 ) -> String {
     let f = *world.frame();
     let (c0, r0, w, h) = crop;
@@ -426,7 +427,7 @@ fn replay_data(
     let last = finished.map_or_else(|| "null".to_string(), |(t, _)| t.to_string());
     let classes = classes_js(world, crop);
     format!(
-        r#"{{"w":{w},"h":{h},"res":{res},"yaw":{yaw},"r":{r},"rt":{rt},"swept_r":{swept_r},"tile":{tile},"start":[{sx},{sy},{st}],"n":{n},"m":{m},"q":{q},"blob":"{blob}","events":{events},"nt":{nt},"tblob":"{tblob}","cov":{cov},"palette":{palette},"zones":{zones},"approach":{approach},"stop":{stop},"last":{last},"classes":{classes},"metrics":{metrics}}}"#,
+        r#"{{"w":{w},"h":{h},"res":{res},"yaw":{yaw},"r":{r},"rt":{rt},"swept_r":{swept_r},"tile":{tile},"start":[{sx},{sy},{st}],"n":{n},"m":{m},"q":{q},"blob":"{blob}","events":{events},"nt":{nt},"tblob":"{tblob}","cov":{cov},"palette":{palette},"zones":{zones},"approach":{approach},"stop":{stop},"last":{last},"classes":{classes},"warnings":{warnings},"metrics":{metrics}}}"#,
         res = js_num(f.resolution),
         yaw = js_num(yaw),
         r = js_num(world.robot().radius / f.resolution),
@@ -442,6 +443,7 @@ fn replay_data(
         m = kept.len(),
         q = Q,
         palette = palette_js(),
+        warnings = serde_json::to_string(warnings).unwrap_or_else(|_| "[]".to_string()),
         metrics = if metrics_json.trim().is_empty() {
             "{}"
         } else {
@@ -544,7 +546,9 @@ fn palette_js() -> String {
 /// kept) as compact base64 varints, draws incrementally on offscreen layers, and shows the
 /// travelled distance, step, live effective coverage and current region or backtracking at the
 /// scrubber. Opened with `#selftest` it checks itself and writes the result (timings and the
-/// side panel's bounding boxes) into the title and `#selftest`.
+/// side panel's bounding boxes) into the title and `#selftest`. The run's `warnings` (as
+/// `ccpp run` prints them) are counted in an amber badge in the header and listed under the
+/// metrics.
 ///
 /// # Errors
 /// When the background image cannot be drawn.
@@ -554,6 +558,7 @@ pub fn replay_html(
     tile_side: Option<f64>,
     metrics_json: &str,
     title: &str,
+    warnings: &[String],
 ) -> Result<String, RenderError> {
     let crop = crop_box(world, trace);
     let bg = base64::engine::general_purpose::STANDARD.encode(background_png(world, crop)?);
@@ -561,7 +566,8 @@ pub fn replay_html(
     // script early, and `<!--<script>` (escaping `</` alone let it through) puts the HTML
     // parser in a state where the real `</script>` no longer ends it: a blank, dead page. In
     // JSON a `<` can only stand in a string, where `\u003c` is the same character.
-    let data = replay_data(world, trace, tile_side, metrics_json, crop).replace('<', "\\u003c");
+    let data =
+        replay_data(world, trace, tile_side, metrics_json, crop, warnings).replace('<', "\\u003c");
     // Braces as character references too: the page's later placeholders are replaced over
     // the whole page, so a map named `x{{DATA}}` put the whole data into the title.
     let title = title
@@ -917,7 +923,7 @@ pub(crate) mod tests_support {
 
     /// The page data of a run (no tiles, no metrics).
     pub(crate) fn data(world: &World, trace: &Trace) -> String {
-        replay_data(world, trace, None, "{}", crate::crop_box(world, trace))
+        replay_data(world, trace, None, "{}", crate::crop_box(world, trace), &[])
     }
 }
 
@@ -1111,13 +1117,13 @@ mod tests {
     fn tiles_are_embedded_when_the_page_can_draw_them() {
         let (world, trace) = zoned();
         let crop = crate::crop_box(&world, &trace);
-        let shown = replay_data(&world, &trace, Some(0.3), "{}", crop);
+        let shown = replay_data(&world, &trace, Some(0.3), "{}", crop, &[]);
         assert!(
             shown.contains(r#""tile":6,"#) && !shown.contains(r#""nt":0,"#),
             "{shown:.300}"
         );
         // 0.1 px tiles on a 120 px map: at most 3.4 device pixels a tile.
-        let hidden = replay_data(&world, &trace, Some(0.005), "{}", crop);
+        let hidden = replay_data(&world, &trace, Some(0.005), "{}", crop, &[]);
         assert!(hidden.contains(r#""tile":null,"#) && hidden.contains(r#""nt":0,"#));
         assert!(TEMPLATE.contains("const k = Math.min(dpr, 4096 / Math.max(cssW, cssH));"));
         assert!(TEMPLATE.contains("D.tile * S >= 6;"));
@@ -1126,6 +1132,19 @@ mod tests {
         // Headings on the canvas: (cos h, -sin h) for an angle h on the image's axes, the
         // same turn as `rotate(+yaw)` on a y-down canvas.
         assert!(TEMPLATE.contains("cy - rr * Math.sin(h)"));
+        // The run's warnings go into the page's data (a `<` in one escaped like the rest)
+        // and the page counts and lists them.
+        let warned = replay_data(
+            &world,
+            &trace,
+            None,
+            "{}",
+            crop,
+            &["a <b> warning".to_string()],
+        );
+        assert!(warned.contains(r#""warnings":["a <b> warning"]"#));
+        assert!(TEMPLATE.contains(r#"b.textContent = D.warnings.length + (D.warnings.length === 1 ? " warning" : " warnings")"#));
+        assert!(TEMPLATE.contains("li.textContent = w;"));
         // The legend's region count says how many of the run's regions are drawn (a region
         // with no move has no colour: it said 24 beside the metrics' 28).
         assert!(TEMPLATE.contains(r#"" drawn of " + D.metrics.regions"#));
@@ -1194,7 +1213,7 @@ mod tests {
             let world = World::new(map, ccpp_core::world::Robot::new(0.1), Some(start)).unwrap();
             let mut trace = Trace::default();
             trace.push_pose(0, start);
-            let data = replay_data(&world, &trace, None, "{}", crop_box(&world, &trace));
+            let data = replay_data(&world, &trace, None, "{}", crop_box(&world, &trace), &[]);
             let blob = data
                 .split("\"blob\":\"")
                 .nth(1)

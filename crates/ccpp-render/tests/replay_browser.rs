@@ -192,7 +192,7 @@ fn boxes(v: &serde_json::Value) -> Vec<(String, [f64; 4])> {
 fn side_panel_values_are_visible_at_desktop_sizes_and_the_page_fits_a_phone() {
     let (world, trace) = run(300, 200, 20_000);
     let metrics = r#"{"planner":"synthetic","map":"room","effective_coverage":0.93,"coverage_rate":0.99,"path_length_m":123.4,"path_ratio":1.05,"revisit_rate":0.1,"regions":2,"backtracks":1,"turns":40,"collisions":1,"wall_time_s":0.01}"#;
-    let html = replay_html(&world, &trace, None, metrics, "synthetic on room").expect("page");
+    let html = replay_html(&world, &trace, None, metrics, "synthetic on room", &[]).expect("page");
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("replay-boxes");
     std::fs::create_dir_all(&dir).expect("dir");
     std::fs::write(dir.join("replay.html"), &html).expect("write");
@@ -276,7 +276,7 @@ fn a_two_million_pose_run_gives_a_small_page_that_opens_and_seeks_fast() {
     let n = trace.poses().count();
     assert!(n >= 2_000_000, "{n} poses");
     let t0 = std::time::Instant::now();
-    let html = replay_html(&world, &trace, None, "{}", "long run").expect("page");
+    let html = replay_html(&world, &trace, None, "{}", "long run", &[]).expect("page");
     let build_s = t0.elapsed().as_secs_f64();
     let mb = html.len() as f64 / 1e6;
     eprintln!("{n} poses: page {mb:.2} MB, built in {build_s:.2} s");
@@ -349,7 +349,7 @@ fn zoned_run() -> (World, Trace) {
 #[test]
 fn the_replay_shows_the_zones_like_the_coverage_picture() {
     let (world, trace) = zoned_run();
-    let html = replay_html(&world, &trace, None, "{}", "zones").expect("page");
+    let html = replay_html(&world, &trace, None, "{}", "zones", &[]).expect("page");
     // The page data holds both polygons (without a browser this is what is checked).
     assert!(
         html.contains(r#""zones":{"area":[["#),
@@ -357,7 +357,7 @@ fn the_replay_shows_the_zones_like_the_coverage_picture() {
     );
     assert!(html.contains(r#""has_keepout":true,"has_outside":true"#));
     let (plain_world, plain_trace) = run(200, 120, 400);
-    let plain = replay_html(&plain_world, &plain_trace, None, "{}", "plain").expect("page");
+    let plain = replay_html(&plain_world, &plain_trace, None, "{}", "plain", &[]).expect("page");
     assert!(plain.contains(r#""zones":null"#));
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("replay-zones");
     std::fs::create_dir_all(&dir).expect("dir");
@@ -412,7 +412,7 @@ fn a_move_before_the_first_region_is_no_region_in_the_replay_legend() {
     for r in plain.records() {
         trace.push(r);
     }
-    let html = replay_html(&world, &trace, None, "{}", "pre-region").expect("page");
+    let html = replay_html(&world, &trace, None, "{}", "pre-region", &[]).expect("page");
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("replay-pre-region");
     std::fs::create_dir_all(&dir).expect("dir");
     std::fs::write(dir.join("page.html"), &html).expect("write");
@@ -457,7 +457,7 @@ fn region_numbers_beyond_sixteen_bits_stay_apart() {
             other => other,
         });
     }
-    let html = replay_html(&world, &trace, None, "{}", "many-regions").expect("page");
+    let html = replay_html(&world, &trace, None, "{}", "many-regions", &[]).expect("page");
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("replay-many-regions");
     std::fs::create_dir_all(&dir).expect("dir");
     std::fs::write(dir.join("page.html"), &html).expect("write");
@@ -510,7 +510,7 @@ fn a_run_that_never_moves_shows_its_swept_start_disk() {
     let swept = ccpp_core::metrics::swept_pixels(&world, &trace).count_ones(..);
     assert_eq!(swept, 29, "the start disk of radius 3 px");
     let metrics = r#"{"planner":"bcd","map":"tiny","effective_coverage":1.0,"path_length_m":0.0}"#;
-    let html = replay_html(&world, &trace, None, metrics, "bcd on tiny").expect("page");
+    let html = replay_html(&world, &trace, None, metrics, "bcd on tiny", &[]).expect("page");
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("replay-still");
     std::fs::create_dir_all(&dir).expect("dir");
     std::fs::write(dir.join("page.html"), &html).expect("write");
@@ -543,7 +543,7 @@ fn a_run_that_never_moves_shows_its_swept_start_disk() {
 #[test]
 fn a_fragment_set_in_the_open_page_moves_the_replay() {
     let (world, trace) = run(200, 120, 400);
-    let html = replay_html(&world, &trace, None, "{}", "hash").expect("page");
+    let html = replay_html(&world, &trace, None, "{}", "hash", &[]).expect("page");
     let probe = r##"<script>
 window.addEventListener("load", () => {
   const seen = [];
@@ -632,7 +632,7 @@ fn the_step_count_runs_along_a_lane_and_ends_at_the_runs_end() {
             reason: "stalled".into(),
         },
     );
-    let html = replay_html(&world, &trace, None, "{}", "stalled lane").expect("page");
+    let html = replay_html(&world, &trace, None, "{}", "stalled lane", &[]).expect("page");
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("replay-steps");
     std::fs::create_dir_all(&dir).expect("dir");
     std::fs::write(dir.join("page.html"), &html).expect("write");
@@ -672,6 +672,7 @@ fn a_map_name_with_html_comment_and_script_tags_still_replays() {
         None,
         &metrics,
         &format!("ba-star on {name}"),
+        &[],
     )
     .expect("page");
     let script = html

@@ -20,7 +20,7 @@ fn far_pose_renders_in_bounded_time() {
         trace.push_pose(2, Pose::new(-3e300, 4e300, 0.0));
         trace.push_pose(3, Pose::new(1.5, 0.75, 0.0));
         let gif = replay_gif(&world, &trace, &GifOptions::default()).unwrap();
-        let html = replay_html(&world, &trace, None, "{}", "far").unwrap();
+        let html = replay_html(&world, &trace, None, "{}", "far", &[]).unwrap();
         let _ = tx.send((gif.len(), html.len()));
     });
     let (gif, html) = rx
