@@ -30,6 +30,7 @@ fuzz_target!(|data: &[u8]| {
             robot: world.robot(),
             sensor_range: sim.sensor_range_for(&world.robot()),
             max_steps: sim.max_steps,
+            noisy: false,
         };
         for &kind in PlannerKind::ALL {
             let config = opts.config(kind);

@@ -44,7 +44,7 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     let tile_side = rec.as_ref().and_then(Scenario::tile_side);
-    let _ = replay_html(world, &trace, tile_side, "{}", "fuzz");
+    let _ = replay_html(world, &trace, tile_side, "{}", "fuzz", &[]);
     // Few small frames: the same drawing code as the CLI's 60 frames of 400 px, at a cost that
     // allows millions of runs.
     let gif = GifOptions {
