@@ -163,12 +163,15 @@ pub(crate) fn zone_class(world: &World, i: usize) -> u8 {
 /// Region colours (colour-blind-friendly-ish, distinct on light blue, at least 60 apart in
 /// RGB). No red: red marks collisions, keep-outs and a stopped run (the second region's path
 /// was the keep-out hatching's red, and the first replacement's brown 24.5 from the olive).
+/// At least 60 from the markers too: an orange lane ran into the critical points' orange
+/// squares (14 apart), a purple one under the restart rings and the area border (30 and 49),
+/// a green one past the start (32).
 const PALETTE: [[u8; 3]; 10] = [
     [0, 90, 181],
     [230, 0, 250],
-    [0, 140, 70],
-    [150, 60, 170],
-    [230, 130, 0],
+    [0, 110, 90],
+    [120, 120, 200],
+    [180, 120, 0],
     [0, 150, 160],
     [130, 190, 0],
     [210, 60, 140],
@@ -2202,6 +2205,15 @@ mod tests {
             }
             for q in PALETTE.iter().filter(|&&q| q != p) {
                 assert!(far(p, *q) > 60.0, "{p:?} is close to {q:?}");
+            }
+            for m in [
+                colours::START,
+                colours::CRITICAL,
+                colours::RESTART,
+                colours::AREA_BORDER,
+                colours::APPROACH,
+            ] {
+                assert!(far(p, m) > 60.0, "{p:?} is close to the marker {m:?}");
             }
         }
     }
