@@ -276,12 +276,10 @@ pub fn run(a: &InfoArgs) -> Result<()> {
                 "accessible     {:.2} m2 (floor a tool of radius {} m can touch from the start{})",
                 w.accessible_area_m2(),
                 num(robot.tool_radius),
-                match w.zones() {
-                    Some(z) if z.area.is_some() && z.keepout.count_ones(..) > 0 => {
-                        ", inside the area, outside the keep-outs"
-                    }
-                    Some(z) if z.area.is_some() => ", inside the area",
-                    Some(z) if z.keepout.count_ones(..) > 0 => ", outside the keep-outs",
+                match w.zones().map(|z| (z.area.is_some(), !z.keepout.is_clear())) {
+                    Some((true, true)) => ", inside the area, outside the keep-outs",
+                    Some((true, false)) => ", inside the area",
+                    Some((false, true)) => ", outside the keep-outs",
                     _ => "",
                 }
             ));

@@ -128,13 +128,7 @@ pub fn replay_dir(dir: &Path) -> Result<()> {
     {
         Ok(m) => {
             let swept = ccpp_core::metrics::swept_pixels(&world, &trace);
-            StartComponent::of(world.map(), world.start().position())
-                .warning()
-                .into_iter()
-                .chain(ccpp_io::warnings::run_warnings(
-                    &scenario, &world, &trace, &m, &swept,
-                ))
-                .collect()
+            ccpp_io::warnings::warnings_with_start(None, &scenario, &world, &trace, &m, &swept)
         }
         // Metrics of another shape (checked above for the figures the replay reads).
         Err(_) => Vec::new(),
@@ -426,17 +420,14 @@ pub fn emit(
     let comp = r
         .start_area
         .unwrap_or_else(|| StartComponent::of(r.world.map(), r.world.start().position()));
-    let warnings: Vec<String> = comp
-        .warning()
-        .into_iter()
-        .chain(ccpp_io::warnings::run_warnings(
-            &job.scenario,
-            &r.world,
-            &r.run.trace,
-            &r.metrics,
-            &r.swept,
-        ))
-        .collect();
+    let warnings = ccpp_io::warnings::warnings_with_start(
+        Some(comp),
+        &job.scenario,
+        &r.world,
+        &r.run.trace,
+        &r.metrics,
+        &r.swept,
+    );
     let metrics = write_run_files(&job.out, job, r, replay, &export_files, &warnings);
     busy.done();
     let metrics = metrics?;

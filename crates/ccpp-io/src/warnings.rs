@@ -6,6 +6,7 @@ use ccpp_core::trace::{Event, Trace};
 use ccpp_core::world::World;
 use fixedbitset::FixedBitSet;
 
+use crate::components::StartComponent;
 use crate::scenario::Scenario;
 
 /// What an early stop (`Metrics::stop_reason`, or a plan's stop) means; `what` is the
@@ -459,6 +460,26 @@ pub fn boxed_in_warning(trace: &Trace) -> Option<String> {
 /// Joins a run's warnings in one field (`ccpp bench`'s `results.csv`, `ccpp.sweep`'s
 /// `warnings` column).
 pub const SEPARATOR: &str = " | ";
+
+/// The warnings `ccpp run` prints, in its order: the start's free area reaching the map's
+/// border ([`StartComponent::warning`], from `start_area` when the caller found it while the
+/// planner worked, else found here), then [`run_warnings`]. `ccpp run`, `ccpp replay DIR` and
+/// Python's `run` list these (the bench's `warnings.txt` is [`run_warnings`] alone).
+pub fn warnings_with_start(
+    start_area: Option<StartComponent>,
+    scenario: &Scenario,
+    world: &World,
+    trace: &Trace,
+    metrics: &Metrics,
+    swept: &FixedBitSet,
+) -> Vec<String> {
+    start_area
+        .unwrap_or_else(|| StartComponent::of(world.map(), world.start().position()))
+        .warning()
+        .into_iter()
+        .chain(run_warnings(scenario, world, trace, metrics, swept))
+        .collect()
+}
 
 /// Every warning of a run of `scenario` in `world` with this trace and these metrics: an early
 /// stop, PID motions cut short, contacts or a true pose far off the plan under drift, no

@@ -1403,20 +1403,14 @@ fn run(
             // The warnings (the flood fill of the start's free area, rect-boustrophedon's
             // reach) here, once, and not on each `warnings` read: a read held the GIL for a
             // second on a 16-million-pixel map.
-            let w = ccpp_io::components::StartComponent::of(
-                run.world.map(),
-                run.world.start().position(),
-            )
-            .warning()
-            .into_iter()
-            .chain(ccpp_io::warnings::run_warnings(
+            let w = ccpp_io::warnings::warnings_with_start(
+                None,
                 &sc,
                 &run.world,
                 &run.output.trace,
                 &run.metrics,
                 &run.swept,
-            ))
-            .collect::<Vec<String>>();
+            );
             (run, w)
         })
     })?
