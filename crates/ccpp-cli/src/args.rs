@@ -392,9 +392,10 @@ impl From<&BenchRobotArgs> for RobotArgs {
 /// `ccpp planners`.
 #[derive(Args, Debug)]
 pub struct PlannersArgs {
-    /// Print the default options of every planner (or of the planners named) as a `--config`
-    /// file: YAML, one section per planner, every field at its default
-    #[arg(long, value_name = "A,B,...", num_args = 0..=1, value_delimiter = ',', require_equals = false, default_missing_value = "")]
+    /// Print the default options of every planner (`--defaults` alone, or `all`) or of the
+    /// planners named as a `--config` file: YAML, one section per planner, every field at its
+    /// default
+    #[arg(long, value_name = "A,B,...", num_args = 0..=1, value_delimiter = ',', require_equals = false, default_missing_value = "all")]
     pub defaults: Option<Vec<String>>,
 }
 

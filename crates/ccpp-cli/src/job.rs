@@ -176,11 +176,19 @@ pub fn planner_options(config: Option<&Path>, seed: Option<u64>) -> Result<Plann
 /// # Errors
 /// An unknown planner name.
 pub fn default_options_yaml(names: &[String]) -> Result<String> {
+    let all = names.len() == 1 && names[0].trim() == "all";
+    // An empty name (`--defaults ''`, `--defaults bcd,`) names no planner: it printed every
+    // one (hostile pass).
+    if !all && names.iter().any(|n| n.trim().is_empty()) {
+        bail!(
+            "--defaults: an empty planner name in {:?}; name the planners (A,B,...), or give --defaults alone (or all) for every planner",
+            names.join(",")
+        );
+    }
     let wanted = names
         .iter()
-        .map(|n| n.trim())
-        .filter(|n| !n.is_empty())
-        .map(|n| parse_planner(n).map(|k| k.info().section))
+        .filter(|_| !all)
+        .map(|n| parse_planner(n.trim()).map(|k| k.info().section))
         .collect::<Result<Vec<_>>>()?;
     // The typed options keep their fields in declaration order (documented order); a section
     // is a top-level key and the lines indented under it.
@@ -513,7 +521,12 @@ fn sim_from(a: &RunArgs, config: &mut PlannerConfig) -> Result<SimConfig> {
     let ask = ExecAsk {
         pid: exec,
         noise,
-        seed: a.seed,
+        // random-bounce's seed, from the flag or its options file, also seeds the noise
+        // (`--seed 7` and `random_bounce: { seed: 7 }` are the same option; hostile pass).
+        seed: a.seed.or(match &*config {
+            PlannerConfig::RandomBounce(o) => Some(o.seed),
+            _ => None,
+        }),
         // A file that gives the noise at all (`noise: null` too, as `planners --defaults`
         // prints it) clashes, as every other flag beside its option in the file does.
         noise_given_in: file_sets(

@@ -135,6 +135,32 @@ fn planners_defaults_is_a_config_of_the_defaults() {
         err.starts_with("error: ") && err.contains("zigzag"),
         "{err}"
     );
+    // `all` is `--defaults` alone; an empty name names nothing (it printed every planner).
+    let every = |args: &[&str]| {
+        String::from_utf8(
+            ccpp()
+                .args(args)
+                .assert()
+                .success()
+                .get_output()
+                .stdout
+                .clone(),
+        )
+        .unwrap()
+    };
+    assert_eq!(
+        every(&["planners", "--defaults", "all"]),
+        every(&["planners", "--defaults"])
+    );
+    for empty in ["", "bcd,", ",bcd"] {
+        let bad = ccpp()
+            .args(["planners", "--defaults", empty])
+            .assert()
+            .code(1);
+        let err = String::from_utf8_lossy(&bad.get_output().stderr).into_owned();
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        assert!(err.contains("an empty planner name"), "{empty:?}: {err}");
+    }
 }
 
 #[test]

@@ -173,8 +173,43 @@ fn the_noise_flag_beside_a_null_noise_in_the_file_is_refused() {
             "--out",
             s(&dir.join("out")),
         ],
-        &["--odometry-noise replaces the odometry noise", "n.yaml"],
+        &[
+            "--odometry-noise and the odometry noise setting of bsa-bfs",
+            "n.yaml",
+            "set the same option",
+        ],
     );
+}
+
+/// random-bounce's seed is one option, given as `--seed` or in the file: under odometry noise
+/// the flag seeded the noise and the file's seed did not (noise seed 0), so the two "same"
+/// runs differed (hostile pass).
+#[test]
+fn random_bounces_seed_from_the_file_seeds_the_noise_as_the_flag_does() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let cfg = write(dir, "seed.yaml", "random_bounce: { seed: 7 }\n");
+    let noisy = ["--odometry-noise", "0.01"];
+    let by_flag = run_ok(
+        dir,
+        "flag",
+        &map,
+        "random-bounce",
+        &[&noisy[..], &["--seed", "7"]].concat(),
+    );
+    let by_file = run_ok(
+        dir,
+        "file",
+        &map,
+        "random-bounce",
+        &[&noisy[..], &["--config", &cfg]].concat(),
+    );
+    let unseeded = run_ok(dir, "zero", &map, "random-bounce", &noisy);
+    assert_eq!(outcome(&by_flag), outcome(&by_file));
+    assert_ne!(outcome(&by_flag), outcome(&unseeded));
+    let rj = common::read_json(&by_file.join("run.json"));
+    assert_eq!(rj["sim"]["exec"]["pid"]["noise"]["seed"], 7, "{rj}");
 }
 
 /// With one turn angle (`min_turn_deg = max_turn_deg`) random-bounce draws nothing, so a seed

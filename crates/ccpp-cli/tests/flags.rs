@@ -28,6 +28,11 @@ fn metrics(out: &Path) -> serde_json::Value {
     v
 }
 
+/// The driven path (`path.csv`).
+fn driven(out: &Path) -> String {
+    std::fs::read_to_string(out.join("path.csv")).unwrap()
+}
+
 fn trace(out: &Path) -> String {
     std::fs::read_to_string(out.join("trace.jsonl")).unwrap()
 }
@@ -68,17 +73,35 @@ fn run_fails(dir: &Path, map: &Path, planner: &str, args: &[&str], needles: &[&s
     assert!(!out.join("metrics.json").exists());
 }
 
-/// Checks that `flag value` changes the output of each planner in `applies` (metrics or
-/// trace), and is refused by every other planner with "does not apply".
+/// Checks that `flag value` changes the output of each planner in `applies` (its metrics or
+/// the driven path: a trace that differs only in its bookkeeping, such as the points of a
+/// `path_smoothed` event, is not a changed run; hostile pass), and is refused by every other planner with "does not apply".
 fn flag_applies(dir: &Path, map: &Path, flag: &[&str], applies: &[&str], base: &[&str]) {
+    flag_applies_with(dir, map, flag, applies, base, &[]);
+}
+
+/// [`flag_applies`], where the planners of `own` run with their own extra base arguments.
+fn flag_applies_with(
+    dir: &Path,
+    map: &Path,
+    flag: &[&str],
+    applies: &[&str],
+    base: &[&str],
+    own: &[(&str, &[&str])],
+) {
     for p in ALL {
         if applies.contains(&p) {
+            let mut base = base.to_vec();
+            if let Some((_, extra)) = own.iter().find(|(q, _)| *q == p) {
+                base.extend_from_slice(extra);
+            }
+            let base = base.as_slice();
             let a = run_ok(dir, &format!("{p}-base"), map, p, base);
             let mut args = base.to_vec();
             args.extend_from_slice(flag);
             let b = run_ok(dir, &format!("{p}-flag"), map, p, &args);
             assert!(
-                metrics(&a) != metrics(&b) || trace(&a) != trace(&b),
+                metrics(&a) != metrics(&b) || driven(&a) != driven(&b),
                 "{flag:?} changes nothing for {p}"
             );
         } else {
@@ -102,13 +125,27 @@ fn planner_flags_apply_where_they_should() {
         &["ba-star", "ba-star-extended", "bsa-bfs"],
         &[],
     );
-    flag_applies(
+    // ba-star-extended drives BA*'s smoothed backtrack only where its own known-free way is
+    // not shorter (`shorter_backtrack`, the default): on this map nowhere (only the trace's
+    // `path_smoothed` points changed), so the flag is shown on BA*'s own backtracks, and on
+    // `nav2_depot` with the defaults.
+    let cfg = dir.join("own-backtrack.yaml");
+    std::fs::write(&cfg, "ba_star_extended: { shorter_backtrack: false }\n").unwrap();
+    flag_applies_with(
         dir,
         m,
         &["--smoothing", "off"],
         &["ba-star", "ba-star-extended"],
         &[],
+        &[("ba-star-extended", &["--config", cfg.to_str().unwrap()])],
     );
+    if let Some(shared) = common::shared_maps() {
+        let depot = shared.join("nav2_depot.yaml");
+        let p = "ba-star-extended";
+        let a = run_ok(dir, "depot", &depot, p, &[]);
+        let b = run_ok(dir, "depot-off", &depot, p, &["--smoothing", "off"]);
+        assert_ne!(driven(&a), driven(&b));
+    }
     flag_applies(dir, m, &["--side", "right"], &["bsa", "bsa-extended"], &[]);
     flag_applies(dir, m, &["--length", "0.5"], &["rect-boustrophedon"], &[]);
     flag_applies(dir, m, &["--width", "0.2"], &["rect-boustrophedon"], &[]);
@@ -158,7 +195,24 @@ fn planner_flags_apply_where_they_should() {
         let b = run_ok(dir, &format!("{p}-range"), m, p, &sensor);
         let run_json = common::read_json(&b.join("run.json"));
         assert_eq!(run_json["sim"]["sensor_range"], 0.475, "{p}");
-        assert!(metrics(&a) != metrics(&b) || trace(&a) != trace(&b), "{p}");
+        assert_ne!(metrics(&a), metrics(&b), "{p}");
+    }
+    // A longer range than the default changes the extended planners' runs on a real map too:
+    // they route over what they know (a test on the small maps alone found nothing to show it;
+    // hostile pass). `aws_small_house` at 1.2 m (8 r): both drive a different path.
+    if let Some(shared) = common::shared_maps() {
+        let house = shared.join("aws_small_house.yaml");
+        for p in ["ba-star-extended", "bsa-extended"] {
+            let a = run_ok(dir, &format!("{p}-house"), &house, p, &[]);
+            let b = run_ok(
+                dir,
+                &format!("{p}-house-far"),
+                &house,
+                p,
+                &["--sensor-range", "1.2"],
+            );
+            assert_ne!(metrics(&a), metrics(&b), "{p}");
+        }
     }
     // Their sensor is set to see the neighbour tiles: a tile whose neighbours lie beyond the
     // default 4 r (0.5 + 0.15 + 0.025 = 0.675 m > 0.6 m) still runs (it was refused, asking

@@ -138,8 +138,10 @@ pub fn execution(
         }
         if pid.noise.is_some() || ask.noise_given_in.is_some() {
             let place = ask.noise_given_in.as_deref().unwrap_or("its options");
+            // `noise: null` (as `planners --defaults` prints it) sets the option too: the
+            // message names the setting, not a noise that may not be there (hostile pass).
             return Err(format!(
-                "{noise} replaces the odometry noise given for {kind} in {place}; remove one of them"
+                "{noise} and the odometry noise setting of {kind} in {place} set the same option; remove one of them"
             ));
         }
         // Exactly the noise asked for: a heading drift left out is 0, not the library's

@@ -935,7 +935,12 @@ fn scenario_from(
     let ask = ExecAsk {
         pid,
         noise,
-        seed,
+        // random-bounce's seed, from `seed=` or its options, also seeds the noise (the two
+        // are the same option; hostile pass).
+        seed: seed.or(match &s.planner {
+            PlannerConfig::RandomBounce(o) => Some(o.seed),
+            _ => None,
+        }),
         noise_given_in: gives_noise
             .then(|| format!("options[\"exec\"], its {section}.exec.pid.noise")),
         pid_given_in: (gives_pid || own_pid)
@@ -1300,7 +1305,9 @@ impl RunResult {
     /// `ccpp run --export FORMAT`. All or nothing, as the command line: the files of an older
     /// run or plan in `folder` are replaced whole, a folder holding other files is refused.
     /// Ctrl-C while the files are drawn raises `KeyboardInterrupt` once they are drawn (the
-    /// picture of a long run takes seconds) and leaves `folder` as it was.
+    /// picture of a long run takes seconds) and leaves `folder` as it was. Ctrl-C after that,
+    /// while they are written, lets the write finish: `folder` then holds the new set whole,
+    /// and Python raises `KeyboardInterrupt` as `save` returns.
     #[pyo3(signature = (folder, export=None))]
     fn save(&self, py: Python<'_>, folder: PathBuf, export: Option<Formats>) -> PyResult<()> {
         utf8_path(&folder, "folder")?;

@@ -140,6 +140,14 @@ def test_pid_execution_is_available(room: Path) -> None:
     _, reward, terminated, _, info = env.step(("translate", 0.5))
     assert reward > 0 and not terminated
     assert info["true_pose"][0] > 0.4
+    # The episode ran under PID execution (without noise it tracks the path exactly, so the
+    # tracking figures are what tells it from ideal execution; the test passed with `exec`
+    # dropped: hostile pass).
+    assert "tracking_error_max_m" in env.metrics()
+    ideal = ccpp.Env(room, radius=0.15)
+    ideal.reset()
+    ideal.step(("translate", 0.5))
+    assert "tracking_error_max_m" not in ideal.metrics()
 
 
 def test_replaying_a_run_sweeps_what_the_run_swept(room: Path) -> None:

@@ -67,6 +67,12 @@ def test_a_keyword_and_the_same_key_in_options_must_agree(room: Path, ccpp_bin: 
     assert np.array_equal(
         ccpp.run(m, "random-bounce", seed=2, options={"seed": 2}).path, ccpp.run(m, "random-bounce", seed=2).path
     )
+    # ... and under odometry noise too: the option's seed seeds the noise as seed= does (the
+    # noise was seeded 0 when the seed came from the options; hostile pass).
+    by_kw = ccpp.run(m, "random-bounce", seed=7, odometry_noise=0.01)
+    by_opt = ccpp.run(m, "random-bounce", options={"seed": 7}, odometry_noise=0.01)
+    assert np.array_equal(by_kw.path, by_opt.path)
+    assert json.loads(by_opt.scenario_json)["sim"]["exec"]["pid"]["noise"]["seed"] == 7
     # Seeds span the whole u64 range, as `--seed` does.
     big = ccpp.run(m, "random-bounce", seed=2**64 - 1)
     assert json.loads(big.scenario_json)["options"]["seed"] == 2**64 - 1
@@ -279,7 +285,7 @@ def test_odometry_noise_and_landmarks_are_the_cli_runs(shared_maps: Path, ccpp_b
             ccpp.run(maze, "bcd", **kw)
     with pytest.raises(ccpp.CcppError, match="does not apply to a plan"):
         ccpp.plan(maze, "bcd", odometry_noise=0.02)
-    with pytest.raises(ccpp.CcppError, match="replaces the odometry noise given for bsa-bfs"):
+    with pytest.raises(ccpp.CcppError, match="the odometry noise setting of bsa-bfs .* set the same option"):
         ccpp.run(maze, "bsa-bfs", odometry_noise=0.02, options={"exec": {"pid": {"noise": None}}})
 
 
@@ -345,3 +351,29 @@ def test_warnings_are_the_cli_warnings(shared_maps: Path, ccpp_bin: str, tmp_pat
     p = cli(ccpp_bin, "run", "--map", str(depot), "--planner", "bsa", "--out", str(tmp_path / "depot"))
     assert p.returncode == 0, p.stderr
     assert r.warnings == [line.removeprefix("warning: ") for line in p.stderr.splitlines() if line.startswith("warning: ")]
+
+
+def test_load_map_thresholds_and_georef_change_the_map(tmp_path: Path) -> None:
+    """`occupied_thresh=`, `free_thresh=` and `georef=` of `load_map` had no test showing they
+    change the map (hostile pass)."""
+    w, h = 20, 10
+    pix = bytearray()
+    for y in range(h):
+        for x in range(w):
+            wall = x in (0, w - 1) or y in (0, h - 1)
+            pix.append(0 if wall else (128 if x == 10 else 254))
+    img = tmp_path / "grey.pgm"
+    img.write_bytes(f"P5\n{w} {h}\n255\n".encode() + bytes(pix))
+    plain = ccpp.load_map(img, resolution=0.05)
+    grey = plain.occupancy[1:-1, 10]
+    # p = (255 - 128) / 255 = 0.498: unknown between the defaults 0.196 and 0.65.
+    assert (grey == 2).all()
+    assert (ccpp.load_map(img, resolution=0.05, occupied_thresh=0.4).occupancy[1:-1, 10] == 1).all()
+    assert (ccpp.load_map(img, resolution=0.05, free_thresh=0.55).occupancy[1:-1, 10] == 0).all()
+    # A georeference of twice the scale: 0.1 m a pixel, the image's corner at (100, 200).
+    g = tmp_path / "g.csv"
+    g.write_text("px,py,wx,wy\n0,10,100,200\n20,10,102,200\n0,0,100,201\n")
+    geo = ccpp.load_map(img, georef=g)
+    assert geo.resolution == pytest.approx(0.1)
+    assert geo.origin[:2] == pytest.approx((100.0, 200.0))
+    assert np.array_equal(geo.occupancy, plain.occupancy)
