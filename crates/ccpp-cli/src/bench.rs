@@ -57,7 +57,7 @@ pub fn run_key(
     h.bytes(serde_json::to_string(&robot)?.as_bytes());
     h.bytes(serde_json::to_string(sim)?.as_bytes());
     h.bytes(env!("CARGO_PKG_VERSION").as_bytes());
-    Ok(format!("ccpp-bench-key v7 {:016x}\n", h.finish()))
+    Ok(format!("ccpp-bench-key v8 {:016x}\n", h.finish()))
 }
 
 /// Runs the benchmark.
@@ -242,7 +242,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     write_file(&a.out.join("results.csv"), results_csv(&rows).as_bytes())?;
     summary.done();
     for line in &left_out {
-        eprintln!("{line}");
+        say!("{line}");
     }
     let failed = rows.iter().filter(|r| r.outcome.is_err()).count();
     crate::print_stdout(&format!(
@@ -281,10 +281,10 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         ))?;
     }
     if !outside.is_empty() {
-        eprintln!("{}", outside_warning(&outside));
+        say!("{}", outside_warning(&outside));
     }
     if let Some(note) = earlier_runs_note(&a.out, &rows) {
-        eprintln!("{note}");
+        say!("{note}");
     }
     if failed > 0 {
         bail!(
@@ -444,7 +444,7 @@ const BENCH_RUN_FILES: [&str; 7] = [
     "trace.jsonl",
     "coverage.png",
     "metrics.json",
-    "bench-key.txt",
+    KEY_FILE,
     WARNINGS_FILE,
 ];
 
@@ -478,10 +478,17 @@ fn run_one(
         .map_err(|e| crate::errors::one_line(&e))?
         .unwrap_or_default();
     let metrics_path = dir.join("metrics.json");
+    if let (Some(parent), Some(name)) = (dir.parent(), dir.file_name().and_then(|n| n.to_str())) {
+        // Staging folders of a killed run beside this one (they stayed for good: the folder
+        // was reused, and only a run into it cleans beside it; hostile pass).
+        crate::staging::clean_stale(parent, name);
+    }
     if !a.force && dir.join("trace.jsonl").is_file() {
         // Regular files only (a FIFO would block the bench forever).
-        let same_key = ccpp_io::file::read_text(&dir.join("bench-key.txt")).is_ok_and(|k| k == key);
-        if same_key {
+        let listed = ccpp_io::file::read_text(&dir.join(KEY_FILE))
+            .ok()
+            .and_then(|k| k.strip_prefix(key.as_str()).map(str::to_string));
+        if let Some(listed) = listed {
             if let Ok(text) = ccpp_io::file::read_text(&metrics_path) {
                 if let Ok(m) = serde_json::from_str::<Metrics>(&text) {
                     // Reused only when its trace reads back whole: a damaged trace was reused
@@ -493,13 +500,15 @@ fn run_one(
                         .find(|f| ccpp_io::file::open_regular(&dir.join(f)).is_err());
                     let whole = match missing {
                         Some(f) => Err(format!("{f} is missing")),
-                        None => whole_trace(dir, map.grid.frame(), robot.radius, budget)
+                        None => same_run(&m, &map.name, planner)
+                            .and_then(|()| sizes_match(dir, &listed))
+                            .and_then(|()| whole_trace(dir, map.grid.frame(), robot.radius, budget))
                             .and_then(|()| read_warnings(dir)),
                     };
                     match whole {
                         Ok(w) => return Ok((m, w)),
                         Err(why) => {
-                            eprintln!("warning: {}: {why}; running it again", dir.display());
+                            say!("warning: {}: {why}; running it again", dir.display());
                         }
                     }
                 }
@@ -524,6 +533,51 @@ fn run_one(
     let _grant = budget.take(bytes);
     let m = run_isolated(&spec)?;
     Ok((m, read_warnings(dir)?))
+}
+
+/// The file of a bench run folder that holds the run's key ([`run_key`]) and then a line
+/// `NAME SIZE` for each of its other files.
+const KEY_FILE: &str = "bench-key.txt";
+
+/// Checks that a reused run folder's metrics are of this run: a `metrics.json` copied from
+/// another run (`bcd`'s into `ba-star`'s folder) was reused and its numbers reported in the
+/// other planner's row (hostile pass).
+fn same_run(m: &Metrics, map: &str, planner: &str) -> Result<(), String> {
+    if m.planner == planner && m.map == map {
+        Ok(())
+    } else {
+        Err(format!(
+            "metrics.json is of {} on {}, not of this run",
+            m.planner, m.map
+        ))
+    }
+}
+
+/// Checks the sizes `listed` in a run folder's [`KEY_FILE`] (after its key) against the files
+/// of `dir`: a copy cut short (a truncated `coverage.png` or `path.csv`) was reused, and a
+/// `run.json` emptied by hand too (hostile pass).
+fn sizes_match(dir: &Path, listed: &str) -> Result<(), String> {
+    let mut seen = 0;
+    for line in listed.lines() {
+        let parsed = line
+            .rsplit_once(' ')
+            .and_then(|(f, n)| Some((f, n.parse::<u64>().ok()?)));
+        let Some((file, len)) = parsed else {
+            return Err(format!("{KEY_FILE} is damaged"));
+        };
+        let actual = std::fs::metadata(dir.join(file)).map_or(None, |m| Some(m.len()));
+        if actual != Some(len) {
+            return Err(format!(
+                "{file} is not the file the run wrote ({len} bytes were written)"
+            ));
+        }
+        seen += 1;
+    }
+    // Every file but the key file itself is listed.
+    if seen + 1 < BENCH_RUN_FILES.len() {
+        return Err(format!("{KEY_FILE} lists too few files"));
+    }
+    Ok(())
 }
 
 /// Checks that the `trace.jsonl` of the run folder `dir` reads back (as the plots read it,
@@ -650,7 +704,7 @@ pub fn child_main() -> std::process::ExitCode {
             Err(_) => std::process::ExitCode::FAILURE,
         },
         Err(e) => {
-            eprintln!("error: {}", crate::errors::one_line(&e));
+            say!("error: {}", crate::errors::one_line(&e));
             std::process::ExitCode::FAILURE
         }
     }
@@ -679,7 +733,7 @@ fn child_job() -> Result<String> {
     };
     let result = job.execute()?;
     if let Some(note) = result.approach_note() {
-        eprintln!("{note}");
+        say!("{note}");
     }
     // One a line (a line break inside one, as from a map's name, made a space).
     let list = ccpp_io::warnings::run_warnings(
@@ -694,11 +748,16 @@ fn child_job() -> Result<String> {
         warnings.push_str(&w.replace(['\n', '\r'], " "));
         warnings.push('\n');
     }
-    let extra = [
-        ("bench-key.txt", spec.key.into_bytes()),
-        (WARNINGS_FILE, warnings.into_bytes()),
-    ];
-    write_run_files(&job.out, &job, &result, false, &extra, &list)
+    let extra = [(WARNINGS_FILE, warnings.into_bytes())];
+    write_run_files(
+        &job.out,
+        &job,
+        &result,
+        false,
+        &extra,
+        &list,
+        Some((KEY_FILE, &spec.key)),
+    )
 }
 
 /// Quotes a CSV field when needed (a carriage return too: a map file named with one split
@@ -872,6 +931,11 @@ fn earlier_runs_note(out: &Path, rows: &[Row]) -> Option<String> {
         planners.sort_by_key(std::fs::DirEntry::file_name);
         for p in planners {
             let planner = p.file_name().to_string_lossy().into_owned();
+            // (a staging folder of a killed run, `.bcd.ccpp-new-PID-N`, is no run folder;
+            // it was named as one of an earlier bench)
+            if planner.starts_with('.') {
+                continue;
+            }
             // (a run of this bench that failed leaves the earlier bench's folder, which its
             // error row does not describe, in place)
             let ours = rows

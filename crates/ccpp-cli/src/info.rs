@@ -197,7 +197,7 @@ pub fn run(a: &InfoArgs) -> Result<()> {
         zones: zones_info,
     };
     if let Some(w) = comp.and_then(|c| c.warning()) {
-        eprintln!("warning: {w}");
+        say!("warning: {w}");
     }
     if a.json {
         crate::print_stdout(&format!("{}\n", serde_json::to_string_pretty(&info)?))?;

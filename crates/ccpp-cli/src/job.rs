@@ -254,7 +254,7 @@ pub fn warn_unused_config(config: Option<&Path>, kinds: &[PlannerKind]) {
         .unwrap_or_default();
     let names: Vec<&str> = kinds.iter().map(|k| k.name()).collect();
     let wanted: Vec<&str> = kinds.iter().map(|k| k.info().section).collect();
-    eprintln!(
+    say!(
         "warning: {} has no section for {} ({}{}): {} at the planner defaults",
         f.display(),
         names.join(", "),

@@ -3,6 +3,17 @@
 //! A thin binary: clap arguments -> a validated [`job::Job`] -> dispatch. All the work lives in
 //! the `ccpp-core`, `ccpp-io` and `ccpp-render` crates.
 
+/// `eprintln!` that never panics: stderr that cannot be written (`2>/dev/full`, a closed
+/// pipe) has no reader to tell, and `eprintln!` panicked there (exit 101) after the run's
+/// folder was written (hostile pass). Warnings and errors go through this.
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        // (nothing to tell when stderr itself fails: see the macro's doc)
+        let _ = writeln!(std::io::stderr(), $($arg)*);
+    }};
+}
+
 mod args;
 mod bench;
 mod budget;
@@ -40,7 +51,7 @@ fn main() -> ExitCode {
         Err(e) => return clap_exit(&e),
     };
     if let Err(msg) = utf8_values(&Cli::command(), &matches) {
-        eprintln!("error: {msg}");
+        say!("error: {msg}");
         return ExitCode::FAILURE;
     }
     let cli = match Cli::from_arg_matches(&matches) {
@@ -52,14 +63,14 @@ fn main() -> ExitCode {
     if let Some(why) =
         ccpp_io::scenario::threads_env_problem(std::env::var("RAYON_NUM_THREADS").ok().as_deref())
     {
-        eprintln!("error: {why}");
+        say!("error: {why}");
         return ExitCode::FAILURE;
     }
     staging::install_signal_handler();
     match dispatch(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {}", errors::one_line(&e));
+            say!("error: {}", errors::one_line(&e));
             ExitCode::FAILURE
         }
     }
@@ -108,14 +119,14 @@ fn clap_exit(e: &clap::Error) -> ExitCode {
             ExitCode::SUCCESS
         }
         ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
-            eprintln!("error: no command given");
-            eprintln!("hint: see `ccpp --help`");
+            say!("error: no command given");
+            say!("hint: see `ccpp --help`");
             ExitCode::FAILURE
         }
         _ => {
             let (line, hint) = errors::clap_lines(e);
-            eprintln!("error: {line}");
-            eprintln!("{hint}");
+            say!("error: {line}");
+            say!("{hint}");
             ExitCode::FAILURE
         }
     }
@@ -148,7 +159,7 @@ fn execute(job: &mut job::Job) -> anyhow::Result<job::JobResult> {
     busy.done();
     let result = result?;
     if let Some(note) = result.approach_note() {
-        eprintln!("{note}");
+        say!("{note}");
     }
     Ok(result)
 }

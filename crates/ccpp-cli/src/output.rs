@@ -23,6 +23,10 @@ use crate::staging::Staging;
 /// marks a complete run where files are written one by one) is written first here: the staging
 /// folder shows all files or none, and its sync then overlaps the drawing of the picture.
 /// Returns the metrics JSON.
+///
+/// `manifest`: a file written last, `(name, head)`: `head` and then a line `NAME SIZE` for
+/// every other file of the folder (a bench run's `bench-key.txt`, by which a resumed bench
+/// tells a whole run folder from one cut short).
 pub fn write_run_files(
     out: &Path,
     job: &Job,
@@ -30,6 +34,7 @@ pub fn write_run_files(
     replay: bool,
     extra: &[(&'static str, Vec<u8>)],
     warnings: &[String],
+    manifest: Option<(&str, &str)>,
 ) -> Result<String> {
     let metrics = ccpp_render::run_files::metrics_json(&r.metrics)?;
     let staging = Staging::new(out)?;
@@ -63,6 +68,16 @@ pub fn write_run_files(
         )?;
         staging.write("replay.html", html.as_bytes())?;
         staging.write("replay.gif", &gif)?;
+    }
+    if let Some((name, head)) = manifest {
+        let mut text = head.to_string();
+        for (file, len) in staging.sizes()? {
+            text.push_str(&file);
+            text.push(' ');
+            text.push_str(&len.to_string());
+            text.push('\n');
+        }
+        staging.write(name, text.as_bytes())?;
     }
     ccpp_io::phase::time("write files", || staging.commit())?;
     Ok(metrics)
@@ -428,13 +443,13 @@ pub fn emit(
         &r.metrics,
         &r.swept,
     );
-    let metrics = write_run_files(&job.out, job, r, replay, &export_files, &warnings);
+    let metrics = write_run_files(&job.out, job, r, replay, &export_files, &warnings, None);
     busy.done();
     let metrics = metrics?;
     // Every warning on stderr, with or without --json (the early stop's was a line of the
     // table on stdout without it), as Python's `RunResult.warnings` lists them.
     for w in &warnings {
-        eprintln!("warning: {w}");
+        say!("warning: {w}");
     }
     if json_only {
         return crate::print_stdout(&metrics);

@@ -100,15 +100,15 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     }
     staging.commit()?;
     if let Some(note) = crate::job::approach_note(&plan.world) {
-        eprintln!("{note}");
+        say!("{note}");
     }
     // As for `run`: a start whose free area reaches the map's border is probably outside.
     let comp = StartComponent::of(plan.world.map(), plan.world.start().position());
     if let Some(w) = comp.warning() {
-        eprintln!("warning: {w}");
+        say!("warning: {w}");
     }
     if let Some(w) = ccpp_io::warnings::rect_lane_area_warning(&scenario) {
-        eprintln!("warning: {w}");
+        say!("warning: {w}");
     }
     let mut s = String::new();
     let _ = writeln!(

@@ -43,6 +43,11 @@ static STOPPING: AtomicBool = AtomicBool::new(false);
 /// while they may still write into it.
 static LOCKS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
+/// The output folders this process has moved into place, whole (as the user named them): an
+/// interrupt after that says they were written, where it said only "interrupted" and a user
+/// took the new complete set for the old one or for a broken one (hostile pass).
+static WRITTEN: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
 /// Test hook: when this environment variable names a file, writing that file fails as on a full
 /// disk (`ENOSPC`). Used by the end-to-end tests to check that a failed run leaves no output.
 pub const FAIL_WRITE_ENV: &str = "CCPP_TEST_FAIL_WRITE";
@@ -50,6 +55,21 @@ pub const FAIL_WRITE_ENV: &str = "CCPP_TEST_FAIL_WRITE";
 /// Test hook: `ccpp replay` waits this many milliseconds after reading the run folder, before
 /// it renders (a test swaps the folder meanwhile, as a `ccpp run` into it would).
 pub const REPLAY_PAUSE_ENV: &str = "CCPP_TEST_REPLAY_PAUSE_MS";
+
+/// Test hook: a staging folder waits this many milliseconds before it is moved into place (a
+/// test puts a file into the target meanwhile, as a user might while a large run writes).
+pub const COMMIT_PAUSE_ENV: &str = "CCPP_TEST_COMMIT_PAUSE_MS";
+
+/// Test hook: a staging folder, once moved into place, waits this many milliseconds (a test
+/// interrupts the process then).
+pub const AFTER_COMMIT_PAUSE_ENV: &str = "CCPP_TEST_AFTER_COMMIT_PAUSE_MS";
+
+/// Sleeps for the milliseconds the environment variable `var` gives, if any (test hooks).
+fn pause_for(var: &str) {
+    if let Some(ms) = std::env::var(var).ok().and_then(|v| v.parse::<u64>().ok()) {
+        std::thread::sleep(std::time::Duration::from_millis(ms));
+    }
+}
 
 fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
     m.lock().unwrap_or_else(PoisonError::into_inner)
@@ -180,7 +200,17 @@ fn interrupted() -> ! {
         let _ = std::fs::remove_file(p);
     }
     // Stderr may be a pipe whose reader is gone (a bench job whose bench died): no panic.
-    let _ = writeln!(std::io::stderr(), "error: interrupted");
+    let written = lock(&WRITTEN);
+    if written.is_empty() {
+        let _ = writeln!(std::io::stderr(), "error: interrupted");
+    } else {
+        let names: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
+        let _ = writeln!(
+            std::io::stderr(),
+            "error: interrupted after the new output was written whole to {}",
+            names.join(", ")
+        );
+    }
     std::process::exit(130);
 }
 
@@ -288,47 +318,11 @@ pub fn write_files_together(dir: &Path, files: &[(&str, &[u8])]) -> Result<()> {
     Ok(())
 }
 
-/// Whether the process `pid` still runs (Linux `/proc`; elsewhere assumed gone).
-fn pid_alive(pid: u32) -> bool {
-    pid == std::process::id() || Path::new("/proc").join(pid.to_string()).exists()
-}
-
-/// The process id in a name `.<name>.ccpp-<kind>-<pid>-<n>`.
-fn parse_pid(rest: &str) -> Option<u32> {
-    rest.split('-').next()?.parse().ok()
-}
-
 /// Removes staging folders of dead processes next to `target`, and puts back an old folder
-/// that a killed process had renamed away when the target is missing.
-fn clean_stale(parent: &Path, name: &str) {
-    let Ok(entries) = std::fs::read_dir(parent) else {
-        return;
-    };
-    let new_prefix = ccpp_io::write::staging_prefix(name, "new");
-    let old_prefix = ccpp_io::write::staging_prefix(name, "old");
-    let mut names: Vec<String> = entries
-        .filter_map(|e| e.ok()?.file_name().into_string().ok())
-        .collect();
-    names.sort();
-    for n in names {
-        let (is_old, rest) = if let Some(r) = n.strip_prefix(&new_prefix) {
-            (false, r)
-        } else if let Some(r) = n.strip_prefix(&old_prefix) {
-            (true, r)
-        } else {
-            continue;
-        };
-        let Some(pid) = parse_pid(rest) else { continue };
-        if pid_alive(pid) {
-            continue;
-        }
-        let p = parent.join(&n);
-        let target = parent.join(name);
-        if is_old && !target.exists() && std::fs::rename(&p, &target).is_ok() {
-            continue;
-        }
-        remove_all(&p);
-    }
+/// that a killed process had renamed away when the target is missing
+/// ([`ccpp_io::write::clean_stale`]).
+pub fn clean_stale(parent: &Path, name: &str) {
+    ccpp_io::write::clean_stale(parent, name);
 }
 
 /// Checks that `target` is absent, or a folder holding only run files
@@ -386,6 +380,7 @@ impl Staging {
             ),
         };
         check_target(target)?;
+        ccpp_io::write::check_output_place(target)?;
         let parent = match target.parent() {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
@@ -459,6 +454,27 @@ impl Staging {
         Ok(())
     }
 
+    /// The files staged so far and their sizes in bytes, by name (a bench run's
+    /// `bench-key.txt` lists them, so a resumed bench can tell a copy cut short).
+    ///
+    /// # Errors
+    /// When the staging folder cannot be read.
+    pub fn sizes(&self) -> Result<Vec<(String, u64)>> {
+        let mut v = Vec::new();
+        for e in std::fs::read_dir(&self.dir)
+            .with_context(|| format!("cannot read {}", self.dir.display()))?
+        {
+            let e = e.with_context(|| format!("cannot read {}", self.dir.display()))?;
+            let len = e
+                .metadata()
+                .with_context(|| format!("cannot read {}", self.dir.display()))?
+                .len();
+            v.push((e.file_name().to_string_lossy().into_owned(), len));
+        }
+        v.sort();
+        Ok(v)
+    }
+
     /// Waits until every file written is on disk.
     fn wait_synced(&self) -> Result<()> {
         let syncs = std::mem::take(&mut *lock(&self.syncs));
@@ -481,8 +497,24 @@ impl Staging {
     /// When a rename fails; the old folder is then put back where possible.
     pub fn commit(mut self) -> Result<()> {
         self.wait_synced()?;
+        pause_for(COMMIT_PAUSE_ENV);
         let old = ccpp_io::write::staging_path(&self.parent, &self.name, "old");
         let swap = ccpp_io::write::swap_lock();
+        // Checked again under the lock: a file the user put into the folder while the run
+        // wrote its files was deleted with the old folder (hostile pass; `write_folder` did
+        // this already).
+        if let Err(e) = ccpp_io::write::check_run_folder(&self.target) {
+            let what = match &e {
+                ccpp_io::write::FolderError::Foreign { name, .. } => {
+                    format!("it now holds {name}, which ccpp did not write")
+                }
+                other => other.to_string(),
+            };
+            bail!(
+                "output folder {} changed while the run wrote its files ({what}); nothing was replaced",
+                self.shown.display()
+            );
+        }
         let had_old = match ccpp_io::write::swap_folder(&self.dir, &self.target, &old, || {
             register(&old);
         }) {
@@ -510,11 +542,13 @@ impl Staging {
         };
         unregister(&self.dir);
         self.done = true;
+        lock(&WRITTEN).push(self.shown.clone());
         drop(swap);
         if had_old {
             remove_all(&old);
             unregister(&old);
         }
+        pause_for(AFTER_COMMIT_PAUSE_ENV);
         Ok(())
     }
 }

@@ -652,3 +652,141 @@ fn a_bench_row_names_a_map_file_with_a_control_character() {
         "{csv}"
     );
 }
+
+/// A file the user put into the output folder while the run wrote its files was deleted with
+/// the old folder at the swap, and the run said it succeeded (hostile pass): the folder is
+/// checked again under the swap lock, and the run fails leaving the folder as it was.
+#[test]
+fn a_file_put_into_the_folder_during_the_run_is_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o");
+    let run = |pause: Option<&str>| {
+        let mut c = std::process::Command::new(assert_cmd::cargo::cargo_bin("ccpp"));
+        c.args(["run", "--planner", "ba-star", "--map"])
+            .arg(data("teb_empty_box.yaml"))
+            .arg("--out")
+            .arg(&out)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped());
+        if let Some(ms) = pause {
+            c.env("CCPP_TEST_COMMIT_PAUSE_MS", ms);
+        }
+        c.spawn().unwrap()
+    };
+    assert!(run(None).wait().unwrap().success());
+    let before = std::fs::read(out.join("path.csv")).unwrap();
+    let child = run(Some("3000"));
+    // The run of this size takes well under a second, then waits three before its swap.
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    std::fs::write(out.join("notes.txt"), b"thesis").unwrap();
+    let o = child.wait_with_output().unwrap();
+    let err = stderr_of(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(
+        err.contains("changed while the run wrote its files (it now holds notes.txt"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read(out.join("notes.txt")).unwrap(), b"thesis");
+    assert_eq!(std::fs::read(out.join("path.csv")).unwrap(), before);
+    // No staging folder is left beside it.
+    assert_eq!(entries(dir.path()), ["o"]);
+}
+
+/// `--out` inside a run folder made the run folder hold a folder, which the next run into it
+/// deleted (and `ccpp demo --out ccpp-demo/x` made `ccpp-demo` a folder runs refuse): refused
+/// before the work, and so is a name longer than a file system takes (it failed only at the
+/// final rename, after the whole run).
+#[test]
+fn an_output_folder_inside_a_run_folder_or_with_a_too_long_name_is_refused_first() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o");
+    let run = |target: &Path| {
+        ccpp()
+            .args(["run", "--planner", "ba-star", "--map"])
+            .arg(data("teb_empty_box.yaml"))
+            .arg("--out")
+            .arg(target)
+            .assert()
+    };
+    run(&out).success();
+    for inner in [out.join("x"), out.join("x/y")] {
+        let a = run(&inner).code(1);
+        let err = stderr_of(a.get_output());
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        assert!(
+            err.contains("lies inside the run folder") && err.contains("choose a folder outside"),
+            "{err}"
+        );
+    }
+    assert_eq!(entries(&out), BASE_SET);
+    let long = dir.path().join("a".repeat(256));
+    let started = std::time::Instant::now();
+    let a = run(&long).code(1);
+    let err = stderr_of(a.get_output());
+    assert!(
+        err.contains("its name is 256 bytes, longer than the 255"),
+        "{err}"
+    );
+    assert!(started.elapsed() < std::time::Duration::from_secs(5));
+    assert_eq!(entries(dir.path()), ["o"]);
+}
+
+/// A run replacing a folder kept its files but not its access: a private folder (mode 2770)
+/// became world-readable 755 (hostile pass). The new folder takes the old one's mode.
+#[cfg(unix)]
+#[test]
+fn a_replaced_folder_keeps_its_permissions() {
+    use std::os::unix::fs::PermissionsExt as _;
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o");
+    std::fs::create_dir(&out).unwrap();
+    std::fs::set_permissions(&out, std::fs::Permissions::from_mode(0o2770)).unwrap();
+    for planner in ["ba-star", "bsa"] {
+        ccpp()
+            .args(["run", "--planner", planner, "--map"])
+            .arg(data("teb_empty_box.yaml"))
+            .arg("--out")
+            .arg(&out)
+            .assert()
+            .success();
+        let mode = std::fs::metadata(&out).unwrap().permissions().mode() & 0o7777;
+        assert_eq!(mode, 0o2770, "{planner}: {mode:o}");
+    }
+}
+
+/// With stderr unwritable (`2>/dev/full`) a failing run, and a run with a warning after its
+/// folder was written, panicked (exit 101) in `eprintln!` (hostile pass): exit 1 and 0.
+#[cfg(target_os = "linux")]
+#[test]
+fn an_unwritable_stderr_is_no_panic() {
+    let dir = tempfile::tempdir().unwrap();
+    let full = || {
+        std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .unwrap()
+    };
+    let run = |map: &Path, out: &str, extra: &[&str]| {
+        std::process::Command::new(assert_cmd::cargo::cargo_bin("ccpp"))
+            .args(["run", "--planner", "bsa-bfs", "--map"])
+            .arg(map)
+            .arg("--out")
+            .arg(dir.path().join(out))
+            .args(extra)
+            .stdout(Stdio::null())
+            .stderr(full())
+            .status()
+            .unwrap()
+    };
+    assert_eq!(run(&dir.path().join("none.yaml"), "a", &[]).code(), Some(1));
+    // Heavy odometry noise without landmarks: the run warns of bumper contacts and of floor
+    // far from the path, after its folder is written.
+    let status = run(
+        &data("teb_empty_box.yaml"),
+        "b",
+        &["--odometry-noise", "0.5", "--seed", "1"],
+    );
+    assert_eq!(status.code(), Some(0));
+    assert!(dir.path().join("b/metrics.json").is_file());
+}

@@ -227,6 +227,44 @@ fn an_interrupted_run_leaves_the_old_or_the_new_complete_set() {
     assert!(seen_old, "no interrupt landed before the commit");
 }
 
+/// An interrupt after the new set was moved into place said only "interrupted" (exit 130),
+/// and the user took the complete new folder for the old one (hostile pass): it says the
+/// output was written whole, and names the folder.
+#[cfg(unix)]
+#[test]
+fn an_interrupt_after_the_swap_says_the_output_was_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o");
+    let child = std::process::Command::new(assert_cmd::cargo::cargo_bin("ccpp"))
+        .args(["run", "--planner", "ba-star", "--map"])
+        .arg(data("teb_empty_box.yaml"))
+        .arg("--out")
+        .arg(&out)
+        .env("CCPP_TEST_AFTER_COMMIT_PAUSE_MS", "5000")
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // The run of this size takes well under a second, then waits after its swap.
+    let t0 = std::time::Instant::now();
+    while !out.join("metrics.json").exists() && t0.elapsed() < std::time::Duration::from_secs(30) {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let _ = std::process::Command::new("kill")
+        .arg("-INT")
+        .arg(child.id().to_string())
+        .status();
+    let o = child.wait_with_output().unwrap();
+    let err = stderr_of(&o);
+    assert_eq!(o.status.code(), Some(130), "{err}");
+    assert!(
+        err.contains("interrupted after the new output was written whole to")
+            && err.contains(out.to_str().unwrap()),
+        "{err}"
+    );
+    assert_eq!(entries(&out), BASE_SET);
+}
+
 /// Every folder under `dir` (recursively), with its entries.
 fn walk(dir: &Path, out: &mut Vec<(PathBuf, Vec<String>)>) {
     let names = entries(dir);
@@ -640,6 +678,71 @@ fn bench_runs_again_a_run_missing_a_file() {
     // Whole again: reused without a word.
     let o = bench(&out, &maps, &["--planners", "bcd"]).output().unwrap();
     assert!(!String::from_utf8_lossy(&o.stderr).contains("warning"));
+}
+
+/// A run folder cut short or mixed was reused and reported `ok` (hostile pass): a truncated
+/// `coverage.png` or `path.csv`, an emptied `run.json`, another run's `metrics.json` (its
+/// numbers then stood in this run's row). Each is run again with a warning naming what is
+/// wrong; a killed run's staging folder beside it is removed and not named as a run of an
+/// earlier bench.
+#[test]
+fn bench_runs_again_a_run_cut_short_or_mixed() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bench");
+    let maps = [data("teb_empty_box.yaml")];
+    let runs = out.join("runs/teb_empty_box");
+    let run = runs.join("bcd");
+    let planners = ["--planners", "ba-star,bcd"];
+    bench(&out, &maps, &planners).assert().success();
+    let whole = |f: &str| std::fs::read(run.join(f)).unwrap();
+    let cut = |f: &str| {
+        let bytes = whole(f);
+        std::fs::write(run.join(f), &bytes[..bytes.len() / 2]).unwrap();
+    };
+    let damages = [
+        ("coverage.png", "coverage.png is not the file the run wrote"),
+        ("path.csv", "path.csv is not the file the run wrote"),
+        ("run.json", "run.json is not the file the run wrote"),
+        (
+            "metrics.json",
+            "metrics.json is of ba-star on teb_empty_box, not of this run",
+        ),
+    ];
+    for (f, why) in &damages {
+        let before = whole(f);
+        match *f {
+            "run.json" => std::fs::write(run.join(f), b"").unwrap(),
+            // Another run's metrics.
+            "metrics.json" => {
+                std::fs::copy(runs.join("ba-star/metrics.json"), run.join(f)).unwrap();
+            }
+            _ => cut(f),
+        }
+        let o = bench(&out, &maps, &planners).output().unwrap();
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{stderr}");
+        assert!(
+            stderr.contains(why) && stderr.contains("running it again"),
+            "{f}: {stderr}"
+        );
+        if *f == "metrics.json" {
+            // (run again: the same but its wall time)
+            let m = String::from_utf8(whole(f)).unwrap();
+            assert!(m.contains("\"planner\": \"bcd\""), "{m}");
+        } else {
+            assert_eq!(whole(f), before, "{f}");
+        }
+    }
+    // A killed run's staging folder beside the reused one.
+    let stale = runs.join(".bcd.ccpp-new-4294967295-0");
+    std::fs::create_dir(&stale).unwrap();
+    std::fs::write(stale.join("metrics.json"), b"{}").unwrap();
+    let o = bench(&out, &maps, &planners).output().unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    assert!(!stderr.contains("earlier bench"), "{stderr}");
+    assert!(!stderr.contains("warning"), "{stderr}");
+    assert!(!stale.exists());
 }
 
 #[test]

@@ -38,9 +38,19 @@ pub fn time<T>(name: &str, f: impl FnOnce() -> T) -> T {
     let ms = t0.elapsed().as_secs_f64() * 1e3;
     match rss_mb() {
         Some((rss, peak)) => {
-            eprintln!("phase {name}: {ms:.1} ms, rss {rss:.0} MB (peak {peak:.0} MB)");
+            say(&format!(
+                "phase {name}: {ms:.1} ms, rss {rss:.0} MB (peak {peak:.0} MB)"
+            ));
         }
-        None => eprintln!("phase {name}: {ms:.1} ms"),
+        None => say(&format!("phase {name}: {ms:.1} ms")),
     }
     out
+}
+
+/// Writes `line` to stderr; a stderr that cannot be written has no reader to tell
+/// (`eprintln!` panicked there).
+fn say(line: &str) {
+    use std::io::Write as _;
+    // (see the doc)
+    let _ = writeln!(std::io::stderr(), "{line}");
 }

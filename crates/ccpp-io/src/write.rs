@@ -219,6 +219,33 @@ pub enum FolderError {
         /// The output folder.
         path: PathBuf,
     },
+    /// The output folder would lie inside a run folder (`--out ccpp-demo/x`): writing it made
+    /// the run folder hold a folder ccpp does not write there, and the next run into the run
+    /// folder replaced both.
+    #[error(
+        "output folder {} lies inside the run folder {}, which a run into it replaces whole; \
+         choose a folder outside it",
+        path.display(), run.display()
+    )]
+    InsideRunFolder {
+        /// The output folder.
+        path: PathBuf,
+        /// The run folder above it.
+        run: PathBuf,
+    },
+    /// The folder's name is longer than a file system takes: found before the work, not at
+    /// the final rename.
+    #[error(
+        "output folder {}: its name is {len} bytes, longer than the {NAME_MAX_BYTES} a file \
+         system takes",
+        path.display()
+    )]
+    NameTooLong {
+        /// The output folder.
+        path: PathBuf,
+        /// The name's length in bytes.
+        len: usize,
+    },
     /// Reading, creating, writing or renaming failed.
     #[error("cannot write output folder {}: {source}", path.display())]
     Io {
@@ -353,6 +380,72 @@ pub fn check_run_folder(target: &Path) -> Result<(), FolderError> {
     }
 }
 
+/// The longest file name most file systems take (ext4, XFS, Btrfs, APFS, NTFS), in bytes.
+pub const NAME_MAX_BYTES: usize = 255;
+
+/// Checks what can be known of the output folder `target` before a run's work, beyond
+/// [`check_run_folder`]: its name fits a file system ([`FolderError::NameTooLong`], found
+/// after the whole run at the final rename; hostile pass), and no folder above it is a run
+/// folder ([`FolderError::InsideRunFolder`]: `ccpp demo --out ccpp-demo/x` made `ccpp-demo`
+/// hold a folder, and a run swapping `ccpp-demo` meanwhile deleted `x` with it).
+///
+/// # Errors
+/// [`FolderError::NameTooLong`], [`FolderError::InsideRunFolder`].
+pub fn check_output_place(target: &Path) -> Result<(), FolderError> {
+    if let Some(name) = target.file_name() {
+        let len = name.as_encoded_bytes().len();
+        if len > NAME_MAX_BYTES {
+            return Err(FolderError::NameTooLong {
+                path: target.to_path_buf(),
+                len,
+            });
+        }
+    }
+    // The folders above, resolved from the nearest that exists (`out/../out` is not inside
+    // `out`: a lexical walk took it for so).
+    let Some(base) = target
+        .ancestors()
+        .skip(1)
+        .map(|a| if a.as_os_str().is_empty() { Path::new(".") } else { a })
+        .find_map(|a| std::fs::canonicalize(a).ok())
+    else {
+        return Ok(());
+    };
+    for above in base.ancestors() {
+        let marked = ["run.json", "metrics.json"]
+            .iter()
+            .any(|f| std::fs::symlink_metadata(above.join(f)).is_ok_and(|m| m.is_file()));
+        if marked && check_run_folder(above).is_ok() {
+            return Err(FolderError::InsideRunFolder {
+                path: target.to_path_buf(),
+                run: above.to_path_buf(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Gives the new folder `staging` the access of the folder `target` it replaces: its
+/// permission bits (setgid too) and, where this process may, its owner and group. A private
+/// folder (`chmod 2770`, group `lab`) became `drwxr-xr-x` of the process's user and group when
+/// a run replaced it (hostile pass). Access control lists are not copied. Best effort: a
+/// failure leaves the staging folder's own access.
+fn copy_access(target: &Path, staging: &Path) {
+    let Ok(meta) = std::fs::metadata(target) else {
+        return;
+    };
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt as _;
+        // (best effort, see the doc: changing the owner needs the privilege to; the group
+        // needs membership)
+        let _ = std::os::unix::fs::chown(staging, Some(meta.uid()), Some(meta.gid()));
+        let _ = std::os::unix::fs::chown(staging, None, Some(meta.gid()));
+    }
+    // (after the owner: a change of owner may clear the setgid bit)
+    let _ = std::fs::set_permissions(staging, meta.permissions());
+}
+
 /// The warnings file of a bench run folder, one of [`RUN_FILES`] only beside its
 /// `bench-key.txt` or `metrics.json` ([`check_run_folder`]).
 pub const BENCH_WARNINGS_FILE: &str = "warnings.txt";
@@ -464,6 +557,7 @@ pub fn swap_folder(
         let again = attempt < SWAP_ATTEMPTS;
         let had_old = std::fs::symlink_metadata(target).is_ok();
         if had_old {
+            copy_access(target, staging);
             if let Some(f) = before_old.take() {
                 f();
             }
@@ -495,6 +589,54 @@ pub fn swap_folder(
             }
         }
         return Err(SwapError::MoveNew(error));
+    }
+}
+
+/// Whether the process `pid` still runs (Linux `/proc`; elsewhere assumed gone). A process
+/// of another PID namespace (a container sharing the folder) is not seen: its staging
+/// folders look stale.
+fn pid_alive(pid: u32) -> bool {
+    pid == std::process::id() || Path::new("/proc").join(pid.to_string()).exists()
+}
+
+/// The process id in a name `.<name>.ccpp-<kind>-<pid>-<n>`.
+fn parse_pid(rest: &str) -> Option<u32> {
+    rest.split('-').next()?.parse().ok()
+}
+
+/// Removes the staging folders of dead processes beside the output folder `parent/name`
+/// ([`staging_name`]: a process killed while it wrote, or while it swapped), and puts back an
+/// old folder that such a process had renamed away when `name` is missing. The command line
+/// does this before each run into a folder, a bench before reusing a run folder, and
+/// [`write_folder`] (Python's `save`) before each write: Python left them for good.
+pub fn clean_stale(parent: &Path, name: &str) {
+    let Ok(entries) = std::fs::read_dir(parent) else {
+        return;
+    };
+    let new_prefix = staging_prefix(name, "new");
+    let old_prefix = staging_prefix(name, "old");
+    let mut names: Vec<String> = entries
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .collect();
+    names.sort();
+    for n in names {
+        let (is_old, rest) = if let Some(r) = n.strip_prefix(&new_prefix) {
+            (false, r)
+        } else if let Some(r) = n.strip_prefix(&old_prefix) {
+            (true, r)
+        } else {
+            continue;
+        };
+        let Some(pid) = parse_pid(rest) else { continue };
+        if pid_alive(pid) {
+            continue;
+        }
+        let p = parent.join(&n);
+        let target = parent.join(name);
+        if is_old && !target.exists() && std::fs::rename(&p, &target).is_ok() {
+            continue;
+        }
+        remove_all_quietly(&p);
     }
 }
 
@@ -530,6 +672,7 @@ pub fn write_folder(target: &Path, files: &[(&str, Vec<u8>)]) -> Result<(), Fold
         }
     };
     check_run_folder(target)?;
+    check_output_place(target)?;
     let io_err = |source| FolderError::Io {
         path: target.to_path_buf(),
         source,
@@ -543,6 +686,7 @@ pub fn write_folder(target: &Path, files: &[(&str, Vec<u8>)]) -> Result<(), Fold
     // Renames go through the resolved parent: with `a/../a` the first rename would remove the
     // path the second goes through.
     let parent = parent.canonicalize().map_err(io_err)?;
+    clean_stale(&parent, &name);
     let target_in = parent.join(&name);
     if !existed {
         // `create_dir_all("a/..")` created `a`, the target itself (empty): not a run folder.

@@ -171,6 +171,17 @@ def test_save_replaces_the_folder_whole(room: Path, tmp_path: Path) -> None:
     ccpp.run(room, "bsa").save(tmp_path / "dd" / ".." / "dd")
     assert sorted(p.name for p in (tmp_path / "dd").iterdir()) == run_files
     assert sorted(p.name for p in tmp_path.iterdir()) == ["dd", "mine", "out", "room.pgm", "room.yaml"]
+    # Staging folders of a killed process beside the folder are removed (they stayed for good;
+    # hostile pass), and a folder inside a run folder is refused (the next run into the run
+    # folder would delete it).
+    dead = tmp_path / ".out.ccpp-new-4294967295-0"
+    dead.mkdir()
+    (dead / "metrics.json").write_text("{}")
+    ccpp.run(room, "bsa").save(out)
+    assert not dead.exists()
+    with pytest.raises(ccpp.CcppError, match="lies inside the run folder"):
+        ccpp.run(room, "bsa").save(out / "inner")
+    assert sorted(p.name for p in out.iterdir()) == run_files
 
 
 def test_errors_name_each_cause_once(room: Path, ccpp_bin: str, tmp_path: Path) -> None:
