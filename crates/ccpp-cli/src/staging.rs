@@ -547,6 +547,15 @@ impl Staging {
         if had_old {
             remove_all(&old);
             unregister(&old);
+            if std::fs::symlink_metadata(&old).is_ok() {
+                // (an undeletable file in it: the previous output stayed hidden without a
+                // word; hostile pass)
+                say!(
+                    "warning: the previous output of {} could not be removed whole; what is left of it is at {}",
+                    self.shown.display(),
+                    old.display()
+                );
+            }
         }
         pause_for(AFTER_COMMIT_PAUSE_ENV);
         Ok(())

@@ -790,3 +790,31 @@ fn an_unwritable_stderr_is_no_panic() {
     assert_eq!(status.code(), Some(0));
     assert!(dir.path().join("b/metrics.json").is_file());
 }
+
+/// `--out loop1/x` under a symbolic link loop (or a link to nothing) said "loop1 is a file,
+/// not a folder" (hostile pass).
+#[cfg(unix)]
+#[test]
+fn an_output_folder_under_a_broken_link_names_the_link() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::os::unix::fs::symlink(d.join("loop1"), d.join("loop2")).unwrap();
+    std::os::unix::fs::symlink(d.join("loop2"), d.join("loop1")).unwrap();
+    std::os::unix::fs::symlink(d.join("nowhere"), d.join("dangling")).unwrap();
+    for link in ["loop1", "dangling"] {
+        let a = ccpp()
+            .args(["run", "--planner", "ba-star", "--map"])
+            .arg(data("teb_empty_box.yaml"))
+            .arg("--out")
+            .arg(d.join(link).join("x"))
+            .assert()
+            .code(1);
+        let err = stderr_of(a.get_output());
+        assert!(
+            err.contains(&format!(
+                "{link} is a symbolic link to nothing or to itself"
+            )),
+            "{err}"
+        );
+    }
+}

@@ -182,6 +182,18 @@ pub enum FolderError {
         /// The part of its path that exists and is not a folder.
         blocker: PathBuf,
     },
+    /// A folder above the output folder is a symbolic link that leads nowhere or to itself
+    /// (it was called a file).
+    #[error(
+        "cannot create output folder {}: {} is a symbolic link to nothing or to itself",
+        path.display(), blocker.display()
+    )]
+    UnderABrokenLink {
+        /// The output folder.
+        path: PathBuf,
+        /// The link.
+        blocker: PathBuf,
+    },
     /// The folder holds something ccpp did not write.
     #[error(
         "output folder {} holds {name}, which ccpp did not write; a run replaces the whole \
@@ -406,7 +418,13 @@ pub fn check_output_place(target: &Path) -> Result<(), FolderError> {
     let Some(base) = target
         .ancestors()
         .skip(1)
-        .map(|a| if a.as_os_str().is_empty() { Path::new(".") } else { a })
+        .map(|a| {
+            if a.as_os_str().is_empty() {
+                Path::new(".")
+            } else {
+                a
+            }
+        })
         .find_map(|a| std::fs::canonicalize(a).ok())
     else {
         return Ok(());
@@ -489,9 +507,18 @@ pub fn create_folder(folder: &Path, target: &Path) -> Result<(), FolderError> {
         .find(|a| std::fs::symlink_metadata(a).is_ok())
         .filter(|a| !a.is_dir())
     {
-        return Err(FolderError::UnderAFile {
-            path: target.to_path_buf(),
-            blocker: blocker.to_path_buf(),
+        let broken = std::fs::symlink_metadata(blocker).is_ok_and(|m| m.file_type().is_symlink())
+            && std::fs::metadata(blocker).is_err();
+        return Err(if broken {
+            FolderError::UnderABrokenLink {
+                path: target.to_path_buf(),
+                blocker: blocker.to_path_buf(),
+            }
+        } else {
+            FolderError::UnderAFile {
+                path: target.to_path_buf(),
+                blocker: blocker.to_path_buf(),
+            }
         });
     }
     std::fs::create_dir_all(folder).map_err(|source| FolderError::Io {
