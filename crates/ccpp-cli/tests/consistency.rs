@@ -248,3 +248,46 @@ fn extended_planners_drive_the_same_path_on_a_moved_map() {
         }
     }
 }
+
+/// PID execution far from the world's origin: the controller and the integration worked in
+/// world coordinates, whose rounding there (1e-9 m at 5.4e6 m) the bearing to an aim point a
+/// few centimetres ahead turned into heading errors of 1e-6 rad, counted as turns:
+/// rect-boustrophedon in an empty room moved to UTM-like coordinates made 10 turns instead of
+/// 8 (hostile pass). They now work relative to the map's origin.
+#[test]
+fn pid_execution_drives_the_same_path_on_a_map_moved_far_out() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = crate::common::pgm(dir.path(), "room.pgm", 30, 20, |_, _| false);
+    for planner in ["rect-boustrophedon", "bsa-bfs"] {
+        let run = |sub: &str, origin: &str| {
+            let out = dir.path().join(format!("{planner}-{sub}"));
+            ccpp()
+                .args(["run", "--planner", planner, "--radius", "0.1", "--map"])
+                .arg(&map)
+                .arg(format!("--origin={origin}"))
+                .arg("--out")
+                .arg(&out)
+                .assert()
+                .success();
+            out
+        };
+        let (here, far) = (run("here", "0,0"), run("far", "500000,5400000"));
+        let m = |d: &std::path::Path| crate::common::read_json(&d.join("metrics.json"));
+        let (a, b) = (m(&here), m(&far));
+        for k in ["turns", "regions", "effective_coverage"] {
+            assert_eq!(a[k], b[k], "{planner} {k}");
+        }
+        let (la, lb) = (
+            a["path_length_m"].as_f64().unwrap(),
+            b["path_length_m"].as_f64().unwrap(),
+        );
+        assert!((la - lb).abs() < 1e-6, "{planner}: {la} vs {lb}");
+        let rows = |d: &std::path::Path| {
+            std::fs::read_to_string(d.join("path.csv"))
+                .unwrap()
+                .lines()
+                .count()
+        };
+        assert_eq!(rows(&here), rows(&far), "{planner}");
+    }
+}

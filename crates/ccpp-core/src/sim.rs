@@ -585,8 +585,27 @@ impl<'w> Simulator<'w> {
         let mut ran = 0u32;
         // Whether the last command turned in place (no linear speed).
         let mut was_in_place = None;
+        // The controller and the integration work in coordinates relative to the map's origin
+        // (a translation: exact at the origin (0, 0)), the world poses being derived from them.
+        // In world coordinates far from zero (UTM, 5.4e6 m) every step rounded the pose to
+        // 1e-9 m, and the controller's bearing to an aim point a few centimetres ahead turned
+        // that into heading errors of 1e-6 rad: rect-boustrophedon on a room moved there made
+        // in-place turns of that size, 10 turns instead of 8 (hostile pass).
+        let o = self.world.frame().origin.position();
+        let local = |p: Pose| Pose::new(p.x - o.x, p.y - o.y, p.theta);
+        let world = |p: Pose| Pose::new(p.x + o.x, p.y + o.y, p.theta);
+        let goal_l = match *goal {
+            Goal::Heading(h) => Goal::Heading(h),
+            Goal::Segment { from, to, reverse } => Goal::Segment {
+                from: from - o,
+                to: to - o,
+                reverse,
+            },
+        };
+        let mut est_l = local(self.est);
+        let mut pose_l = local(self.pose);
         for _ in 0..st.opts.max_steps_per_motion {
-            let Some((v, w)) = st.tracker.command(self.est, goal) else {
+            let Some((v, w)) = st.tracker.command(est_l, &goal_l) else {
                 break;
             };
             ran += 1;
@@ -615,8 +634,9 @@ impl<'w> Simulator<'w> {
                 }
                 _ => (v, w),
             };
-            let new_est = Unicycle::step(self.est, v, w, dt);
-            let new_true = Unicycle::step(self.pose, vt, wt, dt);
+            let new_est_l = Unicycle::step(est_l, v, w, dt);
+            let new_true_l = Unicycle::step(pose_l, vt, wt, dt);
+            let (new_est, new_true) = (world(new_est_l), world(new_true_l));
             let a = self.pose.position();
             let b = new_true.position();
             let hit = if a == b {
@@ -649,8 +669,8 @@ impl<'w> Simulator<'w> {
                 contact = true;
                 break;
             }
-            self.pose = new_true;
-            self.est = new_est;
+            (self.pose, self.est) = (new_true, new_est);
+            (pose_l, est_l) = (new_true_l, new_est_l);
             st.tracking.add(st.seg, self.pose);
             moved = true;
             since_record += 1;
@@ -663,6 +683,7 @@ impl<'w> Simulator<'w> {
             if st.since_fix >= fix_every {
                 st.since_fix = 0;
                 if let Some(fix) = self.landmark_fix(&st.landmarks) {
+                    est_l = local(self.est);
                     glide.flush(&mut self.trace, self.t);
                     self.trace.push_event(self.t, fix);
                 }
@@ -674,7 +695,7 @@ impl<'w> Simulator<'w> {
         glide.flush(&mut self.trace, self.t);
         if !contact
             && ran == st.opts.max_steps_per_motion
-            && st.tracker.command(self.est, goal).is_some()
+            && st.tracker.command(est_l, &goal_l).is_some()
         {
             // The goal was not reached: the run goes on from where the robot is, which a
             // control period far too short for the cap (`dt_s: 1e-9`) made a run of 0 m that
