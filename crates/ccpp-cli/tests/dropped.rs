@@ -1344,3 +1344,84 @@ fn an_option_wrong_for_the_map_names_its_options_file() {
         "{err}"
     );
 }
+
+/// The reachable floor is that of the pixel centres clear of obstacles, while the robot moves
+/// continuously: random-bounce passed a gap in a 1-px wall where no pixel centre is clear,
+/// spent its run in the room beyond and reported 18 % coverage without a word (hostile pass).
+/// The run now says how much it swept outside the reachable floor, and why.
+#[test]
+fn floor_swept_beyond_a_gap_the_pixels_close_is_told() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    // Two rooms 1.2 m wide, a 1-px wall between them with a 0.3 m gap (rows 12-17).
+    let map = common::pgm(dir, "gap.pgm", 50, 30, |x, y| {
+        x == 25 && !(12..=17).contains(&y)
+    });
+    let a = ccpp()
+        .args([
+            "run",
+            "--planner",
+            "random-bounce",
+            "--seed",
+            "1",
+            "--radius",
+            "0.14",
+            "--start",
+            "0.5,0.75",
+            "--map",
+            s(&map),
+            "--out",
+            s(&dir.join("out")),
+        ])
+        .assert()
+        .success();
+    let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
+    assert!(
+        err.contains("outside the floor reachable from its start")
+            && err.contains("a gap narrower than the map's pixels resolve"),
+        "{err}"
+    );
+    let m = common::read_json(&dir.join("out/metrics.json"));
+    assert!(m["effective_coverage"].as_f64().unwrap() < 0.5, "{m}");
+}
+
+/// rect-boustrophedon stops only at lane points, and on a scan speckled with 1-px noise most
+/// of them were left out (its clearance disk does not fit there): 31 % of a connected room
+/// swept, exit 0 and no warning (hostile pass, a generated map). The run now says so, and a
+/// shorter stop and lane spacing, as the warning advises, sweeps more.
+#[test]
+fn rect_lanes_mostly_left_out_are_told() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = common::data("specks_room.yaml");
+    let run = |sub: &str, extra: &[&str]| {
+        let out = dir.join(sub);
+        let a = ccpp()
+            .args([
+                "run",
+                "--planner",
+                "rect-boustrophedon",
+                "--radius",
+                "0.288",
+            ])
+            .args(["--start", "6.345,5.265", "--map", s(&map), "--out", s(&out)])
+            .args(extra)
+            .assert()
+            .success();
+        let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
+        let cov = common::read_json(&out.join("metrics.json"))["effective_coverage"]
+            .as_f64()
+            .unwrap();
+        (err, cov)
+    };
+    let (err, sparse) = run("default", &[]);
+    assert!(
+        err.contains("rect-boustrophedon stops only at lane points: 18 of the 31 lane points")
+            && err.contains("a shorter --length and --width"),
+        "{err}"
+    );
+    assert!(sparse < 0.4, "{sparse}");
+    let (err, dense) = run("dense", &["--length", "0.4", "--width", "0.4"]);
+    assert!(!err.contains("stops only at lane points"), "{err}");
+    assert!(dense > 0.7, "{dense}");
+}

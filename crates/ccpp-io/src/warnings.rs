@@ -1,6 +1,7 @@
 //! The warnings of a finished run: what the command line prints on stderr and Python's
 //! `RunResult.warnings` lists, from one place (the texts without the `warning: ` prefix).
 
+use ccpp_core::grid::Cell;
 use ccpp_core::metrics::Metrics;
 use ccpp_core::trace::{Event, Trace};
 use ccpp_core::world::World;
@@ -354,6 +355,43 @@ pub fn untouched_floor(
     })
 }
 
+/// Floor swept outside the floor reachable from the start (outside the zones' keep-outs and
+/// area), when it is at least [`OUTSIDE_REACH_MIN_M2`] and [`OUTSIDE_REACH_MIN_SHARE`] of
+/// what the robot swept (`None` otherwise). The reachable floor is that of the pixel centres
+/// clear of obstacles (world-and-metrics conventions), while the robot moves continuously: it
+/// can pass a gap where no pixel centre is clear (a 1-px wall's gap a little wider than the
+/// robot), and the floor beyond is not counted. random-bounce spent a whole run in a room
+/// behind such a gap and reported 18 % coverage without a word (hostile pass).
+pub fn outside_reach_warning(world: &World, swept: &FixedBitSet) -> Option<String> {
+    let acc = world.accessible();
+    let cells = world.map().cells();
+    let zones = world.zones();
+    let in_zone = |i: usize| {
+        zones.is_some_and(|z| {
+            z.keepout.contains(i) || z.area.as_ref().is_some_and(|a| !a.contains(i))
+        })
+    };
+    let outside = swept
+        .ones()
+        .filter(|&i| !acc.contains(i) && cells[i] == Cell::Free && !in_zone(i))
+        .count();
+    let res = world.frame().resolution;
+    let area = outside as f64 * res * res;
+    let share = outside as f64 / swept.count_ones(..).max(1) as f64;
+    if area < OUTSIDE_REACH_MIN_M2 || share < OUTSIDE_REACH_MIN_SHARE {
+        return None;
+    }
+    Some(format!(
+        "the robot swept {area:.1} m2 outside the floor reachable from its start ({:.0} % of what it swept): it passed where no pixel centre is clear of obstacles (a gap narrower than the map's pixels resolve), and the coverage does not count that floor; see coverage.png (\"swept, outside reachable floor\")",
+        100.0 * share
+    ))
+}
+
+/// Least area (m2) of [`outside_reach_warning`].
+pub const OUTSIDE_REACH_MIN_M2: f64 = 0.5;
+/// Least share of the swept floor of [`outside_reach_warning`].
+pub const OUTSIDE_REACH_MIN_SHARE: f64 = 0.02;
+
 /// A large part of the floor never approached, said for the runs no other warning explains
 /// (`None` otherwise; see [`run_warnings`]): a rectangle's clearance disk that fits through
 /// no doorway into the other room (53.5 % swept), a random bounce whose budget ran out before
@@ -447,12 +485,13 @@ pub fn rect_lane_area_warning(scenario: &Scenario) -> Option<String> {
 /// A random-bounce run that ended boxed in, with budget left, said (its trace's
 /// [`BOXED_IN_NOTE`](ccpp_core::planners::random_bounce::BOXED_IN_NOTE), `None` otherwise).
 pub fn boxed_in_warning(trace: &Trace) -> Option<String> {
+    note_warning(trace, ccpp_core::planners::random_bounce::BOXED_IN_NOTE)
+}
+
+/// The trace's first note starting with `prefix`, as a warning (`None` when there is none).
+fn note_warning(trace: &Trace, prefix: &str) -> Option<String> {
     trace.events().find_map(|(_, e)| match e {
-        Event::Note { text }
-            if text.starts_with(ccpp_core::planners::random_bounce::BOXED_IN_NOTE) =>
-        {
-            Some(text.clone())
-        }
+        Event::Note { text } if text.starts_with(prefix) => Some(text.clone()),
         _ => None,
     })
 }
@@ -505,16 +544,22 @@ pub fn run_warnings(
     let stranded = stranded_tiles_warning(scenario, metrics, untouched.as_ref());
     let rect = rect_reach_warning(scenario, world, metrics);
     let boxed = boxed_in_warning(trace);
+    let sparse = note_warning(
+        trace,
+        ccpp_core::planners::rect_boustrophedon::SPARSE_STOPS_NOTE,
+    );
     // (floor never approached is said once, by the warning that knows why when one does)
     let explained = stranded.is_some()
         || rect.is_some()
         || boxed.is_some()
+        || sparse.is_some()
         || metrics.stop_reason.is_some()
         || !moved;
     out.extend(stranded);
     out.extend(rect);
     out.extend(rect_lane_area_warning(scenario));
     out.extend(boxed);
+    out.extend(sparse);
     if !explained {
         out.extend(untouched_floor_warning(
             scenario,
@@ -522,6 +567,7 @@ pub fn run_warnings(
             untouched.as_ref(),
         ));
     }
+    out.extend(outside_reach_warning(world, swept));
     out.extend(drift_warning(scenario, trace, metrics));
     out.extend(motions_cut_warning(trace, metrics));
     if let Some(why) = &metrics.stop_reason {
