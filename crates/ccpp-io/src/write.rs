@@ -248,7 +248,7 @@ pub enum FolderError {
     /// The folder's name is longer than a file system takes: found before the work, not at
     /// the final rename.
     #[error(
-        "output folder {}: its name is {len} bytes, longer than the {NAME_MAX_BYTES} a file \
+        "output folder {}: its name is {len} bytes, longer than the {NAME_MAX} a file \
          system takes",
         path.display()
     )]
@@ -279,8 +279,8 @@ pub fn is_run_file_name(name: &str) -> bool {
             .is_some_and(|f| RUN_FILES.contains(&f))
 }
 
-/// Longest file name the usual file systems take, in bytes.
-const NAME_MAX: usize = 255;
+/// Longest file name the usual file systems take (ext4, XFS, Btrfs, APFS, NTFS), in bytes.
+pub const NAME_MAX: usize = 255;
 
 /// The start `.<name>.ccpp-<kind>-` of the names of the staging (`kind` `new`) and set-aside
 /// (`old`) folders of the output folder `name`, which go on with `<pid>-<n>`
@@ -392,9 +392,6 @@ pub fn check_run_folder(target: &Path) -> Result<(), FolderError> {
     }
 }
 
-/// The longest file name most file systems take (ext4, XFS, Btrfs, APFS, NTFS), in bytes.
-pub const NAME_MAX_BYTES: usize = 255;
-
 /// Checks what can be known of the output folder `target` before a run's work, beyond
 /// [`check_run_folder`]: its name fits a file system ([`FolderError::NameTooLong`], found
 /// after the whole run at the final rename; hostile pass), and no folder above it is a run
@@ -406,7 +403,7 @@ pub const NAME_MAX_BYTES: usize = 255;
 pub fn check_output_place(target: &Path) -> Result<(), FolderError> {
     if let Some(name) = target.file_name() {
         let len = name.as_encoded_bytes().len();
-        if len > NAME_MAX_BYTES {
+        if len > NAME_MAX {
             return Err(FolderError::NameTooLong {
                 path: target.to_path_buf(),
                 len,
