@@ -235,3 +235,28 @@ def test_relative_paths_mean_the_callers_folder_on_every_worker(
     assert list(df["dir"]) == [str(Path("sw") / "runs" / "room" / "bsa")]
     assert (tmp_path / "sw" / "runs" / "room" / "bsa" / "metrics.json").is_file()
     assert not (elsewhere / "sw").exists()
+
+
+def test_an_interrupted_sweep_cancels_its_cells() -> None:
+    """Ctrl-C during a sweep left its Dask cells queued: they wrote run folders into the output
+    folder after the sweep had let it go (hostile pass). The cells are cancelled first."""
+    from ccpp import sweeps
+
+    class Client:
+        def __init__(self) -> None:
+            self.cancelled: list = []
+
+        def submit(self, fn, *args, pure=True):
+            return ("future", args[1], args[2])
+
+        def gather(self, futures):
+            raise KeyboardInterrupt
+
+        def cancel(self, futures):
+            self.cancelled.extend(futures)
+
+    c = Client()
+    tasks = [("m.yaml", "m", p, 0.15, None, None, None, None, None) for p in ("bsa", "bcd")]
+    with pytest.raises(KeyboardInterrupt):
+        sweeps._gather(tasks, c, None)
+    assert c.cancelled == [("future", "m", "bsa"), ("future", "m", "bcd")]

@@ -204,6 +204,10 @@ def sweep(
     DataFrame with the columns :data:`CSV_COLUMNS` (plus ``radius`` when several radii are
     given). ``max_memory_mb`` and ``inflate`` are checked before the cluster starts, too.
 
+    Ctrl-C (or a failure) cancels the runs not yet gathered before the sweep lets ``out`` go;
+    with a ``client`` of your own, runs already going on its workers cannot be stopped and may
+    still write their folders after ``sweep`` has returned.
+
     In a script, call it under ``if __name__ == "__main__":`` when it starts a local cluster
     (no ``client`` and no ``scheduler``, or a ``LocalCluster``): Dask's worker processes import
     the script again.
@@ -308,7 +312,13 @@ def _from_here(p: Any) -> str:
 
 
 def _gather(tasks: list[tuple[Any, ...]], client: Any, scheduler: str | None) -> list[Any]:
-    """Runs the sweep's cells on ``client`` (or a cluster of its own) and gathers their rows."""
+    """Runs the sweep's cells on ``client`` (or a cluster of its own) and gathers their rows.
+
+    On Ctrl-C or any failure the cells not gathered are cancelled before the sweep lets its
+    output folder go: they went on writing run folders into it after the sweep had returned
+    and another sweep or bench had taken the folder (hostile pass). Cells already running on
+    a client's workers cannot be stopped by Dask and may still finish theirs; the sweep's own
+    cluster is closed, which stops them."""
     from distributed import Client
 
     own = None
@@ -316,9 +326,14 @@ def _gather(tasks: list[tuple[Any, ...]], client: Any, scheduler: str | None) ->
         address = scheduler or os.environ.get("CCPP_DASK_SCHEDULER")
         own = Client(address) if address else Client(processes=True)
         client = own
+    futures: list[Any] = []
     try:
         futures = [client.submit(_run_cell, *t, pure=False) for t in tasks]
         return list(client.gather(futures))
+    except BaseException:
+        if futures:
+            client.cancel(futures)
+        raise
     finally:
         if own is not None:
             own.close()
