@@ -481,7 +481,7 @@ fn run_one(
     if let (Some(parent), Some(name)) = (dir.parent(), dir.file_name().and_then(|n| n.to_str())) {
         // Staging folders of a killed run beside this one (they stayed for good: the folder
         // was reused, and only a run into it cleans beside it; hostile pass).
-        crate::staging::clean_stale(parent, name);
+        ccpp_io::write::clean_stale(parent, name);
     }
     if !a.force && dir.join("trace.jsonl").is_file() {
         // Regular files only (a FIFO would block the bench forever).
@@ -565,7 +565,7 @@ fn sizes_match(dir: &Path, listed: &str) -> Result<(), String> {
         let Some((file, len)) = parsed else {
             return Err(format!("{KEY_FILE} is damaged"));
         };
-        let actual = std::fs::metadata(dir.join(file)).map_or(None, |m| Some(m.len()));
+        let actual = std::fs::metadata(dir.join(file)).ok().map(|m| m.len());
         if actual != Some(len) {
             return Err(format!(
                 "{file} is not the file the run wrote ({len} bytes were written)"

@@ -523,10 +523,7 @@ fn sim_from(a: &RunArgs, config: &mut PlannerConfig) -> Result<SimConfig> {
         noise,
         // random-bounce's seed, from the flag or its options file, also seeds the noise
         // (`--seed 7` and `random_bounce: { seed: 7 }` are the same option; hostile pass).
-        seed: a.seed.or(match &*config {
-            PlannerConfig::RandomBounce(o) => Some(o.seed),
-            _ => None,
-        }),
+        seed: a.seed.or(config.seed()),
         // A file that gives the noise at all (`noise: null` too, as `planners --defaults`
         // prints it) clashes, as every other flag beside its option in the file does.
         noise_given_in: file_sets(

@@ -131,12 +131,7 @@ pub fn replay_dir(dir: &Path) -> Result<()> {
     })?;
     let reported = check_same_run(dir, &scenario, &map.name, &world, &trace, &metrics)?;
     let trace = check_metrics_of_run(dir, &scenario, &map.name, &world, trace, &reported)?;
-    if let Some(ms) = std::env::var(crate::staging::REPLAY_PAUSE_ENV)
-        .ok()
-        .and_then(|v| v.parse::<u64>().ok())
-    {
-        std::thread::sleep(std::time::Duration::from_millis(ms.min(60_000)));
-    }
+    crate::staging::pause_for(crate::staging::REPLAY_PAUSE_ENV);
     let title = format!("{} on {}", scenario.planner.name(), map.name);
     // The run's warnings, found again as `ccpp run` found them (the folder holds none).
     let warnings: Vec<String> = match serde_json::from_str::<ccpp_core::metrics::Metrics>(&metrics)

@@ -64,10 +64,11 @@ pub const COMMIT_PAUSE_ENV: &str = "CCPP_TEST_COMMIT_PAUSE_MS";
 /// interrupts the process then).
 pub const AFTER_COMMIT_PAUSE_ENV: &str = "CCPP_TEST_AFTER_COMMIT_PAUSE_MS";
 
-/// Sleeps for the milliseconds the environment variable `var` gives, if any (test hooks).
-fn pause_for(var: &str) {
+/// Sleeps for the milliseconds the environment variable `var` gives, if any, at most a
+/// minute (the test hooks above).
+pub fn pause_for(var: &str) {
     if let Some(ms) = std::env::var(var).ok().and_then(|v| v.parse::<u64>().ok()) {
-        std::thread::sleep(std::time::Duration::from_millis(ms));
+        std::thread::sleep(std::time::Duration::from_millis(ms.min(60_000)));
     }
 }
 
@@ -318,13 +319,6 @@ pub fn write_files_together(dir: &Path, files: &[(&str, &[u8])]) -> Result<()> {
     Ok(())
 }
 
-/// Removes staging folders of dead processes next to `target`, and puts back an old folder
-/// that a killed process had renamed away when the target is missing
-/// ([`ccpp_io::write::clean_stale`]).
-pub fn clean_stale(parent: &Path, name: &str) {
-    ccpp_io::write::clean_stale(parent, name);
-}
-
 /// Checks that `target` is absent, or a folder holding only run files
 /// ([`ccpp_io::write::check_run_folder`]).
 ///
@@ -399,7 +393,7 @@ impl Staging {
             // `create_dir_all("a/..")` creates `a`, the target itself: not a run folder.
             let _ = std::fs::remove_dir(&resolved);
         }
-        clean_stale(&parent, &name);
+        ccpp_io::write::clean_stale(&parent, &name);
         let dir = ccpp_io::write::staging_path(&parent, &name, "new");
         {
             // Registered and created under the lock: the signal handler sees both or neither.

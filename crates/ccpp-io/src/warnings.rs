@@ -365,12 +365,7 @@ pub fn untouched_floor(
 pub fn outside_reach_warning(world: &World, swept: &FixedBitSet) -> Option<String> {
     let acc = world.accessible();
     let cells = world.map().cells();
-    let zones = world.zones();
-    let in_zone = |i: usize| {
-        zones.is_some_and(|z| {
-            z.keepout.contains(i) || z.area.as_ref().is_some_and(|a| !a.contains(i))
-        })
-    };
+    let in_zone = |i: usize| world.zones().is_some_and(|z| z.forbidden(i));
     let res = world.frame().resolution;
     let outside: Vec<usize> = swept
         .ones()

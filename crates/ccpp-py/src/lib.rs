@@ -937,10 +937,7 @@ fn scenario_from(
         noise,
         // random-bounce's seed, from `seed=` or its options, also seeds the noise (the two
         // are the same option; hostile pass).
-        seed: seed.or(match &s.planner {
-            PlannerConfig::RandomBounce(o) => Some(o.seed),
-            _ => None,
-        }),
+        seed: seed.or(s.planner.seed()),
         noise_given_in: gives_noise
             .then(|| format!("options[\"exec\"], its {section}.exec.pid.noise")),
         pid_given_in: (gives_pid || own_pid)

@@ -299,6 +299,15 @@ impl PlannerConfig {
         PlannerOptions::default().config(kind)
     }
 
+    /// The planner's own seed (random-bounce's turns), which also seeds the odometry noise
+    /// when no other seed is given; `None` for the planners that draw nothing.
+    pub fn seed(&self) -> Option<u64> {
+        match self {
+            Self::RandomBounce(o) => Some(o.seed),
+            _ => None,
+        }
+    }
+
     /// Command-line name of the planner.
     pub fn name(&self) -> &'static str {
         self.kind().name()
