@@ -168,7 +168,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Run(a) => {
             let mut job = job::Job::from_run_args(&a)?;
-            staging::check_target(&job.out)?;
+            staging::check_user_target(&job.out)?;
             staging::check_inputs(
                 &job.out,
                 &job.scenario,
@@ -179,7 +179,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<()> {
         }
         Command::Demo(a) => {
             let mut job = job::Job::demo(&a)?;
-            staging::check_target(&job.out)?;
+            staging::check_user_target(&job.out)?;
             let result = execute(&mut job)?;
             output::emit(&job, &result, false, true, &[])
         }

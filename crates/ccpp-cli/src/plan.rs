@@ -14,7 +14,7 @@ use ccpp_io::scenario::{Scenario, ScenarioError};
 use crate::args::PlanArgs;
 use crate::components::StartComponent;
 use crate::job::{load_recipe, parse_planner, planner_options, recipe_from, robot_from};
-use crate::staging::{check_target, Staging};
+use crate::staging::{check_user_target, Staging};
 
 /// The exports written when `--export` is not given.
 pub const DEFAULT_EXPORTS: [ExportFormat; 2] = [ExportFormat::Csv, ExportFormat::NavPath];
@@ -56,7 +56,7 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         .zones(a.zones.area.clone(), a.zones.keepout.clone())
         .build()
         .map_err(flag)?;
-    check_target(&a.out)?;
+    check_user_target(&a.out)?;
     crate::staging::check_inputs(&a.out, &scenario, &[a.options.config.as_ref()])?;
     let map = load_recipe(&scenario.map, scenario.max_memory_mb)?;
     let busy = crate::busy::Busy::start(format!("{kind} on {}: planning", map.name));

@@ -57,7 +57,8 @@ pub const FAIL_WRITE_ENV: &str = "CCPP_TEST_FAIL_WRITE";
 pub const REPLAY_PAUSE_ENV: &str = "CCPP_TEST_REPLAY_PAUSE_MS";
 
 /// Test hook: a staging folder waits this many milliseconds before it is moved into place (a
-/// test puts a file into the target meanwhile, as a user might while a large run writes).
+/// test puts a file into the target meanwhile, as a user might while a large run writes), and
+/// so do a replay's page and GIF before they are renamed in (a test starts a second replay).
 pub const COMMIT_PAUSE_ENV: &str = "CCPP_TEST_COMMIT_PAUSE_MS";
 
 /// Test hook: a staging folder, once moved into place, waits this many milliseconds (a test
@@ -265,6 +266,13 @@ pub fn unregister_lock(p: &Path) {
 /// # Errors
 /// When a file cannot be written (named as in `dir`) or renamed into place.
 pub fn write_files_together(dir: &Path, files: &[(&str, &[u8])]) -> Result<()> {
+    // One writer at a time per folder: two `ccpp replay` of one run wrote the same
+    // `<name>.tmp` files, and the second's rename found its file already renamed by the first
+    // ("No such file"). The operating system's advisory lock on the folder itself (no file is
+    // added to it) makes the second wait until the first has renamed its files in; it is
+    // released when the process ends in any way. Where the folder cannot be locked, the
+    // files are written without it.
+    let _writer = std::fs::File::open(dir).ok().filter(|f| f.lock().is_ok());
     let tmp_of = |name: &str| dir.join(format!("{name}.tmp"));
     let clear = |upto: usize| {
         for (name, _) in &files[..upto] {
@@ -291,6 +299,7 @@ pub fn write_files_together(dir: &Path, files: &[(&str, &[u8])]) -> Result<()> {
             bail!("cannot write {}: {e}", dir.join(name).display());
         }
     }
+    pause_for(COMMIT_PAUSE_ENV);
     let _swap = ccpp_io::write::swap_lock();
     // The old content of each file before it is replaced, to put back if a later one fails.
     let mut before: Vec<Option<Vec<u8>>> = Vec::new();
@@ -317,6 +326,17 @@ pub fn write_files_together(dir: &Path, files: &[(&str, &[u8])]) -> Result<()> {
         before.push(old);
     }
     Ok(())
+}
+
+/// [`check_target`] for a user's own run, plan or demo, which also may not write below a
+/// folder another process's bench or sweep is writing
+/// ([`ccpp_io::write::check_not_in_busy_folder`]; a bench's runs write below their own).
+///
+/// # Errors
+/// As [`check_target`], or when a folder above `target` is held.
+pub fn check_user_target(target: &Path) -> Result<()> {
+    check_target(target)?;
+    Ok(ccpp_io::write::check_not_in_busy_folder(target)?)
 }
 
 /// Checks that `target` is absent, or a folder holding only run files

@@ -357,6 +357,89 @@ fn a_replay_never_writes_into_a_folder_swapped_in_meanwhile() {
     assert!(page.contains("ba-star on teb_empty_box"));
 }
 
+/// Two `ccpp replay` of one run at once: both wrote `replay.html.tmp`, and the second's rename
+/// found the file already renamed by the first ("No such file"), so one failed. The second now
+/// waits for the first's files to be renamed in, and both succeed.
+#[test]
+fn two_replays_of_one_run_at_once_both_succeed() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("r");
+    ccpp()
+        .args(["run", "--planner", "ba-star", "--map"])
+        .arg(data("teb_empty_box.yaml"))
+        .arg("--out")
+        .arg(&out)
+        .assert()
+        .success();
+    let first = std::process::Command::new(assert_cmd::cargo::cargo_bin("ccpp"))
+        .arg("replay")
+        .arg(&out)
+        .env("CCPP_TEST_COMMIT_PAUSE_MS", "3000")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Rendering this run takes well under a second; the first then waits three seconds with
+    // its files written beside their names.
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let second = ccpp().arg("replay").arg(&out).output().unwrap();
+    let first = first.wait_with_output().unwrap();
+    assert!(first.status.success(), "{}", stderr_of(&first));
+    assert!(second.status.success(), "{}", stderr_of(&second));
+    let mut want: Vec<String> = BASE_SET.iter().map(|s| (*s).to_string()).collect();
+    want.extend(["replay.gif".into(), "replay.html".into()]);
+    want.sort();
+    assert_eq!(entries(&out), want);
+    let page = std::fs::read_to_string(out.join("replay.html")).unwrap();
+    assert!(page.contains("ba-star on teb_empty_box"));
+}
+
+/// A run, a plan or a demo into a folder below one that a bench or sweep of another process is
+/// writing (its `runs/MAP/PLANNER`) is refused before any work: the bench replaced it, or it
+/// replaced the bench's run. A lock file left unlocked by a killed bench does not count.
+#[test]
+fn runs_below_a_busy_bench_folder_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let bench_out = dir.path().join("b");
+    std::fs::create_dir(&bench_out).unwrap();
+    let target = bench_out.join("runs/teb_empty_box/ba-star");
+    let held = ccpp_io::lock::FolderLock::take(&bench_out).unwrap();
+    let run = |cmd: &str, planner: &str| {
+        ccpp()
+            .args([cmd, "--planner", planner, "--map"])
+            .arg(data("teb_empty_box.yaml"))
+            .arg("--out")
+            .arg(&target)
+            .output()
+            .unwrap()
+    };
+    for (cmd, planner) in [("run", "ba-star"), ("plan", "bcd")] {
+        let o = run(cmd, planner);
+        let err = stderr_of(&o);
+        assert_eq!(o.status.code(), Some(1), "{err}");
+        assert!(
+            err.contains("which a ccpp bench or sweep (pid ")
+                && err.contains(&format!("pid {}", std::process::id())),
+            "{err}"
+        );
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(!target.exists());
+    }
+    let demo = ccpp()
+        .current_dir(&bench_out)
+        .args(["demo", "--out", "d"])
+        .output()
+        .unwrap();
+    assert_eq!(demo.status.code(), Some(1), "{}", stderr_of(&demo));
+    // Released, the lock file is gone; a file left behind unlocked (a killed bench) is no
+    // hold either.
+    drop(held);
+    std::fs::write(bench_out.join(LOCK_FILE), "12345\n").unwrap();
+    let o = run("run", "ba-star");
+    assert!(o.status.success(), "{}", stderr_of(&o));
+    assert_eq!(entries(&target), BASE_SET);
+}
+
 /// A bare-image map named as one of ccpp's outputs (`coverage.png`) inside the output folder:
 /// `run` replaced it with the coverage picture (and `replay` then refused the run), `plan`
 /// deleted it, both exiting 0. Both now refuse the folder in one line naming the map, which

@@ -116,6 +116,21 @@ impl Drop for FolderLock {
     }
 }
 
+/// `pid N` of the process that holds the lock of `folder` now, `None` when nobody does (no
+/// lock file, or one left unlocked by a killed holder). Nothing is created or removed: the existing lock file is
+/// opened for reading and locked shared for a moment, which fails only while a holder has it.
+#[must_use]
+pub fn holder_of(folder: &Path) -> Option<String> {
+    let path = folder.join(LOCK_FILE);
+    let file = File::open(&path).ok()?;
+    match file.try_lock_shared() {
+        Err(TryLockError::WouldBlock) => Some(holder(&path)),
+        // Taken (and released when the file closes), or not lockable: not held as a bench
+        // holds it.
+        Ok(()) | Err(TryLockError::Error(_)) => None,
+    }
+}
+
 /// `pid N` of the process holding the lock file `path`, as it wrote there (it writes its id
 /// just after it takes the lock: a moment is allowed for that).
 fn holder(path: &Path) -> String {

@@ -245,6 +245,21 @@ pub enum FolderError {
         /// The run folder above it.
         run: PathBuf,
     },
+    /// A folder above the output folder is held by a `ccpp bench` or a Python sweep, which
+    /// writes run folders below it and may replace this one.
+    #[error(
+        "output folder {} lies inside {}, which a ccpp bench or sweep ({holder}) is writing; \
+         choose a folder outside it or wait for it to end",
+        path.display(), held.display()
+    )]
+    InsideBusyFolder {
+        /// The output folder.
+        path: PathBuf,
+        /// The held folder above it.
+        held: PathBuf,
+        /// `pid N` of the holder, as its lock file gives it.
+        holder: String,
+    },
     /// The folder's name is longer than a file system takes: found before the work, not at
     /// the final rename.
     #[error(
@@ -434,6 +449,41 @@ pub fn check_output_place(target: &Path) -> Result<(), FolderError> {
             return Err(FolderError::InsideRunFolder {
                 path: target.to_path_buf(),
                 run: above.to_path_buf(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Checks that no folder above the output folder `target` is held by another process's
+/// running bench or sweep ([`crate::lock::holder_of`]): a `ccpp run --out` into a bench's
+/// `runs/MAP/PLANNER` while the bench ran replaced the bench's run folder or was replaced by
+/// it. For a user's own run; a bench's or sweep's runs (in its own process or in worker
+/// processes) write below their own lock and do not call this.
+///
+/// # Errors
+/// [`FolderError::InsideBusyFolder`].
+pub fn check_not_in_busy_folder(target: &Path) -> Result<(), FolderError> {
+    let Some(base) = target
+        .ancestors()
+        .skip(1)
+        .map(|a| {
+            if a.as_os_str().is_empty() {
+                Path::new(".")
+            } else {
+                a
+            }
+        })
+        .find_map(|a| std::fs::canonicalize(a).ok())
+    else {
+        return Ok(());
+    };
+    for above in base.ancestors() {
+        if let Some(holder) = crate::lock::holder_of(above) {
+            return Err(FolderError::InsideBusyFolder {
+                path: target.to_path_buf(),
+                held: above.to_path_buf(),
+                holder,
             });
         }
     }
