@@ -153,6 +153,57 @@ fn keepouts_hold_for_every_planner_on_a_shared_map() {
     keepouts_hold("0.15");
 }
 
+/// Whether the segments `p1`-`p2` and `q1`-`q2` cross (proper crossing).
+fn crosses(p1: (f64, f64), p2: (f64, f64), q1: (f64, f64), q2: (f64, f64)) -> bool {
+    let side = |o: (f64, f64), a: (f64, f64), b: (f64, f64)| {
+        (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0)
+    };
+    side(q1, q2, p1) * side(q1, q2, p2) < 0.0 && side(p1, p2, q1) * side(p1, p2, q2) < 0.0
+}
+
+/// A keep-out drawn as a virtual wall, a strip 0.01 m wide slanted at 1/10 across the house,
+/// is never crossed by the robot's centre, and `keepout_violations` is 0 honestly. Its pixel
+/// centres alone left gaps wider than the robot: bcd drove through it six times with 0
+/// violations (hostile pass).
+#[test]
+fn a_thin_slanted_keepout_is_never_crossed() {
+    let d = tempfile::tempdir().unwrap();
+    let wall = [(1.0, -4.0), (1.01, -4.0), (1.61, 2.0), (1.6, 2.0)];
+    let g = d.path().join("thin.geojson");
+    std::fs::write(
+        &g,
+        r#"{"type":"Polygon","coordinates":[[[1.0,-4.0],[1.01,-4.0],[1.61,2.0],[1.6,2.0],[1.0,-4.0]]]}"#,
+    )
+    .unwrap();
+    let g = g.to_str().unwrap();
+    for p in ["bcd", "ba-star"] {
+        let (v, out) = run(d.path(), p, p, &["--keepout", g]);
+        assert_eq!(v["keepout_violations"], 0, "{p}: {v}");
+        let pts = path_points(&std::fs::read_to_string(out.join("path.csv")).unwrap());
+        // The robot works on both sides of the wall, and never crosses it.
+        assert!(
+            pts.iter()
+                .any(|&(x, y)| x < 0.5 && (-3.0..1.0).contains(&y)),
+            "{p}"
+        );
+        assert!(
+            pts.iter()
+                .any(|&(x, y)| x > 2.2 && (-3.0..1.0).contains(&y)),
+            "{p}"
+        );
+        for s in pts.windows(2) {
+            for i in 0..4 {
+                assert!(
+                    !crosses(s[0], s[1], wall[i], wall[(i + 1) % 4]),
+                    "{p}: {:?} -> {:?} crosses the keep-out",
+                    s[0],
+                    s[1]
+                );
+            }
+        }
+    }
+}
+
 #[test]
 fn a_start_outside_the_area_drives_there_first() {
     let d = tempfile::tempdir().unwrap();

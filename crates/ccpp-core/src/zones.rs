@@ -14,6 +14,11 @@
 //!   centre line; a centre exactly on a left edge is inside, exactly on a right edge outside
 //!   (half-open spans), so two polygons sharing an edge never both claim a pixel column of it
 //!   and the result depends on nothing but the coordinates. Several polygons are united.
+//!   This is the rule of the **area**.
+//! * A **keep-out polygon** holds every pixel whose square its inside overlaps: the pixel-centre
+//!   pixels and every pixel an edge passes through ([`rasterize_keepout`]), so the pixels cover
+//!   the polygon and a robot that keeps off them keeps off the polygon, however thin or
+//!   slanted it is drawn.
 //! * A **keep-out mask** (a Nav2 keepout filter mask, loaded by `ccpp-io`) is given directly as
 //!   pixels; it is united with the keep-out polygons.
 
@@ -375,6 +380,87 @@ pub fn rasterize(frame: &MapFrame, polys: &[Polygon]) -> FixedBitSet {
     m
 }
 
+/// The keep-out pixels of `polys`: every pixel whose square the inside of a polygon overlaps
+/// (the module docs' keep-out rule), [`rasterize`]'s pixels and those that an edge passes
+/// through. By the pixel-centre rule alone a thin keep-out (a virtual wall drawn as a strip a
+/// fraction of a pixel wide, slanted) marked scattered pixels with gaps wider than the robot,
+/// which then drove through the drawn polygon while its `keepout_violations`, counted on the
+/// same pixels, stayed 0 (hostile pass).
+pub fn rasterize_keepout(frame: &MapFrame, polys: &[Polygon]) -> FixedBitSet {
+    let mut m = rasterize(frame, polys);
+    for poly in polys {
+        let ring: Vec<Point> = poly
+            .ring()
+            .into_iter()
+            .filter(|p| p.x.is_finite() && p.y.is_finite())
+            .map(|p| {
+                let g = frame.world_to_grid(p);
+                // A vertex within a billionth of a pixel of a grid line is on it: an edge
+                // along a pixel border (a rectangle given in whole pixels) passes through no
+                // pixel, instead of through a whole row of them by rounding.
+                let snap = |v: f64| {
+                    if (v - v.round()).abs() <= 1e-9 {
+                        v.round()
+                    } else {
+                        v
+                    }
+                };
+                Point::new(snap(g.x), snap(g.y))
+            })
+            .collect();
+        if ring.len() < 3 {
+            continue;
+        }
+        for i in 0..ring.len() {
+            mark_edge_pixels(&mut m, frame, ring[i], ring[(i + 1) % ring.len()]);
+        }
+    }
+    m
+}
+
+/// Marks every pixel of `frame` whose open square the segment `a`-`b` (grid coordinates, y up)
+/// passes through; a segment along pixel borders or through a corner only marks none there.
+fn mark_edge_pixels(mask: &mut FixedBitSet, frame: &MapFrame, a: Point, b: Point) {
+    let (w, h) = (frame.width as i64, frame.height as i64);
+    // Marks the pixels of column `c` whose open y-range meets the open interval `(y0, y1)`,
+    // or, for `y0 == y1`, holds `y0`.
+    let mut mark_column = |c: i64, y0: f64, y1: f64| {
+        if c < 0 || c >= w {
+            return;
+        }
+        let (j0, j1) = if y0 < y1 {
+            (y0.floor() as i64, y1.ceil() as i64 - 1)
+        } else if y0.fract() != 0.0 {
+            (y0.floor() as i64, y0.floor() as i64)
+        } else {
+            return;
+        };
+        for j in j0.max(0)..=j1.min(h - 1) {
+            // Grid row j (y up) is image row h - 1 - j.
+            mask.insert(((h - 1 - j) * w + c) as usize);
+        }
+    };
+    let (lo, hi) = if a.x <= b.x { (a, b) } else { (b, a) };
+    if lo.x == hi.x {
+        if lo.x.fract() != 0.0 {
+            mark_column(lo.x.floor() as i64, lo.y.min(hi.y), lo.y.max(hi.y));
+        }
+        return;
+    }
+    let y_at = |x: f64| lo.y + (x - lo.x) * (hi.y - lo.y) / (hi.x - lo.x);
+    let c_first = (lo.x.floor() as i64).max(-1);
+    let c_last = ((hi.x.ceil() as i64) - 1).min(w);
+    for c in c_first..=c_last {
+        let x0 = lo.x.max(c as f64);
+        let x1 = hi.x.min(c as f64 + 1.0);
+        if x0 >= x1 {
+            continue;
+        }
+        let (ya, yb) = (y_at(x0), y_at(x1));
+        mark_column(c, ya.min(yb), ya.max(yb));
+    }
+}
+
 /// The zones of one run as pixel masks on the map grid.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ZoneMasks {
@@ -398,7 +484,7 @@ impl ZoneMasks {
         keepout: &[Polygon],
         masks: &[FixedBitSet],
     ) -> Self {
-        let mut k = rasterize(frame, keepout);
+        let mut k = rasterize_keepout(frame, keepout);
         for m in masks {
             k.union_with(m);
         }
@@ -769,6 +855,63 @@ mod tests {
         poly(&[[0.0, 0.0], [0.0, 1.0], [1.0, 1.0], [1.0, 0.0]])
             .validate(0)
             .unwrap();
+    }
+
+    /// A keep-out drawn as a thin slanted strip (0.01 m wide at 0.05 m pixels, slope 1/10)
+    /// holds every pixel it overlaps: a chain the robot cannot pass. By the pixel-centre rule
+    /// it held a few scattered pixels, with gaps a robot drove through (hostile pass).
+    #[test]
+    fn a_thin_slanted_keepout_holds_every_pixel_it_overlaps() {
+        let mut f = MapFrame::new(80, 160, 0.05);
+        f.origin = crate::Pose::new(-1.0, -4.0, 0.0);
+        let strip = poly(&[[1.0, -4.0], [1.01, -4.0], [1.61, 2.0], [1.6, 2.0]]);
+        let centre = rasterize(&f, std::slice::from_ref(&strip));
+        let k = rasterize_keepout(&f, std::slice::from_ref(&strip));
+        // The strip crosses 120 rows of pixels; about one in five held a centre.
+        assert!(centre.count_ones(..) <= 30, "{}", centre.count_ones(..));
+        assert!(k.count_ones(..) >= 120, "{}", k.count_ones(..));
+        assert!(k.is_superset(&centre));
+        // Every point of the strip lies in a marked pixel (sampled densely, inside it).
+        for i in 1..6000 {
+            let t = f64::from(i) / 6000.0;
+            for s in [0.001, 0.005, 0.009] {
+                let p = Point::new(1.0 + s + 0.6 * t, -4.0 + 6.0 * t);
+                let g = f.world_to_grid(p);
+                let (c, r) = (g.x.floor() as usize, 159 - g.y.floor() as usize);
+                if g.y < 160.0 {
+                    assert!(k.contains(r * 80 + c), "{p:?} in pixel ({c}, {r})");
+                }
+            }
+        }
+        // Only those: each marked pixel's square meets the strip (no pixel away from it).
+        for i in k.ones() {
+            let (c, r) = ((i % 80) as f64, (i / 80) as f64);
+            let y_lo = -4.0 + (159.0 - r) * 0.05;
+            let x_at = |y: f64| 1.0 + 0.1 * (y + 4.0);
+            let x_lo = -1.0 + c * 0.05;
+            let near = (x_at(y_lo) - 0.01..x_at(y_lo + 0.05) + 0.02).contains(&x_lo)
+                || (x_lo..x_lo + 0.05).contains(&x_at(y_lo));
+            assert!(near, "pixel ({c}, {r}) away from the strip");
+        }
+    }
+
+    /// A keep-out rectangle on pixel borders holds exactly the pixels inside it: its edges
+    /// run along borders and pass through no pixel, whatever the rounding of its corners.
+    #[test]
+    fn a_keepout_on_pixel_borders_holds_only_its_inside() {
+        let mut f = MapFrame::new(100, 100, 0.05);
+        f.origin = crate::Pose::new(-2.5, -2.5, 0.0);
+        for r in [
+            [-1.0, -1.0, 1.0, 1.0],
+            [-0.35, 0.1, 0.3, 1.95],
+            [0.15, -2.05, 0.2, -0.7],
+        ] {
+            let rect = Polygon::rect(r);
+            let k = rasterize_keepout(&f, std::slice::from_ref(&rect));
+            assert_eq!(k, rasterize(&f, std::slice::from_ref(&rect)), "{r:?}");
+            let px = ((r[2] - r[0]) / 0.05).round() * ((r[3] - r[1]) / 0.05).round();
+            assert_eq!(k.count_ones(..) as f64, px, "{r:?}");
+        }
     }
 
     /// An area given as two polygons that share a slanted edge is their union, whichever way

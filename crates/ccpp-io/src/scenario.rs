@@ -1030,7 +1030,7 @@ impl Scenario {
         for spec in &self.keepout {
             let bits = match load("keepout", spec, true)? {
                 ZoneData::Polygons(p) => {
-                    let bits = ccpp_core::zones::rasterize(&frame, &p);
+                    let bits = ccpp_core::zones::rasterize_keepout(&frame, &p);
                     polys.extend(p);
                     bits
                 }
@@ -1043,7 +1043,7 @@ impl Scenario {
                     kind: "keepout",
                     label: spec.label(),
                     message: format!(
-                        "keeps out no pixel of the map {} (it lies outside the map, is thinner than a pixel or, for a mask, has no occupied pixel)",
+                        "keeps out no pixel of the map {} (it lies outside the map or, for a mask, has no occupied pixel)",
                         map.source.display()
                     ),
                 });
