@@ -31,8 +31,10 @@ pub enum Command {
     /// Write the interactive replay.html (self-contained) and replay.gif of a finished run.
     Replay(ReplayArgs),
     /// Print the lane waypoints of a rectangular robot (seed 001) for a map, as CSV or JSON:
-    /// its stops every robot length along each lane, without headings (`ccpp plan --planner
-    /// rect-boustrophedon` gives the same lanes as a drivable route with headings).
+    /// its stops every robot length along each lane, without headings (without `--area`,
+    /// `ccpp plan --planner rect-boustrophedon` gives the same lanes as a drivable route with
+    /// headings; `--area` here is the rectangle the robot's centre lanes cover, there the area
+    /// the whole robot stays inside).
     Waypoints(WaypointsArgs),
     /// Plan a path for a robot on a known map (bcd, rect-boustrophedon) and write only the path
     /// exports (default: `nav_path.yaml` and `waypoints.csv`); no simulation metrics.

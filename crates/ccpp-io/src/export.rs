@@ -48,12 +48,7 @@ pub fn round_m(v: f64) -> f64 {
     if !v.is_finite() {
         return v;
     }
-    // The decimal places: 9, fewer where eight steps of an f64 (2.2e-16 relative each)
-    // exceed a unit of the last place.
-    let mut places = 9usize;
-    while places > 0 && v.abs() * 1.8e-15 > 10f64.powi(-(places as i32)) {
-        places -= 1;
-    }
+    let places = decimal_places(v);
     // Rounded in decimal (the exact value, half to even), then read back: the nearest f64 to
     // that decimal. (Scaling by 1e9 and `round` pushed clean values a step off above 2e6 m
     // and left the noise above 4.5e6 m.)
@@ -63,6 +58,29 @@ pub fn round_m(v: f64) -> f64 {
     } else {
         r
     }
+}
+
+/// The decimal places [`round_m`] keeps of `v`: 9, fewer where eight steps of an `f64`
+/// (2.2e-16 relative each) exceed a unit of the last place.
+fn decimal_places(v: f64) -> usize {
+    let mut places = 9usize;
+    while places > 0 && v.abs() * 1.8e-15 > 10f64.powi(-(places as i32)) {
+        places -= 1;
+    }
+    places
+}
+
+/// Whether the exported positions `a` and `b` ([`round_m`]ed) are one position: at most a unit
+/// of the last place [`round_m`] keeps apart. Far from the origin a unit is above the route's
+/// [`ccpp_core::route::SAME_POSITION_M`], and two poses of one rotation in place under
+/// odometry noise, a few `f64` steps apart, were exported as two waypoints at one position
+/// (or 1e-8 m apart, with a heading that is no direction of travel).
+fn same_exported_position(a: &Pose, b: &Pose) -> bool {
+    let unit = |v: f64| 10f64.powi(-(decimal_places(v) as i32));
+    // (Adjacent values of the last place differ by a unit give or take the f64 steps of
+    // their difference: half a unit more covers them, and no two units.)
+    let close = |u: f64, v: f64| (u - v).abs() <= 1.5 * unit(u.abs().max(v.abs()));
+    close(a.x, b.x) && close(a.y, b.y)
 }
 
 /// `theta` wrapped into `(-pi, pi]`, and set to the multiple of 45 degrees it lies within a
@@ -90,17 +108,21 @@ pub fn tidy_heading(theta: f64) -> f64 {
     }
 }
 
-/// The route as the exports write it: positions [`round_m`], headings [`tidy_heading`].
+/// The route as the exports write it: positions [`round_m`], headings [`tidy_heading`], and
+/// waypoints that come out at one position (within a unit of the last place kept) merged into
+/// the first of them with the heading of the last, as the route merges a rotation in place.
 /// Applying it twice changes nothing.
 #[must_use]
 pub fn tidy(route: &Route) -> Route {
-    Route {
-        waypoints: route
-            .waypoints
-            .iter()
-            .map(|p| Pose::new(round_m(p.x), round_m(p.y), tidy_heading(p.theta)))
-            .collect(),
+    let mut waypoints: Vec<Pose> = Vec::with_capacity(route.waypoints.len());
+    for p in &route.waypoints {
+        let p = Pose::new(round_m(p.x), round_m(p.y), tidy_heading(p.theta));
+        match waypoints.last_mut() {
+            Some(w) if same_exported_position(w, &p) => w.theta = p.theta,
+            _ => waypoints.push(p),
+        }
     }
+    Route { waypoints }
 }
 
 /// An export format.
@@ -814,6 +836,43 @@ mod tests {
         let e = parse_waypoints_csv("x,y,theta\n1,NaN,0\n", Path::new("w.csv"));
         assert!(e.is_err());
         assert!(parse_waypoints_json("{}", Path::new("w.json")).is_err());
+    }
+
+    /// Far from the origin, waypoints that round to one position (two poses of a rotation in
+    /// place under odometry noise, a few `f64` steps apart, or a unit of the last place kept)
+    /// are one waypoint with the later heading; the hostile pass found both exported as two
+    /// rows at one position in every format (`bsa-bfs` with noise at 4.2e6 m).
+    #[test]
+    fn far_out_waypoints_at_one_exported_position_merge() {
+        let x = 4_242_861.700_001_6;
+        let y = 5_340_004.375_736_46;
+        let step = |v: f64| f64::from_bits(v.to_bits() + 2);
+        let r = Route {
+            waypoints: vec![
+                Pose::new(x - 3.0, y, 0.0),
+                Pose::new(x, y, 1.365_933_260_428_760_4),
+                Pose::new(step(x), step(y), 2.257_356_936_097_352),
+                Pose::new(x + 1e-8, y, 2.3),
+                Pose::new(x - 2.0, y + 2.0, 2.3),
+            ],
+        };
+        let t = tidy(&r);
+        assert_eq!(t.waypoints.len(), 3, "{t:?}");
+        assert_eq!(t.waypoints[1].theta, 2.3);
+        assert_eq!(t.waypoints[1].x, round_m(x));
+        assert_eq!(tidy(&t), t);
+        let csv = waypoints_csv(&r);
+        assert_eq!(csv.lines().count(), 4, "{csv}");
+        // Near the origin a nanometre apart is still two positions (nothing merged there
+        // beyond what the route merges).
+        let near = Route {
+            waypoints: vec![
+                Pose::new(0.0, 0.0, 0.0),
+                Pose::new(0.5, 0.0, 1.0),
+                Pose::new(0.5 + 2e-9, 0.0, 2.0),
+            ],
+        };
+        assert_eq!(tidy(&near).waypoints.len(), 3);
     }
 
     #[test]
