@@ -153,6 +153,11 @@ pub fn run(a: &InfoArgs) -> Result<()> {
             );
         }
     };
+    // A start outside the area: where coverage would begin instead, as `run` and `plan` say
+    // (the start printed below is that end; it was printed without a word).
+    if let Some(note) = world.as_ref().and_then(crate::job::approach_note) {
+        say!("{note}");
+    }
     let s = world.as_ref().map(World::start);
     // On the map the planners see (zones as walls), as `run` reports it: on the plain map a
     // run inside a small area reported the start area of the whole floor.
@@ -263,10 +268,8 @@ pub fn run(a: &InfoArgs) -> Result<()> {
                 num(robot.radius),
                 w.cfree().count_ones(..)
             ));
-            line(format!(
-                "start          ({:.3}, {:.3}, {:.3})",
-                s.x, s.y, s.theta
-            ));
+            // (no heading: `info` takes none, and nothing it reports depends on one)
+            line(format!("start          ({:.3}, {:.3})", s.x, s.y));
             line(format!("start area     {}", comp.line()));
             line(format!(
                 "reachable      {} px of C-free from the start",

@@ -1407,8 +1407,12 @@ impl Scenario {
     ) -> Result<World, ScenarioError> {
         self.check_digest(&grid, zones.as_ref(), source)?;
         let start = self.start.map(|s| Pose::new(s[0], s[1], s[2]));
-        let fit = self.planner.settings().start_radius(&self.robot);
-        let world = World::with_zones_fitting(grid, self.robot, start, zones, fit).map_err(
+        let settings = self.planner.settings();
+        let fit = settings.start_radius(&self.robot);
+        // A tile planner's approach ends where its tiles around the start fit too (a disk one
+        // tile side wider), when the part of the area it reaches has such a spot.
+        let room = fit + settings.tile_side(&self.robot).unwrap_or(0.0);
+        let world = World::with_zones_room(grid, self.robot, start, zones, fit, room).map_err(
             |source_err| {
                 match self.zone_error(&source_err, source) {
                     Some(zone) => zone,
