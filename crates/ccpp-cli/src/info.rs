@@ -201,7 +201,8 @@ pub fn run(a: &InfoArgs) -> Result<()> {
         accessible_m2: world.as_ref().map(World::accessible_area_m2),
         zones: zones_info,
     };
-    if let Some(w) = comp.and_then(|c| c.warning()) {
+    let zoned = world.as_ref().is_some_and(|w| w.zones().is_some());
+    for w in comp.map(|c| c.warnings(zoned)).unwrap_or_default() {
         say!("warning: {w}");
     }
     if a.json {

@@ -104,7 +104,7 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     }
     // As for `run`: a start whose free area reaches the map's border is probably outside.
     let comp = StartComponent::of(plan.world.map(), plan.world.start().position());
-    if let Some(w) = comp.warning() {
+    for w in comp.warnings(plan.world.zones().is_some()) {
         say!("warning: {w}");
     }
     if let Some(w) = ccpp_io::warnings::rect_lane_area_warning(&scenario) {

@@ -283,6 +283,45 @@ fn info_tells_of_the_drive_into_the_area() {
     );
 }
 
+/// A keep-out that cuts the area in two leaves one part unswept: the run says so (it said
+/// "99.6 % covered" of the part the start reaches and nothing else: hostile pass), as `info`
+/// and `plan` do; a keep-out that cuts nothing off says nothing.
+#[test]
+fn a_keepout_cutting_the_area_in_two_is_told() {
+    let d = tempfile::tempdir().unwrap();
+    let warned = |cmd: &str, planner: Option<&str>, keepout: &str, sub: &str| {
+        let mut c = ccpp();
+        c.args([cmd, "--map"]).arg(house());
+        c.args(["--area", "0,-4,6,-1", "--keepout", keepout]);
+        if let Some(p) = planner {
+            c.args(["--planner", p, "--out"]).arg(d.path().join(sub));
+        }
+        let o = c.output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr).into_owned();
+        assert!(o.status.success(), "{err}");
+        err.lines()
+            .filter(|l| l.contains("of free floor the zones allow"))
+            .map(str::to_string)
+            .collect::<Vec<_>>()
+    };
+    let cut = "2.9,-4.5,3.1,-0.5";
+    for (cmd, planner) in [
+        ("run", Some("ba-star")),
+        ("plan", Some("bcd")),
+        ("info", None),
+    ] {
+        let w = warned(cmd, planner, cut, cmd);
+        assert_eq!(w.len(), 1, "{cmd}: {w:?}");
+        assert!(
+            w[0].starts_with("warning: 6.7 m2 of the 15.4 m2 of free floor the zones allow (44 %) lies apart from the start"),
+            "{}",
+            w[0]
+        );
+    }
+    // A keep-out inside the area that cuts nothing off.
+    assert!(warned("run", Some("ba-star"), "2.9,-3,3.1,-2", "whole").is_empty());
+}
+
 #[test]
 fn a_start_outside_the_area_drives_there_first() {
     let d = tempfile::tempdir().unwrap();
@@ -976,7 +1015,7 @@ fn info_reports_zones_that_leave_no_floor_naming_the_zone() {
     let robot = out.lines().find(|l| l.starts_with("robot ")).unwrap();
     assert!(
         robot.contains(
-            "keepout rectangle -1,-1,50,50: the area minus the keep-out zones holds no floor"
+            "keepout rectangle -1,-1,50,50: the map outside the keep-out zones holds no floor"
         ),
         "{out}"
     );

@@ -187,16 +187,58 @@ pub enum WorldError {
     },
     /// The zones leave no spot where the robot fits.
     #[error(
-        "the area minus the keep-out zones holds no floor where a robot of radius {} m \
-         fits ({free_px} free pixels inside the area and outside the keep-outs)",
-        Compact((*.radius * 1e6).round() / 1e6)
+        "{} no floor where a robot of radius {} m fits ({free_px} free pixels {})",
+        zones.holds(),
+        Compact((*.radius * 1e6).round() / 1e6),
+        zones.pixels()
     )]
     NoRoomInZones {
         /// Robot radius.
         radius: f64,
         /// Free pixels of the true map that are inside the area and outside every keep-out.
         free_px: usize,
+        /// The zones given.
+        zones: ZonesGiven,
     },
+}
+
+/// Which zones a run has, for the words of [`WorldError::NoRoomInZones`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ZonesGiven {
+    /// An area only.
+    Area,
+    /// Keep-out zones only.
+    Keepout,
+    /// An area and keep-out zones.
+    Both,
+}
+
+impl ZonesGiven {
+    /// The zones of `z`.
+    #[must_use]
+    pub fn of(z: &ZoneMasks) -> Self {
+        match (z.area.is_some(), z.keepout.is_clear()) {
+            (true, true) => Self::Area,
+            (false, _) => Self::Keepout,
+            (true, false) => Self::Both,
+        }
+    }
+
+    fn holds(self) -> &'static str {
+        match self {
+            Self::Area => "the area holds",
+            Self::Keepout => "the map outside the keep-out zones holds",
+            Self::Both => "the area minus the keep-out zones holds",
+        }
+    }
+
+    fn pixels(self) -> &'static str {
+        match self {
+            Self::Area => "inside the area",
+            Self::Keepout => "outside the keep-outs",
+            Self::Both => "inside the area and outside the keep-outs",
+        }
+    }
 }
 
 /// The ground truth for one robot on one map.
@@ -381,10 +423,11 @@ impl World {
             )
             .iter()
             .any(|&d2| f64::from(d2) >= rc2);
-            if fits_without {
+            if let (true, Some(z)) = (fits_without, zones.as_ref()) {
                 return Err(WorldError::NoRoomInZones {
                     radius: robot.radius,
                     free_px,
+                    zones: ZonesGiven::of(z),
                 });
             }
         }
@@ -648,6 +691,7 @@ impl World {
                 return Err(WorldError::NoRoomInZones {
                     radius: fit,
                     free_px: cells.iter().filter(|c| c.is_free()).count(),
+                    zones: ZonesGiven::of(z),
                 });
             }
             return Err(unreachable());

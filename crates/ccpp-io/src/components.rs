@@ -46,6 +46,13 @@ pub fn free_components(g: &GridMap) -> (usize, usize) {
     (n, largest)
 }
 
+/// Least free floor apart from the start, m^2, for [`StartComponent::cut_off_warning`].
+pub const CUT_OFF_MIN_M2: f64 = 1.0;
+
+/// Least share of the allowed free floor apart from the start, for
+/// [`StartComponent::cut_off_warning`].
+pub const CUT_OFF_MIN_SHARE: f64 = 0.1;
+
 /// The free component holding a start position.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StartComponent {
@@ -98,6 +105,35 @@ impl StartComponent {
             "{:.1} m2 of {:.1} m2 free ({share:.0} %) in the free area holding the start",
             self.area_m2, self.free_m2
         )
+    }
+
+    /// The warnings (without `warning: `) of [`Self::warning`] and, for a run with zones
+    /// (`zoned`), [`Self::cut_off_warning`].
+    pub fn warnings(&self, zoned: bool) -> Vec<String> {
+        self.warning()
+            .into_iter()
+            .chain(zoned.then(|| self.cut_off_warning()).flatten())
+            .collect()
+    }
+
+    /// The warning (without `warning: `) when much of the allowed free floor (inside the area,
+    /// outside the keep-outs: the map given has the zones as walls) lies apart from the start:
+    /// at least [`CUT_OFF_MIN_M2`] and [`CUT_OFF_MIN_SHARE`] of it. A keep-out that cut an area
+    /// in two, or an area of two rooms, left one part unswept while the run said "99.6 %
+    /// covered" (coverage is of the floor the start reaches) without a word (hostile pass).
+    pub fn cut_off_warning(&self) -> Option<String> {
+        let apart = self.free_m2 - self.area_m2;
+        (self.area_m2 > 0.0 && apart >= CUT_OFF_MIN_M2 && apart >= CUT_OFF_MIN_SHARE * self.free_m2)
+            .then(|| {
+                format!(
+                    "{apart:.1} m2 of the {:.1} m2 of free floor the zones allow ({:.0} %) lies apart \
+                     from the start, cut off by walls or keep-outs, and is not covered (coverage \
+                     figures are of the part the start reaches); run again with --start X,Y \
+                     there to cover it",
+                    self.free_m2,
+                    100.0 * apart / self.free_m2
+                )
+            })
     }
 
     /// The warning (without `warning: `) when the start's free area reaches the image border.

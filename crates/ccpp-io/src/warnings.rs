@@ -528,7 +528,7 @@ pub fn warnings_with_start(
 ) -> Vec<String> {
     start_area
         .unwrap_or_else(|| StartComponent::of(world.map(), world.start().position()))
-        .warning()
+        .warnings(world.zones().is_some())
         .into_iter()
         .chain(run_warnings(scenario, world, trace, metrics, swept))
         .collect()

@@ -367,8 +367,14 @@ fn point(v: &Value, geo: bool) -> Result<[f64; 2], ZoneFileError> {
             a.len(),
             if geo { "[x, y] or [x, y, z]" } else { "[x, y]" }
         ))),
+        // (`z` too, as a `geometry_msgs/Point32` list is dumped, when it is a number: the
+        // plane's zones ignore it, as a GeoJSON position's third number)
         Value::Object(o) => match (o.get("x"), o.get("y")) {
-            (Some(x), Some(y)) if o.len() == 2 => Ok([num(x)?, num(y)?]),
+            (Some(x), Some(y))
+                if o.len() == 2 || (o.len() == 3 && o.get("z").is_some_and(Value::is_number)) =>
+            {
+                Ok([num(x)?, num(y)?])
+            }
             (Some(_), Some(_)) => Err(bad(format!(
                 "point has keys other than x and y: {}",
                 o.keys()
@@ -496,6 +502,15 @@ fn geojson_polygon(rings: &Value, out: &mut Vec<Polygon>) -> Result<(), ZoneFile
     let Value::Array(r) = rings else {
         return Err(bad("GeoJSON Polygon coordinates must be a list of rings"));
     };
+    // Rings of positions (`[[x, y], ...]`): a list of positions instead is a level of
+    // brackets short (as in a MultiPolygon written like a Polygon), not a polygon with holes.
+    if r.iter()
+        .any(|ring| matches!(ring, Value::Array(pts) if pts.first().is_some_and(Value::is_number)))
+    {
+        return Err(bad(
+            "GeoJSON polygon coordinates must be a list of rings, each a list of [x, y] points: this one is a list of points, a level of brackets short (a MultiPolygon's coordinates are a list of polygons, [[[[x, y], ...]]])",
+        ));
+    }
     if r.len() > 1 {
         return Err(bad(
             "GeoJSON polygon with holes: not supported; give the zone as polygons without holes",
@@ -689,6 +704,7 @@ mod tests {
     #[test]
     fn points_with_more_numbers_are_refused() {
         let yaml = |t: &str| yaml_polygons(&serde_saphyr::from_str::<Value>(t).unwrap());
+        let geo = |t: &str| geojson_polygons(&serde_json::from_str::<Value>(t).unwrap());
         let e = yaml(
             "- [0, -4, 2, -4]
 - [2, -2, 0, -2]
@@ -705,15 +721,31 @@ mod tests {
 "
         )
         .is_err());
-        let e = yaml(
+        // A keyed z (a `geometry_msgs/Point32` list as ROS dumps it) is an altitude, left
+        // out as a GeoJSON position's; any other key, or a z that is no number, is refused.
+        let p = yaml(
             "- {x: 0, y: 0, z: 1}
-- {x: 1, y: 0}
+- {x: 1, y: 0, z: 0.0}
 - {x: 1, y: 1}
 ",
         )
-        .unwrap_err()
-        .to_string();
-        assert!(e.contains("other than x and y: z"), "{e}");
+        .unwrap();
+        assert_eq!(p[0].points, [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]);
+        for bad in [
+            "{x: 0, y: 0, z: up}",
+            "{x: 0, y: 0, w: 1}",
+            "{x: 0, y: 0, z: 1, w: 1}",
+        ] {
+            let e = yaml(&format!("- {bad}\n- {{x: 1, y: 0}}\n- {{x: 1, y: 1}}\n"))
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("other than x and y"), "{bad}: {e}");
+        }
+        // A MultiPolygon a level of brackets short is told as such, not as holes.
+        let e = geo(r#"{"type":"MultiPolygon","coordinates":[[[2,-4],[4,-4],[4,-1],[2,-4]]]}"#)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("a level of brackets short"), "{e}");
         assert_eq!(
             yaml(
                 "- [0, 0]
@@ -725,7 +757,6 @@ mod tests {
             .len(),
             1
         );
-        let geo = |t: &str| geojson_polygons(&serde_json::from_str::<Value>(t).unwrap());
         let z = geo(r#"{"type":"Polygon","coordinates":[[[0,0,9],[1,0,9],[1,1,9]]]}"#).unwrap();
         assert_eq!(z[0].points, [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]);
         let e = geo(r#"{"type":"Polygon","coordinates":[[[0,0,9,9],[1,0],[1,1]]]}"#)
