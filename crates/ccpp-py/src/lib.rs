@@ -283,6 +283,13 @@ impl Map {
         // A negative index is outside too (as `usize` it raised OverflowError), and so is an
         // int beyond 64 bits (as `i64` it raised OverflowError); not an int: TypeError.
         let inside = |v: &Bound<'_, PyAny>, n: usize| -> PyResult<Option<usize>> {
+            // (a bool is no index, as `radius=True` is no radius)
+            if is_bool(v) {
+                return Err(pyo3::exceptions::PyTypeError::new_err(format!(
+                    "a pixel index must be an int, got {}",
+                    repr(v)
+                )));
+            }
             match v.extract::<i64>() {
                 Ok(i) => Ok(usize::try_from(i).ok().filter(|&i| i < n)),
                 // (an int of any kind, a numpy uint64 too, beyond 64 signed bits)
@@ -506,9 +513,6 @@ struct NotBool<T>(T);
 
 /// A real number argument ([`NotBool`]).
 type Real = NotBool<f64>;
-
-/// A whole-number argument, >= 0 ([`NotBool`]).
-type Whole = NotBool<u64>;
 
 impl<'a, 'py, T> FromPyObject<'a, 'py> for NotBool<T>
 where
@@ -1331,7 +1335,7 @@ impl RunResult {
     /// The executed path's waypoints, `float64` `(N, 3)`: x, y, theta at the ends of its
     /// straight segments (poses merged within `tolerance_m`, default 0.001 m, as in
     /// `path.csv` and the exports; `None` is the default).
-    #[pyo3(signature = (tolerance_m=None), text_signature = "(self, tolerance_m=0.001)")]
+    #[pyo3(signature = (tolerance_m=None), text_signature = "($self, tolerance_m=0.001)")]
     fn waypoints<'py>(
         &self,
         py: Python<'py>,
@@ -1590,7 +1594,8 @@ type BenchRow = (Option<Py<PyAny>>, Option<String>, Vec<String>);
 /// One run of `ccpp bench` (default options, start and simulator settings): the metrics, or
 /// the error message the bench's `results.csv` records, and the run's warnings (as
 /// `ccpp run` prints them; none for a failed run). With `out`, the run's files are written
-/// there.
+/// there. Arguments a run would refuse before it starts (an unknown planner, a bad robot or
+/// memory limit) raise `CcppError`, as `run`'s do; what fails in the run is the row's error.
 #[pyfunction]
 #[pyo3(signature = (map_path, planner, radius=None, tool_radius=None, inflate=None, max_memory_mb=None, out=None, name=None))]
 #[allow(clippy::too_many_arguments)] // keyword arguments of a Python function
@@ -1601,12 +1606,16 @@ fn bench_run(
     radius: Option<Real>,
     tool_radius: Option<Real>,
     inflate: Option<Real>,
-    max_memory_mb: Option<Whole>,
+    max_memory_mb: Option<&Bound<'_, PyAny>>,
     out: Option<PathBuf>,
     name: Option<String>,
 ) -> PyResult<BenchRow> {
     let (radius, tool_radius, inflate) = (real(radius), real(tool_radius), real(inflate));
-    let max_memory_mb = max_memory_mb.map(|m| m.0);
+    // (as `run`'s: a value below 0 or past 64 bits raised a bare OverflowError)
+    let max_memory_mb = max_memory_mb
+        .filter(|v| !v.is_none())
+        .map(|v| uint_arg("max_memory_mb", v, 1))
+        .transpose()?;
     let kind = parse_kind(planner)?;
     let radius = radius.unwrap_or(DEFAULT_RADIUS);
     check_robot(NotBool(radius), tool_radius.map(NotBool))?;

@@ -681,3 +681,26 @@ def test_an_empty_landmarks_file_is_refused_in_the_clis_words(room: Path, tmp_pa
             ccpp.run(room, "bcd", landmarks=f, odometry_noise=0.01, seed=1)
     with pytest.raises(ccpp.CcppError, match="^landmarks: no landmark given$"):
         ccpp.run(room, "bcd", landmarks=[], odometry_noise=0.01, seed=1)
+
+
+def test_round_stop59_python_holes(room: Path) -> None:
+    """From the stop-59 stubs pass: `RunResult.waypoints` showed a `self` parameter, a bool
+    was taken as a pixel index, `bench_run` raised a bare OverflowError for a memory limit
+    out of range, and `sweep` iterated a Decimal radius and a bytes map path."""
+    import decimal
+    import inspect
+
+    m = ccpp.load_map(room)
+    r = ccpp.run(m, "bsa")
+    assert str(inspect.signature(r.waypoints)) == "(tolerance_m=0.001)"
+    for col, row in ((True, 0), (0, False), (np.bool_(True), 0)):
+        with pytest.raises(TypeError, match="a pixel index must be an int"):
+            m.pixel_center(col, row)
+    for bad in (-1, 2**70, True):
+        with pytest.raises(ccpp.CcppError, match="max_memory_mb"):
+            ccpp._ccpp.bench_run(str(room), "bsa", max_memory_mb=bad)
+    # A Decimal radius is a number, as `run` takes it; the sweep's own check refuses 0.
+    with pytest.raises(ccpp.CcppError, match="radius"):
+        ccpp.sweep(str(room), ["bsa"], decimal.Decimal("0"))
+    with pytest.raises(ccpp.CcppError, match=r"^maps must be paths \(str or os.PathLike\), got b"):
+        ccpp.sweep(str(room).encode(), ["bsa"])

@@ -1,7 +1,7 @@
 """Type stubs of the ccpp extension module (re-exported by ``ccpp``)."""
 
 import os
-from typing import Any, Sequence
+from typing import Any, Sequence, SupportsFloat
 
 import numpy as np
 import numpy.typing as npt
@@ -128,8 +128,8 @@ class Env:
         self,
         map: Map | _Path,
         *,
-        radius: float | None = 0.15,
-        tool_radius: float | None = None,
+        radius: SupportsFloat | None = 0.15,
+        tool_radius: SupportsFloat | None = None,
         sensor_range: float | None = None,
         start: Sequence[float] | None = None,
         exec: str | None = "ideal",
@@ -186,7 +186,7 @@ def load_map(
     header, before it is decoded."""
 
 def run(
-    map: Map | _Path, planner: str | None = "ba-star", radius: float | None = 0.15, **options: Any
+    map: Map | _Path, planner: str | None = "ba-star", radius: SupportsFloat | None = 0.15, **options: Any
 ) -> RunResult:
     """Runs a planner; options are scenario fields (``tool_radius``, ``start``,
     ``sensor_range``, ``exec``, ``odometry_noise`` (LIN or ``(LIN, ANG, DRIFT)``, as
@@ -200,7 +200,7 @@ def run(
     dropped)."""
 
 def plan(
-    map: Map | _Path, planner: str | None = "bcd", radius: float | None = 0.15, **options: Any
+    map: Map | _Path, planner: str | None = "bcd", radius: SupportsFloat | None = 0.15, **options: Any
 ) -> PlanResult:
     """Plans a path with a known-map planner (``ccpp plan``); options as for ``run`` where they
     apply to a plan (refused: ``exec``, the planner's execution settings, ``sensor_range``, a
@@ -209,16 +209,17 @@ def plan(
 def bench_run(
     map_path: _Path,
     planner: str,
-    radius: float | None = 0.15,
-    tool_radius: float | None = None,
+    radius: SupportsFloat | None = 0.15,
+    tool_radius: SupportsFloat | None = None,
     inflate: float | None = None,
     max_memory_mb: int | None = None,
     out: _Path | None = None,
     name: str | None = None,
 ) -> tuple[dict[str, Any] | None, str | None, list[str]]:
-    """One ``ccpp bench`` run: (metrics, None, warnings) or (None, error message, []); the
-    warnings are those ``ccpp run`` prints (without ``warning: ``); ``name`` is the map's name
-    in the results (default its file stem)."""
+    """One ``ccpp bench`` run: (metrics, None, warnings) or, when the run fails, (None, error
+    message, []); the warnings are those ``ccpp run`` prints (without ``warning: ``); ``name``
+    is the map's name in the results (default its file stem). Arguments a run refuses before
+    it starts (an unknown planner, a bad robot or memory limit) raise ``CcppError``."""
 
 def expand_maps(items: list[_Path]) -> list[Any]:
     """The map files that files and folders stand for, as ``ccpp bench --maps`` takes them."""
@@ -227,7 +228,7 @@ def name_maps(paths: list[_Path]) -> list[tuple[int, str]]:
     """The maps a sweep runs and their names, as ``ccpp bench`` names them: ``(index in
     paths, name)`` for every map kept (a file named twice is run once), in order."""
 
-def check_robot(radius: float, tool_radius: float | None = None) -> None:
+def check_robot(radius: float, tool_radius: SupportsFloat | None = None) -> None:
     """Raises CcppError for a robot a run would refuse."""
 
 def planners() -> list[dict[str, Any]]:

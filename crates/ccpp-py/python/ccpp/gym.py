@@ -6,7 +6,7 @@ right ``turn_rad``. Observations (``Dict``): ``pose`` (x, y, theta as float32), 
 square window of image pixels around the robot, 0 free / 1 occupied / 2 unknown or out of
 range) and, with ``include_known``, ``known`` (the map seen so far, same codes). The reward is
 the newly swept accessible floor in m²; an episode terminates on a collision or at full coverage
-and is truncated after ``max_steps`` actions.
+and is truncated after ``max_steps`` actions (``None``: never).
 """
 
 from __future__ import annotations
@@ -58,7 +58,7 @@ class CoverageEnv(gym.Env):  # type: ignore[misc]
         sensor_range: float | None = None,
         step_m: float | None = None,
         turn_rad: float = math.pi / 2,
-        max_steps: int = 1000,
+        max_steps: int | None = 1000,
         random_start: bool = True,
         include_known: bool = True,
         render_mode: str | None = None,

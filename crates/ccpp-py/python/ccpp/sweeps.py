@@ -14,11 +14,12 @@ installed and the map files at the same paths (a shared file system); so does ``
 from __future__ import annotations
 
 import contextlib
+import decimal
 import math
 import numbers
 import os
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Iterable, Iterator, Sequence
+from typing import TYPE_CHECKING, Any, Iterable, Iterator, SupportsFloat
 
 from . import _ccpp
 
@@ -61,6 +62,10 @@ def expand_maps(items: Iterable[str | os.PathLike[str]] | str | os.PathLike[str]
     folder gives its ``*.yaml``/``*.yml`` maps (or, when it has none, its PNG/PGM images),
     sorted; a file is taken as it is. A name that is neither, a folder without maps, or a map
     whose name is not UTF-8 is refused, as ``ccpp bench`` refuses it, before any run."""
+    if isinstance(items, (bytes, bytearray)):
+        # Iterated, a bytes path was its byte values ("expected str, bytes or os.PathLike
+        # object, not int"); no path argument of ccpp takes bytes.
+        raise _ccpp.CcppError(f"maps must be paths (str or os.PathLike), got {items!r}")
     if isinstance(items, (str, os.PathLike)):
         items = [items]
     return [Path(p) for p in _ccpp.expand_maps(list(items))]
@@ -73,6 +78,13 @@ def _map_names(paths: list[Path]) -> list[tuple[Path, str]]:
     ``-3``, ... if that still repeats); a stem of dots is ``map``, ``summary`` is
     ``summary-map``."""
     return [(paths[i], name) for i, name in _ccpp.name_maps(paths)]
+
+
+def _is_number(v: object) -> bool:
+    """A real number as ``ccpp.run`` takes one for a radius: a ``numbers.Real`` (numpy's
+    scalars too) or a ``decimal.Decimal`` (which ``run`` took and a sweep tried to iterate),
+    not a bool."""
+    return not isinstance(v, bool) and isinstance(v, (numbers.Real, decimal.Decimal))
 
 
 def _check_out(out: str | os.PathLike[str]) -> None:
@@ -177,8 +189,8 @@ def _run_cell(
 
 def sweep(
     maps: Iterable[str | os.PathLike[str]] | str | os.PathLike[str],
-    planners: Sequence[str] | str | None = None,
-    radii: Sequence[float] | float | None = (0.15,),
+    planners: Iterable[str] | str | None = None,
+    radii: Iterable[SupportsFloat] | SupportsFloat | None = (0.15,),
     *,
     tool_radius: float | None = None,
     inflate: float | None = None,
@@ -236,11 +248,11 @@ def sweep(
     elif isinstance(radii, (str, bytes)):
         # Iterated, "0.2" was its characters ("got '0'").
         raise _ccpp.CcppError(f"radii must be numbers (metres), got {radii!r}")
-    elif isinstance(radii, numbers.Real):
+    elif _is_number(radii):
         radii = (radii,)
     for r in radii:
         # `float()` took True as 1.0 m and "0.2" as 0.2: a radius is a number.
-        if isinstance(r, bool) or not isinstance(r, numbers.Real):
+        if not _is_number(r):
             raise _ccpp.CcppError(f"radii must be numbers (metres), got {r!r}")
     radii = _once(float(r) for r in radii)
     if not radii:
