@@ -165,7 +165,7 @@ pub fn write_all(
                         ),
                         coverage_verdict_colour(metrics.effective_coverage),
                     )),
-                    caption: vec![
+                    caption: [
                         format!(
                             "path {:.1} m, ratio {:.2}, revisits {:.2}",
                             metrics.path_length_m, metrics.path_ratio, metrics.revisit_rate
@@ -174,19 +174,33 @@ pub fn write_all(
                             "regions {}, turns {}, collisions {}",
                             metrics.regions, metrics.turns, metrics.collisions
                         ),
-                    ],
+                    ]
+                    .into_iter()
+                    .chain(warning_caption(&r.warnings))
+                    .collect(),
                     png,
                 });
                 shown.push(LegendShown::of(run_world, &trace, &swept));
             }
             let points = tradeoff_points(rows, &planners, &m.name);
             if points.iter().any(Option::is_some) {
-                let c = tradeoff_chart(
-                    &title("Coverage against path ratio"),
-                    &planners,
-                    &points,
-                    &[],
-                );
+                // A run with warnings is named so beside its point (its figures may be of
+                // less than the user meant: a start outside the building, a robot boxed in).
+                let labels: Vec<String> = planners
+                    .iter()
+                    .map(|p| {
+                        let warned = rows
+                            .iter()
+                            .any(|r| r.map == m.name && &r.planner == p && !r.warnings.is_empty());
+                        if warned {
+                            format!("{p} (warned)")
+                        } else {
+                            p.clone()
+                        }
+                    })
+                    .collect();
+                let c =
+                    tradeoff_chart(&title("Coverage against path ratio"), &labels, &points, &[]);
                 write_chart(&dir, &format!("tradeoff_{}", m.name), &c)?;
             }
             if !series.is_empty() {
@@ -280,10 +294,24 @@ pub fn write_all(
                 .iter()
                 .filter(|r| &r.planner == p && r.outcome.is_ok())
                 .count();
+            let warned = rows
+                .iter()
+                .filter(|r| &r.planner == p && r.outcome.is_ok() && !r.warnings.is_empty())
+                .count();
+            let mut notes = Vec::new();
             if ok < ran_maps.len() {
-                format!("{p} ({ok} of {} maps)", ran_maps.len())
-            } else {
+                notes.push(format!("{ok} of {} maps", ran_maps.len()));
+            }
+            if warned > 0 {
+                notes.push(format!(
+                    "warned on {warned} map{}",
+                    if warned == 1 { "" } else { "s" }
+                ));
+            }
+            if notes.is_empty() {
                 p.clone()
+            } else {
+                format!("{p} ({})", notes.join(", "))
             }
         })
         .collect();
@@ -317,6 +345,25 @@ pub fn write_all(
         write_chart(&dir, "tradeoff_summary", &c)?;
     }
     Ok(skipped.into_iter().flatten().collect())
+}
+
+/// Most characters of a run's first warning in its panel's caption.
+const CAPTION_WARNING_CHARS: usize = 64;
+
+/// The caption line of a run's warnings in its map's `paths_` panel: their count and the
+/// first, cut to [`CAPTION_WARNING_CHARS`] (the whole text is in `results.md` and the run's
+/// `warnings.txt`); none without warnings. The panels showed a warned run as any other.
+fn warning_caption(warnings: &[String]) -> Option<String> {
+    let first = warnings.first()?;
+    let mut text: String = first.chars().take(CAPTION_WARNING_CHARS).collect();
+    if first.chars().count() > CAPTION_WARNING_CHARS {
+        text.push_str("...");
+    }
+    let n = warnings.len();
+    Some(format!(
+        "{n} warning{}: {text}",
+        if n == 1 { "" } else { "s" }
+    ))
 }
 
 /// The warning for a run left out of its map's plots (`why` says why).

@@ -3135,6 +3135,18 @@ fn bench_reports_the_warnings_of_its_runs() {
         };
         assert!(row("ba-star").contains(wide), "{csv}");
         assert!(row("bcd").ends_with("bcd,"), "{csv}");
+        // The plots mark the warned run: its name beside its points, its panel's caption
+        // (they showed it as any other run).
+        let plot = |n: &str| std::fs::read_to_string(out.join("plots").join(n)).unwrap();
+        assert!(plot("tradeoff_pillars.svg").contains(">ba-star (warned)</text>"));
+        assert!(!plot("tradeoff_pillars.svg").contains("bcd (warned)"));
+        assert!(plot("tradeoff_summary.svg").contains("(warned on 1 map)"));
+        assert!(plot("summary.svg").contains(">ba-star (warned on 1 map)</text>"));
+        let paths = plot("paths_pillars.svg");
+        assert!(
+            paths.contains(">1 warning: the tile side 0.3 m is wider than the tool sweeps (2 x tool radi...</text>"),
+            "{paths}"
+        );
     };
     let (stdout, _) = bench();
     check(&stdout);

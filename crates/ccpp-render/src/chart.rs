@@ -847,7 +847,14 @@ pub fn bar_panels(title: &str, planners: &[String], metrics: &[(String, Vec<f64>
     let rows = metrics.len().div_ceil(cols).max(1);
     let (pw, ph) = (300f32, 230f32);
     let w = (cols as f32 * pw) as u32;
-    let h = (rows as f32 * ph + 60.0 + 24.0 * planners.len().div_ceil(4) as f32) as u32;
+    // Legend columns: four of 220 px, fewer when a name is wider ("random-bounce (warned on 2
+    // maps)" ran into the next name).
+    let item_w = planners
+        .iter()
+        .map(|p| 40.0 + font::text_width(p, 14.0))
+        .fold(220.0f32, f32::max);
+    let per_row = (((w as f32 - 40.0) / item_w).floor() as usize).clamp(1, 4);
+    let h = (rows as f32 * ph + 60.0 + 24.0 * planners.len().div_ceil(per_row) as f32) as u32;
     let mut c = Chart::new(w, h);
     c.title(title);
     for (m, (name, vals)) in metrics.iter().enumerate() {
@@ -896,8 +903,8 @@ pub fn bar_panels(title: &str, planners: &[String], metrics: &[(String, Vec<f64>
     }
     let ly = 40.0 + rows as f32 * ph;
     for (k, p) in planners.iter().enumerate() {
-        let x = 20.0 + (k % 4) as f32 * 220.0;
-        let y = ly + (k / 4) as f32 * 24.0;
+        let x = 20.0 + (k % per_row) as f32 * item_w;
+        let y = ly + (k / per_row) as f32 * 24.0;
         c.rect(x, y, 14.0, 14.0, Some(SERIES[k % SERIES.len()]), None);
         c.text(
             x + 20.0,
@@ -1291,8 +1298,33 @@ pub fn tradeoff_chart(
     for (k, name) in planners.iter().enumerate() {
         let col = SERIES[k % SERIES.len()];
         c.circle(lx + 8.0, ly + 9.0, 6.0, Some(col), None, 1.0);
-        c.text(lx + 22.0, ly, 14, name.clone(), [30, 30, 30], Anchor::Start);
-        ly += 24.0;
+        // A name with a note wider than the margin ("random-bounce (warned on 2 maps)") goes
+        // on two lines, the note smaller under the name; it ran off the picture.
+        match name.split_once(" (") {
+            Some((head, note)) if lx + 22.0 + font::text_width(name, 14.0) > w as f32 - 4.0 => {
+                c.text(
+                    lx + 22.0,
+                    ly,
+                    14,
+                    head.to_string(),
+                    [30, 30, 30],
+                    Anchor::Start,
+                );
+                c.text(
+                    lx + 22.0,
+                    ly + 17.0,
+                    12,
+                    format!("({note}"),
+                    [90, 90, 90],
+                    Anchor::Start,
+                );
+                ly += 40.0;
+            }
+            _ => {
+                c.text(lx + 22.0, ly, 14, name.clone(), [30, 30, 30], Anchor::Start);
+                ly += 24.0;
+            }
+        }
     }
     ly += 10.0;
     c.rect(lx, ly + 2.0, 16.0, 14.0, Some(shade), Some([150, 190, 160]));
