@@ -858,16 +858,30 @@ fn done_line(runs: usize, failed: usize, maps: usize, planners: usize) -> String
 /// A name as Markdown text on one line: control characters escaped (`\n`; a map file named
 /// with a newline split its heading in two), `|` escaped so it does not end a table cell, and
 /// `<`, `>`, `&` as HTML entities so that they show as written (a map `<script>.yaml` gave the
-/// heading `## <script>`, which a Markdown renderer drops as HTML).
+/// heading `## <script>`, which a Markdown renderer drops as HTML), and the characters of
+/// Markdown's own syntax backslash-escaped (a map `![i](http:__x.png).yaml` became an image in
+/// its heading, `**b**.yaml` bold, `#.yaml` an empty heading: hostile pass).
 fn md_text(name: &str) -> String {
     let mut out = String::with_capacity(name.len());
-    for c in name.chars() {
+    let chars: Vec<char> = name.chars().collect();
+    for (i, &c) in chars.iter().enumerate() {
+        // (an `_` between letters or digits opens no emphasis: `aws_small_house` stays as
+        // it is written)
+        let inside_word = |k: Option<usize>| {
+            k.and_then(|k| chars.get(k))
+                .is_some_and(|c| c.is_alphanumeric())
+        };
         match c {
+            '_' if inside_word(i.checked_sub(1)) && inside_word(Some(i + 1)) => out.push(c),
             '|' => out.push_str("\\|"),
+            '\\' | '`' | '*' | '_' | '[' | ']' | '#' | '!' | '~' => {
+                out.push('\\');
+                out.push(c);
+            }
             '<' => out.push_str("&lt;"),
             '>' => out.push_str("&gt;"),
             '&' => out.push_str("&amp;"),
-            c if c.is_control() => out.extend(c.escape_default()),
+            c if ccpp_io::message::hidden(c) => out.extend(c.escape_default()),
             c => out.push(c),
         }
     }
@@ -1090,6 +1104,22 @@ pub fn results_md(rows: &[Row], outside: &[String]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Names show in results.md as written: Markdown's syntax escaped, an `_` inside a word
+    /// left alone, hidden characters written as escapes.
+    #[test]
+    fn markdown_names_are_written_as_they_are() {
+        assert_eq!(md_text("aws_small_house"), "aws_small_house");
+        assert_eq!(
+            md_text("![img](http:__x.png)"),
+            "\\!\\[img\\](http:\\_\\_x.png)"
+        );
+        assert_eq!(md_text("**b**"), "\\*\\*b\\*\\*");
+        assert_eq!(md_text("#"), "\\#");
+        assert_eq!(md_text("a\\|b`c`"), "a\\\\\\|b\\`c\\`");
+        assert_eq!(md_text("_x_ <s>"), "\\_x\\_ &lt;s&gt;");
+        assert_eq!(md_text("r\u{202e}t\n"), "r\\u{202e}t\\n");
+    }
 
     #[test]
     fn bench_plots_are_known_by_name() {

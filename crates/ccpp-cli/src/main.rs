@@ -5,12 +5,16 @@
 
 /// `eprintln!` that never panics: stderr that cannot be written (`2>/dev/full`, a closed
 /// pipe) has no reader to tell, and `eprintln!` panicked there (exit 101) after the run's
-/// folder was written (hostile pass). Warnings and errors go through this.
+/// folder was written (hostile pass). Warnings and errors go through this, one line each:
+/// characters a terminal would act on (escape sequences, line breaks, bidirectional
+/// overrides), which names and values from the user's files can hold, are written as `\u{..}`
+/// ([`ccpp_io::message::visible`]).
 macro_rules! say {
     ($($arg:tt)*) => {{
         use std::io::Write as _;
+        let line = ccpp_io::message::visible(&format!($($arg)*));
         // (nothing to tell when stderr itself fails: see the macro's doc)
-        let _ = writeln!(std::io::stderr(), $($arg)*);
+        let _ = writeln!(std::io::stderr(), "{line}");
     }};
 }
 

@@ -111,8 +111,14 @@ pub fn replay_dir(dir: &Path) -> Result<()> {
             dir.display()
         )
     })?;
-    let scenario: Scenario =
-        serde_json::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", rec_path.display()))?;
+    let scenario: Scenario = serde_json::from_str(&text).map_err(|e| {
+        // (serde's message quotes the folder's values raw: a line break there cut it)
+        anyhow::anyhow!(
+            "{}: {}",
+            rec_path.display(),
+            ccpp_io::message::visible(&e.to_string())
+        )
+    })?;
     let map = crate::job::load_recipe(&scenario.map, scenario.max_memory_mb)?;
     let world = scenario.world(&map)?;
     // Poses must lie on the map: a damaged trace is refused instead of hanging the renderer.

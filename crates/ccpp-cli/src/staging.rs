@@ -206,7 +206,10 @@ fn interrupted() -> ! {
     if written.is_empty() {
         let _ = writeln!(std::io::stderr(), "error: interrupted");
     } else {
-        let names: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
+        let names: Vec<String> = written
+            .iter()
+            .map(|p| ccpp_io::message::visible(&p.display().to_string()))
+            .collect();
         let _ = writeln!(
             std::io::stderr(),
             "error: interrupted after the new output was written whole to {}",

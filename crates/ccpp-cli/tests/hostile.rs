@@ -3312,3 +3312,73 @@ fn bsa_bfs_estimate_counts_glides_only_without_noise() {
     );
     assert!(!noisy.exists());
 }
+
+/// Names and values from the user's files reach stderr with the characters a terminal acts on
+/// written as `\u{..}`: an option key holding an escape sequence set the terminal's title and
+/// cleared the screen, a line break in a key cut the message and started a forged `error:`
+/// line, and a map YAML's `mode` and a `GeoJSON` `type` were printed raw (hostile pass).
+#[test]
+fn hostile_names_reach_stderr_visible_and_on_one_line() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let check = |args: &[&str], needle: &str| {
+        let o = ccpp().args(args).output().unwrap();
+        assert_eq!(o.status.code(), Some(1));
+        let err = String::from_utf8_lossy(&o.stderr).into_owned();
+        assert!(!err.contains('\u{1b}') && !err.contains('\u{7}') && !err.contains('\r'));
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(err.starts_with("error: ") && err.contains(needle), "{err}");
+    };
+    let yaml = dir.join("c.yaml");
+    std::fs::write(&yaml, "ba_star:\n  \"\\e]0;T\\a\\e[2J\\nerror: fake\": 1\n").unwrap();
+    check(
+        &[
+            "run",
+            "--planner",
+            "ba-star",
+            "--map",
+            s(&map),
+            "--config",
+            s(&yaml),
+        ],
+        "ba_star.\\u{1b}]0;T\\u{7}\\u{1b}[2J\\u{a}error: fake",
+    );
+    let json = dir.join("c.json");
+    std::fs::write(
+        &json,
+        r#"{"bsa":{"side":"\u001b[41mX\rerror: fake\nsecond"}}"#,
+    )
+    .unwrap();
+    check(
+        &[
+            "run",
+            "--planner",
+            "bsa",
+            "--map",
+            s(&map),
+            "--config",
+            s(&json),
+        ],
+        "unknown variant `\\u{1b}[41mX\\u{d}error: fake\\u{a}second`",
+    );
+    let geo = dir.join("g.geojson");
+    std::fs::write(&geo, r#"{"type":"\u001b[41mX\nerror: fake"}"#).unwrap();
+    check(
+        &["info", "--map", s(&map), "--keepout", s(&geo)],
+        "GeoJSON \\u{1b}[41mX\\u{a}error: fake is not a zone",
+    );
+    let moded = dir.join("moded.yaml");
+    std::fs::write(
+        &moded,
+        format!(
+            "image: {}\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\nmode: \"\\e[41mM\\nerror: q\"\n",
+            s(&map)
+        ),
+    )
+    .unwrap();
+    check(
+        &["info", "--map", s(&moded)],
+        "unsupported mode `\\u{1b}[41mM\\u{a}error: q`",
+    );
+}

@@ -148,8 +148,10 @@ pub fn parse_yaml_or_json<T: serde::de::DeserializeOwned + serde::Serialize>(
     text: &str,
     json: bool,
 ) -> Result<T, String> {
+    // (JSON's messages quote values and keys raw; YAML's escape them: made visible, so that
+    // a key holding a line break cannot cut the message, nor an escape act on the terminal)
     let first = if json {
-        serde_json::from_str::<T>(text).map_err(|e| e.to_string())
+        serde_json::from_str::<T>(text).map_err(|e| crate::message::visible(&e.to_string()))
     } else {
         serde_saphyr::from_str::<T>(text).map_err(|e| yaml_words(&e.to_string()))
     };
@@ -164,7 +166,7 @@ pub fn parse_yaml_or_json<T: serde::de::DeserializeOwned + serde::Serialize>(
         let mut de = serde_json::Deserializer::from_str(text);
         serde_path_to_error::deserialize::<_, T>(&mut de)
             .err()
-            .map(|e| e.path().to_string())
+            .map(|e| crate::message::visible(&e.path().to_string()))
     } else {
         // Kept from inside: a deserialization that stops at its error leaves events unread,
         // which the reader then reports instead.
@@ -172,7 +174,7 @@ pub fn parse_yaml_or_json<T: serde::de::DeserializeOwned + serde::Serialize>(
         let outcome = serde_saphyr::with_deserializer_from_str(text, |de| {
             found = serde_path_to_error::deserialize::<_, T>(de)
                 .err()
-                .map(|e| e.path().to_string());
+                .map(|e| crate::message::visible(&e.path().to_string()));
             Ok(())
         });
         // Only the path is wanted; the first parse's message is the one reported.

@@ -7,6 +7,8 @@
 //! joined the causes as they were and showed a YAML error's eight-line snippet, the YAML
 //! library's advice and its raw budget text).
 
+use std::fmt::Write as _;
+
 /// Advice from the YAML library that a ccpp user cannot act on.
 const LIBRARY_ADVICE: [&str; 2] = [
     ", set DuplicateKeyPolicy in Options if acceptable",
@@ -63,7 +65,50 @@ fn clean(text: &str) -> String {
     plain_budget(&s)
 }
 
-/// The error and its sources as one line: each cause once, outermost first, joined by `: `.
+/// Whether `c` is one [`visible`] writes as an escape: a control character (line breaks, tab,
+/// escape, bell, delete and the C1 controls), a bidirectional or other invisible format
+/// control (U+061C, U+200B..=U+200F, U+202A..=U+202E, U+2060..=U+2069, U+FEFF), a line or
+/// paragraph separator (U+2028, U+2029), or a noncharacter (U+FFFE, U+FFFF, which XML
+/// refuses).
+pub fn hidden(c: char) -> bool {
+    c.is_control()
+        || matches!(
+            c,
+            '\u{061c}'
+                | '\u{200b}'..='\u{200f}'
+                | '\u{2028}'..='\u{202e}'
+                | '\u{2060}'..='\u{2069}'
+                | '\u{feff}'
+                | '\u{fffe}'
+                | '\u{ffff}'
+        )
+}
+
+/// `text` with every character that would act on a terminal or hide in it ([`hidden`]:
+/// escape sequences, carriage returns and line breaks, bidirectional overrides) written as
+/// `\u{..}`, so that a name or value from a user's file is shown as it is and cannot set the
+/// terminal's title, clear the screen, overwrite the line or start a forged `error:` line
+/// (hostile pass: planner option keys, a map YAML's `mode`, a `GeoJSON` `type`, names in a run
+/// folder, and a bench map named after a folder holding an escape reached stderr raw).
+#[must_use]
+pub fn visible(text: &str) -> String {
+    if !text.chars().any(hidden) {
+        return text.to_string();
+    }
+    let mut out = String::with_capacity(text.len() + 8);
+    for c in text.chars() {
+        if hidden(c) {
+            // (writing to a String cannot fail)
+            let _ = write!(out, "\\u{{{:x}}}", u32::from(c));
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+/// The error and its sources as one line: each cause once, outermost first, joined by `: `;
+/// characters a terminal would act on are made [`visible`].
 pub fn one_line(e: &(dyn std::error::Error + 'static)) -> String {
     let mut msg = String::new();
     let mut cur = Some(e);
@@ -83,12 +128,29 @@ pub fn one_line(e: &(dyn std::error::Error + 'static)) -> String {
         }
         msg.push_str(&text);
     }
-    msg
+    visible(&msg)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn hidden_characters_are_written_as_escapes() {
+        assert_eq!(visible("plain é ü 日本"), "plain é ü 日本");
+        assert_eq!(
+            visible("a\u{1b}]0;T\u{7}\u{1b}[2Jb\r\nerror: x\t\u{202e}y\u{2028}\u{fffe}"),
+            "a\\u{1b}]0;T\\u{7}\\u{1b}[2Jb\\u{d}\\u{a}error: x\\u{9}\\u{202e}y\\u{2028}\\u{fffe}"
+        );
+        let e = E(
+            "options c.yaml: ba_star.\u{1b}[31mEVIL: unknown field".into(),
+            None,
+        );
+        assert_eq!(
+            one_line(&e),
+            "options c.yaml: ba_star.\\u{1b}[31mEVIL: unknown field"
+        );
+    }
 
     /// An error with a message and an optional source.
     #[derive(Debug)]

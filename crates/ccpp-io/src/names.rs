@@ -147,7 +147,7 @@ pub fn expand_maps(items: &[PathBuf]) -> Result<Vec<PathBuf>, MapListError> {
 fn map_name(p: &Path) -> String {
     let stem = p
         .file_stem()
-        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+        .map_or_else(String::new, |s| shown_name(&s.to_string_lossy()));
     if stem.chars().all(|c| c == '.') {
         "map".into()
     } else if stem == "summary" {
@@ -155,6 +155,18 @@ fn map_name(p: &Path) -> String {
     } else {
         stem
     }
+}
+
+/// `name` with every character a terminal or an XML parser would act on
+/// ([`crate::message::hidden`]: controls, bidirectional overrides, U+FFFE, U+FFFF) replaced by
+/// `_`: a map's name becomes a folder name and goes into pictures, SVG plots, Markdown and
+/// messages. A folder holding an escape sequence named a bench map `<folder>-<stem>` (the
+/// given path, checked for control characters, did not hold it: a link led there), which
+/// reached the terminal raw and made the SVG plots invalid XML (hostile pass).
+fn shown_name(name: &str) -> String {
+    name.chars()
+        .map(|c| if crate::message::hidden(c) { '_' } else { c })
+        .collect()
 }
 
 /// Drops repeated maps (the same file named twice) and gives every map a distinct name, used
@@ -208,7 +220,7 @@ pub fn name_maps_indexed(maps: &[PathBuf]) -> Vec<(usize, String)> {
             match canon
                 .parent()
                 .and_then(Path::file_name)
-                .map(|n| n.to_string_lossy().into_owned())
+                .map(|n| shown_name(&n.to_string_lossy()))
             {
                 Some(folder) => format!("{folder}-{stem}"),
                 None => stem.clone(),
@@ -414,5 +426,28 @@ mod tests {
                 "a".to_string()
             ]
         );
+    }
+
+    /// A name made of a folder whose name holds an escape sequence and a line break (reached
+    /// through a link, so the path given had none) has them as `_`; a stem with U+FFFE too.
+    #[test]
+    fn names_hold_no_hidden_characters() {
+        let dir = tempfile::tempdir().unwrap();
+        let odd = dir.path().join("b\u{1b}]0;T\u{7}\nerror: X");
+        let plain = dir.path().join("a");
+        for d in [&odd, &plain] {
+            std::fs::create_dir(d).unwrap();
+            std::fs::write(d.join("x.yaml"), "").unwrap();
+        }
+        std::fs::write(plain.join("c\u{fffe}d.yaml"), "").unwrap();
+        let names: Vec<String> = name_maps(vec![
+            plain.join("x.yaml"),
+            odd.join("x.yaml"),
+            plain.join("c\u{fffe}d.yaml"),
+        ])
+        .into_iter()
+        .map(|(_, n)| n)
+        .collect();
+        assert_eq!(names, ["a-x", "b_]0;T__error: X-x", "c_d"]);
     }
 }

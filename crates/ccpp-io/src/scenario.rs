@@ -315,6 +315,19 @@ impl MapRecipe {
                 "{map}--origin / map.origin yaw {why}"
             )));
         }
+        // The name goes into folder names, pictures, pages, SVG plots and messages, as a file
+        // stem would (whose control characters are refused with the path): Python's
+        // `name=` took an escape sequence and a line break into every file and the terminal.
+        if let Some(c) = self
+            .name
+            .as_deref()
+            .and_then(|n| n.chars().find(|&c| crate::message::hidden(c)))
+        {
+            return Err(ScenarioError::Invalid(format!(
+                "{map}map.name holds a control or invisible character (U+{:04X}); give a plain name",
+                u32::from(c)
+            )));
+        }
         if let Some(g) = &self.georef {
             // The fit places the image: a resolution or origin given beside it would be
             // validated and then replaced.

@@ -546,8 +546,12 @@ fn geojson_collect(
     }
     let ty = v.get("type").and_then(Value::as_str).unwrap_or("");
     let coords = || {
-        v.get("coordinates")
-            .ok_or_else(|| bad(format!("GeoJSON {ty} without coordinates")))
+        v.get("coordinates").ok_or_else(|| {
+            bad(format!(
+                "GeoJSON {} without coordinates",
+                crate::message::visible(ty)
+            ))
+        })
     };
     match ty {
         "Polygon" => geojson_polygon(coords()?, out),
@@ -609,7 +613,8 @@ fn geojson_collect(
         },
         "" => Err(bad("not GeoJSON: no \"type\"")),
         other => Err(bad(format!(
-            "GeoJSON {other} is not a zone: use Polygon, MultiPolygon, Feature or FeatureCollection"
+            "GeoJSON {} is not a zone: use Polygon, MultiPolygon, Feature or FeatureCollection",
+            crate::message::visible(other)
         ))),
     }
 }

@@ -50,8 +50,11 @@ fn err(e: &(dyn std::error::Error + 'static)) -> PyErr {
     CcppError::new_err(ccpp_io::message::one_line(e))
 }
 
+/// A `CcppError` with this message, on one line with the characters a terminal acts on made
+/// visible ([`ccpp_io::message::visible`]), as every error from [`err`] is: an option key or
+/// value holding an escape sequence and a line break was raised raw.
 fn msg(m: impl Into<String>) -> PyErr {
-    CcppError::new_err(m.into())
+    CcppError::new_err(ccpp_io::message::visible(&m.into()))
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -704,3 +704,15 @@ def test_round_stop59_python_holes(room: Path) -> None:
         ccpp.sweep(str(room), ["bsa"], decimal.Decimal("0"))
     with pytest.raises(ccpp.CcppError, match=r"^maps must be paths \(str or os.PathLike\), got b"):
         ccpp.sweep(str(room).encode(), ["bsa"])
+
+
+def test_hostile_names_are_refused_or_shown(room: Path) -> None:
+    """From the stop-59 injection pass: `name=` took an escape sequence and a line break into
+    every file and the terminal, and errors carried option keys raw."""
+    with pytest.raises(ccpp.CcppError, match=r"map.name holds a control or invisible character \(U\+001B\)"):
+        ccpp.load_map(room, name="a\x1b]0;PWN\x07\nerror: fake")
+    with pytest.raises(ccpp.CcppError) as e:
+        ccpp.run(room, "bsa", side="\x1b[41mX\nerror: fake")
+    text = str(e.value)
+    assert "\x1b" not in text and "\n" not in text, text
+    assert "\\u{1b}[41mX" in text, text

@@ -610,8 +610,18 @@ fn hex(c: [u8; 3]) -> String {
     format!("#{:02x}{:02x}{:02x}", c[0], c[1], c[2])
 }
 
+/// `s` as SVG (XML 1.0) text: markup characters as references, and the characters XML 1.0
+/// does not allow at all (controls but tab and line breaks, U+FFFE, U+FFFF) as U+FFFD: a map
+/// named with one made every plot of its map unparseable (hostile pass).
 fn escape(s: &str) -> String {
-    s.replace('&', "&amp;")
+    s.chars()
+        .map(|c| match c {
+            '\t' | '\n' | '\r' => c,
+            c if u32::from(c) < 0x20 || c == '\u{fffe}' || c == '\u{ffff}' => '\u{fffd}',
+            c => c,
+        })
+        .collect::<String>()
+        .replace('&', "&amp;")
         .replace('<', "&lt;")
         .replace('>', "&gt;")
         .replace('"', "&quot;")
@@ -1530,6 +1540,15 @@ pub fn image_grid_captioned(
 
 #[cfg(test)]
 mod tests {
+
+    /// SVG text is XML 1.0: markup as references, characters XML refuses as U+FFFD.
+    #[test]
+    fn svg_text_is_always_xml() {
+        assert_eq!(
+            super::escape("a\u{1b}[31m<b>&\"\u{fffe}\u{ffff}\tc"),
+            "a\u{fffd}[31m&lt;b&gt;&amp;&quot;\u{fffd}\u{fffd}\tc"
+        );
+    }
 
     /// Tick labels carry the decimals their step needs, so neighbouring ticks never read the
     /// same (a coverage axis in steps of 0.005 read 0.98 twice).

@@ -86,8 +86,9 @@ pub enum MapError {
     },
     /// The YAML asks for a `mode` other than `trinary`, `scale` or `raw`.
     #[error(
-        "map YAML {}: unsupported mode `{mode}` (map_server's modes are trinary, scale and raw)",
-        path.display()
+        "map YAML {}: unsupported mode `{}` (map_server's modes are trinary, scale and raw)",
+        path.display(),
+        crate::message::visible(mode)
     )]
     UnsupportedMode {
         /// The YAML file.
