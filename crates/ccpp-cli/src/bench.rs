@@ -531,7 +531,15 @@ fn run_one(
     // holds nothing: the child says why).
     let bytes = spec.scenario.check_map(map).map_or(0.0, |e| e.bytes);
     let _grant = budget.take(bytes);
-    let m = run_isolated(&spec)?;
+    let m = run_isolated(&spec).inspect_err(|_| {
+        // A job that died (killed, crashed) may have left its staging folder beside the run
+        // folder: removed now that its process is gone, not at the next bench (a finished
+        // bench held a hidden copy of a dead job's files: hostile pass).
+        if let (Some(parent), Some(name)) = (dir.parent(), dir.file_name().and_then(|n| n.to_str()))
+        {
+            ccpp_io::write::clean_stale(parent, name);
+        }
+    })?;
     Ok((m, read_warnings(dir)?))
 }
 

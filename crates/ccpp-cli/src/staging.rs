@@ -62,7 +62,7 @@ pub const REPLAY_PAUSE_ENV: &str = "CCPP_TEST_REPLAY_PAUSE_MS";
 pub const COMMIT_PAUSE_ENV: &str = "CCPP_TEST_COMMIT_PAUSE_MS";
 
 /// Test hook: a staging folder, once moved into place, waits this many milliseconds (a test
-/// interrupts the process then).
+/// interrupts the process then); so do a replay's page and GIF once renamed in.
 pub const AFTER_COMMIT_PAUSE_ENV: &str = "CCPP_TEST_AFTER_COMMIT_PAUSE_MS";
 
 /// Sleeps for the milliseconds the environment variable `var` gives, if any, at most a
@@ -328,6 +328,10 @@ pub fn write_files_together(dir: &Path, files: &[(&str, &[u8])]) -> Result<()> {
         unregister(&tmp_of(name));
         before.push(old);
     }
+    // An interrupt from here on says the files were written whole, as after a folder's swap
+    // (a replay interrupted after its renames said only "interrupted": hostile pass).
+    lock(&WRITTEN).push(dir.to_path_buf());
+    pause_for(AFTER_COMMIT_PAUSE_ENV);
     Ok(())
 }
 

@@ -1214,3 +1214,102 @@ fn info_describes_a_map_the_robot_does_not_fit() {
         .assert()
         .code(1);
 }
+
+/// A replay interrupted after its page and GIF were renamed in says they were written whole,
+/// as a run does after its swap (it said only "interrupted": hostile pass).
+#[test]
+fn a_replay_interrupted_after_its_files_are_in_says_so() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("r");
+    ccpp()
+        .args(["run", "--planner", "ba-star", "--map"])
+        .arg(data("teb_empty_box.yaml"))
+        .arg("--out")
+        .arg(&out)
+        .assert()
+        .success();
+    let child = std::process::Command::new(assert_cmd::cargo::cargo_bin("ccpp"))
+        .arg("replay")
+        .arg(&out)
+        .env("CCPP_TEST_AFTER_COMMIT_PAUSE_MS", "5000")
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let t0 = std::time::Instant::now();
+    while !out.join("replay.gif").exists() && t0.elapsed() < std::time::Duration::from_secs(30) {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    // (the GIF is renamed in last; the process then waits five seconds)
+    std::thread::sleep(std::time::Duration::from_millis(200));
+    let _ = std::process::Command::new("kill")
+        .arg("-INT")
+        .arg(child.id().to_string())
+        .status();
+    let o = child.wait_with_output().unwrap();
+    let err = stderr_of(&o);
+    assert_eq!(o.status.code(), Some(130), "{err}");
+    assert!(
+        err.contains("interrupted after the new output was written whole to")
+            && err.contains(out.to_str().unwrap()),
+        "{err}"
+    );
+}
+
+/// A bench job killed while it held its staging folder (a run's files written, not yet moved
+/// into place) leaves no staging folder in the bench's output once the bench ends: the bench
+/// removes it when the job's failure comes back (a finished bench held a hidden copy of the
+/// dead job's files until the next bench: hostile pass).
+#[cfg(target_os = "linux")]
+#[test]
+fn a_killed_bench_job_leaves_no_staging_folder() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("b");
+    let bench = std::process::Command::new(assert_cmd::cargo::cargo_bin("ccpp"))
+        .args([
+            "bench",
+            "--quiet",
+            "--jobs",
+            "1",
+            "--planners",
+            "ba-star",
+            "--maps",
+        ])
+        .arg(data("teb_empty_box.yaml"))
+        .arg("--out")
+        .arg(&out)
+        .env("CCPP_TEST_COMMIT_PAUSE_MS", "5000")
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let runs = out.join("runs/teb_empty_box");
+    let staged = || {
+        std::fs::read_dir(&runs).ok().is_some_and(|rd| {
+            rd.flatten()
+                .any(|e| e.file_name().to_string_lossy().contains(".ccpp-new-"))
+        })
+    };
+    let t0 = std::time::Instant::now();
+    while !staged() && t0.elapsed() < std::time::Duration::from_secs(30) {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    assert!(staged(), "the job never staged its folder");
+    // The job: the bench's child process.
+    let pid = bench.id();
+    let children =
+        std::fs::read_to_string(format!("/proc/{pid}/task/{pid}/children")).unwrap_or_default();
+    let job = children.split_whitespace().next().expect("a job process");
+    let _ = std::process::Command::new("kill")
+        .args(["-KILL", job])
+        .status();
+    let o = bench.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(1), "{}", stderr_of(&o));
+    assert!(
+        !staged(),
+        "{:?}",
+        std::fs::read_dir(&runs).map(|r| r.count())
+    );
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    assert!(csv.contains("signal 9"), "{csv}");
+}

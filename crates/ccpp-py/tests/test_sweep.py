@@ -260,3 +260,18 @@ def test_an_interrupted_sweep_cancels_its_cells() -> None:
     with pytest.raises(KeyboardInterrupt):
         sweeps._gather(tasks, c, None)
     assert c.cancelled == [("future", "m", "bsa"), ("future", "m", "bcd")]
+
+
+def test_a_scheduler_dask_refuses_leaves_no_folder(room: Path, tmp_path: Path) -> None:
+    """A scheduler name Dask does not take (``"synchronous"``) raised Dask's own ValueError
+    and left the output folder made, empty (hostile pass): a CcppError naming it, no folder."""
+    out = tmp_path / "sw"
+    with pytest.raises(ccpp.CcppError, match=r"^cannot reach the Dask scheduler 'synchronous': "):
+        ccpp.sweep([str(room)], ["bsa"], out=out, scheduler="synchronous")
+    assert not out.exists()
+    # A folder that was there stays, with what it held.
+    out.mkdir()
+    (out / "runs").mkdir()
+    with pytest.raises(ccpp.CcppError):
+        ccpp.sweep([str(room)], ["bsa"], out=out, scheduler="synchronous")
+    assert sorted(p.name for p in out.iterdir()) == ["runs"]

@@ -126,14 +126,21 @@ def _folder_lock(out: str | os.PathLike[str]) -> Iterator[None]:
     """Holds ``out``'s bench lock while a sweep writes there: the lock ``ccpp bench`` takes (one
     implementation, in the native module: the same file and operating-system lock), so a sweep
     and a bench, or two sweeps, never write one folder at once. A lock left by a killed process
-    is taken over; one held is refused naming its process. The folder is made if missing."""
+    is taken over; one held is refused naming its process. The folder is made if missing, and
+    removed again when the sweep wrote nothing into it (a sweep whose cluster could not be
+    reached, ``scheduler="synchronous"``, left an empty folder behind)."""
     folder = Path(out)
+    made = not folder.exists()
     folder.mkdir(parents=True, exist_ok=True)
     lock = _ccpp.FolderLock(folder)
     try:
         yield
     finally:
         lock.release()
+        if made:
+            with contextlib.suppress(OSError):
+                # Only an empty folder goes (rmdir refuses any other).
+                folder.rmdir()
 
 
 def _once(items: Iterable[Any]) -> list[Any]:
@@ -336,7 +343,14 @@ def _gather(tasks: list[tuple[Any, ...]], client: Any, scheduler: str | None) ->
     own = None
     if client is None:
         address = scheduler or os.environ.get("CCPP_DASK_SCHEDULER")
-        own = Client(address) if address else Client(processes=True)
+        try:
+            own = Client(address) if address else Client(processes=True)
+        except (ValueError, OSError, TimeoutError) as e:
+            # (a scheduler name Dask does not take, `"synchronous"`, raised Dask's own
+            # ValueError; an address nobody answers, an OSError)
+            raise _ccpp.CcppError(
+                f"cannot reach the Dask scheduler {address!r}: {e}" if address else f"cannot start a local Dask cluster: {e}"
+            ) from e
         client = own
     futures: list[Any] = []
     try:
