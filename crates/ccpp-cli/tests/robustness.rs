@@ -1308,7 +1308,7 @@ fn a_killed_bench_job_leaves_no_staging_folder() {
     assert!(
         !staged(),
         "{:?}",
-        std::fs::read_dir(&runs).map(|r| r.count())
+        std::fs::read_dir(&runs).map(Iterator::count)
     );
     let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
     assert!(csv.contains("signal 9"), "{csv}");
