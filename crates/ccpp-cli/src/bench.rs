@@ -128,7 +128,19 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     // The summary of an earlier bench in this folder goes before any run starts: an
     // interrupted bench then leaves complete run folders and no summary, never a summary of
     // the earlier bench (another radius, other planners) beside run folders of this one.
+    let had_summary = ["results.csv", "results.md"]
+        .iter()
+        .any(|f| a.out.join(f).is_file());
     clear_summary(&a.out, &plotted)?;
+    crate::staging::set_interrupt_note(format!(
+        "{}: the run folders finished so far are kept whole (a bench with the same --out reuses them) and no summary (results.csv, results.md, plots/) is written{}",
+        a.out.display(),
+        if had_summary {
+            "; the earlier bench's summary there was removed when this one started"
+        } else {
+            ""
+        }
+    ));
     if let Some(j) = a.jobs {
         // A thread beyond one per run would only idle: `--jobs 100000` started 100000
         // threads, which took minutes on two cores before the first run.

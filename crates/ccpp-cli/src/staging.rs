@@ -48,6 +48,17 @@ static LOCKS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 /// took the new complete set for the old one or for a broken one (hostile pass).
 static WRITTEN: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
+/// What an interrupt leaves, for its message when no output was moved into place whole (a
+/// bench: which run folders stay and what became of the summary); `None`: nothing to add.
+static INTERRUPT_NOTE: Mutex<Option<String>> = Mutex::new(None);
+
+/// Sets what an interrupt says it leaves ([`INTERRUPT_NOTE`]): the interrupted bench said only
+/// "interrupted" after it had removed an earlier summary and rewritten some run folders
+/// (hostile pass).
+pub fn set_interrupt_note(note: String) {
+    *lock(&INTERRUPT_NOTE) = Some(note);
+}
+
 /// Test hook: when this environment variable names a file, writing that file fails as on a full
 /// disk (`ENOSPC`). Used by the end-to-end tests to check that a failed run leaves no output.
 pub const FAIL_WRITE_ENV: &str = "CCPP_TEST_FAIL_WRITE";
@@ -203,7 +214,14 @@ fn interrupted() -> ! {
     }
     // Stderr may be a pipe whose reader is gone (a bench job whose bench died): no panic.
     let written = lock(&WRITTEN);
-    if written.is_empty() {
+    let note = lock(&INTERRUPT_NOTE);
+    if let (true, Some(note)) = (written.is_empty(), note.as_deref()) {
+        let _ = writeln!(
+            std::io::stderr(),
+            "error: interrupted; {}",
+            ccpp_io::message::visible(note)
+        );
+    } else if written.is_empty() {
         let _ = writeln!(std::io::stderr(), "error: interrupted");
     } else {
         let names: Vec<String> = written

@@ -460,7 +460,7 @@ fn an_interrupted_bench_never_leaves_the_summary_of_an_earlier_bench() {
     .code(1);
     assert_eq!(std::fs::read(out.join("results.csv")).unwrap(), csv);
     // ... then one at r = 0.15 m into the same folder, stopped while it runs.
-    let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("ccpp"))
+    let child = std::process::Command::new(assert_cmd::cargo::cargo_bin("ccpp"))
         .args([
             "bench",
             "--quiet",
@@ -475,7 +475,7 @@ fn an_interrupted_bench_never_leaves_the_summary_of_an_earlier_bench() {
         .arg("--out")
         .arg(&out)
         .stdout(Stdio::null())
-        .stderr(Stdio::null())
+        .stderr(Stdio::piped())
         .spawn()
         .unwrap();
     // Until the new bench has rewritten the first run folder (the old r = 0.2 m run).
@@ -491,8 +491,19 @@ fn an_interrupted_bench_never_leaves_the_summary_of_an_earlier_bench() {
         .arg("-TERM")
         .arg(child.id().to_string())
         .status();
-    let status = child.wait().unwrap();
+    let o = child.wait_with_output().unwrap();
+    let status = o.status;
     assert!(status.code() == Some(130) || status.success(), "{status:?}");
+    if status.code() == Some(130) {
+        // It says what it leaves (it said only "interrupted").
+        let err = stderr_of(&o);
+        assert!(
+            err.contains("error: interrupted; ")
+                && err.contains("the run folders finished so far are kept whole")
+                && err.contains("the earlier bench's summary there was removed"),
+            "{err}"
+        );
+    }
     if status.success() {
         // Finished before the signal: the summary is the new bench's.
         assert!(csv_rows(&out).iter().all(|r| r.len() > 3));
