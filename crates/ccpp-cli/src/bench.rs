@@ -121,6 +121,8 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         );
     }
     check_bench_target(&a.out, &plotted)?;
+    // (a bench into `runs/` of a bench or sweep at work above it wrote among its runs)
+    ccpp_io::write::check_not_in_busy_folder(&a.out)?;
     ccpp_io::write::create_folder(&a.out, &a.out)?;
     // Held until the bench ends: a second bench on the folder is refused instead of writing
     // its runs and summary among this one's.

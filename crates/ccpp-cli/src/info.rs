@@ -78,7 +78,7 @@ struct ZonesInfo {
     area_m2: Option<f64>,
     /// Free floor inside the work area, m^2.
     area_free_m2: Option<f64>,
-    /// Map area of the keep-out zones, m^2.
+    /// Map area of the keep-out zones' pixels (every pixel a keep-out polygon overlaps), m^2.
     keepout_m2: f64,
     /// Free floor in the keep-out zones, m^2.
     keepout_free_m2: f64,
@@ -201,8 +201,10 @@ pub fn run(a: &InfoArgs) -> Result<()> {
         accessible_m2: world.as_ref().map(World::accessible_area_m2),
         zones: zones_info,
     };
-    let zoned = world.as_ref().is_some_and(|w| w.zones().is_some());
-    for w in comp.map(|c| c.warnings(zoned)).unwrap_or_default() {
+    let cut_off = world
+        .as_ref()
+        .and_then(ccpp_io::components::zone_cut_off_warning);
+    for w in comp.and_then(|c| c.warning()).into_iter().chain(cut_off) {
         say!("warning: {w}");
     }
     if a.json {
@@ -313,7 +315,7 @@ pub fn run(a: &InfoArgs) -> Result<()> {
                 .collect();
             let _ = writeln!(
                 t,
-                "keep-out       {}: {:.2} m2, {:.2} m2 of it free floor",
+                "keep-out       {}: {:.2} m2 of pixels kept out (each pixel a polygon overlaps), {:.2} m2 of it free floor",
                 labels.join(", "),
                 z.keepout_m2,
                 z.keepout_free_m2

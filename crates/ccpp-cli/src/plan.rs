@@ -104,7 +104,8 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     }
     // As for `run`: a start whose free area reaches the map's border is probably outside.
     let comp = StartComponent::of(plan.world.map(), plan.world.start().position());
-    for w in comp.warnings(plan.world.zones().is_some()) {
+    let cut_off = ccpp_io::components::zone_cut_off_warning(&plan.world);
+    for w in comp.warning().into_iter().chain(cut_off) {
         say!("warning: {w}");
     }
     if let Some(w) = ccpp_io::warnings::rect_lane_area_warning(&scenario) {

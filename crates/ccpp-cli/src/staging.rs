@@ -276,6 +276,9 @@ pub fn unregister_lock(p: &Path) {
     lock(&LOCKS).retain(|q| q != p);
 }
 
+/// Longest wait of [`write_files_together`] for another writer of the folder.
+const WRITER_WAIT: std::time::Duration = std::time::Duration::from_mins(1);
+
 /// Writes `files` (name, bytes) into the existing folder `dir` as one set, both or neither:
 /// each is written and synced as `<name>.tmp` first (a failure there removes them all and
 /// leaves the old files as they were); then, under the swap lock (an interrupt waits for it),
@@ -292,8 +295,34 @@ pub fn write_files_together(dir: &Path, files: &[(&str, &[u8])]) -> Result<()> {
     // ("No such file"). The operating system's advisory lock on the folder itself (no file is
     // added to it) makes the second wait until the first has renamed its files in; it is
     // released when the process ends in any way. Where the folder cannot be locked, the
-    // files are written without it.
-    let _writer = std::fs::File::open(dir).ok().filter(|f| f.lock().is_ok());
+    // files are written without it. The wait is said, and bounded: a holder stopped with
+    // Ctrl-Z (or any other process holding the lock) made the next replay hang without a word.
+    let writer = std::fs::File::open(dir).ok();
+    if let Some(f) = &writer {
+        let t0 = std::time::Instant::now();
+        let mut told = false;
+        loop {
+            match f.try_lock() {
+                Ok(()) | Err(std::fs::TryLockError::Error(_)) => break,
+                Err(std::fs::TryLockError::WouldBlock) => {
+                    if !told {
+                        say!(
+                            "note: waiting for another process writing {} to finish",
+                            dir.display()
+                        );
+                        told = true;
+                    }
+                    if t0.elapsed() > WRITER_WAIT {
+                        bail!(
+                            "{} has been held by another process writing it for over a minute (a ccpp replay stopped with Ctrl-Z?); nothing was written",
+                            dir.display()
+                        );
+                    }
+                    std::thread::sleep(std::time::Duration::from_millis(50));
+                }
+            }
+        }
+    }
     let tmp_of = |name: &str| dir.join(format!("{name}.tmp"));
     let clear = |upto: usize| {
         for (name, _) in &files[..upto] {

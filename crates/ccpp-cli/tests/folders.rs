@@ -431,6 +431,18 @@ fn runs_below_a_busy_bench_folder_are_refused() {
         .output()
         .unwrap();
     assert_eq!(demo.status.code(), Some(1), "{}", stderr_of(&demo));
+    // A bench into the held folder's `runs/` too (it wrote among the other bench's runs).
+    let nested = ccpp()
+        .args(["bench", "--quiet", "--planners", "bcd", "--maps"])
+        .arg(data("teb_empty_box.yaml"))
+        .arg("--out")
+        .arg(bench_out.join("runs"))
+        .output()
+        .unwrap();
+    let err = stderr_of(&nested);
+    assert_eq!(nested.status.code(), Some(1), "{err}");
+    assert!(err.contains("which a ccpp bench or sweep (pid "), "{err}");
+    assert!(!bench_out.join("runs").exists());
     // Released, the lock file is gone; a file left behind unlocked (a killed bench) is no
     // hold either.
     drop(held);

@@ -46,12 +46,52 @@ pub fn free_components(g: &GridMap) -> (usize, usize) {
     (n, largest)
 }
 
-/// Least free floor apart from the start, m^2, for [`StartComponent::cut_off_warning`].
+/// Least free floor the zones cut off from the start, m^2, for [`zone_cut_off_warning`].
 pub const CUT_OFF_MIN_M2: f64 = 1.0;
 
-/// Least share of the allowed free floor apart from the start, for
-/// [`StartComponent::cut_off_warning`].
+/// Least share of the allowed free floor beside the start that the zones cut off, for
+/// [`zone_cut_off_warning`].
 pub const CUT_OFF_MIN_SHARE: f64 = 0.1;
+
+/// The warning (without `warning: `) when the zones of `world` cut much of the free floor
+/// they allow apart from the start: floor inside the area and outside the keep-outs that the
+/// start's 4-connected free area reaches on the true map but not across the virtual walls, at
+/// least [`CUT_OFF_MIN_M2`] and [`CUT_OFF_MIN_SHARE`] of the allowed floor the start reaches on
+/// the true map. A keep-out that cut an area in two, or an area of two rooms joined only
+/// outside it, left one part unswept while the run said "99.6 % covered" (coverage is of the
+/// part the start reaches) without a word (hostile pass). Floor that walls already part from
+/// the start is not the zones' doing and not counted (an area over a whole map with rooms
+/// apart behind walls warned of them). `None` without zones.
+pub fn zone_cut_off_warning(world: &ccpp_core::world::World) -> Option<String> {
+    world.zones()?;
+    let (zoned, plain) = (world.map(), world.true_map());
+    let f = *zoned.frame();
+    let (c, r) = f.pixel_of(world.start().position())?;
+    let seed = f.index(c, r);
+    if plain.cells()[seed] != Cell::Free {
+        return None;
+    }
+    let mut near = fixedbitset::FixedBitSet::with_capacity(f.len());
+    flood_runs(plain, seed, &mut near);
+    let mut reached = fixedbitset::FixedBitSet::with_capacity(f.len());
+    if zoned.cells()[seed] == Cell::Free {
+        flood_runs(zoned, seed, &mut reached);
+    }
+    let cells = zoned.cells();
+    let allowed: Vec<usize> = near.ones().filter(|&i| cells[i] == Cell::Free).collect();
+    let apart = allowed.iter().filter(|&&i| !reached.contains(i)).count();
+    let res2 = f.resolution * f.resolution;
+    let (apart_m2, allowed_m2) = (apart as f64 * res2, allowed.len() as f64 * res2);
+    (apart_m2 >= CUT_OFF_MIN_M2 && apart_m2 >= CUT_OFF_MIN_SHARE * allowed_m2).then(|| {
+        format!(
+            "the zones cut {apart_m2:.1} m2 of the {allowed_m2:.1} m2 of free floor they allow \
+             beside the start ({:.0} %) off from it; that floor is not covered (coverage \
+             figures are of the part the start reaches): run again with --start X,Y there to \
+             cover it",
+            100.0 * apart_m2 / allowed_m2
+        )
+    })
+}
 
 /// The free component holding a start position.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -105,35 +145,6 @@ impl StartComponent {
             "{:.1} m2 of {:.1} m2 free ({share:.0} %) in the free area holding the start",
             self.area_m2, self.free_m2
         )
-    }
-
-    /// The warnings (without `warning: `) of [`Self::warning`] and, for a run with zones
-    /// (`zoned`), [`Self::cut_off_warning`].
-    pub fn warnings(&self, zoned: bool) -> Vec<String> {
-        self.warning()
-            .into_iter()
-            .chain(zoned.then(|| self.cut_off_warning()).flatten())
-            .collect()
-    }
-
-    /// The warning (without `warning: `) when much of the allowed free floor (inside the area,
-    /// outside the keep-outs: the map given has the zones as walls) lies apart from the start:
-    /// at least [`CUT_OFF_MIN_M2`] and [`CUT_OFF_MIN_SHARE`] of it. A keep-out that cut an area
-    /// in two, or an area of two rooms, left one part unswept while the run said "99.6 %
-    /// covered" (coverage is of the floor the start reaches) without a word (hostile pass).
-    pub fn cut_off_warning(&self) -> Option<String> {
-        let apart = self.free_m2 - self.area_m2;
-        (self.area_m2 > 0.0 && apart >= CUT_OFF_MIN_M2 && apart >= CUT_OFF_MIN_SHARE * self.free_m2)
-            .then(|| {
-                format!(
-                    "{apart:.1} m2 of the {:.1} m2 of free floor the zones allow ({:.0} %) lies apart \
-                     from the start, cut off by walls or keep-outs, and is not covered (coverage \
-                     figures are of the part the start reaches); run again with --start X,Y \
-                     there to cover it",
-                    self.free_m2,
-                    100.0 * apart / self.free_m2
-                )
-            })
     }
 
     /// The warning (without `warning: `) when the start's free area reaches the image border.

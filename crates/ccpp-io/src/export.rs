@@ -276,7 +276,10 @@ pub fn zone_features(
         .collect();
     let mut mask_only = z.keepout.clone();
     if mask_only.len() == frame.len() {
-        mask_only.difference_with(&ccpp_core::zones::rasterize(frame, &z.keepout_polygons));
+        mask_only.difference_with(&ccpp_core::zones::rasterize_keepout(
+            frame,
+            &z.keepout_polygons,
+        ));
         out.extend(
             pixel_rectangles(&mask_only, frame)
                 .into_iter()

@@ -66,21 +66,16 @@ fn clean(text: &str) -> String {
 }
 
 /// Whether `c` is one [`visible`] writes as an escape: a control character (line breaks, tab,
-/// escape, bell, delete and the C1 controls), a bidirectional or other invisible format
-/// control (U+061C, U+200B..=U+200F, U+202A..=U+202E, U+2060..=U+2069, U+FEFF), a line or
-/// paragraph separator (U+2028, U+2029), or a noncharacter (U+FFFE, U+FFFF, which XML
-/// refuses).
+/// escape, bell, delete and the C1 controls), a bidirectional embedding, override or isolate
+/// (U+202A..=U+202E, U+2066..=U+2069, which reorder the text after them), a line or paragraph
+/// separator (U+2028, U+2029), or a noncharacter (U+FFFE, U+FFFF, which XML refuses). The
+/// joiners and marks that ordinary names hold (U+200C zero-width non-joiner in Persian, U+200D
+/// in emoji, U+200E/U+200F) are not: a map file named with one was refused.
 pub fn hidden(c: char) -> bool {
     c.is_control()
         || matches!(
             c,
-            '\u{061c}'
-                | '\u{200b}'..='\u{200f}'
-                | '\u{2028}'..='\u{202e}'
-                | '\u{2060}'..='\u{2069}'
-                | '\u{feff}'
-                | '\u{fffe}'
-                | '\u{ffff}'
+            '\u{2028}'..='\u{202e}' | '\u{2066}'..='\u{2069}' | '\u{fffe}' | '\u{ffff}'
         )
 }
 

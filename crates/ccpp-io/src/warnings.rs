@@ -528,8 +528,9 @@ pub fn warnings_with_start(
 ) -> Vec<String> {
     start_area
         .unwrap_or_else(|| StartComponent::of(world.map(), world.start().position()))
-        .warnings(world.zones().is_some())
+        .warning()
         .into_iter()
+        .chain(crate::components::zone_cut_off_warning(world))
         .chain(run_warnings(scenario, world, trace, metrics, swept))
         .collect()
 }

@@ -458,8 +458,8 @@ pub fn check_output_place(target: &Path) -> Result<(), FolderError> {
 /// Checks that no folder above the output folder `target` is held by another process's
 /// running bench or sweep ([`crate::lock::holder_of`]): a `ccpp run --out` into a bench's
 /// `runs/MAP/PLANNER` while the bench ran replaced the bench's run folder or was replaced by
-/// it. For a user's own run; a bench's or sweep's runs (in its own process or in worker
-/// processes) write below their own lock and do not call this.
+/// it. For a user's own run, plan, demo, bench or Python `save`; a bench's or sweep's runs (in
+/// its own process or in worker processes) write below their own lock and do not call this.
 ///
 /// # Errors
 /// [`FolderError::InsideBusyFolder`].

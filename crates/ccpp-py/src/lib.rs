@@ -1074,6 +1074,8 @@ fn write_files(
     inputs: &[PathBuf],
 ) -> PyResult<()> {
     ccpp_io::write::check_inputs_outside(folder, inputs).map_err(|e| err(&e))?;
+    // (as `ccpp run --out`: a folder below one a bench or sweep is writing is refused)
+    ccpp_io::write::check_not_in_busy_folder(folder).map_err(|e| err(&e))?;
     ccpp_io::write::write_folder(folder, files).map_err(|e| err(&e))
 }
 

@@ -411,7 +411,9 @@ def test_the_sweep_lock_is_the_bench_lock(tmp_path: Path, room: Path, ccpp_bin: 
         assert p.stderr == f"error: {out} is in use by another ccpp bench or sweep (pid {os.getpid()})\n"
         with pytest.raises(ccpp.CcppError, match=rf"in use by another ccpp bench or sweep \(pid {os.getpid()}\)"):
             ccpp._ccpp.FolderLock(out)
-    assert not (out / ccpp._ccpp.LOCK_FILE).exists()
+    # The folder the lock made, left empty, is removed with the lock.
+    assert not out.exists()
+    out.mkdir()
     lock = ccpp._ccpp.FolderLock(out)
     assert lock.held
     lock.release()
@@ -716,3 +718,26 @@ def test_hostile_names_are_refused_or_shown(room: Path) -> None:
     text = str(e.value)
     assert "\x1b" not in text and "\n" not in text, text
     assert "\\u{1b}[41mX" in text, text
+
+
+def test_save_below_a_busy_bench_folder_is_refused(room: Path, tmp_path: Path) -> None:
+    """`save` into a folder below one a bench or sweep of another process is writing is
+    refused, as `ccpp run --out` is (it replaced that bench's run folder: regression hunt)."""
+    held = tmp_path / "b"
+    held.mkdir()
+    # Another process holds the bench lock.
+    holder = subprocess.Popen(
+        [sys.executable, "-c", "import ccpp, sys, time; l = ccpp._ccpp.FolderLock(sys.argv[1]); print('held', flush=True); time.sleep(30)", str(held)],
+        stdout=subprocess.PIPE, text=True,
+    )
+    try:
+        assert holder.stdout is not None and holder.stdout.readline().strip() == "held"
+        r = ccpp.run(room, "bsa")
+        with pytest.raises(ccpp.CcppError, match=r"which a ccpp bench or sweep \(pid \d+\) is writing"):
+            r.save(held / "runs" / "mine")
+        assert not (held / "runs").exists()
+    finally:
+        holder.kill()
+        holder.wait()
+    r.save(held / "runs" / "mine")
+    assert (held / "runs" / "mine" / "metrics.json").is_file()
