@@ -661,27 +661,7 @@ impl World {
                     break;
                 }
             }
-            let (c, r) = ((i % w) as i64, (i / w) as i64);
-            for (dc, dr, cost) in [
-                (1, 0, 70),
-                (-1, 0, 70),
-                (0, 1, 70),
-                (0, -1, 70),
-                (1, 1, 99),
-                (-1, 1, 99),
-                (1, -1, 99),
-                (-1, -1, 99),
-            ] {
-                if let Some((nc, nr)) = frame.checked(c + dc, r + dr) {
-                    let j = frame.index(nc, nr);
-                    let nd = d + cost;
-                    if ok(j) && nd < dist[j] {
-                        dist[j] = nd;
-                        parent[j] = i as u32;
-                        heap.push(u64::from(nd), j as u32);
-                    }
-                }
-            }
+            relax_octile(&frame, i, d, &ok, &mut dist, &mut parent, &mut heap);
         }
         let Some(goal) = goal else {
             // No way in; or, for a disk larger than the robot, no spot inside to stand at all
@@ -1293,6 +1273,41 @@ fn accessible_pixels(map: &GridMap, reachable: &FixedBitSet, rt: f64) -> FixedBi
 /// 8-connected parts of the pixels of a `w` x `h` grid where `inside` holds: each pixel's part
 /// (`u32::MAX` outside) and each part's pixel count, parts numbered in scan order (each filled
 /// by [`crate::search::fill_runs`]).
+/// Relaxes the 8 neighbours of pixel `i` (settled at cost `d`) where `open` holds, with
+/// integer octile costs (70 straight, 99 diagonal) in a fixed order: the step of the
+/// approach's searches.
+fn relax_octile(
+    frame: &MapFrame,
+    i: usize,
+    d: u32,
+    open: &dyn Fn(usize) -> bool,
+    dist: &mut [u32],
+    parent: &mut [u32],
+    heap: &mut crate::search::MonotoneQueue,
+) {
+    let (c, r) = ((i % frame.width) as i64, (i / frame.width) as i64);
+    for (dc, dr, cost) in [
+        (1, 0, 70),
+        (-1, 0, 70),
+        (0, 1, 70),
+        (0, -1, 70),
+        (1, 1, 99),
+        (-1, 1, 99),
+        (1, -1, 99),
+        (-1, -1, 99),
+    ] {
+        if let Some((nc, nr)) = frame.checked(c + dc, r + dr) {
+            let j = frame.index(nc, nr);
+            let nd = d + cost;
+            if open(j) && nd < dist[j] {
+                dist[j] = nd;
+                parent[j] = i as u32;
+                heap.push(u64::from(nd), j as u32);
+            }
+        }
+    }
+}
+
 /// The shortest 8-connected chain of pixels (integer octile costs, fixed order) from `from`
 /// through pixels where `through` holds to the nearest pixel where `goal` holds, without
 /// `from` itself; empty when `from` is such a pixel or none is reached.
@@ -1325,27 +1340,7 @@ fn nearest_where(
             chain.reverse();
             return chain;
         }
-        let (c, r) = ((i % frame.width) as i64, (i / frame.width) as i64);
-        for (dc, dr, cost) in [
-            (1, 0, 70),
-            (-1, 0, 70),
-            (0, 1, 70),
-            (0, -1, 70),
-            (1, 1, 99),
-            (-1, 1, 99),
-            (1, -1, 99),
-            (-1, -1, 99),
-        ] {
-            if let Some((nc, nr)) = frame.checked(c + dc, r + dr) {
-                let j = frame.index(nc, nr);
-                let nd = d + cost;
-                if through(j) && nd < dist[j] {
-                    dist[j] = nd;
-                    parent[j] = i as u32;
-                    heap.push(u64::from(nd), j as u32);
-                }
-            }
-        }
+        relax_octile(frame, i, d, through, &mut dist, &mut parent, &mut heap);
     }
     Vec::new()
 }

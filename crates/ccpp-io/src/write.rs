@@ -425,20 +425,7 @@ pub fn check_output_place(target: &Path) -> Result<(), FolderError> {
             });
         }
     }
-    // The folders above, resolved from the nearest that exists (`out/../out` is not inside
-    // `out`: a lexical walk took it for so).
-    let Some(base) = target
-        .ancestors()
-        .skip(1)
-        .map(|a| {
-            if a.as_os_str().is_empty() {
-                Path::new(".")
-            } else {
-                a
-            }
-        })
-        .find_map(|a| std::fs::canonicalize(a).ok())
-    else {
+    let Some(base) = resolved_parent(target) else {
         return Ok(());
     };
     for above in base.ancestors() {
@@ -455,16 +442,10 @@ pub fn check_output_place(target: &Path) -> Result<(), FolderError> {
     Ok(())
 }
 
-/// Checks that no folder above the output folder `target` is held by another process's
-/// running bench or sweep ([`crate::lock::holder_of`]): a `ccpp run --out` into a bench's
-/// `runs/MAP/PLANNER` while the bench ran replaced the bench's run folder or was replaced by
-/// it. For a user's own run, plan, demo, bench or Python `save`; a bench's or sweep's runs (in
-/// its own process or in worker processes) write below their own lock and do not call this.
-///
-/// # Errors
-/// [`FolderError::InsideBusyFolder`].
-pub fn check_not_in_busy_folder(target: &Path) -> Result<(), FolderError> {
-    let Some(base) = target
+/// The folder above `target`, resolved from the nearest one above it that exists (`out/../out`
+/// is not inside `out`: a lexical walk took it for so); `None` when none resolves.
+fn resolved_parent(target: &Path) -> Option<PathBuf> {
+    target
         .ancestors()
         .skip(1)
         .map(|a| {
@@ -475,7 +456,18 @@ pub fn check_not_in_busy_folder(target: &Path) -> Result<(), FolderError> {
             }
         })
         .find_map(|a| std::fs::canonicalize(a).ok())
-    else {
+}
+
+/// Checks that no folder above the output folder `target` is held by another process's
+/// running bench or sweep ([`crate::lock::holder_of`]): a `ccpp run --out` into a bench's
+/// `runs/MAP/PLANNER` while the bench ran replaced the bench's run folder or was replaced by
+/// it. For a user's own run, plan, demo, bench or Python `save`; a bench's or sweep's runs (in
+/// its own process or in worker processes) write below their own lock and do not call this.
+///
+/// # Errors
+/// [`FolderError::InsideBusyFolder`].
+pub fn check_not_in_busy_folder(target: &Path) -> Result<(), FolderError> {
+    let Some(base) = resolved_parent(target) else {
         return Ok(());
     };
     for above in base.ancestors() {
