@@ -215,15 +215,7 @@ fn interrupted() -> ! {
     // Stderr may be a pipe whose reader is gone (a bench job whose bench died): no panic.
     let written = lock(&WRITTEN);
     let note = lock(&INTERRUPT_NOTE);
-    if let (true, Some(note)) = (written.is_empty(), note.as_deref()) {
-        let _ = writeln!(
-            std::io::stderr(),
-            "error: interrupted; {}",
-            ccpp_io::message::visible(note)
-        );
-    } else if written.is_empty() {
-        let _ = writeln!(std::io::stderr(), "error: interrupted");
-    } else {
+    if !written.is_empty() {
         let names: Vec<String> = written
             .iter()
             .map(|p| ccpp_io::message::visible(&p.display().to_string()))
@@ -233,6 +225,14 @@ fn interrupted() -> ! {
             "error: interrupted after the new output was written whole to {}",
             names.join(", ")
         );
+    } else if let Some(note) = note.as_deref() {
+        let _ = writeln!(
+            std::io::stderr(),
+            "error: interrupted; {}",
+            ccpp_io::message::visible(note)
+        );
+    } else {
+        let _ = writeln!(std::io::stderr(), "error: interrupted");
     }
     std::process::exit(130);
 }

@@ -1270,9 +1270,6 @@ fn accessible_pixels(map: &GridMap, reachable: &FixedBitSet, rt: f64) -> FixedBi
     acc
 }
 
-/// 8-connected parts of the pixels of a `w` x `h` grid where `inside` holds: each pixel's part
-/// (`u32::MAX` outside) and each part's pixel count, parts numbered in scan order (each filled
-/// by [`crate::search::fill_runs`]).
 /// Relaxes the 8 neighbours of pixel `i` (settled at cost `d`) where `open` holds, with
 /// integer octile costs (70 straight, 99 diagonal) in a fixed order: the step of the
 /// approach's searches.
@@ -1345,6 +1342,9 @@ fn nearest_where(
     Vec::new()
 }
 
+/// 8-connected parts of the pixels of a `w` x `h` grid where `inside` holds: each pixel's part
+/// (`u32::MAX` outside) and each part's pixel count, parts numbered in scan order (each filled
+/// by [`crate::search::fill_runs`]).
 fn parts_of(w: usize, h: usize, inside: &dyn Fn(usize) -> bool) -> (Vec<u32>, Vec<usize>) {
     use crate::search::{fill_runs, Connectivity};
     let mut part = vec![u32::MAX; w * h];

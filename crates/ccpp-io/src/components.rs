@@ -78,10 +78,13 @@ pub fn zone_cut_off_warning(world: &ccpp_core::world::World) -> Option<String> {
         flood_runs(zoned, seed, &mut reached);
     }
     let cells = zoned.cells();
-    let allowed: Vec<usize> = near.ones().filter(|&i| cells[i] == Cell::Free).collect();
-    let apart = allowed.iter().filter(|&&i| !reached.contains(i)).count();
+    let (mut allowed, mut apart) = (0usize, 0usize);
+    for i in near.ones().filter(|&i| cells[i] == Cell::Free) {
+        allowed += 1;
+        apart += usize::from(!reached.contains(i));
+    }
     let res2 = f.resolution * f.resolution;
-    let (apart_m2, allowed_m2) = (apart as f64 * res2, allowed.len() as f64 * res2);
+    let (apart_m2, allowed_m2) = (apart as f64 * res2, allowed as f64 * res2);
     (apart_m2 >= CUT_OFF_MIN_M2 && apart_m2 >= CUT_OFF_MIN_SHARE * allowed_m2).then(|| {
         format!(
             "the zones cut {apart_m2:.1} m2 of the {allowed_m2:.1} m2 of free floor they allow \

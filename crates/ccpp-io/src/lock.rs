@@ -117,8 +117,9 @@ impl Drop for FolderLock {
 }
 
 /// `pid N` of the process that holds the lock of `folder` now, `None` when nobody does (no
-/// lock file, or one left unlocked by a killed holder). Nothing is created or removed: the existing lock file is
-/// opened for reading and locked shared for a moment, which fails only while a holder has it.
+/// lock file, or one left unlocked by a killed holder). Nothing is created or removed: the
+/// existing lock file is opened for reading and locked shared for a moment, which fails only
+/// while a holder has it.
 #[must_use]
 pub fn holder_of(folder: &Path) -> Option<String> {
     let path = folder.join(LOCK_FILE);
