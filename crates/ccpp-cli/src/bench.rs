@@ -720,7 +720,7 @@ pub fn child_main() -> std::process::ExitCode {
     crate::staging::install_signal_handler();
     let parent = std::env::var(PARENT_ENV).ok().and_then(|p| p.parse().ok());
     crate::staging::stop_with_parent(parent);
-    match child_job() {
+    let code = match child_job() {
         Ok(metrics) => match crate::print_stdout(&metrics) {
             Ok(()) => std::process::ExitCode::SUCCESS,
             Err(_) => std::process::ExitCode::FAILURE,
@@ -729,7 +729,8 @@ pub fn child_main() -> std::process::ExitCode {
             say!("error: {}", crate::errors::one_line(&e));
             std::process::ExitCode::FAILURE
         }
-    }
+    };
+    crate::staging::finish(code)
 }
 
 fn child_job() -> Result<String> {

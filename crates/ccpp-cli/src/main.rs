@@ -71,13 +71,17 @@ fn main() -> ExitCode {
         return ExitCode::FAILURE;
     }
     staging::install_signal_handler();
-    match dispatch(cli) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            say!("error: {}", errors::one_line(&e));
-            ExitCode::FAILURE
-        }
+    let result = dispatch(cli);
+    let code = if result.is_ok() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    };
+    let code = staging::finish(code);
+    if let Err(e) = result {
+        say!("error: {}", errors::one_line(&e));
     }
+    code
 }
 
 /// Refuses an argument that is not valid UTF-8 or holds a control character (of `cmd`, whose

@@ -178,6 +178,18 @@ pub fn install_signal_handler() {
     let _ = ctrlc::set_handler(|| interrupted());
 }
 
+/// Called once the command is done, just before the process exits with `code`: takes the
+/// lock the interrupt cleanup ([`install_signal_handler`]) takes first and keeps it until
+/// exit, so that the process ends one way only. An interrupt whose cleanup began first ends
+/// it (status 130, its message); one that comes later finds the lock taken and the process
+/// ends with `code`. Before, a cleanup waiting on a folder swap ran on while `main` returned:
+/// its "interrupted" line came out with status 0.
+pub fn finish(code: std::process::ExitCode) -> std::process::ExitCode {
+    // Never released: the process ends with this function's caller.
+    std::mem::forget(ccpp_io::write::swap_lock());
+    code
+}
+
 /// The interrupt cleanup (module docs), then exit with status 130.
 fn interrupted() -> ! {
     use std::io::Write as _;
@@ -350,7 +362,7 @@ pub fn write_files_together(dir: &Path, files: &[(&str, &[u8])]) -> Result<()> {
         }
     }
     pause_for(COMMIT_PAUSE_ENV);
-    let _swap = ccpp_io::write::swap_lock();
+    let swap = ccpp_io::write::swap_lock();
     // The old content of each file before it is replaced, to put back if a later one fails.
     let mut before: Vec<Option<Vec<u8>>> = Vec::new();
     for (i, (name, _)) in files.iter().enumerate() {
@@ -378,6 +390,10 @@ pub fn write_files_together(dir: &Path, files: &[(&str, &[u8])]) -> Result<()> {
     // An interrupt from here on says the files were written whole, as after a folder's swap
     // (a replay interrupted after its renames said only "interrupted": hostile pass).
     lock(&WRITTEN).push(dir.to_path_buf());
+    // Released before the pause: the interrupt cleanup takes this lock, and it waited out the
+    // rest of the command here, then raced the command's own exit (status 0 after its
+    // "interrupted" line: CI).
+    drop(swap);
     pause_for(AFTER_COMMIT_PAUSE_ENV);
     Ok(())
 }
