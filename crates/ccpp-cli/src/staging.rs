@@ -76,10 +76,19 @@ pub const COMMIT_PAUSE_ENV: &str = "CCPP_TEST_COMMIT_PAUSE_MS";
 /// interrupts the process then); so do a replay's page and GIF once renamed in.
 pub const AFTER_COMMIT_PAUSE_ENV: &str = "CCPP_TEST_AFTER_COMMIT_PAUSE_MS";
 
+/// Test hook: with a pause above, the file this environment variable names is created as the
+/// pause begins (holding the pause's variable name), so that a test acts during the pause
+/// whatever the machine's load, instead of guessing when it began.
+pub const PAUSED_FILE_ENV: &str = "CCPP_TEST_PAUSED_FILE";
+
 /// Sleeps for the milliseconds the environment variable `var` gives, if any, at most a
-/// minute (the test hooks above).
+/// minute (the test hooks above), first creating [`PAUSED_FILE_ENV`]'s file if one is named.
 pub fn pause_for(var: &str) {
     if let Some(ms) = std::env::var(var).ok().and_then(|v| v.parse::<u64>().ok()) {
+        if let Some(mark) = std::env::var_os(PAUSED_FILE_ENV) {
+            // A test hook: a test that finds no file fails on its own, saying so.
+            let _ = std::fs::write(mark, var);
+        }
         std::thread::sleep(std::time::Duration::from_millis(ms.min(60_000)));
     }
 }

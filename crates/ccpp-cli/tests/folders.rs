@@ -9,7 +9,7 @@ use std::process::Stdio;
 
 use assert_cmd::Command;
 
-use crate::common::{ccpp, data};
+use crate::common::{ccpp, data, wait_for_pause};
 
 /// Entry names of a folder, sorted.
 fn entries(dir: &Path) -> Vec<String> {
@@ -334,12 +334,13 @@ fn a_replay_never_writes_into_a_folder_swapped_in_meanwhile() {
         .arg("replay")
         .arg(&out)
         .env("CCPP_TEST_REPLAY_PAUSE_MS", "3000")
+        .env("CCPP_TEST_PAUSED_FILE", dir.path().join("paused"))
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    // Reading a run of this size takes milliseconds; the replay then waits three seconds.
-    std::thread::sleep(std::time::Duration::from_millis(1500));
+    // The replay has read the run and waits three seconds.
+    wait_for_pause(&dir.path().join("paused"));
     std::fs::rename(&out, dir.path().join("old")).unwrap();
     std::fs::rename(&new, &out).unwrap();
     let o = child.wait_with_output().unwrap();
@@ -375,13 +376,13 @@ fn two_replays_of_one_run_at_once_both_succeed() {
         .arg("replay")
         .arg(&out)
         .env("CCPP_TEST_COMMIT_PAUSE_MS", "3000")
+        .env("CCPP_TEST_PAUSED_FILE", dir.path().join("paused"))
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    // Rendering this run takes well under a second; the first then waits three seconds with
-    // its files written beside their names.
-    std::thread::sleep(std::time::Duration::from_millis(1500));
+    // The first waits three seconds with its files written beside their names.
+    wait_for_pause(&dir.path().join("paused"));
     let second = ccpp().arg("replay").arg(&out).output().unwrap();
     let first = first.wait_with_output().unwrap();
     assert!(first.status.success(), "{}", stderr_of(&first));
@@ -754,6 +755,8 @@ fn a_bench_row_names_a_map_file_with_a_control_character() {
 #[test]
 fn a_file_put_into_the_folder_during_the_run_is_kept() {
     let dir = tempfile::tempdir().unwrap();
+    // (apart: the test checks that `dir` holds the output folder only)
+    let marks = tempfile::tempdir().unwrap();
     let out = dir.path().join("o");
     let run = |pause: Option<&str>| {
         let mut c = std::process::Command::new(assert_cmd::cargo::cargo_bin("ccpp"));
@@ -764,15 +767,16 @@ fn a_file_put_into_the_folder_during_the_run_is_kept() {
             .stdout(Stdio::piped())
             .stderr(Stdio::piped());
         if let Some(ms) = pause {
-            c.env("CCPP_TEST_COMMIT_PAUSE_MS", ms);
+            c.env("CCPP_TEST_COMMIT_PAUSE_MS", ms)
+                .env("CCPP_TEST_PAUSED_FILE", marks.path().join("paused"));
         }
         c.spawn().unwrap()
     };
     assert!(run(None).wait().unwrap().success());
     let before = std::fs::read(out.join("path.csv")).unwrap();
     let child = run(Some("3000"));
-    // The run of this size takes well under a second, then waits three before its swap.
-    std::thread::sleep(std::time::Duration::from_millis(1500));
+    // The run waits three seconds before its swap.
+    wait_for_pause(&marks.path().join("paused"));
     std::fs::write(out.join("notes.txt"), b"thesis").unwrap();
     let o = child.wait_with_output().unwrap();
     let err = stderr_of(&o);

@@ -143,3 +143,20 @@ pub fn pillared_room(dir: &Path, name: &str, n: u32) -> PathBuf {
     img.save(&p).unwrap();
     p
 }
+
+/// Waits (a minute at most) until `mark` exists: the file a paused ccpp creates as its pause
+/// begins (`CCPP_TEST_PAUSED_FILE`), so a test acts during the pause on a loaded machine too.
+///
+/// # Panics
+/// When the file never appears.
+pub fn wait_for_pause(mark: &Path) {
+    let t0 = std::time::Instant::now();
+    while !mark.exists() {
+        assert!(
+            t0.elapsed() < std::time::Duration::from_mins(1),
+            "ccpp never reached its pause ({})",
+            mark.display()
+        );
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+}
