@@ -213,8 +213,10 @@ pub fn run(a: &InfoArgs) -> Result<()> {
     }
     let n = f.len() as f64 / 100.0;
     let mut t = String::new();
+    // Each line with the characters a terminal acts on or hides written as `\u{..}`: a
+    // right-to-left override in the map's folder name reversed the rest of its line.
     let mut line = |s: String| {
-        t.push_str(&s);
+        t.push_str(&ccpp_io::message::visible(&s));
         t.push('\n');
     };
     line(format!(

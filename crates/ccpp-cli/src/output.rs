@@ -481,10 +481,12 @@ pub fn emit(
 
 /// A folder as the `wrote DIR/{...}` lines print it: without the separators it was given
 /// with at its end (`--out runs/` printed `wrote runs//{...}`; the root folder prints as
-/// nothing before the `/`).
+/// nothing before the `/`), and with the characters a terminal acts on or hides (a
+/// right-to-left override reversed the rest of the line) written as `\u{..}`, as on stderr
+/// ([`ccpp_io::message::visible`]).
 pub fn folder_shown(dir: &Path) -> String {
     let s = dir.display().to_string();
-    s.trim_end_matches(std::path::MAIN_SEPARATOR).to_string()
+    ccpp_io::message::visible(s.trim_end_matches(std::path::MAIN_SEPARATOR))
 }
 
 /// The summary's line of a run on a map grown by `--inflate` `m` metres.

@@ -3382,3 +3382,52 @@ fn hostile_names_reach_stderr_visible_and_on_one_line() {
         "unsupported mode `\\u{1b}[41mM\\u{a}error: q`",
     );
 }
+
+/// The `wrote DIR/{...}` line on stdout printed an output folder's name raw: a right-to-left
+/// override in `--out` reversed the rest of the line on a terminal (hostile pass; stderr
+/// already wrote such characters as `\u{..}`). The folder itself keeps its name.
+#[test]
+fn the_wrote_line_shows_hidden_characters_of_the_folder() {
+    let d = tempfile::tempdir().unwrap();
+    let map = pillars(d.path());
+    let out = d.path().join("o\u{202e}txt.exe");
+    for sub in ["plan", "run"] {
+        let o = ccpp()
+            .args([sub, "--planner", "bcd", "--map", s(&map), "--out", s(&out)])
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let text = String::from_utf8(o.stdout).unwrap();
+        assert!(!text.contains('\u{202e}'), "{sub}: {text}");
+        assert!(text.contains("o\\u{202e}txt.exe/{"), "{sub}: {text}");
+        assert!(out.join("metrics.json").exists() || out.join("waypoints.csv").exists());
+    }
+    let o = ccpp().arg("replay").arg(&out).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = String::from_utf8(o.stdout).unwrap();
+    assert!(text.contains("o\\u{202e}txt.exe/replay.html"), "{text}");
+    // `info` names the map's file the same way, and so does a bench's last line.
+    let folder = d.path().join("m\u{202e}x");
+    std::fs::create_dir(&folder).unwrap();
+    let moved = folder.join("pillars.pgm");
+    std::fs::copy(&map, &moved).unwrap();
+    let o = ccpp().args(["info", "--map", s(&moved)]).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = String::from_utf8(o.stdout).unwrap();
+    assert!(
+        !text.contains('\u{202e}') && text.contains("m\\u{202e}x"),
+        "{text}"
+    );
+    let o = ccpp()
+        .args(["bench", "--quiet", "--planners", "bcd", "--maps", s(&moved)])
+        .arg("--out")
+        .arg(d.path().join("b\u{202e}x"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = String::from_utf8(o.stdout).unwrap();
+    assert!(
+        !text.contains('\u{202e}') && text.contains("b\\u{202e}x/results.csv"),
+        "{text}"
+    );
+}
