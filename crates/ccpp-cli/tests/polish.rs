@@ -257,8 +257,11 @@ fn on_terminal(args: &[&str]) -> Option<String> {
         line.push(' ');
         line.push_str(a);
     }
+    // A terminal type of its own: with `TERM` unset or `dumb` (as on some CI runners) the
+    // progress library draws no spinner on a terminal either.
     let out = std::process::Command::new("script")
         .args(["-q", "-e", "-c", &line, "/dev/null"])
+        .env("TERM", "xterm-256color")
         .output()
         .ok()?;
     assert!(out.status.success(), "{line}: {out:?}");

@@ -229,7 +229,8 @@ def test_ctrl_c_interrupts_a_long_run(tmp_path: Path, room: Path) -> None:
     waited = time.monotonic() - sent
     out = p.stdout.read()
     assert rc == 3 and "interrupted" in out, (rc, out)
-    assert waited < 5, waited
+    # (a bound far above the few steps it takes, for a CI machine that is busy)
+    assert waited < 15, waited
 
 
 def test_zones_as_text_rectangles_and_no_keepouts(room: Path) -> None:
@@ -288,7 +289,7 @@ def test_a_run_after_an_interrupted_one_waits_for_it_and_completes(tmp_path: Pat
         "for _ in range(2):\n"
         "    interrupt(0.5)\n"
         "    try:\n"
-        "        ccpp.run(room, 'random-bounce', budget_m=3e5)\n"
+        "        ccpp.run(room, 'random-bounce', budget_m=2e6)\n"
         "    except KeyboardInterrupt:\n"
         "        print('interrupted', flush=True)\n"
         "r = ccpp.run(room, 'bsa')\n"
@@ -322,7 +323,8 @@ def test_an_interrupted_run_stops_instead_of_finishing_unseen(tmp_path: Path, ro
     assert out.returncode == 0, out.stderr
     words = out.stdout.split()
     assert words[:2] == ["interrupted", "next"], out.stdout
-    assert float(words[2]) < 5.0, out.stdout
+    # (minutes before the fix; a bound for a busy CI machine)
+    assert float(words[2]) < 15.0, out.stdout
 
 
 @pytest.mark.parametrize("planner", ["bcd", "rect-boustrophedon"])
@@ -357,7 +359,8 @@ def test_an_interrupted_offline_plan_stops_instead_of_holding_the_next_run(
     words = out.stdout.split()
     assert words[0::3] == ["interrupted", "interrupted"], out.stdout
     assert words[1::3] == ["next", "next"], out.stdout
-    assert all(float(w) < 5.0 for w in words[2::3]), out.stdout
+    # (seconds to minutes before the fix; a bound for a busy CI machine)
+    assert all(float(w) < 15.0 for w in words[2::3]), out.stdout
 
 
 def test_a_mistyped_text_rectangle_is_named_as_such(room: Path) -> None:

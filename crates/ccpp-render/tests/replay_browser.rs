@@ -305,8 +305,11 @@ fn a_two_million_pose_run_gives_a_small_page_that_opens_and_seeks_fast() {
         "first frame {first} ms, seek to end {seek} ms, {} display poses",
         v["frames"]
     );
-    assert!(first < 3000.0, "first frame after {first} ms");
-    assert!(seek < 1000.0, "seek to the end took {seek} ms");
+    // Bounds an order of magnitude above what is measured here (a few hundred ms): they catch
+    // a page that went quadratic, not a machine that is busy (the speed itself is reported
+    // above, and measured by benchmarks, not by this test).
+    assert!(first < 15000.0, "first frame after {first} ms");
+    assert!(seek < 5000.0, "seek to the end took {seek} ms");
 }
 
 /// A room with a work area (its left three fifths) and a keep-out square inside it, and a
