@@ -63,10 +63,11 @@ impl MapFrame {
         }
     }
 
-    /// Number of pixels.
+    /// Number of pixels (saturating: a frame too large for memory, which [`GridMap::new`]
+    /// refuses, counts as `usize::MAX` instead of overflowing).
     #[inline]
     pub fn len(&self) -> usize {
-        self.width * self.height
+        self.width.saturating_mul(self.height)
     }
 
     /// `true` when the grid has no pixel.
@@ -151,9 +152,17 @@ impl MapFrame {
     /// outside the image).
     #[inline]
     pub fn grid_to_pixel_signed(&self, g: Point) -> (i64, i64) {
-        let col = g.x.floor() as i64;
-        let row = self.height as i64 - 1 - g.y.floor() as i64;
-        (col, row)
+        // Far off the image (1e300 m) the integers saturate instead of overflowing, and a NaN
+        // coordinate lies outside (it was pixel 0: `pixel_of` found a NaN point on the map).
+        let floor = |v: f64| {
+            if v.is_nan() {
+                i64::MIN
+            } else {
+                v.floor() as i64
+            }
+        };
+        let top = i64::try_from(self.height).unwrap_or(i64::MAX) - 1;
+        (floor(g.x), top.saturating_sub(floor(g.y)))
     }
 
     /// The pixel containing world point `p`, or `None` outside the image.
@@ -258,6 +267,28 @@ pub enum GridError {
     /// Unknown ASCII character.
     #[error("ASCII map has unknown character {0:?} (use '#', '.', '?')")]
     BadChar(char),
+    /// A side longer than [`MAX_SIDE_PX`].
+    #[error("a {width}x{height} px grid is too large: each side may have at most {max} pixels", max = MAX_SIDE_PX)]
+    TooLarge {
+        /// Width given.
+        width: usize,
+        /// Height given.
+        height: usize,
+    },
+}
+
+/// The longest side a grid may have, in pixels (2^31 - 1): pixel coordinates are signed
+/// 64-bit integers in the geometry, whose arithmetic stays far from overflow below this, and a
+/// grid's pixel count then fits in memory's addresses. (A frame of 2^32 x 2^32 px overflowed
+/// `width * height` and gave a grid of no cells.)
+pub const MAX_SIDE_PX: usize = i32::MAX as usize;
+
+/// Refuses a frame with a side beyond [`MAX_SIDE_PX`].
+fn check_sides(width: usize, height: usize) -> Result<(), GridError> {
+    if width > MAX_SIDE_PX || height > MAX_SIDE_PX {
+        return Err(GridError::TooLarge { width, height });
+    }
+    Ok(())
 }
 
 impl GridMap {
@@ -276,6 +307,7 @@ impl GridMap {
         if frame.width == 0 || frame.height == 0 {
             return Err(GridError::Empty);
         }
+        check_sides(frame.width, frame.height)?;
         if cells.len() != frame.len() {
             return Err(GridError::SizeMismatch {
                 width: frame.width,
@@ -292,6 +324,8 @@ impl GridMap {
     /// # Errors
     /// As [`GridMap::new`].
     pub fn filled(frame: MapFrame, value: Cell) -> Result<Self, GridError> {
+        // (before the allocation, which a huge frame would abort)
+        check_sides(frame.width, frame.height)?;
         Self::new(frame, vec![value; frame.len()])
     }
 
@@ -328,7 +362,15 @@ impl GridMap {
             }
         }
         let scale = scale.max(1);
-        let frame = MapFrame::new(w * scale, rows.len() * scale, resolution);
+        let (Some(width), Some(height)) = (w.checked_mul(scale), rows.len().checked_mul(scale))
+        else {
+            return Err(GridError::TooLarge {
+                width: usize::MAX,
+                height: usize::MAX,
+            });
+        };
+        check_sides(width, height)?;
+        let frame = MapFrame::new(width, height, resolution);
         let mut cells = Vec::with_capacity(frame.len());
         for r in 0..frame.height {
             for c in 0..frame.width {
@@ -466,6 +508,34 @@ impl fmt::Debug for GridMap {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A NaN point is off the map (it was pixel (0, 0)), and a point 1e300 m away is off it
+    /// without an overflow; a frame with a side beyond `MAX_SIDE_PX` is refused before any
+    /// allocation (2^32 x 2^32 px overflowed `width * height` and gave a grid of no cells).
+    #[test]
+    fn far_points_and_huge_frames_are_refused_not_overflowed() {
+        let f = MapFrame::new(4, 3, 1.0);
+        assert_eq!(f.pixel_of(Point::new(f64::NAN, 0.5)), None);
+        assert_eq!(f.pixel_of(Point::new(0.5, f64::NAN)), None);
+        assert_eq!(f.pixel_of(Point::new(1e300, -1e300)), None);
+        assert_eq!(f.pixel_of(Point::new(-1e300, 1e300)), None);
+        assert_eq!(f.pixel_of(Point::new(0.5, 0.5)), Some((0, 2)));
+        for (w, h) in [(1 << 32, 1 << 32), ((1 << 63) + 1, 2), (MAX_SIDE_PX + 1, 1)] {
+            let frame = MapFrame::new(w, h, 1.0);
+            assert!(matches!(
+                GridMap::new(frame, vec![Cell::Free; 2]),
+                Err(GridError::TooLarge { .. })
+            ));
+            assert!(matches!(
+                GridMap::filled(frame, Cell::Free),
+                Err(GridError::TooLarge { .. })
+            ));
+        }
+        assert!(matches!(
+            GridMap::from_ascii_scaled("..", usize::MAX, 1.0),
+            Err(GridError::TooLarge { .. })
+        ));
+    }
 
     #[test]
     fn ascii_roundtrip_and_frames() {

@@ -1101,6 +1101,32 @@ mod tests {
         }
     }
 
+    /// The metrics of a trace a library user made by hand, with a pose far off the map (1e9 m,
+    /// 1e300 m) or not a number, are figures, not a panic (a tile difference overflowed 32
+    /// bits: hostile pass). Such poses add no swept floor.
+    #[test]
+    fn a_hand_made_trace_far_off_the_map_is_measured() {
+        let world = World::new(open_room(), Robot::new(0.1), None).unwrap();
+        for far in [
+            Pose::new(1e9, 1e9, 0.0),
+            Pose::new(1e300, -1e300, 0.0),
+            Pose::new(f64::NAN, 1.0, 0.0),
+        ] {
+            let mut trace = Trace::default();
+            trace.push_pose(0, world.start());
+            trace.push_pose(1, far);
+            let out = RunOutput {
+                trace,
+                stop: crate::sim::StopReason::Done,
+                tile_side: None,
+                planner: "hand",
+                wall_time_s: 0.0,
+            };
+            let m = compute(&world, &out, "room");
+            assert!(m.effective_coverage < 0.05, "{far:?}: {m:?}");
+        }
+    }
+
     fn open_room() -> GridMap {
         // 6 m x 4 m at 0.01 m/px with a 1-pixel wall.
         let (w, h) = (600, 400);

@@ -51,9 +51,10 @@ fn is_rounding_turn(turn: f64, dist: f64, a: Point, b: Point) -> bool {
     turn.abs() * dist <= 16.0 * f64::EPSILON * scale
 }
 
-/// Simulator settings.
+/// Simulator settings (deserialized with unknown fields refused: a misspelt `max_step` was
+/// dropped).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(default, deny_unknown_fields)]
 pub struct SimConfig {
     /// Sensor range in metres; `None` = `4 r` (enough to classify all 8 neighbour tiles).
     /// Ranges beyond twice the map's diagonal run as that ([`SimConfig::sensor_range_on`]).

@@ -114,8 +114,8 @@ pub struct TileSet {
 impl TileSet {
     /// An empty set over tiles `i0..=i1`, `j0..=j1`.
     pub fn new(i0: i32, i1: i32, j0: i32, j1: i32) -> Self {
-        let w = (i1 - i0 + 1).max(0) as usize;
-        let h = (j1 - j0 + 1).max(0) as usize;
+        let w = usize::try_from(i64::from(i1) - i64::from(i0) + 1).unwrap_or(0);
+        let h = usize::try_from(i64::from(j1) - i64::from(j0) + 1).unwrap_or(0);
         Self {
             i0,
             j0,
@@ -127,8 +127,10 @@ impl TileSet {
 
     #[inline]
     fn idx(&self, t: Tile) -> Option<usize> {
-        let di = t.0 - self.i0;
-        let dj = t.1 - self.j0;
+        // In 64 bits: the tile of a pose far off the map saturates at `i32::MAX`, and the
+        // difference overflowed 32 bits (a hand-made trace's metrics panicked).
+        let di = i64::from(t.0) - i64::from(self.i0);
+        let dj = i64::from(t.1) - i64::from(self.j0);
         if di < 0 || dj < 0 || di as usize >= self.w || dj as usize >= self.h {
             None
         } else {

@@ -15,7 +15,10 @@ use crate::search::{fill_runs, Connectivity};
 use crate::zones::{MaskOccupancy, ZoneMasks};
 
 /// The robot model: a disk of radius `radius` carrying a cleaning tool of radius `tool_radius`.
+/// (Deserialized with unknown fields refused: a misspelt `tool_radus` ran with the tool as
+/// wide as the robot, without a word.)
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Robot {
     /// Footprint radius `r` (collision), metres.
     pub radius: f64,

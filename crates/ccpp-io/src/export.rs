@@ -377,7 +377,9 @@ pub enum WaypointFileError {
     },
 }
 
-/// The route as CSV: header `x,y,theta`, one waypoint a line.
+/// The route as CSV: header `x,y,theta`, one waypoint a line. A waypoint that is not finite
+/// is written as `NaN` or `inf`, which [`parse_waypoints_csv`] refuses: [`render_exports`]
+/// refuses such a route instead.
 pub fn waypoints_csv(route: &Route) -> String {
     csv_of(&tidy(route))
 }
@@ -458,9 +460,33 @@ struct WaypointsJson {
 /// `waypoints` (objects `{"x","y","theta"}`).
 ///
 /// # Errors
-/// Serialization failure (a non-finite number).
+/// A waypoint that is not finite.
 pub fn waypoints_json(route: &Route, meta: &ExportMeta<'_>) -> Result<String, serde_json::Error> {
+    check_finite(route)?;
     json_of(&tidy(route), meta)
+}
+
+/// Refuses a route with a waypoint that is not finite (`Route`'s field is public: a library
+/// user's route with a NaN was written as `null` coordinates, invalid `GeoJSON`, and as `NaN`
+/// rows that `ccpp` itself cannot read back: hostile pass).
+fn check_finite(route: &Route) -> Result<(), serde_json::Error> {
+    match route
+        .waypoints
+        .iter()
+        .position(|p| !(p.x.is_finite() && p.y.is_finite() && p.theta.is_finite()))
+    {
+        None => Ok(()),
+        Some(k) => {
+            let p = route.waypoints[k];
+            Err(serde::ser::Error::custom(format!(
+                "waypoint {} of the route is not finite: ({}, {}, {})",
+                k + 1,
+                p.x,
+                p.y,
+                p.theta
+            )))
+        }
+    }
 }
 
 /// [`waypoints_json`] of a route already [`tidy`].
@@ -555,7 +581,8 @@ pub fn heading_quaternion(theta: f64) -> [f64; 4] {
 /// `header` (stamp 0, `frame_id: map`) and `poses`, a list of `geometry_msgs/PoseStamped`
 /// (same header; `pose.position` x, y, z = 0; `pose.orientation` the heading quaternion
 /// [`heading_quaternion`]). The trailing `---` document separator is left out so that the file
-/// is one YAML document.
+/// is one YAML document. A waypoint that is not finite is written as `.nan` or `.inf`:
+/// [`render_exports`] refuses such a route instead.
 pub fn nav_path_yaml(route: &Route) -> String {
     nav_path_of(&tidy(route))
 }
@@ -670,12 +697,13 @@ fn robot_json(meta: &ExportMeta<'_>) -> serde_json::Value {
 /// and turned counter-clockwise (holes clockwise).
 ///
 /// # Errors
-/// Serialization failure (a non-finite number).
+/// A waypoint that is not finite.
 pub fn geojson(
     route: &Route,
     meta: &ExportMeta<'_>,
     polygons: &[PolygonFeature],
 ) -> Result<String, serde_json::Error> {
+    check_finite(route)?;
     geojson_of(&tidy(route), meta, polygons)
 }
 
@@ -761,13 +789,14 @@ fn geojson_of(
 /// order): `(file name, bytes)`. `polygons` go into the `GeoJSON`.
 ///
 /// # Errors
-/// Serialization failure (a non-finite number).
+/// A waypoint that is not finite, in any format.
 pub fn render_exports(
     route: &Route,
     meta: &ExportMeta<'_>,
     formats: &[ExportFormat],
     polygons: &[PolygonFeature],
 ) -> Result<Vec<(&'static str, Vec<u8>)>, serde_json::Error> {
+    check_finite(route)?;
     // Tidied once for every format (each public writer tidies its own).
     let route = &tidy(route);
     let mut out = Vec::new();
@@ -812,6 +841,25 @@ mod tests {
             tolerance_m: 0.001,
             metrics: None,
         }
+    }
+
+    /// A route with a waypoint that is not finite is refused, naming it, by every writer that
+    /// can fail (it was written as `null` coordinates in the JSON and `GeoJSON`).
+    #[test]
+    fn a_route_that_is_not_finite_is_refused() {
+        for bad in [f64::NAN, f64::INFINITY] {
+            let mut r = route();
+            r.waypoints[1].y = bad;
+            let e = waypoints_json(&r, &meta()).expect_err("json");
+            assert!(
+                e.to_string()
+                    .contains("waypoint 2 of the route is not finite"),
+                "{e}"
+            );
+            assert!(geojson(&r, &meta(), &[]).is_err());
+            assert!(render_exports(&r, &meta(), &[ExportFormat::Csv], &[]).is_err());
+        }
+        assert!(render_exports(&route(), &meta(), &ExportFormat::ALL, &[]).is_ok());
     }
 
     #[test]

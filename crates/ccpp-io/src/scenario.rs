@@ -660,7 +660,7 @@ pub fn apply_georef(grid: GridMap, path: &Path) -> Result<GridMap, ScenarioError
 ///     keepout: Vec::new(),
 /// };
 /// ```
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 #[non_exhaustive]
 pub struct Scenario {
     /// The map.
@@ -696,6 +696,68 @@ pub struct Scenario {
     /// drawing the run's path over other walls. Remove it to run the scenario on the new map.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub map_digest: Option<String>,
+}
+
+/// [`Scenario`] as read: its fields, and any other key of the file, which is refused
+/// ([`Scenario`]'s `Deserialize`). `#[serde(deny_unknown_fields)]` does not work beside the
+/// flattened planner, and without it a misspelt `keepouts:` ran with no keep-out at all.
+#[derive(Deserialize)]
+struct ScenarioIn {
+    map: MapRecipe,
+    robot: Robot,
+    #[serde(default)]
+    start: Option<[f64; 3]>,
+    #[serde(flatten)]
+    planner: PlannerConfig,
+    #[serde(default)]
+    sim: SimConfig,
+    #[serde(default = "default_max_memory_mb")]
+    max_memory_mb: u64,
+    #[serde(default)]
+    area: Option<ZoneSpec>,
+    #[serde(default)]
+    keepout: Vec<ZoneSpec>,
+    #[serde(default)]
+    map_digest: Option<String>,
+    /// Every key not taken above (the planner takes `planner` and `options`); the values are
+    /// skipped, only the first key is named.
+    #[serde(flatten)]
+    #[allow(clippy::zero_sized_map_values)] // (a set cannot take a map's entries)
+    other: std::collections::BTreeMap<String, serde::de::IgnoredAny>,
+}
+
+/// The keys of a scenario file, as an unknown key's error lists them.
+const SCENARIO_KEYS: &[&str] = &[
+    "map",
+    "robot",
+    "start",
+    "planner",
+    "options",
+    "sim",
+    "max_memory_mb",
+    "area",
+    "keepout",
+    "map_digest",
+];
+
+impl<'de> Deserialize<'de> for Scenario {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let s = ScenarioIn::deserialize(d)?;
+        if let Some(key) = s.other.keys().next() {
+            return Err(serde::de::Error::unknown_field(key, SCENARIO_KEYS));
+        }
+        Ok(Self {
+            map: s.map,
+            robot: s.robot,
+            start: s.start,
+            planner: s.planner,
+            sim: s.sim,
+            max_memory_mb: s.max_memory_mb,
+            area: s.area,
+            keepout: s.keepout,
+            map_digest: s.map_digest,
+        })
+    }
 }
 
 /// A finished run.
@@ -1838,6 +1900,40 @@ mod tests {
         assert_eq!(across(9e307), "1.8e308");
         assert_eq!(across(f64::MAX), "3.5953862697246315e308");
         assert_eq!(across(f64::INFINITY), "inf");
+    }
+
+    /// A misspelt key of a scenario file, of its robot or of its simulator settings is refused,
+    /// named (a misspelt `keepouts:` ran with no keep-out at all, `tool_radus` with the tool
+    /// as wide as the robot: hostile pass), in YAML and in JSON; the file's own keys still read.
+    #[test]
+    fn unknown_keys_of_a_scenario_file_are_refused() {
+        let base = "map: {path: m.yaml}\nrobot: {radius: 0.1, tool_radius: 0.1}\nplanner: bcd\noptions: {turn_cost_m: 0.5}\n";
+        let read = |text: &str, json: bool| {
+            crate::file::parse_yaml_or_json::<Scenario>(text, json).map(|s| s.planner.kind())
+        };
+        assert_eq!(read(base, false), Ok(PlannerKind::Bcd));
+        let with_keepout = format!("{base}keepout: [[0.5, 0.5, 2.5, 1.5]]\n");
+        assert!(read(&with_keepout, false).is_ok());
+        for (text, key) in [
+            (
+                format!("{base}keepouts: [[0.5, 0.5, 2.5, 1.5]]\n"),
+                "keepouts",
+            ),
+            (format!("{base}colour: red\n"), "colour"),
+            (base.replace("tool_radius", "tool_radus"), "tool_radus"),
+            (format!("{base}sim: {{max_step: 1}}\n"), "max_step"),
+        ] {
+            let e = read(&text, false).expect_err(key);
+            assert!(e.contains(&format!("unknown field `{key}`")), "{e}");
+        }
+        let mut s = Scenario::new(MapRecipe::file("m.yaml"), PlannerKind::Bcd);
+        s.keepout = vec![ZoneSpec::Rect([0.0, 0.0, 1.0, 1.0])];
+        let mut v: serde_json::Value =
+            serde_json::from_str(&s.to_json().unwrap_or_default()).unwrap_or_default();
+        assert_eq!(read(&v.to_string(), true), Ok(PlannerKind::Bcd));
+        v["max_memory"] = serde_json::json!(1);
+        let e = read(&v.to_string(), true).expect_err("max_memory");
+        assert!(e.contains("unknown field `max_memory`"), "{e}");
     }
 
     #[test]

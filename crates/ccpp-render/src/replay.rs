@@ -607,11 +607,16 @@ const TEMPLATE: &str = include_str!("replay_template.html");
 pub struct GifOptions {
     /// Largest side in pixels.
     pub max_side: u32,
-    /// Number of animation frames (the last one is held).
+    /// Number of animation frames (the last one is held); at most [`MAX_GIF_FRAMES`], more
+    /// are drawn as that many (`usize::MAX` ran for minutes and hundreds of MB).
     pub frames: usize,
     /// Delay per frame in hundredths of a second.
     pub delay_cs: u16,
 }
+
+/// The most frames [`replay_gif`] draws ([`GifOptions::frames`]): at the default size, about
+/// two seconds and a few MB.
+pub const MAX_GIF_FRAMES: usize = 10_000;
 
 impl Default for GifOptions {
     fn default() -> Self {
@@ -721,7 +726,7 @@ pub fn replay_gif(world: &World, trace: &Trace, opts: &GifOptions) -> Result<Vec
         let mut sweeper = Sweeper::new(world);
         let mut path_layer = vec![false; gw * gh];
         let n = poses.len();
-        let frames = opts.frames.max(1);
+        let frames = opts.frames.clamp(1, MAX_GIF_FRAMES);
         let total = progress.last().copied().unwrap_or(0.0);
         let mut done = 0usize;
         if let Some(&p0) = poses.first() {
@@ -1031,6 +1036,33 @@ mod tests {
         let want = (0.8 + 0.5 * 4.15) / 6.0;
         assert!((xs[4] - want).abs() < 0.01, "{xs:?}");
         assert!(xs.windows(2).all(|p| p[1] >= p[0] - 1e-9), "{xs:?}");
+    }
+
+    /// `frames: usize::MAX` ran for minutes and hundreds of MB (hostile pass): the GIF has
+    /// [`MAX_GIF_FRAMES`] frames.
+    #[test]
+    fn a_gif_has_at_most_the_frame_limit() {
+        let map =
+            ccpp_core::grid::GridMap::from_ascii_scaled("######\n#....#\n######", 4, 0.05).unwrap();
+        let start = ccpp_core::Pose::new(0.3, 0.3, 0.0);
+        let world = World::new(map, ccpp_core::world::Robot::new(0.05), Some(start)).unwrap();
+        let mut trace = Trace::default();
+        trace.push_pose(0, start);
+        trace.push_pose(1, ccpp_core::Pose::new(0.9, 0.3, 0.0));
+        let opts = GifOptions {
+            frames: usize::MAX,
+            max_side: 16,
+            ..GifOptions::default()
+        };
+        let bytes = replay_gif(&world, &trace, &opts).unwrap();
+        let mut dec = gif::DecodeOptions::new()
+            .read_info(std::io::Cursor::new(bytes))
+            .unwrap();
+        let mut n = 0;
+        while dec.read_next_frame().unwrap().is_some() {
+            n += 1;
+        }
+        assert_eq!(n, MAX_GIF_FRAMES);
     }
 
     /// A corridor of 4000 x 9 px was a GIF of 400 x 1 px: the strip is now at least 16 px
