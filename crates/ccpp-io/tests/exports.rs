@@ -117,3 +117,22 @@ fn plan_route_of_known_map_planners_and_online_refusal() {
     let kept = scenario.run_on_until(&prepared, &going).unwrap();
     assert_eq!(kept.output.trace, run.output.trace);
 }
+
+/// A start far off the map, given through the builder, is the same `start ... is outside the
+/// map` error as on the command line: `Scenario::run` panicked on an integer overflow in
+/// debug builds (hostile pass), from the build a library user gets by default.
+#[test]
+fn a_start_far_off_the_map_is_an_error_not_a_panic() {
+    let Some(map) = shared("teb_empty_box.yaml") else {
+        return;
+    };
+    for (x, y) in [(1e300, -1e300), (-1e300, 1e300), (1e15, 0.0)] {
+        let e = Scenario::builder(&map, PlannerKind::Bcd)
+            .radius(0.1)
+            .start(x, y, 0.0)
+            .build()
+            .and_then(|s| s.run().map(|_| ()))
+            .expect_err("outside");
+        assert!(e.to_string().contains("outside the map"), "{e}");
+    }
+}
