@@ -47,7 +47,10 @@ pub fn office(width_px: usize, height_px: usize, resolution: f64, seed: u64) -> 
     assert!(width_px > 0 && height_px > 0, "empty map");
     assert!(resolution.is_finite() && resolution > 0.0, "bad resolution");
     let mut rng = SplitMix64::new(seed);
-    let px = |m: f64| ((m / resolution).round() as i64).max(1);
+    // At most 1e12 px: sums of a few stay far from overflowing (at resolution 1e-300 every
+    // length saturated at i64::MAX and the first sum overflowed: hostile pass); a length
+    // beyond the map leaves a walled empty room, as on any map too small.
+    let px = |m: f64| ((m / resolution).round().min(1e12) as i64).max(1);
     let (w, h) = (width_px as i64, height_px as i64);
     let mut c = Canvas {
         w: width_px,
@@ -156,4 +159,22 @@ pub fn office(width_px: usize, height_px: usize, resolution: f64, seed: u64) -> 
     }
     GridMap::new(MapFrame::new(width_px, height_px, resolution), c.cells)
         .expect("cells match the frame")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A resolution so fine that every length is more pixels than a map has gives a walled
+    /// room, not an integer overflow (hostile pass: `office(20, 20, 1e-300, 0)` panicked in
+    /// debug builds).
+    #[test]
+    fn a_resolution_too_fine_for_any_room_gives_a_walled_map() {
+        for res in [1e-300, 1e-12] {
+            let m = office(20, 20, res, 0);
+            assert_eq!((m.frame().width, m.frame().height), (20, 20));
+        }
+        let m = office(200, 150, 0.05, 3);
+        assert!(m.cells().contains(&Cell::Free));
+    }
 }

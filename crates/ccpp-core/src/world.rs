@@ -56,6 +56,25 @@ impl Robot {
     }
 }
 
+/// [`WorldError::RobotTooBig`]'s message: a map with no free pixel says so (it said "the
+/// widest free spot has clearance 0.000 m" of a map all occupied or unknown, whose cause is
+/// most often its thresholds or `negate`).
+fn too_big_text(radius: f64, max_clearance: f64) -> String {
+    if max_clearance == 0.0 {
+        format!(
+            "robot of radius {} m does not fit anywhere on the map: the map has no free pixel \
+             (every pixel is occupied or unknown; check its thresholds, negate and mode)",
+            Compact(radius)
+        )
+    } else {
+        format!(
+            "robot of radius {} m does not fit anywhere on the map: the widest free spot has \
+             clearance {max_clearance:.3} m",
+            Compact(radius)
+        )
+    }
+}
+
 /// Errors building a world.
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum WorldError {
@@ -76,12 +95,9 @@ pub enum WorldError {
         /// Robot radius.
         radius: f64,
     },
-    /// No centre position anywhere on the map keeps the robot clear of obstacles.
-    #[error(
-        "robot of radius {} m does not fit anywhere on the map: the widest free spot has \
-         clearance {:.3} m",
-        Compact(*.radius), Compact(*.max_clearance)
-    )]
+    /// No centre position anywhere on the map keeps the robot clear of obstacles (with a
+    /// `max_clearance` of 0: the map has no free pixel at all).
+    #[error("{}", too_big_text(*.radius, *.max_clearance))]
     RobotTooBig {
         /// Robot radius.
         radius: f64,
@@ -1542,6 +1558,16 @@ mod tests {
         assert!((w.start().x - 0.55).abs() < 1e-9 && (w.start().y - 0.55).abs() < 1e-9);
         let e = World::new(room(5, 5, 0.1), Robot::new(0.2), None).unwrap_err();
         assert!(matches!(e, WorldError::RobotTooBig { .. }), "{e}");
+        assert!(
+            e.to_string().contains("widest free spot has clearance"),
+            "{e}"
+        );
+        // A map with no free pixel says so (its thresholds or negate are the likely cause).
+        for fill in [Cell::Occupied, Cell::Unknown] {
+            let none = GridMap::filled(MapFrame::new(8, 8, 0.1), fill).unwrap();
+            let e = World::new(none, Robot::new(0.1), None).unwrap_err();
+            assert!(e.to_string().contains("the map has no free pixel"), "{e}");
+        }
         let e = World::new(
             room(11, 11, 0.1),
             Robot::new(0.1),

@@ -533,8 +533,23 @@ pub fn parse_waypoints_json(text: &str, path: &Path) -> Result<Route, WaypointFi
 /// Reads `waypoints.csv` or `waypoints.json` (by extension: `.json` is JSON, anything else CSV).
 ///
 /// # Errors
-/// An unreadable file or the parse errors of [`parse_waypoints_csv`] / [`parse_waypoints_json`].
+/// An unreadable file or the parse errors of [`parse_waypoints_csv`] / [`parse_waypoints_json`];
+/// a `.yaml`, `.yml` or `.geojson` file (ccpp's other exports, which it does not read back) is
+/// refused as such (a `nav_path.yaml` was refused as a CSV without the header `x,y,theta`).
 pub fn read_waypoints(path: &Path) -> Result<Route, WaypointFileError> {
+    if let Some(ext) = path.extension().and_then(|e| e.to_str()).filter(|e| {
+        ["yaml", "yml", "geojson"]
+            .iter()
+            .any(|k| e.eq_ignore_ascii_case(k))
+    }) {
+        return Err(WaypointFileError::Parse {
+            path: path.to_path_buf(),
+            line: 1,
+            message: format!(
+                "a .{ext} file: waypoints are read back from the CSV (x,y,theta) and JSON exports only"
+            ),
+        });
+    }
     let text = crate::file::read_text(path).map_err(|source| WaypointFileError::Io {
         path: path.to_path_buf(),
         source,
@@ -860,6 +875,21 @@ mod tests {
             assert!(render_exports(&r, &meta(), &[ExportFormat::Csv], &[]).is_err());
         }
         assert!(render_exports(&route(), &meta(), &ExportFormat::ALL, &[]).is_ok());
+    }
+
+    /// ccpp's other exports are refused as such, not as a CSV missing its header.
+    #[test]
+    fn the_yaml_and_geojson_exports_are_not_read_as_waypoints() {
+        let d = tempfile::tempdir().unwrap();
+        for name in ["nav_path.yaml", "p.YML", "path.geojson"] {
+            let p = d.path().join(name);
+            std::fs::write(&p, nav_path_yaml(&route())).unwrap();
+            let e = read_waypoints(&p).expect_err(name).to_string();
+            assert!(
+                e.contains("read back from the CSV (x,y,theta) and JSON exports only"),
+                "{e}"
+            );
+        }
     }
 
     #[test]

@@ -325,6 +325,12 @@ impl PlannerConfig {
 
     /// Builds the planner for `world`. Online planners get nothing from `world` but what an
     /// operator knows (its frame and the robot); offline ones read its map.
+    ///
+    /// It does not validate: a planner cannot fail to build, so an option out of its range
+    /// runs as its default. Check the options first with [`validate`](Self::validate) (and
+    /// the checks against the robot and the map, [`PlannerSettings::check`]
+    /// and [`check_world`](PlannerSettings::check_world)),
+    /// as `ccpp_io::scenario::Scenario` does for every run.
     pub fn build(&self, world: &World) -> Box<dyn Planner> {
         self.settings().build(world)
     }
