@@ -103,8 +103,8 @@ impl Default for SimConfig {
 }
 
 /// Motion steps in a row (rotations, translations, moves; marks do not count) after which a
-/// robot whose true position has stayed within half a map pixel of where they began is
-/// stopped as [`StopReason::Stalled`]. A planner that keeps driving into a wall it does not
+/// robot whose true position has stayed within half a map pixel (or half its radius, when
+/// that is smaller) of where they began is stopped as [`StopReason::Stalled`]. A planner that keeps driving into a wall it does not
 /// see where it is (its pose estimate drifted under odometry noise, so each motion meets the
 /// wall at once) would otherwise repeat that motion up to [`SimConfig::max_steps`] times: tens
 /// of millions of collisions and gigabytes of trace before an answer. A working run moves at
@@ -789,9 +789,11 @@ impl<'w> Simulator<'w> {
             self.set_execution(e);
         }
         let mut stop = StopReason::MaxSteps;
-        // The stall rule: motions since the true position last left half a pixel around
-        // `anchor`.
-        let near = 0.5 * self.world.frame().resolution;
+        // The stall rule: motions since the true position last left half a pixel (or half the
+        // robot's radius, when smaller) around `anchor`. (A robot much smaller than a pixel
+        // moves less than half a pixel per tile: BA* at r = 1e-4 m on a 1 m/px map was
+        // stopped as stalled after 0.2 m of correct driving: hostile pass.)
+        let near = 0.5 * self.world.frame().resolution.min(self.world.robot().radius);
         let mut anchor = self.pose.position();
         let mut still = 0u64;
         let mut stopped = false;
@@ -965,6 +967,29 @@ mod tests {
                 self.0.remove(0)
             }
         }
+    }
+
+    /// A robot much smaller than the map's pixels that sweeps back and forth inside one pixel
+    /// (its moves 3 mm, its radius 1 mm, the pixel 1 m) makes progress: it was stopped as
+    /// stalled after 1000 motions, its true position never half a pixel from where it began
+    /// (hostile pass). One that keeps pushing into a wall still stalls.
+    #[test]
+    fn a_tiny_robot_sweeping_inside_one_pixel_is_not_stalled() {
+        let map = GridMap::from_ascii_scaled("#####\n#...#\n#####", 1, 1.0).unwrap();
+        let world = World::new(map, Robot::new(0.001), Some(Pose::new(1.5, 1.5, 0.0))).unwrap();
+        let mut steps = Vec::new();
+        for k in 0..1500 {
+            steps.push(Step::Translate(if (k / 100) % 2 == 0 {
+                0.003
+            } else {
+                -0.003
+            }));
+        }
+        let out = simulate(&world, &mut Script(steps), &SimConfig::default());
+        assert_eq!(out.stop, StopReason::Done);
+        let mut p = Script(vec![Step::Translate(5.0); 1500]);
+        let out = simulate(&world, &mut p, &SimConfig::default());
+        assert_eq!(out.stop, StopReason::Stalled);
     }
 
     #[test]

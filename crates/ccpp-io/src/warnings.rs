@@ -15,7 +15,7 @@ use crate::scenario::Scenario;
 pub fn stop_warning(why: &str, what: &str) -> String {
     match why {
         "stalled" => format!(
-            "the run was stopped: the robot made no progress for {} motions in a row (its true position stayed within half a map pixel, as when it keeps driving into a wall its drifted pose estimate does not show); the {what} is incomplete",
+            "the run was stopped: the robot made no progress for {} motions in a row (its true position stayed within half a map pixel or half its radius, as when it keeps driving into a wall its drifted pose estimate does not show); the {what} is incomplete",
             ccpp_core::sim::STALL_STEPS
         ),
         "max_steps" => format!("the planner hit the simulator's step cap; the {what} is incomplete"),
