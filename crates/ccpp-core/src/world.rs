@@ -331,6 +331,12 @@ impl World {
     /// default start: the C-free pixel centre with the largest clearance in the largest C-free
     /// component, ties by row-major order, heading east).
     ///
+    /// It does not check that the map's frame lies where `f64` keeps the precision the
+    /// geometry needs: `ccpp_io::scenario::Scenario` refuses a resolution finer than 1e-5 m/px,
+    /// a map reaching farther than 1e8 m from the origin and a start heading beyond 4 pi, and
+    /// a world built here outside those bounds may give other results than the same map moved
+    /// in (at origin 1e15 m with a yaw of 0.5 rad, ba-star stalled at 10 % of the floor).
+    ///
     /// # Errors
     /// Invalid radii, a robot that fits nowhere, a start outside the map or in an obstacle.
     pub fn new(map: GridMap, robot: Robot, start: Option<Pose>) -> Result<Self, WorldError> {
