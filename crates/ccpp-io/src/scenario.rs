@@ -1931,6 +1931,23 @@ mod tests {
         let mut v: serde_json::Value =
             serde_json::from_str(&s.to_json().unwrap_or_default()).unwrap_or_default();
         assert_eq!(read(&v.to_string(), true), Ok(PlannerKind::Bcd));
+        // The keys the refusal lists as expected are the file's own, every one: a field added
+        // to `Scenario` and `ScenarioIn` but not to `SCENARIO_KEYS` would be left out of the
+        // message (this keeps the three in step).
+        let mut full = s.clone();
+        full.start = Some([0.0, 0.0, 0.0]);
+        full.area = Some(ZoneSpec::Rect([0.0, 0.0, 1.0, 1.0]));
+        full.map_digest = Some("0123456789abcdef".into());
+        let keys: Vec<String> = serde_json::from_str::<serde_json::Map<String, serde_json::Value>>(
+            &full.to_json().unwrap_or_default(),
+        )
+        .unwrap_or_default()
+        .keys()
+        .cloned()
+        .collect();
+        let mut want: Vec<&str> = SCENARIO_KEYS.to_vec();
+        want.sort_unstable();
+        assert_eq!(keys, want);
         v["max_memory"] = serde_json::json!(1);
         let e = read(&v.to_string(), true).expect_err("max_memory");
         assert!(e.contains("unknown field `max_memory`"), "{e}");
