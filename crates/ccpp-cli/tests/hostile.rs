@@ -3431,3 +3431,39 @@ fn the_wrote_line_shows_hidden_characters_of_the_folder() {
         "{text}"
     );
 }
+
+/// A `run.json` with a misspelt key (`keepouts:`) is refused by `ccpp replay` on one line
+/// naming the key and the keys a run file has: the scenario read it as a run with no
+/// keep-out at all (hostile pass).
+#[test]
+fn a_run_file_with_a_misspelt_key_is_refused_naming_it() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("r");
+    ccpp()
+        .args([
+            "run",
+            "--planner",
+            "ba-star",
+            "--map",
+            s(&pillars(d.path())),
+        ])
+        .arg("--out")
+        .arg(&out)
+        .assert()
+        .success();
+    let rec = out.join("run.json");
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&rec).unwrap()).unwrap();
+    v["keepouts"] = serde_json::json!([[0, 0, 1, 1]]);
+    std::fs::write(&rec, v.to_string()).unwrap();
+    let o = ccpp().arg("replay").arg(&out).output().unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("run.json: unknown field `keepouts`, expected one of")
+            && err.contains("`keepout`"),
+        "{err}"
+    );
+    assert!(!out.join("replay.html").exists());
+}
