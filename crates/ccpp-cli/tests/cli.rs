@@ -810,17 +810,6 @@ fn small_bench_writes_csv_md_and_plots_and_resumes() {
     );
 }
 
-fn chromium() -> Option<PathBuf> {
-    [
-        "/usr/bin/chromium",
-        "/usr/bin/chromium-browser",
-        "/usr/bin/google-chrome",
-    ]
-    .iter()
-    .map(PathBuf::from)
-    .find(|p| p.is_file())
-}
-
 #[test]
 fn replay_page_works_in_headless_chromium() {
     let dir = tempfile::tempdir().unwrap();
@@ -847,7 +836,7 @@ fn replay_page_works_in_headless_chromium() {
         html
     );
 
-    let Some(chrome) = chromium() else {
+    let Some(chrome) = crate::common::chromium() else {
         assert!(
             std::env::var_os("CI").is_none(),
             "CI must install chromium (see .ci/run)"
@@ -875,11 +864,7 @@ fn replay_page_works_in_headless_chromium() {
     };
     let mut c = std::process::Command::new(&chrome);
     base(&mut c);
-    let o = c
-        .arg("--dump-dom")
-        .arg(format!("{url}#selftest"))
-        .output()
-        .unwrap();
+    let o = crate::common::output_within_limit(c.arg("--dump-dom").arg(format!("{url}#selftest")));
     let dom = String::from_utf8_lossy(&o.stdout);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(
@@ -902,11 +887,8 @@ fn replay_page_works_in_headless_chromium() {
     for f in [0.013, 0.37] {
         let mut c = std::process::Command::new(&chrome);
         base(&mut c);
-        let o = c
-            .arg("--dump-dom")
-            .arg(format!("{url}#at={f}"))
-            .output()
-            .unwrap();
+        let o =
+            crate::common::output_within_limit(c.arg("--dump-dom").arg(format!("{url}#at={f}")));
         let dom = String::from_utf8_lossy(&o.stdout);
         let key = "id=\"now-dist\">";
         let at = dom.find(key).expect("the distance readout") + key.len();
@@ -923,11 +905,8 @@ fn replay_page_works_in_headless_chromium() {
     // 99.9 % beside 100.0 %: the curve's samples and distances are rounded apart).
     let mut c = std::process::Command::new(&chrome);
     base(&mut c);
-    let o = c
-        .arg("--dump-dom")
-        .arg(format!("{url}#frame=last"))
-        .output()
-        .unwrap();
+    let o =
+        crate::common::output_within_limit(c.arg("--dump-dom").arg(format!("{url}#frame=last")));
     let dom = String::from_utf8_lossy(&o.stdout);
     let text_after = |key: &str| {
         let at = dom.find(key).unwrap_or_else(|| panic!("{key}")) + key.len();
@@ -943,12 +922,11 @@ fn replay_page_works_in_headless_chromium() {
     let shot = Path::new(env!("CARGO_TARGET_TMPDIR")).join("replay-last-frame.png");
     let mut c = std::process::Command::new(&chrome);
     base(&mut c);
-    let o = c
-        .arg("--window-size=1300,900")
-        .arg(format!("--screenshot={}", shot.display()))
-        .arg(format!("{url}#frame=last"))
-        .output()
-        .unwrap();
+    let o = crate::common::output_within_limit(
+        c.arg("--window-size=1300,900")
+            .arg(format!("--screenshot={}", shot.display()))
+            .arg(format!("{url}#frame=last")),
+    );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let img = image::open(&shot).unwrap().to_rgb8();
     let swept = img

@@ -4,15 +4,8 @@
 //! must fill the width with the panel under it. Screenshots of each size are kept under the test
 //! target folder. Skipped without Chromium (CI installs it, see `.ci/run`).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
-
-fn chromium() -> Option<PathBuf> {
-    ["/usr/bin/chromium", "/usr/bin/chromium-browser"]
-        .iter()
-        .map(PathBuf::from)
-        .find(|p| p.is_file())
-}
 
 fn chrome(chrome: &Path, profile: &Path) -> Command {
     let mut c = Command::new(chrome);
@@ -52,7 +45,7 @@ fn demo_replay_side_panel_is_visible_at_desktop_sizes_and_usable_on_a_phone() {
         .success();
     let run = dir.path().join("ccpp-demo");
     assert!(run.join("replay.html").is_file());
-    let Some(chrome_bin) = chromium() else {
+    let Some(chrome_bin) = crate::common::chromium() else {
         assert!(
             std::env::var_os("CI").is_none(),
             "CI must install chromium (see .ci/run)"
@@ -76,12 +69,12 @@ fn demo_replay_side_panel_is_visible_at_desktop_sizes_and_usable_on_a_phone() {
         let url = format!("file://{}", wrapper.display());
         let mut v = None;
         for _ in 0..3 {
-            let o = chrome(&chrome_bin, profile.path())
-                .arg("--window-size=2000,1200")
-                .arg("--dump-dom")
-                .arg(&url)
-                .output()
-                .unwrap();
+            let o = crate::common::output_within_limit(
+                chrome(&chrome_bin, profile.path())
+                    .arg("--window-size=2000,1200")
+                    .arg("--dump-dom")
+                    .arg(&url),
+            );
             for l in String::from_utf8_lossy(&o.stderr).lines() {
                 let l = l.to_ascii_lowercase();
                 assert!(
@@ -161,12 +154,12 @@ fn demo_replay_side_panel_is_visible_at_desktop_sizes_and_usable_on_a_phone() {
             .unwrap();
             format!("file://{}", phone.display())
         };
-        let o = chrome(&chrome_bin, profile.path())
-            .arg(format!("--window-size={},{h}", w.max(500)))
-            .arg(format!("--screenshot={}", shot.display()))
-            .arg(page)
-            .output()
-            .unwrap();
+        let o = crate::common::output_within_limit(
+            chrome(&chrome_bin, profile.path())
+                .arg(format!("--window-size={},{h}", w.max(500)))
+                .arg(format!("--screenshot={}", shot.display()))
+                .arg(page),
+        );
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         eprintln!("{w}x{h}: screenshot {}", shot.display());
     }

@@ -95,6 +95,40 @@ fn require_chromium() -> Option<PathBuf> {
     c
 }
 
+/// How long one Chromium call may take: a page that never loads fails its test instead of
+/// hanging the suite.
+const BROWSER_LIMIT: std::time::Duration = std::time::Duration::from_mins(2);
+
+/// Runs `c` (Chromium) in a process group of its own and returns its output, or kills the whole
+/// group (the browser's helper processes too) and panics once it has run [`BROWSER_LIMIT`].
+fn output_within_limit(c: &mut Command) -> std::process::Output {
+    use std::os::unix::process::CommandExt;
+    use std::process::Stdio;
+    let child = c
+        .process_group(0)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("chromium starts");
+    let pid = child.id();
+    let (tx, rx) = std::sync::mpsc::channel();
+    let waiter = std::thread::spawn(move || {
+        // (the receiver is gone only when this test has already failed)
+        let _ = tx.send(child.wait_with_output());
+    });
+    if let Ok(out) = rx.recv_timeout(BROWSER_LIMIT) {
+        return out.expect("chromium runs");
+    }
+    // Out of time: the group's id is the browser's pid (`process_group(0)`).
+    let killed = Command::new("kill")
+        .args(["-KILL", "--", &format!("-{pid}")])
+        .status();
+    // (its output is not wanted any more; the join only reaps the waiter)
+    let _ = waiter.join();
+    panic!("chromium did not finish within {BROWSER_LIMIT:?} (killed: {killed:?})");
+}
+
 /// Runs headless Chromium on `url` and returns (DOM, stderr).
 fn dump_dom(chrome: &Path, url: &str, virtual_time: bool) -> (String, String) {
     let profile = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!(
@@ -121,11 +155,7 @@ fn dump_dom(chrome: &Path, url: &str, virtual_time: bool) -> (String, String) {
     if virtual_time {
         c.arg("--virtual-time-budget=10000");
     }
-    let o = c
-        .arg("--dump-dom")
-        .arg(url)
-        .output()
-        .expect("chromium runs");
+    let o = output_within_limit(c.arg("--dump-dom").arg(url));
     let _ = std::fs::remove_dir_all(&profile);
     (
         String::from_utf8_lossy(&o.stdout).into_owned(),

@@ -160,3 +160,97 @@ pub fn wait_for_pause(mark: &Path) {
         std::thread::sleep(std::time::Duration::from_millis(10));
     }
 }
+
+/// The headless browser the page tests drive, where one is installed.
+pub fn chromium() -> Option<PathBuf> {
+    [
+        "/usr/bin/chromium",
+        "/usr/bin/chromium-browser",
+        "/usr/bin/google-chrome",
+    ]
+    .iter()
+    .map(PathBuf::from)
+    .find(|p| p.is_file())
+}
+
+/// How long one browser call of a page test may take: a page that never loads, or a browser
+/// that waits on something, fails its test instead of hanging the suite.
+pub const BROWSER_LIMIT: std::time::Duration = std::time::Duration::from_mins(2);
+
+/// [`output_within`] at [`BROWSER_LIMIT`].
+pub fn output_within_limit(c: &mut std::process::Command) -> std::process::Output {
+    output_within(c, BROWSER_LIMIT)
+}
+
+/// Runs `c` in a process group of its own and returns its output, or kills the whole group (a
+/// browser's helper processes too) and panics once it has run `limit`.
+///
+/// # Panics
+/// When the command cannot start, or runs out of time.
+pub fn output_within(
+    c: &mut std::process::Command,
+    limit: std::time::Duration,
+) -> std::process::Output {
+    use std::os::unix::process::CommandExt;
+    use std::process::Stdio;
+    let child = c
+        .process_group(0)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let pid = child.id();
+    let (tx, rx) = std::sync::mpsc::channel();
+    let waiter = std::thread::spawn(move || {
+        // (the receiver is gone only when this test has already failed)
+        let _ = tx.send(child.wait_with_output());
+    });
+    if let Ok(out) = rx.recv_timeout(limit) {
+        return out.unwrap();
+    }
+    // Out of time: the group's id is the browser's pid (`process_group(0)`).
+    let killed = std::process::Command::new("kill")
+        .args(["-KILL", "--", &format!("-{pid}")])
+        .status();
+    // (its output, if any, is not wanted any more; the join only reaps the waiter)
+    let _ = waiter.join();
+    panic!(
+        "{} did not finish within {limit:?} (killed: {killed:?})",
+        std::path::Path::new(c.get_program()).display()
+    );
+}
+
+/// A command that outlives its limit fails its test, and its whole process group is gone
+/// (a browser's helpers would otherwise live on after the test).
+#[test]
+fn a_command_past_its_limit_is_killed_with_its_group() {
+    let dir = tempfile::tempdir().unwrap();
+    let pid_file = dir.path().join("pid");
+    let mut c = std::process::Command::new("sh");
+    c.arg("-c")
+        .arg(format!("sleep 60 & echo $! > {}; wait", pid_file.display()));
+    let t0 = std::time::Instant::now();
+    let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        output_within(&mut c, std::time::Duration::from_secs(1))
+    }));
+    assert!(r.is_err(), "a minute's sleep finished within a second");
+    assert!(t0.elapsed() < std::time::Duration::from_secs(30));
+    let pid = std::fs::read_to_string(&pid_file).unwrap();
+    let stat = Path::new("/proc").join(pid.trim()).join("stat");
+    // The helper `sleep` is gone, or a zombie waiting for whoever adopted it.
+    let t1 = std::time::Instant::now();
+    while let Ok(s) = std::fs::read_to_string(&stat) {
+        if s.rsplit(')')
+            .next()
+            .is_some_and(|r| r.trim_start().starts_with('Z'))
+        {
+            break;
+        }
+        assert!(
+            t1.elapsed() < std::time::Duration::from_secs(10),
+            "the group's sleep lives on: {s}"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+}
