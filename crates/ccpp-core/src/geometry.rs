@@ -88,6 +88,29 @@ impl std::ops::Add for Point {
     }
 }
 
+/// The largest heading magnitude ccpp accepts, radians: two full turns either way, room for
+/// every convention (`[-pi, pi]`, `[0, 2 pi)`, a wrapped `-6.2`) and no more. A map origin's yaw
+/// or a start heading beyond it is a typo or degrees (`90` for a quarter turn), not a heading,
+/// and is refused rather than wrapped.
+pub const MAX_HEADING_RAD: f64 = 4.0 * PI;
+
+/// Why `theta` (radians) is not a heading ccpp accepts, if it is not: non-finite, or beyond
+/// [`MAX_HEADING_RAD`].
+#[must_use]
+pub fn heading_problem(theta: f64) -> Option<String> {
+    if !theta.is_finite() {
+        Some(format!("{theta} rad is not a finite number"))
+    } else if theta.abs() > MAX_HEADING_RAD {
+        Some(format!(
+            "{} rad is more than two turns (|heading| <= 4 pi = {MAX_HEADING_RAD:.4} rad); \
+             headings are in radians, not degrees",
+            crate::display::Compact(theta)
+        ))
+    } else {
+        None
+    }
+}
+
 /// A robot pose `(x, y, theta)`: theta 0 = east, counter-clockwise positive, in (-pi, pi].
 #[derive(Clone, Copy, Debug, PartialEq, Default, Serialize, Deserialize)]
 pub struct Pose {

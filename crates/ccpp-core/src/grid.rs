@@ -211,6 +211,113 @@ impl MapFrame {
     }
 }
 
+/// Finest map resolution ccpp computes precisely, metres per pixel (10 micrometres): below
+/// about 1e-6 the fixed tolerances of the geometry (contact, free-move and sweep tests) are no
+/// longer small against a pixel, and a map scaled down gave other results than the same map at
+/// its scale (rect-boustrophedon swept 0.841 instead of 0.860 of a room at 5e-7 m/px; bsa-bfs
+/// drove nothing at 5e-8; bcd reported collisions at 5e-14). Down to 5e-6 every planner whose
+/// options scale with the map gives the same coverage as at 0.05.
+pub const MIN_RESOLUTION_M: f64 = 1e-5;
+
+/// Largest world coordinate of a map's corners ccpp computes precisely, metres (100 000 km,
+/// beyond any UTM or Earth-centred coordinate): farther out, `f64` keeps too few digits for
+/// the pixel arithmetic (at 1e9 m the same run covered 0.893 instead of 0.900 of the floor, at
+/// 1e300 m every start looked like a wall), so the results would change without a word.
+pub const MAX_COORD_M: f64 = 1e8;
+
+/// Largest map side ccpp handles, metres (1000 km): larger frames come from a wrong
+/// resolution, and their tile and distance arithmetic would lose all precision.
+pub const MAX_MAP_SIDE_M: f64 = 1e6;
+
+/// Why a [`MapFrame`] lies where `f64` does not keep the precision ccpp's geometry needs
+/// ([`MapFrame::precision_problem`]).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum FrameProblem {
+    /// The resolution (m/px) is finer than [`MIN_RESOLUTION_M`].
+    #[error(
+        "the resolution {0:e} m/px is finer than the {MIN_RESOLUTION_M:e} m/px ccpp computes \
+         precisely"
+    )]
+    TooFine(f64),
+    /// A side is longer than [`MAX_MAP_SIDE_M`].
+    #[error(
+        "the map is {width_m:e} x {height_m:e} m ({width} x {height} px at {resolution:e} \
+         m/px), larger than the {MAX_MAP_SIDE_M:e} m side ccpp handles"
+    )]
+    TooLarge {
+        /// Width, metres.
+        width_m: f64,
+        /// Height, metres.
+        height_m: f64,
+        /// Width, pixels.
+        width: usize,
+        /// Height, pixels.
+        height: usize,
+        /// Resolution, m/px.
+        resolution: f64,
+    },
+    /// A corner lies farther than [`MAX_COORD_M`] from the world's origin along an axis.
+    #[error(
+        "the map reaches {far:.2e} m from the world's origin along an axis (origin {}, {}), \
+         farther than the {MAX_COORD_M:e} m ccpp handles precisely",
+        crate::display::Compact(*.x), crate::display::Compact(*.y)
+    )]
+    TooFar {
+        /// Largest corner coordinate magnitude, metres.
+        far: f64,
+        /// Origin x, metres.
+        x: f64,
+        /// Origin y, metres.
+        y: f64,
+    },
+}
+
+impl FrameProblem {
+    /// The map setting to check: `resolution` (too fine, too large) or `origin` (too far).
+    #[must_use]
+    pub fn setting(&self) -> &'static str {
+        match self {
+            Self::TooFine(_) | Self::TooLarge { .. } => "resolution",
+            Self::TooFar { .. } => "origin",
+        }
+    }
+}
+
+impl MapFrame {
+    /// Why the frame lies beyond the precision bounds ([`MIN_RESOLUTION_M`],
+    /// [`MAX_MAP_SIDE_M`], [`MAX_COORD_M`]), if it does. [`crate::world::World`] refuses such
+    /// a frame, and `ccpp_io`'s scenario names the map file that gave it.
+    #[must_use]
+    pub fn precision_problem(&self) -> Option<FrameProblem> {
+        if self.resolution < MIN_RESOLUTION_M {
+            return Some(FrameProblem::TooFine(self.resolution));
+        }
+        let fits = |v: f64| v.is_finite() && v <= MAX_MAP_SIDE_M;
+        if !(fits(self.width_m()) && fits(self.height_m())) {
+            return Some(FrameProblem::TooLarge {
+                width_m: self.width_m(),
+                height_m: self.height_m(),
+                width: self.width,
+                height: self.height,
+                resolution: self.resolution,
+            });
+        }
+        let (lo, hi) = self.world_bounds();
+        let far = [lo.x, lo.y, hi.x, hi.y]
+            .into_iter()
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        // (a NaN corner is not within bounds either)
+        let within = far
+            .partial_cmp(&MAX_COORD_M)
+            .is_some_and(std::cmp::Ordering::is_le);
+        (!within).then_some(FrameProblem::TooFar {
+            far,
+            x: self.origin.x,
+            y: self.origin.y,
+        })
+    }
+}
+
 /// A 2-D occupancy grid: a [`MapFrame`] plus one [`Cell`] per pixel, row-major, row 0 on top.
 ///
 /// Grids read like drawings in tests (`#` occupied, `.` free, `?` unknown; the first line is the

@@ -129,6 +129,19 @@ pub enum WorldError {
         /// Map bounds.
         y1: f64,
     },
+    /// The map's frame lies where `f64` does not keep the precision the geometry needs
+    /// ([`MapFrame::precision_problem`]).
+    #[error("{0}")]
+    Imprecise(crate::grid::FrameProblem),
+    /// The start heading or the map origin's yaw is beyond
+    /// [`crate::geometry::MAX_HEADING_RAD`] (a heading in degrees, or a typo).
+    #[error("{what} {why}")]
+    BadHeading {
+        /// Which heading: `start heading` or `map origin yaw`.
+        what: &'static str,
+        /// Why it is refused ([`crate::geometry::heading_problem`]).
+        why: String,
+    },
     /// The robot's disk at the start overlaps an obstacle or unknown space.
     #[error(
         "start ({:.3}, {:.3}) is in an obstacle: a robot of radius {} m there overlaps \
@@ -331,14 +344,16 @@ impl World {
     /// default start: the C-free pixel centre with the largest clearance in the largest C-free
     /// component, ties by row-major order, heading east).
     ///
-    /// It does not check that the map's frame lies where `f64` keeps the precision the
-    /// geometry needs: `ccpp_io::scenario::Scenario` refuses a resolution finer than 1e-5 m/px,
-    /// a map reaching farther than 1e8 m from the origin and a start heading beyond 4 pi, and
-    /// a world built here outside those bounds may give other results than the same map moved
-    /// in (at origin 1e15 m with a yaw of 0.5 rad, ba-star stalled at 10 % of the floor).
+    /// The map's frame must lie where `f64` keeps the precision the geometry needs
+    /// ([`MapFrame::precision_problem`]: a resolution of at least 1e-5 m/px, sides of at most
+    /// 1e6 m, corners within 1e8 m of the world's origin), and the start heading and the
+    /// origin's yaw within two turns: outside those bounds results would change without a word
+    /// (at origin 1e15 m with a yaw of 0.5 rad, ba-star stalled at 10 % of the floor).
     ///
     /// # Errors
-    /// Invalid radii, a robot that fits nowhere, a start outside the map or in an obstacle.
+    /// Invalid radii, a frame beyond the precision bounds ([`WorldError::Imprecise`]), a
+    /// heading beyond two turns ([`WorldError::BadHeading`]), a robot that fits nowhere, a start
+    /// outside the map or in an obstacle.
     pub fn new(map: GridMap, robot: Robot, start: Option<Pose>) -> Result<Self, WorldError> {
         Self::with_zones(map, robot, start, None)
     }
@@ -410,6 +425,22 @@ impl World {
     ) -> Result<Self, WorldError> {
         robot.validate()?;
         let frame = *map.frame();
+        if let Some(p) = frame.precision_problem() {
+            return Err(WorldError::Imprecise(p));
+        }
+        // (a non-finite start is refused below as such: `BadStart`)
+        let headings = [
+            ("map origin yaw", Some(frame.origin.theta)),
+            ("start heading", start.map(|s| s.theta)),
+        ];
+        for (what, theta) in headings {
+            if let Some(why) = theta
+                .filter(|t| t.is_finite())
+                .and_then(crate::geometry::heading_problem)
+            {
+                return Err(WorldError::BadHeading { what, why });
+            }
+        }
         let zones = zones.filter(|z| !z.is_empty());
         let plan = zones.as_ref().map(|z| {
             assert!(
@@ -1415,6 +1446,98 @@ mod tests {
             s.push('\n');
         }
         GridMap::from_ascii_scaled(&s, 1, res).unwrap()
+    }
+
+    /// A world whose frame lies beyond the precision bounds is refused, naming the setting
+    /// (the same room at origin 1e15 m with a yaw of 0.5 rad let ba-star stall at 10 % of the
+    /// floor), and so is a heading beyond two turns; within the bounds the room is a world.
+    #[test]
+    fn frames_and_headings_beyond_the_precision_bounds_are_refused() {
+        let placed = |res: f64, origin: Pose| {
+            let m = room(12, 10, res);
+            let mut frame = *m.frame();
+            frame.origin = origin;
+            GridMap::new(frame, m.cells().to_vec()).unwrap()
+        };
+        let robot = Robot::new(1.0);
+        let ok =
+            |res: f64, origin: Pose| World::new(placed(res, origin), Robot::new(res * 2.0), None);
+        assert!(ok(1.0, Pose::new(1e7, -1e7, 0.5)).is_ok());
+        assert!(ok(1e-5, Pose::new(0.0, 0.0, 0.0)).is_ok());
+        let far = World::new(placed(1.0, Pose::new(1e15, 0.0, 0.5)), robot, None);
+        match far {
+            Err(WorldError::Imprecise(p)) => {
+                assert_eq!(p.setting(), "origin");
+                assert!(p.to_string().contains("farther than the 1e8 m"), "{p}");
+            }
+            other => panic!("{:?}", other.map(|_| ())),
+        }
+        let fine = World::new(
+            placed(1e-6, Pose::new(0.0, 0.0, 0.0)),
+            Robot::new(2e-6),
+            None,
+        );
+        match fine {
+            Err(WorldError::Imprecise(p)) => assert_eq!(p.setting(), "resolution"),
+            other => panic!("{:?}", other.map(|_| ())),
+        }
+        let big = World::new(placed(2e5, Pose::new(0.0, 0.0, 0.0)), Robot::new(4e5), None);
+        assert!(
+            matches!(
+                big,
+                Err(WorldError::Imprecise(
+                    crate::grid::FrameProblem::TooLarge { .. }
+                ))
+            ),
+            "{:?}",
+            big.map(|_| ())
+        );
+        // (a pose's fields are public: `Pose::new` wraps, a literal does not)
+        let turned = Pose {
+            x: 6.0,
+            y: 5.0,
+            theta: 90.0,
+        };
+        let e = World::new(placed(1.0, Pose::new(0.0, 0.0, 0.0)), robot, Some(turned));
+        match e {
+            Err(e @ WorldError::BadHeading { .. }) => {
+                assert!(
+                    e.to_string()
+                        .starts_with("start heading 90 rad is more than two turns"),
+                    "{e}"
+                );
+            }
+            other => panic!("{:?}", other.map(|_| ())),
+        }
+        let yawed = Pose {
+            x: 0.0,
+            y: 0.0,
+            theta: -20.0,
+        };
+        let e = World::new(placed(1.0, yawed), robot, None);
+        assert!(
+            matches!(
+                e,
+                Err(WorldError::BadHeading {
+                    what: "map origin yaw",
+                    ..
+                })
+            ),
+            "{:?}",
+            e.map(|_| ())
+        );
+        // A non-finite start is still refused as such.
+        let nan = Pose {
+            x: 6.0,
+            y: 5.0,
+            theta: f64::NAN,
+        };
+        let e = World::new(placed(1.0, Pose::new(0.0, 0.0, 0.0)), robot, Some(nan));
+        assert!(
+            matches!(e, Err(WorldError::BadStart(..))),
+            "{:?}",
+            e.map(|_| ())
+        );
     }
 
     /// Whenever the free-box test clears a short motion, the exact tests find no contact:

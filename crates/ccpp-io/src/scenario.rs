@@ -32,6 +32,7 @@ use std::path::{Path, PathBuf};
 use ccpp_core::display::Compact;
 use ccpp_core::exec::{Execution, PidOptions};
 use ccpp_core::grid::{GridError, GridMap, MapFrame};
+pub use ccpp_core::grid::{MAX_COORD_M, MAX_MAP_SIDE_M, MIN_RESOLUTION_M};
 use ccpp_core::metrics::{self, Metrics};
 use ccpp_core::planners::settings::{
     add_sim_pid_records, estimate_run, estimate_zones, fmt_m, validate_execution, ZoneLoad,
@@ -61,27 +62,9 @@ pub const DEFAULT_MAX_MEMORY_MB: u64 = 4096;
 /// than the memory limit of 18446744073709551615 MB".
 pub const MAX_MEMORY_LIMIT_MB: u64 = 1 << 40;
 
-/// Largest map side ccpp accepts, metres (1000 km): larger frames come from a wrong
-/// resolution, and their tile and distance arithmetic would lose all precision.
-pub const MAX_MAP_SIDE_M: f64 = 1e6;
-
 /// Largest need, MB, for which a memory refusal suggests raising `--max-memory` (a
 /// petabyte): beyond it only a larger robot, tile, spacing or smaller budget helps.
 const MAX_SENSIBLE_MB: f64 = 1e9;
-
-/// Largest world coordinate of a map's corners ccpp accepts, metres (100 000 km, beyond any
-/// UTM or Earth-centred coordinate): farther out, `f64` keeps too few digits for the pixel
-/// arithmetic (at 1e9 m the same run covered 0.893 instead of 0.900 of the floor, at 1e300 m
-/// every start looked like a wall), so the results would change without a word.
-pub const MAX_COORD_M: f64 = 1e8;
-
-/// Finest map resolution ccpp accepts, metres per pixel (10 micrometres): below about 1e-6 the
-/// fixed tolerances of the geometry (contact, free-move and sweep tests) are no longer small
-/// against a pixel, and a map scaled down gave other results than the same map at its scale
-/// (rect-boustrophedon swept 0.841 instead of 0.860 of a room at 5e-7 m/px; bsa-bfs drove
-/// nothing at 5e-8; bcd reported collisions at 5e-14). Down to 5e-6 every planner whose
-/// options scale with the map gives the same coverage as at 0.05.
-pub const MIN_RESOLUTION_M: f64 = 1e-5;
 
 fn default_max_memory_mb() -> u64 {
     DEFAULT_MAX_MEMORY_MB
@@ -531,48 +514,12 @@ pub fn check_extent(grid: &GridMap, source: &Path) -> Result<(), ScenarioError> 
     }
 }
 
-/// What [`check_extent`] refuses in `grid`'s frame, and which of the map's settings to check
-/// (`resolution` or `origin`); `None` when the frame is within bounds.
+/// What [`check_extent`] refuses in `grid`'s frame ([`MapFrame::precision_problem`]), and
+/// which of the map's settings to check (`resolution` or `origin`); `None` when the frame is
+/// within bounds.
 fn extent_problem(grid: &GridMap) -> Option<(String, &'static str)> {
-    let f = grid.frame();
-    if f.resolution < MIN_RESOLUTION_M {
-        return Some((
-            format!(
-                "the resolution {:e} m/px is finer than the {MIN_RESOLUTION_M:e} m/px ccpp computes precisely",
-                f.resolution
-            ),
-            "resolution",
-        ));
-    }
-    let fits = |v: f64| v.is_finite() && v <= MAX_MAP_SIDE_M;
-    if fits(f.width_m()) && fits(f.height_m()) {
-        let (lo, hi) = f.world_bounds();
-        let far = [lo.x, lo.y, hi.x, hi.y]
-            .into_iter()
-            .fold(0.0f64, |m, v| m.max(v.abs()));
-        if far <= MAX_COORD_M {
-            return None;
-        }
-        return Some((
-            format!(
-                "the map reaches {far:.2e} m from the world's origin along an axis (origin {}, {}), farther than the {MAX_COORD_M:e} m ccpp handles precisely",
-                Compact(f.origin.x),
-                Compact(f.origin.y)
-            ),
-            "origin",
-        ));
-    }
-    Some((
-        format!(
-            "the map is {:e} x {:e} m ({} x {} px at {:e} m/px), larger than the {MAX_MAP_SIDE_M:e} m side ccpp handles",
-            f.width_m(),
-            f.height_m(),
-            f.width,
-            f.height,
-            f.resolution
-        ),
-        "resolution",
-    ))
+    let p = grid.frame().precision_problem()?;
+    Some((p.to_string(), p.setting()))
 }
 
 /// Places `grid` by the affine fit of the point pairs in `path` (pixel coordinates from the

@@ -7,8 +7,6 @@ use std::path::Path;
 use serde::de::{self, Deserializer, Visitor};
 use serde::Deserialize;
 
-use ccpp_core::display::Compact;
-
 use super::classify::{MapMode, Thresholds, DEFAULT_FREE_THRESH, DEFAULT_OCCUPIED_THRESH};
 use super::error::{one_line, MapError};
 
@@ -294,26 +292,7 @@ fn yaml_message(e: &serde_saphyr::Error) -> String {
         .unwrap_or(text)
 }
 
-/// The largest heading magnitude ccpp accepts, radians: two full turns either way, room for
-/// every convention (`[-pi, pi]`, `[0, 2 pi)`, a wrapped `-6.2`) and no more. A map origin's yaw
-/// or a start heading beyond it is a typo or degrees (`90` for a quarter turn), not a heading,
-/// and is refused rather than wrapped.
-pub const MAX_HEADING_RAD: f64 = 4.0 * std::f64::consts::PI;
-
-/// Why `theta` (radians) is not a heading ccpp accepts, if it is not: non-finite, or beyond
-/// [`MAX_HEADING_RAD`].
-pub fn heading_problem(theta: f64) -> Option<String> {
-    if !theta.is_finite() {
-        Some(format!("{theta} rad is not a finite number"))
-    } else if theta.abs() > MAX_HEADING_RAD {
-        Some(format!(
-            "{} rad is more than two turns (|heading| <= 4 pi = {MAX_HEADING_RAD:.4} rad); headings are in radians, not degrees",
-            Compact(theta)
-        ))
-    } else {
-        None
-    }
-}
+pub use ccpp_core::geometry::{heading_problem, MAX_HEADING_RAD};
 
 /// Checks that `resolution` is finite and > 0, that `origin` is finite and that its yaw is a
 /// heading ([`heading_problem`]).
