@@ -7,6 +7,9 @@
 mod heading_tick;
 mod replay_browser;
 mod replay_far_pose;
+mod support {
+    pub mod browser;
+}
 
 /// Every `tests/*.rs` file is a module of this binary (otherwise its tests would not run).
 #[test]

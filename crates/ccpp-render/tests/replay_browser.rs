@@ -3,7 +3,7 @@
 //! writes out), the page works on a phone-sized viewport, and a 2 M-pose run stays small,
 //! opens fast and seeks fast. Without Chromium the browser parts are skipped (CI installs it).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 use ccpp_core::grid::{Cell, GridMap, MapFrame};
@@ -11,6 +11,8 @@ use ccpp_core::trace::{Event, Trace};
 use ccpp_core::world::{Robot, World};
 use ccpp_core::Pose;
 use ccpp_render::replay::replay_html;
+
+use crate::support::browser::{output_within_limit, require_chromium};
 
 const RES: f64 = 0.05;
 
@@ -74,59 +76,6 @@ fn run(w: usize, h: usize, n: usize) -> (World, Trace) {
         }
     }
     (world, t)
-}
-
-fn chromium() -> Option<PathBuf> {
-    ["/usr/bin/chromium", "/usr/bin/chromium-browser"]
-        .iter()
-        .map(PathBuf::from)
-        .find(|p| p.is_file())
-}
-
-fn require_chromium() -> Option<PathBuf> {
-    let c = chromium();
-    if c.is_none() {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "CI must install chromium (see .ci/run)"
-        );
-        eprintln!("chromium not found; skipping the browser part");
-    }
-    c
-}
-
-/// How long one Chromium call may take: a page that never loads fails its test instead of
-/// hanging the suite.
-const BROWSER_LIMIT: std::time::Duration = std::time::Duration::from_mins(2);
-
-/// Runs `c` (Chromium) in a process group of its own and returns its output, or kills the whole
-/// group (the browser's helper processes too) and panics once it has run [`BROWSER_LIMIT`].
-fn output_within_limit(c: &mut Command) -> std::process::Output {
-    use std::os::unix::process::CommandExt;
-    use std::process::Stdio;
-    let child = c
-        .process_group(0)
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("chromium starts");
-    let pid = child.id();
-    let (tx, rx) = std::sync::mpsc::channel();
-    let waiter = std::thread::spawn(move || {
-        // (the receiver is gone only when this test has already failed)
-        let _ = tx.send(child.wait_with_output());
-    });
-    if let Ok(out) = rx.recv_timeout(BROWSER_LIMIT) {
-        return out.expect("chromium runs");
-    }
-    // Out of time: the group's id is the browser's pid (`process_group(0)`).
-    let killed = Command::new("kill")
-        .args(["-KILL", "--", &format!("-{pid}")])
-        .status();
-    // (its output is not wanted any more; the join only reaps the waiter)
-    let _ = waiter.join();
-    panic!("chromium did not finish within {BROWSER_LIMIT:?} (killed: {killed:?})");
 }
 
 /// Runs headless Chromium on `url` and returns (DOM, stderr).
