@@ -144,3 +144,31 @@ fn the_fuzz_corpus_defaults_are_the_current_defaults() {
     let back: PlannerOptions = serde_json::from_str(&text).unwrap();
     assert_eq!(serde_json::to_value(back).unwrap(), want);
 }
+
+/// `planners::build` refuses an option out of its range, naming its section and field, where
+/// it ran the planner with the default instead (`tile_side_m: -1` built BA* with its tiles
+/// of the robot's diameter, without a word); valid options still build.
+#[test]
+fn build_by_name_refuses_an_option_out_of_its_range() {
+    use ccpp_core::grid::GridMap;
+    use ccpp_core::planners::{build, BuildError};
+    use ccpp_core::world::{Robot, World};
+    let map: GridMap = "##########\n#........#\n#........#\n#........#\n##########"
+        .parse()
+        .unwrap();
+    let world = World::new(map, Robot::new(0.5), None).unwrap();
+    let mut opts = PlannerOptions::default();
+    opts.ba_star.tile_side_m = Some(-1.0);
+    match build("ba-star", &opts, &world) {
+        Err(BuildError::Options(e)) => {
+            assert!(e.to_string().contains("ba_star.tile_side_m"), "{e}");
+        }
+        other => panic!("{:?}", other.map(|p| p.name())),
+    }
+    opts.ba_star.tile_side_m = Some(1.0);
+    assert_eq!(build("ba-star", &opts, &world).unwrap().name(), "ba-star");
+    assert!(matches!(
+        build("ba-star-x", &opts, &world),
+        Err(BuildError::Unknown(_))
+    ));
+}

@@ -330,7 +330,8 @@ impl PlannerConfig {
     /// runs as its default. Check the options first with [`validate`](Self::validate) (and
     /// the checks against the robot and the map, [`PlannerSettings::check`]
     /// and [`check_world`](PlannerSettings::check_world)),
-    /// as `ccpp_io::scenario::Scenario` does for every run.
+    /// as `ccpp_io::scenario::Scenario` does for every run, or build by name with
+    /// [`build`], which refuses an option out of its range.
     pub fn build(&self, world: &World) -> Box<dyn Planner> {
         self.settings().build(world)
     }
@@ -352,17 +353,32 @@ pub enum BuildError {
     /// No planner of that name.
     #[error("unknown planner {0:?}; run `ccpp planners` for the list")]
     Unknown(String),
+    /// An option of the planner's section is out of its range, or does not suit the world
+    /// ([`PlannerConfig::validate`], [`PlannerSettings::check_world`]).
+    #[error(transparent)]
+    Options(#[from] OptionsError),
 }
 
-/// Builds the planner `name` with its section of `opts` (see [`PlannerConfig::build`]).
+/// Builds the planner `name` with its section of `opts`, after checking the section's values
+/// ([`PlannerConfig::validate`]) and their fit to `world`
+/// ([`PlannerSettings::check_world`]): unlike [`PlannerConfig::build`], an option out of its
+/// range is refused instead of running as its default. (The checks against the robot and the
+/// run's sensor, [`PlannerSettings::check`], need the run's settings: `ccpp_io`'s scenario
+/// makes them all.)
 ///
 /// # Errors
-/// [`BuildError::Unknown`] for an unknown name.
+/// [`BuildError::Unknown`] for an unknown name, [`BuildError::Options`] for an invalid option.
 pub fn build(
     name: &str,
     opts: &PlannerOptions,
     world: &World,
 ) -> Result<Box<dyn Planner>, BuildError> {
     let kind: PlannerKind = name.parse()?;
-    Ok(opts.config(kind).build(world))
+    let config = opts.config(kind);
+    config.validate()?;
+    config
+        .settings()
+        .check_world(world)
+        .map_err(|e| e.in_section(kind.info().section))?;
+    Ok(config.build(world))
 }
