@@ -1061,3 +1061,32 @@ fn info_reports_zones_that_leave_no_floor_naming_the_zone() {
         "{err}"
     );
 }
+
+/// A keep-out or area reaching 1e9 m off the map is a zone like any other (it panicked while
+/// its border was drawn in `coverage.png`): the run, its picture and its replay are written,
+/// and the keep-out is kept out of.
+#[test]
+fn a_zone_reaching_far_off_the_map_runs_and_is_drawn() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = crate::common::data("teb_empty_box.yaml");
+    for (sub, zone) in [
+        ("keepout", "--keepout=-1e9,1,2,1.3"),
+        ("area", "--area=-1e9,-1e9,3,3"),
+    ] {
+        let out = dir.path().join(sub);
+        let a = ccpp()
+            .args(["run", "--planner", "bcd", "--replay", zone, "--map"])
+            .arg(&map)
+            .arg("--out")
+            .arg(&out)
+            .assert()
+            .success();
+        let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
+        assert!(!err.contains("panicked"), "{err}");
+        for f in ["coverage.png", "replay.html", "replay.gif", "metrics.json"] {
+            assert!(out.join(f).is_file(), "{sub}: {f}");
+        }
+        let m = crate::common::read_json(&out.join("metrics.json"));
+        assert_eq!(m["keepout_violations"], 0, "{sub}");
+    }
+}

@@ -210,6 +210,17 @@ impl View {
             ((self.height - g.y - self.row0) as f32) * self.scale + self.top,
         )
     }
+
+    /// [`View::to_canvas`] in `f64`, for points that may lie far off the picture (clipped
+    /// before they are drawn).
+    fn to_canvas_f64(self, world: &World, p: Point) -> (f64, f64) {
+        let g = world.frame().world_to_grid(p);
+        let s = f64::from(self.scale);
+        (
+            (g.x - self.col0) * s + f64::from(self.left),
+            (self.height - g.y - self.row0) * s + f64::from(self.top),
+        )
+    }
 }
 
 /// The part of the map worth drawing: the bounding box of known (free or occupied) pixels and
@@ -1178,23 +1189,25 @@ fn draw_zone_borders(pm: &mut Pixmap, world: &World, view: View, (mw, ch): (u32,
         );
         Some(mask)
     });
+    // Edges are cut to the picture plus a margin wider than the stroke (a zone reaching 1e9 m
+    // off the map made the rasterizer panic on its coordinates).
+    let margin = f64::from(width) + 4.0;
+    let lo = (f64::from(view.left) - margin, f64::from(view.top) - margin);
+    let hi = (
+        f64::from(view.left) + f64::from(mw) + margin,
+        f64::from(view.top) + f64::from(ch) + margin,
+    );
     for (polys, colour) in [
         (&z.area_polygons, colours::AREA_BORDER),
         (&z.keepout_polygons, colours::KEEPOUT_HATCH),
     ] {
         for poly in polys {
-            let ring = poly.ring();
-            let mut pb = PathBuilder::new();
-            for (k, p) in ring.iter().enumerate() {
-                let (x, y) = view.to_canvas(world, *p);
-                if k == 0 {
-                    pb.move_to(x, y);
-                } else {
-                    pb.line_to(x, y);
-                }
-            }
-            pb.close();
-            if let Some(path) = pb.finish() {
+            let pts: Vec<(f64, f64)> = poly
+                .ring()
+                .iter()
+                .map(|p| view.to_canvas_f64(world, *p))
+                .collect();
+            if let Some(path) = ring_path(&pts, (lo, hi)) {
                 let stroke = Stroke {
                     width,
                     ..Stroke::default()
@@ -1209,6 +1222,40 @@ fn draw_zone_borders(pm: &mut Pixmap, world: &World, view: View, (mw, ch): (u32,
             }
         }
     }
+}
+
+/// The closed ring `pts` (canvas coordinates) as a path of its parts inside the box `lo`-`hi`:
+/// the whole ring, closed, when it lies inside; else each run of edges that stays inside as
+/// one polyline (an edge crossing the box's side starts or ends one there). `None` when no
+/// edge reaches the box.
+fn ring_path(pts: &[(f64, f64)], (lo, hi): ((f64, f64), (f64, f64))) -> Option<tiny_skia::Path> {
+    let n = pts.len();
+    let mut pb = PathBuilder::new();
+    let inside = |p: (f64, f64)| p.0 >= lo.0 && p.0 <= hi.0 && p.1 >= lo.1 && p.1 <= hi.1;
+    if pts.iter().all(|&p| inside(p)) {
+        for (k, &(x, y)) in pts.iter().enumerate() {
+            if k == 0 {
+                pb.move_to(x as f32, y as f32);
+            } else {
+                pb.line_to(x as f32, y as f32);
+            }
+        }
+        pb.close();
+        return pb.finish();
+    }
+    let mut end: Option<(f64, f64)> = None;
+    for k in 0..n {
+        let Some((a, b)) = replay::clip_segment(pts[k], pts[(k + 1) % n], lo, hi) else {
+            end = None;
+            continue;
+        };
+        if end != Some(a) {
+            pb.move_to(a.0 as f32, a.1 as f32);
+        }
+        pb.line_to(b.0 as f32, b.1 as f32);
+        end = Some(b);
+    }
+    pb.finish()
 }
 
 /// The entries of a trace with each straight run reduced to its first and last pose (what a
@@ -2016,6 +2063,29 @@ mod tests {
         let header = 0..30;
         assert_eq!(count_colour(&pm, header, colours::AREA_BORDER), 0);
         assert!(count_colour(&pm, 0..pm.height(), colours::AREA_BORDER) > 50);
+    }
+
+    /// A keep-out reaching 1e9 m off the map is drawn cut to the picture (its coordinates
+    /// made the rasterizer panic), its border where it crosses the map; the same keep-out
+    /// within the map's reach draws the same pixels.
+    #[test]
+    fn a_zone_reaching_far_off_the_map_is_drawn_cut_to_the_picture() {
+        use ccpp_core::zones::{Polygon, ZoneMasks};
+        let (room, trace) = run(1);
+        let drawn = |x0: f64| {
+            let map = room.true_map().clone();
+            let keepout = [Polygon {
+                points: vec![[x0, 1.0], [1.0, 1.0], [1.0, 1.2], [x0, 1.2]],
+                name: None,
+            }];
+            let zones = ZoneMasks::new(map.frame(), None, &keepout, &[]);
+            let world = World::with_zones(map, Robot::new(0.15), None, Some(zones)).unwrap();
+            let pm = coverage_pixmap(&world, &trace, &style()).unwrap();
+            count_colour(&pm, 0..pm.height(), colours::KEEPOUT_HATCH)
+        };
+        let far = drawn(-1e9);
+        assert!(far > 20, "{far} border pixels");
+        assert_eq!(far, drawn(-50.0));
     }
 
     /// A run the simulator stopped says so in the header: one more red badge.

@@ -864,7 +864,7 @@ fn draw_line(layer: &mut [bool], w: usize, h: usize, a: (f64, f64), b: (f64, f64
 
 /// The part of segment `a`-`b` inside the box `lo`-`hi` (Liang-Barsky), `None` when there is
 /// none or a coordinate is not finite. Endpoints inside the box are returned unchanged.
-fn clip_segment(
+pub(crate) fn clip_segment(
     a: (f64, f64),
     b: (f64, f64),
     lo: (f64, f64),
