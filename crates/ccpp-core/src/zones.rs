@@ -395,11 +395,20 @@ pub fn rasterize_keepout(frame: &MapFrame, polys: &[Polygon]) -> FixedBitSet {
             .filter(|p| p.x.is_finite() && p.y.is_finite())
             .map(|p| {
                 let g = frame.world_to_grid(p);
-                // A vertex within a billionth of a pixel of a grid line is on it: an edge
-                // along a pixel border (a rectangle given in whole pixels) passes through no
-                // pixel, instead of through a whole row of them by rounding.
+                // A vertex within a millionth of a pixel of a grid line (more where the
+                // coordinates' own rounding is larger: far from the origin, on a fine grid)
+                // is on it: an edge along a pixel border (a rectangle given in whole pixels, a
+                // keep-out exported by ccpp and read back) passes through no pixel, instead of
+                // through a whole row of them by rounding. (At a billionth, a mask exported to
+                // `path.geojson`, whose coordinates have nine decimals, and read back on a map
+                // at a UTM origin or with a yaw took in a strip of pixels more: 5.00 m2 became
+                // 5.32; hostile pass.)
+                let mag = [p.x, p.y, frame.origin.x, frame.origin.y]
+                    .into_iter()
+                    .fold(1.0f64, |m, v| m.max(v.abs()));
+                let tol = 1e-6 + 8.0 * f64::EPSILON * mag / frame.resolution;
                 let snap = |v: f64| {
-                    if (v - v.round()).abs() <= 1e-9 {
+                    if (v - v.round()).abs() <= tol {
                         v.round()
                     } else {
                         v
@@ -860,6 +869,36 @@ mod tests {
     /// A keep-out drawn as a thin slanted strip (0.01 m wide at 0.05 m pixels, slope 1/10)
     /// holds every pixel it overlaps: a chain the robot cannot pass. By the pixel-centre rule
     /// it held a few scattered pixels, with gaps a robot drove through (hostile pass).
+    /// A keep-out drawn along pixel borders holds exactly the pixels inside, also where the
+    /// coordinates carry rounding: a rectangle in whole pixels at a UTM origin, and a block of
+    /// pixels whose corners went out with nine decimals (as `path.geojson` writes them) on a
+    /// yawed map. At a snap of a billionth of a pixel both took in a strip more (1.05 m2
+    /// instead of 1.00; 5.32 instead of 5.00 on a round trip; hostile pass).
+    #[test]
+    fn a_keepout_along_pixel_borders_holds_the_pixels_inside_despite_rounding() {
+        let mut utm = MapFrame::new(200, 200, 0.05);
+        utm.origin = crate::Pose::new(600_000.0, 5_300_000.0, 0.0);
+        let rect = poly(&[
+            [600_001.05, 5_300_001.05],
+            [600_002.05, 5_300_001.05],
+            [600_002.05, 5_300_002.05],
+            [600_001.05, 5_300_002.05],
+        ]);
+        assert_eq!(rasterize_keepout(&utm, &[rect]).count_ones(..), 400);
+        let mut yawed = MapFrame::new(200, 200, 0.05);
+        yawed.origin = crate::Pose::new(2.0, -1.0, 0.5);
+        let nine = |v: f64| (v * 1e9).round() / 1e9;
+        let corners: Vec<[f64; 2]> = [(30.0, 40.0), (90.0, 40.0), (90.0, 65.0), (30.0, 65.0)]
+            .into_iter()
+            .map(|(x, y)| {
+                let w = yawed.grid_to_world(Point::new(x, y));
+                [nine(w.x), nine(w.y)]
+            })
+            .collect();
+        let block = poly(&corners);
+        assert_eq!(rasterize_keepout(&yawed, &[block]).count_ones(..), 60 * 25);
+    }
+
     #[test]
     fn a_thin_slanted_keepout_holds_every_pixel_it_overlaps() {
         let mut f = MapFrame::new(80, 160, 0.05);
