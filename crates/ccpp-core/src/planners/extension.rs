@@ -296,6 +296,13 @@ pub(crate) struct Chunk {
     pub(crate) transfer: Vec<Point>,
     /// The sweep along the rim, after the transfer (empty when the pass ends where it starts).
     pub(crate) sweep: Vec<Point>,
+    /// The sweep's first move is more way than rim: merging dropped the walk's first position
+    /// and joined the way's last stretch to the walk's first in one straight move, most of
+    /// whose length lay on the way. It is then driven as the transfer's last move (drawn
+    /// dashed, counted in `backtrack_length`) instead of as the pass's first, which drew a move
+    /// of metres across an open room as rim sweeping. How the chunk is judged
+    /// ([`Chunk::trip_len`], [`Chunk::walk_len`]) does not change.
+    pub(crate) lead_in: bool,
     /// Target pixels the chunk's walk claims.
     pub(crate) gained: usize,
     /// Those pixels.

@@ -61,23 +61,27 @@ impl Drive {
         if chunk.transfer.is_empty() && chunk.sweep.is_empty() {
             return false;
         }
-        let transfer = polyline_length(pos, &chunk.transfer) >= 2.0 * radius;
+        // (a lead-in move is driven as the transfer's last: [`Chunk::lead_in`])
+        let head = usize::from(chunk.lead_in).min(chunk.sweep.len());
+        let (lead, sweep) = chunk.sweep.split_at(head);
+        let way: Vec<Point> = chunk.transfer.iter().chain(lead).copied().collect();
+        let transfer = polyline_length(pos, &way) >= 2.0 * radius;
         if transfer {
             self.end_pass();
             self.queue.push_back(Step::Mark(Event::BacktrackStart));
         }
-        for &p in &chunk.transfer {
+        for &p in &way {
             self.queue.push_back(Step::MoveTo(p));
             self.trail.push(p);
         }
         if transfer {
             self.queue.push_back(Step::Mark(Event::BacktrackEnd));
         }
-        if !self.in_pass && !chunk.sweep.is_empty() {
+        if !self.in_pass && !sweep.is_empty() {
             self.in_pass = true;
             self.queue.push_back(Step::Mark(Event::WallFollowStart));
         }
-        for &p in &chunk.sweep {
+        for &p in sweep {
             self.queue.push_back(Step::MoveTo(p));
             self.trail.push(p);
         }

@@ -5,7 +5,7 @@
 use super::graph::NB;
 use super::search::COST_ORTHO;
 use super::{Chunk, Extension, Wanted};
-use crate::geometry::Point;
+use crate::geometry::{path_length, Point};
 use crate::planner::KnownMap;
 use crate::planners::ba_star::{judge_motion, Judgement};
 
@@ -171,9 +171,15 @@ impl Extension {
             verts
         };
         let split = verts.partition_point(|v| v.0 <= nt);
+        // A move from before the walk's first position to after it: more way or more walk?
+        let lead_in = split >= 1 && split < verts.len() && verts[split - 1].0 < nt && {
+            let (j, k) = (verts[split - 1].0, verts[split].0);
+            path_length(&pts[j..=nt]) > path_length(&pts[nt..=k])
+        };
         Chunk {
             transfer: verts[1..split].iter().map(|v| self.world(v.1)).collect(),
             sweep: verts[split..].iter().map(|v| self.world(v.1)).collect(),
+            lead_in,
             gained: gains.iter().map(Vec::len).sum(),
             claimed: gains.iter().flatten().copied().collect(),
             owed: self.any_owed && gains.iter().flatten().any(|&i| self.owed.contains(i)),
