@@ -1090,3 +1090,22 @@ fn a_zone_reaching_far_off_the_map_runs_and_is_drawn() {
         assert_eq!(m["keepout_violations"], 0, "{sub}");
     }
 }
+
+/// A tile planner's approach into an area ends where its tile lattice leads on through the
+/// area: from a start below this area of `aws_small_house` it ended at the nearest roomy
+/// spot, whose lattice stayed in a pocket above an L-shaped obstacle, and ba-star, bsa and
+/// bsa-bfs swept 8.5 % of the area (hostile pass; the default start inside sweeps 80 %).
+#[test]
+fn a_tile_planners_approach_ends_where_its_lattice_leads_out_of_a_pocket() {
+    let dir = tempfile::tempdir().unwrap();
+    for planner in ["ba-star", "bsa", "bsa-bfs"] {
+        let (m, _) = run(
+            dir.path(),
+            planner,
+            planner,
+            &["--start", "0,0", "--area=-2,-3.75,7,-0.45"],
+        );
+        let ec = m["effective_coverage"].as_f64().unwrap();
+        assert!(ec > 0.75, "{planner}: {ec}");
+    }
+}

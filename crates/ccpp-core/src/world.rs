@@ -403,12 +403,16 @@ impl World {
     }
 
     /// [`World::with_zones_fitting`] whose approach, once inside the area, goes on through the
-    /// part of the area it reached to the nearest pixel centre where a disk of radius `room`
-    /// fits under every virtual wall, when the part has one (else it ends where it reached
-    /// the part, as with `room` = `fit`). For a tile planner, whose tiles are anchored at the
-    /// start: an approach that ended at the first spot where the robot fitted (a strip beside
-    /// a wall, at the end of the wall) left BA*'s tiles no way into the room beyond, and it
-    /// swept 0.6 % of the area (hostile pass, on `teb_maze` with a yawed origin).
+    /// part of the area it reached to a pixel centre where a disk of radius `room` fits under
+    /// every virtual wall, when the part has one (else it ends where it reached the part, as
+    /// with `room` = `fit`): of the nearest 48 such centres, the one whose lattice of tiles of
+    /// side `room - fit` anchored there reaches the most tiles (a tile counts where the disk
+    /// of radius `fit` fits at its centre and halfway to its neighbour), ties to the nearest.
+    /// For a tile planner, whose tiles are anchored at the start: an approach that ended at
+    /// the first spot where the robot fitted (a strip beside a wall, at the end of the wall)
+    /// left BA*'s tiles no way into the room beyond, and it swept 0.6 % of the area (hostile
+    /// pass, on `teb_maze` with a yawed origin); one that ended at the nearest roomy spot left
+    /// them in a pocket above an obstacle on `aws_small_house` (8.5 %; now 82 %).
     ///
     /// # Errors
     /// As [`World::with_zones`].
@@ -742,7 +746,13 @@ impl World {
         if room > fit {
             let rr = contact_radius_px(room / frame.resolution);
             let roomy = |i: usize| f64::from(self.obstacle_dt2.get(i)) >= rr * rr;
-            chain.extend(nearest_where(&frame, goal, &fits, &roomy));
+            // Of the nearest roomy spots, the one whose tile lattice (tiles of the extra
+            // room's side, anchored there as the planner's are at its start) reaches the most
+            // tiles; ties: the nearest. The nearest alone left BA*'s lattice in a pocket of
+            // an area on `aws_small_house` (8.5 % swept where a start 5 cm away swept 90 %).
+            let side_px = (room - fit) / frame.resolution;
+            let reach = |i: usize| tiles_reached(&frame, i, side_px, &fits);
+            chain.extend(best_roomy(&frame, goal, &fits, &roomy, &reach));
         }
         let pts: Vec<Point> = std::iter::once(g0)
             .chain(chain.iter().map(|&i| {
@@ -1361,41 +1371,114 @@ fn relax_octile(
     }
 }
 
-/// The shortest 8-connected chain of pixels (integer octile costs, fixed order) from `from`
-/// through pixels where `through` holds to the nearest pixel where `goal` holds, without
-/// `from` itself; empty when `from` is such a pixel or none is reached.
-fn nearest_where(
+/// Roomy spots [`best_roomy`] ranks: the nearest this many.
+const ROOMY_CANDIDATES: usize = 48;
+
+/// The way (pixels after `from`, through `through`) to the best of the [`ROOMY_CANDIDATES`]
+/// pixels nearest to `from` where `goal` holds: the one with the largest `score`, ties to the
+/// nearer (Dijkstra order); empty when `from` itself is one and scores at least as well, or
+/// when none is reached.
+fn best_roomy(
     frame: &MapFrame,
     from: usize,
     through: &dyn Fn(usize) -> bool,
     goal: &dyn Fn(usize) -> bool,
+    score: &dyn Fn(usize) -> usize,
 ) -> Vec<usize> {
-    if goal(from) {
-        return Vec::new();
-    }
     let mut dist = vec![u32::MAX; frame.len()];
     let mut parent = vec![u32::MAX; frame.len()];
     let mut heap = crate::search::MonotoneQueue::new();
     dist[from] = 0;
     heap.push(0, from as u32);
+    let mut best: Option<(usize, usize)> = None;
+    let mut seen = 0;
     while let Some((d, i)) = heap.pop() {
         let (d, i) = (d as u32, i as usize);
         if d > dist[i] {
             continue;
         }
         if goal(i) {
-            let mut chain = vec![i];
-            let mut k = i;
-            while parent[k] != u32::MAX && parent[k] as usize != from {
-                k = parent[k] as usize;
-                chain.push(k);
+            let s = score(i);
+            if best.is_none_or(|b| s > b.0) {
+                best = Some((s, i));
             }
-            chain.reverse();
-            return chain;
+            seen += 1;
+            if seen == ROOMY_CANDIDATES {
+                break;
+            }
         }
         relax_octile(frame, i, d, through, &mut dist, &mut parent, &mut heap);
     }
-    Vec::new()
+    let Some((_, end)) = best else {
+        return Vec::new();
+    };
+    let mut chain = Vec::new();
+    let mut k = end;
+    while k != from {
+        chain.push(k);
+        k = parent[k] as usize;
+    }
+    chain.reverse();
+    chain
+}
+
+/// Most tiles [`tiles_reached`] counts (a bound on its work on a large map).
+const TILES_COUNTED: usize = 1 << 20;
+
+/// Tiles of side `side_px` on the lattice whose tile centres include pixel `at`'s centre,
+/// reached from `at`'s tile through the four neighbours: a tile counts where `fits` holds at
+/// the pixel of its centre and halfway to the tile it is reached from (the lattice a tile
+/// planner starting at `at` has). At most [`TILES_COUNTED`].
+fn tiles_reached(frame: &MapFrame, at: usize, side_px: f64, fits: &dyn Fn(usize) -> bool) -> usize {
+    if !(side_px.is_finite() && side_px >= 1.0) {
+        return 0;
+    }
+    let (c0, r0) = frame.col_row(at);
+    let centre = |i: i64, j: i64| {
+        let x = c0 as f64 + 0.5 + i as f64 * side_px;
+        let y = r0 as f64 + 0.5 + j as f64 * side_px;
+        frame.checked(x.floor() as i64, y.floor() as i64)
+    };
+    let half = |i: i64, j: i64, di: i64, dj: i64| {
+        let x = c0 as f64 + 0.5 + (i as f64 + 0.5 * di as f64) * side_px;
+        let y = r0 as f64 + 0.5 + (j as f64 + 0.5 * dj as f64) * side_px;
+        frame.checked(x.floor() as i64, y.floor() as i64)
+    };
+    let ok = |p: Option<(usize, usize)>| p.is_some_and(|(c, r)| fits(frame.index(c, r)));
+    // Lattice indices whose centres lie on the map, and a flag per tile.
+    let span = |v0: usize, n: usize| {
+        let lo = -((v0 as f64 + 0.5) / side_px).floor() as i64;
+        let hi = ((n as f64 - v0 as f64 - 0.5) / side_px).floor() as i64;
+        (lo, hi)
+    };
+    let ((i0, i1), (j0, j1)) = (span(c0, frame.width), span(r0, frame.height));
+    let ni = (i1 - i0 + 1) as usize;
+    let nj = (j1 - j0 + 1) as usize;
+    let mut seen = vec![false; ni.saturating_mul(nj)];
+    let slot = |i: i64, j: i64| {
+        (i >= i0 && i <= i1 && j >= j0 && j <= j1)
+            .then(|| (j - j0) as usize * ni + (i - i0) as usize)
+    };
+    let mut queue = std::collections::VecDeque::new();
+    let Some(first) = slot(0, 0) else { return 0 };
+    seen[first] = true;
+    queue.push_back((0i64, 0i64));
+    let mut count = 1;
+    while let Some((i, j)) = queue.pop_front() {
+        if count >= TILES_COUNTED {
+            break;
+        }
+        for (di, dj) in [(1, 0), (-1, 0), (0, 1), (0, -1)] {
+            let (a, b) = (i + di, j + dj);
+            let Some(k) = slot(a, b) else { continue };
+            if !seen[k] && ok(centre(a, b)) && ok(half(i, j, di, dj)) {
+                seen[k] = true;
+                count += 1;
+                queue.push_back((a, b));
+            }
+        }
+    }
+    count
 }
 
 /// 8-connected parts of the pixels of a `w` x `h` grid where `inside` holds: each pixel's part
