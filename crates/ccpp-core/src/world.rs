@@ -1434,17 +1434,14 @@ fn tiles_reached(frame: &MapFrame, at: usize, side_px: f64, fits: &dyn Fn(usize)
         return 0;
     }
     let (c0, r0) = frame.col_row(at);
-    let centre = |i: i64, j: i64| {
-        let x = c0 as f64 + 0.5 + i as f64 * side_px;
-        let y = r0 as f64 + 0.5 + j as f64 * side_px;
-        frame.checked(x.floor() as i64, y.floor() as i64)
+    // Whether `fits` holds at the pixel of lattice point `(u, v)` (in tile sides from `at`).
+    let ok = |u: f64, v: f64| {
+        let x = c0 as f64 + 0.5 + u * side_px;
+        let y = r0 as f64 + 0.5 + v * side_px;
+        frame
+            .checked(x.floor() as i64, y.floor() as i64)
+            .is_some_and(|(c, r)| fits(frame.index(c, r)))
     };
-    let half = |i: i64, j: i64, di: i64, dj: i64| {
-        let x = c0 as f64 + 0.5 + (i as f64 + 0.5 * di as f64) * side_px;
-        let y = r0 as f64 + 0.5 + (j as f64 + 0.5 * dj as f64) * side_px;
-        frame.checked(x.floor() as i64, y.floor() as i64)
-    };
-    let ok = |p: Option<(usize, usize)>| p.is_some_and(|(c, r)| fits(frame.index(c, r)));
     // Lattice indices whose centres lie on the map, and a flag per tile.
     let span = |v0: usize, n: usize| {
         let lo = -((v0 as f64 + 0.5) / side_px).floor() as i64;
@@ -1471,7 +1468,8 @@ fn tiles_reached(frame: &MapFrame, at: usize, side_px: f64, fits: &dyn Fn(usize)
         for (di, dj) in [(1, 0), (-1, 0), (0, 1), (0, -1)] {
             let (a, b) = (i + di, j + dj);
             let Some(k) = slot(a, b) else { continue };
-            if !seen[k] && ok(centre(a, b)) && ok(half(i, j, di, dj)) {
+            let (mid_u, mid_v) = (i as f64 + 0.5 * di as f64, j as f64 + 0.5 * dj as f64);
+            if !seen[k] && ok(a as f64, b as f64) && ok(mid_u, mid_v) {
                 seen[k] = true;
                 count += 1;
                 queue.push_back((a, b));
