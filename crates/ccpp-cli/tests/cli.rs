@@ -841,24 +841,12 @@ fn replay_page_works_in_headless_chromium() {
     };
     let url = format!("file://{}", out.join("replay.html").display());
     let profile = tempfile::tempdir().unwrap();
-    let base = |c: &mut std::process::Command| {
-        c.args([
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--disable-quic",
-            "--no-first-run",
-            "--disable-background-networking",
-            "--disable-component-update",
-            "--disable-sync",
-            "--virtual-time-budget=5000",
-            "--enable-logging=stderr",
-            "--v=0",
-        ])
-        .arg(format!("--user-data-dir={}", profile.path().display()));
+    let base = || {
+        let mut c = crate::common::headless(&chrome, profile.path());
+        c.arg("--virtual-time-budget=5000");
+        c
     };
-    let mut c = std::process::Command::new(&chrome);
-    base(&mut c);
+    let mut c = base();
     let o = crate::common::output_within_limit(c.arg("--dump-dom").arg(format!("{url}#selftest")));
     let dom = String::from_utf8_lossy(&o.stdout);
     let err = String::from_utf8_lossy(&o.stderr);
@@ -880,8 +868,7 @@ fn replay_page_works_in_headless_chromium() {
     // snapped back to the last pose before: 0.0 m at `#at=0.01` of a run whose first move was
     // longer than that).
     for f in [0.013, 0.37] {
-        let mut c = std::process::Command::new(&chrome);
-        base(&mut c);
+        let mut c = base();
         let o =
             crate::common::output_within_limit(c.arg("--dump-dom").arg(format!("{url}#at={f}")));
         let dom = String::from_utf8_lossy(&o.stdout);
@@ -898,8 +885,7 @@ fn replay_page_works_in_headless_chromium() {
     }
     // At the last frame "Now" reads the run's own coverage, as "Whole run" does (it read
     // 99.9 % beside 100.0 %: the curve's samples and distances are rounded apart).
-    let mut c = std::process::Command::new(&chrome);
-    base(&mut c);
+    let mut c = base();
     let o =
         crate::common::output_within_limit(c.arg("--dump-dom").arg(format!("{url}#frame=last")));
     let dom = String::from_utf8_lossy(&o.stdout);
@@ -915,8 +901,7 @@ fn replay_page_works_in_headless_chromium() {
     );
     // Screenshot of the last frame, kept as a test artefact.
     let shot = Path::new(env!("CARGO_TARGET_TMPDIR")).join("replay-last-frame.png");
-    let mut c = std::process::Command::new(&chrome);
-    base(&mut c);
+    let mut c = base();
     let o = crate::common::output_within_limit(
         c.arg("--window-size=1300,900")
             .arg(format!("--screenshot={}", shot.display()))

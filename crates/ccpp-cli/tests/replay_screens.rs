@@ -8,22 +8,8 @@ use std::path::Path;
 use std::process::Command;
 
 fn chrome(chrome: &Path, profile: &Path) -> Command {
-    let mut c = Command::new(chrome);
-    c.args([
-        "--headless",
-        "--no-sandbox",
-        "--disable-gpu",
-        "--disable-quic",
-        "--no-first-run",
-        "--disable-background-networking",
-        "--disable-component-update",
-        "--disable-sync",
-        "--hide-scrollbars",
-        "--enable-logging=stderr",
-        "--v=0",
-        "--virtual-time-budget=10000",
-    ])
-    .arg(format!("--user-data-dir={}", profile.display()));
+    let mut c = crate::common::headless(chrome, profile);
+    c.args(["--hide-scrollbars", "--virtual-time-budget=10000"]);
     c
 }
 

@@ -4,7 +4,6 @@
 //! opens fast and seeks fast. Without Chromium the browser parts are skipped (CI installs it).
 
 use std::path::Path;
-use std::process::Command;
 
 use ccpp_core::grid::{Cell, GridMap, MapFrame};
 use ccpp_core::trace::{Event, Trace};
@@ -12,7 +11,7 @@ use ccpp_core::world::{Robot, World};
 use ccpp_core::Pose;
 use ccpp_render::replay::replay_html;
 
-use crate::support::browser::{output_within_limit, require_chromium};
+use crate::support::browser::{headless, output_within_limit, require_chromium};
 
 const RES: f64 = 0.05;
 
@@ -85,22 +84,8 @@ fn dump_dom(chrome: &Path, url: &str, virtual_time: bool) -> (String, String) {
         std::process::id(),
         url.len()
     ));
-    let mut c = Command::new(chrome);
-    c.args([
-        "--headless",
-        "--no-sandbox",
-        "--disable-gpu",
-        "--disable-quic",
-        "--no-first-run",
-        "--disable-background-networking",
-        "--disable-component-update",
-        "--disable-sync",
-        "--enable-logging=stderr",
-        "--v=0",
-        "--window-size=2000,1200",
-        "--hide-scrollbars",
-    ])
-    .arg(format!("--user-data-dir={}", profile.display()));
+    let mut c = headless(chrome, &profile);
+    c.args(["--window-size=2000,1200", "--hide-scrollbars"]);
     if virtual_time {
         c.arg("--virtual-time-budget=10000");
     }

@@ -164,4 +164,4 @@ pub fn wait_for_pause(mark: &Path) {
 /// The page tests' browser helpers, shared with `ccpp-render`'s tests.
 #[path = "../../../ccpp-render/tests/support/browser.rs"]
 mod browser;
-pub use browser::{output_within_limit, require_chromium};
+pub use browser::{headless, output_within_limit, require_chromium};

@@ -1,7 +1,7 @@
 //! Headless Chromium for the page tests of `ccpp-render` and `ccpp-cli` (the CLI's tests include
 //! this file by path): where the browser is, and a call of it that cannot hang the suite.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::Duration;
 
@@ -31,6 +31,27 @@ pub fn require_chromium() -> Option<PathBuf> {
         );
         eprintln!("chromium not found; skipping the browser part");
     }
+    c
+}
+
+/// A headless Chromium command for `chrome` with its own profile folder `profile`: no GPU, no
+/// network side traffic, console messages on stderr (the page tests look there for errors).
+/// Callers add their own window size, virtual time and action.
+pub fn headless(chrome: &Path, profile: &Path) -> Command {
+    let mut c = Command::new(chrome);
+    c.args([
+        "--headless",
+        "--no-sandbox",
+        "--disable-gpu",
+        "--disable-quic",
+        "--no-first-run",
+        "--disable-background-networking",
+        "--disable-component-update",
+        "--disable-sync",
+        "--enable-logging=stderr",
+        "--v=0",
+    ])
+    .arg(format!("--user-data-dir={}", profile.display()));
     c
 }
 
