@@ -3438,19 +3438,7 @@ fn the_wrote_line_shows_hidden_characters_of_the_folder() {
 #[test]
 fn a_run_file_with_a_misspelt_key_is_refused_naming_it() {
     let d = tempfile::tempdir().unwrap();
-    let out = d.path().join("r");
-    ccpp()
-        .args([
-            "run",
-            "--planner",
-            "ba-star",
-            "--map",
-            s(&pillars(d.path())),
-        ])
-        .arg("--out")
-        .arg(&out)
-        .assert()
-        .success();
+    let out = crate::common::run_ok(d.path(), "r", &pillars(d.path()), "ba-star", &[]);
     let rec = out.join("run.json");
     let mut v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&rec).unwrap()).unwrap();
