@@ -96,3 +96,71 @@ impl Drive {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn p(x: f64, y: f64) -> Point {
+        Point::new(x, y)
+    }
+
+    /// The queued steps as letters: `B`/`b` backtrack start/end, `W`/`w` wall pass start/end,
+    /// `m` a move.
+    fn shape(d: &Drive) -> String {
+        d.queue
+            .iter()
+            .map(|s| match s {
+                Step::Mark(Event::BacktrackStart) => 'B',
+                Step::Mark(Event::BacktrackEnd) => 'b',
+                Step::Mark(Event::WallFollowStart) => 'W',
+                Step::Mark(Event::WallFollowEnd) => 'w',
+                Step::MoveTo(_) => 'm',
+                _ => '?',
+            })
+            .collect()
+    }
+
+    fn chunk(transfer: Vec<Point>, sweep: Vec<Point>, lead_in: bool) -> Chunk {
+        Chunk {
+            transfer,
+            sweep,
+            lead_in,
+            ..Chunk::default()
+        }
+    }
+
+    #[test]
+    fn a_lead_in_move_is_driven_as_the_transfers_last() {
+        // Way 0 -> 1 m, then one merged move 1 -> 3 m (mostly way) and rim 3 -> 3.2 m.
+        let c = chunk(vec![p(1.0, 0.0)], vec![p(3.0, 0.0), p(3.0, 0.2)], true);
+        let mut d = Drive::default();
+        assert!(d.queue_chunk(p(0.0, 0.0), &c, 0.15));
+        assert_eq!(shape(&d), "BmmbWm");
+        // Without the lead-in the merged move is the pass's first.
+        let mut d = Drive::default();
+        assert!(d.queue_chunk(
+            p(0.0, 0.0),
+            &chunk(c.transfer.clone(), c.sweep.clone(), false),
+            0.15
+        ));
+        assert_eq!(shape(&d), "BmbWmm");
+        assert_eq!(d.trail, vec![p(1.0, 0.0), p(3.0, 0.0), p(3.0, 0.2)]);
+    }
+
+    #[test]
+    fn a_way_shorter_than_the_robot_is_part_of_the_pass() {
+        // A way of 0.25 m < 2 r = 0.3 m, lead-in included: no transfer marks.
+        let c = chunk(vec![p(0.1, 0.0)], vec![p(0.25, 0.0), p(0.25, 1.0)], true);
+        let mut d = Drive::default();
+        assert!(d.queue_chunk(p(0.0, 0.0), &c, 0.15));
+        assert_eq!(shape(&d), "mmWm");
+        // Of a diameter or more, it is a transfer, and it closes the pass that was open.
+        let c = chunk(vec![p(0.25, 1.0), p(0.25, 1.4)], vec![p(0.3, 1.4)], false);
+        assert!(d.queue_chunk(p(0.25, 1.0), &c, 0.15));
+        assert_eq!(shape(&d), "mmWmwBmmbWm");
+        // An empty chunk queues nothing.
+        assert!(!d.queue_chunk(p(0.3, 1.4), &Chunk::default(), 0.15));
+        assert_eq!(d.queue.len(), 11);
+    }
+}
