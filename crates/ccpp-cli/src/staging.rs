@@ -81,6 +81,10 @@ pub const AFTER_COMMIT_PAUSE_ENV: &str = "CCPP_TEST_AFTER_COMMIT_PAUSE_MS";
 /// whatever the machine's load, instead of guessing when it began.
 pub const PAUSED_FILE_ENV: &str = "CCPP_TEST_PAUSED_FILE";
 
+/// Test hook: [`write_files_together`] waits at most this many milliseconds (instead of a
+/// minute) for another writer of the folder, so that a test sees the wait end in an error.
+pub const WRITER_WAIT_ENV: &str = "CCPP_TEST_WRITER_WAIT_MS";
+
 /// Sleeps for the milliseconds the environment variable `var` gives, if any, at most a
 /// minute (the test hooks above), first creating [`PAUSED_FILE_ENV`]'s file if one is named.
 pub fn pause_for(var: &str) {
@@ -320,6 +324,12 @@ pub fn write_files_together(dir: &Path, files: &[(&str, &[u8])]) -> Result<()> {
     // Ctrl-Z (or any other process holding the lock) made the next replay hang without a word.
     let writer = std::fs::File::open(dir).ok();
     if let Some(f) = &writer {
+        let wait = std::env::var(WRITER_WAIT_ENV)
+            .ok()
+            .and_then(|v| v.parse::<u64>().ok())
+            .map_or(WRITER_WAIT, |ms| {
+                std::time::Duration::from_millis(ms).min(WRITER_WAIT)
+            });
         let t0 = std::time::Instant::now();
         let mut told = false;
         loop {
@@ -333,7 +343,7 @@ pub fn write_files_together(dir: &Path, files: &[(&str, &[u8])]) -> Result<()> {
                         );
                         told = true;
                     }
-                    if t0.elapsed() > WRITER_WAIT {
+                    if t0.elapsed() > wait {
                         bail!(
                             "{} has been held by another process writing it for over a minute (a ccpp replay stopped with Ctrl-Z?); nothing was written",
                             dir.display()

@@ -395,6 +395,68 @@ fn two_replays_of_one_run_at_once_both_succeed() {
     assert!(page.contains("ba-star on teb_empty_box"));
 }
 
+/// A replay whose run folder another process holds (a replay stopped with Ctrl-Z) waits for it,
+/// says so, and after the wait (a minute; shortened here by the test hook) gives up with one
+/// error line, writing nothing; once the folder is free, the replay is written.
+#[test]
+fn a_replay_gives_up_on_a_folder_held_too_long_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("r");
+    ccpp()
+        .args(["run", "--planner", "ba-star", "--map"])
+        .arg(data("teb_empty_box.yaml"))
+        .arg("--out")
+        .arg(&out)
+        .assert()
+        .success();
+    let before: Vec<(String, Vec<u8>)> = entries(&out)
+        .into_iter()
+        .map(|n| {
+            let bytes = std::fs::read(out.join(&n)).unwrap();
+            (n, bytes)
+        })
+        .collect();
+    // This process holds the folder as a writing replay would.
+    let held = std::fs::File::open(&out).unwrap();
+    held.lock().unwrap();
+    let t0 = std::time::Instant::now();
+    let o = ccpp()
+        .arg("replay")
+        .arg(&out)
+        .env("CCPP_TEST_WRITER_WAIT_MS", "1500")
+        .output()
+        .unwrap();
+    let waited = t0.elapsed();
+    let err = stderr_of(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("note: waiting for another process writing"),
+        "{err}"
+    );
+    let last: Vec<&str> = err.lines().filter(|l| l.starts_with("error:")).collect();
+    assert_eq!(last.len(), 1, "{err}");
+    assert!(
+        last[0].contains("held by another process writing it for over a minute")
+            && last[0].contains("nothing was written"),
+        "{err}"
+    );
+    assert!(
+        waited >= std::time::Duration::from_millis(1500),
+        "{waited:?}"
+    );
+    let after: Vec<(String, Vec<u8>)> = entries(&out)
+        .into_iter()
+        .map(|n| {
+            let bytes = std::fs::read(out.join(&n)).unwrap();
+            (n, bytes)
+        })
+        .collect();
+    assert_eq!(after, before, "the folder changed");
+    held.unlock().unwrap();
+    ccpp().arg("replay").arg(&out).assert().success();
+    assert!(out.join("replay.html").is_file() && out.join("replay.gif").is_file());
+}
+
 /// A run, a plan or a demo into a folder below one that a bench or sweep of another process is
 /// writing (its `runs/MAP/PLANNER`) is refused before any work: the bench replaced it, or it
 /// replaced the bench's run. A lock file left unlocked by a killed bench does not count.
