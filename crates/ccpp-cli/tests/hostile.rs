@@ -1182,6 +1182,16 @@ fn an_inflation_that_leaves_no_room_is_named() {
     let o = ccpp().args(["info", "--map", s(&map)]).assert().success();
     let text = String::from_utf8_lossy(&o.get_output().stdout).into_owned();
     assert!(!text.contains("inflat"), "{text}");
+    // A start off the map is refused as such whether or not the robot fits (`info` took it
+    // without a word when the robot did not fit: hostile pass).
+    for extra in [&["--radius", "4"][..], &["--inflate", "3"], &[]] {
+        let mut args = vec!["info", "--map", s(&map), "--start", "100,100"];
+        args.extend_from_slice(extra);
+        refused(
+            &args,
+            &["pillars.pgm", "start (100.000, 100.000) is outside the map"],
+        );
+    }
     // Without an inflation the message stays as it was.
     refused(
         &[

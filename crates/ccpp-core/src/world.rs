@@ -492,6 +492,11 @@ impl World {
             }
         }
         if cfree.is_clear() {
+            // A start given off the map is refused as such first: the robot's size does not
+            // matter to it (`ccpp info`, which reports a robot too big, took such a start).
+            if let Some(s) = start {
+                start_on_map(&frame, s)?;
+            }
             let mut max_d2 = 0u32;
             obstacle_dt2.for_each(|_, d2| {
                 if d2 != INF {
@@ -539,21 +544,8 @@ impl World {
 
     fn check_start(&self) -> Result<(), WorldError> {
         let s = self.start;
-        if !(s.x.is_finite() && s.y.is_finite() && s.theta.is_finite()) {
-            return Err(WorldError::BadStart(s.x, s.y, s.theta));
-        }
+        start_on_map(self.map.frame(), s)?;
         let frame = self.map.frame();
-        if frame.pixel_of(s.position()).is_none() {
-            let (lo, hi) = frame.world_bounds();
-            return Err(WorldError::StartOutside {
-                x: s.x,
-                y: s.y,
-                x0: lo.x,
-                x1: hi.x,
-                y0: lo.y,
-                y1: hi.y,
-            });
-        }
         if self.true_disk_collides(s.position()) {
             return Err(WorldError::StartInObstacle {
                 x: s.x,
@@ -1510,6 +1502,25 @@ fn parts_of(w: usize, h: usize, inside: &dyn Fn(usize) -> bool) -> (Vec<u32>, Ve
     (part, sizes)
 }
 
+/// The checks of a start that do not depend on the robot: finite, and on the map.
+fn start_on_map(frame: &MapFrame, s: Pose) -> Result<(), WorldError> {
+    if !(s.x.is_finite() && s.y.is_finite() && s.theta.is_finite()) {
+        return Err(WorldError::BadStart(s.x, s.y, s.theta));
+    }
+    if frame.pixel_of(s.position()).is_none() {
+        let (lo, hi) = frame.world_bounds();
+        return Err(WorldError::StartOutside {
+            x: s.x,
+            y: s.y,
+            x0: lo.x,
+            x1: hi.x,
+            y0: lo.y,
+            y1: hi.y,
+        });
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1790,6 +1801,19 @@ mod tests {
             Some(Pose::new(5.0, 0.5, 0.0)),
         );
         assert!(matches!(e, Err(WorldError::StartOutside { .. })));
+        // Off the map whatever the robot's size: a robot that fits nowhere does not hide it.
+        let e = World::new(
+            room(11, 11, 0.1),
+            Robot::new(2.0),
+            Some(Pose::new(5.0, 0.5, 0.0)),
+        );
+        assert!(matches!(e, Err(WorldError::StartOutside { .. })), "{e:?}");
+        let e = World::new(
+            room(11, 11, 0.1),
+            Robot::new(2.0),
+            Some(Pose::new(0.5, 0.5, 0.0)),
+        );
+        assert!(matches!(e, Err(WorldError::RobotTooBig { .. })), "{e:?}");
         let e = World::new(room(11, 11, 0.1), Robot::new(f64::NAN), None);
         assert!(matches!(e, Err(WorldError::BadRadius(_))));
         let e = World::new(
