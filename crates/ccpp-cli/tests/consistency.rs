@@ -63,6 +63,35 @@ fn planner_names_with_spaces_around_them_are_read_everywhere() {
         "{}",
         String::from_utf8_lossy(&o.stderr)
     );
+    // A planner's name but for case or underscores (its options-file section) is refused
+    // with the name to use (it was refused without a hint: hostile pass).
+    let cases: [(&[&str], &str); 3] = [
+        (
+            &["run", "--planner", "rect_boustrophedon", "--map"],
+            "rect-boustrophedon",
+        ),
+        (&["bench", "--planners", "bcd,BA_STAR", "--maps"], "ba-star"),
+        (
+            &["planners", "--defaults", "ba_star_extended"],
+            "ba-star-extended",
+        ),
+    ];
+    for (args, name) in cases {
+        let mut c = ccpp();
+        c.args(args);
+        if args.len() > 3 {
+            c.arg(&map).arg("--out").arg(dir.path().join("bad"));
+        }
+        let o = c.output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{err}");
+        assert!(
+            err.contains(&format!("(did you mean \"{name}\"?); run `ccpp planners`")),
+            "{args:?}: {err}"
+        );
+        assert_eq!(err.lines().count(), 1, "{err}");
+    }
+    assert!(!dir.path().join("bad").exists());
 }
 
 /// A map file named `<script>.yaml` gave the heading `## <script>` in `results.md`, which a

@@ -511,7 +511,7 @@ fn negative_pid_gains_and_a_seed_for_the_options_noise_are_refused_as_such() {
     refused(
         "bsa_bfs: { exec: { pid: { noise: { linear_rel_std: 0.02 } } } }\n",
         &["--seed", "3"],
-        "has its own seed there (noise.seed): set it there",
+        "takes its seed from there (noise.seed, 0 when left out): set noise.seed there instead",
     );
 }
 

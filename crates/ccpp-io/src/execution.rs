@@ -160,7 +160,7 @@ pub fn execution(
         if pid.noise.is_some() {
             let place = ask.noise_given_in.as_deref().unwrap_or("its options");
             return Err(format!(
-                "{seed} seeds {noise}; the odometry noise of {kind} given in {place} has its own seed there (noise.seed): set it there"
+                "{seed} seeds {noise}; the odometry noise of {kind} given in {place} takes its seed from there (noise.seed, 0 when left out): set noise.seed there instead"
             ));
         }
         return Err(format!(

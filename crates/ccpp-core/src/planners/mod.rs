@@ -351,12 +351,22 @@ impl PlannerConfig {
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum BuildError {
     /// No planner of that name.
-    #[error("unknown planner {0:?}; run `ccpp planners` for the list")]
+    #[error("unknown planner {0:?}{hint}; run `ccpp planners` for the list", hint = did_you_mean(.0))]
     Unknown(String),
     /// An option of the planner's section is out of its range, or does not suit the world
     /// ([`PlannerConfig::validate`], [`PlannerSettings::check_world`]).
     #[error(transparent)]
     Options(#[from] OptionsError),
+}
+
+/// ` (did you mean "NAME"?)` when `name` is a planner's name but for case, underscores for
+/// hyphens (its options-file section, `rect_boustrophedon`) or spaces; else nothing.
+fn did_you_mean(name: &str) -> String {
+    let norm = name.trim().to_ascii_lowercase().replace(['_', ' '], "-");
+    CATALOG
+        .iter()
+        .find(|p| p.name == norm)
+        .map_or_else(String::new, |p| format!(" (did you mean {:?}?)", p.name))
 }
 
 /// Builds the planner `name` with its section of `opts`, after checking the section's values
