@@ -31,7 +31,9 @@ pub enum Command {
     /// Write the interactive replay.html (self-contained) and replay.gif of a finished run.
     Replay(ReplayArgs),
     /// Print the lane waypoints of a rectangular robot (seed 001) for a map, as CSV or JSON:
-    /// its stops every robot length along each lane, without headings (without `--area`,
+    /// its stops every robot length along each lane and the points of the detours between
+    /// lanes (and from the start to the first lane; the start itself is not listed), without
+    /// headings (without `--area`,
     /// `ccpp plan --planner rect-boustrophedon` gives the same lanes as a drivable route with
     /// headings; `--area` here is the rectangle the robot's centre lanes cover, there the area
     /// the whole robot stays inside).
