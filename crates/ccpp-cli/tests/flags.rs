@@ -558,6 +558,57 @@ fn map_and_robot_flags_change_the_run() {
     assert!(!said(&[]).contains("inflated"));
 }
 
+/// `--resolution` and `--origin` stand in for a map YAML's missing (or bad) `resolution` and
+/// `origin`: such a YAML was refused as lacking the field even with the flag given (hostile
+/// pass). The run is the one of a full YAML with those values, and replays.
+#[test]
+fn placement_flags_stand_in_for_the_yamls_missing_fields() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    pillars(dir);
+    let full = dir.join("full.yaml");
+    std::fs::write(
+        &full,
+        "image: pillars.pgm\nresolution: 0.04\norigin: [1, 2, 0]\n",
+    )
+    .unwrap();
+    let bare = dir.join("bare.yaml");
+    std::fs::write(&bare, "image: pillars.pgm\nresolution: -1\n").unwrap();
+    let flags = ["--resolution", "0.04", "--origin", "1,2"];
+    let want = run_ok(dir, "full", &full, "ba-star", &[]);
+    let got = run_ok(dir, "bare", &bare, "ba-star", &flags);
+    let mut a = metrics(&want);
+    let mut b = metrics(&got);
+    a["map"] = 0.into();
+    b["map"] = 0.into();
+    assert_eq!(a, b);
+    assert_eq!(driven(&want), driven(&got));
+    ccpp().arg("replay").arg(&got).assert().success();
+    // Without the flags, or with one of them only, the file is refused naming what it lacks
+    // or holds wrong.
+    run_fails(
+        dir,
+        &bare,
+        "ba-star",
+        &[],
+        &["bare.yaml", "lacks the required field `origin`"],
+    );
+    run_fails(
+        dir,
+        &bare,
+        "ba-star",
+        &flags[..2],
+        &["bare.yaml", "lacks the required field `origin`"],
+    );
+    run_fails(
+        dir,
+        &bare,
+        "ba-star",
+        &flags[2..],
+        &["bare.yaml", "resolution", "-1"],
+    );
+}
+
 #[test]
 fn config_values_go_through_the_same_validation() {
     let d = tempfile::tempdir().unwrap();

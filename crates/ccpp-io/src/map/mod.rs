@@ -126,7 +126,7 @@ pub fn load_map(path: &Path, opts: &LoadOptions) -> Result<LoadedMap, MapError> 
             message: format!("not UTF-8 text ({e})"),
         })?;
         // The thresholds are checked with the overrides applied (`finish`).
-        let yaml = MapYaml::parse_fields(text, path)?;
+        let yaml = MapYaml::parse_fields(text, path, opts.resolution, opts.origin)?;
         let image_path = image_beside(path, &yaml.image);
         let file = match crate::file::open_regular(&image_path) {
             Ok(f) => f,
@@ -188,7 +188,7 @@ pub fn load_map_bytes(
     let reader = ImageReader::new(Cursor::new(image));
     match yaml {
         Some(text) => {
-            let y = MapYaml::parse_fields(text, name)?;
+            let y = MapYaml::parse_fields(text, name, opts.resolution, opts.origin)?;
             let image_path = image_beside(name, &y.image);
             finish(Some(&y), name, image_path, reader, opts)
         }
@@ -311,7 +311,8 @@ pub fn yaml_image_path(path: &Path) -> Option<PathBuf> {
     }
     let bytes = crate::file::read_bytes(path).ok()?;
     let text = std::str::from_utf8(&bytes).ok()?;
-    let yaml = MapYaml::parse_fields(text, path).ok()?;
+    // Any placement stands in for the file's: only the image is read here.
+    let yaml = MapYaml::parse_fields(text, path, Some(1.0), Some([0.0; 3])).ok()?;
     Some(image_beside(path, &yaml.image))
 }
 

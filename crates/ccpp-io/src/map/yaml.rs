@@ -22,6 +22,9 @@ use super::error::{one_line, MapError};
 /// mode: trinary             # optional: trinary (default), scale or raw
 /// ```
 ///
+/// A load's overrides of `resolution` and `origin` (`--resolution`, `--origin`) stand in for
+/// those fields, which may then be left out.
+///
 /// Unknown keys are ignored, as `map_server` does, except one so near a field that it is taken
 /// for a misspelling of it ([`MapError::MisspeltField`]: `negat`, `free_threshold`, `Origin`).
 #[derive(Clone, Debug, PartialEq)]
@@ -172,7 +175,7 @@ impl MapYaml {
     /// [`MapError::BadValue`] for out-of-domain values (see [`validate_placement`] and
     /// [`Thresholds::validate`]). The mode is not checked here.
     pub fn parse(text: &str, path: &Path) -> Result<Self, MapError> {
-        let yaml = Self::parse_fields(text, path)?;
+        let yaml = Self::parse_fields(text, path, None, None)?;
         yaml.thresholds().validate(path)?;
         Ok(yaml)
     }
@@ -180,7 +183,15 @@ impl MapYaml {
     /// [`Self::parse`] without the check of the thresholds, for a load that checks them after
     /// its overrides: `--occupied-thresh 0.3` could not repair a YAML of `occupied_thresh 0.1`
     /// beside `free_thresh 0.196` (the YAML's pair was refused before the override applied).
-    pub(crate) fn parse_fields(text: &str, path: &Path) -> Result<Self, MapError> {
+    /// `resolution` and `origin`, when given, are the load's overrides: they stand in for the
+    /// file's fields, which may then be missing or out of their domain (a YAML without
+    /// `resolution` was refused as lacking it with `--resolution` given).
+    pub(crate) fn parse_fields(
+        text: &str,
+        path: &Path,
+        resolution: Option<f64>,
+        origin: Option<[f64; 3]>,
+    ) -> Result<Self, MapError> {
         // Let `.nan` / `.inf` through so they are reported as bad values of their field.
         let mut options = serde_saphyr::Options::default();
         options.non_finite_float_policy = serde_saphyr::NonFiniteFloatPolicy::PassThrough;
@@ -232,17 +243,24 @@ impl MapYaml {
                 ),
             ));
         }
-        let resolution = raw.resolution.ok_or_else(|| missing("resolution"))?;
-        let origin_v = raw.origin.ok_or_else(|| missing("origin"))?;
-        let origin: [f64; 3] = origin_v.as_slice().try_into().map_err(|_| {
-            bad(
-                "origin",
-                format!(
-                    "expected 3 numbers [x, y, yaw], got {} ({origin_v:?})",
-                    origin_v.len()
-                ),
-            )
-        })?;
+        let resolution = match resolution {
+            Some(r) => r,
+            None => raw.resolution.ok_or_else(|| missing("resolution"))?,
+        };
+        let origin: [f64; 3] = if let Some(o) = origin {
+            o
+        } else {
+            let origin_v = raw.origin.ok_or_else(|| missing("origin"))?;
+            origin_v.as_slice().try_into().map_err(|_| {
+                bad(
+                    "origin",
+                    format!(
+                        "expected 3 numbers [x, y, yaw], got {} ({origin_v:?})",
+                        origin_v.len()
+                    ),
+                )
+            })?
+        };
         let negate = match raw.negate {
             None | Some(Negate::Int(0) | Negate::Bool(false)) => false,
             Some(Negate::Int(1) | Negate::Bool(true)) => true,
@@ -459,6 +477,31 @@ mod tests {
             let msg = e.to_string();
             assert!(msg.contains("test.yaml") && msg.contains(field), "{msg}");
         }
+    }
+
+    #[test]
+    fn overrides_stand_in_for_missing_or_bad_placement() {
+        let p = Path::new("test.yaml");
+        let y =
+            MapYaml::parse_fields("image: m.pgm\n", p, Some(0.1), Some([1.0, 2.0, 0.5])).unwrap();
+        assert_eq!((y.resolution, y.origin), (0.1, [1.0, 2.0, 0.5]));
+        // A value out of its domain (or of the wrong length) is replaced too.
+        let text = "image: m.pgm\nresolution: -1\norigin: [0, 0]\n";
+        assert!(MapYaml::parse_fields(text, p, None, None).is_err());
+        let y = MapYaml::parse_fields(text, p, Some(0.05), Some([0.0; 3])).unwrap();
+        assert_eq!((y.resolution, y.origin), (0.05, [0.0; 3]));
+        // Only the one given: the other must still be in the file.
+        let e = MapYaml::parse_fields("image: m.pgm\n", p, Some(0.1), None).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                MapError::MissingField {
+                    field: "origin",
+                    ..
+                }
+            ),
+            "{e}"
+        );
     }
 
     #[test]
