@@ -377,3 +377,21 @@ def test_load_map_thresholds_and_georef_change_the_map(tmp_path: Path) -> None:
     assert geo.resolution == pytest.approx(0.1)
     assert geo.origin[:2] == pytest.approx((100.0, 200.0))
     assert np.array_equal(geo.occupancy, plain.occupancy)
+
+
+def test_load_map_placement_stands_in_for_a_yamls_missing_fields(tmp_path: Path) -> None:
+    """`resolution=` and `origin=` stand in for a map YAML without them: it was refused as
+    lacking the field with the override given (hostile pass)."""
+    w, h = 20, 10
+    pix = bytes(0 if x in (0, w - 1) or y in (0, h - 1) else 254 for y in range(h) for x in range(w))
+    (tmp_path / "m.pgm").write_bytes(f"P5\n{w} {h}\n255\n".encode() + pix)
+    y = tmp_path / "m.yaml"
+    y.write_text("image: m.pgm\n")
+    with pytest.raises(ccpp.CcppError, match="lacks the required field `resolution`"):
+        ccpp.load_map(y)
+    with pytest.raises(ccpp.CcppError, match="lacks the required field `origin`"):
+        ccpp.load_map(y, resolution=0.1)
+    m = ccpp.load_map(y, resolution=0.1, origin=(3.0, 4.0, 0.0))
+    assert m.resolution == pytest.approx(0.1)
+    assert m.origin == pytest.approx((3.0, 4.0, 0.0))
+    assert ccpp.run(m, "ba-star").metrics["effective_coverage"] > 0.5
