@@ -21,6 +21,28 @@ fn entries(dir: &Path) -> Vec<String> {
     v
 }
 
+/// `ccpp run --planner PLANNER` on the bundled `teb_empty_box` into `out`, which must succeed.
+fn run_box(planner: &str, out: &Path) {
+    ccpp()
+        .args(["run", "--planner", planner, "--map"])
+        .arg(data("teb_empty_box.yaml"))
+        .arg("--out")
+        .arg(out)
+        .assert()
+        .success();
+}
+
+/// Every file of a folder with its bytes, by name.
+fn contents(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    entries(dir)
+        .into_iter()
+        .map(|n| {
+            let bytes = std::fs::read(dir.join(&n)).unwrap();
+            (n, bytes)
+        })
+        .collect()
+}
+
 fn stderr_of(o: &std::process::Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
@@ -189,13 +211,7 @@ fn run_and_plan_refuse_a_users_tmp_file() {
     // The `.tmp` of a file ccpp writes (left by an interrupted `ccpp replay`) is its own.
     std::fs::remove_file(out.join("thesis.tmp")).unwrap();
     std::fs::write(out.join("replay.html.tmp"), "cut short").unwrap();
-    ccpp()
-        .args(["run", "--planner", "bcd", "--map"])
-        .arg(data("teb_empty_box.yaml"))
-        .arg("--out")
-        .arg(&out)
-        .assert()
-        .success();
+    run_box("bcd", &out);
     assert_eq!(entries(&out), BASE_SET);
 }
 
@@ -205,13 +221,7 @@ fn run_and_plan_refuse_a_users_tmp_file() {
 fn replay_writes_its_page_and_gif_together() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("r");
-    ccpp()
-        .args(["run", "--planner", "bcd", "--map"])
-        .arg(data("teb_empty_box.yaml"))
-        .arg("--out")
-        .arg(&out)
-        .assert()
-        .success();
+    run_box("bcd", &out);
     let replay = |fail: &str| {
         let mut c = ccpp();
         c.arg("replay").arg(&out);
@@ -365,13 +375,7 @@ fn a_replay_never_writes_into_a_folder_swapped_in_meanwhile() {
 fn two_replays_of_one_run_at_once_both_succeed() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("r");
-    ccpp()
-        .args(["run", "--planner", "ba-star", "--map"])
-        .arg(data("teb_empty_box.yaml"))
-        .arg("--out")
-        .arg(&out)
-        .assert()
-        .success();
+    run_box("ba-star", &out);
     let first = std::process::Command::new(assert_cmd::cargo::cargo_bin("ccpp"))
         .arg("replay")
         .arg(&out)
@@ -402,20 +406,8 @@ fn two_replays_of_one_run_at_once_both_succeed() {
 fn a_replay_gives_up_on_a_folder_held_too_long_and_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("r");
-    ccpp()
-        .args(["run", "--planner", "ba-star", "--map"])
-        .arg(data("teb_empty_box.yaml"))
-        .arg("--out")
-        .arg(&out)
-        .assert()
-        .success();
-    let before: Vec<(String, Vec<u8>)> = entries(&out)
-        .into_iter()
-        .map(|n| {
-            let bytes = std::fs::read(out.join(&n)).unwrap();
-            (n, bytes)
-        })
-        .collect();
+    run_box("ba-star", &out);
+    let before = contents(&out);
     // This process holds the folder as a writing replay would.
     let held = std::fs::File::open(&out).unwrap();
     held.lock().unwrap();
@@ -444,14 +436,7 @@ fn a_replay_gives_up_on_a_folder_held_too_long_and_writes_nothing() {
         waited >= std::time::Duration::from_millis(1500),
         "{waited:?}"
     );
-    let after: Vec<(String, Vec<u8>)> = entries(&out)
-        .into_iter()
-        .map(|n| {
-            let bytes = std::fs::read(out.join(&n)).unwrap();
-            (n, bytes)
-        })
-        .collect();
-    assert_eq!(after, before, "the folder changed");
+    assert_eq!(contents(&out), before, "the folder changed");
     held.unlock().unwrap();
     ccpp().arg("replay").arg(&out).assert().success();
     assert!(out.join("replay.html").is_file() && out.join("replay.gif").is_file());
