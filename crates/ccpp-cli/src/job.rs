@@ -193,8 +193,12 @@ pub fn default_options_yaml(names: &[String]) -> Result<String> {
     // The typed options keep their fields in declaration order (documented order); a section
     // is a top-level key and the lines indented under it.
     let yaml = serde_saphyr::to_string(&PlannerOptions::default())?;
+    // Every option is written out, so a flag that sets one of them (`--exec`, `--seed`,
+    // `--odometry-noise`, `--tile-side`...) meets it in the file and is refused as setting it
+    // twice: the header says so (a user took the file as a base for flags: hostile pass).
     let mut out = format!(
-        "# ccpp {} planner options at their defaults: edit and pass with --config FILE\n",
+        "# ccpp {} planner options at their defaults: edit and pass with --config FILE\n\
+         # (every option is set here: delete the lines of those you set by a flag instead)\n",
         env!("CARGO_PKG_VERSION")
     );
     let mut keep = wanted.is_empty();
