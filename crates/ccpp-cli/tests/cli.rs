@@ -180,6 +180,37 @@ fn demo_writes_all_files() {
     assert!(m["effective_coverage"].as_f64().unwrap() > 0.5);
     let png = std::fs::read(out.join("coverage.png")).unwrap();
     assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    // The README shows the demo's picture and GIF: they are the files the demo writes now
+    // (outputs are byte-identical run to run), so a change to the planner or the drawing
+    // cannot leave them stale (the clean-up's moves were drawn solid there after they became
+    // dashed: README truth pass).
+    let docs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/img");
+    for (ours, theirs) in [
+        ("coverage.png", "demo-ba-star-extended.png"),
+        ("replay.gif", "demo-replay.gif"),
+    ] {
+        assert!(
+            std::fs::read(out.join(ours)).unwrap() == std::fs::read(docs.join(theirs)).unwrap(),
+            "docs/img/{theirs} is not what `ccpp demo` draws now: run `ccpp demo` and copy \
+             ccpp-demo/{ours} over it"
+        );
+    }
+    // So is the picture of the paper's BA* on the same map.
+    let ba = dir.path().join("ba");
+    let map = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/aws_small_house.yaml");
+    ccpp()
+        .args(["run", "--planner", "ba-star", "--map"])
+        .arg(&map)
+        .arg("--out")
+        .arg(&ba)
+        .assert()
+        .success();
+    assert!(
+        std::fs::read(ba.join("coverage.png")).unwrap()
+            == std::fs::read(docs.join("bench-ba-star-small-house.png")).unwrap(),
+        "docs/img/bench-ba-star-small-house.png is not what `ccpp run --planner ba-star` draws \
+         on the demo map now: copy that run's coverage.png over it"
+    );
 }
 
 const METRIC_KEYS: [&str; 18] = [
