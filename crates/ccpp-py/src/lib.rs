@@ -709,6 +709,16 @@ fn exec_arg(v: &Bound<'_, PyAny>) -> PyResult<String> {
     })
 }
 
+/// Keywords of [`load_map`] that set the map (told apart from unknown run options).
+const MAP_KEYS: [&str; 6] = [
+    "resolution",
+    "origin",
+    "occupied_thresh",
+    "free_thresh",
+    "inflate",
+    "georef",
+];
+
 /// Builds the scenario of `ccpp.run` / `ccpp.plan`: keyword options -> scenario fields
 /// (validated later, once, by the scenario). The rules are the command line's:
 /// * an option that does not apply to the planner (or to a plan) is refused, not ignored;
@@ -907,6 +917,16 @@ fn scenario_from(
                 RUN_KEYS.join(", ")
             )));
         }
+    }
+    // A map's own setting given to a run is no planner option: say where it goes (the message
+    // named the planner's fields and the run options only: hostile pass).
+    if let Some(k) = planner_opts
+        .keys()
+        .find(|k| MAP_KEYS.contains(&k.as_str()) && !defaults.is_some_and(|o| o.contains_key(*k)))
+    {
+        return Err(msg(format!(
+            "{k} is a setting of the map, not of the run: load the map with ccpp.load_map(path, {k}=...) and pass that map"
+        )));
     }
     if !planner_opts.is_empty() {
         let mut cfg = serde_json::to_value(&s.planner).map_err(|e| err(&e))?;

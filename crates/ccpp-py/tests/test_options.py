@@ -395,3 +395,14 @@ def test_load_map_placement_stands_in_for_a_yamls_missing_fields(tmp_path: Path)
     assert m.resolution == pytest.approx(0.1)
     assert m.origin == pytest.approx((3.0, 4.0, 0.0))
     assert ccpp.run(m, "ba-star").metrics["effective_coverage"] > 0.5
+
+
+def test_a_maps_setting_given_to_run_or_plan_points_to_load_map(room: Path) -> None:
+    """`run(m, resolution=0.1)` was refused as an unknown ba_star field without a word of
+    `load_map`, where it belongs (hostile pass)."""
+    for key, value in [("resolution", 0.1), ("origin", (1.0, 2.0, 0.0)), ("inflate", 0.1),
+                       ("occupied_thresh", 0.5), ("free_thresh", 0.1), ("georef", "g.csv")]:
+        for call in (lambda **kw: ccpp.run(room, "ba-star", **kw), lambda **kw: ccpp.plan(room, "bcd", **kw)):
+            with pytest.raises(ccpp.CcppError, match=rf"^{key} is a setting of the map, not of the run: "
+                               rf"load the map with ccpp.load_map\(path, {key}=\.\.\.\) and pass that map$"):
+                call(**{key: value})

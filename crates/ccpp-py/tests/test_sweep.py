@@ -158,6 +158,31 @@ def test_sweep_takes_one_planner_name_and_none_as_defaults(room: Path, client) -
     # Spaces around a name are dropped, as ccpp.run and `ccpp bench --planners` drop them.
     spaced = ccpp.sweep(str(room), [" bsa "], client=client)
     assert spaced["planner"].tolist() == ["bsa"]
+    # Any iterable of radii, a generator too (it was read up by the check before the sweep
+    # took it: "radii is empty"); a radius that is no iterable nor number, and planners as
+    # bytes, are refused naming the value (hostile pass).
+    gen = ccpp.sweep(str(room), ["bsa"], (r for r in [0.2, 0.25]), client=client)
+    assert gen["robot_radius_m"].tolist() == [0.2, 0.25]
+    with pytest.raises(ccpp.CcppError, match=r"radii must be a number or numbers \(metres\), got True"):
+        ccpp.sweep(str(room), ["bsa"], True, client=client)
+    with pytest.raises(ccpp.CcppError, match=r"planners must be names \(str\), got b'bsa'"):
+        ccpp.sweep(str(room), b"bsa", client=client)
+
+
+def test_sweep_without_its_extra_says_how_to_install_it(room: Path, monkeypatch) -> None:
+    import importlib
+
+    real = importlib.import_module
+
+    def without_pandas(name: str, *args, **kwargs):
+        if name == "pandas":
+            raise ModuleNotFoundError("No module named 'pandas'", name="pandas")
+        return real(name, *args, **kwargs)
+
+    monkeypatch.setattr(importlib, "import_module", without_pandas)
+    with pytest.raises(ModuleNotFoundError, match=r"needs pandas: install the sweep extra") as e:
+        ccpp.sweep(str(room), ["bsa"])
+    assert e.value.name == "pandas"
 
 
 def test_sweep_status_of_a_stalled_run_is_stalled(shared_maps: Path, monkeypatch) -> None:

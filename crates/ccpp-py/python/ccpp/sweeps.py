@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import contextlib
 import decimal
+import importlib
 import math
 import numbers
 import os
@@ -78,6 +79,19 @@ def _map_names(paths: list[Path]) -> list[tuple[Path, str]]:
     ``-3``, ... if that still repeats); a stem of dots is ``map``, ``summary`` is
     ``summary-map``."""
     return [(paths[i], name) for i, name in _ccpp.name_maps(paths)]
+
+
+def _extra(module: str) -> Any:
+    """Imports ``module``, a dependency of the ``[sweep]`` extra, saying how to install it when
+    it is missing (a bare ``ModuleNotFoundError: pandas`` named no fix)."""
+    try:
+        return importlib.import_module(module)
+    except ModuleNotFoundError as e:
+        raise ModuleNotFoundError(
+            f"ccpp.sweep needs {module}: install the sweep extra, pip install 'ccpp-planner[sweep]'"
+            f" (or pip install './crates/ccpp-py[sweep]' from a clone)",
+            name=e.name,
+        ) from e
 
 
 def _is_number(v: object) -> bool:
@@ -231,7 +245,7 @@ def sweep(
     (no ``client`` and no ``scheduler``, or a ``LocalCluster``): Dask's worker processes import
     the script again.
     """
-    import pandas as pd
+    pd = _extra("pandas")
 
     if client is not None and scheduler is not None:
         # One of them would be ignored.
@@ -240,6 +254,9 @@ def sweep(
     if isinstance(planners, str):
         # One planner, not its letters.
         planners = [planners]
+    elif isinstance(planners, (bytes, bytearray)):
+        # Iterated, b"bcd" was its byte values ('unknown planner "98"').
+        raise _ccpp.CcppError(f"planners must be names (str), got {planners!r}")
     if planners is not None:
         # Any iterable (a generator has no len()); spaces around a name are dropped, as
         # `ccpp.run(planner=" bsa")` and `ccpp bench --planners "bsa, bcd"` drop them.
@@ -257,6 +274,12 @@ def sweep(
         raise _ccpp.CcppError(f"radii must be numbers (metres), got {radii!r}")
     elif _is_number(radii):
         radii = (radii,)
+    try:
+        # Read once: a generator checked below and then converted was empty by then
+        # ("radii is empty" for `(r for r in [0.2])`).
+        radii = list(radii)
+    except TypeError:
+        raise _ccpp.CcppError(f"radii must be a number or numbers (metres), got {radii!r}") from None
     for r in radii:
         # `float()` took True as 1.0 m and "0.2" as 0.2: a radius is a number.
         if not _is_number(r):
@@ -338,7 +361,7 @@ def _gather(tasks: list[tuple[Any, ...]], client: Any, scheduler: str | None) ->
     and another sweep or bench had taken the folder (hostile pass). Cells already running on
     a client's workers cannot be stopped by Dask and may still finish theirs; the sweep's own
     cluster is closed, which stops them."""
-    from distributed import Client
+    Client = _extra("distributed").Client
 
     own = None
     if client is None:
