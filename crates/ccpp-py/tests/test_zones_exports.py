@@ -74,6 +74,19 @@ def test_run_with_zones_and_exports_equals_the_cli(room: Path, ccpp_bin: str, tm
     assert not (bare / "waypoints.csv").exists() and (bare / "path.csv").is_file()
 
 
+def test_waypoints_tolerance_merges_a_drifting_route(room: Path) -> None:
+    """`waypoints(tolerance_m=)` was checked only with `<=`, which holds if the tolerance is
+    ignored (kwargs pass): under heading drift the driven route bends between turns, and a
+    finer tolerance keeps more of its poses, a coarser one fewer."""
+    r = ccpp.run(room, "ba-star-extended", odometry_noise=(0.02, 0.02, 0.01), seed=1)
+    fine, default, coarse = (len(r.waypoints(tolerance_m=t)) for t in (1e-6, None, 0.05))
+    assert fine > 10 * default, (fine, default)
+    assert default > coarse, (default, coarse)
+    # Exactly straight moves (ideal execution) have nothing to merge at any tolerance.
+    ideal = ccpp.run(room, "ba-star-extended")
+    assert len({len(ideal.waypoints(tolerance_m=t)) for t in (1e-6, None, 0.05, 1e9)}) == 1
+
+
 def test_export_refuses_unknown_formats_and_tolerances(room: Path) -> None:
     r = ccpp.run(room, "bcd")
     with pytest.raises(ccpp.CcppError, match="unknown export format"):
