@@ -301,6 +301,13 @@ impl MapRecipe {
         // The name goes into folder names, pictures, pages, SVG plots and messages, as a file
         // stem would (whose control characters are refused with the path): Python's
         // `name=` took an escape sequence and a line break into every file and the terminal.
+        // An empty (or blank) name left the map nameless in metrics, titles and results
+        // (Python's `name=""`: kwargs pass).
+        if self.name.as_deref().is_some_and(|n| n.trim().is_empty()) {
+            return Err(ScenarioError::Invalid(format!(
+                "{map}map.name is empty; give a name, or leave it out for the file's stem"
+            )));
+        }
         if let Some(c) = self
             .name
             .as_deref()

@@ -716,6 +716,12 @@ def test_hostile_names_are_refused_or_shown(room: Path) -> None:
     every file and the terminal, and errors carried option keys raw."""
     with pytest.raises(ccpp.CcppError, match=r"map.name holds a control or invisible character \(U\+001B\)"):
         ccpp.load_map(room, name="a\x1b]0;PWN\x07\nerror: fake")
+    # An empty or blank name left the map nameless in metrics and titles (kwargs pass).
+    for blank in ("", "  "):
+        with pytest.raises(ccpp.CcppError, match=r"map.name is empty; give a name, or leave it out"):
+            ccpp.load_map(room, name=blank)
+        with pytest.raises(ccpp.CcppError, match=r"map.name is empty"):
+            ccpp.run(room, "bsa", name=blank)
     with pytest.raises(ccpp.CcppError) as e:
         ccpp.run(room, "bsa", side="\x1b[41mX\nerror: fake")
     text = str(e.value)
