@@ -185,6 +185,14 @@ pub fn default_options_yaml(names: &[String]) -> Result<String> {
             names.join(",")
         );
     }
+    // `all` means every planner only alone: beside names it is no planner (and the message
+    // said just that: hostile pass).
+    if !all && names.iter().any(|n| n.trim() == "all") {
+        bail!(
+            "--defaults: \"all\" stands alone (every planner); beside planner names in {:?} it names none: give the names, or all",
+            names.join(",")
+        );
+    }
     let wanted = names
         .iter()
         .filter(|_| !all)

@@ -161,6 +161,19 @@ fn planners_defaults_is_a_config_of_the_defaults() {
         assert_eq!(err.trim_end().lines().count(), 1, "{err}");
         assert!(err.contains("an empty planner name"), "{empty:?}: {err}");
     }
+    // `all` beside names is no planner: said so (it was `unknown planner "all"`).
+    for mixed in ["all,bcd", "bcd,all"] {
+        let bad = ccpp()
+            .args(["planners", "--defaults", mixed])
+            .assert()
+            .code(1);
+        let err = String::from_utf8_lossy(&bad.get_output().stderr).into_owned();
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        assert!(
+            err.contains("\"all\" stands alone (every planner)"),
+            "{mixed:?}: {err}"
+        );
+    }
 }
 
 #[test]

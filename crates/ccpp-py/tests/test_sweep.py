@@ -167,6 +167,8 @@ def test_sweep_takes_one_planner_name_and_none_as_defaults(room: Path, client) -
         ccpp.sweep(str(room), ["bsa"], True, client=client)
     with pytest.raises(ccpp.CcppError, match=r"planners must be names \(str\), got b'bsa'"):
         ccpp.sweep(str(room), b"bsa", client=client)
+    with pytest.raises(ccpp.CcppError, match=r"client must be a distributed.Client, got <object"):
+        ccpp.sweep(str(room), ["bsa"], client=object())
 
 
 def test_sweep_without_its_extra_says_how_to_install_it(room: Path, monkeypatch) -> None:

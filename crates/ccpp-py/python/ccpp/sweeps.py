@@ -250,6 +250,9 @@ def sweep(
     if client is not None and scheduler is not None:
         # One of them would be ignored.
         raise _ccpp.CcppError("client and scheduler both name the cluster to use; give one of them")
+    if client is not None and not (callable(getattr(client, "submit", None)) and callable(getattr(client, "gather", None))):
+        # Found only when the tasks were submitted, as a bare AttributeError (kwargs pass).
+        raise _ccpp.CcppError(f"client must be a distributed.Client, got {client!r}")
     known = [p["name"] for p in _ccpp.planners()]
     if isinstance(planners, str):
         # One planner, not its letters.
