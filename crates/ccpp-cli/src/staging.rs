@@ -85,15 +85,22 @@ pub const PAUSED_FILE_ENV: &str = "CCPP_TEST_PAUSED_FILE";
 /// minute) for another writer of the folder, so that a test sees the wait end in an error.
 pub const WRITER_WAIT_ENV: &str = "CCPP_TEST_WRITER_WAIT_MS";
 
+/// The milliseconds a test hook's environment variable `var` gives, at most a minute; `None`
+/// when it is not set to a whole number.
+fn hook_duration(var: &str) -> Option<std::time::Duration> {
+    let ms = std::env::var(var).ok()?.parse::<u64>().ok()?;
+    Some(std::time::Duration::from_millis(ms.min(60_000)))
+}
+
 /// Sleeps for the milliseconds the environment variable `var` gives, if any, at most a
 /// minute (the test hooks above), first creating [`PAUSED_FILE_ENV`]'s file if one is named.
 pub fn pause_for(var: &str) {
-    if let Some(ms) = std::env::var(var).ok().and_then(|v| v.parse::<u64>().ok()) {
+    if let Some(pause) = hook_duration(var) {
         if let Some(mark) = std::env::var_os(PAUSED_FILE_ENV) {
             // A test hook: a test that finds no file fails on its own, saying so.
             let _ = std::fs::write(mark, var);
         }
-        std::thread::sleep(std::time::Duration::from_millis(ms.min(60_000)));
+        std::thread::sleep(pause);
     }
 }
 
@@ -324,12 +331,7 @@ pub fn write_files_together(dir: &Path, files: &[(&str, &[u8])]) -> Result<()> {
     // Ctrl-Z (or any other process holding the lock) made the next replay hang without a word.
     let writer = std::fs::File::open(dir).ok();
     if let Some(f) = &writer {
-        let wait = std::env::var(WRITER_WAIT_ENV)
-            .ok()
-            .and_then(|v| v.parse::<u64>().ok())
-            .map_or(WRITER_WAIT, |ms| {
-                std::time::Duration::from_millis(ms).min(WRITER_WAIT)
-            });
+        let wait = hook_duration(WRITER_WAIT_ENV).map_or(WRITER_WAIT, |d| d.min(WRITER_WAIT));
         let t0 = std::time::Instant::now();
         let mut told = false;
         loop {

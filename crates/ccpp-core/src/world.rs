@@ -544,8 +544,8 @@ impl World {
 
     fn check_start(&self) -> Result<(), WorldError> {
         let s = self.start;
-        start_on_map(self.map.frame(), s)?;
         let frame = self.map.frame();
+        start_on_map(frame, s)?;
         if self.true_disk_collides(s.position()) {
             return Err(WorldError::StartInObstacle {
                 x: s.x,
