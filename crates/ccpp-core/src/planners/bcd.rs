@@ -222,6 +222,23 @@
 //!               |  w                       w
 //!    ```
 //!
+//!    A U-turn between two lanes whose join bends round a speck or a bump of the wall (three
+//!    or four turns where no straight move across them is free) competes with the spans in
+//!    the same ranking as two turns: both lanes cut short or extended to the depth of one of
+//!    the bend's vertices and joined by one straight move. On the 14 shared maps (r = 0.15 m)
+//!    the mean turns go from 1123.5 to 1114.6 and the mean path ratio from 1.1344 to 1.1349
+//!    (`tuw_freihaus_eg` 767 to 732 turns, `mit_building_31` 3155 to 3129, `teb_empty_box`
+//!    51 to 39 at path ratio 0.990 to 1.022; `aws_bookstore`, `aws_small_house` and
+//!    `rmf_office_scan` 2-3 turns more), for about 18 % more CPU time of the bcd bench:
+//!
+//!    ```text
+//!    u ---------- v1             u --------------- x
+//!                   \    #  ->                    |
+//!                    v2  #                        |
+//!                   /    #                        |
+//!    w ---------- v3             w --------------- y
+//!    ```
+//!
 //! 6. **Lower turn costs as a second opinion** (not in the paper). The choices of steps 1-5
 //!    rest on estimates priced with `turn_cost_m` (a cell's lane direction, the sweep, which
 //!    turns pruning cuts first), and an estimate that prices turns lower sometimes leads to a
@@ -319,10 +336,10 @@ pub struct BcdOptions {
     ///
     /// | `min_coverage` | mean effective coverage | mean path ratio | mean turns |
     /// |---|---:|---:|---:|
-    /// | 0.97 | 0.9707 | 1.050 | 779 |
-    /// | 0.98 | 0.9811 | 1.072 | 868 |
-    /// | 0.99 | 0.9909 | 1.105 | 1002 |
-    /// | 0.9952 (default) | 0.9958 | 1.134 | 1124 |
+    /// | 0.97 | 0.9720 | 1.047 | 762 |
+    /// | 0.98 | 0.9818 | 1.070 | 849 |
+    /// | 0.99 | 0.9906 | 1.104 | 992 |
+    /// | 0.9952 (default) | 0.9960 | 1.135 | 1115 |
     pub min_coverage: f64,
     /// Turned lattices tried per off-axis wall angle (step 1 of the module docs): at the
     /// angle, then half a degree above and below it, one degree, ...; the cheapest plan of
@@ -340,9 +357,9 @@ pub struct BcdOptions {
     /// plan where it is cheaper (length plus `turn_cost_m` per turn). `None` (`null` in an
     /// options file): no headland. Must be finite and >= 0. Default
     /// `Some(`[`DEFAULT_HEADLAND_MIN_M`]`)`: on the 14 shared maps (r = 0.15 m, measured on
-    /// the current code) the mean path ratio is 1.1344 with it and 1.1766 with `None`
-    /// (`tuw_single_corridors` 0.960 instead of 1.300, `teb_empty_box` 0.990 instead of
-    /// 1.046), for about 1.25 times the planning time of the 14-map bench (the headland plan
+    /// the current code) the mean path ratio is 1.1349 with it and 1.1730 with `None`
+    /// (`tuw_single_corridors` 0.957 instead of 1.295, `teb_empty_box` 1.022 instead of
+    /// 1.040), for about 1.25 times the planning time of the 14-map bench (the headland plan
     /// is made beside the plain one; up to twice as long on the largest maps). It also enables
     /// the peeled plan (offset loops from the outer walls in, module docs step 3), which takes
     /// `nobleo_grid` from 1.102 to 0.973. (When the headland came, against the code of its
