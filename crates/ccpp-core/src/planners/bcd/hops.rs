@@ -502,14 +502,16 @@ struct EndRows {
     far: u32,
 }
 
-/// A hasher for the two coordinate bit patterns of a point: mixed per word, then finished
-/// with the `MurmurHash3` finaliser (pixel-centre coordinates have all-zero low mantissa bits,
-/// which a plain multiply would leave in the low bits the table indexes by). Maps keyed by
-/// points are only looked up, never iterated, so the hash does not affect any plan.
+/// A hasher for keys written as whole words (the bits of a point's coordinates here, a hop's
+/// end points in `plan`): mixed per word, then finished with the `MurmurHash3` finaliser
+/// (pixel-centre coordinates have all-zero low mantissa bits, which a plain multiply would
+/// leave in the low bits the table indexes by). bcd's maps are only looked up, never
+/// iterated, so the hash does not affect any plan; the standard library's default hasher is
+/// seeded per process and several times slower on these small keys.
 #[derive(Default, Clone, Copy)]
-struct PointHasher(u64);
+pub(super) struct WordHasher(u64);
 
-impl std::hash::Hasher for PointHasher {
+impl std::hash::Hasher for WordHasher {
     fn finish(&self) -> u64 {
         let mut h = self.0;
         h ^= h >> 33;
@@ -528,9 +530,9 @@ impl std::hash::Hasher for PointHasher {
     }
 }
 
-/// A map keyed by the bits of a point's coordinates ([`PointHasher`]).
+/// A map keyed by the bits of a point's coordinates ([`WordHasher`]).
 type PointMap<V> =
-    std::collections::HashMap<(u64, u64), V, std::hash::BuildHasherDefault<PointHasher>>;
+    std::collections::HashMap<(u64, u64), V, std::hash::BuildHasherDefault<WordHasher>>;
 
 /// The key of point `p` in a [`PointMap`]: its exact coordinates, so that a value cached for
 /// a point is the value computed from that very point.

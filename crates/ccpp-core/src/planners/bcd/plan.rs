@@ -10,6 +10,7 @@ use rayon::prelude::*;
 use super::angles::{dominant_angles, ANGLE_STEP_DEG, AXIS_TOL_DEG};
 use super::cells::{decompose, split_ends, split_jumps, Cell};
 use super::finish::{moves, repair, smooth, turns, Item};
+use super::hops::WordHasher;
 use super::lanes::{cell_paths, drop_covered, estimate, lanes_of, odd_runs, side_open};
 use super::lattice::{Ctx, Lattice};
 use super::rim::{rim_contours, rim_pass};
@@ -1046,13 +1047,10 @@ struct HopKey([i64; 4]);
 
 impl std::hash::Hash for HopKey {
     fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
-        // One word per key (multiply and rotate per coordinate): maps keyed by hops are only
-        // looked up, never iterated, so the hash does not affect any plan.
-        let mut h = 0u64;
+        // One word per coordinate (mixed by [`WordHasher`]).
         for v in self.0 {
-            h = (h.rotate_left(23) ^ v as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+            state.write_u64(v as u64);
         }
-        state.write_u64(h);
     }
 }
 
@@ -1061,26 +1059,8 @@ fn hop_key(a: Point, b: Point) -> HopKey {
     HopKey([q(a.x), q(a.y), q(b.x), q(b.y)])
 }
 
-/// A hasher that passes on the one word [`HopKey`] writes.
-#[derive(Default, Clone, Copy)]
-struct KeyHasher(u64);
-
-impl std::hash::Hasher for KeyHasher {
-    fn finish(&self) -> u64 {
-        self.0
-    }
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.0 = (self.0.rotate_left(8) ^ u64::from(b)).wrapping_mul(0x9e37_79b9_7f4a_7c15);
-        }
-    }
-    fn write_u64(&mut self, v: u64) {
-        self.0 = v;
-    }
-}
-
-/// A map keyed by hops ([`KeyHasher`]).
-type HopMap<V> = std::collections::HashMap<HopKey, V, std::hash::BuildHasherDefault<KeyHasher>>;
+/// A map keyed by hops (looked up only, never iterated: [`WordHasher`]).
+type HopMap<V> = std::collections::HashMap<HopKey, V, std::hash::BuildHasherDefault<WordHasher>>;
 
 /// Transfers already routed, by hop (looked up only, never iterated).
 #[derive(Default)]
