@@ -1167,15 +1167,10 @@ mod tests {
         }
     }
 
-    /// A step of three turns among specks becomes one corner where the moves before and
-    /// after it meet: every straight move across the step hits a speck and the turns taken
-    /// two at a time never meet (their moves are parallel), so only a run of three turns
-    /// ([`MERGE_RUN`]) completes it.
-    #[test]
-    fn a_step_of_three_turns_among_specks_becomes_one_corner() {
-        // The room of `room()` (10 px a cell) with four obstacle pixels, given by (column,
-        // row) of the image; the pixel centre is (column + 0.5, 59.5 - row) in grid points.
-        let specks = [(52, 34), (52, 28), (52, 18), (27, 34)];
+    /// The room of `room()` (10 px a cell) at one pixel a cell, with obstacle pixels given by
+    /// (column, row) of the image; a pixel's centre is (column + 0.5, 59.5 - row) in grid
+    /// points.
+    fn specked_room(specks: &[(usize, usize)]) -> World {
         let mut rows: Vec<String> = Vec::new();
         for r in 0..60usize {
             let line: String = (0..120usize)
@@ -1191,12 +1186,21 @@ mod tests {
             rows.push(line);
         }
         let map = crate::grid::GridMap::from_ascii_scaled(&rows.join("\n"), 1, 0.02).unwrap();
-        let world = World::new(
+        World::new(
             map,
             Robot::new(0.05),
             Some(crate::geometry::Pose::new(0.3, 0.3, 0.0)),
         )
-        .unwrap();
+        .unwrap()
+    }
+
+    /// A step of three turns among specks becomes one corner where the moves before and
+    /// after it meet: every straight move across the step hits a speck and the turns taken
+    /// two at a time never meet (their moves are parallel), so only a run of three turns
+    /// ([`MERGE_RUN`]) completes it.
+    #[test]
+    fn a_step_of_three_turns_among_specks_becomes_one_corner() {
+        let world = specked_room(&[(52, 34), (52, 28), (52, 18), (27, 34)]);
         let c = ctx(&world);
         let p = Point::new;
         let pts = [
@@ -1223,30 +1227,7 @@ mod tests {
     /// bend's depth are joined by a free straight move, for little floor.
     #[test]
     fn a_u_turn_bent_round_a_speck_becomes_two_turns() {
-        // The room of `room()` (10 px a cell) with one obstacle pixel, given by (column, row)
-        // of the image; the pixel centre is (column + 0.5, 59.5 - row) in grid points.
-        let speck = (90, 42);
-        let mut rows: Vec<String> = Vec::new();
-        for r in 0..60usize {
-            let line: String = (0..120usize)
-                .map(|c| {
-                    let wall = !(10..110).contains(&c) || !(10..50).contains(&r);
-                    if wall || (c, r) == speck {
-                        '#'
-                    } else {
-                        '.'
-                    }
-                })
-                .collect();
-            rows.push(line);
-        }
-        let map = crate::grid::GridMap::from_ascii_scaled(&rows.join("\n"), 1, 0.02).unwrap();
-        let world = World::new(
-            map,
-            Robot::new(0.05),
-            Some(crate::geometry::Pose::new(0.3, 0.3, 0.0)),
-        )
-        .unwrap();
+        let world = specked_room(&[(90, 42)]);
         let c = ctx(&world);
         let p = Point::new;
         // Lane out along y = 14, a join bent round the speck (x 90-91, y 17-18), lane back
