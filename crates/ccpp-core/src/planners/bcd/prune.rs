@@ -801,11 +801,8 @@ impl Pruner<'_, '_> {
                                 let at =
                                     |c: usize| (c as f64 + 0.5 - pu.x) * e.x + (yc - pu.y) * e.y;
                                 let (mut lo, mut hi) = (c0, c0 + len - 1);
-                                while lo <= hi && at(lo) < dmin && at(hi) < dmin {
-                                    // both ends shallow: the whole run is (depth is linear)
-                                    lo = hi + 1;
-                                }
-                                if lo > hi {
+                                if at(lo) < dmin && at(hi) < dmin {
+                                    // Both ends shallow: the whole run is (depth is linear).
                                     continue;
                                 }
                                 if e.x > 0.0 {
