@@ -534,6 +534,13 @@ impl std::hash::Hasher for WordHasher {
 type PointMap<V> =
     std::collections::HashMap<(u64, u64), V, std::hash::BuildHasherDefault<WordHasher>>;
 
+/// The row (of `row_of`, per node of `coarse`) of the node holding `p`; `u32::MAX` when `p` is
+/// in no node or its node holds no end point. One function for the near table and the far
+/// costs, whose rows are looked up alike.
+fn end_row(coarse: &Coarse, row_of: &[u32], p: Point) -> u32 {
+    coarse.node(p).map_or(u32::MAX, |k| row_of[k as usize])
+}
+
 /// The key of point `p` in a [`PointMap`]: its exact coordinates, so that a value cached for
 /// a point is the value computed from that very point.
 fn point_key(p: Point) -> (u64, u64) {
@@ -637,8 +644,8 @@ impl<'a> HopTable<'a> {
     /// The rows of `p` ([`EndRows`]), found from the point itself.
     fn rows_of_uncached(&self, p: Point) -> EndRows {
         EndRows {
-            row: self.row_uncached(p).unwrap_or(u32::MAX),
-            far: self.far.row(p).unwrap_or(u32::MAX),
+            row: end_row(self.coarse, &self.row_of, p),
+            far: end_row(self.far.coarse, &self.far.row_of, p),
         }
     }
 
@@ -654,13 +661,6 @@ impl<'a> HopTable<'a> {
     /// The row of the node of `p`, if it holds an end point.
     fn row(&self, p: Point) -> Option<u32> {
         let r = self.rows_of(p).row;
-        (r != u32::MAX).then_some(r)
-    }
-
-    /// [`Self::row`] found from the point (not from the cache).
-    fn row_uncached(&self, p: Point) -> Option<u32> {
-        let k = self.coarse.node(p)?;
-        let r = self.row_of[k as usize];
         (r != u32::MAX).then_some(r)
     }
 
@@ -943,17 +943,10 @@ impl<'a> Far<'a> {
         FarCosts::Landmarks { k, d }
     }
 
-    /// The row of the far node of `p`, if it holds an end point.
-    fn row(&self, p: Point) -> Option<u32> {
-        let k = self.coarse.node(p)?;
-        let r = self.row_of[k as usize];
-        (r != u32::MAX).then_some(r)
-    }
-
     /// Estimated path cost (pixels) between `a` and `b`; 0 when unknown.
     #[cfg(test)]
     fn path_px(&self, a: Point, b: Point) -> f64 {
-        let row = |p: Point| self.row(p).unwrap_or(u32::MAX);
+        let row = |p: Point| end_row(self.coarse, &self.row_of, p);
         self.rows_px(row(a), row(b))
     }
 

@@ -528,12 +528,12 @@ impl Pruner<'_, '_> {
                 self.prev[v2] = v1;
                 self.next[v2] = s.w;
                 self.prev[s.w] = v2;
+                // (their versions move with the starts re-evaluated below)
                 for v in [u, v1, v2] {
                     self.seg[v].clear();
                     let seg = self.segment(v);
                     self.apply(&seg, true);
                     self.seg[v] = seg;
-                    self.version[v] = self.version[v].wrapping_add(1);
                 }
             } else {
                 let j = self.chord(u, s.w);
