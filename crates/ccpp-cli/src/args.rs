@@ -50,16 +50,16 @@ pub struct MapArgs {
     #[arg(long, value_name = "FILE")]
     pub map: PathBuf,
     /// Override the resolution (m/px); bare images default to 0.05.
-    #[arg(long, value_name = "M")]
+    #[arg(long, value_parser = parse_number, value_name = "M")]
     pub resolution: Option<f64>,
     /// Override the origin `X,Y[,YAW]` (world pose of the lower-left pixel; YAW left out is 0, not the map's yaw).
     #[arg(long, value_name = "X,Y[,YAW]", value_parser = parse_triple, allow_hyphen_values = true)]
     pub origin: Option<[f64; 3]>,
     /// Override `occupied_thresh`.
-    #[arg(long, value_name = "P")]
+    #[arg(long, value_parser = parse_number, value_name = "P")]
     pub occupied_thresh: Option<f64>,
     /// Override `free_thresh`.
-    #[arg(long, value_name = "P")]
+    #[arg(long, value_parser = parse_number, value_name = "P")]
     pub free_thresh: Option<f64>,
     /// Place the image by a least-squares affine fit of surveyed point pairs: a CSV of
     /// `px,py,wx,wy` lines (pixel coordinates from the image's top-left corner, y down; world
@@ -70,7 +70,7 @@ pub struct MapArgs {
     /// costmap's inflation: the grown map is what the command works on (a run's planner, sensor,
     /// collisions and coverage figures, a plan's path, `info`'s figures), so the floor within M
     /// of an obstacle is no floor to cover and touching it is a collision.
-    #[arg(long, value_name = "M")]
+    #[arg(long, value_parser = parse_number, value_name = "M")]
     pub inflate: Option<f64>,
 }
 
@@ -80,10 +80,10 @@ pub struct RobotArgs {
     /// Robot (footprint) radius in metres [default: 0.15].
     // An `Option` (its default applied in `job::robot_from`): `plan` and `waypoints` refuse a
     // radius given beside a rectangle whose disk it cannot change.
-    #[arg(long, value_name = "M")]
+    #[arg(long, value_parser = parse_number, value_name = "M")]
     pub radius: Option<f64>,
     /// Cleaning tool radius in metres (default: the robot radius).
-    #[arg(long, value_name = "M")]
+    #[arg(long, value_parser = parse_number, value_name = "M")]
     pub tool_radius: Option<f64>,
     /// Start pose `X,Y[,THETA]` in metres/radians (default: the widest free spot, heading
     /// east). THETA is for `run`: `info`, `plan` and `waypoints` use no heading and refuse
@@ -143,7 +143,7 @@ pub struct LimitArgs {
     /// Refuse work whose estimated memory exceeds this many MB (default 4096; `bench` checks
     /// each run, and its runs in progress and summary pictures share the limit: a run starts
     /// when its estimate fits beside theirs).
-    #[arg(long, value_name = "MB")]
+    #[arg(long, value_parser = parse_whole::<u64>, value_name = "MB")]
     pub max_memory: Option<u64>,
 }
 
@@ -169,7 +169,7 @@ pub struct RunArgs {
     #[arg(long, value_name = "NAME")]
     pub planner: String,
     /// Seed of random-bounce's turns and of --odometry-noise (refused for other runs).
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_parser = parse_whole::<u64>, value_name = "N")]
     pub seed: Option<u64>,
     /// Planner options.
     #[command(flatten)]
@@ -177,10 +177,10 @@ pub struct RunArgs {
     /// Sensor range in metres (default 4 r) of random-bounce, ba-star-extended and
     /// bsa-extended; ba-star, bsa and bsa-bfs decide from their neighbour tiles alone and sense
     /// as far as that needs (refused for them and for the offline planners)
-    #[arg(long, value_name = "M")]
+    #[arg(long, value_parser = parse_number, value_name = "M")]
     pub sensor_range: Option<f64>,
     /// Tile side in metres: ba-star and ba-star-extended tiles, bsa-bfs cells (default 2 r).
-    #[arg(long, value_name = "M")]
+    #[arg(long, value_parser = parse_number, value_name = "M")]
     pub tile_side: Option<f64>,
     /// BA* backtracking path smoothing (A*SPT): `on` (default) or `off` to compare (also
     /// `true`/`false`, `yes`/`no`, `1`/`0`). For
@@ -194,11 +194,11 @@ pub struct RunArgs {
     pub side: Option<String>,
     /// Rectangular robot length in metres (rect-boustrophedon: waypoint spacing; default: the
     /// tool's width 2 x tool radius).
-    #[arg(long, value_name = "M")]
+    #[arg(long, value_parser = parse_number, value_name = "M")]
     pub length: Option<f64>,
     /// Rectangular robot width in metres (rect-boustrophedon: lane spacing; default and at
     /// most, in a run: the tool's width 2 x tool radius).
-    #[arg(long, value_name = "M")]
+    #[arg(long, value_parser = parse_number, value_name = "M")]
     pub width: Option<f64>,
     /// Work area and keep-out zones.
     #[command(flatten)]
@@ -255,11 +255,11 @@ pub struct PlanArgs {
     pub options: OptionsArgs,
     /// Rectangular robot length in metres (rect-boustrophedon: waypoint spacing; default: the
     /// robot's diameter).
-    #[arg(long, value_name = "M")]
+    #[arg(long, value_parser = parse_number, value_name = "M")]
     pub length: Option<f64>,
     /// Rectangular robot width in metres (rect-boustrophedon: lane spacing; default: the
     /// robot's diameter; any width: a plan has no tool, the rectangle is the robot).
-    #[arg(long, value_name = "M")]
+    #[arg(long, value_parser = parse_number, value_name = "M")]
     pub width: Option<f64>,
     /// Work area and keep-out zones (the path stays inside the area, outside the keep-outs).
     #[command(flatten)]
@@ -289,10 +289,10 @@ pub struct WaypointsArgs {
     #[command(flatten)]
     pub robot: RobotArgs,
     /// Robot length in metres (waypoint spacing along a lane; default: the robot's diameter).
-    #[arg(long, value_name = "M")]
+    #[arg(long, value_parser = parse_number, value_name = "M")]
     pub length: Option<f64>,
     /// Robot width in metres (lane spacing; default: the robot's diameter).
-    #[arg(long, value_name = "M")]
+    #[arg(long, value_parser = parse_number, value_name = "M")]
     pub width: Option<f64>,
     /// Area to cover `X0,Y0,X1,Y1`: the seed's lane rectangle for the robot's centre
     /// (default: the start's free component).
@@ -347,10 +347,10 @@ pub struct BenchArgs {
     pub robot: BenchRobotArgs,
     /// Grow obstacles by this many metres before planning (the grown map is each run's world,
     /// its figures included: see `ccpp run --help`).
-    #[arg(long, value_name = "M")]
+    #[arg(long, value_parser = parse_number, value_name = "M")]
     pub inflate: Option<f64>,
     /// Seed of random-bounce's turns.
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_parser = parse_whole::<u64>, value_name = "N")]
     pub seed: Option<u64>,
     /// Planner options.
     #[command(flatten)]
@@ -365,7 +365,7 @@ pub struct BenchArgs {
     #[arg(long)]
     pub force: bool,
     /// Worker threads (default: all cores; at most one per run).
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_parser = parse_whole::<usize>, value_name = "N")]
     pub jobs: Option<usize>,
     /// No progress bar.
     #[arg(long)]
@@ -376,10 +376,10 @@ pub struct BenchArgs {
 #[derive(Args, Debug, Clone)]
 pub struct BenchRobotArgs {
     /// Robot (footprint) radius in metres.
-    #[arg(long, value_name = "M", default_value_t = 0.15)]
+    #[arg(long, value_parser = parse_number, value_name = "M", default_value_t = 0.15)]
     pub radius: f64,
     /// Cleaning tool radius in metres (default: the robot radius).
-    #[arg(long, value_name = "M")]
+    #[arg(long, value_parser = parse_number, value_name = "M")]
     pub tool_radius: Option<f64>,
 }
 
@@ -437,6 +437,28 @@ fn parse_finite_list(s: &str) -> Result<Vec<f64>, String> {
             Err(_) => Err(format!("{p:?} is not a number")),
         })
         .collect()
+}
+
+/// Parses a single-number flag, with whitespace around it taken as the list flags take it
+/// (`--start " 1, 2"` ran while `--radius " 0.15"` was refused). A number out of its range
+/// (infinite, negative, ...) is left to the scenario's checks, which name the setting.
+fn parse_number(s: &str) -> Result<f64, String> {
+    let t = s.trim();
+    // `-0` is 0, as in `parse_finite_list`.
+    t.parse::<f64>()
+        .map(|x| x + 0.0)
+        .map_err(|_| format!("{t:?} is not a number"))
+}
+
+/// Parses a whole-number flag (`--seed`, `--jobs`, `--max-memory`), whitespace around it
+/// taken as [`parse_number`] takes it.
+fn parse_whole<T: std::str::FromStr>(s: &str) -> Result<T, String>
+where
+    T::Err: std::fmt::Display,
+{
+    let t = s.trim();
+    t.parse::<T>()
+        .map_err(|e| format!("{t:?} is not a whole number ({e})"))
 }
 
 /// Parses `A,B,C,D` into four finite numbers.

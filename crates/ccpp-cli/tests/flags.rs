@@ -558,6 +558,52 @@ fn map_and_robot_flags_change_the_run() {
     assert!(!said(&[]).contains("inflated"));
 }
 
+/// Single-number flags take whitespace around their value as the list flags do (`--start
+/// " 1, 1"` ran while `--radius " 0.2"` was refused as "invalid float literal"), and the run is
+/// the one of the bare value; a value that is no number is refused with the flag named.
+#[test]
+fn single_number_flags_take_whitespace_as_the_list_flags_do() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let bare = run_ok(
+        dir,
+        "bare",
+        &map,
+        "random-bounce",
+        &["--radius", "0.2", "--seed", "3", "--start", "1,1"],
+    );
+    let padded = run_ok(
+        dir,
+        "padded",
+        &map,
+        "random-bounce",
+        &["--radius", " 0.2 ", "--seed", "3 ", "--start", " 1, 1"],
+    );
+    assert_eq!(metrics(&bare), metrics(&padded));
+    assert_eq!(trace(&bare), trace(&padded));
+    for (flag, value) in [
+        ("--radius", "0.2x"),
+        ("--seed", " -3"),
+        ("--max-memory", "1e3"),
+    ] {
+        let o = ccpp()
+            .args(["run", "--planner", "random-bounce", "--map"])
+            .arg(&map)
+            .args([flag, value, "--out"])
+            .arg(dir.join("refused"))
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(1), "{flag} {value:?}");
+        let err = String::from_utf8(o.stderr).unwrap();
+        assert!(
+            err.starts_with("error: ") && err.contains(flag),
+            "{flag} {value:?}: {err}"
+        );
+        assert!(!dir.join("refused").exists());
+    }
+}
+
 /// `--resolution` and `--origin` stand in for a map YAML's missing (or bad) `resolution` and
 /// `origin`: such a YAML was refused as lacking the field even with the flag given (hostile
 /// pass). The run is the one of a full YAML with those values, and replays.
