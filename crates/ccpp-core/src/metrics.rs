@@ -1182,7 +1182,11 @@ mod tests {
         let world =
             World::new(open_room(), Robot::new(0.2), Some(Pose::new(1.0, 1.0, 0.0))).unwrap();
         let config = crate::planners::PlannerConfig::new(crate::planners::PlannerKind::BaStar);
-        let out = simulate(&world, config.build(&world).as_mut(), &SimConfig::default());
+        let out = simulate(
+            &world,
+            config.build(&world).unwrap().as_mut(),
+            &SimConfig::default(),
+        );
         assert!(
             out.trace.pieces().any(|p| matches!(p, Piece::Run(_))),
             "the trace has runs"
@@ -1211,7 +1215,11 @@ mod tests {
         let world =
             World::new(open_room(), Robot::new(0.2), Some(Pose::new(1.0, 1.0, 0.0))).unwrap();
         let config = crate::planners::PlannerConfig::new(crate::planners::PlannerKind::BaStar);
-        let out = simulate(&world, config.build(&world).as_mut(), &SimConfig::default());
+        let out = simulate(
+            &world,
+            config.build(&world).unwrap().as_mut(),
+            &SimConfig::default(),
+        );
         let side = out.tile_side.expect("BA* has tiles");
         let (want, swept) = compute_swept(&world, &out, "room");
         assert!(want.coverage_rate.is_some_and(|c| c > 0.9));
@@ -1238,7 +1246,11 @@ mod tests {
         let start = Some(Pose::new(1.0, 1.0, 0.0));
         let world = World::new(open_room(), Robot::new(0.2), start).unwrap();
         let config = crate::planners::PlannerConfig::new(crate::planners::PlannerKind::BaStar);
-        let out = simulate(&world, config.build(&world).as_mut(), &SimConfig::default());
+        let out = simulate(
+            &world,
+            config.build(&world).unwrap().as_mut(),
+            &SimConfig::default(),
+        );
         let want = compute(&world, &out, "room").revisit_rate;
         assert!(want > 0.0);
         let mut other_tiles = out.clone();

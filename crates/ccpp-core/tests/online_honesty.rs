@@ -45,7 +45,7 @@ fn art(variant: u64) -> String {
 }
 
 fn run(world: &World, config: &PlannerConfig) -> Trace {
-    let mut p = config.build(world);
+    let mut p = config.build(world).unwrap();
     simulate(world, p.as_mut(), &SimConfig::default()).trace
 }
 

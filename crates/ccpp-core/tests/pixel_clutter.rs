@@ -457,7 +457,10 @@ fn drivable_floor(world: &World) -> fixedbitset::FixedBitSet {
 /// finishing safely on any world.
 fn unchecked(name: &str, world: &World) -> Box<dyn Planner> {
     let kind: PlannerKind = name.parse().unwrap();
-    PlannerOptions::default().config(kind).build(world)
+    PlannerOptions::default()
+        .config(kind)
+        .settings()
+        .build(world)
 }
 
 /// The known-map planners (`bcd`, `rect-boustrophedon`) on the world of `p`: they finish by

@@ -85,7 +85,7 @@ fn online_and_offline_planners_respect_the_zones() {
     assert!(s.x < 3.0 - 0.1 && !(1.1..=1.9).contains(&s.x) || !(0.5..=1.5).contains(&s.y));
     for kind in PlannerKind::ALL {
         let cfg = PlannerConfig::new(*kind);
-        let mut p = cfg.build(&world);
+        let mut p = cfg.build(&world).unwrap();
         let out = simulate(&world, p.as_mut(), &SimConfig::default());
         let m = metrics::compute(&world, &out, "room");
         assert_eq!(m.keepout_violations, 0, "{kind}");
@@ -184,7 +184,10 @@ fn zone_errors_are_specific() {
     assert_eq!(sim.true_pose().position(), w.start().position());
     let out = simulate(
         &w,
-        PlannerConfig::new(PlannerKind::BaStar).build(&w).as_mut(),
+        PlannerConfig::new(PlannerKind::BaStar)
+            .build(&w)
+            .unwrap()
+            .as_mut(),
         &SimConfig::default(),
     );
     let m = metrics::compute(&w, &out, "room");

@@ -147,7 +147,8 @@ pub fn plan_route_until(
     let started = std::time::Instant::now();
     let mut sim = scenario.sim.clone();
     sim.exec = Some(Execution::Ideal);
-    let mut planner = scenario.planner.build_until(&world, stop);
+    // (options checked when the world was built, `Scenario::world`)
+    let mut planner = scenario.planner.settings().build_until(&world, stop);
     let output = simulate_until(&world, planner.as_mut(), &sim, &mut |_| {}, stop)
         .ok_or(ScenarioError::Interrupted)?;
     let route = Route::from_trace(&output.trace, tolerance_m);

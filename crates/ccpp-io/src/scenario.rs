@@ -1593,8 +1593,9 @@ impl Scenario {
                 let other = s.spawn(|| (metrics::WorldPart::of(&world, side), beside(&world)));
                 // Wall time covers planning (offline planners plan in `build`) and simulation.
                 let started = std::time::Instant::now();
-                // (bcd's and rect-boustrophedon's planning end early too when `stop` is set)
-                let mut planner = self.planner.build_until(&world, stop);
+                // (bcd's and rect-boustrophedon's planning end early too when `stop` is set;
+                // the options were checked when the world was built, `Scenario::world`)
+                let mut planner = self.planner.settings().build_until(&world, stop);
                 let sim = self.sim_on(world.frame());
                 let output = simulate_until(&world, planner.as_mut(), &sim, &mut |_| {}, stop);
                 let wall_time_s = started.elapsed().as_secs_f64();
@@ -1648,7 +1649,8 @@ impl Scenario {
                     });
                     // Wall time covers planning (offline planners plan in `build`) and simulation.
                     let started = std::time::Instant::now();
-                    let mut planner = self.planner.build(world);
+                    // (options checked when the world was built, `Scenario::world`)
+                    let mut planner = self.planner.settings().build(world);
                     let sim = self.sim_on(world.frame());
                     let mut sent = 0usize;
                     let mut output = simulate_tapped(world, planner.as_mut(), &sim, &mut |t| {

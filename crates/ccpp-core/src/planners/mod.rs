@@ -323,27 +323,46 @@ impl PlannerConfig {
             .map_err(|e| e.in_section(self.kind().info().section))
     }
 
-    /// Builds the planner for `world`. Online planners get nothing from `world` but what an
-    /// operator knows (its frame and the robot); offline ones read its map.
+    /// Builds the planner for `world`, after checking its options
+    /// ([`validate`](Self::validate)) and their fit to `world`
+    /// ([`PlannerSettings::check_world`]). Online planners get nothing from `world` but what
+    /// an operator knows (its frame and the robot); offline ones read its map.
     ///
-    /// It does not validate: a planner cannot fail to build, so an option out of its range
-    /// runs as its default. Check the options first with [`validate`](Self::validate) (and
-    /// the checks against the robot and the map, [`PlannerSettings::check`]
-    /// and [`check_world`](PlannerSettings::check_world)),
-    /// as `ccpp_io::scenario::Scenario` does for every run, or build by name with
-    /// [`build`], which refuses an option out of its range.
-    pub fn build(&self, world: &World) -> Box<dyn Planner> {
-        self.settings().build(world)
+    /// (It used to build unchecked, an option out of its range running as its default: a
+    /// library user's `margin_px: -1.0` ran as `0.0` without a word. The checks against the
+    /// robot and the run's sensor, [`PlannerSettings::check`], need the run's settings:
+    /// `ccpp_io::scenario::Scenario` makes them all.)
+    ///
+    /// # Errors
+    /// [`BuildError::Options`] for the first option out of its range or unfit for `world`.
+    pub fn build(&self, world: &World) -> Result<Box<dyn Planner>, BuildError> {
+        let settings = self.checked(world)?;
+        Ok(settings.build(world))
     }
 
     /// [`build`](Self::build) that another thread can give up by setting `stop` (bcd's and
     /// rect-boustrophedon's planning end early; the planner built then must not be driven).
+    ///
+    /// # Errors
+    /// As [`build`](Self::build).
     pub fn build_until(
         &self,
         world: &World,
         stop: &std::sync::atomic::AtomicBool,
-    ) -> Box<dyn Planner> {
-        self.settings().build_until(world, stop)
+    ) -> Result<Box<dyn Planner>, BuildError> {
+        let settings = self.checked(world)?;
+        Ok(settings.build_until(world, stop))
+    }
+
+    /// The settings, once [`validate`](Self::validate) and
+    /// [`PlannerSettings::check_world`] accept them.
+    fn checked(&self, world: &World) -> Result<&dyn PlannerSettings, BuildError> {
+        self.validate()?;
+        let settings = self.settings();
+        settings
+            .check_world(world)
+            .map_err(|e| e.in_section(self.kind().info().section))?;
+        Ok(settings)
     }
 }
 
@@ -369,12 +388,8 @@ fn did_you_mean(name: &str) -> String {
         .map_or_else(String::new, |p| format!(" (did you mean {:?}?)", p.name))
 }
 
-/// Builds the planner `name` with its section of `opts`, after checking the section's values
-/// ([`PlannerConfig::validate`]) and their fit to `world`
-/// ([`PlannerSettings::check_world`]): unlike [`PlannerConfig::build`], an option out of its
-/// range is refused instead of running as its default. (The checks against the robot and the
-/// run's sensor, [`PlannerSettings::check`], need the run's settings: `ccpp_io`'s scenario
-/// makes them all.)
+/// Builds the planner `name` with its section of `opts` ([`PlannerConfig::build`], which
+/// checks the section's values and their fit to `world`).
 ///
 /// # Errors
 /// [`BuildError::Unknown`] for an unknown name, [`BuildError::Options`] for an invalid option.
@@ -384,11 +399,43 @@ pub fn build(
     world: &World,
 ) -> Result<Box<dyn Planner>, BuildError> {
     let kind: PlannerKind = name.parse()?;
-    let config = opts.config(kind);
-    config.validate()?;
-    config
-        .settings()
-        .check_world(world)
-        .map_err(|e| e.in_section(kind.info().section))?;
-    Ok(config.build(world))
+    opts.config(kind).build(world)
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use crate::grid::GridMap;
+    use crate::world::Robot;
+
+    /// `PlannerConfig::build` refuses an option out of its range, naming its section (it used
+    /// to build unchecked, the option running as its default), and builds the defaults.
+    #[test]
+    fn a_config_builds_only_with_options_in_range() {
+        let map = GridMap::from_ascii_scaled(
+            "##########\n#........#\n#........#\n#...##...#\n#........#\n#........#\n##########",
+            4,
+            0.05,
+        )
+        .unwrap();
+        let world = World::new(map, Robot::new(0.05), None).unwrap();
+        for &kind in PlannerKind::ALL {
+            assert!(PlannerConfig::new(kind).build(&world).is_ok(), "{kind}");
+        }
+        let bcd = bcd::BcdOptions {
+            margin_px: -1.0,
+            ..bcd::BcdOptions::default()
+        };
+        let e = PlannerConfig::Bcd(bcd.clone()).build(&world).err().unwrap();
+        assert!(
+            e.to_string().contains("bcd") && e.to_string().contains("margin_px"),
+            "{e}"
+        );
+        let stop = std::sync::atomic::AtomicBool::new(false);
+        assert!(PlannerConfig::Bcd(bcd).build_until(&world, &stop).is_err());
+        let mut opts = PlannerOptions::default();
+        opts.bcd.margin_px = f64::NAN;
+        assert!(build("bcd", &opts, &world).is_err());
+    }
 }

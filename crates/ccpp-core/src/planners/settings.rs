@@ -279,7 +279,10 @@ pub trait PlannerSettings {
         robot.radius
     }
 
-    /// Builds the planner for `world` (offline planners plan here).
+    /// Builds the planner for `world` (offline planners plan here), unchecked: an option out
+    /// of its range runs as its default. [`PlannerConfig::build`](super::PlannerConfig::build)
+    /// checks the options first ([`validate`](Self::validate),
+    /// [`check_world`](Self::check_world)) and is the one to call.
     fn build(&self, world: &World) -> Box<dyn Planner>;
 
     /// [`build`](Self::build) that another thread can give up by setting `stop`: a planner
