@@ -213,6 +213,10 @@ fn mask<'py>(py: Python<'py>, frame: &MapFrame, bits: &FixedBitSet) -> Bound<'py
 #[pyclass(module = "ccpp", frozen)]
 pub struct Map {
     map: PreparedMap,
+    /// The memory limit it was loaded within when one was given (`load_map(...,
+    /// max_memory_mb=)`, an `Env`'s): the default of the runs, plans and environments made on
+    /// it (a limit given to them wins).
+    max_memory_mb: Option<u64>,
 }
 
 #[pymethods]
@@ -353,6 +357,8 @@ fn utf8_path(path: &Path, what: &str) -> PyResult<()> {
 /// Loads a map: a ROS `map_server` YAML (with its PGM/PNG) or a bare image. An image whose
 /// pixels alone would need more than `max_memory_mb` (default 4096) in a run is refused from
 /// its header, before it is decoded.
+/// A limit given here stays with the map: it is the default `max_memory_mb` of `run`,
+/// `plan` and `Env` on it.
 #[pyfunction]
 #[pyo3(signature = (path, *, resolution=None, origin=None, occupied_thresh=None, free_thresh=None, inflate=None, georef=None, name=None, max_memory_mb=None))]
 #[allow(clippy::too_many_arguments)] // keyword arguments of a Python function
@@ -394,15 +400,18 @@ fn load_map(
         recipe.name = name;
     }
     // As `Env` and `run` read it (a -1 or 2**64 was a bare `OverflowError` here).
-    let limit = max_memory_mb
+    let given = max_memory_mb
         .filter(|v| !v.is_none())
         .map(|v| uint_arg("max_memory_mb", v, 1))
-        .transpose()?
-        .unwrap_or(ccpp_io::scenario::DEFAULT_MAX_MEMORY_MB);
+        .transpose()?;
+    let limit = given.unwrap_or(ccpp_io::scenario::DEFAULT_MAX_MEMORY_MB);
     let map = py
         .detach(|| recipe.load_within(limit))
         .map_err(|e| err(&e))?;
-    Ok(Map { map })
+    Ok(Map {
+        map,
+        max_memory_mb: given,
+    })
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1208,9 +1217,11 @@ fn plan(
 ) -> PyResult<PlanResult> {
     let radius = real(radius);
     let given = radius;
-    let mut prepared = as_map(py, map, memory_option(options)?)?;
+    let limit = memory_limit(map, memory_option(options)?);
+    let mut prepared = as_map(py, map, limit)?;
     let (planner, radius) = (planner.unwrap_or("bcd"), radius.unwrap_or(DEFAULT_RADIUS));
-    let scenario = scenario_from(&prepared, planner, radius, options, Purpose::Plan)?;
+    let mut scenario = scenario_from(&prepared, planner, radius, options, Purpose::Plan)?;
+    scenario.max_memory_mb = limit;
     // Beside a rectangle a plan's radius is only a floor under its disk, as `ccpp plan` says.
     if let PlannerConfig::RectBoustrophedon(o) = &scenario.planner {
         if let Some(why) = ccpp_io::plan::radius_under_the_rectangle("radius", given, o) {
@@ -1417,12 +1428,14 @@ fn run(
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<RunResult> {
     let radius = real(radius);
-    let mut prepared = as_map(py, map, memory_option(options)?)?;
+    let limit = memory_limit(map, memory_option(options)?);
+    let mut prepared = as_map(py, map, limit)?;
     let (planner, radius) = (
         planner.unwrap_or("ba-star"),
         radius.unwrap_or(DEFAULT_RADIUS),
     );
-    let scenario = scenario_from(&prepared, planner, radius, options, Purpose::Run)?;
+    let mut scenario = scenario_from(&prepared, planner, radius, options, Purpose::Run)?;
+    scenario.max_memory_mb = limit;
     // The files the run reads (`save` refuses a folder holding one): the scenario's, and a
     // landmarks file, which the scenario holds as read.
     let mut inputs = scenario.input_files();
@@ -1582,20 +1595,29 @@ fn as_map(py: Python<'_>, map: &Bound<'_, PyAny>, max_memory_mb: u64) -> PyResul
         .map_err(|e| err(&e))
 }
 
-/// The memory limit of `run` and `plan` keyword options (`max_memory_mb`, default
-/// [`DEFAULT_MAX_MEMORY_MB`](ccpp_io::scenario::DEFAULT_MAX_MEMORY_MB)), read before the map
-/// is loaded so that loading honours it too (it used to load within the default 4096 MB
+/// The memory limit of `run` and `plan` keyword options (`max_memory_mb`), read before the
+/// map is loaded so that loading honours it too (it used to load within the default 4096 MB
 /// whatever the user asked: a raised limit was refused as 4096 MB, and a lower one came too
-/// late to keep a large image from being decoded).
-fn memory_option(options: Option<&Bound<'_, PyDict>>) -> PyResult<u64> {
+/// late to keep a large image from being decoded); [`memory_limit`] gives the default.
+fn memory_option(options: Option<&Bound<'_, PyDict>>) -> PyResult<Option<u64>> {
     let v = options
         .map(|o| o.get_item("max_memory_mb"))
         .transpose()?
         .flatten();
     match v {
-        Some(v) if !v.is_none() => uint_arg("max_memory_mb", &v, 1),
-        _ => Ok(ccpp_io::scenario::DEFAULT_MAX_MEMORY_MB),
+        Some(v) if !v.is_none() => uint_arg("max_memory_mb", &v, 1).map(Some),
+        _ => Ok(None),
     }
+}
+
+/// The memory limit of work on `map`: the one `given` to it, else the limit the `Map` was
+/// loaded within when one was given (`load_map(..., max_memory_mb=)`: it was dropped after
+/// the load, and a run on that map planned within the default 4096 MB), else
+/// [`DEFAULT_MAX_MEMORY_MB`](ccpp_io::scenario::DEFAULT_MAX_MEMORY_MB).
+fn memory_limit(map: &Bound<'_, PyAny>, given: Option<u64>) -> u64 {
+    given
+        .or_else(|| map.cast::<Map>().ok().and_then(|m| m.get().max_memory_mb))
+        .unwrap_or(ccpp_io::scenario::DEFAULT_MAX_MEMORY_MB)
 }
 
 /// The map files that `items` (files and folders) stand for, as `ccpp bench --maps` takes them
@@ -1979,15 +2001,12 @@ impl Env {
             .filter(|v| !v.is_none())
             .map(|v| uint_arg("max_steps", v, 1))
             .transpose()?;
-        let limit = max_memory_mb
+        let given = max_memory_mb
             .filter(|v| !v.is_none())
             .map(|v| uint_arg("max_memory_mb", v, 1))
             .transpose()?;
-        let map = as_map(
-            py,
-            map,
-            limit.unwrap_or(ccpp_io::scenario::DEFAULT_MAX_MEMORY_MB),
-        )?;
+        let limit = memory_limit(map, given);
+        let map = as_map(py, map, limit)?;
         let radius = radius.unwrap_or(DEFAULT_RADIUS);
         // `start` and `exec` are read as `ccpp.run` reads them (a text start or a number for
         // `exec` was a bare TypeError here, a CcppError there).
@@ -2019,7 +2038,7 @@ impl Env {
                 ..SimConfig::default()
             })
             .zones(area, keepout)
-            .memory_limit(limit)
+            .max_memory_mb(limit)
             .build()
             .map_err(|e| err(&e))?;
         // What a run of the same robot on the map would hold (the world, the sweep, the known
@@ -2164,6 +2183,7 @@ impl Env {
     fn map(&self) -> Map {
         Map {
             map: self.map.clone(),
+            max_memory_mb: Some(self.scenario.max_memory_mb),
         }
     }
 

@@ -535,6 +535,28 @@ def test_load_map_reads_max_memory_mb_as_run_and_env_do(room: Path) -> None:
     assert ccpp.load_map(room, max_memory_mb=None).size == ccpp.load_map(room).size
 
 
+def test_a_maps_memory_limit_is_the_default_of_the_work_on_it(room: Path) -> None:
+    # load_map's max_memory_mb bounded the load only: a run on the map planned within the
+    # default 4096 MB. A limit given to the work itself still wins.
+    tight = ccpp.load_map(room, max_memory_mb=2)
+    for work in (
+        lambda: ccpp.run(tight, "bcd"),
+        lambda: ccpp.plan(tight, "bcd"),
+        lambda: ccpp.Env(tight),
+    ):
+        with pytest.raises(ccpp.CcppError, match="memory limit of 2 MB"):
+            work()
+    assert ccpp.run(tight, "bcd", max_memory_mb=4096).metrics["collisions"] == 0
+    assert ccpp.plan(tight, "bcd", max_memory_mb=4096).finished
+    ccpp.Env(tight, max_memory_mb=4096)
+    # A map loaded without a limit gets the default, and an Env's map carries the Env's.
+    assert ccpp.run(ccpp.load_map(room), "bcd").metrics["collisions"] == 0
+    env_map = ccpp.Env(room, max_memory_mb=4000).map
+    with pytest.raises(ccpp.CcppError, match="memory limit of 2 MB"):
+        ccpp.run(env_map, "bcd", max_memory_mb=2)
+    assert ccpp.run(env_map, "bcd").metrics["collisions"] == 0
+
+
 def test_env_reads_start_and_exec_as_run_does(room: Path) -> None:
     # A text start or a number for exec was a bare TypeError from Env, a CcppError from run.
     for kw, needle in [

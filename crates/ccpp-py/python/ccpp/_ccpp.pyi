@@ -139,8 +139,9 @@ class Env:
         max_memory_mb: int | None = None,
     ) -> None:
         """``max_steps`` (>= 1) truncates episodes; values are validated as a run's.
-        ``max_memory_mb`` (default 4096) bounds the map's load and what an episode holds, as a
-        run's. One Env may be used from several threads: calls take turns."""
+        ``max_memory_mb`` (default: the limit ``map`` was loaded within, else 4096) bounds the
+        map's load and what an episode holds, as a run's. One Env may be used from several
+        threads: calls take turns."""
     def reset(self, seed: int | None = None) -> tuple[dict[str, Any], dict[str, Any]]:
         """Starts an episode; returns (observation, info). A seed draws a random free start
         (refused for an Env given ``start=``)."""
@@ -183,7 +184,8 @@ def load_map(
 ) -> Map:
     """Loads a ROS map_server YAML (with its image) or a bare PGM/PNG; an image whose pixels
     alone would need more than ``max_memory_mb`` (default 4096) in a run is refused from its
-    header, before it is decoded."""
+    header, before it is decoded. A limit given here stays with the map: it is the default
+    ``max_memory_mb`` of ``run``, ``plan`` and ``Env`` on it."""
 
 def run(
     map: Map | _Path, planner: str | None = "ba-star", radius: SupportsFloat | None = 0.15, **options: Any
@@ -195,7 +197,8 @@ def run(
     ``area``, ``keepout``) or the planner's own options (directly or in ``options={...}``; a key given
     both ways must have one value). Options that do not apply are refused; ``exec="pid"`` runs
     the planner's own PID settings, ``exec="ideal"`` beside them is refused. A keyword given as
-    ``None`` is its default, as if left out. ``max_memory_mb`` bounds the map's load too.
+    ``None`` is its default, as if left out. ``max_memory_mb`` (default: the limit a ``Map``
+    was loaded within, else 4096) bounds the map's load too.
     Ctrl-C raises ``KeyboardInterrupt`` at once (the run ends on its own thread, its result
     dropped)."""
 
