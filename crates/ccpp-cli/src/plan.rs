@@ -111,6 +111,9 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     if let Some(w) = ccpp_io::warnings::rect_lane_area_warning(&scenario) {
         say!("warning: {w}");
     }
+    for w in &plan.warnings {
+        say!("warning: {w}");
+    }
     let mut s = String::new();
     let _ = writeln!(
         s,

@@ -424,3 +424,39 @@ fn bsa_bfs_and_pid_options_change_the_run() {
         .collect();
     check_rows(&rows);
 }
+
+/// bcd's `margin_px` that no transfer can keep is said by `ccpp run` and `ccpp plan`, as a
+/// warning naming how many transfers it concerns: three rooms in a row joined by corridors
+/// 0.4 m wide (the robot's 0.3 m fit with 0.05 m to spare), the start in the middle room, so
+/// one corridor is driven again as a transfer. Without a margin nothing is said. (A margin
+/// wider than every corridor used to fall back to the plain clearance without a word.)
+#[test]
+fn a_bcd_margin_no_transfer_can_keep_is_said() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = crate::common::pgm(dir, "three_rooms.pgm", 182, 42, |x, y| {
+        ((41..71).contains(&x) || (111..141).contains(&x)) && !(17..25).contains(&y)
+    });
+    std::fs::write(dir.join("margin.yaml"), "bcd: { margin_px: 3 }\n").unwrap();
+    let said = |sub: &str, out: &str, margin: bool| {
+        let mut cmd = crate::common::ccpp();
+        cmd.args([sub, "--planner", "bcd", "--start", "4.5,1.0", "--map"])
+            .arg(&map)
+            .arg("--out")
+            .arg(dir.join(out));
+        if margin {
+            cmd.arg("--config").arg(dir.join("margin.yaml"));
+        }
+        let o = cmd.output().unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8(o.stdout).unwrap() + &String::from_utf8(o.stderr).unwrap()
+    };
+    for sub in ["run", "plan"] {
+        let text = said(sub, &format!("{sub}-margin"), true);
+        assert!(
+            text.contains("warning: bcd: margin_px 3 was not kept on "),
+            "{sub}: {text}"
+        );
+        assert!(!said(sub, &format!("{sub}-plain"), false).contains("margin_px"));
+    }
+}

@@ -40,6 +40,9 @@ pub struct Plan {
     pub stop: StopReason,
     /// Wall time of planning and execution, seconds.
     pub wall_time_s: f64,
+    /// What the planner said of the plan that its user should hear
+    /// ([`plan_warnings`](crate::warnings::plan_warnings), without `warning: `).
+    pub warnings: Vec<String>,
 }
 
 /// Why a robot radius given beside the rectangle of rect-boustrophedon's `o` changes nothing in
@@ -157,6 +160,7 @@ pub fn plan_route_until(
         route,
         stop: output.stop,
         wall_time_s: started.elapsed().as_secs_f64(),
+        warnings: crate::warnings::plan_warnings(&output.trace),
     })
 }
 

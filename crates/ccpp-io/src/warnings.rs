@@ -502,6 +502,18 @@ pub fn boxed_in_warning(trace: &Trace) -> Option<String> {
     note_warning(trace, ccpp_core::planners::random_bounce::BOXED_IN_NOTE)
 }
 
+/// Transfers of a bcd plan that could not keep its `margin_px`, said (the trace's
+/// [`MARGIN_NOTE`](ccpp_core::planners::bcd::MARGIN_NOTE); `None` otherwise).
+pub fn margin_warning(trace: &Trace) -> Option<String> {
+    note_warning(trace, ccpp_core::planners::bcd::MARGIN_NOTE)
+}
+
+/// The warnings of a plan (`ccpp plan`, Python's `plan`) that its trace holds: transfers that
+/// could not keep bcd's `margin_px` ([`margin_warning`]).
+pub fn plan_warnings(trace: &Trace) -> Vec<String> {
+    margin_warning(trace).into_iter().collect()
+}
+
 /// The trace's first note starting with `prefix`, as a warning (`None` when there is none).
 fn note_warning(trace: &Trace, prefix: &str) -> Option<String> {
     trace.events().find_map(|(_, e)| match e {
@@ -540,7 +552,7 @@ pub fn warnings_with_start(
 /// motion at all, a tool narrower than the pixels, tiles wider than the tool or stranded at
 /// the start, a rectangle whose clearance disk reaches little of the floor or whose lane
 /// rectangle bounds the work area, a random bounce boxed in, a large part of the floor never
-/// approached. `swept` are the run's swept pixels (found with its metrics).
+/// approached, bcd transfers that could not keep its `margin_px`. `swept` are the run's swept pixels (found with its metrics).
 pub fn run_warnings(
     scenario: &Scenario,
     world: &World,
@@ -583,6 +595,7 @@ pub fn run_warnings(
         ));
     }
     out.extend(outside_reach_warning(world, swept));
+    out.extend(margin_warning(trace));
     out.extend(drift_warning(scenario, trace, metrics));
     out.extend(motions_cut_warning(trace, metrics));
     if let Some(why) = &metrics.stop_reason {

@@ -1121,6 +1121,8 @@ pub struct PlanResult {
     /// The map's frame (for keep-out masks in the exports).
     frame: MapFrame,
     finished: bool,
+    /// What `ccpp plan` warns of this plan (without `warning: `).
+    warnings: Vec<String>,
     /// The files the plan read (`save` refuses a folder holding one).
     inputs: Vec<PathBuf>,
 }
@@ -1163,6 +1165,13 @@ impl PlanResult {
     #[getter]
     fn finished(&self) -> bool {
         self.finished
+    }
+
+    /// What `ccpp plan` warns of this plan (without `warning: `): transfers of a bcd plan
+    /// that could not keep its `margin_px`.
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.warnings.clone()
     }
 
     /// The path in export format `format` (`"csv"`, `"json"`, `"nav-path"`, `"geojson"`), as
@@ -1245,6 +1254,7 @@ fn plan(
         zones: p.world.zones().cloned(),
         frame: *p.world.frame(),
         finished: p.stop == StopReason::Done,
+        warnings: p.warnings,
         inputs: scenario.input_files(),
     })
 }

@@ -406,3 +406,23 @@ def test_a_maps_setting_given_to_run_or_plan_points_to_load_map(room: Path) -> N
             with pytest.raises(ccpp.CcppError, match=rf"^{key} is a setting of the map, not of the run: "
                                rf"load the map with ccpp.load_map\(path, {key}=\.\.\.\) and pass that map$"):
                 call(**{key: value})
+
+
+def test_a_bcd_margin_no_transfer_can_keep_is_a_plan_and_run_warning(tmp_path: Path) -> None:
+    # Three rooms in a row joined by corridors 0.4 m wide, the start in the middle one: one
+    # corridor is driven again as a transfer, closer to its walls than margin_px 3 asks. It
+    # fell back to the plain clearance without a word.
+    w, h = 182, 42
+    pix = bytearray()
+    for y in range(h):
+        for x in range(w):
+            wall = x in (0, w - 1) or y in (0, h - 1)
+            wall |= (41 <= x < 71 or 111 <= x < 141) and not 17 <= y < 25
+            pix.append(0 if wall else 254)
+    img = tmp_path / "three_rooms.pgm"
+    img.write_bytes(f"P5\n{w} {h}\n255\n".encode() + bytes(pix))
+    said = ccpp.plan(img, "bcd", start=(4.5, 1.0), margin_px=3).warnings
+    assert len(said) == 1 and said[0].startswith("bcd: margin_px 3 was not kept on "), said
+    assert ccpp.plan(img, "bcd", start=(4.5, 1.0)).warnings == []
+    ran = ccpp.run(img, "bcd", start=(4.5, 1.0), margin_px=3).warnings
+    assert any(w.startswith("bcd: margin_px 3 was not kept on ") for w in ran), ran

@@ -311,7 +311,8 @@ pub struct BcdOptions {
     pub lane_spacing_m: Option<f64>,
     /// Extra clearance (pixels, >= 0) that transfer paths keep from obstacles when they can,
     /// apart from the stretches next to their ends (a lane end may sit at plain clearance);
-    /// where no such path exists they fall back to the plain C-free set.
+    /// where no such path exists they fall back to the plain C-free set, and the plan says
+    /// how many of its transfers did (a [`MARGIN_NOTE`], a warning of `ccpp run` and `plan`).
     pub margin_px: f64,
     /// Cost of one turn, in metres of path, when choosing sweep directions (>= 0).
     pub turn_cost_m: f64,
@@ -377,6 +378,13 @@ pub struct BcdOptions {
 /// Default of [`BcdOptions::headland_min_m`], metres: walls and obstacles whose C-free
 /// boundary is at least this long get a headland pass in the second plan.
 pub const DEFAULT_HEADLAND_MIN_M: f64 = 6.0;
+
+/// The start of the [`Event::Note`](crate::trace::Event::Note) written when transfers of the
+/// plan come closer to obstacles than [`BcdOptions::margin_px`] asks (no way keeps that
+/// clearance, or the smoothing and pruning cut it): the command line and Python say it as a
+/// warning, with how many of the plan's transfers it concerns. A margin that could not be
+/// kept anywhere (wider than every corridor) used to be dropped without a word.
+pub const MARGIN_NOTE: &str = "bcd: margin_px";
 
 /// Most turned lattices [`BcdOptions::angle_tries`] may ask for per wall angle: half-degree
 /// steps up to 10 degrees either side, where the second wall direction may begin. Each try is

@@ -100,6 +100,9 @@ class PlanResult:
     def length_m(self) -> float: ...
     @property
     def finished(self) -> bool: ...
+    @property
+    def warnings(self) -> list[str]:
+        """What ``ccpp plan`` warns of this plan (without ``warning: ``)."""
     def export(self, format: str) -> str:
         """The text of ``ccpp plan --export FORMAT``'s file (csv, json, nav-path, geojson)."""
     def save(self, folder: _Path, export: str | Sequence[str] | None = None) -> None:

@@ -98,6 +98,48 @@ const ROT: usize = 16;
 /// Most offset-loop walks a peeled plan may have (module docs, step 3): beyond, it is not made.
 const PEEL_WALKS: usize = 32;
 
+/// The [`MARGIN_NOTE`](super::MARGIN_NOTE) of a finished plan (`None` without a margin, or
+/// when every transfer keeps it): its transfers (the moves between a backtrack's marks) whose
+/// moves come closer to obstacles than the margin asks, away from their ends.
+fn margin_note(ctx: &Ctx<'_>, items: &[Item], margin_px: f64) -> Option<String> {
+    ctx.keep_px?;
+    let (mut hops, mut short) = (0usize, 0usize);
+    // The point before the current transfer, and its moves so far.
+    let mut at: Option<Point> = None;
+    let mut hop: Option<(Point, Vec<Point>)> = None;
+    for it in items {
+        match it {
+            Item::Move(p) => {
+                if let Some((_, pts)) = hop.as_mut() {
+                    pts.push(*p);
+                }
+                at = Some(*p);
+            }
+            Item::Mark(Event::BacktrackStart) => {
+                hop = at.map(|a| (a, vec![a]));
+            }
+            Item::Mark(Event::BacktrackEnd) => {
+                if let Some((a, pts)) = hop.take() {
+                    let b = pts[pts.len() - 1];
+                    if pts.len() > 1 {
+                        hops += 1;
+                        if !pts.windows(2).all(|m| ctx.keeps_margin(m[0], m[1], [a, b])) {
+                            short += 1;
+                        }
+                    }
+                }
+            }
+            Item::Mark(_) => {}
+        }
+    }
+    (short > 0).then(|| {
+        format!(
+            "{} {margin_px} was not kept on {short} of the plan's {hops} transfers (no way keeps that clearance there, or smoothing cut it): they keep the robot's plain clearance",
+            super::MARGIN_NOTE
+        )
+    })
+}
+
 /// Factors of the user's `turn_cost_m` every plan is also made with (module docs, step 6).
 const TURN_FACTORS: [f64; 3] = [1.0, 0.5, 0.0];
 
@@ -376,12 +418,14 @@ impl Bcd {
         let best = best_index(&plans).map(|i| plans.swap_remove(i));
         let (items, ncells) = best.map_or((Vec::new(), 0), |(p, n)| (p.items, n));
         let start = frame.world_to_grid_snapped(world.start().position());
+        let note = margin_note(&ctx, &items, opts.margin_px);
 
         // A region whose moves the smoothing and pruning merged into the moves around it (or
         // a cell whose lane is a single point) has nothing left between its start and end: it
         // is not reported (marks inside it are kept), and the regions left are numbered 1, 2,
         // ... in order.
-        let mut steps = VecDeque::with_capacity(items.len());
+        let mut steps = VecDeque::with_capacity(items.len() + 1);
+        steps.extend(note.map(|text| Step::Mark(Event::Note { text })));
         let mut at = start;
         // Marks since a region's start while it has no move yet (`None`: no region pending).
         let mut pending: Option<Vec<Event>> = None;

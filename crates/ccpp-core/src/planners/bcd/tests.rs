@@ -914,3 +914,58 @@ fn plans_run_on_a_pool_of_plans_at_a_time_threads() {
         assert_eq!(b.steps, pool.steps, "{n}");
     }
 }
+
+/// A margin no way can keep is said: three rooms in a row joined by corridors one robot wide
+/// (0.2 m, robot radius 0.08 m), the start in the middle one, so one corridor is driven twice,
+/// once as a transfer. With `margin_px: 3` (more clearance than the corridor has) the plan
+/// starts with a [`super::MARGIN_NOTE`] naming the transfers; without a margin it says nothing.
+/// (A margin wider than every corridor used to fall back to the plain clearance in silence.)
+#[test]
+fn a_margin_no_transfer_can_keep_is_said() {
+    let rooms = |mid: char| {
+        let mut s = String::from("#");
+        for k in 0..3 {
+            if k > 0 {
+                s.extend(std::iter::repeat_n(mid, 5));
+            }
+            s.push_str("....");
+        }
+        s.push('#');
+        s
+    };
+    let wall = "#".repeat(24);
+    let art = [
+        wall.clone(),
+        rooms('#'),
+        rooms('#'),
+        rooms('.'),
+        rooms('#'),
+        rooms('#'),
+        wall,
+    ]
+    .join("\n");
+    let map = crate::grid::GridMap::from_ascii_scaled(&art, 10, 0.02).unwrap();
+    let world = World::new(
+        map,
+        crate::world::Robot::new(0.08),
+        Some(crate::geometry::Pose::new(2.4, 0.7, 0.0)),
+    )
+    .unwrap();
+    let note = |margin_px: f64| {
+        let opts = BcdOptions {
+            margin_px,
+            ..BcdOptions::default()
+        };
+        let plan = Bcd::new(&world, &opts);
+        plan.steps.iter().find_map(|s| match s {
+            Step::Mark(Event::Note { text }) => Some(text.clone()),
+            _ => None,
+        })
+    };
+    let said = note(3.0).expect("a note");
+    assert!(
+        said.starts_with(super::MARGIN_NOTE) && said.contains("margin_px 3 was not kept on"),
+        "{said}"
+    );
+    assert_eq!(note(0.0), None);
+}
