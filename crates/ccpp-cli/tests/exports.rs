@@ -602,3 +602,50 @@ fn plan_takes_zones_and_exports_them() {
     let g: serde_json::Value = serde_json::from_str(&read(&run.join("path.geojson"))).unwrap();
     assert_eq!(named(&g), want, "{g}");
 }
+
+/// `ccpp plan` says what `ccpp run` says of a path that goes nowhere and of lanes the tool
+/// cannot fill (a plan has no coverage figures to show it): a rect-boustrophedon path of one
+/// waypoint (its 0.6 m rectangle fits nowhere else beside a keep-out in a 2 x 1.5 m room) was
+/// written at 0 m without a word, and bcd's lanes a pixel apart for a tool narrower than a
+/// pixel left strips unswept in silence. The usual plans say neither.
+#[test]
+fn plan_warns_of_a_path_that_goes_nowhere_and_of_lanes_the_tool_cannot_fill() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let small = pgm(dir, "small.pgm", 40, 30, |_, _| false);
+    let ko = dir.join("ko.yaml");
+    std::fs::write(
+        &ko,
+        "polygons:\n  - [[1.2955, 0.8735], [0.9918, 1.2711], [0.7468, 0.8642]]\n",
+    )
+    .unwrap();
+    let said = |map: &Path, planner: &str, args: &[&str], out: &str| {
+        let o = ccpp()
+            .args(["plan", "--planner", planner, "--map"])
+            .arg(map)
+            .args(args)
+            .arg("--out")
+            .arg(dir.join(out))
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8(o.stdout).unwrap() + &String::from_utf8(o.stderr).unwrap()
+    };
+    let still = "warning: the path does not move the robot (one waypoint, 0 m)";
+    let ko_arg = ko.to_str().unwrap();
+    let text = said(
+        &small,
+        "rect-boustrophedon",
+        &["--keepout", ko_arg, "--radius", "0.3"],
+        "still",
+    );
+    assert!(
+        text.contains(still) && text.contains("1 waypoints, 0.00 m"),
+        "{text}"
+    );
+    assert!(!said(&small, "rect-boustrophedon", &["--radius", "0.3"], "moves").contains(still));
+    let map = room(dir);
+    let narrow = "warning: the tool sweeps 0.04 m but bcd's lanes lie at least a map pixel";
+    assert!(said(&map, "bcd", &["--tool-radius", "0.02"], "narrow").contains(narrow));
+    assert!(!said(&map, "bcd", &[], "wide").contains("warning:"));
+}

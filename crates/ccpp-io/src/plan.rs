@@ -155,12 +155,13 @@ pub fn plan_route_until(
     let output = simulate_until(&world, planner.as_mut(), &sim, &mut |_| {}, stop)
         .ok_or(ScenarioError::Interrupted)?;
     let route = Route::from_trace(&output.trace, tolerance_m);
+    let warnings = crate::warnings::plan_warnings(scenario, &world, &output.trace, &route);
     Ok(Plan {
         world,
         route,
         stop: output.stop,
         wall_time_s: started.elapsed().as_secs_f64(),
-        warnings: crate::warnings::plan_warnings(&output.trace),
+        warnings,
     })
 }
 

@@ -508,10 +508,49 @@ pub fn margin_warning(trace: &Trace) -> Option<String> {
     note_warning(trace, ccpp_core::planners::bcd::MARGIN_NOTE)
 }
 
-/// The warnings of a plan (`ccpp plan`, Python's `plan`) that its trace holds: transfers that
-/// could not keep bcd's `margin_px` ([`margin_warning`]).
-pub fn plan_warnings(trace: &Trace) -> Vec<String> {
-    margin_warning(trace).into_iter().collect()
+/// The warnings of a plan (`ccpp plan`, Python's `plan`): a path that does not move the
+/// robot ([`still_plan_warning`]), bcd lanes farther apart than the tool sweeps
+/// ([`narrow_lanes_warning`]), transfers that could not keep bcd's `margin_px`
+/// ([`margin_warning`]). A run says the first two its own way ([`no_motion_warning`],
+/// [`narrow_tool_warning`]); a plan, which has no coverage figures, said nothing.
+pub fn plan_warnings(
+    scenario: &Scenario,
+    world: &World,
+    trace: &Trace,
+    route: &ccpp_core::route::Route,
+) -> Vec<String> {
+    still_plan_warning(route)
+        .into_iter()
+        .chain(narrow_lanes_warning(scenario, world))
+        .chain(margin_warning(trace))
+        .collect()
+}
+
+/// A plan whose path does not move the robot (one waypoint, 0 m), said: `ccpp plan` wrote it
+/// without a word where `ccpp run` warns that the robot did not move (rect-boustrophedon whose
+/// rectangle fits nowhere else in the area a keep-out leaves it).
+pub fn still_plan_warning(route: &ccpp_core::route::Route) -> Option<String> {
+    (route.length_m() == 0.0).then(|| {
+        "the path does not move the robot (one waypoint, 0 m): the planner found nowhere to go from the start, as when its lanes do not fit the floor, the area or what the keep-outs leave at this robot size".to_string()
+    })
+}
+
+/// bcd lanes farther apart than the tool sweeps, said (`None` otherwise): its lanes lie at
+/// least a map pixel apart, so a tool narrower than a pixel (`--tool-radius 0.02` on a 0.05 m
+/// map) leaves strips between them that no pass sweeps. A plan wrote such lanes without a word
+/// (an explicit `lane_spacing_m` that wide is refused).
+pub fn narrow_lanes_warning(scenario: &Scenario, world: &World) -> Option<String> {
+    let res = world.frame().resolution;
+    let sweep = 2.0 * world.robot().tool_radius;
+    (matches!(scenario.planner, ccpp_core::planners::PlannerConfig::Bcd(_)) && sweep < res).then(
+        || {
+            format!(
+                "the tool sweeps {} m but bcd's lanes lie at least a map pixel ({} m) apart: strips between them stay unswept (use a finer map or a wider tool)",
+                ccpp_core::display::Compact(sweep),
+                ccpp_core::display::Compact(res)
+            )
+        },
+    )
 }
 
 /// The trace's first note starting with `prefix`, as a warning (`None` when there is none).

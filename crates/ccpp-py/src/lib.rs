@@ -1167,8 +1167,9 @@ impl PlanResult {
         self.finished
     }
 
-    /// What `ccpp plan` warns of this plan (without `warning: `): transfers of a bcd plan
-    /// that could not keep its `margin_px`.
+    /// What `ccpp plan` warns of this plan (without `warning: `): a path that does not move
+    /// the robot, bcd lanes farther apart than the tool sweeps, transfers that could not keep
+    /// bcd's `margin_px`.
     #[getter]
     fn warnings(&self) -> Vec<String> {
         self.warnings.clone()
