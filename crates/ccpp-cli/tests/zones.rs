@@ -1109,3 +1109,29 @@ fn a_tile_planners_approach_ends_where_its_lattice_leads_out_of_a_pocket() {
         assert!(ec > 0.75, "{planner}: {ec}");
     }
 }
+
+/// rect-boustrophedon's clearance disk that fits nowhere in a small area names the area: it
+/// said "fits nowhere on the map (the widest free spot has clearance 0.175 m)" of a map whose
+/// widest spot has about 2.8 m, 0.175 m being the area's.
+#[test]
+fn a_disk_that_fits_nowhere_in_the_area_names_the_area() {
+    let Some(maps) = crate::common::shared_maps() else {
+        return;
+    };
+    let d = tempfile::tempdir().unwrap();
+    let o = ccpp()
+        .args(["plan", "--planner", "rect-boustrophedon", "--map"])
+        .arg(maps.join("teb_empty_box.yaml"))
+        .args(["--area=-0.2,-0.2,0.2,0.2", "--out"])
+        .arg(d.path().join("out"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8(o.stderr).unwrap();
+    assert!(
+        err.contains("fits nowhere in what the area and keep-outs leave of the map")
+            && !err.contains("on the map"),
+        "{err}"
+    );
+    assert_eq!(err.lines().count(), 1, "{err}");
+}

@@ -209,6 +209,11 @@ fn clearance_world(world: &World, opts: &RectOptions) -> Result<(World, f64), St
             let why = match e {
                 E::StartInObstacle { .. } => "it overlaps occupied or unknown pixels there".into(),
                 E::StartInKeepout { .. } => "it overlaps a keep-out zone there".into(),
+                // (`world.map()` is the planning map: with zones, what the area and keep-outs
+                // leave of the floor, so the widest spot is theirs, not the drawn map's)
+                E::RobotTooBig { max_clearance, .. } if world.zones().is_some() => {
+                    format!("it fits nowhere in what the area and keep-outs leave of the map (the widest free spot there has clearance {max_clearance:.3} m)")
+                }
                 E::RobotTooBig { max_clearance, .. } => {
                     format!("it fits nowhere on the map (the widest free spot has clearance {max_clearance:.3} m)")
                 }
