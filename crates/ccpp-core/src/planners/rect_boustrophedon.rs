@@ -297,25 +297,37 @@ fn stop_valid(rw: &World, p: Point) -> bool {
 ///
 /// # Errors
 /// `clearance_radius_m`: why the disk does not fit, with the disk, the rectangle and the
-/// start. `area`: the area, clipped to the map, and the clearance radius, when no lane point
-/// is valid.
+/// start. `area`: the area as given and the clearance radius, when no lane point is valid
+/// (with the reachable floor's box when the area misses it).
 pub fn check(world: &World, opts: &RectOptions) -> Result<(), OptionsError> {
     let (rw, rad) =
         clearance_world(world, opts).map_err(|m| OptionsError::new("clearance_radius_m", m))?;
-    if opts.area.is_none() {
+    let Some(given) = opts.area else {
         return Ok(());
-    }
+    };
     let area = lane_area(&rw, opts);
     let robot = world.robot();
     let lanes = lanes(area, opts.length_for(&robot), opts.width_for(&robot));
     if lanes.iter().flatten().any(|&p| stop_valid(&rw, p)) {
         return Ok(());
     }
+    // The area as the user gave it (the clipped one, shown before, came out reversed and
+    // with rounding noise where the area misses the floor: `0.425,0.375,0.2,0.2` for
+    // `0,0,0.2,0.2`), and why when it misses the floor the disk reaches.
+    let outside = if area[0] > area[2] || area[1] > area[3] {
+        let floor = reachable_box(&rw);
+        format!(
+            " (it lies outside the box of the floor the disk reaches, {:.3},{:.3},{:.3},{:.3})",
+            floor[0], floor[1], floor[2], floor[3]
+        )
+    } else {
+        String::new()
+    };
     Err(OptionsError::new(
         "area",
         format!(
-            "{} holds no lane point where the robot (clearance disk {:.3} m) fits and that it can reach from the start",
-            crate::display::join(&area),
+            "{} holds no lane point where the robot (clearance disk {:.3} m) fits and that it can reach from the start{outside}",
+            crate::display::join(&given),
             rad
         ),
     ))
