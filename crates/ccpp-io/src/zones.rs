@@ -357,7 +357,7 @@ fn point(v: &Value, geo: bool) -> Result<[f64; 2], ZoneFileError> {
             Ok([num(&a[0])?, num(&a[1])?])
         }
         Value::Array(a) if a.len() > most => Err(bad(format!(
-            "point [{}{}] has {} numbers; a point is {}",
+            "point [{}{}] has {} {}; a point is {}",
             a.iter()
                 .take(4)
                 .map(Value::to_string)
@@ -365,8 +365,18 @@ fn point(v: &Value, geo: bool) -> Result<[f64; 2], ZoneFileError> {
                 .join(", "),
             if a.len() > 4 { ", ..." } else { "" },
             a.len(),
+            // (a list nested once too deep is a point of lists, not of numbers)
+            if a.iter().all(Value::is_number) {
+                "numbers"
+            } else {
+                "items"
+            },
             if geo { "[x, y] or [x, y, z]" } else { "[x, y]" }
-        ))),
+        ) + if a.iter().any(Value::is_array) {
+            " (a level of brackets too many?)"
+        } else {
+            ""
+        })),
         // (`z` too, as a `geometry_msgs/Point32` list is dumped, when it is a number: the
         // plane's zones ignore it, as a GeoJSON position's third number)
         Value::Object(o) => match (o.get("x"), o.get("y")) {
@@ -768,6 +778,15 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("[x, y] or [x, y, z]"), "{e}");
+        // A list of points a level too deep: items, not numbers (it said "point [[-2, -2],
+        // [2, -2], [2, 2]] has 3 numbers").
+        let e = yaml("- [[[-2, -2], [2, -2], [2, 2]]]\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("has 3 items; a point is [x, y] (a level of brackets too many?)"),
+            "{e}"
+        );
         // One polygon's points and a list of points mixed: named as such (it was "point
         // [[2, 2], [3, 2], [3, 3]] has 3 numbers").
         let e = yaml("- [-1, 2]\n- [[2, 2], [3, 2], [3, 3]]\n")
