@@ -581,8 +581,12 @@ fn geojson_collect(
         },
         "Feature" => match v.get("geometry") {
             Some(g) if !g.is_null() => {
-                let kind = v.pointer("/properties/kind").and_then(Value::as_str);
-                if let (Some(role), Some(kind)) = (kinds.role, kind) {
+                // (matched whatever its case: a hand-written `"Keepout"` was taken as area)
+                let kind = v
+                    .pointer("/properties/kind")
+                    .and_then(Value::as_str)
+                    .map(str::to_ascii_lowercase);
+                if let (Some(role), Some(kind)) = (kinds.role, kind.as_deref()) {
                     if kind == "path" {
                         return Ok(());
                     }
@@ -716,6 +720,25 @@ mod tests {
 
     /// A YAML point is `[x, y]` or `{x, y}` and nothing more; a `GeoJSON` position may add
     /// an altitude. A row `[0, -4, 2, -4]` (two points on one line) was read as `[0, -4]`.
+    /// A feature's `kind` is matched whatever its case: a hand-written `"Keepout"` was read as
+    /// area (`--area` took the keep-out's polygon as part of the work area).
+    #[test]
+    fn feature_kinds_match_whatever_their_case() {
+        let v: Value = serde_json::from_str(
+            r#"{"type":"FeatureCollection","features":[
+              {"type":"Feature","properties":{"kind":"Area"},"geometry":{"type":"Polygon","coordinates":[[[0,0],[4,0],[4,4],[0,0]]]}},
+              {"type":"Feature","properties":{"kind":"Keepout"},"geometry":{"type":"Polygon","coordinates":[[[1,1],[2,1],[2,2],[1,1]]]}},
+              {"type":"Feature","properties":{"kind":"PATH"},"geometry":{"type":"Polygon","coordinates":[[[5,5],[6,5],[6,6],[5,5]]]}}]}"#,
+        )
+        .unwrap();
+        let area = geojson_polygons_as(&v, "area").unwrap();
+        assert_eq!(area.len(), 1);
+        assert_eq!(area[0].points[1], [4.0, 0.0]);
+        let keep = geojson_polygons_as(&v, "keepout").unwrap();
+        assert_eq!(keep.len(), 1);
+        assert_eq!(keep[0].points[1], [2.0, 1.0]);
+    }
+
     #[test]
     fn points_with_more_numbers_are_refused() {
         let yaml = |t: &str| yaml_polygons(&serde_saphyr::from_str::<Value>(t).unwrap());
