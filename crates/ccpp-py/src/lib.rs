@@ -1805,10 +1805,15 @@ pub struct Env {
     robot: Robot,
     sim: SimConfig,
     max_steps: Option<u64>,
+    /// What a run of the same robot on the map holds without its trace (the estimate the map
+    /// was checked with), bytes: with the episode's trace, held against the memory limit.
+    base_bytes: f64,
     episode: Option<Episode>,
     /// The episode terminated or was truncated: `step` refuses until `reset` (a robot that had
     /// hit a wall kept moving, and a truncated episode kept adding path).
     ended: bool,
+    /// The last step truncated the episode at the memory limit (`info["memory_limit"]`).
+    memory_cut: bool,
 }
 
 /// `(observation, reward, terminated, truncated, info)` of [`Env::step`].
@@ -1879,6 +1884,7 @@ impl Env {
         let t = live.sim.true_pose();
         d.set_item("true_pose", (t.x, t.y, t.theta))?;
         d.set_item("bumped", live.sim.bumped())?;
+        d.set_item("memory_limit", self.memory_cut)?;
         Ok(d.unbind())
     }
 }
@@ -2054,7 +2060,7 @@ impl Env {
             .map_err(|e| err(&e))?;
         // What a run of the same robot on the map would hold (the world, the sweep, the known
         // map), against the limit: an episode holds as much.
-        s.check_driven_map(&map).map_err(|e| err(&e))?;
+        let base_bytes = s.check_driven_map(&map).map_err(|e| err(&e))?.bytes;
         let zones = py.detach(|| s.zone_masks(&map)).map_err(|e| err(&e))?;
         // The zones and the start are checked now, not at the first reset.
         py.detach(|| s.world_with_zones(&map, zones.clone()))
@@ -2066,8 +2072,10 @@ impl Env {
             robot: s.robot,
             sim: s.sim,
             max_steps,
+            base_bytes,
             episode: None,
             ended: false,
+            memory_cut: false,
         })
     }
 
@@ -2144,6 +2152,7 @@ impl Env {
         .map_err(|e| err(&e))?;
         self.episode = Some(episode);
         self.ended = false;
+        self.memory_cut = false;
         Ok((self.observation(py)?, self.info(py, false)?))
     }
 
@@ -2151,7 +2160,9 @@ impl Env {
     /// `("move_to", x, y)` — and returns `(observation, reward, terminated, truncated, info)`:
     /// the reward is the newly swept accessible area in m²; the episode terminates on a
     /// collision (the bumper) or when every accessible pixel is swept; it is truncated after
-    /// `max_steps` actions. A step after the episode has ended is refused (call `reset`).
+    /// `max_steps` actions, or when what the episode holds (its recorded path, with the map's
+    /// share) passes `max_memory_mb` (`info["memory_limit"]` is then true). A step after the
+    /// episode has ended is refused (call `reset`).
     fn step(&mut self, py: Python<'_>, action: &Bound<'_, PyAny>) -> PyResult<StepResult> {
         let step = parse_action(action)?;
         if self.ended {
@@ -2163,7 +2174,7 @@ impl Env {
             .episode
             .as_mut()
             .ok_or_else(|| msg("the episode has not begun: call reset() first"))?;
-        let (gain, collided, done, steps) = ep.with_dependent_mut(|world, live| {
+        let (gain, collided, done, steps, trace_bytes) = ep.with_dependent_mut(|world, live| {
             let before = live.covered;
             live.sim.execute(step);
             live.steps += 1;
@@ -2176,9 +2187,15 @@ impl Env {
                 collided,
                 done,
                 live.steps,
+                live.sim.trace().heap_bytes(),
             )
         });
-        let truncated = self.max_steps.is_some_and(|m| steps >= m);
+        // The episode's trace grows with every step (by about 1 kB a second of PID
+        // execution): past the memory limit the episode is truncated, as a run is refused
+        // (an Env left stepping grew without bound, 3.5 GB at `max_memory_mb=17`).
+        self.memory_cut = self.base_bytes + trace_bytes as f64
+            > self.scenario.max_memory_mb as f64 * 1024.0 * 1024.0;
+        let truncated = self.memory_cut || self.max_steps.is_some_and(|m| steps >= m);
         self.ended = collided || done || truncated;
         Ok((
             self.observation(py)?,

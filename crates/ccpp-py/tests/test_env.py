@@ -195,3 +195,25 @@ def test_env_memory_is_its_own_not_a_planners(shared_maps: Path) -> None:
     # What it does hold is still checked against the limit, naming the step API.
     with pytest.raises(ccpp.CcppError, match="the step API would need"):
         ccpp.Env(shared_maps / "teb_maze.yaml", radius=0.001, max_memory_mb=17)
+
+
+def test_an_episode_is_truncated_at_the_memory_limit(room: Path) -> None:
+    # An Env left stepping grew without bound (3.5 GB at max_memory_mb=17, PID execution):
+    # the episode's recorded path now counts against the limit, and the episode is truncated
+    # there, saying so in info; reset starts a fresh one.
+    env = ccpp.Env(room, exec="pid", max_memory_mb=18)
+    for _ in range(2):
+        env.reset()
+        for n in range(1, 100_000):
+            _, _, terminated, truncated, info = env.step(("rotate", 3.0))
+            if terminated or truncated:
+                break
+        assert truncated and not terminated and info["memory_limit"], (n, info)
+        with pytest.raises(ccpp.CcppError, match="call reset"):
+            env.step(("rotate", 3.0))
+    # Under the default limit the same steps go on.
+    env = ccpp.Env(room, exec="pid")
+    env.reset()
+    for _ in range(n + 10):
+        *_, truncated, info = env.step(("rotate", 3.0))
+        assert not truncated and not info["memory_limit"]

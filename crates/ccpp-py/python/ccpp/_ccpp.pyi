@@ -141,7 +141,9 @@ class Env:
         keepout: Any = None,
         max_memory_mb: int | None = None,
     ) -> None:
-        """``max_steps`` (>= 1) truncates episodes; values are validated as a run's.
+        """``max_steps`` (>= 1) truncates episodes; values are validated as a run's. ``area``
+        and ``keepout`` are shown to the sensor as walls but do not stop the robot: a step into
+        a keep-out (or out of the area) counts in ``metrics()["keepout_violations"]``.
         ``max_memory_mb`` (default: the limit ``map`` was loaded within, else 4096) bounds the
         map's load and what an episode holds, as a run's. One Env may be used from several
         threads: calls take turns."""
@@ -152,7 +154,9 @@ class Env:
         self, action: Sequence[Any]
     ) -> tuple[dict[str, Any], float, bool, bool, dict[str, Any]]:
         """``("rotate", a)``, ``("translate", d)`` or ``("move_to", x, y)`` ->
-        (observation, reward m², terminated, truncated, info)."""
+        (observation, reward m², terminated, truncated, info). Truncated after ``max_steps``
+        actions, or when the episode's recorded path passes ``max_memory_mb``
+        (``info["memory_limit"]`` is then True)."""
     @property
     def map(self) -> Map: ...
     @property
