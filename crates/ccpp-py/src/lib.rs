@@ -591,12 +591,20 @@ fn uint_arg(key: &str, v: &Bound<'_, PyAny>, lo: u64) -> PyResult<u64> {
     } else {
         u64::MAX
     };
-    v.extract().map_err(|_| {
+    let range = || {
         msg(format!(
             "{key} must be a whole number from {lo} to {hi}, got {}",
             repr(v)
         ))
-    })
+    };
+    let n: u64 = v.extract().map_err(|_| range())?;
+    // The memory limit's range is checked here too: `0` or `2**62` passed, and were refused
+    // only later, by the run (`bench_run` made them a row's error, `sweep` every row's). The
+    // other keys' ranges are the scenario's, which says them as the command line does.
+    if key == "max_memory_mb" && !(lo..=hi).contains(&n) {
+        return Err(range());
+    }
+    Ok(n)
 }
 
 /// Whether two Python values set an option alike: equal, or text equal but for case (option

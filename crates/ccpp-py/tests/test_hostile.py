@@ -772,3 +772,16 @@ def test_save_below_a_busy_bench_folder_is_refused(room: Path, tmp_path: Path) -
         holder.wait()
     r.save(held / "runs" / "mine")
     assert (held / "runs" / "mine" / "metrics.json").is_file()
+
+
+def test_memory_limits_out_of_range_are_refused_before_any_work(room: Path) -> None:
+    # 0 and 2**62 passed the keyword reading and were refused by the run only: bench_run made
+    # them the row's error, and sweep started its cluster and wrote an error row per run.
+    from ccpp import _ccpp
+
+    for bad in (0, 2**40 + 1, 2**62):
+        with pytest.raises(ccpp.CcppError, match="from 1 to 1099511627776"):
+            _ccpp.bench_run(str(room), "bcd", max_memory_mb=bad)
+        with pytest.raises(ccpp.CcppError, match="max_memory_mb"):
+            ccpp.sweep(room, "bcd", max_memory_mb=bad)
+    assert _ccpp.bench_run(str(room), "bcd", max_memory_mb=2**40)[1] is None

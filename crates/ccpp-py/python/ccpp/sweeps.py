@@ -298,9 +298,9 @@ def sweep(
         isinstance(max_memory_mb, bool)
         or not isinstance(max_memory_mb, numbers.Integral)
         or max_memory_mb < 1
-        or max_memory_mb >= 2**64
+        or max_memory_mb > 2**40  # the library's limit (1 EiB), as `ccpp bench --max-memory`
     ):
-        raise _ccpp.CcppError(f"max_memory_mb must be a whole number of MB >= 1, got {max_memory_mb!r}")
+        raise _ccpp.CcppError(f"max_memory_mb must be a whole number of MB from 1 to {2**40}, got {max_memory_mb!r}")
     if inflate is not None and (
         isinstance(inflate, bool)
         or not isinstance(inflate, numbers.Real)
