@@ -1341,10 +1341,12 @@ impl RunResult {
         self.warnings.clone()
     }
 
-    /// The start pose used, `(x, y, theta)`.
+    /// The start pose used, `(x, y, theta)`: where the robot was placed, the first pose of
+    /// `path` and the start of `run.json`. (With a start outside the area it was the point
+    /// where the drive to the area ends, which neither `path` nor `run.json` holds.)
     #[getter]
     fn start(&self) -> (f64, f64, f64) {
-        let s = self.world.start();
+        let s = self.world.initial_pose();
         (s.x, s.y, s.theta)
     }
 

@@ -184,3 +184,12 @@ def test_zone_and_seed_arguments_take_paths_and_numpy(room: Path, tmp_path: Path
         ccpp.run(room, "bcd", area=[0, 0, 1])
     with pytest.raises(ccpp.CcppError, match="keepout must be a zone"):
         ccpp.run(room, "bcd", keepout=[0, 0, 1])
+
+
+def test_a_runs_start_is_where_the_robot_was_placed(shared_maps: Path) -> None:
+    # With a start outside the area, RunResult.start was where the drive to the area ends:
+    # neither the path's first pose nor run.json's start.
+    r = ccpp.run(shared_maps / "teb_maze.yaml", "bcd", area=[0, 0, 5, 5], start=(8, 8))
+    assert r.start == (8.0, 8.0, 0.0)
+    assert tuple(r.path[0]) == r.start
+    assert json.loads(r.scenario_json)["start"] == [8.0, 8.0, 0.0]
