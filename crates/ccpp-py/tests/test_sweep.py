@@ -7,6 +7,7 @@ import os
 import subprocess
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 pd = pytest.importorskip("pandas")
@@ -163,6 +164,13 @@ def test_sweep_takes_one_planner_name_and_none_as_defaults(room: Path, client) -
     # bytes, are refused naming the value (hostile pass).
     gen = ccpp.sweep(str(room), ["bsa"], (r for r in [0.2, 0.25]), client=client)
     assert gen["robot_radius_m"].tolist() == [0.2, 0.25]
+    # A 0-d numpy array is a number, as ccpp.run takes it (a sweep refused np.array(0.2)).
+    zero_d = ccpp.sweep(str(room), ["bsa"], np.array(0.2), client=client)
+    assert zero_d["robot_radius_m"].tolist() == [0.2]
+    listed = ccpp.sweep(str(room), ["bsa"], [np.array(0.25)], client=client)
+    assert listed["robot_radius_m"].tolist() == [0.25]
+    with pytest.raises(ccpp.CcppError, match="radii must be"):
+        ccpp.sweep(str(room), ["bsa"], np.array(True), client=client)
     with pytest.raises(ccpp.CcppError, match=r"radii must be a number or numbers \(metres\), got True"):
         ccpp.sweep(str(room), ["bsa"], True, client=client)
     with pytest.raises(ccpp.CcppError, match=r"planners must be names \(str\), got b'bsa'"):

@@ -97,7 +97,10 @@ def _extra(module: str) -> Any:
 def _is_number(v: object) -> bool:
     """A real number as ``ccpp.run`` takes one for a radius: a ``numbers.Real`` (numpy's
     scalars too) or a ``decimal.Decimal`` (which ``run`` took and a sweep tried to iterate),
-    not a bool."""
+    not a bool; a 0-d numpy array of numbers too, as ``run`` takes it (a sweep refused
+    ``np.array(0.2)``)."""
+    if getattr(v, "ndim", None) == 0:
+        return getattr(getattr(v, "dtype", None), "kind", None) in ("i", "u", "f")
     return not isinstance(v, bool) and isinstance(v, (numbers.Real, decimal.Decimal))
 
 
