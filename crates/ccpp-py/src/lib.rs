@@ -598,11 +598,11 @@ fn uint_arg(key: &str, v: &Bound<'_, PyAny>, lo: u64) -> PyResult<u64> {
         ))
     };
     let n: u64 = v.extract().map_err(|_| range())?;
-    // The memory limit's range is checked here too: `0` or `2**62` passed, and were refused
-    // only later, by the run (`bench_run` made them a row's error, `sweep` every row's). The
-    // other keys' ranges are the scenario's, which says them as the command line does.
-    if key == "max_memory_mb" && !(lo..=hi).contains(&n) {
-        return Err(range());
+    // The memory limit's range is checked here too, by the scenario's own check: `0` or
+    // `2**62` passed, and were refused only later, by the run (`bench_run` made them a row's
+    // error, `sweep` every row's). The other keys' ranges are the scenario's, checked there.
+    if key == "max_memory_mb" {
+        ccpp_io::scenario::check_memory_limit(n).map_err(|e| err(&e))?;
     }
     Ok(n)
 }
