@@ -174,8 +174,9 @@ pub struct RunArgs {
     /// Planner options.
     #[command(flatten)]
     pub options: OptionsArgs,
-    /// Sensor range in metres (default 4 r) of random-bounce, ba-star-extended and
-    /// bsa-extended; ba-star, bsa and bsa-bfs decide from their neighbour tiles alone and sense
+    /// Sensor range in metres of random-bounce, ba-star-extended and bsa-extended (default
+    /// 4 r, or the least the planner runs with where that is more: a robot of a pixel or two,
+    /// a tile wider than 3 r); ba-star, bsa and bsa-bfs decide from their neighbour tiles alone and sense
     /// as far as that needs (refused for them and for the offline planners)
     #[arg(long, value_parser = parse_number, value_name = "M")]
     pub sensor_range: Option<f64>,

@@ -993,6 +993,42 @@ fn max_memory_refuses_and_allows() {
     );
 }
 
+/// With no `--sensor-range`, the default 4 r is raised to the least range the planner runs
+/// with, so a run the user gave no range for is not refused for its range: a robot of about
+/// a pixel (random-bounce needs r + 2 px, bsa-extended a neighbour cell's disk, 3 r + half a
+/// pixel) or a tile wider than 3 r (ba-star-extended sees its neighbour tiles whole). Before,
+/// these three were refused with "the sensor range 4 r m ..." and asked to raise a flag never
+/// given. The raised default runs exactly as that range asked for.
+#[test]
+fn default_sensor_range_rises_to_what_the_planner_needs() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = box60(dir);
+    for (p, args, least) in [
+        ("random-bounce", &["--radius", "0.03", "--seed", "3"][..], "0.13005"),
+        ("bsa-extended", &["--radius", "0.02"][..], "0.085"),
+        ("ba-star-extended", &["--tile-side", "0.5"][..], "0.675"),
+    ] {
+        let a = run_ok(dir, &format!("{p}-default"), &map, p, args);
+        let m = metrics(&a);
+        assert!(m["path_length_m"].as_f64().unwrap() > 1.0, "{p}: {m}");
+        assert_eq!(m["collisions"], 0, "{p}");
+        let mut with = args.to_vec();
+        with.extend(["--sensor-range", least]);
+        let b = run_ok(dir, &format!("{p}-least"), &map, p, &with);
+        assert_eq!(
+            std::fs::read(a.join("path.csv")).unwrap(),
+            std::fs::read(b.join("path.csv")).unwrap(),
+            "{p}: the raised default is not the least range"
+        );
+        assert_eq!(m, metrics(&b), "{p}");
+        // A range asked for below it is still refused.
+        let mut short = args.to_vec();
+        short.extend(["--sensor-range", "0.06"]);
+        run_fails(dir, &map, p, &short, &["sensor range"]);
+    }
+}
+
 #[test]
 fn absurd_sizes_end_within_seconds() {
     let d = tempfile::tempdir().unwrap();
@@ -1026,18 +1062,21 @@ fn absurd_sizes_end_within_seconds() {
         };
         run_fails(dir, &map, p, args, &["memory limit"]);
     }
-    // random-bounce's sensor (4 r) sees nothing beyond its footprint at this radius.
+    // With no range asked for, random-bounce's sensor is raised from 4 r to what it needs
+    // (r + 2 px and a little), so at this radius the size is what is refused (it was refused
+    // for the range the user never gave).
     run_fails(
         dir,
         &map,
         "random-bounce",
         &["--radius", "1e-6"],
-        &["sensor range"],
+        &["memory limit"],
     );
-    // Nor half a pixel beyond it (0.05 m map): these runs turned in place 65 times and ended
-    // "done" at 0 m (r = 0.03 at the default 4 r, and a range of r + 1.6 px).
+    // A range asked for that sees less than half a pixel beyond the footprint is refused
+    // (0.05 m map): such runs turned in place 65 times and ended "done" at 0 m (r = 0.03 at
+    // 4 r, and a range of r + 1.6 px).
     for args in [
-        &["--radius", "0.03"][..],
+        &["--radius", "0.03", "--sensor-range", "0.12"][..],
         &["--radius", "0.15", "--sensor-range", "0.23"],
     ] {
         run_fails(

@@ -56,8 +56,10 @@ fn is_rounding_turn(turn: f64, dist: f64, a: Point, b: Point) -> bool {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SimConfig {
-    /// Sensor range in metres; `None` = `4 r` (enough to classify all 8 neighbour tiles).
-    /// Ranges beyond twice the map's diagonal run as that ([`SimConfig::sensor_range_on`]).
+    /// Sensor range in metres; `None` = `4 r` (enough to classify all 8 neighbour tiles). A
+    /// run built from a scenario (the CLI's, Python's) raises a `None` to the planner's
+    /// [`least_sensor_range`](crate::planners::PlannerSettings::least_sensor_range) where
+    /// that is more. Ranges beyond twice the map's diagonal run as that ([`SimConfig::sensor_range_on`]).
     pub sensor_range: Option<f64>,
     /// Safety cap on planner steps (default 50 million): a bound on the run's time and trace
     /// that no finishing planner comes near (the bench's longest run, random-bounce on the

@@ -1140,11 +1140,11 @@ impl Scenario {
         self.setup_on(map.grid.frame())
     }
 
-    /// [`Self::setup`] for a map of `frame`: the sensor range in force is the one asked for
-    /// (default 4 r), or for a planner that decides from its neighbour tiles alone, with no
-    /// range asked for, at least what sees them
-    /// ([`sensor_need`](ccpp_core::planners::PlannerSettings::sensor_need): a tiny robot
-    /// or a large tile needs more than 4 r, and more changes nothing).
+    /// [`Self::setup`] for a map of `frame`: the sensor range in force is the one asked for,
+    /// or with no range asked for 4 r raised to the least the planner runs with
+    /// ([`least_sensor_range`](ccpp_core::planners::PlannerSettings::least_sensor_range): a
+    /// robot of a pixel or two, or a tile wider than 3 r, needs more than 4 r; for a planner
+    /// that decides from its neighbour tiles alone more changes nothing).
     fn setup_on(&self, frame: &MapFrame) -> Setup {
         let mut setup = Setup {
             frame: *frame,
@@ -1154,7 +1154,7 @@ impl Scenario {
             noisy: matches!(self.execution(), Execution::Pid(p) if p.noise.is_some()),
         };
         if self.sim.sensor_range.is_none() {
-            if let Some(need) = self.planner.settings().sensor_need(&setup) {
+            if let Some(need) = self.planner.settings().least_sensor_range(&setup) {
                 setup.sensor_range = setup.sensor_range.max(need);
             }
         }

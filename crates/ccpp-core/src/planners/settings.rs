@@ -263,6 +263,16 @@ pub trait PlannerSettings {
         None
     }
 
+    /// The shortest sensor range the planner runs with on `setup`, if it needs more than
+    /// nothing: a run that asks for no range senses at least this far (the default `4 r` is
+    /// raised to it: a robot of a pixel or two, or a tile wider than `3 r`, needs more), and
+    /// a range asked for below it is refused by [`check`](Self::check). Default:
+    /// [`sensor_need`](Self::sensor_need), which for the planners it is given for is also
+    /// all they ever use.
+    fn least_sensor_range(&self, setup: &Setup) -> Option<f64> {
+        self.sensor_need(setup)
+    }
+
     /// The tile (cell) side the planner works on, if it is tile-based.
     fn tile_side(&self, robot: &Robot) -> Option<f64>;
 
@@ -739,6 +749,15 @@ fn least_shown(min: f64) -> f64 {
     shown
 }
 
+/// The shortest sensor range random-bounce runs with. It looks `range - r - 1.5 px` ahead
+/// and drives only strides of half a pixel or more: a range below r + 2 px turned it in place
+/// 65 times and ended the run "done" at 0 m (r = 0.03 m at a range of 4 r on a 0.05 m map).
+/// A thousandth of a pixel above that: the strides stop 1e-4 px short of what is seen.
+fn random_bounce_least_range(s: &Setup) -> f64 {
+    let res = s.frame.resolution;
+    s.robot.radius + 2.0 * res + 1e-3 * res
+}
+
 /// The largest turn random-bounce takes, either way (degrees): two whole turns, so that a
 /// range across 360 degrees (`300` to `420`) can be written.
 pub const MAX_TURN_DEG: f64 = 720.0;
@@ -816,12 +835,7 @@ impl PlannerSettings for RandomBounceOptions {
                 ));
             }
         }
-        // It looks `range - r - 1.5 px` ahead and drives only strides of half a pixel or
-        // more: a range below r + 2 px turned it in place 65 times and ended the run "done"
-        // at 0 m (r = 0.03 m at the default range 4 r on a 0.05 m map).
-        let need = s.robot.radius + 2.0 * res;
-        // A thousandth of a pixel above it: the strides stop 1e-4 px short of what is seen.
-        let min = need + 1e-3 * res;
+        let min = random_bounce_least_range(s);
         if s.sensor_range < min {
             // (the message named r + 2 px itself, which was refused)
             return Err(OptionsError::new(
@@ -833,6 +847,10 @@ impl PlannerSettings for RandomBounceOptions {
             ));
         }
         Ok(())
+    }
+
+    fn least_sensor_range(&self, s: &Setup) -> Option<f64> {
+        Some(random_bounce_least_range(s))
     }
 
     fn estimate(&self, s: &Setup) -> ResourceEstimate {
@@ -1094,6 +1112,12 @@ impl PlannerSettings for BaStarExtendedOptions {
         self.ba_star.check(s).map_err(|e| e.in_section("ba_star"))
     }
 
+    fn least_sensor_range(&self, s: &Setup) -> Option<f64> {
+        // BA*'s own need: its tiles' neighbours seen whole (a longer range also lets the
+        // extension see farther, so unlike BA*'s it is a floor, not all it uses).
+        self.ba_star.sensor_need(s)
+    }
+
     fn estimate(&self, s: &Setup) -> ResourceEstimate {
         // BA*'s tiles plus the extension's per-pixel state (swept and target bitsets, the search
         // records of its position searches: about 16 bytes a pixel).
@@ -1164,6 +1188,10 @@ impl PlannerSettings for BsaExtendedOptions {
 
     fn check(&self, s: &Setup) -> Result<(), OptionsError> {
         check_neighbour_sight(s, 2.0 * s.robot.radius, "cell")
+    }
+
+    fn least_sensor_range(&self, s: &Setup) -> Option<f64> {
+        Some(neighbour_sight(s, 2.0 * s.robot.radius))
     }
 
     fn estimate(&self, s: &Setup) -> ResourceEstimate {
