@@ -93,16 +93,7 @@ impl JobResult {
 /// The note telling the user that the start lies outside the area of `world` and how far the
 /// robot drives to reach it first (`None` when it starts inside): `run` and `plan` print it.
 pub fn approach_note(world: &World) -> Option<String> {
-    if world.approach().is_empty() {
-        return None;
-    }
-    let e = world.start();
-    Some(format!(
-        "note: the start is outside the area: the robot first drives {:.2} m on the known map to reach it at ({:.3}, {:.3})",
-        world.approach_length_m(),
-        e.x,
-        e.y
-    ))
+    ccpp_io::warnings::approach_note(world).map(|n| format!("note: {n}"))
 }
 
 /// The recipe of `args`: paths made absolute so that `run.json` works from any folder.

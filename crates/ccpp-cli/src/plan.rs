@@ -102,15 +102,7 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     if let Some(note) = crate::job::approach_note(&plan.world) {
         say!("{note}");
     }
-    // As for `run`: a start whose free area reaches the map's border is probably outside.
     let comp = StartComponent::of(plan.world.map(), plan.world.start().position());
-    let cut_off = ccpp_io::components::zone_cut_off_warning(&plan.world);
-    for w in comp.warning().into_iter().chain(cut_off) {
-        say!("warning: {w}");
-    }
-    if let Some(w) = ccpp_io::warnings::rect_lane_area_warning(&scenario) {
-        say!("warning: {w}");
-    }
     for w in &plan.warnings {
         say!("warning: {w}");
     }

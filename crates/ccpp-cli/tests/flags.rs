@@ -1005,7 +1005,11 @@ fn default_sensor_range_rises_to_what_the_planner_needs() {
     let dir = d.path();
     let map = box60(dir);
     for (p, args, least) in [
-        ("random-bounce", &["--radius", "0.03", "--seed", "3"][..], "0.13005"),
+        (
+            "random-bounce",
+            &["--radius", "0.03", "--seed", "3"][..],
+            "0.13005",
+        ),
         ("bsa-extended", &["--radius", "0.02"][..], "0.085"),
         ("ba-star-extended", &["--tile-side", "0.5"][..], "0.675"),
     ] {

@@ -508,7 +508,10 @@ pub fn margin_warning(trace: &Trace) -> Option<String> {
     note_warning(trace, ccpp_core::planners::bcd::MARGIN_NOTE)
 }
 
-/// The warnings of a plan (`ccpp plan`, Python's `plan`): a path that does not move the
+/// The warnings of a plan (`ccpp plan`, Python's `plan`), in the order `ccpp plan` prints
+/// them: the start's free area reaching the map's border ([`StartComponent::warning`]), zones
+/// cutting floor off from the start, a rect-boustrophedon lane rectangle that bounds the area
+/// ([`rect_lane_area_warning`]), a path that does not move the
 /// robot ([`still_plan_warning`]), bcd lanes farther apart than the tool sweeps
 /// ([`narrow_lanes_warning`]), transfers that could not keep bcd's `margin_px`
 /// ([`margin_warning`]). A run says the first two its own way ([`no_motion_warning`],
@@ -519,8 +522,13 @@ pub fn plan_warnings(
     trace: &Trace,
     route: &ccpp_core::route::Route,
 ) -> Vec<String> {
-    still_plan_warning(route)
+    // As for a run: a start whose free area reaches the map's border is probably outside.
+    StartComponent::of(world.map(), world.start().position())
+        .warning()
         .into_iter()
+        .chain(crate::components::zone_cut_off_warning(world))
+        .chain(rect_lane_area_warning(scenario))
+        .chain(still_plan_warning(route))
         .chain(narrow_lanes_warning(scenario, world))
         .chain(margin_warning(trace))
         .collect()
@@ -559,6 +567,22 @@ fn note_warning(trace: &Trace, prefix: &str) -> Option<String> {
         Event::Note { text } if text.starts_with(prefix) => Some(text.clone()),
         _ => None,
     })
+}
+
+/// The note that the start lies outside the work area and how far the robot drives on the
+/// known map to reach it first (`None` when it starts inside), without `note: `: `ccpp run`,
+/// `plan` and `info` print it, and Python's `RunResult.notes` and `PlanResult.notes` hold it.
+pub fn approach_note(world: &World) -> Option<String> {
+    if world.approach().is_empty() {
+        return None;
+    }
+    let e = world.start();
+    Some(format!(
+        "the start is outside the area: the robot first drives {:.2} m on the known map to reach it at ({:.3}, {:.3})",
+        world.approach_length_m(),
+        e.x,
+        e.y
+    ))
 }
 
 /// Joins a run's warnings in one field (`ccpp bench`'s `results.csv`, `ccpp.sweep`'s

@@ -1131,6 +1131,8 @@ pub struct PlanResult {
     finished: bool,
     /// What `ccpp plan` warns of this plan (without `warning: `).
     warnings: Vec<String>,
+    /// What `ccpp plan` notes of it (without `note: `): a start outside the area.
+    notes: Vec<String>,
     /// The files the plan read (`save` refuses a folder holding one).
     inputs: Vec<PathBuf>,
 }
@@ -1175,12 +1177,20 @@ impl PlanResult {
         self.finished
     }
 
-    /// What `ccpp plan` warns of this plan (without `warning: `): a path that does not move
-    /// the robot, bcd lanes farther apart than the tool sweeps, transfers that could not keep
-    /// bcd's `margin_px`.
+    /// What `ccpp plan` warns of this plan (without `warning: `): a start whose free area
+    /// reaches the map's border, zones that cut floor off from the start, a rect-boustrophedon
+    /// lane rectangle that bounds the area, a path that does not move the robot, bcd lanes
+    /// farther apart than the tool sweeps, transfers that could not keep bcd's `margin_px`.
     #[getter]
     fn warnings(&self) -> Vec<String> {
         self.warnings.clone()
+    }
+
+    /// What `ccpp plan` notes of this plan (without `note: `): a start outside the area, and
+    /// how far the path first drives to reach it. Empty otherwise.
+    #[getter]
+    fn notes(&self) -> Vec<String> {
+        self.notes.clone()
     }
 
     /// The path in export format `format` (`"csv"`, `"json"`, `"nav-path"`, `"geojson"`), as
@@ -1263,6 +1273,9 @@ fn plan(
         zones: p.world.zones().cloned(),
         frame: *p.world.frame(),
         finished: p.stop == StopReason::Done,
+        notes: ccpp_io::warnings::approach_note(&p.world)
+            .into_iter()
+            .collect(),
         warnings: p.warnings,
         inputs: scenario.input_files(),
     })
@@ -1339,6 +1352,16 @@ impl RunResult {
     #[getter]
     fn warnings(&self) -> Vec<String> {
         self.warnings.clone()
+    }
+
+    /// What `ccpp run` notes of this run (without `note: `): a start outside the area, and how
+    /// far the robot first drives to reach it (that drive is part of `path` and of the
+    /// metrics). Empty otherwise.
+    #[getter]
+    fn notes(&self) -> Vec<String> {
+        ccpp_io::warnings::approach_note(&self.world)
+            .into_iter()
+            .collect()
     }
 
     /// The start pose used, `(x, y, theta)`: where the robot was placed, the first pose of

@@ -193,3 +193,31 @@ def test_a_runs_start_is_where_the_robot_was_placed(shared_maps: Path) -> None:
     assert r.start == (8.0, 8.0, 0.0)
     assert tuple(r.path[0]) == r.start
     assert json.loads(r.scenario_json)["start"] == [8.0, 8.0, 0.0]
+
+
+def said(stderr: str, kind: str) -> list[str]:
+    return [line[len(kind) + 2 :] for line in stderr.splitlines() if line.startswith(f"{kind}: ")]
+
+
+def test_notes_and_warnings_are_the_clis(shared_maps: Path, ccpp_bin: str, tmp_path: Path) -> None:
+    # A start outside the area: `ccpp run` and `ccpp plan` say the drive to the area as a note,
+    # which Python kept to itself (RunResult and PlanResult had no notes).
+    maze = shared_maps / "teb_maze.yaml"
+    p = cli(ccpp_bin, "run", "--map", str(maze), "--planner", "bcd", "--area", "0,0,5,5", "--start", "8,8", "--out", str(tmp_path / "r"))
+    assert p.returncode == 0, p.stderr
+    r = ccpp.run(maze, "bcd", area=[0, 0, 5, 5], start=(8, 8))
+    assert r.notes == said(p.stderr, "note") and len(r.notes) == 1, p.stderr
+    assert r.notes[0].startswith("the start is outside the area: the robot first drives")
+    p = cli(ccpp_bin, "plan", "--map", str(maze), "--planner", "bcd", "--area", "0,0,5,5", "--start", "8,8", "--out", str(tmp_path / "p"))
+    assert p.returncode == 0, p.stderr
+    plan = ccpp.plan(maze, area=[0, 0, 5, 5], start=(8, 8))
+    assert plan.notes == said(p.stderr, "note") == r.notes
+    assert ccpp.run(maze, "bcd").notes == [] and ccpp.plan(maze).notes == []
+    # `ccpp plan`'s warning of a start whose free area reaches the map's border is a
+    # PlanResult warning too (Python's plan had only the planner's own).
+    depot = shared_maps / "nav2_depot.yaml"
+    p = cli(ccpp_bin, "plan", "--map", str(depot), "--planner", "bcd", "--out", str(tmp_path / "d"))
+    assert p.returncode == 0, p.stderr
+    warned = said(p.stderr, "warning")
+    assert any("reaches the map's border" in w for w in warned), p.stderr
+    assert ccpp.plan(depot).warnings == warned

@@ -73,6 +73,10 @@ class RunResult:
         odometry noise without landmarks, a run that never moved, a tool narrower than the
         map's pixels."""
     @property
+    def notes(self) -> list[str]:
+        """What ``ccpp run`` notes (without ``note: ``): a start outside the area, and how far
+        the robot first drives to reach it. Empty otherwise."""
+    @property
     def start(self) -> tuple[float, float, float]: ...
     @property
     def scenario_json(self) -> str:
@@ -103,6 +107,9 @@ class PlanResult:
     @property
     def warnings(self) -> list[str]:
         """What ``ccpp plan`` warns of this plan (without ``warning: ``)."""
+    @property
+    def notes(self) -> list[str]:
+        """What ``ccpp plan`` notes (without ``note: ``): a start outside the area."""
     def export(self, format: str) -> str:
         """The text of ``ccpp plan --export FORMAT``'s file (csv, json, nav-path, geojson)."""
     def save(self, folder: _Path, export: str | Sequence[str] | None = None) -> None:
