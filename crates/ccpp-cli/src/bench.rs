@@ -110,6 +110,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         .collect();
     crate::job::warn_unused_config(a.options.config.as_deref(), &kinds);
     let maps = name_maps(expand_maps(&a.maps)?);
+    check_map_names(&maps)?;
     // The maps whose plots a bench in this folder writes: this bench's and those of the run
     // folders an earlier one left (`runs/MAP`).
     let mut plotted: Vec<String> = maps.iter().map(|(_, n)| n.clone()).collect();
@@ -553,8 +554,40 @@ fn run_one(
         {
             ccpp_io::write::clean_stale(parent, name);
         }
+        // An earlier bench's run in this slot (another radius, other options: not reused)
+        // goes too: it stayed beside this bench's runs while `results.csv` listed this run
+        // as failed, and `ccpp replay` showed it as this bench's (hostile pass).
+        if dir.join(KEY_FILE).is_file() {
+            if let Err(e) = std::fs::remove_dir_all(dir) {
+                say!(
+                    "warning: {}: cannot remove an earlier bench's run here ({e}); it is not this bench's",
+                    dir.display()
+                );
+            }
+        }
     })?;
     Ok((m, read_warnings(dir)?))
+}
+
+/// Longest map name a bench takes, in bytes: a map's plots are `tradeoff_NAME.svg` and
+/// `coverage_NAME.png`, written through `NAME.svg.tmp`, and a file name holds at most 255
+/// bytes. A longer name (a legal file name of 239 bytes or more) ran every run and then lost
+/// the whole summary to "File name too long" (hostile pass).
+const MAX_MAP_NAME_BYTES: usize = 255 - "tradeoff_".len() - ".svg.tmp".len();
+
+/// Refuses, before any run, a map whose name is too long for the bench's file names
+/// ([`MAX_MAP_NAME_BYTES`]).
+fn check_map_names(maps: &[(PathBuf, String)]) -> Result<()> {
+    for (path, name) in maps {
+        if name.len() > MAX_MAP_NAME_BYTES {
+            anyhow::bail!(
+                "map {}: its name is {} bytes, more than the {MAX_MAP_NAME_BYTES} a bench takes (its plots are named tradeoff_NAME.svg, and a file name holds at most 255 bytes); link or copy the map under a shorter name",
+                path.display(),
+                name.len()
+            );
+        }
+    }
+    Ok(())
 }
 
 /// The file of a bench run folder that holds the run's key ([`run_key`]) and then a line

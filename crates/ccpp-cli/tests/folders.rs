@@ -729,9 +729,10 @@ fn bench_maps(out: &Path, maps: &[&Path]) -> std::process::Output {
 /// one file name in two folders (`site1-box`) were named so in metrics.json but not in run.json,
 /// and `ccpp replay` refused them as mixed; a run reused after the maps folder moved kept a
 /// run.json naming the old path, which replay could not find; and a run that failed on its
-/// second bench left the first bench's folder in place beside an error row, unnamed.
+/// second bench left the first bench's folder in place beside an error row (unnamed, then
+/// named; now removed).
 #[test]
-fn bench_run_folders_replay_and_a_failed_rerun_names_the_old_folder() {
+fn bench_run_folders_replay_and_a_failed_rerun_removes_the_old_folder() {
     let dir = tempfile::tempdir().unwrap();
     let (a, b) = (
         map_copy(&dir.path().join("site1"), "box"),
@@ -757,8 +758,9 @@ fn bench_run_folders_replay_and_a_failed_rerun_names_the_old_folder() {
     assert!(json.contains("site2-moved"), "{json}");
     let o = ccpp().arg("replay").arg(&run).output().unwrap();
     assert!(o.status.success(), "{}", stderr_of(&o));
-    // A rerun that fails (the map's scale changed: the robot no longer fits on it) names the
-    // earlier folder it leaves.
+    // A rerun that fails (the map's scale changed: the robot no longer fits on it) removes
+    // the earlier bench's folder from the failed run's slot (it was left and named: "also
+    // holds 1 run folder of an earlier bench that this summary leaves out (box/ba-star)").
     let c = a;
     let yaml = std::fs::read_to_string(&c).unwrap();
     let o = bench_maps(&dir.path().join("b4"), &[&c]);
@@ -769,13 +771,14 @@ fn bench_run_folders_replay_and_a_failed_rerun_names_the_old_folder() {
         yaml.replace("resolution: 0.050000", "resolution: 0.0001"),
     )
     .unwrap();
+    assert!(dir.path().join("b4/runs/box/ba-star/run.json").is_file());
     let o = bench_maps(&dir.path().join("b4"), &[&c]);
     assert_eq!(o.status.code(), Some(1));
     let e = stderr_of(&o);
-    assert!(
-        e.contains("also holds 1 run folder of an earlier bench that this summary leaves out (box/ba-star)"),
-        "{e}"
-    );
+    assert!(!e.contains("earlier bench"), "{e}");
+    assert!(!dir.path().join("b4/runs/box/ba-star").exists());
+    let csv = std::fs::read_to_string(dir.path().join("b4/results.csv")).unwrap();
+    assert!(csv.contains("box,ba-star,error"), "{csv}");
 }
 
 /// A map file named with a newline in a maps folder: its error row said `map maps/new` (the

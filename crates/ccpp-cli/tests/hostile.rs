@@ -717,6 +717,90 @@ fn a_bench_folder_is_never_mixed() {
     assert!(!plots.iter().any(|p| p.contains("pillars")), "{plots:?}");
 }
 
+/// A re-bench whose run of a planner fails removes the earlier bench's run of it from that
+/// slot: the folder of a run at r = 0.15 m stayed in `runs/MAP/bcd` beside this bench's
+/// r = 0.2 m runs while `results.csv` listed bcd as failed, and `ccpp replay` showed it.
+#[test]
+fn a_failed_rerun_leaves_no_earlier_run_in_its_slot() {
+    let Some(maps) = common::shared_maps() else {
+        return;
+    };
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("b");
+    let map = maps.join("teb_maze.yaml");
+    let bench = |extra: &[&str]| {
+        ccpp()
+            .args(["bench", "--quiet", "--planners", "bsa,bcd", "--maps"])
+            .arg(&map)
+            .arg("--out")
+            .arg(&out)
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    assert!(bench(&[]).status.success());
+    assert!(out.join("runs/teb_maze/bcd/run.json").is_file());
+    // bcd needs more than 20 MB here, bsa less.
+    let o = bench(&["--radius", "0.2", "--max-memory", "20"]);
+    assert_eq!(o.status.code(), Some(1));
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    assert!(csv.contains("teb_maze,bsa,ok"), "{csv}");
+    assert!(csv.contains("teb_maze,bcd,error"), "{csv}");
+    assert!(!out.join("runs/teb_maze/bcd").exists());
+    let bsa = std::fs::read_to_string(out.join("runs/teb_maze/bsa/run.json")).unwrap();
+    assert!(bsa.contains("0.2"), "{bsa}");
+}
+
+/// A map name too long for the bench's plot file names (`tradeoff_NAME.svg` through
+/// `NAME.svg.tmp`, 255 bytes a name) is refused before any run: a legal 245-byte name ran
+/// every run and then lost the whole summary to "File name too long".
+#[test]
+fn a_map_name_too_long_for_the_plots_is_refused_before_any_run() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let long = dir.join(format!("{}.png", "m".repeat(239)));
+    pgm(dir, "p.pgm", 40, 40, |_, _| false);
+    image::open(dir.join("p.pgm")).unwrap().save(&long).unwrap();
+    let out = dir.join("out");
+    refused(
+        &[
+            "bench",
+            "--quiet",
+            "--planners",
+            "bsa",
+            "--maps",
+            s(&long),
+            "--out",
+            s(&out),
+        ],
+        &[
+            "239 bytes",
+            "more than the 238 a bench takes",
+            "shorter name",
+        ],
+    );
+    assert!(!out.exists());
+    // 238 bytes is taken, with its plots.
+    let fits = dir.join(format!("{}.png", "m".repeat(238)));
+    std::fs::rename(&long, &fits).unwrap();
+    ccpp()
+        .args([
+            "bench",
+            "--quiet",
+            "--planners",
+            "bsa",
+            "--maps",
+            s(&fits),
+            "--out",
+            s(&out),
+        ])
+        .assert()
+        .success();
+    assert!(out
+        .join(format!("plots/tradeoff_{}.svg", "m".repeat(238)))
+        .is_file());
+}
+
 /// BA* under odometry noise drifted until it drove into a wall it did not see where it was,
 /// and then repeated that motion, each one meeting the wall at once, up to the simulator's 50
 /// million step cap: minutes of work and gigabytes of trace for 50 million collisions, and no
