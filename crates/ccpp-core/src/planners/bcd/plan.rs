@@ -132,10 +132,30 @@ fn margin_note(ctx: &Ctx<'_>, items: &[Item], margin_px: f64) -> Option<String> 
             Item::Mark(_) => {}
         }
     }
+    // A margin no reachable point has: every point of a transfer near enough to its ends
+    // counted as keeping it, so `margin_px: 1000` ran as 0 with no word (hostile pass).
+    if hops > 0 && !ctx.safe.iter().any(|&s| s) {
+        let robot =
+            crate::collide::contact_radius_px(ctx.world.robot().radius / ctx.frame.resolution);
+        let widest = (0..ctx.ok.len())
+            .filter(|&i| ctx.ok[i])
+            .map(|i| {
+                let w = ctx.frame.width;
+                ctx.world.pixel_clearance(i % w, i / w) / ctx.frame.resolution + 0.5 - robot
+            })
+            .fold(0.0_f64, f64::max);
+        return Some(format!(
+            "{} {} was kept on none of the plan's {hops} transfers: no reachable point is that far beyond the robot's clearance from obstacles (the widest spot allows {:.1}); they keep the robot's plain clearance",
+            super::MARGIN_NOTE,
+            crate::display::Compact(margin_px),
+            widest.max(0.0)
+        ));
+    }
     (short > 0).then(|| {
         format!(
-            "{} {margin_px} was not kept on {short} of the plan's {hops} transfers (no way keeps that clearance there, or smoothing cut it): they keep the robot's plain clearance",
-            super::MARGIN_NOTE
+            "{} {} was not kept on {short} of the plan's {hops} transfers (no way keeps that clearance there, or smoothing cut it): they keep the robot's plain clearance",
+            super::MARGIN_NOTE,
+            crate::display::Compact(margin_px)
         )
     })
 }

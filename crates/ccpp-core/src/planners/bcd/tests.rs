@@ -968,4 +968,15 @@ fn a_margin_no_transfer_can_keep_is_said() {
         "{said}"
     );
     assert_eq!(note(0.0), None);
+    // A margin beyond every point's clearance: every transfer point lay near enough to an
+    // end to count as keeping it, so it ran as no margin with no word (hostile pass).
+    for huge in [1000.0, 1e300] {
+        let said = note(huge).expect("a note");
+        assert!(
+            said.starts_with(super::MARGIN_NOTE)
+                && said.contains("was kept on none of the plan's")
+                && said.contains("the widest spot allows"),
+            "{said}"
+        );
+    }
 }
