@@ -96,13 +96,19 @@ pub enum MapError {
         /// The mode asked for.
         mode: String,
     },
-    /// A key that is not one of `map_server`'s but so near one that it is taken for a misspelling
-    /// (`negat`, `occupied_threshold`, `Resolution`). `map_server` ignores unknown keys, so a
+    /// A key that is not one of `map_server`'s but so near one the file leaves out, with a
+    /// value that field could take, that it is taken for a misspelling (`negat: 1`,
+    /// `occupied_threshold: 0.5`, `Resolution: 0.05`). `map_server` ignores unknown keys, so a
     /// misspelt optional field silently falls back to its default (an un-negated map, other
     /// thresholds); other unknown keys are ignored here too.
     #[error(
-        "map YAML {}: unknown key `{key}`; did you mean `{field}`? (map_server would ignore it and use the default of `{field}`)",
-        path.display()
+        "map YAML {}: unknown key `{key}`; did you mean `{field}`? (map_server would ignore it {})",
+        path.display(),
+        if matches!(*field, "image" | "resolution" | "origin") {
+            format!("and refuse the map without `{field}`")
+        } else {
+            format!("and use the default of `{field}`")
+        }
     )]
     MisspeltField {
         /// The YAML file.

@@ -25,8 +25,9 @@ use super::error::{one_line, MapError};
 /// A load's overrides of `resolution` and `origin` (`--resolution`, `--origin`) stand in for
 /// those fields, which may then be left out.
 ///
-/// Unknown keys are ignored, as `map_server` does, except one so near a field that it is taken
-/// for a misspelling of it ([`MapError::MisspeltField`]: `negat`, `free_threshold`, `Origin`).
+/// Unknown keys are ignored, as `map_server` does, except one so near a field the file leaves
+/// out, with a value that field could take, that it is taken for a misspelling of it
+/// ([`MapError::MisspeltField`]: `negat: 1`, `free_threshold: 0.2`, `Origin: [0, 0, 0]`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct MapYaml {
     /// The image file as written in the YAML (not yet resolved against the YAML's folder).
@@ -55,13 +56,95 @@ struct RawYaml {
     occupied_thresh: Option<f64>,
     free_thresh: Option<f64>,
     mode: Option<String>,
-    /// Every other key (checked for misspellings of the fields above).
-    #[allow(
-        clippy::zero_sized_map_values,
-        reason = "only the keys are wanted; the values are skipped unread"
-    )]
+    /// Every other key, with the kind of its value (checked for misspellings of the fields
+    /// above).
     #[serde(flatten)]
-    other: BTreeMap<String, de::IgnoredAny>,
+    other: BTreeMap<String, Loose>,
+}
+
+/// The kind of an unknown key's value: enough to tell whether it could be the value of the
+/// field the key is near (`moed: raw` is a misspelt `mode`, `model: burger` is not).
+#[derive(Clone, Debug, PartialEq)]
+enum Loose {
+    Bool,
+    Number,
+    /// A string: its first characters, trimmed and in lower case.
+    Text(String),
+    List,
+    Other,
+}
+
+impl<'de> Deserialize<'de> for Loose {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = Loose;
+            fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str("any YAML value")
+            }
+            fn visit_bool<E: de::Error>(self, _: bool) -> Result<Loose, E> {
+                Ok(Loose::Bool)
+            }
+            fn visit_i64<E: de::Error>(self, _: i64) -> Result<Loose, E> {
+                Ok(Loose::Number)
+            }
+            fn visit_u64<E: de::Error>(self, _: u64) -> Result<Loose, E> {
+                Ok(Loose::Number)
+            }
+            fn visit_f64<E: de::Error>(self, _: f64) -> Result<Loose, E> {
+                Ok(Loose::Number)
+            }
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<Loose, E> {
+                Ok(Loose::Text(
+                    v.trim().chars().take(16).collect::<String>().to_lowercase(),
+                ))
+            }
+            fn visit_unit<E: de::Error>(self) -> Result<Loose, E> {
+                Ok(Loose::Other)
+            }
+            fn visit_none<E: de::Error>(self) -> Result<Loose, E> {
+                Ok(Loose::Other)
+            }
+            fn visit_some<D2: Deserializer<'de>>(self, d: D2) -> Result<Loose, D2::Error> {
+                Loose::deserialize(d)
+            }
+            fn visit_seq<A: de::SeqAccess<'de>>(self, mut seq: A) -> Result<Loose, A::Error> {
+                while seq.next_element::<de::IgnoredAny>()?.is_some() {}
+                Ok(Loose::List)
+            }
+            fn visit_map<A: de::MapAccess<'de>>(self, mut map: A) -> Result<Loose, A::Error> {
+                while map
+                    .next_entry::<de::IgnoredAny, de::IgnoredAny>()?
+                    .is_some()
+                {}
+                Ok(Loose::Other)
+            }
+        }
+        deserializer.deserialize_any(V)
+    }
+}
+
+impl Loose {
+    /// Could this be a value of `field`?
+    fn fits(&self, field: &str) -> bool {
+        match field {
+            "image" => matches!(self, Self::Text(_)),
+            "origin" => *self == Self::List,
+            "negate" => match self {
+                Self::Bool | Self::Number => true,
+                Self::Text(t) => [
+                    "0", "1", "y", "yes", "true", "on", "n", "no", "false", "off",
+                ]
+                .contains(&t.as_str()),
+                _ => false,
+            },
+            "mode" => {
+                matches!(self, Self::Text(t) if ["trinary", "scale", "raw"].contains(&t.as_str()))
+            }
+            // resolution and the thresholds
+            _ => *self == Self::Number,
+        }
+    }
 }
 
 /// The fields of a `map_server` YAML.
@@ -214,8 +297,24 @@ impl MapYaml {
             reason,
         };
 
-        // BTreeMap: the first misspelling in key order, whatever the file's order.
-        if let Some((key, field)) = raw.other.keys().find_map(|k| misspelt(k).map(|f| (k, f))) {
+        // BTreeMap: the first misspelling in key order, whatever the file's order. Only of a
+        // field the file leaves out, and only with a value that field could take: beside
+        // `origin`, `origin_frame: map` is another key, and so is `model: burger` or
+        // `note: scanned` (refused as a misspelt `origin`, `mode`: hostile pass).
+        let given = |f: &str| match f {
+            "image" => raw.image.is_some(),
+            "resolution" => raw.resolution.is_some(),
+            "origin" => raw.origin.is_some(),
+            "negate" => raw.negate.is_some(),
+            "occupied_thresh" => raw.occupied_thresh.is_some(),
+            "free_thresh" => raw.free_thresh.is_some(),
+            _ => raw.mode.is_some(),
+        };
+        if let Some((key, field)) = raw.other.iter().find_map(|(k, v)| {
+            misspelt(k)
+                .filter(|f| !given(f) && v.fits(f))
+                .map(|f| (k, f))
+        }) {
             return Err(MapError::MisspeltField {
                 path: path.to_path_buf(),
                 // Escaped: a tab or an escape sequence in the key was trimmed or printed raw.
@@ -360,8 +459,9 @@ mod tests {
             ("Negate: 1", "negate"),
             ("occupied_threshold: 0.5", "occupied_thresh"),
             ("free_tresh: 0.1", "free_thresh"),
-            ("orgin: [0, 0, 0]", "origin"),
             ("moed: raw", "mode"),
+            ("Mode: Scale", "mode"),
+            ("negat: yes", "negate"),
         ] {
             let e = parse(&format!("{BASE}{key}\n")).unwrap_err();
             assert!(
@@ -381,6 +481,14 @@ mod tests {
         // A key near no field is ignored, as map_server does.
         let y = parse(&format!("{BASE}name: lab\nsensor: lidar\n")).unwrap();
         assert_eq!(y, parse(BASE).unwrap());
+        // So is a key near a field the file gives, or with a value that field cannot take:
+        // these were refused as misspellings ("did you mean `origin`?" beside `origin`).
+        let extra = "origin_frame: map\nimages: [a.png]\nresolution_note: scanned\nnote: scanned 2024\nmodel: burger\nnode: map_server\ncode: 7\nnegative: [1]\n";
+        let y = parse(&format!("{BASE}{extra}")).unwrap();
+        assert_eq!(y, parse(BASE).unwrap());
+        // A misspelt required field the file leaves out is named, not said missing.
+        let e = parse("image: m.pgm\nresolution: 0.05\norgin: [0, 0, 0]\n").unwrap_err();
+        assert!(e.to_string().contains("did you mean `origin`"), "{e}");
         // A misspelt `image` is named as such, not as a missing field.
         let e = parse("Image: m.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n").unwrap_err();
         assert!(e.to_string().contains("did you mean `image`"), "{e}");
