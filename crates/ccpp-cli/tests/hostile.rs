@@ -1047,6 +1047,49 @@ fn georef_errors_name_the_file_once() {
     }
 }
 
+/// A georef pair far off the transform fitted to all the pairs (a typo in a coordinate) is
+/// refused, naming it: one wrong digit in seven pairs moved the map 1.43 m without a word. A
+/// pair picked a pixel off is taken. And a map YAML without the `resolution` and `origin` the
+/// fit replaces loads with `--georef` (it was refused for lacking them).
+#[test]
+fn a_georef_pair_off_the_fit_is_refused_and_the_fit_needs_no_placement() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    pgm(dir, "sq.pgm", 100, 50, |_, _| false);
+    let exact = "0,0,1,7\n100,0,11,7\n0,50,1,2\n100,50,11,2\n50,0,6,7\n50,50,6,2\n";
+    let info = |yaml: &Path, csv: &str| {
+        let g = dir.join("g.csv");
+        std::fs::write(&g, csv).unwrap();
+        ccpp()
+            .args(["info", "--map", s(yaml), "--georef", s(&g)])
+            .output()
+            .unwrap()
+    };
+    let img = dir.join("sq.pgm");
+    let o = info(&img, &format!("{exact}50,25,6,14.5\n"));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.starts_with("error: georef ")
+            && err.contains("the pair 50,25 -> 6,14.5 (pair 7 of 7) is 8.57 m")
+            && err.contains("a typo in it"),
+        "{err}"
+    );
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    // A pixel picked a pixel off (0.1 m here) is within the fit's tolerance.
+    let o = info(&img, &format!("{exact}51,25,6,4.5\n"));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // The YAML's placement, which the fit replaces, may be left out.
+    let yaml = dir.join("bare.yaml");
+    std::fs::write(&yaml, "image: sq.pgm\n").unwrap();
+    let o = info(&yaml, exact);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.contains("origin         (1, 2, 0)"), "{out}");
+    // Without --georef it is still required.
+    refused(&["info", "--map", s(&yaml)], &["resolution"]);
+}
+
 /// A rectangular robot longer or wider than the map: `ccpp waypoints --width 1e300` printed
 /// nothing and exited 0 (an empty route as a success), and `run` refused it with an absurd
 /// memory need and the advice to use a *larger* robot. Now refused by what is wrong, naming

@@ -90,6 +90,8 @@ pub struct AffineFit {
     pub rms_residual: f64,
     /// Largest residual.
     pub max_residual: f64,
+    /// The pairs fitted, `(pixel, world)`, in the order of [`residuals`](Self::residuals).
+    pub pairs: Vec<(Point, Point)>,
 }
 
 /// Errors of [`fit_affine`].
@@ -253,6 +255,7 @@ pub fn fit_affine(pairs: &[(Point, Point)]) -> Result<AffineFit, GeorefError> {
         residuals,
         rms_residual,
         max_residual,
+        pairs: pairs.to_vec(),
     })
 }
 

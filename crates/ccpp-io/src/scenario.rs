@@ -370,9 +370,12 @@ impl MapRecipe {
         check_memory_limit(max_memory_mb)?;
         let path = self.path.as_ref().ok_or(ScenarioError::NoMapPath)?;
         let per_pixel = ccpp_core::planners::settings::PIXEL_BYTES as u64;
+        // With a georef file the fit places the map: the YAML's resolution and origin, which
+        // it replaces, may be left out (they were required, though any value was taken).
+        let placed = self.georef.is_some();
         let opts = LoadOptions {
-            resolution: self.resolution,
-            origin: self.origin,
+            resolution: self.resolution.or(placed.then_some(1.0)),
+            origin: self.origin.or(placed.then_some([0.0; 3])),
             occupied_thresh: self.occupied_thresh,
             free_thresh: self.free_thresh,
             negate: None,
@@ -575,6 +578,31 @@ pub fn apply_georef(grid: GridMap, path: &Path) -> Result<GridMap, ScenarioError
             100.0 * dev
         )));
     }
+    // A pair far off the fit of all (a typo in a coordinate): the placement it pulls off is
+    // used silently otherwise (one wrong digit of seven pairs moved the map 1.43 m).
+    let limit = (GEOREF_MISS_PX * res).max(GEOREF_MISS_M);
+    if fit.max_residual > limit {
+        let worst = (0..fit.residuals.len())
+            .max_by(|&i, &j| fit.residuals[i].total_cmp(&fit.residuals[j]))
+            .unwrap_or(0);
+        let (p, w) = fit.pairs[worst];
+        let others = (0..fit.residuals.len())
+            .filter(|&i| i != worst)
+            .map(|i| fit.residuals[i])
+            .fold(0.0, f64::max);
+        return Err(err(format!(
+            "the pair {},{} -> {},{} (pair {} of {}) is {} m ({:.1} px) off the transform fitted to all the pairs, the others at most {} m: a typo in it, or in another pair? (a pair may miss the fit by at most {GEOREF_MISS_PX} px or {GEOREF_MISS_M} m, whichever is more)",
+            Compact(p.x),
+            Compact(p.y),
+            Compact(w.x),
+            Compact(w.y),
+            worst + 1,
+            fit.residuals.len(),
+            Compact(round_sig(fit.residuals[worst])),
+            fit.residuals[worst] / res,
+            Compact(round_sig(others)),
+        )));
+    }
     let h = grid.frame().height as f64;
     let o = fit.affine.apply(ccpp_core::Point::new(0.0, h));
     // A placement the grid refuses, or one out of the bounds every map is held to
@@ -589,6 +617,24 @@ pub fn apply_georef(grid: GridMap, path: &Path) -> Result<GridMap, ScenarioError
         )));
     }
     Ok(placed)
+}
+
+/// Most pixels a georef pair may miss the fitted transform by (or [`GEOREF_MISS_M`], whichever
+/// is more): a picked pixel is a pixel or two off, a surveyed point a few centimetres, while a
+/// typo in a coordinate misses by metres.
+pub const GEOREF_MISS_PX: f64 = 5.0;
+
+/// Most metres a georef pair may miss the fitted transform by, on maps whose pixels are small
+/// ([`GEOREF_MISS_PX`]): room for a GPS-surveyed point on a 1 cm map.
+pub const GEOREF_MISS_M: f64 = 0.5;
+
+/// `v` to three significant digits (for messages).
+fn round_sig(v: f64) -> f64 {
+    if v == 0.0 || !v.is_finite() {
+        return v;
+    }
+    let k = 10f64.powi(2 - v.abs().log10().floor() as i32);
+    (v * k).round() / k
 }
 
 /// One coverage run, fully described. `run.json` is this, serialized.
