@@ -277,7 +277,14 @@ fn read_mask(path: &Path, frame: &MapFrame) -> Result<FixedBitSet, ZoneFileError
             return Err(size_err(w, h));
         }
     }
-    let m = load_map(path, &LoadOptions::default()).map_err(|e| bad(e.to_string()))?;
+    // At most the map's own pixels, which the memory limit has admitted: with no budget the
+    // decoder kept its default cap of 512 MiB, and a 16-bit RGBA mask of an 8500 x 8500 px
+    // map was refused at any --max-memory ("Memory limit exceeded"; hostile pass).
+    let opts = LoadOptions {
+        max_pixels: Some(frame.len() as u64),
+        ..LoadOptions::default()
+    };
+    let m = load_map(path, &opts).map_err(|e| bad(e.to_string()))?;
     let f = *m.grid.frame();
     if f.width != frame.width || f.height != frame.height {
         return Err(size_err(f.width, f.height));
