@@ -258,9 +258,9 @@ pub enum FrameProblem {
     },
     /// A corner lies farther than [`MAX_COORD_M`] from the world's origin along an axis.
     #[error(
-        "the map reaches {far:.2e} m from the world's origin along an axis (origin {}, {}), \
+        "the map reaches {} m from the world's origin along an axis (origin {}, {}), \
          farther than the {MAX_COORD_M:e} m ccpp handles precisely",
-        crate::display::Compact(*.x), crate::display::Compact(*.y)
+        beyond_limit(*.far), crate::display::Compact(*.x), crate::display::Compact(*.y)
     )]
     TooFar {
         /// Largest corner coordinate magnitude, metres.
@@ -270,6 +270,15 @@ pub enum FrameProblem {
         /// Origin y, metres.
         y: f64,
     },
+}
+
+/// A reach beyond [`MAX_COORD_M`] in three significant digits, or in as many more as show it
+/// beyond: 1.005e8 m read "1.00e8 m ... farther than the 1e8 m", as if equal to the limit.
+fn beyond_limit(far: f64) -> String {
+    (2..=15)
+        .map(|d| format!("{far:.d$e}"))
+        .find(|t| t.parse::<f64>().is_ok_and(|v| v > MAX_COORD_M))
+        .unwrap_or_else(|| format!("{far:e}"))
 }
 
 impl FrameProblem {
@@ -614,6 +623,14 @@ impl fmt::Debug for GridMap {
 
 #[cfg(test)]
 mod tests {
+    /// A reach just beyond the limit shows as beyond it (1.005e8 m read "1.00e8 m").
+    #[test]
+    fn a_reach_beyond_the_limit_reads_beyond_it() {
+        assert_eq!(super::beyond_limit(1.005e8), "1.005e8");
+        assert_eq!(super::beyond_limit(1.000_000_012e9), "1.00e9");
+        assert_eq!(super::beyond_limit(2.5e8), "2.50e8");
+    }
+
     use super::*;
 
     /// A NaN point is off the map (it was pixel (0, 0)), and a point 1e300 m away is off it

@@ -112,8 +112,8 @@ pub enum WorldError {
     BadStart(f64, f64, f64),
     /// Start outside the image.
     #[error(
-        "start ({:.3}, {:.3}) is outside the map (x in [{:.3}, {:.3}], y in [{:.3}, {:.3}])",
-        Compact(*.x), Compact(*.y), Compact(*.x0), Compact(*.x1), Compact(*.y0), Compact(*.y1)
+        "start ({:.3}, {:.3}) is outside the map ({}x in [{:.3}, {:.3}], y in [{:.3}, {:.3}])",
+        Compact(*.x), Compact(*.y), turned_text(*.yaw), Compact(*.x0), Compact(*.x1), Compact(*.y0), Compact(*.y1)
     )]
     StartOutside {
         /// Start x.
@@ -128,6 +128,9 @@ pub enum WorldError {
         y0: f64,
         /// Map bounds.
         y1: f64,
+        /// The yaw of the map's origin: a map turned off the axes is a turned rectangle within
+        /// the bounds, and a start inside them may be outside it.
+        yaw: f64,
     },
     /// The map's frame lies where `f64` does not keep the precision the geometry needs
     /// ([`MapFrame::precision_problem`]).
@@ -1516,9 +1519,26 @@ fn start_on_map(frame: &MapFrame, s: Pose) -> Result<(), WorldError> {
             x1: hi.x,
             y0: lo.y,
             y1: hi.y,
+            yaw: frame.origin.theta,
         });
     }
     Ok(())
+}
+
+/// How [`WorldError::StartOutside`] shows a map turned off the axes: the bounds it prints are
+/// the turned rectangle's box, which a start may lie inside while off the map (a start
+/// within both printed ranges was said to be outside them, with no word of the turn).
+fn turned_text(yaw: f64) -> String {
+    let quarter = std::f64::consts::FRAC_PI_2;
+    let off = (yaw / quarter - (yaw / quarter).round()).abs() * quarter;
+    if off > 1e-9 {
+        format!(
+            "a rectangle turned by {} rad, within ",
+            Compact((yaw * 1e4).round() / 1e4)
+        )
+    } else {
+        String::new()
+    }
 }
 
 #[cfg(test)]
@@ -1801,6 +1821,21 @@ mod tests {
             Some(Pose::new(5.0, 0.5, 0.0)),
         );
         assert!(matches!(e, Err(WorldError::StartOutside { .. })));
+        let text = e.err().unwrap().to_string();
+        assert!(text.contains("outside the map (x in ["), "{text}");
+        // A map turned off the axes is a turned rectangle within the printed bounds: a start
+        // inside both ranges but off the map was said to be outside them.
+        let turned = room(11, 11, 0.1)
+            .with_placement(0.1, Pose::new(0.0, 0.0, std::f64::consts::FRAC_PI_4))
+            .unwrap();
+        let e = World::new(turned, Robot::new(0.1), Some(Pose::new(0.7, 0.1, 0.0)));
+        let text = e.err().unwrap().to_string();
+        assert!(
+            text.contains(
+                "outside the map (a rectangle turned by 0.7854 rad, within x in [-0.778, 0.778]"
+            ),
+            "{text}"
+        );
         // Off the map whatever the robot's size: a robot that fits nowhere does not hide it.
         let e = World::new(
             room(11, 11, 0.1),
