@@ -419,7 +419,8 @@ pub fn write_files_together(dir: &Path, files: &[(&str, &[u8])]) -> Result<()> {
     Ok(())
 }
 
-/// [`check_target`] for a user's own run, plan or demo, which also may not write below a
+/// [`check_target`] for a user's own run, plan or demo, which also may not replace a bench's
+/// run folder ([`ccpp_io::write::check_not_bench_run`]) nor write below a
 /// folder another process's bench or sweep is writing
 /// ([`ccpp_io::write::check_not_in_busy_folder`]; a bench's runs write below their own).
 ///
@@ -427,6 +428,7 @@ pub fn write_files_together(dir: &Path, files: &[(&str, &[u8])]) -> Result<()> {
 /// As [`check_target`], or when a folder above `target` is held.
 pub fn check_user_target(target: &Path) -> Result<()> {
     check_target(target)?;
+    ccpp_io::write::check_not_bench_run(target)?;
     Ok(ccpp_io::write::check_not_in_busy_folder(target)?)
 }
 

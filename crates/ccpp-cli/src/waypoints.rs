@@ -91,6 +91,9 @@ pub fn run(a: &WaypointsArgs) -> Result<()> {
     match &a.out {
         Some(path) => {
             check_target(path)?;
+            // Not into a folder a bench or sweep is writing (a file dropped among its runs
+            // made every later bench there refuse the folder; hostile pass).
+            ccpp_io::write::check_not_in_busy_folder(path)?;
             write_file(path, text.as_bytes())?;
         }
         None => crate::print_stdout(&text)?,

@@ -442,6 +442,56 @@ fn a_replay_gives_up_on_a_folder_held_too_long_and_writes_nothing() {
     assert!(out.join("replay.html").is_file() && out.join("replay.gif").is_file());
 }
 
+/// A user's run, plan or demo into a bench's run folder (`runs/MAP/PLANNER`, holding its
+/// `bench-key.txt`) is refused: `ccpp demo --out b/runs/teb_empty_box/ba-star` put another
+/// map's run there under the bench's `results.csv` (hostile pass). `ccpp replay` of it, which
+/// adds to the bench's run, still works, and so does a bench's rerun into it.
+#[test]
+fn a_users_run_into_a_bench_run_folder_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("b");
+    let bench = || {
+        ccpp()
+            .args(["bench", "--quiet", "--planners", "ba-star", "--maps"])
+            .arg(data("teb_empty_box.yaml"))
+            .arg("--out")
+            .arg(&out)
+            .assert()
+            .success();
+    };
+    bench();
+    let run_dir = out.join("runs/teb_empty_box/ba-star");
+    let before = std::fs::read(run_dir.join("path.csv")).unwrap();
+    for (cmd, planner) in [("run", "bsa"), ("plan", "bcd")] {
+        let o = ccpp()
+            .args([cmd, "--planner", planner, "--map"])
+            .arg(data("teb_empty_box.yaml"))
+            .arg("--out")
+            .arg(&run_dir)
+            .output()
+            .unwrap();
+        let err = stderr_of(&o);
+        assert_eq!(o.status.code(), Some(1), "{err}");
+        assert!(
+            err.starts_with("error: output folder ")
+                && err.contains("is a run of a ccpp bench (it holds bench-key.txt)"),
+            "{err}"
+        );
+        assert_eq!(err.lines().count(), 1, "{err}");
+    }
+    let demo = ccpp()
+        .args(["demo", "--out"])
+        .arg(&run_dir)
+        .output()
+        .unwrap();
+    assert_eq!(demo.status.code(), Some(1), "{}", stderr_of(&demo));
+    assert_eq!(std::fs::read(run_dir.join("path.csv")).unwrap(), before);
+    ccpp().arg("replay").arg(&run_dir).assert().success();
+    std::fs::remove_file(run_dir.join("bench-key.txt")).unwrap();
+    bench();
+    assert!(run_dir.join("bench-key.txt").is_file());
+}
+
 /// A run, a plan or a demo into a folder below one that a bench or sweep of another process is
 /// writing (its `runs/MAP/PLANNER`) is refused before any work: the bench replaced it, or it
 /// replaced the bench's run. A lock file left unlocked by a killed bench does not count.
@@ -479,6 +529,19 @@ fn runs_below_a_busy_bench_folder_are_refused() {
         .output()
         .unwrap();
     assert_eq!(demo.status.code(), Some(1), "{}", stderr_of(&demo));
+    // A waypoints file too (dropped among the bench's files, it made every later bench there
+    // refuse the folder: hostile pass).
+    let w = ccpp()
+        .args(["waypoints", "--map"])
+        .arg(data("teb_empty_box.yaml"))
+        .arg("--out")
+        .arg(bench_out.join("w.csv"))
+        .output()
+        .unwrap();
+    let err = stderr_of(&w);
+    assert_eq!(w.status.code(), Some(1), "{err}");
+    assert!(err.contains("which a ccpp bench or sweep (pid "), "{err}");
+    assert!(!bench_out.join("w.csv").exists());
     // A bench into the held folder's `runs/` too (it wrote among the other bench's runs).
     let nested = ccpp()
         .args(["bench", "--quiet", "--planners", "bcd", "--maps"])

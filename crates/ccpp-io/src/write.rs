@@ -194,6 +194,19 @@ pub enum FolderError {
         /// The link.
         blocker: PathBuf,
     },
+    /// The folder is a run of a `ccpp bench` (it holds its `bench-key.txt`): a user's run,
+    /// plan or demo written there replaced it with another map's or planner's run under the
+    /// bench's `results.csv`, which then no longer told what the folder held (hostile pass).
+    #[error(
+        "output folder {} is a run of a ccpp bench (it holds bench-key.txt): written there, it \
+         would no longer match the bench's results; choose another folder, or remove that one \
+         first",
+        path.display()
+    )]
+    BenchRun {
+        /// The output folder.
+        path: PathBuf,
+    },
     /// The folder holds something ccpp did not write.
     #[error(
         "output folder {} holds {name}, which ccpp did not write; a run replaces the whole \
@@ -405,6 +418,20 @@ pub fn check_run_folder(target: &Path) -> Result<(), FolderError> {
         }),
         _ => Ok(()),
     }
+}
+
+/// Checks that `target` is not a run folder of a `ccpp bench` ([`FolderError::BenchRun`]), for
+/// the runs, plans and demos a user writes (the bench's own runs replace theirs).
+///
+/// # Errors
+/// [`FolderError::BenchRun`].
+pub fn check_not_bench_run(target: &Path) -> Result<(), FolderError> {
+    if target.join("bench-key.txt").is_file() {
+        return Err(FolderError::BenchRun {
+            path: target.to_path_buf(),
+        });
+    }
+    Ok(())
 }
 
 /// Checks what can be known of the output folder `target` before a run's work, beyond

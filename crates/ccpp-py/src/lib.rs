@@ -1113,6 +1113,7 @@ fn write_files(
     ccpp_io::write::check_inputs_outside(folder, inputs).map_err(|e| err(&e))?;
     // (as `ccpp run --out`: a folder below one a bench or sweep is writing is refused)
     ccpp_io::write::check_not_in_busy_folder(folder).map_err(|e| err(&e))?;
+    ccpp_io::write::check_not_bench_run(folder).map_err(|e| err(&e))?;
     ccpp_io::write::write_folder(folder, files).map_err(|e| err(&e))
 }
 

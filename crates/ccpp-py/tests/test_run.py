@@ -285,3 +285,18 @@ def test_scenario_json_is_the_saved_run_json(room: Path, tmp_path: Path) -> None
         assert r.scenario_json == (out / "run.json").read_text()
         assert len(json.loads(r.scenario_json)["map_digest"]) == 16
     assert json.loads(r.scenario_json)["start"] == [0.5, 0.5, 0.0]
+
+
+def test_save_refuses_a_bench_run_folder(room: Path, ccpp_bin: str, tmp_path: Path) -> None:
+    # As `ccpp run --out`: a bench's run folder (it holds bench-key.txt) is the bench's; a run
+    # saved there would no longer match its results.csv.
+    out = tmp_path / "b"
+    p = subprocess.run([ccpp_bin, "bench", "--quiet", "--planners", "bsa", "--maps", str(room), "--out", str(out)], capture_output=True, text=True, check=False)
+    assert p.returncode == 0, p.stderr
+    run_dir = next((out / "runs").iterdir()) / "bsa"
+    before = (run_dir / "path.csv").read_bytes()
+    with pytest.raises(ccpp.CcppError, match="is a run of a ccpp bench"):
+        ccpp.run(room, "ba-star").save(run_dir)
+    with pytest.raises(ccpp.CcppError, match="is a run of a ccpp bench"):
+        ccpp.plan(room).save(run_dir)
+    assert (run_dir / "path.csv").read_bytes() == before
