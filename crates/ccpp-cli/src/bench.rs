@@ -517,7 +517,9 @@ fn run_one(
                         Some(f) => Err(format!("{f} is missing")),
                         None => same_run(&m, &map.name, planner)
                             .and_then(|()| sizes_match(dir, &listed))
-                            .and_then(|()| whole_trace(dir, map.grid.frame(), robot.radius, budget))
+                            .and_then(|()| {
+                                whole_trace(dir, map.grid.frame(), robot.radius, budget, &m)
+                            })
                             .and_then(|()| read_warnings(dir)),
                     };
                     match whole {
@@ -636,8 +638,9 @@ fn sizes_match(dir: &Path, listed: &str) -> Result<(), String> {
 }
 
 /// Checks that the `trace.jsonl` of the run folder `dir` reads back (as the plots read it,
-/// every pose on the map of `frame`, within the robot's `radius` and two pixels) and
-/// ends with the simulator's `finished` record (a trace cut at a line's end reads back). The
+/// every pose on the map of `frame`, within the robot's `radius` and two pixels),
+/// ends with the simulator's `finished` record (a trace cut at a line's end reads back) and
+/// drives the path length `metrics` reports. The
 /// parsed trace is held against `budget` while it is checked (streamed, about twice the
 /// file's size).
 fn whole_trace(
@@ -645,20 +648,32 @@ fn whole_trace(
     frame: &ccpp_core::grid::MapFrame,
     radius: f64,
     budget: &MemoryBudget,
+    metrics: &Metrics,
 ) -> Result<(), String> {
     let path = dir.join("trace.jsonl");
     let len = std::fs::metadata(&path).map_or(0, |m| m.len());
     let _grant = budget.take(2.0 * len as f64);
     let trace =
         crate::plots::read_trace(&path, frame, radius).map_err(|e| crate::errors::one_line(&e))?;
-    if matches!(
+    if !matches!(
         trace.events().last(),
         Some((_, ccpp_core::trace::Event::Finished { .. }))
     ) {
-        Ok(())
-    } else {
-        Err("trace.jsonl does not end with the simulator's `finished` record (cut short)".into())
+        return Err(
+            "trace.jsonl does not end with the simulator's `finished` record (cut short)".into(),
+        );
     }
+    // The path the trace drives is the one metrics.json reports, as `ccpp replay` checks: a
+    // metrics.json edited to another length of the same size was reused (hostile pass).
+    let positions: Vec<ccpp_core::geometry::Point> = trace.poses().map(|p| p.position()).collect();
+    let driven = ccpp_core::geometry::path_length(&positions);
+    let reported = metrics.path_length_m;
+    if (driven - reported).abs() > 1e-9 + 1e-9 * reported.abs() {
+        return Err(format!(
+            "trace.jsonl drives {driven:.3} m but metrics.json reports {reported:.3} m"
+        ));
+    }
+    Ok(())
 }
 
 /// Hidden first argument that makes `ccpp` run one bench job (a [`JobSpec`] as JSON on stdin)

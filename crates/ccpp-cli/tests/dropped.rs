@@ -1286,6 +1286,12 @@ fn a_drift_without_contact_is_said() {
         )) && err.contains("the planner sweeps floor it believes is elsewhere; give --landmarks"),
         "{err}"
     );
+    // Named as `ccpp run`'s: a bench, whose runs reach noise through an options file, has no
+    // --landmarks, and its results.csv gave the same advice.
+    assert!(
+        err.contains("landmarks= to `ccpp run` or Python's `run`"),
+        "{err}"
+    );
 }
 
 /// A planner option fine on its own but wrong on the map names the options file that set it

@@ -767,6 +767,23 @@ fn bench_runs_again_a_run_cut_short_or_mixed() {
             assert_eq!(whole(f), before, "{f}");
         }
     }
+    // A metrics.json of this run whose path length was edited, its size kept: reused (as
+    // `ccpp replay` refuses it, "the folder mixes files of two runs").
+    let m = String::from_utf8(whole("metrics.json")).unwrap();
+    let at = m.find("\"path_length_m\": ").unwrap() + "\"path_length_m\": ".len();
+    let digit = m.as_bytes()[at];
+    let other = if digit == b'9' { '1' } else { '9' };
+    let edited = format!("{}{other}{}", &m[..at], &m[at + 1..]);
+    assert_eq!(edited.len(), m.len());
+    std::fs::write(run.join("metrics.json"), &edited).unwrap();
+    let o = bench(&out, &maps, &planners).output().unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("but metrics.json reports") && stderr.contains("running it again"),
+        "{stderr}"
+    );
+    assert_ne!(whole("metrics.json"), edited.as_bytes());
     // A killed run's staging folder beside the reused one.
     let stale = runs.join(".bcd.ccpp-new-4294967295-0");
     std::fs::create_dir(&stale).unwrap();
