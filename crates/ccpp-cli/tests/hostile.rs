@@ -1136,6 +1136,41 @@ fn world_axis_planners_warn_on_a_turned_map() {
     assert!(!said("plan", "bcd", "0,0,0.3"));
 }
 
+/// Map files named or pointing wrong get messages that say so (hostile pass): a `map_server`
+/// YAML named `map.txt` was "not a PNG or PNM/PGM image"; `image: /dev/zero` or a folder read
+/// "cannot read /dev/zero: not a regular file", naming neither the YAML nor its image field.
+#[test]
+fn a_misnamed_yaml_and_an_unreadable_image_are_said_as_such() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    pgm(dir, "m.pgm", 20, 20, |_, _| false);
+    let txt = dir.join("map.txt");
+    std::fs::write(&txt, "image: m.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n").unwrap();
+    refused(
+        &["info", "--map", s(&txt)],
+        &[
+            "map.txt",
+            "reads as a map_server YAML",
+            "must end in .yaml or .yml; rename it",
+        ],
+    );
+    let y = dir.join("dev.yaml");
+    for image in ["/dev/zero", s(dir)] {
+        std::fs::write(
+            &y,
+            format!("image: {image}\nresolution: 0.05\norigin: [0, 0, 0]\n"),
+        )
+        .unwrap();
+        refused(
+            &["info", "--map", s(&y)],
+            &[&format!(
+                "map YAML {} names image {image}, which cannot be read",
+                s(&y)
+            )],
+        );
+    }
+}
+
 /// A rectangular robot longer or wider than the map: `ccpp waypoints --width 1e300` printed
 /// nothing and exited 0 (an empty route as a success), and `run` refused it with an absurd
 /// memory need and the advice to use a *larger* robot. Now refused by what is wrong, naming

@@ -313,8 +313,10 @@ impl MapRecipe {
             .as_deref()
             .and_then(|n| n.chars().find(|&c| crate::message::hidden(c)))
         {
+            // (the name is the file's stem unless given: a user who gave none is told to
+            // rename the file, the only way the command line has to change it)
             return Err(ScenarioError::Invalid(format!(
-                "{map}map.name holds a control or invisible character (U+{:04X}); give a plain name",
+                "{map}map.name holds a control or invisible character (U+{:04X}); give a plain name (it is the map file's name without its extension unless map.name / Python's name= gives one: rename the file)",
                 u32::from(c)
             )));
         }

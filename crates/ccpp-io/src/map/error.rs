@@ -60,6 +60,23 @@ pub enum MapError {
         /// The image path, resolved against the YAML's folder.
         image: PathBuf,
     },
+    /// The image named by the YAML's `image` field exists but cannot be read (a folder, a
+    /// device, no permission): said with the YAML that names it (`image: /dev/zero` read
+    /// "cannot read /dev/zero: not a regular file", naming neither the YAML nor the field).
+    #[error(
+        "map YAML {} names image {}, which cannot be read: {source}",
+        yaml.display(),
+        image.display()
+    )]
+    ImageUnreadable {
+        /// The YAML file.
+        yaml: PathBuf,
+        /// The image path, resolved against the YAML's folder.
+        image: PathBuf,
+        /// The underlying I/O error.
+        #[source]
+        source: io::Error,
+    },
     /// The image could not be decoded (corrupt, truncated, unsupported format, too large).
     #[error("cannot decode map image {}: {message}", path.display())]
     Decode {

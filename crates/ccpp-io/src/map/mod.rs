@@ -137,8 +137,9 @@ pub fn load_map(path: &Path, opts: &LoadOptions) -> Result<LoadedMap, MapError> 
                 })
             }
             Err(e) => {
-                return Err(MapError::Io {
-                    path: image_path,
+                return Err(MapError::ImageUnreadable {
+                    yaml: path.to_path_buf(),
+                    image: image_path,
                     source: e,
                 })
             }

@@ -5,7 +5,7 @@
 //! is ignored except in `scale` mode, where a transparent pixel is unknown; 16-bit samples are mapped to the 0..=255 scale as `v / 257` (exact, not truncated
 //! to 8 bits first); float samples as `v * 255` clamped to `[0, 255]`.
 
-use std::io::{BufRead, Seek, SeekFrom};
+use std::io::{BufRead, Read as _, Seek, SeekFrom};
 use std::path::Path;
 
 use ccpp_core::grid::Cell;
@@ -114,9 +114,25 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
     };
     let reader = reader.with_guessed_format().map_err(io_err)?;
     let Some(format) = reader.format() else {
+        // A map_server YAML named otherwise (`map.txt`) is read as an image, by its name: said
+        // as such (it was "not a PNG or PNM/PGM image"; hostile pass).
+        let mut head = Vec::new();
+        let yaml_like = reader
+            .into_inner()
+            .take(4096)
+            .read_to_end(&mut head)
+            .is_ok()
+            && String::from_utf8_lossy(&head)
+                .lines()
+                .any(|l| l.trim_start_matches('\u{feff}').starts_with("image:"));
+        let message = if yaml_like {
+            "not a PNG or PNM/PGM image: it reads as a map_server YAML (an `image:` line), but a map's YAML is known by its name, which must end in .yaml or .yml; rename it"
+        } else {
+            "not a PNG or PNM/PGM image (unrecognised content)"
+        };
         return Err(MapError::Decode {
             path: path.to_path_buf(),
-            message: "not a PNG or PNM/PGM image (unrecognised content)".to_owned(),
+            message: message.to_owned(),
         });
     };
     let image_err = |e: image::ImageError| match e {
