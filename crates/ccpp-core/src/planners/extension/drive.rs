@@ -65,7 +65,11 @@ impl Drive {
         let head = usize::from(chunk.lead_in).min(chunk.sweep.len());
         let (lead, sweep) = chunk.sweep.split_at(head);
         let way: Vec<Point> = chunk.transfer.iter().chain(lead).copied().collect();
-        let transfer = polyline_length(pos, &way) >= 2.0 * radius;
+        // A micrometre's slack: a one-tile trip is 2 r long, and its length in world
+        // coordinates carries their rounding (0.30000000000000004 near the origin,
+        // 0.2999999996 at 5.4e6 m), so a translated map labelled the same move otherwise
+        // (hostile pass: 10 backtracks instead of 9, same path).
+        let transfer = polyline_length(pos, &way) >= 2.0 * radius - 1e-6;
         if transfer {
             self.end_pass();
             self.queue.push_back(Step::Mark(Event::BacktrackStart));
