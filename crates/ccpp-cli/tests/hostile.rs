@@ -1171,6 +1171,39 @@ fn a_misnamed_yaml_and_an_unreadable_image_are_said_as_such() {
     }
 }
 
+/// A robot under `sqrt(0.5) - 0.5` of a pixel passes where two occupied pixels meet only at a
+/// corner, so a diagonal wall one pixel thick does not stop it: bcd covered both halves of a
+/// room so divided, with 0 collisions, and nothing said so (hostile pass). Now `run` and
+/// `plan` warn of it; a robot above the bound does not get the warning.
+#[test]
+fn a_robot_that_slips_through_diagonal_walls_is_warned_of() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    // 32 x 32 px at 0.2 m/px, a staircase wall from corner to corner.
+    pgm(dir, "diag.pgm", 32, 32, |x, y| x == y);
+    let y = dir.join("diag.yaml");
+    std::fs::write(
+        &y,
+        "image: diag.pgm\nresolution: 0.2\norigin: [0.0, 0.0, 0.0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n",
+    )
+    .unwrap();
+    let warned = |sub: &str, radius: &str| {
+        let o = ccpp()
+            .args([sub, "--map", s(&y), "--planner", "bcd", "--radius", radius])
+            .arg("--out")
+            .arg(dir.join(format!("{sub}-{radius}")))
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stderr)
+            .contains("between two occupied pixels that meet only at a corner")
+    };
+    for sub in ["run", "plan"] {
+        assert!(warned(sub, "0.04"), "{sub}");
+        assert!(!warned(sub, "0.045"), "{sub}");
+    }
+}
+
 /// A rectangular robot longer or wider than the map: `ccpp waypoints --width 1e300` printed
 /// nothing and exited 0 (an empty route as a success), and `run` refused it with an absurd
 /// memory need and the advice to use a *larger* robot. Now refused by what is wrong, naming

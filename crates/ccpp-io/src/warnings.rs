@@ -151,6 +151,28 @@ pub fn narrow_tool_warning(world: &World) -> Option<String> {
     })
 }
 
+/// The radius below which a robot passes between two occupied pixels that meet only at a
+/// corner, in pixels: the contact model counts an obstacle pixel as a disk of half a pixel
+/// ([`ccpp_core::collide`]), and the corner lies `sqrt(0.5) - 0.5` from both disks.
+pub const CORNER_GAP_PX: f64 = std::f64::consts::FRAC_1_SQRT_2 - 0.5;
+
+/// A robot so small that it passes where the pixels of a one-pixel wall meet only at their
+/// corners, said (`None` otherwise): such a wall, drawn diagonally, is closed on the map and
+/// open to the robot, so it crosses it (bcd covered both halves of a room so divided, with no
+/// collision and no word; hostile pass).
+pub fn corner_gap_warning(world: &World) -> Option<String> {
+    let res = world.frame().resolution;
+    let r = world.robot().radius;
+    (r < CORNER_GAP_PX * res).then(|| {
+        format!(
+            "the robot radius {} m is below {:.3} of the map's pixel ({} m): it passes between two occupied pixels that meet only at a corner, so a wall one pixel thick drawn diagonally does not stop it (use a finer map or a larger robot)",
+            ccpp_core::display::Compact(r),
+            CORNER_GAP_PX,
+            ccpp_core::display::Compact((CORNER_GAP_PX * res * 1e6).round() / 1e6)
+        )
+    })
+}
+
 /// The planners whose lanes lie a tile apart and leave the floor between them to no one:
 /// the tile planners without the coverage extension (which sweeps what the lanes leave).
 fn tiles_only(scenario: &Scenario) -> bool {
@@ -562,6 +584,7 @@ pub fn plan_warnings(
         .into_iter()
         .chain(crate::components::zone_cut_off_warning(world))
         .chain(rect_lane_area_warning(scenario))
+        .chain(corner_gap_warning(world))
         .chain(world_axes_warning(scenario, world))
         .chain(still_plan_warning(route))
         .chain(narrow_lanes_warning(scenario, world))
@@ -659,6 +682,7 @@ pub fn run_warnings(
     swept: &FixedBitSet,
 ) -> Vec<String> {
     let mut out = Vec::new();
+    out.extend(corner_gap_warning(world));
     out.extend(narrow_tool_warning(world));
     out.extend(world_axes_warning(scenario, world));
     let no_motion = no_motion_warning(metrics);
