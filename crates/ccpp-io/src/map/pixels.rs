@@ -215,9 +215,12 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
         if let Some((sample, maxval)) = pnm_sample_over_maxval(&mut inner).map_err(io_err)? {
             return Err(MapError::Decode {
                 path: path.to_path_buf(),
-                message: format!(
-                    "sample {sample} exceeds the image's maxval {maxval} (a malformed PNM)"
-                ),
+                // (a sample of 23 digits was shown as 4294967295, the largest u32)
+                message: if sample == u64::MAX {
+                    format!("a sample too large to hold (over {}) exceeds the image's maxval {maxval} (a malformed PNM)", u64::MAX - 1)
+                } else {
+                    format!("sample {sample} exceeds the image's maxval {maxval} (a malformed PNM)")
+                },
             });
         }
         inner.seek(SeekFrom::Start(start)).map_err(io_err)?;
@@ -270,7 +273,7 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
 /// The first sample of a PNM image (`P2`, `P3`, `P5`, `P6`, `P7`) above the header's maxval,
 /// with the maxval; `None` when there is none, for bitmaps (`P1`, `P4`) and for a header
 /// the decoder will refuse anyway. Reads from the stream's position to the raster's end.
-fn pnm_sample_over_maxval<R: BufRead>(r: &mut R) -> std::io::Result<Option<(u32, u32)>> {
+fn pnm_sample_over_maxval<R: BufRead>(r: &mut R) -> std::io::Result<Option<(u64, u32)>> {
     let mut magic = [0u8; 2];
     if r.read_exact(&mut magic).is_err() {
         return Ok(None);
@@ -319,8 +322,7 @@ fn pnm_sample_over_maxval<R: BufRead>(r: &mut R) -> std::io::Result<Option<(u32,
         return Ok(None);
     }
     let samples = w.saturating_mul(h).saturating_mul(channels);
-    let over =
-        |v: u64| (v > maxval).then_some((u32::try_from(v).unwrap_or(u32::MAX), maxval as u32));
+    let over = |v: u64| (v > maxval).then_some((v, maxval as u32));
     if ascii {
         for _ in 0..samples {
             match header_number(r)? {
@@ -590,6 +592,10 @@ mod tests {
         };
         assert!(over(b"P5 2 1 100\n\x00\xc8").contains("sample 200 exceeds the image's maxval 100"));
         assert!(over(b"P2\n# c\n2 1\n100\n0 150\n").contains("sample 150"));
+        // Beyond u32 as it is; beyond u64 as too large (it read "sample 4294967295").
+        assert!(over(b"P2\n2 1\n100\n0 99999999999\n").contains("sample 99999999999 exceeds"));
+        assert!(over(b"P2\n2 1\n100\n0 99999999999999999999999\n")
+            .contains("a sample too large to hold"));
         assert!(
             over(b"P5 1 1 1000\n\x03\xe9").contains("sample 1001 exceeds the image's maxval 1000")
         );
