@@ -1171,6 +1171,26 @@ fn a_misnamed_yaml_and_an_unreadable_image_are_said_as_such() {
     }
 }
 
+/// A zone file's `.nan` is said in the user's words: "rejected by the configured policy"
+/// named a parser setting the user cannot see (hostile pass).
+#[test]
+fn a_zone_files_nan_is_said_plainly() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let z = dir.join("z.yaml");
+    std::fs::write(&z, "polygons:\n  - [[0, 0], [1, .nan], [1, 1]]\n").unwrap();
+    refused(
+        &["info", "--map", s(&map), "--keepout", s(&z)],
+        &["non-finite float `.nan` where a finite number is needed"],
+    );
+    let a = ccpp()
+        .args(["info", "--map", s(&map), "--keepout", s(&z)])
+        .output()
+        .unwrap();
+    assert!(!String::from_utf8_lossy(&a.stderr).contains("configured policy"));
+}
+
 /// A robot under `sqrt(0.5) - 0.5` of a pixel passes where two occupied pixels meet only at a
 /// corner, so a diagonal wall one pixel thick does not stop it: bcd covered both halves of a
 /// room so divided, with 0 collisions, and nothing said so (hostile pass). Now `run` and

@@ -128,10 +128,17 @@ mod tests {
 pub fn yaml_words(message: &str) -> String {
     const MULTI: &str =
         "multiple YAML documents detected; use from_str_multiple or from_str_multiple_with_options";
-    message.replace(
-        MULTI,
-        "holds a second YAML document (after a `---` line); ccpp reads files of one document",
-    )
+    message
+        .replace(
+            MULTI,
+            "holds a second YAML document (after a `---` line); ccpp reads files of one document",
+        )
+        // (the parser's own words for `.nan` or `.inf` where a zone file's numbers are read:
+        // "rejected by the configured policy" named a setting the user cannot see)
+        .replace(
+            " rejected by the configured policy",
+            " where a finite number is needed",
+        )
 }
 
 /// Deserializes YAML, or JSON when `json`, and on an error names the field it is in: the text
