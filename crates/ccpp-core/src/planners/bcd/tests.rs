@@ -13,6 +13,24 @@ use crate::planner::Step;
 use crate::trace::Event;
 use crate::world::World;
 
+/// The geometry of `world` on its reachable C-free set, without a transfer margin, for a tool
+/// of `rt` pixels.
+fn reach_ctx(world: &World, rt: f64) -> Ctx<'_> {
+    let n = world.frame().len();
+    let reach = world.reachable();
+    let ok: Vec<bool> = (0..n).map(|i| reach.contains(i)).collect();
+    Ctx {
+        world,
+        frame: *world.frame(),
+        safe: ok.clone(),
+        keep_px: None,
+        ok,
+        rt,
+        coarse: super::hops::CoarseCache::default(),
+        stop: None,
+    }
+}
+
 #[test]
 fn decomposition_splits_and_merges_around_a_block() {
     let art = "........\n..##....\n..##....\n........";
@@ -66,20 +84,7 @@ fn turned_room(deg: f64) -> World {
 fn walls_at_an_angle_get_a_turned_lattice() {
     for deg in [0.0, 30.0] {
         let world = turned_room(deg);
-        let frame = *world.frame();
-        let n = frame.width * frame.height;
-        let reach = world.reachable();
-        let ok: Vec<bool> = (0..n).map(|i| reach.contains(i)).collect();
-        let ctx = Ctx {
-            world: &world,
-            frame,
-            safe: ok.clone(),
-            keep_px: None,
-            ok,
-            rt: 3.0,
-            coarse: super::hops::CoarseCache::default(),
-            stop: None,
-        };
+        let ctx = reach_ctx(&world, 3.0);
         let a = dominant_angles(&ctx)[0].to_degrees();
         // The image's rows run down: a room turned by +30 degrees there has walls at
         // 30 or 60 degrees (mod 90), whichever way the turn is read.
@@ -98,19 +103,7 @@ fn walls_at_an_angle_get_a_turned_lattice() {
     // Its plan on the lattice turned to its walls reaches every piece and costs about what
     // the pixel lattice's does (here the pixels' is kept: the room is small).
     let frame = *world.frame();
-    let n = frame.width * frame.height;
-    let reach = world.reachable();
-    let ok: Vec<bool> = (0..n).map(|i| reach.contains(i)).collect();
-    let ctx = Ctx {
-        world: &world,
-        frame,
-        safe: ok.clone(),
-        keep_px: None,
-        ok,
-        rt: 3.0,
-        coarse: super::hops::CoarseCache::default(),
-        stop: None,
-    };
+    let ctx = reach_ctx(&world, 3.0);
     let mut search = Search::new(frame.width, frame.height);
     // The lattices' plain plans (`plan_on` makes the plan of the options it is given: with a
     // headland, only the headland's).
@@ -822,20 +815,7 @@ fn ring() -> World {
 #[test]
 fn a_ring_is_peeled_into_offset_loops_from_the_outer_wall() {
     let world = ring();
-    let frame = *world.frame();
-    let n = frame.width * frame.height;
-    let reach = world.reachable();
-    let ok: Vec<bool> = (0..n).map(|i| reach.contains(i)).collect();
-    let ctx = Ctx {
-        world: &world,
-        frame,
-        safe: ok.clone(),
-        keep_px: None,
-        ok,
-        rt: 3.0,
-        coarse: super::hops::CoarseCache::default(),
-        stop: None,
-    };
+    let ctx = reach_ctx(&world, 3.0);
     let lat = Lattice::pixels(&ctx);
     // Row 50 (through the block) from the left border: C-free from column 3 to 16 (the
     // block starts at 20). Pass 1 beside the outer wall and beside the block, then the
@@ -1008,18 +988,7 @@ fn rim_witnesses_are_the_nearest_c_free_pixels() {
     .unwrap();
     let frame = *world.frame();
     let n = frame.len();
-    let reach = world.reachable();
-    let ok: Vec<bool> = (0..n).map(|i| reach.contains(i)).collect();
-    let ctx = Ctx {
-        world: &world,
-        frame,
-        safe: ok.clone(),
-        keep_px: None,
-        ok,
-        rt: 3.0,
-        coarse: super::hops::CoarseCache::default(),
-        stop: None,
-    };
+    let ctx = reach_ctx(&world, 3.0);
     // Every pixel but every seventh one is "missed".
     let mut missed = fixedbitset::FixedBitSet::with_capacity(n);
     for i in (0..n).filter(|i| i % 7 != 0) {
