@@ -665,15 +665,7 @@ fn whole_trace(
     }
     // The path the trace drives is the one metrics.json reports, as `ccpp replay` checks: a
     // metrics.json edited to another length of the same size was reused (hostile pass).
-    let positions: Vec<ccpp_core::geometry::Point> = trace.poses().map(|p| p.position()).collect();
-    let driven = ccpp_core::geometry::path_length(&positions);
-    let reported = metrics.path_length_m;
-    if (driven - reported).abs() > 1e-9 + 1e-9 * reported.abs() {
-        return Err(format!(
-            "trace.jsonl drives {driven:.3} m but metrics.json reports {reported:.3} m"
-        ));
-    }
-    Ok(())
+    crate::output::length_mismatch(&trace, metrics.path_length_m).map_or(Ok(()), Err)
 }
 
 /// Hidden first argument that makes `ccpp` run one bench job (a [`JobSpec`] as JSON on stdin)

@@ -397,17 +397,24 @@ fn check_same_run(
             dir.display()
         );
     };
-    // Summed in the trace's order, as the metrics sum it.
-    let positions: Vec<ccpp_core::geometry::Point> = trace.poses().map(|p| p.position()).collect();
-    let driven = ccpp_core::geometry::path_length(&positions);
-    if (driven - reported).abs() > 1e-9 + 1e-9 * reported.abs() {
+    if let Some(why) = length_mismatch(trace, reported) {
         bail!(
-            "{}: trace.jsonl drives {driven:.3} m but metrics.json reports {reported:.3} m: the \
-             folder mixes files of two runs",
+            "{}: {why}: the folder mixes files of two runs",
             dir.display()
         );
     }
     Ok(m)
+}
+
+/// The trace's path length against the `reported` one of a `metrics.json`, `None` when they
+/// agree (to 1e-9, relative): replay and a bench's reuse of a run folder both check it.
+pub fn length_mismatch(trace: &Trace, reported: f64) -> Option<String> {
+    // Summed in the trace's order, as the metrics sum it.
+    let positions: Vec<ccpp_core::geometry::Point> = trace.poses().map(|p| p.position()).collect();
+    let driven = ccpp_core::geometry::path_length(&positions);
+    ((driven - reported).abs() > 1e-9 + 1e-9 * reported.abs()).then(|| {
+        format!("trace.jsonl drives {driven:.3} m but metrics.json reports {reported:.3} m")
+    })
 }
 
 /// Writes the run's files (with the replay when `replay`, and the path in each of `exports`)

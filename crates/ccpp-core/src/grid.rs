@@ -272,6 +272,14 @@ pub enum FrameProblem {
     },
 }
 
+/// Whether a map origin's `yaw` turns the image's axes off the world's (not a multiple of a
+/// quarter turn, beyond 1e-9 rad): planners that lay tiles or lanes along the world axes then
+/// cross the map's walls, and the map's world bounds are a turned rectangle's box.
+pub fn off_the_axes(yaw: f64) -> bool {
+    let quarter = std::f64::consts::FRAC_PI_2;
+    (yaw / quarter - (yaw / quarter).round()).abs() * quarter > 1e-9
+}
+
 /// A reach beyond [`MAX_COORD_M`] in three significant digits, or in as many more as show it
 /// beyond: 1.005e8 m read "1.00e8 m ... farther than the 1e8 m", as if equal to the limit.
 fn beyond_limit(far: f64) -> String {

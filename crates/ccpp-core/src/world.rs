@@ -1529,9 +1529,7 @@ fn start_on_map(frame: &MapFrame, s: Pose) -> Result<(), WorldError> {
 /// the turned rectangle's box, which a start may lie inside while off the map (a start
 /// within both printed ranges was said to be outside them, with no word of the turn).
 fn turned_text(yaw: f64) -> String {
-    let quarter = std::f64::consts::FRAC_PI_2;
-    let off = (yaw / quarter - (yaw / quarter).round()).abs() * quarter;
-    if off > 1e-9 {
+    if crate::grid::off_the_axes(yaw) {
         format!(
             "a rectangle turned by {} rad, within ",
             Compact((yaw * 1e4).round() / 1e4)

@@ -217,8 +217,6 @@ pub fn wide_tiles_warning(scenario: &Scenario) -> Option<String> {
 pub fn world_axes_warning(scenario: &Scenario, world: &World) -> Option<String> {
     use ccpp_core::planners::PlannerConfig;
     let yaw = world.frame().origin.theta;
-    let quarter = std::f64::consts::FRAC_PI_2;
-    let off = (yaw / quarter - (yaw / quarter).round()).abs() * quarter;
     let axes = match scenario.planner {
         PlannerConfig::RectBoustrophedon(_) => "lanes",
         _ if scenario
@@ -231,7 +229,7 @@ pub fn world_axes_warning(scenario: &Scenario, world: &World) -> Option<String> 
         }
         _ => return None,
     };
-    (off > 1e-9).then(|| {
+    ccpp_core::grid::off_the_axes(yaw).then(|| {
         format!(
             "the map's origin has a yaw of {} rad: {}'s {axes} run along the world axes, so they cross the map's walls at that angle (bcd plans in the map's own frame); --origin X,Y,0 (Python: origin=(x, y, 0)) lays them along the image's axes",
             ccpp_core::display::Compact((yaw * 1e4).round() / 1e4),
