@@ -1191,6 +1191,49 @@ fn a_zone_files_nan_is_said_plainly() {
     assert!(!String::from_utf8_lossy(&a.stderr).contains("configured policy"));
 }
 
+/// A number the YAML parser cannot read is shown with its place: `resolution: 1e400` said
+/// "invalid floating point" only, as `abc` did, in map YAMLs and options files (a zone file
+/// reads it as infinite and says so).
+#[test]
+fn a_number_beyond_a_float_is_said_as_such() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let big = dir.join("big.yaml");
+    let text = "image: pillars.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n";
+    let resolution = "resolution: 0.05";
+    std::fs::write(&big, text.replace(resolution, "resolution: 1e400")).unwrap();
+    refused(
+        &["info", "--map", s(&big)],
+        &["`1e400` is beyond the range of a number (at most about 1.8e308)"],
+    );
+    std::fs::write(&big, text.replace(resolution, "resolution: 1.2.3")).unwrap();
+    refused(&["info", "--map", s(&big)], &["`1.2.3` is not a number"]);
+    let z = dir.join("z.yaml");
+    std::fs::write(&z, "polygons:\n  - [[0, 0], [1, -1e999], [1, 1]]\n").unwrap();
+    refused(
+        &["info", "--map", s(&map), "--keepout", s(&z)],
+        &["non-finite float `-1e999` where a finite number is needed"],
+    );
+    let o = dir.join("o.yaml");
+    std::fs::write(&o, "bcd:\n  turn_cost_m: 1e999\n").unwrap();
+    let out = dir.join("out");
+    refused(
+        &[
+            "run",
+            "--map",
+            s(&map),
+            "--planner",
+            "bcd",
+            "--config",
+            s(&o),
+            "--out",
+            s(&out),
+        ],
+        &["bcd.turn_cost_m: line 2 column 16: `1e999` is beyond the range of a number"],
+    );
+}
+
 /// A robot under `sqrt(0.5) - 0.5` of a pixel passes where two occupied pixels meet only at a
 /// corner, so a diagonal wall one pixel thick does not stop it: bcd covered both halves of a
 /// room so divided, with 0 collisions, and nothing said so (hostile pass). Now `run` and

@@ -116,6 +116,21 @@ mod tests {
     }
 
     #[test]
+    fn a_number_the_parser_cannot_read_is_shown() {
+        let text = "image: m.png\nresolution: 1e400\norigin: [abc, 0, 0]\n";
+        let big = yaml_words("invalid floating point at line 2, column 13", text);
+        assert_eq!(
+            big,
+            "`1e400` is beyond the range of a number (at most about 1.8e308) at line 2, column 13"
+        );
+        let word = yaml_words("line 3 column 10: invalid floating point", text);
+        assert_eq!(word, "line 3 column 10: `abc` is not a number");
+        // a place outside the text leaves the message as it came
+        let off = yaml_words("invalid floating point at line 9, column 1", text);
+        assert_eq!(off, "invalid floating point at line 9, column 1");
+    }
+
+    #[test]
     fn folders_are_refused() {
         let d = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
         let e = read_text(d.path()).err().map(|e| e.to_string());
@@ -125,10 +140,13 @@ mod tests {
 
 /// A YAML parser message in the user's words: the parser's advice to its programmer (a second
 /// document "detected; use `from_str_multiple` ...") becomes what the file holds.
-pub fn yaml_words(message: &str) -> String {
+/// A number the parser could not read is shown as written in `text`: "invalid floating point at
+/// line 2, column 13" says which value, and whether it is not a number (`abc`, `1.2.3`) or one
+/// beyond the range of a float (`1e400`, which `.inf` is not: that one reads as infinite).
+pub fn yaml_words(message: &str, text: &str) -> String {
     const MULTI: &str =
         "multiple YAML documents detected; use from_str_multiple or from_str_multiple_with_options";
-    message
+    float_words(message, text)
         .replace(
             MULTI,
             "holds a second YAML document (after a `---` line); ccpp reads files of one document",
@@ -139,6 +157,50 @@ pub fn yaml_words(message: &str) -> String {
             " rejected by the configured policy",
             " where a finite number is needed",
         )
+}
+
+/// The parser's "invalid floating point" with the value found at the line and column the
+/// message names (see [`yaml_words`]); any other message as it is.
+fn float_words(message: &str, text: &str) -> String {
+    const BAD: &str = "invalid floating point";
+    if !message.contains(BAD) {
+        return message.to_owned();
+    }
+    // The number after `word` in the message ("line 2, column 13" or "line 2 column 13").
+    let number_after = |word: &str| {
+        let at = message.find(word)? + word.len();
+        let digits: String = message[at..]
+            .chars()
+            .take_while(char::is_ascii_digit)
+            .collect();
+        digits.parse::<usize>().ok()
+    };
+    let (Some(line), Some(col)) = (number_after("line "), number_after("column ")) else {
+        return message.to_owned();
+    };
+    let token: String = text
+        .lines()
+        .nth(line.saturating_sub(1))
+        .map(|l| {
+            l.chars()
+                .skip(col.saturating_sub(1))
+                .take_while(|c| !c.is_whitespace() && !matches!(c, ',' | ']' | '}' | '#'))
+                .take(40)
+                .collect()
+        })
+        .unwrap_or_default();
+    if token.is_empty() {
+        return message.to_owned();
+    }
+    let why = match token.trim_start_matches('+').parse::<f64>() {
+        Ok(v) if v.is_infinite() => "is beyond the range of a number (at most about 1.8e308)",
+        _ => "is not a number",
+    };
+    message.replacen(
+        BAD,
+        &format!("`{}` {why}", crate::message::visible(&token)),
+        1,
+    )
 }
 
 /// Deserializes YAML, or JSON when `json`, and on an error names the field it is in: the text
@@ -160,7 +222,7 @@ pub fn parse_yaml_or_json<T: serde::de::DeserializeOwned + serde::Serialize>(
     let first = if json {
         serde_json::from_str::<T>(text).map_err(|e| crate::message::visible(&e.to_string()))
     } else {
-        serde_saphyr::from_str::<T>(text).map_err(|e| yaml_words(&e.to_string()))
+        serde_saphyr::from_str::<T>(text).map_err(|e| yaml_words(&e.to_string(), text))
     };
     let message = match first {
         Ok(v) => match (!json).then(|| quoted_scalar_problem(text, &v)).flatten() {

@@ -223,8 +223,12 @@ fn read_file(path: &Path, frame: &MapFrame, mask_ok: bool) -> Result<ZoneData, Z
         let role = if mask_ok { "keepout" } else { "area" };
         return within_total(geojson_polygons_as(&v, role)?, "GeoJSON");
     }
-    let v: serde_json::Value = serde_saphyr::from_str(&text)
-        .map_err(|e| bad(format!("YAML: {}", crate::file::yaml_words(&e.to_string()))))?;
+    let v: serde_json::Value = serde_saphyr::from_str(&text).map_err(|e| {
+        bad(format!(
+            "YAML: {}",
+            crate::file::yaml_words(&e.to_string(), &text)
+        ))
+    })?;
     if v.get("image").is_some() {
         if !mask_ok {
             return Err(bad(AREA_NOT_MASK));

@@ -285,7 +285,7 @@ impl MapYaml {
         let raw: RawYaml =
             serde_saphyr::from_str_with_options(text, options).map_err(|e| MapError::Yaml {
                 path: path.to_path_buf(),
-                message: yaml_message(&e),
+                message: yaml_message(&e, text),
             })?;
         let missing = |field| MapError::MissingField {
             path: path.to_path_buf(),
@@ -400,10 +400,10 @@ impl MapYaml {
 }
 
 /// The parser's message without its source snippet, on one line.
-fn yaml_message(e: &serde_saphyr::Error) -> String {
+fn yaml_message(e: &serde_saphyr::Error, text: &str) -> String {
     let mut opts = serde_saphyr::RenderOptions::default();
     opts.snippets = serde_saphyr::SnippetMode::Off;
-    let text = crate::file::yaml_words(&one_line(&e.render_with_options(opts)));
+    let text = crate::file::yaml_words(&one_line(&e.render_with_options(opts)), text);
     text.strip_prefix("error: ")
         .map(str::to_owned)
         .unwrap_or(text)
