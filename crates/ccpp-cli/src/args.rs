@@ -61,10 +61,11 @@ pub struct MapArgs {
     /// Override `free_thresh`.
     #[arg(long, value_parser = parse_number, value_name = "P")]
     pub free_thresh: Option<f64>,
-    /// Place the image by a least-squares affine fit of surveyed point pairs: a CSV of
-    /// `px,py,wx,wy` lines (pixel coordinates from the image's top-left corner, y down; world
-    /// metres). Overrides resolution and origin (a map YAML may leave them out). Refused
-    /// when a pair misses the fit by more than 5 px or 0.5 m, whichever is more (a typo).
+    /// Place the image by the rotation + uniform scale that fits surveyed point pairs best
+    /// (least squares): a CSV of `px,py,wx,wy` lines (pixel coordinates from the image's
+    /// top-left corner, y down; world metres). Overrides resolution and origin (a map YAML may
+    /// leave them out). Refused when a pair misses the placement by more than 5 px or 0.5 m,
+    /// whichever is more (a typo, or survey axes scaled apart).
     #[arg(long, value_name = "FILE")]
     pub georef: Option<PathBuf>,
     /// Grow obstacles by this many metres (exact distance transform) before anything else, as a

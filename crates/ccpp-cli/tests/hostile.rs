@@ -1234,6 +1234,71 @@ fn a_number_beyond_a_float_is_said_as_such() {
     );
 }
 
+/// A map is placed by the rotation + uniform scale that fits the georef pairs best, and every
+/// pair is held to that placement: a survey whose axes are 1.4 % apart was placed by parts of
+/// the affine fit, its pairs up to 20 px off a 2000 px map with nothing said (hostile pass);
+/// a smaller map with the same survey error is placed within the tolerance, the pairs'
+/// centre where the survey puts it.
+#[test]
+fn georef_pairs_are_held_to_the_placement_used() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let pairs = |side: f64| {
+        [
+            (0.0, 0.0),
+            (side, 0.0),
+            (0.0, side),
+            (side, side),
+            (side / 2.0, side / 5.0),
+        ]
+        .iter()
+        .map(|&(px, py)| format!("{px},{py},{},{}\n", 0.05 * px, 0.0507 * (side - py)))
+        .collect::<String>()
+    };
+    let info = |img: &Path, csv: &str| {
+        let g = dir.join("g.csv");
+        std::fs::write(&g, csv).unwrap();
+        ccpp()
+            .args(["info", "--map", s(img), "--georef", s(&g), "--json"])
+            .output()
+            .unwrap()
+    };
+    pgm(dir, "big.pgm", 2000, 2000, |_, _| false);
+    let o = info(&dir.join("big.pgm"), &pairs(2000.0));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.starts_with("error: georef ")
+            && err.contains("placed by rotation and uniform scale")
+            && err.contains("(pair 4 of 5) is 0.524 m (10.4 px) off")
+            && err.contains("1.4 % more scale along one axis"),
+        "{err}"
+    );
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    // 200 px: the same 1.4 % misses by about a pixel, within the tolerance
+    pgm(dir, "small.pgm", 200, 200, |_, _| false);
+    let o = info(&dir.join("small.pgm"), &pairs(200.0));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let res = j["resolution_m"].as_f64().unwrap();
+    let origin: Vec<f64> = j["origin"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    // best fit: res between the two axes' scales, no turn, the centre of the pairs kept
+    assert!(res > 0.05 && res < 0.0507, "{res}");
+    assert!(origin[2].abs() < 1e-9, "{origin:?}");
+    let centre_y =
+        origin[1] + res * (200.0 - 200.0 * (0.0 + 0.0 + 200.0 + 200.0 + 40.0) / 5.0 / 200.0);
+    let surveyed_y = 0.0507 * (200.0 - (0.0 + 0.0 + 200.0 + 200.0 + 40.0) / 5.0);
+    assert!(
+        (centre_y - surveyed_y).abs() < 1e-9,
+        "{centre_y} {surveyed_y}"
+    );
+}
+
 /// A robot under `sqrt(0.5) - 0.5` of a pixel passes where two occupied pixels meet only at a
 /// corner, so a diagonal wall one pixel thick does not stop it: bcd covered both halves of a
 /// room so divided, with 0 collisions, and nothing said so (hostile pass). Now `run` and

@@ -534,9 +534,12 @@ fn extent_problem(grid: &GridMap) -> Option<(String, &'static str)> {
     Some((p.to_string(), p.setting()))
 }
 
-/// Places `grid` by the affine fit of the point pairs in `path` (pixel coordinates from the
-/// image's top-left corner, y down). ccpp frames are similarities (rotation + uniform scale),
-/// so a fit with more than 1 % shear or anisotropy is refused.
+/// Places `grid` by the point pairs in `path` (pixel coordinates from the image's top-left
+/// corner, y down). ccpp frames are similarities (rotation + uniform scale):
+/// the map is placed by the similarity that fits the pairs best, and a pair it misses by more
+/// than [`GEOREF_MISS_PX`] pixels or [`GEOREF_MISS_M`] metres, whichever is more, is refused
+/// (a typo in one pair is named from the affine fit first; axes scaled apart or sheared are
+/// said as such).
 ///
 /// # Errors
 /// An unreadable or degenerate georef file, a fit that is not a similarity, or a placement
@@ -565,21 +568,6 @@ pub fn apply_georef(grid: GridMap, path: &Path) -> Result<GridMap, ScenarioError
                 .to_string(),
         ));
     }
-    let yaw = c.atan2(a);
-    // Pixel y grows downwards, so the second column is res * (sin yaw, -cos yaw).
-    let (sy, cy) = yaw.sin_cos();
-    let dev = ((a - res * cy).powi(2)
-        + (c - res * sy).powi(2)
-        + (b - res * sy).powi(2)
-        + (d + res * cy).powi(2))
-    .sqrt()
-        / res;
-    if dev > 0.01 {
-        return Err(err(format!(
-            "the fitted transform has {:.1} % shear or anisotropy; ccpp needs rotation + uniform scale",
-            100.0 * dev
-        )));
-    }
     // A pair far off the fit of all (a typo in a coordinate): the placement it pulls off is
     // used silently otherwise (one wrong digit of seven pairs moved the map 1.43 m).
     let limit = (GEOREF_MISS_PX * res).max(GEOREF_MISS_M);
@@ -605,8 +593,34 @@ pub fn apply_georef(grid: GridMap, path: &Path) -> Result<GridMap, ScenarioError
             Compact(round_sig(others)),
         )));
     }
+    // The map is placed by the rotation + uniform scale that fits the pairs best (every map
+    // frame is one), and each pair is held to that placement: placed by parts of the affine
+    // fit (its scale, its first column's angle, its corner), a survey with axes 1.4 % apart
+    // put a 2000 px map's pairs 14-20 px off, with nothing said (hostile pass).
+    let sim =
+        ccpp_core::georef::fit_image_similarity(&fit.pairs).map_err(|e| err(e.to_string()))?;
+    let res = sim.res;
+    if let Some(worst) = (0..sim.residuals.len())
+        .filter(|&i| sim.residuals[i] > limit)
+        .max_by(|&i, &j| sim.residuals[i].total_cmp(&sim.residuals[j]))
+    {
+        let (p, w) = fit.pairs[worst];
+        return Err(err(format!(
+            "placed by rotation and uniform scale (as every map is), the pair {},{} -> {},{} (pair {} of {}) is {} m ({:.1} px) off: the pairs need {:.1} % more scale along one axis than across it (anisotropy or shear), which a map frame cannot hold; check the survey (a pair may miss the placement by at most {GEOREF_MISS_PX} px or {GEOREF_MISS_M} m, whichever is more)",
+            Compact(p.x),
+            Compact(p.y),
+            Compact(w.x),
+            Compact(w.y),
+            worst + 1,
+            sim.residuals.len(),
+            Compact(round_sig(sim.residuals[worst])),
+            sim.residuals[worst] / res,
+            100.0 * ccpp_core::georef::anisotropy(fit.affine.m),
+        )));
+    }
     let h = grid.frame().height as f64;
-    let o = fit.affine.apply(ccpp_core::Point::new(0.0, h));
+    let o = sim.apply(ccpp_core::Point::new(0.0, h));
+    let yaw = sim.yaw;
     // A placement the grid refuses, or one out of the bounds every map is held to
     // ([`check_extent`]), is the georef file's fault: named as such (not `map FILE`, whose
     // origin and resolution the fit replaced).
