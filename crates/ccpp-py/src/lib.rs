@@ -649,6 +649,25 @@ fn nested_section<'a>(
     }
 }
 
+/// The planners (command-line names) that have an option `key`, as their own or in one of
+/// their nested sections (ba-star-extended's `ba_star` and `extension`).
+fn planners_with_option(key: &str) -> Vec<String> {
+    PlannerKind::ALL
+        .iter()
+        .filter(|kind| {
+            let cfg = serde_json::to_value(PlannerConfig::new(**kind)).ok();
+            let opts = cfg.as_ref().and_then(|c| c.get("options")?.as_object());
+            opts.is_some_and(|o| {
+                o.contains_key(key)
+                    || o.iter().any(|(sec, v)| {
+                        sec != "exec" && v.as_object().is_some_and(|n| n.contains_key(key))
+                    })
+            })
+        })
+        .map(ToString::to_string)
+        .collect()
+}
+
 /// `odometry_noise=`: a number (LIN) or a sequence of one to three numbers (LIN, ANG, DRIFT),
 /// as `--odometry-noise LIN[,ANG[,DRIFT]]`.
 fn noise_arg(v: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
@@ -944,6 +963,18 @@ fn scenario_from(
         return Err(msg(format!(
             "{k} is a setting of the map, not of the run: load the map with ccpp.load_map(path, {k}=...) and pass that map"
         )));
+    }
+    // Another planner's option is said as the command line says it ("--side does not apply to
+    // ba-star (it applies to bsa, bsa-extended)"); it was serde's "unknown field" with this
+    // planner's fields (docs review).
+    if let Some(k) = planner_opts
+        .keys()
+        .find(|k| !defaults.is_some_and(|o| o.contains_key(*k)))
+    {
+        let holders = planners_with_option(k);
+        if !holders.is_empty() {
+            return Err(not_applicable(k, kind, &holders.join(", ")));
+        }
     }
     if !planner_opts.is_empty() {
         let mut cfg = serde_json::to_value(&s.planner).map_err(|e| err(&e))?;

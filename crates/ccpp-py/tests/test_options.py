@@ -426,3 +426,21 @@ def test_a_bcd_margin_no_transfer_can_keep_is_a_plan_and_run_warning(tmp_path: P
     assert ccpp.plan(img, "bcd", start=(4.5, 1.0)).warnings == []
     ran = ccpp.run(img, "bcd", start=(4.5, 1.0), margin_px=3).warnings
     assert any(w.startswith("bcd: margin_px 3 was not kept on ") for w in ran), ran
+
+
+def test_another_planners_option_is_said_as_the_cli_says_it(room: Path, ccpp_bin: str, tmp_path: Path) -> None:
+    """`side="left"` for ba-star was serde's "unknown field `side`, expected one of ..." while
+    `ccpp run --planner ba-star --side left` says the option belongs to bsa and bsa-extended
+    (docs review). Both say it now; an option of no planner is still "unknown field"."""
+    p = cli(ccpp_bin, "run", "--map", str(room), "--planner", "ba-star", "--side", "left", "--out", str(tmp_path / "o"))
+    assert p.returncode == 1 and "does not apply to ba-star (it applies to bsa, bsa-extended)" in p.stderr, p.stderr
+    for kw in ({"side": "left"}, {"options": {"side": "left"}}):
+        with pytest.raises(ccpp.CcppError, match=r"^side does not apply to ba-star \(it applies to bsa, bsa-extended\)$"):
+            ccpp.run(room, "ba-star", **kw)
+    # bcd's option for a tile planner; ba-star-extended's nested ba_star option for bsa
+    with pytest.raises(ccpp.CcppError, match=r"turn_cost_m does not apply to bsa \(it applies to bcd"):
+        ccpp.run(room, "bsa", turn_cost_m=0.5)
+    with pytest.raises(ccpp.CcppError, match=r"smoothing does not apply to bsa \(it applies to ba-star, ba-star-extended\)"):
+        ccpp.run(room, "bsa", smoothing=False)
+    with pytest.raises(ccpp.CcppError, match="unknown field"):
+        ccpp.run(room, "ba-star", no_such_option=1)
