@@ -84,7 +84,8 @@ pub struct RobotArgs {
     // radius given beside a rectangle whose disk it cannot change.
     #[arg(long, value_parser = parse_number, value_name = "M")]
     pub radius: Option<f64>,
-    /// Cleaning tool radius in metres (default: the robot radius).
+    /// Cleaning tool radius in metres (default: the robot radius). `plan` refuses it for
+    /// rect-boustrophedon, whose lanes follow its lane width.
     #[arg(long, value_parser = parse_number, value_name = "M")]
     pub tool_radius: Option<f64>,
     /// Start pose `X,Y[,THETA]` in metres/radians (default: the widest free spot, heading
@@ -119,13 +120,13 @@ fn parse_start(s: &str) -> Result<StartArg, String> {
 #[derive(Args, Debug, Clone, Default)]
 pub struct ZoneArgs {
     /// Work area: a polygon file (`GeoJSON`, or YAML list of x,y points; map coordinates) or a
-    /// rectangle `X0,Y0,X1,Y1`. The robot stays inside it (virtual walls) and coverage is
-    /// measured on the floor inside it. Default: the whole map.
+    /// rectangle `X0,Y0,X1,Y1`. The robot stays inside it (virtual walls); `run` measures
+    /// coverage on the floor inside it. Default: the whole map.
     #[arg(long, value_name = "FILE|X0,Y0,X1,Y1", value_parser = parse_zone, allow_hyphen_values = true)]
     pub area: Option<ZoneSpec>,
     /// Keep-out zone (repeatable): a Nav2 keepout filter mask (`map_server` YAML + image in the
     /// map's frame, occupied = forbidden), a polygon file (`GeoJSON` or YAML) or a rectangle
-    /// `X0,Y0,X1,Y1`. Never entered; entries are counted as `keepout_violations`.
+    /// `X0,Y0,X1,Y1`. Never entered (`run` counts entries as `keepout_violations`).
     #[arg(long, value_name = "FILE|X0,Y0,X1,Y1", value_parser = parse_zone, allow_hyphen_values = true)]
     pub keepout: Vec<ZoneSpec>,
 }
@@ -142,9 +143,7 @@ pub struct OptionsArgs {
 /// The memory budget, shared by every command that plans (`run`, `plan`, `waypoints`, `bench`).
 #[derive(Args, Debug, Clone, Default)]
 pub struct LimitArgs {
-    /// Refuse work whose estimated memory exceeds this many MB (default 4096; `bench` checks
-    /// each run, and its runs in progress and summary pictures share the limit: a run starts
-    /// when its estimate fits beside theirs).
+    /// Refuse work whose estimated memory exceeds this many MB (default 4096).
     #[arg(long, value_parser = parse_whole::<u64>, value_name = "MB")]
     pub max_memory: Option<u64>,
 }
@@ -339,7 +338,10 @@ pub struct DemoArgs {
 
 /// `ccpp bench`.
 #[derive(Args, Debug)]
-#[command(allow_negative_numbers = true)]
+#[command(
+    allow_negative_numbers = true,
+    mut_arg("max_memory", |a| a.help("Refuse work whose estimated memory exceeds this many MB (default 4096): each run is checked, and the runs in progress and the summary pictures share the limit (a run starts when its estimate fits beside theirs)"))
+)]
 pub struct BenchArgs {
     /// Map files and/or folders (a folder contributes its `*.yaml` maps, or its images).
     #[arg(long, value_name = "DIR|FILES", num_args = 1.., required = true)]
