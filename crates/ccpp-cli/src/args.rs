@@ -53,7 +53,7 @@ pub struct MapArgs {
     #[arg(long, value_parser = parse_number, value_name = "M")]
     pub resolution: Option<f64>,
     /// Override the origin `X,Y[,YAW]` (world pose of the lower-left pixel; YAW left out is 0, not the map's yaw).
-    #[arg(long, value_name = "X,Y[,YAW]", value_parser = parse_triple, allow_hyphen_values = true)]
+    #[arg(long, value_name = "X,Y[,YAW]", value_parser = parse_origin, allow_hyphen_values = true)]
     pub origin: Option<[f64; 3]>,
     /// Override `occupied_thresh`.
     #[arg(long, value_parser = parse_number, value_name = "P")]
@@ -464,8 +464,19 @@ where
     T::Err: std::fmt::Display,
 {
     let t = s.trim();
-    t.parse::<T>()
-        .map_err(|e| format!("{t:?} is not a whole number ({e})"))
+    t.parse::<T>().map_err(|e| {
+        // (`-5` "is not a whole number (invalid digit found in string)": docs review)
+        let digits = |d: &str| !d.is_empty() && d.bytes().all(|b| b.is_ascii_digit());
+        if digits(t.strip_prefix('+').unwrap_or(t)) {
+            format!("{t:?} is too large ({e})")
+        } else if t.strip_prefix('-').is_some_and(digits) {
+            format!("{t:?} is negative: give a whole number")
+        } else if t.parse::<f64>().is_ok_and(f64::is_finite) {
+            format!("{t:?} is not a whole number: give one without a fraction or exponent")
+        } else {
+            format!("{t:?} is not a whole number ({e})")
+        }
+    })
 }
 
 /// Parses `A,B,C,D` into four finite numbers.
@@ -488,11 +499,22 @@ fn parse_zone(s: &str) -> Result<ZoneSpec, String> {
     }
 }
 
+/// Parses `--origin`'s `X,Y[,YAW]` (as [`parse_triple`], the message naming YAW).
+fn parse_origin(s: &str) -> Result<[f64; 3], String> {
+    parse_triple_named(s, "YAW")
+}
+
 /// Parses `A,B` or `A,B,C` into three numbers (C defaults to 0).
 fn parse_triple(s: &str) -> Result<[f64; 3], String> {
+    parse_triple_named(s, "THETA")
+}
+
+/// [`parse_triple`], the third number called `third` in the message (as the flag's help
+/// calls it: `--origin 1,2,3,4` said "X,Y,THETA" of `X,Y[,YAW]`).
+fn parse_triple_named(s: &str, third: &str) -> Result<[f64; 3], String> {
     let parts = parse_finite_list(s)?;
     if !(2..=3).contains(&parts.len()) {
-        return Err(format!("expected X,Y or X,Y,THETA, got {s:?}"));
+        return Err(format!("expected X,Y or X,Y,{third}, got {s:?}"));
     }
     let mut v = [0.0; 3];
     v[..parts.len()].copy_from_slice(&parts);

@@ -105,6 +105,20 @@ pub fn replay_dir(dir: &Path) -> Result<()> {
     // GIF beside the new run's files (a folder mixing two runs).
     let identity = folder_identity(dir);
     let rec_path = dir.join("run.json");
+    // A `ccpp plan` folder holds exports only (it said "no readable run.json: No such file or
+    // directory": docs review).
+    let plan_files = [
+        "nav_path.yaml",
+        "waypoints.csv",
+        "waypoints.json",
+        "path.geojson",
+    ];
+    if !rec_path.exists() && plan_files.iter().any(|f| dir.join(f).is_file()) {
+        anyhow::bail!(
+            "{} holds a plan (ccpp plan), not a run: a plan is not simulated, so there is nothing to replay; `ccpp run` with the same map and planner writes a run folder",
+            dir.display()
+        );
+    }
     let text = ccpp_io::file::read_text(&rec_path).with_context(|| {
         format!(
             "{} is not a ccpp run folder (no readable run.json)",

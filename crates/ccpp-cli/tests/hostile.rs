@@ -21,6 +21,20 @@ fn refused(args: &[&str], needles: &[&str]) {
     }
 }
 
+/// An argument error: one `error:` line holding `needle` and clap's `hint:` line, status 1.
+fn arg_refused(args: &[&str], needle: &str) {
+    let o = ccpp().args(args).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+    let lines: Vec<&str> = err.trim_end().lines().collect();
+    assert_eq!(lines.len(), 2, "{err}");
+    assert!(
+        lines[0].starts_with("error: ") && lines[0].contains(needle),
+        "{err:?} should contain {needle:?}"
+    );
+    assert!(lines[1].starts_with("hint: see `ccpp "), "{err}");
+}
+
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
@@ -1296,6 +1310,81 @@ fn georef_pairs_are_held_to_the_placement_used() {
     assert!(
         (centre_y - surveyed_y).abs() < 1e-9,
         "{centre_y} {surveyed_y}"
+    );
+}
+
+/// Likely mistakes are said as what they are (docs review): a map and planner swapped, a
+/// folder given as the map, a plan folder given to `replay`, a negative or fractional whole
+/// number, `--origin` with four numbers (its help calls the third YAW).
+#[test]
+fn likely_mistakes_are_said_as_such() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let out = dir.join("o");
+    refused(
+        &[
+            "run",
+            "--map",
+            "bcd",
+            "--planner",
+            s(&map),
+            "--out",
+            s(&out),
+        ],
+        &["that looks like a map file, not a planner name: were the map and the planner swapped?"],
+    );
+    refused(
+        &["run", "--map", s(dir), "--planner", "bcd", "--out", s(&out)],
+        &["a folder, not a map: give a map_server YAML or an image"],
+    );
+    for (value, said) in [
+        ("-5", "\"-5\" is negative"),
+        (
+            "1.5",
+            "\"1.5\" is not a whole number: give one without a fraction or exponent",
+        ),
+        ("99999999999999999999999", "is too large"),
+    ] {
+        arg_refused(
+            &[
+                "run",
+                "--map",
+                s(&map),
+                "--planner",
+                "bsa",
+                "--max-memory",
+                value,
+                "--out",
+                s(&out),
+            ],
+            said,
+        );
+    }
+    arg_refused(
+        &["info", "--map", s(&map), "--origin", "1,2,3,4"],
+        "expected X,Y or X,Y,YAW, got \"1,2,3,4\"",
+    );
+    let plan = dir.join("plan");
+    let o = ccpp()
+        .args([
+            "plan",
+            "--map",
+            s(&map),
+            "--planner",
+            "bcd",
+            "--out",
+            s(&plan),
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    refused(
+        &["replay", s(&plan)],
+        &[
+            "holds a plan (ccpp plan), not a run",
+            "`ccpp run` with the same map and planner",
+        ],
     );
 }
 

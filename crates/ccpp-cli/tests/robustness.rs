@@ -1046,10 +1046,10 @@ fn user_errors_are_one_line_and_exit_1() {
             "--map",
             dir.path().to_str().unwrap(),
         ],
-        &["not a regular file"],
+        &["a folder, not a map: give a map_server YAML or an image"],
         1,
     );
-    assert_eq!(e.matches("not a regular file").count(), 1, "{e}");
+    assert_eq!(e.matches("a folder, not a map").count(), 1, "{e}");
     // Config errors: one line, no library advice or debug dumps.
     let dup = dir.path().join("dup.yaml");
     std::fs::write(

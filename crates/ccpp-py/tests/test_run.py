@@ -189,7 +189,7 @@ def test_errors_name_each_cause_once(room: Path, ccpp_bin: str, tmp_path: Path) 
     regular file: not a regular file`); they are the command line's lines."""
     with pytest.raises(ccpp.CcppError) as e:
         ccpp.load_map(tmp_path)
-    assert str(e.value) == f"cannot read {tmp_path}: not a regular file"
+    assert str(e.value) == f"cannot read {tmp_path}: a folder, not a map: give a map_server YAML or an image"
     p = cli(ccpp_bin, "run", "--map", str(room), "--planner", "bsa", "--start", "0.02,0.02", "--out", str(tmp_path / "o"))
     assert p.returncode == 1 and p.stderr.startswith("error: ")
     with pytest.raises(ccpp.CcppError) as e:

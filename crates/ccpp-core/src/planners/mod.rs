@@ -382,6 +382,14 @@ pub enum BuildError {
 /// hyphens (its options-file section, `rect_boustrophedon`) or spaces; else nothing.
 fn did_you_mean(name: &str) -> String {
     let norm = name.trim().to_ascii_lowercase().replace(['_', ' '], "-");
+    // A map file in the planner's place (`--map bcd --planner maze.yaml`: docs review).
+    let file_like = norm.contains(['/', '\\'])
+        || [".yaml", ".yml", ".png", ".pgm", ".pnm"]
+            .iter()
+            .any(|ext| norm.ends_with(ext));
+    if file_like {
+        return " (that looks like a map file, not a planner name: were the map and the planner swapped?)".to_string();
+    }
     CATALOG
         .iter()
         .find(|p| p.name == norm)

@@ -98,11 +98,17 @@ pub struct LoadedMap {
 pub fn load_map(path: &Path, opts: &LoadOptions) -> Result<LoadedMap, MapError> {
     match std::fs::metadata(path) {
         Ok(m) if m.is_file() => {}
-        Ok(_) => {
+        Ok(m) => {
+            // (a folder given as the map said "not a regular file" only: docs review)
+            let what = if m.is_dir() {
+                "a folder, not a map: give a map_server YAML or an image"
+            } else {
+                "not a regular file"
+            };
             return Err(MapError::Io {
                 path: path.to_path_buf(),
-                source: std::io::Error::other("not a regular file"),
-            })
+                source: std::io::Error::other(what),
+            });
         }
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
             return Err(MapError::NotFound {
