@@ -1388,6 +1388,45 @@ fn likely_mistakes_are_said_as_such() {
     );
 }
 
+/// A lane rectangle narrower than a map pixel is refused (`waypoints --area` and the options
+/// file's `rect_boustrophedon.area`): `1,1,1.0000001,1.0000001` gave four waypoints 0.1 um
+/// apart (hostile pass); one a pixel wide still plans.
+#[test]
+fn a_lane_area_narrower_than_a_pixel_is_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    refused(
+        &["waypoints", "--map", s(&map), "--area=1,1,1.0000001,1.0000001"],
+        &["--area: 1,1,1.0000001,1.0000001 is 1.000e-7 x 1.000e-7 m, narrower than a map pixel (0.05 m)"],
+    );
+    let o = dir.join("o.yaml");
+    std::fs::write(&o, "rect_boustrophedon:\n  area: [1, 1, 2, 1.01]\n").unwrap();
+    refused(
+        &[
+            "run",
+            "--map",
+            s(&map),
+            "--planner",
+            "rect-boustrophedon",
+            "--config",
+            s(&o),
+            "--out",
+            s(&dir.join("r")),
+        ],
+        &["rect_boustrophedon.area: 1,1,2,1.01 is 1 x 0.01 m, narrower than a map pixel"],
+    );
+    let ok = ccpp()
+        .args(["waypoints", "--map", s(&map), "--area=1,1,2,1.05"])
+        .output()
+        .unwrap();
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+}
+
 /// A robot under `sqrt(0.5) - 0.5` of a pixel passes where two occupied pixels meet only at a
 /// corner, so a diagonal wall one pixel thick does not stop it: bcd covered both halves of a
 /// room so divided, with 0 collisions, and nothing said so (hostile pass). Now `run` and

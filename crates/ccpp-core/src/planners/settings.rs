@@ -1471,6 +1471,22 @@ impl PlannerSettings for RectOptions {
                     ),
                 ));
             }
+            // A lane rectangle narrower than a pixel: its edges' lanes and stops lie within one
+            // pixel of each other (`1,1,1.0000001,1.0000001` gave four waypoints 0.1 um apart:
+            // hostile pass).
+            let (aw, ah) = (a[2] - a[0], a[3] - a[1]);
+            if aw.min(ah) < res {
+                return Err(OptionsError::new(
+                    "area",
+                    format!(
+                        "{} is {} x {} m, narrower than a map pixel ({} m): its lanes and stops would lie within one pixel of each other",
+                        crate::display::join(&a),
+                        fmt_m(aw),
+                        fmt_m(ah),
+                        crate::display::Compact(res)
+                    ),
+                ));
+            }
         }
         Ok(())
     }
