@@ -225,12 +225,12 @@ pub fn run(a: &InfoArgs) -> Result<()> {
         map.source.display()
     ));
     line(format!(
-        "size           {} x {} px, {} m/px = {:.2} x {:.2} m",
+        "size           {} x {} px, {} m/px = {} x {} m",
         f.width,
         f.height,
         num(f.resolution),
-        info.width_m,
-        info.height_m
+        ccpp_core::display::fixed(info.width_m, 2),
+        ccpp_core::display::fixed(info.height_m, 2)
     ));
     line(format!(
         "origin         ({}, {}, {})",
@@ -256,9 +256,9 @@ pub fn run(a: &InfoArgs) -> Result<()> {
         ));
     }
     line(format!(
-        "free           {free} px ({:.1} %), {:.1} m2",
+        "free           {free} px ({:.1} %), {} m2",
         free as f64 / n,
-        info.free_m2
+        ccpp_core::display::fixed(info.free_m2, 1)
     ));
     line(format!("occupied       {occ} px ({:.1} %)", occ as f64 / n));
     line(format!("unknown        {unk} px ({:.1} %)", unk as f64 / n));
@@ -274,15 +274,19 @@ pub fn run(a: &InfoArgs) -> Result<()> {
                 w.cfree().count_ones(..)
             ));
             // (no heading: `info` takes none, and nothing it reports depends on one)
-            line(format!("start          ({:.3}, {:.3})", s.x, s.y));
+            line(format!(
+                "start          ({}, {})",
+                ccpp_core::display::fixed(s.x, 3),
+                ccpp_core::display::fixed(s.y, 3)
+            ));
             line(format!("start area     {}", comp.line()));
             line(format!(
                 "reachable      {} px of C-free from the start",
                 w.reachable().count_ones(..)
             ));
             line(format!(
-                "accessible     {:.2} m2 (floor a tool of radius {} m can touch from the start{})",
-                w.accessible_area_m2(),
+                "accessible     {} m2 (floor a tool of radius {} m can touch from the start{})",
+                ccpp_core::display::fixed(w.accessible_area_m2(), 2),
                 num(robot.tool_radius),
                 match w.zones().map(|z| (z.area.is_some(), !z.keepout.is_clear())) {
                     Some((true, true)) => ", inside the area, outside the keep-outs",
@@ -306,7 +310,9 @@ pub fn run(a: &InfoArgs) -> Result<()> {
                 .unwrap_or_default();
             let _ = writeln!(
                 t,
-                "area           {label}: {a:.2} m2, {af:.2} m2 of it free floor"
+                "area           {label}: {} m2, {} m2 of it free floor",
+                ccpp_core::display::fixed(a, 2),
+                ccpp_core::display::fixed(af, 2)
             );
         }
         if !zs.keepout.is_empty() {
@@ -317,10 +323,10 @@ pub fn run(a: &InfoArgs) -> Result<()> {
                 .collect();
             let _ = writeln!(
                 t,
-                "keep-out       {}: {:.2} m2 of pixels kept out (each pixel a polygon overlaps), {:.2} m2 of it free floor",
+                "keep-out       {}: {} m2 of pixels kept out (each pixel a polygon overlaps), {} m2 of it free floor",
                 labels.join(", "),
-                z.keepout_m2,
-                z.keepout_free_m2
+                ccpp_core::display::fixed(z.keepout_m2, 2),
+                ccpp_core::display::fixed(z.keepout_free_m2, 2)
             );
         }
     }

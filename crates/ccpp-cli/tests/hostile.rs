@@ -1427,6 +1427,23 @@ fn a_lane_area_narrower_than_a_pixel_is_refused() {
     );
 }
 
+/// `info` on a map of tiny pixels shows its sizes, not zeros: `--resolution 1e-5` printed a
+/// 160 x 120 px map as "0.00 x 0.00 m" and its widest spot as "clearance 0.000 m" (docs review).
+#[test]
+fn info_shows_tiny_sizes_as_numbers() {
+    let d = tempfile::tempdir().unwrap();
+    let map = pillars(d.path());
+    let o = ccpp()
+        .args(["info", "--map", s(&map), "--resolution", "1e-5"])
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.contains("1e-5 m/px = 1.60e-3 x 1.20e-3 m"), "{out}");
+    assert!(!out.contains(" 0.00 ") && !out.contains("0.000 m"), "{out}");
+    assert!(out.contains("the widest free spot has clearance "), "{out}");
+}
+
 /// A robot under `sqrt(0.5) - 0.5` of a pixel passes where two occupied pixels meet only at a
 /// corner, so a diagonal wall one pixel thick does not stop it: bcd covered both halves of a
 /// room so divided, with 0 collisions, and nothing said so (hostile pass). Now `run` and

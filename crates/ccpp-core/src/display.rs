@@ -42,6 +42,30 @@ pub fn join(values: &[f64]) -> String {
         .join(",")
 }
 
+/// `v` with `decimals` decimals, as a table shows it, but never a non-zero value as 0: one that
+/// would show as zeros is written to three significant digits (`--resolution 1e-5` printed a
+/// 200 px map as "0.00 x 0.00 m" and its widest spot as "clearance 0.000 m").
+///
+/// ```
+/// use ccpp_core::display::fixed;
+/// assert_eq!(fixed(10.0, 2), "10.00");
+/// assert_eq!(fixed(0.002, 2), "2.00e-3");
+/// assert_eq!(fixed(0.0, 2), "0.00");
+/// assert_eq!(fixed(-0.0004, 3), "-4.00e-4");
+/// ```
+pub fn fixed(v: f64, decimals: usize) -> String {
+    let shown = format!("{v:.decimals$}");
+    let all_zero = shown
+        .trim_start_matches('-')
+        .bytes()
+        .all(|b| b == b'0' || b == b'.');
+    if v != 0.0 && v.is_finite() && all_zero {
+        format!("{v:.2e}")
+    } else {
+        shown
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

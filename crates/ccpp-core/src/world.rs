@@ -69,8 +69,9 @@ fn too_big_text(radius: f64, max_clearance: f64) -> String {
     } else {
         format!(
             "robot of radius {} m does not fit anywhere on the map: the widest free spot has \
-             clearance {max_clearance:.3} m",
-            Compact(radius)
+             clearance {} m",
+            Compact(radius),
+            crate::display::fixed(max_clearance, 3)
         )
     }
 }

@@ -495,10 +495,11 @@ pub fn inflated_world_error(e: &WorldError, inflation: Option<f64>) -> Option<St
             max_clearance,
         } => Some(format!(
             "robot of radius {} m does not fit anywhere once --inflate / map.inflate {} m has \
-             grown the obstacles (the widest free spot then has clearance {max_clearance:.3} m); \
+             grown the obstacles (the widest free spot then has clearance {} m); \
              lower the inflation",
             Compact(*radius),
             Compact(m),
+            ccpp_core::display::fixed(*max_clearance, 3),
         )),
         WorldError::StartInObstacle { .. } => Some(format!(
             "{e} once --inflate / map.inflate {} m has grown the obstacles",

@@ -212,10 +212,10 @@ fn clearance_world(world: &World, opts: &RectOptions) -> Result<(World, f64), St
                 // (`world.map()` is the planning map: with zones, what the area and keep-outs
                 // leave of the floor, so the widest spot is theirs, not the drawn map's)
                 E::RobotTooBig { max_clearance, .. } if world.zones().is_some() => {
-                    format!("it fits nowhere in what the area and keep-outs leave of the map (the widest free spot there has clearance {max_clearance:.3} m)")
+                    format!("it fits nowhere in what the area and keep-outs leave of the map (the widest free spot there has clearance {} m)", crate::display::fixed(max_clearance, 3))
                 }
                 E::RobotTooBig { max_clearance, .. } => {
-                    format!("it fits nowhere on the map (the widest free spot has clearance {max_clearance:.3} m)")
+                    format!("it fits nowhere on the map (the widest free spot has clearance {} m)", crate::display::fixed(max_clearance, 3))
                 }
                 e => e.to_string(),
             };
