@@ -343,7 +343,8 @@ pub struct DemoArgs {
     mut_arg("max_memory", |a| a.help("Refuse work whose estimated memory exceeds this many MB (default 4096): each run is checked, and the runs in progress and the summary pictures share the limit (a run starts when its estimate fits beside theirs)"))
 )]
 pub struct BenchArgs {
-    /// Map files and/or folders (a folder contributes its `*.yaml` maps, or its images).
+    /// Map files and/or folders (a folder contributes its `*.yaml` maps, or its images; a
+    /// YAML naming no image, such as an options file, is left out with a note).
     #[arg(long, value_name = "DIR|FILES", num_args = 1.., required = true)]
     pub maps: Vec<PathBuf>,
     /// Planners, comma-separated (default: all).

@@ -8,7 +8,7 @@ use anyhow::{bail, Context, Result};
 use ccpp_core::metrics::Metrics;
 use ccpp_core::planners::{self, PlannerOptions};
 use ccpp_core::sim::SimConfig;
-use ccpp_io::names::{expand_maps, name_maps};
+use ccpp_io::names::{expand_maps_noting, name_maps};
 use ccpp_io::scenario::Scenario;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
@@ -109,7 +109,21 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         .filter_map(|p| parse_planner(p).ok())
         .collect();
     crate::job::warn_unused_config(a.options.config.as_deref(), &kinds);
-    let maps = name_maps(expand_maps(&a.maps)?);
+    let (found, skipped) = expand_maps_noting(&a.maps)?;
+    if !skipped.is_empty() {
+        let names: Vec<String> = skipped
+            .iter()
+            .map(|p| ccpp_io::message::visible(&p.display().to_string()))
+            .collect();
+        say!(
+            "note: left out {} YAML file{} that name{} no image (not map_server maps): {}",
+            names.len(),
+            if names.len() == 1 { "" } else { "s" },
+            if names.len() == 1 { "s" } else { "" },
+            names.join(", ")
+        );
+    }
+    let maps = name_maps(found);
     check_map_names(&maps)?;
     // The maps whose plots a bench in this folder writes: this bench's and those of the run
     // folders an earlier one left (`runs/MAP`).

@@ -79,6 +79,34 @@ pub enum MapListError {
 /// An empty list, an item that is neither file nor folder, a folder that cannot be read or
 /// holds a map whose name is not UTF-8, or no map at all.
 pub fn expand_maps(items: &[PathBuf]) -> Result<Vec<PathBuf>, MapListError> {
+    expand_maps_noting(items).map(|(maps, _)| maps)
+}
+
+/// Whether the YAML file `p` reads as a mapping without an `image` key: a planner options,
+/// zone or other YAML file beside the maps, not a `map_server` map. A file that cannot be read
+/// or parsed is kept (its run reports the problem), and so is a file over 1 MiB.
+fn yaml_without_image(p: &Path) -> bool {
+    const MAX: u64 = 1 << 20;
+    if std::fs::metadata(p).map_or(true, |m| m.len() > MAX) {
+        return false;
+    }
+    let Ok(text) = std::fs::read_to_string(p) else {
+        return false;
+    };
+    match serde_saphyr::from_str::<serde_json::Value>(text.trim_start_matches('\u{feff}')) {
+        Ok(serde_json::Value::Object(o)) => !o.contains_key("image"),
+        _ => false,
+    }
+}
+
+/// [`expand_maps`], with the YAML files of the folders that were left out because they name
+/// no image ([`yaml_without_image`]: a bench's options file in its maps folder became a failed
+/// run); files given by name are taken as they are.
+///
+/// # Errors
+/// As [`expand_maps`].
+pub fn expand_maps_noting(items: &[PathBuf]) -> Result<(Vec<PathBuf>, Vec<PathBuf>), MapListError> {
+    let mut skipped = Vec::new();
     if items.is_empty() {
         return Err(MapListError::Empty);
     }
@@ -108,11 +136,12 @@ pub fn expand_maps(items: &[PathBuf]) -> Result<Vec<PathBuf>, MapListError> {
                     file: bad.clone(),
                 });
             }
-            let yamls: Vec<PathBuf> = files
+            let (yamls, others): (Vec<PathBuf>, Vec<PathBuf>) = files
                 .iter()
                 .filter(|p| has_ext(p, &["yaml", "yml"]))
                 .cloned()
-                .collect();
+                .partition(|p| !yaml_without_image(p));
+            skipped.extend(others);
             if yamls.is_empty() {
                 out.extend(
                     files
@@ -137,7 +166,7 @@ pub fn expand_maps(items: &[PathBuf]) -> Result<Vec<PathBuf>, MapListError> {
                 .join(", "),
         });
     }
-    Ok(out)
+    Ok((out, skipped))
 }
 
 /// A map's name from its file stem. A stem that is not a usable folder name (`..yaml` and
@@ -260,6 +289,29 @@ pub fn name_maps_indexed(maps: &[PathBuf]) -> Vec<(usize, String)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A folder's YAML files that name no image (an options file beside the maps) are left
+    /// out and listed; one that does not parse, or one given by name, is kept.
+    #[test]
+    fn a_folders_yaml_without_an_image_is_no_map() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        for (f, text) in [
+            (
+                "a.yaml",
+                "image: a.png\nresolution: 0.05\norigin: [0, 0, 0]\n",
+            ),
+            ("bench.yaml", "bcd:\n  turn_cost_m: 0.5\n"),
+            ("broken.yaml", "image: [\n"),
+        ] {
+            std::fs::write(d.join(f), text).unwrap();
+        }
+        let (maps, skipped) = expand_maps_noting(&[d.to_path_buf()]).unwrap();
+        assert_eq!(maps, [d.join("a.yaml"), d.join("broken.yaml")]);
+        assert_eq!(skipped, [d.join("bench.yaml")]);
+        let (maps, skipped) = expand_maps_noting(&[d.join("bench.yaml")]).unwrap();
+        assert_eq!((maps, skipped.len()), (vec![d.join("bench.yaml")], 0));
+    }
 
     /// A folder gives its YAML maps, or its images when it has none, sorted; what is neither
     /// file nor folder, a folder without maps and a map whose name is not UTF-8 are refused.
