@@ -1258,16 +1258,18 @@ fn georef_pairs_are_held_to_the_placement_used() {
     let d = tempfile::tempdir().unwrap();
     let dir = d.path();
     let pairs = |side: f64| {
-        [
+        use std::fmt::Write as _;
+        let mut csv = String::new();
+        for (px, py) in [
             (0.0, 0.0),
             (side, 0.0),
             (0.0, side),
             (side, side),
             (side / 2.0, side / 5.0),
-        ]
-        .iter()
-        .map(|&(px, py)| format!("{px},{py},{},{}\n", 0.05 * px, 0.0507 * (side - py)))
-        .collect::<String>()
+        ] {
+            writeln!(csv, "{px},{py},{},{}", 0.05 * px, 0.0507 * (side - py)).unwrap();
+        }
+        csv
     };
     let info = |img: &Path, csv: &str| {
         let g = dir.join("g.csv");

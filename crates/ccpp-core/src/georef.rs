@@ -341,7 +341,7 @@ pub fn anisotropy(m: [f64; 4]) -> f64 {
     let f2 = a * a + b * b + c * c + d * d;
     let det = (a * d - b * c).abs();
     let root = (f2 * f2 - 4.0 * det * det).max(0.0).sqrt();
-    let (s1, s2) = (((f2 + root) / 2.0).sqrt(), ((f2 - root) / 2.0).sqrt());
+    let (s1, s2) = (f64::midpoint(f2, root).sqrt(), ((f2 - root) / 2.0).sqrt());
     if s2 > 0.0 {
         s1 / s2 - 1.0
     } else {

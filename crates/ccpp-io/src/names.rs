@@ -100,7 +100,7 @@ fn yaml_without_image(p: &Path) -> bool {
 }
 
 /// [`expand_maps`], with the YAML files of the folders that were left out because they name
-/// no image ([`yaml_without_image`]: a bench's options file in its maps folder became a failed
+/// no image (a mapping without an `image` key: a bench's options file in its maps folder became a failed
 /// run); files given by name are taken as they are.
 ///
 /// # Errors
