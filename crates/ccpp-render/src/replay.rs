@@ -594,7 +594,10 @@ pub fn replay_html(
             )
             .replace("{{SR}}", &C_SWEPT[0].to_string())
             .replace("{{SG}}", &C_SWEPT[1].to_string())
-            .replace("{{SB}}", &C_SWEPT[2].to_string()),
+            .replace("{{SB}}", &C_SWEPT[2].to_string())
+            .replace("{{AR}}", &C_ACC[0].to_string())
+            .replace("{{AG}}", &C_ACC[1].to_string())
+            .replace("{{AB}}", &C_ACC[2].to_string()),
     );
     html = html.replace("{{BG}}", &bg).replace("{{DATA}}", &data);
     Ok(html)
