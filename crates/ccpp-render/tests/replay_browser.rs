@@ -435,6 +435,44 @@ fn the_last_frame_shows_the_missed_floor_as_the_metrics_count_it() {
     );
 }
 
+/// The distance travelled is shown as the metrics measure the path: the page holds whole
+/// millimetres, and a path of 9.84999 m (9 850 mm) showed "9.9 / 9.9 m" beside the path length
+/// "9.8" (hostile pass: 198.9 against 198.8).
+#[test]
+fn the_distance_travelled_ends_at_the_metrics_path_length() {
+    let (world, _) = run(300, 60, 10);
+    let mut trace = Trace::default();
+    trace.push_event(0, Event::RegionStart { region: 1 });
+    trace.push_pose(0, Pose::new(0.3, 0.3, 0.0));
+    trace.push_pose(1, Pose::new(0.3 + 9.849_99, 0.3, 0.0));
+    let html = replay_html(
+        &world,
+        &trace,
+        None,
+        r#"{"path_length_m": 9.84999}"#,
+        "mm",
+        &[],
+    )
+    .expect("page");
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("replay-mm");
+    std::fs::create_dir_all(&dir).expect("dir");
+    std::fs::write(dir.join("page.html"), &html).expect("write");
+    let Some(chrome) = require_chromium() else {
+        return;
+    };
+    let _serial = BROWSER
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    let url = format!("file://{}#frame=last", dir.join("page.html").display());
+    let (dom, err) = dump_dom(&chrome, &url, true);
+    no_console_errors(&err);
+    assert!(
+        dom.contains(r#"id="now-dist">9.8 / 9.8 m<"#),
+        "{}",
+        &dom[dom.find("now-dist").unwrap_or(0)..][..60.min(dom.len())]
+    );
+}
+
 /// Region numbers are not bounded by 16 bits: a run whose second region is number 65 537 (a
 /// bcd plan of many cells, a long random run cut into regions) keeps two regions in the
 /// legend, not one (65 537 read back as 1).
