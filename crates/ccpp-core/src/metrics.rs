@@ -392,13 +392,23 @@ impl<'w> Sweeper<'w> {
 /// after each travelled `total / samples` metres (and at the end), for coverage-over-distance
 /// plots.
 pub fn coverage_curve(world: &World, trace: &Trace, samples: usize) -> Vec<[f64; 2]> {
+    coverage_curve_and_swept(world, trace, samples).0
+}
+
+/// [`coverage_curve`] and the pixels the whole path swept (whose centres lie within the swept
+/// radius of a move), from the one sweep.
+pub fn coverage_curve_and_swept(
+    world: &World,
+    trace: &Trace,
+    samples: usize,
+) -> (Vec<[f64; 2]>, FixedBitSet) {
     let frame = *world.frame();
     let acc = world.accessible();
     let a_count = world.accessible_count().max(1) as f64;
     let rt = world.robot().tool_radius / frame.resolution + SWEEP_EPS_PX;
     let poses: Vec<Pose> = trace.poses().collect();
     let Some(first) = poses.first() else {
-        return Vec::new();
+        return (Vec::new(), FixedBitSet::with_capacity(frame.len()));
     };
     let total: f64 = poses
         .windows(2)
@@ -439,7 +449,7 @@ pub fn coverage_curve(world: &World, trace: &Trace, samples: usize) -> Vec<[f64;
     if out.last().is_some_and(|l| l[0] < travelled) {
         out.push([travelled, covered.get() as f64 / a_count]);
     }
-    out
+    (out, swept)
 }
 
 /// Tile boundaries of the revisit walk lie this far (in tiles) below the half-way lines:

@@ -4,7 +4,7 @@ use std::fmt::Write as _;
 
 use base64::Engine as _;
 use ccpp_core::grid::Cell;
-use ccpp_core::metrics::{coverage_curve, Sweeper};
+use ccpp_core::metrics::{coverage_curve_and_swept, Sweeper};
 use ccpp_core::trace::{Entry, Event, Trace};
 use ccpp_core::world::World;
 use ccpp_core::Point;
@@ -397,7 +397,24 @@ fn replay_data(
     }
     let tblob = base64::engine::general_purpose::STANDARD.encode(&tblob);
     // Live coverage: [distance m, coverage] samples.
-    let curve = coverage_curve(world, trace, COVERAGE_SAMPLES);
+    let (curve, swept) = coverage_curve_and_swept(world, trace, COVERAGE_SAMPLES);
+    // The legend entry of swept floor the metrics do not count (as coverage.png's), or null.
+    let swept_outside = {
+        let (mut out_of_reach, mut outside_area) = (false, false);
+        for i in swept.ones() {
+            match class_of(world, i) {
+                Class::OutOfReach => out_of_reach = true,
+                Class::OutsideArea => outside_area = true,
+                _ => {}
+            }
+        }
+        match (out_of_reach, outside_area) {
+            (false, false) => "null",
+            (true, false) => "\"swept, outside reachable floor\"",
+            (false, true) => "\"swept, outside the area\"",
+            (true, true) => "\"swept, outside the area or reachable floor\"",
+        }
+    };
     let mut cov = String::from("[");
     for (k, c) in curve.iter().enumerate() {
         if k > 0 {
@@ -427,7 +444,7 @@ fn replay_data(
     let last = finished.map_or_else(|| "null".to_string(), |(t, _)| t.to_string());
     let classes = classes_js(world, crop);
     format!(
-        r#"{{"w":{w},"h":{h},"res":{res},"yaw":{yaw},"r":{r},"rt":{rt},"swept_r":{swept_r},"tile":{tile},"start":[{sx},{sy},{st}],"n":{n},"m":{m},"q":{q},"blob":"{blob}","events":{events},"nt":{nt},"tblob":"{tblob}","cov":{cov},"palette":{palette},"zones":{zones},"approach":{approach},"stop":{stop},"last":{last},"classes":{classes},"warnings":{warnings},"metrics":{metrics}}}"#,
+        r#"{{"w":{w},"h":{h},"res":{res},"yaw":{yaw},"r":{r},"rt":{rt},"swept_r":{swept_r},"tile":{tile},"start":[{sx},{sy},{st}],"n":{n},"m":{m},"q":{q},"blob":"{blob}","events":{events},"nt":{nt},"tblob":"{tblob}","cov":{cov},"palette":{palette},"zones":{zones},"approach":{approach},"stop":{stop},"last":{last},"classes":{classes},"swept_outside":{swept_outside},"warnings":{warnings},"metrics":{metrics}}}"#,
         res = js_num(f.resolution),
         yaw = js_num(yaw),
         r = js_num(world.robot().radius / f.resolution),
@@ -595,6 +612,12 @@ pub fn replay_html(
             .replace("{{SR}}", &C_SWEPT[0].to_string())
             .replace("{{SG}}", &C_SWEPT[1].to_string())
             .replace("{{SB}}", &C_SWEPT[2].to_string())
+            .replace("{{XR}}", &crate::colours::SWEPT_OUTSIDE[0].to_string())
+            .replace("{{XG}}", &crate::colours::SWEPT_OUTSIDE[1].to_string())
+            .replace("{{XB}}", &crate::colours::SWEPT_OUTSIDE[2].to_string())
+            .replace("{{OR}}", &C_FREE_OUT[0].to_string())
+            .replace("{{OG}}", &C_FREE_OUT[1].to_string())
+            .replace("{{OB}}", &C_FREE_OUT[2].to_string())
             .replace("{{AR}}", &C_ACC[0].to_string())
             .replace("{{AG}}", &C_ACC[1].to_string())
             .replace("{{AB}}", &C_ACC[2].to_string()),

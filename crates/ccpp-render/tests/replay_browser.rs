@@ -326,6 +326,13 @@ fn the_replay_shows_the_zones_like_the_coverage_picture() {
     let (plain_world, plain_trace) = run(200, 120, 400);
     let plain = replay_html(&plain_world, &plain_trace, None, "{}", "plain", &[]).expect("page");
     assert!(plain.contains(r#""zones":null"#));
+    // Floor swept outside the area is drawn in coverage.png's lighter colour, with its legend
+    // entry (it was drawn as counted floor: hostile pass); a run inside its floor has none.
+    assert!(
+        html.contains(r#""swept_outside":"swept, outside the area"#),
+        "no legend entry for floor swept outside the area"
+    );
+    assert!(plain.contains(r#""swept_outside":null"#));
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("replay-zones");
     std::fs::create_dir_all(&dir).expect("dir");
     std::fs::write(dir.join("zones.html"), &html).expect("write");
