@@ -473,6 +473,15 @@ impl<'w> Simulator<'w> {
         self.trace.push_pose(self.t, self.pose);
     }
 
+    /// Longest move that can stay on the map: its diagonal plus the robot's diameter and a
+    /// metre. A longer one meets the map's edge first, so it is cut to this length: a move of
+    /// 1e307 m met its contact at a fraction of the move below `f64`'s resolution, and the
+    /// robot stayed where it was, reported in collision (Python `Env`: hostile pass).
+    fn reach_limit(&self) -> f64 {
+        let f = self.world.frame();
+        f.width_m().hypot(f.height_m()) + 2.0 * self.world.robot().radius + 1.0
+    }
+
     fn translate(&mut self, d: f64) {
         if !d.is_finite() || d == 0.0 {
             return;
@@ -484,7 +493,8 @@ impl<'w> Simulator<'w> {
         };
         let a = self.pose.position();
         let (c, s) = self.trig.cos_sin(dir);
-        let b = Point::new(a.x + d.abs() * c, a.y + d.abs() * s);
+        let len = d.abs().min(self.reach_limit());
+        let b = Point::new(a.x + len * c, a.y + len * s);
         match self.world.true_first_contact(a, b) {
             None => {
                 self.pose.x = b.x;
@@ -519,6 +529,7 @@ impl<'w> Simulator<'w> {
             }
             Step::Translate(d) => {
                 if d.is_finite() && d != 0.0 {
+                    let d = d.clamp(-self.reach_limit(), self.reach_limit());
                     let from = est.position();
                     let to = Point::new(from.x + d * est.theta.cos(), from.y + d * est.theta.sin());
                     self.push_segment(from, to);
@@ -1013,6 +1024,30 @@ mod tests {
                 .count(),
             1
         );
+    }
+
+    /// A move far longer than the map stops at the same contact as a short one that reaches the
+    /// wall: one of 1e307 m met its contact at a fraction of the move below `f64`'s resolution,
+    /// and the robot stayed where it was, in collision (Python `Env`: hostile pass).
+    #[test]
+    fn a_move_of_any_length_stops_at_the_wall() {
+        let map = GridMap::from_ascii_scaled("#####\n#...#\n#####", 10, 0.1).unwrap();
+        let world = World::new(map, Robot::new(0.3), Some(Pose::new(1.5, 1.5, 0.0))).unwrap();
+        let end = |d: f64| {
+            let out = simulate(
+                &world,
+                &mut Script(vec![Step::Translate(d)]),
+                &SimConfig::default(),
+            );
+            out.trace.poses().last().unwrap()
+        };
+        let wall = end(5.0);
+        for d in [1e200, 1e307, f64::MAX] {
+            assert_eq!(end(d), wall, "{d}");
+        }
+        let back = end(-5.0);
+        assert_eq!(end(-f64::MAX), back);
+        assert!(back.x < 1.5 && wall.x > 3.0, "{back:?} {wall:?}");
     }
 
     use crate::exec::{OdometryNoise, PidOptions};
