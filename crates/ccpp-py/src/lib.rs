@@ -2223,8 +2223,11 @@ impl Env {
 
     /// Executes one action — `("rotate", angle_rad)`, `("translate", distance_m)` or
     /// `("move_to", x, y)` — and returns `(observation, reward, terminated, truncated, info)`:
-    /// the reward is the newly swept accessible area in m²; the episode terminates on a
-    /// collision (the bumper) or when every accessible pixel is swept; it is truncated after
+    /// the reward is the accessible area the action newly swept, in m² (what the start pose
+    /// sweeps is in `info["coverage"]` from `reset` on, so an episode's return is the final
+    /// swept area less the start's); the episode terminates on a collision (the bumper) or
+    /// when every accessible pixel is swept (one whose start already sweeps everything,
+    /// `info["coverage"]` 1.0 at `reset`, ends at its first step with reward 0); it is truncated after
     /// `max_steps` actions, or when what the episode holds (its recorded path, with the map's
     /// share) passes `max_memory_mb` (`info["memory_limit"]` is then true). A step after the
     /// episode has ended is refused (call `reset`).
