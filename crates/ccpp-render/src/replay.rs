@@ -23,6 +23,8 @@ pub const C_SWEPT: [u8; 3] = [120, 190, 245];
 const C_PATH: [u8; 3] = [0, 70, 160];
 /// The robot: the replay page's yellow disc (green means the start in every picture).
 const C_ROBOT: [u8; 3] = [255, 212, 0];
+/// The start: the replay page's green disc, as in the coverage picture.
+const C_START: [u8; 3] = crate::colours::START;
 
 /// Period of the keep-out hatching, in map pixels (the replay's background has one pixel per
 /// map pixel; the coverage picture hatches in canvas pixels).
@@ -666,8 +668,8 @@ pub fn replay_gif(world: &World, trace: &Trace, opts: &GifOptions) -> Result<Vec
     // The map's offset on the canvas (white margins around a map thinner than the canvas).
     let (ox, oy) = ((gw - mw) / 2, (gh - mh) / 2);
     // Palette: 0 occ, 1 unk, 2 free-out, 3 accessible, 4 swept, 5 path, 6 robot, 7 white,
-    // 8 keep-out, 9 keep-out hatching and border, 10 outside the area, 11 area border (then
-    // padding to 16).
+    // 8 keep-out, 9 keep-out hatching and border, 10 outside the area, 11 area border, 12 the
+    // start, 13 swept floor the metrics do not count (then padding to 16).
     let palette: Vec<u8> = [
         C_OCC,
         C_UNK,
@@ -681,8 +683,8 @@ pub fn replay_gif(world: &World, trace: &Trace, opts: &GifOptions) -> Result<Vec
         KEEPOUT_HATCH,
         OUTSIDE_AREA,
         AREA_BORDER,
-        [255, 255, 255],
-        [255, 255, 255],
+        C_START,
+        crate::colours::SWEPT_OUTSIDE,
         [255, 255, 255],
         [255, 255, 255],
     ]
@@ -795,11 +797,12 @@ pub fn replay_gif(world: &World, trace: &Trace, opts: &GifOptions) -> Result<Vec
             let mut buf = base.clone();
             for (p, v) in buf.iter_mut().enumerate() {
                 // Keep-outs keep their colours, as in the coverage picture; floor outside the
-                // area that the tool swept (the approach to it) shows as swept.
+                // area or out of reach that the tool swept (the approach to the area) shows in
+                // the coverage picture's lighter swept colour.
                 if matches!(*v, 2 | 3 | 10)
                     && src(p % gw, p / gw).is_some_and(|i| swept.contains(i))
                 {
-                    *v = 4;
+                    *v = if *v == 3 { 4 } else { 13 };
                 }
                 if borders[p] != 0 {
                     *v = borders[p];
@@ -808,9 +811,15 @@ pub fn replay_gif(world: &World, trace: &Trace, opts: &GifOptions) -> Result<Vec
                     *v = 5;
                 }
             }
+            let rr = (world.robot().radius / f.resolution * k).max(2.0);
+            // The start, as on the page and in the coverage picture (hostile pass: the GIF had
+            // none).
+            if let Some(&p0) = poses.first() {
+                let (x, y) = to_gif(p0);
+                fill_disk(&mut buf, gw, gh, x, y, (rr * 0.6).max(2.0), 12);
+            }
             if let Some(p) = robot {
                 let (x, y) = to_gif(p);
-                let rr = (world.robot().radius / f.resolution * k).max(2.0);
                 fill_disk(&mut buf, gw, gh, x, y, rr, 6);
             }
             let mut frame = gif::Frame::from_indexed_pixels(gw as u16, gh as u16, buf, None);
@@ -1011,6 +1020,18 @@ mod tests {
         assert!(count(C_ROBOT) > 10, "robot pixels");
         assert_eq!(C_ROBOT, [255, 212, 0]);
         assert!(TEMPLATE.contains("rgba(255,212,0,"));
+        // The start is marked once the robot has left it, in the page's green (the GIF had
+        // no start: hostile pass).
+        let mut last = frame.buffer.to_vec();
+        while let Some(f) = dec.read_next_frame().unwrap() {
+            last = f.buffer.to_vec();
+        }
+        let starts = last
+            .chunks_exact(4)
+            .filter(|p| p[..3] == C_START[..])
+            .count();
+        assert!(starts > 3, "start pixels: {starts}");
+        assert!(TEMPLATE.contains("rgb(0,170,60)") && C_START == [0, 170, 60]);
     }
 
     /// The GIF's frames are spaced in motion, not in poses: one long move then a hundred
