@@ -125,6 +125,20 @@ fn self_test(chrome: &Path, url: &str, virtual_time: bool) -> serde_json::Value 
     );
 }
 
+/// Writes `html` as `page.html` in a folder `name` of the test's temporary space and returns
+/// its self-test result (virtual time), or `None` without Chromium.
+fn page_self_test(html: &str, name: &str) -> Option<serde_json::Value> {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    std::fs::create_dir_all(&dir).expect("dir");
+    std::fs::write(dir.join("page.html"), html).expect("write");
+    let chrome = require_chromium()?;
+    let _serial = BROWSER
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    let url = format!("file://{}#selftest", dir.join("page.html").display());
+    Some(self_test(&chrome, &url, true))
+}
+
 fn no_console_errors(stderr: &str) {
     for l in stderr.lines() {
         let l = l.to_ascii_lowercase();
@@ -387,17 +401,9 @@ fn a_move_before_the_first_region_is_no_region_in_the_replay_legend() {
         trace.push(r);
     }
     let html = replay_html(&world, &trace, None, "{}", "pre-region", &[]).expect("page");
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("replay-pre-region");
-    std::fs::create_dir_all(&dir).expect("dir");
-    std::fs::write(dir.join("page.html"), &html).expect("write");
-    let Some(chrome) = require_chromium() else {
+    let Some(v) = page_self_test(&html, "replay-pre-region") else {
         return;
     };
-    let _serial = BROWSER
-        .lock()
-        .unwrap_or_else(std::sync::PoisonError::into_inner);
-    let url = format!("file://{}#selftest", dir.join("page.html").display());
-    let v = self_test(&chrome, &url, true);
     assert_eq!(v["pass"], true, "{v}");
     let legend: Vec<&str> = v["legend"]
         .as_array()
@@ -413,23 +419,15 @@ fn a_move_before_the_first_region_is_no_region_in_the_replay_legend() {
 
 /// The last frame shows as not yet swept what the run missed, no more: the swept floor was
 /// drawn as strokes of the tool's width, which left the corners of swept pixels showing "floor
-/// not yet swept" between lanes (3.4 % of teb_maze's floor against 0.13 % missed: hostile
+/// not yet swept" between lanes (3.4 % of `teb_maze`'s floor against 0.13 % missed: hostile
 /// pass). Lanes exactly two tool radii apart are the hardest case.
 #[test]
 fn the_last_frame_shows_the_missed_floor_as_the_metrics_count_it() {
     let (world, trace) = run(200, 120, 400);
     let html = replay_html(&world, &trace, None, "{}", "lanes", &[]).expect("page");
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("replay-missed");
-    std::fs::create_dir_all(&dir).expect("dir");
-    std::fs::write(dir.join("page.html"), &html).expect("write");
-    let Some(chrome) = require_chromium() else {
+    let Some(v) = page_self_test(&html, "replay-missed") else {
         return;
     };
-    let _serial = BROWSER
-        .lock()
-        .unwrap_or_else(std::sync::PoisonError::into_inner);
-    let url = format!("file://{}#selftest", dir.join("page.html").display());
-    let v = self_test(&chrome, &url, true);
     assert_eq!(v["pass"], true, "{v}");
     let swept = v["swept_px"].as_f64().expect("swept");
     let unswept = v["unswept_px"].as_f64().expect("unswept");
