@@ -1489,6 +1489,35 @@ fn bench_leaves_out_a_folders_yaml_that_names_no_image() {
     assert_eq!(csv.lines().count(), 2, "{csv}");
     let run = std::fs::read_to_string(out.join("runs/pillars/bcd/run.json")).unwrap();
     assert!(run.contains("\"turn_cost_m\": 0.5"), "{run}");
+    // Given by name, a file that is no map is refused before any run, and no folder is
+    // written (a landmarks CSV became a failed row after every other run).
+    let lm = dir.join("lm.csv");
+    std::fs::write(&lm, "id,x,y\n1,0,0\n").unwrap();
+    let out2 = dir.join("bench2");
+    for (file, said) in [
+        (
+            &lm,
+            "is not a map: neither a map_server YAML (.yaml/.yml) nor a PNG or PNM/PGM image",
+        ),
+        (
+            &cfg,
+            "is not a map: a YAML naming no image (an options or zone file?)",
+        ),
+    ] {
+        refused(
+            &[
+                "bench",
+                "--quiet",
+                "--maps",
+                s(&maps.join("pillars.yaml")),
+                s(file),
+                "--out",
+                s(&out2),
+            ],
+            &[said],
+        );
+        assert!(!out2.exists());
+    }
 }
 
 /// A robot under `sqrt(0.5) - 0.5` of a pixel passes where two occupied pixels meet only at a

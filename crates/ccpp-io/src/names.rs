@@ -58,6 +58,15 @@ pub enum MapListError {
         /// The map file.
         file: PathBuf,
     },
+    /// A file given by name that is no map: neither a YAML naming an image nor a PNG or
+    /// PNM/PGM image (a landmarks CSV given as a map became a failed run after the others).
+    #[error("maps: {} is not a map: {why}", file.display())]
+    NotAMap {
+        /// The file as given.
+        file: PathBuf,
+        /// What it is instead.
+        why: &'static str,
+    },
     /// An item that is neither a file nor a folder.
     #[error("maps: {}: no such file or folder", item.display())]
     Missing {
@@ -97,6 +106,25 @@ fn yaml_without_image(p: &Path) -> bool {
         Ok(serde_json::Value::Object(o)) => !o.contains_key("image"),
         _ => false,
     }
+}
+
+/// Why the file `p`, given by name, is no map (`yaml`: named as a YAML): a YAML that reads as
+/// a mapping without an `image` key, or another file that does not begin as a PNG or a
+/// PNM/PGM image does. `None` for anything else, left to the map loader (a YAML that does
+/// not parse, an image that does not decode: their runs say why).
+fn not_a_map(p: &Path, yaml: bool) -> Option<&'static str> {
+    if yaml {
+        return yaml_without_image(p)
+            .then_some("a YAML naming no image (an options or zone file?), not a map_server map");
+    }
+    let mut head = [0u8; 8];
+    let n = std::fs::File::open(p)
+        .and_then(|mut f| std::io::Read::read(&mut f, &mut head))
+        .ok()?;
+    let head = &head[..n];
+    let png = head.starts_with(b"\x89PNG");
+    let pnm = head.len() >= 2 && head[0] == b'P' && (b'1'..=b'7').contains(&head[1]);
+    (!png && !pnm).then_some("neither a map_server YAML (.yaml/.yml) nor a PNG or PNM/PGM image")
 }
 
 /// [`expand_maps`], with the YAML files of the folders that were left out because they name
@@ -152,6 +180,12 @@ pub fn expand_maps_noting(items: &[PathBuf]) -> Result<(Vec<PathBuf>, Vec<PathBu
                 out.extend(yamls);
             }
         } else if item.is_file() {
+            if let Some(why) = not_a_map(item, has_ext(item, &["yaml", "yml"])) {
+                return Err(MapListError::NotAMap {
+                    file: item.clone(),
+                    why,
+                });
+            }
             out.push(item.clone());
         } else {
             return Err(MapListError::Missing { item: item.clone() });
@@ -291,7 +325,8 @@ mod tests {
     use super::*;
 
     /// A folder's YAML files that name no image (an options file beside the maps) are left
-    /// out and listed; one that does not parse, or one given by name, is kept.
+    /// out and listed; one that does not parse is kept; a file given by name that is no map
+    /// is refused.
     #[test]
     fn a_folders_yaml_without_an_image_is_no_map() {
         let dir = tempfile::tempdir().unwrap();
@@ -309,8 +344,18 @@ mod tests {
         let (maps, skipped) = expand_maps_noting(&[d.to_path_buf()]).unwrap();
         assert_eq!(maps, [d.join("a.yaml"), d.join("broken.yaml")]);
         assert_eq!(skipped, [d.join("bench.yaml")]);
-        let (maps, skipped) = expand_maps_noting(&[d.join("bench.yaml")]).unwrap();
-        assert_eq!((maps, skipped.len()), (vec![d.join("bench.yaml")], 0));
+        // Given by name, a file that is no map is refused before any run.
+        let e = expand_maps_noting(&[d.join("bench.yaml")])
+            .unwrap_err()
+            .to_string();
+        assert!(e.ends_with("bench.yaml is not a map: a YAML naming no image (an options or zone file?), not a map_server map"), "{e}");
+        std::fs::write(d.join("lm.csv"), "id,x,y\n1,0,0\n").unwrap();
+        let e = expand_maps_noting(&[d.join("lm.csv")])
+            .unwrap_err()
+            .to_string();
+        assert!(e.ends_with("lm.csv is not a map: neither a map_server YAML (.yaml/.yml) nor a PNG or PNM/PGM image"), "{e}");
+        std::fs::write(d.join("m.pgm"), "P5\n1 1\n255\n\0").unwrap();
+        assert!(expand_maps_noting(&[d.join("m.pgm"), d.join("broken.yaml")]).is_ok());
     }
 
     /// A folder gives its YAML maps, or its images when it has none, sorted; what is neither
@@ -325,7 +370,13 @@ mod tests {
         ] {
             std::fs::create_dir(folder).unwrap();
             for f in files {
-                std::fs::write(folder.join(f), "").unwrap();
+                // (an image begins as one: a file given by name is looked at)
+                let head: &[u8] = if f.ends_with(".png") {
+                    b"\x89PNG\r\n\x1a\n"
+                } else {
+                    b""
+                };
+                std::fs::write(folder.join(f), head).unwrap();
             }
         }
         let got = expand_maps(&[a.clone(), b.clone(), a.join("x.png")]).unwrap();
