@@ -287,14 +287,19 @@ impl SimilarityFit {
     }
 }
 
-/// Fits the [`SimilarityFit`] of `pairs` of `(pixel, world)` points.
-///
-/// # Errors
-/// Fewer than 3 pairs, non-finite input, collinear pixel points, or a degenerate fit (all world
-/// points at one place).
-pub fn fit_image_similarity(pairs: &[(Point, Point)]) -> Result<SimilarityFit, GeorefError> {
-    // The checks of the affine fit (count, finite, spread) hold here too.
-    fit_affine(pairs)?;
+impl AffineFit {
+    /// The [`SimilarityFit`] of the same pairs (image pixel coordinates, y down): checked
+    /// already (count, finite, spread) by the affine fit that made `self`.
+    ///
+    /// # Errors
+    /// [`GeorefError::Singular`] for a degenerate fit (all world points at one place).
+    pub fn image_similarity(&self) -> Result<SimilarityFit, GeorefError> {
+        similarity_of(&self.pairs)
+    }
+}
+
+/// The least-squares [`SimilarityFit`] of checked `pairs`.
+fn similarity_of(pairs: &[(Point, Point)]) -> Result<SimilarityFit, GeorefError> {
     let n = pairs.len() as f64;
     let flip = |p: Point| Point::new(p.x, -p.y);
     let (mut qc, mut wc) = (Point::default(), Point::default());
@@ -367,7 +372,9 @@ mod tests {
             .iter()
             .map(|&(c, r)| (Point::new(c, r), truth.apply(Point::new(c, r))))
             .collect();
-        let fit = fit_image_similarity(&pairs).unwrap_or_else(|e| panic!("{e}"));
+        let fit = fit_affine(&pairs)
+            .and_then(|a| a.image_similarity())
+            .unwrap_or_else(|e| panic!("{e}"));
         assert!((fit.res - 0.05).abs() < 1e-12);
         assert!((fit.yaw - 0.3).abs() < 1e-12);
         assert!(fit.t.dist(Point::new(4.0, -2.0)) < 1e-9);

@@ -598,8 +598,7 @@ pub fn apply_georef(grid: GridMap, path: &Path) -> Result<GridMap, ScenarioError
     // frame is one), and each pair is held to that placement: placed by parts of the affine
     // fit (its scale, its first column's angle, its corner), a survey with axes 1.4 % apart
     // put a 2000 px map's pairs 14-20 px off, with nothing said (hostile pass).
-    let sim =
-        ccpp_core::georef::fit_image_similarity(&fit.pairs).map_err(|e| err(e.to_string()))?;
+    let sim = fit.image_similarity().map_err(|e| err(e.to_string()))?;
     let res = sim.res;
     if let Some(worst) = (0..sim.residuals.len())
         .filter(|&i| sim.residuals[i] > limit)
