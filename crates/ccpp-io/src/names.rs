@@ -109,22 +109,16 @@ fn yaml_without_image(p: &Path) -> bool {
 }
 
 /// Why the file `p`, given by name, is no map (`yaml`: named as a YAML): a YAML that reads as
-/// a mapping without an `image` key, or another file that does not begin as a PNG or a
-/// PNM/PGM image does. `None` for anything else, left to the map loader (a YAML that does
-/// not parse, an image that does not decode: their runs say why).
+/// a mapping without an `image` key, or another file that the map loader's content guess
+/// does not take for a PNG or PNM image. `None` for anything else, left to the map loader (a YAML that
+/// does not parse, an image that does not decode: their runs say why).
 fn not_a_map(p: &Path, yaml: bool) -> Option<&'static str> {
     if yaml {
         return yaml_without_image(p)
             .then_some("a YAML naming no image (an options or zone file?), not a map_server map");
     }
-    let mut head = [0u8; 8];
-    let n = std::fs::File::open(p)
-        .and_then(|mut f| std::io::Read::read(&mut f, &mut head))
-        .ok()?;
-    let head = &head[..n];
-    let png = head.starts_with(b"\x89PNG");
-    let pnm = head.len() >= 2 && head[0] == b'P' && (b'1'..=b'7').contains(&head[1]);
-    (!png && !pnm).then_some("neither a map_server YAML (.yaml/.yml) nor a PNG or PNM/PGM image")
+    (!crate::map::pixels::decodable_format(p))
+        .then_some("neither a map_server YAML (.yaml/.yml) nor a PNG or PNM/PGM image")
 }
 
 /// [`expand_maps`], with the YAML files of the folders that were left out because they name
@@ -354,6 +348,12 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.ends_with("lm.csv is not a map: neither a map_server YAML (.yaml/.yml) nor a PNG or PNM/PGM image"), "{e}");
+        // An image of a format ccpp does not decode (JPEG) is no map either.
+        std::fs::write(d.join("photo.jpg"), b"\xff\xd8\xff\xe0\0\x10JFIF\0").unwrap();
+        let e = expand_maps_noting(&[d.join("photo.jpg")])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("photo.jpg is not a map"), "{e}");
         std::fs::write(d.join("m.pgm"), "P5\n1 1\n255\n\0").unwrap();
         assert!(expand_maps_noting(&[d.join("m.pgm"), d.join("broken.yaml")]).is_ok());
     }

@@ -94,6 +94,20 @@ fn png_ihdr_size<R: std::io::Read>(r: &mut R) -> std::io::Result<Option<(u32, u3
     Ok(Some((word(16), word(20))))
 }
 
+/// Whether the file at `path` begins as a PNG or PNM image, by the content guess
+/// [`decode_and_classify`] starts with (the formats ccpp decodes); `false` also when it
+/// cannot be read.
+pub(crate) fn decodable_format(path: &Path) -> bool {
+    ImageReader::open(path)
+        .and_then(ImageReader::with_guessed_format)
+        .is_ok_and(|r| {
+            matches!(
+                r.format(),
+                Some(image::ImageFormat::Png | image::ImageFormat::Pnm)
+            )
+        })
+}
+
 /// Decodes an image (format guessed from its content) and classifies every pixel. The decoded
 /// image buffer is dropped before returning, so at most the image plus the cells are alive.
 /// With `max_pixels`, the image's size is read from its header first and a larger image is
