@@ -639,14 +639,23 @@ fn nested_section<'a>(
     if d.contains_key(key) {
         return None;
     }
-    let mut holders = d
-        .iter()
-        .filter(|(sec, v)| *sec != "exec" && v.as_object().is_some_and(|o| o.contains_key(key)))
-        .map(|(sec, _)| sec.as_str());
+    let mut holders = sections_holding(d, key);
     match (holders.next(), holders.next()) {
         (Some(sec), None) => Some(sec),
         _ => None,
     }
+}
+
+/// The nested sections of the planner options `d` (not `exec`) that hold an option `key`.
+fn sections_holding<'a, 'k>(
+    d: &'a serde_json::Map<String, Value>,
+    key: &'k str,
+) -> impl Iterator<Item = &'a str> + use<'a, 'k> {
+    d.iter()
+        .filter(move |(sec, v)| {
+            *sec != "exec" && v.as_object().is_some_and(|o| o.contains_key(key))
+        })
+        .map(|(sec, _)| sec.as_str())
 }
 
 /// The planners (command-line names) that have an option `key`, as their own or in one of
@@ -657,12 +666,7 @@ fn planners_with_option(key: &str) -> Vec<String> {
         .filter(|kind| {
             let cfg = serde_json::to_value(PlannerConfig::new(**kind)).ok();
             let opts = cfg.as_ref().and_then(|c| c.get("options")?.as_object());
-            opts.is_some_and(|o| {
-                o.contains_key(key)
-                    || o.iter().any(|(sec, v)| {
-                        sec != "exec" && v.as_object().is_some_and(|n| n.contains_key(key))
-                    })
-            })
+            opts.is_some_and(|o| o.contains_key(key) || sections_holding(o, key).next().is_some())
         })
         .map(ToString::to_string)
         .collect()
