@@ -819,23 +819,29 @@ fn a_map_name_too_long_for_the_plots_is_refused_before_any_run() {
 /// and then repeated that motion, each one meeting the wall at once, up to the simulator's 50
 /// million step cap: minutes of work and gigabytes of trace for 50 million collisions, and no
 /// word of it in the results. The run now stops after 1000 motions without progress, and says
-/// why in `metrics.json`, the summary and the trace.
+/// why in `metrics.json`, the summary and the trace. (BA* itself now gives up a move its
+/// bumper stopped and no longer stalls there; rect-boustrophedon, which replays a plan made
+/// on the known map, still pushes into the wall under strong noise.)
 #[test]
 fn a_robot_that_stops_making_progress_is_stopped_and_says_so() {
+    let Some(maps) = common::shared_maps() else {
+        eprintln!("skipped: no shared maps");
+        return;
+    };
     let d = tempfile::tempdir().unwrap();
     let dir = d.path();
     let map = pillars(dir);
+    let config = dir.join("noise.yaml");
+    std::fs::write(
+        &config,
+        "rect_boustrophedon:\n  exec:\n    pid:\n      noise:\n        seed: 6\n        linear_rel_std: 0.2\n        angular_rel_std: 0.2\n        heading_drift_std: 0.2\n",
+    )
+    .unwrap();
     let out = dir.join("noisy");
     let a = ccpp()
-        .args([
-            "run",
-            "--planner",
-            "ba-star",
-            "--odometry-noise",
-            "0.1",
-            "--map",
-        ])
-        .arg(&map)
+        .args(["run", "--planner", "rect-boustrophedon", "--map"])
+        .arg(maps.join("aws_small_house.yaml"))
+        .args(["--config", s(&config)])
         .arg("--out")
         .arg(&out)
         .timeout(std::time::Duration::from_mins(1))
@@ -857,10 +863,30 @@ fn a_robot_that_stops_making_progress_is_stopped_and_says_so() {
     let m = read_json(&out.join("metrics.json"));
     assert_eq!(m["stop_reason"], "stalled");
     let collisions = m["collisions"].as_u64().unwrap();
-    assert!((1000..1100).contains(&collisions), "{collisions}");
+    assert!(collisions >= 1000, "{collisions}");
     assert!(trace(&out)
         .trim_end()
         .ends_with(r#""event":"finished","reason":"stalled"}"#));
+    // BA* at the noise that made it stall: it finishes, with few contacts.
+    let ba = ccpp()
+        .args([
+            "run",
+            "--planner",
+            "ba-star",
+            "--odometry-noise",
+            "0.1",
+            "--map",
+        ])
+        .arg(&map)
+        .arg("--out")
+        .arg(dir.join("ba"))
+        .timeout(std::time::Duration::from_mins(1))
+        .assert()
+        .success();
+    let ba_out = String::from_utf8_lossy(&ba.get_output().stdout).into_owned();
+    assert!(!ba_out.contains("stalled"), "{ba_out}");
+    let m = read_json(&dir.join("ba").join("metrics.json"));
+    assert!(m["collisions"].as_u64().unwrap() < 100, "{m}");
     // A run the planner finishes has no stop reason.
     let clean = run_ok(dir, "clean", &map, "ba-star", &[]);
     assert!(read_json(&clean.join("metrics.json"))

@@ -653,7 +653,12 @@ impl<'w> Simulator<'w> {
             let (new_est, new_true) = (world(new_est_l), world(new_true_l));
             let a = self.pose.position();
             let b = new_true.position();
-            let hit = if a == b {
+            // A turn in place (no linear speed) cannot touch anything the disk does not touch
+            // already; the world-local round trip can still move its position by a rounding
+            // error, which, against a wall the robot had bumped, counted as a contact: the
+            // robot could never turn away from a wall it touched (ba-star under odometry
+            // noise: 1000 contacts in one place, then the stall stop).
+            let hit = if a == b || vt == 0.0 {
                 None
             } else {
                 self.world.true_first_contact(a, b)
@@ -1332,6 +1337,42 @@ mod tests {
                 "record_every {n}: the records alone give another mean"
             );
         }
+    }
+
+    /// A robot that bumped a wall turns away from it and drives off: the turn in place is no
+    /// contact. The world-local round trip of the PID loop moved the position by a rounding
+    /// error during the turn, which against the wall counted as a contact, so every later
+    /// motion stopped at once (ba-star under odometry noise: 1000 contacts in one place).
+    #[test]
+    fn a_robot_at_a_wall_turns_away_and_drives_off() {
+        let mut stuck = 0;
+        for k in 0..40 {
+            // Origins whose world-local round trip rounds (at (0, 0) it is exact).
+            let o = Point::new(-10.3 - 0.0137 * f64::from(k), -7.7 + 0.0093 * f64::from(k));
+            let world = big_room();
+            let map = world
+                .map()
+                .clone()
+                .with_placement(0.05, Pose::new(o.x, o.y, 0.0))
+                .unwrap();
+            let world = World::new(
+                map,
+                Robot::new(0.15),
+                Some(Pose::new(o.x + 4.0, o.y + 4.0, 0.0)),
+            )
+            .unwrap();
+            let mut sim = Simulator::new(&world, &pid(None));
+            // Into the east wall (x = 8 m less the wall pixel), at a slant.
+            sim.execute(Step::MoveTo(Point::new(o.x + 9.0, o.y + 4.3)));
+            assert!(sim.bumped(), "origin {o:?}: no contact at the wall");
+            let at = sim.true_pose().position();
+            // Back west, away from the wall.
+            sim.execute(Step::MoveTo(Point::new(o.x + 4.0, o.y + 4.0)));
+            if sim.bumped() || sim.true_pose().position().dist(at) < 1.0 {
+                stuck += 1;
+            }
+        }
+        assert_eq!(stuck, 0, "runs that could not leave the wall");
     }
 
     #[test]

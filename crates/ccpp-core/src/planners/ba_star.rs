@@ -432,6 +432,15 @@ impl Planner for BaStar {
             }
             Phase::Bm => self.bm_step(sensor),
             Phase::Backtrack { path, next } => {
+                if *next > 1 && sensor.bumped() {
+                    // The bumper stopped a move of the way to `s_sp`: give up its frontier
+                    // (the robot starts a region where it is instead).
+                    let sp = path.last().copied();
+                    if let (Some(sp), Some(m)) = (sp, self.mind.as_deref_mut()) {
+                        m.give_up_frontier(sp);
+                    }
+                    return self.arrive(sensor);
+                }
                 let target = path.get(*next).copied();
                 *next += 1;
                 match (target, self.mind.as_ref()) {

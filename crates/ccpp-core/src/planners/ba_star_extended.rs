@@ -346,6 +346,17 @@ impl Planner for BaStarExtended {
                 ext.set_speck_fields(true);
             });
         self.ba.observe(sensor);
+        if self.drive.stuck() {
+            // Stuck against a wall under odometry noise (`Drive::stuck`): the moves queued
+            // from a position the robot is not at are dropped and the cleaning in progress is
+            // given up (the host goes on; at the end, the run ends).
+            self.drive.abandon();
+            match self.mode {
+                Mode::Clean { last: true } => self.mode = Mode::Done,
+                Mode::Clean { last: false } => self.mode = Mode::Host,
+                Mode::Host | Mode::Done => {}
+            }
+        }
         loop {
             if let Some(s) = self.drive.queue.pop_front() {
                 return s;

@@ -101,6 +101,7 @@ impl BaStar {
             gx,
             gy,
             sent_to: None,
+            sent_move: None,
             centres_home: centres_round_home(&grid),
         }));
     }
@@ -109,12 +110,21 @@ impl BaStar {
         let Some(m) = self.mind.as_deref_mut() else {
             return Step::Done;
         };
-        let c = m.robot_tile(sensor.pose().position());
+        let mut c = m.robot_tile(sensor.pose().position());
+        if let Some((from, k)) = m.sent_move.take() {
+            if sensor.bumped() {
+                // The move did not arrive: the robot stays on the tile it left (its estimate
+                // may lie inside the target's square, which it has not reached).
+                m.block_bumped_move(from, k);
+                c = from;
+            }
+        }
         m.cover(c);
         for k in [2, 6, 0, 4] {
             let n = (c.0 + N8[k].0, c.1 + N8[k].1);
             if !m.tiles.covered(n) && m.judge_move(c, k) == Judgement::Free {
                 m.sent_to = Some(n);
+                m.sent_move = Some((c, k));
                 return Step::MoveTo(m.center(n));
             }
         }

@@ -69,6 +69,9 @@ pub(super) struct Mind {
     pub(super) row_tiles: Vec<(i32, i32)>,
     /// The tile of the last BM move sent ([`Mind::robot_tile`]).
     pub(super) sent_to: Option<Tile>,
+    /// The last BM move sent, as its tile and direction (index into `N8`): blocked when the
+    /// bumper stops it ([`BaStar::bm_step`](super::BaStar)).
+    pub(super) sent_move: Option<(Tile, usize)>,
     /// The tiling is one where a tile centre lies in its own tile by the rounding of
     /// [`TileGrid::tile_of`] ([`centres_round_home`]).
     ///
@@ -556,6 +559,44 @@ impl Mind {
             .filter(|(&[a, b], _)| a <= b)
             .map(|(&[a, b], row)| (row, col0 + i64::from(a), col0 + i64::from(b)));
         known.runs_state(runs).into()
+    }
+
+    /// The bumper stopped the BM move `t -> t + N8[k]`: the move is judged blocked, whatever
+    /// the known map says, and `L` is updated around both tiles.
+    ///
+    /// Why: under odometry noise the pose estimate drifts from the truth, so a move that is
+    /// free on the known map can run the real robot into a wall. Left free, the same move was
+    /// sent again at every step (BA* on `teb_maze` at `--odometry-noise 0.02`: 1002 bumper
+    /// contacts in one place, then the simulator's stall stop at 20 % of the floor). Blocked,
+    /// BM takes the next direction or ends the region, and `L` (which reads move judgements)
+    /// no longer lists a tile for a neighbour it cannot enter, so backtracking does not
+    /// return to it. A move once blocked stays blocked (judgements are cached for good), so
+    /// every bump removes one of finitely many moves: the planner terminates. Under ideal
+    /// execution a correct BA* never bumps, so nothing changes there.
+    pub(super) fn block_bumped_move(&mut self, t: Tile, k: usize) {
+        let n = (t.0 + N8[k].0, t.1 + N8[k].1);
+        self.tiles.set_move(t, k, Judgement::Blocked);
+        self.tiles.update_l_around(t);
+        self.tiles.update_l_around(n);
+    }
+
+    /// The bumper stopped a move of the way to the backtracking start `sp`: the moves from
+    /// `sp` to its free-uncovered 4-neighbours are judged blocked, so `sp` leaves `L` (which
+    /// counts a tile only for a neighbour it can enter) and is not chosen again.
+    ///
+    /// Why: under odometry noise the way to `sp` can run the real robot into a wall however
+    /// free it is on the known map; chosen again, `sp` was driven at again from the same
+    /// place (BA* on `teb_maze` at `--odometry-noise 0.02`: the same backtrack and the same
+    /// contact 1000 times, then the stall stop). Those neighbours stay reachable from other
+    /// covered tiles. Every bump removes at least one of finitely many moves, so the planner
+    /// terminates; under ideal execution a correct BA* never bumps.
+    pub(super) fn give_up_frontier(&mut self, sp: Tile) {
+        for k in [0, 2, 4, 6] {
+            if self.tiles.free_uncovered(sp, k) {
+                self.block_bumped_move(sp, k);
+            }
+        }
+        self.tiles.update_l_around(sp);
     }
 
     /// Marks `t` covered (the robot stands on it), decides its moves and updates L.

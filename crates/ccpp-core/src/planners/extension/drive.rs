@@ -20,7 +20,13 @@ pub(crate) struct Drive {
     /// Inside a `wall_follow_start` / `wall_follow_end` pair.
     in_pass: bool,
     last_pos: Option<Point>,
+    /// Bumper contacts in a row with the robot's position unchanged between them.
+    stuck: u32,
 }
+
+/// Bumper contacts in a row, the robot's position unchanged between them, after which the
+/// queued moves are dropped and the cleaning in progress is given up ([`Drive::stuck`]).
+pub(crate) const STUCK_BUMPS: u32 = 3;
 
 impl Drive {
     /// Records the move since the last step into `ext` (made at the first step, when the
@@ -34,6 +40,15 @@ impl Drive {
         configure: impl FnOnce(&mut Extension),
     ) -> Point {
         let pos = sensor.pose().position();
+        if sensor.bumped() {
+            self.stuck = if self.last_pos == Some(pos) {
+                self.stuck.saturating_add(1)
+            } else {
+                1
+            };
+        } else {
+            self.stuck = 0;
+        }
         if let (Some(ext), Some(prev)) = (ext.as_mut(), self.last_pos) {
             if prev != pos {
                 ext.record(prev, pos);
@@ -90,6 +105,26 @@ impl Drive {
             self.trail.push(p);
         }
         true
+    }
+
+    /// Is the robot stuck: [`STUCK_BUMPS`] bumper contacts in a row without moving?
+    ///
+    /// Why: under odometry noise the pose estimate drifts from the truth, and the robot can
+    /// face a wall it believes is elsewhere; every move it is sent then stops at once on the
+    /// same contact (`ba-star-extended` on `nobleo_basement` at `--odometry-noise 0.02`: the
+    /// same nine-move way to one rim piece, planned again and bumped 1492 times, then the
+    /// simulator's stall stop). The host then calls [`Drive::abandon`] and gives up the
+    /// cleaning in progress. Under ideal execution a correct plan never bumps.
+    pub fn stuck(&self) -> bool {
+        self.stuck >= STUCK_BUMPS
+    }
+
+    /// Drops the queued moves (their marks stay, so every start mark keeps its end), closes
+    /// an open wall pass and starts counting contacts anew.
+    pub fn abandon(&mut self) {
+        self.queue.retain(|s| matches!(s, Step::Mark(_)));
+        self.end_pass();
+        self.stuck = 0;
     }
 
     /// Closes an open wall pass (`wall_follow_end`).
