@@ -151,17 +151,13 @@ impl Polygon {
         n - usize::from(n > 1 && self.points.first() == self.points.last())
     }
 
-    /// Signed area (positive counter-clockwise), square metres.
+    /// Signed area (positive counter-clockwise), square metres. The shoelace sum is taken
+    /// about the first vertex: about the frame's origin, a 5 cm square at a survey northing
+    /// (5.5e6 m) lost its area to rounding and was refused as "zero area", and the ring
+    /// orientation exported to `GeoJSON` came out at random (hostile pass).
     pub fn signed_area(&self) -> f64 {
         let r = self.ring();
-        let n = r.len();
-        (0..n)
-            .map(|i| {
-                let (a, b) = (r[i], r[(i + 1) % n]);
-                a.x * b.y - b.x * a.y
-            })
-            .sum::<f64>()
-            / 2.0
+        shoelace(&r, r.first().copied().unwrap_or(Point::new(0.0, 0.0)))
     }
 
     /// Checks the polygon (`index` names it in errors): finite coordinates, at least three
@@ -188,7 +184,8 @@ impl Polygon {
                 max: MAX_POLYGON_POINTS,
             });
         }
-        if !self.signed_area().is_finite() {
+        let raw = self.ring();
+        if !(shoelace(&raw, Point::new(0.0, 0.0)).is_finite() && self.signed_area().is_finite()) {
             // Products of coordinates overflow: every geometric test below would be noise.
             return Err(ZoneError::Overflow { index });
         }
@@ -253,6 +250,18 @@ fn on_one_line(r: &[Point]) -> bool {
     let tol = 8.0 * f64::EPSILON * bbox_scale(r);
     r.iter()
         .all(|p| ((b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x)).abs() <= tol)
+}
+
+/// The signed area of the ring `r` by the shoelace formula about `o`.
+fn shoelace(r: &[Point], o: Point) -> f64 {
+    let n = r.len();
+    (0..n)
+        .map(|i| {
+            let (a, b) = (r[i] - o, r[(i + 1) % n] - o);
+            a.x * b.y - b.x * a.y
+        })
+        .sum::<f64>()
+        / 2.0
 }
 
 fn bbox_scale(r: &[Point]) -> f64 {
@@ -774,6 +783,37 @@ impl BlockSummary {
 
 #[cfg(test)]
 mod tests {
+
+    /// A small polygon far from the origin keeps its area and orientation: the shoelace sum
+    /// about the origin lost them to rounding (a 5 cm square at 5.5e6 m was refused as "zero
+    /// area", a 0.3 m one at 8e7 m too, and exported rings came out clockwise: hostile pass).
+    #[test]
+    fn a_small_polygon_far_out_keeps_its_area_and_orientation() {
+        for (o, side) in [
+            (5.5e6, 0.05),
+            (8e7, 0.3),
+            (8e7, 0.8),
+            (3e7, 0.1),
+            (0.0, 0.05),
+        ] {
+            let p = Polygon {
+                points: vec![
+                    [o + 1.0, o + 1.0],
+                    [o + 1.0 + side, o + 1.0],
+                    [o + 1.0 + side, o + 1.0 + side],
+                    [o + 1.0, o + 1.0 + side],
+                ],
+                name: None,
+            };
+            p.validate(0).unwrap();
+            let a = p.signed_area();
+            assert!(
+                (a - side * side).abs() < 1e-6 * side * side + 1e-9,
+                "{o} {side}: {a}"
+            );
+        }
+    }
+
     use super::*;
 
     fn poly(p: &[[f64; 2]]) -> Polygon {
