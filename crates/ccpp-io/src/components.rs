@@ -53,45 +53,29 @@ pub const CUT_OFF_MIN_M2: f64 = 1.0;
 /// [`zone_cut_off_warning`].
 pub const CUT_OFF_MIN_SHARE: f64 = 0.1;
 
-/// The warning (without `warning: `) when the zones of `world` cut much of the free floor
-/// they allow apart from the start: floor inside the area and outside the keep-outs that the
-/// start's 4-connected free area reaches on the true map but not across the virtual walls, at
-/// least [`CUT_OFF_MIN_M2`] and [`CUT_OFF_MIN_SHARE`] of the allowed floor the start reaches on
-/// the true map. A keep-out that cut an area in two, or an area of two rooms joined only
-/// outside it, left one part unswept while the run said "99.6 % covered" (coverage is of the
-/// part the start reaches) without a word (hostile pass). Floor that walls already part from
-/// the start is not the zones' doing and not counted (an area over a whole map with rooms
-/// apart behind walls warned of them). `None` without zones.
+/// The warning (without `warning: `) when the zones of `world` cut much of the floor they
+/// allow apart from the start ([`ccpp_core::world::World::zone_cut_off_px`]: floor inside the
+/// area and outside the keep-outs that the robot could sweep were the zones no walls on its
+/// way, but cannot with them), at least [`CUT_OFF_MIN_M2`] and [`CUT_OFF_MIN_SHARE`] of that
+/// floor. A keep-out that cut an area in two, or an area of two rooms joined only outside it,
+/// left one part unswept while the run said "99.6 % covered" (coverage is of the part the
+/// start reaches) without a word (hostile pass); so did a gap between keep-outs narrower than
+/// the robot. Floor that walls already part from the start is not the zones' doing and not
+/// counted (an area over a whole map with rooms apart behind walls warned of them). `None`
+/// without zones.
 pub fn zone_cut_off_warning(world: &ccpp_core::world::World) -> Option<String> {
-    world.zones()?;
-    let (zoned, plain) = (world.map(), world.true_map());
-    let f = *zoned.frame();
-    let (c, r) = f.pixel_of(world.start().position())?;
-    let seed = f.index(c, r);
-    if plain.cells()[seed] != Cell::Free {
-        return None;
-    }
-    let mut near = fixedbitset::FixedBitSet::with_capacity(f.len());
-    flood_runs(plain, seed, &mut near);
-    let mut reached = fixedbitset::FixedBitSet::with_capacity(f.len());
-    if zoned.cells()[seed] == Cell::Free {
-        flood_runs(zoned, seed, &mut reached);
-    }
-    let cells = zoned.cells();
-    let (mut allowed, mut apart) = (0usize, 0usize);
-    for i in near.ones().filter(|&i| cells[i] == Cell::Free) {
-        allowed += 1;
-        apart += usize::from(!reached.contains(i));
-    }
+    let (allowed, apart) = world.zone_cut_off_px()?;
+    let f = *world.frame();
     let res2 = f.resolution * f.resolution;
     let (apart_m2, allowed_m2) = (apart as f64 * res2, allowed as f64 * res2);
     (apart_m2 >= CUT_OFF_MIN_M2 && apart_m2 >= CUT_OFF_MIN_SHARE * allowed_m2).then(|| {
         format!(
-            "the zones cut {apart_m2:.1} m2 of the {allowed_m2:.1} m2 of free floor they allow \
-             beside the start ({:.0} %) off from it; that floor is not covered (coverage \
-             figures are of the part the start reaches): run again with --start X,Y there to \
-             cover it",
-            100.0 * apart_m2 / allowed_m2
+            "the zones cut {apart_m2:.1} m2 of the {allowed_m2:.1} m2 of floor they allow \
+             beside the start ({:.0} %) off from it (a {:.2} m wide robot cannot get past them); \
+             that floor is not covered (coverage figures are of the part the start reaches): \
+             run again with --start X,Y there to cover it",
+            100.0 * apart_m2 / allowed_m2,
+            2.0 * world.robot().radius
         )
     })
 }
