@@ -4,6 +4,7 @@ as a script of its own (its workers import the script again, as a user's would).
 
 from __future__ import annotations
 
+import importlib.util
 import os
 import re
 import subprocess
@@ -35,6 +36,10 @@ def test_the_readme_python_blocks_run_as_written(tmp_path: Path) -> None:
         namespace: dict = {"__name__": "readme"}
         for k, block in enumerate(blocks):
             if "distributed" in block:
+                if importlib.util.find_spec("distributed") is None:
+                    # The cluster block needs the sweep extra (`pip install '.[sweep]'`).
+                    print(f"README block {k} not run: distributed is not installed")
+                    continue
                 script = work / f"block{k}.py"
                 script.write_text(block)
                 out = subprocess.run(

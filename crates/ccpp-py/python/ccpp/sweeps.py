@@ -248,8 +248,6 @@ def sweep(
     (no ``client`` and no ``scheduler``, or a ``LocalCluster``): Dask's worker processes import
     the script again.
     """
-    pd = _extra("pandas")
-
     if client is not None and scheduler is not None:
         # One of them would be ignored.
         raise _ccpp.CcppError("client and scheduler both name the cluster to use; give one of them")
@@ -314,6 +312,11 @@ def sweep(
     maps_named = _map_names(expand_maps(maps))
     if out is not None:
         _check_out(out)
+    # The extras, after the arguments (a wrong argument is told the same with or without
+    # them) and before any run (a sweep without pandas ran every task and then failed).
+    pd = _extra("pandas")
+    if client is None:
+        _extra("distributed")
     tasks = []
     # The workers get absolute paths, made here: a worker of a cluster started in another
     # folder read relative map paths, and wrote relative `out` folders, in its own folder
