@@ -10,7 +10,7 @@ use serde::Serialize;
 use crate::args::InfoArgs;
 use crate::components::{free_components, StartComponent};
 use crate::job::{prepare_map, robot_from};
-use crate::output::num;
+use crate::output::{fitted, num};
 
 /// How the map's pixels were read.
 #[derive(Serialize)]
@@ -228,15 +228,15 @@ pub fn run(a: &InfoArgs) -> Result<()> {
         "size           {} x {} px, {} m/px = {} x {} m",
         f.width,
         f.height,
-        num(f.resolution),
+        fitted(f.resolution, 0.0),
         ccpp_core::display::fixed(info.width_m, 2),
         ccpp_core::display::fixed(info.height_m, 2)
     ));
     line(format!(
         "origin         ({}, {}, {})",
-        num(f.origin.x),
-        num(f.origin.y),
-        num(f.origin.theta)
+        fitted(f.origin.x, 1e-9),
+        fitted(f.origin.y, 1e-9),
+        fitted(f.origin.theta, 1e-12)
     ));
     line(format!(
         "pixels         {}: occupied above p = {}, free below {}{}",
@@ -323,7 +323,7 @@ pub fn run(a: &InfoArgs) -> Result<()> {
                 .collect();
             let _ = writeln!(
                 t,
-                "keep-out       {}: {} m2 of pixels kept out (each pixel a polygon overlaps), {} m2 of it free floor",
+                "keep-out       {}: {} m2 of pixels kept out (each pixel a polygon overlaps, and a mask's occupied pixels), {} m2 of it free floor",
                 labels.join(", "),
                 ccpp_core::display::fixed(z.keepout_m2, 2),
                 ccpp_core::display::fixed(z.keepout_free_m2, 2)

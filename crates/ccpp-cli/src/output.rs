@@ -522,11 +522,25 @@ pub fn inflated_line(m: f64) -> String {
 /// A user-given number as `{}` prints it (`0.15`, `50000000`), but in exponent form (`1e-300`)
 /// below 1e-4 and from 1e9 up, where `{}` would print a line of hundreds of digits.
 pub fn num(v: f64) -> String {
-    if v != 0.0 && (v.abs() < 1e-4 || v.abs() >= 1e9) {
+    if v == 0.0 {
+        // (a YAML's `origin: [-0.0, ...]` printed `-0`)
+        return "0".to_string();
+    }
+    if v.abs() < 1e-4 || v.abs() >= 1e9 {
         format!("{v:e}")
     } else {
         format!("{v}")
     }
+}
+
+/// A number a fit computed (a `--georef` map's resolution and origin), as [`num`] prints it
+/// after rounding to 12 significant digits, and 0 within `zero` of it: the fit's rounding
+/// showed as `0.049999999999999996 m/px` and an origin of `7.00e-17` (hostile pass).
+pub fn fitted(v: f64, zero: f64) -> String {
+    if v.abs() <= zero {
+        return "0".to_string();
+    }
+    num(format!("{v:.11e}").parse().unwrap_or(v))
 }
 
 /// `n` and its noun: `1 map`, `2 maps`.

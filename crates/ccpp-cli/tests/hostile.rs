@@ -4093,3 +4093,40 @@ fn a_run_file_with_a_misspelt_key_is_refused_naming_it() {
     );
     assert!(!out.join("replay.html").exists());
 }
+
+/// A map YAML whose `image:` names another map YAML (or itself) was told to rename the file
+/// to .yaml, which it already was: it is told that `image:` names the image, not a YAML.
+#[test]
+fn a_yaml_named_as_the_image_of_a_yaml_is_told_so() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let inner = dir.join("inner.yaml");
+    std::fs::write(
+        &inner,
+        format!(
+            "image: {}\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n",
+            map.display()
+        ),
+    )
+    .unwrap();
+    for (name, image) in [("outer.yaml", "inner.yaml"), ("self.yaml", "self.yaml")] {
+        let y = dir.join(name);
+        std::fs::write(
+            &y,
+            format!("image: {image}\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n"),
+        )
+        .unwrap();
+        refused(
+            &["info", "--map", s(&y)],
+            &[
+                image,
+                "a map YAML's `image:` names the image file (PGM or PNG), not a YAML",
+            ],
+        );
+    }
+    // A map YAML named otherwise is still told to take a YAML's name.
+    let txt = dir.join("map.txt");
+    std::fs::copy(&inner, &txt).unwrap();
+    refused(&["info", "--map", s(&txt)], &["rename it"]);
+}

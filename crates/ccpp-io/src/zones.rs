@@ -396,10 +396,18 @@ fn point(v: &Value, geo: bool) -> Result<[f64; 2], ZoneFileError> {
             {
                 Ok([num(x)?, num(y)?])
             }
+            // `z` allowed but not a number: that is the problem (it was named as a key
+            // other than x and y: hostile pass).
+            (Some(_), Some(_)) if o.len() == 3 && o.get("z").is_some_and(|z| !z.is_number()) => {
+                Err(bad(format!(
+                    "point's z must be a number (it is ignored), got {}",
+                    o.get("z").map_or_else(String::new, Value::to_string)
+                )))
+            }
             (Some(_), Some(_)) => Err(bad(format!(
-                "point has keys other than x and y: {}",
+                "point has keys other than x, y and z: {}",
                 o.keys()
-                    .filter(|k| *k != "x" && *k != "y")
+                    .filter(|k| !matches!(k.as_str(), "x" | "y" | "z"))
                     .take(3)
                     .map(|k| key_text(k, 40))
                     .collect::<Vec<_>>()
@@ -780,15 +788,19 @@ mod tests {
         )
         .unwrap();
         assert_eq!(p[0].points, [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]);
-        for bad in [
-            "{x: 0, y: 0, z: up}",
-            "{x: 0, y: 0, w: 1}",
-            "{x: 0, y: 0, z: 1, w: 1}",
+        for (bad, says) in [
+            // (the z named as a key other than x and y: hostile pass)
+            (
+                "{x: 0, y: 0, z: up}",
+                "point's z must be a number (it is ignored), got \"up\"",
+            ),
+            ("{x: 0, y: 0, w: 1}", "keys other than x, y and z: w"),
+            ("{x: 0, y: 0, z: 1, w: 1}", "keys other than x, y and z: w"),
         ] {
             let e = yaml(&format!("- {bad}\n- {{x: 1, y: 0}}\n- {{x: 1, y: 1}}\n"))
                 .unwrap_err()
                 .to_string();
-            assert!(e.contains("other than x and y"), "{bad}: {e}");
+            assert!(e.contains(says), "{bad}: {e}");
         }
         // A MultiPolygon a level of brackets short is told as such, not as holes.
         let e = geo(r#"{"type":"MultiPolygon","coordinates":[[[2,-4],[4,-4],[4,-1],[2,-4]]]}"#)

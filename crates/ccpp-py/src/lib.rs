@@ -563,9 +563,15 @@ fn reals(v: Option<Vec<Real>>) -> Option<Vec<f64>> {
     v.map(|v| v.into_iter().map(|r| r.0).collect())
 }
 
-/// The `repr` of a Python value, for messages.
+/// The `repr` of a Python value, for messages, on one line: a line break and the indent after
+/// it become one space (numpy's repr of a 2-D array spans lines, which the one-line messages
+/// showed as `\u{a}` escapes: hostile pass).
 fn repr(v: &Bound<'_, PyAny>) -> String {
-    v.repr().map_or_else(|_| "?".to_string(), |r| r.to_string())
+    let r = v.repr().map_or_else(|_| "?".to_string(), |r| r.to_string());
+    if !r.contains(['\n', '\r']) {
+        return r;
+    }
+    r.lines().map(str::trim).collect::<Vec<_>>().join(" ")
 }
 
 /// A keyword option that must be a number (its range is the scenario's to check).

@@ -184,6 +184,10 @@ def test_zone_and_seed_arguments_take_paths_and_numpy(room: Path, tmp_path: Path
         ccpp.run(room, "bcd", area=[0, 0, 1])
     with pytest.raises(ccpp.CcppError, match="keepout must be a zone"):
         ccpp.run(room, "bcd", keepout=[0, 0, 1])
+    # A value whose repr spans lines (numpy's 2-D arrays) is shown on one line, not with
+    # `\u{a}` escapes.
+    with pytest.raises(ccpp.CcppError, match=r"got array\(\[\[0\., 0\.\], \[0\., 0\.\]\]\)$"):
+        ccpp.run(room, "bcd", area=np.zeros((2, 2)))
 
 
 def test_a_runs_start_is_where_the_robot_was_placed(shared_maps: Path) -> None:

@@ -108,6 +108,27 @@ pub(crate) fn decodable_format(path: &Path) -> bool {
         })
 }
 
+/// The PNG decoder's words with its chunk types as their names: `ChunkType { type: IHDR,
+/// critical: true, private: false, reserved: false, safecopy: false }` (the decoder's debug
+/// text of a chunk, in its CRC errors) becomes `IHDR` (hostile pass).
+fn chunk_names(text: &str) -> String {
+    const OPEN: &str = "ChunkType { type: ";
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(i) = rest.find(OPEN) {
+        out.push_str(&rest[..i]);
+        let after = &rest[i + OPEN.len()..];
+        let (Some(end), Some(comma)) = (after.find('}'), after.find(',')) else {
+            out.push_str(&rest[i..]);
+            return out;
+        };
+        out.push_str(after[..comma.min(end)].trim());
+        rest = &after[end + 1..];
+    }
+    out.push_str(rest);
+    out
+}
+
 /// Decodes an image (format guessed from its content) and classifies every pixel. The decoded
 /// image buffer is dropped before returning, so at most the image plus the cells are alive.
 /// With `max_pixels`, the image's size is read from its header first and a larger image is
@@ -120,7 +141,7 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
 ) -> Result<Classified, MapError> {
     let decode_err = |e: &dyn std::fmt::Display| MapError::Decode {
         path: path.to_path_buf(),
-        message: one_line(&e.to_string()),
+        message: one_line(&chunk_names(&e.to_string())),
     };
     let io_err = |e: std::io::Error| MapError::Io {
         path: path.to_path_buf(),
@@ -139,7 +160,15 @@ pub(crate) fn decode_and_classify<R: BufRead + Seek>(
             && String::from_utf8_lossy(&head)
                 .lines()
                 .any(|l| l.trim_start_matches('\u{feff}').starts_with("image:"));
-        let message = if yaml_like {
+        let yaml_named = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| e.eq_ignore_ascii_case("yaml") || e.eq_ignore_ascii_case("yml"));
+        let message = if yaml_like && yaml_named {
+            // Reached as the `image:` of another YAML (or itself): the advice to rename it
+            // was wrong (hostile pass).
+            "not a PNG or PNM/PGM image: it is a map_server YAML, and a map YAML's `image:` names the image file (PGM or PNG), not a YAML"
+        } else if yaml_like {
             "not a PNG or PNM/PGM image: it reads as a map_server YAML (an `image:` line), but a map's YAML is known by its name, which must end in .yaml or .yml; rename it"
         } else {
             "not a PNG or PNM/PGM image (unrecognised content)"
@@ -585,6 +614,20 @@ fn rgb16_level(p: &[u16]) -> f64 {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn chunk_types_are_named() {
+        assert_eq!(
+            super::chunk_names("CRC error: expected 0x8700c623 have 0x87d0c623 while decoding ChunkType { type: IHDR, critical: true, private: false, reserved: false, safecopy: false } chunk."),
+            "CRC error: expected 0x8700c623 have 0x87d0c623 while decoding IHDR chunk."
+        );
+        assert_eq!(super::chunk_names("plain"), "plain");
+        assert_eq!(
+            super::chunk_names("ChunkType { type: x"),
+            "ChunkType { type: x"
+        );
+    }
+
     use super::*;
 
     fn load(bytes: &[u8]) -> Result<crate::map::LoadedMap, MapError> {
