@@ -109,15 +109,30 @@ impl Coarse {
     /// pixels (at least 4); `move_free(i, j)` tells whether the straight move between the
     /// centres of pixels `i` and `j` is free on the map (asked of a diagonal step whose side
     /// pixels are not both C-free).
+    ///
+    /// `stop` is asked once per row of blocks: when it says so, the grid of an empty C-free
+    /// set is returned instead (the plan is being given up; the grid of a 4000 x 4000 px
+    /// map took a second, during which a Python Ctrl-C held the next run: hostile pass).
     pub(super) fn new(
         w: usize,
         h: usize,
         ok: &[bool],
         move_free: impl Fn(usize, usize) -> bool,
         sp: f64,
+        stop: &dyn Fn() -> bool,
     ) -> Self {
         let b = Self::side(sp);
         let (bw, bh) = (w.div_ceil(b), h.div_ceil(b));
+        let given_up = || Self {
+            b,
+            bw,
+            width: w,
+            height: h,
+            label: vec![NOT_FREE; w * h],
+            first: vec![0; bw * bh + 1],
+            adj_start: vec![0],
+            adj: Vec::new(),
+        };
         // A diagonal pixel step from `i` to `j` (both C-free): as the transfers' search.
         let diag = |i: usize, j: usize| {
             let (ci, ri, cj, rj) = (i % w, i / w, j % w, j / w);
@@ -133,6 +148,9 @@ impl Coarse {
         let mut parent: Vec<u32> = Vec::new();
         let mut pix: Vec<(usize, u32)> = Vec::new();
         for br in 0..bh {
+            if stop() {
+                return given_up();
+            }
             for bc in 0..bw {
                 first.push(nodes);
                 let (r0, r1) = (br * b, ((br + 1) * b).min(h));
@@ -1023,6 +1041,24 @@ mod tests {
             coarse: CoarseCache::default(),
             stop: None,
         }
+    }
+
+    /// A grid whose planning is given up while it is made is the grid of an empty C-free set
+    /// (the plan is dropped; the grid must not index past its arrays meanwhile).
+    #[test]
+    fn a_grid_given_up_is_empty() {
+        let (w, h) = (40, 30);
+        let ok = vec![true; w * h];
+        let whole = Coarse::new(w, h, &ok, |_, _| true, 6.0, &|| false);
+        assert!(whole.nodes() > 0);
+        let asked = std::cell::Cell::new(0);
+        let given_up = Coarse::new(w, h, &ok, |_, _| true, 6.0, &|| {
+            asked.set(asked.get() + 1);
+            asked.get() > 2
+        });
+        assert_eq!(given_up.nodes(), 0);
+        assert_eq!(given_up.first.len(), whole.first.len());
+        assert!(given_up.node(Point::new(10.5, 10.5)).is_none());
     }
 
     /// Are the nodes of pixels `a` and `b` joined by the grid's links (unbounded search)?

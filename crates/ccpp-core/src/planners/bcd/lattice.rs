@@ -134,6 +134,7 @@ impl Ctx<'_> {
             &self.ok,
             |i, j| self.pixel_move_free(i, j),
             sp,
+            &|| self.stopped(),
         )
     }
 
