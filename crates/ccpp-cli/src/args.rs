@@ -84,8 +84,8 @@ pub struct RobotArgs {
     // radius given beside a rectangle whose disk it cannot change.
     #[arg(long, value_parser = parse_number, value_name = "M")]
     pub radius: Option<f64>,
-    /// Cleaning tool radius in metres (default: the robot radius). `plan` refuses it for
-    /// rect-boustrophedon, whose lanes follow its lane width.
+    /// Cleaning tool radius in metres, at most the robot radius (default: the robot radius).
+    /// `plan` refuses it for rect-boustrophedon, whose lanes follow its lane width.
     #[arg(long, value_parser = parse_number, value_name = "M")]
     pub tool_radius: Option<f64>,
     /// Start pose `X,Y[,THETA]` in metres/radians (default: the widest free spot, heading
@@ -169,7 +169,8 @@ pub struct RunArgs {
     /// Planner name (see `ccpp planners`).
     #[arg(long, value_name = "NAME")]
     pub planner: String,
-    /// Seed of random-bounce's turns and of --odometry-noise (refused for other runs).
+    /// Seed of random-bounce's turns and of --odometry-noise (default 0; refused for other
+    /// runs).
     #[arg(long, value_parser = parse_whole::<u64>, value_name = "N")]
     pub seed: Option<u64>,
     /// Planner options.
@@ -213,7 +214,7 @@ pub struct RunArgs {
     /// heading drift while driving (rad/s per m/s), standard deviations per control step of
     /// 0.05 s (the default `dt_s`; another period scales them by `sqrt(0.05 / dt_s)`, so the
     /// drift over a run does not depend on it), `LIN[,ANG[,DRIFT]]` (ANG defaults to LIN,
-    /// DRIFT to 0; LIN and ANG at most 1, DRIFT at most 6; each 0 or at least 1e-9; seeded by --seed). Without --exec it switches the run to PID execution;
+    /// DRIFT to 0; LIN and ANG at most 1, DRIFT at most 6; each 0 or at least 1e-9, not all 0; seeded by --seed, default 0). Without --exec it switches the run to PID execution;
     /// refused with --exec ideal.
     #[arg(long, value_name = "LIN[,ANG[,DRIFT]]")]
     pub odometry_noise: Option<String>,
@@ -357,7 +358,7 @@ pub struct BenchArgs {
     /// its figures included: see `ccpp run --help`).
     #[arg(long, value_parser = parse_number, value_name = "M")]
     pub inflate: Option<f64>,
-    /// Seed of random-bounce's turns.
+    /// Seed of random-bounce's turns (default 0).
     #[arg(long, value_parser = parse_whole::<u64>, value_name = "N")]
     pub seed: Option<u64>,
     /// Planner options.
@@ -386,7 +387,7 @@ pub struct BenchRobotArgs {
     /// Robot (footprint) radius in metres.
     #[arg(long, value_parser = parse_number, value_name = "M", default_value_t = 0.15)]
     pub radius: f64,
-    /// Cleaning tool radius in metres (default: the robot radius).
+    /// Cleaning tool radius in metres, at most the robot radius (default: the robot radius).
     #[arg(long, value_parser = parse_number, value_name = "M")]
     pub tool_radius: Option<f64>,
 }

@@ -249,6 +249,13 @@ pub fn run(a: &InfoArgs) -> Result<()> {
             ""
         }
     ));
+    if map.alpha_differs > 0 {
+        line(format!(
+            "note           {} px ({:.1} %) would read as another class under ROS map_server, which averages the alpha channel in with the colour in trinary mode (ccpp ignores alpha there, as the ROS docs describe the mode; see the README, Maps)",
+            map.alpha_differs,
+            map.alpha_differs as f64 / n
+        ));
+    }
     if let Some(m) = info.inflate_m {
         line(format!(
             "inflated       obstacles grown by {} m (--inflate): every figure below is on the grown map",

@@ -1451,7 +1451,9 @@ fn rect_lanes_mostly_left_out_are_told() {
 /// then the simulator's stall stop, on `teb_maze`, `aws_small_house` and `nobleo_basement`;
 /// ba-star-extended did the same with a wall pass's way (1492 contacts on `nobleo_basement`).
 /// The simulator also counted a turn in place at a wall as a contact, so a robot that had
-/// bumped could never turn away.
+/// bumped could never turn away. A first reaction (giving up the backtracking target) left
+/// a shared first leg in place (600 contacts on `tuw_freihaus_eg`) and cut the robot's tile
+/// off the covered ones (`aws_small_house`, seed 5: "done" at 19 %): hostile pass.
 #[test]
 fn online_planners_do_not_push_into_a_wall_under_odometry_noise() {
     let Some(maps) = common::shared_maps() else {
@@ -1459,19 +1461,23 @@ fn online_planners_do_not_push_into_a_wall_under_odometry_noise() {
         return;
     };
     let d = tempfile::tempdir().unwrap();
-    for (planner, map) in [
-        ("ba-star", "teb_maze"),
-        ("ba-star", "aws_small_house"),
-        ("ba-star", "nobleo_basement"),
-        ("ba-star-extended", "nobleo_basement"),
-        ("ba-star-extended", "teb_maze"),
-        ("bsa-extended", "aws_small_house"),
+    // (planner, map, noise, seed, least effective coverage)
+    for (planner, map, noise, seed, least) in [
+        ("ba-star", "teb_maze", "0.02", "0", 0.3),
+        ("ba-star", "aws_small_house", "0.02", "0", 0.1),
+        ("ba-star", "nobleo_basement", "0.02", "0", 0.1),
+        ("ba-star", "aws_small_house", "0.005", "5", 0.7),
+        ("ba-star", "tuw_freihaus_eg", "0.02", "3", 0.0),
+        ("ba-star-extended", "nobleo_basement", "0.02", "0", 0.1),
+        ("ba-star-extended", "teb_maze", "0.02", "0", 0.3),
+        ("ba-star-extended", "aws_small_house", "0.005", "1", 0.4),
+        ("bsa-extended", "aws_small_house", "0.02", "0", 0.1),
     ] {
-        let out = d.path().join(format!("{planner}-{map}"));
+        let out = d.path().join(format!("{planner}-{map}-{seed}"));
         let o = ccpp()
             .args(["run", "--planner", planner, "--map"])
             .arg(maps.join(format!("{map}.yaml")))
-            .args(["--odometry-noise", "0.02", "--json"])
+            .args(["--odometry-noise", noise, "--seed", seed, "--json"])
             .args(["--out", s(&out)])
             .output()
             .unwrap();
@@ -1480,10 +1486,9 @@ fn online_planners_do_not_push_into_a_wall_under_odometry_noise() {
         let m: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
         let contacts = m["collisions"].as_u64().unwrap();
         assert!(contacts < 400, "{planner} on {map}: {contacts} contacts");
-        assert!(
-            !err.contains("made no progress"),
-            "{planner} on {map}: {err}"
-        );
+        assert!(m.get("stop_reason").is_none(), "{planner} on {map}: {m}");
+        let ec = m["effective_coverage"].as_f64().unwrap();
+        assert!(ec >= least, "{planner} on {map} seed {seed}: {ec}");
         // The drift is still said (the figures are honest, not good).
         assert!(
             err.contains("give --landmarks"),

@@ -250,6 +250,11 @@ pub struct PreparedMap {
     /// How its pixels were classified (the YAML's or the overridden thresholds, negate and
     /// mode; the defaults for a grid made in memory).
     pub thresholds: Thresholds,
+    /// Pixels ROS `map_server` would classify otherwise ([`LoadedMap::alpha_differs`]; 0
+    /// for a grid made in memory).
+    ///
+    /// [`LoadedMap::alpha_differs`]: crate::map::LoadedMap::alpha_differs
+    pub alpha_differs: usize,
 }
 
 /// Serializes [`MapRecipe::inflate`]: 0 (or -0) as `null`.
@@ -445,6 +450,7 @@ impl MapRecipe {
             source: loaded.source,
             recipe: self.clone(),
             thresholds: loaded.thresholds,
+            alpha_differs: loaded.alpha_differs,
         })
     }
 }
@@ -1001,7 +1007,7 @@ impl Scenario {
         }
         if !lm.landmarks.is_empty() && !matches!(self.execution(), Execution::Pid(_)) {
             return Err(invalid(format!(
-                "landmarks correct the pose estimate of PID execution only, and {} runs with ideal execution (use --exec pid / exec=\"pid\", or odometry noise, which runs PID)",
+                "landmarks correct the pose estimate of PID execution only, and {} runs with ideal execution, where the estimate is the true pose (add --odometry-noise / odometry_noise=, which runs PID; PID alone has no drift to correct either)",
                 self.planner.name()
             )));
         }
@@ -1611,6 +1617,7 @@ impl Scenario {
             source,
             recipe,
             thresholds,
+            alpha_differs,
         } = map;
         let world = crate::phase::time("world", || {
             // The checks read the map as prepared; the grid is moved back out afterwards.
@@ -1620,6 +1627,7 @@ impl Scenario {
                 source,
                 recipe,
                 thresholds,
+                alpha_differs,
             };
             let zones = self.world_checks(&prepared)?;
             self.world_on(

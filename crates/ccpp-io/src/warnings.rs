@@ -73,7 +73,8 @@ pub fn drift_warning(scenario: &Scenario, trace: &Trace, metrics: &Metrics) -> O
     // the run without them (it got no warning). Seen somewhere, they still leave the estimate
     // to drift between fixes: one landmark by the start of `teb_corridor` gave 824 fixes
     // there, and the run beyond it made 22 contacts, strayed 0.54 m on average and swept 42 %
-    // without a word (hostile pass).
+    // without a word (hostile pass; since the simulator lets a robot turn away from a wall
+    // it touched, 702 fixes, 20 contacts, 0.84 m and 43 %).
     let given = scenario.sim.landmarks.landmarks.len();
     let fixes = trace
         .events()

@@ -35,6 +35,7 @@ fn room() -> PreparedMap {
         source: "room.yaml".into(),
         recipe: MapRecipe::file("room.yaml"),
         thresholds: ccpp_io::map::Thresholds::default(),
+        alpha_differs: 0,
     }
 }
 

@@ -433,11 +433,12 @@ impl Planner for BaStar {
             Phase::Bm => self.bm_step(sensor),
             Phase::Backtrack { path, next } => {
                 if *next > 1 && sensor.bumped() {
-                    // The bumper stopped a move of the way to `s_sp`: give up its frontier
-                    // (the robot starts a region where it is instead).
-                    let sp = path.last().copied();
-                    if let (Some(sp), Some(m)) = (sp, self.mind.as_deref_mut()) {
-                        m.give_up_frontier(sp);
+                    // The bumper stopped the move from `path[next - 2]` to `path[next - 1]`:
+                    // judged as `Mind::bumped_leg` says, and the region starts at the tile
+                    // the robot last reached.
+                    let leg = (path[*next - 2], path[*next - 1]);
+                    if let Some(m) = self.mind.as_deref_mut() {
+                        m.bumped_leg(leg.0, leg.1);
                     }
                     return self.arrive(sensor);
                 }

@@ -84,6 +84,10 @@ pub struct LoadedMap {
     pub image_path: PathBuf,
     /// The thresholds used, after overrides.
     pub thresholds: Thresholds,
+    /// Pixels ROS `map_server` would classify otherwise: it averages the alpha channel of an
+    /// 8-bit RGBA or grey+alpha image in with the colour in trinary mode, which ccpp does
+    /// not (README, Maps); 0 for other images and modes. `ccpp info` notes it.
+    pub alpha_differs: usize,
 }
 
 /// Loads a map from a YAML (`.yaml` / `.yml`, case-insensitive) or a bare image (any other
@@ -307,6 +311,7 @@ fn finish<R: std::io::BufRead + std::io::Seek>(
         source: source.to_path_buf(),
         image_path,
         thresholds,
+        alpha_differs: c.alpha_differs,
     })
 }
 

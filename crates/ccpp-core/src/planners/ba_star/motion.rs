@@ -102,6 +102,7 @@ impl BaStar {
             gy,
             sent_to: None,
             sent_move: None,
+            held: None,
             centres_home: centres_round_home(&grid),
         }));
     }
@@ -110,7 +111,10 @@ impl BaStar {
         let Some(m) = self.mind.as_deref_mut() else {
             return Step::Done;
         };
-        let mut c = m.robot_tile(sensor.pose().position());
+        let mut c = match m.held.take() {
+            Some(t) => t,
+            None => m.robot_tile(sensor.pose().position()),
+        };
         if let Some((from, k)) = m.sent_move.take() {
             if sensor.bumped() {
                 // The move did not arrive: the robot stays on the tile it left (its estimate
@@ -175,9 +179,14 @@ impl BaStar {
         let targets = tiles.l_tiles();
         let found = m.search.nearest_of(tiles, c, &targets, |t| tiles.in_l(t));
         let Some((sp, sp_cost)) = found else {
-            // Cannot happen: covered tiles form one connected graph.
+            // Covered tiles form one connected graph, but for moves the bumper stopped
+            // (`Mind::bumped_leg`): under odometry noise the tiles left in `L` may lie beyond
+            // them.
             self.pending.push_back(Step::Mark(Event::Note {
-                text: "ba-star: no backtracking candidate reachable".to_string(),
+                text: format!(
+                    "ba-star: no backtracking candidate reachable: the {} tile(s) left in the backtracking list lie beyond moves the bumper stopped",
+                    m.tiles.l.len()
+                ),
             }));
             self.phase = Phase::Finished;
             return self.pending.pop_front().unwrap_or(Step::Done);
@@ -188,7 +197,7 @@ impl BaStar {
             .map_or_else(|| vec![c, sp], |(p, _)| p);
         let smoothed = if self.opts.smoothing {
             let mm = &*m;
-            smooth_path(&raw, |a, b| mm.visible(a, b))
+            smooth_path(&raw, |a, b| !mm.tiles.rough(a) && mm.visible(a, b))
         } else {
             raw.clone()
         };
@@ -224,7 +233,9 @@ impl BaStar {
             region: self.region,
         }));
         if let Some(m) = self.mind.as_deref_mut() {
-            let c = m.tiles.grid.tile_of(sensor.pose().position());
+            let c = m
+                .held
+                .unwrap_or_else(|| m.tiles.grid.tile_of(sensor.pose().position()));
             // The direction of the first BM move (N, S, E, W order).
             let first = [2, 6, 0, 4].into_iter().find(|&k| {
                 let n = (c.0 + N8[k].0, c.1 + N8[k].1);

@@ -72,6 +72,10 @@ pub(super) struct Mind {
     /// The last BM move sent, as its tile and direction (index into `N8`): blocked when the
     /// bumper stops it ([`BaStar::bm_step`](super::BaStar)).
     pub(super) sent_move: Option<(Tile, usize)>,
+    /// The tile the robot is taken to stand on at its next decision instead of the tile of
+    /// its pose: the last tile of a backtracking way the bumper cut short
+    /// ([`Mind::bumped_leg`]), which the covered tiles reach.
+    pub(super) held: Option<Tile>,
     /// The tiling is one where a tile centre lies in its own tile by the rounding of
     /// [`TileGrid::tile_of`] ([`centres_round_home`]).
     ///
@@ -580,23 +584,34 @@ impl Mind {
         self.tiles.update_l_around(n);
     }
 
-    /// The bumper stopped a move of the way to the backtracking start `sp`: the moves from
-    /// `sp` to its free-uncovered 4-neighbours are judged blocked, so `sp` leaves `L` (which
-    /// counts a tile only for a neighbour it can enter) and is not chosen again.
+    /// The bumper stopped the backtracking move from tile `a` to tile `b`: a move between
+    /// neighbours is judged blocked ([`Mind::block_bumped_move`]), and `a` is marked rough
+    /// ([`ST_ROUGH`](super::tile_model::ST_ROUGH)), so the ways from `a` are driven tile by
+    /// tile from then on, and a step of them that bumps is blocked in turn.
+    /// The robot is then taken to stand on `a`, the last tile of the way it reached
+    /// ([`Mind::held`]).
     ///
-    /// Why: under odometry noise the way to `sp` can run the real robot into a wall however
-    /// free it is on the known map; chosen again, `sp` was driven at again from the same
+    /// Why: under odometry noise the way to `s_sp` can run the real robot into a wall however
+    /// free it is on the known map. Chosen again, the same way was driven again from the same
     /// place (BA* on `teb_maze` at `--odometry-noise 0.02`: the same backtrack and the same
-    /// contact 1000 times, then the stall stop). Those neighbours stay reachable from other
-    /// covered tiles. Every bump removes at least one of finitely many moves, so the planner
-    /// terminates; under ideal execution a correct BA* never bumps.
-    pub(super) fn give_up_frontier(&mut self, sp: Tile) {
-        for k in [0, 2, 4, 6] {
-            if self.tiles.free_uncovered(sp, k) {
-                self.block_bumped_move(sp, k);
-            }
+    /// contact 1000 times, then the simulator's stall stop). Giving up `s_sp` instead left
+    /// the shared first leg of every later way in place (600 contacts at one spot on
+    /// `tuw_freihaus_eg`), and starting the next region at the tile the drifted estimate
+    /// lay in cut it off from the covered tiles (the run ended "done" at a fifth of the floor:
+    /// hostile pass). Every bump now marks one of finitely many tiles or blocks one of
+    /// finitely many moves, so the planner terminates; a correct BA* never bumps under ideal
+    /// execution.
+    pub(super) fn bumped_leg(&mut self, a: Tile, b: Tile) {
+        let d = (b.0 - a.0, b.1 - a.1);
+        if let Some(k) = N8.iter().position(|&n| n == d) {
+            self.block_bumped_move(a, k);
         }
-        self.tiles.update_l_around(sp);
+        // (also after a move between neighbours: smoothing judges by line of sight, not by
+        // the move's judgement, and a diagonal move blocked was smoothed again)
+        if let Some(k) = self.tiles.idx(a) {
+            self.tiles.state[k] |= super::tile_model::ST_ROUGH;
+        }
+        self.held = Some(a);
     }
 
     /// Marks `t` covered (the robot stands on it), decides its moves and updates L.

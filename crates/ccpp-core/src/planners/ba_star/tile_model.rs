@@ -15,6 +15,9 @@ pub(super) const ST_STAND: u8 = 0b0011; // Judgement of standing at the centre
 pub(super) const ST_COVERED: u8 = 0b0100;
 /// The tile's contact disk is in the [`DiskCache`](super::sensing::DiskCache).
 pub(super) const ST_DISK: u8 = 0b1000;
+/// A smoothed backtracking move from the tile was stopped by the bumper: moves from it are
+/// not smoothed any more ([`Mind::bumped_leg`](super::sensing::Mind::bumped_leg)).
+pub(super) const ST_ROUGH: u8 = 0b1_0000;
 
 /// The discovered tiling `M̂` with cached judgements, dense over the frame's tile extent.
 #[derive(Clone, Debug)]
@@ -137,6 +140,12 @@ impl TileModel {
             Some(k) => Judgement::from_bits(self.state[k] & ST_STAND),
             None => Judgement::Blocked,
         }
+    }
+
+    /// Was a smoothed move from `t` stopped by the bumper ([`ST_ROUGH`])?
+    #[inline]
+    pub(super) fn rough(&self, t: Tile) -> bool {
+        self.idx(t).is_some_and(|k| self.state[k] & ST_ROUGH != 0)
     }
 
     #[inline]
