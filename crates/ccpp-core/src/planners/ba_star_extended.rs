@@ -56,7 +56,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::ba_star::{BaStar, BaStarOptions};
-use super::extension::{Chunk, Drive, Extension, ExtensionOptions};
+use super::extension::{Chunk, Drive, Extension, ExtensionOptions, Mode};
 use crate::geometry::{polyline_length, Point};
 use crate::planner::{Planner, Sensor, Step};
 use crate::trace::Event;
@@ -120,16 +120,6 @@ impl Default for BaStarExtendedOptions {
             backtrack_sweep: 2.0,
         }
     }
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Mode {
-    /// BA* decides.
-    Host,
-    /// Cleaning passes at the end of a region (`false`) or of BA* (`true`).
-    Clean { last: bool },
-    /// Everything done.
-    Done,
 }
 
 /// BA* plus the coverage extension (see the module docs).
@@ -346,17 +336,9 @@ impl Planner for BaStarExtended {
                 ext.set_speck_fields(true);
             });
         self.ba.observe(sensor);
-        if self.drive.stuck() {
-            // Stuck against a wall under odometry noise (`Drive::stuck`): the moves queued
-            // from a position the robot is not at are dropped and the cleaning in progress is
-            // given up (the host goes on; at the end, the run ends).
-            self.drive.abandon();
-            match self.mode {
-                Mode::Clean { last: true } => self.mode = Mode::Done,
-                Mode::Clean { last: false } => self.mode = Mode::Host,
-                Mode::Host | Mode::Done => {}
-            }
-        }
+        // Stuck against a wall under odometry noise: the moves queued from a position the
+        // robot is not at are dropped and the cleaning in progress is given up.
+        self.drive.abandon_if_stuck(&mut self.mode);
         loop {
             if let Some(s) = self.drive.queue.pop_front() {
                 return s;

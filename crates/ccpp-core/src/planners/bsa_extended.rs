@@ -91,7 +91,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::bsa::{Bsa, BsaOptions, Side};
-use super::extension::{Chunk, Drive, Extension, ExtensionOptions};
+use super::extension::{Chunk, Drive, Extension, ExtensionOptions, Mode};
 use crate::geometry::polyline_length;
 use crate::geometry::Point;
 use crate::planner::{Planner, Sensor, Step};
@@ -148,16 +148,6 @@ impl Default for BsaExtendedOptions {
             strip_walk: true,
         }
     }
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Mode {
-    /// BSA decides.
-    Host,
-    /// Cleaning passes at the end of a spiral (`false`) or of BSA (`true`).
-    Clean { last: bool },
-    /// Everything done.
-    Done,
 }
 
 /// Basic BSA plus the coverage extension (see the module docs).
@@ -268,17 +258,9 @@ impl Planner for BsaExtended {
                 ext.set_strip_walk(strip_walk);
             });
         self.bsa.observe(sensor);
-        if self.drive.stuck() {
-            // Stuck against a wall under odometry noise (`Drive::stuck`): the moves queued
-            // from a position the robot is not at are dropped and the cleaning in progress is
-            // given up (the host goes on; at the end, the run ends).
-            self.drive.abandon();
-            match self.mode {
-                Mode::Clean { last: true } => self.mode = Mode::Done,
-                Mode::Clean { last: false } => self.mode = Mode::Host,
-                Mode::Host | Mode::Done => {}
-            }
-        }
+        // Stuck against a wall under odometry noise: the moves queued from a position the
+        // robot is not at are dropped and the cleaning in progress is given up.
+        self.drive.abandon_if_stuck(&mut self.mode);
         loop {
             if let Some(s) = self.drive.queue.pop_front() {
                 return s;

@@ -180,7 +180,7 @@ use search::{BucketQueue, Node};
 use targets::Window;
 use walk::STRIP_PX;
 
-pub(crate) use drive::Drive;
+pub(crate) use drive::{Drive, Mode};
 
 /// Options of the extension (shared by every planner that uses it).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -7,6 +7,18 @@ use crate::geometry::{polyline_length, Point};
 use crate::planner::{Sensor, Step};
 use crate::trace::Event;
 
+/// Who decides the next step of a host planner plus the extension (`ba-star-extended`,
+/// `bsa-extended`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Mode {
+    /// The host planner decides.
+    Host,
+    /// Cleaning passes at the end of a host region (`false`) or of the host (`true`).
+    Clean { last: bool },
+    /// Everything done.
+    Done,
+}
+
 /// What a host planner plus the extension keep while they drive (shared by `ba-star-extended`
 /// and `bsa-extended`): the steps queued, the waypoints driven since the cleaning began (to
 /// retreat by), whether a wall pass is open, and the last position seen (to record each move
@@ -113,18 +125,28 @@ impl Drive {
     /// face a wall it believes is elsewhere; every move it is sent then stops at once on the
     /// same contact (`ba-star-extended` on `nobleo_basement` at `--odometry-noise 0.02`: the
     /// same nine-move way to one rim piece, planned again and bumped 1492 times, then the
-    /// simulator's stall stop). The host then calls [`Drive::abandon`] and gives up the
-    /// cleaning in progress. Under ideal execution a correct plan never bumps.
+    /// simulator's stall stop). The host then gives the cleaning in progress up
+    /// ([`Drive::abandon_if_stuck`]). Under ideal execution a correct plan never bumps.
     pub fn stuck(&self) -> bool {
         self.stuck >= STUCK_BUMPS
     }
 
-    /// Drops the queued moves (their marks stay, so every start mark keeps its end), closes
-    /// an open wall pass and starts counting contacts anew.
-    pub fn abandon(&mut self) {
+    /// When the robot is [`stuck`](Drive::stuck): drops the queued moves (their marks stay,
+    /// so every start mark keeps its end), closes an open wall pass, starts counting contacts
+    /// anew and gives up the cleaning in progress in `mode` (the host goes on; at the end,
+    /// the run ends).
+    pub fn abandon_if_stuck(&mut self, mode: &mut Mode) {
+        if !self.stuck() {
+            return;
+        }
         self.queue.retain(|s| matches!(s, Step::Mark(_)));
         self.end_pass();
         self.stuck = 0;
+        match *mode {
+            Mode::Clean { last: true } => *mode = Mode::Done,
+            Mode::Clean { last: false } => *mode = Mode::Host,
+            Mode::Host | Mode::Done => {}
+        }
     }
 
     /// Closes an open wall pass (`wall_follow_end`).
