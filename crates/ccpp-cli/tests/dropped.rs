@@ -1494,5 +1494,31 @@ fn online_planners_do_not_push_into_a_wall_under_odometry_noise() {
             err.contains("give --landmarks"),
             "{planner} on {map}: {err}"
         );
+        // A BA* run that ended with its frontier beyond blocked moves says so, not "the path
+        // never went there, as into a room behind a doorway".
+        if err.contains("no backtracking candidate reachable") {
+            assert!(
+                err.contains("lie beyond moves the bumper stopped")
+                    && !err.contains("as into a room behind a doorway"),
+                "{planner} on {map}: {err}"
+            );
+        }
     }
+    // teb_maze's BA* run ends so.
+    let o = ccpp()
+        .args(["run", "--planner", "ba-star", "--map"])
+        .arg(maps.join("teb_maze.yaml"))
+        .args([
+            "--odometry-noise",
+            "0.02",
+            "--out",
+            s(&d.path().join("maze")),
+        ])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("warning: ba-star: no backtracking candidate reachable: the "),
+        "{err}"
+    );
 }

@@ -697,11 +697,15 @@ pub fn run_warnings(
         trace,
         ccpp_core::planners::rect_boustrophedon::SPARSE_STOPS_NOTE,
     );
+    // BA* under odometry noise ended with its frontier beyond moves its bumper stopped (it
+    // was told as "the path never went there, as into a room behind a doorway": hostile pass).
+    let unreachable = note_warning(trace, ccpp_core::planners::ba_star::UNREACHABLE_NOTE);
     // (floor never approached is said once, by the warning that knows why when one does)
     let explained = stranded.is_some()
         || rect.is_some()
         || boxed.is_some()
         || sparse.is_some()
+        || unreachable.is_some()
         || metrics.stop_reason.is_some()
         || !moved;
     out.extend(stranded);
@@ -709,6 +713,7 @@ pub fn run_warnings(
     out.extend(rect_lane_area_warning(scenario));
     out.extend(boxed);
     out.extend(sparse);
+    out.extend(unreachable);
     if !explained {
         out.extend(untouched_floor_warning(
             scenario,

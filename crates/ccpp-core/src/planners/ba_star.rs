@@ -160,6 +160,11 @@ enum Phase {
     Finished,
 }
 
+/// The start of the trace note BA* writes when it ends with tiles left in its backtracking
+/// list that the covered tiles no longer reach (moves its bumper stopped, under odometry
+/// noise, lie between); `ccpp run` says it as a warning.
+pub const UNREACHABLE_NOTE: &str = "ba-star: no backtracking candidate reachable";
+
 /// The backtracking-list points a run's trace holds at most, per tile of the map (and never
 /// more than [`LIST_POINTS_MAX`]): lists are recorded whole at each critical point while they
 /// fit, and a `note` event says where the recording stopped (the run's memory estimate counts

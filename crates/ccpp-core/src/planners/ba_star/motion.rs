@@ -184,7 +184,8 @@ impl BaStar {
             // them.
             self.pending.push_back(Step::Mark(Event::Note {
                 text: format!(
-                    "ba-star: no backtracking candidate reachable: the {} tile(s) left in the backtracking list lie beyond moves the bumper stopped",
+                    "{}: the {} tile(s) left in its backtracking list lie beyond moves the bumper stopped, so the floor there was not covered",
+                    super::UNREACHABLE_NOTE,
                     m.tiles.l.len()
                 ),
             }));
