@@ -463,20 +463,9 @@ impl World {
             p
         });
         let cells = plan.as_ref().unwrap_or(&map).cells();
-        let obstacle_dt2 =
-            squared_edt_compact(frame.width, frame.height, |i| !cells[i].is_free(), true);
-        let r_px = robot.radius / frame.resolution;
-        // C-free at a pixel centre: distance to every blocked centre >= contact radius.
-        let rc = contact_radius_px(r_px);
+        let (obstacle_dt2, cfree) = cfree_of(plan.as_ref().unwrap_or(&map), robot.radius);
+        let rc = contact_radius_px(robot.radius / frame.resolution);
         let rc2 = rc * rc;
-        // `CompactDt::get` per pixel, with the storage matched once.
-        let cfree = match &obstacle_dt2 {
-            CompactDt::U16(v) => bitset_where(frame.len(), |i| {
-                let d = v[i];
-                f64::from(if d == u16::MAX { INF } else { u32::from(d) }) >= rc2
-            }),
-            CompactDt::U32(v) => bitset_where(frame.len(), |i| f64::from(v[i]) >= rc2),
-        };
         if cfree.is_clear() && zones.is_some() {
             let free_px = cells.iter().filter(|c| c.is_free()).count();
             let fits_without = squared_edt(
@@ -863,20 +852,15 @@ impl World {
         self.zones.as_ref()?;
         let frame = *self.map.frame();
         let seed = self.start_seed()?;
-        let cells = self.map.cells();
-        let plain_dt2 =
-            squared_edt_compact(frame.width, frame.height, |i| !cells[i].is_free(), true);
-        let rc = contact_radius_px(self.robot.radius / frame.resolution);
-        let rc2 = rc * rc;
-        let cfree_plain = |i: usize| f64::from(plain_dt2.get(i)) >= rc2;
-        if !cfree_plain(seed) {
+        let (_, cfree_plain) = cfree_of(&self.map, self.robot.radius);
+        if !cfree_plain.contains(seed) {
             return None;
         }
         let mut near = FixedBitSet::with_capacity(frame.len());
         fill_runs(
             frame.width,
             frame.height,
-            cfree_plain,
+            |i| cfree_plain.contains(i),
             seed,
             Connectivity::Eight,
             &mut near,
@@ -1261,6 +1245,26 @@ impl collide::Occupancy for Truth<'_> {
 }
 
 /// The set of `i < n` where `pred(i)` holds, built a word at a time.
+/// The squared distance transform of `map`'s blocked (not free) pixels and the C-free pixel
+/// centres for a robot of radius `radius` metres: those whose distance to every blocked
+/// centre is at least the contact radius.
+fn cfree_of(map: &GridMap, radius: f64) -> (CompactDt, FixedBitSet) {
+    let frame = *map.frame();
+    let cells = map.cells();
+    let dt2 = squared_edt_compact(frame.width, frame.height, |i| !cells[i].is_free(), true);
+    let rc = contact_radius_px(radius / frame.resolution);
+    let rc2 = rc * rc;
+    // `CompactDt::get` per pixel, with the storage matched once.
+    let cfree = match &dt2 {
+        CompactDt::U16(v) => bitset_where(frame.len(), |i| {
+            let d = v[i];
+            f64::from(if d == u16::MAX { INF } else { u32::from(d) }) >= rc2
+        }),
+        CompactDt::U32(v) => bitset_where(frame.len(), |i| f64::from(v[i]) >= rc2),
+    };
+    (dt2, cfree)
+}
+
 fn bitset_where(n: usize, pred: impl Fn(usize) -> bool) -> FixedBitSet {
     let mut set = FixedBitSet::with_capacity(n);
     let bits = usize::BITS as usize;

@@ -184,12 +184,15 @@ impl Polygon {
                 max: MAX_POLYGON_POINTS,
             });
         }
-        let raw = self.ring();
-        if !(shoelace(&raw, Point::new(0.0, 0.0)).is_finite() && self.signed_area().is_finite()) {
+        let r = self.ring();
+        let about_first = r.first().copied().unwrap_or(Point::new(0.0, 0.0));
+        if !(shoelace(&r, Point::new(0.0, 0.0)).is_finite()
+            && shoelace(&r, about_first).is_finite())
+        {
             // Products of coordinates overflow: every geometric test below would be noise.
             return Err(ZoneError::Overflow { index });
         }
-        let r = self.ring();
+        let area = shoelace(&r, about_first);
         let mut distinct: Vec<(u64, u64)> =
             r.iter().map(|p| (p.x.to_bits(), p.y.to_bits())).collect();
         distinct.sort_unstable();
@@ -202,7 +205,7 @@ impl Polygon {
         }
         // All on one line: that is the problem to name (its edges fold back onto each other,
         // which the test below called "intersects itself").
-        if self.signed_area().abs() <= f64::EPSILON * bbox_scale(&r) && on_one_line(&r) {
+        if area.abs() <= f64::EPSILON * bbox_scale(&r) && on_one_line(&r) {
             return Err(ZoneError::ZeroArea { index });
         }
         let n = r.len();
@@ -233,7 +236,7 @@ impl Polygon {
                 }
             }
         }
-        if self.signed_area().abs() <= f64::EPSILON * bbox_scale(&r) {
+        if area.abs() <= f64::EPSILON * bbox_scale(&r) {
             return Err(ZoneError::ZeroArea { index });
         }
         Ok(())

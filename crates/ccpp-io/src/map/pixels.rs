@@ -603,9 +603,7 @@ fn alpha_averaged_differs(img: &DynamicImage, t: &Thresholds, cells: &[Cell]) ->
     }
     match img {
         DynamicImage::ImageRgba8(b) => {
-            let lut: Vec<Cell> = (0..=1020u16)
-                .map(|s| t.classify_level(f64::from(s) / 4.0))
-                .collect();
+            let lut = mean_lut(t, 4);
             b.as_raw()
                 .chunks_exact(4)
                 .zip(cells)
@@ -613,9 +611,7 @@ fn alpha_averaged_differs(img: &DynamicImage, t: &Thresholds, cells: &[Cell]) ->
                 .count()
         }
         DynamicImage::ImageLumaA8(b) => {
-            let lut: Vec<Cell> = (0..=510u16)
-                .map(|s| t.classify_level(f64::from(s) / 2.0))
-                .collect();
+            let lut = mean_lut(t, 2);
             b.as_raw()
                 .chunks_exact(2)
                 .zip(cells)
@@ -632,11 +628,17 @@ fn rgb_sum(p: &[u8]) -> usize {
     usize::from(p[0]) + usize::from(p[1]) + usize::from(p[2])
 }
 
+/// Classification of every possible sum of `channels` 8-bit samples (0..=255 channels),
+/// using the exact mean.
+fn mean_lut(t: &Thresholds, channels: u16) -> Vec<Cell> {
+    (0..=255 * channels)
+        .map(|s| t.classify_level(f64::from(s) / f64::from(channels)))
+        .collect()
+}
+
 /// Classification of every possible 8-bit `R + G + B` sum (0..=765), using the exact mean.
 fn sum_lut(t: &Thresholds) -> Vec<Cell> {
-    (0..=765u16)
-        .map(|s| t.classify_level(f64::from(s) / 3.0))
-        .collect()
+    mean_lut(t, 3)
 }
 
 /// A 16-bit sample on the 0..=255 scale.
