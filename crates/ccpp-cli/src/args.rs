@@ -143,7 +143,8 @@ pub struct OptionsArgs {
 /// The memory budget, shared by every command that plans (`run`, `plan`, `waypoints`, `bench`).
 #[derive(Args, Debug, Clone, Default)]
 pub struct LimitArgs {
-    /// Refuse work whose estimated memory exceeds this many MB (default 4096).
+    /// Refuse work whose estimated memory exceeds this many MB (default 4096). MB in the limit and in
+    /// every memory figure ccpp prints is 2^20 bytes (a MiB).
     #[arg(long, value_parser = parse_whole::<u64>, value_name = "MB")]
     pub max_memory: Option<u64>,
 }
@@ -341,7 +342,7 @@ pub struct DemoArgs {
 #[derive(Args, Debug)]
 #[command(
     allow_negative_numbers = true,
-    mut_arg("max_memory", |a| a.help("Refuse work whose estimated memory exceeds this many MB (default 4096): each run is checked, and the runs in progress and the summary pictures share the limit (a run starts when its estimate fits beside theirs)"))
+    mut_arg("max_memory", |a| a.help("Refuse work whose estimated memory exceeds this many MB (2^20 bytes, as in every memory figure ccpp prints; default 4096): each run is checked, and the runs in progress and the summary pictures share the limit (a run starts when its estimate fits beside theirs)"))
 )]
 pub struct BenchArgs {
     /// Map files and/or folders (a folder contributes its `*.yaml` maps, or its images; a

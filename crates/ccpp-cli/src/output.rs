@@ -103,6 +103,17 @@ pub fn replay_dir(dir: &Path) -> Result<()> {
     // The folder read, to write into that one only: a `ccpp run` into the same folder swaps a
     // new folder in under the same name, and a replay that read the old run wrote its page and
     // GIF beside the new run's files (a folder mixing two runs).
+    // A missing folder is said as such (it was "not a ccpp run folder (no readable run.json):
+    // No such file or directory": hostile pass).
+    if !dir.is_dir() {
+        if dir.exists() {
+            anyhow::bail!(
+                "{} is not a folder: replay reads a run folder",
+                dir.display()
+            );
+        }
+        anyhow::bail!("{}: no such folder", dir.display());
+    }
     let identity = folder_identity(dir);
     let rec_path = dir.join("run.json");
     // A `ccpp plan` folder holds exports only (it said "no readable run.json: No such file or
@@ -197,7 +208,7 @@ pub fn replay_dir(dir: &Path) -> Result<()> {
         bail!(replaced());
     }
     crate::print_stdout(&format!(
-        "wrote {}/replay.html and replay.gif\n",
+        "wrote {}/{{replay.html, replay.gif}}\n",
         folder_shown(dir)
     ))
 }

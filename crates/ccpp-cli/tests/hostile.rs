@@ -1414,6 +1414,15 @@ fn likely_mistakes_are_said_as_such() {
             "`ccpp run` with the same map and planner",
         ],
     );
+    // A folder that is not there, or a file, is said as such (not "not a ccpp run folder (no
+    // readable run.json): No such file or directory (os error 2)": hostile pass).
+    let gone = dir.join("gone");
+    refused(&["replay", s(&gone)], &["gone: no such folder"]);
+    refused(
+        &["replay", s(&map)],
+        &["is not a folder: replay reads a run folder"],
+    );
+    assert!(!gone.exists());
 }
 
 /// A lane rectangle narrower than a map pixel is refused (`waypoints --area` and the options
@@ -2343,21 +2352,29 @@ fn bcd_counts_its_plans_pixels_once_per_plan_at_a_time() {
         for n in needles {
             assert!(err.contains(n), "{err:?} should contain {n:?}");
         }
+        if err.contains("1 plan at a time") {
+            assert!(!err.contains("bcd.plans_at_a_time: 1"), "{err}");
+        }
         assert!(!out.exists());
         let about = err.split("about ").nth(1).expect("a figure");
         about.split(' ').next().unwrap().parse().expect("MB")
     };
-    let common = [
-        "big.pgm",
-        "bcd would need",
-        "map pixels",
-        "limit of 120 MB",
-        "bcd.plans_at_a_time: 1",
-    ];
+    let common = ["big.pgm", "bcd would need", "map pixels", "limit of 120 MB"];
+    // The way down to one plan at a time is named where more run at once (at one it was
+    // offered as the remedy of a refusal that already counted one: hostile pass).
+    let down = "bcd.plans_at_a_time: 1";
     let one = figure("1", None, &[&common[..], &["1 plan at a time"]].concat());
-    let four = figure("4", None, &[&common[..], &["4 plans at a time"]].concat());
+    let four = figure(
+        "4",
+        None,
+        &[&common[..], &["4 plans at a time", down]].concat(),
+    );
     // Up to four plans at a time: eight threads make no more than four.
-    let eight = figure("8", None, &[&common[..], &["4 plans at a time"]].concat());
+    let eight = figure(
+        "8",
+        None,
+        &[&common[..], &["4 plans at a time", down]].concat(),
+    );
     // 1e6 pixels x (64 + 64 + 32) bytes (153 MiB), 64 000 lane squares of 0.2 m (18 MiB)
     // and the process's own 16 MiB; 3 x 32 bytes more a pixel for four plans.
     assert!((181..196).contains(&one), "{one} MB");
@@ -2376,7 +2393,7 @@ fn bcd_counts_its_plans_pixels_once_per_plan_at_a_time() {
     let cfg_three = figure(
         "1",
         Some(&three_cfg),
-        &[&common[..], &["3 plans at a time"]].concat(),
+        &[&common[..], &["3 plans at a time", down]].concat(),
     );
     assert!(cfg_three > one && cfg_three < four, "{cfg_three}");
 }

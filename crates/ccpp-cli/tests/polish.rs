@@ -357,7 +357,7 @@ fn an_output_folder_given_with_a_slash_is_printed_with_one() {
         ),
         (
             stdout(&["replay", &run]),
-            format!("wrote {run}replay.html and replay.gif"),
+            format!("wrote {run}{{replay.html, replay.gif}}"),
         ),
         (
             stdout(&["plan", "--map", m, "--planner", "bcd", "--out", &plan]),

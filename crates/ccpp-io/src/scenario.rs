@@ -701,7 +701,7 @@ pub struct Scenario {
     /// noise), landmarks.
     #[serde(default)]
     pub sim: SimConfig,
-    /// Refuse runs whose estimated memory exceeds this many MB.
+    /// Refuse runs whose estimated memory exceeds this many MB (2^20 bytes).
     #[serde(default = "default_max_memory_mb")]
     pub max_memory_mb: u64,
     /// Work area: the robot stays inside it (virtual walls for every planner) and metrics

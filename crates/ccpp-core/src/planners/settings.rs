@@ -1328,9 +1328,14 @@ impl PlannerSettings for BcdOptions {
             .map_or_else(rayon::current_num_threads, |n| n as usize)
             .clamp(1, BCD_MAX_JOBS);
         let per_px = BCD_PIXEL_BYTES + BCD_JOB_PIXEL_BYTES * jobs as f64;
-        let mut px = ResourceEstimate::units(s.pixels(), per_px, "map pixels").remedy(&format!(
-            "{PIXELS_REMEDY}, or one plan at a time (bcd.plans_at_a_time: 1)"
-        ));
+        // (one plan at a time is a remedy only where more run at once: at 1 it was offered
+        // as the way out of a refusal that already counted 1: hostile pass)
+        let remedy = if jobs > 1 {
+            format!("{PIXELS_REMEDY}, or one plan at a time (bcd.plans_at_a_time: 1)")
+        } else {
+            PIXELS_REMEDY.to_string()
+        };
+        let mut px = ResourceEstimate::units(s.pixels(), per_px, "map pixels").remedy(&remedy);
         px.detail = format!(
             "{}, {jobs} plan{} at a time",
             px.detail,
