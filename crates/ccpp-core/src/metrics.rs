@@ -71,7 +71,8 @@ pub struct Metrics {
     /// obstacles; see [`crate::zones::keepout_entries`]), plus exits from the work area
     /// counted alike (its outside is forbidden floor: [`crate::zones::area_exits`]; the
     /// approach from a start outside the area is none); 0 without zones and for a correct
-    /// planner.
+    /// planner. Only forbidden floor counts: zone pixels that are obstacles (or unknown) on
+    /// the true map are walls, and touching them is a collision.
     #[serde(default)]
     pub keepout_violations: u32,
     /// Planning + simulation wall time, seconds (the one non-deterministic figure).
@@ -872,8 +873,17 @@ fn compute_rest(
             .map(|p| frame.world_to_grid(p.position()))
             .collect();
         let r_px = robot.radius / frame.resolution;
-        let entries = crate::zones::keepout_entries(&frame, &z.keepout, &pts, r_px);
+        // Only forbidden *floor* counts: a zone pixel that is an obstacle on the true map is a
+        // wall, and touching it is a collision, counted as one (a bump into a wall the area's
+        // border ran behind also counted as an exit from the area: 11 "violations" against 3
+        // with the border drawn just beyond the wall, same run: hostile pass).
+        let walls = world.true_blocked();
+        let mut keepout = z.keepout.clone();
+        keepout.difference_with(walls);
+        let entries = crate::zones::keepout_entries(&frame, &keepout, &pts, r_px);
         let exits = z.area.as_ref().map_or(0, |area| {
+            let mut area = area.clone();
+            area.union_with(walls);
             // From the end of the approach to the area (driven from a start outside it, not
             // by the planner): the first pose at the start the planner began from.
             let begin = frame.world_to_grid(world.start().position());
@@ -881,7 +891,7 @@ fn compute_rest(
                 .iter()
                 .position(|p| p.x == begin.x && p.y == begin.y)
                 .unwrap_or(0);
-            crate::zones::area_exits(&frame, area, &pts[from..], r_px)
+            crate::zones::area_exits(&frame, &area, &pts[from..], r_px)
         });
         entries + exits
     });

@@ -916,6 +916,11 @@ impl World {
         self.start
     }
 
+    /// Non-free pixels of the true map (obstacles and unknown; zones not included).
+    pub fn true_blocked(&self) -> &FixedBitSet {
+        &self.blocked
+    }
+
     /// C-free pixel centres (whole map; virtual walls count as obstacles).
     pub fn cfree(&self) -> &FixedBitSet {
         &self.cfree
