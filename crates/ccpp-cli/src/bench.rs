@@ -573,8 +573,12 @@ fn run_one(
         // An earlier bench's run in this slot (another radius, other options: not reused)
         // goes too: it stayed beside this bench's runs while `results.csv` listed this run
         // as failed, and `ccpp replay` showed it as this bench's (hostile pass).
-        if dir.join(KEY_FILE).is_file() {
-            if let Err(e) = std::fs::remove_dir_all(dir) {
+        // Not when the bench is being interrupted (the child died of that, not of its run:
+        // the earlier run is whole and keyed, and stays), and never file by file: an
+        // interrupt cut such removals short and left folders holding a `path.csv` alone
+        // (hostile pass).
+        if !crate::staging::stopping() && dir.join(KEY_FILE).is_file() {
+            if let Err(e) = ccpp_io::write::remove_folder(dir) {
                 say!(
                     "warning: {}: cannot remove an earlier bench's run here ({e}); it is not this bench's",
                     dir.display()

@@ -192,6 +192,12 @@ pub fn unregister_child(pid: u32) {
     lock(&CHILDREN).retain(|&p| p != pid);
 }
 
+/// Whether an interrupt is being handled (no new child may start, and what a stopped child
+/// leaves is not its run's failure).
+pub fn stopping() -> bool {
+    STOPPING.load(Ordering::SeqCst)
+}
+
 /// Installs the SIGINT/SIGTERM handler (once, at start-up).
 pub fn install_signal_handler() {
     // Failure to install (a handler already set) only loses the cleanup.

@@ -445,14 +445,106 @@ fn an_interrupted_bench_leaves_only_complete_runs() {
                 "{signal}: stray entry in {}: {names:?}",
                 d.display()
             );
-            if names.iter().any(|n| n == "metrics.json") {
-                let mut want: Vec<&str> = BASE_SET.to_vec();
-                want.push("bench-key.txt");
-                want.push("warnings.txt");
-                want.sort_unstable();
+            // Any run file makes a run folder, which holds every one (an earlier bench's
+            // folder removed file by file by a stopped bench kept a `path.csv` alone, and a
+            // run folder without `metrics.json` went unchecked here: hostile pass), and no
+            // run folder is left empty.
+            let mut want: Vec<&str> = BASE_SET.to_vec();
+            want.push("bench-key.txt");
+            want.push("warnings.txt");
+            want.sort_unstable();
+            if names.iter().any(|n| want.contains(&n.as_str())) {
+                assert_eq!(names, &want, "{signal}: incomplete run {}", d.display());
+            }
+            assert!(
+                !names.is_empty() || !is_run_slot(d),
+                "{signal}: empty run folder {}",
+                d.display()
+            );
+        }
+    }
+}
+
+/// Whether `d` is a bench run folder's place, `.../runs/MAP/PLANNER` (a map's folder
+/// `runs/MAP` is made before its runs, and is empty until the first is written).
+fn is_run_slot(d: &Path) -> bool {
+    d.parent()
+        .and_then(Path::parent)
+        .and_then(Path::file_name)
+        .is_some_and(|n| n == "runs")
+}
+
+/// A bench stopped while it replaces an earlier bench's runs (another radius: none reused)
+/// leaves each run folder whole, the earlier run's or absent (the earlier runs of the slots
+/// whose jobs the stop ended were removed file by file, cut short by the exit: folders with a
+/// `path.csv` alone, or empty; hostile pass).
+#[cfg(unix)]
+#[test]
+fn a_bench_stopped_over_an_earlier_bench_leaves_whole_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bench");
+    let bin = assert_cmd::cargo::cargo_bin("ccpp");
+    let maps = [data("teb_empty_box.yaml"), data("specks_room.yaml")];
+    let first = std::process::Command::new(&bin)
+        .args([
+            "bench",
+            "--quiet",
+            "--planners",
+            "bsa,bcd,random-bounce",
+            "--maps",
+        ])
+        .args(&maps)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(first.status.success(), "{first:?}");
+    for (k, signal) in ["INT", "TERM", "INT"].iter().enumerate() {
+        let mut child = std::process::Command::new(&bin)
+            .args(["bench", "--quiet", "--radius", "0.2", "--planners"])
+            .arg("bsa,bcd,random-bounce")
+            .arg("--maps")
+            .args(&maps)
+            .arg("--out")
+            .arg(&out)
+            .env("CCPP_TEST_COMMIT_PAUSE_MS", (200 * (k + 1)).to_string())
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(400 + 300 * k as u64));
+        let _ = std::process::Command::new("kill")
+            .arg(format!("-{signal}"))
+            .arg(child.id().to_string())
+            .status();
+        child.wait().unwrap();
+        let t0 = std::time::Instant::now();
+        while t0.elapsed() < std::time::Duration::from_mins(1) && has_staging(&out) {
+            std::thread::sleep(std::time::Duration::from_millis(50));
+        }
+        let mut dirs = Vec::new();
+        walk(&out, &mut dirs);
+        let mut want: Vec<&str> = BASE_SET.to_vec();
+        want.push("bench-key.txt");
+        want.push("warnings.txt");
+        want.sort_unstable();
+        for (d, names) in &dirs {
+            assert!(
+                !names.is_empty() || !is_run_slot(d),
+                "{signal}: empty run folder {}",
+                d.display()
+            );
+            if names.iter().any(|n| want.contains(&n.as_str())) {
                 assert_eq!(names, &want, "{signal}: incomplete run {}", d.display());
             }
         }
+        // Every slot still holds a run, the earlier bench's or this one's: a job the stop
+        // ended did not fail its run, and the earlier run in its place stays.
+        let runs = dirs
+            .iter()
+            .filter(|(_, names)| names.iter().any(|n| n == "metrics.json"))
+            .count();
+        assert_eq!(runs, 6, "{signal}: {dirs:?}");
     }
 }
 

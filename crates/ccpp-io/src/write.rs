@@ -708,15 +708,19 @@ pub fn clean_stale(parent: &Path, name: &str) {
     };
     let new_prefix = staging_prefix(name, "new");
     let old_prefix = staging_prefix(name, "old");
+    let gone_prefix = staging_prefix(name, GONE);
     let mut names: Vec<String> = entries
         .filter_map(|e| e.ok()?.file_name().into_string().ok())
         .collect();
     names.sort();
     for n in names {
+        // (a folder being removed, [`remove_folder`], is never put back: it may be cut short)
         let (is_old, rest) = if let Some(r) = n.strip_prefix(&new_prefix) {
             (false, r)
         } else if let Some(r) = n.strip_prefix(&old_prefix) {
             (true, r)
+        } else if let Some(r) = n.strip_prefix(&gone_prefix) {
+            (false, r)
         } else {
             continue;
         };
@@ -731,6 +735,32 @@ pub fn clean_stale(parent: &Path, name: &str) {
         }
         remove_all_quietly(&p);
     }
+}
+
+/// The staging kind of a folder [`remove_folder`] renamed away to remove it.
+const GONE: &str = "gone";
+
+/// Removes the folder `target` all or nothing as a reader of `target` sees it: it is renamed
+/// to a hidden `.NAME.ccpp-gone-PID-N` beside it (under [`swap_lock`], so an interrupt
+/// cleanup holding that lock never sees it half moved), then removed. A process stopped
+/// during the removal leaves only the hidden folder, which the next [`clean_stale`] beside
+/// `target` removes. Removing a folder in place, file by file, left run folders holding a
+/// `path.csv` alone when a bench was interrupted (hostile pass).
+///
+/// # Errors
+/// The rename's error (nothing moved); the removal of the renamed folder is best effort.
+pub fn remove_folder(target: &Path) -> io::Result<()> {
+    let (Some(parent), Some(name)) = (target.parent(), target.file_name().and_then(|n| n.to_str()))
+    else {
+        return std::fs::remove_dir_all(target);
+    };
+    let aside = staging_path(parent, name, GONE);
+    {
+        let _swap = swap_lock();
+        std::fs::rename(target, &aside)?;
+    }
+    remove_all_quietly(&aside);
+    Ok(())
 }
 
 /// Rounds of [`swap_folder`] against other processes swapping the same folder.
@@ -909,6 +939,26 @@ pub fn save_map(grid: &GridMap, yaml_path: &Path) -> Result<PathBuf, WriteError>
 mod tests {
     #![allow(clippy::unwrap_used)]
     use super::*;
+
+    /// `remove_folder` takes the folder away whole, and a removal a dead process left (its
+    /// hidden `gone` folder, maybe cut short) is removed beside the target, never put back
+    /// in its place as a set-aside `old` folder is.
+    #[test]
+    fn a_folder_being_removed_is_never_put_back() {
+        let d = tempfile::tempdir().unwrap();
+        let run = d.path().join("run");
+        std::fs::create_dir(&run).unwrap();
+        std::fs::write(run.join("path.csv"), "x,y,theta\n").unwrap();
+        remove_folder(&run).unwrap();
+        assert!(!run.exists());
+        assert_eq!(std::fs::read_dir(d.path()).unwrap().count(), 0);
+        // A dead process's cut-short removal (no such process id: beyond pid_max).
+        let cut = d.path().join(staging_name("run", GONE, 4_194_305, 0));
+        std::fs::create_dir(&cut).unwrap();
+        std::fs::write(cut.join("path.csv"), "x,y,theta\n").unwrap();
+        clean_stale(d.path(), "run");
+        assert!(!run.exists() && !cut.exists());
+    }
 
     /// `warnings.txt` is a bench run's only beside its `bench-key.txt` or `metrics.json`: a
     /// user's notes of that name were deleted with a folder given to `ccpp run --out`, and a
