@@ -916,6 +916,12 @@ impl World {
         self.start
     }
 
+    /// Non-free pixels of the planning map: the true map's, and with zones the pixels they
+    /// forbid (virtual walls).
+    pub fn plan_blocked(&self) -> &FixedBitSet {
+        self.plan_blocked.as_ref().unwrap_or(&self.blocked)
+    }
+
     /// Non-free pixels of the true map (obstacles and unknown; zones not included).
     pub fn true_blocked(&self) -> &FixedBitSet {
         &self.blocked

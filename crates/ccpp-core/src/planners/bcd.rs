@@ -291,12 +291,12 @@ mod tests;
 mod transfer;
 mod tsp;
 
-use std::collections::VecDeque;
 use std::sync::atomic::AtomicBool;
 
 use serde::{Deserialize, Serialize};
 
 use crate::planner::{Planner, Sensor, Step};
+use crate::planners::replay::Replay;
 use crate::world::World;
 
 /// Options of [`Bcd`].
@@ -509,7 +509,7 @@ fn on_pool<T: Send>(threads: Option<u32>, f: impl FnOnce() -> T + Send) -> T {
 
 /// The BCD planner: a precomputed list of steps.
 pub struct Bcd {
-    steps: VecDeque<Step>,
+    replay: Replay,
     cells: usize,
 }
 
@@ -637,7 +637,7 @@ impl Planner for Bcd {
     fn is_offline(&self) -> bool {
         true
     }
-    fn next(&mut self, _sensor: &dyn Sensor) -> Step {
-        self.steps.pop_front().unwrap_or(Step::Done)
+    fn next(&mut self, sensor: &dyn Sensor) -> Step {
+        self.replay.next(sensor)
     }
 }

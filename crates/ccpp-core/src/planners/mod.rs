@@ -17,6 +17,7 @@ pub mod bsa_extended;
 pub mod extension;
 pub mod random_bounce;
 pub mod rect_boustrophedon;
+pub mod replay;
 pub mod settings;
 
 use serde::{Deserialize, Serialize};

@@ -60,7 +60,6 @@
 //! assert!(m.rect_guarantee.unwrap() > 0.9);
 //! ```
 
-use std::collections::VecDeque;
 use std::sync::atomic::AtomicBool;
 
 use serde::{Deserialize, Serialize};
@@ -69,6 +68,7 @@ use crate::exec::{Execution, PidOptions};
 use crate::geometry::Point;
 use crate::options::OptionsError;
 use crate::planner::{Planner, Sensor, Step};
+use crate::planners::replay::Replay;
 use crate::search::{DeeperFirst, SearchSpace};
 use crate::trace::Event;
 use crate::world::{Robot, World};
@@ -829,7 +829,7 @@ impl<'a> Roadmap<'a> {
 
 /// The planner: replays [`plan`]'s steps.
 pub struct RectBoustrophedon {
-    steps: VecDeque<Step>,
+    replay: Replay,
     exec: Execution,
     plan: RectPlan,
 }
@@ -845,7 +845,7 @@ impl RectBoustrophedon {
     pub fn new_until(world: &World, opts: &RectOptions, stop: Option<&AtomicBool>) -> Self {
         let plan = plan_until(world, opts, stop);
         Self {
-            steps: plan.steps.clone().into(),
+            replay: Replay::new(world, plan.steps.clone().into()),
             exec: opts.exec,
             plan,
         }
@@ -870,8 +870,8 @@ impl Planner for RectBoustrophedon {
         Some(self.exec)
     }
 
-    fn next(&mut self, _sensor: &dyn Sensor) -> Step {
-        self.steps.pop_front().unwrap_or(Step::Done)
+    fn next(&mut self, sensor: &dyn Sensor) -> Step {
+        self.replay.next(sensor)
     }
 }
 

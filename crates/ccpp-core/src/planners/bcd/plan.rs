@@ -19,6 +19,7 @@ use super::{hops, prune, tsp};
 use super::{Bcd, BcdOptions};
 use crate::geometry::{path_length, Point};
 use crate::planner::Step;
+use crate::planners::replay::Replay;
 use crate::trace::Event;
 use crate::world::World;
 
@@ -431,7 +432,7 @@ impl Bcd {
         plans.extend(run(&cut_jobs, Sets::Split));
         if ctx.stopped() {
             return Self {
-                steps: VecDeque::new(),
+                replay: Replay::new(world, VecDeque::new()),
                 cells: 0,
             };
         }
@@ -482,7 +483,7 @@ impl Bcd {
             steps.extend(marks.into_iter().map(Step::Mark));
         }
         Self {
-            steps: drop_empty_transfers(steps),
+            replay: Replay::new(world, drop_empty_transfers(steps)),
             cells: ncells,
         }
     }

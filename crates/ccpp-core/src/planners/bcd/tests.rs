@@ -319,12 +319,12 @@ fn a_plan_given_up_has_no_steps_and_one_not_given_up_is_the_plan() {
     let world = block_room();
     let opts = BcdOptions::default();
     let given_up = Bcd::new_until(&world, &opts, &AtomicBool::new(true));
-    assert!(given_up.steps.is_empty());
+    assert!(given_up.replay.steps().is_empty());
     assert_eq!(given_up.cells(), 0);
     let kept = Bcd::new_until(&world, &opts, &AtomicBool::new(false));
     let plain = Bcd::new(&world, &opts);
-    assert!(!kept.steps.is_empty());
-    assert_eq!(kept.steps, plain.steps);
+    assert!(!kept.replay.steps().is_empty());
+    assert_eq!(kept.replay.steps(), plain.replay.steps());
     assert_eq!(kept.cells(), plain.cells());
 }
 
@@ -333,7 +333,7 @@ fn same_plan_twice() {
     let world = block_room();
     let a = Bcd::new(&world, &BcdOptions::default());
     let b = Bcd::new(&world, &BcdOptions::default());
-    assert_eq!(a.steps, b.steps);
+    assert_eq!(a.replay.steps(), b.replay.steps());
     assert_eq!(a.cells(), b.cells());
 }
 
@@ -458,7 +458,7 @@ fn invalid_options_are_refused() {
         let e = Bcd::try_new(&world, &bad).err().unwrap();
         assert!(e.to_string().starts_with("bcd option "), "{e}");
         // The infallible constructor falls back to the defaults and still plans.
-        assert!(!Bcd::new(&world, &bad).steps.is_empty());
+        assert!(!Bcd::new(&world, &bad).replay.steps().is_empty());
     }
 }
 
@@ -565,7 +565,7 @@ fn every_reported_region_has_moves_and_regions_count_up() {
     .unwrap();
     let plan = Bcd::new(&world, &BcdOptions::default());
     let (mut open, mut moved, mut ended) = (None, false, 0u32);
-    for s in &plan.steps {
+    for s in plan.replay.steps() {
         match s {
             Step::Mark(Event::RegionStart { region }) => {
                 assert_eq!(open, None, "region {region} starts inside another");
@@ -891,7 +891,7 @@ fn plans_run_on_a_pool_of_plans_at_a_time_threads() {
                 ..BcdOptions::default()
             },
         );
-        assert_eq!(b.steps, pool.steps, "{n}");
+        assert_eq!(b.replay.steps(), pool.replay.steps(), "{n}");
     }
 }
 
@@ -937,7 +937,7 @@ fn a_margin_no_transfer_can_keep_is_said() {
             ..BcdOptions::default()
         };
         let plan = Bcd::new(&world, &opts);
-        plan.steps.iter().find_map(|s| match s {
+        plan.replay.steps().iter().find_map(|s| match s {
             Step::Mark(Event::Note { text }) => Some(text.clone()),
             _ => None,
         })
