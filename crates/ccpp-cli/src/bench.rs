@@ -982,21 +982,23 @@ fn starts_maybe_outside(
         .zip(prepared)
         .filter_map(|((_, name), (_, map))| {
             let map = map.as_ref().ok()?;
-            let start = rows
+            let scenario = rows
                 .iter()
                 .filter(|r| r.map == *name && r.outcome.is_ok())
-                .find_map(|r| run_start(&r.dir))?;
-            crate::components::StartComponent::of(&map.grid, start)
+                .find_map(|r| Scenario::from_file(&r.dir.join("run.json")).ok())?;
+            let [x, y, _] = scenario.start?;
+            let start = ccpp_core::geometry::Point::new(x, y);
+            // The pixel flood first (cheap); where it reaches the border, the floor the
+            // robot reaches decides, as `ccpp run` says it.
+            if !crate::components::StartComponent::of(&map.grid, start).touches_border {
+                return None;
+            }
+            let world = scenario.world(map).ok()?;
+            crate::components::StartComponent::of_world(&world)
                 .touches_border
                 .then(|| name.clone())
         })
         .collect()
-}
-
-/// The start position a run used (`run.json`'s `start`), when its folder says.
-fn run_start(dir: &Path) -> Option<ccpp_core::geometry::Point> {
-    let [x, y, _] = Scenario::from_file(&dir.join("run.json")).ok()?.start?;
-    Some(ccpp_core::geometry::Point::new(x, y))
 }
 
 /// The warning a bench prints for [`starts_maybe_outside`]'s maps.

@@ -163,7 +163,7 @@ pub fn run(a: &InfoArgs) -> Result<()> {
     // run inside a small area reported the start area of the whole floor.
     let comp = world
         .as_ref()
-        .and_then(|w| s.map(|s| StartComponent::of(w.map(), s.position())));
+        .and_then(|w| s.map(|_| StartComponent::of_world(w)));
     let info = Info {
         map: map.name.clone(),
         width_px: f.width,

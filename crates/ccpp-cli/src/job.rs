@@ -683,10 +683,7 @@ impl Job {
         let map = self.map.take().context("the job has already run")?;
         let (run, start_area, formed) = self.scenario.run_owned_with(
             map,
-            |w| {
-                start_area
-                    .then(|| crate::components::StartComponent::of(w.map(), w.start().position()))
-            },
+            |w| start_area.then(|| crate::components::StartComponent::of_world(w)),
             form_files,
         )?;
         let s = run.world.initial_pose();

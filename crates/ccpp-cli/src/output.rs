@@ -467,7 +467,7 @@ pub fn emit(
     // works) and the run's warnings, before the files: `coverage.png` shows them.
     let comp = r
         .start_area
-        .unwrap_or_else(|| StartComponent::of(r.world.map(), r.world.start().position()));
+        .unwrap_or_else(|| StartComponent::of_world(&r.world));
     let warnings = ccpp_io::warnings::warnings_with_start(
         Some(comp),
         &job.scenario,

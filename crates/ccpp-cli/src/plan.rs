@@ -102,7 +102,7 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     if let Some(note) = crate::job::approach_note(&plan.world) {
         say!("{note}");
     }
-    let comp = StartComponent::of(plan.world.map(), plan.world.start().position());
+    let comp = StartComponent::of_world(&plan.world);
     for w in &plan.warnings {
         say!("warning: {w}");
     }

@@ -80,6 +80,20 @@ pub fn zone_cut_off_warning(world: &ccpp_core::world::World) -> Option<String> {
     })
 }
 
+/// Whether `bits` (`frame`-sized) holds a pixel of the image's outer rows or columns.
+pub fn touches_image_border(
+    frame: &ccpp_core::grid::MapFrame,
+    bits: &fixedbitset::FixedBitSet,
+) -> bool {
+    let (w, h) = (frame.width, frame.height);
+    if w == 0 || h == 0 {
+        return false;
+    }
+    let row = |r: usize| (0..w).any(|c| bits.contains(frame.index(c, r)));
+    let col = |c: usize| (0..h).any(|r| bits.contains(frame.index(c, r)));
+    row(0) || row(h - 1) || col(0) || col(w - 1)
+}
+
 /// The free component holding a start position.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StartComponent {
@@ -119,6 +133,19 @@ impl StartComponent {
             free_m2,
             touches_border,
         }
+    }
+
+    /// [`Self::of`] on `world`'s map and start, where the component reaches the image
+    /// border only when the floor the robot can reach from the start does (its accessible
+    /// surface): free pixels that join the border through gaps narrower than the robot are
+    /// no way out of the building (`nav2_depot`'s start was warned about as maybe outside,
+    /// though its robot never comes within 5 px of the border: hostile pass).
+    pub fn of_world(world: &ccpp_core::world::World) -> Self {
+        let mut c = Self::of(world.map(), world.start().position());
+        if c.touches_border {
+            c.touches_border = touches_image_border(world.frame(), world.accessible());
+        }
+        c
     }
 
     /// One line: the component's area next to all free area.

@@ -578,7 +578,7 @@ pub fn plan_warnings(
     route: &ccpp_core::route::Route,
 ) -> Vec<String> {
     // As for a run: a start whose free area reaches the map's border is probably outside.
-    StartComponent::of(world.map(), world.start().position())
+    StartComponent::of_world(world)
         .warning()
         .into_iter()
         .chain(crate::components::zone_cut_off_warning(world))
@@ -659,7 +659,7 @@ pub fn warnings_with_start(
     swept: &FixedBitSet,
 ) -> Vec<String> {
     start_area
-        .unwrap_or_else(|| StartComponent::of(world.map(), world.start().position()))
+        .unwrap_or_else(|| StartComponent::of_world(world))
         .warning()
         .into_iter()
         .chain(crate::components::zone_cut_off_warning(world))
