@@ -490,15 +490,44 @@ const DIRS: [(i64, i64); 8] = [
     (-1, -1),
 ];
 
+/// One row of a [`HopTable`]: end-point nodes sorted by index, and the path cost to each in
+/// tenths of a block (at most `10 * RADIUS_BLOCKS`, so a byte). Two exact-size slices, 5
+/// bytes an entry: the rows grow with the square of the end points where the radius spans
+/// the map, and as `Vec<(u32, u32)>` (8 bytes an entry, up to twice that in spare capacity)
+/// they were most of bcd's memory on cluttered maps (a 500 x 500 px map of 1 % salt noise at
+/// r = 0.05 m peaked at 404 MB against an estimate of 81 MB: hostile pass).
+#[derive(Default)]
+struct HopRow {
+    node: Box<[u32]>,
+    cost: Box<[u8]>,
+}
+
+// Every cost a row holds fits a byte.
+const _: () = assert!(RADIUS_BLOCKS * 10 < u8::MAX as u32);
+
+impl HopRow {
+    #[cfg(test)]
+    fn is_empty(&self) -> bool {
+        self.node.is_empty()
+    }
+
+    /// The (node, cost) entries, by node.
+    fn iter(&self) -> impl Iterator<Item = (u32, u32)> + '_ {
+        self.node
+            .iter()
+            .zip(self.cost.iter())
+            .map(|(&k, &g)| (k, u32::from(g)))
+    }
+}
+
 /// Hop costs between the end points of a set of pieces (module docs).
 pub(super) struct HopTable<'a> {
     coarse: &'a Coarse,
     far: Far<'a>,
     /// Per node: its row in `rows`, or `u32::MAX` when no end point lies in it.
     row_of: Vec<u32>,
-    /// Per end-point node: (other end-point node, path cost in tenths of a block), sorted by
-    /// node.
-    rows: Vec<Vec<(u32, u32)>>,
+    /// Per end-point node: the other end-point nodes within the radius and their path costs.
+    rows: Vec<HopRow>,
     /// The node of each row.
     nodes: Vec<u32>,
     /// `rows` as a square matrix (`u8::MAX`: beyond the radius), when it has at most
@@ -610,13 +639,14 @@ impl<'a> HopTable<'a> {
         let mut g = vec![u32::MAX; coarse.nodes()];
         let mut touched: Vec<u32> = Vec::new();
         let mut buckets: [Vec<u32>; BUCKETS] = std::array::from_fn(|_| Vec::new());
-        let mut rows = Vec::with_capacity(nodes.len());
+        let mut rows: Vec<HopRow> = Vec::with_capacity(nodes.len());
+        let mut row: Vec<(u32, u32)> = Vec::new();
         for (i, &s) in nodes.iter().enumerate() {
             if i.is_multiple_of(STOP_EVERY_ROWS) && stop() {
-                rows.resize_with(nodes.len(), Vec::new);
+                rows.resize_with(nodes.len(), HopRow::default);
                 break;
             }
-            let mut row: Vec<(u32, u32)> = Vec::new();
+            row.clear();
             coarse.search(s, cap, &mut g, &mut touched, &mut buckets, |k, gk| {
                 if row_of[k as usize] != u32::MAX {
                     row.push((k, gk));
@@ -624,14 +654,21 @@ impl<'a> HopTable<'a> {
                 true
             });
             row.sort_unstable();
-            rows.push(row);
+            rows.push(HopRow {
+                node: row.iter().map(|e| e.0).collect(),
+                // (searched within `cap` = 10 * RADIUS_BLOCKS <= 255)
+                cost: row
+                    .iter()
+                    .map(|e| e.1.min(u32::from(u8::MAX - 1)) as u8)
+                    .collect(),
+            });
         }
         // Dense copy when small enough: one byte per pair (costs are at most 10 * radius).
         let m = nodes.len();
         let dense = if m * m <= DENSE_MAX {
             let mut d = vec![u8::MAX; m * m];
             for (i, row) in rows.iter().enumerate() {
-                for &(k, g) in row {
+                for (k, g) in row.iter() {
                     d[i * m + row_of[k as usize] as usize] = g as u8;
                 }
             }
@@ -691,8 +728,8 @@ impl<'a> HopTable<'a> {
         }
         let kb = self.nodes[rb as usize];
         let row = &self.rows[ra as usize];
-        let i = row.binary_search_by_key(&kb, |e| e.0).ok()?;
-        Some(f64::from(row[i].1) / 10.0 * self.coarse.b as f64)
+        let i = row.node.binary_search(&kb).ok()?;
+        Some(f64::from(row.cost[i]) / 10.0 * self.coarse.b as f64)
     }
 
     /// The hop cost from `a` to `b` (pixels; module docs): the straight line within one
@@ -751,7 +788,7 @@ impl<'a> HopTable<'a> {
         for _ in 0..pieces.len() {
             let mut best: Option<(f64, usize, usize)> = None;
             if let Some(r) = self.row(here) {
-                for &(k, g) in &self.rows[r as usize] {
+                for (k, g) in self.rows[r as usize].iter() {
                     let kr = self.row_of[k as usize] as usize;
                     if left[kr] == 0 {
                         continue;
@@ -1162,7 +1199,7 @@ mod tests {
             .collect();
         let given_up = HopTable::new(&grid, &far, &pieces, pts[0], &|| true);
         assert_eq!(given_up.rows.len(), given_up.nodes.len());
-        assert!(given_up.rows.iter().all(Vec::is_empty));
+        assert!(given_up.rows.iter().all(super::HopRow::is_empty));
         let full = HopTable::new(&grid, &far, &pieces, pts[0], &|| false);
         assert!(full.rows.iter().all(|r| !r.is_empty()));
         for &a in &pts {
