@@ -1004,7 +1004,7 @@ fn starts_maybe_outside(
 /// The warning a bench prints for [`starts_maybe_outside`]'s maps.
 fn outside_warning(maps: &[String]) -> String {
     format!(
-        "warning: on {} the free area holding the start reaches the map's border, so the start \
+        "warning: on {} the floor open to the robot from the start reaches the map's border, so the start \
          may be outside the building (only that area is covered; `ccpp info` shows it); a \
          start inside needs `ccpp run --start X,Y`",
         maps.join(", ")
@@ -1119,7 +1119,7 @@ pub fn results_md(rows: &[Row], outside: &[String]) -> String {
         let names: Vec<String> = outside.iter().map(|m| md_text(m)).collect();
         let _ = writeln!(
             s,
-            "\nOn {} the free area holding the start reaches the map's border: the start may be \
+            "\nOn {} the floor open to the robot from the start reaches the map's border: the start may be \
              outside the building, and only that area is covered and measured.",
             names.join(", ")
         );
@@ -1129,7 +1129,7 @@ pub fn results_md(rows: &[Row], outside: &[String]) -> String {
         let _ = writeln!(s, "## {}\n", md_text(map));
         if outside.iter().any(|m| m == map) {
             s.push_str(
-                "The free area holding the start reaches the map's border: the start may be \
+                "The floor open to the robot from the start reaches the map's border: the start may be \
                  outside the building.\n\n",
             );
         }

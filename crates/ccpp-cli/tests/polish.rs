@@ -581,7 +581,9 @@ fn coverage_png_shows_the_runs_warnings() {
         .success();
     let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
     assert!(
-        err.contains("warning: the free area holding the start reaches the map's border"),
+        err.contains(
+            "warning: the floor open to the robot from the start reaches the map's border"
+        ),
         "{err}"
     );
     assert!(amber(&out.join("coverage.png")) > 500);

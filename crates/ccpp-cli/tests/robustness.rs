@@ -1228,7 +1228,10 @@ fn bench_warns_of_a_start_outside_the_building() {
         .lines()
         .find(|l| l.contains("border"))
         .unwrap_or_else(|| panic!("no warning: {err}"));
-    assert!(line.starts_with("warning: on plan the free area"), "{line}");
+    assert!(
+        line.starts_with("warning: on plan the floor open to the robot"),
+        "{line}"
+    );
     assert!(!line.contains("room"), "{line}");
     let md = std::fs::read_to_string(out.join("results.md")).unwrap();
     let section = |name: &str| {
@@ -1242,7 +1245,7 @@ fn bench_warns_of_a_start_outside_the_building() {
     );
     assert!(!section("room").contains("outside the building"), "{md}");
     assert!(
-        md.contains("On plan the free area holding the start reaches"),
+        md.contains("On plan the floor open to the robot from the start reaches"),
         "{md}"
     );
 }

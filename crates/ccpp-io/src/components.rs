@@ -80,18 +80,28 @@ pub fn zone_cut_off_warning(world: &ccpp_core::world::World) -> Option<String> {
     })
 }
 
-/// Whether `bits` (`frame`-sized) holds a pixel of the image's outer rows or columns.
-pub fn touches_image_border(
+/// Whether the floor `accessible` (the robot's accessible surface, `frame`-sized) comes
+/// within a pixel of a free pixel of the image's outer rows or columns (`free`): the robot
+/// sweeps up to the image's edge there, as around a building drawn with its outside free. (Not
+/// the border pixels themselves: outside the image counts as obstacle, so the robot's reach
+/// ends a pixel or so short of it.)
+pub fn reaches_image_border(
     frame: &ccpp_core::grid::MapFrame,
-    bits: &fixedbitset::FixedBitSet,
+    accessible: &fixedbitset::FixedBitSet,
+    free: impl Fn(usize, usize) -> bool,
 ) -> bool {
     let (w, h) = (frame.width, frame.height);
     if w == 0 || h == 0 {
         return false;
     }
-    let row = |r: usize| (0..w).any(|c| bits.contains(frame.index(c, r)));
-    let col = |c: usize| (0..h).any(|r| bits.contains(frame.index(c, r)));
-    row(0) || row(h - 1) || col(0) || col(w - 1)
+    let near = |c: usize, r: usize| {
+        free(c, r)
+            && (r.saturating_sub(1)..=(r + 1).min(h - 1)).any(|rr| {
+                (c.saturating_sub(1)..=(c + 1).min(w - 1))
+                    .any(|cc| accessible.contains(frame.index(cc, rr)))
+            })
+    };
+    (0..w).any(|c| near(c, 0) || near(c, h - 1)) || (0..h).any(|r| near(0, r) || near(w - 1, r))
 }
 
 /// The free component holding a start position.
@@ -143,7 +153,10 @@ impl StartComponent {
     pub fn of_world(world: &ccpp_core::world::World) -> Self {
         let mut c = Self::of(world.map(), world.start().position());
         if c.touches_border {
-            c.touches_border = touches_image_border(world.frame(), world.accessible());
+            let map = world.map();
+            c.touches_border = reaches_image_border(world.frame(), world.accessible(), |c, r| {
+                map.get(c, r).is_free()
+            });
         }
         c
     }
@@ -164,7 +177,7 @@ impl StartComponent {
     /// The warning (without `warning: `) when the start's free area reaches the image border.
     pub fn warning(&self) -> Option<String> {
         self.touches_border.then(|| {
-            "the free area holding the start reaches the map's border, so the start may be \
+            "the floor open to the robot from the start reaches the map's border, so the start may be \
              outside the building (only that area is covered); pass --start X,Y (Python: \
              start=(x, y)) to start inside"
                 .to_string()

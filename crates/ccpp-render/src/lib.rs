@@ -2116,7 +2116,7 @@ mod tests {
         let plain = coverage_pixmap(&world, &trace, &style()).unwrap();
         let warned_style = CoverageStyle {
             warnings: vec![
-                "the free area holding the start reaches the map's border".to_string(),
+                "the floor open to the robot from the start reaches the map's border".to_string(),
                 "a second one".to_string(),
             ],
             ..style()
