@@ -1030,3 +1030,34 @@ fn an_output_folder_under_a_broken_link_names_the_link() {
         );
     }
 }
+
+/// A write-protected output folder is refused, not replaced: the swap renames in the parent
+/// went through, and the old run, which could not be removed, stayed beside it as a hidden
+/// `.NAME.ccpp-old-*` copy per run (hostile pass).
+#[cfg(unix)]
+#[test]
+fn a_read_only_output_folder_is_refused() {
+    use std::os::unix::fs::PermissionsExt as _;
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("res");
+    run_box("bcd", &out);
+    let before = contents(&out);
+    std::fs::set_permissions(&out, std::fs::Permissions::from_mode(0o555)).unwrap();
+    let o = ccpp()
+        .args(["run", "--planner", "bsa", "--map"])
+        .arg(data("teb_empty_box.yaml"))
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    std::fs::set_permissions(&out, std::fs::Permissions::from_mode(0o755)).unwrap();
+    assert_eq!(o.status.code(), Some(1), "{o:?}");
+    let err = stderr_of(&o);
+    assert!(
+        err.starts_with("error: ") && err.contains("is read-only") && err.contains("res"),
+        "{err}"
+    );
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert_eq!(contents(&out), before);
+    assert_eq!(entries(d.path()), ["res"]);
+}

@@ -171,6 +171,15 @@ pub enum FolderError {
         /// The output folder.
         path: PathBuf,
     },
+    /// The folder is write-protected: its owner said not to change it.
+    #[error(
+        "output folder {} is read-only: make it writable or give another --out",
+        path.display()
+    )]
+    ReadOnly {
+        /// The output folder.
+        path: PathBuf,
+    },
     /// A folder above the output folder exists as a file (`--out notes.txt/run`).
     #[error(
         "cannot create output folder {}: {} is a file, not a folder",
@@ -366,6 +375,14 @@ pub fn check_run_folder(target: &Path) -> Result<(), FolderError> {
     };
     if !meta.is_dir() {
         return Err(FolderError::NotAFolder {
+            path: target.to_path_buf(),
+        });
+    }
+    // A write-protected folder is replaced by renames in its parent all the same, and its
+    // old content, which cannot be removed, stayed beside it as a hidden copy per run
+    // (`chmod 555 out`, then `ccpp run --out out`: exit 0: hostile pass).
+    if meta.permissions().readonly() {
+        return Err(FolderError::ReadOnly {
             path: target.to_path_buf(),
         });
     }
