@@ -275,16 +275,8 @@ impl Replay {
                 |v, out| {
                     let (c, r) = f.col_row(v as usize);
                     let (c, r) = (c as i64, r as i64);
-                    for (dc, dr) in [
-                        (1, 0),
-                        (-1, 0),
-                        (0, 1),
-                        (0, -1),
-                        (1, 1),
-                        (1, -1),
-                        (-1, 1),
-                        (-1, -1),
-                    ] {
+                    for (dc, dr) in crate::tiles::N8 {
+                        let (dc, dr) = (i64::from(dc), i64::from(dr));
                         let (nc, nr) = (c + dc, r + dr);
                         if nc < 0 || nr < 0 || nc >= w || nr >= h {
                             continue;
