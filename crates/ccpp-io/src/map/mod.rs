@@ -295,7 +295,27 @@ fn finish<R: std::io::BufRead + std::io::Seek>(
         }
     })?;
 
-    let c = pixels::decode_and_classify(reader, &image_path, &thresholds, opts.max_pixels)?;
+    // A PNM header with a comment right after a token (`50#c`, which Netpbm allows) is
+    // rewritten without its comments first: the decoder refused it ("Non-ASCII-digit character
+    // when parsing number in preamble": hostile pass).
+    let mut inner = reader.into_inner();
+    let c = match pixels::tight_pnm_header(&mut inner).map_err(|e| MapError::Io {
+        path: image_path.clone(),
+        source: e,
+    })? {
+        Some(plain) => pixels::decode_and_classify(
+            ImageReader::new(Cursor::new(plain)),
+            &image_path,
+            &thresholds,
+            opts.max_pixels,
+        )?,
+        None => pixels::decode_and_classify(
+            ImageReader::new(inner),
+            &image_path,
+            &thresholds,
+            opts.max_pixels,
+        )?,
+    };
     let frame = MapFrame {
         width: c.width,
         height: c.height,

@@ -131,6 +131,93 @@ fn chunk_names(text: &str) -> String {
     out
 }
 
+/// Largest file [`tight_pnm_header`] reads whole to rewrite its header (a larger one is left
+/// to the decoder, which then names the header it cannot read).
+const TIGHT_PNM_MAX_BYTES: u64 = 256 << 20;
+
+/// The PNM image in `r` (from its current position) with a plain header, when its header has
+/// a comment right after a token (`P5\n50#c\n40\n255\n`: Netpbm allows a comment anywhere
+/// in the header, the decoder only after whitespace); `None` (and `r` back where it was) for
+/// any other file, which is decoded as it is. The raster starts after the whitespace that
+/// ends the last token, or after the end of the comment right after it.
+pub(crate) fn tight_pnm_header<R: BufRead + Seek>(r: &mut R) -> std::io::Result<Option<Vec<u8>>> {
+    let start = r.stream_position()?;
+    let mut head = Vec::new();
+    r.by_ref().take(4096).read_to_end(&mut head)?;
+    r.seek(SeekFrom::Start(start))?;
+    let Some(plain_head) = plain_pnm_header(&head) else {
+        return Ok(None);
+    };
+    let (header, raster_at) = plain_head;
+    let len = r.seek(SeekFrom::End(0))?.saturating_sub(start);
+    r.seek(SeekFrom::Start(start))?;
+    if len > TIGHT_PNM_MAX_BYTES {
+        return Ok(None);
+    }
+    let mut all = Vec::new();
+    r.read_to_end(&mut all)?;
+    r.seek(SeekFrom::Start(start))?;
+    let mut out = header.into_bytes();
+    out.extend_from_slice(all.get(raster_at..).unwrap_or_default());
+    Ok(Some(out))
+}
+
+/// The plain header (`P5\nW H\nMAX\n`) of a PNM header `head` (P1-P6) that has a comment
+/// right after one of its tokens, and where its raster starts; `None` otherwise.
+fn plain_pnm_header(head: &[u8]) -> Option<(String, usize)> {
+    let kind = match head {
+        [b'P', d @ b'1'..=b'6', ..] => *d,
+        _ => return None,
+    };
+    let count = if matches!(kind, b'1' | b'4') { 2 } else { 3 };
+    let mut tokens: Vec<&[u8]> = Vec::new();
+    let mut tight = false;
+    let mut i = 2;
+    // (the magic number itself may be followed by a comment at once)
+    if head.get(i) == Some(&b'#') {
+        tight = true;
+    }
+    let skip_comment = |i: usize| -> Option<usize> {
+        let nl = head[i..].iter().position(|&b| b == b'\n')?;
+        Some(i + nl + 1)
+    };
+    loop {
+        match head.get(i)? {
+            b' ' | b'\t' | b'\n' | b'\r' | 0x0b | 0x0c => i += 1,
+            b'#' => i = skip_comment(i)?,
+            _ => {
+                let s = i;
+                while head
+                    .get(i)
+                    .is_some_and(|b| !b.is_ascii_whitespace() && *b != b'#')
+                {
+                    i += 1;
+                }
+                let token = &head[s..i];
+                if !token.iter().all(u8::is_ascii_digit) || token.len() > 10 {
+                    return None;
+                }
+                tokens.push(token);
+                let at_comment = head.get(i)? == &b'#';
+                tight |= at_comment;
+                if tokens.len() == count {
+                    let raster = if at_comment { skip_comment(i)? } else { i + 1 };
+                    if !tight {
+                        return None;
+                    }
+                    let t = |k: usize| String::from_utf8_lossy(tokens[k]).into_owned();
+                    let header = if count == 2 {
+                        format!("P{}\n{} {}\n", kind as char, t(0), t(1))
+                    } else {
+                        format!("P{}\n{} {}\n{}\n", kind as char, t(0), t(1), t(2))
+                    };
+                    return Some((header, raster));
+                }
+            }
+        }
+    }
+}
+
 /// Decodes an image (format guessed from its content) and classifies every pixel. The decoded
 /// image buffer is dropped before returning, so at most the image plus the cells are alive.
 /// With `max_pixels`, the image's size is read from its header first and a larger image is
@@ -678,6 +765,48 @@ mod tests {
             bytes,
             &crate::map::LoadOptions::default(),
         )
+    }
+
+    /// Netpbm allows a comment anywhere in a header, also right after a token (`50#c`); the
+    /// decoder refused those ("Non-ASCII-digit character when parsing number in preamble":
+    /// hostile pass). They load as the plain header does.
+    #[test]
+    fn pnm_headers_with_a_comment_right_after_a_token_are_read() {
+        use crate::map::{load_map_bytes, LoadOptions};
+        let raster = [0u8, 254, 254, 0, 254, 0];
+        let load = |head: &[u8]| {
+            let mut bytes = head.to_vec();
+            bytes.extend_from_slice(&raster);
+            load_map_bytes(Path::new("m.pgm"), None, &bytes, &LoadOptions::default())
+                .map(|m| m.grid)
+        };
+        let plain = load(b"P5\n3 2\n255\n").unwrap();
+        for head in [
+            &b"P5\n3#c\n2\n255\n"[..],
+            b"P5\n3 2\n255#c\n",
+            b"P5#c1\n3#c2\n 2 #c3\n255#c4\n",
+            b"P5 # spaced\n3 2 255\n",
+        ] {
+            assert_eq!(
+                load(head).unwrap(),
+                plain,
+                "{}",
+                String::from_utf8_lossy(head)
+            );
+        }
+        // Only a header with a tight comment is rewritten; the raster starts after the
+        // comment that ends the last token.
+        assert_eq!(plain_pnm_header(b"P5\n3 2\n255\n"), None);
+        assert_eq!(
+            plain_pnm_header(b"P5\n3 2\n255#c\nXY"),
+            Some(("P5\n3 2\n255\n".to_string(), 13))
+        );
+        assert_eq!(
+            plain_pnm_header(b"P4\n3#w\n2\nXY"),
+            Some(("P4\n3 2\n".to_string(), 9))
+        );
+        // A malformed header is the decoder's to name.
+        assert_eq!(plain_pnm_header(b"P5\n3#c\nx 255\n"), None);
     }
 
     /// A sample above the maxval (Netpbm forbids it) read as free floor: the decoder scaled
