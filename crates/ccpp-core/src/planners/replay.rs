@@ -133,7 +133,8 @@ impl Replay {
         // The waypoint the stopped motion was on its way to (handed out already) first.
         let mut again = self.heading_for.take();
         for _ in 0..MAX_TARGETS {
-            let (w, handed) = match again.take() {
+            // (`in_list`: the waypoint's index in `steps`; `None` for one handed out already)
+            let (w, in_list) = match again.take() {
                 Some(w) => (w, None),
                 None => match self.next_target() {
                     Some((i, w)) => (w, Some(i)),
@@ -158,7 +159,7 @@ impl Replay {
                         .extend(pts.into_iter().map(|g| f.grid_to_world(g)));
                     // (a waypoint handed out already is driven to again at the detour's end;
                     // one still in the list comes after the events before it)
-                    if handed.is_none() {
+                    if in_list.is_none() {
                         self.detour.push_back(w);
                     }
                     self.heading_for = Some(w);
@@ -167,14 +168,14 @@ impl Replay {
                 // The estimate lies where the map has no room for the robot: no route from
                 // there; the waypoint is tried straight (and given up after more contacts).
                 Route::NoStart => {
-                    if handed.is_none() {
+                    if in_list.is_none() {
                         self.detour.push_back(w);
                     }
                     self.heading_for = Some(w);
                     return;
                 }
                 Route::Unreachable => {
-                    if let Some(i) = handed {
+                    if let Some(i) = in_list {
                         self.steps.remove(i);
                     }
                     self.target = None;
