@@ -821,9 +821,8 @@ fn a_map_name_too_long_for_the_plots_is_refused_before_any_run() {
 /// word of it in the results. The run now stops after 1000 motions without progress, and says
 /// why in `metrics.json`, the summary and the trace. (BA* itself now gives up a move its
 /// bumper stopped and no longer stalls there; rect-boustrophedon replays its plan with a
-/// bumper reaction (`planners::replay`) that gives a waypoint up after 3 contacts, and under
-/// this strong noise still ends pinned in a corner on seed 5: seed 6 stalled before the
-/// reaction and now ends "done" at 3.5 %.)
+/// bumper reaction (`planners::replay`) that no longer stalls either, so the stalled run is
+/// rect-boustrophedon with `bumper_reaction: false`, the plan replayed blindly.)
 #[test]
 fn a_robot_that_stops_making_progress_is_stopped_and_says_so() {
     let Some(maps) = common::shared_maps() else {
@@ -836,7 +835,7 @@ fn a_robot_that_stops_making_progress_is_stopped_and_says_so() {
     let config = dir.join("noise.yaml");
     std::fs::write(
         &config,
-        "rect_boustrophedon:\n  exec:\n    pid:\n      noise:\n        seed: 5\n        linear_rel_std: 0.2\n        angular_rel_std: 0.2\n        heading_drift_std: 0.2\n",
+        "rect_boustrophedon:\n  bumper_reaction: false\n  exec:\n    pid:\n      noise:\n        seed: 6\n        linear_rel_std: 0.2\n        angular_rel_std: 0.2\n        heading_drift_std: 0.2\n",
     )
     .unwrap();
     let out = dir.join("noisy");
@@ -1838,8 +1837,9 @@ fn an_inflation_that_leaves_no_room_is_named() {
 
 /// A run the simulator stops because the robot made no progress (`stalled`) was tested with
 /// `ccpp run` only: `bench` writes it as the run's status in `results.csv` (not `ok`) and now
-/// also names it after its summary line. rect-boustrophedon under strong odometry noise from an
-/// options file (bench has no `--odometry-noise`) stalls on `aws_small_house`.
+/// also names it after its summary line. rect-boustrophedon without its bumper reaction under
+/// strong odometry noise from an options file (bench has no `--odometry-noise`) stalls on
+/// `aws_small_house`.
 #[test]
 fn a_stalled_run_is_named_by_run_and_bench() {
     let Some(maps) = common::shared_maps() else {
@@ -1852,7 +1852,7 @@ fn a_stalled_run_is_named_by_run_and_bench() {
     let config = dir.join("noise.yaml");
     std::fs::write(
         &config,
-        "rect_boustrophedon:\n  exec:\n    pid:\n      noise:\n        seed: 5\n        linear_rel_std: 0.2\n        angular_rel_std: 0.2\n        heading_drift_std: 0.2\n",
+        "rect_boustrophedon:\n  bumper_reaction: false\n  exec:\n    pid:\n      noise:\n        seed: 6\n        linear_rel_std: 0.2\n        angular_rel_std: 0.2\n        heading_drift_std: 0.2\n",
     )
     .unwrap();
     let run = run_ok(

@@ -729,6 +729,12 @@ pub fn run_warnings(
     out.extend(outside_reach_warning(world, swept));
     out.extend(margin_warning(trace));
     out.extend(drift);
+    // (bcd and rect-boustrophedon under noise: waypoints their bumper reaction gave up; a run
+    // that gave up most of its plan read as drift alone: hostile pass, stop 69)
+    out.extend(note_warning(
+        trace,
+        ccpp_core::planners::replay::GAVE_UP_NOTE,
+    ));
     out.extend(motions_cut_warning(trace, metrics));
     if let Some(why) = &metrics.stop_reason {
         out.push(stop_warning(why, "coverage"));

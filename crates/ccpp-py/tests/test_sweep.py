@@ -199,11 +199,11 @@ def test_sweep_status_of_a_stalled_run_is_stalled(shared_maps: Path, monkeypatch
     # As `ccpp bench`'s results.csv: a run the simulator stopped says why instead of "ok". A
     # sweep has no noise settings (nor has `ccpp bench` but through --config), so the row is
     # built from the metrics of a `ccpp.run` that stalls, in place of the worker's run.
-    # (Seed 5: rect-boustrophedon reacts to the bumper since stop 68, and seed 6 ends "done".)
+    # (rect-boustrophedon's bumper reaction no longer stalls: the plan replayed blindly does.)
     r = ccpp.run(
         str(shared_maps / "aws_small_house.yaml"), "rect-boustrophedon",
-        options={"exec": {"pid": {"noise": {
-            "seed": 5, "linear_rel_std": 0.2, "angular_rel_std": 0.2, "heading_drift_std": 0.2,
+        options={"bumper_reaction": False, "exec": {"pid": {"noise": {
+            "seed": 6, "linear_rel_std": 0.2, "angular_rel_std": 0.2, "heading_drift_std": 0.2,
         }}}},
     )
     assert r.metrics["stop_reason"] == "stalled"

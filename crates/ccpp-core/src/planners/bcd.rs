@@ -373,6 +373,13 @@ pub struct BcdOptions {
     /// the cost of time; the plan kept is the same whatever the count (the plans are
     /// independent and compared in a fixed order). From 1 to [`MAX_PLANS_AT_A_TIME`].
     pub plans_at_a_time: Option<u32>,
+    /// React to bumper contacts while replaying the plan (module [`crate::planners::replay`]:
+    /// mark the obstacle, route round it, give a waypoint up after
+    /// [`MAX_TRIES`](crate::planners::replay::MAX_TRIES) contacts). `false` replays the plan
+    /// as planned, as a robot without a costmap would, to compare: under odometry noise it
+    /// often ends pinned against an obstacle, and the simulator stops the run as stalled.
+    /// Only a run with odometry noise meets obstacles, so `false` is refused without it.
+    pub bumper_reaction: bool,
 }
 
 /// Default of [`BcdOptions::headland_min_m`], metres: walls and obstacles whose C-free
@@ -414,6 +421,7 @@ impl Default for BcdOptions {
             angle_tries: 1,
             headland_min_m: Some(DEFAULT_HEADLAND_MIN_M),
             plans_at_a_time: None,
+            bumper_reaction: true,
         }
     }
 }
@@ -581,6 +589,7 @@ impl Bcd {
                 } else {
                     d.min_coverage
                 },
+                bumper_reaction: opts.bumper_reaction,
             };
             Self::plan_on_pool(world, &fixed, stop)
         }

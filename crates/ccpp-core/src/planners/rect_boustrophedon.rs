@@ -93,6 +93,13 @@ pub struct RectOptions {
     /// The execution this planner asks the simulator for (seed 001: drive to each waypoint
     /// within a tolerance, i.e. PID).
     pub exec: Execution,
+    /// React to bumper contacts while replaying the plan (module [`crate::planners::replay`]:
+    /// mark the obstacle, route round it, give a waypoint up after
+    /// [`MAX_TRIES`](crate::planners::replay::MAX_TRIES) contacts). `false` replays the plan
+    /// as planned, as a robot without a costmap would, to compare: under odometry noise it
+    /// often ends pinned against an obstacle, and the simulator stops the run as stalled.
+    /// Only a run with odometry noise meets obstacles, so `false` is refused without it.
+    pub bumper_reaction: bool,
 }
 
 impl Default for RectOptions {
@@ -103,6 +110,7 @@ impl Default for RectOptions {
             area: None,
             clearance_radius_m: None,
             exec: Execution::Pid(PidOptions::default()),
+            bumper_reaction: true,
         }
     }
 }
@@ -845,7 +853,7 @@ impl RectBoustrophedon {
     pub fn new_until(world: &World, opts: &RectOptions, stop: Option<&AtomicBool>) -> Self {
         let plan = plan_until(world, opts, stop);
         Self {
-            replay: Replay::new(world, plan.steps.clone().into()),
+            replay: Replay::new(world, plan.steps.clone().into()).reacting(opts.bumper_reaction),
             exec: opts.exec,
             plan,
         }

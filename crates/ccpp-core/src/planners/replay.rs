@@ -18,7 +18,9 @@
 //! 2. **Routes to its next waypoint around it**: A\* over the pixel centres where the robot's
 //!    disk touches nothing of that map (8 neighbours, integer costs 10 and 14, the octile
 //!    heuristic, [`DeeperFirst`] ties), shortened to the farthest waypoint each straight move
-//!    reaches without contact. The route's moves go before the waypoint's.
+//!    reaches without contact. The route's moves go before the waypoint's. Where the
+//!    estimate itself has no room for the robot in that map (drift put it into a wall of the
+//!    map), the route starts with a move out to the nearest clear pixel centre.
 //! 3. **Gives a waypoint up** after [`MAX_TRIES`] contacts on the way to it (its detours
 //!    included), or when no route reaches it within [`MAX_EXPANSIONS`] pixels, and goes on
 //!    with the next one (at most [`MAX_TARGETS`] given up per contact).
@@ -50,11 +52,19 @@ use crate::zones::MaskOccupancy;
 /// Contacts on the way to one waypoint before it is given up.
 pub const MAX_TRIES: u32 = 3;
 
+/// The start of the [`Event::Note`](crate::trace::Event::Note) a replay that gave waypoints
+/// up writes at its end: the command line and Python say it as a warning, with how many.
+pub const GAVE_UP_NOTE: &str = "the replay of the plan";
+
 /// Waypoints given up at most per contact (each costs one search).
 pub const MAX_TARGETS: usize = 8;
 
 /// Pixels a route search settles at most before its waypoint counts as out of reach.
 pub const MAX_EXPANSIONS: usize = 250_000;
+
+/// Pixels beyond the robot's radius that the way out of a spot with no room for the robot
+/// (in the marked map) looks for a clear pixel centre.
+const ESCAPE_PX: i64 = 2;
 
 /// Orthogonal and diagonal step costs of the route search.
 const ORTHO: u32 = 10;
@@ -77,12 +87,27 @@ pub struct Replay {
     tries: u32,
     /// Route search state (made at the first contact).
     space: Option<SearchSpace<u32, DeeperFirst>>,
+    /// Whether the last step handed out moved the robot. The sensor's bumper flag tells of
+    /// the last *motion* and stays set over the event steps after it, so a contact is
+    /// reacted to only at the first step asked for after that motion.
+    moved: bool,
+    /// Whether contacts are reacted to at all ([`Replay::reacting`]).
+    react: bool,
+    /// The plan's waypoints, and how many of them were given up (told by a [`GAVE_UP_NOTE`]
+    /// at the end).
+    planned: usize,
+    given_up: usize,
+    told: bool,
 }
 
 impl Replay {
     /// The replay of `steps`, planned on `world`'s known map (with its zones).
     pub fn new(world: &World, steps: VecDeque<Step>) -> Self {
         let frame = *world.frame();
+        let planned = steps
+            .iter()
+            .filter(|s| matches!(s, Step::MoveTo(_)))
+            .count();
         Self {
             steps,
             frame,
@@ -93,7 +118,20 @@ impl Replay {
             target: None,
             tries: 0,
             space: None,
+            moved: false,
+            react: true,
+            planned,
+            given_up: 0,
+            told: false,
         }
+    }
+
+    /// With `react` false the plan is replayed as planned, contacts or not (a robot without a
+    /// costmap; the options' `bumper_reaction: false`, for comparison). Default true.
+    #[must_use]
+    pub fn reacting(mut self, react: bool) -> Self {
+        self.react = react;
+        self
     }
 
     /// The steps left.
@@ -104,13 +142,31 @@ impl Replay {
     /// The next step: after a motion the bumper stopped, the reaction of the module docs
     /// first.
     pub fn next(&mut self, sensor: &dyn Sensor) -> Step {
-        if sensor.bumped() {
+        // Once per contact: the flag stays set over the event steps after the motion (each
+        // reaction counts a try and may give waypoints up; reacting at every event step gave
+        // up hundreds of waypoints after a few dozen contacts: hostile pass, stop 69).
+        if self.react && self.moved && sensor.bumped() {
             self.react(sensor.pose());
         }
         if let Some(p) = self.detour.pop_front() {
+            self.moved = true;
             return Step::MoveTo(p);
         }
-        let step = self.steps.pop_front().unwrap_or(Step::Done);
+        let step = match self.steps.pop_front() {
+            Some(s) => s,
+            None if self.given_up > 0 && !self.told => {
+                self.told = true;
+                self.moved = false;
+                return Step::Mark(crate::trace::Event::Note {
+                    text: format!(
+                        "{GAVE_UP_NOTE}: {} of the plan's {} waypoints given up after bumper contacts ({MAX_TRIES} contacts on the way to one, or no way round the obstacles the bumper found), with the floor their moves would have swept",
+                        self.given_up, self.planned
+                    ),
+                });
+            }
+            None => Step::Done,
+        };
+        self.moved = matches!(step, Step::MoveTo(_) | Step::Rotate(_) | Step::Translate(_));
         if let Step::MoveTo(p) = step {
             self.heading_for = Some(p);
         }
@@ -178,6 +234,7 @@ impl Replay {
                     if let Some(i) = in_list {
                         self.steps.remove(i);
                     }
+                    self.given_up += 1;
                     self.target = None;
                     self.tries = 0;
                 }
@@ -244,10 +301,22 @@ impl Replay {
             }
             out
         };
-        let starts = anchors(self, from);
-        if starts.is_empty() {
-            return Route::NoStart;
-        }
+        let mut starts = anchors(self, from);
+        // The estimate where the marked map has no room for the robot (drift put it into a
+        // wall of the map, or a mark beside it): first out to the nearest clear pixel centre.
+        let lead = if starts.is_empty() {
+            let Some(q) = self.escape(from) else {
+                return Route::NoStart;
+            };
+            let (c, r) = f.grid_to_pixel_signed(q);
+            let Some((c, r)) = f.checked(c, r) else {
+                return Route::NoStart;
+            };
+            starts = vec![f.index(c, r) as u32];
+            Some(q)
+        } else {
+            None
+        };
         let goals = anchors(self, to);
         if goals.is_empty() {
             return Route::Unreachable;
@@ -317,7 +386,7 @@ impl Replay {
             }
         };
         self.space = Some(space);
-        let mut pts: Vec<Point> = std::iter::once(from)
+        let mut pts: Vec<Point> = std::iter::once(lead.unwrap_or(from))
             .chain(path.into_iter().map(centre))
             .chain(std::iter::once(to))
             .collect();
@@ -338,7 +407,35 @@ impl Replay {
         }
         // The waypoint itself is the plan's own step, already in the list.
         kept.pop();
+        if let Some(q) = lead {
+            kept.insert(0, q);
+        }
         Route::Found(kept)
+    }
+
+    /// The nearest pixel centre within [`ESCAPE_PX`] pixels beyond the robot's radius of grid
+    /// point `from` where the robot's disk is clear of the marked map (ties: the lower pixel
+    /// index); `None` when there is none.
+    fn escape(&self, from: Point) -> Option<Point> {
+        let f = self.frame;
+        let (c0, r0) = f.grid_to_pixel_signed(from);
+        let reach = self.r_px.ceil() as i64 + ESCAPE_PX;
+        let mut best: Option<(f64, usize, Point)> = None;
+        for dr in -reach..=reach {
+            for dc in -reach..=reach {
+                let Some((c, r)) = f.checked(c0 + dc, r0 + dr) else {
+                    continue;
+                };
+                let q = f.pixel_center_grid(c, r);
+                let d = q.dist(from);
+                let i = f.index(c, r);
+                if best.is_some_and(|(bd, bi, _)| (bd, bi) <= (d, i)) || !self.clear_at(q) {
+                    continue;
+                }
+                best = Some((d, i, q));
+            }
+        }
+        best.map(|(_, _, q)| q)
     }
 }
 
@@ -346,8 +443,92 @@ impl Replay {
 enum Route {
     /// The points to drive through before the waypoint (possibly none: a clear straight move).
     Found(Vec<Point>),
-    /// No clear pixel centre next to the robot's estimated position.
+    /// No clear pixel centre near the robot's estimated position.
     NoStart,
     /// The waypoint is out of reach (or beyond the search's bound).
     Unreachable,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Replay;
+    use crate::geometry::{Point, Pose};
+    use crate::grid::{GridMap, MapFrame};
+    use crate::planner::{Scan, Sensor, Step};
+    use crate::trace::Event;
+    use crate::world::{Robot, World};
+
+    /// A sensor whose bumper always reports a contact, at a fixed pose.
+    struct Stuck<'a> {
+        world: &'a World,
+        pose: Pose,
+    }
+
+    impl Sensor for Stuck<'_> {
+        fn frame(&self) -> &MapFrame {
+            self.world.frame()
+        }
+        fn robot(&self) -> Robot {
+            self.world.robot()
+        }
+        fn pose(&self) -> Pose {
+            self.pose
+        }
+        fn sensor_range(&self) -> f64 {
+            1.0
+        }
+        fn scan(&self) -> Scan<'_> {
+            Scan::new(self.world.map(), self.pose.position(), 1.0)
+        }
+        fn bumped(&self) -> bool {
+            true
+        }
+    }
+
+    fn world() -> World {
+        let art =
+            "############\n#..........#\n#..........#\n#..........#\n#..........#\n############";
+        let map = GridMap::from_ascii_scaled(art, 10, 0.02).unwrap();
+        World::new(map, Robot::new(0.08), Some(Pose::new(0.5, 0.5, 0.0))).unwrap()
+    }
+
+    /// The bumper flag tells of the last motion and stays set over the event steps after
+    /// it: a contact is reacted to once, not at every event step (each reaction counts a try
+    /// towards giving waypoints up; a noisy bcd run gave up hundreds of waypoints after a few
+    /// dozen contacts and ended "done" at 9 % swept: hostile pass, stop 69).
+    #[test]
+    fn a_contact_is_reacted_to_once_over_event_steps() {
+        let world = world();
+        let mut steps = std::collections::VecDeque::new();
+        steps.push_back(Step::Rotate(0.1));
+        for _ in 0..40 {
+            steps.push_back(Step::Mark(Event::RegionStart { region: 1 }));
+            steps.push_back(Step::Mark(Event::RegionEnd { region: 1 }));
+        }
+        for k in 0..20 {
+            steps.push_back(Step::MoveTo(Point::new(0.5 + 0.05 * f64::from(k), 0.8)));
+        }
+        let mut replay = Replay::new(&world, steps);
+        let sensor = Stuck {
+            world: &world,
+            pose: Pose::new(0.5, 0.5, 0.0),
+        };
+        // The motion that meets the contact, then the 80 event steps after it, in order.
+        assert!(matches!(replay.next(&sensor), Step::Rotate(_)));
+        for k in 0..80 {
+            let s = replay.next(&sensor);
+            assert!(
+                matches!(s, Step::Mark(_)),
+                "step {k} after the contact: {s:?}"
+            );
+            assert_eq!(replay.tries, 1, "step {k}: tries");
+        }
+        // None of the 20 waypoints was given up for that one contact.
+        let left = replay
+            .steps()
+            .iter()
+            .filter(|s| matches!(s, Step::MoveTo(_)))
+            .count();
+        assert_eq!(left, 20);
+    }
 }

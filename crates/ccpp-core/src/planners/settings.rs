@@ -1020,6 +1020,19 @@ fn unused_option<T: PartialEq + Copy + std::fmt::Display>(
     Ok(())
 }
 
+/// `bumper_reaction: false` (bcd, rect-boustrophedon) in a run without odometry noise, where
+/// no motion meets an obstacle and the replay is the plan either way.
+/// `how` says how to add noise for this planner.
+fn bumper_reaction_applies(react: bool, s: &Setup, how: &str) -> Result<(), OptionsError> {
+    if !react && !s.noisy {
+        return Err(OptionsError::new(
+            "bumper_reaction",
+            format!("false changes nothing without odometry noise (no motion meets an obstacle); leave it out or add noise ({how})"),
+        ));
+    }
+    Ok(())
+}
+
 /// The extension options that another one turns off, set anyway (`d`: the host's defaults).
 fn extension_unused(e: &ExtensionOptions, d: &ExtensionOptions) -> Result<(), OptionsError> {
     let no_yield = e.min_yield <= 0.0;
@@ -1284,6 +1297,7 @@ impl PlannerSettings for BcdOptions {
     }
 
     fn check(&self, s: &Setup) -> Result<(), OptionsError> {
+        bumper_reaction_applies(self.bumper_reaction, s, "--odometry-noise")?;
         // Lanes farther apart than the tool's width leave a strip between each pair that no
         // lane sweeps (the rim pass only mops up what is left at the walls), and a spacing far
         // beyond the map would only reach the lane arithmetic as a huge count.
@@ -1412,6 +1426,11 @@ impl PlannerSettings for RectOptions {
     }
 
     fn check(&self, s: &Setup) -> Result<(), OptionsError> {
+        bumper_reaction_applies(
+            self.bumper_reaction,
+            s,
+            "--odometry-noise, or rect_boustrophedon.exec.pid.noise",
+        )?;
         let res = s.frame.resolution;
         let (w, h) = (s.frame.width_m(), s.frame.height_m());
         // The lanes are planned for at least the robot's own disk: a smaller clearance was

@@ -483,7 +483,7 @@ impl Bcd {
             steps.extend(marks.into_iter().map(Step::Mark));
         }
         Self {
-            replay: Replay::new(world, drop_empty_transfers(steps)),
+            replay: Replay::new(world, drop_empty_transfers(steps)).reacting(opts.bumper_reaction),
             cells: ncells,
         }
     }
