@@ -114,6 +114,15 @@ pub fn replay_dir(dir: &Path) -> Result<()> {
         }
         anyhow::bail!("{}: no such folder", dir.display());
     }
+    // As `ccpp run` refuses such a folder: the write permission is the user's word, also
+    // where the process could write anyway (as root the replay wrote into a `chmod 555`
+    // folder that `ccpp run --out` refused: hostile pass, stop 69).
+    if std::fs::metadata(dir).is_ok_and(|m| m.permissions().readonly()) {
+        anyhow::bail!(
+            "run folder {} is read-only: replay writes replay.html and replay.gif into it; make it writable",
+            dir.display()
+        );
+    }
     let identity = folder_identity(dir);
     let rec_path = dir.join("run.json");
     // A `ccpp plan` folder holds exports only (it said "no readable run.json: No such file or

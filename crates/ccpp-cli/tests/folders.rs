@@ -1060,4 +1060,19 @@ fn a_read_only_output_folder_is_refused() {
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
     assert_eq!(contents(&out), before);
     assert_eq!(entries(d.path()), ["res"]);
+    // `ccpp replay` refuses it the same way (it wrote its page and GIF into it when the
+    // process could write anyway, as root: hostile pass, stop 69), and writes once writable.
+    std::fs::set_permissions(&out, std::fs::Permissions::from_mode(0o555)).unwrap();
+    let o = ccpp().arg("replay").arg(&out).output().unwrap();
+    std::fs::set_permissions(&out, std::fs::Permissions::from_mode(0o755)).unwrap();
+    assert_eq!(o.status.code(), Some(1), "{o:?}");
+    let err = stderr_of(&o);
+    assert!(
+        err.starts_with("error: run folder ") && err.contains("res is read-only"),
+        "{err}"
+    );
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert_eq!(contents(&out), before);
+    ccpp().arg("replay").arg(&out).assert().success();
+    assert!(out.join("replay.html").is_file() && out.join("replay.gif").is_file());
 }

@@ -317,6 +317,14 @@ fn a_keepout_cutting_the_area_in_two_is_told() {
             "{}",
             w[0]
         );
+        // The same words for a plan and `info`, which have no coverage figures ("that floor
+        // is not covered (coverage figures are ...)" in a plan: hostile pass, stop 69).
+        assert!(
+            w[0].contains("no path from the start reaches that floor (a run's coverage figures")
+                && w[0].ends_with("plan or run again with --start X,Y there to cover it"),
+            "{}",
+            w[0]
+        );
     }
     // A keep-out inside the area that cuts nothing off.
     assert!(warned("run", Some("ba-star"), "2.9,-3,3.1,-2", "whole").is_empty());

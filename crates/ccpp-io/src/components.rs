@@ -72,8 +72,8 @@ pub fn zone_cut_off_warning(world: &ccpp_core::world::World) -> Option<String> {
         format!(
             "the zones cut {apart_m2:.1} m2 of the {allowed_m2:.1} m2 of floor they allow \
              beside the start ({:.0} %) off from it (a {:.2} m wide robot cannot get past them); \
-             that floor is not covered (coverage figures are of the part the start reaches): \
-             run again with --start X,Y there to cover it",
+             no path from the start reaches that floor (a run's coverage figures are of the \
+             part the start reaches): plan or run again with --start X,Y there to cover it",
             100.0 * apart_m2 / allowed_m2,
             2.0 * world.robot().radius
         )
