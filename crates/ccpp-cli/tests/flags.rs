@@ -1795,3 +1795,67 @@ fn angle_tries_changes_the_bcd_plan() {
         runs[1].0
     );
 }
+
+/// A JSON options file with a list where a section or a struct is expected is refused, as
+/// YAML refuses it: serde filled a struct from a list by position, so `{"bcd": [0.2]}` ran bcd
+/// with `lane_spacing_m: 0.2` without a word, and `[{}, {}, {}, {}, {}, {}, [0.2]]` did the same
+/// while the warning said bcd "runs at the planner defaults" (hostile pass, stop 69). Lists
+/// where an option is a list (rect-boustrophedon's `area`) are still read.
+#[test]
+fn a_json_list_in_place_of_a_mapping_is_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let map = common::data("teb_empty_box.yaml");
+    for (text, words) in [
+        (r#"{"bcd": [0.2]}"#, "bcd: a list where a mapping"),
+        (r#"{"bcd": []}"#, "bcd: a list where a mapping"),
+        (
+            "[{}, {}, {}, {}, {}, {}, [0.2]]",
+            "the file is a list where a mapping",
+        ),
+        ("[]", "the file is a list where a mapping"),
+        (
+            r#"{"bsa_bfs": {"exec": {"pid": {"linear": [1.0]}}}}"#,
+            "bsa_bfs.exec.pid.linear: a list where a mapping",
+        ),
+    ] {
+        let f = d.path().join("opts.json");
+        std::fs::write(&f, text).unwrap();
+        let out = d.path().join("out");
+        let o = ccpp()
+            .args(["run", "--planner", "bcd", "--map"])
+            .arg(&map)
+            .arg("--config")
+            .arg(&f)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{text}: {err}");
+        assert!(
+            err.starts_with("error: ") && err.contains("opts.json") && err.contains(words),
+            "{text}: {err}"
+        );
+        assert_eq!(err.trim_end().lines().count(), 1, "{text}: {err}");
+        assert!(!out.exists(), "{text}");
+    }
+    let f = d.path().join("area.json");
+    std::fs::write(
+        &f,
+        r#"{"rect_boustrophedon": {"area": [-1.0, -1.0, 1.0, 1.0]}}"#,
+    )
+    .unwrap();
+    let area = run_ok(
+        d.path(),
+        "area",
+        &map,
+        "rect-boustrophedon",
+        &["--config", f.to_str().unwrap()],
+    );
+    let rec = common::read_json(&area.join("run.json"));
+    assert_eq!(
+        rec["options"]["area"],
+        serde_json::json!([-1.0, -1.0, 1.0, 1.0]),
+        "{rec}"
+    );
+}

@@ -203,6 +203,42 @@ fn float_words(message: &str, text: &str) -> String {
     )
 }
 
+/// A JSON list where the typed value has a mapping (a section or a struct), named by its
+/// path: serde fills a struct from a list by position, so `{"bcd": [0.2]}` set bcd's first
+/// option (`lane_spacing_m`) without naming it, `[{}, ...]` filled the planners' sections by
+/// their order, and a new field would shift every later one; YAML refuses both shapes
+/// (`expected mapping start`). Hostile pass, stop 69.
+fn json_list_for_mapping<T: serde::Serialize>(text: &str, typed: &T) -> Option<String> {
+    use serde_json::Value;
+    fn walk(raw: &Value, typed: &Value, path: &str) -> Option<String> {
+        match (raw, typed) {
+            (Value::Array(_), Value::Object(_)) => Some(if path.is_empty() {
+                "the file is a list where a mapping (a JSON object) of sections is expected"
+                    .to_string()
+            } else {
+                format!("{path}: a list where a mapping (a JSON object) of fields is expected")
+            }),
+            (Value::Object(r), Value::Object(t)) => r.iter().find_map(|(k, rv)| {
+                let p = if path.is_empty() {
+                    crate::message::visible(k)
+                } else {
+                    format!("{path}.{}", crate::message::visible(k))
+                };
+                t.get(k).and_then(|tv| walk(rv, tv, &p))
+            }),
+            (Value::Array(r), Value::Array(t)) => r
+                .iter()
+                .zip(t)
+                .enumerate()
+                .find_map(|(i, (rv, tv))| walk(rv, tv, &format!("{path}[{i}]"))),
+            _ => None,
+        }
+    }
+    let raw: Value = serde_json::from_str(text).ok()?;
+    let typed = serde_json::to_value(typed).ok()?;
+    walk(&raw, &typed, "")
+}
+
 /// Deserializes YAML, or JSON when `json`, and on an error names the field it is in: the text
 /// is parsed as `serde_saphyr::from_str` / `serde_json::from_str` parse it, and only a failed
 /// parse is read again to find the error's path (`bcd.turn_cost_m: line 1 column 21: invalid
@@ -225,10 +261,17 @@ pub fn parse_yaml_or_json<T: serde::de::DeserializeOwned + serde::Serialize>(
         serde_saphyr::from_str::<T>(text).map_err(|e| yaml_words(&e.to_string(), text))
     };
     let message = match first {
-        Ok(v) => match (!json).then(|| quoted_scalar_problem(text, &v)).flatten() {
-            None => return Ok(v),
-            Some(problem) => return Err(problem),
-        },
+        Ok(v) => {
+            let problem = if json {
+                json_list_for_mapping(text, &v)
+            } else {
+                quoted_scalar_problem(text, &v)
+            };
+            match problem {
+                None => return Ok(v),
+                Some(problem) => return Err(problem),
+            }
+        }
         Err(m) => m,
     };
     let path = if json {

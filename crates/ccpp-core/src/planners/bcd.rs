@@ -314,7 +314,8 @@ pub struct BcdOptions {
     /// where no such path exists they fall back to the plain C-free set, and the plan says
     /// how many of its transfers did (a [`MARGIN_NOTE`], a warning of `ccpp run` and `plan`).
     pub margin_px: f64,
-    /// Cost of one turn, in metres of path, when choosing sweep directions (>= 0).
+    /// Cost of one turn, in metres of path, when choosing sweep directions (from 0 to
+    /// [`MAX_TURN_COST_M`]).
     pub turn_cost_m: f64,
     /// Sweep the rim that lanes miss (step 3 of the module docs).
     pub rim: bool,
@@ -402,6 +403,12 @@ pub const MAX_ANGLE_TRIES: u32 = 40;
 /// round only adds idle threads).
 pub const MAX_PLANS_AT_A_TIME: u32 = 64;
 
+/// Largest [`BcdOptions::turn_cost_m`], metres: far beyond any turn's worth (every choice is
+/// by turns alone long before it), and a bound that keeps the plan's costs finite (1e308 m
+/// became an infinite cost per pixel, every comparison tied, and the plan came out as if
+/// turns cost nothing: 249 turns on `teb_maze` against 125 at 1e300; hostile pass, stop 69).
+pub const MAX_TURN_COST_M: f64 = 1e6;
+
 /// Most improvement rounds [`BcdOptions::tour_rounds`] may ask for. Each round costs a pass of
 /// 2-opt and Or-opt moves over every cell of the tour; on the shared maps the tour settles
 /// within 2-6 rounds, so the bound only keeps a mistyped count from planning for hours.
@@ -461,8 +468,12 @@ impl BcdOptions {
         if !(self.margin_px.is_finite() && self.margin_px >= 0.0) {
             return bad("margin_px", "a finite number >= 0", self.margin_px);
         }
-        if !(self.turn_cost_m.is_finite() && self.turn_cost_m >= 0.0) {
-            return bad("turn_cost_m", "a finite number >= 0", self.turn_cost_m);
+        if !(0.0..=MAX_TURN_COST_M).contains(&self.turn_cost_m) {
+            return bad(
+                "turn_cost_m",
+                "from 0 to 1000000 (metres of path per turn)",
+                self.turn_cost_m,
+            );
         }
         if !(0.0..=1.0).contains(&self.rim_min_yield) {
             return bad("rim_min_yield", "in [0, 1]", self.rim_min_yield);
@@ -558,7 +569,7 @@ impl Bcd {
                 } else {
                     d.margin_px
                 },
-                turn_cost_m: if opts.turn_cost_m.is_finite() && opts.turn_cost_m >= 0.0 {
+                turn_cost_m: if (0.0..=MAX_TURN_COST_M).contains(&opts.turn_cost_m) {
                     opts.turn_cost_m
                 } else {
                     d.turn_cost_m

@@ -1022,12 +1022,12 @@ fn unused_option<T: PartialEq + Copy + std::fmt::Display>(
 
 /// `bumper_reaction: false` (bcd, rect-boustrophedon) in a run without odometry noise, where
 /// no motion meets an obstacle and the replay is the plan either way.
-/// `how` says how to add noise for this planner.
+/// `how` says where the option applies for this planner.
 fn bumper_reaction_applies(react: bool, s: &Setup, how: &str) -> Result<(), OptionsError> {
     if !react && !s.noisy {
         return Err(OptionsError::new(
             "bumper_reaction",
-            format!("false changes nothing without odometry noise (no motion meets an obstacle); leave it out or add noise ({how})"),
+            format!("false changes nothing without odometry noise (no motion meets an obstacle), as in a plan; leave it out, or give it to {how}"),
         ));
     }
     Ok(())
@@ -1297,7 +1297,11 @@ impl PlannerSettings for BcdOptions {
     }
 
     fn check(&self, s: &Setup) -> Result<(), OptionsError> {
-        bumper_reaction_applies(self.bumper_reaction, s, "--odometry-noise")?;
+        bumper_reaction_applies(
+            self.bumper_reaction,
+            s,
+            "`ccpp run` with --odometry-noise (a bench has no noise for bcd)",
+        )?;
         // Lanes farther apart than the tool's width leave a strip between each pair that no
         // lane sweeps (the rim pass only mops up what is left at the walls), and a spacing far
         // beyond the map would only reach the lane arithmetic as a huge count.
@@ -1429,7 +1433,7 @@ impl PlannerSettings for RectOptions {
         bumper_reaction_applies(
             self.bumper_reaction,
             s,
-            "--odometry-noise, or rect_boustrophedon.exec.pid.noise",
+            "`ccpp run` with --odometry-noise, or with rect_boustrophedon.exec.pid.noise (also in `ccpp bench`)",
         )?;
         let res = s.frame.resolution;
         let (w, h) = (s.frame.width_m(), s.frame.height_m());

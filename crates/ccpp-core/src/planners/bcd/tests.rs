@@ -434,6 +434,11 @@ fn invalid_options_are_refused() {
             turn_cost_m: f64::NAN,
             ..BcdOptions::default()
         },
+        // Finite, but an infinite cost per pixel (every comparison tied).
+        BcdOptions {
+            turn_cost_m: 1e308,
+            ..BcdOptions::default()
+        },
         BcdOptions {
             rim_min_yield: 1.5,
             ..BcdOptions::default()
