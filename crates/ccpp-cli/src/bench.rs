@@ -109,6 +109,27 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         .filter_map(|p| parse_planner(p).ok())
         .collect();
     crate::job::warn_unused_config(a.options.config.as_deref(), &kinds);
+    // The planners' checks that need no map, before the folder is touched: every run would
+    // meet them (`bcd: { bumper_reaction: false }`, a lane spacing wider than the tool: the
+    // last good bench in the folder was replaced by error rows, which blamed the map and not
+    // the options file: hostile pass, stop 69).
+    for &kind in &kinds {
+        Scenario::configure(
+            ccpp_io::scenario::MapRecipe::default(),
+            options.config(kind),
+        )
+        .robot(robot)
+        .sim(SimConfig::default())
+        .build()
+        .and_then(|s| s.check_unplaced())
+        .map_err(|e| {
+            crate::job::naming_config(
+                anyhow::Error::from(e),
+                a.options.config.as_deref(),
+                kind.info().section,
+            )
+        })?;
+    }
     let (found, skipped) = expand_maps_noting(&a.maps)?;
     if !skipped.is_empty() {
         let names: Vec<String> = skipped

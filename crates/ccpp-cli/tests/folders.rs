@@ -1076,3 +1076,82 @@ fn a_read_only_output_folder_is_refused() {
     ccpp().arg("replay").arg(&out).assert().success();
     assert!(out.join("replay.html").is_file() && out.join("replay.gif").is_file());
 }
+
+/// Options that every run of a bench would be refused for, whatever the map, are refused
+/// before the bench touches its folder, naming the options file: they were found run by run,
+/// every run failed, and the last good bench in the folder was replaced by error rows that
+/// blamed the map (hostile pass, stop 69). Options a planner of the bench can use (noise of
+/// rect-boustrophedon's own) still run.
+#[test]
+fn a_bench_refuses_options_no_run_can_take_before_touching_its_folder() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("bench");
+    let map = data("teb_empty_box.yaml");
+    let bench = |config: Option<&Path>| {
+        let mut c = ccpp();
+        c.args([
+            "bench",
+            "--planners",
+            "bcd,rect-boustrophedon",
+            "--quiet",
+            "--maps",
+        ])
+        .arg(&map)
+        .arg("--out")
+        .arg(&out);
+        if let Some(f) = config {
+            c.arg("--config").arg(f);
+        }
+        c.output().unwrap()
+    };
+    assert!(bench(None).status.success());
+    let kept = [
+        "results.csv",
+        "results.md",
+        "runs/teb_empty_box/bcd/metrics.json",
+        "runs/teb_empty_box/rect-boustrophedon/path.csv",
+    ];
+    let snapshot = || -> Vec<Vec<u8>> {
+        kept.iter()
+            .map(|f| std::fs::read(out.join(f)).unwrap())
+            .collect()
+    };
+    let before = snapshot();
+    for (text, words) in [
+        (
+            "bcd: { bumper_reaction: false }",
+            "bcd.bumper_reaction: false changes nothing without odometry noise",
+        ),
+        (
+            "bcd: { lane_spacing_m: 1.0 }",
+            "bcd.lane_spacing_m: lane spacing 1 m is wider than the tool",
+        ),
+        (
+            "rect_boustrophedon: { clearance_radius_m: 0.01 }",
+            "rect_boustrophedon.clearance_radius_m: 0.01 m is below the robot radius",
+        ),
+    ] {
+        let f = d.path().join("opts.yaml");
+        std::fs::write(&f, text).unwrap();
+        let o = bench(Some(&f));
+        let err = stderr_of(&o);
+        assert_eq!(o.status.code(), Some(1), "{text}: {err}");
+        assert!(
+            err.starts_with("error: ")
+                && err.contains(words)
+                && err.contains("(set in planner options ")
+                && err.contains("opts.yaml"),
+            "{text}: {err}"
+        );
+        assert_eq!(err.trim_end().lines().count(), 1, "{text}: {err}");
+        assert!(snapshot() == before, "{text}: the earlier bench changed");
+    }
+    let f = d.path().join("noisy.yaml");
+    std::fs::write(
+        &f,
+        "rect_boustrophedon: { bumper_reaction: false, exec: { pid: { noise: { seed: 1, linear_rel_std: 0.01 } } } }",
+    )
+    .unwrap();
+    let o = bench(Some(&f));
+    assert!(o.status.success(), "{}", stderr_of(&o));
+}

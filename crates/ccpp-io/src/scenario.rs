@@ -1250,6 +1250,24 @@ impl Scenario {
         self.check_map_as(map, true)
     }
 
+    /// The planner's checks that need no map
+    /// ([`check_unplaced`](ccpp_core::planners::PlannerSettings::check_unplaced)): its options
+    /// against the robot and the run's odometry noise. [`Self::check_map`] makes them too; a
+    /// bench makes them before it touches its folder.
+    ///
+    /// # Errors
+    /// [`ScenarioError::Invalid`]: `PLANNER: SECTION.FIELD: message`.
+    pub fn check_unplaced(&self) -> Result<(), ScenarioError> {
+        let noisy = matches!(self.execution(), Execution::Pid(p) if p.noise.is_some());
+        self.planner
+            .settings()
+            .check_unplaced(&self.robot, noisy)
+            .map_err(|e| {
+                let e = e.in_section(self.planner.kind().info().section);
+                ScenarioError::Invalid(format!("{}: {e}", self.planner.name()))
+            })
+    }
+
     /// [`Self::check_map`] for a robot its caller drives (Python's step API): the planner's
     /// checks and its memory are left out (an `Env` holds the world, the sweep and the known
     /// map, and no planner; a tiny robot was refused for the tiles of a planner it never ran).

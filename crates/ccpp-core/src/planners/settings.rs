@@ -225,6 +225,17 @@ pub trait PlannerSettings {
     /// What makes the run degenerate.
     fn check(&self, setup: &Setup) -> Result<(), OptionsError>;
 
+    /// The part of [`Self::check`] that needs no map: the options against the robot and
+    /// whether the run has odometry noise. `check` makes it too; a bench makes it for every
+    /// planner before it touches its folder (a refusal that every run of it meets replaced
+    /// the last good bench there with error rows: hostile pass, stop 69).
+    ///
+    /// # Errors
+    /// What makes every run of these options degenerate.
+    fn check_unplaced(&self, _robot: &Robot, _noisy: bool) -> Result<(), OptionsError> {
+        Ok(())
+    }
+
     /// Checks the options against the world itself, once it is built (what [`Self::check`]
     /// cannot tell from the frame: a user area that holds nothing the planner can reach).
     ///
@@ -1023,8 +1034,8 @@ fn unused_option<T: PartialEq + Copy + std::fmt::Display>(
 /// `bumper_reaction: false` (bcd, rect-boustrophedon) in a run without odometry noise, where
 /// no motion meets an obstacle and the replay is the plan either way.
 /// `how` says where the option applies for this planner.
-fn bumper_reaction_applies(react: bool, s: &Setup, how: &str) -> Result<(), OptionsError> {
-    if !react && !s.noisy {
+fn bumper_reaction_applies(react: bool, noisy: bool, how: &str) -> Result<(), OptionsError> {
+    if !react && !noisy {
         return Err(OptionsError::new(
             "bumper_reaction",
             format!("false changes nothing without odometry noise (no motion meets an obstacle), as in a plan; leave it out, or give it to {how}"),
@@ -1296,16 +1307,16 @@ impl PlannerSettings for BcdOptions {
         )
     }
 
-    fn check(&self, s: &Setup) -> Result<(), OptionsError> {
+    fn check_unplaced(&self, robot: &Robot, noisy: bool) -> Result<(), OptionsError> {
         bumper_reaction_applies(
             self.bumper_reaction,
-            s,
+            noisy,
             "`ccpp run` with --odometry-noise (a bench has no noise for bcd)",
         )?;
         // Lanes farther apart than the tool's width leave a strip between each pair that no
         // lane sweeps (the rim pass only mops up what is left at the walls), and a spacing far
         // beyond the map would only reach the lane arithmetic as a huge count.
-        let tool = 2.0 * s.robot.tool_radius;
+        let tool = 2.0 * robot.tool_radius;
         if let Some(sp) = self.lane_spacing_m {
             if sp > tool * (1.0 + 1e-9) {
                 return Err(OptionsError::new(
@@ -1317,6 +1328,13 @@ impl PlannerSettings for BcdOptions {
                     ),
                 ));
             }
+        }
+        Ok(())
+    }
+
+    fn check(&self, s: &Setup) -> Result<(), OptionsError> {
+        self.check_unplaced(&s.robot, s.noisy)?;
+        if let Some(sp) = self.lane_spacing_m {
             // Lanes lie on pixel lines: a finer spacing ran as one pixel (0.05 and 0.02 m on a
             // 0.05 m map gave the same plan).
             let res = s.frame.resolution;
@@ -1429,29 +1447,34 @@ impl PlannerSettings for RectOptions {
         noise_that_draws("exec", &self.exec)
     }
 
-    fn check(&self, s: &Setup) -> Result<(), OptionsError> {
+    fn check_unplaced(&self, robot: &Robot, noisy: bool) -> Result<(), OptionsError> {
         bumper_reaction_applies(
             self.bumper_reaction,
-            s,
+            noisy,
             "`ccpp run` with --odometry-noise, or with rect_boustrophedon.exec.pid.noise (also in `ccpp bench`)",
         )?;
-        let res = s.frame.resolution;
-        let (w, h) = (s.frame.width_m(), s.frame.height_m());
         // The lanes are planned for at least the robot's own disk: a smaller clearance was
         // raised to the radius in silence (0.1 m, 0.01 m and 0.15 m gave the same run), while
         // run.json recorded the value given.
         if let Some(c) = self.clearance_radius_m {
-            if c < s.robot.radius {
+            if c < robot.radius {
                 return Err(OptionsError::new(
                     "clearance_radius_m",
                     format!(
                         "{} m is below the robot radius {} m: the lanes keep at least the robot's own clearance (leave it out, or give at least the radius)",
                         crate::display::Compact(c),
-                        crate::display::Compact(s.robot.radius)
+                        crate::display::Compact(robot.radius)
                     ),
                 ));
             }
         }
+        Ok(())
+    }
+
+    fn check(&self, s: &Setup) -> Result<(), OptionsError> {
+        self.check_unplaced(&s.robot, s.noisy)?;
+        let res = s.frame.resolution;
+        let (w, h) = (s.frame.width_m(), s.frame.height_m());
         for (f, given, v) in [
             ("length_m", self.length_m, self.length_for(&s.robot)),
             ("width_m", self.width_m, self.width_for(&s.robot)),
