@@ -73,7 +73,7 @@ const ESCAPE_PX: i64 = 2;
 
 /// Contacts whose marks are kept when the marks leave no way to a waypoint at its first
 /// contact (module docs, step 2).
-const KEEP_MARKS: usize = 4;
+pub const KEEP_MARKS: usize = 4;
 
 /// Orthogonal and diagonal step costs of the route search.
 const ORTHO: u32 = 10;
