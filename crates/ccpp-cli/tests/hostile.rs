@@ -1259,37 +1259,25 @@ fn a_number_beyond_a_float_is_said_as_such() {
     let o = dir.join("o.yaml");
     std::fs::write(&o, "bcd:\n  turn_cost_m: 1e999\n").unwrap();
     let out = dir.join("out");
+    let run = [
+        "run",
+        "--map",
+        s(&map),
+        "--planner",
+        "bcd",
+        "--config",
+        s(&o),
+        "--out",
+        s(&out),
+    ];
     refused(
-        &[
-            "run",
-            "--map",
-            s(&map),
-            "--planner",
-            "bcd",
-            "--config",
-            s(&o),
-            "--out",
-            s(&out),
-        ],
+        &run,
         &["bcd.turn_cost_m: line 2 column 16: `1e999` is beyond the range of a number"],
     );
     // Within a float's range but beyond any turn's worth: refused, not run as an infinite
     // cost per pixel, which tied every choice (turns as if free: hostile pass, stop 69).
     std::fs::write(&o, "bcd:\n  turn_cost_m: 1e308\n").unwrap();
-    refused(
-        &[
-            "run",
-            "--map",
-            s(&map),
-            "--planner",
-            "bcd",
-            "--config",
-            s(&o),
-            "--out",
-            s(&out),
-        ],
-        &["turn_cost_m", "from 0 to 1000000"],
-    );
+    refused(&run, &["turn_cost_m", "from 0 to 1000000"]);
 }
 
 /// A map is placed by the rotation + uniform scale that fits the georef pairs best, and every
