@@ -1311,7 +1311,7 @@ impl PlannerSettings for BcdOptions {
         bumper_reaction_applies(
             self.bumper_reaction,
             noisy,
-            "`ccpp run` with --odometry-noise (a bench has no noise for bcd)",
+            "`ccpp run` with --odometry-noise (Python: `run` with odometry_noise=; a bench has no noise for bcd)",
         )?;
         // Lanes farther apart than the tool's width leave a strip between each pair that no
         // lane sweeps (the rim pass only mops up what is left at the walls), and a spacing far
@@ -1451,7 +1451,7 @@ impl PlannerSettings for RectOptions {
         bumper_reaction_applies(
             self.bumper_reaction,
             noisy,
-            "`ccpp run` with --odometry-noise, or with rect_boustrophedon.exec.pid.noise (also in `ccpp bench`)",
+            "`ccpp run` with --odometry-noise (Python: `run` with odometry_noise=), or with rect_boustrophedon.exec.pid.noise (also in `ccpp bench`)",
         )?;
         // The lanes are planned for at least the robot's own disk: a smaller clearance was
         // raised to the radius in silence (0.1 m, 0.01 m and 0.15 m gave the same run), while
