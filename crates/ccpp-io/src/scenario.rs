@@ -1219,7 +1219,7 @@ impl Scenario {
             robot: self.robot,
             sensor_range: self.sim.sensor_range_on(&self.robot, frame),
             max_steps: self.sim.max_steps,
-            noisy: matches!(self.execution(), Execution::Pid(p) if p.noise.is_some()),
+            noisy: self.noisy(),
         };
         if self.sim.sensor_range.is_none() {
             if let Some(need) = self.planner.settings().least_sensor_range(&setup) {
@@ -1250,6 +1250,11 @@ impl Scenario {
         self.check_map_as(map, true)
     }
 
+    /// Whether the run's execution carries odometry noise ([`Setup::noisy`]).
+    fn noisy(&self) -> bool {
+        matches!(self.execution(), Execution::Pid(p) if p.noise.is_some())
+    }
+
     /// The planner's checks that need no map
     /// ([`check_unplaced`](ccpp_core::planners::PlannerSettings::check_unplaced)): its options
     /// against the robot and the run's odometry noise. [`Self::check_map`] makes them too; a
@@ -1258,10 +1263,9 @@ impl Scenario {
     /// # Errors
     /// [`ScenarioError::Invalid`]: `PLANNER: SECTION.FIELD: message`.
     pub fn check_unplaced(&self) -> Result<(), ScenarioError> {
-        let noisy = matches!(self.execution(), Execution::Pid(p) if p.noise.is_some());
         self.planner
             .settings()
-            .check_unplaced(&self.robot, noisy)
+            .check_unplaced(&self.robot, self.noisy())
             .map_err(|e| {
                 let e = e.in_section(self.planner.kind().info().section);
                 ScenarioError::Invalid(format!("{}: {e}", self.planner.name()))

@@ -107,10 +107,9 @@ pub struct Replay {
     /// Whether contacts are reacted to at all ([`Replay::reacting`]).
     react: bool,
     /// The plan's waypoints, and how many of them were given up (told by a [`GAVE_UP_NOTE`]
-    /// at the end).
+    /// at the end, which takes the count back to 0).
     planned: usize,
     given_up: usize,
-    told: bool,
 }
 
 impl Replay {
@@ -137,7 +136,6 @@ impl Replay {
             react: true,
             planned,
             given_up: 0,
-            told: false,
         }
     }
 
@@ -169,13 +167,13 @@ impl Replay {
         }
         let step = match self.steps.pop_front() {
             Some(s) => s,
-            None if self.given_up > 0 && !self.told => {
-                self.told = true;
+            None if self.given_up > 0 => {
+                let given_up = std::mem::take(&mut self.given_up);
                 self.moved = false;
                 return Step::Mark(crate::trace::Event::Note {
                     text: format!(
                         "{GAVE_UP_NOTE}: {} of the plan's {} waypoints given up after bumper contacts ({MAX_TRIES} contacts on the way to one, or no way round the obstacles the bumper found), with the floor their moves would have swept",
-                        self.given_up, self.planned
+                        given_up, self.planned
                     ),
                 });
             }
@@ -353,14 +351,10 @@ impl Replay {
         // The estimate where the marked map has no room for the robot (drift put it into a
         // wall of the map, or a mark beside it): first out to the nearest clear pixel centre.
         let lead = if starts.is_empty() {
-            let Some(q) = self.escape(from) else {
+            let Some((i, q)) = self.escape(from) else {
                 return Route::NoStart;
             };
-            let (c, r) = f.grid_to_pixel_signed(q);
-            let Some((c, r)) = f.checked(c, r) else {
-                return Route::NoStart;
-            };
-            starts = vec![f.index(c, r) as u32];
+            starts = vec![i as u32];
             Some(q)
         } else {
             None
@@ -463,8 +457,8 @@ impl Replay {
 
     /// The nearest pixel centre within [`ESCAPE_PX`] pixels beyond the robot's radius of grid
     /// point `from` where the robot's disk is clear of the marked map (ties: the lower pixel
-    /// index); `None` when there is none.
-    fn escape(&self, from: Point) -> Option<Point> {
+    /// index), with its pixel index; `None` when there is none.
+    fn escape(&self, from: Point) -> Option<(usize, Point)> {
         let f = self.frame;
         let (c0, r0) = f.grid_to_pixel_signed(from);
         let reach = self.r_px.ceil() as i64 + ESCAPE_PX;
@@ -483,7 +477,7 @@ impl Replay {
                 best = Some((d, i, q));
             }
         }
-        best.map(|(_, _, q)| q)
+        best.map(|(_, i, q)| (i, q))
     }
 }
 
