@@ -947,6 +947,14 @@ fn memory_refusals_give_finite_numbers_and_the_right_advice() {
         &["unbounded memory", "lane squares", "larger tool radius"],
         &["inf", "--max-memory MB"],
     );
+    // BA*'s backtracking lists are named as a remedy only where they are most of the need:
+    // turning them off could not rescue 1.5e16 MB, whose lists were 123 MB (stop 70).
+    run(
+        "ba-star",
+        &["--radius", "1e-9"],
+        &["no machine has that much", "a larger robot or tile side"],
+        &["record_backtrack_list"],
+    );
     // Within reach of a real machine the limit may be raised; the map's pixels are refused
     // from the header here, but below the process's own 16 MB a smaller map would not fit
     // either: the advice is only to raise the limit.

@@ -986,8 +986,12 @@ impl PlannerSettings for BaStarOptions {
         } else {
             0.0
         };
+        let tiles_bytes = s.tiles(t) * (TILE_BYTES + 2.0 * rows);
+        // (the lists named as a remedy only where they are most of the need: turning them
+        // off could not rescue an estimate of 1.5e16 MB, whose lists were 123 MB; hostile
+        // pass, stop 70)
         let mut e = ResourceEstimate::units(s.tiles(t), TILE_BYTES + 2.0 * rows, "tiles")
-            .remedy(&if self.record_backtrack_list {
+            .remedy(&if self.record_backtrack_list && lists >= tiles_bytes {
                 format!(
                     "a larger robot or tile side, or ba_star.record_backtrack_list: false (its lists: up to {} MB)",
                     (lists / MIB).ceil()
