@@ -521,7 +521,7 @@ impl Staging {
                 .with_context(|| format!("cannot create output folder {}", target.display()))?;
             pending.push(dir.clone());
         }
-        Ok(Self {
+        let staged = Self {
             shown: target.to_path_buf(),
             target: resolved,
             dir,
@@ -529,7 +529,13 @@ impl Staging {
             name,
             done: false,
             syncs: Mutex::new(Vec::new()),
-        })
+        };
+        // (a folder holding files is replaced only when it holds this stamp)
+        staged.write(
+            ccpp_io::write::STAMP_FILE,
+            ccpp_io::write::STAMP_TEXT.as_bytes(),
+        )?;
+        Ok(staged)
     }
 
     /// Writes `bytes` as `name` into the staging folder.
@@ -578,6 +584,9 @@ impl Staging {
             .with_context(|| format!("cannot read {}", self.dir.display()))?
         {
             let e = e.with_context(|| format!("cannot read {}", self.dir.display()))?;
+            if e.file_name() == ccpp_io::write::STAMP_FILE {
+                continue;
+            }
             let len = e
                 .metadata()
                 .with_context(|| format!("cannot read {}", self.dir.display()))?

@@ -16,6 +16,8 @@ fn entries(dir: &Path) -> Vec<String> {
     let mut v: Vec<String> = std::fs::read_dir(dir)
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        // (ccpp's stamp, in every folder it writes: `folders.rs` tests it)
+        .filter(|n| n != ".ccpp")
         .collect();
     v.sort();
     v
@@ -208,11 +210,62 @@ fn run_and_plan_refuse_a_users_tmp_file() {
         );
         assert_eq!(entries(&out), ["thesis.tmp"], "{sub}");
     }
-    // The `.tmp` of a file ccpp writes (left by an interrupted `ccpp replay`) is its own.
+    // The `.tmp` of a file ccpp writes (left by an interrupted `ccpp replay` in a run folder,
+    // which holds ccpp's stamp) is its own.
     std::fs::remove_file(out.join("thesis.tmp")).unwrap();
+    std::fs::write(out.join(".ccpp"), "stamp").unwrap();
     std::fs::write(out.join("replay.html.tmp"), "cut short").unwrap();
     run_box("bcd", &out);
     assert_eq!(entries(&out), BASE_SET);
+}
+
+/// A folder was taken for ccpp's by its files' names alone: a user's own `path.csv` and
+/// `metrics.json` in a folder given to `--out` were deleted with it (hostile pass, stop 70).
+/// Only a folder holding ccpp's `.ccpp` stamp is replaced; every folder ccpp writes holds it.
+#[test]
+fn a_folder_of_files_named_as_ccpps_without_its_stamp_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("mine");
+    std::fs::create_dir(&out).unwrap();
+    std::fs::write(out.join("path.csv"), "my precious data").unwrap();
+    std::fs::write(out.join("metrics.json"), "not json").unwrap();
+    for sub in ["run", "plan"] {
+        let o = ccpp()
+            .args([sub, "--planner", "bcd", "--map"])
+            .arg(data("teb_empty_box.yaml"))
+            .arg("--out")
+            .arg(&out)
+            .assert()
+            .code(1)
+            .get_output()
+            .clone();
+        let err = stderr_of(&o);
+        assert!(
+            err.starts_with("error: ")
+                && err.contains("holds metrics.json but no .ccpp stamp")
+                && err.trim_end().lines().count() == 1,
+            "{sub}: {err}"
+        );
+        assert_eq!(entries(&out), ["metrics.json", "path.csv"], "{sub}");
+        assert_eq!(
+            std::fs::read_to_string(out.join("path.csv")).unwrap(),
+            "my precious data"
+        );
+    }
+    // What ccpp writes it may replace: a run's folder, then a plan into it, then a run again.
+    let ours = dir.path().join("ours");
+    run_box("bcd", &ours);
+    assert!(ours.join(".ccpp").is_file());
+    ccpp()
+        .args(["plan", "--planner", "bcd", "--map"])
+        .arg(data("teb_empty_box.yaml"))
+        .arg("--out")
+        .arg(&ours)
+        .assert()
+        .success();
+    assert_eq!(entries(&ours), ["nav_path.yaml", "waypoints.csv"]);
+    assert!(ours.join(".ccpp").is_file());
+    run_box("bcd", &ours);
 }
 
 /// `ccpp replay` wrote `replay.html` and then `replay.gif`: a failure between them left the page
@@ -574,6 +627,8 @@ fn an_output_folder_holding_the_runs_own_input_is_refused() {
     let png = std::fs::read(data("teb_empty_box.png")).unwrap();
     let out = dir.path().join("m");
     std::fs::create_dir(&out).unwrap();
+    // (a folder ccpp wrote, with its stamp: a folder without it is refused for that)
+    std::fs::write(out.join(".ccpp"), "stamp").unwrap();
     let map = out.join("coverage.png");
     std::fs::write(&map, &png).unwrap();
     for (sub, planner) in [("run", "bsa"), ("plan", "bcd")] {

@@ -155,6 +155,16 @@ pub const RUN_FILES: [&str; 13] = [
     "path.geojson",
 ];
 
+/// The stamp file ccpp writes into every run or plan folder it writes ([`STAMP_TEXT`]): a
+/// folder that holds files is replaced by a run into it only when it holds the stamp too.
+/// Before, the files' names alone decided, and a user's own `path.csv` or `metrics.json` in a
+/// folder given to `--out` was deleted with the folder (hostile pass, stop 70).
+pub const STAMP_FILE: &str = ".ccpp";
+
+/// What the [`STAMP_FILE`] says.
+pub const STAMP_TEXT: &str =
+    "This folder was written by ccpp: the next ccpp run, plan or save into it replaces it whole.\n";
+
 /// Error of [`check_run_folder`] and [`write_folder`].
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
@@ -226,6 +236,20 @@ pub enum FolderError {
         /// The output folder.
         path: PathBuf,
         /// The entry ccpp did not write.
+        name: String,
+    },
+    /// The folder holds only files named as ccpp's, but no [`STAMP_FILE`]: ccpp did not
+    /// write it (or a ccpp from before the stamp did), and the files may be a user's.
+    #[error(
+        "output folder {} holds {name} but no {STAMP_FILE} stamp, so ccpp did not write it (or \
+         an older ccpp did); a run replaces the whole folder, so choose a new folder, or remove \
+         that one first",
+        path.display()
+    )]
+    Unstamped {
+        /// The output folder.
+        path: PathBuf,
+        /// One of its files.
         name: String,
     },
     /// The folder holds one of the run's own input files (a map named `coverage.png`): the
@@ -310,7 +334,8 @@ pub enum FolderError {
 /// of one of them that an interrupted atomic write left (`ccpp replay` writes its files into
 /// the run folder that way). Any other `.tmp` is a user's file.
 pub fn is_run_file_name(name: &str) -> bool {
-    RUN_FILES.contains(&name)
+    name == STAMP_FILE
+        || RUN_FILES.contains(&name)
         || name
             .strip_suffix(".tmp")
             .is_some_and(|f| RUN_FILES.contains(&f))
@@ -412,6 +437,8 @@ pub fn check_run_folder(target: &Path) -> Result<(), FolderError> {
     // refused as holding a file ccpp did not write.)
     let mut bench_only = None;
     let mut beside_run_file = false;
+    let mut stamped = false;
+    let mut first = None;
     for e in entries {
         let e = e.map_err(io_err)?;
         let name = e.file_name().to_string_lossy().into_owned();
@@ -422,14 +449,25 @@ pub fn check_run_folder(target: &Path) -> Result<(), FolderError> {
                 name,
             });
         }
+        if name == STAMP_FILE {
+            stamped = true;
+            continue;
+        }
+        if first.as_ref().is_none_or(|f: &String| name < *f) {
+            first = Some(name.clone());
+        }
         if name == "bench-key.txt" || name == "metrics.json" {
             beside_run_file = true;
         } else if name.trim_end_matches(".tmp") == BENCH_WARNINGS_FILE {
             bench_only = Some(name);
         }
     }
-    match bench_only {
-        Some(name) if !beside_run_file => Err(FolderError::Foreign {
+    match (bench_only, first) {
+        (Some(name), _) if !beside_run_file => Err(FolderError::Foreign {
+            path: target.to_path_buf(),
+            name,
+        }),
+        (_, Some(name)) if !stamped => Err(FolderError::Unstamped {
             path: target.to_path_buf(),
             name,
         }),
@@ -836,11 +874,14 @@ pub fn write_folder(target: &Path, files: &[(&str, Vec<u8>)]) -> Result<(), Fold
     let tag = |kind: &str| staging_path(&parent, &name, kind);
     let staging = tag("new");
     std::fs::create_dir(&staging).map_err(io_err)?;
-    let written = files.iter().try_for_each(|(file, bytes)| {
-        let mut f = File::create(staging.join(file))?;
-        f.write_all(bytes)?;
-        f.sync_all()
-    });
+    let stamp = (STAMP_FILE, STAMP_TEXT.as_bytes().to_vec());
+    let written = std::iter::once(&stamp)
+        .chain(files)
+        .try_for_each(|(file, bytes)| {
+            let mut f = File::create(staging.join(file))?;
+            f.write_all(bytes)?;
+            f.sync_all()
+        });
     if let Err(e) = written {
         // Best effort: the write's error is the one to report; a staging folder left behind
         // carries the staging name, never the target's.
@@ -992,6 +1033,8 @@ mod tests {
         ));
         std::fs::write(notes.join("path.csv"), "x,y,theta\n").unwrap();
         assert!(check_run_folder(&notes).is_err());
+        // (beside a run file, and with ccpp's stamp: without it, no folder is ccpp's)
+        std::fs::write(notes.join(STAMP_FILE), STAMP_TEXT).unwrap();
         for beside in ["metrics.json", "bench-key.txt"] {
             std::fs::write(notes.join(beside), "{}").unwrap();
             check_run_folder(&notes).unwrap();
@@ -1003,9 +1046,34 @@ mod tests {
         let mut v: Vec<String> = std::fs::read_dir(dir)
             .unwrap()
             .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n != STAMP_FILE)
             .collect();
         v.sort();
         v
+    }
+
+    /// A folder of files named as ccpp's but without its stamp is not ccpp's (a user's own
+    /// `path.csv` was deleted with it); every folder `write_folder` writes holds the stamp.
+    #[test]
+    fn only_a_stamped_folder_is_ccpps() {
+        let d = tempfile::tempdir().unwrap();
+        let mine = d.path().join("mine");
+        std::fs::create_dir(&mine).unwrap();
+        std::fs::write(mine.join("path.csv"), "my data").unwrap();
+        assert!(matches!(
+            check_run_folder(&mine),
+            Err(FolderError::Unstamped { ref name, .. }) if name == "path.csv"
+        ));
+        assert!(write_folder(&mine, &[("path.csv", b"x".to_vec())]).is_err());
+        assert_eq!(std::fs::read(mine.join("path.csv")).unwrap(), b"my data");
+        let ours = d.path().join("ours");
+        write_folder(&ours, &[("path.csv", b"x".to_vec())]).unwrap();
+        assert_eq!(
+            std::fs::read_to_string(ours.join(STAMP_FILE)).unwrap(),
+            STAMP_TEXT
+        );
+        write_folder(&ours, &[("metrics.json", b"{}".to_vec())]).unwrap();
+        assert_eq!(names(&ours), ["metrics.json"]);
     }
 
     #[test]

@@ -444,7 +444,7 @@ def test_round_three_python_holes(room: Path, tmp_path: Path) -> None:
     r.save(tmp_path / "one", export="csv")
     assert (tmp_path / "one" / "waypoints.csv").is_file()
     ccpp.plan(m, "bcd").save(tmp_path / "plan", export="geojson")
-    assert sorted(p.name for p in (tmp_path / "plan").iterdir()) == ["path.geojson"]
+    assert sorted(p.name for p in (tmp_path / "plan").iterdir()) == [".ccpp", "path.geojson"]
     with pytest.raises(ccpp.CcppError, match=r"^max_steps / sim.max_steps must be >= 1, got 0"):
         ccpp.run(m, "bsa", max_steps=0)
 

@@ -154,11 +154,13 @@ def test_save_replaces_the_folder_whole(room: Path, tmp_path: Path) -> None:
     out = tmp_path / "out"
     ccpp.run(room, "bsa").save(out, export=["geojson", "csv"])
     ccpp.run(room, "bcd").save(out)
-    run_files = ["coverage.png", "metrics.json", "path.csv", "run.json", "trace.jsonl"]
+    # (every folder ccpp writes holds its `.ccpp` stamp: a folder of files named as ccpp's
+    # without it is refused, so a user's own `path.csv` is never deleted)
+    run_files = [".ccpp", "coverage.png", "metrics.json", "path.csv", "run.json", "trace.jsonl"]
     assert sorted(p.name for p in out.iterdir()) == run_files
     assert json.loads((out / "metrics.json").read_text())["planner"] == "bcd"
     ccpp.plan(room, "bcd").save(out)
-    assert sorted(p.name for p in out.iterdir()) == ["nav_path.yaml", "waypoints.csv"]
+    assert sorted(p.name for p in out.iterdir()) == [".ccpp", "nav_path.yaml", "waypoints.csv"]
     mine = tmp_path / "mine"
     mine.mkdir()
     (mine / "notes.txt").write_text("mine")
@@ -167,6 +169,13 @@ def test_save_replaces_the_folder_whole(room: Path, tmp_path: Path) -> None:
     with pytest.raises(ccpp.CcppError, match="holds notes.txt, which ccpp did not write"):
         ccpp.plan(room, "bcd").save(mine)
     assert [p.name for p in mine.iterdir()] == ["notes.txt"]
+    (mine / "notes.txt").unlink()
+    (mine / "path.csv").write_text("mine")
+    with pytest.raises(ccpp.CcppError, match="holds path.csv but no .ccpp stamp"):
+        ccpp.run(room, "bsa").save(mine)
+    assert (mine / "path.csv").read_text() == "mine"
+    (mine / "path.csv").unlink()
+    (mine / "notes.txt").write_text("mine")
     # A path through `..` and no staging folder left anywhere.
     ccpp.run(room, "bsa").save(tmp_path / "dd" / ".." / "dd")
     assert sorted(p.name for p in (tmp_path / "dd").iterdir()) == run_files
@@ -256,6 +265,7 @@ def test_save_refuses_a_folder_holding_an_input(room: Path, tmp_path: Path) -> N
     save deleted it); the save is refused and the map kept, as `ccpp run` and `ccpp plan` do."""
     folder = tmp_path / "out"
     folder.mkdir()
+    (folder / ".ccpp").write_text("stamp")  # (a folder ccpp wrote: else refused for that)
     map_png = folder / "coverage.png"
     map_png.write_bytes((room.parent / "room.pgm").read_bytes())  # sniffed by content
     before = map_png.read_bytes()
@@ -263,10 +273,11 @@ def test_save_refuses_a_folder_holding_an_input(room: Path, tmp_path: Path) -> N
         with pytest.raises(ccpp.CcppError, match="coverage.png, an input of this run"):
             result.save(folder)
         assert map_png.read_bytes() == before
-        assert sorted(p.name for p in folder.iterdir()) == ["coverage.png"]
+        assert sorted(p.name for p in folder.iterdir()) == [".ccpp", "coverage.png"]
     # A landmarks file named as a run file (`path.csv`) in the folder: refused too.
     other = tmp_path / "other"
     other.mkdir()
+    (other / ".ccpp").write_text("stamp")
     marks = other / "path.csv"
     marks.write_text("1,0.5,0.5\n2,2.5,1.5\n")
     noisy = ccpp.run(room, "bsa", odometry_noise=0.01, seed=1, landmarks=marks)

@@ -107,7 +107,7 @@ def test_plan_equals_cli_plan(room: Path, ccpp_bin: str, tmp_path: Path) -> None
     py_out = tmp_path / "py"
     plan.save(py_out)
     # Default files as `ccpp plan`: waypoints.csv and nav_path.yaml, byte for byte.
-    assert sorted(x.name for x in py_out.iterdir()) == ["nav_path.yaml", "waypoints.csv"]
+    assert sorted(x.name for x in py_out.iterdir()) == [".ccpp", "nav_path.yaml", "waypoints.csv"]
     for name in ("waypoints.csv", "nav_path.yaml"):
         assert (py_out / name).read_text() == (out / name).read_text(), name
     assert np.array_equal(plan.waypoints, csv_rows(plan.export("csv")))
