@@ -84,6 +84,13 @@ struct ZonesInfo {
     keepout_free_m2: f64,
 }
 
+/// Metres (and square metres) as `info --json` prints them: rounded to a nanometre as the
+/// path exports are (`0.9750000000000001` and `2.3400000000000003` were printed; hostile pass,
+/// stop 70).
+fn round_m(v: f64) -> f64 {
+    ccpp_io::export::round_m(v)
+}
+
 /// Runs `ccpp info`.
 pub fn run(a: &InfoArgs) -> Result<()> {
     let (robot, start) = robot_from(&a.robot)?;
@@ -109,13 +116,18 @@ pub fn run(a: &InfoArgs) -> Result<()> {
     let zones_info = zones.as_ref().map(|z| {
         let free_of = |i: usize| g.cells()[i] == Cell::Free;
         ZonesInfo {
-            area_m2: z.area.as_ref().map(|m| m.count_ones(..) as f64 * res2),
+            area_m2: z
+                .area
+                .as_ref()
+                .map(|m| round_m(m.count_ones(..) as f64 * res2)),
             area_free_m2: z
                 .area
                 .as_ref()
-                .map(|m| m.ones().filter(|&i| free_of(i)).count() as f64 * res2),
-            keepout_m2: z.keepout.count_ones(..) as f64 * res2,
-            keepout_free_m2: z.keepout.ones().filter(|&i| free_of(i)).count() as f64 * res2,
+                .map(|m| round_m(m.ones().filter(|&i| free_of(i)).count() as f64 * res2)),
+            keepout_m2: round_m(z.keepout.count_ones(..) as f64 * res2),
+            keepout_free_m2: round_m(
+                z.keepout.ones().filter(|&i| free_of(i)).count() as f64 * res2,
+            ),
         }
     });
     let (world, robot_error) = match World::with_zones(g.clone(), robot, start, zones) {
@@ -170,8 +182,8 @@ pub fn run(a: &InfoArgs) -> Result<()> {
         height_px: f.height,
         resolution_m: f.resolution,
         origin: [f.origin.x, f.origin.y, f.origin.theta],
-        width_m: f.width_m(),
-        height_m: f.height_m(),
+        width_m: round_m(f.width_m()),
+        height_m: round_m(f.height_m()),
         pixels: Pixels {
             mode: map.thresholds.mode.name(),
             occupied_thresh: map.thresholds.occupied,
@@ -182,7 +194,7 @@ pub fn run(a: &InfoArgs) -> Result<()> {
         free_px: free,
         occupied_px: occ,
         unknown_px: unk,
-        free_m2: free as f64 * res2,
+        free_m2: round_m(free as f64 * res2),
         free_components: ncomp,
         largest_component_share: if free == 0 {
             0.0
@@ -194,11 +206,11 @@ pub fn run(a: &InfoArgs) -> Result<()> {
         robot_fits: world.is_some(),
         robot_error: robot_error.clone(),
         cfree_px: world.as_ref().map(|w| w.cfree().count_ones(..)),
-        start: s.map(|s| [s.x, s.y, s.theta]),
-        start_component_m2: comp.map(|c| c.area_m2),
+        start: s.map(|s| [round_m(s.x), round_m(s.y), s.theta]),
+        start_component_m2: comp.map(|c| round_m(c.area_m2)),
         start_component_touches_border: comp.map(|c| c.touches_border),
         reachable_px: world.as_ref().map(|w| w.reachable().count_ones(..)),
-        accessible_m2: world.as_ref().map(World::accessible_area_m2),
+        accessible_m2: world.as_ref().map(|w| round_m(w.accessible_area_m2())),
         zones: zones_info,
     };
     let cut_off = world

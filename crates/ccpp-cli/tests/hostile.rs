@@ -3160,6 +3160,8 @@ fn a_start_where_the_rectangle_does_not_fit_is_refused() {
         "radius 0.427 m",
         "does not fit at the start (1.700, 3.000)",
         "pillars.pgm",
+        // (the fields the disk comes from: it named clearance_radius_m, not given; stop 70)
+        "length_m / width_m (clearance_radius_m not given",
     ];
     for cmd in ["run", "plan"] {
         let mut args = vec![cmd, "--planner", "rect-boustrophedon", "--map", s(&map)];

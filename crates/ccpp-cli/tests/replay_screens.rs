@@ -70,6 +70,12 @@ fn demo_replay_side_panel_is_visible_at_desktop_sizes_and_usable_on_a_phone() {
         }
         let v = v.unwrap_or_else(|| panic!("{w}x{h}: no self-test result"));
         assert_eq!(v["pass"], true, "{w}x{h}: {v}");
+        // The last frame says the run ended (it said its last region: hostile pass, stop 70).
+        assert_eq!(
+            (v["state_start"].as_str(), v["state_end"].as_str()),
+            (Some("starting"), Some("finished")),
+            "{w}x{h}"
+        );
         assert_eq!(
             (v["vw"].as_f64(), v["vh"].as_f64()),
             (Some(f64::from(w)), Some(f64::from(h)))

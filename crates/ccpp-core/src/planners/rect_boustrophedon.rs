@@ -308,8 +308,15 @@ fn stop_valid(rw: &World, p: Point) -> bool {
 /// start. `area`: the area as given and the clearance radius, when no lane point is valid
 /// (with the reachable floor's box when the area misses it).
 pub fn check(world: &World, opts: &RectOptions) -> Result<(), OptionsError> {
-    let (rw, rad) =
-        clearance_world(world, opts).map_err(|m| OptionsError::new("clearance_radius_m", m))?;
+    // (the field the disk comes from: a clearance given, else the rectangle's length and
+    // width, which the user may have set; the message named clearance_radius_m for a
+    // `length_m: 5` that made the disk too big: hostile pass, stop 70)
+    let field = if opts.clearance_radius_m.is_some() {
+        "clearance_radius_m"
+    } else {
+        "length_m / width_m (clearance_radius_m not given: the rectangle's circumscribed disk)"
+    };
+    let (rw, rad) = clearance_world(world, opts).map_err(|m| OptionsError::new(field, m))?;
     let Some(given) = opts.area else {
         return Ok(());
     };
