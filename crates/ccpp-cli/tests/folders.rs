@@ -185,6 +185,30 @@ fn bench_keeps_a_users_files_in_plots_and_refuses_the_folder() {
     );
 }
 
+/// `run` and `plan` of bcd on the bundled `teb_empty_box` into `out` both refuse it in one
+/// `error:` line holding `needle`, leaving exactly the entries `left`.
+fn run_and_plan_refuse(out: &Path, needle: &str, left: &[&str]) {
+    for sub in ["run", "plan"] {
+        let o = ccpp()
+            .args([sub, "--planner", "bcd", "--map"])
+            .arg(data("teb_empty_box.yaml"))
+            .arg("--out")
+            .arg(out)
+            .assert()
+            .code(1)
+            .get_output()
+            .clone();
+        let err = stderr_of(&o);
+        assert!(
+            err.starts_with("error: ")
+                && err.contains(needle)
+                && err.trim_end().lines().count() == 1,
+            "{sub}: {err}"
+        );
+        assert_eq!(entries(out), left, "{sub}");
+    }
+}
+
 /// `run` and `plan` took any `*.tmp` in `--out` for their own and deleted it with the old
 /// folder. Only the `.tmp` of a file ccpp writes is its own.
 #[test]
@@ -193,23 +217,7 @@ fn run_and_plan_refuse_a_users_tmp_file() {
     let out = dir.path().join("u");
     std::fs::create_dir(&out).unwrap();
     std::fs::write(out.join("thesis.tmp"), "precious").unwrap();
-    for sub in ["run", "plan"] {
-        let o = ccpp()
-            .args([sub, "--planner", "bcd", "--map"])
-            .arg(data("teb_empty_box.yaml"))
-            .arg("--out")
-            .arg(&out)
-            .assert()
-            .code(1)
-            .get_output()
-            .clone();
-        let err = stderr_of(&o);
-        assert!(
-            err.starts_with("error: ") && err.contains("holds thesis.tmp"),
-            "{sub}: {err}"
-        );
-        assert_eq!(entries(&out), ["thesis.tmp"], "{sub}");
-    }
+    run_and_plan_refuse(&out, "holds thesis.tmp", &["thesis.tmp"]);
     // The `.tmp` of a file ccpp writes (left by an interrupted `ccpp replay` in a run folder,
     // which holds ccpp's stamp) is its own.
     std::fs::remove_file(out.join("thesis.tmp")).unwrap();
@@ -229,29 +237,15 @@ fn a_folder_of_files_named_as_ccpps_without_its_stamp_is_refused() {
     std::fs::create_dir(&out).unwrap();
     std::fs::write(out.join("path.csv"), "my precious data").unwrap();
     std::fs::write(out.join("metrics.json"), "not json").unwrap();
-    for sub in ["run", "plan"] {
-        let o = ccpp()
-            .args([sub, "--planner", "bcd", "--map"])
-            .arg(data("teb_empty_box.yaml"))
-            .arg("--out")
-            .arg(&out)
-            .assert()
-            .code(1)
-            .get_output()
-            .clone();
-        let err = stderr_of(&o);
-        assert!(
-            err.starts_with("error: ")
-                && err.contains("holds metrics.json but no .ccpp stamp")
-                && err.trim_end().lines().count() == 1,
-            "{sub}: {err}"
-        );
-        assert_eq!(entries(&out), ["metrics.json", "path.csv"], "{sub}");
-        assert_eq!(
-            std::fs::read_to_string(out.join("path.csv")).unwrap(),
-            "my precious data"
-        );
-    }
+    run_and_plan_refuse(
+        &out,
+        "holds metrics.json but no .ccpp stamp",
+        &["metrics.json", "path.csv"],
+    );
+    assert_eq!(
+        std::fs::read_to_string(out.join("path.csv")).unwrap(),
+        "my precious data"
+    );
     // What ccpp writes it may replace: a run's folder, then a plan into it, then a run again.
     let ours = dir.path().join("ours");
     run_box("bcd", &ours);
