@@ -314,7 +314,8 @@ pub struct WaypointsArgs {
     /// Output format.
     #[arg(long, value_name = "csv|json", default_value = "csv")]
     pub format: String,
-    /// Write to this file instead of stdout. An existing file is replaced only when it reads as
+    /// Write to this file instead of stdout; a name ending in `.csv` or `.json` must match
+    /// `--format`. An existing file is replaced only when it reads as
     /// a waypoints file (a CSV whose first line is `x,y`, or the JSON this command writes);
     /// any other is refused.
     #[arg(long, value_name = "FILE")]

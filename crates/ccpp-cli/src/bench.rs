@@ -163,6 +163,11 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     // Held until the bench ends: a second bench on the folder is refused instead of writing
     // its runs and summary among this one's.
     let _lock = crate::lock::FolderLock::take(&a.out)?;
+    // (the folder is ccpp's from now on: a later bench into it is not refused as a user's)
+    crate::staging::write_file(
+        &a.out.join(ccpp_io::write::STAMP_FILE),
+        ccpp_io::write::STAMP_TEXT.as_bytes(),
+    )?;
     // The summary of an earlier bench in this folder goes before any run starts: an
     // interrupted bench then leaves complete run folders and no summary, never a summary of
     // the earlier bench (another radius, other planners) beside run folders of this one.
@@ -364,11 +369,22 @@ fn check_bench_target(out: &Path, maps: &[String]) -> Result<()> {
     }
     let entries = std::fs::read_dir(out)
         .with_context(|| format!("cannot read output folder {}", out.display()))?;
+    // (the first entry of what a bench writes, for a folder without ccpp's stamp: a user's
+    // own `results.csv` there was overwritten; hostile pass, stop 70)
+    let mut unstamped: Option<String> = None;
+    let mut stamped = false;
     for e in entries {
         let e = e.with_context(|| format!("cannot read output folder {}", out.display()))?;
         let name = e.file_name();
         let name = name.to_string_lossy();
         let Ok(t) = e.file_type() else { continue };
+        if name == ccpp_io::write::STAMP_FILE && t.is_file() {
+            stamped = true;
+            continue;
+        }
+        if name != crate::lock::LOCK_FILE && unstamped.as_deref().is_none_or(|u| *name < *u) {
+            unstamped = Some(name.to_string());
+        }
         let known = match name.as_ref() {
             // A write cut short leaves `<file>.tmp` (see `staging::write_file`; any other
             // `.tmp` is a user's), and a bench its lock file while it runs (a later bench is
@@ -394,6 +410,15 @@ fn check_bench_target(out: &Path, maps: &[String]) -> Result<()> {
                 out.display()
             );
         }
+    }
+    if let (Some(name), false) = (unstamped, stamped) {
+        bail!(
+            "output folder {} holds {name} but no {} stamp, so ccpp did not write it (or an \
+             older ccpp did); a bench rewrites its results there, so choose a new folder, or \
+             remove that one first",
+            out.display(),
+            ccpp_io::write::STAMP_FILE
+        );
     }
     Ok(())
 }
@@ -1095,7 +1120,12 @@ pub fn results_md(rows: &[Row], outside: &[String]) -> String {
         }
     }
     let header = "| planner | eff. coverage | tile coverage | path_ratio | regions | revisit_rate | turns | collisions | wall time (s) |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
-    let _ = writeln!(s, "## Summary across {} maps\n", maps.len());
+    let _ = writeln!(
+        s,
+        "## Summary across {} map{}\n",
+        maps.len(),
+        if maps.len() == 1 { "" } else { "s" }
+    );
     let _ = writeln!(
         s,
         "Means over the maps where the planner ran; `fails` counts runs that returned an error.\n"

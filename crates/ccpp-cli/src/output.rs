@@ -200,6 +200,20 @@ pub fn replay_dir(dir: &Path) -> Result<()> {
     if folder_identity(dir) != identity {
         bail!(replaced());
     }
+    // Only a folder ccpp wrote (its stamp, and no file of the user's): the replay's files go
+    // into it. (Checked last: what is wrong with the run itself is said first.)
+    match ccpp_io::write::check_run_folder_entries(dir) {
+        Err(ccpp_io::write::FolderError::Foreign { name, .. }) => anyhow::bail!(
+            "run folder {} holds {name}, which ccpp did not write; replay writes replay.html and replay.gif into it, so it must hold ccpp's files only",
+            dir.display()
+        ),
+        Err(ccpp_io::write::FolderError::Unstamped { .. }) => anyhow::bail!(
+            "{} has no {} stamp, so ccpp did not write it as a run folder (or an older ccpp did); replay writes replay.html and replay.gif only into a run folder ccpp wrote",
+            dir.display(),
+            ccpp_io::write::STAMP_FILE
+        ),
+        other => other?,
+    }
     let files: [(&str, &[u8]); 2] = [("replay.html", html.as_bytes()), ("replay.gif", &gif)];
     // Both or neither: one by one, a failure or an interrupt between them left the page
     // without its GIF (or beside the GIF of an earlier replay).

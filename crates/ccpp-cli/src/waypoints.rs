@@ -18,6 +18,21 @@ pub fn run(a: &WaypointsArgs) -> Result<()> {
     if format != "csv" && format != "json" {
         bail!("--format must be csv or json, got {:?}", a.format);
     }
+    // A file named for the other format got this one (`--out w.json` wrote CSV, the default,
+    // and replaced a JSON waypoints file with CSV: hostile pass, stop 70).
+    if let Some(ext) = a
+        .out
+        .as_deref()
+        .and_then(|p| p.extension())
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+    {
+        if (ext == "json" || ext == "csv") && ext != format {
+            bail!(
+                "--out {} ends in .{ext} but the format is {format}: give --format {ext}, or name the file .{format}",
+                a.out.as_deref().map_or_else(String::new, |p| p.display().to_string())
+            );
+        }
+    }
     if a.robot.tool_radius.is_some() {
         // The lanes follow --width: the value would be validated and then change nothing.
         bail!("--tool-radius does not apply to `ccpp waypoints` (its lanes follow --width)");

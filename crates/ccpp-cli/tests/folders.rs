@@ -165,6 +165,8 @@ fn bench_keeps_a_users_files_in_plots_and_refuses_the_folder() {
     // earlier bench left in `runs/`) still go; one of no such map is a user's, refused; a
     // stray `.tmp` at the top that a bench does not write is refused like any other file.
     std::fs::remove_file(out.join("plots/my_figure.png")).unwrap();
+    // (an empty `plots/` of no bench: taken as a bench's once the folder holds ccpp's stamp)
+    std::fs::write(out.join(".ccpp"), "stamp").unwrap();
     bench(&out, "bsa").assert().success();
     std::fs::write(out.join("plots/coverage_gone.png"), "old").unwrap();
     let o = bench(&out, "bsa").assert().code(1).get_output().clone();
@@ -260,6 +262,67 @@ fn a_folder_of_files_named_as_ccpps_without_its_stamp_is_refused() {
     assert_eq!(entries(&ours), ["nav_path.yaml", "waypoints.csv"]);
     assert!(ours.join(".ccpp").is_file());
     run_box("bcd", &ours);
+}
+
+/// `ccpp bench` overwrote a user's own `results.csv` and `results.md` in a folder of theirs,
+/// and `ccpp replay` a user's own `replay.html` in a run folder without the stamp, or wrote
+/// beside a file of theirs (hostile pass, stop 70). Both now want ccpp's stamp; a bench's
+/// folder holds it, so a second bench there resumes.
+#[test]
+fn bench_and_replay_refuse_a_folder_ccpp_did_not_write() {
+    let dir = tempfile::tempdir().unwrap();
+    let mine = dir.path().join("mine");
+    std::fs::create_dir(&mine).unwrap();
+    std::fs::write(mine.join("results.csv"), "my table").unwrap();
+    let o = bench(&mine, "bsa").assert().code(1).get_output().clone();
+    let err = stderr_of(&o);
+    assert!(
+        err.starts_with("error: ")
+            && err.contains("holds results.csv but no .ccpp stamp")
+            && err.trim_end().lines().count() == 1,
+        "{err}"
+    );
+    assert_eq!(entries(&mine), ["results.csv"]);
+    assert_eq!(
+        std::fs::read_to_string(mine.join("results.csv")).unwrap(),
+        "my table"
+    );
+    // A bench's own folder: stamped, and a second bench there resumes its run.
+    let b = dir.path().join("b");
+    bench(&b, "bsa").assert().success();
+    assert!(b.join(".ccpp").is_file());
+    let run_file = b.join("runs/teb_empty_box/bsa/trace.jsonl");
+    let before = std::fs::metadata(&run_file).unwrap().modified().unwrap();
+    bench(&b, "bsa").assert().success();
+    // (the finished run kept, not redone)
+    assert_eq!(
+        std::fs::metadata(&run_file).unwrap().modified().unwrap(),
+        before
+    );
+    assert!(b.join("results.csv").is_file());
+    // Replay: a run folder whose stamp is gone, or that holds a file of the user's.
+    let run = dir.path().join("r");
+    run_box("bsa", &run);
+    let replay = |want: &str| {
+        let o = ccpp()
+            .arg("replay")
+            .arg(&run)
+            .assert()
+            .code(1)
+            .get_output()
+            .clone();
+        let err = stderr_of(&o);
+        assert!(
+            err.starts_with("error: ") && err.contains(want) && err.trim_end().lines().count() == 1,
+            "{err}"
+        );
+        assert!(!run.join("replay.html").exists());
+    };
+    std::fs::write(run.join("notes.txt"), "mine").unwrap();
+    replay("holds notes.txt, which ccpp did not write");
+    std::fs::remove_file(run.join("notes.txt")).unwrap();
+    std::fs::remove_file(run.join(".ccpp")).unwrap();
+    replay("has no .ccpp stamp");
 }
 
 /// `ccpp replay` wrote `replay.html` and then `replay.gif`: a failure between them left the page

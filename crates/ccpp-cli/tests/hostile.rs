@@ -4223,3 +4223,68 @@ fn landmarks_without_noise_are_told_to_add_noise() {
         refused(&args, &["add --odometry-noise"]);
     }
 }
+
+/// `waypoints --out w.json` wrote CSV (the default format) into it, and replaced a JSON
+/// waypoints file with CSV in silence (hostile pass, stop 70): a name ending in `.csv` or
+/// `.json` must match `--format`.
+#[test]
+fn waypoints_refuse_a_file_named_for_the_other_format() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let map = pillars(dir);
+    let json = dir.join("w.json");
+    refused(
+        &["waypoints", "--map", s(&map), "--out", s(&json)],
+        &[
+            "w.json ends in .json but the format is csv",
+            "--format json",
+        ],
+    );
+    assert!(!json.exists());
+    ccpp()
+        .args([
+            "waypoints",
+            "--map",
+            s(&map),
+            "--format",
+            "json",
+            "--out",
+            s(&json),
+        ])
+        .assert()
+        .success();
+    let text = std::fs::read_to_string(&json).unwrap();
+    assert!(text.trim_start().starts_with('{'), "{text}");
+    refused(
+        &[
+            "waypoints",
+            "--map",
+            s(&map),
+            "--format",
+            "csv",
+            "--out",
+            s(&json),
+        ],
+        &["ends in .json but the format is csv"],
+    );
+    assert_eq!(std::fs::read_to_string(&json).unwrap(), text);
+    let csv = dir.join("w.CSV");
+    refused(
+        &[
+            "waypoints",
+            "--map",
+            s(&map),
+            "--format",
+            "json",
+            "--out",
+            s(&csv),
+        ],
+        &["ends in .csv but the format is json"],
+    );
+    // Other names take either format.
+    let txt = dir.join("w.txt");
+    ccpp()
+        .args(["waypoints", "--map", s(&map), "--out", s(&txt)])
+        .assert()
+        .success();
+}

@@ -420,6 +420,18 @@ pub fn check_run_folder(target: &Path) -> Result<(), FolderError> {
             });
         }
     }
+    check_run_folder_entries(target)
+}
+
+/// The part of [`check_run_folder`] about what the folder holds: only run files
+/// ([`is_run_file_name`]) and, when it holds any, ccpp's [`STAMP_FILE`]. For `ccpp replay`,
+/// which writes into a run folder (it wrote over a user's own `replay.html` in a folder
+/// without the stamp: hostile pass, stop 70), and which may be run from inside it.
+///
+/// # Errors
+/// [`FolderError::Foreign`], [`FolderError::Unstamped`], or [`FolderError::Io`] when the
+/// folder cannot be read.
+pub fn check_run_folder_entries(target: &Path) -> Result<(), FolderError> {
     let io_err = |source| FolderError::Io {
         path: target.to_path_buf(),
         source,
