@@ -2411,6 +2411,9 @@ fn _ccpp(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Env>()?;
     m.add_class::<FolderLock>()?;
     m.add("LOCK_FILE", ccpp_io::lock::LOCK_FILE)?;
+    // (ccpp's stamp in every folder it writes: a sweep's folder holds it too)
+    m.add("STAMP_FILE", ccpp_io::write::STAMP_FILE)?;
+    m.add("STAMP_TEXT", ccpp_io::write::STAMP_TEXT)?;
     m.add("WARNINGS_SEPARATOR", ccpp_io::warnings::SEPARATOR)?;
     m.add_function(wrap_pyfunction!(load_map, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;

@@ -48,6 +48,8 @@ def test_sweep_equals_bench(shared_maps: Path, ccpp_bin: str, tmp_path: Path, cl
     )
     sweep_out = tmp_path / "sweep"
     got = ccpp.sweep(maps, planners, [0.15], client=client, out=sweep_out)
+    # (ccpp's stamp, as in a bench's folder: `ccpp bench` refuses a folder of files without it)
+    assert (sweep_out / ".ccpp").is_file()
     assert list(got.columns) == ccpp.CSV_COLUMNS == list(expected.columns)
     assert len(got) == len(expected) == len(maps) * len(planners)
     # The workers really ran in two processes. Asked of the scheduler: `scheduler_info()` is

@@ -116,6 +116,8 @@ class PlanResult:
         """Writes the exports (default csv and nav-path), as ``ccpp plan --out folder``."""
 
 LOCK_FILE: str
+STAMP_FILE: str
+STAMP_TEXT: str
 """The lock file a ``ccpp bench`` or a sweep holds in its output folder."""
 
 WARNINGS_SEPARATOR: str

@@ -125,6 +125,9 @@ def _check_out(out: str | os.PathLike[str]) -> None:
             )
         if e.name == "runs":
             known = e.is_dir() and not e.is_symlink()
+        elif e.name == _ccpp.STAMP_FILE:
+            # ccpp's stamp: a bench's or sweep's folder holds it.
+            known = e.is_file() and not e.is_symlink()
         elif e.name == _ccpp.LOCK_FILE:
             # A bench's or sweep's lock: held by a live one (refused when taken), or left by
             # a killed one (taken over).
@@ -150,13 +153,26 @@ def _folder_lock(out: str | os.PathLike[str]) -> Iterator[None]:
     made = not folder.exists()
     folder.mkdir(parents=True, exist_ok=True)
     lock = _ccpp.FolderLock(folder)
+    stamp = folder / _ccpp.STAMP_FILE
+    had_stamp = stamp.is_file()
+    done = False
     try:
+        # The folder is ccpp's, as a bench's is (`ccpp bench` refuses a folder holding files
+        # without ccpp's stamp); a sweep that fails takes back a stamp it wrote, so a folder
+        # that was there stays with what it held.
+        stamp.write_text(_ccpp.STAMP_TEXT)
         yield
+        done = True
     finally:
         lock.release()
+        if not done and not had_stamp:
+            with contextlib.suppress(OSError):
+                stamp.unlink()
         if made:
             with contextlib.suppress(OSError):
-                # Only an empty folder goes (rmdir refuses any other).
+                # Only a folder holding nothing but the stamp goes (rmdir refuses any other).
+                if [e.name for e in folder.iterdir()] == [_ccpp.STAMP_FILE]:
+                    stamp.unlink()
                 folder.rmdir()
 
 
