@@ -120,10 +120,9 @@ fn parse_start(s: &str) -> Result<StartArg, String> {
 #[derive(Args, Debug, Clone, Default)]
 pub struct ZoneArgs {
     /// Work area: a polygon file (`GeoJSON`, or YAML list of x,y points; map coordinates) or a
-    /// rectangle `X0,Y0,X1,Y1`. The robot stays inside it (virtual walls) to the pixel: a
-    /// pixel whose centre is inside belongs to it, so an edge between pixel borders may be
-    /// crossed by up to half a pixel; `run` measures coverage on the floor inside it. Default:
-    /// the whole map.
+    /// rectangle `X0,Y0,X1,Y1`. The robot stays inside it (virtual walls: its pixels are
+    /// those wholly inside); `run` measures coverage on the floor inside it. Default: the
+    /// whole map.
     #[arg(long, value_name = "FILE|X0,Y0,X1,Y1", value_parser = parse_zone, allow_hyphen_values = true)]
     pub area: Option<ZoneSpec>,
     /// Keep-out zone (repeatable): a Nav2 keepout filter mask (`map_server` YAML + image in the

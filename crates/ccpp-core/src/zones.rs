@@ -14,7 +14,9 @@
 //!   centre line; a centre exactly on a left edge is inside, exactly on a right edge outside
 //!   (half-open spans), so two polygons sharing an edge never both claim a pixel column of it
 //!   and the result depends on nothing but the coordinates. Several polygons are united.
-//!   This is the rule of the **area**.
+//! * The **area** holds the pixel-centre pixels less those its border cuts whose square
+//!   reaches out of it ([`rasterize_area`]): a robot that keeps off the pixels outside keeps
+//!   its disk inside the area (to within a pixel only at a reflex vertex inside a square).
 //! * A **keep-out polygon** holds every pixel whose square its inside overlaps: the pixel-centre
 //!   pixels and every pixel an edge passes through ([`rasterize_keepout`]), so the pixels cover
 //!   the polygon and a robot that keeps off them keeps off the polygon, however thin or
@@ -401,34 +403,7 @@ pub fn rasterize(frame: &MapFrame, polys: &[Polygon]) -> FixedBitSet {
 pub fn rasterize_keepout(frame: &MapFrame, polys: &[Polygon]) -> FixedBitSet {
     let mut m = rasterize(frame, polys);
     for poly in polys {
-        let ring: Vec<Point> = poly
-            .ring()
-            .into_iter()
-            .filter(|p| p.x.is_finite() && p.y.is_finite())
-            .map(|p| {
-                let g = frame.world_to_grid(p);
-                // A vertex within a millionth of a pixel of a grid line (more where the
-                // coordinates' own rounding is larger: far from the origin, on a fine grid)
-                // is on it: an edge along a pixel border (a rectangle given in whole pixels, a
-                // keep-out exported by ccpp and read back) passes through no pixel, instead of
-                // through a whole row of them by rounding. (At a billionth, a mask exported to
-                // `path.geojson`, whose coordinates have nine decimals, and read back on a map
-                // at a UTM origin or with a yaw took in a strip of pixels more: 5.00 m2 became
-                // 5.32; hostile pass.)
-                let mag = [p.x, p.y, frame.origin.x, frame.origin.y]
-                    .into_iter()
-                    .fold(1.0f64, |m, v| m.max(v.abs()));
-                let tol = 1e-6 + 8.0 * f64::EPSILON * mag / frame.resolution;
-                let snap = |v: f64| {
-                    if (v - v.round()).abs() <= tol {
-                        v.round()
-                    } else {
-                        v
-                    }
-                };
-                Point::new(snap(g.x), snap(g.y))
-            })
-            .collect();
+        let ring = snapped_ring(frame, poly);
         if ring.len() < 3 {
             continue;
         }
@@ -437,6 +412,110 @@ pub fn rasterize_keepout(frame: &MapFrame, polys: &[Polygon]) -> FixedBitSet {
         }
     }
     m
+}
+
+/// The ring of `poly` in grid coordinates, its finite vertices only, each snapped onto a grid
+/// line it lies within rounding of (see [`rasterize_keepout`]).
+fn snapped_ring(frame: &MapFrame, poly: &Polygon) -> Vec<Point> {
+    poly.ring()
+        .into_iter()
+        .filter(|p| p.x.is_finite() && p.y.is_finite())
+        .map(|p| {
+            let g = frame.world_to_grid(p);
+            // A vertex within a millionth of a pixel of a grid line (more where the
+            // coordinates' own rounding is larger: far from the origin, on a fine grid)
+            // is on it: an edge along a pixel border (a rectangle given in whole pixels, a
+            // keep-out exported by ccpp and read back) passes through no pixel, instead of
+            // through a whole row of them by rounding. (At a billionth, a mask exported to
+            // `path.geojson`, whose coordinates have nine decimals, and read back on a map
+            // at a UTM origin or with a yaw took in a strip of pixels more: 5.00 m2 became
+            // 5.32; hostile pass.)
+            let mag = [p.x, p.y, frame.origin.x, frame.origin.y]
+                .into_iter()
+                .fold(1.0f64, |m, v| m.max(v.abs()));
+            let tol = 1e-6 + 8.0 * f64::EPSILON * mag / frame.resolution;
+            let snap = |v: f64| {
+                if (v - v.round()).abs() <= tol {
+                    v.round()
+                } else {
+                    v
+                }
+            };
+            Point::new(snap(g.x), snap(g.y))
+        })
+        .collect()
+}
+
+/// The area pixels of `polys`: [`rasterize`]'s (the pixel-centre rule) less those an edge
+/// passes through whose square reaches out of the polygons' union (a corner outside every
+/// polygon), so that a robot keeping off the pixels outside keeps inside the area also where
+/// its border runs between pixel borders. By the pixel-centre rule alone a pixel half out of
+/// the area was in it, and the robot's disk reached up to half a pixel past the border
+/// (hostile pass, stop 70). An edge two abutting polygons share passes through squares
+/// wholly inside their union, which stay. At a reflex vertex of the area that lies inside a
+/// square whose corners are all inside, the disk may still reach past the border by less
+/// than a pixel.
+pub fn rasterize_area(frame: &MapFrame, polys: &[Polygon]) -> FixedBitSet {
+    let mut m = rasterize(frame, polys);
+    let rings: Vec<Vec<Point>> = polys
+        .iter()
+        .map(|p| snapped_ring(frame, p))
+        .filter(|r| r.len() >= 3)
+        .collect();
+    let mut edge = FixedBitSet::with_capacity(frame.len());
+    for ring in &rings {
+        for i in 0..ring.len() {
+            mark_edge_pixels(&mut edge, frame, ring[i], ring[(i + 1) % ring.len()]);
+        }
+    }
+    let h = frame.height as f64;
+    for i in edge.ones() {
+        if !m.contains(i) {
+            continue;
+        }
+        let (col, row) = (i % frame.width, i / frame.width);
+        // The square in grid coordinates (y up): x in [col, col + 1], y in [h - 1 - row, h - row].
+        let (x0, y0) = (col as f64, h - 1.0 - row as f64);
+        let corners = [
+            Point::new(x0, y0),
+            Point::new(x0 + 1.0, y0),
+            Point::new(x0, y0 + 1.0),
+            Point::new(x0 + 1.0, y0 + 1.0),
+        ];
+        if !corners
+            .iter()
+            .all(|&c| rings.iter().any(|r| inside_or_on(r, c)))
+        {
+            m.set(i, false);
+        }
+    }
+    m
+}
+
+/// Is `p` inside the ring `r` (even-odd) or on one of its edges (within a millionth of a
+/// pixel)?
+fn inside_or_on(r: &[Point], p: Point) -> bool {
+    let n = r.len();
+    let mut inside = false;
+    for i in 0..n {
+        let (a, b) = (r[i], r[(i + 1) % n]);
+        let (dx, dy) = (b.x - a.x, b.y - a.y);
+        let len2 = dx * dx + dy * dy;
+        if len2 > 0.0 {
+            let t = (((p.x - a.x) * dx + (p.y - a.y) * dy) / len2).clamp(0.0, 1.0);
+            let (qx, qy) = (a.x + t * dx - p.x, a.y + t * dy - p.y);
+            if qx * qx + qy * qy <= 1e-12 {
+                return true;
+            }
+        }
+        if (a.y <= p.y) != (b.y <= p.y) {
+            let x = a.x + (p.y - a.y) * dx / dy;
+            if x > p.x {
+                inside = !inside;
+            }
+        }
+    }
+    inside
 }
 
 /// Marks every pixel of `frame` whose open square the segment `a`-`b` (grid coordinates, y up)
@@ -523,7 +602,7 @@ impl ZoneMasks {
         keepout_polygons: Vec<Polygon>,
     ) -> Self {
         Self {
-            area: area.map(|a| rasterize(frame, a)),
+            area: area.map(|a| rasterize_area(frame, a)),
             keepout,
             area_polygons: area.map(<[Polygon]>::to_vec).unwrap_or_default(),
             keepout_polygons,
@@ -1293,5 +1372,42 @@ mod tests {
             ],
         );
         assert_eq!(keepout_entries(&f, &two, &[g(0.1, 0.5), g(1.9, 0.5)], r), 2);
+    }
+
+    /// The area rule: a rectangle on pixel borders keeps every pixel of the centre rule; one
+    /// with borders between them loses the pixels they cut (each kept pixel's square is inside
+    /// the rectangle); two polygons sharing an edge through pixel squares give their union's
+    /// pixels, not a seam.
+    #[test]
+    fn area_pixels_lie_wholly_inside_the_area() {
+        let f = MapFrame::new(40, 30, 0.05);
+        let on_grid = Polygon::rect([0.1, 0.1, 1.0, 1.4]);
+        assert_eq!(
+            rasterize_area(&f, std::slice::from_ref(&on_grid)),
+            rasterize(&f, std::slice::from_ref(&on_grid))
+        );
+        let off = [0.12, 0.1, 1.0, 1.376];
+        let a = rasterize_area(&f, &[Polygon::rect(off)]);
+        let centre = rasterize(&f, &[Polygon::rect(off)]);
+        assert!(a.is_subset(&centre) && a.count_ones(..) < centre.count_ones(..));
+        for i in a.ones() {
+            let (col, row) = (i % f.width, i / f.width);
+            let (x0, y1) = (col as f64 * 0.05, (f.height - row) as f64 * 0.05);
+            assert!(
+                x0 >= off[0] - 1e-9 && x0 + 0.05 <= off[2] + 1e-9,
+                "pixel ({col}, {row}) x"
+            );
+            assert!(
+                y1 - 0.05 >= off[1] - 1e-9 && y1 <= off[3] + 1e-9,
+                "pixel ({col}, {row}) y"
+            );
+        }
+        // Split at x = 0.512 (inside a pixel column): the union's pixels, no seam.
+        let left = Polygon::rect([0.1, 0.1, 0.512, 1.4]);
+        let right = Polygon::rect([0.512, 0.1, 1.0, 1.4]);
+        assert_eq!(
+            rasterize_area(&f, &[left, right]),
+            rasterize_area(&f, std::slice::from_ref(&on_grid))
+        );
     }
 }
