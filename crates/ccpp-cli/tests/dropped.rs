@@ -364,12 +364,6 @@ fn landmarks_off_the_map_out_of_turn_or_too_many_are_refused() {
             "no robot on the map sees it",
         ],
     );
-    // (two landmarks with one id: the run depended on which the sensor took; stop 70)
-    let twice = write(dir, "twice.csv", "id,x,y\n1,2,2\n1,5,5\n");
-    run(
-        &twice,
-        &["twice.csv", "landmark id 1 is given twice (entries 0 and 1"],
-    );
     let turned = write(dir, "turned.csv", "1,1,1,100\n");
     run(
         &turned,

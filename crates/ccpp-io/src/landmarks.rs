@@ -51,17 +51,6 @@ pub enum LandmarkFileError {
     /// More landmarks than [`MAX_LANDMARKS`].
     #[error("more than {MAX_LANDMARKS} landmarks: every control step looks at each of them (2.8 million rows ran for hours); give the landmarks of the site")]
     TooMany,
-    /// Two landmarks with one id: the sensor reports a landmark by its id, so the run
-    /// depended on which of the two it took (accepted in silence: hostile pass, stop 70).
-    #[error("landmark id {id} is given twice (entries {first} and {second}, counted from 0): each landmark needs an id of its own")]
-    DuplicateId {
-        /// The id.
-        id: u32,
-        /// 0-based index of its first entry.
-        first: usize,
-        /// 0-based index of its second entry.
-        second: usize,
-    },
     /// A file that holds no landmark (blank, or comments only): read and then nothing to
     /// correct with, the run would be the run without it.
     #[error("the file holds no landmark")]
@@ -145,15 +134,6 @@ pub fn parse_landmarks(text: &str) -> Result<Vec<Landmark>, LandmarkFileError> {
         .position(|l| !(l.x.is_finite() && l.y.is_finite() && l.theta.is_finite()))
     {
         return Err(LandmarkFileError::NonFinite { index });
-    }
-    let mut ids: Vec<(u32, usize)> = list.iter().enumerate().map(|(i, l)| (l.id, i)).collect();
-    ids.sort_unstable();
-    if let Some(w) = ids.windows(2).find(|w| w[0].0 == w[1].0) {
-        return Err(LandmarkFileError::DuplicateId {
-            id: w[0].0,
-            first: w[0].1,
-            second: w[1].1,
-        });
     }
     Ok(list)
 }
@@ -259,24 +239,5 @@ mod tests {
             load_landmarks(&dir.path().join("none")),
             Err(LandmarkFileError::Io { .. })
         ));
-    }
-
-    /// Two landmarks with one id are refused, naming the id and both entries.
-    #[test]
-    fn a_duplicate_id_is_refused() {
-        let e = parse_landmarks("id,x,y\n1,2,2\n3,4,4\n1,5,5\n").unwrap_err();
-        assert!(
-            matches!(
-                e,
-                LandmarkFileError::DuplicateId {
-                    id: 1,
-                    first: 0,
-                    second: 2
-                }
-            ),
-            "{e}"
-        );
-        assert!(parse_landmarks("[[2, 1, 1], [2, 3, 3]]").is_err());
-        assert_eq!(parse_landmarks("1,2,2\n2,5,5\n").unwrap().len(), 2);
     }
 }
